@@ -1,0 +1,92 @@
+#include "cellmap/lattice.h"
+
+#include <math.h>
+
+cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
+{
+    if (!lat || lat->dim < 1 || lat->dim > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "lattice dimension must be 1..%d", CM_MAX_DIM);
+    for (int d = 0; d < lat->dim; d++) {
+        if (!isfinite(lat->origin[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "lattice origin[%d] is not finite", d);
+        if (!(lat->width[d] > 0.0) || !isfinite(lat->width[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "cell width in dimension %d must be positive and finite (got %g)", d,
+                           lat->width[d]);
+    }
+    return CM_OK;
+}
+
+bool cm_lattice_cell(const cm_lattice *lat, const double *x, int64_t *cell)
+{
+    const double limit = (double)CM_WORLD_LIMIT;
+    int64_t c[CM_MAX_DIM];
+    for (int d = 0; d < lat->dim; d++) {
+        const double u = floor((x[d] - lat->origin[d]) / lat->width[d]);
+        /* NaN fails both comparisons, so it is caught here too. */
+        if (!(u >= -limit && u < limit))
+            return false;
+        c[d] = (int64_t)u;
+    }
+    for (int d = 0; d < lat->dim; d++)
+        cell[d] = c[d];
+    return true;
+}
+
+void cm_lattice_centre(const cm_lattice *lat, const int64_t *cell, double *x)
+{
+    for (int d = 0; d < lat->dim; d++)
+        x[d] = lat->origin[d] + ((double)cell[d] + 0.5) * lat->width[d];
+}
+
+cm_status cm_box_check(const cm_box *box, char *msg, size_t msg_size)
+{
+    if (!box || box->dim < 1 || box->dim > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "box dimension must be 1..%d", CM_MAX_DIM);
+    for (int d = 0; d < box->dim; d++) {
+        if (box->lo[d] >= box->hi[d])
+            return cm_fail(CM_EINVAL, msg, msg_size, "box is empty in dimension %d", d);
+        if (box->lo[d] < -CM_WORLD_LIMIT || box->hi[d] > CM_WORLD_LIMIT)
+            return cm_fail(CM_ERANGE, msg, msg_size, "box leaves the world in dimension %d", d);
+    }
+    if (cm_box_cells(box) == 0)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "box has too many cells");
+    return CM_OK;
+}
+
+uint64_t cm_box_cells(const cm_box *box)
+{
+    uint64_t n = 1;
+    for (int d = 0; d < box->dim; d++) {
+        const uint64_t side = (uint64_t)(box->hi[d] - box->lo[d]);
+        if (side != 0 && n > UINT64_MAX / side)
+            return 0;
+        n *= side;
+    }
+    return n;
+}
+
+bool cm_box_contains(const cm_box *box, const int64_t *cell)
+{
+    for (int d = 0; d < box->dim; d++)
+        if (cell[d] < box->lo[d] || cell[d] >= box->hi[d])
+            return false;
+    return true;
+}
+
+uint64_t cm_box_index(const cm_box *box, const int64_t *cell)
+{
+    uint64_t index = 0;
+    for (int d = box->dim - 1; d >= 0; d--)
+        index = index * (uint64_t)(box->hi[d] - box->lo[d]) + (uint64_t)(cell[d] - box->lo[d]);
+    return index;
+}
+
+void cm_box_cell(const cm_box *box, uint64_t index, int64_t *cell)
+{
+    for (int d = 0; d < box->dim; d++) {
+        const uint64_t side = (uint64_t)(box->hi[d] - box->lo[d]);
+        cell[d] = box->lo[d] + (int64_t)(index % side);
+        index /= side;
+    }
+}

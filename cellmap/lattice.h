@@ -1,0 +1,63 @@
+/* cellmap/lattice.h - the global cell lattice and boxes of cells.
+ *
+ * One lattice per cluster: origin o[d] and cell width h[d]. Cell c (64-bit
+ * integer coordinates) covers [o + c h, o + (c+1) h) in every dimension and
+ * has centre o + (c + 1/2) h. Because every region of a cluster lives on the
+ * same lattice, cells of different regions never partially overlap.
+ *
+ * A point is outside the world (the sink) when it is not finite or when its
+ * cell coordinate would exceed CM_WORLD_LIMIT in magnitude.
+ * All functions are pure and thread-safe.
+ */
+#ifndef CM_LATTICE_H
+#define CM_LATTICE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cellmap/status.h"
+
+#define CM_MAX_DIM 6
+/* |cell coordinate| must stay below 2^40: far enough for any real analysis,
+ * small enough that coordinate arithmetic never overflows int64. */
+#define CM_WORLD_LIMIT ((int64_t)1 << 40)
+
+typedef struct cm_lattice {
+    int dim;                    /* 1 .. CM_MAX_DIM */
+    double origin[CM_MAX_DIM];  /* state coordinates of cell 0's lower corner */
+    double width[CM_MAX_DIM];   /* cell widths, > 0 and finite */
+} cm_lattice;
+
+/* A box of cells: lo[d] <= c[d] < hi[d]. Local (row-major) index puts
+ * dimension 0 fastest, so a box row along x is contiguous in memory. */
+typedef struct cm_box {
+    int dim;
+    int64_t lo[CM_MAX_DIM];
+    int64_t hi[CM_MAX_DIM];
+} cm_box;
+
+/* Validates dimension and widths; fills msg on failure. */
+cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size);
+
+/* Cell of point x. Returns false (cell untouched) when x is outside the world. */
+bool cm_lattice_cell(const cm_lattice *lat, const double *x, int64_t *cell);
+
+/* Centre of cell c in state coordinates. */
+void cm_lattice_centre(const cm_lattice *lat, const int64_t *cell, double *x);
+
+/* Validates a box (dim matches, lo < hi, inside the world). */
+cm_status cm_box_check(const cm_box *box, char *msg, size_t msg_size);
+
+/* Number of cells in a box; 0 if the count overflows uint64. */
+uint64_t cm_box_cells(const cm_box *box);
+
+/* true when cell c is inside the box. */
+bool cm_box_contains(const cm_box *box, const int64_t *cell);
+
+/* Local row-major index of a cell inside the box (caller checked contains). */
+uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
+
+/* Cell coordinates of local index i. */
+void cm_box_cell(const cm_box *box, uint64_t index, int64_t *cell);
+
+#endif

@@ -1,0 +1,89 @@
+/* cellmap/model.h - the contract between the engine and a dynamical system.
+ *
+ * A model is a value (in the spirit of gsl_odeiv2_system): a dimension, a
+ * pure step function and a context of coefficients derived once from the
+ * parameters. The engine only ever calls step(); everything else here is for
+ * the command line, the renderer and the analysis commands.
+ *
+ * Thread safety: step() and fixed_points() must be pure; the engine calls
+ * step() from many threads at once on one model.
+ */
+#ifndef CM_MODEL_H
+#define CM_MODEL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cellmap/lattice.h"
+
+#define CM_MAX_PARAMS 16
+#define CM_PARAM_MAX_VALUES 64
+
+/* Description of one parameter. A scalar has max_count 1; a vector parameter
+ * is written v1:v2:... on the command line (max_count entries at most).
+ * A parameter with choices ("none|output|...") takes one of the words and
+ * stores the word's index. */
+typedef struct cm_param_spec {
+    const char *name;
+    const char *def;     /* default, in command-line syntax */
+    double min, max;     /* inclusive range of every element */
+    int max_count;
+    const char *choices; /* NULL or '|'-separated words */
+    const char *doc;     /* one line */
+} cm_param_spec;
+
+typedef struct cm_param_value {
+    int count;
+    double v[CM_PARAM_MAX_VALUES];
+} cm_param_value;
+
+/* Values of all parameters of a spec, in the spec's order. */
+typedef struct cm_params {
+    const cm_param_spec *spec; /* terminated by an entry with name == NULL */
+    int count;
+    cm_param_value value[CM_MAX_PARAMS];
+} cm_params;
+
+/* A fixed point of a quantised map for control level `level`. `band` is the
+ * level actually produced at the point; the point is regular iff they agree. */
+typedef struct cm_fixed_point {
+    int64_t level;
+    int64_t band;
+    bool regular;
+    double x[CM_MAX_DIM];
+} cm_fixed_point;
+
+/* Return values of step(), SUNDIALS style. */
+enum { CM_STEP_OK = 0, CM_STEP_NO_IMAGE = 1, CM_STEP_ABORT = -1 };
+
+typedef struct cm_model {
+    const char *name;
+    int dim;
+    const cm_param_spec *params;
+    cm_params values;  /* the parameters the model was built from */
+    void *ctx;         /* derived coefficients; owned by the model */
+    /* 0: image in y; >0: no image (the sink); <0: abort the run. */
+    int (*step)(const struct cm_model *m, const double *x, double *y);
+    /* Optional. Fixed points for levels m0..m1 into out (cap entries);
+     * *count receives how many were written. Returns 0, or -1 when the model
+     * has no enumerable fixed points (a message then goes to msg). */
+    int (*fixed_points)(const struct cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
+                        size_t cap, size_t *count, char *msg, size_t msg_size);
+    void (*destroy)(void *ctx);
+} cm_model;
+
+/* Releases the model's context; NULL-safe; leaves the struct zeroed. */
+void cm_model_release(cm_model *m);
+
+/* Integer part rounding toward zero, as the thesis' Int (MODELS.md 1.1).
+ * Returns false for NaN, infinities and |z| >= 2^62, where no level exists. */
+static inline bool cm_int_part(double z, double *level)
+{
+    if (!(z > -4611686018427387904.0 && z < 4611686018427387904.0))
+        return false;
+    *level = (double)(int64_t)z; /* conversion truncates toward zero */
+    return true;
+}
+
+#endif

@@ -1,0 +1,230 @@
+#include "cellmap/scm.h"
+
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Sentinels of group[] used only while classifying. */
+#define GROUP_UNVISITED UINT32_C(0xFFFFFFFF)
+#define GROUP_ON_PATH UINT32_C(0xFFFFFFFE)
+#define MAX_GROUPS UINT32_C(0xFFFFFFF0)
+
+cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size)
+{
+    memset(r, 0, sizeof *r);
+    cm_status st = cm_box_check(box, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const uint64_t n = cm_box_cells(box);
+    if (n > CM_REGION_MAX_CELLS)
+        return cm_fail(CM_ETOOBIG, msg, msg_size,
+                       "a region holds at most %llu cells (asked for %llu); split it",
+                       (unsigned long long)CM_REGION_MAX_CELLS, (unsigned long long)n);
+    r->box = *box;
+    r->ncells = n;
+    r->image = malloc(n * sizeof *r->image);
+    r->group = malloc(n * sizeof *r->group);
+    r->step = malloc(n * sizeof *r->step);
+    if (!r->image || !r->group || !r->step) {
+        cm_region_free(r);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "cannot allocate %llu cells (%llu bytes)",
+                       (unsigned long long)n, (unsigned long long)(n * 12));
+    }
+    return CM_OK;
+}
+
+void cm_region_free(cm_region *r)
+{
+    if (!r)
+        return;
+    free(r->image);
+    free(r->group);
+    free(r->step);
+    memset(r, 0, sizeof *r);
+}
+
+uint64_t cm_region_bytes(const cm_region *r)
+{
+    return r->ncells * (sizeof *r->image + sizeof *r->group + sizeof *r->step);
+}
+
+/* Image of the point x that starts in cell `from`, re-stepping while the
+ * image stays in `from` (at most max_steps steps in all). */
+static int image_of(const cm_model *model, const cm_lattice *lat, const cm_box *box,
+                    const int64_t *from, int max_steps, double *x, uint32_t *image)
+{
+    double y[CM_MAX_DIM];
+    int64_t cell[CM_MAX_DIM];
+    const int dim = lat->dim;
+    for (int k = 0;; k++) {
+        const int rc = model->step(model, x, y);
+        if (rc < 0)
+            return rc;
+        if (rc > 0 || !cm_lattice_cell(lat, y, cell)) {
+            *image = CM_IMAGE_SINK;
+            return 0;
+        }
+        bool same = true;
+        for (int d = 0; d < dim; d++)
+            same = same && cell[d] == from[d];
+        if (!same || k + 1 >= max_steps)
+            break;
+        memcpy(x, y, (size_t)dim * sizeof *x);
+    }
+    *image = cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
+    return 0;
+}
+
+/* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1. */
+static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                         int max_steps, uint64_t row)
+{
+    const cm_box *box = &r->box;
+    const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
+    int64_t cell[CM_MAX_DIM];
+    double x[CM_MAX_DIM];
+    cm_box_cell(box, row * nx, cell);
+    for (uint64_t i = 0; i < nx; i++, cell[0]++) {
+        cm_lattice_centre(lat, cell, x);
+        const int rc = image_of(model, lat, box, cell, max_steps, x, &r->image[row * nx + i]);
+        if (rc < 0)
+            return rc;
+    }
+    return 0;
+}
+
+cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
+                        cm_region *r, char *msg, size_t msg_size)
+{
+    if (!model || !model->step || model->dim != lat->dim || r->box.dim != lat->dim)
+        return cm_fail(CM_EINVAL, msg, msg_size, "model, lattice and region dimensions differ");
+    const uint64_t nx = (uint64_t)(r->box.hi[0] - r->box.lo[0]);
+    const int64_t rows = (int64_t)(r->ncells / nx);
+    const int max_steps = opt && opt->max_steps > 1 ? opt->max_steps : 1;
+    int threads = 1;
+#ifdef _OPENMP
+    threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+#endif
+    int aborted = 0;
+    /* Rows are independent and every image depends on its cell alone, so the
+     * result is the same whatever the schedule or thread count. */
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads) reduction(| : aborted)
+    for (int64_t row = 0; row < rows; row++) {
+        if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row) < 0)
+            aborted = 1;
+    }
+    (void)threads;
+    if (aborted)
+        return cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
+    return CM_OK;
+}
+
+/* Assigns group g to the path that starts at `start` and ends at `stop`
+ * (exclusive); `tail_step` is the step number of `stop` and `path_len` the
+ * path's length. Cells at position >= cycle_at belong to a new cycle. */
+static void label_path(cm_region *r, uint32_t start, uint32_t path_len, uint32_t g,
+                       uint32_t tail_step, uint32_t cycle_at)
+{
+    uint32_t i = start;
+    for (uint32_t pos = 0; pos < path_len; pos++) {
+        const uint32_t next = r->image[i];
+        r->group[i] = g;
+        r->step[i] = pos >= cycle_at ? 0 : (cycle_at == UINT32_MAX ? tail_step + (path_len - pos)
+                                                                   : cycle_at - pos);
+        i = next;
+    }
+}
+
+cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
+{
+    const uint32_t n = (uint32_t)r->ncells;
+    uint32_t *group = r->group;
+    uint32_t *step = r->step;
+    const uint32_t *image = r->image;
+    for (uint32_t i = 0; i < n; i++)
+        group[i] = GROUP_UNVISITED;
+    uint32_t ngroups = 0;
+    for (uint32_t start = 0; start < n; start++) {
+        if (group[start] != GROUP_UNVISITED)
+            continue;
+        /* Walk until the sink, a classified cell or a cell of this path. */
+        uint32_t i = start, len = 0;
+        while (i < n && group[i] == GROUP_UNVISITED) {
+            group[i] = GROUP_ON_PATH;
+            step[i] = len++;
+            i = image[i];
+        }
+        if (i >= n) { /* the path leaves the region: the sink's domain */
+            label_path(r, start, len, 0, 0, UINT32_MAX);
+        } else if (group[i] == GROUP_ON_PATH) { /* a new periodic group */
+            if (ngroups == MAX_GROUPS)
+                return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups");
+            label_path(r, start, len, ++ngroups, 0, step[i]);
+        } else { /* reaches a known group */
+            label_path(r, start, len, group[i], step[i], UINT32_MAX);
+        }
+    }
+    r->ngroups = ngroups;
+    return CM_OK;
+}
+
+cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
+                       cm_region *r, char *msg, size_t msg_size)
+{
+    cm_status st = cm_scm_images(model, lat, opt, r, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_classify(r, msg, msg_size);
+    return st;
+}
+
+static bool cell_less(const int64_t *a, const int64_t *b, int dim)
+{
+    for (int d = dim - 1; d >= 0; d--)
+        if (a[d] != b[d])
+            return a[d] < b[d];
+    return false;
+}
+
+cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info *groups,
+                        uint64_t *sink_cells)
+{
+    const int dim = lat->dim;
+    uint64_t sink = 0;
+    for (uint32_t k = 0; k < r->ngroups; k++) {
+        memset(&groups[k], 0, sizeof groups[k]);
+        groups[k].id = k + 1;
+    }
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        const uint32_t g = r->group[i];
+        if (g == 0) {
+            sink++;
+            continue;
+        }
+        cm_group_info *gi = &groups[g - 1];
+        gi->basin_cells++;
+        if (r->step[i] != 0)
+            continue;
+        int64_t cell[CM_MAX_DIM];
+        double x[CM_MAX_DIM];
+        cm_box_cell(&r->box, i, cell);
+        cm_lattice_centre(lat, cell, x);
+        if (gi->period == 0 || cell_less(cell, gi->anchor, dim))
+            memcpy(gi->anchor, cell, sizeof gi->anchor);
+        for (int d = 0; d < dim; d++) {
+            if (gi->period == 0 || x[d] < gi->lo[d])
+                gi->lo[d] = x[d];
+            if (gi->period == 0 || x[d] > gi->hi[d])
+                gi->hi[d] = x[d];
+            gi->centre[d] += x[d];
+        }
+        gi->period++;
+    }
+    for (uint32_t k = 0; k < r->ngroups; k++)
+        for (int d = 0; d < dim; d++)
+            groups[k].centre[d] /= groups[k].period;
+    if (sink_cells)
+        *sink_cells = sink;
+    return CM_OK;
+}

@@ -1,0 +1,85 @@
+/* cellmap/scm.h - simple cell mapping (SCM) on one region (thesis 4.6.1,
+ * Algorithm C.8).
+ *
+ * A region is a box of cells of a lattice with three per-cell arrays
+ * (structure of arrays, 12 bytes per cell):
+ *   image[i]  local index of the image cell, CM_IMAGE_EXIT when the image
+ *             lies in the world but outside the box, CM_IMAGE_SINK when the
+ *             model gives no image or the image is outside the world;
+ *   group[i]  0 for the sink's domain of attraction, else a group id 1..G;
+ *   step[i]   steps to the periodic group (0 for periodic cells; a cell whose
+ *             image is the sink has step 1).
+ *
+ * Images are computed in parallel (OpenMP) by the centre-point method;
+ * classification is a sequential O(n) walk, so group ids (numbered in order
+ * of the lowest local index that reaches them) never depend on the thread
+ * count. Ownership: cm_region_alloc allocates, cm_region_free releases.
+ */
+#ifndef CM_SCM_H
+#define CM_SCM_H
+
+#include <stdint.h>
+
+#include "cellmap/lattice.h"
+#include "cellmap/model.h"
+#include "cellmap/status.h"
+
+#define CM_IMAGE_SINK UINT32_C(0xFFFFFFFF)
+#define CM_IMAGE_EXIT UINT32_C(0xFFFFFFFE)
+/* Largest number of cells in one region (local indices stay below the marks). */
+#define CM_REGION_MAX_CELLS UINT64_C(0xFFFFFFF0)
+
+typedef struct cm_region {
+    cm_box box;
+    uint64_t ncells;
+    uint32_t *image;
+    uint32_t *group;
+    uint32_t *step;
+    uint32_t ngroups; /* periodic groups other than the sink */
+} cm_region;
+
+/* Progress callback: fraction done in [0, 1]; return nonzero to cancel. */
+typedef int (*cm_progress_fn)(void *user, const char *phase, double fraction);
+
+typedef struct cm_scm_options {
+    /* Re-step from the image while it stays in the starting cell, up to this
+     * many steps in all (0 and 1 both mean a single step). Useful for flows. */
+    int max_steps;
+    int threads;             /* 0: the OpenMP default */
+    cm_progress_fn progress; /* optional */
+    void *user;
+} cm_scm_options;
+
+/* Summary of one periodic group. */
+typedef struct cm_group_info {
+    uint32_t id;
+    uint32_t period;             /* number of periodic cells */
+    uint64_t basin_cells;        /* cells with this group, periodic ones included */
+    double centre[CM_MAX_DIM];   /* mean centre of the periodic cells */
+    int64_t anchor[CM_MAX_DIM];  /* lexicographically smallest periodic cell:
+                                    the group's identity, whatever its id */
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* bounding box of periodic cells' centres */
+} cm_group_info;
+
+cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size);
+void cm_region_free(cm_region *r);
+/* Bytes held by the region's per-cell arrays. */
+uint64_t cm_region_bytes(const cm_region *r);
+
+/* Computes image[] for every cell. CM_EMODEL if the model aborted. */
+cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
+                        cm_region *r, char *msg, size_t msg_size);
+
+/* Classifies the functional graph in image[] into group[] and step[]. */
+cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size);
+
+/* Images then classification. */
+cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
+                       cm_region *r, char *msg, size_t msg_size);
+
+/* Summaries of groups 1..ngroups into a caller array of r->ngroups entries
+ * (entry k describes group k+1). Also counts the sink's cells if sink_cells. */
+cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info *groups,
+                        uint64_t *sink_cells);
+
+#endif

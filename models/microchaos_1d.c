@@ -1,0 +1,62 @@
+/* 1D micro-chaos map (4.1): x_{j+1} = a x_j - b Int(x_j). MODELS.md 3. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models/models.h"
+#include "models/params.h"
+
+const cm_param_spec cm_microchaos_1d_spec[] = {
+    {"a", "3.5", -1e6, 1e6, 1, NULL, "slope (a > 1: locally unstable); Fig. 4.2 uses 3.5"},
+    {"b", "2.8", -1e6, 1e6, 1, NULL, "control step (|a - b| < 1: globally attracting)"},
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+typedef struct map1d {
+    double a, b;
+} map1d;
+
+static int step_1d(const cm_model *m, const double *x, double *y)
+{
+    const map1d *c = m->ctx;
+    double level;
+    if (!cm_int_part(x[0], &level))
+        return CM_STEP_NO_IMAGE;
+    y[0] = c->a * x[0] - c->b * level;
+    return CM_STEP_OK;
+}
+
+/* (4.2): x_m* = b m/(a-1), regular iff Int(x_m*) = m. */
+static int fixed_points_1d(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
+                           size_t cap, size_t *count, char *msg, size_t msg_size)
+{
+    const map1d *c = m->ctx;
+    *count = 0;
+    if (c->a == 1.0) {
+        cm_fail(CM_EINVAL, msg, msg_size, "a = 1: the fixed points are not isolated");
+        return -1;
+    }
+    for (int64_t k = m0; k <= m1 && *count < cap; k++) {
+        cm_fixed_point *fp = &out[(*count)++];
+        double band;
+        memset(fp, 0, sizeof *fp);
+        fp->level = k;
+        fp->x[0] = c->b * (double)k / (c->a - 1.0);
+        fp->band = cm_int_part(fp->x[0], &band) ? (int64_t)band : INT64_MIN;
+        fp->regular = fp->band == k;
+    }
+    return 0;
+}
+
+cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    cm_status st = cm_model_setup(m, "microchaos-1d", 1, p, sizeof(map1d), msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    map1d *c = m->ctx;
+    c->a = cm_params_get(p, "a");
+    c->b = cm_params_get(p, "b");
+    m->step = step_1d;
+    m->fixed_points = fixed_points_1d;
+    return CM_OK;
+}

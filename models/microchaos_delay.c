@@ -1,0 +1,63 @@
+/* 2D micro-chaos map with delay (4.37): [x_{j-1}, x_j] ->
+ * [x_j, a x_j - b Int(x_{j-1})]. MODELS.md 5. */
+#include <math.h>
+#include <string.h>
+
+#include "models/models.h"
+#include "models/params.h"
+
+const cm_param_spec cm_microchaos_delay_spec[] = {
+    {"a", "1.5", -1e6, 1e6, 1, NULL, "slope; stability domain G: a > 1, b < 1, b > a - 1"},
+    {"b", "0.6", -1e6, 1e6, 1, NULL, "control step; Fig. 4.9 uses a = 1.5, b = 0.6"},
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+typedef struct delay_map {
+    double a, b;
+} delay_map;
+
+static int step_delay(const cm_model *m, const double *x, double *y)
+{
+    const delay_map *c = m->ctx;
+    double level;
+    if (!cm_int_part(x[0], &level))
+        return CM_STEP_NO_IMAGE;
+    y[0] = x[1];
+    y[1] = c->a * x[1] - c->b * level;
+    return CM_STEP_OK;
+}
+
+/* (4.40): y_m* = [x, x], x = m b/(a-1), regular iff Int(x) = m. */
+static int fixed_points_delay(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
+                              size_t cap, size_t *count, char *msg, size_t msg_size)
+{
+    const delay_map *c = m->ctx;
+    *count = 0;
+    if (c->a == 1.0) {
+        cm_fail(CM_EINVAL, msg, msg_size, "a = 1: the fixed points are not isolated");
+        return -1;
+    }
+    for (int64_t k = m0; k <= m1 && *count < cap; k++) {
+        cm_fixed_point *fp = &out[(*count)++];
+        double band;
+        memset(fp, 0, sizeof *fp);
+        fp->level = k;
+        fp->x[0] = fp->x[1] = (double)k * c->b / (c->a - 1.0);
+        fp->band = cm_int_part(fp->x[0], &band) ? (int64_t)band : INT64_MIN;
+        fp->regular = fp->band == k;
+    }
+    return 0;
+}
+
+cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    cm_status st = cm_model_setup(m, "microchaos-delay", 2, p, sizeof(delay_map), msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    delay_map *c = m->ctx;
+    c->a = cm_params_get(p, "a");
+    c->b = cm_params_get(p, "b");
+    m->step = step_delay;
+    m->fixed_points = fixed_points_delay;
+    return CM_OK;
+}

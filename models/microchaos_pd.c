@@ -1,0 +1,156 @@
+/* 2D micro-chaos map of the PD-controlled inverted pendulum (4.66).
+ * MODELS.md 6. */
+#include "models/microchaos_pd.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "models/models.h"
+#include "models/params.h"
+
+const cm_param_spec cm_microchaos_pd_spec[] = {
+    {"alpha", "0.078", 1e-12, 1e3, 1, NULL, "alpha = tau sqrt(k/M) > 0 (4.59)"},
+    {"beta", "0", -1e3, 1e3, 1, NULL, "beta = d tau/(2M), damping (4.59)"},
+    {"P", "0.007", -1e6, 1e6, 1, NULL, "proportional gain P = P~ tau^2/M (4.59)"},
+    {"D", "0.02", -1e6, 1e6, 1, NULL, "derivative gain D = D~ tau/M (4.59)"},
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+void cm_pd_coefficients(double alpha, double beta, double P, double D, cm_pd_coef *c)
+{
+    const double a2 = alpha * alpha;
+    const double g = sqrt(a2 + beta * beta);
+    const double s = sinh(g), ch = cosh(g), e = exp(beta);
+    memset(c, 0, sizeof *c);
+    c->alpha = alpha;
+    c->beta = beta;
+    c->P = P;
+    c->D = D;
+    c->gamma = g;
+    c->A[0] = (g * ch + beta * s) / (e * g);
+    c->A[1] = s / (e * g);
+    c->A[2] = a2 * s / (e * g);
+    c->A[3] = (g * ch - beta * s) / (e * g);
+    c->b[0] = (e - ch) / (e * a2) - beta * s / (e * g * a2);
+    c->b[1] = -s / (e * g);
+    c->S[0] = c->A[0] + c->b[0] * P;
+    c->S[1] = c->A[1] + c->b[0] * D;
+    c->S[2] = c->A[2] + c->b[1] * P;
+    c->S[3] = c->A[3] + c->b[1] * D;
+    c->lambda_u = exp(g - beta);
+    c->lambda_s = exp(-g - beta);
+    c->e_u[0] = 1.0;
+    c->e_u[1] = g - beta;
+    c->e_s[0] = 1.0;
+    c->e_s[1] = -g - beta;
+}
+
+void cm_pd_switching_line(double P, double D, int64_t m, double *slope, double *intercept)
+{
+    *slope = -P / D;
+    *intercept = (double)m / D;
+}
+
+void cm_pd_stability_at(double alpha, double beta, double P, double D, cm_pd_stability *st)
+{
+    const double a2 = alpha * alpha;
+    const double g = sqrt(a2 + beta * beta);
+    const double s = sinh(g), c = cosh(g), e = exp(beta);
+    st->p = ((s * D - 2 * g * c) * a2 - P * (g * (e - c) - beta * s)) / (e * g * a2);
+    st->q = (g * a2 - D * e * s * a2 - P * (e * beta * s - e * g * c + g)) / (e * e * g * a2);
+    st->b2 = (P - a2) * g * (2 * c * e - 1 - e * e);
+    st->b1 = -a2 * (-2 * s * D * e + 2 * g * (1 - e * e)) - 2 * P * (e * c * g - e * s * beta - g);
+    st->b0 = a2 * (g * (e * e + 1 + 2 * c * e) - 2 * s * D * e) -
+             P * (2 * e * s * beta + g * (1 - e * e));
+    st->D_b0 = (a2 * (1 + 2 * c * e + e * e) * g + P * ((e * e - 1) * g - 2 * beta * e * s)) /
+               (2 * a2 * e * s);
+    st->D_b1 = (a2 * (g - e * e * g) + P * ((c * e - 1) * g - beta * e * s)) / (a2 * e * s);
+    st->stable = st->b0 > 0 && st->b1 > 0 && st->b2 > 0;
+}
+
+double cm_pd_P_max(double alpha, double beta)
+{
+    const double g = sqrt(alpha * alpha + beta * beta);
+    const double c = cosh(g), e = exp(beta);
+    return alpha * alpha * (1 - 2 * c * e - 3 * e * e) / (1 - 2 * c * e + e * e);
+}
+
+double cm_pd_D_at_P_max(double alpha, double beta)
+{
+    const double g = sqrt(alpha * alpha + beta * beta);
+    const double s = sinh(g), c = cosh(g), e = exp(beta);
+    const double den = 2 * c * e - e * e - 1;
+    return (-3 * e + 2 * c * c * e + e * e * e + c * (-1 + e * e)) * g / (den * s) +
+           (1 - 2 * c * e - 3 * e * e) * beta / den;
+}
+
+int64_t cm_pd_m_fix_max(double alpha, double P)
+{
+    const double a2 = alpha * alpha;
+    if (!(P > a2))
+        return -1;
+    /* The band test decides: the largest m >= 0 whose x_m* = m/alpha^2 lies in
+     * band m. Start from the closed form (4.75) and correct at the border. */
+    double level;
+    int64_t m = cm_int_part(a2 / (P - a2), &level) ? (int64_t)level : -1;
+    while (m > 0 && !(cm_int_part(P * ((double)m / a2), &level) && (int64_t)level == m))
+        m--;
+    return m;
+}
+
+int64_t cm_pd_m_max(double alpha, double P)
+{
+    const int64_t m = cm_pd_m_fix_max(alpha, P);
+    return m < 0 ? -1 : m + 1;
+}
+
+typedef struct pd_map {
+    double a11, a12, a21, a22, b1, b2, P, D, alpha2;
+} pd_map;
+
+static int step_pd(const cm_model *m, const double *x, double *y)
+{
+    const pd_map *c = m->ctx;
+    double level;
+    if (!cm_int_part(c->P * x[0] + c->D * x[1], &level))
+        return CM_STEP_NO_IMAGE;
+    y[0] = c->a11 * x[0] + c->a12 * x[1] + c->b1 * level;
+    y[1] = c->a21 * x[0] + c->a22 * x[1] + c->b2 * level;
+    return CM_STEP_OK;
+}
+
+/* (4.71): x_m* = [m/alpha^2, 0], regular iff Int(P x + D 0) = m. */
+static int fixed_points_pd(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
+                           size_t cap, size_t *count, char *msg, size_t msg_size)
+{
+    const pd_map *c = m->ctx;
+    (void)msg;
+    (void)msg_size;
+    *count = 0;
+    for (int64_t k = m0; k <= m1 && *count < cap; k++) {
+        cm_fixed_point *fp = &out[(*count)++];
+        double band;
+        memset(fp, 0, sizeof *fp);
+        fp->level = k;
+        fp->x[0] = (double)k / c->alpha2;
+        fp->x[1] = 0.0;
+        fp->band = cm_int_part(c->P * fp->x[0] + c->D * 0.0, &band) ? (int64_t)band : INT64_MIN;
+        fp->regular = fp->band == k;
+    }
+    return 0;
+}
+
+cm_status cm_microchaos_pd_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    cm_status st = cm_model_setup(m, "microchaos-pd", 2, p, sizeof(pd_map), msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_pd_coef k;
+    cm_pd_coefficients(cm_params_get(p, "alpha"), cm_params_get(p, "beta"), cm_params_get(p, "P"),
+                       cm_params_get(p, "D"), &k);
+    pd_map *c = m->ctx;
+    *c = (pd_map){k.A[0], k.A[1], k.A[2], k.A[3], k.b[0], k.b[1], k.P, k.D, k.alpha * k.alpha};
+    m->step = step_pd;
+    m->fixed_points = fixed_points_pd;
+    return CM_OK;
+}

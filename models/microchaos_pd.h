@@ -1,0 +1,46 @@
+/* models/microchaos_pd.h - analytic results for the 2D micro-chaos map of the
+ * PD-controlled inverted pendulum (thesis 4.5, App. C.4; MODELS.md 6).
+ * All functions are pure. alpha > 0 is required throughout. */
+#ifndef CM_MODELS_MICROCHAOS_PD_H
+#define CM_MODELS_MICROCHAOS_PD_H
+
+#include <stdint.h>
+
+typedef struct cm_pd_coef {
+    double alpha, beta, P, D;
+    double gamma;          /* sqrt(alpha^2 + beta^2) */
+    double A[4];           /* (4.67), row-major */
+    double b[2];           /* (4.67) */
+    double S[4];           /* A + b [P, D] (4.62) */
+    double lambda_u, lambda_s; /* eigenvalues of A: exp(+-gamma - beta) */
+    double e_u[2], e_s[2]; /* eigenvectors (4.68), first component 1 */
+} cm_pd_coef;
+
+/* Matrices of (4.66)/(4.67) and the eigen-structure of A. */
+void cm_pd_coefficients(double alpha, double beta, double P, double D, cm_pd_coef *c);
+
+/* Switching line SW_m (4.70): x' = (m - P x)/D, i.e. slope -P/D and
+ * intercept m/D; it crosses x' = 0 at x = m/P. */
+void cm_pd_switching_line(double P, double D, int64_t m, double *slope, double *intercept);
+
+/* Stability of the quantisation-free loop (C.43)-(C.47). */
+typedef struct cm_pd_stability {
+    double p, q;        /* characteristic polynomial mu^2 + p mu + q of S */
+    double b0, b1, b2;  /* (C.44); stable iff all three are positive */
+    double D_b0, D_b1;  /* (C.45): stable iff P > alpha^2 and D_b1 < D < D_b0 */
+    int stable;
+} cm_pd_stability;
+
+void cm_pd_stability_at(double alpha, double beta, double P, double D, cm_pd_stability *s);
+
+/* (C.46): P where D_b0 and D_b1 meet; (C.47): D there. */
+double cm_pd_P_max(double alpha, double beta);
+double cm_pd_D_at_P_max(double alpha, double beta);
+
+/* (4.75) m_fix,max = Int(alpha^2/(P - alpha^2)), with the border rule of
+ * MODELS.md 6.4 (a colliding fixed point is virtual); (4.76) m_max =
+ * m_fix,max + 1. Return -1 when P <= alpha^2 (unbounded). */
+int64_t cm_pd_m_fix_max(double alpha, double P);
+int64_t cm_pd_m_max(double alpha, double P);
+
+#endif

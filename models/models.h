@@ -1,0 +1,38 @@
+/* models/models.h - constructors of the micro-chaos models.
+ *
+ * Each constructor validates the parameter values (already range-checked
+ * against the spec by models/params.c), precomputes the coefficients and
+ * fills *m. On failure *m is left zeroed and msg says what to change.
+ * Use the registry (models/registry.h) rather than calling these directly.
+ */
+#ifndef CM_MODELS_MODELS_H
+#define CM_MODELS_MODELS_H
+
+#include "cellmap/model.h"
+
+typedef cm_status (*cm_model_create_fn)(const cm_params *p, cm_model *m, char *msg,
+                                        size_t msg_size);
+
+extern const cm_param_spec cm_microchaos_1d_spec[];
+extern const cm_param_spec cm_microchaos_1d_friction_spec[];
+extern const cm_param_spec cm_microchaos_delay_spec[];
+extern const cm_param_spec cm_microchaos_pd_spec[];
+extern const cm_param_spec cm_microchaos_pd_twofold_spec[];
+extern const cm_param_spec cm_microchaos_general_spec[];
+
+cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
+cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char *msg,
+                                           size_t msg_size);
+cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
+cm_status cm_microchaos_pd_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
+cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char *msg,
+                                          size_t msg_size);
+cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg,
+                                       size_t msg_size);
+
+/* Shared by the constructors: allocates a zeroed context of `size` bytes and
+ * fills the common fields of *m. */
+cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
+                         size_t ctx_size, char *msg, size_t msg_size);
+
+#endif

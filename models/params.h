@@ -1,0 +1,28 @@
+/* models/params.h - parameter values from command-line text.
+ *
+ * Text syntax: "name=value[,name=value...]". A vector value is written
+ * v1:v2:...; a choice parameter takes one of its words. Unknown names,
+ * malformed numbers, values out of range and too many entries are errors
+ * whose message names the parameter and the accepted range.
+ */
+#ifndef CM_MODELS_PARAMS_H
+#define CM_MODELS_PARAMS_H
+
+#include "cellmap/model.h"
+
+/* Fills p with the spec's defaults. */
+cm_status cm_params_defaults(const cm_param_spec *spec, cm_params *p, char *msg, size_t msg_size);
+
+/* Overrides values from text (may be called repeatedly). */
+cm_status cm_params_set(cm_params *p, const char *text, char *msg, size_t msg_size);
+
+/* Index of a parameter by name, or -1. */
+int cm_params_find(const cm_params *p, const char *name);
+
+/* Scalar value of parameter `name` (first element). The name must exist. */
+double cm_params_get(const cm_params *p, const char *name);
+
+/* Writes the values as "name=value,..." (doubles with %.17g) into buf. */
+void cm_params_format(const cm_params *p, char *buf, size_t size);
+
+#endif

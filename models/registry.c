@@ -1,0 +1,75 @@
+#include "models/registry.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "models/models.h"
+#include "models/params.h"
+
+/* The left region of the thesis' C-SCM example (4.6.3): it holds the chaotic
+ * attractors at SW_1..SW_3 on the x-axis (x = m/P). */
+#define CM_PD_EXAMPLE_REGION "0:500,-40:40"
+
+static const cm_model_entry entries[] = {
+    {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15", cm_microchaos_1d_spec,
+     cm_microchaos_1d_create},
+    {"microchaos-1d-friction", "x_j",
+     "1D transient micro-chaos map with Coulomb friction (4.23)", "-2:2", cm_microchaos_1d_friction_spec,
+     cm_microchaos_1d_friction_create},
+    {"microchaos-delay", "x_{j-1}, x_j", "2D micro-chaos map with delay (4.37)", "-6:6,-6:6",
+     cm_microchaos_delay_spec, cm_microchaos_delay_create},
+    {"microchaos-pd", "x, x'", "PD-controlled inverted pendulum, output quantisation (4.66)", CM_PD_EXAMPLE_REGION,
+     cm_microchaos_pd_spec, cm_microchaos_pd_create},
+    {"microchaos-pd-twofold", "x, x'", "PD map with twofold (input and output) quantisation (4.84)", CM_PD_EXAMPLE_REGION,
+     cm_microchaos_pd_twofold_spec, cm_microchaos_pd_twofold_create},
+    {"microchaos-general", "x_{j-d}, ..., x_j",
+     "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
+     NULL,
+     cm_microchaos_general_spec, cm_microchaos_general_create},
+};
+
+size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }
+
+const cm_model_entry *cm_model_at(size_t i) { return i < cm_model_count() ? &entries[i] : NULL; }
+
+const cm_model_entry *cm_model_find(const char *name)
+{
+    for (size_t i = 0; i < cm_model_count(); i++)
+        if (strcmp(entries[i].name, name) == 0)
+            return &entries[i];
+    return NULL;
+}
+
+cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
+                         size_t ctx_size, char *msg, size_t msg_size)
+{
+    memset(m, 0, sizeof *m);
+    m->ctx = calloc(1, ctx_size);
+    if (!m->ctx)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory building model %s", name);
+    m->name = name;
+    m->dim = dim;
+    m->params = p->spec;
+    m->values = *p;
+    m->destroy = free;
+    return CM_OK;
+}
+
+cm_status cm_model_create(const char *name, const char *const *texts, int n_texts, cm_model *m,
+                          char *msg, size_t msg_size)
+{
+    memset(m, 0, sizeof *m);
+    const cm_model_entry *e = cm_model_find(name);
+    if (!e)
+        return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                       "unknown model '%s' (`cellmap models` lists them)", name);
+    cm_params p;
+    cm_status st = cm_params_defaults(e->params, &p, msg, msg_size);
+    for (int i = 0; st == CM_OK && i < n_texts; i++)
+        st = cm_params_set(&p, texts[i], msg, msg_size);
+    if (st == CM_OK)
+        st = e->create(&p, m, msg, msg_size);
+    if (st != CM_OK)
+        cm_model_release(m);
+    return st;
+}

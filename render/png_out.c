@@ -1,0 +1,74 @@
+#include "render/png_out.h"
+
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Everything libpng touches after setjmp lives in this struct, so nothing
+ * is clobbered by longjmp. */
+typedef struct png_job {
+    FILE *file;
+    png_structp png;
+    png_infop info;
+    uint8_t *row;
+} png_job;
+
+static cm_status encode(png_job *job, const uint8_t *rgba, int width, int height,
+                        const cm_png_text *texts, int n_texts)
+{
+    if (setjmp(png_jmpbuf(job->png)))
+        return CM_EIO;
+    png_init_io(job->png, job->file);
+    png_set_IHDR(job->png, job->info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_compression_level(job->png, 6);
+    for (int i = 0; i < n_texts; i++) {
+        png_text t;
+        memset(&t, 0, sizeof t);
+        t.compression = PNG_TEXT_COMPRESSION_NONE;
+        t.key = (png_charp)texts[i].key;
+        t.text = (png_charp)texts[i].value;
+        png_set_text(job->png, job->info, &t, 1);
+    }
+    png_write_info(job->png, job->info);
+    for (int y = 0; y < height; y++) {
+        const uint8_t *src = rgba + (size_t)y * (size_t)width * 4;
+        for (int x = 0; x < width; x++)
+            memcpy(job->row + 3 * (size_t)x, src + 4 * (size_t)x, 3);
+        png_write_row(job->png, job->row);
+    }
+    png_write_end(job->png, job->info);
+    return CM_OK;
+}
+
+cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
+                       const cm_png_text *texts, int n_texts, char *msg, size_t msg_size)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    png_job job;
+    memset(&job, 0, sizeof job);
+    job.file = fopen(tmp, "wb");
+    if (!job.file)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot create %s (check the directory exists and "
+                       "is writable)", tmp);
+    job.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    job.info = job.png ? png_create_info_struct(job.png) : NULL;
+    job.row = malloc(3 * (size_t)width);
+    cm_status st = job.png && job.info && job.row
+                       ? encode(&job, rgba, width, height, texts, n_texts)
+                       : CM_ENOMEM;
+    png_destroy_write_struct(&job.png, &job.info);
+    free(job.row);
+    if (fclose(job.file) != 0 && st == CM_OK)
+        st = CM_EIO;
+    if (st == CM_OK && rename(tmp, path) != 0)
+        st = CM_EIO;
+    if (st != CM_OK) {
+        unlink(tmp);
+        return cm_fail(st, msg, msg_size, "cannot write PNG %s: %s", path, cm_strerror(st));
+    }
+    return CM_OK;
+}

@@ -1,0 +1,23 @@
+/* render/png_out.h - PNG files through libpng's classic API.
+ *
+ * cm_png_write writes an 8-bit RGB PNG (from an RGBA buffer, row 0 at the
+ * top) with tEXt chunks recording provenance, first to PATH.tmp-PID, then
+ * renamed over PATH: a reader never sees a half-written image. No time chunk
+ * is written, so the same pixels and texts give the same bytes.
+ */
+#ifndef CM_RENDER_PNG_OUT_H
+#define CM_RENDER_PNG_OUT_H
+
+#include <stdint.h>
+
+#include "cellmap/status.h"
+
+typedef struct cm_png_text {
+    const char *key;   /* 1..79 Latin-1 characters */
+    const char *value;
+} cm_png_text;
+
+cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
+                       const cm_png_text *texts, int n_texts, char *msg, size_t msg_size);
+
+#endif

@@ -1,0 +1,166 @@
+#include "src/args.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models/registry.h"
+
+int cli_usage_error(const cli *c, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "cellmap %s: ", c->cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n(see `cellmap %s --help`)\n", c->cmd);
+    return EXIT_USAGE;
+}
+
+bool cli_next(cli *c)
+{
+    c->i++;
+    c->opt = c->i < c->argc ? c->argv[c->i] : NULL;
+    c->value = NULL;
+    return c->opt != NULL;
+}
+
+bool cli_is(cli *c, const char *name, bool needs_value, int *error)
+{
+    const size_t n = strlen(name);
+    if (strncmp(c->opt, name, n) != 0 || (c->opt[n] != '\0' && c->opt[n] != '='))
+        return false;
+    if (!needs_value) {
+        if (c->opt[n] == '=')
+            *error = cli_usage_error(c, "%s takes no value", name);
+        return true;
+    }
+    if (c->opt[n] == '=') {
+        c->value = c->opt + n + 1;
+    } else if (c->i + 1 < c->argc) {
+        c->value = c->argv[++c->i];
+    } else {
+        *error = cli_usage_error(c, "%s needs a value", name);
+    }
+    return true;
+}
+
+bool parse_int64(const char *s, int64_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const long long v = strtoll(s, &end, 10);
+    if (end == s || *end != '\0' || errno == ERANGE)
+        return false;
+    *out = v;
+    return true;
+}
+
+bool parse_double(const char *s, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const double v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v))
+        return false;
+    *out = v;
+    return true;
+}
+
+/* Splits s at sep into at most max pieces of at most 255 characters. */
+static int split(const char *s, char sep, char pieces[][256], int max)
+{
+    int n = 0;
+    while (n < max) {
+        const char *end = strchr(s, sep);
+        const size_t len = end ? (size_t)(end - s) : strlen(s);
+        if (len == 0 || len >= 256)
+            return -1;
+        memcpy(pieces[n], s, len);
+        pieces[n++][len] = '\0';
+        if (!end)
+            return n;
+        s = end + 1;
+    }
+    return -1;
+}
+
+bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max)
+{
+    char pieces[CM_MAX_DIM][256];
+    const int n = split(s, ',', pieces, max);
+    if (n < 1)
+        return false;
+    for (int d = 0; d < n; d++) {
+        char *colon = strchr(pieces[d], ':');
+        if (!colon)
+            return false;
+        *colon = '\0';
+        if (!parse_double(pieces[d], &lo[d]) || !parse_double(colon + 1, &hi[d]) ||
+            !(lo[d] < hi[d]))
+            return false;
+    }
+    *count = n;
+    return true;
+}
+
+bool parse_counts(const char *s, int64_t *v, int *count, int max)
+{
+    char pieces[CM_MAX_DIM][256];
+    const int n = split(s, 'x', pieces, max);
+    if (n < 1)
+        return false;
+    for (int d = 0; d < n; d++)
+        if (!parse_int64(pieces[d], &v[d]) || v[d] < 1)
+            return false;
+    *count = n;
+    return true;
+}
+
+bool parse_doubles(const char *s, double *v, int *count, int max)
+{
+    char pieces[CM_MAX_DIM][256];
+    const int n = split(s, ',', pieces, max);
+    if (n < 1)
+        return false;
+    for (int d = 0; d < n; d++)
+        if (!parse_double(pieces[d], &v[d]))
+            return false;
+    *count = n;
+    return true;
+}
+
+bool model_opts_take(cli *c, model_opts *mo, int *error)
+{
+    if (cli_is(c, "--model", true, error)) {
+        mo->name = c->value;
+        return true;
+    }
+    if (cli_is(c, "--param", true, error)) {
+        if (c->value && mo->n_texts == MAX_PARAM_TEXTS)
+            *error = cli_usage_error(c, "too many --param options (at most %d)", MAX_PARAM_TEXTS);
+        else if (c->value)
+            mo->texts[mo->n_texts++] = c->value;
+        return true;
+    }
+    return false;
+}
+
+int model_opts_build(const cli *c, const model_opts *mo, cm_model *m)
+{
+    char msg[512];
+    if (cm_model_create(mo->name, mo->texts, mo->n_texts, m, msg, sizeof msg) != CM_OK)
+        return cli_usage_error(c, "%s", msg);
+    return EXIT_OK;
+}
+
+void join_argv(int argc, char **argv, char *buf, size_t size)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < argc && used + 1 < size; i++)
+        used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? " " : "", argv[i]);
+}

@@ -1,0 +1,59 @@
+/* src/args.h - command-line helpers shared by the subcommands.
+ * Bad usage prints "cellmap CMD: problem (hint)" and gives exit status 2. */
+#ifndef CM_SRC_ARGS_H
+#define CM_SRC_ARGS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cellmap/lattice.h"
+#include "cellmap/model.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2 };
+#define MAX_PARAM_TEXTS 32
+
+/* Cursor over argv; options are "--name VALUE" or "--name=VALUE". */
+typedef struct cli {
+    const char *cmd; /* subcommand name, for messages */
+    int argc;
+    char **argv;
+    int i;
+    const char *opt;   /* current option name */
+    const char *value; /* its value, when it takes one */
+} cli;
+
+/* Prints the usage error and returns EXIT_USAGE. */
+int cli_usage_error(const cli *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Advances to the next argument. Returns false at the end. */
+bool cli_next(cli *c);
+/* True when the current argument is option `name`; takes its value if
+ * needs_value (a missing value is reported and *error set). */
+bool cli_is(cli *c, const char *name, bool needs_value, int *error);
+
+/* Parsers: false on malformed input. */
+bool parse_int64(const char *s, int64_t *out);
+bool parse_double(const char *s, double *out);
+/* "LO:HI,LO:HI,..." -> lo[], hi[], count. */
+bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
+/* "NxMx..." -> counts, count. */
+bool parse_counts(const char *s, int64_t *n, int *count, int max);
+/* "X,Y,..." -> values. */
+bool parse_doubles(const char *s, double *v, int *count, int max);
+
+/* The options every model-driven command shares. */
+typedef struct model_opts {
+    const char *name;
+    const char *texts[MAX_PARAM_TEXTS];
+    int n_texts;
+} model_opts;
+
+/* Handles --model and --param; returns true if the current option was one. */
+bool model_opts_take(cli *c, model_opts *mo, int *error);
+/* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
+int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);
+
+/* Command line joined by spaces (for provenance). */
+void join_argv(int argc, char **argv, char *buf, size_t size);
+
+#endif

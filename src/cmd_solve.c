@@ -1,0 +1,303 @@
+/* cellmap solve: simple cell mapping of one region, with a summary, a basin
+ * PNG and a .cmdb database. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "cellmap/scm.h"
+#include "cellmap/store.h"
+#include "models/registry.h"
+#include "render/basin.h"
+#include "render/png_out.h"
+#include "src/args.h"
+#include "src/commands.h"
+
+static const char solve_help[] =
+    "usage: cellmap solve [--model NAME] [--param k=v[,k=v]] [--region LO:HI[,LO:HI...]]\n"
+    "                     [--cells N[xM...]] [--max-steps K] [--threads T]\n"
+    "                     [--png FILE] [--size WxH] [--db FILE] [--json]\n\n"
+    "Simple cell mapping (centre-point method) of a box of state space cut into\n"
+    "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
+    "centre). Without options it solves the thesis' C-SCM example (4.6.3):\n"
+    "microchaos-pd, alpha=0.078, beta=0, P=0.007, D=0.02 on 0:500,-40:40.\n\n"
+    "  --model NAME        a model of `cellmap models` (default microchaos-pd)\n"
+    "  --param k=v,...     parameters (repeatable; vectors as v1:v2:...)\n"
+    "  --region LO:HI,...  the box, one range per state dimension\n"
+    "                      (default: the model's example region)\n"
+    "  --cells NxM...      cells per dimension (default 1000 per dimension, 100 in 3-D+)\n"
+    "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
+    "  --threads T         OpenMP threads for the images (default: all cores)\n"
+    "  --png FILE          write the basin image (written to a temporary file, renamed)\n"
+    "  --size WxH          image size in pixels (default: one pixel per cell, at most 4096)\n"
+    "  --db FILE           write a .cmdb SQLite database (replaces an older .cmdb only)\n"
+    "  --json              print the summary as JSON\n";
+
+typedef struct solve_args {
+    model_opts mo;
+    const char *region_text;
+    int64_t cells[CM_MAX_DIM];
+    int n_cells;
+    int max_steps, threads, width, height, json;
+    const char *png, *db;
+} solve_args;
+
+static int parse_solve(cli *c, solve_args *a)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        int64_t v;
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(solve_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (cli_is(c, "--region", true, &err)) {
+            a->region_text = c->value;
+        } else if (cli_is(c, "--cells", true, &err)) {
+            if (c->value && !parse_counts(c->value, a->cells, &a->n_cells, CM_MAX_DIM))
+                err = cli_usage_error(c, "--cells: '%s' is not N[xM...] with positive integers",
+                                      c->value);
+        } else if (cli_is(c, "--max-steps", true, &err)) {
+            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
+                err = cli_usage_error(c, "--max-steps: '%s' must be an integer in 1..1000000",
+                                      c->value);
+            a->max_steps = (int)v;
+        } else if (cli_is(c, "--threads", true, &err)) {
+            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1024))
+                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024",
+                                      c->value);
+            a->threads = (int)v;
+        } else if (cli_is(c, "--size", true, &err)) {
+            int64_t wh[2];
+            int n = 0;
+            if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] > 16384 ||
+                             wh[1] > 16384))
+                err = cli_usage_error(c, "--size: '%s' must be WxH, each 1..16384", c->value);
+            else if (c->value) {
+                a->width = (int)wh[0];
+                a->height = (int)wh[1];
+            }
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_is(c, "--db", true, &err)) {
+            a->db = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = 1;
+        } else {
+            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+        }
+    }
+    return err;
+}
+
+/* Lattice and box from --region and --cells: the region's lower corner is
+ * the lattice origin, cells are (HI-LO)/N wide. */
+static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm_lattice *lat,
+                        cm_box *box)
+{
+    const cm_model_entry *e = cm_model_find(m->name);
+    const char *text = a->region_text ? a->region_text : e->region;
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    if (!text)
+        return cli_usage_error(c, "--region is required for model %s (one LO:HI per dimension)",
+                               m->name);
+    if (!parse_ranges(text, lo, hi, &n, CM_MAX_DIM))
+        return cli_usage_error(c, "--region: '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
+    if (n != m->dim)
+        return cli_usage_error(c, "--region has %d range(s) but model %s has dimension %d", n,
+                               m->name, m->dim);
+    if (a->n_cells && a->n_cells != m->dim)
+        return cli_usage_error(c, "--cells has %d count(s) but model %s has dimension %d",
+                               a->n_cells, m->name, m->dim);
+    memset(lat, 0, sizeof *lat);
+    memset(box, 0, sizeof *box);
+    lat->dim = box->dim = m->dim;
+    double total = 1.0;
+    for (int d = 0; d < m->dim; d++) {
+        const int64_t cells = a->n_cells ? a->cells[d] : (m->dim <= 2 ? 1000 : 100);
+        lat->origin[d] = lo[d];
+        lat->width[d] = (hi[d] - lo[d]) / (double)cells;
+        box->hi[d] = cells;
+        total *= (double)cells;
+    }
+    if (total > (double)CM_REGION_MAX_CELLS)
+        return cli_usage_error(c, "--cells asks for %.0f cells; one region holds at most %llu",
+                               total, (unsigned long long)CM_REGION_MAX_CELLS);
+    char msg[256];
+    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK)
+        return cli_usage_error(c, "%s", msg);
+    return EXIT_OK;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void print_vector(const double *v, int n, const char *sep)
+{
+    for (int d = 0; d < n; d++)
+        printf("%s%.9g", d ? sep : "", v[d]);
+}
+
+static void print_text(const cm_model *m, const cm_region *r, const cm_group_info *g,
+                       uint64_t sink, double t_img, double t_cls)
+{
+    char params[2048];
+    cm_params_json(&m->values, params, sizeof params);
+    printf("model %s %s\n", m->name, params);
+    printf("cells %llu, periodic groups %u, sink basin %llu cells (%.1f%%)\n",
+           (unsigned long long)r->ncells, r->ngroups, (unsigned long long)sink,
+           100.0 * (double)sink / (double)r->ncells);
+    printf("time: images %.3f s, classification %.3f s (%.1f ns/cell)\n", t_img, t_cls,
+           1e9 * (t_img + t_cls) / (double)r->ncells);
+    printf("%6s %8s %12s %12s  %s\n", "group", "period", "basin", "doa", "centre");
+    for (uint32_t k = 0; k < r->ngroups; k++) {
+        printf("%6u %8u %12llu %12llu  (", g[k].id, g[k].period,
+               (unsigned long long)g[k].basin_cells,
+               (unsigned long long)(g[k].basin_cells - g[k].period));
+        print_vector(g[k].centre, m->dim, ", ");
+        printf(")\n");
+    }
+}
+
+static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region *r,
+                       const cm_group_info *g, uint64_t sink, double t_img, double t_cls)
+{
+    char params[2048];
+    cm_params_json(&m->values, params, sizeof params);
+    printf("{\"model\":\"%s\",\"params\":%s,\"lattice\":{\"origin\":[", m->name, params);
+    print_vector(lat->origin, lat->dim, ",");
+    printf("],\"width\":[");
+    print_vector(lat->width, lat->dim, ",");
+    printf("]},\"cells\":%llu,\"sink_cells\":%llu,\"time_s\":{\"images\":%.6f,"
+           "\"classification\":%.6f},\"groups\":[",
+           (unsigned long long)r->ncells, (unsigned long long)sink, t_img, t_cls);
+    for (uint32_t k = 0; k < r->ngroups; k++) {
+        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"centre\":[", k ? "," : "",
+               g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
+               (unsigned long long)(g[k].basin_cells - g[k].period));
+        print_vector(g[k].centre, m->dim, ",");
+        printf("]}");
+    }
+    printf("]}\n");
+}
+
+static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                     const cm_region *r, const cm_group_info *g)
+{
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    const uint64_t nx = (uint64_t)r->box.hi[0], ny = lat->dim > 1 ? (uint64_t)r->box.hi[1] : 64;
+    const double shrink = nx > 4096 || ny > 4096 ? 4096.0 / (double)(nx > ny ? nx : ny) : 1.0;
+    ro.width = a->width ? a->width : (int)((double)nx * shrink + 0.5);
+    ro.height = a->height ? a->height : (int)((double)ny * shrink + 0.5);
+    ro.width = ro.width < 1 ? 1 : ro.width;
+    ro.height = ro.height < 1 ? 1 : ro.height;
+    ro.markers = 1;
+    uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
+    char msg[512];
+    if (!rgba) {
+        fprintf(stderr, "cellmap solve: out of memory for a %dx%d image\n", ro.width, ro.height);
+        return EXIT_FAIL;
+    }
+    cm_status st = cm_render_basin(lat, r, g, &ro, rgba, msg, sizeof msg);
+    if (st == CM_OK) {
+        char params[2048], lattice[512], view[256];
+        cm_params_json(&m->values, params, sizeof params);
+        snprintf(lattice, sizeof lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
+                 lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
+                 lat->dim > 1 ? lat->width[1] : 0.0);
+        snprintf(view, sizeof view, "cells %lldx%lld", (long long)nx,
+                 lat->dim > 1 ? (long long)ny : 1LL);
+        const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},
+                                     {"Model", m->name},
+                                     {"Parameters", params},
+                                     {"Lattice", lattice},
+                                     {"View", view}};
+        st = cm_png_write(a->png, rgba, ro.width, ro.height, texts, 5, msg, sizeof msg);
+    }
+    free(rgba);
+    if (st != CM_OK) {
+        fprintf(stderr, "cellmap solve: %s\n", msg);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+static int write_db(const solve_args *a, int argc, char **argv, const cm_model *m,
+                    const cm_lattice *lat, const cm_region *r, const cm_group_info *g)
+{
+    char command[4096], msg[512];
+    join_argv(argc, argv, command, sizeof command);
+    const char *epoch = getenv("SOURCE_DATE_EPOCH");
+    const cm_store_meta meta = {m, lat, command, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
+    if (cm_store_save(a->db, &meta, r, g, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap solve: %s\n", msg);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+int cmd_solve(int argc, char **argv)
+{
+    cli c = {"solve", argc, argv, 0, NULL, NULL};
+    solve_args a;
+    memset(&a, 0, sizeof a);
+    a.mo.name = "microchaos-pd";
+    int rc = parse_solve(&c, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+    cm_model m;
+    if ((rc = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
+        return rc;
+    cm_lattice lat;
+    cm_box box;
+    cm_region r;
+    cm_group_info *groups = NULL;
+    char msg[512];
+    memset(&r, 0, sizeof r);
+    if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK)
+        goto done;
+    rc = EXIT_FAIL;
+    if (cm_region_alloc(&r, &box, msg, sizeof msg) != CM_OK)
+        goto fail;
+    const cm_scm_options opt = {a.max_steps, a.threads, NULL, NULL};
+    const double t0 = now_seconds();
+    if (cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK)
+        goto fail;
+    const double t1 = now_seconds();
+    if (cm_scm_classify(&r, msg, sizeof msg) != CM_OK)
+        goto fail;
+    const double t2 = now_seconds();
+    groups = calloc(r.ngroups + 1, sizeof *groups);
+    uint64_t sink = 0;
+    if (!groups) {
+        snprintf(msg, sizeof msg, "out of memory for %u groups", r.ngroups);
+        goto fail;
+    }
+    cm_scm_groups(&r, &lat, groups, &sink);
+    if (a.json)
+        print_json(&m, &lat, &r, groups, sink, t1 - t0, t2 - t1);
+    else
+        print_text(&m, &r, groups, sink, t1 - t0, t2 - t1);
+    rc = EXIT_OK;
+    if (a.png && write_png(&a, &m, &lat, &r, groups) != EXIT_OK)
+        rc = EXIT_FAIL;
+    if (rc == EXIT_OK && a.db && write_db(&a, argc + 1, argv - 1, &m, &lat, &r, groups) != EXIT_OK)
+        rc = EXIT_FAIL;
+    goto done;
+fail:
+    fprintf(stderr, "cellmap solve: %s\n", msg);
+done:
+    free(groups);
+    cm_region_free(&r);
+    cm_model_release(&m);
+    return rc;
+}

@@ -1,0 +1,11 @@
+/* src/commands.h - the subcommands of `cellmap`. Each returns the exit
+ * status: 0 success, 1 failure, 2 bad usage. */
+#ifndef CM_SRC_COMMANDS_H
+#define CM_SRC_COMMANDS_H
+
+int cmd_models(int argc, char **argv);
+int cmd_solve(int argc, char **argv);
+int cmd_orbit(int argc, char **argv);
+int cmd_fixed_points(int argc, char **argv);
+
+#endif

@@ -1,0 +1,47 @@
+/* cellmap - cell mapping and global dynamics from the command line. */
+#include <stdio.h>
+#include <string.h>
+
+#include "src/args.h"
+#include "src/commands.h"
+
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *doc;
+} commands[] = {
+    {"models", cmd_models, "list the models, their parameters and defaults"},
+    {"solve", cmd_solve, "simple cell mapping of a region: summary, PNG, database"},
+    {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},
+    {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
+};
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: cellmap COMMAND [OPTIONS]   (cellmap COMMAND --help for details)\n\n"
+                 "commands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(out, "  %-14s %s\n", commands[i].name, commands[i].doc);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("cellmap %s\n", CELLMAP_VERSION);
+        return EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(argv[1], commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "cellmap: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,352 @@
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "models/microchaos_pd.h"
+#include "models/params.h"
+#include "models/registry.h"
+
+static cm_model make(const char *name, const char *params)
+{
+    cm_model m;
+    char msg[256];
+    const char *texts[1] = {params};
+    if (cm_model_create(name, texts, params ? 1 : 0, &m, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cannot build %s: %s\n", name, msg);
+        exit(1);
+    }
+    return m;
+}
+
+static size_t fixed(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *fp)
+{
+    size_t n = 0;
+    char msg[256];
+    CHECK(m->fixed_points(m, m0, m1, fp, 64, &n, msg, sizeof msg) == 0);
+    return n;
+}
+
+/* Thesis Fig. 4.2: x_8* = 8.96 regular, x_9* = 10.08 virtual. */
+static void fig_4_2(void)
+{
+    cm_model m = make("microchaos-1d", "a=3.5,b=2.8");
+    cm_fixed_point fp[64];
+    const size_t n = fixed(&m, 0, 9, fp);
+    CHECK_INT(n, 10);
+    CHECK_NEAR(fp[8].x[0], 8.96, 1e-12);
+    CHECK(fp[8].regular);
+    CHECK_NEAR(fp[9].x[0], 10.08, 1e-12);
+    CHECK(!fp[9].regular);
+    CHECK_INT(fp[9].band, 10);
+    for (int k = 0; k <= 8; k++)
+        CHECK(fp[k].regular); /* m_fix,max = Int(1/(1.12 - 1)) = 8 */
+    cm_model_release(&m);
+}
+
+/* Fig. 4.13: five regular fixed points, x_3* virtual in band 4. */
+static void fig_4_13(void)
+{
+    cm_model m = make("microchaos-pd", "alpha=0.8,beta=0.3,P=0.9,D=0.4");
+    cm_fixed_point fp[64];
+    const size_t n = fixed(&m, -5, 5, fp);
+    int regular = 0;
+    for (size_t i = 0; i < n; i++)
+        regular += fp[i].regular;
+    CHECK_INT(regular, 5);
+    CHECK(fp[5 + 2].regular);
+    CHECK(!fp[5 + 3].regular);
+    CHECK_INT(fp[5 + 3].band, 4);
+    CHECK_NEAR(fp[5 + 3].x[0], 3 / 0.64, 1e-14);
+    CHECK_INT(cm_pd_m_fix_max(0.8, 0.9), 2);
+    CHECK_INT(cm_pd_m_max(0.8, 0.9), 3);
+    cm_model_release(&m);
+}
+
+/* The band test wins at a border collision (MODELS.md 6.4): P = 3/2 alpha^2
+ * puts x_2* exactly on SW_3 ... if the arithmetic is exact; either way the
+ * count must match the fixed points the model calls regular. */
+static void border_collision(void)
+{
+    const double alphas[] = {0.5, 0.8, 0.078, 6.8511e-3};
+    for (int a = 0; a < 4; a++)
+        for (int k = 1; k <= 6; k++) {
+            const double alpha = alphas[a], P = alpha * alpha * (k + 1) / k;
+            char text[128];
+            snprintf(text, sizeof text, "alpha=%.17g,P=%.17g,D=0.1", alpha, P);
+            cm_model m = make("microchaos-pd", text);
+            cm_fixed_point fp[64];
+            const size_t n = fixed(&m, 0, 20, fp);
+            int64_t largest = -1;
+            for (size_t i = 0; i < n; i++)
+                if (fp[i].regular)
+                    largest = fp[i].level;
+            CHECK_INT(cm_pd_m_fix_max(alpha, P), largest);
+            CHECK(largest == k || largest == k - 1);
+            cm_model_release(&m);
+        }
+    CHECK_INT(cm_pd_m_fix_max(0.8, 0.5), -1); /* P <= alpha^2: unbounded */
+}
+
+/* exp of the 2x2 matrix [[0, 1], [a2, -2 beta]] by a long Taylor series:
+ * an evaluation independent of the closed form (4.67). */
+static void expm2(double a2, double beta, double *E)
+{
+    const double M[4] = {0, 1, a2, -2 * beta};
+    double term[4] = {1, 0, 0, 1};
+    E[0] = 1, E[1] = 0, E[2] = 0, E[3] = 1;
+    for (int k = 1; k < 60; k++) {
+        const double t[4] = {(term[0] * M[0] + term[1] * M[2]) / k,
+                             (term[0] * M[1] + term[1] * M[3]) / k,
+                             (term[2] * M[0] + term[3] * M[2]) / k,
+                             (term[2] * M[1] + term[3] * M[3]) / k};
+        memcpy(term, t, sizeof t);
+        for (int i = 0; i < 4; i++)
+            E[i] += term[i];
+    }
+}
+
+static void pd_coefficients(void)
+{
+    const double cases[][4] = {{0.078, 0, 0.007, 0.02}, {0.8, 0.3, 0.9, 0.4}, {0.5, -0.2, 1, 2}};
+    for (int c = 0; c < 3; c++) {
+        cm_pd_coef k;
+        cm_pd_coefficients(cases[c][0], cases[c][1], cases[c][2], cases[c][3], &k);
+        double E[4];
+        const double a2 = cases[c][0] * cases[c][0];
+        expm2(a2, cases[c][1], E);
+        for (int i = 0; i < 4; i++)
+            CHECK_NEAR(k.A[i], E[i], 1e-12);
+        /* b = (I - A) [1/alpha^2, 0] */
+        CHECK_NEAR(k.b[0], (1 - k.A[0]) / a2, 1e-12);
+        CHECK_NEAR(k.b[1], -k.A[2] / a2, 1e-12);
+        /* e_u, e_s are eigenvectors with eigenvalues exp(+-gamma - beta) */
+        CHECK_NEAR(k.A[0] + k.A[1] * k.e_u[1], k.lambda_u, 1e-12);
+        CHECK_NEAR(k.A[2] + k.A[3] * k.e_u[1], k.lambda_u * k.e_u[1], 1e-12);
+        CHECK_NEAR(k.A[2] + k.A[3] * k.e_s[1], k.lambda_s * k.e_s[1], 1e-12);
+        /* (4.62) written out */
+        const double g = k.gamma, s = sinh(g), ch = cosh(g), e = exp(k.beta), P = k.P, D = k.D;
+        CHECK_NEAR(k.S[0], ((a2 - P) * (k.beta * s + g * ch) + P * e * g) / a2 / (e * g), 1e-12);
+        CHECK_NEAR(k.S[1], (a2 * s - (k.beta * s + g * ch - e * g) * D) / a2 / (e * g), 1e-12);
+        CHECK_NEAR(k.S[2], (a2 - P) * s / (e * g), 1e-12);
+        CHECK_NEAR(k.S[3], (g * ch - (k.beta + D) * s) / (e * g), 1e-12);
+    }
+}
+
+/* Stability domain (C.43)-(C.47) against the eigenvalues of S. */
+static void stability_domain(void)
+{
+    const double alpha = 0.8, beta = 0.3;
+    int agree = 0, total = 0, stable = 0;
+    for (double P = -0.5; P <= 3.0; P += 0.0371)
+        for (double D = -1.0; D <= 3.0; D += 0.0433) {
+            cm_pd_coef k;
+            cm_pd_stability st;
+            cm_pd_coefficients(alpha, beta, P, D, &k);
+            cm_pd_stability_at(alpha, beta, P, D, &st);
+            const double tr = k.S[0] + k.S[3], det = k.S[0] * k.S[3] - k.S[1] * k.S[2];
+            CHECK_NEAR(st.p, -tr, 1e-11);
+            CHECK_NEAR(st.q, det, 1e-11);
+            const double disc = tr * tr / 4 - det;
+            const double radius = disc >= 0 ? fmax(fabs(tr / 2 + sqrt(disc)), fabs(tr / 2 - sqrt(disc)))
+                                            : sqrt(det);
+            if (fabs(radius - 1) < 1e-9)
+                continue; /* on the boundary */
+            total++;
+            agree += (radius < 1) == (st.stable != 0);
+            stable += radius < 1;
+            if ((radius < 1) && st.stable)
+                CHECK(P > alpha * alpha && st.D_b1 < D && D < st.D_b0);
+        }
+    CHECK_INT(agree, total);
+    CHECK(stable > 50);
+    const double Pmax = cm_pd_P_max(alpha, beta);
+    cm_pd_stability at;
+    cm_pd_stability_at(alpha, beta, Pmax, 0, &at);
+    CHECK_NEAR(at.D_b0, at.D_b1, 1e-12);
+    CHECK_NEAR(at.D_b0, cm_pd_D_at_P_max(alpha, beta), 1e-12);
+}
+
+/* ---- orbits against independent evaluations of the formulas ---------- */
+
+static double Int(double z) { return trunc(z); }
+
+static double urand(unsigned *seed, double lo, double hi)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    return lo + (hi - lo) * ((*seed >> 8) & 0xffffff) / 16777216.0;
+}
+
+static void compare_step(const cm_model *m, const double *x, const double *expect, const char *what)
+{
+    double y[CM_MAX_DIM];
+    CHECK_INT(m->step(m, x, y), 0);
+    for (int d = 0; d < m->dim; d++)
+        if (!(fabs(y[d] - expect[d]) <= 1e-12 * fmax(1.0, fabs(expect[d])))) {
+            fprintf(stderr, "%s: step(%.17g, ...)[%d] = %.17g, expected %.17g\n", what, x[0], d,
+                    y[d], expect[d]);
+            check_failures++;
+        }
+}
+
+static void orbits(void)
+{
+    unsigned seed = 7;
+    cm_model m1 = make("microchaos-1d", "a=3.5,b=2.8");
+    cm_model mf = make("microchaos-1d-friction", "a=1.5,b=1.2,c=0.1333");
+    cm_model md = make("microchaos-delay", "a=1.3,b=0.66");
+    cm_model mp = make("microchaos-pd", "alpha=0.8,beta=0.3,P=0.9,D=0.4");
+    cm_model mt = make("microchaos-pd-twofold", "alpha=0.8,beta=0.3,P=0.9,D=0.4,rho=0.7");
+    double E[4];
+    expm2(0.64, 0.3, E);
+    const double b0 = (1 - E[0]) / 0.64, b1 = -E[2] / 0.64;
+    for (int i = 0; i < 2000; i++) {
+        double x[2] = {urand(&seed, -12, 12), urand(&seed, -12, 12)}, e[2] = {0, 0};
+        e[0] = 3.5 * x[0] - 2.8 * Int(x[0]);
+        compare_step(&m1, x, e, "microchaos-1d");
+        const double a = 1.5, c = 0.1333;
+        e[0] = x[0] > c / a ? a * x[0] - 1.2 * Int(x[0]) - c
+                            : (x[0] < -c / a ? a * x[0] - 1.2 * Int(x[0]) + c : 0.0);
+        compare_step(&mf, x, e, "microchaos-1d-friction");
+        e[0] = x[1];
+        e[1] = 1.3 * x[1] - 0.66 * Int(x[0]);
+        compare_step(&md, x, e, "microchaos-delay");
+        double mj = Int(0.9 * x[0] + 0.4 * x[1]);
+        e[0] = E[0] * x[0] + E[1] * x[1] + b0 * mj;
+        e[1] = E[2] * x[0] + E[3] * x[1] + b1 * mj;
+        compare_step(&mp, x, e, "microchaos-pd");
+        mj = Int(0.7 * (0.9 * Int(x[0] / 0.7) + 0.4 * Int(x[1] / 0.7)));
+        e[0] = E[0] * x[0] + E[1] * x[1] + b0 * mj;
+        e[1] = E[2] * x[0] + E[3] * x[1] + b1 * mj;
+        compare_step(&mt, x, e, "microchaos-pd-twofold");
+    }
+    /* The dead zone maps to 0 and huge or NaN arguments have no image. */
+    double x = 0.05, y;
+    CHECK_INT(mf.step(&mf, &x, &y), 0);
+    CHECK(y == 0.0);
+    x = NAN;
+    CHECK_INT(m1.step(&m1, &x, &y), CM_STEP_NO_IMAGE);
+    x = 1e300;
+    CHECK_INT(m1.step(&m1, &x, &y), CM_STEP_NO_IMAGE);
+    cm_model_release(&m1);
+    cm_model_release(&mf);
+    cm_model_release(&md);
+    cm_model_release(&mp);
+    cm_model_release(&mt);
+}
+
+/* microchaos-general reproduces the specific maps it generalises. */
+static void general_equals_specific(void)
+{
+    cm_pd_coef k;
+    /* Gains with no simple ratio to rho, so that rho (P i + D j) never lands on
+     * an integer, where the two evaluation orders could round differently. */
+    cm_pd_coefficients(0.8, 0.3, 0.9137, 0.4211, &k);
+    char pd_text[512];
+    snprintf(pd_text, sizeof pd_text, "n=2,A=%.17g:%.17g:%.17g:%.17g,B=%.17g:%.17g,K=0.9137:0.4211",
+             k.A[0], k.A[1], k.A[2], k.A[3], k.b[0], k.b[1]);
+    const struct {
+        const char *name, *params, *general;
+    } pairs[] = {
+        {"microchaos-1d", "a=3.5,b=2.8", "A=3.5,B=-2.8,K=1"},
+        {"microchaos-delay", "a=1.3,b=0.66", "d=1,A=1.3,B=-0.66,K=0:1"},
+        {"microchaos-pd", "alpha=0.8,beta=0.3,P=0.9137,D=0.4211", pd_text},
+        {"microchaos-pd-twofold", "alpha=0.8,beta=0.3,P=0.9137,D=0.4211,rho=0.7",
+         "mode=twofold,rO=1,rI=0.7"},
+    };
+    unsigned seed = 11;
+    for (int p = 0; p < 4; p++) {
+        cm_model s = make(pairs[p].name, pairs[p].params);
+        const char *texts[2] = {pd_text, pairs[p].general};
+        cm_model g;
+        char msg[256];
+        CHECK(cm_model_create("microchaos-general", texts, p == 3 ? 2 : 1, &g, msg, sizeof msg) ==
+              CM_OK);
+        if (p < 3) {
+            cm_model_release(&g);
+            const char *one[1] = {pairs[p].general};
+            CHECK(cm_model_create("microchaos-general", one, 1, &g, msg, sizeof msg) == CM_OK);
+        }
+        CHECK_INT(g.dim, s.dim);
+        for (int i = 0; i < 1000; i++) {
+            double x[2] = {urand(&seed, -20, 20), urand(&seed, -20, 20)}, ys[2], yg[2];
+            CHECK_INT(s.step(&s, x, ys), g.step(&g, x, yg));
+            for (int d = 0; d < s.dim; d++)
+                CHECK_NEAR(yg[d], ys[d], 1e-13);
+        }
+        cm_fixed_point fs[64], fg[64];
+        const size_t ns = fixed(&s, -4, 4, fs), ng = fixed(&g, -4, 4, fg);
+        CHECK_INT(ns, ng);
+        for (size_t i = 0; i < ns && i < ng; i++) {
+            CHECK_INT(fs[i].regular, fg[i].regular);
+            CHECK_NEAR(fg[i].x[0], fs[i].x[0], 1e-9);
+        }
+        cm_model_release(&s);
+        cm_model_release(&g);
+    }
+}
+
+static void friction_and_delay_fixed_points(void)
+{
+    cm_model mf = make("microchaos-1d-friction", NULL); /* Fig. 4.4 defaults */
+    const double a = 1.5, b = 1.2, c = 0.13333333333333333;
+    /* (4.27): |I0| = a c/(a-1) - (a-b) = 0.1 */
+    CHECK_NEAR(a * cm_params_get(&mf.values, "c") / (a - 1) - (a - b), 0.1, 1e-12);
+    cm_fixed_point fp[64];
+    const size_t n = fixed(&mf, 0, 1, fp);
+    CHECK_INT(n, 4); /* origin, -c/(a-1), +c/(a-1), (b + c)/(a-1) */
+    CHECK(fp[0].regular && fp[0].x[0] == 0.0);
+    CHECK_NEAR(fp[2].x[0], c / (a - 1), 1e-14);
+    CHECK(fp[2].regular);
+    CHECK(fp[1].regular); /* -c/(a-1): the mirror image, also in band 0 */
+    CHECK_NEAR(fp[3].x[0], (b + c) / (a - 1), 1e-14); /* 2.67: band 2, virtual */
+    CHECK(!fp[3].regular);
+    cm_model_release(&mf);
+    cm_model md = make("microchaos-delay", "a=1.5,b=0.6");
+    const size_t nd = fixed(&md, 0, 6, fp);
+    for (size_t i = 0; i < nd; i++) {
+        CHECK_NEAR(fp[i].x[0], 1.2 * (double)fp[i].level, 1e-14);
+        CHECK_INT(fp[i].regular, fp[i].level <= 4);
+    }
+    cm_model_release(&md);
+}
+
+static void parameter_errors(void)
+{
+    const struct {
+        const char *model, *text, *needle;
+    } bad[] = {
+        {"microchaos-pd", "gamma=1", "unknown parameter"},
+        {"microchaos-pd", "alpha=0", "outside"},
+        {"microchaos-pd", "P=abc", "not a finite number"},
+        {"microchaos-pd", "P=1:2", "at most 1 value"},
+        {"microchaos-pd", "P", "name=value"},
+        {"microchaos-general", "n=2,d=3", "exceeds"},
+        {"microchaos-general", "n=2,A=1:2:3", "needs 4 values"},
+        {"microchaos-general", "mode=fancy", "not one of"},
+        {"no-such-model", "", "unknown model"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        cm_model m;
+        char msg[256] = "";
+        const char *texts[1] = {bad[i].text};
+        CHECK(cm_model_create(bad[i].model, texts, 1, &m, msg, sizeof msg) != CM_OK);
+        if (!strstr(msg, bad[i].needle)) {
+            fprintf(stderr, "message for %s '%s' was '%s'\n", bad[i].model, bad[i].text, msg);
+            check_failures++;
+        }
+    }
+}
+
+int main(void)
+{
+    fig_4_2();
+    fig_4_13();
+    border_collision();
+    pd_coefficients();
+    stability_domain();
+    orbits();
+    general_equals_specific();
+    friction_and_delay_fixed_points();
+    parameter_errors();
+    CHECK_DONE();
+}

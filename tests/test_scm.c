@@ -1,0 +1,338 @@
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/scm.h"
+#include "check.h"
+#include "models/registry.h"
+
+/* ---- hand-made maps ---------------------------------------------------- */
+
+static int contraction(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = 0.1 * (x[0] - 0.34) + 0.34;
+    y[1] = 0.1 * (x[1] - 0.76) + 0.76;
+    return 0;
+}
+
+static int quarter_turn(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = -x[1];
+    y[1] = x[0];
+    return 0;
+}
+
+static int half_turn(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = -x[0];
+    y[1] = -x[1];
+    return 0;
+}
+
+static int shift_right(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] + 0.35;
+    return 0;
+}
+
+static int creep(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] + 0.01;
+    return 0;
+}
+
+static int no_image(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] > 0.5 ? NAN : x[0];
+    return x[0] < 0.25 ? CM_STEP_NO_IMAGE : 0;
+}
+
+/* A random functional graph: each cell maps to a pseudo-random cell of a
+ * box a little larger than the region (so some images leave). */
+typedef struct random_map {
+    int64_t lo, hi; /* target range per dimension */
+    uint64_t seed;
+} random_map;
+
+static uint64_t mix(uint64_t h)
+{
+    h ^= h >> 31;
+    h *= UINT64_C(0x9e3779b97f4a7c15);
+    h ^= h >> 29;
+    h *= UINT64_C(0xbf58476d1ce4e5b9);
+    return h ^ (h >> 32);
+}
+
+static int random_step(const cm_model *m, const double *x, double *y)
+{
+    const random_map *r = m->ctx;
+    uint64_t h = r->seed;
+    for (int d = 0; d < m->dim; d++)
+        h = mix(h ^ (uint64_t)(int64_t)floor(x[d]));
+    const uint64_t span = (uint64_t)(r->hi - r->lo);
+    for (int d = 0; d < m->dim; d++) {
+        h = mix(h + (uint64_t)d);
+        /* Bias towards few targets so that long trees and shared cycles form. */
+        y[d] = (double)(r->lo + (int64_t)(h % span) / (1 + (int64_t)(h >> 60) % 3)) + 0.5;
+    }
+    return 0;
+}
+
+static cm_model hand_model(int dim, int (*step)(const cm_model *, const double *, double *))
+{
+    cm_model m;
+    memset(&m, 0, sizeof m);
+    m.name = "test";
+    m.dim = dim;
+    m.step = step;
+    return m;
+}
+
+static cm_status solve(const cm_model *m, const cm_lattice *lat, const cm_box *box, int threads,
+                       int max_steps, cm_region *r)
+{
+    char msg[256];
+    cm_status st = cm_region_alloc(r, box, msg, sizeof msg);
+    const cm_scm_options opt = {max_steps, threads, NULL, NULL};
+    if (st == CM_OK)
+        st = cm_scm_solve(m, lat, &opt, r, msg, sizeof msg);
+    if (st != CM_OK)
+        fprintf(stderr, "solve: %s\n", msg);
+    return st;
+}
+
+/* ---- brute force ------------------------------------------------------- */
+
+/* Classifies every cell by walking its own sequence; compares with r:
+ * the same partition (bijection of group ids, sink <-> sink), the same
+ * periodic cells and the same step numbers. Returns mismatches. */
+static int compare_with_brute_force(const cm_region *r)
+{
+    const uint64_t n = r->ncells;
+    int64_t *seen = malloc(n * sizeof *seen);
+    uint32_t *cycle_id = malloc(n * sizeof *cycle_id); /* brute: min cell of the cycle + 1 */
+    uint32_t *brute_to_engine = calloc(n + 1, sizeof *brute_to_engine);
+    uint32_t *engine_to_brute = calloc(r->ngroups + 1, sizeof *engine_to_brute);
+    int bad = 0;
+    for (uint64_t i = 0; i < n; i++)
+        seen[i] = -1;
+    for (uint64_t start = 0; start < n && bad < 10; start++) {
+        uint64_t cell = start, len = 0;
+        uint32_t id = 0, steps = 0;
+        bool periodic = false;
+        while (cell < n && seen[cell] < 0) {
+            seen[cell] = (int64_t)len++;
+            cell = r->image[cell];
+        }
+        if (cell >= n) {
+            steps = (uint32_t)len;
+        } else {
+            steps = (uint32_t)seen[cell];
+            uint64_t c = cell, min = cell;
+            do {
+                min = c < min ? c : min;
+                c = r->image[c];
+            } while (c != cell);
+            id = (uint32_t)min + 1;
+            periodic = steps == 0;
+        }
+        /* reset the marks of this walk */
+        for (uint64_t c = start, k = 0; k < len; k++, c = r->image[c])
+            seen[c] = -1;
+        cycle_id[start] = id;
+        const uint32_t g = r->group[start];
+        if (g > r->ngroups) {
+            bad++;
+            continue;
+        }
+        if ((id == 0) != (g == 0) || r->step[start] != steps || (periodic != (r->step[start] == 0 && g != 0))) {
+            fprintf(stderr, "cell %llu: engine group %u step %u, brute id %u step %u\n",
+                    (unsigned long long)start, g, r->step[start], id, steps);
+            bad++;
+        }
+        if (brute_to_engine[id] == 0 && engine_to_brute[g] == 0) {
+            brute_to_engine[id] = g + 1;
+            engine_to_brute[g] = id + 1;
+        } else if (brute_to_engine[id] != g + 1 || engine_to_brute[g] != id + 1) {
+            fprintf(stderr, "cell %llu: partition differs (engine %u, brute %u)\n",
+                    (unsigned long long)start, g, id);
+            bad++;
+        }
+    }
+    free(seen);
+    free(cycle_id);
+    free(brute_to_engine);
+    free(engine_to_brute);
+    return bad;
+}
+
+/* ---- tests -------------------------------------------------------------- */
+
+static void test_contraction(void)
+{
+    const cm_model m = hand_model(2, contraction);
+    const cm_lattice lat = {2, {0, 0}, {0.1, 0.1}};
+    const cm_box box = {2, {0, 0}, {10, 10}};
+    cm_region r;
+    CHECK(solve(&m, &lat, &box, 2, 1, &r) == CM_OK);
+    CHECK_INT(r.ngroups, 1);
+    const int64_t fixed[2] = {3, 7};
+    const uint64_t k = cm_box_index(&box, fixed);
+    CHECK_INT(r.image[k], k);
+    CHECK_INT(r.step[k], 0);
+    for (uint64_t i = 0; i < r.ncells; i++)
+        CHECK_INT(r.group[i], 1);
+    const int64_t corner[2] = {0, 0}; /* y: 0.05 -> 0.689 (cell 6) -> 0.749 (cell 7) */
+    CHECK_INT(r.step[cm_box_index(&box, corner)], 2);
+    CHECK_INT(compare_with_brute_force(&r), 0);
+    cm_group_info g;
+    uint64_t sink = 99;
+    cm_scm_groups(&r, &lat, &g, &sink);
+    CHECK_INT(sink, 0);
+    CHECK_INT(g.period, 1);
+    CHECK_INT(g.basin_cells, 100);
+    CHECK_NEAR(g.centre[0], 0.35, 1e-12);
+    CHECK_NEAR(g.centre[1], 0.75, 1e-12);
+    cm_region_free(&r);
+}
+
+static void test_rotation(int quarter)
+{
+    const cm_model m = hand_model(2, quarter ? quarter_turn : half_turn);
+    const cm_lattice lat = {2, {-1, -1}, {0.2, 0.2}};
+    const cm_box box = {2, {0, 0}, {10, 10}};
+    const uint32_t k = quarter ? 4 : 2;
+    cm_region r;
+    CHECK(solve(&m, &lat, &box, 2, 1, &r) == CM_OK);
+    CHECK_INT(r.ngroups, 100 / k);
+    cm_group_info *g = calloc(r.ngroups, sizeof *g);
+    cm_scm_groups(&r, &lat, g, NULL);
+    for (uint32_t i = 0; i < r.ngroups; i++) {
+        CHECK_INT(g[i].period, k);
+        CHECK_INT(g[i].basin_cells, k);
+        CHECK_NEAR(g[i].centre[0], 0.0, 1e-12); /* symmetric about the origin */
+    }
+    for (uint64_t i = 0; i < r.ncells; i++)
+        CHECK_INT(r.step[i], 0);
+    CHECK_INT(compare_with_brute_force(&r), 0);
+    free(g);
+    cm_region_free(&r);
+}
+
+static void test_leaving(void)
+{
+    const cm_model m = hand_model(1, shift_right);
+    const cm_lattice lat = {1, {0}, {0.1}};
+    const cm_box box = {1, {0}, {10}};
+    cm_region r;
+    CHECK(solve(&m, &lat, &box, 1, 1, &r) == CM_OK);
+    CHECK_INT(r.ngroups, 0);
+    /* cell 9 (0.95) leaves at once; cell 0 (0.05 -> .4 -> .75 -> 1.1) after 3 steps */
+    CHECK_INT(r.image[9], CM_IMAGE_EXIT);
+    CHECK_INT(r.step[9], 1);
+    CHECK_INT(r.step[0], 3);
+    for (uint64_t i = 0; i < r.ncells; i++)
+        CHECK_INT(r.group[i], 0);
+    CHECK_INT(compare_with_brute_force(&r), 0);
+    cm_region_free(&r);
+}
+
+static void test_no_image(void)
+{
+    const cm_model m = hand_model(1, no_image);
+    const cm_lattice lat = {1, {0}, {0.1}};
+    const cm_box box = {1, {0}, {10}};
+    cm_region r;
+    CHECK(solve(&m, &lat, &box, 2, 1, &r) == CM_OK);
+    CHECK_INT(r.image[0], CM_IMAGE_SINK); /* step said "no image" */
+    CHECK_INT(r.image[7], CM_IMAGE_SINK); /* NaN image: outside the world */
+    CHECK_INT(r.image[3], 3);             /* identity in the middle */
+    CHECK_INT(r.group[7], 0);
+    CHECK_INT(r.group[0], 0);
+    CHECK_INT(r.group[2], 1); /* cells 0, 1 go to the sink: cell 2 is the first group */
+    CHECK_INT(r.group[3], 2);
+    CHECK_INT(r.ngroups, 3);  /* cells 2..4 are fixed; 5..9 have NaN images */
+    cm_region_free(&r);
+}
+
+static void test_max_steps(void)
+{
+    const cm_model m = hand_model(1, creep);
+    const cm_lattice lat = {1, {0}, {0.1}};
+    const cm_box box = {1, {0}, {10}};
+    cm_region r;
+    CHECK(solve(&m, &lat, &box, 1, 1, &r) == CM_OK);
+    CHECK_INT(r.image[2], 2); /* 0.25 + 0.01 stays in cell 2: a spurious fixed cell */
+    CHECK_INT(r.ngroups, 10);
+    cm_region_free(&r);
+    CHECK(solve(&m, &lat, &box, 1, 20, &r) == CM_OK);
+    CHECK_INT(r.image[2], 3); /* re-stepped until it left its cell */
+    CHECK_INT(r.ngroups, 0);
+    cm_region_free(&r);
+    CHECK(solve(&m, &lat, &box, 1, 3, &r) == CM_OK);
+    CHECK_INT(r.image[2], 2); /* three steps are not enough */
+    cm_region_free(&r);
+}
+
+static void test_random_maps(void)
+{
+    uint64_t groups = 0, sink_cells = 0;
+    for (uint64_t seed = 1; seed <= 12; seed++) {
+        const int dim = 1 + (int)(seed % 3);
+        random_map rm = {-1, 13, seed};
+        cm_model m = hand_model(dim, random_step);
+        m.ctx = &rm;
+        const cm_lattice lat = {dim, {0, 0, 0}, {1, 1, 1}};
+        const cm_box box = {dim, {0, 0, 0}, {12, 12, 12}};
+        cm_region r;
+        CHECK(solve(&m, &lat, &box, 2, 1, &r) == CM_OK);
+        groups += r.ngroups;
+        for (uint64_t i = 0; i < r.ncells; i++)
+            sink_cells += r.group[i] == 0;
+        CHECK_INT(compare_with_brute_force(&r), 0);
+        cm_region_free(&r);
+    }
+    /* the maps must exercise both outcomes */
+    fprintf(stderr, "random maps: %llu groups, %llu sink cells\n", (unsigned long long)groups,
+            (unsigned long long)sink_cells);
+    CHECK(groups > 12);
+    CHECK(sink_cells > 100);
+}
+
+static void test_threads_identical(void)
+{
+    cm_model m;
+    char msg[256];
+    CHECK(cm_model_create("microchaos-pd", NULL, 0, &m, msg, sizeof msg) == CM_OK);
+    const cm_lattice lat = {2, {0, -40}, {0.5, 0.1}};
+    const cm_box box = {2, {0, 0}, {1000, 800}};
+    cm_region a, b;
+    CHECK(solve(&m, &lat, &box, 1, 1, &a) == CM_OK);
+    CHECK(solve(&m, &lat, &box, 2, 1, &b) == CM_OK);
+    CHECK_INT(a.ngroups, b.ngroups);
+    CHECK(memcmp(a.image, b.image, a.ncells * 4) == 0);
+    CHECK(memcmp(a.group, b.group, a.ncells * 4) == 0);
+    CHECK(memcmp(a.step, b.step, a.ncells * 4) == 0);
+    CHECK_INT(compare_with_brute_force(&a), 0);
+    cm_region_free(&a);
+    cm_region_free(&b);
+    cm_model_release(&m);
+}
+
+int main(void)
+{
+    test_contraction();
+    test_rotation(1);
+    test_rotation(0);
+    test_leaving();
+    test_no_image();
+    test_max_steps();
+    test_random_maps();
+    test_threads_identical();
+    CHECK_DONE();
+}

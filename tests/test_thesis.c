@@ -1,0 +1,134 @@
+/* Simple cell mapping reproduces the thesis' published pictures (MODELS.md
+ * 6.7): where the attractors are, and how many. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/scm.h"
+#include "check.h"
+#include "models/registry.h"
+
+typedef struct solved {
+    cm_region r;
+    cm_group_info *g;
+} solved;
+
+static solved run(const char *params, double x0, double x1, double v0, double v1, int64_t nx,
+                  int64_t nv, int max_steps)
+{
+    cm_model m;
+    char msg[256];
+    const char *texts[1] = {params};
+    solved s;
+    memset(&s, 0, sizeof s);
+    if (cm_model_create("microchaos-pd", texts, 1, &m, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "%s\n", msg);
+        exit(1);
+    }
+    const cm_lattice lat = {2, {x0, v0}, {(x1 - x0) / (double)nx, (v1 - v0) / (double)nv}};
+    const cm_box box = {2, {0, 0}, {nx, nv}};
+    const cm_scm_options opt = {max_steps, 0, NULL, NULL};
+    CHECK(cm_region_alloc(&s.r, &box, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, &s.r, msg, sizeof msg) == CM_OK);
+    s.g = calloc(s.r.ngroups + 1, sizeof *s.g);
+    cm_scm_groups(&s.r, &lat, s.g, NULL);
+    cm_model_release(&m);
+    return s;
+}
+
+static void release(solved *s)
+{
+    cm_region_free(&s->r);
+    free(s->g);
+}
+
+/* Cells of all groups whose periodic cells lie within the x-interval. */
+static uint64_t basin_between(const solved *s, double lo, double hi, uint64_t min_basin)
+{
+    uint64_t cells = 0;
+    for (uint32_t k = 0; k < s->r.ngroups; k++)
+        if (s->g[k].basin_cells >= min_basin && s->g[k].lo[0] > lo && s->g[k].hi[0] < hi)
+            cells += s->g[k].basin_cells;
+    return cells;
+}
+
+/* Sec. 4.6.3 (alpha = 0.078, beta = 0, P = 0.007, D = 0.02), the left region
+ * of the C-SCM example: the small chaotic attractors at the crossings of
+ * SW_1, SW_2, SW_3 with the x-axis (x = m/P), and nothing else of size. */
+static void cscm_example(void)
+{
+    solved s = run("alpha=0.078,beta=0,P=0.007,D=0.02", 0, 500, -40, 40, 1000, 1000, 1);
+    uint64_t near_switching_lines = 0, large = 0;
+    for (int m = 1; m <= 3; m++) {
+        const double x = m / 0.007;
+        const uint64_t b = basin_between(&s, x - 2.5, x + 2.5, 5000);
+        fprintf(stderr, "4.6.3: basin of the attractor at SW_%d (x = %.2f): %llu cells\n", m, x,
+                (unsigned long long)b);
+        CHECK(b > 20000);
+        near_switching_lines += b;
+    }
+    for (uint32_t k = 0; k < s.r.ngroups; k++) {
+        if (s.g[k].basin_cells >= 5000) {
+            large += s.g[k].basin_cells;
+            CHECK(fabs(s.g[k].centre[1]) < 1.0); /* on the x-axis */
+        }
+    }
+    CHECK_INT(large, near_switching_lines);
+    release(&s);
+}
+
+/* Fig. 4.16 (0.8, 0.3, P = 0.7, D = 0.6): two attractors at SW_5 and SW_6,
+ * between the fixed points x_4*, x_5*, x_6* (x_m* = m/alpha^2); the objects
+ * at SW_4 and SW_7 are repellers, so little can settle there. */
+static void fig_4_16(void)
+{
+    solved s = run("alpha=0.8,beta=0.3,P=0.7,D=0.6", -13, 13, -4, 4, 1300, 400, 1);
+    const double xs = 1 / 0.64; /* x_m* = m xs */
+    const uint64_t total = s.r.ncells;
+    const uint64_t sw4 = basin_between(&s, 3 * xs, 4 * xs, 1);
+    const uint64_t sw5 = basin_between(&s, 4 * xs, 5 * xs, 1);
+    const uint64_t sw6 = basin_between(&s, 5 * xs, 6 * xs, 1);
+    const uint64_t sw7 = basin_between(&s, 6 * xs, 7 * xs, 1);
+    fprintf(stderr, "Fig 4.16 basin shares: SW4 %.3f SW5 %.3f SW6 %.3f SW7 %.3f\n",
+            (double)sw4 / total, (double)sw5 / total, (double)sw6 / total, (double)sw7 / total);
+    CHECK(sw5 > total / 10);
+    CHECK(sw6 > total / 10);
+    CHECK(sw4 < total / 20);
+    CHECK(sw7 < total / 20);
+    /* the mirror image on the negative side */
+    CHECK_INT(basin_between(&s, -5 * xs, -4 * xs, 1), sw5);
+    release(&s);
+}
+
+/* Fig. 4.21 (alpha = 6.8511e-3, beta = 0, P = 5.4997e-5, D = 2.5665e-3):
+ * twelve tiny attractors, one at each SW_m, 1 <= |m| <= m_max = 6, i.e. one
+ * between each pair of neighbouring fixed points x_{m-1}*, x_m* (x_m* =
+ * m/alpha^2), the interval SW_m crosses. The sampling step is short compared
+ * with the cells, so images are re-stepped. */
+static void fig_4_21(void)
+{
+    const double P = 5.4997e-5, a2 = 6.8511e-3 * 6.8511e-3;
+    solved s = run("alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3", -125000, 125000, -600, 600,
+                   1000, 400, 100000);
+    int found = 0, large = 0;
+    for (uint32_t k = 0; k < s.r.ngroups; k++)
+        large += s.g[k].basin_cells >= s.r.ncells / 200;
+    for (int m = -6; m <= 6; m++) {
+        if (m == 0)
+            continue;
+        const double lo = (m > 0 ? m - 1 : m) / a2, hi = (m > 0 ? m : m + 1) / a2;
+        CHECK(lo < m / P && m / P < hi);
+        found += basin_between(&s, lo, hi, s.r.ncells / 200) > 0;
+    }
+    fprintf(stderr, "Fig 4.21: %d of 12 attractors found, %d large groups\n", found, large);
+    CHECK_INT(found, 12);
+    CHECK_INT(large, 12);
+    release(&s);
+}
+
+int main(void)
+{
+    cscm_example();
+    fig_4_16();
+    fig_4_21();
+    CHECK_DONE();
+}
