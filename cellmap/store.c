@@ -281,29 +281,44 @@ static cm_status write_groups(sqlite3 *db, const cm_region *r, const cm_lattice 
     return status;
 }
 
-/* Periodic cells of every group as local indices (little-endian uint32). */
-static cm_status write_periodic_cells(sqlite3 *db, const cm_region *r, char *msg, size_t msg_size)
+/* Periodic cells of every group as local indices (little-endian uint32),
+ * one BLOB per group. */
+static cm_status write_periodic_cells(sqlite3 *db, const cm_region *r, const cm_group_info *groups,
+                                      char *msg, size_t msg_size)
 {
-    sqlite3_stmt *st = NULL;
-    cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(db,
-                           "UPDATE groups SET periodic_cells = coalesce(periodic_cells, x'') || ? "
-                           "WHERE id = ?",
-                           -1, &st, NULL))
-        return db_error(db, "prepare periodic cells", msg, msg_size);
-    for (uint64_t i = 0; status == CM_OK && i < r->ncells; i++) {
+    uint64_t *offset = calloc((size_t)r->ngroups + 1, sizeof *offset);
+    uint64_t total = 0;
+    for (uint32_t k = 0; offset && k < r->ngroups; k++) {
+        offset[k] = total;
+        total += groups[k].period;
+    }
+    unsigned char *cells = offset ? malloc(4 * (total ? total : 1)) : NULL;
+    if (!cells) {
+        free(offset);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing periodic cells");
+    }
+    for (uint64_t i = 0; i < r->ncells; i++) {
         if (r->group[i] == 0 || r->step[i] != 0)
             continue;
-        unsigned char b[4];
         const uint32_t idx = (uint32_t)i;
-        put_u32le(b, &idx, 1);
-        sqlite3_bind_blob(st, 1, b, 4, SQLITE_TRANSIENT);
-        sqlite3_bind_int64(st, 2, r->group[i]);
+        put_u32le(cells + 4 * offset[r->group[i] - 1]++, &idx, 1);
+    }
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_OK;
+    if (sqlite3_prepare_v2(db, "UPDATE groups SET periodic_cells = ? WHERE id = ?", -1, &st, NULL))
+        status = db_error(db, "prepare periodic cells", msg, msg_size);
+    for (uint32_t k = 0; status == CM_OK && k < r->ngroups; k++) {
+        /* offset[k] now points at the end of group k's cells */
+        sqlite3_bind_blob(st, 1, cells + 4 * (offset[k] - groups[k].period),
+                          (int)(4 * groups[k].period), SQLITE_STATIC);
+        sqlite3_bind_int64(st, 2, groups[k].id);
         if (sqlite3_step(st) != SQLITE_DONE)
             status = db_error(db, "write periodic cells", msg, msg_size);
         sqlite3_reset(st);
     }
     sqlite3_finalize(st);
+    free(cells);
+    free(offset);
     return status;
 }
 
@@ -349,7 +364,7 @@ cm_status cm_store_save(const char *path, const cm_store_meta *meta, const cm_re
     if (status == CM_OK)
         status = write_groups(db, r, meta->lattice, groups, msg, msg_size);
     if (status == CM_OK)
-        status = write_periodic_cells(db, r, msg, msg_size);
+        status = write_periodic_cells(db, r, groups, msg, msg_size);
     if (status == CM_OK && exec(db, "COMMIT") != SQLITE_OK)
         status = db_error(db, "commit", msg, msg_size);
     if (sqlite3_close(db) != SQLITE_OK && status == CM_OK)

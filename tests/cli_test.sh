@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Integration tests of the `cellmap` command: outputs, exit codes, messages.
+# usage: cli_test.sh PATH/TO/cellmap
+set -u
+CM=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+
+# expect_usage "needle" args...: exit 2 and a message containing needle
+expect_usage() {
+  local needle=$1; shift
+  local out rc
+  out=$("$CM" "$@" 2>&1 >/dev/null); rc=$?
+  [ "$rc" -eq 2 ] || fail "cellmap $* exited $rc, expected 2"
+  grep -qF -- "$needle" <<<"$out" || fail "cellmap $*: message '$out' lacks '$needle'"
+}
+
+# --- the default job: the thesis 4.6.3 example, PNG + database ------------
+cd "$work"
+"$CM" solve --png basin.png --db basin.cmdb --json > summary.json || fail "default solve failed"
+[ -s basin.png ] || fail "no basin.png"
+[ -s basin.cmdb ] || fail "no basin.cmdb"
+ls | grep -q tmp- && fail "temporary files left behind"
+python3 - summary.json <<'PY' || fail "JSON summary"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["model"] == "microchaos-pd" and s["cells"] == 1000000, s
+big = [g for g in s["groups"] if g["basin"] > 5000]
+xs = sorted(round(g["centre"][0] / (1 / 0.007)) for g in big)
+assert set(xs) == {1, 2, 3}, xs        # attractors at SW_1..SW_3 (x = m/P)
+PY
+[ "$(sqlite3 basin.cmdb 'PRAGMA application_id')" = "$((0x434D4442))" ] || fail "application_id"
+[ "$(sqlite3 basin.cmdb "SELECT value FROM meta WHERE key='model'")" = microchaos-pd ] || fail "meta model"
+[ "$(sqlite3 basin.cmdb 'SELECT sum(basin_cells) FROM groups')" = 1000000 ] || fail "group sizes"
+# PNG: the right size and provenance text
+python3 - basin.png <<'PY' || fail "PNG header/text"
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+assert d[:8] == b"\x89PNG\r\n\x1a\n"
+w, h = struct.unpack(">II", d[16:24]); assert (w, h) == (1000, 1000), (w, h)
+assert b"tEXtModel\x00microchaos-pd" in d and b"tEXtParameters" in d
+PY
+# deterministic whatever the thread count
+"$CM" solve --threads 1 --png one.png --db one.cmdb > /dev/null || fail "solve 1 thread"
+"$CM" solve --threads 2 --png two.png > /dev/null || fail "solve 2 threads"
+cmp -s one.png two.png || fail "PNG differs between 1 and 2 threads"
+cmp -s one.png basin.png || fail "PNG differs between runs"
+[ "$(sqlite3 one.cmdb 'SELECT group_concat(id||":"||period||":"||basin_cells) FROM groups')" = \
+  "$(sqlite3 basin.cmdb 'SELECT group_concat(id||":"||period||":"||basin_cells) FROM groups')" ] \
+  || fail "databases differ between thread counts"
+# a foreign file is never overwritten
+echo "precious" > notes.txt
+"$CM" solve --cells 50x50 --db notes.txt > /dev/null 2>err.txt; rc=$?
+[ $rc -eq 1 ] || fail "overwriting a foreign file exited $rc"
+[ "$(cat notes.txt)" = precious ] || fail "foreign file modified"
+grep -q "refusing" err.txt || fail "no refusal message"
+
+# --- orbit and fixed points ---------------------------------------------------
+"$CM" orbit --model microchaos-1d --param a=3.5,b=2.8 --from 0.5 --steps 2 > orbit.csv || fail orbit
+[ "$(sed -n 3p orbit.csv)" = "1,1.75" ] || fail "orbit step 1: $(sed -n 3p orbit.csv)"
+[ "$(sed -n 4p orbit.csv)" = "2,3.3250000000000002" ] || fail "orbit step 2: $(sed -n 4p orbit.csv)"
+"$CM" fixed-points --model microchaos-1d --param a=3.5,b=2.8 --range 8:9 > fp.csv || fail fp
+grep -q '^8,8,regular,8.959999999999999' fp.csv || fail "x_8* = 8.96 regular: $(cat fp.csv)"
+grep -q '^9,10,virtual,10.08' fp.csv || fail "x_9* = 10.08 virtual: $(cat fp.csv)"
+"$CM" models | grep -q microchaos-pd-twofold || fail "models list"
+for c in solve orbit fixed-points models; do
+  "$CM" $c --help | grep -q usage || fail "$c --help"
+done
+
+# --- every bad argument: exit 2 and a message naming it -----------------------
+expect_usage "unknown command" frobnicate
+expect_usage "unknown option '--frob'" solve --frob
+expect_usage "unknown model" solve --model nope
+expect_usage "unknown parameter 'gamma'" solve --param gamma=1
+expect_usage "alpha = -1 is outside" solve --param alpha=-1
+expect_usage "not a finite number" solve --param P=abc
+expect_usage "--region: '5:1,0:1'" solve --region 5:1,0:1
+expect_usage "--region: 'abc'" solve --region abc
+expect_usage "--region has 1 range(s)" solve --region 0:1
+expect_usage "--cells: '0x10'" solve --cells 0x10
+expect_usage "--cells has 3 count(s)" solve --cells 10x10x10
+expect_usage "--cells asks for" solve --cells 100000x100000
+expect_usage "--max-steps" solve --max-steps 0
+expect_usage "--threads" solve --threads x
+expect_usage "--size" solve --size 10
+expect_usage "--png needs a value" solve --png
+expect_usage "--json takes no value" solve --json=1
+expect_usage "--region is required" solve --model microchaos-general
+expect_usage "--from and --steps are required" orbit
+expect_usage "--from has 1 value(s)" orbit --from 1 --steps 3
+expect_usage "--steps" orbit --from 1,2 --steps -1
+expect_usage "--range" fixed-points --range 5:1
+expect_usage "unexpected argument" models extra
+expect_usage "needs 4 values" solve --model microchaos-general --param n=2,A=1 --region 0:1,0:1
+"$CM" fixed-points --model microchaos-general --param mode=input > /dev/null 2>&1
+[ $? -eq 1 ] || fail "fixed points of input quantisation should fail with 1"
+
+[ $fails -eq 0 ] && echo "cli tests passed" || echo "$fails cli test(s) failed"
+exit $fails
