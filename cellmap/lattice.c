@@ -20,16 +20,19 @@ cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
 bool cm_lattice_cell(const cm_lattice *lat, const double *x, int64_t *cell)
 {
     const double limit = (double)CM_WORLD_LIMIT;
-    int64_t c[CM_MAX_DIM];
+    double u[CM_MAX_DIM];
     for (int d = 0; d < lat->dim; d++) {
-        const double u = floor((x[d] - lat->origin[d]) / lat->width[d]);
+        u[d] = (x[d] - lat->origin[d]) / lat->width[d];
         /* NaN fails both comparisons, so it is caught here too. */
-        if (!(u >= -limit && u < limit))
+        if (!(u[d] >= -limit && u[d] < limit))
             return false;
-        c[d] = (int64_t)u;
     }
-    for (int d = 0; d < lat->dim; d++)
-        cell[d] = c[d];
+    /* floor without a libm call: truncate, then step down for negative
+     * non-integers. Exact for every |u| < 2^40. */
+    for (int d = 0; d < lat->dim; d++) {
+        const int64_t t = (int64_t)u[d];
+        cell[d] = t - ((double)t > u[d]);
+    }
     return true;
 }
 

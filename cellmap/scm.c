@@ -50,31 +50,27 @@ uint64_t cm_region_bytes(const cm_region *r)
     return r->ncells * (sizeof *r->image + sizeof *r->group + sizeof *r->step);
 }
 
-/* Image of the point x that starts in cell `from`, re-stepping while the
- * image stays in `from` (at most max_steps steps in all). */
-static int image_of(const cm_model *model, const cm_lattice *lat, const cm_box *box,
-                    const int64_t *from, int max_steps, double *x, uint32_t *image)
+/* Image cell of the point x that starts in cell `from`, re-stepping while
+ * the image stays in `from` (at most max_steps steps in all). Returns the
+ * model's status; *in_world is false when there is no image cell. */
+static int image_cell(const cm_model *model, const cm_lattice *lat, const int64_t *from,
+                      int max_steps, double *x, int64_t *cell, bool *in_world)
 {
     double y[CM_MAX_DIM];
-    int64_t cell[CM_MAX_DIM];
     const int dim = lat->dim;
-    for (int k = 0;; k++) {
+    for (int k = 1;; k++) {
         const int rc = model->step(model, x, y);
-        if (rc < 0)
-            return rc;
-        if (rc > 0 || !cm_lattice_cell(lat, y, cell)) {
-            *image = CM_IMAGE_SINK;
-            return 0;
-        }
+        *in_world = rc == 0 && cm_lattice_cell(lat, y, cell);
+        if (rc < 0 || !*in_world || k >= max_steps)
+            return rc < 0 ? rc : 0;
         bool same = true;
         for (int d = 0; d < dim; d++)
             same = same && cell[d] == from[d];
-        if (!same || k + 1 >= max_steps)
-            break;
-        memcpy(x, y, (size_t)dim * sizeof *x);
+        if (!same)
+            return 0;
+        for (int d = 0; d < dim; d++)
+            x[d] = y[d];
     }
-    *image = cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
-    return 0;
 }
 
 /* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1. */
@@ -83,14 +79,22 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
 {
     const cm_box *box = &r->box;
     const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
-    int64_t cell[CM_MAX_DIM];
+    uint32_t *image = r->image + row * nx;
+    int64_t from[CM_MAX_DIM], cell[CM_MAX_DIM];
     double x[CM_MAX_DIM];
-    cm_box_cell(box, row * nx, cell);
-    for (uint64_t i = 0; i < nx; i++, cell[0]++) {
-        cm_lattice_centre(lat, cell, x);
-        const int rc = image_of(model, lat, box, cell, max_steps, x, &r->image[row * nx + i]);
+    cm_box_cell(box, row * nx, from);
+    for (uint64_t i = 0; i < nx; i++, from[0]++) {
+        bool in_world;
+        cm_lattice_centre(lat, from, x);
+        const int rc = image_cell(model, lat, from, max_steps, x, cell, &in_world);
         if (rc < 0)
             return rc;
+        if (!in_world)
+            image[i] = CM_IMAGE_SINK;
+        else if (cm_box_contains(box, cell))
+            image[i] = (uint32_t)cm_box_index(box, cell);
+        else
+            image[i] = CM_IMAGE_EXIT;
     }
     return 0;
 }
@@ -110,7 +114,7 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     int aborted = 0;
     /* Rows are independent and every image depends on its cell alone, so the
      * result is the same whatever the schedule or thread count. */
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threads) reduction(| : aborted)
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(| : aborted)
     for (int64_t row = 0; row < rows; row++) {
         if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row) < 0)
             aborted = 1;
