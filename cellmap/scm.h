@@ -26,8 +26,10 @@
 
 #define CM_IMAGE_SINK UINT32_C(0xFFFFFFFF)
 #define CM_IMAGE_EXIT UINT32_C(0xFFFFFFFE)
-/* Largest number of cells in one region (local indices stay below the marks). */
-#define CM_REGION_MAX_CELLS UINT64_C(0xFFFFFFF0)
+/* Largest number of cells in one region: local indices stay below the
+ * image marks, and step numbers below 2^31 (classification keeps a flag in
+ * the top bit). */
+#define CM_REGION_MAX_CELLS UINT64_C(0x7FFFFFF0)
 
 typedef struct cm_region {
     cm_box box;
