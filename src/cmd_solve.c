@@ -146,6 +146,18 @@ static void print_vector(const double *v, int n, const char *sep)
         printf("%s%.9g", d ? sep : "", v[d]);
 }
 
+static int larger_basin_first(const void *a, const void *b)
+{
+    const cm_group_info *x = a, *y = b;
+    if (x->basin_cells != y->basin_cells)
+        return x->basin_cells > y->basin_cells ? -1 : 1;
+    return x->id < y->id ? -1 : (x->id > y->id);
+}
+
+/* The text summary lists the groups with the largest basins first; --json
+ * lists all of them in id order. */
+enum { TEXT_GROUPS = 20 };
+
 static void print_text(const cm_model *m, const cm_region *r, const cm_group_info *g,
                        uint64_t sink, double t_img, double t_cls)
 {
@@ -157,14 +169,22 @@ static void print_text(const cm_model *m, const cm_region *r, const cm_group_inf
            100.0 * (double)sink / (double)r->ncells);
     printf("time: images %.3f s, classification %.3f s (%.1f ns/cell)\n", t_img, t_cls,
            1e9 * (t_img + t_cls) / (double)r->ncells);
+    cm_group_info *sorted = malloc((r->ngroups + 1) * sizeof *sorted);
+    if (!sorted)
+        return;
+    memcpy(sorted, g, r->ngroups * sizeof *sorted);
+    qsort(sorted, r->ngroups, sizeof *sorted, larger_basin_first);
     printf("%6s %8s %12s %12s  %s\n", "group", "period", "basin", "doa", "centre");
-    for (uint32_t k = 0; k < r->ngroups; k++) {
-        printf("%6u %8u %12llu %12llu  (", g[k].id, g[k].period,
-               (unsigned long long)g[k].basin_cells,
-               (unsigned long long)(g[k].basin_cells - g[k].period));
-        print_vector(g[k].centre, m->dim, ", ");
+    for (uint32_t k = 0; k < r->ngroups && k < TEXT_GROUPS; k++) {
+        printf("%6u %8u %12llu %12llu  (", sorted[k].id, sorted[k].period,
+               (unsigned long long)sorted[k].basin_cells,
+               (unsigned long long)(sorted[k].basin_cells - sorted[k].period));
+        print_vector(sorted[k].centre, m->dim, ", ");
         printf(")\n");
     }
+    if (r->ngroups > TEXT_GROUPS)
+        printf("... and %u smaller groups (--json lists all)\n", r->ngroups - TEXT_GROUPS);
+    free(sorted);
 }
 
 static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region *r,
