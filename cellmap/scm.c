@@ -150,11 +150,10 @@ static void label_path(cm_region *r, const uint32_t *path, uint32_t start, const
 {
     uint32_t i = start;
     for (uint32_t pos = 0; pos < l->length; pos++) {
-        if (pos < PATH_BUFFER)
-            i = path[pos];
+        /* beyond the buffer, the next cell is the image of the previous one */
+        i = pos < PATH_BUFFER ? path[pos] : r->image[i];
         r->group[i] = l->group;
         r->step[i] = step_at(l, pos);
-        i = r->image[i];
     }
 }
 
