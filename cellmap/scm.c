@@ -1,12 +1,12 @@
 #include "cellmap/scm.h"
 
+#include "cellmap/classify.h"
+
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-#define MAX_GROUPS UINT32_C(0xFFFFFFF0)
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size)
 {
@@ -122,81 +122,10 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     return CM_OK;
 }
 
-/* While classifying, step[] holds each cell's state: STEP_UNVISITED, or
- * ON_PATH | position for a cell of the path being walked, or (below
- * ON_PATH) the final step number of a classified cell. Keeping the state in
- * one array means a walk touches two arrays per cell, not three. */
-#define STEP_UNVISITED UINT32_C(0xFFFFFFFF)
-#define ON_PATH UINT32_C(0x80000000)
-/* Paths up to this length are remembered, so labelling them needs no second
- * walk through image[]; longer ones are walked again. */
-#define PATH_BUFFER 65536
-
-typedef struct path_label {
-    uint32_t group;
-    uint32_t cycle_at;  /* positions >= cycle_at are periodic; UINT32_MAX: none */
-    uint32_t tail_step; /* step number of the cell the path ran into */
-    uint32_t length;
-} path_label;
-
-static uint32_t step_at(const path_label *l, uint32_t pos)
-{
-    if (l->cycle_at == UINT32_MAX)
-        return l->tail_step + (l->length - pos);
-    return pos >= l->cycle_at ? 0 : l->cycle_at - pos;
-}
-
-static void label_path(cm_region *r, const uint32_t *path, uint32_t start, const path_label *l)
-{
-    uint32_t i = start;
-    for (uint32_t pos = 0; pos < l->length; pos++) {
-        /* beyond the buffer, the next cell is the image of the previous one */
-        i = pos < PATH_BUFFER ? path[pos] : r->image[i];
-        r->group[i] = l->group;
-        r->step[i] = step_at(l, pos);
-    }
-}
-
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
 {
-    const uint32_t n = (uint32_t)r->ncells;
-    uint32_t *step = r->step;
-    const uint32_t *image = r->image;
-    uint32_t *path = malloc(PATH_BUFFER * sizeof *path);
-    if (!path)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffer");
-    for (uint32_t i = 0; i < n; i++)
-        step[i] = STEP_UNVISITED;
-    uint32_t ngroups = 0;
-    for (uint32_t start = 0; start < n; start++) {
-        if (step[start] != STEP_UNVISITED)
-            continue;
-        /* Walk until the sink, a classified cell or a cell of this path. */
-        uint32_t i = start, len = 0;
-        while (i < n && step[i] == STEP_UNVISITED) {
-            if (len < PATH_BUFFER)
-                path[len] = i;
-            step[i] = ON_PATH | len++;
-            i = image[i];
-        }
-        path_label l = {0, UINT32_MAX, 0, len};
-        if (i >= n) { /* the path leaves the region: the sink's domain */
-        } else if (step[i] & ON_PATH) { /* a new periodic group */
-            if (ngroups == MAX_GROUPS) {
-                free(path);
-                return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups");
-            }
-            l.group = ++ngroups;
-            l.cycle_at = step[i] & ~ON_PATH;
-        } else { /* reaches a classified cell */
-            l.group = r->group[i];
-            l.tail_step = step[i];
-        }
-        label_path(r, path, start, &l);
-    }
-    free(path);
-    r->ngroups = ngroups;
-    return CM_OK;
+    return cm_classify((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups, msg,
+                       msg_size);
 }
 
 cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,

@@ -11,9 +11,9 @@
  *             image is the sink has step 1).
  *
  * Images are computed in parallel (OpenMP) by the centre-point method;
- * classification is a sequential O(n) walk, so group ids (numbered in order
- * of the lowest local index that reaches them) never depend on the thread
- * count. Ownership: cm_region_alloc allocates, cm_region_free releases.
+ * classification (cellmap/classify.h) runs O(n) on one thread, so group ids
+ * (numbered in order of the lowest local index that reaches them) never
+ * depend on the thread count. Ownership: cm_region_alloc allocates, cm_region_free releases.
  */
 #ifndef CM_SCM_H
 #define CM_SCM_H

@@ -1,0 +1,22 @@
+/* cellmap/classify.h - periodic groups, domains and step numbers of a
+ * functional graph given by image[] (thesis Algorithm C.8, second half).
+ *
+ * image[i] is a local index below n, or any value >= n for "no image here"
+ * (the sink, or a cell outside the region). On return group[i] is 0 for the
+ * sink's domain, else a group id 1..ngroups, numbered in order of the lowest
+ * local index of each group's domain; step[i] is 0 for periodic cells, else
+ * the number of steps to the periodic group (or to leaving: a cell whose
+ * image is >= n has step 1). Linear time; deterministic; needs n < 2^31.
+ */
+#ifndef CM_CLASSIFY_H
+#define CM_CLASSIFY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cellmap/status.h"
+
+cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
+                      uint32_t *ngroups, char *msg, size_t msg_size);
+
+#endif
