@@ -39,12 +39,14 @@ void cm_region_free(cm_region *r)
     free(r->image);
     free(r->group);
     free(r->step);
+    free(r->exit_target);
     memset(r, 0, sizeof *r);
 }
 
 uint64_t cm_region_bytes(const cm_region *r)
 {
-    return r->ncells * (sizeof *r->image + sizeof *r->group + sizeof *r->step);
+    return r->ncells * (sizeof *r->image + sizeof *r->group + sizeof *r->step) +
+           r->nexits * (uint64_t)r->box.dim * sizeof *r->exit_target;
 }
 
 /* Image cell of the point x that starts in cell `from`, re-stepping while
@@ -96,6 +98,47 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
     return 0;
 }
 
+/* Numbers the exits in local index order and stores their target cells. The
+ * targets are computed again (the step is pure), which costs a step per exit
+ * but keeps the parallel image loop free of shared output. */
+static cm_status record_exits(const cm_model *model, const cm_lattice *lat, int max_steps,
+                              int threads, cm_region *r, char *msg, size_t msg_size)
+{
+    uint64_t nexits = 0;
+    for (uint64_t i = 0; i < r->ncells; i++)
+        nexits += r->image[i] == CM_IMAGE_EXIT;
+    if (nexits > CM_IMAGE_EXIT - CM_IMAGE_EXIT_BASE)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many exits; split the region");
+    const int dim = r->box.dim;
+    uint64_t *cells = malloc((nexits + 1) * sizeof *cells);
+    r->exit_target = malloc((nexits + 1) * (uint64_t)dim * sizeof *r->exit_target);
+    if (!cells || !r->exit_target) {
+        free(cells);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                       (unsigned long long)nexits);
+    }
+    uint64_t k = 0;
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        if (r->image[i] == CM_IMAGE_EXIT) {
+            cells[k] = i;
+            r->image[i] = CM_IMAGE_EXIT_BASE + (uint32_t)k++;
+        }
+    }
+    r->nexits = nexits;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int64_t e = 0; e < (int64_t)nexits; e++) {
+        int64_t from[CM_MAX_DIM];
+        double x[CM_MAX_DIM];
+        bool in_world;
+        cm_box_cell(&r->box, cells[e], from);
+        cm_lattice_centre(lat, from, x);
+        image_cell(model, lat, from, max_steps, x, r->exit_target + e * dim, &in_world);
+    }
+    (void)threads;
+    free(cells);
+    return CM_OK;
+}
+
 cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
                         cm_region *r, char *msg, size_t msg_size)
 {
@@ -116,9 +159,13 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
         if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row) < 0)
             aborted = 1;
     }
-    (void)threads;
     if (aborted)
         return cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
+    free(r->exit_target);
+    r->exit_target = NULL;
+    r->nexits = 0;
+    if (opt && opt->record_exits)
+        return record_exits(model, lat, max_steps, threads, r, msg, msg_size);
     return CM_OK;
 }
 
@@ -156,6 +203,8 @@ cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info
     }
     for (uint64_t i = 0; i < r->ncells; i++) {
         const uint32_t g = r->group[i];
+        if (g == CM_GROUP_NONE)
+            continue;
         if (g == 0) {
             sink++;
             continue;

@@ -3,9 +3,11 @@
  *
  * A region is a box of cells of a lattice with three per-cell arrays
  * (structure of arrays, 12 bytes per cell):
- *   image[i]  local index of the image cell, CM_IMAGE_EXIT when the image
- *             lies in the world but outside the box, CM_IMAGE_SINK when the
- *             model gives no image or the image is outside the world;
+ *   image[i]  local index of the image cell; for an image in the world but
+ *             outside the box, CM_IMAGE_EXIT_BASE + k when exits are recorded
+ *             (k indexes the exit table, which holds the target cell), else
+ *             CM_IMAGE_EXIT; CM_IMAGE_SINK when the model gives no image or
+ *             the image is outside the world;
  *   group[i]  0 for the sink's domain of attraction, else a group id 1..G;
  *   step[i]   steps to the periodic group (0 for periodic cells; a cell whose
  *             image is the sink has step 1).
@@ -26,6 +28,17 @@
 
 #define CM_IMAGE_SINK UINT32_C(0xFFFFFFFF)
 #define CM_IMAGE_EXIT UINT32_C(0xFFFFFFFE)
+#define CM_IMAGE_EXIT_BASE UINT32_C(0x80000000)
+/* group[] of a cell that was not computed (outside every region of a
+ * flattened cluster); cm_scm_groups and the renderer skip it. */
+#define CM_GROUP_NONE UINT32_C(0xFFFFFFFF)
+
+/* Index into the exit table of an image value, or -1 if it is not a recorded exit. */
+static inline int64_t cm_image_exit_index(uint32_t image)
+{
+    return image >= CM_IMAGE_EXIT_BASE && image < CM_IMAGE_EXIT ? (int64_t)(image - CM_IMAGE_EXIT_BASE)
+                                                                : -1;
+}
 /* Largest number of cells in one region: local indices stay below the
  * image marks, and step numbers below 2^31 (classification keeps a flag in
  * the top bit). */
@@ -38,6 +51,8 @@ typedef struct cm_region {
     uint32_t *group;
     uint32_t *step;
     uint32_t ngroups; /* periodic groups other than the sink */
+    uint64_t nexits;  /* recorded exits (cm_scm_options.record_exits) */
+    int64_t *exit_target; /* nexits * box.dim cell coordinates, in local index order */
 } cm_region;
 
 /* Progress callback: fraction done in [0, 1]; return nonzero to cancel. */
@@ -50,6 +65,8 @@ typedef struct cm_scm_options {
     int threads;             /* 0: the OpenMP default */
     cm_progress_fn progress; /* optional */
     void *user;
+    int record_exits; /* keep the target cell of every image that leaves the box
+                         (needed to join regions into a cluster) */
 } cm_scm_options;
 
 /* Summary of one periodic group. */
@@ -65,7 +82,7 @@ typedef struct cm_group_info {
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size);
 void cm_region_free(cm_region *r);
-/* Bytes held by the region's per-cell arrays. */
+/* Bytes held by the region's per-cell arrays and its exit table. */
 uint64_t cm_region_bytes(const cm_region *r);
 
 /* Computes image[] for every cell. CM_EMODEL if the model aborted. */

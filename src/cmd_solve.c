@@ -288,7 +288,7 @@ int cmd_solve(int argc, char **argv)
     rc = EXIT_FAIL;
     if (cm_region_alloc(&r, &box, msg, sizeof msg) != CM_OK)
         goto fail;
-    const cm_scm_options opt = {a.max_steps, a.threads, NULL, NULL};
+    const cm_scm_options opt = {a.max_steps, a.threads, NULL, NULL, 0};
     const double t0 = now_seconds();
     if (cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK)
         goto fail;

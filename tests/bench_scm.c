@@ -65,7 +65,7 @@ int main(int argc, char **argv)
         double t_img[2][100], t_cls[2][100], t_tot[2][100];
         for (int k = -1; k < repeats; k++) {
             for (int threads = 1; threads <= 2; threads++) {
-                const cm_scm_options opt = {1, threads, NULL, NULL};
+                const cm_scm_options opt = {1, threads, NULL, NULL, 0};
                 const double t0 = now();
                 cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg);
                 const double t1 = now();

@@ -98,7 +98,7 @@ static cm_status solve(const cm_model *m, const cm_lattice *lat, const cm_box *b
 {
     char msg[256];
     cm_status st = cm_region_alloc(r, box, msg, sizeof msg);
-    const cm_scm_options opt = {max_steps, threads, NULL, NULL};
+    const cm_scm_options opt = {max_steps, threads, NULL, NULL, 0};
     if (st == CM_OK)
         st = cm_scm_solve(m, lat, &opt, r, msg, sizeof msg);
     if (st != CM_OK)

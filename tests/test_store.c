@@ -78,7 +78,7 @@ int main(void)
     const cm_box box = {2, {0, 0}, {300, 1000}}; /* several pages of 65536 cells */
     cm_region r;
     CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
-    const cm_scm_options opt = {1, 0, NULL, NULL};
+    const cm_scm_options opt = {1, 0, NULL, NULL, 0};
     CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
     cm_group_info *g = calloc(r.ngroups + 1, sizeof *g);
     cm_scm_groups(&r, &lat, g, NULL);

@@ -26,7 +26,7 @@ static solved run(const char *params, double x0, double x1, double v0, double v1
     }
     const cm_lattice lat = {2, {x0, v0}, {(x1 - x0) / (double)nx, (v1 - v0) / (double)nv}};
     const cm_box box = {2, {0, 0}, {nx, nv}};
-    const cm_scm_options opt = {max_steps, 0, NULL, NULL};
+    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
     CHECK(cm_region_alloc(&s.r, &box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(&m, &lat, &opt, &s.r, msg, sizeof msg) == CM_OK);
     s.g = calloc(s.r.ngroups + 1, sizeof *s.g);

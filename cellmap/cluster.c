@@ -1,0 +1,428 @@
+#include "cellmap/cluster.h"
+
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* While walking, step[] of a cell to be walked again is STEP_UNVISITED, and
+ * ON_PATH | position while it is on the current walk (as in classify.c). */
+#define STEP_UNVISITED UINT32_C(0xFFFFFFFF)
+#define ON_PATH UINT32_C(0x80000000)
+#define MAX_GROUPS UINT32_C(0xFFFFFFF0)
+
+typedef struct cell_ref {
+    uint32_t region, index;
+} cell_ref;
+
+void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
+{
+    memset(c, 0, sizeof *c);
+    c->lat = *lat;
+}
+
+void cm_cluster_free(cm_cluster *c)
+{
+    if (!c)
+        return;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        cm_region_free(&c->regions[k].r);
+        free(c->regions[k].escapes);
+        free(c->regions[k].targets);
+    }
+    free(c->regions);
+    memset(c, 0, sizeof *c);
+}
+
+int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local)
+{
+    for (uint32_t n = 0; n < c->nregions; n++) {
+        /* try the region of the last hit first: exits mostly land next door */
+        const uint32_t k = (c->hint + n) % c->nregions;
+        const cm_box *box = &c->regions[k].r.box;
+        if (cm_box_contains(box, cell)) {
+            c->hint = k;
+            *local = cm_box_index(box, cell);
+            return k;
+        }
+    }
+    return -1;
+}
+
+void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
+{
+    *box = c->regions[0].r.box;
+    for (uint32_t k = 1; k < c->nregions; k++) {
+        const cm_box *b = &c->regions[k].r.box;
+        for (int d = 0; d < box->dim; d++) {
+            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
+            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
+        }
+    }
+}
+
+uint64_t cm_cluster_cells(const cm_cluster *c)
+{
+    uint64_t n = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        n += c->regions[k].r.ncells;
+    return n;
+}
+
+uint64_t cm_cluster_bytes(const cm_cluster *c)
+{
+    uint64_t bytes = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        bytes += cm_region_bytes(&cr->r) + cr->nescapes * sizeof *cr->escapes +
+                 cr->targets_cap * sizeof *cr->targets;
+    }
+    return bytes;
+}
+
+static bool boxes_overlap(const cm_box *a, const cm_box *b)
+{
+    for (int d = 0; d < a->dim; d++)
+        if (a->hi[d] <= b->lo[d] || b->hi[d] <= a->lo[d])
+            return false;
+    return true;
+}
+
+static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg, size_t msg_size)
+{
+    if (r->box.dim != c->lat.dim)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region of %d dimensions, lattice of %d",
+                       r->box.dim, c->lat.dim);
+    if (c->nregions == UINT32_MAX)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions in one cluster");
+    if (c->ngroups > MAX_GROUPS - r->ngroups)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups in one cluster");
+    for (uint32_t k = 0; k < c->nregions; k++)
+        if (boxes_overlap(&c->regions[k].r.box, &r->box))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the new region overlaps region %u of the cluster; regions of a "
+                           "cluster must not share cells",
+                           k);
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (r->image[i] == CM_IMAGE_EXIT)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the region was solved without record_exits; its exits cannot be "
+                           "followed into the cluster");
+    return CM_OK;
+}
+
+static cm_status add_target(cm_cluster_region *cr, uint32_t region)
+{
+    for (uint32_t t = 0; t < cr->ntargets; t++)
+        if (cr->targets[t] == region)
+            return CM_OK;
+    if (cr->ntargets == cr->targets_cap) {
+        const uint32_t cap = cr->targets_cap ? 2 * cr->targets_cap : 4;
+        uint32_t *t = realloc(cr->targets, cap * sizeof *t);
+        if (!t)
+            return CM_ENOMEM;
+        cr->targets = t;
+        cr->targets_cap = cap;
+    }
+    cr->targets[cr->ntargets++] = region;
+    return CM_OK;
+}
+
+static const int64_t *exit_target(const cm_region *r, uint64_t exit)
+{
+    return r->exit_target + exit * (uint64_t)r->box.dim;
+}
+
+/* Escapes of the older regions that land in the new region `added` become
+ * region links; the new region's exits become links or escapes. */
+static cm_status update_links(cm_cluster *c, uint32_t added)
+{
+    const cm_box *new_box = &c->regions[added].r.box;
+    for (uint32_t k = 0; k < added; k++) {
+        cm_cluster_region *cr = &c->regions[k];
+        uint64_t kept = 0;
+        for (uint64_t e = 0; e < cr->nescapes; e++) {
+            if (!cm_box_contains(new_box, exit_target(&cr->r, cr->escapes[e])))
+                cr->escapes[kept++] = cr->escapes[e];
+            else if (add_target(cr, added) != CM_OK)
+                return CM_ENOMEM;
+        }
+        cr->nescapes = kept;
+    }
+    cm_cluster_region *nr = &c->regions[added];
+    nr->escapes = malloc((nr->r.nexits + 1) * sizeof *nr->escapes);
+    if (!nr->escapes)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < nr->r.nexits; e++) {
+        uint64_t local;
+        const int64_t k = cm_cluster_find(c, exit_target(&nr->r, e), &local);
+        if (k < 0)
+            nr->escapes[nr->nescapes++] = (uint32_t)e;
+        else if (add_target(nr, (uint32_t)k) != CM_OK)
+            return CM_ENOMEM;
+    }
+    return CM_OK;
+}
+
+/* Marks the regions from which the region `added` can be reached through
+ * exits (itself included): only their sink cells can change. */
+static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affected)
+{
+    memset(affected, 0, c->nregions);
+    affected[added] = 1;
+    uint32_t count = 1;
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (uint32_t k = 0; k < c->nregions; k++) {
+            const cm_cluster_region *cr = &c->regions[k];
+            for (uint32_t t = 0; t < cr->ntargets && !affected[k]; t++) {
+                if (affected[cr->targets[t]]) {
+                    affected[k] = 1;
+                    count++;
+                    grew = true;
+                }
+            }
+        }
+    }
+    return count;
+}
+
+/* The cell after `at` in the cluster; false when the sequence leaves it. */
+static bool next_cell(cm_cluster *c, cell_ref at, cell_ref *next)
+{
+    const cm_region *r = &c->regions[at.region].r;
+    const uint32_t v = r->image[at.index];
+    if (v < r->ncells) {
+        *next = (cell_ref){at.region, v};
+        return true;
+    }
+    const int64_t e = cm_image_exit_index(v);
+    uint64_t local;
+    const int64_t k = e < 0 ? -1 : cm_cluster_find(c, exit_target(r, (uint64_t)e), &local);
+    if (k < 0)
+        return false;
+    *next = (cell_ref){(uint32_t)k, (uint32_t)local};
+    return true;
+}
+
+typedef struct walk {
+    cell_ref *path;
+    uint64_t len, cap;
+} walk;
+
+static cm_status walk_push(walk *w, cell_ref cell)
+{
+    if (w->len == w->cap) {
+        const uint64_t cap = w->cap ? 2 * w->cap : 4096;
+        cell_ref *p = realloc(w->path, cap * sizeof *p);
+        if (!p)
+            return CM_ENOMEM;
+        w->path = p;
+        w->cap = cap;
+    }
+    w->path[w->len++] = cell;
+    return CM_OK;
+}
+
+/* Walks from `start` until the sequence leaves the cluster, reaches a
+ * classified cell or closes a cycle on the walk, then labels the walk. */
+static cm_status walk_from(cm_cluster *c, cell_ref start, walk *w, cm_join_stats *stats)
+{
+    w->len = 0;
+    cell_ref at = start, next;
+    bool inside;
+    for (;;) {
+        if (w->len >= ON_PATH - 1)
+            return CM_ETOOBIG;
+        cm_status st = walk_push(w, at);
+        if (st != CM_OK)
+            return st;
+        c->regions[at.region].r.step[at.index] = ON_PATH | (uint32_t)(w->len - 1);
+        inside = next_cell(c, at, &next);
+        if (!inside || c->regions[next.region].r.step[next.index] != STEP_UNVISITED)
+            break;
+        at = next;
+    }
+    uint32_t group = 0, cycle_at = UINT32_MAX, tail = 0;
+    if (inside) {
+        const cm_region *nr = &c->regions[next.region].r;
+        const uint32_t s = nr->step[next.index];
+        if (s & ON_PATH) {
+            if (c->ngroups == MAX_GROUPS)
+                return CM_ETOOBIG;
+            group = ++c->ngroups;
+            cycle_at = s & ~ON_PATH;
+            stats->straddling_groups++;
+        } else {
+            group = nr->group[next.index];
+            tail = s;
+        }
+    }
+    if (cycle_at == UINT32_MAX && (uint64_t)tail + w->len >= ON_PATH)
+        return CM_ETOOBIG;
+    for (uint64_t p = 0; p < w->len; p++) {
+        cm_region *r = &c->regions[w->path[p].region].r;
+        r->group[w->path[p].index] = group;
+        if (cycle_at == UINT32_MAX)
+            r->step[w->path[p].index] = tail + (uint32_t)(w->len - p);
+        else
+            r->step[w->path[p].index] = p >= cycle_at ? 0 : cycle_at - (uint32_t)p;
+    }
+    stats->walked_cells += w->len;
+    return CM_OK;
+}
+
+/* Walks the sink cells of the affected regions again, across borders. */
+static cm_status rewalk(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats)
+{
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        if (!affected[k])
+            continue;
+        cm_region *r = &c->regions[k].r;
+        for (uint64_t i = 0; i < r->ncells; i++)
+            if (r->group[i] == 0)
+                r->step[i] = STEP_UNVISITED;
+    }
+    walk w = {NULL, 0, 0};
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        if (!affected[k])
+            continue;
+        const cm_region *r = &c->regions[k].r;
+        for (uint64_t i = 0; i < r->ncells && st == CM_OK; i++)
+            if (r->step[i] == STEP_UNVISITED)
+                st = walk_from(c, (cell_ref){k, (uint32_t)i}, &w, stats);
+    }
+    free(w.path);
+    return st;
+}
+
+cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
+                          size_t msg_size)
+{
+    cm_join_stats local_stats;
+    if (!stats)
+        stats = &local_stats;
+    memset(stats, 0, sizeof *stats);
+    cm_status st = check_region(c, r, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (c->nregions == c->cap) {
+        const uint32_t cap = c->cap ? 2 * c->cap : 8;
+        cm_cluster_region *regions = realloc(c->regions, cap * sizeof *regions);
+        if (!regions)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
+        c->regions = regions;
+        c->cap = cap;
+    }
+    /* the region's own groups take the next cluster-wide ids */
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (r->group[i] != 0)
+            r->group[i] += c->ngroups;
+    const uint32_t added = c->nregions++;
+    memset(&c->regions[added], 0, sizeof c->regions[added]);
+    c->regions[added].r = *r;
+    memset(r, 0, sizeof *r);
+    c->ngroups += c->regions[added].r.ngroups;
+    stats->new_groups = c->regions[added].r.ngroups;
+    uint8_t *affected = malloc(c->nregions);
+    st = affected ? update_links(c, added) : CM_ENOMEM;
+    if (st == CM_OK) {
+        stats->affected_regions = mark_affected(c, added, affected);
+        st = rewalk(c, affected, stats);
+    }
+    free(affected);
+    stats->new_groups += stats->straddling_groups;
+    if (st != CM_OK)
+        return cm_fail(st, msg, msg_size, "joining region %u: %s", added, cm_strerror(st));
+    return CM_OK;
+}
+
+cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
+                                 uint32_t nboxes, const cm_scm_options *opt, char *msg,
+                                 size_t msg_size)
+{
+    cm_region *solved = calloc(nboxes + 1, sizeof *solved);
+    cm_status *status = calloc(nboxes + 1, sizeof *status);
+    char (*msgs)[256] = calloc(nboxes + 1, sizeof *msgs);
+    if (!solved || !status || !msgs) {
+        free(solved);
+        free(status);
+        free(msgs);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u regions", nboxes);
+    }
+    int threads = 1;
+#ifdef _OPENMP
+    threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+#endif
+    cm_scm_options one = opt ? *opt : (cm_scm_options){0};
+    one.record_exits = 1;
+    one.threads = 1;
+    /* One region per thread: classification is sequential, so this is how
+     * a big box uses every core. Each region's result depends on its box
+     * alone, and the joins below run in a fixed order. */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int64_t k = 0; k < (int64_t)nboxes; k++) {
+        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
+        if (status[k] == CM_OK)
+            status[k] = cm_scm_solve(model, &c->lat, &one, &solved[k], msgs[k], sizeof msgs[k]);
+    }
+    (void)threads;
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < nboxes; k++) {
+        if (st == CM_OK && status[k] != CM_OK)
+            st = cm_fail(status[k], msg, msg_size, "region %u: %s", k, msgs[k]);
+        if (st == CM_OK)
+            st = cm_cluster_join(c, &solved[k], NULL, msg, msg_size);
+        cm_region_free(&solved[k]);
+    }
+    free(solved);
+    free(status);
+    free(msgs);
+    return st;
+}
+
+/* Image of a cluster cell as an index of `box`, or CM_IMAGE_EXIT beyond it. */
+static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
+{
+    int64_t cell[CM_MAX_DIM];
+    const uint32_t v = r->image[i];
+    const int64_t e = cm_image_exit_index(v);
+    if (v < r->ncells)
+        cm_box_cell(&r->box, v, cell);
+    else if (e >= 0)
+        memcpy(cell, exit_target(r, (uint64_t)e), (size_t)box->dim * sizeof *cell);
+    else
+        return CM_IMAGE_SINK;
+    return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
+}
+
+cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
+                             size_t msg_size)
+{
+    cm_status st = cm_region_alloc(out, box, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    out->ngroups = c->ngroups;
+    for (uint64_t i = 0; i < out->ncells; i++) {
+        out->image[i] = CM_IMAGE_SINK;
+        out->group[i] = CM_GROUP_NONE;
+        out->step[i] = 0;
+    }
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_region *r = &c->regions[k].r;
+        int64_t cell[CM_MAX_DIM];
+        for (uint64_t i = 0; i < r->ncells; i++) {
+            cm_box_cell(&r->box, i, cell);
+            if (!cm_box_contains(box, cell))
+                continue;
+            const uint64_t j = cm_box_index(box, cell);
+            out->image[j] = flat_image(r, i, box);
+            out->group[j] = r->group[i];
+            out->step[j] = r->step[i];
+        }
+    }
+    return CM_OK;
+}

@@ -1,0 +1,83 @@
+/* cellmap/cluster.h - clustered simple cell mapping (thesis 4.6.2,
+ * Algorithms C.3-C.7, generalised from two solutions to any number of
+ * regions in any dimension).
+ *
+ * A cluster is a set of non-overlapping regions on one lattice. Each region
+ * keeps its own image[] (local indices, and exits into its exit table);
+ * group[] holds cluster-wide group ids (0: the sink, i.e. the sequence leaves
+ * the cluster or the world) and step[] the cluster-wide step numbers.
+ *
+ * Joining a region changes only cells whose sequences used to leave the
+ * cluster into the new region: the cells of the sink's domain in the regions
+ * from which the new one can be reached through exits, and the new region's
+ * own. These are walked again across region borders: a walk that reaches a
+ * classified cell takes its group (Stage 1 of the thesis); walks that close a
+ * cycle across borders create the groups that straddle them (Stage 2).
+ * Existing group ids never change; groups of the new region and straddling
+ * groups get the next ids in a deterministic order.
+ *
+ * The invariant (tests/test_cluster.c): for regions tiling a box, the result
+ * equals cm_scm_solve on the box, cell by cell, up to the numbering of groups.
+ * Not thread-safe; one cluster per thread.
+ */
+#ifndef CM_CLUSTER_H
+#define CM_CLUSTER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cellmap/scm.h"
+
+typedef struct cm_cluster_region {
+    cm_region r;
+    uint32_t *escapes;  /* exits whose target lies outside the cluster */
+    uint64_t nescapes;
+    uint32_t *targets;  /* regions that exits lead into (no duplicates) */
+    uint32_t ntargets, targets_cap;
+} cm_cluster_region;
+
+typedef struct cm_cluster {
+    cm_lattice lat;
+    cm_cluster_region *regions; /* in the order they were joined */
+    uint32_t nregions, cap;
+    uint32_t ngroups; /* cluster-wide group ids 1..ngroups */
+    uint32_t hint;    /* region of the last lookup */
+} cm_cluster;
+
+typedef struct cm_join_stats {
+    uint32_t affected_regions; /* regions whose sink cells were walked again */
+    uint64_t walked_cells;     /* cells walked again */
+    uint32_t new_groups;       /* groups of the new region plus straddling ones */
+    uint32_t straddling_groups;
+} cm_join_stats;
+
+void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
+void cm_cluster_free(cm_cluster *c);
+
+/* Joins a region solved with record_exits on the cluster's lattice. The
+ * cluster takes the region's arrays (r is zeroed). CM_EINVAL if its box
+ * overlaps a region of the cluster. stats may be NULL. */
+cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
+                          size_t msg_size);
+
+/* Solves the boxes concurrently (one region per thread, images included),
+ * then joins them in the given order. */
+cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
+                                 uint32_t nboxes, const cm_scm_options *opt, char *msg,
+                                 size_t msg_size);
+
+/* The region holding the cell and the cell's local index, or -1. */
+int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local);
+
+/* Bounding box of all regions (the cluster must not be empty). */
+void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
+uint64_t cm_cluster_cells(const cm_cluster *c);
+uint64_t cm_cluster_bytes(const cm_cluster *c);
+
+/* The cluster as one region over `box`: group and step of every cell (group
+ * CM_GROUP_NONE outside every region), images as box indices (exits and
+ * cells beyond the box as CM_IMAGE_EXIT). out->ngroups is the cluster's. */
+cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
+                             size_t msg_size);
+
+#endif

@@ -1,0 +1,369 @@
+/* Clustered SCM: the invariant. For tilings of a box into 2, 3, 4 and 9
+ * regions of unequal sizes, joined in several orders, the cluster equals
+ * simple cell mapping on the whole box cell by cell: the same images, the
+ * same partition into groups up to renumbering, the same periodic cells and
+ * step numbers. Models: the PD micro-chaos map (sec. 4.6.3 and Fig. 4.21
+ * parameters), the 2-D delayed map, a 3-D map, random functional maps, and a
+ * rotation whose periodic groups exist only across the borders. Also: group
+ * ids of existing groups survive a join, and the thread count changes
+ * nothing. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/cluster.h"
+#include "check.h"
+#include "models/registry.h"
+
+/* ---- tilings ------------------------------------------------------------ */
+
+/* Splits [0, n) at the given fractions (ascending, in (0, 1)). */
+static int cuts(int64_t n, const double *fractions, int nf, int64_t *at)
+{
+    at[0] = 0;
+    for (int k = 0; k < nf; k++)
+        at[k + 1] = (int64_t)llround(fractions[k] * (double)n);
+    at[nf + 1] = n;
+    return nf + 1;
+}
+
+/* Tiles `whole` (dims 0 and 1 cut, others whole) into a grid of boxes. */
+static uint32_t tile(const cm_box *whole, const double *fx, int nfx, const double *fy, int nfy,
+                     cm_box *boxes)
+{
+    int64_t ax[8], ay[8];
+    const int nx = cuts(whole->hi[0] - whole->lo[0], fx, nfx, ax);
+    const int ny = whole->dim > 1 ? cuts(whole->hi[1] - whole->lo[1], fy, nfy, ay) : 1;
+    uint32_t n = 0;
+    for (int j = 0; j < ny; j++) {
+        for (int i = 0; i < nx; i++) {
+            cm_box b = *whole;
+            b.lo[0] = whole->lo[0] + ax[i];
+            b.hi[0] = whole->lo[0] + ax[i + 1];
+            if (whole->dim > 1) {
+                b.lo[1] = whole->lo[1] + ay[j];
+                b.hi[1] = whole->lo[1] + ay[j + 1];
+            }
+            boxes[n++] = b;
+        }
+    }
+    return n;
+}
+
+/* ---- comparison --------------------------------------------------------- */
+
+/* Equal up to a bijection of group ids that keeps the sink; returns the
+ * number of differing cells (reports the first few). */
+static uint64_t compare_regions(const char *what, const cm_region *a, const cm_region *b)
+{
+    uint32_t *a_to_b = calloc(a->ngroups + 2, sizeof *a_to_b);
+    uint32_t *b_to_a = calloc(b->ngroups + 2, sizeof *b_to_a);
+    uint64_t bad = 0;
+    for (uint64_t i = 0; i < a->ncells; i++) {
+        const uint32_t ga = a->group[i], gb = b->group[i];
+        bool same = a->image[i] == b->image[i] && a->step[i] == b->step[i] &&
+                    (ga == 0) == (gb == 0) && ga <= a->ngroups && gb <= b->ngroups;
+        if (same && a_to_b[ga] == 0 && b_to_a[gb] == 0) {
+            a_to_b[ga] = gb + 1;
+            b_to_a[gb] = ga + 1;
+        } else if (same) {
+            same = a_to_b[ga] == gb + 1 && b_to_a[gb] == ga + 1;
+        }
+        if (!same && bad++ < 5)
+            fprintf(stderr, "%s: cell %llu: image %u/%u group %u/%u step %u/%u\n", what,
+                    (unsigned long long)i, a->image[i], b->image[i], ga, gb, a->step[i],
+                    b->step[i]);
+    }
+    if (a->ngroups != b->ngroups) {
+        fprintf(stderr, "%s: %u groups vs %u\n", what, a->ngroups, b->ngroups);
+        bad++;
+    }
+    free(a_to_b);
+    free(b_to_a);
+    return bad;
+}
+
+static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *box,
+                        int max_steps, cm_region *r)
+{
+    char msg[256];
+    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
+    CHECK(cm_region_alloc(r, box, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(m, lat, &opt, r, msg, sizeof msg) == CM_OK);
+}
+
+/* Solves the boxes one by one, joins them in `order`, flattens over whole. */
+static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_box *whole,
+                            const cm_box *boxes, const uint32_t *order, uint32_t n,
+                            int max_steps, cm_region *flat, uint32_t *straddling)
+{
+    char msg[256];
+    cm_cluster c;
+    cm_cluster_init(&c, lat);
+    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 1};
+    *straddling = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        cm_region r;
+        cm_join_stats stats;
+        CHECK(cm_region_alloc(&r, &boxes[order[k]], msg, sizeof msg) == CM_OK);
+        CHECK(cm_scm_solve(m, lat, &opt, &r, msg, sizeof msg) == CM_OK);
+        CHECK(cm_cluster_join(&c, &r, &stats, msg, sizeof msg) == CM_OK);
+        *straddling += stats.straddling_groups;
+    }
+    CHECK(cm_cluster_flatten(&c, whole, flat, msg, sizeof msg) == CM_OK);
+    cm_cluster_free(&c);
+}
+
+/* Every tiling, in natural, reversed and interleaved order, against the
+ * whole box. Returns the straddling groups found by the 2x2 tiling. */
+static uint32_t check_invariant(const char *name, const cm_model *m, const cm_lattice *lat,
+                                const cm_box *whole, int max_steps)
+{
+    static const double f2[] = {0.37}, f3[] = {0.21, 0.58}, f3b[] = {0.4, 0.77};
+    const struct {
+        const double *fx, *fy;
+        int nfx, nfy;
+    } tilings[] = {{f2, NULL, 1, 0}, {f3, NULL, 2, 0}, {f2, f2, 1, 1}, {f3, f3b, 2, 2}};
+    cm_region whole_r;
+    solve_whole(m, lat, whole, max_steps, &whole_r);
+    uint32_t straddling_2x2 = 0;
+    for (size_t t = 0; t < sizeof tilings / sizeof tilings[0]; t++) {
+        if (whole->dim == 1 && tilings[t].nfy > 0)
+            continue;
+        cm_box boxes[9];
+        const uint32_t n = tile(whole, tilings[t].fx, tilings[t].nfx, tilings[t].fy,
+                                tilings[t].nfy, boxes);
+        uint32_t orders[3][9];
+        for (uint32_t k = 0; k < n; k++) {
+            orders[0][k] = k;
+            orders[1][k] = n - 1 - k;
+            orders[2][k] = (k * 5 + 2) % n; /* n <= 9 and coprime with 5 except n = 5 */
+        }
+        for (int o = 0; o < 3; o++) {
+            cm_region flat;
+            uint32_t straddling;
+            char what[128];
+            snprintf(what, sizeof what, "%s, %u regions, order %d", name, n, o);
+            solve_clustered(m, lat, whole, boxes, orders[o], n, max_steps, &flat, &straddling);
+            CHECK_INT(compare_regions(what, &whole_r, &flat), 0);
+            if (t == 2)
+                straddling_2x2 = straddling;
+            cm_region_free(&flat);
+        }
+    }
+    fprintf(stderr, "%s: %u groups; 2x2 tiling found %u groups across borders\n", name,
+            whole_r.ngroups, straddling_2x2);
+    cm_region_free(&whole_r);
+    return straddling_2x2;
+}
+
+/* ---- models --------------------------------------------------------------- */
+
+static cm_model registry_model(const char *name, const char *params)
+{
+    cm_model m;
+    char msg[256];
+    const char *texts[1] = {params};
+    if (cm_model_create(name, params ? texts : NULL, params ? 1 : 0, &m, msg, sizeof msg) !=
+        CM_OK) {
+        fprintf(stderr, "%s\n", msg);
+        exit(1);
+    }
+    return m;
+}
+
+static void test_pd_maps(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {0, -40}, {500.0 / 300, 80.0 / 240}};
+    const cm_box whole = {2, {0, 0}, {300, 240}};
+    check_invariant("PD sec. 4.6.3", &m, &lat, &whole, 1);
+    cm_model_release(&m);
+
+    m = registry_model("microchaos-pd", "alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3");
+    const cm_lattice lat21 = {2, {-125000, -600}, {250000.0 / 200, 1200.0 / 80}};
+    const cm_box whole21 = {2, {0, 0}, {200, 80}};
+    check_invariant("PD Fig. 4.21", &m, &lat21, &whole21, 1000);
+    cm_model_release(&m);
+}
+
+static void test_delay_and_3d(void)
+{
+    cm_model m = registry_model("microchaos-delay", NULL);
+    const cm_lattice lat = {2, {-12, -12}, {0.1, 0.1}};
+    const cm_box whole = {2, {0, 0}, {240, 240}};
+    check_invariant("delayed map", &m, &lat, &whole, 1);
+    cm_model_release(&m);
+
+    m = registry_model("microchaos-general", "n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1");
+    const cm_lattice lat3 = {3, {-6, -6, -6}, {0.5, 0.5, 0.5}};
+    const cm_box whole3 = {3, {0, 0, 0}, {24, 24, 24}};
+    check_invariant("3-D map", &m, &lat3, &whole3, 1);
+    cm_model_release(&m);
+}
+
+/* ---- hand-made maps --------------------------------------------------------- */
+
+static cm_model hand_model(int dim, int (*step)(const cm_model *, const double *, double *),
+                           void *ctx)
+{
+    cm_model m;
+    memset(&m, 0, sizeof m);
+    m.name = "test";
+    m.dim = dim;
+    m.step = step;
+    m.ctx = ctx;
+    return m;
+}
+
+static uint64_t mix(uint64_t h)
+{
+    h ^= h >> 31;
+    h *= UINT64_C(0x9e3779b97f4a7c15);
+    h ^= h >> 29;
+    h *= UINT64_C(0xbf58476d1ce4e5b9);
+    return h ^ (h >> 32);
+}
+
+/* Each cell moves by a pseudo-random offset of -2..2 cells per dimension
+ * (many small cycles, some across borders, long trees), or one time in eight
+ * jumps to a pseudo-random cell of a box a little larger than the region. */
+static int random_step(const cm_model *m, const double *x, double *y)
+{
+    const uint64_t *seed = m->ctx;
+    uint64_t h = *seed;
+    for (int d = 0; d < m->dim; d++)
+        h = mix(h ^ (uint64_t)(int64_t)floor(x[d]));
+    const bool jump = (h & 7) == 0;
+    for (int d = 0; d < m->dim; d++) {
+        h = mix(h + (uint64_t)d);
+        y[d] = jump ? (double)((int64_t)(h % 34) - 2) + 0.5 : x[d] + (double)((int64_t)(h % 5) - 2);
+    }
+    return 0;
+}
+
+static void test_random_maps(void)
+{
+    for (uint64_t seed = 1; seed <= 6; seed++) {
+        const int dim = 1 + (int)(seed % 3);
+        cm_model m = hand_model(dim, random_step, &seed);
+        const cm_lattice lat = {dim, {0, 0, 0}, {1, 1, 1}};
+        const cm_box whole = {dim, {0, 0, 0}, {30, 30, 30}};
+        char name[64];
+        snprintf(name, sizeof name, "random map %llu (%d-D)", (unsigned long long)seed, dim);
+        check_invariant(name, &m, &lat, &whole, 1);
+    }
+}
+
+/* Rotation by a quarter turn about the centre of a 20x20 box: every orbit
+ * visits all four quadrants, so with a 2x2 tiling each group exists only
+ * across the borders. */
+static int quarter_turn(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = 20 - x[1];
+    y[1] = x[0];
+    return 0;
+}
+
+static void test_straddling_groups(void)
+{
+    cm_model m = hand_model(2, quarter_turn, NULL);
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    const cm_box whole = {2, {0, 0}, {20, 20}};
+    static const double half[] = {0.5};
+    cm_box boxes[4];
+    tile(&whole, half, 1, half, 1, boxes);
+    const uint32_t order[4] = {0, 1, 2, 3};
+    cm_region whole_r, flat;
+    uint32_t straddling;
+    solve_whole(&m, &lat, &whole, 1, &whole_r);
+    solve_clustered(&m, &lat, &whole, boxes, order, 4, 1, &flat, &straddling);
+    CHECK_INT(whole_r.ngroups, 100); /* 400 cells in orbits of 4 */
+    CHECK_INT(straddling, 100);
+    CHECK_INT(compare_regions("quarter turn 2x2", &whole_r, &flat), 0);
+    cm_region_free(&whole_r);
+    cm_region_free(&flat);
+}
+
+/* Groups that existed before a join keep their ids and cells. */
+static void test_ids_stable(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {0, -40}, {1, 0.25}};
+    const cm_box left = {2, {0, 0}, {250, 320}}, right = {2, {250, 0}, {500, 320}};
+    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    char msg[256];
+    cm_cluster c;
+    cm_region r;
+    cm_cluster_init(&c, &lat);
+    CHECK(cm_region_alloc(&r, &left, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_join(&c, &r, NULL, msg, sizeof msg) == CM_OK);
+    const uint64_t n = c.regions[0].r.ncells;
+    uint32_t *before = malloc(n * sizeof *before);
+    memcpy(before, c.regions[0].r.group, n * sizeof *before);
+    CHECK(c.ngroups > 0);
+    CHECK(cm_region_alloc(&r, &right, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+    cm_join_stats stats;
+    CHECK(cm_cluster_join(&c, &r, &stats, msg, sizeof msg) == CM_OK);
+    uint64_t kept = 0, had = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        had += before[i] != 0;
+        kept += before[i] != 0 && c.regions[0].r.group[i] == before[i];
+    }
+    CHECK(had > 0);
+    CHECK_INT(kept, had);
+    /* overlapping boxes are refused */
+    const cm_box overlap = {2, {240, 0}, {260, 10}};
+    CHECK(cm_region_alloc(&r, &overlap, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_join(&c, &r, NULL, msg, sizeof msg) == CM_EINVAL);
+    cm_region_free(&r);
+    free(before);
+    cm_cluster_free(&c);
+    cm_model_release(&m);
+}
+
+/* cm_cluster_solve_boxes gives the same bytes with 1 and 2 threads. */
+static void test_threads_identical(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {0, -40}, {1, 0.25}};
+    const cm_box whole = {2, {0, 0}, {500, 320}};
+    static const double f[] = {0.3, 0.55};
+    cm_box boxes[9];
+    const uint32_t n = tile(&whole, f, 2, f, 2, boxes);
+    cm_region flat[2];
+    char msg[256];
+    for (int t = 0; t < 2; t++) {
+        cm_cluster c;
+        cm_cluster_init(&c, &lat);
+        const cm_scm_options opt = {1, t + 1, NULL, NULL, 1};
+        CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, msg, sizeof msg) == CM_OK);
+        CHECK(cm_cluster_flatten(&c, &whole, &flat[t], msg, sizeof msg) == CM_OK);
+        cm_cluster_free(&c);
+    }
+    CHECK(memcmp(flat[0].image, flat[1].image, flat[0].ncells * 4) == 0);
+    CHECK(memcmp(flat[0].group, flat[1].group, flat[0].ncells * 4) == 0);
+    CHECK(memcmp(flat[0].step, flat[1].step, flat[0].ncells * 4) == 0);
+    cm_region whole_r;
+    solve_whole(&m, &lat, &whole, 1, &whole_r);
+    CHECK_INT(compare_regions("solve_boxes 3x3", &whole_r, &flat[0]), 0);
+    cm_region_free(&whole_r);
+    cm_region_free(&flat[0]);
+    cm_region_free(&flat[1]);
+    cm_model_release(&m);
+}
+
+int main(void)
+{
+    test_straddling_groups();
+    test_random_maps();
+    test_pd_maps();
+    test_delay_and_3d();
+    test_ids_stable();
+    test_threads_identical();
+    CHECK_DONE();
+}
