@@ -8,6 +8,7 @@
 #include <omp.h>
 #endif
 
+#include "cellmap/cluster.h"
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
@@ -18,7 +19,8 @@
 
 static const char solve_help[] =
     "usage: cellmap solve [--model NAME] [--param k=v[,k=v]] [--region LO:HI[,LO:HI...]]\n"
-    "                     [--cells N[xM...]] [--max-steps K] [--threads T]\n"
+    "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
+    "                     [--threads T]\n"
     "                     [--png FILE] [--size WxH] [--db FILE] [--json]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
     "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
@@ -29,6 +31,8 @@ static const char solve_help[] =
     "  --region LO:HI,...  the box, one range per state dimension\n"
     "                      (default: the model's example region)\n"
     "  --cells NxM...      cells per dimension (default 1000 per dimension, 100 in 3-D+)\n"
+    "  --split KxL...      solve the box as K x L x ... regions concurrently and join\n"
+    "                      them into one cluster (same result; uses every core)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
     "  --threads T         OpenMP threads for the images (default: all cores)\n"
     "  --png FILE          write the basin image (written to a temporary file, renamed)\n"
@@ -36,11 +40,14 @@ static const char solve_help[] =
     "  --db FILE           write a .cmdb SQLite database (replaces an older .cmdb only)\n"
     "  --json              print the summary as JSON\n";
 
+/* Most regions --split may cut the box into. */
+enum { MAX_SPLIT = 4096 };
+
 typedef struct solve_args {
     model_opts mo;
     const char *region_text;
-    int64_t cells[CM_MAX_DIM];
-    int n_cells;
+    int64_t cells[CM_MAX_DIM], split[CM_MAX_DIM];
+    int n_cells, n_split;
     int max_steps, threads, width, height, json;
     const char *png, *db;
 } solve_args;
@@ -59,6 +66,10 @@ static int parse_solve(cli *c, solve_args *a)
         } else if (cli_is(c, "--cells", true, &err)) {
             if (c->value && !parse_counts(c->value, a->cells, &a->n_cells, CM_MAX_DIM))
                 err = cli_usage_error(c, "--cells: '%s' is not N[xM...] with positive integers",
+                                      c->value);
+        } else if (cli_is(c, "--split", true, &err)) {
+            if (c->value && !parse_counts(c->value, a->split, &a->n_split, CM_MAX_DIM))
+                err = cli_usage_error(c, "--split: '%s' is not K[xL...] with positive integers",
                                       c->value);
         } else if (cli_is(c, "--max-steps", true, &err)) {
             if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
@@ -124,6 +135,19 @@ static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm
         box->hi[d] = cells;
         total *= (double)cells;
     }
+    if (a->n_split && a->n_split != m->dim)
+        return cli_usage_error(c, "--split has %d count(s) but model %s has dimension %d",
+                               a->n_split, m->name, m->dim);
+    double parts = 1.0;
+    for (int d = 0; d < a->n_split; d++) {
+        parts *= (double)a->split[d];
+        if (a->split[d] > box->hi[d])
+            return cli_usage_error(c, "--split: %lld parts in dimension %d, but it has only "
+                                   "%lld cells", (long long)a->split[d], d + 1,
+                                   (long long)box->hi[d]);
+    }
+    if (parts > MAX_SPLIT)
+        return cli_usage_error(c, "--split asks for %.0f regions; at most %d", parts, MAX_SPLIT);
     if (total > (double)CM_REGION_MAX_CELLS)
         return cli_usage_error(c, "--cells asks for %.0f cells; one region holds at most %llu",
                                total, (unsigned long long)CM_REGION_MAX_CELLS);
@@ -158,8 +182,15 @@ static int larger_basin_first(const void *a, const void *b)
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
 
+/* Durations of the two phases of a solve: images and classification, or,
+ * with --split, the regions (solved concurrently) and their joins. */
+typedef struct timing {
+    const char *first, *second;
+    double t1, t2;
+} timing;
+
 static void print_text(const cm_model *m, const cm_region *r, const cm_group_info *g,
-                       uint64_t sink, double t_img, double t_cls)
+                       uint64_t sink, const timing *t)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
@@ -167,8 +198,8 @@ static void print_text(const cm_model *m, const cm_region *r, const cm_group_inf
     printf("cells %llu, periodic groups %u, sink basin %llu cells (%.1f%%)\n",
            (unsigned long long)r->ncells, r->ngroups, (unsigned long long)sink,
            100.0 * (double)sink / (double)r->ncells);
-    printf("time: images %.3f s, classification %.3f s (%.1f ns/cell)\n", t_img, t_cls,
-           1e9 * (t_img + t_cls) / (double)r->ncells);
+    printf("time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
+           1e9 * (t->t1 + t->t2) / (double)r->ncells);
     cm_group_info *sorted = malloc((r->ngroups + 1) * sizeof *sorted);
     if (!sorted)
         return;
@@ -188,7 +219,7 @@ static void print_text(const cm_model *m, const cm_region *r, const cm_group_inf
 }
 
 static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region *r,
-                       const cm_group_info *g, uint64_t sink, double t_img, double t_cls)
+                       const cm_group_info *g, uint64_t sink, const timing *t)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
@@ -196,9 +227,10 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region
     print_vector(lat->origin, lat->dim, ",");
     printf("],\"width\":[");
     print_vector(lat->width, lat->dim, ",");
-    printf("]},\"cells\":%llu,\"sink_cells\":%llu,\"time_s\":{\"images\":%.6f,"
-           "\"classification\":%.6f},\"groups\":[",
-           (unsigned long long)r->ncells, (unsigned long long)sink, t_img, t_cls);
+    printf("]},\"cells\":%llu,\"sink_cells\":%llu,\"time_s\":{\"%s\":%.6f,\"%s\":%.6f},"
+           "\"groups\":[",
+           (unsigned long long)r->ncells, (unsigned long long)sink, t->first, t->t1, t->second,
+           t->t2);
     for (uint32_t k = 0; k < r->ngroups; k++) {
         printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"centre\":[", k ? "," : "",
                g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
@@ -265,6 +297,68 @@ static int write_db(const solve_args *a, int argc, char **argv, const cm_model *
     return EXIT_OK;
 }
 
+static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                             const cm_box *box, cm_region *r, timing *t, char *msg,
+                             size_t msg_size)
+{
+    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 0};
+    *t = (timing){"images", "classification", 0, 0};
+    cm_status st = cm_region_alloc(r, box, msg, msg_size);
+    const double t0 = now_seconds();
+    if (st == CM_OK)
+        st = cm_scm_images(m, lat, &opt, r, msg, msg_size);
+    const double t1 = now_seconds();
+    if (st == CM_OK)
+        st = cm_scm_classify(r, msg, msg_size);
+    t->t1 = t1 - t0;
+    t->t2 = now_seconds() - t1;
+    return st;
+}
+
+/* The box cut into a->split[d] nearly equal parts per dimension. */
+static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
+{
+    uint32_t n = 1;
+    for (int d = 0; d < box->dim; d++)
+        n *= (uint32_t)a->split[d];
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t rest = k;
+        boxes[k] = *box;
+        for (int d = 0; d < box->dim; d++) {
+            const int64_t parts = a->split[d], i = rest % (uint32_t)parts;
+            const int64_t size = box->hi[d] - box->lo[d];
+            rest /= (uint32_t)parts;
+            boxes[k].lo[d] = box->lo[d] + size * i / parts;
+            boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts;
+        }
+    }
+    return n;
+}
+
+static cm_status solve_split(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                             const cm_box *box, cm_region *r, timing *t, char *msg,
+                             size_t msg_size)
+{
+    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
+    cm_box *boxes = malloc(MAX_SPLIT * sizeof *boxes);
+    if (!boxes)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
+    const uint32_t n = split_boxes(a, box, boxes);
+    cm_cluster c;
+    cm_cluster_init(&c, lat);
+    *t = (timing){"regions and joins", "flattening", 0, 0};
+    const double t0 = now_seconds();
+    cm_status st = cm_cluster_solve_boxes(&c, m, boxes, n, &opt, msg, msg_size);
+    const double t1 = now_seconds();
+    if (st == CM_OK)
+        st = cm_cluster_flatten(&c, box, r, msg, msg_size);
+    t->t1 = t1 - t0;
+    t->t2 = now_seconds() - t1;
+    cm_cluster_free(&c);
+    free(boxes);
+    return st;
+}
+
 int cmd_solve(int argc, char **argv)
 {
     cli c = {"solve", argc, argv, 0, NULL, NULL};
@@ -286,16 +380,10 @@ int cmd_solve(int argc, char **argv)
     if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK)
         goto done;
     rc = EXIT_FAIL;
-    if (cm_region_alloc(&r, &box, msg, sizeof msg) != CM_OK)
+    timing t = {"images", "classification", 0, 0};
+    if ((a.n_split ? solve_split(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)
+                   : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
         goto fail;
-    const cm_scm_options opt = {a.max_steps, a.threads, NULL, NULL, 0};
-    const double t0 = now_seconds();
-    if (cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK)
-        goto fail;
-    const double t1 = now_seconds();
-    if (cm_scm_classify(&r, msg, sizeof msg) != CM_OK)
-        goto fail;
-    const double t2 = now_seconds();
     groups = calloc(r.ngroups + 1, sizeof *groups);
     uint64_t sink = 0;
     if (!groups) {
@@ -304,9 +392,9 @@ int cmd_solve(int argc, char **argv)
     }
     cm_scm_groups(&r, &lat, groups, &sink);
     if (a.json)
-        print_json(&m, &lat, &r, groups, sink, t1 - t0, t2 - t1);
+        print_json(&m, &lat, &r, groups, sink, &t);
     else
-        print_text(&m, &r, groups, sink, t1 - t0, t2 - t1);
+        print_text(&m, &r, groups, sink, &t);
     rc = EXIT_OK;
     if (a.png && write_png(&a, &m, &lat, &r, groups) != EXIT_OK)
         rc = EXIT_FAIL;

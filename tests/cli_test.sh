@@ -50,6 +50,12 @@ cmp -s one.png basin.png || fail "PNG differs between runs"
 [ "$(sqlite3 one.cmdb 'SELECT group_concat(id||":"||period||":"||basin_cells) FROM groups')" = \
   "$(sqlite3 basin.cmdb 'SELECT group_concat(id||":"||period||":"||basin_cells) FROM groups')" ] \
   || fail "databases differ between thread counts"
+# --split: the clustered solve gives the same picture and the same groups
+"$CM" solve --split 3x2 --threads 2 --png split.png --db split.cmdb > /dev/null || fail "solve --split"
+cmp -s split.png basin.png || fail "PNG of --split 3x2 differs from the single solve"
+[ "$(sqlite3 split.cmdb 'SELECT group_concat(period||":"||basin_cells) FROM (SELECT * FROM groups ORDER BY basin_cells, period)')" = \
+  "$(sqlite3 basin.cmdb 'SELECT group_concat(period||":"||basin_cells) FROM (SELECT * FROM groups ORDER BY basin_cells, period)')" ] \
+  || fail "groups of --split 3x2 differ from the single solve"
 # a foreign file is never overwritten
 echo "precious" > notes.txt
 "$CM" solve --cells 50x50 --db notes.txt > /dev/null 2>err.txt; rc=$?
@@ -83,6 +89,10 @@ expect_usage "--cells: '0x10'" solve --cells 0x10
 expect_usage "--cells has 3 count(s)" solve --cells 10x10x10
 expect_usage "--cells asks for" solve --cells 100000x100000
 expect_usage "--max-steps" solve --max-steps 0
+expect_usage "--split: '0x2'" solve --split 0x2
+expect_usage "--split has 3 count(s)" solve --split 2x2x2
+expect_usage "only 10 cells" solve --cells 10x10 --split 11x1
+expect_usage "at most 4096" solve --split 100x100
 expect_usage "--threads" solve --threads x
 expect_usage "--size" solve --size 10
 expect_usage "--png needs a value" solve --png
