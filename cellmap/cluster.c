@@ -166,26 +166,27 @@ static cm_status update_links(cm_cluster *c, uint32_t added)
     return CM_OK;
 }
 
-/* Marks the regions from which the region `added` can be reached through
- * exits (itself included): only their sink cells can change. */
+/* Marks the regions whose sink cells can change: those from which the
+ * region `added` can be reached through exits, and `added` itself if its
+ * exits lead into the cluster (if not, its sink cells keep leaving it). */
 static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affected)
 {
-    memset(affected, 0, c->nregions);
-    affected[added] = 1;
-    uint32_t count = 1;
+    uint8_t *reaches = affected; /* reaches[k]: region k leads into `added` */
+    memset(reaches, 0, c->nregions);
+    reaches[added] = 1;
     for (bool grew = true; grew;) {
         grew = false;
         for (uint32_t k = 0; k < c->nregions; k++) {
             const cm_cluster_region *cr = &c->regions[k];
-            for (uint32_t t = 0; t < cr->ntargets && !affected[k]; t++) {
-                if (affected[cr->targets[t]]) {
-                    affected[k] = 1;
-                    count++;
-                    grew = true;
-                }
-            }
+            for (uint32_t t = 0; t < cr->ntargets && !reaches[k]; t++)
+                if (reaches[cr->targets[t]])
+                    reaches[k] = grew = true;
         }
     }
+    affected[added] = c->regions[added].ntargets > 0;
+    uint32_t count = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        count += affected[k];
     return count;
 }
 

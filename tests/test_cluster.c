@@ -357,6 +357,58 @@ static void test_threads_identical(void)
     cm_model_release(&m);
 }
 
+/* Figs. 4.26-4.28 (alpha = 0.07, beta = 0, P = 0.007, D = 0.02): regions
+ * x in [85.4, 285.4] and [285.4, 485.4], x' in [-12.5, 12.5], 1000x1000
+ * cells each. The attractors at SW_2 (x = 2/P = 285.71) straddle the shared
+ * border: neither region finds them alone, the join does, and the joined
+ * cluster equals the 2000x1000 union solve. */
+static void test_figs_4_26_to_4_28(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.07,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {85.4, -12.5}, {0.2, 0.025}};
+    const cm_box left = {2, {0, 0}, {1000, 1000}}, right = {2, {1000, 0}, {2000, 1000}};
+    const cm_box whole = {2, {0, 0}, {2000, 1000}};
+    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const double sw2 = 2 / 0.007;
+    char msg[256];
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    int near_sw2_alone = 0;
+    for (int k = 0; k < 2; k++) {
+        cm_region r;
+        CHECK(cm_region_alloc(&r, k ? &right : &left, msg, sizeof msg) == CM_OK);
+        CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+        cm_group_info *g = calloc(r.ngroups + 1, sizeof *g);
+        cm_scm_groups(&r, &lat, g, NULL);
+        for (uint32_t i = 0; i < r.ngroups; i++)
+            near_sw2_alone += fabs(g[i].centre[0] - sw2) < 1.0;
+        free(g);
+        cm_join_stats stats;
+        CHECK(cm_cluster_join(&c, &r, &stats, msg, sizeof msg) == CM_OK);
+        if (k == 1)
+            CHECK(stats.straddling_groups > 0);
+    }
+    cm_region flat, union_r;
+    CHECK(cm_cluster_flatten(&c, &whole, &flat, msg, sizeof msg) == CM_OK);
+    cm_group_info *g = calloc(flat.ngroups + 1, sizeof *g);
+    cm_scm_groups(&flat, &lat, g, NULL);
+    int near_sw2_joined = 0;
+    for (uint32_t i = 0; i < flat.ngroups; i++)
+        near_sw2_joined += fabs(g[i].centre[0] - sw2) < 1.0 && g[i].lo[0] < 285.4 &&
+                           g[i].hi[0] > 285.4;
+    fprintf(stderr, "Figs 4.26-4.28: %d groups near SW_2 in the regions alone, %d straddling "
+            "ones after the join\n", near_sw2_alone, near_sw2_joined);
+    CHECK_INT(near_sw2_alone, 0);
+    CHECK(near_sw2_joined > 0);
+    solve_whole(&m, &lat, &whole, 1, &union_r);
+    CHECK_INT(compare_regions("Figs 4.26-4.28", &union_r, &flat), 0);
+    free(g);
+    cm_region_free(&flat);
+    cm_region_free(&union_r);
+    cm_cluster_free(&c);
+    cm_model_release(&m);
+}
+
 int main(void)
 {
     test_straddling_groups();
@@ -365,5 +417,6 @@ int main(void)
     test_delay_and_3d();
     test_ids_stable();
     test_threads_identical();
+    test_figs_4_26_to_4_28();
     CHECK_DONE();
 }
