@@ -25,13 +25,9 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
-/* While classifying, step[] holds each cell's state: STEP_UNVISITED, or
- * ON_PATH | position for a cell on a walk's path (group[] then holds
- * LANE_MARK + the walk's lane), or, below ON_PATH, the final step number. */
-#define STEP_UNVISITED UINT32_C(0xFFFFFFFF)
-#define ON_PATH UINT32_C(0x80000000)
+/* step[] holds each cell's state (classify.h); while a cell is on a walk's
+ * path, group[] holds LANE_MARK + the walk's lane, above every group id. */
 #define LANE_MARK UINT32_C(0xFFFFFF00)
-#define MAX_GROUPS (LANE_MARK - 1)
 /* Enough walks in flight to overlap memory latency, few enough that their
  * path buffers stay in cache. */
 #define LANES 8
@@ -75,7 +71,7 @@ static int lane_of(const classifier *c, uint32_t cell)
     if (cell >= c->n)
         return NO_LANE;
     const uint32_t s = c->step[cell];
-    if (s == STEP_UNVISITED || !(s & ON_PATH))
+    if (s == CM_STEP_UNVISITED || !(s & CM_STEP_ON_PATH))
         return NO_LANE;
     return (int)(c->group[cell] - LANE_MARK);
 }
@@ -100,7 +96,7 @@ static void append(classifier *c, int k, uint32_t cell)
     lane *l = &c->lanes[k];
     if (l->len < LANE_BUFFER)
         l->path[l->len] = cell;
-    c->step[cell] = ON_PATH | l->len++;
+    c->step[cell] = CM_STEP_ON_PATH | l->len++;
     c->group[cell] = LANE_MARK + (uint32_t)k;
     l->next = c->image[cell];
     prefetch_cell(c, l->next);
@@ -126,7 +122,7 @@ static void label(classifier *c, const lane *l, uint32_t group, uint32_t cycle_a
 /* Starts the lane on the next unvisited cell; false when none is left. */
 static bool start_walk(classifier *c, int k)
 {
-    while (c->cursor < c->n && c->step[c->cursor] != STEP_UNVISITED)
+    while (c->cursor < c->n && c->step[c->cursor] != CM_STEP_UNVISITED)
         c->cursor++;
     lane *l = &c->lanes[k];
     l->busy = c->cursor < c->n;
@@ -148,21 +144,21 @@ static walk_result advance(classifier *c, int k, cm_status *st)
         return WALK_DONE;
     }
     const uint32_t s = c->step[cell];
-    if (s == STEP_UNVISITED) {
+    if (s == CM_STEP_UNVISITED) {
         append(c, k, cell);
         return WALK_ON;
     }
-    if (!(s & ON_PATH)) { /* a classified cell */
+    if (!(s & CM_STEP_ON_PATH)) { /* a classified cell */
         label(c, l, c->group[cell], UINT32_MAX, s);
         return WALK_DONE;
     }
     const int owner = (int)(c->group[cell] - LANE_MARK);
     if (owner == k) { /* the path closes a new cycle */
-        if (c->ngroups == MAX_GROUPS) {
+        if (c->ngroups == CM_MAX_GROUPS) {
             *st = CM_ETOOBIG;
             return WALK_DONE;
         }
-        label(c, l, ++c->ngroups, s & ~ON_PATH, 0);
+        label(c, l, ++c->ngroups, s & ~CM_STEP_ON_PATH, 0);
         return WALK_DONE;
     }
     if (!waits_on(c, owner, k))
@@ -172,7 +168,7 @@ static walk_result advance(classifier *c, int k, cm_status *st)
      * its end. The owner then waits on this walk and is off the cycle, so
      * every takeover shortens the chain of walks around it. */
     lane *o = &c->lanes[owner];
-    const uint32_t from = s & ~ON_PATH, count = o->len - from;
+    const uint32_t from = s & ~CM_STEP_ON_PATH, count = o->len - from;
     o->len = from;
     o->next = cell;
     for (uint32_t q = 0; q < count; q++)
@@ -208,7 +204,7 @@ cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32
     if (!buffers)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffers");
     for (uint32_t i = 0; i < n; i++)
-        step[i] = STEP_UNVISITED;
+        step[i] = CM_STEP_UNVISITED;
     int busy = 0;
     for (int k = 0; k < LANES; k++) {
         c.lanes[k].path = buffers + (size_t)k * LANE_BUFFER;
@@ -227,7 +223,7 @@ cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32
     free(buffers);
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "more than %lu periodic groups in one region",
-                       (unsigned long)MAX_GROUPS);
+                       (unsigned long)CM_MAX_GROUPS);
     *ngroups = c.ngroups;
     return renumber(&c, msg, msg_size);
 }

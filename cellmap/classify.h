@@ -16,6 +16,14 @@
 
 #include "cellmap/status.h"
 
+/* While cells are walked (here and when joining regions into a cluster),
+ * step[] holds each cell's state: CM_STEP_UNVISITED, CM_STEP_ON_PATH |
+ * position for a cell on a walk, or, below CM_STEP_ON_PATH, the final step
+ * number. Group ids stay at most CM_MAX_GROUPS. */
+#define CM_STEP_UNVISITED UINT32_C(0xFFFFFFFF)
+#define CM_STEP_ON_PATH UINT32_C(0x80000000)
+#define CM_MAX_GROUPS UINT32_C(0xFFFFFEFF)
+
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
                       uint32_t *ngroups, char *msg, size_t msg_size);
 

@@ -1,5 +1,7 @@
 #include "cellmap/cluster.h"
 
+#include "cellmap/classify.h"
+
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,12 +9,7 @@
 #include <omp.h>
 #endif
 
-/* While walking, step[] of a cell to be walked again is STEP_UNVISITED, and
- * ON_PATH | position while it is on the current walk (as in classify.c). */
-#define STEP_UNVISITED UINT32_C(0xFFFFFFFF)
-#define ON_PATH UINT32_C(0x80000000)
-#define MAX_GROUPS UINT32_C(0xFFFFFFF0)
-
+/* Cells to be walked again are marked in step[] as classify.h describes. */
 typedef struct cell_ref {
     uint32_t region, index;
 } cell_ref;
@@ -51,26 +48,6 @@ int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local)
     return -1;
 }
 
-void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
-{
-    *box = c->regions[0].r.box;
-    for (uint32_t k = 1; k < c->nregions; k++) {
-        const cm_box *b = &c->regions[k].r.box;
-        for (int d = 0; d < box->dim; d++) {
-            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
-            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
-        }
-    }
-}
-
-uint64_t cm_cluster_cells(const cm_cluster *c)
-{
-    uint64_t n = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        n += c->regions[k].r.ncells;
-    return n;
-}
-
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
     uint64_t bytes = 0;
@@ -97,7 +74,7 @@ static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg
                        r->box.dim, c->lat.dim);
     if (c->nregions == UINT32_MAX)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions in one cluster");
-    if (c->ngroups > MAX_GROUPS - r->ngroups)
+    if (c->ngroups > CM_MAX_GROUPS - r->ngroups)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups in one cluster");
     for (uint32_t k = 0; k < c->nregions; k++)
         if (boxes_overlap(&c->regions[k].r.box, &r->box))
@@ -105,11 +82,10 @@ static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg
                            "the new region overlaps region %u of the cluster; regions of a "
                            "cluster must not share cells",
                            k);
-    for (uint64_t i = 0; i < r->ncells; i++)
-        if (r->image[i] == CM_IMAGE_EXIT)
-            return cm_fail(CM_EINVAL, msg, msg_size,
-                           "the region was solved without record_exits; its exits cannot be "
-                           "followed into the cluster");
+    if (!r->exits_recorded)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the region was solved without record_exits; its exits cannot be "
+                       "followed into the cluster");
     return CM_OK;
 }
 
@@ -235,14 +211,14 @@ static cm_status walk_from(cm_cluster *c, cell_ref start, walk *w, cm_join_stats
     cell_ref at = start, next;
     bool inside;
     for (;;) {
-        if (w->len >= ON_PATH - 1)
+        if (w->len >= CM_STEP_ON_PATH - 1)
             return CM_ETOOBIG;
         cm_status st = walk_push(w, at);
         if (st != CM_OK)
             return st;
-        c->regions[at.region].r.step[at.index] = ON_PATH | (uint32_t)(w->len - 1);
+        c->regions[at.region].r.step[at.index] = CM_STEP_ON_PATH | (uint32_t)(w->len - 1);
         inside = next_cell(c, at, &next);
-        if (!inside || c->regions[next.region].r.step[next.index] != STEP_UNVISITED)
+        if (!inside || c->regions[next.region].r.step[next.index] != CM_STEP_UNVISITED)
             break;
         at = next;
     }
@@ -250,18 +226,18 @@ static cm_status walk_from(cm_cluster *c, cell_ref start, walk *w, cm_join_stats
     if (inside) {
         const cm_region *nr = &c->regions[next.region].r;
         const uint32_t s = nr->step[next.index];
-        if (s & ON_PATH) {
-            if (c->ngroups == MAX_GROUPS)
+        if (s & CM_STEP_ON_PATH) {
+            if (c->ngroups == CM_MAX_GROUPS)
                 return CM_ETOOBIG;
             group = ++c->ngroups;
-            cycle_at = s & ~ON_PATH;
+            cycle_at = s & ~CM_STEP_ON_PATH;
             stats->straddling_groups++;
         } else {
             group = nr->group[next.index];
             tail = s;
         }
     }
-    if (cycle_at == UINT32_MAX && (uint64_t)tail + w->len >= ON_PATH)
+    if (cycle_at == UINT32_MAX && (uint64_t)tail + w->len >= CM_STEP_ON_PATH)
         return CM_ETOOBIG;
     for (uint64_t p = 0; p < w->len; p++) {
         cm_region *r = &c->regions[w->path[p].region].r;
@@ -284,7 +260,7 @@ static cm_status rewalk(cm_cluster *c, const uint8_t *affected, cm_join_stats *s
         cm_region *r = &c->regions[k].r;
         for (uint64_t i = 0; i < r->ncells; i++)
             if (r->group[i] == 0)
-                r->step[i] = STEP_UNVISITED;
+                r->step[i] = CM_STEP_UNVISITED;
     }
     walk w = {NULL, 0, 0};
     cm_status st = CM_OK;
@@ -293,7 +269,7 @@ static cm_status rewalk(cm_cluster *c, const uint8_t *affected, cm_join_stats *s
             continue;
         const cm_region *r = &c->regions[k].r;
         for (uint64_t i = 0; i < r->ncells && st == CM_OK; i++)
-            if (r->step[i] == STEP_UNVISITED)
+            if (r->step[i] == CM_STEP_UNVISITED)
                 st = walk_from(c, (cell_ref){k, (uint32_t)i}, &w, stats);
     }
     free(w.path);

@@ -69,9 +69,7 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 /* The region holding the cell and the cell's local index, or -1. */
 int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local);
 
-/* Bounding box of all regions (the cluster must not be empty). */
-void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
-uint64_t cm_cluster_cells(const cm_cluster *c);
+/* Bytes held by the regions' arrays, exit tables and escape lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
 /* The cluster as one region over `box`: group and step of every cell (group

@@ -125,6 +125,7 @@ static cm_status record_exits(const cm_model *model, const cm_lattice *lat, int 
         }
     }
     r->nexits = nexits;
+    r->exits_recorded = 1;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t e = 0; e < (int64_t)nexits; e++) {
         int64_t from[CM_MAX_DIM];
@@ -164,6 +165,7 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     free(r->exit_target);
     r->exit_target = NULL;
     r->nexits = 0;
+    r->exits_recorded = 0;
     if (opt && opt->record_exits)
         return record_exits(model, lat, max_steps, threads, r, msg, msg_size);
     return CM_OK;

@@ -51,7 +51,8 @@ typedef struct cm_region {
     uint32_t *group;
     uint32_t *step;
     uint32_t ngroups; /* periodic groups other than the sink */
-    uint64_t nexits;  /* recorded exits (cm_scm_options.record_exits) */
+    int exits_recorded; /* images were computed with record_exits */
+    uint64_t nexits;    /* recorded exits */
     int64_t *exit_target; /* nexits * box.dim cell coordinates, in local index order */
 } cm_region;
 

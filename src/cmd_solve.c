@@ -315,13 +315,18 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     return st;
 }
 
-/* The box cut into a->split[d] nearly equal parts per dimension. */
-static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
+static uint32_t split_count(const solve_args *a)
 {
     uint32_t n = 1;
-    for (int d = 0; d < box->dim; d++)
+    for (int d = 0; d < a->n_split; d++)
         n *= (uint32_t)a->split[d];
-    for (uint32_t k = 0; k < n; k++) {
+    return n;
+}
+
+/* The box cut into a->split[d] nearly equal parts per dimension. */
+static void split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
+{
+    for (uint32_t k = 0; k < split_count(a); k++) {
         uint32_t rest = k;
         boxes[k] = *box;
         for (int d = 0; d < box->dim; d++) {
@@ -332,7 +337,6 @@ static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxe
             boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts;
         }
     }
-    return n;
 }
 
 static cm_status solve_split(const solve_args *a, const cm_model *m, const cm_lattice *lat,
@@ -340,10 +344,11 @@ static cm_status solve_split(const solve_args *a, const cm_model *m, const cm_la
                              size_t msg_size)
 {
     const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
-    cm_box *boxes = malloc(MAX_SPLIT * sizeof *boxes);
+    const uint32_t n = split_count(a);
+    cm_box *boxes = malloc(n * sizeof *boxes);
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
-    const uint32_t n = split_boxes(a, box, boxes);
+    split_boxes(a, box, boxes);
     cm_cluster c;
     cm_cluster_init(&c, lat);
     *t = (timing){"regions and joins", "flattening", 0, 0};

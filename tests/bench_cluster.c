@@ -5,35 +5,17 @@
  * Prints medians of `repeats` runs on 2 threads: SCM of one region, the join
  * of the second region into the first, the clustered total (both regions
  * solved concurrently, then joined) and SCM on the union, in ms and ns per
- * cell of the joined regions, and the ratio clustered / union.
+ * cell of the joined regions, the ratio clustered / union, and the cluster's
+ * bytes per cell (cell arrays, exit tables, escape lists).
  *
  * usage: bench_cluster [repeats (default 5)] [max million cells per region (default 8)] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
 #include "cellmap/cluster.h"
+#include "bench_util.h"
 #include "models/registry.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, compare);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static void die(const char *msg)
 {
@@ -53,8 +35,8 @@ int main(int argc, char **argv)
     if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
         die(msg);
     const double millions[] = {0.5, 1, 2, 4, 8};
-    printf("%9s %9s %9s %9s %9s %9s %11s %11s %6s %8s\n", "cells/reg", "region_ms", "join_ms",
-           "clust_ms", "union_ms", "walked", "join_ns/c", "clust_ns/c", "ratio", "groups");
+    printf("%9s %9s %9s %9s %9s %9s %11s %11s %6s %8s %8s\n", "cells/reg", "region_ms", "join_ms",
+           "clust_ms", "union_ms", "walked", "join_ns/c", "clust_ns/c", "ratio", "bytes/c", "groups");
     for (int s = 0; s < 5 && millions[s] <= max_million; s++) {
         const int64_t side = (int64_t)llround(sqrt(millions[s] * 1e6));
         const cm_lattice lat = {2, {85.4, -12.5}, {200.0 / (double)side, 25.0 / (double)side}};
@@ -63,6 +45,7 @@ int main(int argc, char **argv)
         double t_region[100], t_join[100], t_clust[100], t_union[100];
         uint64_t walked = 0;
         uint32_t groups = 0;
+        double bytes = 0;
         for (int k = -1; k < repeats; k++) {
             const cm_scm_options opt = {1, 2, NULL, NULL, 1};
             const cm_scm_options plain = {1, 2, NULL, NULL, 0};
@@ -85,6 +68,7 @@ int main(int argc, char **argv)
             double t3 = now();
             groups = c.ngroups;
             walked = stats.walked_cells;
+            bytes = (double)cm_cluster_bytes(&c);
             cm_cluster_free(&c);
             /* clustered total: regions concurrently, then joined */
             cm_cluster_init(&c, &lat);
@@ -114,10 +98,10 @@ int main(int argc, char **argv)
         const double n2 = 2.0 * (double)(side * side);
         const double join = median(t_join, repeats), clust = median(t_clust, repeats),
                      uni = median(t_union, repeats);
-        printf("%9lld %9.1f %9.1f %9.1f %9.1f %9llu %11.2f %11.2f %6.3f %8u\n",
+        printf("%9lld %9.1f %9.1f %9.1f %9.1f %9llu %11.2f %11.2f %6.3f %8.2f %8u\n",
                (long long)(side * side), 1e3 * median(t_region, repeats), 1e3 * join,
                1e3 * clust, 1e3 * uni, (unsigned long long)walked, 1e9 * join / n2,
-               1e9 * clust / n2, clust / uni, groups);
+               1e9 * clust / n2, clust / uni, bytes / n2, groups);
         fflush(stdout);
     }
     cm_model_release(&m);
