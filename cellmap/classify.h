@@ -16,10 +16,10 @@
 
 #include "cellmap/status.h"
 
-/* While cells are walked (here and when joining regions into a cluster),
- * step[] holds each cell's state: CM_STEP_UNVISITED, CM_STEP_ON_PATH |
- * position for a cell on a walk, or, below CM_STEP_ON_PATH, the final step
- * number. Group ids stay at most CM_MAX_GROUPS. */
+/* While cells are walked, step[] holds each cell's state: CM_STEP_UNVISITED,
+ * CM_STEP_ON_PATH | position for a cell on a walk, or, below
+ * CM_STEP_ON_PATH, the final step number (joins flag the cells they resolve
+ * again with CM_STEP_ON_PATH too). Group ids stay at most CM_MAX_GROUPS. */
 #define CM_STEP_UNVISITED UINT32_C(0xFFFFFFFF)
 #define CM_STEP_ON_PATH UINT32_C(0x80000000)
 #define CM_MAX_GROUPS UINT32_C(0xFFFFFEFF)

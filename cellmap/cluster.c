@@ -1,6 +1,8 @@
 #include "cellmap/cluster.h"
 
 #include "cellmap/classify.h"
+#include "cellmap/grow.h"
+#include "cellmap/resolve.h"
 
 #include <stdbool.h>
 #include <stdlib.h>
@@ -8,11 +10,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-/* Cells to be walked again are marked in step[] as classify.h describes. */
-typedef struct cell_ref {
-    uint32_t region, index;
-} cell_ref;
 
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
 {
@@ -33,14 +30,15 @@ void cm_cluster_free(cm_cluster *c)
     memset(c, 0, sizeof *c);
 }
 
-int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local)
+int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
+                          uint64_t *local)
 {
     for (uint32_t n = 0; n < c->nregions; n++) {
         /* try the region of the last hit first: exits mostly land next door */
-        const uint32_t k = (c->hint + n) % c->nregions;
+        const uint32_t k = (*hint + n) % c->nregions;
         const cm_box *box = &c->regions[k].r.box;
         if (cm_box_contains(box, cell)) {
-            c->hint = k;
+            *hint = k;
             *local = cm_box_index(box, cell);
             return k;
         }
@@ -94,21 +92,11 @@ static cm_status add_target(cm_cluster_region *cr, uint32_t region)
     for (uint32_t t = 0; t < cr->ntargets; t++)
         if (cr->targets[t] == region)
             return CM_OK;
-    if (cr->ntargets == cr->targets_cap) {
-        const uint32_t cap = cr->targets_cap ? 2 * cr->targets_cap : 4;
-        uint32_t *t = realloc(cr->targets, cap * sizeof *t);
-        if (!t)
-            return CM_ENOMEM;
-        cr->targets = t;
-        cr->targets_cap = cap;
-    }
+    if (cm_grow((void **)&cr->targets, &cr->targets_cap, cr->ntargets + 1,
+                sizeof *cr->targets) != CM_OK)
+        return CM_ENOMEM;
     cr->targets[cr->ntargets++] = region;
     return CM_OK;
-}
-
-static const int64_t *exit_target(const cm_region *r, uint64_t exit)
-{
-    return r->exit_target + exit * (uint64_t)r->box.dim;
 }
 
 /* Escapes of the older regions that land in the new region `added` become
@@ -120,7 +108,7 @@ static cm_status update_links(cm_cluster *c, uint32_t added)
         cm_cluster_region *cr = &c->regions[k];
         uint64_t kept = 0;
         for (uint64_t e = 0; e < cr->nescapes; e++) {
-            if (!cm_box_contains(new_box, exit_target(&cr->r, cr->escapes[e])))
+            if (!cm_box_contains(new_box, cm_region_exit(&cr->r, cr->escapes[e])))
                 cr->escapes[kept++] = cr->escapes[e];
             else if (add_target(cr, added) != CM_OK)
                 return CM_ENOMEM;
@@ -131,9 +119,10 @@ static cm_status update_links(cm_cluster *c, uint32_t added)
     nr->escapes = malloc((nr->r.nexits + 1) * sizeof *nr->escapes);
     if (!nr->escapes)
         return CM_ENOMEM;
+    uint32_t hint = 0;
     for (uint64_t e = 0; e < nr->r.nexits; e++) {
         uint64_t local;
-        const int64_t k = cm_cluster_find(c, exit_target(&nr->r, e), &local);
+        const int64_t k = cm_cluster_locate(c, cm_region_exit(&nr->r, e), &hint, &local);
         if (k < 0)
             nr->escapes[nr->nescapes++] = (uint32_t)e;
         else if (add_target(nr, (uint32_t)k) != CM_OK)
@@ -166,116 +155,6 @@ static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affe
     return count;
 }
 
-/* The cell after `at` in the cluster; false when the sequence leaves it. */
-static bool next_cell(cm_cluster *c, cell_ref at, cell_ref *next)
-{
-    const cm_region *r = &c->regions[at.region].r;
-    const uint32_t v = r->image[at.index];
-    if (v < r->ncells) {
-        *next = (cell_ref){at.region, v};
-        return true;
-    }
-    const int64_t e = cm_image_exit_index(v);
-    uint64_t local;
-    const int64_t k = e < 0 ? -1 : cm_cluster_find(c, exit_target(r, (uint64_t)e), &local);
-    if (k < 0)
-        return false;
-    *next = (cell_ref){(uint32_t)k, (uint32_t)local};
-    return true;
-}
-
-typedef struct walk {
-    cell_ref *path;
-    uint64_t len, cap;
-} walk;
-
-static cm_status walk_push(walk *w, cell_ref cell)
-{
-    if (w->len == w->cap) {
-        const uint64_t cap = w->cap ? 2 * w->cap : 4096;
-        cell_ref *p = realloc(w->path, cap * sizeof *p);
-        if (!p)
-            return CM_ENOMEM;
-        w->path = p;
-        w->cap = cap;
-    }
-    w->path[w->len++] = cell;
-    return CM_OK;
-}
-
-/* Walks from `start` until the sequence leaves the cluster, reaches a
- * classified cell or closes a cycle on the walk, then labels the walk. */
-static cm_status walk_from(cm_cluster *c, cell_ref start, walk *w, cm_join_stats *stats)
-{
-    w->len = 0;
-    cell_ref at = start, next;
-    bool inside;
-    for (;;) {
-        if (w->len >= CM_STEP_ON_PATH - 1)
-            return CM_ETOOBIG;
-        cm_status st = walk_push(w, at);
-        if (st != CM_OK)
-            return st;
-        c->regions[at.region].r.step[at.index] = CM_STEP_ON_PATH | (uint32_t)(w->len - 1);
-        inside = next_cell(c, at, &next);
-        if (!inside || c->regions[next.region].r.step[next.index] != CM_STEP_UNVISITED)
-            break;
-        at = next;
-    }
-    uint32_t group = 0, cycle_at = UINT32_MAX, tail = 0;
-    if (inside) {
-        const cm_region *nr = &c->regions[next.region].r;
-        const uint32_t s = nr->step[next.index];
-        if (s & CM_STEP_ON_PATH) {
-            if (c->ngroups == CM_MAX_GROUPS)
-                return CM_ETOOBIG;
-            group = ++c->ngroups;
-            cycle_at = s & ~CM_STEP_ON_PATH;
-            stats->straddling_groups++;
-        } else {
-            group = nr->group[next.index];
-            tail = s;
-        }
-    }
-    if (cycle_at == UINT32_MAX && (uint64_t)tail + w->len >= CM_STEP_ON_PATH)
-        return CM_ETOOBIG;
-    for (uint64_t p = 0; p < w->len; p++) {
-        cm_region *r = &c->regions[w->path[p].region].r;
-        r->group[w->path[p].index] = group;
-        if (cycle_at == UINT32_MAX)
-            r->step[w->path[p].index] = tail + (uint32_t)(w->len - p);
-        else
-            r->step[w->path[p].index] = p >= cycle_at ? 0 : cycle_at - (uint32_t)p;
-    }
-    stats->walked_cells += w->len;
-    return CM_OK;
-}
-
-/* Walks the sink cells of the affected regions again, across borders. */
-static cm_status rewalk(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats)
-{
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        if (!affected[k])
-            continue;
-        cm_region *r = &c->regions[k].r;
-        for (uint64_t i = 0; i < r->ncells; i++)
-            if (r->group[i] == 0)
-                r->step[i] = CM_STEP_UNVISITED;
-    }
-    walk w = {NULL, 0, 0};
-    cm_status st = CM_OK;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
-        if (!affected[k])
-            continue;
-        const cm_region *r = &c->regions[k].r;
-        for (uint64_t i = 0; i < r->ncells && st == CM_OK; i++)
-            if (r->step[i] == CM_STEP_UNVISITED)
-                st = walk_from(c, (cell_ref){k, (uint32_t)i}, &w, stats);
-    }
-    free(w.path);
-    return st;
-}
-
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
                           size_t msg_size)
 {
@@ -286,14 +165,8 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     cm_status st = check_region(c, r, msg, msg_size);
     if (st != CM_OK)
         return st;
-    if (c->nregions == c->cap) {
-        const uint32_t cap = c->cap ? 2 * c->cap : 8;
-        cm_cluster_region *regions = realloc(c->regions, cap * sizeof *regions);
-        if (!regions)
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
-        c->regions = regions;
-        c->cap = cap;
-    }
+    if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
     /* the region's own groups take the next cluster-wide ids */
     for (uint64_t i = 0; i < r->ncells; i++)
         if (r->group[i] != 0)
@@ -308,7 +181,7 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     st = affected ? update_links(c, added) : CM_ENOMEM;
     if (st == CM_OK) {
         stats->affected_regions = mark_affected(c, added, affected);
-        st = rewalk(c, affected, stats);
+        st = cm_resolve_sink_cells(c, affected, stats);
     }
     free(affected);
     stats->new_groups += stats->straddling_groups;
@@ -370,7 +243,7 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
     if (v < r->ncells)
         cm_box_cell(&r->box, v, cell);
     else if (e >= 0)
-        memcpy(cell, exit_target(r, (uint64_t)e), (size_t)box->dim * sizeof *cell);
+        memcpy(cell, cm_region_exit(r, (uint64_t)e), (size_t)box->dim * sizeof *cell);
     else
         return CM_IMAGE_SINK;
     return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;

@@ -10,15 +10,16 @@
  * Joining a region changes only cells whose sequences used to leave the
  * cluster into the new region: the cells of the sink's domain in the regions
  * from which the new one can be reached through exits, and the new region's
- * own. These are walked again across region borders: a walk that reaches a
- * classified cell takes its group (Stage 1 of the thesis); walks that close a
- * cycle across borders create the groups that straddle them (Stage 2).
- * Existing group ids never change; groups of the new region and straddling
- * groups get the next ids in a deterministic order.
+ * own. These are resolved again across region borders (cellmap/resolve.h):
+ * a sequence that reaches a classified cell takes its group (Stage 1 of the
+ * thesis); sequences that close a cycle across borders create the groups
+ * that straddle them (Stage 2). Existing group ids never change; groups of
+ * the new region and straddling groups get the next ids in a fixed order.
  *
  * The invariant (tests/test_cluster.c): for regions tiling a box, the result
  * equals cm_scm_solve on the box, cell by cell, up to the numbering of groups.
- * Not thread-safe; one cluster per thread.
+ * A join uses c->threads threads; the result does not depend on them. One
+ * cluster must not be joined into from two threads at once.
  */
 #ifndef CM_CLUSTER_H
 #define CM_CLUSTER_H
@@ -33,20 +34,23 @@ typedef struct cm_cluster_region {
     uint32_t *escapes;  /* exits whose target lies outside the cluster */
     uint64_t nescapes;
     uint32_t *targets;  /* regions that exits lead into (no duplicates) */
-    uint32_t ntargets, targets_cap;
+    uint32_t ntargets;
+    uint64_t targets_cap;
 } cm_cluster_region;
 
 typedef struct cm_cluster {
     cm_lattice lat;
     cm_cluster_region *regions; /* in the order they were joined */
-    uint32_t nregions, cap;
+    uint32_t nregions;
+    uint64_t cap;
     uint32_t ngroups; /* cluster-wide group ids 1..ngroups */
-    uint32_t hint;    /* region of the last lookup */
+    int threads;      /* OpenMP threads for joins; 0: the OpenMP default */
 } cm_cluster;
 
 typedef struct cm_join_stats {
-    uint32_t affected_regions; /* regions whose sink cells were walked again */
-    uint64_t walked_cells;     /* cells walked again */
+    uint32_t affected_regions; /* regions whose sink cells were resolved again */
+    uint64_t resolved_cells;   /* sink cells of those regions resolved again */
+    uint64_t nodes;            /* of those, cells whose image leaves their region */
     uint32_t new_groups;       /* groups of the new region plus straddling ones */
     uint32_t straddling_groups;
 } cm_join_stats;
@@ -66,8 +70,10 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
                                  uint32_t nboxes, const cm_scm_options *opt, char *msg,
                                  size_t msg_size);
 
-/* The region holding the cell and the cell's local index, or -1. */
-int64_t cm_cluster_find(cm_cluster *c, const int64_t *cell, uint64_t *local);
+/* The region holding the cell and the cell's local index, or -1. *hint is
+ * the region tried first (any value will do) and is set to the one found. */
+int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
+                          uint64_t *local);
 
 /* Bytes held by the regions' arrays, exit tables and escape lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);

@@ -56,6 +56,12 @@ typedef struct cm_region {
     int64_t *exit_target; /* nexits * box.dim cell coordinates, in local index order */
 } cm_region;
 
+/* Target cell of recorded exit k of a region (box.dim coordinates). */
+static inline const int64_t *cm_region_exit(const cm_region *r, uint64_t k)
+{
+    return r->exit_target + k * (uint64_t)r->box.dim;
+}
+
 /* Progress callback: fraction done in [0, 1]; return nonzero to cancel. */
 typedef int (*cm_progress_fn)(void *user, const char *phase, double fraction);
 

@@ -351,6 +351,7 @@ static cm_status solve_split(const solve_args *a, const cm_model *m, const cm_la
     split_boxes(a, box, boxes);
     cm_cluster c;
     cm_cluster_init(&c, lat);
+    c.threads = a->threads;
     *t = (timing){"regions and joins", "flattening", 0, 0};
     const double t0 = now_seconds();
     cm_status st = cm_cluster_solve_boxes(&c, m, boxes, n, &opt, msg, msg_size);

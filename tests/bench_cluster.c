@@ -35,15 +35,15 @@ int main(int argc, char **argv)
     if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
         die(msg);
     const double millions[] = {0.5, 1, 2, 4, 8};
-    printf("%9s %9s %9s %9s %9s %9s %11s %11s %6s %8s %8s\n", "cells/reg", "region_ms", "join_ms",
-           "clust_ms", "union_ms", "walked", "join_ns/c", "clust_ns/c", "ratio", "bytes/c", "groups");
+    printf("%9s %9s %9s %9s %9s %9s %9s %11s %11s %6s %8s %8s\n", "cells/reg", "region_ms", "join_ms",
+           "clust_ms", "union_ms", "resolved", "nodes", "join_ns/c", "clust_ns/c", "ratio", "bytes/c", "groups");
     for (int s = 0; s < 5 && millions[s] <= max_million; s++) {
         const int64_t side = (int64_t)llround(sqrt(millions[s] * 1e6));
         const cm_lattice lat = {2, {85.4, -12.5}, {200.0 / (double)side, 25.0 / (double)side}};
         const cm_box boxes[2] = {{2, {0, 0}, {side, side}}, {2, {side, 0}, {2 * side, side}}};
         const cm_box whole = {2, {0, 0}, {2 * side, side}};
         double t_region[100], t_join[100], t_clust[100], t_union[100];
-        uint64_t walked = 0;
+        uint64_t resolved = 0, nodes = 0;
         uint32_t groups = 0;
         double bytes = 0;
         for (int k = -1; k < repeats; k++) {
@@ -54,6 +54,7 @@ int main(int argc, char **argv)
             cm_region r[2];
             cm_join_stats stats;
             cm_cluster_init(&c, &lat);
+            c.threads = 2;
             double t0 = now();
             for (int j = 0; j < 2; j++)
                 if (cm_region_alloc(&r[j], &boxes[j], msg, sizeof msg) != CM_OK ||
@@ -67,11 +68,13 @@ int main(int argc, char **argv)
                 die(msg);
             double t3 = now();
             groups = c.ngroups;
-            walked = stats.walked_cells;
+            resolved = stats.resolved_cells;
+            nodes = stats.nodes;
             bytes = (double)cm_cluster_bytes(&c);
             cm_cluster_free(&c);
             /* clustered total: regions concurrently, then joined */
             cm_cluster_init(&c, &lat);
+            c.threads = 2;
             const double t4 = now();
             if (cm_cluster_solve_boxes(&c, &m, boxes, 2, &opt, msg, sizeof msg) != CM_OK)
                 die(msg);
@@ -98,9 +101,9 @@ int main(int argc, char **argv)
         const double n2 = 2.0 * (double)(side * side);
         const double join = median(t_join, repeats), clust = median(t_clust, repeats),
                      uni = median(t_union, repeats);
-        printf("%9lld %9.1f %9.1f %9.1f %9.1f %9llu %11.2f %11.2f %6.3f %8.2f %8u\n",
+        printf("%9lld %9.1f %9.1f %9.1f %9.1f %9llu %9llu %11.2f %11.2f %6.3f %8.2f %8u\n",
                (long long)(side * side), 1e3 * median(t_region, repeats), 1e3 * join,
-               1e3 * clust, 1e3 * uni, (unsigned long long)walked, 1e9 * join / n2,
+               1e3 * clust, 1e3 * uni, (unsigned long long)resolved, (unsigned long long)nodes, 1e9 * join / n2,
                1e9 * clust / n2, clust / uni, bytes / n2, groups);
         fflush(stdout);
     }

@@ -326,12 +326,14 @@ static void test_ids_stable(void)
     cm_model_release(&m);
 }
 
-/* cm_cluster_solve_boxes gives the same bytes with 1 and 2 threads. */
+/* cm_cluster_solve_boxes gives the same bytes with 1 and 2 threads, for the
+ * regions and for the joins (regions big enough for the joins' parallel
+ * passes). */
 static void test_threads_identical(void)
 {
     cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
-    const cm_lattice lat = {2, {0, -40}, {1, 0.25}};
-    const cm_box whole = {2, {0, 0}, {500, 320}};
+    const cm_lattice lat = {2, {0, -40}, {0.5, 0.125}};
+    const cm_box whole = {2, {0, 0}, {1000, 640}};
     static const double f[] = {0.3, 0.55};
     cm_box boxes[9];
     const uint32_t n = tile(&whole, f, 2, f, 2, boxes);
@@ -340,6 +342,7 @@ static void test_threads_identical(void)
     for (int t = 0; t < 2; t++) {
         cm_cluster c;
         cm_cluster_init(&c, &lat);
+        c.threads = t + 1;
         const cm_scm_options opt = {1, t + 1, NULL, NULL, 1};
         CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, msg, sizeof msg) == CM_OK);
         CHECK(cm_cluster_flatten(&c, &whole, &flat[t], msg, sizeof msg) == CM_OK);

@@ -1,0 +1,30 @@
+/* cellmap/grow.h - growable arrays: the one place that doubles a buffer. */
+#ifndef CM_GROW_H
+#define CM_GROW_H
+
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "cellmap/status.h"
+
+/* Makes room for at least `need` items of `item_size` bytes in *items
+ * (capacity *cap, doubled as needed, at least 16). On failure *items is
+ * unchanged and CM_ENOMEM returned. */
+static inline cm_status cm_grow(void **items, uint64_t *cap, uint64_t need, size_t item_size)
+{
+    if (need <= *cap)
+        return CM_OK;
+    uint64_t new_cap = *cap ? *cap : 16;
+    while (new_cap < need)
+        new_cap *= 2;
+    if (new_cap > SIZE_MAX / item_size)
+        return CM_ENOMEM;
+    void *p = realloc(*items, (size_t)new_cap * item_size);
+    if (!p)
+        return CM_ENOMEM;
+    *items = p;
+    *cap = new_cap;
+    return CM_OK;
+}
+
+#endif

@@ -1,0 +1,503 @@
+#include "cellmap/resolve.h"
+
+#include "cellmap/classify.h"
+#include "cellmap/grow.h"
+
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* step[] of a sink cell that is being resolved: this flag plus its old step
+ * number. Cells without the flag hold final values. */
+#define PENDING CM_STEP_ON_PATH
+#define NO_NODE UINT32_MAX
+/* A region with fewer sink cells is resolved on one thread. */
+#define PARALLEL_MIN_CELLS 65536
+
+enum node_state {
+    NODE_NEW,          /* linked, not yet resolved */
+    NODE_ON_WALK,      /* on the current walk; step holds the position */
+    NODE_DONE,         /* group and step final */
+    NODE_CYCLE,        /* on a cycle across borders: step 0 */
+    NODE_CYCLE_BOUND   /* leads into such a cycle; step still to count */
+};
+
+/* A sink cell whose image leaves its region: the root of a tree of sink cells. */
+typedef struct node {
+    uint32_t region, cell;
+    uint32_t next;  /* the node whose tree the image lies in, or NO_NODE */
+    uint32_t dist;  /* steps from this cell to next's cell */
+    uint32_t old_step; /* before the join */
+    uint32_t group, step;
+    uint32_t state; /* enum node_state */
+} node;
+
+/* A region's sink cells in order of their old step number. */
+typedef struct step_order {
+    uint32_t *cells;
+    uint32_t *start; /* cells of step s: cells[start[s] .. start[s + 1]) */
+    uint64_t nsteps, start_cap;
+} step_order;
+
+typedef struct u32_stack {
+    uint32_t *v;
+    uint64_t len, cap;
+} u32_stack;
+
+typedef struct resolver {
+    cm_cluster *c;
+    const uint8_t *affected;
+    int threads;
+    step_order *orders; /* per region; empty where not affected */
+    node *nodes;
+    uint64_t nnodes, nodes_cap;
+    u32_stack walk;  /* nodes of a walk */
+    u32_stack chain; /* cells of a chain in one region */
+} resolver;
+
+/* a + b as a step number, or CM_ETOOBIG */
+static cm_status add_steps(uint32_t a, uint32_t b, uint32_t *sum)
+{
+    if ((uint64_t)a + b >= PENDING)
+        return CM_ETOOBIG;
+    *sum = a + b;
+    return CM_OK;
+}
+
+static cm_status push(u32_stack *stack, uint32_t value)
+{
+    if (cm_grow((void **)&stack->v, &stack->cap, stack->len + 1, sizeof *stack->v) != CM_OK)
+        return CM_ENOMEM;
+    stack->v[stack->len++] = value;
+    return CM_OK;
+}
+
+/* The sink cells of one part of a region, counted by step number. */
+typedef struct part_count {
+    uint32_t *count; /* then the next position in cells[] of each step */
+    uint64_t nsteps, cap;
+    uint64_t nodes, sink;
+    uint32_t node_base; /* id of the part's first node */
+    int failed;
+} part_count;
+
+/* Counts the part's sink cells by step number and flags them PENDING. */
+static void count_part(cm_region *r, uint64_t lo, uint64_t hi, part_count *pc)
+{
+    const uint32_t *group = r->group, *image = r->image;
+    uint32_t *step = r->step;
+    const uint64_t n = r->ncells;
+    uint64_t nodes = 0, sink = 0;
+    for (uint64_t i = lo; i < hi; i++) {
+        if (group[i] != 0)
+            continue;
+        const uint32_t s = step[i];
+        if (s >= pc->nsteps) {
+            if (cm_grow((void **)&pc->count, &pc->cap, (uint64_t)s + 1, sizeof *pc->count) !=
+                CM_OK) {
+                pc->failed = 1;
+                break;
+            }
+            memset(pc->count + pc->nsteps, 0, (s + 1 - pc->nsteps) * sizeof *pc->count);
+            pc->nsteps = (uint64_t)s + 1;
+        }
+        pc->count[s]++;
+        step[i] = s | PENDING;
+        nodes += image[i] >= n;
+        sink++;
+    }
+    pc->nodes = nodes;
+    pc->sink = sink;
+}
+
+/* Bucket beginnings for all parts together, in part order within a step
+ * (so the order is that of one sequential pass), and node ids per part. */
+static cm_status plan_parts(resolver *rs, step_order *o, part_count *parts, int nparts)
+{
+    uint64_t nsteps = 0, nodes = rs->nnodes;
+    for (int t = 0; t < nparts; t++) {
+        if (parts[t].failed)
+            return CM_ENOMEM;
+        nsteps = parts[t].nsteps > nsteps ? parts[t].nsteps : nsteps;
+        parts[t].node_base = (uint32_t)nodes;
+        nodes += parts[t].nodes;
+        if (nodes >= NO_NODE)
+            return CM_ETOOBIG;
+    }
+    for (int t = 0; t < nparts; t++) {
+        part_count *pc = &parts[t];
+        if (cm_grow((void **)&pc->count, &pc->cap, nsteps, sizeof *pc->count) != CM_OK)
+            return CM_ENOMEM;
+        memset(pc->count + pc->nsteps, 0, (nsteps - pc->nsteps) * sizeof *pc->count);
+    }
+    o->nsteps = nsteps + 1;
+    o->start = malloc(o->nsteps * sizeof *o->start);
+    if (!o->start ||
+        cm_grow((void **)&rs->nodes, &rs->nodes_cap, nodes, sizeof *rs->nodes) != CM_OK)
+        return CM_ENOMEM;
+    uint32_t pos = 0;
+    for (uint64_t s = 0; s < nsteps; s++) {
+        o->start[s] = pos;
+        for (int t = 0; t < nparts; t++) {
+            const uint32_t count = parts[t].count[s];
+            parts[t].count[s] = pos;
+            pos += count;
+        }
+    }
+    o->start[nsteps] = pos;
+    rs->nnodes = nodes;
+    o->cells = malloc(((uint64_t)pos + 1) * sizeof *o->cells);
+    return o->cells ? CM_OK : CM_ENOMEM;
+}
+
+/* Puts the part's sink cells in step order and makes each one whose image
+ * leaves the region a node (its id in group[]). */
+static void place_part(const resolver *rs, uint32_t k, uint64_t lo, uint64_t hi, part_count *pc)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    uint32_t *cells = rs->orders[k].cells;
+    for (uint64_t i = lo; i < hi; i++) {
+        const uint32_t s = r->step[i];
+        if (!(s & PENDING))
+            continue;
+        cells[pc->count[s & ~PENDING]++] = (uint32_t)i;
+        if (r->image[i] >= r->ncells) {
+            const uint32_t id = pc->node_base++;
+            r->group[i] = id;
+            rs->nodes[id] = (node){k, (uint32_t)i, NO_NODE, 0, s & ~PENDING, 0, 0, NODE_NEW};
+        }
+    }
+}
+
+/* Region k's sink cells sorted by old step number (a counting sort over
+ * parts of the region in parallel). */
+static cm_status order_region(resolver *rs, uint32_t k, uint64_t *nsink)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    const int nparts = r->ncells >= PARALLEL_MIN_CELLS ? rs->threads : 1;
+    part_count *parts = calloc((size_t)nparts, sizeof *parts);
+    if (!parts)
+        return CM_ENOMEM;
+#define PART_LO(t) (r->ncells * (uint64_t)(t) / (uint64_t)nparts)
+#pragma omp parallel for schedule(static, 1) num_threads(nparts)
+    for (int t = 0; t < nparts; t++)
+        count_part(r, PART_LO(t), PART_LO(t + 1), &parts[t]);
+    cm_status st = plan_parts(rs, &rs->orders[k], parts, nparts);
+    if (st == CM_OK) {
+#pragma omp parallel for schedule(static, 1) num_threads(nparts)
+        for (int t = 0; t < nparts; t++)
+            place_part(rs, k, PART_LO(t), PART_LO(t + 1), &parts[t]);
+    }
+#undef PART_LO
+    *nsink = 0;
+    for (int t = 0; t < nparts; t++) {
+        *nsink += parts[t].sink;
+        free(parts[t].count);
+    }
+    free(parts);
+    return st;
+}
+
+/* The root pass reads the image of each cell of a step and then the
+ * image's group: independent cache misses, fetched this many cells ahead
+ * (the image entry twice as far ahead) so that they overlap. */
+#define AHEAD 16
+
+/* Pass 1: every sink cell takes the node at the root of its tree. */
+static void propagate_roots(const resolver *rs, uint32_t k)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    const step_order *o = &rs->orders[k];
+    const uint32_t *image = r->image, *cells = o->cells;
+    uint32_t *group = r->group;
+    const uint32_t n = (uint32_t)r->ncells;
+#pragma omp parallel num_threads(rs->threads) if (o->start[o->nsteps - 1] >= PARALLEL_MIN_CELLS)
+    for (uint64_t s = 0; s + 1 < o->nsteps; s++) {
+        const int64_t end = o->start[s + 1];
+#pragma omp for schedule(static)
+        for (int64_t p = o->start[s]; p < end; p++) {
+            if (p + 2 * AHEAD < end)
+                __builtin_prefetch(&image[cells[p + 2 * AHEAD]]);
+            if (p + AHEAD < end && image[cells[p + AHEAD]] < n)
+                __builtin_prefetch(&group[image[cells[p + AHEAD]]]);
+            const uint32_t i = cells[p], j = image[i];
+            if (j < n)
+                group[i] = group[j];
+        }
+    }
+}
+
+/* Where node id's exit leads: a final value, or the tree of another node. */
+static cm_status link_node(const resolver *rs, uint32_t id, uint32_t *hint)
+{
+    const cm_cluster *c = rs->c;
+    node *nd = &rs->nodes[id];
+    const cm_region *r = &c->regions[nd->region].r;
+    const int64_t e = cm_image_exit_index(r->image[nd->cell]);
+    nd->state = NODE_DONE; /* the sequence leaves the cluster (or the world) */
+    nd->group = 0;
+    nd->step = 1;
+    uint64_t local;
+    const int64_t k =
+        e < 0 ? -1 : cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), hint, &local);
+    if (k < 0)
+        return CM_OK;
+    const cm_region *tr = &c->regions[k].r;
+    const uint32_t s = tr->step[local];
+    if (!(s & PENDING)) { /* a classified cell, or a sink cell that stays */
+        nd->group = tr->group[local];
+        return add_steps(s, 1, &nd->step);
+    }
+    /* In a tree without cycle cells, the chain from the target to the root
+     * is as long as the difference of their old step numbers. */
+    nd->next = tr->group[local];
+    nd->dist = 1 + (s & ~PENDING) - rs->nodes[nd->next].old_step;
+    nd->state = NODE_NEW;
+    return CM_OK;
+}
+
+static cm_status link_nodes(resolver *rs)
+{
+    int failed = 0; /* the only failure is a step number overflow */
+#pragma omp parallel num_threads(rs->threads) if (rs->nnodes >= PARALLEL_MIN_CELLS / 4)
+    {
+        uint32_t hint = 0; /* exits mostly land in the region of the last one */
+#pragma omp for schedule(static) reduction(| : failed)
+        for (int64_t id = 0; id < (int64_t)rs->nnodes; id++)
+            failed |= link_node(rs, (uint32_t)id, &hint) != CM_OK;
+    }
+    return failed ? CM_ETOOBIG : CM_OK;
+}
+
+/* The cell after `at`, following exits into the cluster (at is on a cycle). */
+static void next_cell(const cm_cluster *c, uint32_t *region, uint32_t *cell, uint32_t *hint)
+{
+    const cm_region *r = &c->regions[*region].r;
+    const uint32_t v = r->image[*cell];
+    if (v < r->ncells) {
+        *cell = v;
+        return;
+    }
+    uint64_t local;
+    const int64_t e = cm_image_exit_index(v);
+    *region = (uint32_t)cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), hint, &local);
+    *cell = (uint32_t)local;
+}
+
+/* Gives the cells of the cycle through node `start` group g and step 0. */
+static void mark_cycle(const resolver *rs, uint32_t start, uint32_t g)
+{
+    const node *nd = &rs->nodes[start];
+    uint32_t region = nd->region, cell = nd->cell, hint = region;
+    do {
+        cm_region *r = &rs->c->regions[region].r;
+        r->group[cell] = g;
+        r->step[cell] = 0;
+        next_cell(rs->c, &region, &cell, &hint);
+    } while (region != nd->region || cell != nd->cell);
+}
+
+/* The walk on the stack ended at node x: a cycle (new group) if x is on it. */
+static cm_status close_walk(resolver *rs, uint32_t x, cm_join_stats *stats)
+{
+    const uint32_t *walk = rs->walk.v;
+    uint64_t len = rs->walk.len;
+    if (rs->nodes[x].state == NODE_ON_WALK) {
+        if (rs->c->ngroups == CM_MAX_GROUPS)
+            return CM_ETOOBIG;
+        const uint32_t g = ++rs->c->ngroups;
+        stats->straddling_groups++;
+        const uint64_t from = rs->nodes[x].step;
+        for (uint64_t p = from; p < len; p++) {
+            node *y = &rs->nodes[walk[p]];
+            y->group = g;
+            y->step = 0;
+            y->state = NODE_CYCLE;
+        }
+        mark_cycle(rs, x, g);
+        len = from;
+    }
+    for (uint64_t p = len; p-- > 0;) {
+        node *y = &rs->nodes[walk[p]];
+        const node *next = &rs->nodes[y->next];
+        y->group = next->group;
+        y->state = next->state == NODE_DONE ? NODE_DONE : NODE_CYCLE_BOUND;
+        if (y->state == NODE_DONE && add_steps(next->step, y->dist, &y->step) != CM_OK)
+            return CM_ETOOBIG;
+    }
+    return CM_OK;
+}
+
+/* Walks the graph of nodes in id order: each walk ends at a resolved node or
+ * closes a cycle across region borders. */
+static cm_status walk_nodes(resolver *rs, cm_join_stats *stats)
+{
+    for (uint64_t first = 0; first < rs->nnodes; first++) {
+        rs->walk.len = 0;
+        uint32_t x = (uint32_t)first;
+        while (rs->nodes[x].state == NODE_NEW) {
+            rs->nodes[x].state = NODE_ON_WALK;
+            rs->nodes[x].step = (uint32_t)rs->walk.len;
+            if (push(&rs->walk, x) != CM_OK)
+                return CM_ENOMEM;
+            x = rs->nodes[x].next;
+        }
+        if (rs->walk.len > 0) {
+            cm_status st = close_walk(rs, x, stats);
+            if (st != CM_OK)
+                return st;
+        }
+    }
+    return CM_OK;
+}
+
+/* Steps from `cell` of region k, in the tree of a cycle node, to the cycle;
+ * the cells of the chain on the way are resolved too. */
+static cm_status steps_to_cycle(resolver *rs, uint32_t k, uint32_t cell, uint32_t *steps)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    rs->chain.len = 0;
+    while (r->step[cell] & PENDING) {
+        if (push(&rs->chain, cell) != CM_OK)
+            return CM_ENOMEM;
+        cell = r->image[cell]; /* stays in the region up to the cycle node */
+    }
+    const uint32_t g = r->group[cell];
+    uint32_t s = r->step[cell];
+    for (uint64_t p = rs->chain.len; p-- > 0;) {
+        if (add_steps(s, 1, &s) != CM_OK)
+            return CM_ETOOBIG;
+        r->group[rs->chain.v[p]] = g;
+        r->step[rs->chain.v[p]] = s;
+    }
+    *steps = s;
+    return CM_OK;
+}
+
+/* Step number of node nd, whose exit leads into the tree of a cycle node:
+ * there the chain can meet the cycle before the root, so it is walked. */
+static cm_status cycle_entry_step(resolver *rs, const node *nd, uint32_t *step)
+{
+    uint32_t region = nd->region, cell = nd->cell, hint = region, steps;
+    next_cell(rs->c, &region, &cell, &hint);
+    cm_status st = steps_to_cycle(rs, region, cell, &steps);
+    return st == CM_OK ? add_steps(steps, 1, step) : st;
+}
+
+/* Counts the steps of the nodes that lead into cycles, chain by chain from
+ * the node nearest the cycle. */
+static cm_status count_cycle_bound(resolver *rs)
+{
+    for (uint64_t id = 0; id < rs->nnodes; id++) {
+        rs->walk.len = 0;
+        for (uint32_t x = (uint32_t)id; rs->nodes[x].state == NODE_CYCLE_BOUND;
+             x = rs->nodes[x].next)
+            if (push(&rs->walk, x) != CM_OK)
+                return CM_ENOMEM;
+        for (uint64_t p = rs->walk.len; p-- > 0;) {
+            node *nd = &rs->nodes[rs->walk.v[p]];
+            const node *next = &rs->nodes[nd->next];
+            cm_status st = next->state == NODE_CYCLE ? cycle_entry_step(rs, nd, &nd->step)
+                                                     : add_steps(next->step, nd->dist, &nd->step);
+            if (st != CM_OK)
+                return st;
+            nd->state = NODE_DONE;
+        }
+    }
+    return CM_OK;
+}
+
+/* Pass 2: every pending cell outside the trees of cycle nodes takes its
+ * root node's group, and its step number moves as the root's did. Returns
+ * the number of cells left pending. */
+static uint64_t assign_region(const resolver *rs, uint32_t k, int *overflow)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    uint32_t *group = r->group, *step = r->step;
+    const node *nodes = rs->nodes;
+    uint64_t left = 0;
+    int over = 0;
+#pragma omp parallel for schedule(static) num_threads(rs->threads) \
+    if (r->ncells >= PARALLEL_MIN_CELLS) reduction(+ : left) reduction(| : over)
+    for (int64_t i = 0; i < (int64_t)r->ncells; i++) {
+        if (!(step[i] & PENDING))
+            continue;
+        const node *nd = &nodes[group[i]];
+        if (nd->state == NODE_CYCLE) {
+            left++;
+            continue;
+        }
+        const uint64_t s = (uint64_t)(step[i] & ~PENDING) - nd->old_step + nd->step;
+        over |= s >= PENDING;
+        group[i] = nd->group;
+        step[i] = (uint32_t)s;
+    }
+    *overflow |= over;
+    return left;
+}
+
+/* The cells left in the trees of cycle nodes: their chains can meet the
+ * cycle before the root, so they are walked (these trees are small). */
+static cm_status assign_cycle_trees(resolver *rs, uint32_t k)
+{
+    const cm_region *r = &rs->c->regions[k].r;
+    uint32_t steps;
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (r->step[i] & PENDING) {
+            cm_status st = steps_to_cycle(rs, k, (uint32_t)i, &steps);
+            if (st != CM_OK)
+                return st;
+        }
+    return CM_OK;
+}
+
+static cm_status resolve(resolver *rs, cm_join_stats *stats)
+{
+    const uint32_t nregions = rs->c->nregions;
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < nregions && st == CM_OK; k++) {
+        uint64_t nsink = 0;
+        if (rs->affected[k])
+            st = order_region(rs, k, &nsink);
+        stats->resolved_cells += nsink;
+    }
+    for (uint32_t k = 0; k < nregions && st == CM_OK; k++) {
+        if (!rs->affected[k])
+            continue;
+        propagate_roots(rs, k);
+        free(rs->orders[k].cells); /* the step order is needed for pass 1 only */
+        rs->orders[k].cells = NULL;
+    }
+    stats->nodes = rs->nnodes;
+    if (st == CM_OK)
+        st = link_nodes(rs);
+    if (st == CM_OK)
+        st = walk_nodes(rs, stats);
+    if (st == CM_OK)
+        st = count_cycle_bound(rs);
+    int overflow = 0;
+    for (uint32_t k = 0; k < nregions && st == CM_OK; k++)
+        if (rs->affected[k] && assign_region(rs, k, &overflow) > 0)
+            st = assign_cycle_trees(rs, k);
+    return st == CM_OK && overflow ? CM_ETOOBIG : st;
+}
+
+cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats)
+{
+    resolver rs = {.c = c, .affected = affected, .threads = 1};
+#ifdef _OPENMP
+    rs.threads = c->threads > 0 ? c->threads : omp_get_max_threads();
+#endif
+    rs.orders = calloc(c->nregions, sizeof *rs.orders);
+    cm_status st = rs.orders ? resolve(&rs, stats) : CM_ENOMEM;
+    for (uint32_t k = 0; rs.orders && k < c->nregions; k++) {
+        free(rs.orders[k].cells);
+        free(rs.orders[k].start);
+    }
+    free(rs.orders);
+    free(rs.nodes);
+    free(rs.walk.v);
+    free(rs.chain.v);
+    return st;
+}
