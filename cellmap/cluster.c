@@ -46,6 +46,18 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hi
     return -1;
 }
 
+void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
+{
+    *box = c->regions[0].r.box;
+    for (uint32_t k = 1; k < c->nregions; k++) {
+        const cm_box *b = &c->regions[k].r.box;
+        for (int d = 0; d < box->dim; d++) {
+            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
+            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
+        }
+    }
+}
+
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
     uint64_t bytes = 0;
@@ -190,9 +202,18 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     return CM_OK;
 }
 
+static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
+{
+    sum->affected_regions += one->affected_regions;
+    sum->resolved_cells += one->resolved_cells;
+    sum->nodes += one->nodes;
+    sum->new_groups += one->new_groups;
+    sum->straddling_groups += one->straddling_groups;
+}
+
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt, char *msg,
-                                 size_t msg_size)
+                                 uint32_t nboxes, const cm_scm_options *opt,
+                                 cm_join_stats *stats, char *msg, size_t msg_size)
 {
     cm_region *solved = calloc(nboxes + 1, sizeof *solved);
     cm_status *status = calloc(nboxes + 1, sizeof *status);
@@ -221,11 +242,16 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     }
     (void)threads;
     cm_status st = CM_OK;
+    if (stats)
+        memset(stats, 0, sizeof *stats);
     for (uint32_t k = 0; k < nboxes; k++) {
+        cm_join_stats one_join;
         if (st == CM_OK && status[k] != CM_OK)
             st = cm_fail(status[k], msg, msg_size, "region %u: %s", k, msgs[k]);
         if (st == CM_OK)
-            st = cm_cluster_join(c, &solved[k], NULL, msg, msg_size);
+            st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
+        if (st == CM_OK && stats)
+            add_join_stats(stats, &one_join);
         cm_region_free(&solved[k]);
     }
     free(solved);

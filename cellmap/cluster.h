@@ -65,15 +65,18 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
                           size_t msg_size);
 
 /* Solves the boxes concurrently (one region per thread, images included),
- * then joins them in the given order. */
+ * then joins them in the given order. stats (may be NULL) sums the joins'. */
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt, char *msg,
-                                 size_t msg_size);
+                                 uint32_t nboxes, const cm_scm_options *opt,
+                                 cm_join_stats *stats, char *msg, size_t msg_size);
 
 /* The region holding the cell and the cell's local index, or -1. *hint is
  * the region tried first (any value will do) and is set to the one found. */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
                           uint64_t *local);
+
+/* The smallest box holding every region (the cluster must have one). */
+void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
 /* Bytes held by the regions' arrays, exit tables and escape lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);

@@ -56,6 +56,13 @@ typedef struct cm_region {
     int64_t *exit_target; /* nexits * box.dim cell coordinates, in local index order */
 } cm_region;
 
+/* Whether cell i is a periodic cell of a group (not the sink, not a cell
+ * outside the computed regions). */
+static inline int cm_is_periodic(const cm_region *r, uint64_t i)
+{
+    return r->step[i] == 0 && r->group[i] != 0 && r->group[i] != CM_GROUP_NONE;
+}
+
 /* Target cell of recorded exit k of a region (box.dim coordinates). */
 static inline const int64_t *cm_region_exit(const cm_region *r, uint64_t k)
 {

@@ -298,7 +298,7 @@ static cm_status write_periodic_cells(sqlite3 *db, const cm_region *r, const cm_
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing periodic cells");
     }
     for (uint64_t i = 0; i < r->ncells; i++) {
-        if (r->group[i] == 0 || r->step[i] != 0)
+        if (!cm_is_periodic(r, i))
             continue;
         const uint32_t idx = (uint32_t)i;
         put_u32le(cells + 4 * offset[r->group[i] - 1]++, &idx, 1);
@@ -500,7 +500,8 @@ cm_status cm_store_load(const char *path, cm_lattice *lat, cm_region *r, char *m
     if (st == CM_OK) {
         uint32_t max_group = 0;
         for (uint64_t i = 0; i < r->ncells; i++)
-            max_group = r->group[i] > max_group ? r->group[i] : max_group;
+            if (r->group[i] != CM_GROUP_NONE && r->group[i] > max_group)
+                max_group = r->group[i];
         r->ngroups = max_group;
     }
     if (st != CM_OK)

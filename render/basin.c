@@ -39,6 +39,8 @@ static void make_geometry(const cm_lattice *lat, const cm_region *r, const cm_re
 static cm_rgb cell_colour(const cm_region *r, const cm_rgb *colours, uint64_t index)
 {
     const uint32_t grp = r->group[index];
+    if (grp == CM_GROUP_NONE)
+        return cm_colour_not_computed;
     return grp == 0 ? cm_colour_sink : colours[grp - 1];
 }
 
@@ -106,7 +108,7 @@ static void draw_markers(const cm_region *r, const slice_geometry *g, double px,
     for (uint64_t j = 0; j < g->ny; j++)
         for (uint64_t i = 0; i < g->nx; i++) {
             const uint64_t k = g->base + j * g->row_stride + i;
-            if (r->group[k] == 0 || r->step[k] != 0)
+            if (!cm_is_periodic(r, k))
                 continue;
             const double cx = g->x0 + ((double)i + 0.5) * g->dx;
             const double cy = g->y0 + ((double)j + 0.5) * g->dy;

@@ -1,5 +1,6 @@
 /* cellmap solve: simple cell mapping of one region, with a summary, a basin
  * PNG and a .cmdb database. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,7 @@
 #endif
 
 #include "cellmap/cluster.h"
+#include "cellmap/extend.h"
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
@@ -20,6 +22,7 @@
 static const char solve_help[] =
     "usage: cellmap solve [--model NAME] [--param k=v[,k=v]] [--region LO:HI[,LO:HI...]]\n"
     "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
+    "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
     "                     [--png FILE] [--size WxH] [--db FILE] [--json]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
@@ -33,6 +36,11 @@ static const char solve_help[] =
     "  --cells NxM...      cells per dimension (default 1000 per dimension, 100 in 3-D+)\n"
     "  --split KxL...      solve the box as K x L x ... regions concurrently and join\n"
     "                      them into one cluster (same result; uses every core)\n"
+    "  --extend N          adaptive extension (4.6.4): then add, N times, the neighbouring\n"
+    "                      box of the region's size where the most sequences escape\n"
+    "  --escape-below F    stop extending once the sequences of fewer than this fraction\n"
+    "                      of the cluster's cells escape into the world (default 0: never)\n"
+    "  --bounds LO:HI,...  extend only within this box of state space (default: anywhere)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
     "  --threads T         OpenMP threads for the images (default: all cores)\n"
     "  --png FILE          write the basin image (written to a temporary file, renamed)\n"
@@ -40,8 +48,8 @@ static const char solve_help[] =
     "  --db FILE           write a .cmdb SQLite database (replaces an older .cmdb only)\n"
     "  --json              print the summary as JSON\n";
 
-/* Most regions --split may cut the box into. */
-enum { MAX_SPLIT = 4096 };
+/* Most regions --split may cut the box into; most --extend steps. */
+enum { MAX_SPLIT = 4096, MAX_EXTEND = 1000 };
 
 typedef struct solve_args {
     model_opts mo;
@@ -49,6 +57,9 @@ typedef struct solve_args {
     int64_t cells[CM_MAX_DIM], split[CM_MAX_DIM];
     int n_cells, n_split;
     int max_steps, threads, width, height, json;
+    int extend;
+    double escape_below;
+    const char *bounds_text;
     const char *png, *db;
 } solve_args;
 
@@ -71,6 +82,18 @@ static int parse_solve(cli *c, solve_args *a)
             if (c->value && !parse_counts(c->value, a->split, &a->n_split, CM_MAX_DIM))
                 err = cli_usage_error(c, "--split: '%s' is not K[xL...] with positive integers",
                                       c->value);
+        } else if (cli_is(c, "--extend", true, &err)) {
+            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > MAX_EXTEND))
+                err = cli_usage_error(c, "--extend: '%s' must be an integer in 1..%d", c->value,
+                                      MAX_EXTEND);
+            a->extend = (int)v;
+        } else if (cli_is(c, "--escape-below", true, &err)) {
+            if (c->value && (!parse_double(c->value, &a->escape_below) ||
+                             !(a->escape_below >= 0 && a->escape_below <= 1)))
+                err = cli_usage_error(c, "--escape-below: '%s' must be a fraction in 0..1",
+                                      c->value);
+        } else if (cli_is(c, "--bounds", true, &err)) {
+            a->bounds_text = c->value;
         } else if (cli_is(c, "--max-steps", true, &err)) {
             if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
                 err = cli_usage_error(c, "--max-steps: '%s' must be an integer in 1..1000000",
@@ -101,6 +124,8 @@ static int parse_solve(cli *c, solve_args *a)
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
+    if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
+        err = cli_usage_error(c, "--bounds and --escape-below apply to --extend; add --extend N");
     return err;
 }
 
@@ -157,6 +182,44 @@ static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm
     return EXIT_OK;
 }
 
+/* A lattice coordinate of state x, rounded to the nearest cell border when
+ * it lies within rounding of one. */
+static int64_t border_cell(double x, double origin, double width, int round_up)
+{
+    const double c = (x - origin) / width, nearest = floor(c + 0.5);
+    if (fabs(c - nearest) < 1e-9 * (fabs(c) + 1))
+        return (int64_t)nearest;
+    return (int64_t)(round_up ? ceil(c) : floor(c));
+}
+
+/* --bounds as a box of cells (the cells the bounds touch); it must hold
+ * the region. */
+static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat,
+                       const cm_box *box, cm_box *bounds)
+{
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    *bounds = *box;
+    if (!a->bounds_text)
+        return EXIT_OK;
+    if (!parse_ranges(a->bounds_text, lo, hi, &n, CM_MAX_DIM))
+        return cli_usage_error(c, "--bounds: '%s' is not LO:HI[,LO:HI...] with LO < HI",
+                               a->bounds_text);
+    if (n != lat->dim)
+        return cli_usage_error(c, "--bounds has %d range(s) but the model has dimension %d", n,
+                               lat->dim);
+    for (int d = 0; d < n; d++) {
+        if (fabs(lo[d]) > 1e15 || fabs(hi[d]) > 1e15 ||
+            fabs((hi[d] - lo[d]) / lat->width[d]) > 1e15)
+            return cli_usage_error(c, "--bounds: range %d is too large for the lattice", d + 1);
+        bounds->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
+        bounds->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+        if (bounds->lo[d] > box->lo[d] || bounds->hi[d] < box->hi[d])
+            return cli_usage_error(c, "--bounds must contain the region (dimension %d)", d + 1);
+    }
+    return EXIT_OK;
+}
+
 static double now_seconds(void)
 {
     struct timespec ts;
@@ -182,6 +245,27 @@ static int larger_basin_first(const void *a, const void *b)
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
 
+static void print_box(const cm_lattice *lat, const cm_box *box, FILE *out)
+{
+    for (int d = 0; d < box->dim; d++)
+        fprintf(out, "%s%.9g:%.9g", d ? "," : "", lat->origin[d] + (double)box->lo[d] * lat->width[d],
+                lat->origin[d] + (double)box->hi[d] * lat->width[d]);
+}
+
+/* One step of --extend, as reported. */
+typedef struct extend_step {
+    cm_box box;
+    uint64_t escaping, all_escaping, cluster_cells;
+    uint32_t new_groups, straddling;
+    double seconds;
+} extend_step;
+
+typedef struct extend_log {
+    extend_step steps[MAX_EXTEND];
+    int n;
+    char stop[600]; /* why the extension ended */
+} extend_log;
+
 /* Durations of the two phases of a solve: images and classification, or,
  * with --split, the regions (solved concurrently) and their joins. */
 typedef struct timing {
@@ -189,17 +273,32 @@ typedef struct timing {
     double t1, t2;
 } timing;
 
+/* Cells computed: the bounding box of a cluster has others. */
+static uint64_t computed_cells(const cm_region *r)
+{
+    uint64_t n = 0;
+    for (uint64_t i = 0; i < r->ncells; i++)
+        n += r->group[i] != CM_GROUP_NONE;
+    return n;
+}
+
 static void print_text(const cm_model *m, const cm_region *r, const cm_group_info *g,
-                       uint64_t sink, const timing *t)
+                       uint64_t sink, const timing *t, const extend_log *log)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
+    const uint64_t cells = computed_cells(r);
+    if (log)
+        printf("extension stopped: %s\n", log->stop);
     printf("model %s %s\n", m->name, params);
-    printf("cells %llu, periodic groups %u, sink basin %llu cells (%.1f%%)\n",
-           (unsigned long long)r->ncells, r->ngroups, (unsigned long long)sink,
-           100.0 * (double)sink / (double)r->ncells);
+    printf("cells %llu", (unsigned long long)cells);
+    if (cells != r->ncells)
+        printf(" (of %llu in the bounding box; the others not computed)",
+               (unsigned long long)r->ncells);
+    printf(", periodic groups %u, sink basin %llu cells (%.1f%%)\n", r->ngroups,
+           (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
     printf("time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
-           1e9 * (t->t1 + t->t2) / (double)r->ncells);
+           1e9 * (t->t1 + t->t2) / (double)cells);
     cm_group_info *sorted = malloc((r->ngroups + 1) * sizeof *sorted);
     if (!sorted)
         return;
@@ -218,8 +317,25 @@ static void print_text(const cm_model *m, const cm_region *r, const cm_group_inf
     free(sorted);
 }
 
+static void print_json_extension(const cm_lattice *lat, const extend_log *log)
+{
+    printf(",\"extension\":{\"steps\":[");
+    for (int k = 0; k < log->n; k++) {
+        const extend_step *s = &log->steps[k];
+        printf("%s{\"box\":\"", k ? "," : "");
+        print_box(lat, &s->box, stdout);
+        printf("\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_cells\":%llu,"
+               "\"new_groups\":%u,\"straddling_groups\":%u,\"time_s\":%.6f}",
+               (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
+               (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells,
+               s->new_groups, s->straddling, s->seconds);
+    }
+    printf("],\"stop\":\"%s\"}", log->stop);
+}
+
 static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region *r,
-                       const cm_group_info *g, uint64_t sink, const timing *t)
+                       const cm_group_info *g, uint64_t sink, const timing *t,
+                       const extend_log *log)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
@@ -227,10 +343,15 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region
     print_vector(lat->origin, lat->dim, ",");
     printf("],\"width\":[");
     print_vector(lat->width, lat->dim, ",");
-    printf("]},\"cells\":%llu,\"sink_cells\":%llu,\"time_s\":{\"%s\":%.6f,\"%s\":%.6f},"
-           "\"groups\":[",
-           (unsigned long long)r->ncells, (unsigned long long)sink, t->first, t->t1, t->second,
-           t->t2);
+    printf("]},\"box\":\"");
+    print_box(lat, &r->box, stdout);
+    printf("\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
+           "\"time_s\":{\"%s\":%.6f,\"%s\":%.6f}",
+           (unsigned long long)r->ncells, (unsigned long long)computed_cells(r),
+           (unsigned long long)sink, t->first, t->t1, t->second, t->t2);
+    if (log)
+        print_json_extension(lat, log);
+    printf(",\"groups\":[");
     for (uint32_t k = 0; k < r->ngroups; k++) {
         printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"centre\":[", k ? "," : "",
                g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
@@ -315,53 +436,116 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     return st;
 }
 
-static uint32_t split_count(const solve_args *a)
+/* The box cut into a->split[d] nearly equal parts per dimension (fewer
+ * where the box has fewer cells). Returns the number of boxes. */
+static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
 {
+    int64_t parts[CM_MAX_DIM];
     uint32_t n = 1;
-    for (int d = 0; d < a->n_split; d++)
-        n *= (uint32_t)a->split[d];
-    return n;
-}
-
-/* The box cut into a->split[d] nearly equal parts per dimension. */
-static void split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
-{
-    for (uint32_t k = 0; k < split_count(a); k++) {
+    for (int d = 0; d < box->dim; d++) {
+        const int64_t size = box->hi[d] - box->lo[d];
+        parts[d] = d < a->n_split ? (a->split[d] < size ? a->split[d] : size) : 1;
+        n *= (uint32_t)parts[d];
+    }
+    for (uint32_t k = 0; k < n; k++) {
         uint32_t rest = k;
         boxes[k] = *box;
         for (int d = 0; d < box->dim; d++) {
-            const int64_t parts = a->split[d], i = rest % (uint32_t)parts;
-            const int64_t size = box->hi[d] - box->lo[d];
-            rest /= (uint32_t)parts;
-            boxes[k].lo[d] = box->lo[d] + size * i / parts;
-            boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts;
+            const int64_t i = rest % (uint32_t)parts[d], size = box->hi[d] - box->lo[d];
+            rest /= (uint32_t)parts[d];
+            boxes[k].lo[d] = box->lo[d] + size * i / parts[d];
+            boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts[d];
         }
     }
+    return n;
 }
 
-static cm_status solve_split(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                             const cm_box *box, cm_region *r, timing *t, char *msg,
-                             size_t msg_size)
+/* Solves the box (split as --split says) and joins it into the cluster. */
+static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *box,
+                         cm_cluster *c, cm_join_stats *stats, char *msg, size_t msg_size)
 {
     const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
-    const uint32_t n = split_count(a);
-    cm_box *boxes = malloc(n * sizeof *boxes);
+    cm_box *boxes = malloc(MAX_SPLIT * sizeof *boxes);
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
-    split_boxes(a, box, boxes);
+    const uint32_t n = split_boxes(a, box, boxes);
+    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, &opt, stats, msg, msg_size);
+    free(boxes);
+    return st;
+}
+
+static void print_step(const cm_lattice *lat, const extend_step *s, int k)
+{
+    printf("extend %d: box ", k + 1);
+    print_box(lat, &s->box, stdout);
+    printf(" (%llu cells): %llu of the %llu escaping sequences of %llu cells led there; %u new "
+           "groups (%u across borders); %.3f s\n",
+           (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
+           (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells,
+           s->new_groups, s->straddling, s->seconds);
+}
+
+/* Adds the neighbouring tile that receives the most escaping images, step
+ * by step, until --extend steps are done, the escaping fraction is below
+ * --escape-below, or no neighbour receives any. */
+static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm_box *tile,
+                                const cm_box *bounds, cm_cluster *c, extend_log *log, char *msg,
+                                size_t msg_size)
+{
+    cm_status st = CM_OK;
+    snprintf(log->stop, sizeof log->stop, "%d extension steps done", a->extend);
+    for (log->n = 0; log->n < a->extend && st == CM_OK; log->n++) {
+        cm_extend_choice choice;
+        const double t0 = now_seconds();
+        st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
+        const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
+        if (st == CM_OK && fraction < a->escape_below) {
+            snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g",
+                     fraction, a->escape_below);
+            break;
+        }
+        if (st == CM_ENOTFOUND) {
+            snprintf(log->stop, sizeof log->stop, "%s", msg);
+            return CM_OK;
+        }
+        cm_join_stats stats;
+        if (st == CM_OK)
+            st = add_box(a, m, &choice.box, c, &stats, msg, msg_size);
+        if (st != CM_OK)
+            break;
+        extend_step *s = &log->steps[log->n];
+        *s = (extend_step){choice.box,          choice.escaping,          choice.all_escaping,
+                           choice.cluster_cells, stats.new_groups, stats.straddling_groups,
+                           now_seconds() - t0};
+        if (!a->json)
+            print_step(&c->lat, s, log->n);
+    }
+    return st;
+}
+
+/* --split and --extend: a cluster of regions, flattened over its bounding
+ * box (cells outside its regions are "not computed"). */
+static cm_status solve_cluster(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                               const cm_box *box, const cm_box *bounds, cm_region *r, timing *t,
+                               extend_log *log, char *msg, size_t msg_size)
+{
     cm_cluster c;
     cm_cluster_init(&c, lat);
     c.threads = a->threads;
     *t = (timing){"regions and joins", "flattening", 0, 0};
     const double t0 = now_seconds();
-    cm_status st = cm_cluster_solve_boxes(&c, m, boxes, n, &opt, msg, msg_size);
+    cm_status st = add_box(a, m, box, &c, NULL, msg, msg_size);
+    if (st == CM_OK && a->extend > 0)
+        st = extend_cluster(a, m, box, bounds, &c, log, msg, msg_size);
     const double t1 = now_seconds();
-    if (st == CM_OK)
-        st = cm_cluster_flatten(&c, box, r, msg, msg_size);
+    cm_box all;
+    if (st == CM_OK) {
+        cm_cluster_bounds(&c, &all);
+        st = cm_cluster_flatten(&c, &all, r, msg, msg_size);
+    }
     t->t1 = t1 - t0;
     t->t2 = now_seconds() - t1;
     cm_cluster_free(&c);
-    free(boxes);
     return st;
 }
 
@@ -383,12 +567,21 @@ int cmd_solve(int argc, char **argv)
     cm_group_info *groups = NULL;
     char msg[512];
     memset(&r, 0, sizeof r);
-    if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK)
+    extend_log *log = calloc(1, sizeof *log);
+    cm_box bounds;
+    if (!log) {
+        fprintf(stderr, "cellmap solve: out of memory\n");
+        rc = EXIT_FAIL;
+        goto done;
+    }
+    if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK ||
+        (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK)
         goto done;
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
-    if ((a.n_split ? solve_split(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)
-                   : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
+    if ((a.n_split || a.extend
+             ? solve_cluster(&a, &m, &lat, &box, &bounds, &r, &t, log, msg, sizeof msg)
+             : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
         goto fail;
     groups = calloc(r.ngroups + 1, sizeof *groups);
     uint64_t sink = 0;
@@ -397,10 +590,11 @@ int cmd_solve(int argc, char **argv)
         goto fail;
     }
     cm_scm_groups(&r, &lat, groups, &sink);
+    const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
-        print_json(&m, &lat, &r, groups, sink, &t);
+        print_json(&m, &lat, &r, groups, sink, &t, shown);
     else
-        print_text(&m, &r, groups, sink, &t);
+        print_text(&m, &r, groups, sink, &t, shown);
     rc = EXIT_OK;
     if (a.png && write_png(&a, &m, &lat, &r, groups) != EXIT_OK)
         rc = EXIT_FAIL;
@@ -410,6 +604,7 @@ int cmd_solve(int argc, char **argv)
 fail:
     fprintf(stderr, "cellmap solve: %s\n", msg);
 done:
+    free(log);
     free(groups);
     cm_region_free(&r);
     cm_model_release(&m);

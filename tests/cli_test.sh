@@ -89,6 +89,31 @@ expect_usage "--cells: '0x10'" solve --cells 0x10
 expect_usage "--cells has 3 count(s)" solve --cells 10x10x10
 expect_usage "--cells asks for" solve --cells 100000x100000
 expect_usage "--max-steps" solve --max-steps 0
+# --extend: from the left region of Figs. 4.25-4.28 the right neighbour
+# comes first; the JSON reports each step; the PNG covers the bounding box
+fig="--param alpha=0.07,beta=0,P=0.007,D=0.02 --region 85.4:285.4,-12.5:12.5"
+"$CM" solve $fig --cells 400x400 --extend 2 --json --png extend.png > extend.json \
+  || fail "solve --extend"
+python3 - extend.json <<'PY' || fail "JSON of --extend"
+import json, sys
+s = json.load(open(sys.argv[1]))
+steps = s["extension"]["steps"]
+assert len(steps) == 2 and steps[0]["box"] == "285.4:485.4,-12.5:12.5", steps
+assert steps[0]["straddling_groups"] > 0 and 2 * steps[0]["escaping"] > steps[0]["all_escaping"], steps
+assert s["cells"] == 3 * 160000, s["cells"]
+PY
+"$CM" solve $fig --cells 200x200 --extend 3 --bounds 85.4:485.4,-12.5:12.5 > bounded.txt \
+  || fail "solve --extend --bounds"
+grep -q "extend 1: box 285.4:485.4,-12.5:12.5" bounded.txt || fail "--bounds: first step"
+grep -q "extension stopped: no neighbouring tile within the bounds" bounded.txt \
+  || fail "--bounds: the stop reason"
+"$CM" solve $fig --cells 200x200 --extend 3 --escape-below 0.99 > early.txt || fail "--escape-below"
+grep -q "extension stopped: escaping fraction .* is below 0.99" early.txt || fail "--escape-below stop"
+grep -q "^extend 1" early.txt && fail "--escape-below 0.99 still extended"
+expect_usage "apply to --extend" solve --bounds 0:1,0:1
+expect_usage "--bounds must contain the region" solve $fig --extend 1 --bounds 100:485.4,-12.5:12.5
+expect_usage "--escape-below: '1.5'" solve --extend 1 --escape-below 1.5
+expect_usage "--extend: '0'" solve --extend 0
 expect_usage "--split: '0x2'" solve --split 0x2
 expect_usage "--split has 3 count(s)" solve --split 2x2x2
 expect_usage "only 10 cells" solve --cells 10x10 --split 11x1

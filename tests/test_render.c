@@ -81,8 +81,20 @@ int main(void)
     CHECK(same_rgb(pixel(b, W, 101, 49), cm_colour_marker)); /* (0.15, 0.15) is a fixed cell */
     CHECK(same_rgb(pixel(b, W, 2, 2), cm_colour_not_computed));
 
-    /* deterministic */
+    /* cells not computed (outside a cluster's regions, CM_GROUP_NONE, step
+     * 0 as flattening leaves them) are drawn as such, without markers */
     ro.lo[0] = ro.hi[0] = ro.lo[1] = ro.hi[1] = 0;
+    const uint32_t kept_group = r.group[0], kept_step = r.step[0];
+    r.group[0] = CM_GROUP_NONE;
+    r.step[0] = 0;
+    CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
+    CHECK(same_rgb(pixel(b, W, 10, 95), cm_colour_not_computed));
+    CHECK(same_rgb(pixel(b, W, 30, 95), cm_colour_marker)); /* its neighbour, fixed */
+    r.group[0] = kept_group;
+    r.step[0] = kept_step;
+    ro.markers = 0;
+
+    /* deterministic */
     CHECK(cm_render_basin(&lat, &r, g, &ro, a, msg, sizeof msg) == CM_OK);
     CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
     CHECK(memcmp(a, b, (size_t)W * H * 4) == 0);

@@ -1,0 +1,239 @@
+#include "cellmap/extend.h"
+
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/grow.h"
+
+/* A tile of the grid: its index and its box clipped to the bounds. */
+typedef struct tile_ref {
+    int64_t index[CM_MAX_DIM];
+    cm_box box;
+    uint64_t escaping;
+} tile_ref;
+
+typedef struct tile_list {
+    tile_ref *items;
+    uint64_t n, cap;
+} tile_list;
+
+static int64_t floor_div(int64_t a, int64_t b)
+{
+    const int64_t q = a / b;
+    return q * b > a ? q - 1 : q;
+}
+
+static void tile_of(const cm_box *tile, const int64_t *cell, int64_t *index)
+{
+    for (int d = 0; d < tile->dim; d++)
+        index[d] = floor_div(cell[d] - tile->lo[d], tile->hi[d] - tile->lo[d]);
+}
+
+/* The tile's box clipped to the bounds; false if nothing is left. */
+static bool tile_box(const cm_box *tile, const cm_box *bounds, const int64_t *index, cm_box *box)
+{
+    memset(box, 0, sizeof *box);
+    box->dim = tile->dim;
+    for (int d = 0; d < tile->dim; d++) {
+        const int64_t size = tile->hi[d] - tile->lo[d];
+        box->lo[d] = tile->lo[d] + index[d] * size;
+        box->hi[d] = box->lo[d] + size;
+        if (bounds) {
+            box->lo[d] = box->lo[d] > bounds->lo[d] ? box->lo[d] : bounds->lo[d];
+            box->hi[d] = box->hi[d] < bounds->hi[d] ? box->hi[d] : bounds->hi[d];
+        }
+        if (box->lo[d] >= box->hi[d])
+            return false;
+    }
+    return true;
+}
+
+static int64_t find_tile(const tile_list *list, const int64_t *index, int dim)
+{
+    for (uint64_t k = 0; k < list->n; k++)
+        if (memcmp(list->items[k].index, index, (size_t)dim * sizeof *index) == 0)
+            return (int64_t)k;
+    return -1;
+}
+
+static cm_status add_tile(tile_list *list, const int64_t *index, const cm_box *box)
+{
+    if (cm_grow((void **)&list->items, &list->cap, list->n + 1, sizeof *list->items) != CM_OK)
+        return CM_ENOMEM;
+    tile_ref *t = &list->items[list->n++];
+    memset(t, 0, sizeof *t);
+    memcpy(t->index, index, sizeof t->index);
+    t->box = *box;
+    return CM_OK;
+}
+
+/* The tiles holding the cluster's regions, in join order. */
+static cm_status cluster_tiles(const cm_cluster *c, const cm_box *tile, tile_list *tiles)
+{
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        int64_t index[CM_MAX_DIM] = {0};
+        tile_of(tile, c->regions[k].r.box.lo, index);
+        if (find_tile(tiles, index, tile->dim) < 0 &&
+            add_tile(tiles, index, &c->regions[k].r.box) != CM_OK)
+            return CM_ENOMEM;
+    }
+    return CM_OK;
+}
+
+/* Tiles sharing a face with a cluster tile, not in the cluster, within bounds. */
+static cm_status neighbour_tiles(const tile_list *tiles, const cm_box *tile, const cm_box *bounds,
+                                 tile_list *candidates)
+{
+    for (uint64_t k = 0; k < tiles->n; k++)
+        for (int d = 0; d < tile->dim; d++)
+            for (int side = -1; side <= 1; side += 2) {
+                int64_t index[CM_MAX_DIM];
+                cm_box box;
+                memcpy(index, tiles->items[k].index, sizeof index);
+                index[d] += side;
+                if (find_tile(tiles, index, tile->dim) >= 0 ||
+                    find_tile(candidates, index, tile->dim) >= 0 ||
+                    !tile_box(tile, bounds, index, &box))
+                    continue;
+                if (add_tile(candidates, index, &box) != CM_OK)
+                    return CM_ENOMEM;
+            }
+    return CM_OK;
+}
+
+/* A sink cell of the cluster. */
+typedef struct sink_ref {
+    uint32_t region, cell;
+} sink_ref;
+
+/* The cluster's sink cells in decreasing order of step number: every cell
+ * comes before the next cell of its sequence (a counting sort). */
+static cm_status order_sink_cells(const cm_cluster *c, sink_ref **order, uint64_t *n)
+{
+    uint64_t *start = NULL, nsteps = 0, cap = 0;
+    *order = NULL;
+    *n = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_region *r = &c->regions[k].r;
+        for (uint64_t i = 0; i < r->ncells; i++) {
+            if (r->group[i] != 0)
+                continue;
+            const uint64_t s = r->step[i];
+            if (s >= nsteps) {
+                if (cm_grow((void **)&start, &cap, s + 2, sizeof *start) != CM_OK) {
+                    free(start);
+                    return CM_ENOMEM;
+                }
+                memset(start + nsteps, 0, (s + 2 - nsteps) * sizeof *start);
+                nsteps = s + 1;
+            }
+            start[s]++;
+            (*n)++;
+        }
+    }
+    *order = malloc((*n + 1) * sizeof **order);
+    if (!*order) {
+        free(start);
+        return CM_ENOMEM;
+    }
+    uint64_t pos = 0; /* the highest step first */
+    for (uint64_t s = nsteps; s-- > 0;) {
+        const uint64_t count = start[s];
+        start[s] = pos;
+        pos += count;
+    }
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_region *r = &c->regions[k].r;
+        for (uint64_t i = 0; i < r->ncells; i++)
+            if (r->group[i] == 0)
+                (*order)[start[r->step[i]]++] = (sink_ref){k, (uint32_t)i};
+    }
+    free(start);
+    return CM_OK;
+}
+
+/* Follows every sink cell's sequence to where it leaves the cluster: each
+ * cell passes its weight (itself plus the cells that lead through it) to
+ * the next one, in step order. Weights arriving outside the cluster but in
+ * the world count for the candidate tile they land in. */
+static cm_status count_escapes(const cm_cluster *c, const cm_box *tile, tile_list *candidates,
+                               cm_extend_choice *choice)
+{
+    sink_ref *order = NULL;
+    uint64_t n = 0;
+    uint64_t **weight = calloc(c->nregions, sizeof *weight);
+    cm_status st = weight ? order_sink_cells(c, &order, &n) : CM_ENOMEM;
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++) {
+        choice->cluster_cells += c->regions[k].r.ncells;
+        weight[k] = calloc(c->regions[k].r.ncells + 1, sizeof **weight);
+        st = weight[k] ? CM_OK : CM_ENOMEM;
+    }
+    uint32_t hint = 0;
+    for (uint64_t p = 0; st == CM_OK && p < n; p++) {
+        const cm_region *r = &c->regions[order[p].region].r;
+        const uint32_t i = order[p].cell, v = r->image[i];
+        const uint64_t w = ++weight[order[p].region][i]; /* the cell itself */
+        const int64_t e = cm_image_exit_index(v);
+        uint64_t local;
+        if (v < r->ncells) {
+            weight[order[p].region][v] += w;
+            continue;
+        }
+        if (e < 0)
+            continue; /* leaves the world */
+        const int64_t *cell = cm_region_exit(r, (uint64_t)e);
+        const int64_t k = cm_cluster_locate(c, cell, &hint, &local);
+        if (k >= 0) {
+            weight[k][local] += w;
+            continue;
+        }
+        choice->all_escaping += w;
+        int64_t index[CM_MAX_DIM] = {0};
+        tile_of(tile, cell, index);
+        const int64_t t = find_tile(candidates, index, tile->dim);
+        if (t >= 0 && cm_box_contains(&candidates->items[t].box, cell))
+            candidates->items[t].escaping += w;
+    }
+    for (uint32_t k = 0; weight && k < c->nregions; k++)
+        free(weight[k]);
+    free(weight);
+    free(order);
+    return st;
+}
+
+cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,
+                           cm_extend_choice *choice, char *msg, size_t msg_size)
+{
+    memset(choice, 0, sizeof *choice);
+    if (c->nregions == 0 || tile->dim != c->lat.dim || cm_box_cells(tile) == 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "extension needs a cluster with a region and a non-empty tile of its "
+                       "dimension");
+    tile_list tiles = {NULL, 0, 0}, candidates = {NULL, 0, 0};
+    cm_status st = cluster_tiles(c, tile, &tiles);
+    if (st == CM_OK)
+        st = neighbour_tiles(&tiles, tile, bounds, &candidates);
+    if (st == CM_OK)
+        st = count_escapes(c, tile, &candidates, choice);
+    if (st != CM_OK) {
+        st = cm_fail(st, msg, msg_size, "out of memory following the escaping sequences");
+    } else {
+        int64_t best = -1;
+        for (uint64_t k = 0; k < candidates.n; k++)
+            if (candidates.items[k].escaping > 0 &&
+                (best < 0 || candidates.items[k].escaping > candidates.items[best].escaping))
+                best = (int64_t)k;
+        if (best < 0) {
+            st = cm_fail(CM_ENOTFOUND, msg, msg_size,
+                         "no neighbouring tile%s receives an escaping sequence",
+                         bounds ? " within the bounds" : "");
+        } else {
+            choice->box = candidates.items[best].box;
+            choice->escaping = candidates.items[best].escaping;
+        }
+    }
+    free(tiles.items);
+    free(candidates.items);
+    return st;
+}

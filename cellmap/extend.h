@@ -1,0 +1,36 @@
+/* cellmap/extend.h - adaptive extension of a cluster (thesis 4.6.4 and
+ * Fig. 4.25): solve next where the sequences that leave the cluster go.
+ *
+ * The state space is cut into tiles of one size on a grid aligned to a
+ * given tile (normally the first region solved). Among the tiles that share
+ * a face with a tile of the cluster and are not in it, clipped to optional
+ * bounds, the next one is the tile where the most sequences escape: the
+ * sequences of cluster cells are followed (in step order, linear time) to
+ * where they leave the cluster, and each escape into the world counts the
+ * cells whose sequences take it, as the thesis chooses "the adjacent region
+ * to where most of the trajectories escape" (4.6.2). Ties go to the first candidate in a
+ * fixed order (cluster tiles in join order, then dimension, lower side
+ * first), so the choice is deterministic.
+ */
+#ifndef CM_EXTEND_H
+#define CM_EXTEND_H
+
+#include <stdint.h>
+
+#include "cellmap/cluster.h"
+
+typedef struct cm_extend_choice {
+    cm_box box;            /* the chosen tile, clipped to the bounds */
+    uint64_t escaping;      /* cells whose sequences leave the cluster into it */
+    uint64_t all_escaping;  /* cells whose sequences leave the cluster into the world */
+    uint64_t cluster_cells;
+} cm_extend_choice;
+
+/* Chooses the next tile. `tile` is the grid's tile (0, 0, ...); `bounds`
+ * may be NULL (unbounded). Fills choice->all_escaping and cluster_cells in
+ * any case; CM_ENOTFOUND when no sequence escapes into a neighbouring tile.
+ * Temporary memory: 8 bytes per cluster cell and per sink cell. */
+cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,
+                           cm_extend_choice *choice, char *msg, size_t msg_size);
+
+#endif
