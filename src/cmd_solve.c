@@ -245,11 +245,15 @@ static int larger_basin_first(const void *a, const void *b)
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
 
-static void print_box(const cm_lattice *lat, const cm_box *box, FILE *out)
+/* The box in state coordinates, "x0:x1,y0:y1,...". */
+static void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size)
 {
-    for (int d = 0; d < box->dim; d++)
-        fprintf(out, "%s%.9g:%.9g", d ? "," : "", lat->origin[d] + (double)box->lo[d] * lat->width[d],
-                lat->origin[d] + (double)box->hi[d] * lat->width[d]);
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 0; d < box->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%.9g:%.9g", d ? "," : "",
+                                 lat->origin[d] + (double)box->lo[d] * lat->width[d],
+                                 lat->origin[d] + (double)box->hi[d] * lat->width[d]);
 }
 
 /* One step of --extend, as reported. */
@@ -322,13 +326,13 @@ static void print_json_extension(const cm_lattice *lat, const extend_log *log)
     printf(",\"extension\":{\"steps\":[");
     for (int k = 0; k < log->n; k++) {
         const extend_step *s = &log->steps[k];
-        printf("%s{\"box\":\"", k ? "," : "");
-        print_box(lat, &s->box, stdout);
-        printf("\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_cells\":%llu,"
+        char box[CM_MAX_DIM * 64];
+        format_box(lat, &s->box, box, sizeof box);
+        printf("%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_cells\":%llu,"
                "\"new_groups\":%u,\"straddling_groups\":%u,\"time_s\":%.6f}",
-               (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
-               (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells,
-               s->new_groups, s->straddling, s->seconds);
+               k ? "," : "", box, (unsigned long long)cm_box_cells(&s->box),
+               (unsigned long long)s->escaping, (unsigned long long)s->all_escaping,
+               (unsigned long long)s->cluster_cells, s->new_groups, s->straddling, s->seconds);
     }
     printf("],\"stop\":\"%s\"}", log->stop);
 }
@@ -343,11 +347,11 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region
     print_vector(lat->origin, lat->dim, ",");
     printf("],\"width\":[");
     print_vector(lat->width, lat->dim, ",");
-    printf("]},\"box\":\"");
-    print_box(lat, &r->box, stdout);
-    printf("\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
+    char box[CM_MAX_DIM * 64];
+    format_box(lat, &r->box, box, sizeof box);
+    printf("]},\"box\":\"%s\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
            "\"time_s\":{\"%s\":%.6f,\"%s\":%.6f}",
-           (unsigned long long)r->ncells, (unsigned long long)computed_cells(r),
+           box, (unsigned long long)r->ncells, (unsigned long long)computed_cells(r),
            (unsigned long long)sink, t->first, t->t1, t->second, t->t2);
     if (log)
         print_json_extension(lat, log);
@@ -367,7 +371,9 @@ static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *l
 {
     cm_render_options ro;
     memset(&ro, 0, sizeof ro);
-    const uint64_t nx = (uint64_t)r->box.hi[0], ny = lat->dim > 1 ? (uint64_t)r->box.hi[1] : 64;
+    const cm_box *b = &r->box;
+    const uint64_t nx = (uint64_t)(b->hi[0] - b->lo[0]);
+    const uint64_t ny = lat->dim > 1 ? (uint64_t)(b->hi[1] - b->lo[1]) : 64;
     const double shrink = nx > 4096 || ny > 4096 ? 4096.0 / (double)(nx > ny ? nx : ny) : 1.0;
     ro.width = a->width ? a->width : (int)((double)nx * shrink + 0.5);
     ro.height = a->height ? a->height : (int)((double)ny * shrink + 0.5);
@@ -387,7 +393,9 @@ static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *l
         snprintf(lattice, sizeof lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
                  lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
                  lat->dim > 1 ? lat->width[1] : 0.0);
-        snprintf(view, sizeof view, "cells %lldx%lld", (long long)nx,
+        char box[CM_MAX_DIM * 64];
+        format_box(lat, b, box, sizeof box);
+        snprintf(view, sizeof view, "box %s cells %lldx%lld", box, (long long)nx,
                  lat->dim > 1 ? (long long)ny : 1LL);
         const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},
                                      {"Model", m->name},
@@ -476,18 +484,18 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
 
 static void print_step(const cm_lattice *lat, const extend_step *s, int k)
 {
-    printf("extend %d: box ", k + 1);
-    print_box(lat, &s->box, stdout);
-    printf(" (%llu cells): %llu of the %llu escaping sequences of %llu cells led there; %u new "
-           "groups (%u across borders); %.3f s\n",
-           (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
+    char box[CM_MAX_DIM * 64];
+    format_box(lat, &s->box, box, sizeof box);
+    printf("extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu "
+           "cells led there; %u new groups (%u across borders); %.3f s\n",
+           k + 1, box, (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
            (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells,
            s->new_groups, s->straddling, s->seconds);
 }
 
-/* Adds the neighbouring tile that receives the most escaping images, step
- * by step, until --extend steps are done, the escaping fraction is below
- * --escape-below, or no neighbour receives any. */
+/* Adds the neighbouring tile where the most sequences escape, step by step,
+ * until --extend steps are done, the escaping fraction is below
+ * --escape-below, or no sequence escapes into a neighbour. */
 static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm_box *tile,
                                 const cm_box *bounds, cm_cluster *c, extend_log *log, char *msg,
                                 size_t msg_size)
