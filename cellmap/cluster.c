@@ -17,6 +17,16 @@ void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
     c->lat = *lat;
 }
 
+int cm_cluster_threads(const cm_cluster *c)
+{
+#ifdef _OPENMP
+    return c->threads > 0 ? c->threads : omp_get_max_threads();
+#else
+    (void)c;
+    return 1;
+#endif
+}
+
 void cm_cluster_free(cm_cluster *c)
 {
     if (!c)
@@ -180,9 +190,13 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
     /* the region's own groups take the next cluster-wide ids */
-    for (uint64_t i = 0; i < r->ncells; i++)
-        if (r->group[i] != 0)
-            r->group[i] += c->ngroups;
+    const uint32_t base = c->ngroups;
+    uint32_t *group = r->group;
+#pragma omp parallel for schedule(static) num_threads(cm_cluster_threads(c)) \
+    if (r->ncells >= 65536)
+    for (int64_t i = 0; i < (int64_t)r->ncells; i++)
+        if (group[i] != 0)
+            group[i] += base;
     const uint32_t added = c->nregions++;
     memset(&c->regions[added], 0, sizeof c->regions[added]);
     c->regions[added].r = *r;

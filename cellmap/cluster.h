@@ -58,6 +58,9 @@ typedef struct cm_join_stats {
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
 void cm_cluster_free(cm_cluster *c);
 
+/* Threads a join uses: c->threads, or the OpenMP default. */
+int cm_cluster_threads(const cm_cluster *c);
+
 /* Joins a region solved with record_exits on the cluster's lattice. The
  * cluster takes the region's arrays (r is zeroed). CM_EINVAL if its box
  * overlaps a region of the cluster. stats may be NULL. */

@@ -4,9 +4,6 @@
 #include "cellmap/grow.h"
 
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 /* step[] of a sink cell that is being resolved: this flag plus its old step
  * number. Cells without the flag hold final values. */
@@ -485,10 +482,7 @@ static cm_status resolve(resolver *rs, cm_join_stats *stats)
 
 cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats)
 {
-    resolver rs = {.c = c, .affected = affected, .threads = 1};
-#ifdef _OPENMP
-    rs.threads = c->threads > 0 ? c->threads : omp_get_max_threads();
-#endif
+    resolver rs = {.c = c, .affected = affected, .threads = cm_cluster_threads(c)};
     rs.orders = calloc(c->nregions, sizeof *rs.orders);
     cm_status st = rs.orders ? resolve(&rs, stats) : CM_ENOMEM;
     for (uint32_t k = 0; rs.orders && k < c->nregions; k++) {
