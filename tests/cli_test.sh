@@ -92,7 +92,7 @@ expect_usage "--max-steps" solve --max-steps 0
 # --extend: from the left region of Figs. 4.25-4.28 the right neighbour
 # comes first; the JSON reports each step; the PNG covers the bounding box
 fig="--param alpha=0.07,beta=0,P=0.007,D=0.02 --region 85.4:285.4,-12.5:12.5"
-"$CM" solve $fig --cells 400x400 --extend 2 --json --png extend.png > extend.json \
+"$CM" solve $fig --cells 400x400 --extend 2 --threads 2 --json --png extend.png > extend.json \
   || fail "solve --extend"
 python3 - extend.json <<'PY' || fail "JSON of --extend"
 import json, sys
@@ -102,6 +102,9 @@ assert len(steps) == 2 and steps[0]["box"] == "285.4:485.4,-12.5:12.5", steps
 assert steps[0]["straddling_groups"] > 0 and 2 * steps[0]["escaping"] > steps[0]["all_escaping"], steps
 assert s["cells"] == 3 * 160000, s["cells"]
 PY
+"$CM" solve $fig --cells 400x400 --extend 2 --threads 1 --png extend1.png > /dev/null \
+  || fail "solve --extend --threads 1"
+cmp -s extend.png extend1.png || fail "--extend PNG differs between 1 and 2 threads"
 "$CM" solve $fig --cells 200x200 --extend 3 --bounds 85.4:485.4,-12.5:12.5 > bounded.txt \
   || fail "solve --extend --bounds"
 grep -q "extend 1: box 285.4:485.4,-12.5:12.5" bounded.txt || fail "--bounds: first step"
