@@ -34,7 +34,7 @@ typedef struct node {
 typedef struct step_order {
     uint32_t *cells;
     uint32_t *start; /* cells of step s: cells[start[s] .. start[s + 1]) */
-    uint64_t nsteps, start_cap;
+    uint64_t nsteps;
 } step_order;
 
 typedef struct u32_stack {

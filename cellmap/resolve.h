@@ -4,22 +4,24 @@
  *
  * Within a region, a sink cell's image is either in the region (a cell whose
  * step number is one less) or an exit. So the sink cells of a region form
- * trees, each rooted at an exit cell, and sorting them by step number orders
- * every cell after its image. The join works on these trees, not on the
- * cells one by one:
- *   1. per region, each cell learns the exit cell (node) at its tree's root,
- *      by one pass over the cells in step order (parallel within a step);
+ * trees, each rooted at a cell whose image leaves the region (a node), and
+ * sorting them by step number orders every cell after its image. The join
+ * works on these trees, not on the cells one by one:
+ *   1. per region, each cell learns its tree's node, by one pass over the
+ *      cells in step order (parallel within a step);
  *   2. each node follows its exit into the cluster: to a classified cell
  *      (Stage 1 of the thesis), out of the cluster (still the sink), or into
  *      the tree of another node. Walking this small graph of nodes finds the
  *      cycles that cross region borders: the new straddling groups (Stage 2);
  *   3. the cells of those cycles are marked, and every node gets its group
  *      and step number;
- *   4. per region, one more pass in step order gives every cell its image's
- *      group and step number plus one (parallel within a step).
- * The passes touch each sink cell a fixed number of times, with independent
- * memory accesses inside one step number, instead of walking dependent
- * chains; the result does not depend on the thread count.
+ *   4. one parallel pass over each region gives every cell its node's group,
+ *      its step number moved by as much as its node's; cells in the trees of
+ *      cycle nodes, whose chains can meet the cycle before the node, are
+ *      walked instead (such trees are small).
+ * Each sink cell is read and written a fixed number of times, with
+ * independent memory accesses, instead of walking dependent chains; the
+ * result does not depend on the thread count.
  */
 #ifndef CM_RESOLVE_H
 #define CM_RESOLVE_H
