@@ -388,7 +388,7 @@ static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *l
     }
     cm_status st = cm_render_basin(lat, r, g, &ro, rgba, msg, sizeof msg);
     if (st == CM_OK) {
-        char params[2048], lattice[512], view[256];
+        char params[2048], lattice[512], view[CM_MAX_DIM * 64 + 64];
         cm_params_json(&m->values, params, sizeof params);
         snprintf(lattice, sizeof lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
                  lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
