@@ -120,13 +120,10 @@ static cm_status order_sink_cells(const cm_cluster *c, sink_ref **order, uint64_
             if (r->group[i] != 0)
                 continue;
             const uint64_t s = r->step[i];
-            if (s >= nsteps) {
-                if (cm_grow((void **)&start, &cap, s + 2, sizeof *start) != CM_OK) {
-                    free(start);
-                    return CM_ENOMEM;
-                }
-                memset(start + nsteps, 0, (s + 2 - nsteps) * sizeof *start);
-                nsteps = s + 1;
+            if (s >= nsteps &&
+                cm_grow_zeroed((void **)&start, &cap, &nsteps, s + 1, sizeof *start) != CM_OK) {
+                free(start);
+                return CM_ENOMEM;
             }
             start[s]++;
             (*n)++;

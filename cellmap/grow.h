@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cellmap/status.h"
 
@@ -24,6 +25,20 @@ static inline cm_status cm_grow(void **items, uint64_t *cap, uint64_t need, size
         return CM_ENOMEM;
     *items = p;
     *cap = new_cap;
+    return CM_OK;
+}
+
+/* Like cm_grow for a table indexed up to need - 1 whose *len entries are in
+ * use: the new entries [*len, need) are zero and *len becomes need. */
+static inline cm_status cm_grow_zeroed(void **items, uint64_t *cap, uint64_t *len, uint64_t need,
+                                       size_t item_size)
+{
+    if (need <= *len)
+        return CM_OK;
+    if (cm_grow(items, cap, need, item_size) != CM_OK)
+        return CM_ENOMEM;
+    memset((char *)*items + *len * item_size, 0, (need - *len) * item_size);
+    *len = need;
     return CM_OK;
 }
 

@@ -90,14 +90,10 @@ static void count_part(cm_region *r, uint64_t lo, uint64_t hi, part_count *pc)
         if (group[i] != 0)
             continue;
         const uint32_t s = step[i];
-        if (s >= pc->nsteps) {
-            if (cm_grow((void **)&pc->count, &pc->cap, (uint64_t)s + 1, sizeof *pc->count) !=
-                CM_OK) {
-                pc->failed = 1;
-                break;
-            }
-            memset(pc->count + pc->nsteps, 0, (s + 1 - pc->nsteps) * sizeof *pc->count);
-            pc->nsteps = (uint64_t)s + 1;
+        if (s >= pc->nsteps && cm_grow_zeroed((void **)&pc->count, &pc->cap, &pc->nsteps,
+                                              (uint64_t)s + 1, sizeof *pc->count) != CM_OK) {
+            pc->failed = 1;
+            break;
         }
         pc->count[s]++;
         step[i] = s | PENDING;
@@ -122,12 +118,10 @@ static cm_status plan_parts(resolver *rs, step_order *o, part_count *parts, int 
         if (nodes >= NO_NODE)
             return CM_ETOOBIG;
     }
-    for (int t = 0; t < nparts; t++) {
-        part_count *pc = &parts[t];
-        if (cm_grow((void **)&pc->count, &pc->cap, nsteps, sizeof *pc->count) != CM_OK)
+    for (int t = 0; t < nparts; t++)
+        if (cm_grow_zeroed((void **)&parts[t].count, &parts[t].cap, &parts[t].nsteps, nsteps,
+                           sizeof *parts[t].count) != CM_OK)
             return CM_ENOMEM;
-        memset(pc->count + pc->nsteps, 0, (nsteps - pc->nsteps) * sizeof *pc->count);
-    }
     o->nsteps = nsteps + 1;
     o->start = malloc(o->nsteps * sizeof *o->start);
     if (!o->start ||

@@ -445,7 +445,8 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
 }
 
 /* The box cut into a->split[d] nearly equal parts per dimension (fewer
- * where the box has fewer cells). Returns the number of boxes. */
+ * where the box has fewer cells). Returns the number of boxes; with boxes
+ * NULL only counts them. */
 static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
 {
     int64_t parts[CM_MAX_DIM];
@@ -455,7 +456,7 @@ static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxe
         parts[d] = d < a->n_split ? (a->split[d] < size ? a->split[d] : size) : 1;
         n *= (uint32_t)parts[d];
     }
-    for (uint32_t k = 0; k < n; k++) {
+    for (uint32_t k = 0; boxes && k < n; k++) {
         uint32_t rest = k;
         boxes[k] = *box;
         for (int d = 0; d < box->dim; d++) {
@@ -473,10 +474,11 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
                          cm_cluster *c, cm_join_stats *stats, char *msg, size_t msg_size)
 {
     const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
-    cm_box *boxes = malloc(MAX_SPLIT * sizeof *boxes);
+    const uint32_t n = split_boxes(a, box, NULL);
+    cm_box *boxes = malloc(n * sizeof *boxes);
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
-    const uint32_t n = split_boxes(a, box, boxes);
+    split_boxes(a, box, boxes);
     cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, &opt, stats, msg, msg_size);
     free(boxes);
     return st;

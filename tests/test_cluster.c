@@ -13,6 +13,7 @@
 
 #include "cellmap/cluster.h"
 #include "check.h"
+#include "mix.h"
 #include "models/registry.h"
 
 /* ---- tilings ------------------------------------------------------------ */
@@ -214,15 +215,6 @@ static cm_model hand_model(int dim, int (*step)(const cm_model *, const double *
     m.step = step;
     m.ctx = ctx;
     return m;
-}
-
-static uint64_t mix(uint64_t h)
-{
-    h ^= h >> 31;
-    h *= UINT64_C(0x9e3779b97f4a7c15);
-    h ^= h >> 29;
-    h *= UINT64_C(0xbf58476d1ce4e5b9);
-    return h ^ (h >> 32);
 }
 
 /* Each cell moves by a pseudo-random offset of -2..2 cells per dimension

@@ -3,6 +3,7 @@
 
 #include "cellmap/scm.h"
 #include "check.h"
+#include "mix.h"
 #include "models/registry.h"
 
 /* ---- hand-made maps ---------------------------------------------------- */
@@ -58,15 +59,6 @@ typedef struct random_map {
     int64_t lo, hi; /* target range per dimension */
     uint64_t seed;
 } random_map;
-
-static uint64_t mix(uint64_t h)
-{
-    h ^= h >> 31;
-    h *= UINT64_C(0x9e3779b97f4a7c15);
-    h ^= h >> 29;
-    h *= UINT64_C(0xbf58476d1ce4e5b9);
-    return h ^ (h >> 32);
-}
 
 static int random_step(const cm_model *m, const double *x, double *y)
 {
