@@ -40,8 +40,7 @@ void cm_cluster_free(cm_cluster *c)
     memset(c, 0, sizeof *c);
 }
 
-int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
-                          uint64_t *local)
+int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint, uint64_t *local)
 {
     for (uint32_t n = 0; n < c->nregions; n++) {
         /* try the region of the last hit first: exits mostly land next door */
@@ -68,15 +67,84 @@ void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
     }
 }
 
-uint64_t cm_cluster_bytes(const cm_cluster *c)
+static int is_resident(const cm_cluster_region *cr) { return cr->r.group != NULL; }
+
+uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 {
     uint64_t bytes = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        if (is_resident(&c->regions[k]))
+            bytes += cm_region_bytes(&c->regions[k].r);
+    return bytes;
+}
+
+uint64_t cm_cluster_bytes(const cm_cluster *c)
+{
+    uint64_t bytes = cm_cluster_resident_bytes(c);
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
-        bytes += cm_region_bytes(&cr->r) + cr->nescapes * sizeof *cr->escapes +
+        bytes += cr->nescapes * (uint64_t)c->lat.dim * sizeof *cr->escapes +
                  cr->targets_cap * sizeof *cr->targets;
     }
     return bytes;
+}
+
+cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    cr->last_used = ++c->clock;
+    if (is_resident(cr))
+        return CM_OK;
+    if (!c->page_in)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is paged out and there is no pager", k);
+    cm_status st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
+    if (st == CM_OK && !is_resident(cr))
+        st = cm_fail(CM_EIO, msg, msg_size, "region %u was not read back", k);
+    return st;
+}
+
+static void evict(cm_cluster_region *cr)
+{
+    free(cr->r.image);
+    free(cr->r.group);
+    free(cr->r.step);
+    free(cr->r.exit_target);
+    cr->r.image = cr->r.group = cr->r.step = NULL;
+    cr->r.exit_target = NULL;
+}
+
+/* The clean resident region to evict next, or -1. */
+static int64_t eviction_victim(const cm_cluster *c)
+{
+    int64_t best = -1;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        if (!is_resident(cr) || cr->dirty)
+            continue;
+        if (best < 0)
+            best = k;
+        const cm_cluster_region *b = &c->regions[best];
+        /* surrounded regions (no escapes) first, then the least recently used */
+        const int surrounded = cr->nescapes == 0, best_surrounded = b->nescapes == 0;
+        if (surrounded > best_surrounded ||
+            (surrounded == best_surrounded && cr->last_used < b->last_used))
+            best = k;
+    }
+    return best;
+}
+
+void cm_cluster_trim(cm_cluster *c)
+{
+    if (!c->page_in || c->mem_budget == 0)
+        return;
+    uint64_t bytes = cm_cluster_resident_bytes(c);
+    while (bytes > c->mem_budget) {
+        const int64_t k = eviction_victim(c);
+        if (k < 0)
+            return;
+        bytes -= cm_region_bytes(&c->regions[k].r);
+        evict(&c->regions[k]);
+    }
 }
 
 static bool boxes_overlap(const cm_box *a, const cm_box *b)
@@ -114,39 +182,43 @@ static cm_status add_target(cm_cluster_region *cr, uint32_t region)
     for (uint32_t t = 0; t < cr->ntargets; t++)
         if (cr->targets[t] == region)
             return CM_OK;
-    if (cm_grow((void **)&cr->targets, &cr->targets_cap, cr->ntargets + 1,
-                sizeof *cr->targets) != CM_OK)
+    if (cm_grow((void **)&cr->targets, &cr->targets_cap, cr->ntargets + 1, sizeof *cr->targets) !=
+        CM_OK)
         return CM_ENOMEM;
     cr->targets[cr->ntargets++] = region;
     return CM_OK;
 }
 
 /* Escapes of the older regions that land in the new region `added` become
- * region links; the new region's exits become links or escapes. */
+ * region links; the new region's exits become links or escapes. Escapes
+ * keep their target cells, so this works on paged-out regions too. */
 static cm_status update_links(cm_cluster *c, uint32_t added)
 {
     const cm_box *new_box = &c->regions[added].r.box;
+    const size_t dim = (size_t)c->lat.dim;
     for (uint32_t k = 0; k < added; k++) {
         cm_cluster_region *cr = &c->regions[k];
         uint64_t kept = 0;
         for (uint64_t e = 0; e < cr->nescapes; e++) {
-            if (!cm_box_contains(new_box, cm_region_exit(&cr->r, cr->escapes[e])))
-                cr->escapes[kept++] = cr->escapes[e];
+            const int64_t *cell = cr->escapes + e * dim;
+            if (!cm_box_contains(new_box, cell))
+                memmove(cr->escapes + kept++ * dim, cell, dim * sizeof *cell);
             else if (add_target(cr, added) != CM_OK)
                 return CM_ENOMEM;
         }
         cr->nescapes = kept;
     }
     cm_cluster_region *nr = &c->regions[added];
-    nr->escapes = malloc((nr->r.nexits + 1) * sizeof *nr->escapes);
+    nr->escapes = malloc((nr->r.nexits + 1) * dim * sizeof *nr->escapes);
     if (!nr->escapes)
         return CM_ENOMEM;
     uint32_t hint = 0;
     for (uint64_t e = 0; e < nr->r.nexits; e++) {
         uint64_t local;
-        const int64_t k = cm_cluster_locate(c, cm_region_exit(&nr->r, e), &hint, &local);
+        const int64_t *cell = cm_region_exit(&nr->r, e);
+        const int64_t k = cm_cluster_locate(c, cell, &hint, &local);
         if (k < 0)
-            nr->escapes[nr->nescapes++] = (uint32_t)e;
+            memcpy(nr->escapes + nr->nescapes++ * dim, cell, dim * sizeof *cell);
         else if (add_target(nr, (uint32_t)k) != CM_OK)
             return CM_ENOMEM;
     }
@@ -177,6 +249,25 @@ static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affe
     return count;
 }
 
+/* Reads back every region a join reads or writes: the affected ones (which
+ * it marks dirty) and the regions their exits lead into. */
+static cm_status acquire_affected(cm_cluster *c, const uint8_t *affected, char *msg,
+                                  size_t msg_size)
+{
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        if (!affected[k])
+            continue;
+        cm_cluster_region *cr = &c->regions[k];
+        cm_status st = cm_cluster_acquire(c, k, msg, msg_size);
+        for (uint32_t t = 0; st == CM_OK && t < cr->ntargets; t++)
+            st = cm_cluster_acquire(c, cr->targets[t], msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        cr->dirty = 1;
+    }
+    return CM_OK;
+}
+
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
                           size_t msg_size)
 {
@@ -192,8 +283,7 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     /* the region's own groups take the next cluster-wide ids */
     const uint32_t base = c->ngroups;
     uint32_t *group = r->group;
-#pragma omp parallel for schedule(static) num_threads(cm_cluster_threads(c)) \
-    if (r->ncells >= 65536)
+#pragma omp parallel for schedule(static) num_threads(cm_cluster_threads(c)) if (r->ncells >= 65536)
     for (int64_t i = 0; i < (int64_t)r->ncells; i++)
         if (group[i] != 0)
             group[i] += base;
@@ -203,10 +293,17 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     memset(r, 0, sizeof *r);
     c->ngroups += c->regions[added].r.ngroups;
     stats->new_groups = c->regions[added].r.ngroups;
+    c->regions[added].dirty = 1;
+    c->regions[added].last_used = ++c->clock;
     uint8_t *affected = malloc(c->nregions);
     st = affected ? update_links(c, added) : CM_ENOMEM;
     if (st == CM_OK) {
         stats->affected_regions = mark_affected(c, added, affected);
+        st = acquire_affected(c, affected, msg, msg_size);
+        if (st != CM_OK) {
+            free(affected);
+            return st; /* msg says which region could not be read back */
+        }
         st = cm_resolve_sink_cells(c, affected, stats);
     }
     free(affected);
@@ -214,6 +311,30 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "joining region %u: %s", added, cm_strerror(st));
     return CM_OK;
+}
+
+cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
+                             char *msg, size_t msg_size)
+{
+    if (record->box.dim != c->lat.dim)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "region of %d dimensions, lattice of %d",
+                       record->box.dim, c->lat.dim);
+    if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
+    const uint32_t added = c->nregions++;
+    cm_cluster_region *cr = &c->regions[added];
+    memset(cr, 0, sizeof *cr);
+    cr->r.box = record->box;
+    cr->r.ncells = record->ncells;
+    cr->r.nexits = record->nexits;
+    cr->r.ngroups = record->ngroups;
+    cr->r.exits_recorded = 1;
+    cr->r.exit_target = (int64_t *)exit_target; /* borrowed for update_links only */
+    const cm_status st = update_links(c, added);
+    cr->r.exit_target = NULL;
+    return st == CM_OK
+               ? CM_OK
+               : cm_fail(st, msg, msg_size, "restoring region %u: %s", added, cm_strerror(st));
 }
 
 static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
@@ -225,48 +346,61 @@ static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
     sum->straddling_groups += one->straddling_groups;
 }
 
-cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt,
-                                 cm_join_stats *stats, char *msg, size_t msg_size)
+/* Solves boxes[0..n) concurrently, one region per thread. */
+static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box *boxes, uint32_t n,
+                        const cm_scm_options *one, int threads, cm_region *solved,
+                        cm_status *status, char (*msgs)[256])
 {
-    cm_region *solved = calloc(nboxes + 1, sizeof *solved);
-    cm_status *status = calloc(nboxes + 1, sizeof *status);
-    char (*msgs)[256] = calloc(nboxes + 1, sizeof *msgs);
-    if (!solved || !status || !msgs) {
-        free(solved);
-        free(status);
-        free(msgs);
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u regions", nboxes);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int64_t k = 0; k < (int64_t)n; k++) {
+        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
+        if (status[k] == CM_OK)
+            status[k] = cm_scm_solve(model, &c->lat, one, &solved[k], msgs[k], sizeof msgs[k]);
     }
+    (void)threads;
+}
+
+cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
+                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
+                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size)
+{
     int threads = 1;
 #ifdef _OPENMP
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
+    cm_region *solved = calloc((size_t)threads, sizeof *solved);
+    cm_status *status = calloc((size_t)threads, sizeof *status);
+    char(*msgs)[256] = calloc((size_t)threads, sizeof *msgs);
+    if (!solved || !status || !msgs) {
+        free(solved);
+        free(status);
+        free(msgs);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d regions", threads);
+    }
     cm_scm_options one = opt ? *opt : (cm_scm_options){0};
     one.record_exits = 1;
     one.threads = 1;
-    /* One region per thread: classification is sequential, so this is how
-     * a big box uses every core. Each region's result depends on its box
-     * alone, and the joins below run in a fixed order. */
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int64_t k = 0; k < (int64_t)nboxes; k++) {
-        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
-        if (status[k] == CM_OK)
-            status[k] = cm_scm_solve(model, &c->lat, &one, &solved[k], msgs[k], sizeof msgs[k]);
-    }
-    (void)threads;
-    cm_status st = CM_OK;
     if (stats)
         memset(stats, 0, sizeof *stats);
-    for (uint32_t k = 0; k < nboxes; k++) {
-        cm_join_stats one_join;
-        if (st == CM_OK && status[k] != CM_OK)
-            st = cm_fail(status[k], msg, msg_size, "region %u: %s", k, msgs[k]);
-        if (st == CM_OK)
-            st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
-        if (st == CM_OK && stats)
-            add_join_stats(stats, &one_join);
-        cm_region_free(&solved[k]);
+    /* One region per thread: classification is sequential, so this is how
+     * a big box uses every core. Each region's result depends on its box
+     * alone, and the joins run in a fixed order. */
+    cm_status st = CM_OK;
+    for (uint32_t first = 0; first < nboxes && st == CM_OK; first += (uint32_t)threads) {
+        const uint32_t n = nboxes - first < (uint32_t)threads ? nboxes - first : (uint32_t)threads;
+        solve_batch(c, model, boxes + first, n, &one, threads, solved, status, msgs);
+        for (uint32_t k = 0; k < n; k++) {
+            cm_join_stats one_join;
+            if (st == CM_OK && status[k] != CM_OK)
+                st = cm_fail(status[k], msg, msg_size, "region %u: %s", first + k, msgs[k]);
+            if (st == CM_OK)
+                st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
+            if (st == CM_OK && stats)
+                add_join_stats(stats, &one_join);
+            if (st == CM_OK && joined)
+                st = joined(user, c, first + k, &one_join, msg, msg_size);
+            cm_region_free(&solved[k]);
+        }
     }
     free(solved);
     free(status);
@@ -289,7 +423,7 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
     return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
 }
 
-cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
+cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
     cm_status st = cm_region_alloc(out, box, msg, msg_size);
@@ -304,6 +438,13 @@ cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_region *r = &c->regions[k].r;
         int64_t cell[CM_MAX_DIM];
+        if (!boxes_overlap(&r->box, box))
+            continue;
+        st = cm_cluster_acquire(c, k, msg, msg_size);
+        if (st != CM_OK) {
+            cm_region_free(out);
+            return st;
+        }
         for (uint64_t i = 0; i < r->ncells; i++) {
             cm_box_cell(&r->box, i, cell);
             if (!cm_box_contains(box, cell))
@@ -313,6 +454,7 @@ cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *
             out->group[j] = r->group[i];
             out->step[j] = r->step[i];
         }
+        cm_cluster_trim(c);
     }
     return CM_OK;
 }

@@ -30,13 +30,21 @@
 #include "cellmap/scm.h"
 
 typedef struct cm_cluster_region {
-    cm_region r;
-    uint32_t *escapes;  /* exits whose target lies outside the cluster */
+    cm_region r;      /* arrays NULL while the region is paged out */
+    int64_t *escapes; /* target cells of the exits that leave the cluster */
     uint64_t nescapes;
-    uint32_t *targets;  /* regions that exits lead into (no duplicates) */
+    uint32_t *targets; /* regions that exits lead into (no duplicates) */
     uint32_t ntargets;
     uint64_t targets_cap;
+    int dirty;          /* cells changed since the owner last saved them */
+    uint64_t last_used; /* paging clock of the last acquire */
 } cm_cluster_region;
+
+/* Reads back the arrays of a paged-out region: r has box, ncells, nexits
+ * and ngroups set and NULL arrays; the pager allocates and fills image,
+ * group, step and exit_target exactly as they were when last saved. */
+typedef cm_status (*cm_page_in_fn)(void *user, uint32_t region, cm_region *r, char *msg,
+                                   size_t msg_size);
 
 typedef struct cm_cluster {
     cm_lattice lat;
@@ -45,6 +53,14 @@ typedef struct cm_cluster {
     uint64_t cap;
     uint32_t ngroups; /* cluster-wide group ids 1..ngroups */
     int threads;      /* OpenMP threads for joins; 0: the OpenMP default */
+    /* Paging, off while page_in is NULL. cm_cluster_trim evicts clean
+     * regions (dirty == 0: their cells are saved) until the resident arrays
+     * take at most mem_budget bytes; joins and cm_cluster_acquire read
+     * regions back through page_in. */
+    cm_page_in_fn page_in;
+    void *pager;
+    uint64_t mem_budget; /* 0: no limit */
+    uint64_t clock;
 } cm_cluster;
 
 typedef struct cm_join_stats {
@@ -67,27 +83,52 @@ int cm_cluster_threads(const cm_cluster *c);
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
                           size_t msg_size);
 
-/* Solves the boxes concurrently (one region per thread, images included),
- * then joins them in the given order. stats (may be NULL) sums the joins'. */
+/* Called after each join of cm_cluster_solve_boxes (box is its index);
+ * a status other than CM_OK stops the solve with it. */
+typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
+                                  const cm_join_stats *stats, char *msg, size_t msg_size);
+
+/* Solves the boxes in batches of one box per thread (images included) and
+ * joins each batch in the given order, calling joined (may be NULL) after
+ * every join, so at most a batch of unjoined regions is held at once.
+ * stats (may be NULL) sums the joins'. */
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt,
-                                 cm_join_stats *stats, char *msg, size_t msg_size);
+                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
+                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size);
 
 /* The region holding the cell and the cell's local index, or -1. *hint is
  * the region tried first (any value will do) and is set to the one found. */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
                           uint64_t *local);
 
+/* Restores a region from its record (box, ncells, nexits, ngroups) and the
+ * target cells of its exits, paged out: a cluster reopened from a file.
+ * Regions must be restored in the order they were joined. */
+cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
+                             char *msg, size_t msg_size);
+
+/* Makes region k resident (reading it back if paged out) and marks it used. */
+cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
+
+/* Evicts clean resident regions, least recently used first and those no
+ * sequence leaves (all neighbours known) before the others, until the
+ * resident arrays fit c->mem_budget. Does nothing without a pager. */
+void cm_cluster_trim(cm_cluster *c);
+
+/* Bytes held by the resident regions' cell arrays and exit tables. */
+uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
+
 /* The smallest box holding every region (the cluster must have one). */
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
-/* Bytes held by the regions' arrays, exit tables and escape lists. */
+/* Bytes held by the resident regions' arrays and exit tables, and by
+ * every region's escape and target lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
 /* The cluster as one region over `box`: group and step of every cell (group
  * CM_GROUP_NONE outside every region), images as box indices (exits and
  * cells beyond the box as CM_IMAGE_EXIT). out->ngroups is the cluster's. */
-cm_status cm_cluster_flatten(const cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
+cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size);
 
 #endif

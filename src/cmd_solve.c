@@ -479,7 +479,7 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
     split_boxes(a, box, boxes);
-    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, &opt, stats, msg, msg_size);
+    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, NULL, stats, msg, msg_size);
     free(boxes);
     return st;
 }

@@ -76,7 +76,7 @@ int main(int argc, char **argv)
             cm_cluster_init(&c, &lat);
             c.threads = 2;
             const double t4 = now();
-            if (cm_cluster_solve_boxes(&c, &m, boxes, 2, &opt, NULL, msg, sizeof msg) != CM_OK)
+            if (cm_cluster_solve_boxes(&c, &m, boxes, 2, &opt, NULL, NULL, NULL, msg, sizeof msg) != CM_OK)
                 die(msg);
             const double t5 = now();
             cm_cluster_free(&c);

@@ -336,7 +336,7 @@ static void test_threads_identical(void)
         cm_cluster_init(&c, &lat);
         c.threads = t + 1;
         const cm_scm_options opt = {1, t + 1, NULL, NULL, 1};
-        CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, msg, sizeof msg) == CM_OK);
+        CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
         CHECK(cm_cluster_flatten(&c, &whole, &flat[t], msg, sizeof msg) == CM_OK);
         cm_cluster_free(&c);
     }

@@ -29,7 +29,7 @@ static void add_boxes(cm_cluster *c, const cm_model *m, const cm_box *boxes, uin
 {
     const cm_scm_options opt = {1, 0, NULL, NULL, 1};
     char msg[256];
-    CHECK(cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
 }
 
 static int64_t floor_div(int64_t a, int64_t b)
@@ -138,7 +138,7 @@ static void test_fig_4_25(void)
     CHECK(2 * choice.escaping > choice.all_escaping); /* most of them */
     cm_join_stats stats;
     const cm_scm_options opt = {1, 0, NULL, NULL, 1};
-    CHECK(cm_cluster_solve_boxes(&c, &m, &choice.box, 1, &opt, &stats, msg, sizeof msg) ==
+    CHECK(cm_cluster_solve_boxes(&c, &m, &choice.box, 1, &opt, NULL, NULL, &stats, msg, sizeof msg) ==
           CM_OK);
     CHECK(stats.straddling_groups > 0);
     cm_region flat;
