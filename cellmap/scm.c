@@ -186,7 +186,7 @@ cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_sc
     return st;
 }
 
-static bool cell_less(const int64_t *a, const int64_t *b, int dim)
+bool cm_cell_less(const int64_t *a, const int64_t *b, int dim)
 {
     for (int d = dim - 1; d >= 0; d--)
         if (a[d] != b[d])
@@ -194,10 +194,31 @@ static bool cell_less(const int64_t *a, const int64_t *b, int dim)
     return false;
 }
 
+void cm_group_add_periodic(cm_group_info *gi, const cm_lattice *lat, const int64_t *cell)
+{
+    double x[CM_MAX_DIM];
+    cm_lattice_centre(lat, cell, x);
+    if (gi->period == 0 || cm_cell_less(cell, gi->anchor, lat->dim))
+        memcpy(gi->anchor, cell, (size_t)lat->dim * sizeof *cell);
+    for (int d = 0; d < lat->dim; d++) {
+        if (gi->period == 0 || x[d] < gi->lo[d])
+            gi->lo[d] = x[d];
+        if (gi->period == 0 || x[d] > gi->hi[d])
+            gi->hi[d] = x[d];
+        gi->centre[d] += x[d];
+    }
+    gi->period++;
+}
+
+void cm_group_finish(cm_group_info *gi, int dim)
+{
+    for (int d = 0; d < dim && gi->period > 0; d++)
+        gi->centre[d] /= gi->period;
+}
+
 cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info *groups,
                         uint64_t *sink_cells)
 {
-    const int dim = lat->dim;
     uint64_t sink = 0;
     for (uint32_t k = 0; k < r->ngroups; k++) {
         memset(&groups[k], 0, sizeof groups[k]);
@@ -216,23 +237,11 @@ cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info
         if (r->step[i] != 0)
             continue;
         int64_t cell[CM_MAX_DIM];
-        double x[CM_MAX_DIM];
         cm_box_cell(&r->box, i, cell);
-        cm_lattice_centre(lat, cell, x);
-        if (gi->period == 0 || cell_less(cell, gi->anchor, dim))
-            memcpy(gi->anchor, cell, sizeof gi->anchor);
-        for (int d = 0; d < dim; d++) {
-            if (gi->period == 0 || x[d] < gi->lo[d])
-                gi->lo[d] = x[d];
-            if (gi->period == 0 || x[d] > gi->hi[d])
-                gi->hi[d] = x[d];
-            gi->centre[d] += x[d];
-        }
-        gi->period++;
+        cm_group_add_periodic(gi, lat, cell);
     }
     for (uint32_t k = 0; k < r->ngroups; k++)
-        for (int d = 0; d < dim; d++)
-            groups[k].centre[d] /= groups[k].period;
+        cm_group_finish(&groups[k], lat->dim);
     if (sink_cells)
         *sink_cells = sink;
     return CM_OK;

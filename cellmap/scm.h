@@ -20,6 +20,7 @@
 #ifndef CM_SCM_H
 #define CM_SCM_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "cellmap/lattice.h"
@@ -109,6 +110,16 @@ cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size);
 /* Images then classification. */
 cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
                        cm_region *r, char *msg, size_t msg_size);
+
+/* Box order of cells: the last coordinate first (true if a comes before b). */
+bool cm_cell_less(const int64_t *a, const int64_t *b, int dim);
+
+/* Adds a periodic cell to a group's summary (period, anchor, bounds, the
+ * centre's running sum); cells must come in box order (cm_cell_less) for
+ * the centre to be the same bits whoever sums it. cm_group_finish turns
+ * the sum into the mean. */
+void cm_group_add_periodic(cm_group_info *gi, const cm_lattice *lat, const int64_t *cell);
+void cm_group_finish(cm_group_info *gi, int dim);
 
 /* Summaries of groups 1..ngroups into a caller array of r->ngroups entries
  * (entry k describes group k+1). Also counts the sink's cells if sink_cells. */

@@ -1,26 +1,17 @@
 #include "cellmap/store.h"
 
+#include "cellmap/classify.h"
+#include "cellmap/codec.h"
+#include "cellmap/grow.h"
+
 #include <sqlite3.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
-
-static const char *const schema_sql =
-    "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-    "CREATE TABLE regions(id INTEGER PRIMARY KEY, lo TEXT NOT NULL, hi TEXT NOT NULL,"
-    " cells INTEGER NOT NULL, status TEXT NOT NULL);"
-    "CREATE TABLE pages(region INTEGER NOT NULL REFERENCES regions(id), first_cell INTEGER NOT "
-    "NULL,"
-    " cells INTEGER NOT NULL, image BLOB NOT NULL, grp BLOB NOT NULL, step BLOB NOT NULL,"
-    " PRIMARY KEY(region, first_cell));"
-    "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
-    " basin_cells INTEGER NOT NULL, is_sink INTEGER NOT NULL, centre TEXT, lo TEXT, hi TEXT,"
-    " anchor TEXT, periodic_cells BLOB);"
-    "CREATE TABLE exits(region INTEGER NOT NULL, cell INTEGER NOT NULL, target TEXT NOT NULL,"
-    " PRIMARY KEY(region, cell));";
 
 /* Appends text to a fixed buffer, never overflowing. */
 static void append(char *buf, size_t size, size_t *used, const char *fmt, ...)
@@ -82,24 +73,6 @@ void cm_params_json(const cm_params *p, char *buf, size_t size)
     append(buf, size, &used, "}");
 }
 
-/* Little-endian encoding, whatever the host's byte order. */
-static void put_u32le(unsigned char *dst, const uint32_t *src, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        dst[4 * i] = (unsigned char)(src[i]);
-        dst[4 * i + 1] = (unsigned char)(src[i] >> 8);
-        dst[4 * i + 2] = (unsigned char)(src[i] >> 16);
-        dst[4 * i + 3] = (unsigned char)(src[i] >> 24);
-    }
-}
-
-static void get_u32le(uint32_t *dst, const unsigned char *src, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        dst[i] = (uint32_t)src[4 * i] | (uint32_t)src[4 * i + 1] << 8 |
-                 (uint32_t)src[4 * i + 2] << 16 | (uint32_t)src[4 * i + 3] << 24;
-}
-
 static cm_status db_error(sqlite3 *db, const char *what, char *msg, size_t msg_size)
 {
     return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, db ? sqlite3_errmsg(db) : "no database");
@@ -117,59 +90,194 @@ static int pragma_int(sqlite3 *db, const char *sql, int *value)
     return rc;
 }
 
-/* Opens path read-only and checks application id and version. */
-static cm_status open_checked(const char *path, sqlite3 **out, char *msg, size_t msg_size)
+static const char *const schema_sql =
+    "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+    "CREATE TABLE regions(id INTEGER PRIMARY KEY, lo TEXT NOT NULL, hi TEXT NOT NULL,"
+    " cells INTEGER NOT NULL, exits INTEGER NOT NULL, own_groups INTEGER NOT NULL,"
+    " status TEXT NOT NULL);"
+    "CREATE TABLE pages(region INTEGER NOT NULL REFERENCES regions(id),"
+    " first_cell INTEGER NOT NULL, cells INTEGER NOT NULL,"
+    " image BLOB NOT NULL, grp BLOB NOT NULL, step BLOB NOT NULL,"
+    " PRIMARY KEY(region, first_cell));"
+    "CREATE TABLE exits(region INTEGER PRIMARY KEY REFERENCES regions(id),"
+    " count INTEGER NOT NULL, targets BLOB NOT NULL);"
+    "CREATE TABLE region_groups(region INTEGER NOT NULL REFERENCES regions(id),"
+    " grp INTEGER NOT NULL, cells INTEGER NOT NULL, PRIMARY KEY(region, grp));"
+    "CREATE INDEX region_groups_grp ON region_groups(grp);"
+    "CREATE TABLE attractors(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
+    " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
+    " periodic_cells BLOB NOT NULL);"
+    "CREATE VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor,"
+    " periodic_cells) AS"
+    " SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1,"
+    "  NULL, NULL, NULL, NULL, NULL"
+    " UNION ALL"
+    " SELECT a.id, a.period,"
+    "  (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = a.id), 0,"
+    "  a.centre, a.lo, a.hi, a.anchor, a.periodic_cells FROM attractors a;";
+
+/* Tables a file of this version must have; their absence means corruption. */
+static const char *const check_sql =
+    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
+    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
+    " (SELECT COUNT(*) FROM region_groups), (SELECT COUNT(*) FROM pages WHERE region = 1)";
+
+struct cm_store {
+    sqlite3 *db;
+    char *path;
+    int writable;
+    uint32_t saved_regions; /* regions of the cluster already in the file */
+    uint32_t saved_groups;
+    uint64_t **page_hash; /* per saved region: hash of each page's grp and step as saved */
+    uint64_t hash_cap, hash_len;
+    unsigned char *buf, *scratch; /* encode/decode buffers */
+    uint64_t *count;              /* per group, for region_groups */
+    uint64_t count_cap;
+    cm_store_stats stats;
+};
+
+static double seconds_now(void)
 {
-    sqlite3 *db = NULL;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int exec(sqlite3 *db, const char *sql) { return sqlite3_exec(db, sql, NULL, NULL, NULL); }
+
+static cm_status read_text(sqlite3 *db, const char *sql, char *out, size_t size, char *msg,
+                           size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_EFORMAT;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW &&
+        sqlite3_column_text(st, 0)) {
+        snprintf(out, size, "%s", (const char *)sqlite3_column_text(st, 0));
+        status = CM_OK;
+    }
+    sqlite3_finalize(st);
+    return status == CM_OK ? CM_OK
+                           : cm_fail(CM_EFORMAT, msg, msg_size, "corrupt database: %s failed", sql);
+}
+
+/* Checks an open connection: SQLite, cellmap's application id, a version
+ * this cellmap reads, the tables present (and, if full, every page sound). */
+static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, size_t msg_size)
+{
+    int app = 0, version = 0;
+    if (pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
+        pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       sqlite3_errcode(db) == SQLITE_CORRUPT
+                           ? "%s is a damaged database (%s); restore it from a copy or solve again"
+                           : "%s is not a cellmap database (%s)",
+                       path, sqlite3_errmsg(db));
+    if (app != CM_STORE_APP_ID)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "%s is an SQLite file but not a cellmap database (application_id %d)", path,
+                       app);
+    if (version > CM_STORE_VERSION)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "%s has format version %d, newer than this cellmap reads (%d): use a "
+                       "newer cellmap",
+                       path, version, CM_STORE_VERSION);
+    if (version < CM_STORE_VERSION)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "%s has format version %d (single region, no exits), which cannot be "
+                       "migrated to version %d: solve it again with --db",
+                       path, version, CM_STORE_VERSION);
+    sqlite3_stmt *st = NULL;
+    int rc = sqlite3_prepare_v2(db, check_sql, -1, &st, NULL);
+    if (rc == SQLITE_OK)
+        rc = sqlite3_step(st) == SQLITE_ROW ? SQLITE_OK : SQLITE_CORRUPT;
+    sqlite3_finalize(st);
+    char result[64] = "ok";
+    if (rc == SQLITE_OK && full)
+        rc = read_text(db, "PRAGMA quick_check(1)", result, sizeof result, msg, msg_size) == CM_OK
+                 ? SQLITE_OK
+                 : SQLITE_CORRUPT;
+    if (rc != SQLITE_OK || strcmp(result, "ok") != 0)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is a damaged cellmap database (%s)", path,
+                       rc != SQLITE_OK ? sqlite3_errmsg(db) : result);
+    return CM_OK;
+}
+
+static cm_status open_db(const char *path, int flags, sqlite3 **out, char *msg, size_t msg_size)
+{
     *out = NULL;
-    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
-        cm_status st = cm_fail(CM_EIO, msg, msg_size, "cannot open %s: %s", path,
-                               db ? sqlite3_errmsg(db) : "out of memory");
+    sqlite3 *db = NULL;
+    if (sqlite3_open_v2(path, &db, flags, NULL) != SQLITE_OK) {
+        const cm_status st = cm_fail(CM_EIO, msg, msg_size, "cannot open %s: %s", path,
+                                     db ? sqlite3_errmsg(db) : "out of memory");
         sqlite3_close(db);
         return st;
     }
-    int app = 0, version = 0;
-    if (pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
-        pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK) {
-        sqlite3_close(db);
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is not a cellmap database (not SQLite)",
-                       path);
-    }
-    if (app != CM_STORE_APP_ID) {
-        sqlite3_close(db);
-        return cm_fail(CM_EFORMAT, msg, msg_size,
-                       "%s is an SQLite file but not a cellmap database (application_id %d)",
-                       path, app);
-    }
-    if (version > CM_STORE_VERSION || version < 1) {
-        sqlite3_close(db);
-        return cm_fail(CM_EFORMAT, msg, msg_size,
-                       "%s has format version %d; this cellmap reads version %d (upgrade cellmap)",
-                       path, version, CM_STORE_VERSION);
-    }
+    sqlite3_busy_timeout(db, 5000);
     *out = db;
     return CM_OK;
 }
 
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
 {
+    struct stat sb;
+    if (stat(path, &sb) != 0)
+        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist", path);
     sqlite3 *db = NULL;
-    cm_status st = open_checked(path, &db, msg, msg_size);
+    cm_status st = open_db(path, SQLITE_OPEN_READONLY, &db, msg, msg_size);
+    if (st == CM_OK)
+        st = check_file(db, path, 0, msg, msg_size);
     sqlite3_close(db);
     return st;
 }
 
-static int exec(sqlite3 *db, const char *sql) { return sqlite3_exec(db, sql, NULL, NULL, NULL); }
+static cm_status new_store(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
+                           size_t msg_size)
+{
+    cm_store *s = calloc(1, sizeof *s);
+    const size_t raw = 8 * (size_t)CM_STORE_PAGE_CELLS * CM_MAX_DIM;
+    if (s) {
+        s->path = strdup(path);
+        s->buf = malloc(cm_codec_bound(raw));
+        s->scratch = malloc(raw);
+    }
+    if (!s || !s->path || !s->buf || !s->scratch) {
+        if (s) {
+            free(s->path);
+            free(s->buf);
+            free(s->scratch);
+        }
+        free(s);
+        sqlite3_close(db);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory opening %s", path);
+    }
+    s->db = db;
+    s->writable = writable;
+    *out = s;
+    return CM_OK;
+}
+
+static cm_status use_wal(sqlite3 *db, const char *path, char *msg, size_t msg_size)
+{
+    /* NORMAL: in WAL mode a commit survives the process being killed; only
+     * an operating-system crash may lose the last commits, never consistency. */
+    char mode[16] = "";
+    if (read_text(db, "PRAGMA journal_mode=WAL", mode, sizeof mode, msg, msg_size) != CM_OK ||
+        strcmp(mode, "wal") != 0 || exec(db, "PRAGMA synchronous=NORMAL") != SQLITE_OK)
+        return cm_fail(CM_EDB, msg, msg_size, "cannot put %s in WAL mode: %s", path,
+                       sqlite3_errmsg(db));
+    return CM_OK;
+}
 
 static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, size_t msg_size)
 {
-    char params[8192], origin[512], width[512], created[32], dim[8];
+    char params[8192], origin[512], width[512], created[32], dim[8], page[16];
     const cm_lattice *lat = meta->lattice;
     cm_params_json(&meta->model->values, params, sizeof params);
     json_doubles(origin, sizeof origin, lat->origin, lat->dim);
     json_doubles(width, sizeof width, lat->width, lat->dim);
     snprintf(created, sizeof created, "%lld", meta->created);
     snprintf(dim, sizeof dim, "%d", lat->dim);
+    snprintf(page, sizeof page, "%d", CM_STORE_PAGE_CELLS);
     const char *rows[][2] = {
         {"format", "cellmap cluster database"},
         {"tool_version", meta->tool_version ? meta->tool_version : ""},
@@ -179,7 +287,11 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
         {"lattice_origin", origin},
         {"lattice_width", width},
         {"command", meta->command ? meta->command : ""},
+        {"plan", meta->plan ? meta->plan : ""},
         {"created", created},
+        {"codec", "zstd-planes-1"},
+        {"page_cells", page},
+        {"groups", "0"},
     };
     sqlite3_stmt *st = NULL;
     if (sqlite3_prepare_v2(db, "INSERT INTO meta(key, value) VALUES(?, ?)", -1, &st, NULL))
@@ -197,133 +309,8 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
     return CM_OK;
 }
 
-static cm_status write_pages(sqlite3 *db, const cm_region *r, char *msg, size_t msg_size)
-{
-    char lo[512], hi[512];
-    json_ints(lo, sizeof lo, r->box.lo, r->box.dim);
-    json_ints(hi, sizeof hi, r->box.hi, r->box.dim);
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, "INSERT INTO regions VALUES(1, ?, ?, ?, 'solved')", -1, &st, NULL))
-        return db_error(db, "prepare regions", msg, msg_size);
-    sqlite3_bind_text(st, 1, lo, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(st, 2, hi, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_int64(st, 3, (sqlite3_int64)r->ncells);
-    const int rc = sqlite3_step(st);
-    sqlite3_finalize(st);
-    if (rc != SQLITE_DONE)
-        return db_error(db, "write region", msg, msg_size);
-    unsigned char *buf = malloc(3 * 4 * (size_t)CM_STORE_PAGE_CELLS);
-    if (!buf)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing pages");
-    cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(db, "INSERT INTO pages VALUES(1, ?, ?, ?, ?, ?)", -1, &st, NULL))
-        status = db_error(db, "prepare pages", msg, msg_size);
-    for (uint64_t first = 0; status == CM_OK && first < r->ncells; first += CM_STORE_PAGE_CELLS) {
-        const uint64_t n =
-            r->ncells - first < CM_STORE_PAGE_CELLS ? r->ncells - first : CM_STORE_PAGE_CELLS;
-        const uint32_t *arrays[3] = {r->image + first, r->group + first, r->step + first};
-        sqlite3_bind_int64(st, 1, (sqlite3_int64)first);
-        sqlite3_bind_int64(st, 2, (sqlite3_int64)n);
-        for (int a = 0; a < 3; a++) {
-            put_u32le(buf + (size_t)a * 4 * CM_STORE_PAGE_CELLS, arrays[a], n);
-            sqlite3_bind_blob(st, 3 + a, buf + (size_t)a * 4 * CM_STORE_PAGE_CELLS, (int)(4 * n),
-                              SQLITE_STATIC);
-        }
-        if (sqlite3_step(st) != SQLITE_DONE)
-            status = db_error(db, "write page", msg, msg_size);
-        sqlite3_reset(st);
-    }
-    sqlite3_finalize(st);
-    free(buf);
-    return status;
-}
-
-static cm_status write_groups(sqlite3 *db, const cm_region *r, const cm_lattice *lat,
-                              const cm_group_info *groups, char *msg, size_t msg_size)
-{
-    sqlite3_stmt *st = NULL;
-    uint64_t sink = r->ncells;
-    for (uint32_t k = 0; k < r->ngroups; k++)
-        sink -= groups[k].basin_cells;
-    if (sqlite3_prepare_v2(db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
-                           NULL))
-        return db_error(db, "prepare groups", msg, msg_size);
-    /* The sink: group 0, period 1, no periodic cells in the lattice. */
-    sqlite3_bind_int(st, 1, 0);
-    sqlite3_bind_int(st, 2, 1);
-    sqlite3_bind_int64(st, 3, (sqlite3_int64)sink);
-    sqlite3_bind_int(st, 4, 1);
-    for (int c = 5; c <= 9; c++)
-        sqlite3_bind_null(st, c);
-    cm_status status = sqlite3_step(st) == SQLITE_DONE ? CM_OK : db_error(db, "write sink", msg,
-                                                                          msg_size);
-    for (uint32_t k = 0; status == CM_OK && k < r->ngroups; k++) {
-        const cm_group_info *g = &groups[k];
-        char centre[512], lo[512], hi[512], anchor[512];
-        json_doubles(centre, sizeof centre, g->centre, lat->dim);
-        json_doubles(lo, sizeof lo, g->lo, lat->dim);
-        json_doubles(hi, sizeof hi, g->hi, lat->dim);
-        json_ints(anchor, sizeof anchor, g->anchor, lat->dim);
-        sqlite3_reset(st);
-        sqlite3_bind_int64(st, 1, g->id);
-        sqlite3_bind_int64(st, 2, g->period);
-        sqlite3_bind_int64(st, 3, (sqlite3_int64)g->basin_cells);
-        sqlite3_bind_int(st, 4, 0);
-        sqlite3_bind_text(st, 5, centre, -1, SQLITE_TRANSIENT);
-        sqlite3_bind_text(st, 6, lo, -1, SQLITE_TRANSIENT);
-        sqlite3_bind_text(st, 7, hi, -1, SQLITE_TRANSIENT);
-        sqlite3_bind_text(st, 8, anchor, -1, SQLITE_TRANSIENT);
-        sqlite3_bind_null(st, 9);
-        if (sqlite3_step(st) != SQLITE_DONE)
-            status = db_error(db, "write group", msg, msg_size);
-    }
-    sqlite3_finalize(st);
-    return status;
-}
-
-/* Periodic cells of every group as local indices (little-endian uint32),
- * one BLOB per group. */
-static cm_status write_periodic_cells(sqlite3 *db, const cm_region *r, const cm_group_info *groups,
-                                      char *msg, size_t msg_size)
-{
-    uint64_t *offset = calloc((size_t)r->ngroups + 1, sizeof *offset);
-    uint64_t total = 0;
-    for (uint32_t k = 0; offset && k < r->ngroups; k++) {
-        offset[k] = total;
-        total += groups[k].period;
-    }
-    unsigned char *cells = offset ? malloc(4 * (total ? total : 1)) : NULL;
-    if (!cells) {
-        free(offset);
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing periodic cells");
-    }
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        if (!cm_is_periodic(r, i))
-            continue;
-        const uint32_t idx = (uint32_t)i;
-        put_u32le(cells + 4 * offset[r->group[i] - 1]++, &idx, 1);
-    }
-    sqlite3_stmt *st = NULL;
-    cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(db, "UPDATE groups SET periodic_cells = ? WHERE id = ?", -1, &st, NULL))
-        status = db_error(db, "prepare periodic cells", msg, msg_size);
-    for (uint32_t k = 0; status == CM_OK && k < r->ngroups; k++) {
-        /* offset[k] now points at the end of group k's cells */
-        sqlite3_bind_blob(st, 1, cells + 4 * (offset[k] - groups[k].period),
-                          (int)(4 * groups[k].period), SQLITE_STATIC);
-        sqlite3_bind_int64(st, 2, groups[k].id);
-        if (sqlite3_step(st) != SQLITE_DONE)
-            status = db_error(db, "write periodic cells", msg, msg_size);
-        sqlite3_reset(st);
-    }
-    sqlite3_finalize(st);
-    free(cells);
-    free(offset);
-    return status;
-}
-
-/* Refuses to replace an existing file that is not a cellmap database. */
-static cm_status check_replaceable(const char *path, char *msg, size_t msg_size)
+/* Removes an existing cellmap database (and its WAL) that a new one replaces. */
+static cm_status remove_old(const char *path, char *msg, size_t msg_size)
 {
     struct stat sb;
     if (stat(path, &sb) != 0)
@@ -332,49 +319,98 @@ static cm_status check_replaceable(const char *path, char *msg, size_t msg_size)
     if (cm_store_check(path, why, sizeof why) != CM_OK)
         return cm_fail(CM_EFORMAT, msg, msg_size,
                        "refusing to overwrite %s: %s; choose another --db file", path, why);
+    char side[4200];
+    const char *suffixes[] = {"-wal", "-shm", "-journal"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(side, sizeof side, "%s%s", path, suffixes[k]);
+        unlink(side);
+    }
+    if (unlink(path) != 0)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot replace %s", path);
     return CM_OK;
 }
 
-cm_status cm_store_save(const char *path, const cm_store_meta *meta, const cm_region *r,
-                        const cm_group_info *groups, char *msg, size_t msg_size)
+cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
+                          size_t msg_size)
 {
-    cm_status status = check_replaceable(path, msg, msg_size);
-    if (status != CM_OK)
-        return status;
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
-    unlink(tmp);
+    *out = NULL;
+    cm_status st = remove_old(path, msg, msg_size);
     sqlite3 *db = NULL;
-    if (sqlite3_open_v2(tmp, &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK) {
-        status = cm_fail(CM_EIO, msg, msg_size, "cannot create %s: %s", tmp,
-                         db ? sqlite3_errmsg(db) : "out of memory");
-        sqlite3_close(db);
-        return status;
-    }
+    if (st == CM_OK)
+        st = open_db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, &db, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     char pragmas[128];
     snprintf(pragmas, sizeof pragmas, "PRAGMA application_id=%d; PRAGMA user_version=%d;",
              CM_STORE_APP_ID, CM_STORE_VERSION);
     if (exec(db, "BEGIN") != SQLITE_OK || exec(db, pragmas) != SQLITE_OK ||
         exec(db, schema_sql) != SQLITE_OK)
-        status = db_error(db, "create schema", msg, msg_size);
-    if (status == CM_OK)
-        status = write_meta(db, meta, msg, msg_size);
-    if (status == CM_OK)
-        status = write_pages(db, r, msg, msg_size);
-    if (status == CM_OK)
-        status = write_groups(db, r, meta->lattice, groups, msg, msg_size);
-    if (status == CM_OK)
-        status = write_periodic_cells(db, r, groups, msg, msg_size);
-    if (status == CM_OK && exec(db, "COMMIT") != SQLITE_OK)
-        status = db_error(db, "commit", msg, msg_size);
-    if (sqlite3_close(db) != SQLITE_OK && status == CM_OK)
-        status = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", tmp);
-    if (status == CM_OK && rename(tmp, path) != 0)
-        status = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s", tmp, path);
-    if (status != CM_OK)
-        unlink(tmp);
-    return status;
+        st = db_error(db, "create schema", msg, msg_size);
+    if (st == CM_OK)
+        st = write_meta(db, meta, msg, msg_size);
+    if (st == CM_OK && exec(db, "COMMIT") != SQLITE_OK)
+        st = db_error(db, "commit", msg, msg_size);
+    if (st == CM_OK)
+        st = use_wal(db, path, msg, msg_size);
+    if (st != CM_OK) {
+        sqlite3_close(db);
+        unlink(path);
+        return st;
+    }
+    return new_store(path, db, 1, out, msg, msg_size);
 }
+
+cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size)
+{
+    *out = NULL;
+    struct stat sb;
+    if (stat(path, &sb) != 0)
+        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist", path);
+    /* Check read-only first: a file that is not ours is never written. */
+    sqlite3 *db = NULL;
+    cm_status st = open_db(path, SQLITE_OPEN_READONLY, &db, msg, msg_size);
+    if (st == CM_OK)
+        st = check_file(db, path, writable, msg, msg_size);
+    if (st != CM_OK || !writable) {
+        if (st != CM_OK)
+            sqlite3_close(db);
+        return st == CM_OK ? new_store(path, db, 0, out, msg, msg_size) : st;
+    }
+    sqlite3_close(db);
+    st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
+    if (st == CM_OK)
+        st = use_wal(db, path, msg, msg_size);
+    if (st != CM_OK) {
+        sqlite3_close(db);
+        return st;
+    }
+    return new_store(path, db, 1, out, msg, msg_size);
+}
+
+cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
+{
+    if (!s)
+        return CM_OK;
+    cm_status st = CM_OK;
+    /* Back to one self-contained file for users and their sqlite3 shell. */
+    if (s->writable && exec(s->db, "PRAGMA journal_mode=DELETE") != SQLITE_OK)
+        st = db_error(s->db, "leave WAL mode", msg, msg_size);
+    if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
+        st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
+    for (uint64_t k = 0; k < s->hash_len; k++)
+        free(s->page_hash[k]);
+    free(s->page_hash);
+    free(s->path);
+    free(s->buf);
+    free(s->scratch);
+    free(s->count);
+    free(s);
+    return st;
+}
+
+void cm_store_get_stats(const cm_store *s, cm_store_stats *stats) { *stats = s->stats; }
+
+/* ---- reading ---------------------------------------------------------- */
 
 /* Parses a JSON array of numbers written by this module. */
 static int parse_json_numbers(const char *text, double *out, int cap)
@@ -393,119 +429,664 @@ static int parse_json_numbers(const char *text, double *out, int cap)
         while (*p == ',' || *p == ' ')
             p++;
     }
-    return n;
+    return *p == ']' ? n : -1;
 }
 
-static cm_status read_text(sqlite3 *db, const char *sql, char *out, size_t size, char *msg,
+static cm_status meta_text(sqlite3 *db, const char *key, char *out, size_t size, char *msg,
                            size_t msg_size)
 {
-    sqlite3_stmt *st = NULL;
-    cm_status status = CM_EFORMAT;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW &&
-        sqlite3_column_text(st, 0)) {
-        snprintf(out, size, "%s", (const char *)sqlite3_column_text(st, 0));
-        status = CM_OK;
-    }
-    sqlite3_finalize(st);
-    return status == CM_OK ? CM_OK
-                           : cm_fail(CM_EFORMAT, msg, msg_size, "database lacks: %s", sql);
+    char sql[128];
+    snprintf(sql, sizeof sql, "SELECT value FROM meta WHERE key='%s'", key);
+    return read_text(db, sql, out, size, msg, msg_size);
 }
 
-static cm_status read_lattice(sqlite3 *db, cm_lattice *lat, cm_box *box, char *msg,
-                              size_t msg_size)
+static cm_status read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size)
 {
     char text[1024];
-    double v[CM_MAX_DIM];
-    cm_status st;
     memset(lat, 0, sizeof *lat);
-    memset(box, 0, sizeof *box);
-    if ((st = read_text(db, "SELECT value FROM meta WHERE key='lattice_origin'", text, sizeof text,
-                        msg, msg_size)) != CM_OK)
+    cm_status st = meta_text(db, "lattice_origin", text, sizeof text, msg, msg_size);
+    if (st != CM_OK)
         return st;
     lat->dim = parse_json_numbers(text, lat->origin, CM_MAX_DIM);
-    if ((st = read_text(db, "SELECT value FROM meta WHERE key='lattice_width'", text, sizeof text,
-                        msg, msg_size)) != CM_OK)
+    if ((st = meta_text(db, "lattice_width", text, sizeof text, msg, msg_size)) != CM_OK)
         return st;
-    if (parse_json_numbers(text, lat->width, CM_MAX_DIM) != lat->dim)
+    if (lat->dim < 1 || parse_json_numbers(text, lat->width, CM_MAX_DIM) != lat->dim)
         return cm_fail(CM_EFORMAT, msg, msg_size, "corrupt lattice metadata");
-    box->dim = lat->dim;
-    if ((st = read_text(db, "SELECT lo FROM regions WHERE id=1", text, sizeof text, msg,
-                        msg_size)) != CM_OK)
-        return st;
-    if (parse_json_numbers(text, v, CM_MAX_DIM) != lat->dim)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "corrupt region box");
-    for (int d = 0; d < lat->dim; d++)
-        box->lo[d] = (int64_t)v[d];
-    if ((st = read_text(db, "SELECT hi FROM regions WHERE id=1", text, sizeof text, msg,
-                        msg_size)) != CM_OK)
-        return st;
-    if (parse_json_numbers(text, v, CM_MAX_DIM) != lat->dim)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "corrupt region box");
-    for (int d = 0; d < lat->dim; d++)
-        box->hi[d] = (int64_t)v[d];
     return cm_lattice_check(lat, msg, msg_size);
 }
 
-static cm_status read_pages(sqlite3 *db, cm_region *r, char *msg, size_t msg_size)
+static int64_t query_int(sqlite3 *db, const char *sql)
 {
     sqlite3_stmt *st = NULL;
-    uint64_t seen = 0;
-    if (sqlite3_prepare_v2(db,
-                           "SELECT first_cell, cells, image, grp, step FROM pages WHERE region=1 "
+    int64_t v = -1;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
+        v = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return v;
+}
+
+cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t msg_size)
+{
+    memset(info, 0, sizeof *info);
+    sqlite3 *db = s->db;
+    cm_status st = meta_text(db, "model", info->model, sizeof info->model, msg, msg_size);
+    if (st == CM_OK)
+        st = meta_text(db, "params", info->params, sizeof info->params, msg, msg_size);
+    if (st == CM_OK)
+        st = meta_text(db, "command", info->command, sizeof info->command, msg, msg_size);
+    if (st == CM_OK)
+        st = meta_text(db, "plan", info->plan, sizeof info->plan, msg, msg_size);
+    if (st == CM_OK)
+        st = meta_text(db, "tool_version", info->tool_version, sizeof info->tool_version, msg,
+                       msg_size);
+    if (st == CM_OK)
+        st = read_lattice(db, &info->lattice, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int64_t regions = query_int(db, "SELECT COUNT(*) FROM regions");
+    const int64_t cells = query_int(db, "SELECT IFNULL(SUM(cells), 0) FROM regions");
+    const int64_t groups = query_int(db, "SELECT COUNT(*) FROM attractors");
+    const int64_t pages = query_int(db, "SELECT IFNULL(SUM(LENGTH(image) + LENGTH(grp) + "
+                                        "LENGTH(step)), 0) FROM pages");
+    if (regions < 0 || cells < 0 || groups < 0 || pages < 0 || groups > CM_MAX_GROUPS)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is a damaged cellmap database (%s)", s->path,
+                       sqlite3_errmsg(db));
+    info->regions = (uint32_t)regions;
+    info->cells = (uint64_t)cells;
+    info->groups = (uint32_t)groups;
+    info->page_bytes = (uint64_t)pages;
+    char side[4200];
+    struct stat sb;
+    if (stat(s->path, &sb) == 0)
+        info->file_bytes = (uint64_t)sb.st_size;
+    snprintf(side, sizeof side, "%s-wal", s->path);
+    if (stat(side, &sb) == 0)
+        info->file_bytes += (uint64_t)sb.st_size;
+    return CM_OK;
+}
+
+/* Hash of a page's grp and step arrays: a page is rewritten when it changes. */
+static uint64_t page_hash(const uint32_t *group, const uint32_t *step, uint64_t n)
+{
+    uint64_t h = UINT64_C(0x9E3779B97F4A7C15) ^ n;
+    for (uint64_t i = 0; i < n; i++) {
+        h = (h ^ ((uint64_t)group[i] << 32 | step[i])) * UINT64_C(0xFF51AFD7ED558CCD);
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+static uint64_t npages(uint64_t ncells)
+{
+    return (ncells + CM_STORE_PAGE_CELLS - 1) / CM_STORE_PAGE_CELLS;
+}
+
+static uint64_t page_cells(uint64_t ncells, uint64_t page)
+{
+    const uint64_t first = page * CM_STORE_PAGE_CELLS;
+    return ncells - first < CM_STORE_PAGE_CELLS ? ncells - first : CM_STORE_PAGE_CELLS;
+}
+
+/* Remembers the hashes of region k's pages as they are on disk. */
+static cm_status remember_hashes(cm_store *s, uint32_t k, const cm_region *r)
+{
+    if (cm_grow_zeroed((void **)&s->page_hash, &s->hash_cap, &s->hash_len, (uint64_t)k + 1,
+                       sizeof *s->page_hash) != CM_OK)
+        return CM_ENOMEM;
+    if (!s->page_hash[k] && !(s->page_hash[k] = malloc(npages(r->ncells) * sizeof(uint64_t))))
+        return CM_ENOMEM;
+    for (uint64_t p = 0; p < npages(r->ncells); p++) {
+        const uint64_t first = p * CM_STORE_PAGE_CELLS;
+        s->page_hash[k][p] = page_hash(r->group + first, r->step + first, page_cells(r->ncells, p));
+    }
+    return CM_OK;
+}
+
+static cm_status decode_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t n, int width,
+                               int64_t first_index, void *out, char *msg, size_t msg_size)
+{
+    const void *blob = sqlite3_column_blob(st, col);
+    const int len = sqlite3_column_bytes(st, col);
+    s->stats.bytes_read += (uint64_t)len;
+    if (!blob ||
+        cm_codec_decode(blob, (size_t)len, n, width, first_index, s->scratch, out) != CM_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: a page does not decode", s->path);
+    return CM_OK;
+}
+
+static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT first_cell, cells, image, grp, step FROM pages WHERE region=? "
                            "ORDER BY first_cell",
                            -1, &st, NULL))
-        return db_error(db, "read pages", msg, msg_size);
+        return db_error(s->db, "read pages", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
     cm_status status = CM_OK;
-    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+    uint64_t seen = 0;
+    int rc;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         const uint64_t first = (uint64_t)sqlite3_column_int64(st, 0);
         const uint64_t n = (uint64_t)sqlite3_column_int64(st, 1);
-        uint32_t *arrays[3] = {r->image, r->group, r->step};
-        if (first != seen || n == 0 || first + n > r->ncells) {
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "corrupt page table at cell %llu",
-                             (unsigned long long)first);
+        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > r->ncells) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u page at %llu",
+                             s->path, k + 1, (unsigned long long)first);
             break;
         }
-        for (int a = 0; a < 3 && status == CM_OK; a++) {
-            const void *blob = sqlite3_column_blob(st, 2 + a);
-            if ((uint64_t)sqlite3_column_bytes(st, 2 + a) != 4 * n || !blob)
-                status = cm_fail(CM_EFORMAT, msg, msg_size, "corrupt page blob");
-            else
-                get_u32le(arrays[a] + first, blob, n);
-        }
+        status = decode_column(s, st, 2, n, 4, (int64_t)first, r->image + first, msg, msg_size);
+        if (status == CM_OK)
+            status = decode_column(s, st, 3, n, 4, -1, r->group + first, msg, msg_size);
+        if (status == CM_OK)
+            status = decode_column(s, st, 4, n, 4, -1, r->step + first, msg, msg_size);
         seen += n;
     }
+    if (status == CM_OK && rc != SQLITE_DONE)
+        status = db_error(s->db, "read pages", msg, msg_size);
     sqlite3_finalize(st);
     if (status == CM_OK && seen != r->ncells)
-        status = cm_fail(CM_EFORMAT, msg, msg_size, "pages cover %llu of %llu cells",
-                         (unsigned long long)seen, (unsigned long long)r->ncells);
+        status =
+            cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u has %llu of %llu cells",
+                    s->path, k + 1, (unsigned long long)seen, (unsigned long long)r->ncells);
     return status;
 }
 
-cm_status cm_store_load(const char *path, cm_lattice *lat, cm_region *r, char *model_name,
-                        size_t name_size, char *msg, size_t msg_size)
+/* Region k's exit targets into a new array of nexits * dim cells. */
+static cm_status read_exits(cm_store *s, uint32_t k, uint64_t nexits, int dim, int64_t **out,
+                            char *msg, size_t msg_size)
 {
-    sqlite3 *db = NULL;
-    cm_box box;
-    memset(r, 0, sizeof *r);
-    cm_status st = open_checked(path, &db, msg, msg_size);
-    if (st == CM_OK)
-        st = read_text(db, "SELECT value FROM meta WHERE key='model'", model_name, name_size, msg,
-                       msg_size);
-    if (st == CM_OK)
-        st = read_lattice(db, lat, &box, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_region_alloc(r, &box, msg, msg_size);
-    if (st == CM_OK)
-        st = read_pages(db, r, msg, msg_size);
-    if (st == CM_OK) {
-        uint32_t max_group = 0;
-        for (uint64_t i = 0; i < r->ncells; i++)
-            if (r->group[i] != CM_GROUP_NONE && r->group[i] > max_group)
-                max_group = r->group[i];
-        r->ngroups = max_group;
+    const uint64_t n = nexits * (uint64_t)dim;
+    int64_t *targets = malloc((n + 1) * sizeof *targets);
+    unsigned char *scratch = malloc(8 * (n + 1));
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_OK;
+    if (!targets || !scratch)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                         (unsigned long long)nexits);
+    else if (sqlite3_prepare_v2(s->db, "SELECT count, targets FROM exits WHERE region=?", -1, &st,
+                                NULL))
+        status = db_error(s->db, "read exits", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        const void *blob = NULL;
+        int len = 0;
+        if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == nexits) {
+            blob = sqlite3_column_blob(st, 1);
+            len = sqlite3_column_bytes(st, 1);
+        }
+        if (!blob || cm_codec_decode(blob, (size_t)len, n, 8, -1, scratch, targets) != CM_OK)
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: exits of region %u",
+                             s->path, k + 1);
+        s->stats.bytes_read += (uint64_t)len;
     }
-    if (st != CM_OK)
-        cm_region_free(r);
-    sqlite3_close(db);
+    sqlite3_finalize(st);
+    free(scratch);
+    if (status != CM_OK) {
+        free(targets);
+        return status;
+    }
+    *out = targets;
+    return CM_OK;
+}
+
+/* The pager: reads region k's arrays and exit table back. */
+static cm_status page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = seconds_now();
+    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
+    r->image = malloc(bytes + 4);
+    r->group = malloc(bytes + 4);
+    r->step = malloc(bytes + 4);
+    cm_status st = r->image && r->group && r->step
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
+    if (st == CM_OK)
+        st = read_pages(s, k, r, msg, msg_size);
+    if (st == CM_OK)
+        st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
+    if (st == CM_OK && (k >= s->hash_len || !s->page_hash[k]) && remember_hashes(s, k, r) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
+    if (st != CM_OK) {
+        free(r->image);
+        free(r->group);
+        free(r->step);
+        r->image = r->group = r->step = NULL;
+    }
+    s->stats.regions_read++;
+    s->stats.read_seconds += seconds_now() - t0;
     return st;
+}
+
+void cm_store_attach(cm_store *s, cm_cluster *c)
+{
+    c->page_in = page_in;
+    c->pager = s;
+}
+
+static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
+{
+    double l[CM_MAX_DIM], h[CM_MAX_DIM];
+    if (!lo || !hi || parse_json_numbers(lo, l, CM_MAX_DIM) != dim ||
+        parse_json_numbers(hi, h, CM_MAX_DIM) != dim)
+        return CM_EFORMAT;
+    box->dim = dim;
+    for (int d = 0; d < dim; d++) {
+        box->lo[d] = (int64_t)l[d];
+        box->hi[d] = (int64_t)h[d];
+        if (box->hi[d] <= box->lo[d])
+            return CM_EFORMAT;
+    }
+    return CM_OK;
+}
+
+cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_lattice lat;
+    cm_status status = read_lattice(s->db, &lat, msg, msg_size);
+    if (status != CM_OK)
+        return status;
+    cm_cluster_init(c, &lat);
+    cm_store_attach(s, c);
+    const int64_t groups = query_int(s->db, "SELECT COUNT(*) FROM attractors");
+    if (groups < 0 || groups > CM_MAX_GROUPS)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: attractors", s->path);
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
+                           -1, &st, NULL))
+        return db_error(s->db, "read regions", msg, msg_size);
+    int rc;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        cm_region rec;
+        memset(&rec, 0, sizeof rec);
+        rec.ncells = (uint64_t)sqlite3_column_int64(st, 3);
+        rec.nexits = (uint64_t)sqlite3_column_int64(st, 4);
+        rec.ngroups = (uint32_t)sqlite3_column_int64(st, 5);
+        if (sqlite3_column_int64(st, 0) != (sqlite3_int64)c->nregions + 1 ||
+            parse_box((const char *)sqlite3_column_text(st, 1),
+                      (const char *)sqlite3_column_text(st, 2), lat.dim, &rec.box) != CM_OK ||
+            rec.ncells != cm_box_cells(&rec.box) || rec.ncells > CM_REGION_MAX_CELLS ||
+            rec.nexits > rec.ncells) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u", s->path,
+                             c->nregions + 1);
+            break;
+        }
+        int64_t *targets = NULL;
+        status = read_exits(s, c->nregions, rec.nexits, lat.dim, &targets, msg, msg_size);
+        if (status == CM_OK)
+            status = cm_cluster_restore(c, &rec, targets, msg, msg_size);
+        free(targets);
+    }
+    if (status == CM_OK && rc != SQLITE_DONE)
+        status = db_error(s->db, "read regions", msg, msg_size);
+    sqlite3_finalize(st);
+    c->ngroups = (uint32_t)groups;
+    s->saved_regions = c->nregions;
+    s->saved_groups = c->ngroups;
+    return status;
+}
+
+/* ---- writing ---------------------------------------------------------- */
+
+static cm_status bind_encoded(cm_store *s, sqlite3_stmt *st, int col, const void *v, uint64_t n,
+                              int width, int64_t first_index, unsigned char *out, size_t cap)
+{
+    size_t len = 0;
+    if (cm_codec_encode(v, n, width, first_index, s->scratch, out, cap, &len) != CM_OK)
+        return CM_ENOMEM;
+    s->stats.bytes_written += len;
+    return sqlite3_bind_blob(st, col, out, (int)len, SQLITE_TRANSIENT) == SQLITE_OK ? CM_OK
+                                                                                    : CM_EDB;
+}
+
+static cm_status step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
+                           size_t msg_size)
+{
+    const int rc = sqlite3_step(st);
+    sqlite3_reset(st);
+    return rc == SQLITE_DONE ? CM_OK : db_error(db, what, msg, msg_size);
+}
+
+static cm_status insert_region(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                               size_t msg_size)
+{
+    char lo[512], hi[512];
+    json_ints(lo, sizeof lo, r->box.lo, r->box.dim);
+    json_ints(hi, sizeof hi, r->box.hi, r->box.dim);
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined')", -1, &st,
+                           NULL))
+        return db_error(s->db, "prepare regions", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+    sqlite3_bind_text(st, 2, lo, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 3, hi, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 4, (sqlite3_int64)r->ncells);
+    sqlite3_bind_int64(st, 5, (sqlite3_int64)r->nexits);
+    sqlite3_bind_int64(st, 6, (sqlite3_int64)r->ngroups);
+    cm_status status = step_done(s->db, st, "write region", msg, msg_size);
+    sqlite3_finalize(st);
+    if (status != CM_OK)
+        return status;
+    /* the exit table: nexits * dim little-endian int64 cell coordinates */
+    const uint64_t n = r->nexits * (uint64_t)r->box.dim;
+    unsigned char *scratch = malloc(8 * (n + 1)), *out = malloc(cm_codec_bound(8 * (n + 1)));
+    size_t len = 0;
+    if (!scratch || !out ||
+        cm_codec_encode(r->exit_target, n, 8, -1, scratch, out, cm_codec_bound(8 * (n + 1)),
+                        &len) != CM_OK)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing exits");
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT INTO exits VALUES(?, ?, ?)", -1, &st, NULL))
+        status = db_error(s->db, "prepare exits", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)r->nexits);
+        sqlite3_bind_blob(st, 3, out, (int)len, SQLITE_STATIC);
+        status = step_done(s->db, st, "write exits", msg, msg_size);
+        sqlite3_finalize(st);
+        s->stats.bytes_written += len;
+    }
+    free(scratch);
+    free(out);
+    return status;
+}
+
+/* Writes region k's pages: all of them for a new region, else those whose
+ * grp or step changed (images never change once a region is solved). */
+static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, int is_new, char *msg,
+                             size_t msg_size)
+{
+    const char *sql = is_new ? "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)"
+                             : "UPDATE pages SET grp = ?5, step = ?6 WHERE region = ?1 AND "
+                               "first_cell = ?2 AND cells = ?3";
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL))
+        return db_error(s->db, "prepare pages", msg, msg_size);
+    const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
+    cm_status status = CM_OK;
+    for (uint64_t p = 0; status == CM_OK && p < npages(r->ncells); p++) {
+        const uint64_t first = p * CM_STORE_PAGE_CELLS, n = page_cells(r->ncells, p);
+        if (!is_new && s->page_hash[k][p] == page_hash(r->group + first, r->step + first, n))
+            continue;
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
+        sqlite3_bind_int64(st, 3, (sqlite3_int64)n);
+        if (is_new)
+            status = bind_encoded(s, st, 4, r->image + first, n, 4, (int64_t)first, s->buf, part);
+        if (status == CM_OK)
+            status = bind_encoded(s, st, 5, r->group + first, n, 4, -1, s->buf + part, part);
+        if (status == CM_OK)
+            status = bind_encoded(s, st, 6, r->step + first, n, 4, -1, s->buf + 2 * part, part);
+        if (status == CM_OK)
+            status = step_done(s->db, st, "write page", msg, msg_size);
+        else
+            status = cm_fail(status, msg, msg_size, "encoding a page of region %u", k + 1);
+        if (status == CM_OK && !is_new && sqlite3_changes(s->db) != 1)
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: page %llu of region %u",
+                             s->path, (unsigned long long)p, k + 1);
+        s->stats.pages_written++;
+    }
+    sqlite3_finalize(st);
+    return status;
+}
+
+/* Replaces region k's row counts per group. */
+static cm_status write_region_groups(cm_store *s, uint32_t k, const cm_region *r, uint32_t ngroups,
+                                     char *msg, size_t msg_size)
+{
+    if (cm_grow((void **)&s->count, &s->count_cap, (uint64_t)ngroups + 1, sizeof *s->count) !=
+        CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory counting groups");
+    memset(s->count, 0, ((size_t)ngroups + 1) * sizeof *s->count);
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (r->group[i] <= ngroups)
+            s->count[r->group[i]]++;
+    sqlite3_stmt *del = NULL, *ins = NULL;
+    cm_status status = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "DELETE FROM region_groups WHERE region = ?", -1, &del, NULL) ||
+        sqlite3_prepare_v2(s->db, "INSERT INTO region_groups VALUES(?, ?, ?)", -1, &ins, NULL))
+        status = db_error(s->db, "prepare region_groups", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(del, 1, (sqlite3_int64)k + 1);
+        status = step_done(s->db, del, "clear region_groups", msg, msg_size);
+    }
+    for (uint32_t g = 0; status == CM_OK && g <= ngroups; g++) {
+        if (!s->count[g])
+            continue;
+        sqlite3_bind_int64(ins, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(ins, 2, g);
+        sqlite3_bind_int64(ins, 3, (sqlite3_int64)s->count[g]);
+        status = step_done(s->db, ins, "write region_groups", msg, msg_size);
+    }
+    sqlite3_finalize(del);
+    sqlite3_finalize(ins);
+    return status;
+}
+
+typedef struct periodic_cell {
+    uint32_t group;
+    int64_t cell[CM_MAX_DIM];
+} periodic_cell;
+
+/* Group first, then box order; unused coordinates are zero, so comparing
+ * all CM_MAX_DIM of them is box order in any dimension. */
+static int periodic_cell_cmp(const void *a, const void *b)
+{
+    const periodic_cell *x = a, *y = b;
+    if (x->group != y->group)
+        return x->group < y->group ? -1 : 1;
+    return cm_cell_less(x->cell, y->cell, CM_MAX_DIM)   ? -1
+           : cm_cell_less(y->cell, x->cell, CM_MAX_DIM) ? 1
+                                                        : 0;
+}
+
+/* The periodic cells of the groups new since the last commit, sorted by
+ * group and box order. They lie in dirty regions: a new group's cycle is
+ * in the new region or crosses the borders of the regions a join changed. */
+static cm_status collect_new_periodic(const cm_store *s, const cm_cluster *c, periodic_cell **out,
+                                      uint64_t *count)
+{
+    uint64_t n = 0, cap = 0;
+    periodic_cell *cells = NULL;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_region *r = &c->regions[k].r;
+        if (!c->regions[k].dirty)
+            continue;
+        for (uint64_t i = 0; i < r->ncells; i++) {
+            if (!cm_is_periodic(r, i) || r->group[i] <= s->saved_groups)
+                continue;
+            if (cm_grow((void **)&cells, &cap, n + 1, sizeof *cells) != CM_OK) {
+                free(cells);
+                return CM_ENOMEM;
+            }
+            memset(&cells[n], 0, sizeof cells[n]);
+            cells[n].group = r->group[i];
+            cm_box_cell(&r->box, i, cells[n].cell);
+            n++;
+        }
+    }
+    if (n)
+        qsort(cells, n, sizeof *cells, periodic_cell_cmp);
+    *out = cells;
+    *count = n;
+    return CM_OK;
+}
+
+static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattice *lat,
+                                  const periodic_cell *cells, uint64_t n, char *msg,
+                                  size_t msg_size)
+{
+    cm_group_info gi;
+    memset(&gi, 0, sizeof gi);
+    unsigned char *blob = malloc(n * (size_t)lat->dim * 8);
+    if (!blob) {
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing groups");
+    }
+    for (uint64_t i = 0; i < n; i++) {
+        cm_group_add_periodic(&gi, lat, cells[i].cell);
+        for (int d = 0; d < lat->dim; d++) {
+            const uint64_t v = (uint64_t)cells[i].cell[d];
+            for (int b = 0; b < 8; b++)
+                blob[(i * (uint64_t)lat->dim + (uint64_t)d) * 8 + (uint64_t)b] =
+                    (unsigned char)(v >> (8 * b));
+        }
+    }
+    cm_group_finish(&gi, lat->dim);
+    char centre[512], lo[512], hi[512], anchor[512];
+    json_doubles(centre, sizeof centre, gi.centre, lat->dim);
+    json_doubles(lo, sizeof lo, gi.lo, lat->dim);
+    json_doubles(hi, sizeof hi, gi.hi, lat->dim);
+    json_ints(anchor, sizeof anchor, gi.anchor, lat->dim);
+    sqlite3_bind_int64(st, 1, cells[0].group);
+    sqlite3_bind_int64(st, 2, gi.period);
+    sqlite3_bind_text(st, 3, centre, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 4, lo, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 5, hi, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 6, anchor, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_blob(st, 7, blob, (int)(n * (uint64_t)lat->dim * 8), SQLITE_TRANSIENT);
+    const cm_status status = step_done(s->db, st, "write group", msg, msg_size);
+    free(blob);
+    return status;
+}
+
+/* Rows of `attractors` for groups saved_groups+1 .. c->ngroups. */
+static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
+{
+    periodic_cell *cells = NULL;
+    uint64_t n = 0;
+    if (collect_new_periodic(s, c, &cells, &n) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory collecting periodic cells");
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?)", -1, &st,
+                           NULL))
+        status = db_error(s->db, "prepare groups", msg, msg_size);
+    uint32_t expected = s->saved_groups + 1;
+    for (uint64_t i = 0; status == CM_OK && i < n;) {
+        uint64_t j = i;
+        while (j < n && cells[j].group == cells[i].group)
+            j++;
+        if (cells[i].group != expected++)
+            status = cm_fail(CM_EINVAL, msg, msg_size,
+                             "group %u has no periodic cell in the "
+                             "changed regions",
+                             expected - 1);
+        else
+            status = insert_attractor(s, st, &c->lat, cells + i, j - i, msg, msg_size);
+        i = j;
+    }
+    if (status == CM_OK && expected != c->ngroups + 1)
+        status = cm_fail(CM_EINVAL, msg, msg_size,
+                         "group %u has no periodic cell in the changed "
+                         "regions",
+                         expected);
+    sqlite3_finalize(st);
+    free(cells);
+    return status;
+}
+
+static cm_status write_dirty(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++) {
+        const cm_region *r = &c->regions[k].r;
+        if (!c->regions[k].dirty)
+            continue;
+        if (!r->group)
+            return cm_fail(CM_EINVAL, msg, msg_size, "region %u is dirty but paged out", k);
+        const int is_new = k >= s->saved_regions;
+        if (is_new)
+            st = insert_region(s, k, r, msg, msg_size);
+        if (st == CM_OK)
+            st = write_pages(s, k, r, is_new, msg, msg_size);
+        if (st == CM_OK)
+            st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
+        s->stats.regions_written++;
+    }
+    if (st == CM_OK)
+        st = write_new_groups(s, c, msg, msg_size);
+    if (st == CM_OK) {
+        char sql[96];
+        snprintf(sql, sizeof sql, "UPDATE meta SET value = '%u' WHERE key = 'groups'", c->ngroups);
+        if (exec(s->db, sql) != SQLITE_OK)
+            st = db_error(s->db, "write meta", msg, msg_size);
+    }
+    return st;
+}
+
+cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    if (!s->writable)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s is open read-only", s->path);
+    const double t0 = seconds_now();
+    if (exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
+        return db_error(s->db, "begin", msg, msg_size);
+    cm_status st = write_dirty(s, c, msg, msg_size);
+    if (st == CM_OK && exec(s->db, "COMMIT") != SQLITE_OK)
+        st = db_error(s->db, "commit", msg, msg_size);
+    if (st != CM_OK) {
+        exec(s->db, "ROLLBACK");
+        return st;
+    }
+    /* the file now holds these pages: remember them and mark them clean */
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        if (!c->regions[k].dirty)
+            continue;
+        if (remember_hashes(s, k, &c->regions[k].r) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory after a commit");
+        c->regions[k].dirty = 0;
+    }
+    s->saved_regions = c->nregions;
+    s->saved_groups = c->ngroups;
+    s->stats.commit_seconds += seconds_now() - t0;
+    return CM_OK;
+}
+
+cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
+                          char *msg, size_t msg_size)
+{
+    cm_lattice lat;
+    cm_status status = read_lattice(s->db, &lat, msg, msg_size);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db,
+                           "SELECT id, period, basin_cells, centre, lo, hi, anchor FROM groups "
+                           "ORDER BY id",
+                           -1, &st, NULL))
+        status = db_error(s->db, "read groups", msg, msg_size);
+    uint32_t seen = 0;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t id = sqlite3_column_int64(st, 0);
+        if (id == 0) {
+            *sink_cells = (uint64_t)sqlite3_column_int64(st, 2);
+            continue;
+        }
+        double anchor[CM_MAX_DIM];
+        cm_group_info *g = &groups[seen];
+        memset(g, 0, sizeof *g);
+        g->id = (uint32_t)id;
+        g->period = (uint32_t)sqlite3_column_int64(st, 1);
+        g->basin_cells = (uint64_t)sqlite3_column_int64(st, 2);
+        if (id != (int64_t)seen + 1 || seen >= n ||
+            parse_json_numbers((const char *)sqlite3_column_text(st, 3), g->centre, CM_MAX_DIM) !=
+                lat.dim ||
+            parse_json_numbers((const char *)sqlite3_column_text(st, 4), g->lo, CM_MAX_DIM) !=
+                lat.dim ||
+            parse_json_numbers((const char *)sqlite3_column_text(st, 5), g->hi, CM_MAX_DIM) !=
+                lat.dim ||
+            parse_json_numbers((const char *)sqlite3_column_text(st, 6), anchor, CM_MAX_DIM) !=
+                lat.dim) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
+                             (long long)id);
+            break;
+        }
+        for (int d = 0; d < lat.dim; d++)
+            g->anchor[d] = (int64_t)anchor[d];
+        seen++;
+    }
+    sqlite3_finalize(st);
+    if (status == CM_OK && seen != n)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s holds %u groups, not %u", s->path, seen, n);
+    return status;
 }

@@ -1,45 +1,105 @@
-/* cellmap/store.h - the .cmdb cluster database (SQLite).
+/* cellmap/store.h - the .cmdb cluster database (SQLite): the cluster's
+ * page store and the file users keep, query and export.
  *
  * A .cmdb file holds one cluster: metadata (model, parameters as JSON,
- * lattice, tool version, command line), regions, the regions' cell arrays as
- * little-endian BLOB pages of CM_STORE_PAGE_CELLS cells, and the periodic
- * groups. The file carries application_id CM_STORE_APP_ID and user_version
- * CM_STORE_VERSION; files with another application id or a newer version are
- * refused and never modified. The byte layout is documented in FORMAT.md.
+ * lattice, tool version, command line, solve plan), the regions in join
+ * order, their cell arrays as compressed pages of CM_STORE_PAGE_CELLS cells
+ * (cellmap/codec.h), their exit tables, each region's cell count per group,
+ * and the attractors (periodic groups). The view `groups` adds basin sizes
+ * and the sink. Layout: README, "The .cmdb database".
  *
- * cm_store_save writes a complete database to PATH.tmp-PID in one
- * transaction and renames it over PATH, so PATH is either the old file or
- * the complete new one. An existing PATH that is not a cellmap database is
- * refused (CM_EFORMAT) and left untouched.
+ * The file carries application_id CM_STORE_APP_ID and user_version
+ * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
+ * version or corrupt are refused (CM_EFORMAT) and never modified.
+ *
+ * Crash safety: the file is in WAL mode while open for writing, and
+ * cm_store_commit writes everything a join changed in one transaction, so
+ * a killed process leaves the cluster of the last commit. Closing switches
+ * the file back to a single file (rollback journal).
+ *
+ * Paging: cm_store_attach makes the store the cluster's pager; committed
+ * regions can then be evicted (cm_cluster_trim) and are read back on demand.
+ * A store is used from one thread at a time.
  */
 #ifndef CM_STORE_H
 #define CM_STORE_H
 
+#include "cellmap/cluster.h"
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 1
+#define CM_STORE_VERSION 2
 #define CM_STORE_PAGE_CELLS 65536
 
+typedef struct cm_store cm_store;
+
 typedef struct cm_store_meta {
-    const cm_model *model;    /* name and parameter values */
+    const cm_model *model; /* name and parameter values */
     const cm_lattice *lattice;
-    const char *command;      /* command line that made the file, may be NULL */
+    const char *command; /* command line that made the file, may be NULL */
+    const char *plan;    /* what a resumed solve must repeat, may be NULL */
     const char *tool_version;
-    long long created;        /* seconds since the epoch (SOURCE_DATE_EPOCH or 0) */
+    long long created; /* seconds since the epoch (SOURCE_DATE_EPOCH or 0) */
 } cm_store_meta;
 
-cm_status cm_store_save(const char *path, const cm_store_meta *meta, const cm_region *r,
-                        const cm_group_info *groups, char *msg, size_t msg_size);
+/* What a file says about itself (cm_store_read_info). */
+typedef struct cm_store_info {
+    char model[64];
+    char params[4096]; /* JSON object */
+    char command[4096];
+    char plan[1024];
+    char tool_version[64];
+    cm_lattice lattice;
+    uint32_t regions;
+    uint64_t cells;
+    uint32_t groups;     /* periodic groups (attractors) */
+    uint64_t file_bytes; /* database file, WAL included */
+    uint64_t page_bytes; /* encoded cell arrays */
+} cm_store_info;
+
+/* Paging and commit figures since the store was opened. */
+typedef struct cm_store_stats {
+    uint64_t regions_read, regions_written, pages_written;
+    uint64_t bytes_read, bytes_written; /* encoded */
+    double read_seconds, commit_seconds;
+} cm_store_stats;
+
+/* Creates a new, empty database at path. An existing cellmap database there
+ * is replaced; any other existing file is refused (CM_EFORMAT), untouched. */
+cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
+                          size_t msg_size);
+
+/* Opens an existing database, read-only or for writing (to resume). Checks
+ * application id, version and (for writing) integrity before any write. */
+cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size);
+
+/* Closes and frees (NULL-safe). A writable store returns to rollback mode. */
+cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size);
 
 /* Checks that path is a cellmap database this version can read. */
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size);
 
-/* Reads the lattice and the (single) region's arrays of a saved file into a
- * newly allocated region. model_name receives the model's name. */
-cm_status cm_store_load(const char *path, cm_lattice *lat, cm_region *r, char *model_name,
-                        size_t name_size, char *msg, size_t msg_size);
+cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t msg_size);
+
+void cm_store_get_stats(const cm_store *s, cm_store_stats *stats);
+
+/* Makes the store the pager of c (c->page_in, c->pager). */
+void cm_store_attach(cm_store *s, cm_cluster *c);
+
+/* Rebuilds the saved cluster into c (initialised on the file's lattice):
+ * every region restored paged out, the store attached as pager. */
+cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
+
+/* Writes, in one transaction, every dirty region of c (new regions whole,
+ * changed pages of older ones), the group counts of those regions and the
+ * groups new since the last commit; then marks the regions clean. */
+cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
+
+/* Summaries of the saved groups 1..n into a caller array (entry k: group
+ * k+1), n = the info's groups, and the sink's cell count. */
+cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
+                          char *msg, size_t msg_size);
 
 /* Parameters as a JSON object text, e.g. {"alpha":0.078,"mode":"output"}. */
 void cm_params_json(const cm_params *p, char *buf, size_t size);

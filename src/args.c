@@ -59,6 +59,24 @@ bool parse_int64(const char *s, int64_t *out)
     return true;
 }
 
+bool parse_bytes(const char *s, uint64_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const unsigned long long v = strtoull(s, &end, 10);
+    if (end == s || *s == '-' || errno == ERANGE)
+        return false;
+    const char units[] = "KMG";
+    const char *u = *end ? strchr(units, *end) : NULL;
+    if (*end && (!u || end[1] != '\0'))
+        return false;
+    const int shift = u ? 10 * (int)(u - units + 1) : 0;
+    if (v > (UINT64_MAX >> shift))
+        return false;
+    *out = (uint64_t)v << shift;
+    return true;
+}
+
 bool parse_double(const char *s, double *out)
 {
     char *end = NULL;

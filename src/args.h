@@ -34,6 +34,8 @@ bool cli_is(cli *c, const char *name, bool needs_value, int *error);
 /* Parsers: false on malformed input. */
 bool parse_int64(const char *s, int64_t *out);
 bool parse_double(const char *s, double *out);
+/* A size in bytes: digits with an optional K, M or G (powers of 1024). */
+bool parse_bytes(const char *s, uint64_t *out);
 /* "LO:HI,LO:HI,..." -> lo[], hi[], count. */
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
 /* "NxMx..." -> counts, count. */

@@ -24,7 +24,8 @@ static const char solve_help[] =
     "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
     "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
-    "                     [--png FILE] [--size WxH] [--db FILE] [--json]\n\n"
+    "                     [--png FILE] [--size WxH] [--db FILE [--resume] [--mem BYTES]]\n"
+    "                     [--json]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
     "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
     "centre). Without options it solves the thesis' C-SCM example (4.6.3):\n"
@@ -45,7 +46,12 @@ static const char solve_help[] =
     "  --threads T         OpenMP threads for the images (default: all cores)\n"
     "  --png FILE          write the basin image (written to a temporary file, renamed)\n"
     "  --size WxH          image size in pixels (default: one pixel per cell, at most 4096)\n"
-    "  --db FILE           write a .cmdb SQLite database (replaces an older .cmdb only)\n"
+    "  --db FILE           write the cluster to a .cmdb SQLite database as it is solved,\n"
+    "                      one transaction per region (replaces an older .cmdb only)\n"
+    "  --resume            continue the solve saved in --db FILE (same options) after\n"
+    "                      it was interrupted; a finished file is only summarised\n"
+    "  --mem BYTES         bound the cell arrays held in memory (e.g. 512M, 2G); regions\n"
+    "                      are paged to and from --db FILE (same results)\n"
     "  --json              print the summary as JSON\n";
 
 /* Most regions --split may cut the box into; most --extend steps. */
@@ -61,6 +67,8 @@ typedef struct solve_args {
     double escape_below;
     const char *bounds_text;
     const char *png, *db;
+    int resume;
+    uint64_t mem;
 } solve_args;
 
 static int parse_solve(cli *c, solve_args *a)
@@ -118,6 +126,12 @@ static int parse_solve(cli *c, solve_args *a)
             a->png = c->value;
         } else if (cli_is(c, "--db", true, &err)) {
             a->db = c->value;
+        } else if (cli_is(c, "--resume", false, &err)) {
+            a->resume = 1;
+        } else if (cli_is(c, "--mem", true, &err)) {
+            if (c->value && (!parse_bytes(c->value, &a->mem) || a->mem < (1u << 20)))
+                err = cli_usage_error(c, "--mem: '%s' must be a size of at least 1M, as "
+                                         "BYTES[K|M|G]", c->value);
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = 1;
         } else {
@@ -126,6 +140,8 @@ static int parse_solve(cli *c, solve_args *a)
     }
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
         err = cli_usage_error(c, "--bounds and --escape-below apply to --extend; add --extend N");
+    if (!err && !a->db && (a->resume || a->mem))
+        err = cli_usage_error(c, "--resume and --mem need a database to page to; add --db FILE");
     return err;
 }
 
@@ -267,7 +283,7 @@ typedef struct extend_step {
 typedef struct extend_log {
     extend_step steps[MAX_EXTEND];
     int n;
-    char stop[600]; /* why the extension ended */
+    char stop[1100]; /* why the extension ended */
 } extend_log;
 
 /* Durations of the two phases of a solve: images and classification, or,
@@ -277,47 +293,49 @@ typedef struct timing {
     double t1, t2;
 } timing;
 
-/* Cells computed: the bounding box of a cluster has others. */
-static uint64_t computed_cells(const cm_region *r)
-{
-    uint64_t n = 0;
-    for (uint64_t i = 0; i < r->ncells; i++)
-        n += r->group[i] != CM_GROUP_NONE;
-    return n;
-}
+/* What the summary and the JSON report. */
+typedef struct summary {
+    cm_box box;         /* the region, or the cluster's bounding box */
+    uint64_t cells;     /* cells computed (the bounding box has others) */
+    uint64_t sink;      /* cells of the sink's domain */
+    uint32_t ngroups;
+    cm_group_info *groups; /* in id order */
+} summary;
 
-static void print_text(const cm_model *m, const cm_region *r, const cm_group_info *g,
-                       uint64_t sink, const timing *t, const extend_log *log)
+static void print_text(const cm_model *m, const summary *sum, const timing *t,
+                       const extend_log *log)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
-    const uint64_t cells = computed_cells(r);
+    const uint64_t cells = sum->cells, box_cells = cm_box_cells(&sum->box), sink = sum->sink;
+    const cm_group_info *g = sum->groups;
+    const uint32_t ngroups = sum->ngroups;
     if (log)
         printf("extension stopped: %s\n", log->stop);
     printf("model %s %s\n", m->name, params);
     printf("cells %llu", (unsigned long long)cells);
-    if (cells != r->ncells)
+    if (cells != box_cells)
         printf(" (of %llu in the bounding box; the others not computed)",
-               (unsigned long long)r->ncells);
-    printf(", periodic groups %u, sink basin %llu cells (%.1f%%)\n", r->ngroups,
+               (unsigned long long)box_cells);
+    printf(", periodic groups %u, sink basin %llu cells (%.1f%%)\n", ngroups,
            (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
     printf("time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
            1e9 * (t->t1 + t->t2) / (double)cells);
-    cm_group_info *sorted = malloc((r->ngroups + 1) * sizeof *sorted);
+    cm_group_info *sorted = malloc((ngroups + 1) * sizeof *sorted);
     if (!sorted)
         return;
-    memcpy(sorted, g, r->ngroups * sizeof *sorted);
-    qsort(sorted, r->ngroups, sizeof *sorted, larger_basin_first);
+    memcpy(sorted, g, ngroups * sizeof *sorted);
+    qsort(sorted, ngroups, sizeof *sorted, larger_basin_first);
     printf("%6s %8s %12s %12s  %s\n", "group", "period", "basin", "doa", "centre");
-    for (uint32_t k = 0; k < r->ngroups && k < TEXT_GROUPS; k++) {
+    for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
         printf("%6u %8u %12llu %12llu  (", sorted[k].id, sorted[k].period,
                (unsigned long long)sorted[k].basin_cells,
                (unsigned long long)(sorted[k].basin_cells - sorted[k].period));
         print_vector(sorted[k].centre, m->dim, ", ");
         printf(")\n");
     }
-    if (r->ngroups > TEXT_GROUPS)
-        printf("... and %u smaller groups (--json lists all)\n", r->ngroups - TEXT_GROUPS);
+    if (ngroups > TEXT_GROUPS)
+        printf("... and %u smaller groups (--json lists all)\n", ngroups - TEXT_GROUPS);
     free(sorted);
 }
 
@@ -337,10 +355,10 @@ static void print_json_extension(const cm_lattice *lat, const extend_log *log)
     printf("],\"stop\":\"%s\"}", log->stop);
 }
 
-static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region *r,
-                       const cm_group_info *g, uint64_t sink, const timing *t,
-                       const extend_log *log)
+static void print_json(const cm_model *m, const cm_lattice *lat, const summary *sum,
+                       const timing *t, const extend_log *log)
 {
+    const cm_group_info *g = sum->groups;
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
     printf("{\"model\":\"%s\",\"params\":%s,\"lattice\":{\"origin\":[", m->name, params);
@@ -348,15 +366,15 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const cm_region
     printf("],\"width\":[");
     print_vector(lat->width, lat->dim, ",");
     char box[CM_MAX_DIM * 64];
-    format_box(lat, &r->box, box, sizeof box);
+    format_box(lat, &sum->box, box, sizeof box);
     printf("]},\"box\":\"%s\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
            "\"time_s\":{\"%s\":%.6f,\"%s\":%.6f}",
-           box, (unsigned long long)r->ncells, (unsigned long long)computed_cells(r),
-           (unsigned long long)sink, t->first, t->t1, t->second, t->t2);
+           box, (unsigned long long)cm_box_cells(&sum->box), (unsigned long long)sum->cells,
+           (unsigned long long)sum->sink, t->first, t->t1, t->second, t->t2);
     if (log)
         print_json_extension(lat, log);
     printf(",\"groups\":[");
-    for (uint32_t k = 0; k < r->ngroups; k++) {
+    for (uint32_t k = 0; k < sum->ngroups; k++) {
         printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"centre\":[", k ? "," : "",
                g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
                (unsigned long long)(g[k].basin_cells - g[k].period));
@@ -412,20 +430,6 @@ static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *l
     return EXIT_OK;
 }
 
-static int write_db(const solve_args *a, int argc, char **argv, const cm_model *m,
-                    const cm_lattice *lat, const cm_region *r, const cm_group_info *g)
-{
-    char command[4096], msg[512];
-    join_argv(argc, argv, command, sizeof command);
-    const char *epoch = getenv("SOURCE_DATE_EPOCH");
-    const cm_store_meta meta = {m, lat, command, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
-    if (cm_store_save(a->db, &meta, r, g, msg, sizeof msg) != CM_OK) {
-        fprintf(stderr, "cellmap solve: %s\n", msg);
-        return EXIT_FAIL;
-    }
-    return EXIT_OK;
-}
-
 static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
                              const cm_box *box, cm_region *r, timing *t, char *msg,
                              size_t msg_size)
@@ -469,9 +473,36 @@ static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxe
     return n;
 }
 
-/* Solves the box (split as --split says) and joins it into the cluster. */
-static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *box,
-                         cm_cluster *c, cm_join_stats *stats, char *msg, size_t msg_size)
+/* The cluster being solved and the database it is saved to (may be NULL). */
+typedef struct run {
+    cm_cluster c;
+    cm_store *store;
+} run;
+
+/* After each join: commit it, then page out what the budget cannot hold. */
+static cm_status commit_join(void *user, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                             char *msg, size_t msg_size)
+{
+    (void)box;
+    (void)stats;
+    cm_status st = cm_store_commit(user, c, msg, msg_size);
+    cm_cluster_trim(c);
+    return st;
+}
+
+static int has_box(const cm_cluster *c, const cm_box *box)
+{
+    for (uint32_t k = 0; k < c->nregions; k++)
+        if (memcmp(c->regions[k].r.box.lo, box->lo, sizeof box->lo) == 0 &&
+            memcmp(c->regions[k].r.box.hi, box->hi, sizeof box->hi) == 0)
+            return 1;
+    return 0;
+}
+
+/* Solves the box (split as --split says) and joins it into the cluster;
+ * parts a resumed cluster already has are skipped. */
+static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *box, run *rn,
+                         cm_join_stats *stats, char *msg, size_t msg_size)
 {
     const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
     const uint32_t n = split_boxes(a, box, NULL);
@@ -479,7 +510,13 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
     split_boxes(a, box, boxes);
-    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, NULL, stats, msg, msg_size);
+    uint32_t todo = 0;
+    for (uint32_t k = 0; k < n; k++)
+        if (!has_box(&rn->c, &boxes[k]))
+            boxes[todo++] = boxes[k];
+    cm_status st = cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt,
+                                          rn->store ? commit_join : NULL, rn->store, stats, msg,
+                                          msg_size);
     free(boxes);
     return st;
 }
@@ -495,19 +532,63 @@ static void print_step(const cm_lattice *lat, const extend_step *s, int k)
            s->new_groups, s->straddling, s->seconds);
 }
 
+/* The tile (of the region's size, aligned to it) that holds `box`. */
+static cm_box tile_of(const cm_box *tile, const cm_box *box)
+{
+    cm_box t = *tile;
+    for (int d = 0; d < tile->dim; d++) {
+        const int64_t size = tile->hi[d] - tile->lo[d], off = box->lo[d] - tile->lo[d];
+        const int64_t i = off >= 0 ? off / size : -((-off + size - 1) / size);
+        t.lo[d] = tile->lo[d] + i * size;
+        t.hi[d] = t.lo[d] + size;
+    }
+    return t;
+}
+
+/* Extension steps a resumed cluster has done, and the tile of a step that
+ * was interrupted between its regions (or the empty box). */
+static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile,
+                      cm_box *partial)
+{
+    const uint32_t per_tile = split_boxes(a, tile, NULL);
+    const uint32_t extra = c->nregions > per_tile ? c->nregions - per_tile : 0;
+    memset(partial, 0, sizeof *partial);
+    if (extra % per_tile)
+        *partial = tile_of(tile, &c->regions[c->nregions - 1].r.box);
+    return (int)((extra + per_tile - 1) / per_tile);
+}
+
+static cm_status acquire_all(cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
+        st = cm_cluster_acquire(c, k, msg, msg_size);
+    return st;
+}
+
 /* Adds the neighbouring tile where the most sequences escape, step by step,
  * until --extend steps are done, the escaping fraction is below
  * --escape-below, or no sequence escapes into a neighbour. */
 static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm_box *tile,
-                                const cm_box *bounds, cm_cluster *c, extend_log *log, char *msg,
+                                const cm_box *bounds, run *rn, extend_log *log, char *msg,
                                 size_t msg_size)
 {
+    cm_cluster *c = &rn->c;
+    cm_box partial;
+    const int done = steps_done(a, c, tile, &partial);
     cm_status st = CM_OK;
+    /* a step interrupted between its regions is finished first */
+    if (partial.dim)
+        st = add_box(a, m, &partial, rn, NULL, msg, msg_size);
     snprintf(log->stop, sizeof log->stop, "%d extension steps done", a->extend);
-    for (log->n = 0; log->n < a->extend && st == CM_OK; log->n++) {
+    for (log->n = 0; done + log->n < a->extend && st == CM_OK; log->n++) {
         cm_extend_choice choice;
         const double t0 = now_seconds();
-        st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
+        /* the choice follows every escaping sequence: it needs every region */
+        st = acquire_all(c, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg,
+                                  msg_size);
         const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
         if (st == CM_OK && fraction < a->escape_below) {
             snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g",
@@ -520,7 +601,7 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
         }
         cm_join_stats stats;
         if (st == CM_OK)
-            st = add_box(a, m, &choice.box, c, &stats, msg, msg_size);
+            st = add_box(a, m, &choice.box, rn, &stats, msg, msg_size);
         if (st != CM_OK)
             break;
         extend_step *s = &log->steps[log->n];
@@ -533,29 +614,129 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
     return st;
 }
 
-/* --split and --extend: a cluster of regions, flattened over its bounding
- * box (cells outside its regions are "not computed"). */
-static cm_status solve_cluster(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                               const cm_box *box, const cm_box *bounds, cm_region *r, timing *t,
-                               extend_log *log, char *msg, size_t msg_size)
+/* What a resumed solve must repeat exactly: the box, the split, the steps. */
+static void make_plan(const solve_args *a, const cm_box *box, char *out, size_t size)
 {
-    cm_cluster c;
-    cm_cluster_init(&c, lat);
-    c.threads = a->threads;
-    *t = (timing){"regions and joins", "flattening", 0, 0};
-    const double t0 = now_seconds();
-    cm_status st = add_box(a, m, box, &c, NULL, msg, msg_size);
-    if (st == CM_OK && a->extend > 0)
-        st = extend_cluster(a, m, box, bounds, &c, log, msg, msg_size);
-    const double t1 = now_seconds();
-    cm_box all;
-    if (st == CM_OK) {
-        cm_cluster_bounds(&c, &all);
-        st = cm_cluster_flatten(&c, &all, r, msg, msg_size);
+    size_t used = 0;
+    used += (size_t)snprintf(out + used, size - used, "box");
+    for (int d = 0; d < box->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, " %lld:%lld", (long long)box->lo[d],
+                                 (long long)box->hi[d]);
+    for (int d = 0; d < a->n_split && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%lld", d ? "x" : " split ",
+                                 (long long)a->split[d]);
+    if (used < size)
+        snprintf(out + used, size - used, " max-steps %d extend %d escape-below %.17g bounds %s",
+                 a->max_steps, a->extend, a->escape_below, a->bounds_text ? a->bounds_text : "-");
+}
+
+static int same_lattice(const cm_lattice *a, const cm_lattice *b)
+{
+    if (a->dim != b->dim)
+        return 0;
+    for (int d = 0; d < a->dim; d++)
+        if (a->origin[d] != b->origin[d] || a->width[d] != b->width[d])
+            return 0;
+    return 1;
+}
+
+/* The database of --db: a new one, or (--resume) the saved cluster, which
+ * must come from the same model, parameters, lattice and plan. */
+static cm_status open_store(const solve_args *a, const char *command, const cm_model *m,
+                            const cm_lattice *lat, const char *plan, run *rn, char *msg,
+                            size_t msg_size)
+{
+    if (!a->resume) {
+        const char *epoch = getenv("SOURCE_DATE_EPOCH");
+        const cm_store_meta meta = {m, lat, command, plan, CELLMAP_VERSION,
+                                    epoch ? atoll(epoch) : 0};
+        cm_cluster_init(&rn->c, lat);
+        cm_status st = cm_store_create(a->db, &meta, &rn->store, msg, msg_size);
+        if (st == CM_OK)
+            cm_store_attach(rn->store, &rn->c);
+        return st;
     }
-    t->t1 = t1 - t0;
-    t->t2 = now_seconds() - t1;
-    cm_cluster_free(&c);
+    cm_store_info info;
+    char params[4096];
+    cm_params_json(&m->values, params, sizeof params);
+    cm_status st = cm_store_open(a->db, 1, &rn->store, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_read_info(rn->store, &info, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const char *differs = strcmp(info.model, m->name)                ? "model"
+                          : strcmp(info.params, params)               ? "parameters"
+                          : !same_lattice(&info.lattice, lat)          ? "lattice (--region, --cells)"
+                          : strcmp(info.plan, plan)                   ? "plan (--split, --extend, ...)"
+                                                                      : NULL;
+    if (differs)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s was made by another solve (its %s differs): resume with the options "
+                       "of: %s",
+                       a->db, differs, info.command);
+    return cm_store_load_cluster(rn->store, &rn->c, msg, msg_size);
+}
+
+/* --split, --extend and --db: a cluster of regions. */
+static cm_status solve_cluster(const solve_args *a, const char *command, const cm_model *m,
+                               const cm_lattice *lat, const cm_box *box, const cm_box *bounds,
+                               run *rn, timing *t, extend_log *log, char *msg, size_t msg_size)
+{
+    char plan[1024];
+    make_plan(a, box, plan, sizeof plan);
+    cm_status st = CM_OK;
+    if (a->db)
+        st = open_store(a, command, m, lat, plan, rn, msg, msg_size);
+    else
+        cm_cluster_init(&rn->c, lat);
+    rn->c.threads = a->threads;
+    rn->c.mem_budget = a->mem;
+    *t = (timing){"regions and joins", "summary", 0, 0};
+    const double t0 = now_seconds();
+    if (st == CM_OK)
+        st = add_box(a, m, box, rn, NULL, msg, msg_size);
+    if (st == CM_OK && a->extend > 0)
+        st = extend_cluster(a, m, box, bounds, rn, log, msg, msg_size);
+    t->t1 = now_seconds() - t0;
+    return st;
+}
+
+/* The summary of a cluster: from the database when there is one (no cell
+ * is read back), else from the flattened bounding box. */
+static cm_status summarise_cluster(run *rn, cm_region *flat, summary *sum, char *msg,
+                                   size_t msg_size)
+{
+    cm_cluster *c = &rn->c;
+    cm_cluster_bounds(c, &sum->box);
+    sum->cells = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        sum->cells += c->regions[k].r.ncells;
+    sum->ngroups = c->ngroups;
+    sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
+    if (!sum->groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
+    if (rn->store)
+        return cm_store_groups(rn->store, sum->groups, c->ngroups, &sum->sink, msg, msg_size);
+    cm_status st = cm_cluster_flatten(c, &sum->box, flat, msg, msg_size);
+    if (st == CM_OK)
+        cm_scm_groups(flat, &c->lat, sum->groups, &sum->sink);
+    return st;
+}
+
+static void print_database(const solve_args *a, const run *rn, const summary *sum)
+{
+    cm_store_stats ss;
+    cm_store_get_stats(rn->store, &ss);
+    printf("database %s: %u regions, %.2f bytes/cell written; paging: %llu regions read "
+           "back (%.3f s), commits %.3f s\n",
+           a->db, rn->c.nregions, (double)ss.bytes_written / (double)sum->cells,
+           (unsigned long long)ss.regions_read, ss.read_seconds, ss.commit_seconds);
+}
+
+static cm_status finish_store(run *rn, char *msg, size_t msg_size)
+{
+    cm_status st = cm_store_close(rn->store, msg, msg_size);
+    rn->store = NULL;
     return st;
 }
 
@@ -572,13 +753,16 @@ int cmd_solve(int argc, char **argv)
     if ((rc = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
         return rc;
     cm_lattice lat;
-    cm_box box;
+    cm_box box, bounds;
     cm_region r;
-    cm_group_info *groups = NULL;
-    char msg[512];
+    summary sum;
+    run rn;
+    char msg[1024], command[4096];
     memset(&r, 0, sizeof r);
+    memset(&sum, 0, sizeof sum);
+    memset(&rn, 0, sizeof rn);
+    join_argv(argc + 1, argv - 1, command, sizeof command);
     extend_log *log = calloc(1, sizeof *log);
-    cm_box bounds;
     if (!log) {
         fprintf(stderr, "cellmap solve: out of memory\n");
         rc = EXIT_FAIL;
@@ -589,33 +773,47 @@ int cmd_solve(int argc, char **argv)
         goto done;
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
-    if ((a.n_split || a.extend
-             ? solve_cluster(&a, &m, &lat, &box, &bounds, &r, &t, log, msg, sizeof msg)
-             : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
-        goto fail;
-    groups = calloc(r.ngroups + 1, sizeof *groups);
-    uint64_t sink = 0;
-    if (!groups) {
-        snprintf(msg, sizeof msg, "out of memory for %u groups", r.ngroups);
-        goto fail;
+    if (a.n_split || a.extend || a.db) {
+        const double t0 = now_seconds();
+        if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
+                CM_OK ||
+            summarise_cluster(&rn, &r, &sum, msg, sizeof msg) != CM_OK)
+            goto fail;
+        t.t2 = now_seconds() - t0 - t.t1;
+    } else {
+        if (solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg) != CM_OK)
+            goto fail;
+        sum.box = r.box;
+        sum.cells = r.ncells;
+        sum.ngroups = r.ngroups;
+        if (!(sum.groups = calloc(r.ngroups + 1, sizeof *sum.groups))) {
+            snprintf(msg, sizeof msg, "out of memory for %u groups", r.ngroups);
+            goto fail;
+        }
+        cm_scm_groups(&r, &lat, sum.groups, &sum.sink);
     }
-    cm_scm_groups(&r, &lat, groups, &sink);
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
-        print_json(&m, &lat, &r, groups, sink, &t, shown);
+        print_json(&m, &lat, &sum, &t, shown);
     else
-        print_text(&m, &r, groups, sink, &t, shown);
+        print_text(&m, &sum, &t, shown);
+    if (rn.store && !a.json)
+        print_database(&a, &rn, &sum);
+    if (a.png && !r.group && cm_cluster_flatten(&rn.c, &sum.box, &r, msg, sizeof msg) != CM_OK)
+        goto fail;
+    if (a.png && write_png(&a, &m, &lat, &r, sum.groups) != EXIT_OK)
+        goto done;
+    if (rn.store && finish_store(&rn, msg, sizeof msg) != CM_OK)
+        goto fail;
     rc = EXIT_OK;
-    if (a.png && write_png(&a, &m, &lat, &r, groups) != EXIT_OK)
-        rc = EXIT_FAIL;
-    if (rc == EXIT_OK && a.db && write_db(&a, argc + 1, argv - 1, &m, &lat, &r, groups) != EXIT_OK)
-        rc = EXIT_FAIL;
     goto done;
 fail:
     fprintf(stderr, "cellmap solve: %s\n", msg);
 done:
+    cm_store_close(rn.store, msg, sizeof msg);
+    cm_cluster_free(&rn.c);
     free(log);
-    free(groups);
+    free(sum.groups);
     cm_region_free(&r);
     cm_model_release(&m);
     return rc;

@@ -1,10 +1,14 @@
+/* The .cmdb store: codec round trips, paged clusters equal to in-memory
+ * ones under any budget, reopening, and files that must be refused. */
 #include <sqlite3.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "cellmap/codec.h"
 #include "cellmap/store.h"
 #include "check.h"
+#include "mix.h"
 #include "models/registry.h"
 
 static char *slurp(const char *path, long *size)
@@ -22,14 +26,14 @@ static char *slurp(const char *path, long *size)
     return buf;
 }
 
-static int sql_int(const char *path, const char *sql)
+static int64_t sql_int(const char *path, const char *sql)
 {
     sqlite3 *db = NULL;
     sqlite3_stmt *st = NULL;
-    int v = -1;
+    int64_t v = -1;
     sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL);
     if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
-        v = sqlite3_column_int(st, 0);
+        v = sqlite3_column_int64(st, 0);
     sqlite3_finalize(st);
     sqlite3_close(db);
     return v;
@@ -43,16 +47,217 @@ static void sql_exec(const char *path, const char *sql)
     sqlite3_close(db);
 }
 
-/* A file that is refused must stay byte-identical. */
-static void check_refused_untouched(const char *path, const cm_store_meta *meta,
-                                    const cm_region *r, const cm_group_info *g)
+/* A hash of every row of the cluster's tables (not meta: it holds the
+ * command line): two files with equal hashes hold the same cluster. */
+static uint64_t content_hash(const char *path)
+{
+    static const char *const queries[] = {
+        "SELECT id, lo, hi, cells, exits, own_groups, status FROM regions ORDER BY id",
+        "SELECT region, first_cell, cells, image, grp, step FROM pages ORDER BY region, first_cell",
+        "SELECT region, count, targets FROM exits ORDER BY region",
+        "SELECT region, grp, cells FROM region_groups ORDER BY region, grp",
+        "SELECT * FROM attractors ORDER BY id"};
+    sqlite3 *db = NULL;
+    uint64_t h = 1;
+    CHECK(sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK);
+    for (size_t q = 0; q < sizeof queries / sizeof queries[0]; q++) {
+        sqlite3_stmt *st = NULL;
+        CHECK(sqlite3_prepare_v2(db, queries[q], -1, &st, NULL) == SQLITE_OK);
+        while (sqlite3_step(st) == SQLITE_ROW)
+            for (int c = 0; c < sqlite3_column_count(st); c++) {
+                const unsigned char *p = sqlite3_column_blob(st, c);
+                const int n = sqlite3_column_bytes(st, c);
+                for (int i = 0; i < n; i++)
+                    h = mix(h ^ p[i]);
+                h = mix(h + (uint64_t)n);
+            }
+        sqlite3_finalize(st);
+    }
+    sqlite3_close(db);
+    return h;
+}
+
+static void test_codec(void)
+{
+    enum { N = 70000 };
+    uint32_t *v = malloc(N * sizeof *v), *back = malloc(N * sizeof *back);
+    int64_t *w = malloc(N * sizeof *w), *wback = malloc(N * sizeof *wback);
+    unsigned char *scratch = malloc(8 * N), *out = malloc(cm_codec_bound(8 * N));
+    for (uint32_t i = 0; i < N; i++) {
+        v[i] = i % 7 == 0 ? 0xFFFFFFFFu : (uint32_t)(mix(i) % (N + 5)); /* marks, images */
+        w[i] = (int64_t)mix(i + 1000) >> (i % 60);
+    }
+    size_t len = 0;
+    CHECK(cm_codec_encode(v, N, 4, 123, scratch, out, cm_codec_bound(4 * N), &len) == CM_OK);
+    CHECK(cm_codec_decode(out, len, N, 4, 123, scratch, back) == CM_OK);
+    CHECK(memcmp(v, back, N * sizeof *v) == 0);
+    /* a BLOB of another size, or damaged, is refused */
+    CHECK(cm_codec_decode(out, len, N - 1, 4, 123, scratch, back) == CM_EFORMAT);
+    out[len / 2] ^= 0x5A;
+    out[len / 2 + 1] ^= 0xA5;
+    const cm_status damaged = cm_codec_decode(out, len, N, 4, 123, scratch, back);
+    CHECK(damaged == CM_EFORMAT);
+    CHECK(cm_codec_decode(out, 3, N, 4, 123, scratch, back) == CM_EFORMAT);
+    CHECK(cm_codec_encode(w, N, 8, -1, scratch, out, cm_codec_bound(8 * N), &len) == CM_OK);
+    CHECK(cm_codec_decode(out, len, N, 8, -1, scratch, wback) == CM_OK);
+    CHECK(memcmp(w, wback, N * sizeof *w) == 0);
+    free(v);
+    free(back);
+    free(w);
+    free(wback);
+    free(scratch);
+    free(out);
+}
+
+/* Fig. 4.16's map on 0..900 x 0..600 cells cut into 3 x 2 regions of two pages: groups
+ * straddle borders and joins change older regions' pages. */
+enum { NX = 900, NY = 600, TX = 3, TY = 2 };
+static const cm_lattice lat416 = {2, {-13, -4}, {26.0 / 1300, 8.0 / 400}};
+
+static void tiles(cm_box *boxes)
+{
+    for (int j = 0; j < TY; j++)
+        for (int i = 0; i < TX; i++)
+            boxes[j * TX + i] =
+                (cm_box){2, {NX * i / TX, NY * j / TY}, {NX * (i + 1) / TX, NY * (j + 1) / TY}};
+}
+
+static cm_status commit_and_trim(void *user, cm_cluster *c, uint32_t box,
+                                 const cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    (void)box;
+    (void)stats;
+    const cm_status st = cm_store_commit(user, c, msg, msg_size);
+    cm_cluster_trim(c);
+    return st;
+}
+
+/* Solves the tiling into path (NULL: in memory only) under a budget of
+ * `budget_regions` regions (0: none) with `threads` threads; returns the
+ * flattened cluster in flat. */
+static void solve_tiles(const cm_model *m, const char *path, int budget_regions, int threads,
+                        cm_region *flat, cm_store_stats *stats)
+{
+    char msg[512];
+    cm_box boxes[TX * TY], all = {2, {0, 0}, {NX, NY}};
+    tiles(boxes);
+    cm_cluster c;
+    cm_cluster_init(&c, &lat416);
+    c.threads = threads;
+    cm_store *s = NULL;
+    if (path) {
+        const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0};
+        CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_OK);
+        cm_store_attach(s, &c);
+        c.mem_budget = (uint64_t)budget_regions * 12 * cm_box_cells(&boxes[0]);
+    }
+    const cm_scm_options opt = {1, threads, NULL, NULL, 1};
+    CHECK(cm_cluster_solve_boxes(&c, m, boxes, TX * TY, &opt, s ? commit_and_trim : NULL, s, NULL,
+                                 msg, sizeof msg) == CM_OK);
+    if (budget_regions)
+        CHECK(cm_cluster_resident_bytes(&c) <= c.mem_budget);
+    CHECK(cm_cluster_flatten(&c, &all, flat, msg, sizeof msg) == CM_OK);
+    if (s) {
+        cm_store_get_stats(s, stats);
+        CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+    }
+    cm_cluster_free(&c);
+}
+
+static int same_region(const cm_region *a, const cm_region *b)
+{
+    return a->ncells == b->ncells && a->ngroups == b->ngroups &&
+           memcmp(a->image, b->image, 4 * a->ncells) == 0 &&
+           memcmp(a->group, b->group, 4 * a->ncells) == 0 &&
+           memcmp(a->step, b->step, 4 * a->ncells) == 0;
+}
+
+static void test_budgets(const char *dir, const cm_model *m)
+{
+    char path[4][256];
+    cm_region flat[5];
+    cm_store_stats st[4];
+    const int budgets[4] = {0, 4, 1, 0};
+    const int threads[4] = {2, 2, 2, 1};
+    solve_tiles(m, NULL, 0, 2, &flat[4], NULL);
+    for (int k = 0; k < 4; k++) {
+        snprintf(path[k], sizeof path[k], "%s/budget%d-%d.cmdb", dir, budgets[k], threads[k]);
+        solve_tiles(m, path[k], budgets[k], threads[k], &flat[k], &st[k]);
+        CHECK(same_region(&flat[k], &flat[4]));
+    }
+    /* unlimited never reads back; 4 and 1 regions do, the smaller more */
+    CHECK_INT(st[0].regions_read, 0);
+    CHECK(st[1].regions_read > 0);
+    CHECK(st[2].regions_read > st[1].regions_read);
+    /* same files whatever the budget and the thread count */
+    const uint64_t h = content_hash(path[0]);
+    for (int k = 1; k < 4; k++)
+        CHECK(content_hash(path[k]) == h);
+    /* the groups view: every cell counted once; periodic cells are dim int64 each */
+    CHECK_INT(sql_int(path[0], "SELECT SUM(basin_cells) FROM groups"), NX * NY);
+    CHECK_INT(sql_int(path[0], "SELECT COUNT(*) FROM groups WHERE is_sink = 0"), flat[4].ngroups);
+    CHECK_INT(sql_int(path[0], "SELECT SUM(LENGTH(periodic_cells)) / 16 FROM attractors"),
+              sql_int(path[0], "SELECT SUM(period) FROM attractors"));
+    CHECK(sql_int(path[0], "SELECT COUNT(*) FROM pages") > TX * TY);
+
+    /* reopened read-only, paged in on demand under a budget: the same cells */
+    char msg[512];
+    cm_store *s = NULL;
+    cm_cluster c;
+    cm_region back;
+    const cm_box all = {2, {0, 0}, {NX, NY}};
+    CHECK(cm_store_open(path[0], 0, &s, msg, sizeof msg) == CM_OK);
+    CHECK(cm_store_load_cluster(s, &c, msg, sizeof msg) == CM_OK);
+    CHECK_INT(c.nregions, TX * TY);
+    CHECK_INT(cm_cluster_resident_bytes(&c), 0);
+    c.mem_budget = 1;
+    CHECK(cm_cluster_flatten(&c, &all, &back, msg, sizeof msg) == CM_OK);
+    CHECK(same_region(&back, &flat[4]));
+    cm_store_info info;
+    CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_OK);
+    CHECK(strcmp(info.model, "microchaos-pd") == 0);
+    CHECK_INT(info.regions, TX * TY);
+    CHECK_INT(info.cells, NX * NY);
+    CHECK_INT(info.groups, flat[4].ngroups);
+    CHECK(info.lattice.width[0] == lat416.width[0] && info.lattice.origin[1] == lat416.origin[1]);
+    /* bytes per cell on disk, with compression */
+    CHECK(info.page_bytes < 6 * (uint64_t)NX * NY);
+    cm_group_info *g = calloc(info.groups + 1, sizeof *g),
+                  *ref = calloc(info.groups + 1, sizeof *g);
+    uint64_t sink = 0, ref_sink = 0;
+    CHECK(cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK);
+    cm_scm_groups(&flat[4], &lat416, ref, &ref_sink);
+    CHECK_INT(sink, ref_sink);
+    for (uint32_t k = 0; k < info.groups; k++)
+        CHECK(memcmp(&g[k], &ref[k], sizeof g[k]) == 0);
+    free(g);
+    free(ref);
+    cm_region_free(&back);
+    cm_cluster_free(&c);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+    for (int k = 0; k < 5; k++)
+        cm_region_free(&flat[k]);
+    for (int k = 1; k < 4; k++)
+        unlink(path[k]);
+}
+
+/* A refused file stays byte-identical, whatever tries to use it. */
+static void check_refused_untouched(const char *path, const cm_model *m, const char *why)
 {
     long before_size = 0, after_size = 0;
     char *before = slurp(path, &before_size);
     char msg[512] = "";
+    cm_store *s = NULL;
     CHECK(cm_store_check(path, msg, sizeof msg) == CM_EFORMAT);
-    CHECK(strlen(msg) > 10);
-    CHECK(cm_store_save(path, meta, r, g, msg, sizeof msg) == CM_EFORMAT);
+    if (!strstr(msg, why))
+        fprintf(stderr, "expected '%s' in: %s\n", why, msg);
+    CHECK(strstr(msg, why) != NULL);
+    CHECK(cm_store_open(path, 1, &s, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(s == NULL);
+    CHECK(strstr(msg, why) != NULL);
+    CHECK(cm_store_open(path, 0, &s, msg, sizeof msg) == CM_EFORMAT);
+    const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0};
+    CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_EFORMAT);
     CHECK(strstr(msg, "refusing") != NULL);
     char *after = slurp(path, &after_size);
     CHECK_INT(before_size, after_size);
@@ -61,88 +266,58 @@ static void check_refused_untouched(const char *path, const cm_store_meta *meta,
     free(after);
 }
 
+static void test_refused(const char *dir, const char *good, const cm_model *m)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/foreign.sqlite", dir);
+    sql_exec(path, "CREATE TABLE t(x); INSERT INTO t VALUES(1);");
+    check_refused_untouched(path, m, "not a cellmap database (application_id 0)");
+    unlink(path);
+
+    snprintf(path, sizeof path, "%s/random.cmdb", dir);
+    FILE *f = fopen(path, "wb");
+    for (int i = 0; i < 50000; i++)
+        fputc((int)(mix((uint64_t)i) & 0xff), f);
+    fclose(f);
+    check_refused_untouched(path, m, "not a cellmap database");
+    unlink(path);
+
+    long size = 0;
+    char *whole = slurp(good, &size);
+    snprintf(path, sizeof path, "%s/truncated.cmdb", dir);
+    f = fopen(path, "wb");
+    fwrite(whole, 1, (size_t)size / 2, f);
+    fclose(f);
+    check_refused_untouched(path, m, "damaged");
+    unlink(path);
+
+    snprintf(path, sizeof path, "%s/newer.cmdb", dir);
+    f = fopen(path, "wb");
+    fwrite(whole, 1, (size_t)size, f);
+    fclose(f);
+    sql_exec(path, "PRAGMA user_version = 99");
+    check_refused_untouched(path, m, "version 99, newer");
+    sql_exec(path, "PRAGMA user_version = 1");
+    check_refused_untouched(path, m, "cannot be migrated");
+    unlink(path);
+    free(whole);
+}
+
 int main(void)
 {
     char dir[] = "/tmp/cellmap-store-XXXXXX";
     CHECK(mkdtemp(dir) != NULL);
-    char path[256], foreign[256], junk[256], newer[256];
-    snprintf(path, sizeof path, "%s/a.cmdb", dir);
-    snprintf(foreign, sizeof foreign, "%s/foreign.sqlite", dir);
-    snprintf(junk, sizeof junk, "%s/junk.cmdb", dir);
-    snprintf(newer, sizeof newer, "%s/newer.cmdb", dir);
-
     cm_model m;
     char msg[512];
-    CHECK(cm_model_create("microchaos-pd", NULL, 0, &m, msg, sizeof msg) == CM_OK);
-    const cm_lattice lat = {2, {0, -40}, {0.5, 0.08}};
-    const cm_box box = {2, {0, 0}, {300, 1000}}; /* several pages of 65536 cells */
-    cm_region r;
-    CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
-    const cm_scm_options opt = {1, 0, NULL, NULL, 0};
-    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
-    cm_group_info *g = calloc(r.ngroups + 1, sizeof *g);
-    cm_scm_groups(&r, &lat, g, NULL);
-    const cm_store_meta meta = {&m, &lat, "cellmap solve (test)", "test", 0};
-
-    CHECK(cm_store_save(path, &meta, &r, g, msg, sizeof msg) == CM_OK);
-    CHECK(cm_store_check(path, msg, sizeof msg) == CM_OK);
-    CHECK_INT(sql_int(path, "PRAGMA application_id"), CM_STORE_APP_ID);
-    CHECK_INT(sql_int(path, "PRAGMA user_version"), CM_STORE_VERSION);
-    CHECK_INT(sql_int(path, "SELECT count(*) FROM groups"), r.ngroups + 1);
-    CHECK_INT(sql_int(path, "SELECT sum(basin_cells) FROM groups"), r.ncells);
-    CHECK_INT(sql_int(path, "SELECT count(*) FROM pages"), (300 * 1000 + 65535) / 65536);
-    CHECK_INT(sql_int(path, "SELECT sum(length(periodic_cells)) / 4 FROM groups"),
-              sql_int(path, "SELECT sum(period) FROM groups WHERE is_sink = 0"));
-
-    /* round trip, cell by cell */
-    cm_lattice lat2;
-    cm_region back;
-    char name[64];
-    CHECK(cm_store_load(path, &lat2, &back, name, sizeof name, msg, sizeof msg) == CM_OK);
-    CHECK(strcmp(name, "microchaos-pd") == 0);
-    CHECK_INT(lat2.dim, 2);
-    CHECK(lat2.width[1] == lat.width[1] && lat2.origin[1] == lat.origin[1]);
-    CHECK_INT(back.ncells, r.ncells);
-    CHECK_INT(back.ngroups, r.ngroups);
-    CHECK(memcmp(back.image, r.image, 4 * r.ncells) == 0);
-    CHECK(memcmp(back.group, r.group, 4 * r.ncells) == 0);
-    CHECK(memcmp(back.step, r.step, 4 * r.ncells) == 0);
-    cm_region_free(&back);
-
-    /* replacing an older cellmap database works and is atomic */
-    CHECK(cm_store_save(path, &meta, &r, g, msg, sizeof msg) == CM_OK);
-
-    /* a foreign SQLite file, random bytes, an empty file, a newer version */
-    sql_exec(foreign, "CREATE TABLE t(x); INSERT INTO t VALUES(1);");
-    check_refused_untouched(foreign, &meta, &r, g);
-    FILE *f = fopen(junk, "wb");
-    for (int i = 0; i < 5000; i++)
-        fputc((i * 7919 + 13) & 0xff, f);
-    fclose(f);
-    check_refused_untouched(junk, &meta, &r, g);
-    CHECK(cm_store_save(newer, &meta, &r, g, msg, sizeof msg) == CM_OK);
-    sql_exec(newer, "PRAGMA user_version = 99");
-    check_refused_untouched(newer, &meta, &r, g);
-    CHECK(cm_store_check(newer, msg, sizeof msg) == CM_EFORMAT);
-    CHECK(strstr(msg, "version 99") != NULL);
-
-    /* truncated: half of a valid file */
-    long size = 0;
-    char *whole = slurp(path, &size);
-    f = fopen(junk, "wb");
-    fwrite(whole, 1, (size_t)size / 2, f);
-    fclose(f);
-    free(whole);
-    cm_region tr;
-    CHECK(cm_store_load(junk, &lat2, &tr, name, sizeof name, msg, sizeof msg) != CM_OK);
-
-    free(g);
-    cm_region_free(&r);
-    cm_model_release(&m);
-    unlink(path);
-    unlink(foreign);
-    unlink(junk);
-    unlink(newer);
+    const char *const params[] = {"alpha=0.8,beta=0.3,P=0.7,D=0.6"};
+    CHECK(cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) == CM_OK);
+    test_codec();
+    test_budgets(dir, &m);
+    char good[256];
+    snprintf(good, sizeof good, "%s/budget0-2.cmdb", dir);
+    test_refused(dir, good, &m);
+    unlink(good);
     rmdir(dir);
+    cm_model_release(&m);
     CHECK_DONE();
 }

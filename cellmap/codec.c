@@ -1,0 +1,81 @@
+#include "cellmap/codec.h"
+
+#include <string.h>
+#include <zstd.h>
+
+/* Level 1: pages compress to 1-2 bytes per cell already (Fig. 4.16 and 4.21
+ * regions), and higher levels cost far more time than they save bytes. */
+#define CODEC_LEVEL 1
+
+size_t cm_codec_bound(size_t bytes) { return ZSTD_compressBound(bytes) + 32; /* + checksum */ }
+
+static uint64_t load_value(const void *v, size_t i, int width)
+{
+    if (width == 4) {
+        uint32_t x;
+        memcpy(&x, (const unsigned char *)v + 4 * i, 4);
+        return x;
+    }
+    uint64_t x;
+    memcpy(&x, (const unsigned char *)v + 8 * i, 8);
+    return x;
+}
+
+static void store_value(void *v, size_t i, int width, uint64_t x)
+{
+    if (width == 4) {
+        const uint32_t y = (uint32_t)x;
+        memcpy((unsigned char *)v + 4 * i, &y, 4);
+    } else {
+        memcpy((unsigned char *)v + 8 * i, &x, 8);
+    }
+}
+
+cm_status cm_codec_encode(const void *v, size_t n, int width, int64_t first_index, void *scratch,
+                          void *out, size_t out_cap, size_t *len)
+{
+    unsigned char *planes = scratch;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t x = load_value(v, i, width);
+        if (first_index >= 0)
+            x = (uint32_t)(x - (uint64_t)first_index - i);
+        for (int b = 0; b < width; b++)
+            planes[(size_t)b * n + i] = (unsigned char)(x >> (8 * b));
+    }
+    /* the frame's checksum makes a damaged BLOB an error when it is read */
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    if (!cctx)
+        return CM_ENOMEM;
+    size_t r = ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, CODEC_LEVEL);
+    if (!ZSTD_isError(r))
+        r = ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    if (!ZSTD_isError(r))
+        r = ZSTD_compress2(cctx, out, out_cap, planes, n * (size_t)width);
+    ZSTD_freeCCtx(cctx);
+    if (ZSTD_isError(r))
+        return CM_ENOMEM;
+    *len = r;
+    return CM_OK;
+}
+
+cm_status cm_codec_decode(const void *in, size_t len, size_t n, int width, int64_t first_index,
+                          void *scratch, void *v)
+{
+    unsigned char *planes = scratch;
+    const size_t bytes = n * (size_t)width;
+    const unsigned long long size = ZSTD_getFrameContentSize(in, len);
+    if (size != bytes)
+        return CM_EFORMAT;
+    const size_t r = ZSTD_decompress(planes, bytes, in, len);
+    if (ZSTD_isError(r) || r != bytes)
+        return CM_EFORMAT;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t x = 0;
+        for (int b = 0; b < width; b++)
+            x |= (uint64_t)planes[(size_t)b * n + i] << (8 * b);
+        if (first_index >= 0)
+            x = (uint32_t)(x + (uint64_t)first_index + i);
+        store_value(v, i, width, x);
+    }
+    return CM_OK;
+}
