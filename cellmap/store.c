@@ -309,8 +309,9 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
     return CM_OK;
 }
 
-/* Removes an existing cellmap database (and its WAL) that a new one replaces. */
-static cm_status remove_old(const char *path, char *msg, size_t msg_size)
+/* Checks that an existing file at path is a cellmap database (which a new
+ * one may replace) and removes its WAL and shared-memory files. */
+static cm_status prepare_replace(const char *path, char *msg, size_t msg_size)
 {
     struct stat sb;
     if (stat(path, &sb) != 0)
@@ -325,19 +326,16 @@ static cm_status remove_old(const char *path, char *msg, size_t msg_size)
         snprintf(side, sizeof side, "%s%s", path, suffixes[k]);
         unlink(side);
     }
-    if (unlink(path) != 0)
-        return cm_fail(CM_EIO, msg, msg_size, "cannot replace %s", path);
     return CM_OK;
 }
 
-cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
-                          size_t msg_size)
+/* Writes the schema and metadata of an empty cluster to a new file. */
+static cm_status write_empty(const char *path, const cm_store_meta *meta, char *msg,
+                             size_t msg_size)
 {
-    *out = NULL;
-    cm_status st = remove_old(path, msg, msg_size);
     sqlite3 *db = NULL;
-    if (st == CM_OK)
-        st = open_db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, &db, msg, msg_size);
+    unlink(path);
+    cm_status st = open_db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, &db, msg, msg_size);
     if (st != CM_OK)
         return st;
     char pragmas[128];
@@ -350,11 +348,34 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         st = write_meta(db, meta, msg, msg_size);
     if (st == CM_OK && exec(db, "COMMIT") != SQLITE_OK)
         st = db_error(db, "commit", msg, msg_size);
+    if (sqlite3_close(db) != SQLITE_OK && st == CM_OK)
+        st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", path);
+    return st;
+}
+
+cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
+                          size_t msg_size)
+{
+    *out = NULL;
+    /* The empty database appears at path by a rename, so a process killed
+     * now leaves either the old file or a complete empty cluster. */
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    cm_status st = prepare_replace(path, msg, msg_size);
+    if (st == CM_OK)
+        st = write_empty(tmp, meta, msg, msg_size);
+    if (st == CM_OK && rename(tmp, path) != 0)
+        st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s", tmp, path);
+    if (st != CM_OK) {
+        unlink(tmp);
+        return st;
+    }
+    sqlite3 *db = NULL;
+    st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
     if (st == CM_OK)
         st = use_wal(db, path, msg, msg_size);
     if (st != CM_OK) {
         sqlite3_close(db);
-        unlink(path);
         return st;
     }
     return new_store(path, db, 1, out, msg, msg_size);

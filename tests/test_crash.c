@@ -1,0 +1,206 @@
+/* Crash safety: `cellmap solve --db` killed with SIGKILL at 20 random
+ * moments. After every kill the file must open as a consistent cluster;
+ * resuming after the last kill must end with the same database as a run
+ * that was never interrupted.
+ *
+ * usage: test_crash CELLMAP_BINARY */
+#include <dirent.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cellmap/store.h"
+#include "check.h"
+#include "mix.h"
+
+enum { KILLS = 20 };
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Starts `cellmap solve` on db (resuming if it exists); returns its pid. */
+static pid_t start_solve(const char *cellmap, const char *db, int resume)
+{
+    const pid_t pid = fork();
+    if (pid == 0) {
+        if (!freopen("/dev/null", "w", stdout))
+            _exit(3);
+        char *argv[] = {(char *)cellmap,
+                        "solve",
+                        "--param",
+                        "alpha=0.8,beta=0.3,P=0.7,D=0.6",
+                        "--region",
+                        "-13:13,-4:4",
+                        "--cells",
+                        "1200x800",
+                        "--split",
+                        "6x4",
+                        "--mem",
+                        "2M",
+                        "--threads",
+                        "2",
+                        "--db",
+                        (char *)db,
+                        resume ? "--resume" : NULL,
+                        NULL};
+        execv(cellmap, argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+static int run_to_end(const char *cellmap, const char *db, int resume)
+{
+    int status = 0;
+    waitpid(start_solve(cellmap, db, resume), &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static uint64_t content_hash(const char *path)
+{
+    static const char *const queries[] = {
+        "SELECT * FROM regions ORDER BY id",
+        "SELECT * FROM pages ORDER BY region, first_cell",
+        "SELECT * FROM exits ORDER BY region",
+        "SELECT * FROM region_groups ORDER BY region, grp",
+        "SELECT * FROM attractors ORDER BY id",
+        "SELECT * FROM meta WHERE key NOT IN ('command') ORDER BY key"};
+    sqlite3 *db = NULL;
+    uint64_t h = 1;
+    CHECK(sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK);
+    for (size_t q = 0; q < sizeof queries / sizeof queries[0]; q++) {
+        sqlite3_stmt *st = NULL;
+        CHECK(sqlite3_prepare_v2(db, queries[q], -1, &st, NULL) == SQLITE_OK);
+        while (sqlite3_step(st) == SQLITE_ROW)
+            for (int c = 0; c < sqlite3_column_count(st); c++) {
+                const unsigned char *p = sqlite3_column_blob(st, c);
+                const int n = sqlite3_column_bytes(st, c);
+                for (int i = 0; i < n; i++)
+                    h = mix(h ^ p[i]);
+                h = mix(h + (uint64_t)n);
+            }
+        sqlite3_finalize(st);
+    }
+    sqlite3_close(db);
+    return h;
+}
+
+/* Opens the file as a cluster and checks it cell by cell: every region
+ * reads back, its group counts match its cells, every group id is known,
+ * and every group's periodic cells are periodic cells of that group.
+ * Returns the number of regions. */
+static uint32_t check_consistent(const char *path)
+{
+    char msg[512];
+    cm_store *s = NULL;
+    cm_cluster c;
+    memset(&c, 0, sizeof c);
+    CHECK(cm_store_open(path, 0, &s, msg, sizeof msg) == CM_OK);
+    if (!s) {
+        fprintf(stderr, "%s\n", msg);
+        return 0;
+    }
+    CHECK(cm_store_load_cluster(s, &c, msg, sizeof msg) == CM_OK);
+    c.mem_budget = 1; /* one region at a time */
+    cm_store_info info;
+    CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_OK);
+    CHECK_INT(info.groups, c.ngroups);
+    uint64_t periodic = 0;
+    for (uint32_t k = 0; k < c.nregions; k++) {
+        CHECK(cm_cluster_acquire(&c, k, msg, sizeof msg) == CM_OK);
+        const cm_region *r = &c.regions[k].r;
+        for (uint64_t i = 0; r->group && i < r->ncells; i++) {
+            CHECK(r->group[i] <= c.ngroups);
+            periodic += cm_is_periodic(r, i);
+        }
+        cm_cluster_trim(&c);
+    }
+    cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
+    uint64_t sink = 0, cells = 0, period = 0;
+    CHECK(cm_store_groups(s, g, c.ngroups, &sink, msg, sizeof msg) == CM_OK);
+    cells = sink;
+    for (uint32_t k = 0; k < c.ngroups; k++) {
+        cells += g[k].basin_cells;
+        period += g[k].period;
+        CHECK(g[k].period >= 1 && g[k].basin_cells >= g[k].period);
+    }
+    CHECK_INT(cells, info.cells);
+    CHECK_INT(period, periodic);
+    free(g);
+    const uint32_t n = c.nregions;
+    cm_cluster_free(&c);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+    return n;
+}
+
+/* Removes the directory and what the runs left in it (WAL files, and the
+ * temporary file of a run killed while creating the database). */
+static void remove_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    char path[512];
+    while (d && (e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+    if (d)
+        closedir(d);
+    rmdir(dir);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_crash CELLMAP_BINARY\n");
+        return 2;
+    }
+    char dir[] = "/tmp/cellmap-crash-XXXXXX", ref[256], db[256];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(ref, sizeof ref, "%s/ref.cmdb", dir);
+    snprintf(db, sizeof db, "%s/killed.cmdb", dir);
+
+    const double t0 = now();
+    CHECK_INT(run_to_end(argv[1], ref, 0), 0);
+    const double whole = now() - t0;
+    const uint64_t want = content_hash(ref);
+    CHECK_INT(check_consistent(ref), 24);
+
+    /* Kill moments spread over a fifteenth of a whole run each, so that
+     * together they fall all along the solve: creation, solving, commits. */
+    int interrupted = 0;
+    for (int k = 0; k < KILLS; k++) {
+        struct stat sb;
+        const int exists = stat(db, &sb) == 0;
+        const pid_t pid = start_solve(argv[1], db, exists);
+        const double delay = whole / 15 * (double)(mix((uint64_t)k + 77) % 1000) / 1000.0;
+        struct timespec ts = {(time_t)delay, (long)((delay - (double)(time_t)delay) * 1e9)};
+        nanosleep(&ts, NULL);
+        kill(pid, SIGKILL);
+        int status = 0;
+        waitpid(pid, &status, 0);
+        interrupted += WIFSIGNALED(status);
+        if (stat(db, &sb) == 0) /* killed before the empty file appeared: nothing to check */
+            check_consistent(db);
+    }
+    struct stat sb;
+    CHECK_INT(run_to_end(argv[1], db, stat(db, &sb) == 0), 0);
+    CHECK(content_hash(db) == want);
+    printf("%d of %d kills interrupted the solve (whole run %.3f s); the resumed file equals "
+           "the uninterrupted one\n",
+           interrupted, KILLS, whole);
+    CHECK(interrupted >= KILLS / 2);
+    remove_dir(dir);
+    CHECK_DONE();
+}
