@@ -98,8 +98,8 @@ static int parse_solve(cli *c, solve_args *a)
         } else if (cli_is(c, "--escape-below", true, &err)) {
             if (c->value && (!parse_double(c->value, &a->escape_below) ||
                              !(a->escape_below >= 0 && a->escape_below <= 1)))
-                err = cli_usage_error(c, "--escape-below: '%s' must be a fraction in 0..1",
-                                      c->value);
+                err =
+                    cli_usage_error(c, "--escape-below: '%s' must be a fraction in 0..1", c->value);
         } else if (cli_is(c, "--bounds", true, &err)) {
             a->bounds_text = c->value;
         } else if (cli_is(c, "--max-steps", true, &err)) {
@@ -109,14 +109,13 @@ static int parse_solve(cli *c, solve_args *a)
             a->max_steps = (int)v;
         } else if (cli_is(c, "--threads", true, &err)) {
             if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1024))
-                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024",
-                                      c->value);
+                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024", c->value);
             a->threads = (int)v;
         } else if (cli_is(c, "--size", true, &err)) {
             int64_t wh[2];
             int n = 0;
-            if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] > 16384 ||
-                             wh[1] > 16384))
+            if (c->value &&
+                (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] > 16384 || wh[1] > 16384))
                 err = cli_usage_error(c, "--size: '%s' must be WxH, each 1..16384", c->value);
             else if (c->value) {
                 a->width = (int)wh[0];
@@ -130,8 +129,10 @@ static int parse_solve(cli *c, solve_args *a)
             a->resume = 1;
         } else if (cli_is(c, "--mem", true, &err)) {
             if (c->value && (!parse_bytes(c->value, &a->mem) || a->mem < (1u << 20)))
-                err = cli_usage_error(c, "--mem: '%s' must be a size of at least 1M, as "
-                                         "BYTES[K|M|G]", c->value);
+                err = cli_usage_error(c,
+                                      "--mem: '%s' must be a size of at least 1M, as "
+                                      "BYTES[K|M|G]",
+                                      c->value);
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = 1;
         } else {
@@ -183,9 +184,10 @@ static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm
     for (int d = 0; d < a->n_split; d++) {
         parts *= (double)a->split[d];
         if (a->split[d] > box->hi[d])
-            return cli_usage_error(c, "--split: %lld parts in dimension %d, but it has only "
-                                   "%lld cells", (long long)a->split[d], d + 1,
-                                   (long long)box->hi[d]);
+            return cli_usage_error(c,
+                                   "--split: %lld parts in dimension %d, but it has only "
+                                   "%lld cells",
+                                   (long long)a->split[d], d + 1, (long long)box->hi[d]);
     }
     if (parts > MAX_SPLIT)
         return cli_usage_error(c, "--split asks for %.0f regions; at most %d", parts, MAX_SPLIT);
@@ -210,8 +212,8 @@ static int64_t border_cell(double x, double origin, double width, int round_up)
 
 /* --bounds as a box of cells (the cells the bounds touch); it must hold
  * the region. */
-static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat,
-                       const cm_box *box, cm_box *bounds)
+static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat, const cm_box *box,
+                       cm_box *bounds)
 {
     double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
     int n = 0;
@@ -295,9 +297,9 @@ typedef struct timing {
 
 /* What the summary and the JSON report. */
 typedef struct summary {
-    cm_box box;         /* the region, or the cluster's bounding box */
-    uint64_t cells;     /* cells computed (the bounding box has others) */
-    uint64_t sink;      /* cells of the sink's domain */
+    cm_box box;     /* the region, or the cluster's bounding box */
+    uint64_t cells; /* cells computed (the bounding box has others) */
+    uint64_t sink;  /* cells of the sink's domain */
     uint32_t ngroups;
     cm_group_info *groups; /* in id order */
 } summary;
@@ -346,7 +348,8 @@ static void print_json_extension(const cm_lattice *lat, const extend_log *log)
         const extend_step *s = &log->steps[k];
         char box[CM_MAX_DIM * 64];
         format_box(lat, &s->box, box, sizeof box);
-        printf("%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_cells\":%llu,"
+        printf("%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_"
+               "cells\":%llu,"
                "\"new_groups\":%u,\"straddling_groups\":%u,\"time_s\":%.6f}",
                k ? "," : "", box, (unsigned long long)cm_box_cells(&s->box),
                (unsigned long long)s->escaping, (unsigned long long)s->all_escaping,
@@ -431,8 +434,7 @@ static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *l
 }
 
 static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                             const cm_box *box, cm_region *r, timing *t, char *msg,
-                             size_t msg_size)
+                             const cm_box *box, cm_region *r, timing *t, char *msg, size_t msg_size)
 {
     const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 0};
     *t = (timing){"images", "classification", 0, 0};
@@ -514,9 +516,9 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
     for (uint32_t k = 0; k < n; k++)
         if (!has_box(&rn->c, &boxes[k]))
             boxes[todo++] = boxes[k];
-    cm_status st = cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt,
-                                          rn->store ? commit_join : NULL, rn->store, stats, msg,
-                                          msg_size);
+    cm_status st =
+        cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt, rn->store ? commit_join : NULL,
+                               rn->store, stats, msg, msg_size);
     free(boxes);
     return st;
 }
@@ -528,8 +530,8 @@ static void print_step(const cm_lattice *lat, const extend_step *s, int k)
     printf("extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu "
            "cells led there; %u new groups (%u across borders); %.3f s\n",
            k + 1, box, (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
-           (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells,
-           s->new_groups, s->straddling, s->seconds);
+           (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells, s->new_groups,
+           s->straddling, s->seconds);
 }
 
 /* The tile (of the region's size, aligned to it) that holds `box`. */
@@ -547,8 +549,7 @@ static cm_box tile_of(const cm_box *tile, const cm_box *box)
 
 /* Extension steps a resumed cluster has done, and the tile of a step that
  * was interrupted between its regions (or the empty box). */
-static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile,
-                      cm_box *partial)
+static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile, cm_box *partial)
 {
     const uint32_t per_tile = split_boxes(a, tile, NULL);
     const uint32_t extra = c->nregions > per_tile ? c->nregions - per_tile : 0;
@@ -587,12 +588,11 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
         /* the choice follows every escaping sequence: it needs every region */
         st = acquire_all(c, msg, msg_size);
         if (st == CM_OK)
-            st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg,
-                                  msg_size);
+            st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
         const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
         if (st == CM_OK && fraction < a->escape_below) {
-            snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g",
-                     fraction, a->escape_below);
+            snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g", fraction,
+                     a->escape_below);
             break;
         }
         if (st == CM_ENOTFOUND) {
@@ -605,7 +605,7 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
         if (st != CM_OK)
             break;
         extend_step *s = &log->steps[log->n];
-        *s = (extend_step){choice.box,          choice.escaping,          choice.all_escaping,
+        *s = (extend_step){choice.box,           choice.escaping,  choice.all_escaping,
                            choice.cluster_cells, stats.new_groups, stats.straddling_groups,
                            now_seconds() - t0};
         if (!a->json)
@@ -648,8 +648,8 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
 {
     if (!a->resume) {
         const char *epoch = getenv("SOURCE_DATE_EPOCH");
-        const cm_store_meta meta = {m, lat, command, plan, CELLMAP_VERSION,
-                                    epoch ? atoll(epoch) : 0};
+        const cm_store_meta meta = {
+            m, lat, command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
         cm_cluster_init(&rn->c, lat);
         cm_status st = cm_store_create(a->db, &meta, &rn->store, msg, msg_size);
         if (st == CM_OK)
@@ -664,11 +664,11 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
         st = cm_store_read_info(rn->store, &info, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const char *differs = strcmp(info.model, m->name)                ? "model"
-                          : strcmp(info.params, params)               ? "parameters"
-                          : !same_lattice(&info.lattice, lat)          ? "lattice (--region, --cells)"
-                          : strcmp(info.plan, plan)                   ? "plan (--split, --extend, ...)"
-                                                                      : NULL;
+    const char *differs = strcmp(info.model, m->name)         ? "model"
+                          : strcmp(info.params, params)       ? "parameters"
+                          : !same_lattice(&info.lattice, lat) ? "lattice (--region, --cells)"
+                          : strcmp(info.plan, plan)           ? "plan (--split, --extend, ...)"
+                                                              : NULL;
     if (differs)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "%s was made by another solve (its %s differs): resume with the options "

@@ -1,0 +1,447 @@
+/* cellmap export: a .cmdb file's groups and cells as CSV, NumPy .npy or a
+ * flat SQLite table, for users' own tools. Every output is written to a
+ * temporary file and renamed when complete. */
+#include <math.h>
+#include <sqlite3.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/dbfile.h"
+
+static const char export_help[] =
+    "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
+    "                      [--flat OUT.sqlite] [--window X0:X1[,Y0:Y1...]] [--mem BYTES]\n\n"
+    "  --groups OUT.csv    one row per group: id, period, basin_cells, is_sink (group 0),\n"
+    "                      centre, bounds of the periodic cells' centres, anchor cell\n"
+    "  --cells OUT         one row per computed cell: lattice indices ix, iy, ..., cell\n"
+    "                      centre x, y, ..., grp, step, periodic; CSV with a header, or\n"
+    "                      .npy (a structured array with those fields, little-endian)\n"
+    "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iy, ..., x, y, ...,\n"
+    "                      grp, step, periodic), with tables groups and meta\n"
+    "  --window X0:X1,...  only cells whose centre lies in this box of state space\n"
+    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n";
+
+enum { SLAB_CELLS = 1 << 22 }; /* cells flattened at a time */
+
+typedef enum { OUT_CSV, OUT_NPY, OUT_SQLITE } out_kind;
+
+/* One cells output being written. */
+typedef struct cell_out {
+    out_kind kind;
+    const char *path;
+    char tmp[4200];
+    FILE *f;
+    sqlite3 *db;
+    sqlite3_stmt *insert;
+    uint64_t rows;
+    long shape_at; /* .npy: where the row count is written at the end */
+} cell_out;
+
+typedef struct export_args {
+    const char *file, *groups, *cells, *flat, *window;
+    uint64_t mem;
+} export_args;
+
+static int ends_with(const char *s, const char *suffix)
+{
+    const size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcmp(s + n - m, suffix) == 0;
+}
+
+static int parse_export(cli *c, export_args *a)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(export_help, stdout);
+            return -1;
+        } else if (cli_is(c, "--groups", true, &err)) {
+            a->groups = c->value;
+        } else if (cli_is(c, "--cells", true, &err)) {
+            a->cells = c->value;
+            if (a->cells && !ends_with(a->cells, ".csv") && !ends_with(a->cells, ".npy"))
+                err = cli_usage_error(c, "--cells: '%s' must end in .csv or .npy", a->cells);
+        } else if (cli_is(c, "--flat", true, &err)) {
+            a->flat = c->value;
+        } else if (cli_is(c, "--window", true, &err)) {
+            a->window = c->value;
+        } else if (cli_is(c, "--mem", true, &err)) {
+            if (c->value && (!parse_bytes(c->value, &a->mem) || a->mem < (1u << 20)))
+                err = cli_usage_error(c,
+                                      "--mem: '%s' must be a size of at least 1M, as "
+                                      "BYTES[K|M|G]",
+                                      c->value);
+        } else if (c->opt[0] != '-' && !a->file) {
+            a->file = c->opt;
+        } else {
+            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+        }
+    }
+    if (!err && !a->file)
+        err = cli_usage_error(c, "which file? usage: cellmap export FILE.cmdb --cells OUT.csv");
+    if (!err && !a->groups && !a->cells && !a->flat)
+        err = cli_usage_error(c, "nothing to export: add --groups, --cells or --flat");
+    if (!err && a->window && !a->cells && !a->flat)
+        err = cli_usage_error(c, "--window applies to --cells and --flat");
+    return err;
+}
+
+/* The cells whose centres lie in the window, within the cluster's bounds. */
+static int window_box(const cli *c, const char *text, const cm_lattice *lat, cm_box *box)
+{
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    if (!parse_ranges(text, lo, hi, &n, CM_MAX_DIM))
+        return cli_usage_error(c, "--window: '%s' is not X0:X1[,Y0:Y1...] with X0 < X1", text);
+    if (n != lat->dim)
+        return cli_usage_error(c, "--window has %d range(s) but the lattice has dimension %d", n,
+                               lat->dim);
+    for (int d = 0; d < n; d++) {
+        const double a = ceil((lo[d] - lat->origin[d]) / lat->width[d] - 0.5);
+        const double b = floor((hi[d] - lat->origin[d]) / lat->width[d] - 0.5) + 1;
+        const int64_t clo = box->lo[d], chi = box->hi[d];
+        box->lo[d] = a > (double)clo ? (a < (double)chi ? (int64_t)a : chi) : clo;
+        box->hi[d] = b < (double)chi ? (b > (double)box->lo[d] ? (int64_t)b : box->lo[d]) : chi;
+    }
+    return EXIT_OK;
+}
+
+/* ---- outputs ---------------------------------------------------------- */
+
+static int npy_header(cell_out *o, int dim)
+{
+    char descr[512];
+    size_t used = 0;
+    for (int d = 0; d < dim; d++)
+        used +=
+            (size_t)snprintf(descr + used, sizeof descr - used, "('i%s', '<i8'), ", axis_name(d));
+    for (int d = 0; d < dim; d++)
+        used +=
+            (size_t)snprintf(descr + used, sizeof descr - used, "('%s', '<f8'), ", axis_name(d));
+    snprintf(descr + used, sizeof descr - used,
+             "('grp', '<u4'), ('step', '<u4'), ('periodic', '|u1')");
+    char header[1024];
+    int n = snprintf(header, sizeof header, "{'descr': [%s], 'fortran_order': False, 'shape': (",
+                     descr);
+    o->shape_at = 10 + n;
+    n += snprintf(header + n, sizeof header - (size_t)n, "%20d,), }", 0);
+    while ((10 + n + 1) % 64)
+        header[n++] = ' ';
+    header[n++] = '\n';
+    const unsigned char magic[10] = {
+        0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, (unsigned char)(n & 0xff), (unsigned char)(n >> 8)};
+    return fwrite(magic, 1, 10, o->f) == 10 && fwrite(header, 1, (size_t)n, o->f) == (size_t)n;
+}
+
+static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
+{
+    char sql[1024];
+    size_t used = (size_t)snprintf(sql, sizeof sql, "CREATE TABLE cells(");
+    for (int d = 0; d < dim; d++)
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "i%s INTEGER, ", axis_name(d));
+    for (int d = 0; d < dim; d++)
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "%s REAL, ", axis_name(d));
+    snprintf(sql + used, sizeof sql - used,
+             "grp INTEGER, step INTEGER, periodic INTEGER);"
+             "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
+             " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT);"
+             "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT);");
+    if (sqlite3_open(o->tmp, &o->db) != SQLITE_OK ||
+        sqlite3_exec(o->db, "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF; BEGIN", NULL, NULL,
+                     NULL) != SQLITE_OK ||
+        sqlite3_exec(o->db, sql, NULL, NULL, NULL) != SQLITE_OK)
+        return 0;
+    sqlite3_stmt *st = NULL;
+    const char *rows[][2] = {{"model", info->model},
+                             {"params", info->params},
+                             {"command", info->command},
+                             {"source", o->path}};
+    if (sqlite3_prepare_v2(o->db, "INSERT INTO meta VALUES(?, ?)", -1, &st, NULL) != SQLITE_OK)
+        return 0;
+    int ok = 1;
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0] && ok; k++) {
+        sqlite3_bind_text(st, 1, rows[k][0], -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 2, rows[k][1], -1, SQLITE_STATIC);
+        ok = sqlite3_step(st) == SQLITE_DONE;
+        sqlite3_reset(st);
+    }
+    sqlite3_finalize(st);
+    used = (size_t)snprintf(sql, sizeof sql, "INSERT INTO cells VALUES(");
+    for (int k = 0; k < 2 * dim + 3; k++)
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "%s?", k ? "," : "");
+    snprintf(sql + used, sizeof sql - used, ")");
+    return ok && sqlite3_prepare_v2(o->db, sql, -1, &o->insert, NULL) == SQLITE_OK;
+}
+
+static int out_begin(cell_out *o, int dim, const cm_store_info *info)
+{
+    snprintf(o->tmp, sizeof o->tmp, "%s.tmp-%ld", o->path, (long)getpid());
+    unlink(o->tmp);
+    if (o->kind == OUT_SQLITE)
+        return sqlite_begin(o, dim, info);
+    if (!(o->f = fopen(o->tmp, "wb")))
+        return 0;
+    if (o->kind == OUT_NPY)
+        return npy_header(o, dim);
+    for (int d = 0; d < dim; d++)
+        fprintf(o->f, "i%s,", axis_name(d));
+    for (int d = 0; d < dim; d++)
+        fprintf(o->f, "%s,", axis_name(d));
+    return fprintf(o->f, "grp,step,periodic\n") > 0;
+}
+
+static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, uint32_t grp,
+                   uint32_t step, int periodic)
+{
+    o->rows++;
+    if (o->kind == OUT_CSV) {
+        for (int d = 0; d < dim; d++)
+            fprintf(o->f, "%lld,", (long long)cell[d]);
+        for (int d = 0; d < dim; d++)
+            fprintf(o->f, "%.17g,", x[d]);
+        return fprintf(o->f, "%u,%u,%d\n", grp, step, periodic) > 0;
+    }
+    if (o->kind == OUT_NPY) {
+        unsigned char row[CM_MAX_DIM * 16 + 9];
+        size_t n = 0;
+        for (int d = 0; d < dim; d++, n += 8)
+            for (int b = 0; b < 8; b++)
+                row[n + (size_t)b] = (unsigned char)((uint64_t)cell[d] >> (8 * b));
+        for (int d = 0; d < dim; d++, n += 8) {
+            uint64_t bits;
+            memcpy(&bits, &x[d], 8);
+            for (int b = 0; b < 8; b++)
+                row[n + (size_t)b] = (unsigned char)(bits >> (8 * b));
+        }
+        const uint32_t u[2] = {grp, step};
+        for (int k = 0; k < 2; k++, n += 4)
+            for (int b = 0; b < 4; b++)
+                row[n + (size_t)b] = (unsigned char)(u[k] >> (8 * b));
+        row[n++] = (unsigned char)periodic;
+        return fwrite(row, 1, n, o->f) == n;
+    }
+    int col = 1;
+    for (int d = 0; d < dim; d++)
+        sqlite3_bind_int64(o->insert, col++, cell[d]);
+    for (int d = 0; d < dim; d++)
+        sqlite3_bind_double(o->insert, col++, x[d]);
+    sqlite3_bind_int64(o->insert, col++, grp);
+    sqlite3_bind_int64(o->insert, col++, step);
+    sqlite3_bind_int(o->insert, col, periodic);
+    const int ok = sqlite3_step(o->insert) == SQLITE_DONE;
+    sqlite3_reset(o->insert);
+    return ok;
+}
+
+static int json_array(char *buf, size_t size, const double *v, int n)
+{
+    size_t used = (size_t)snprintf(buf, size, "[");
+    for (int d = 0; d < n && used < size; d++)
+        used += (size_t)snprintf(buf + used, size - used, "%s%.17g", d ? "," : "", v[d]);
+    return snprintf(buf + used, used < size ? size - used : 0, "]") > 0;
+}
+
+static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info *g, uint32_t n,
+                         uint64_t sink)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(o->db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
+                           NULL) != SQLITE_OK)
+        return 0;
+    int ok = 1;
+    for (uint32_t k = 0; k <= n && ok; k++) {
+        char centre[512], lo[512], hi[512], anchor[512];
+        if (k == 0) {
+            sqlite3_bind_int(st, 1, 0);
+            sqlite3_bind_int(st, 2, 1);
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)sink);
+            sqlite3_bind_int(st, 4, 1);
+            for (int c = 5; c <= 8; c++)
+                sqlite3_bind_null(st, c);
+        } else {
+            const cm_group_info *gi = &g[k - 1];
+            double a[CM_MAX_DIM];
+            for (int d = 0; d < lat->dim; d++)
+                a[d] = (double)gi->anchor[d];
+            json_array(centre, sizeof centre, gi->centre, lat->dim);
+            json_array(lo, sizeof lo, gi->lo, lat->dim);
+            json_array(hi, sizeof hi, gi->hi, lat->dim);
+            json_array(anchor, sizeof anchor, a, lat->dim);
+            sqlite3_bind_int64(st, 1, gi->id);
+            sqlite3_bind_int64(st, 2, gi->period);
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)gi->basin_cells);
+            sqlite3_bind_int(st, 4, 0);
+            sqlite3_bind_text(st, 5, centre, -1, SQLITE_TRANSIENT);
+            sqlite3_bind_text(st, 6, lo, -1, SQLITE_TRANSIENT);
+            sqlite3_bind_text(st, 7, hi, -1, SQLITE_TRANSIENT);
+            sqlite3_bind_text(st, 8, anchor, -1, SQLITE_TRANSIENT);
+        }
+        ok = sqlite3_step(st) == SQLITE_DONE;
+        sqlite3_reset(st);
+    }
+    sqlite3_finalize(st);
+    return ok;
+}
+
+/* Completes the output and renames it into place; on failure removes it. */
+static int out_end(cell_out *o, int ok)
+{
+    if (o->kind == OUT_NPY && ok && o->f) {
+        char shape[32];
+        snprintf(shape, sizeof shape, "%20llu", (unsigned long long)o->rows);
+        ok = fseek(o->f, o->shape_at, SEEK_SET) == 0 && fwrite(shape, 1, 20, o->f) == 20;
+    }
+    if (o->f)
+        ok = (fclose(o->f) == 0) && ok;
+    if (o->db) {
+        sqlite3_finalize(o->insert);
+        ok = ok && sqlite3_exec(o->db, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+        ok = (sqlite3_close(o->db) == SQLITE_OK) && ok;
+    }
+    if (ok && rename(o->tmp, o->path) != 0)
+        ok = 0;
+    if (!ok)
+        unlink(o->tmp);
+    return ok;
+}
+
+/* ---- what is exported ------------------------------------------------- */
+
+static int export_groups(const char *path, const cm_lattice *lat, const cm_group_info *g,
+                         uint32_t n, uint64_t sink)
+{
+    cell_out o = {OUT_CSV, path, "", NULL, NULL, NULL, 0, 0};
+    snprintf(o.tmp, sizeof o.tmp, "%s.tmp-%ld", path, (long)getpid());
+    if (!(o.f = fopen(o.tmp, "w")))
+        return 0;
+    const char *parts[] = {"centre_", "lo_", "hi_", "anchor_i"};
+    fprintf(o.f, "id,period,basin_cells,is_sink");
+    for (int p = 0; p < 4; p++)
+        for (int d = 0; d < lat->dim; d++)
+            fprintf(o.f, ",%s%s", parts[p], axis_name(d));
+    fprintf(o.f, "\n0,1,%llu,1", (unsigned long long)sink);
+    for (int k = 0; k < 4 * lat->dim; k++)
+        fprintf(o.f, ",");
+    fprintf(o.f, "\n");
+    for (uint32_t k = 0; k < n; k++) {
+        fprintf(o.f, "%u,%u,%llu,0", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells);
+        const double *v[3] = {g[k].centre, g[k].lo, g[k].hi};
+        for (int p = 0; p < 3; p++)
+            for (int d = 0; d < lat->dim; d++)
+                fprintf(o.f, ",%.17g", v[p][d]);
+        for (int d = 0; d < lat->dim; d++)
+            fprintf(o.f, ",%lld", (long long)g[k].anchor[d]);
+        fprintf(o.f, "\n");
+    }
+    return out_end(&o, !ferror(o.f));
+}
+
+/* Walks the window in slabs along the last dimension, reading regions
+ * back as needed, and writes every computed cell to each output. */
+static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *outs, int nouts,
+                              char *msg, size_t msg_size)
+{
+    const int dim = c->lat.dim, last = dim - 1;
+    const uint64_t row =
+        cm_box_cells(window) /
+        (uint64_t)(window->hi[last] - window->lo[last] ? window->hi[last] - window->lo[last] : 1);
+    const int64_t step = row >= SLAB_CELLS ? 1 : (int64_t)(SLAB_CELLS / (row ? row : 1));
+    for (int64_t at = window->lo[last]; at < window->hi[last]; at += step) {
+        cm_box slab = *window;
+        slab.lo[last] = at;
+        slab.hi[last] = at + step < window->hi[last] ? at + step : window->hi[last];
+        cm_region flat;
+        cm_status st = cm_cluster_flatten(c, &slab, &flat, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        for (uint64_t i = 0; i < flat.ncells && st == CM_OK; i++) {
+            if (flat.group[i] == CM_GROUP_NONE)
+                continue;
+            int64_t cell[CM_MAX_DIM];
+            double x[CM_MAX_DIM];
+            cm_box_cell(&slab, i, cell);
+            cm_lattice_centre(&c->lat, cell, x);
+            for (int k = 0; k < nouts && st == CM_OK; k++)
+                if (!out_row(&outs[k], dim, cell, x, flat.group[i], flat.step[i],
+                             cm_is_periodic(&flat, i)))
+                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %s", outs[k].tmp);
+        }
+        cm_region_free(&flat);
+        if (st != CM_OK)
+            return st;
+    }
+    return CM_OK;
+}
+
+static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm_store_info *info,
+                      cm_cluster *c)
+{
+    char msg[1024];
+    cm_group_info *g = calloc((size_t)info->groups + 1, sizeof *g);
+    uint64_t sink = 0;
+    if (!g || cm_store_groups(s, g, info->groups, &sink, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap export: %s\n", g ? msg : "out of memory");
+        free(g);
+        return EXIT_FAIL;
+    }
+    int rc = EXIT_OK;
+    if (a->groups && !export_groups(a->groups, &c->lat, g, info->groups, sink)) {
+        fprintf(stderr, "cellmap export: cannot write %s\n", a->groups);
+        rc = EXIT_FAIL;
+    }
+    cell_out outs[2];
+    int nouts = 0;
+    memset(outs, 0, sizeof outs);
+    if (a->cells) {
+        outs[nouts].kind = ends_with(a->cells, ".npy") ? OUT_NPY : OUT_CSV;
+        outs[nouts++].path = a->cells;
+    }
+    if (a->flat) {
+        outs[nouts].kind = OUT_SQLITE;
+        outs[nouts++].path = a->flat;
+    }
+    cm_box window;
+    cm_cluster_bounds(c, &window);
+    if (rc == EXIT_OK && a->window && (rc = window_box(cl, a->window, &c->lat, &window)) != EXIT_OK)
+        nouts = 0;
+    int ok = 1;
+    for (int k = 0; k < nouts; k++)
+        if (!(ok = out_begin(&outs[k], c->lat.dim, info) && ok))
+            snprintf(msg, sizeof msg, "cannot write %s", outs[k].tmp);
+    if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink))
+        ok = 0, snprintf(msg, sizeof msg, "cannot write %s", a->flat);
+    if (ok && nouts)
+        ok = export_cells(c, &window, outs, nouts, msg, sizeof msg) == CM_OK;
+    for (int k = 0; k < nouts; k++)
+        if (!out_end(&outs[k], ok) && ok)
+            ok = 0, snprintf(msg, sizeof msg, "cannot complete %s", outs[k].path);
+    if (!ok) {
+        fprintf(stderr, "cellmap export: %s\n", msg);
+        rc = EXIT_FAIL;
+    } else if (nouts) {
+        fprintf(stderr, "cellmap export: %llu cells\n", (unsigned long long)outs[0].rows);
+    }
+    free(g);
+    return rc;
+}
+
+int cmd_export(int argc, char **argv)
+{
+    cli c = {"export", argc, argv, 0, NULL, NULL};
+    export_args a = {NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20};
+    const int rc = parse_export(&c, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_cluster cl;
+    if (open_cluster_file("export", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+        return EXIT_FAIL;
+    const int result = run_export(&c, &a, s, &info, &cl);
+    close_cluster_file(s, &cl);
+    return result;
+}

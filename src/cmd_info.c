@@ -1,0 +1,148 @@
+/* cellmap info: what a .cmdb file holds, and what it costs on disk and in
+ * memory. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/dbfile.h"
+
+static const char info_help[] =
+    "usage: cellmap info FILE.cmdb [--json]\n\n"
+    "Prints the model, parameters, lattice, the command that made the file, its\n"
+    "regions and groups (largest basins first), and its size on disk and in memory.\n"
+    "The file is opened read-only.\n";
+
+enum { SHOWN_GROUPS = 10 };
+
+static int larger_basin_first(const void *a, const void *b)
+{
+    const cm_group_info *x = a, *y = b;
+    if (x->basin_cells != y->basin_cells)
+        return x->basin_cells > y->basin_cells ? -1 : 1;
+    return x->id < y->id ? -1 : (x->id > y->id);
+}
+
+static void print_cells(const cm_lattice *lat, const int64_t *cell)
+{
+    double x[CM_MAX_DIM];
+    cm_lattice_centre(lat, cell, x);
+    for (int d = 0; d < lat->dim; d++)
+        printf("%s%.9g", d ? ", " : "", x[d]);
+}
+
+static void print_text(const char *path, const cm_store_info *info, const cm_box *bounds,
+                       const cm_group_info *g, uint64_t sink, uint64_t largest_region)
+{
+    const cm_lattice *lat = &info->lattice;
+    printf("file %s: cellmap database format %d, written by cellmap %s\n", path, CM_STORE_VERSION,
+           info->tool_version);
+    printf("model %s %s\n", info->model, info->params);
+    printf("lattice origin (");
+    for (int d = 0; d < lat->dim; d++)
+        printf("%s%.17g", d ? ", " : "", lat->origin[d]);
+    printf(") cell width (");
+    for (int d = 0; d < lat->dim; d++)
+        printf("%s%.17g", d ? ", " : "", lat->width[d]);
+    printf(")\nmade by: %s\n", info->command);
+    printf("regions %u, cells %llu, bounding box", info->regions, (unsigned long long)info->cells);
+    for (int d = 0; d < lat->dim; d++)
+        printf("%s%.9g:%.9g", d ? "," : " ", lat->origin[d] + (double)bounds->lo[d] * lat->width[d],
+               lat->origin[d] + (double)bounds->hi[d] * lat->width[d]);
+    printf(" (%llu cells)\n", (unsigned long long)cm_box_cells(bounds));
+    printf("groups %u periodic, sink basin %llu cells (%.1f%%)\n", info->groups,
+           (unsigned long long)sink, 100.0 * (double)sink / (double)info->cells);
+    printf("%6s %8s %12s  %s\n", "group", "period", "basin", "centre");
+    for (uint32_t k = 0; k < info->groups && k < SHOWN_GROUPS; k++) {
+        printf("%6u %8u %12llu  (", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells);
+        for (int d = 0; d < lat->dim; d++)
+            printf("%s%.9g", d ? ", " : "", g[k].centre[d]);
+        printf(")  anchor cell centre (");
+        print_cells(lat, g[k].anchor);
+        printf(")\n");
+    }
+    if (info->groups > SHOWN_GROUPS)
+        printf("... and %u smaller groups (cellmap export --groups lists all)\n",
+               info->groups - SHOWN_GROUPS);
+    printf("disk: %llu bytes (%.2f bytes/cell; cell pages %.2f bytes/cell)\n",
+           (unsigned long long)info->file_bytes, (double)info->file_bytes / (double)info->cells,
+           (double)info->page_bytes / (double)info->cells);
+    printf("memory: %.1f MiB to hold every region (12 bytes/cell plus exits), %.1f MiB for "
+           "the largest region (the least useful --mem)\n",
+           (double)(info->cells * 12) / 1048576.0, (double)largest_region / 1048576.0);
+}
+
+static void print_json(const cm_store_info *info, const cm_box *bounds, const cm_group_info *g,
+                       uint64_t sink)
+{
+    printf("{\"format\":%d,\"tool_version\":\"%s\",\"model\":\"%s\","
+           "\"params\":%s,\"regions\":%u,\"cells\":%llu,\"bounding_box\":[",
+           CM_STORE_VERSION, info->tool_version, info->model, info->params, info->regions,
+           (unsigned long long)info->cells);
+    for (int d = 0; d < bounds->dim; d++)
+        printf("%s[%lld,%lld]", d ? "," : "", (long long)bounds->lo[d], (long long)bounds->hi[d]);
+    printf("],\"sink_cells\":%llu,\"file_bytes\":%llu,\"page_bytes\":%llu,\"groups\":[",
+           (unsigned long long)sink, (unsigned long long)info->file_bytes,
+           (unsigned long long)info->page_bytes);
+    for (uint32_t k = 0; k < info->groups; k++)
+        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu}", k ? "," : "", g[k].id, g[k].period,
+               (unsigned long long)g[k].basin_cells);
+    printf("]}\n");
+}
+
+int cmd_info(int argc, char **argv)
+{
+    cli c = {"info", argc, argv, 0, NULL, NULL};
+    const char *path = NULL;
+    int json = 0, err = 0;
+    while (cli_next(&c) && !err) {
+        if (strcmp(c.opt, "--help") == 0) {
+            fputs(info_help, stdout);
+            return EXIT_OK;
+        } else if (cli_is(&c, "--json", false, &err)) {
+            json = 1;
+        } else if (c.opt[0] != '-' && !path) {
+            path = c.opt;
+        } else {
+            err = cli_usage_error(&c, "unexpected argument '%s'", c.opt);
+        }
+    }
+    if (err)
+        return err;
+    if (!path)
+        return cli_usage_error(&c, "which file? usage: cellmap info FILE.cmdb");
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_cluster cl;
+    if (open_cluster_file("info", path, 0, &s, &info, &cl) != EXIT_OK)
+        return EXIT_FAIL;
+    cm_group_info *g = calloc((size_t)info.groups + 1, sizeof *g);
+    uint64_t sink = 0;
+    char msg[1024];
+    int rc = EXIT_FAIL;
+    if (!g)
+        snprintf(msg, sizeof msg, "out of memory for %u groups", info.groups);
+    else if (cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK)
+        rc = EXIT_OK;
+    if (rc == EXIT_OK) {
+        cm_box bounds;
+        cm_cluster_bounds(&cl, &bounds);
+        uint64_t largest = 0;
+        for (uint32_t k = 0; k < cl.nregions; k++) {
+            const uint64_t bytes = cm_region_bytes(&cl.regions[k].r);
+            largest = bytes > largest ? bytes : largest;
+        }
+        if (json) {
+            print_json(&info, &bounds, g, sink);
+        } else {
+            qsort(g, info.groups, sizeof *g, larger_basin_first);
+            print_text(path, &info, &bounds, g, sink, largest);
+        }
+    } else {
+        fprintf(stderr, "cellmap info: %s\n", msg);
+    }
+    free(g);
+    close_cluster_file(s, &cl);
+    return rc;
+}

@@ -1,0 +1,21 @@
+/* src/dbfile.h - opening a .cmdb file for the commands that read one. */
+#ifndef CM_SRC_DBFILE_H
+#define CM_SRC_DBFILE_H
+
+#include "cellmap/cluster.h"
+#include "cellmap/store.h"
+
+/* Opens path read-only, reads what it says about itself and restores its
+ * cluster (paged out; regions are read back on demand within mem_budget
+ * bytes). Prints "cellmap CMD: problem" and returns EXIT_FAIL on failure,
+ * leaving nothing open. */
+int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
+                      cm_store_info *info, cm_cluster *c);
+
+/* Closes what open_cluster_file opened. */
+void close_cluster_file(cm_store *s, cm_cluster *c);
+
+/* The name of coordinate d: x, y, z, w, v, u. */
+const char *axis_name(int d);
+
+#endif
