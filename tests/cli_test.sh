@@ -63,6 +63,66 @@ echo "precious" > notes.txt
 [ "$(cat notes.txt)" = precious ] || fail "foreign file modified"
 grep -q "refusing" err.txt || fail "no refusal message"
 
+# --- the database: paging, resume, info, export, refused files ----------------
+small="--cells 300x200 --split 3x2 --threads 2"
+"$CM" solve $small --db mem.cmdb --json > mem.json || fail "solve --db"
+"$CM" solve $small --db paged.cmdb --mem 1M --json > paged.json || fail "solve --db --mem"
+"$CM" solve $small --json > plain.json || fail "solve in memory"
+strip() { sed 's/"time_s":{[^}]*}//' "$1"; }
+[ "$(strip mem.json)" = "$(strip plain.json)" ] || fail "summary from the database differs"
+[ "$(strip paged.json)" = "$(strip plain.json)" ] || fail "summary under --mem 1M differs"
+"$CM" solve $small --db paged.cmdb --mem 1M --resume > resumed.txt || fail "--resume of a finished file"
+grep -q "^database paged.cmdb: 6 regions" resumed.txt || fail "resume summary: $(tail -1 resumed.txt)"
+"$CM" solve --cells 300x300 --split 3x2 --db paged.cmdb --resume > /dev/null 2> err.txt
+[ $? -eq 1 ] && grep -q "made by another solve" err.txt || fail "resume with other options"
+"$CM" info paged.cmdb > info.txt || fail "info"
+grep -q "^regions 6, cells 60000" info.txt || fail "info regions: $(cat info.txt)"
+grep -q "^disk: .* bytes/cell" info.txt || fail "info disk"
+"$CM" export paged.cmdb --groups g.csv --cells c.csv --flat flat.sqlite --window 0:250,-40:0 \
+  2> export.txt || fail "export"
+head -1 c.csv | grep -qx "ix,iy,x,y,grp,step,periodic" || fail "cells CSV header"
+[ "$(($(wc -l < c.csv) - 1))" = "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" ] \
+  || fail "CSV and flat table differ"
+[ "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" = 15000 ] || fail "window 150x100 cells"
+[ "$(sqlite3 flat.sqlite 'SELECT MIN(ix)||":"||MAX(ix)||":"||MIN(iy)||":"||MAX(iy) FROM cells')" = \
+  "0:149:0:99" ] || fail "window bounds"
+[ "$(($(wc -l < g.csv) - 1))" = "$(sqlite3 paged.cmdb 'SELECT COUNT(*) FROM groups')" ] \
+  || fail "groups CSV rows"
+"$CM" export paged.cmdb --cells c.npy 2> /dev/null || fail "export .npy"
+python3 - c.npy <<'PY' || fail ".npy layout"
+import ast, struct, sys
+d = open(sys.argv[1], "rb").read()
+assert d[:8] == b"\x93NUMPY\x01\x00"
+n = struct.unpack("<H", d[8:10])[0]
+h = ast.literal_eval(d[10:10 + n].decode())
+assert h["shape"] == (60000,), h
+size = 8 * 4 + 4 + 4 + 1
+assert len(d) == 10 + n + 60000 * size and (10 + n) % 64 == 0
+PY
+ls | grep -q tmp- && fail "temporary files left behind"
+# refused files: exit 1, a message, the file unchanged
+head -c 4096 mem.cmdb > truncated.cmdb
+head -c 5000 /dev/urandom > random.cmdb
+sqlite3 foreign.cmdb "CREATE TABLE t(x)"
+cp mem.cmdb newer.cmdb && sqlite3 newer.cmdb "PRAGMA user_version = 7"
+for f in truncated random foreign newer notes; do
+  [ -f $f.cmdb ] || cp notes.txt $f.cmdb
+  sum=$(md5sum < $f.cmdb)
+  for cmd in "info $f.cmdb" "export $f.cmdb --groups x.csv" \
+             "solve $small --db $f.cmdb --resume" "solve --cells 50x50 --db $f.cmdb"; do
+    "$CM" $cmd > /dev/null 2> err.txt; rc=$?
+    [ $rc -eq 1 ] || fail "cellmap $cmd exited $rc, expected 1"
+    grep -q "$f.cmdb" err.txt || fail "cellmap $cmd: message lacks the file: $(cat err.txt)"
+    [ "$(md5sum < $f.cmdb)" = "$sum" ] || fail "cellmap $cmd modified $f.cmdb"
+  done
+done
+grep -q "newer than this cellmap" <("$CM" info newer.cmdb 2>&1) || fail "newer version message"
+expect_usage "add --db FILE" solve --mem 1G
+expect_usage "--mem: '12Q'" solve --db x.cmdb --mem 12Q
+expect_usage "nothing to export" export mem.cmdb
+expect_usage "must end in .csv or .npy" export mem.cmdb --cells x.txt
+expect_usage "which file?" info
+
 # --- orbit and fixed points ---------------------------------------------------
 "$CM" orbit --model microchaos-1d --param a=3.5,b=2.8 --from 0.5 --steps 2 > orbit.csv || fail orbit
 [ "$(sed -n 3p orbit.csv)" = "1,1.75" ] || fail "orbit step 1: $(sed -n 3p orbit.csv)"
@@ -71,7 +131,7 @@ grep -q "refusing" err.txt || fail "no refusal message"
 grep -q '^8,8,regular,8.959999999999999' fp.csv || fail "x_8* = 8.96 regular: $(cat fp.csv)"
 grep -q '^9,10,virtual,10.08' fp.csv || fail "x_9* = 10.08 virtual: $(cat fp.csv)"
 "$CM" models | grep -q microchaos-pd-twofold || fail "models list"
-for c in solve orbit fixed-points models; do
+for c in solve orbit fixed-points models info export; do
   "$CM" $c --help | grep -q usage || fail "$c --help"
 done
 
