@@ -249,6 +249,37 @@ static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affe
     return count;
 }
 
+/* The regions the exits of region k's sink cells lead into. Only sink
+ * cells' sequences can change in later joins, so these links are all that
+ * marks k affected: a region whose sink cells cannot reach the new region
+ * is neither resolved nor read back. */
+static cm_status sink_targets(cm_cluster *c, uint32_t k)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    const cm_region *r = &cr->r;
+    uint32_t hint = k;
+    cr->ntargets = 0;
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        const int64_t e = r->group[i] == 0 ? cm_image_exit_index(r->image[i]) : -1;
+        uint64_t local;
+        const int64_t t =
+            e < 0 ? -1 : cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), &hint, &local);
+        if (t >= 0 && add_target(cr, (uint32_t)t) != CM_OK)
+            return CM_ENOMEM;
+    }
+    return CM_OK;
+}
+
+/* After a join: the links of the regions whose sink cells changed. */
+static cm_status refine_targets(cm_cluster *c, const uint8_t *changed)
+{
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
+        if (changed[k])
+            st = sink_targets(c, k);
+    return st;
+}
+
 /* Reads back every region a join reads or writes: the affected ones (which
  * it marks dirty) and the regions their exits lead into. */
 static cm_status acquire_affected(cm_cluster *c, const uint8_t *affected, char *msg,
@@ -305,6 +336,9 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
             return st; /* msg says which region could not be read back */
         }
         st = cm_resolve_sink_cells(c, affected, stats);
+        affected[added] = 1;
+        if (st == CM_OK)
+            st = refine_targets(c, affected);
     }
     free(affected);
     stats->new_groups += stats->straddling_groups;
@@ -314,7 +348,7 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
 }
 
 cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
-                             char *msg, size_t msg_size)
+                             const uint32_t *targets, uint32_t ntargets, char *msg, size_t msg_size)
 {
     if (record->box.dim != c->lat.dim)
         return cm_fail(CM_EFORMAT, msg, msg_size, "region of %d dimensions, lattice of %d",
@@ -330,8 +364,11 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64
     cr->r.ngroups = record->ngroups;
     cr->r.exits_recorded = 1;
     cr->r.exit_target = (int64_t *)exit_target; /* borrowed for update_links only */
-    const cm_status st = update_links(c, added);
+    cm_status st = update_links(c, added);
     cr->r.exit_target = NULL;
+    cr->ntargets = 0; /* the saved links: those of sink cells only */
+    for (uint32_t t = 0; t < ntargets && st == CM_OK; t++)
+        st = add_target(cr, targets[t]);
     return st == CM_OK
                ? CM_OK
                : cm_fail(st, msg, msg_size, "restoring region %u: %s", added, cm_strerror(st));

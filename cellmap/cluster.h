@@ -101,11 +101,12 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
                           uint64_t *local);
 
-/* Restores a region from its record (box, ncells, nexits, ngroups) and the
- * target cells of its exits, paged out: a cluster reopened from a file.
- * Regions must be restored in the order they were joined. */
+/* Restores a region from its record (box, ncells, nexits, ngroups), the
+ * target cells of its exits and its targets list as saved, paged out: a
+ * cluster reopened from a file. Regions must be restored in join order. */
 cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
-                             char *msg, size_t msg_size);
+                             const uint32_t *targets, uint32_t ntargets, char *msg,
+                             size_t msg_size);
 
 /* Makes region k resident (reading it back if paged out) and marks it used. */
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);

@@ -21,8 +21,8 @@
 
 typedef struct cm_extend_choice {
     cm_box box;            /* the chosen tile, clipped to the bounds */
-    uint64_t escaping;      /* cells whose sequences leave the cluster into it */
-    uint64_t all_escaping;  /* cells whose sequences leave the cluster into the world */
+    uint64_t escaping;     /* cells whose sequences leave the cluster into it */
+    uint64_t all_escaping; /* cells whose sequences leave the cluster into the world */
     uint64_t cluster_cells;
 } cm_extend_choice;
 

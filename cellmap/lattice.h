@@ -23,9 +23,9 @@
 #define CM_WORLD_LIMIT ((int64_t)1 << 40)
 
 typedef struct cm_lattice {
-    int dim;                    /* 1 .. CM_MAX_DIM */
-    double origin[CM_MAX_DIM];  /* state coordinates of cell 0's lower corner */
-    double width[CM_MAX_DIM];   /* cell widths, > 0 and finite */
+    int dim;                   /* 1 .. CM_MAX_DIM */
+    double origin[CM_MAX_DIM]; /* state coordinates of cell 0's lower corner */
+    double width[CM_MAX_DIM];  /* cell widths, > 0 and finite */
 } cm_lattice;
 
 /* A box of cells: lo[d] <= c[d] < hi[d]. Local (row-major) index puts

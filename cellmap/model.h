@@ -26,8 +26,8 @@
  * stores the word's index. */
 typedef struct cm_param_spec {
     const char *name;
-    const char *def;     /* default, in command-line syntax */
-    double min, max;     /* inclusive range of every element */
+    const char *def; /* default, in command-line syntax */
+    double min, max; /* inclusive range of every element */
     int max_count;
     const char *choices; /* NULL or '|'-separated words */
     const char *doc;     /* one line */
@@ -61,8 +61,8 @@ typedef struct cm_model {
     const char *name;
     int dim;
     const cm_param_spec *params;
-    cm_params values;  /* the parameters the model was built from */
-    void *ctx;         /* derived coefficients; owned by the model */
+    cm_params values; /* the parameters the model was built from */
+    void *ctx;        /* derived coefficients; owned by the model */
     /* 0: image in y; >0: no image (the sink); <0: abort the run. */
     int (*step)(const struct cm_model *m, const double *x, double *y);
     /* Optional. Fixed points for levels m0..m1 into out (cap entries);

@@ -13,18 +13,18 @@
 #define PARALLEL_MIN_CELLS 65536
 
 enum node_state {
-    NODE_NEW,          /* linked, not yet resolved */
-    NODE_ON_WALK,      /* on the current walk; step holds the position */
-    NODE_DONE,         /* group and step final */
-    NODE_CYCLE,        /* on a cycle across borders: step 0 */
-    NODE_CYCLE_BOUND   /* leads into such a cycle; step still to count */
+    NODE_NEW,        /* linked, not yet resolved */
+    NODE_ON_WALK,    /* on the current walk; step holds the position */
+    NODE_DONE,       /* group and step final */
+    NODE_CYCLE,      /* on a cycle across borders: step 0 */
+    NODE_CYCLE_BOUND /* leads into such a cycle; step still to count */
 };
 
 /* A sink cell whose image leaves its region: the root of a tree of sink cells. */
 typedef struct node {
     uint32_t region, cell;
-    uint32_t next;  /* the node whose tree the image lies in, or NO_NODE */
-    uint32_t dist;  /* steps from this cell to next's cell */
+    uint32_t next;     /* the node whose tree the image lies in, or NO_NODE */
+    uint32_t dist;     /* steps from this cell to next's cell */
     uint32_t old_step; /* before the join */
     uint32_t group, step;
     uint32_t state; /* enum node_state */

@@ -37,8 +37,9 @@
 /* Index into the exit table of an image value, or -1 if it is not a recorded exit. */
 static inline int64_t cm_image_exit_index(uint32_t image)
 {
-    return image >= CM_IMAGE_EXIT_BASE && image < CM_IMAGE_EXIT ? (int64_t)(image - CM_IMAGE_EXIT_BASE)
-                                                                : -1;
+    return image >= CM_IMAGE_EXIT_BASE && image < CM_IMAGE_EXIT
+               ? (int64_t)(image - CM_IMAGE_EXIT_BASE)
+               : -1;
 }
 /* Largest number of cells in one region: local indices stay below the
  * image marks, and step numbers below 2^31 (classification keeps a flag in
@@ -51,9 +52,9 @@ typedef struct cm_region {
     uint32_t *image;
     uint32_t *group;
     uint32_t *step;
-    uint32_t ngroups; /* periodic groups other than the sink */
-    int exits_recorded; /* images were computed with record_exits */
-    uint64_t nexits;    /* recorded exits */
+    uint32_t ngroups;     /* periodic groups other than the sink */
+    int exits_recorded;   /* images were computed with record_exits */
+    uint64_t nexits;      /* recorded exits */
     int64_t *exit_target; /* nexits * box.dim cell coordinates, in local index order */
 } cm_region;
 
@@ -87,11 +88,11 @@ typedef struct cm_scm_options {
 /* Summary of one periodic group. */
 typedef struct cm_group_info {
     uint32_t id;
-    uint32_t period;             /* number of periodic cells */
-    uint64_t basin_cells;        /* cells with this group, periodic ones included */
-    double centre[CM_MAX_DIM];   /* mean centre of the periodic cells */
-    int64_t anchor[CM_MAX_DIM];  /* lexicographically smallest periodic cell:
-                                    the group's identity, whatever its id */
+    uint32_t period;                       /* number of periodic cells */
+    uint64_t basin_cells;                  /* cells with this group, periodic ones included */
+    double centre[CM_MAX_DIM];             /* mean centre of the periodic cells */
+    int64_t anchor[CM_MAX_DIM];            /* lexicographically smallest periodic cell:
+                                              the group's identity, whatever its id */
     double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* bounding box of periodic cells' centres */
 } cm_group_info;
 

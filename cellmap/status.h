@@ -10,24 +10,24 @@
 #include <stddef.h>
 
 /* One table generates the enum, the names and the messages (libuv style). */
-#define CM_STATUS_TABLE(X)                                                     \
-    X(CM_OK, "success")                                                        \
-    X(CM_EINVAL, "invalid argument")                                           \
-    X(CM_ENOMEM, "out of memory")                                              \
-    X(CM_ERANGE, "value out of range")                                         \
-    X(CM_ETOOBIG, "problem too large")                                         \
-    X(CM_EMODEL, "the model aborted the computation")                          \
-    X(CM_EIO, "input/output error")                                            \
-    X(CM_EDB, "database error")                                                \
-    X(CM_EFORMAT, "not a valid cellmap file")                                  \
-    X(CM_ERENDER, "rendering error")                                           \
+#define CM_STATUS_TABLE(X)                                                                         \
+    X(CM_OK, "success")                                                                            \
+    X(CM_EINVAL, "invalid argument")                                                               \
+    X(CM_ENOMEM, "out of memory")                                                                  \
+    X(CM_ERANGE, "value out of range")                                                             \
+    X(CM_ETOOBIG, "problem too large")                                                             \
+    X(CM_EMODEL, "the model aborted the computation")                                              \
+    X(CM_EIO, "input/output error")                                                                \
+    X(CM_EDB, "database error")                                                                    \
+    X(CM_EFORMAT, "not a valid cellmap file")                                                      \
+    X(CM_ERENDER, "rendering error")                                                               \
     X(CM_ENOTFOUND, "not found")
 
 typedef enum cm_status {
 #define CM_STATUS_ENUM(code, msg) code,
     CM_STATUS_TABLE(CM_STATUS_ENUM)
 #undef CM_STATUS_ENUM
-    CM_STATUS_COUNT
+        CM_STATUS_COUNT
 } cm_status;
 
 /* Static description of a status; unknown values give "unknown status". */

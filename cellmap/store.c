@@ -94,7 +94,7 @@ static const char *const schema_sql =
     "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
     "CREATE TABLE regions(id INTEGER PRIMARY KEY, lo TEXT NOT NULL, hi TEXT NOT NULL,"
     " cells INTEGER NOT NULL, exits INTEGER NOT NULL, own_groups INTEGER NOT NULL,"
-    " status TEXT NOT NULL);"
+    " status TEXT NOT NULL, targets TEXT NOT NULL);"
     "CREATE TABLE pages(region INTEGER NOT NULL REFERENCES regions(id),"
     " first_cell INTEGER NOT NULL, cells INTEGER NOT NULL,"
     " image BLOB NOT NULL, grp BLOB NOT NULL, step BLOB NOT NULL,"
@@ -701,6 +701,36 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
     return CM_OK;
 }
 
+/* A JSON array of 1-based region ids as 0-based indices. */
+static cm_status parse_links(const cm_store *s, const char *text, uint32_t **out, uint32_t *n,
+                             char *msg, size_t msg_size)
+{
+    const char *p = text ? strchr(text, '[') : NULL;
+    size_t cap = 1;
+    for (const char *q = p; q && *q; q++)
+        cap += *q == ',';
+    uint32_t *links = malloc(cap * sizeof *links);
+    *n = 0;
+    while (p && links && *++p && *p != ']') {
+        char *end = NULL;
+        const unsigned long v = strtoul(p, &end, 10);
+        if (end == p || v < 1 || v > UINT32_MAX || *n >= cap)
+            break;
+        links[(*n)++] = (uint32_t)(v - 1);
+        p = end;
+        if (*p == ']')
+            break;
+        if (*p != ',')
+            p = NULL;
+    }
+    if (!links || !p || *p != ']') {
+        free(links);
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region links", s->path);
+    }
+    *out = links;
+    return CM_OK;
+}
+
 cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
     cm_lattice lat;
@@ -713,9 +743,9 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
     if (groups < 0 || groups > CM_MAX_GROUPS)
         return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: attractors", s->path);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(s->db,
-                           "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
-                           -1, &st, NULL))
+    if (sqlite3_prepare_v2(
+            s->db, "SELECT id, lo, hi, cells, exits, own_groups, targets FROM regions ORDER BY id",
+            -1, &st, NULL))
         return db_error(s->db, "read regions", msg, msg_size);
     int rc;
     while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
@@ -733,12 +763,23 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
                              c->nregions + 1);
             break;
         }
-        int64_t *targets = NULL;
-        status = read_exits(s, c->nregions, rec.nexits, lat.dim, &targets, msg, msg_size);
+        int64_t *exits = NULL;
+        uint32_t *links = NULL, nlinks = 0;
+        status = read_exits(s, c->nregions, rec.nexits, lat.dim, &exits, msg, msg_size);
         if (status == CM_OK)
-            status = cm_cluster_restore(c, &rec, targets, msg, msg_size);
-        free(targets);
+            status = parse_links(s, (const char *)sqlite3_column_text(st, 6), &links, &nlinks, msg,
+                                 msg_size);
+        if (status == CM_OK)
+            status = cm_cluster_restore(c, &rec, exits, links, nlinks, msg, msg_size);
+        free(exits);
+        free(links);
     }
+    for (uint32_t k = 0; status == CM_OK && k < c->nregions; k++)
+        for (uint32_t t = 0; t < c->regions[k].ntargets; t++)
+            if (c->regions[k].targets[t] >= c->nregions)
+                status = cm_fail(CM_EFORMAT, msg, msg_size,
+                                 "%s is damaged: region %u links to region %u", s->path, k + 1,
+                                 c->regions[k].targets[t] + 1);
     if (status == CM_OK && rc != SQLITE_DONE)
         status = db_error(s->db, "read regions", msg, msg_size);
     sqlite3_finalize(st);
@@ -776,8 +817,8 @@ static cm_status insert_region(cm_store *s, uint32_t k, const cm_region *r, char
     json_ints(lo, sizeof lo, r->box.lo, r->box.dim);
     json_ints(hi, sizeof hi, r->box.hi, r->box.dim);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined')", -1, &st,
-                           NULL))
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined', '[]')",
+                           -1, &st, NULL))
         return db_error(s->db, "prepare regions", msg, msg_size);
     sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
     sqlite3_bind_text(st, 2, lo, -1, SQLITE_TRANSIENT);
@@ -1007,6 +1048,33 @@ static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, s
     return status;
 }
 
+/* The regions that exits of region k's sink cells lead into (1-based ids). */
+static cm_status write_targets(cm_store *s, uint32_t k, const cm_cluster_region *cr, char *msg,
+                               size_t msg_size)
+{
+    const size_t size = 16 + 12 * (size_t)cr->ntargets;
+    char *text = malloc(size);
+    if (!text)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing links");
+    size_t used = 0;
+    append(text, size, &used, "[");
+    for (uint32_t t = 0; t < cr->ntargets; t++)
+        append(text, size, &used, "%s%u", t ? "," : "", cr->targets[t] + 1);
+    append(text, size, &used, "]");
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "UPDATE regions SET targets = ? WHERE id = ?", -1, &st, NULL))
+        status = db_error(s->db, "prepare links", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_text(st, 1, text, -1, SQLITE_STATIC);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)k + 1);
+        status = step_done(s->db, st, "write links", msg, msg_size);
+    }
+    sqlite3_finalize(st);
+    free(text);
+    return status;
+}
+
 static cm_status write_dirty(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
     cm_status st = CM_OK;
@@ -1023,6 +1091,8 @@ static cm_status write_dirty(cm_store *s, cm_cluster *c, char *msg, size_t msg_s
             st = write_pages(s, k, r, is_new, msg, msg_size);
         if (st == CM_OK)
             st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
+        if (st == CM_OK)
+            st = write_targets(s, k, &c->regions[k], msg, msg_size);
         s->stats.regions_written++;
     }
     if (st == CM_OK)

@@ -1,0 +1,165 @@
+/* Benchmark of a cluster that outgrows its memory budget: the Fig. 4.21
+ * region of the PD micro-chaos map (alpha = 6.8511e-3, beta = 0,
+ * P = 5.4997e-5, D = 2.5665e-3; x in [-125000, 125000], x' in [-600, 600],
+ * re-stepping up to 100000 times as in the figure) cut into TX x TY regions
+ * of SIDE x SIDE cells, solved two at a time and joined in row order.
+ *
+ * Three runs, each in its own process so each has its own peak RSS:
+ *   paged   --db with a budget of MEM MiB for the cell arrays
+ *   db      --db without a budget (every region stays in memory)
+ *   memory  no database
+ * Each prints total time, time reading regions back (paging), time in
+ * commits, ns/cell, peak RSS and the database's bytes per cell. The paged
+ * and db files must be byte-identical (same cluster, any budget).
+ *
+ * usage: bench_store [TX TY SIDE MEM_MiB DIR]   (default 20 10 1000 256 /tmp) */
+#define _DEFAULT_SOURCE /* wait4: the peak RSS of one child */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench_util.h"
+#include "cellmap/store.h"
+#include "models/registry.h"
+
+typedef struct config {
+    int tx, ty;
+    int64_t side;
+    uint64_t mem;
+    const char *dir;
+} config;
+
+static void die(const char *what, const char *msg)
+{
+    fprintf(stderr, "bench_store: %s: %s\n", what, msg);
+    exit(1);
+}
+
+static cm_status commit_and_trim(void *user, cm_cluster *c, uint32_t box,
+                                 const cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    (void)box;
+    (void)stats;
+    const cm_status st = cm_store_commit(user, c, msg, msg_size);
+    cm_cluster_trim(c);
+    return st;
+}
+
+/* One run (in a child process): prints its figures. */
+static void run(const config *cf, const char *name, const char *db, uint64_t budget)
+{
+    char msg[1024];
+    cm_model m;
+    const char *params[1] = {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3"};
+    if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
+        die("model", msg);
+    const int64_t nx = cf->tx * cf->side, ny = cf->ty * cf->side;
+    const cm_lattice lat = {2, {-125000, -600}, {250000.0 / (double)nx, 1200.0 / (double)ny}};
+    const uint32_t n = (uint32_t)(cf->tx * cf->ty);
+    cm_box *boxes = malloc(n * sizeof *boxes);
+    for (int j = 0; j < cf->ty; j++)
+        for (int i = 0; i < cf->tx; i++)
+            boxes[j * cf->tx + i] =
+                (cm_box){2, {i * cf->side, j * cf->side}, {(i + 1) * cf->side, (j + 1) * cf->side}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    c.threads = 2;
+    c.mem_budget = budget;
+    cm_store *s = NULL;
+    if (db) {
+        const cm_store_meta meta = {&m, &lat, "bench_store", "bench", "bench", 0};
+        if (cm_store_create(db, &meta, &s, msg, sizeof msg) != CM_OK)
+            die("create", msg);
+        cm_store_attach(s, &c);
+    }
+    const cm_scm_options opt = {100000, 2, NULL, NULL, 1};
+    const double t0 = now();
+    if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? commit_and_trim : NULL, s, NULL, msg,
+                               sizeof msg) != CM_OK)
+        die("solve", msg);
+    const double total = now() - t0;
+    cm_store_stats ss;
+    memset(&ss, 0, sizeof ss);
+    if (s)
+        cm_store_get_stats(s, &ss);
+    const double cells = (double)nx * (double)ny;
+    printf("%-7s %10.0f %9.2f %9.2f %9.2f %9.1f %6u %9llu", name, cells, total, ss.read_seconds,
+           ss.commit_seconds, 1e9 * total / cells, c.ngroups, (unsigned long long)ss.regions_read);
+    if (s && cm_store_close(s, msg, sizeof msg) != CM_OK)
+        die("close", msg);
+    if (db) {
+        struct stat sb;
+        stat(db, &sb);
+        printf(" %9.3f", (double)sb.st_size / cells);
+    } else {
+        printf(" %9s", "-");
+    }
+    fflush(stdout);
+    cm_cluster_free(&c);
+    free(boxes);
+    cm_model_release(&m);
+}
+
+/* Runs one configuration in a child process and prints its peak RSS. */
+static void run_child(const config *cf, const char *name, const char *db, uint64_t budget)
+{
+    fflush(stdout);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        run(cf, name, db, budget);
+        _exit(0);
+    }
+    int status = 0;
+    struct rusage ru;
+    if (wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        die(name, "the run failed");
+    printf(" %9.1f\n", (double)ru.ru_maxrss / 1024.0);
+}
+
+static int same_files(const char *a, const char *b)
+{
+    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
+    int same = f && g;
+    for (int x = 0, y = 0; same && (x != EOF || y != EOF);) {
+        x = fgetc(f);
+        y = fgetc(g);
+        same = x == y;
+    }
+    if (f)
+        fclose(f);
+    if (g)
+        fclose(g);
+    return same;
+}
+
+int main(int argc, char **argv)
+{
+    config cf = {20, 10, 1000, 256, "/tmp"};
+    if (argc > 1 && argc != 6)
+        die("usage", "bench_store [TX TY SIDE MEM_MiB DIR]");
+    if (argc == 6)
+        cf = (config){atoi(argv[1]), atoi(argv[2]), atoll(argv[3]), strtoull(argv[4], NULL, 10),
+                      argv[5]};
+    if (cf.tx < 1 || cf.ty < 1 || cf.side < 2 || cf.mem < 1)
+        die("usage", "TX, TY >= 1, SIDE >= 2, MEM_MiB >= 1");
+    char paged[4096], whole[4096];
+    snprintf(paged, sizeof paged, "%s/bench-paged.cmdb", cf.dir);
+    snprintf(whole, sizeof whole, "%s/bench-db.cmdb", cf.dir);
+    printf("%d x %d regions of %lld x %lld cells, budget %llu MiB, 2 threads\n", cf.tx, cf.ty,
+           (long long)cf.side, (long long)cf.side, (unsigned long long)cf.mem);
+    printf("%-7s %10s %9s %9s %9s %9s %6s %9s %9s %9s\n", "run", "cells", "total_s", "paging_s",
+           "commit_s", "ns/cell", "groups", "reads", "disk_B/c", "rss_MiB");
+    run_child(&cf, "paged", paged, cf.mem << 20);
+    run_child(&cf, "db", whole, 0);
+    run_child(&cf, "memory", NULL, 0);
+    printf("paged and db files %s; RSS target: %llu MiB (2 x budget + 100)\n",
+           same_files(paged, whole) ? "byte-identical" : "DIFFER",
+           (unsigned long long)(2 * cf.mem + 100));
+    unlink(paged);
+    unlink(whole);
+    return 0;
+}
