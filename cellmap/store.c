@@ -353,6 +353,20 @@ static cm_status write_empty(const char *path, const cm_store_meta *meta, char *
     return st;
 }
 
+/* Opens a checked cellmap database for writing, in WAL mode. */
+static cm_status open_writable(const char *path, cm_store **out, char *msg, size_t msg_size)
+{
+    sqlite3 *db = NULL;
+    cm_status st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
+    if (st == CM_OK)
+        st = use_wal(db, path, msg, msg_size);
+    if (st != CM_OK) {
+        sqlite3_close(db);
+        return st;
+    }
+    return new_store(path, db, 1, out, msg, msg_size);
+}
+
 cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
                           size_t msg_size)
 {
@@ -370,15 +384,7 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         unlink(tmp);
         return st;
     }
-    sqlite3 *db = NULL;
-    st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
-    if (st == CM_OK)
-        st = use_wal(db, path, msg, msg_size);
-    if (st != CM_OK) {
-        sqlite3_close(db);
-        return st;
-    }
-    return new_store(path, db, 1, out, msg, msg_size);
+    return open_writable(path, out, msg, msg_size);
 }
 
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size)
@@ -398,14 +404,7 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
         return st == CM_OK ? new_store(path, db, 0, out, msg, msg_size) : st;
     }
     sqlite3_close(db);
-    st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
-    if (st == CM_OK)
-        st = use_wal(db, path, msg, msg_size);
-    if (st != CM_OK) {
-        sqlite3_close(db);
-        return st;
-    }
-    return new_store(path, db, 1, out, msg, msg_size);
+    return open_writable(path, out, msg, msg_size);
 }
 
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
@@ -1132,6 +1131,16 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
     s->saved_groups = c->ngroups;
     s->stats.commit_seconds += seconds_now() - t0;
     return CM_OK;
+}
+
+cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                               char *msg, size_t msg_size)
+{
+    (void)box;
+    (void)stats;
+    const cm_status st = cm_store_commit(store, c, msg, msg_size);
+    cm_cluster_trim(c);
+    return st;
 }
 
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,

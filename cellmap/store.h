@@ -96,6 +96,11 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
  * groups new since the last commit; then marks the regions clean. */
 cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
 
+/* A cm_joined_fn for cm_cluster_solve_boxes with the store as user: commits
+ * the join, then pages out what c->mem_budget cannot hold. */
+cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                               char *msg, size_t msg_size);
+
 /* Summaries of the saved groups 1..n into a caller array (entry k: group
  * k+1), n = the info's groups, and the sink's cell count. */
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,

@@ -77,6 +77,16 @@ bool parse_bytes(const char *s, uint64_t *out)
     return true;
 }
 
+bool cli_take_mem(cli *c, uint64_t *mem, int *error)
+{
+    if (!cli_is(c, "--mem", true, error))
+        return false;
+    if (c->value && (!parse_bytes(c->value, mem) || *mem < (1u << 20)))
+        *error = cli_usage_error(c, "--mem: '%s' must be a size of at least 1M, as BYTES[K|M|G]",
+                                 c->value);
+    return true;
+}
+
 bool parse_double(const char *s, double *out)
 {
     char *end = NULL;

@@ -36,6 +36,8 @@ bool parse_int64(const char *s, int64_t *out);
 bool parse_double(const char *s, double *out);
 /* A size in bytes: digits with an optional K, M or G (powers of 1024). */
 bool parse_bytes(const char *s, uint64_t *out);
+/* Handles --mem BYTES (at least 1M); true if the current option was it. */
+bool cli_take_mem(cli *c, uint64_t *mem, int *error);
 /* "LO:HI,LO:HI,..." -> lo[], hi[], count. */
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
 /* "NxMx..." -> counts, count. */

@@ -69,12 +69,7 @@ static int parse_export(cli *c, export_args *a)
             a->flat = c->value;
         } else if (cli_is(c, "--window", true, &err)) {
             a->window = c->value;
-        } else if (cli_is(c, "--mem", true, &err)) {
-            if (c->value && (!parse_bytes(c->value, &a->mem) || a->mem < (1u << 20)))
-                err = cli_usage_error(c,
-                                      "--mem: '%s' must be a size of at least 1M, as "
-                                      "BYTES[K|M|G]",
-                                      c->value);
+        } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (c->opt[0] != '-' && !a->file) {
             a->file = c->opt;
         } else {
@@ -368,7 +363,7 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
             for (int k = 0; k < nouts && st == CM_OK; k++)
                 if (!out_row(&outs[k], dim, cell, x, flat.group[i], flat.step[i],
                              cm_is_periodic(&flat, i)))
-                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %s", outs[k].tmp);
+                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s", outs[k].tmp);
         }
         cm_region_free(&flat);
         if (st != CM_OK)
@@ -411,14 +406,14 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     int ok = 1;
     for (int k = 0; k < nouts; k++)
         if (!(ok = out_begin(&outs[k], c->lat.dim, info) && ok))
-            snprintf(msg, sizeof msg, "cannot write %s", outs[k].tmp);
+            snprintf(msg, sizeof msg, "cannot write %.900s", outs[k].tmp);
     if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink))
-        ok = 0, snprintf(msg, sizeof msg, "cannot write %s", a->flat);
+        ok = 0, snprintf(msg, sizeof msg, "cannot write %.900s", a->flat);
     if (ok && nouts)
         ok = export_cells(c, &window, outs, nouts, msg, sizeof msg) == CM_OK;
     for (int k = 0; k < nouts; k++)
         if (!out_end(&outs[k], ok) && ok)
-            ok = 0, snprintf(msg, sizeof msg, "cannot complete %s", outs[k].path);
+            ok = 0, snprintf(msg, sizeof msg, "cannot complete %.900s", outs[k].path);
     if (!ok) {
         fprintf(stderr, "cellmap export: %s\n", msg);
         rc = EXIT_FAIL;

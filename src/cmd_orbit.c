@@ -25,8 +25,8 @@ int cmd_orbit(int argc, char **argv)
         } else if (model_opts_take(&c, &mo, &err)) {
         } else if (cli_is(&c, "--from", true, &err)) {
             if (c.value && !parse_doubles(c.value, from, &n_from, CM_MAX_DIM))
-                err = cli_usage_error(&c, "--from: '%s' is not a list of numbers X[,Y...]",
-                                      c.value);
+                err =
+                    cli_usage_error(&c, "--from: '%s' is not a list of numbers X[,Y...]", c.value);
         } else if (cli_is(&c, "--steps", true, &err)) {
             if (c.value && (!parse_int64(c.value, &steps) || steps < 0 || steps > 100000000))
                 err = cli_usage_error(&c, "--steps: '%s' must be an integer in 0..1e8", c.value);

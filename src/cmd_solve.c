@@ -127,12 +127,7 @@ static int parse_solve(cli *c, solve_args *a)
             a->db = c->value;
         } else if (cli_is(c, "--resume", false, &err)) {
             a->resume = 1;
-        } else if (cli_is(c, "--mem", true, &err)) {
-            if (c->value && (!parse_bytes(c->value, &a->mem) || a->mem < (1u << 20)))
-                err = cli_usage_error(c,
-                                      "--mem: '%s' must be a size of at least 1M, as "
-                                      "BYTES[K|M|G]",
-                                      c->value);
+        } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = 1;
         } else {
@@ -481,17 +476,6 @@ typedef struct run {
     cm_store *store;
 } run;
 
-/* After each join: commit it, then page out what the budget cannot hold. */
-static cm_status commit_join(void *user, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
-                             char *msg, size_t msg_size)
-{
-    (void)box;
-    (void)stats;
-    cm_status st = cm_store_commit(user, c, msg, msg_size);
-    cm_cluster_trim(c);
-    return st;
-}
-
 static int has_box(const cm_cluster *c, const cm_box *box)
 {
     for (uint32_t k = 0; k < c->nregions; k++)
@@ -516,9 +500,9 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
     for (uint32_t k = 0; k < n; k++)
         if (!has_box(&rn->c, &boxes[k]))
             boxes[todo++] = boxes[k];
-    cm_status st =
-        cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt, rn->store ? commit_join : NULL,
-                               rn->store, stats, msg, msg_size);
+    cm_status st = cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt,
+                                          rn->store ? cm_store_commit_join : NULL, rn->store, stats,
+                                          msg, msg_size);
     free(boxes);
     return st;
 }

@@ -39,16 +39,6 @@ static void die(const char *what, const char *msg)
     exit(1);
 }
 
-static cm_status commit_and_trim(void *user, cm_cluster *c, uint32_t box,
-                                 const cm_join_stats *stats, char *msg, size_t msg_size)
-{
-    (void)box;
-    (void)stats;
-    const cm_status st = cm_store_commit(user, c, msg, msg_size);
-    cm_cluster_trim(c);
-    return st;
-}
-
 /* One run (in a child process): prints its figures. */
 static void run(const config *cf, const char *name, const char *db, uint64_t budget)
 {
@@ -78,8 +68,8 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     }
     const cm_scm_options opt = {100000, 2, NULL, NULL, 1};
     const double t0 = now();
-    if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? commit_and_trim : NULL, s, NULL, msg,
-                               sizeof msg) != CM_OK)
+    if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? cm_store_commit_join : NULL, s, NULL,
+                               msg, sizeof msg) != CM_OK)
         die("solve", msg);
     const double total = now() - t0;
     cm_store_stats ss;

@@ -17,6 +17,7 @@
 
 #include "cellmap/store.h"
 #include "check.h"
+#include "cmdb_hash.h"
 #include "mix.h"
 
 enum { KILLS = 20 };
@@ -64,35 +65,6 @@ static int run_to_end(const char *cellmap, const char *db, int resume)
     int status = 0;
     waitpid(start_solve(cellmap, db, resume), &status, 0);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static uint64_t content_hash(const char *path)
-{
-    static const char *const queries[] = {
-        "SELECT * FROM regions ORDER BY id",
-        "SELECT * FROM pages ORDER BY region, first_cell",
-        "SELECT * FROM exits ORDER BY region",
-        "SELECT * FROM region_groups ORDER BY region, grp",
-        "SELECT * FROM attractors ORDER BY id",
-        "SELECT * FROM meta WHERE key NOT IN ('command') ORDER BY key"};
-    sqlite3 *db = NULL;
-    uint64_t h = 1;
-    CHECK(sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK);
-    for (size_t q = 0; q < sizeof queries / sizeof queries[0]; q++) {
-        sqlite3_stmt *st = NULL;
-        CHECK(sqlite3_prepare_v2(db, queries[q], -1, &st, NULL) == SQLITE_OK);
-        while (sqlite3_step(st) == SQLITE_ROW)
-            for (int c = 0; c < sqlite3_column_count(st); c++) {
-                const unsigned char *p = sqlite3_column_blob(st, c);
-                const int n = sqlite3_column_bytes(st, c);
-                for (int i = 0; i < n; i++)
-                    h = mix(h ^ p[i]);
-                h = mix(h + (uint64_t)n);
-            }
-        sqlite3_finalize(st);
-    }
-    sqlite3_close(db);
-    return h;
 }
 
 /* Opens the file as a cluster and checks it cell by cell: every region
@@ -174,7 +146,7 @@ int main(int argc, char **argv)
     const double t0 = now();
     CHECK_INT(run_to_end(argv[1], ref, 0), 0);
     const double whole = now() - t0;
-    const uint64_t want = content_hash(ref);
+    const uint64_t want = cmdb_content_hash(ref);
     CHECK_INT(check_consistent(ref), 24);
 
     /* Kill moments spread over a fifteenth of a whole run each, so that
@@ -196,7 +168,7 @@ int main(int argc, char **argv)
     }
     struct stat sb;
     CHECK_INT(run_to_end(argv[1], db, stat(db, &sb) == 0), 0);
-    CHECK(content_hash(db) == want);
+    CHECK(cmdb_content_hash(db) == want);
     printf("%d of %d kills interrupted the solve (whole run %.3f s); the resumed file equals "
            "the uninterrupted one\n",
            interrupted, KILLS, whole);

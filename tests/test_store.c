@@ -8,6 +8,7 @@
 #include "cellmap/codec.h"
 #include "cellmap/store.h"
 #include "check.h"
+#include "cmdb_hash.h"
 #include "mix.h"
 #include "models/registry.h"
 
@@ -45,36 +46,6 @@ static void sql_exec(const char *path, const char *sql)
     sqlite3_open(path, &db);
     CHECK(sqlite3_exec(db, sql, NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(db);
-}
-
-/* A hash of every row of the cluster's tables (not meta: it holds the
- * command line): two files with equal hashes hold the same cluster. */
-static uint64_t content_hash(const char *path)
-{
-    static const char *const queries[] = {
-        "SELECT id, lo, hi, cells, exits, own_groups, status FROM regions ORDER BY id",
-        "SELECT region, first_cell, cells, image, grp, step FROM pages ORDER BY region, first_cell",
-        "SELECT region, count, targets FROM exits ORDER BY region",
-        "SELECT region, grp, cells FROM region_groups ORDER BY region, grp",
-        "SELECT * FROM attractors ORDER BY id"};
-    sqlite3 *db = NULL;
-    uint64_t h = 1;
-    CHECK(sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK);
-    for (size_t q = 0; q < sizeof queries / sizeof queries[0]; q++) {
-        sqlite3_stmt *st = NULL;
-        CHECK(sqlite3_prepare_v2(db, queries[q], -1, &st, NULL) == SQLITE_OK);
-        while (sqlite3_step(st) == SQLITE_ROW)
-            for (int c = 0; c < sqlite3_column_count(st); c++) {
-                const unsigned char *p = sqlite3_column_blob(st, c);
-                const int n = sqlite3_column_bytes(st, c);
-                for (int i = 0; i < n; i++)
-                    h = mix(h ^ p[i]);
-                h = mix(h + (uint64_t)n);
-            }
-        sqlite3_finalize(st);
-    }
-    sqlite3_close(db);
-    return h;
 }
 
 static void test_codec(void)
@@ -122,16 +93,6 @@ static void tiles(cm_box *boxes)
                 (cm_box){2, {NX * i / TX, NY * j / TY}, {NX * (i + 1) / TX, NY * (j + 1) / TY}};
 }
 
-static cm_status commit_and_trim(void *user, cm_cluster *c, uint32_t box,
-                                 const cm_join_stats *stats, char *msg, size_t msg_size)
-{
-    (void)box;
-    (void)stats;
-    const cm_status st = cm_store_commit(user, c, msg, msg_size);
-    cm_cluster_trim(c);
-    return st;
-}
-
 /* Solves the tiling into path (NULL: in memory only) under a budget of
  * `budget_regions` regions (0: none) with `threads` threads; returns the
  * flattened cluster in flat. */
@@ -152,8 +113,8 @@ static void solve_tiles(const cm_model *m, const char *path, int budget_regions,
         c.mem_budget = (uint64_t)budget_regions * 12 * cm_box_cells(&boxes[0]);
     }
     const cm_scm_options opt = {1, threads, NULL, NULL, 1};
-    CHECK(cm_cluster_solve_boxes(&c, m, boxes, TX * TY, &opt, s ? commit_and_trim : NULL, s, NULL,
-                                 msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_solve_boxes(&c, m, boxes, TX * TY, &opt, s ? cm_store_commit_join : NULL, s,
+                                 NULL, msg, sizeof msg) == CM_OK);
     if (budget_regions)
         CHECK(cm_cluster_resident_bytes(&c) <= c.mem_budget);
     CHECK(cm_cluster_flatten(&c, &all, flat, msg, sizeof msg) == CM_OK);
@@ -190,9 +151,9 @@ static void test_budgets(const char *dir, const cm_model *m)
     CHECK(st[1].regions_read > 0);
     CHECK(st[2].regions_read > st[1].regions_read);
     /* same files whatever the budget and the thread count */
-    const uint64_t h = content_hash(path[0]);
+    const uint64_t h = cmdb_content_hash(path[0]);
     for (int k = 1; k < 4; k++)
-        CHECK(content_hash(path[k]) == h);
+        CHECK(cmdb_content_hash(path[k]) == h);
     /* the groups view: every cell counted once; periodic cells are dim int64 each */
     CHECK_INT(sql_int(path[0], "SELECT SUM(basin_cells) FROM groups"), NX * NY);
     CHECK_INT(sql_int(path[0], "SELECT COUNT(*) FROM groups WHERE is_sink = 0"), flat[4].ngroups);
