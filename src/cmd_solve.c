@@ -711,9 +711,9 @@ static void print_database(const solve_args *a, const run *rn, const summary *su
 {
     cm_store_stats ss;
     cm_store_get_stats(rn->store, &ss);
-    printf("database %s: %u regions, %.2f bytes/cell written; paging: %llu regions read "
+    printf("database %s: %u region%s, %.2f bytes/cell written; paging: %llu regions read "
            "back (%.3f s), commits %.3f s\n",
-           a->db, rn->c.nregions, (double)ss.bytes_written / (double)sum->cells,
+           a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s", (double)ss.bytes_written / (double)sum->cells,
            (unsigned long long)ss.regions_read, ss.read_seconds, ss.commit_seconds);
 }
 
