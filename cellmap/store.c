@@ -217,15 +217,30 @@ static cm_status open_db(const char *path, int flags, sqlite3 **out, char *msg, 
     return CM_OK;
 }
 
-cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
+/* Opens an existing file read-only and checks it (check_file); on failure
+ * nothing stays open. A file that is not ours is never opened for writing. */
+static cm_status open_checked(const char *path, int full, sqlite3 **out, char *msg, size_t msg_size)
 {
     struct stat sb;
+    *out = NULL;
     if (stat(path, &sb) != 0)
         return cm_fail(CM_EIO, msg, msg_size, "%s does not exist", path);
     sqlite3 *db = NULL;
     cm_status st = open_db(path, SQLITE_OPEN_READONLY, &db, msg, msg_size);
     if (st == CM_OK)
-        st = check_file(db, path, 0, msg, msg_size);
+        st = check_file(db, path, full, msg, msg_size);
+    if (st != CM_OK) {
+        sqlite3_close(db);
+        return st;
+    }
+    *out = db;
+    return CM_OK;
+}
+
+cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
+{
+    sqlite3 *db = NULL;
+    const cm_status st = open_checked(path, 0, &db, msg, msg_size);
     sqlite3_close(db);
     return st;
 }
@@ -390,19 +405,12 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size)
 {
     *out = NULL;
-    struct stat sb;
-    if (stat(path, &sb) != 0)
-        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist", path);
-    /* Check read-only first: a file that is not ours is never written. */
     sqlite3 *db = NULL;
-    cm_status st = open_db(path, SQLITE_OPEN_READONLY, &db, msg, msg_size);
-    if (st == CM_OK)
-        st = check_file(db, path, writable, msg, msg_size);
-    if (st != CM_OK || !writable) {
-        if (st != CM_OK)
-            sqlite3_close(db);
-        return st == CM_OK ? new_store(path, db, 0, out, msg, msg_size) : st;
-    }
+    const cm_status st = open_checked(path, writable, &db, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (!writable)
+        return new_store(path, db, 0, out, msg, msg_size);
     sqlite3_close(db);
     return open_writable(path, out, msg, msg_size);
 }
