@@ -49,6 +49,13 @@ static bool tile_box(const cm_box *tile, const cm_box *bounds, const int64_t *in
     return true;
 }
 
+bool cm_extend_tile(const cm_box *tile, const cm_box *bounds, const int64_t *cell, cm_box *box)
+{
+    int64_t index[CM_MAX_DIM];
+    tile_of(tile, cell, index);
+    return tile_box(tile, bounds, index, box);
+}
+
 static int64_t find_tile(const tile_list *list, const int64_t *index, int dim)
 {
     for (uint64_t k = 0; k < list->n; k++)

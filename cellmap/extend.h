@@ -17,6 +17,8 @@
 
 #include <stdint.h>
 
+#include <stdbool.h>
+
 #include "cellmap/cluster.h"
 
 typedef struct cm_extend_choice {
@@ -25,6 +27,12 @@ typedef struct cm_extend_choice {
     uint64_t all_escaping; /* cells whose sequences leave the cluster into the world */
     uint64_t cluster_cells;
 } cm_extend_choice;
+
+/* The tile of the grid cm_extend_choose uses (tiles of `tile`'s size
+ * aligned to it) that holds `cell`, clipped to bounds (may be NULL): the
+ * box a step of the extension adds there. False if the clipping leaves
+ * nothing. */
+bool cm_extend_tile(const cm_box *tile, const cm_box *bounds, const int64_t *cell, cm_box *box);
 
 /* Chooses the next tile. `tile` is the grid's tile (0, 0, ...); `bounds`
  * may be NULL (unbounded). Fills choice->all_escaping and cluster_cells in

@@ -518,28 +518,17 @@ static void print_step(const cm_lattice *lat, const extend_step *s, int k)
            s->straddling, s->seconds);
 }
 
-/* The tile (of the region's size, aligned to it) that holds `box`. */
-static cm_box tile_of(const cm_box *tile, const cm_box *box)
-{
-    cm_box t = *tile;
-    for (int d = 0; d < tile->dim; d++) {
-        const int64_t size = tile->hi[d] - tile->lo[d], off = box->lo[d] - tile->lo[d];
-        const int64_t i = off >= 0 ? off / size : -((-off + size - 1) / size);
-        t.lo[d] = tile->lo[d] + i * size;
-        t.hi[d] = t.lo[d] + size;
-    }
-    return t;
-}
-
 /* Extension steps a resumed cluster has done, and the tile of a step that
  * was interrupted between its regions (or the empty box). */
-static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile, cm_box *partial)
+static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile,
+                      const cm_box *bounds, cm_box *partial)
 {
     const uint32_t per_tile = split_boxes(a, tile, NULL);
     const uint32_t extra = c->nregions > per_tile ? c->nregions - per_tile : 0;
     memset(partial, 0, sizeof *partial);
     if (extra % per_tile)
-        *partial = tile_of(tile, &c->regions[c->nregions - 1].r.box);
+        cm_extend_tile(tile, a->bounds_text ? bounds : NULL, c->regions[c->nregions - 1].r.box.lo,
+                       partial);
     return (int)((extra + per_tile - 1) / per_tile);
 }
 
@@ -560,7 +549,7 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
 {
     cm_cluster *c = &rn->c;
     cm_box partial;
-    const int done = steps_done(a, c, tile, &partial);
+    const int done = steps_done(a, c, tile, bounds, &partial);
     cm_status st = CM_OK;
     /* a step interrupted between its regions is finished first */
     if (partial.dim)
@@ -713,8 +702,9 @@ static void print_database(const solve_args *a, const run *rn, const summary *su
     cm_store_get_stats(rn->store, &ss);
     printf("database %s: %u region%s, %.2f bytes/cell written; paging: %llu regions read "
            "back (%.3f s), commits %.3f s\n",
-           a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s", (double)ss.bytes_written / (double)sum->cells,
-           (unsigned long long)ss.regions_read, ss.read_seconds, ss.commit_seconds);
+           a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s",
+           (double)ss.bytes_written / (double)sum->cells, (unsigned long long)ss.regions_read,
+           ss.read_seconds, ss.commit_seconds);
 }
 
 static cm_status finish_store(run *rn, char *msg, size_t msg_size)
