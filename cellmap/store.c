@@ -160,18 +160,9 @@ static cm_status read_text(sqlite3 *db, const char *sql, char *out, size_t size,
                            : cm_fail(CM_EFORMAT, msg, msg_size, "corrupt database: %s failed", sql);
 }
 
-/* Checks an open connection: SQLite, cellmap's application id, a version
- * this cellmap reads, the tables present (and, if full, every page sound). */
-static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, size_t msg_size)
+/* The application id and version a file of this cellmap must carry. */
+static cm_status check_ids(const char *path, int app, int version, char *msg, size_t msg_size)
 {
-    int app = 0, version = 0;
-    if (pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
-        pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
-        return cm_fail(CM_EFORMAT, msg, msg_size,
-                       sqlite3_errcode(db) == SQLITE_CORRUPT
-                           ? "%s is a damaged database (%s); restore it from a copy or solve again"
-                           : "%s is not a cellmap database (%s)",
-                       path, sqlite3_errmsg(db));
     if (app != CM_STORE_APP_ID)
         return cm_fail(CM_EFORMAT, msg, msg_size,
                        "%s is an SQLite file but not a cellmap database (application_id %d)", path,
@@ -186,6 +177,24 @@ static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, 
                        "%s has format version %d (single region, no exits), which cannot be "
                        "migrated to version %d: solve it again with --db",
                        path, version, CM_STORE_VERSION);
+    return CM_OK;
+}
+
+/* Checks an open connection: SQLite, cellmap's application id, a version
+ * this cellmap reads, the tables present (and, if full, every page sound). */
+static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, size_t msg_size)
+{
+    int app = 0, version = 0;
+    if (pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
+        pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       sqlite3_errcode(db) == SQLITE_CORRUPT
+                           ? "%s is a damaged database (%s); restore it from a copy or solve again"
+                           : "%s is not a cellmap database (%s)",
+                       path, sqlite3_errmsg(db));
+    const cm_status ids = check_ids(path, app, version, msg, msg_size);
+    if (ids != CM_OK)
+        return ids;
     sqlite3_stmt *st = NULL;
     int rc = sqlite3_prepare_v2(db, check_sql, -1, &st, NULL);
     if (rc == SQLITE_OK)
@@ -217,18 +226,47 @@ static cm_status open_db(const char *path, int flags, sqlite3 **out, char *msg, 
     return CM_OK;
 }
 
-/* Opens an existing file read-only and checks it (check_file); on failure
- * nothing stays open. A file that is not ours is never opened for writing. */
-static cm_status open_checked(const char *path, int full, sqlite3 **out, char *msg, size_t msg_size)
+/* Reads the file header itself: SQLite's magic, and the application id and
+ * version SQLite keeps at bytes 68 and 60 (big-endian). Nothing is opened
+ * through SQLite before this passes, so a file that is not ours, or is of
+ * another version, is never written, not even to recover a journal. */
+static cm_status check_header(const char *path, char *msg, size_t msg_size)
 {
-    struct stat sb;
+    unsigned char h[100];
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist or cannot be read", path);
+    const size_t n = fread(h, 1, sizeof h, f);
+    fclose(f);
+    if (n < sizeof h || memcmp(h, "SQLite format 3", 16) != 0)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "%s is not a cellmap database (not an SQLite 3 file)", path);
+    const int32_t app =
+        (int32_t)((uint32_t)h[68] << 24 | (uint32_t)h[69] << 16 | (uint32_t)h[70] << 8 | h[71]);
+    const int32_t version =
+        (int32_t)((uint32_t)h[60] << 24 | (uint32_t)h[61] << 16 | (uint32_t)h[62] << 8 | h[63]);
+    return check_ids(path, app, version, msg, msg_size);
+}
+
+/* Opens an existing cellmap database and checks it (check_file; full: every
+ * page too); on failure nothing stays open. A read-only open that finds a
+ * WAL left by a killed writer opens read-write so SQLite can recover it:
+ * the header has shown the file is ours. */
+static cm_status open_checked(const char *path, int full, int writable, sqlite3 **out, char *msg,
+                              size_t msg_size)
+{
     *out = NULL;
-    if (stat(path, &sb) != 0)
-        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist", path);
+    cm_status st = check_header(path, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     sqlite3 *db = NULL;
-    cm_status st = open_db(path, SQLITE_OPEN_READONLY, &db, msg, msg_size);
+    st = open_db(path, writable ? SQLITE_OPEN_READWRITE : SQLITE_OPEN_READONLY, &db, msg, msg_size);
     if (st == CM_OK)
         st = check_file(db, path, full, msg, msg_size);
+    if (st != CM_OK && !writable && db && (sqlite3_errcode(db) & 0xff) == SQLITE_READONLY) {
+        sqlite3_close(db);
+        return open_checked(path, full, 1, out, msg, msg_size);
+    }
     if (st != CM_OK) {
         sqlite3_close(db);
         return st;
@@ -240,7 +278,7 @@ static cm_status open_checked(const char *path, int full, sqlite3 **out, char *m
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
 {
     sqlite3 *db = NULL;
-    const cm_status st = open_checked(path, 0, &db, msg, msg_size);
+    const cm_status st = open_checked(path, 0, 0, &db, msg, msg_size);
     sqlite3_close(db);
     return st;
 }
@@ -368,20 +406,6 @@ static cm_status write_empty(const char *path, const cm_store_meta *meta, char *
     return st;
 }
 
-/* Opens a checked cellmap database for writing, in WAL mode. */
-static cm_status open_writable(const char *path, cm_store **out, char *msg, size_t msg_size)
-{
-    sqlite3 *db = NULL;
-    cm_status st = open_db(path, SQLITE_OPEN_READWRITE, &db, msg, msg_size);
-    if (st == CM_OK)
-        st = use_wal(db, path, msg, msg_size);
-    if (st != CM_OK) {
-        sqlite3_close(db);
-        return st;
-    }
-    return new_store(path, db, 1, out, msg, msg_size);
-}
-
 cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
                           size_t msg_size)
 {
@@ -399,20 +423,21 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         unlink(tmp);
         return st;
     }
-    return open_writable(path, out, msg, msg_size);
+    return cm_store_open(path, 1, out, msg, msg_size);
 }
 
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size)
 {
     *out = NULL;
     sqlite3 *db = NULL;
-    const cm_status st = open_checked(path, writable, &db, msg, msg_size);
-    if (st != CM_OK)
+    cm_status st = open_checked(path, writable, writable, &db, msg, msg_size);
+    if (st == CM_OK && writable)
+        st = use_wal(db, path, msg, msg_size);
+    if (st != CM_OK) {
+        sqlite3_close(db);
         return st;
-    if (!writable)
-        return new_store(path, db, 0, out, msg, msg_size);
-    sqlite3_close(db);
-    return open_writable(path, out, msg, msg_size);
+    }
+    return new_store(path, db, writable, out, msg, msg_size);
 }
 
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
