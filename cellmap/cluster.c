@@ -35,6 +35,7 @@ void cm_cluster_free(cm_cluster *c)
         cm_region_free(&c->regions[k].r);
         free(c->regions[k].escapes);
         free(c->regions[k].targets);
+        free(c->regions[k].entries);
     }
     free(c->regions);
     memset(c, 0, sizeof *c);
@@ -84,23 +85,9 @@ uint64_t cm_cluster_bytes(const cm_cluster *c)
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
         bytes += cr->nescapes * (uint64_t)c->lat.dim * sizeof *cr->escapes +
-                 cr->targets_cap * sizeof *cr->targets;
+                 cr->targets_cap * sizeof *cr->targets + cr->entries_cap * sizeof *cr->entries;
     }
     return bytes;
-}
-
-cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
-{
-    cm_cluster_region *cr = &c->regions[k];
-    cr->last_used = ++c->clock;
-    if (is_resident(cr))
-        return CM_OK;
-    if (!c->page_in)
-        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is paged out and there is no pager", k);
-    cm_status st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
-    if (st == CM_OK && !is_resident(cr))
-        st = cm_fail(CM_EIO, msg, msg_size, "region %u was not read back", k);
-    return st;
 }
 
 static void evict(cm_cluster_region *cr)
@@ -113,24 +100,66 @@ static void evict(cm_cluster_region *cr)
     cr->r.exit_target = NULL;
 }
 
-/* The clean resident region to evict next, or -1. */
-static int64_t eviction_victim(const cm_cluster *c)
+/* The resident region to evict next, other than `keep`, or -1: clean ones
+ * before dirty ones (which only with_dirty allows), then those no sequence
+ * leaves (all neighbours known), then the least recently used. */
+static int64_t eviction_victim(const cm_cluster *c, int64_t keep, int with_dirty)
 {
     int64_t best = -1;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
-        if (!is_resident(cr) || cr->dirty)
+        if (!is_resident(cr) || (int64_t)k == keep || (cr->dirty && !with_dirty))
             continue;
-        if (best < 0)
+        if (best < 0) {
             best = k;
+            continue;
+        }
         const cm_cluster_region *b = &c->regions[best];
-        /* surrounded regions (no escapes) first, then the least recently used */
-        const int surrounded = cr->nescapes == 0, best_surrounded = b->nescapes == 0;
-        if (surrounded > best_surrounded ||
-            (surrounded == best_surrounded && cr->last_used < b->last_used))
+        const int rank = 2 * !cr->dirty + (cr->nescapes == 0),
+                  best_rank = 2 * !b->dirty + (b->nescapes == 0);
+        if (rank > best_rank || (rank == best_rank && cr->last_used < b->last_used))
             best = k;
     }
     return best;
+}
+
+/* Evicts regions other than `keep` until `extra` more bytes fit the budget. */
+static cm_status make_room(cm_cluster *c, int64_t keep, uint64_t extra, char *msg, size_t msg_size)
+{
+    if (!c->page_in || c->mem_budget == 0)
+        return CM_OK;
+    uint64_t bytes = cm_cluster_resident_bytes(c) + extra;
+    while (bytes > c->mem_budget) {
+        const int64_t k = eviction_victim(c, keep, c->page_out != NULL);
+        if (k < 0)
+            return CM_OK;
+        cm_cluster_region *cr = &c->regions[k];
+        if (cr->dirty) {
+            cm_status st = c->page_out(c->pager, c, (uint32_t)k, msg, msg_size);
+            if (st != CM_OK)
+                return st;
+            cr->dirty = 0;
+        }
+        bytes -= cm_region_bytes(&cr->r);
+        evict(cr);
+    }
+    return CM_OK;
+}
+
+cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    cr->last_used = ++c->clock;
+    if (is_resident(cr))
+        return CM_OK;
+    if (!c->page_in)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is paged out and there is no pager", k);
+    cm_status st = make_room(c, k, cm_region_bytes(&cr->r), msg, msg_size);
+    if (st == CM_OK)
+        st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
+    if (st == CM_OK && !is_resident(cr))
+        st = cm_fail(CM_EIO, msg, msg_size, "region %u was not read back", k);
+    return st;
 }
 
 void cm_cluster_trim(cm_cluster *c)
@@ -139,7 +168,7 @@ void cm_cluster_trim(cm_cluster *c)
         return;
     uint64_t bytes = cm_cluster_resident_bytes(c);
     while (bytes > c->mem_budget) {
-        const int64_t k = eviction_victim(c);
+        const int64_t k = eviction_victim(c, -1, 0);
         if (k < 0)
             return;
         bytes -= cm_region_bytes(&c->regions[k].r);
@@ -189,12 +218,41 @@ static cm_status add_target(cm_cluster_region *cr, uint32_t region)
     return CM_OK;
 }
 
+static cm_status add_entry(cm_cluster_region *cr, uint64_t cell)
+{
+    if (cm_grow((void **)&cr->entries, &cr->entries_cap, cr->nentries + 1, sizeof *cr->entries) !=
+        CM_OK)
+        return CM_ENOMEM;
+    cr->entries[cr->nentries++] = (uint32_t)cell;
+    return CM_OK;
+}
+
+static int u32_cmp(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void sort_entries(cm_cluster_region *cr)
+{
+    if (cr->nentries == 0)
+        return;
+    qsort(cr->entries, cr->nentries, sizeof *cr->entries, u32_cmp);
+    uint64_t kept = 1;
+    for (uint64_t e = 1; e < cr->nentries; e++)
+        if (cr->entries[e] != cr->entries[kept - 1])
+            cr->entries[kept++] = cr->entries[e];
+    cr->nentries = kept;
+}
+
 /* Escapes of the older regions that land in the new region `added` become
- * region links; the new region's exits become links or escapes. Escapes
- * keep their target cells, so this works on paged-out regions too. */
+ * region links and entries of `added`; the new region's exits become links
+ * and entries of older regions, or escapes. Escapes keep their target
+ * cells, so this works on paged-out regions too. */
 static cm_status update_links(cm_cluster *c, uint32_t added)
 {
-    const cm_box *new_box = &c->regions[added].r.box;
+    cm_cluster_region *nr = &c->regions[added];
+    const cm_box *new_box = &nr->r.box;
     const size_t dim = (size_t)c->lat.dim;
     for (uint32_t k = 0; k < added; k++) {
         cm_cluster_region *cr = &c->regions[k];
@@ -203,12 +261,12 @@ static cm_status update_links(cm_cluster *c, uint32_t added)
             const int64_t *cell = cr->escapes + e * dim;
             if (!cm_box_contains(new_box, cell))
                 memmove(cr->escapes + kept++ * dim, cell, dim * sizeof *cell);
-            else if (add_target(cr, added) != CM_OK)
+            else if (add_target(cr, added) != CM_OK ||
+                     add_entry(nr, cm_box_index(new_box, cell)) != CM_OK)
                 return CM_ENOMEM;
         }
         cr->nescapes = kept;
     }
-    cm_cluster_region *nr = &c->regions[added];
     nr->escapes = malloc((nr->r.nexits + 1) * dim * sizeof *nr->escapes);
     if (!nr->escapes)
         return CM_ENOMEM;
@@ -219,9 +277,12 @@ static cm_status update_links(cm_cluster *c, uint32_t added)
         const int64_t k = cm_cluster_locate(c, cell, &hint, &local);
         if (k < 0)
             memcpy(nr->escapes + nr->nescapes++ * dim, cell, dim * sizeof *cell);
-        else if (add_target(nr, (uint32_t)k) != CM_OK)
+        else if (add_target(nr, (uint32_t)k) != CM_OK || add_entry(&c->regions[k], local) != CM_OK)
             return CM_ENOMEM;
     }
+    sort_entries(nr);
+    for (uint32_t t = 0; t < nr->ntargets; t++)
+        sort_entries(&c->regions[nr->targets[t]]);
     return CM_OK;
 }
 
@@ -249,11 +310,7 @@ static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affe
     return count;
 }
 
-/* The regions the exits of region k's sink cells lead into. Only sink
- * cells' sequences can change in later joins, so these links are all that
- * marks k affected: a region whose sink cells cannot reach the new region
- * is neither resolved nor read back. */
-static cm_status sink_targets(cm_cluster *c, uint32_t k)
+cm_status cm_cluster_relink(cm_cluster *c, uint32_t k)
 {
     cm_cluster_region *cr = &c->regions[k];
     const cm_region *r = &cr->r;
@@ -266,35 +323,6 @@ static cm_status sink_targets(cm_cluster *c, uint32_t k)
             e < 0 ? -1 : cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), &hint, &local);
         if (t >= 0 && add_target(cr, (uint32_t)t) != CM_OK)
             return CM_ENOMEM;
-    }
-    return CM_OK;
-}
-
-/* After a join: the links of the regions whose sink cells changed. */
-static cm_status refine_targets(cm_cluster *c, const uint8_t *changed)
-{
-    cm_status st = CM_OK;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
-        if (changed[k])
-            st = sink_targets(c, k);
-    return st;
-}
-
-/* Reads back every region a join reads or writes: the affected ones (which
- * it marks dirty) and the regions their exits lead into. */
-static cm_status acquire_affected(cm_cluster *c, const uint8_t *affected, char *msg,
-                                  size_t msg_size)
-{
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        if (!affected[k])
-            continue;
-        cm_cluster_region *cr = &c->regions[k];
-        cm_status st = cm_cluster_acquire(c, k, msg, msg_size);
-        for (uint32_t t = 0; st == CM_OK && t < cr->ntargets; t++)
-            st = cm_cluster_acquire(c, cr->targets[t], msg, msg_size);
-        if (st != CM_OK)
-            return st;
-        cr->dirty = 1;
     }
     return CM_OK;
 }
@@ -327,23 +355,17 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     c->regions[added].dirty = 1;
     c->regions[added].last_used = ++c->clock;
     uint8_t *affected = malloc(c->nregions);
+    char detail[256] = "";
     st = affected ? update_links(c, added) : CM_ENOMEM;
     if (st == CM_OK) {
         stats->affected_regions = mark_affected(c, added, affected);
-        st = acquire_affected(c, affected, msg, msg_size);
-        if (st != CM_OK) {
-            free(affected);
-            return st; /* msg says which region could not be read back */
-        }
-        st = cm_resolve_sink_cells(c, affected, stats);
-        affected[added] = 1;
-        if (st == CM_OK)
-            st = refine_targets(c, affected);
+        st = cm_resolve_sink_cells(c, affected, stats, detail, sizeof detail);
     }
     free(affected);
     stats->new_groups += stats->straddling_groups;
     if (st != CM_OK)
-        return cm_fail(st, msg, msg_size, "joining region %u: %s", added, cm_strerror(st));
+        return cm_fail(st, msg, msg_size, "joining region %u: %s", added,
+                       detail[0] ? detail : cm_strerror(st));
     return CM_OK;
 }
 

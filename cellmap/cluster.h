@@ -36,6 +36,8 @@ typedef struct cm_cluster_region {
     uint32_t *targets; /* regions that exits lead into (no duplicates) */
     uint32_t ntargets;
     uint64_t targets_cap;
+    uint32_t *entries; /* cells that exits of other regions lead into, ascending */
+    uint64_t nentries, entries_cap;
     int dirty;          /* cells changed since the owner last saved them */
     uint64_t last_used; /* paging clock of the last acquire */
 } cm_cluster_region;
@@ -46,6 +48,14 @@ typedef struct cm_cluster_region {
 typedef cm_status (*cm_page_in_fn)(void *user, uint32_t region, cm_region *r, char *msg,
                                    size_t msg_size);
 
+struct cm_cluster;
+
+/* Saves region `region`'s arrays as they are now, so that it can be evicted
+ * while dirty, also in the middle of a join: the owner keeps such writes
+ * uncommitted until the cluster is consistent again (the next commit). */
+typedef cm_status (*cm_page_out_fn)(void *user, const struct cm_cluster *c, uint32_t region,
+                                    char *msg, size_t msg_size);
+
 typedef struct cm_cluster {
     cm_lattice lat;
     cm_cluster_region *regions; /* in the order they were joined */
@@ -53,11 +63,15 @@ typedef struct cm_cluster {
     uint64_t cap;
     uint32_t ngroups; /* cluster-wide group ids 1..ngroups */
     int threads;      /* OpenMP threads for joins; 0: the OpenMP default */
-    /* Paging, off while page_in is NULL. cm_cluster_trim evicts clean
-     * regions (dirty == 0: their cells are saved) until the resident arrays
-     * take at most mem_budget bytes; joins and cm_cluster_acquire read
-     * regions back through page_in. */
+    /* Paging, off while page_in is NULL. cm_cluster_acquire reads regions
+     * back through page_in and first evicts others, least recently used
+     * first, so that the resident arrays take at most mem_budget bytes
+     * (more only while one region alone is bigger): clean ones (dirty == 0,
+     * their cells are saved) are freed, dirty ones saved through page_out
+     * if there is one. A join holds only the region it works on, so a
+     * cluster whose joins touch more than the budget still fits in it. */
     cm_page_in_fn page_in;
+    cm_page_out_fn page_out; /* may be NULL: dirty regions then stay */
     void *pager;
     uint64_t mem_budget; /* 0: no limit */
     uint64_t clock;
@@ -108,13 +122,22 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64
                              const uint32_t *targets, uint32_t ntargets, char *msg,
                              size_t msg_size);
 
-/* Makes region k resident (reading it back if paged out) and marks it used. */
+/* Makes region k resident (reading it back if paged out) and marks it used.
+ * Under a budget it may evict other regions (never k): pointers into other
+ * regions' arrays are invalid after it. */
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
 
-/* Evicts clean resident regions, least recently used first and those no
- * sequence leaves (all neighbours known) before the others, until the
- * resident arrays fit c->mem_budget. Does nothing without a pager. */
+/* Evicts clean resident regions, those no sequence leaves (all neighbours
+ * known) first, then the least recently used, until the resident arrays
+ * fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);
+
+/* Sets region k's links (targets) to the regions that the exits of its
+ * sink cells lead into; k must be resident. Joins call it for every region
+ * whose sink cells they resolved: only those cells can change later, so a
+ * region none of whose sink cells leads towards a new region is neither
+ * resolved nor read back when it is joined. */
+cm_status cm_cluster_relink(cm_cluster *c, uint32_t k);
 
 /* Bytes held by the resident regions' cell arrays and exit tables. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
@@ -123,7 +146,7 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
 /* Bytes held by the resident regions' arrays and exit tables, and by
- * every region's escape and target lists. */
+ * every region's escape, target and entry lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
 /* The cluster as one region over `box`: group and step of every cell (group

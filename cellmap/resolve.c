@@ -9,6 +9,7 @@
  * number. Cells without the flag hold final values. */
 #define PENDING CM_STEP_ON_PATH
 #define NO_NODE UINT32_MAX
+#define NO_REGION UINT32_MAX
 /* A region with fewer sink cells is resolved on one thread. */
 #define PARALLEL_MIN_CELLS 65536
 
@@ -23,9 +24,10 @@ enum node_state {
 /* A sink cell whose image leaves its region: the root of a tree of sink cells. */
 typedef struct node {
     uint32_t region, cell;
-    uint32_t next;     /* the node whose tree the image lies in, or NO_NODE */
-    uint32_t dist;     /* steps from this cell to next's cell */
-    uint32_t old_step; /* before the join */
+    uint32_t target_region, target_cell; /* where the image lies, or NO_REGION */
+    uint32_t next;                       /* the node whose tree the image lies in, or NO_NODE */
+    uint32_t dist;                       /* steps from this cell to next's cell */
+    uint32_t old_step;                   /* before the join */
     uint32_t group, step;
     uint32_t state; /* enum node_state */
 } node;
@@ -42,16 +44,41 @@ typedef struct u32_stack {
     uint64_t len, cap;
 } u32_stack;
 
+/* group[] and step[] of an entry cell after pass 1 */
+typedef struct entry_value {
+    uint32_t group, step;
+} entry_value;
+
+/* A cell of a cycle that crosses region borders, and its new group. */
+typedef struct cycle_cell {
+    uint32_t region, cell, group;
+} cycle_cell;
+
 typedef struct resolver {
     cm_cluster *c;
     const uint8_t *affected;
     int threads;
-    step_order *orders; /* per region; empty where not affected */
+    int first_pass;        /* pass 1 makes the nodes; pass 2 finds them again */
+    step_order order;      /* of the region being ordered */
+    entry_value **entries; /* per affected region, of its entries after pass 1 */
+    uint32_t *node_base;   /* per affected region, the id of its first node */
+    cycle_cell *cycles;    /* ascending by region and cell once walked */
+    uint64_t ncycles, cycles_cap;
     node *nodes;
     uint64_t nnodes, nodes_cap;
     u32_stack walk;  /* nodes of a walk */
     u32_stack chain; /* cells of a chain in one region */
+    char *msg;       /* why a region could not be read back or saved */
+    size_t msg_size;
 } resolver;
+
+/* Makes region k resident. Other regions may be evicted: the resolver
+ * holds one region's arrays at a time. */
+static cm_status use_region(const resolver *rs, uint32_t k, cm_region **r)
+{
+    *r = &rs->c->regions[k].r;
+    return cm_cluster_acquire(rs->c, k, rs->msg, rs->msg_size);
+}
 
 /* a + b as a step number, or CM_ETOOBIG */
 static cm_status add_steps(uint32_t a, uint32_t b, uint32_t *sum)
@@ -60,6 +87,12 @@ static cm_status add_steps(uint32_t a, uint32_t b, uint32_t *sum)
         return CM_ETOOBIG;
     *sum = a + b;
     return CM_OK;
+}
+
+static int u32_cmp(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
 }
 
 static cm_status push(u32_stack *stack, uint32_t value)
@@ -106,9 +139,10 @@ static void count_part(cm_region *r, uint64_t lo, uint64_t hi, part_count *pc)
 
 /* Bucket beginnings for all parts together, in part order within a step
  * (so the order is that of one sequential pass), and node ids per part. */
-static cm_status plan_parts(resolver *rs, step_order *o, part_count *parts, int nparts)
+static cm_status plan_parts(resolver *rs, uint32_t k, step_order *o, part_count *parts, int nparts)
 {
-    uint64_t nsteps = 0, nodes = rs->nnodes;
+    uint64_t nsteps = 0, nodes = rs->first_pass ? rs->nnodes : rs->node_base[k];
+    rs->node_base[k] = (uint32_t)nodes;
     for (int t = 0; t < nparts; t++) {
         if (parts[t].failed)
             return CM_ENOMEM;
@@ -137,17 +171,19 @@ static cm_status plan_parts(resolver *rs, step_order *o, part_count *parts, int 
         }
     }
     o->start[nsteps] = pos;
-    rs->nnodes = nodes;
+    if (rs->first_pass)
+        rs->nnodes = nodes;
     o->cells = malloc(((uint64_t)pos + 1) * sizeof *o->cells);
     return o->cells ? CM_OK : CM_ENOMEM;
 }
 
-/* Puts the part's sink cells in step order and makes each one whose image
- * leaves the region a node (its id in group[]). */
+/* Puts the part's sink cells in step order and gives each one whose image
+ * leaves the region its node id in group[]; pass 1 makes these nodes. Ids
+ * follow cell order whatever the parts, so pass 2 finds the same ones. */
 static void place_part(const resolver *rs, uint32_t k, uint64_t lo, uint64_t hi, part_count *pc)
 {
     cm_region *r = &rs->c->regions[k].r;
-    uint32_t *cells = rs->orders[k].cells;
+    uint32_t *cells = rs->order.cells, hint = k;
     for (uint64_t i = lo; i < hi; i++) {
         const uint32_t s = r->step[i];
         if (!(s & PENDING))
@@ -156,7 +192,23 @@ static void place_part(const resolver *rs, uint32_t k, uint64_t lo, uint64_t hi,
         if (r->image[i] >= r->ncells) {
             const uint32_t id = pc->node_base++;
             r->group[i] = id;
-            rs->nodes[id] = (node){k, (uint32_t)i, NO_NODE, 0, s & ~PENDING, 0, 0, NODE_NEW};
+            if (!rs->first_pass)
+                continue;
+            const int64_t e = cm_image_exit_index(r->image[i]);
+            uint64_t local = 0;
+            const int64_t t =
+                e < 0 ? -1
+                      : cm_cluster_locate(rs->c, cm_region_exit(r, (uint64_t)e), &hint, &local);
+            rs->nodes[id] = (node){k,
+                                   (uint32_t)i,
+                                   t < 0 ? NO_REGION : (uint32_t)t,
+                                   (uint32_t)local,
+                                   NO_NODE,
+                                   0,
+                                   s & ~PENDING,
+                                   0,
+                                   0,
+                                   NODE_NEW};
         }
     }
 }
@@ -174,7 +226,7 @@ static cm_status order_region(resolver *rs, uint32_t k, uint64_t *nsink)
 #pragma omp parallel for schedule(static, 1) num_threads(nparts)
     for (int t = 0; t < nparts; t++)
         count_part(r, PART_LO(t), PART_LO(t + 1), &parts[t]);
-    cm_status st = plan_parts(rs, &rs->orders[k], parts, nparts);
+    cm_status st = plan_parts(rs, k, &rs->order, parts, nparts);
     if (st == CM_OK) {
 #pragma omp parallel for schedule(static, 1) num_threads(nparts)
         for (int t = 0; t < nparts; t++)
@@ -199,7 +251,7 @@ static cm_status order_region(resolver *rs, uint32_t k, uint64_t *nsink)
 static void propagate_roots(const resolver *rs, uint32_t k)
 {
     cm_region *r = &rs->c->regions[k].r;
-    const step_order *o = &rs->orders[k];
+    const step_order *o = &rs->order;
     const uint32_t *image = r->image, *cells = o->cells;
     uint32_t *group = r->group;
     const uint32_t n = (uint32_t)r->ncells;
@@ -219,46 +271,85 @@ static void propagate_roots(const resolver *rs, uint32_t k)
     }
 }
 
-/* Where node id's exit leads: a final value, or the tree of another node. */
-static cm_status link_node(const resolver *rs, uint32_t id, uint32_t *hint)
+/* Where node id's exit leads, given the group and step of the cell it
+ * leads to: a final value, or the tree of another node. */
+static cm_status link_node(const resolver *rs, uint32_t id, uint32_t group, uint32_t step)
 {
-    const cm_cluster *c = rs->c;
     node *nd = &rs->nodes[id];
-    const cm_region *r = &c->regions[nd->region].r;
-    const int64_t e = cm_image_exit_index(r->image[nd->cell]);
-    nd->state = NODE_DONE; /* the sequence leaves the cluster (or the world) */
-    nd->group = 0;
-    nd->step = 1;
-    uint64_t local;
-    const int64_t k =
-        e < 0 ? -1 : cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), hint, &local);
-    if (k < 0)
-        return CM_OK;
-    const cm_region *tr = &c->regions[k].r;
-    const uint32_t s = tr->step[local];
-    if (!(s & PENDING)) { /* a classified cell, or a sink cell that stays */
-        nd->group = tr->group[local];
-        return add_steps(s, 1, &nd->step);
+    if (!(step & PENDING)) { /* a classified cell, or a sink cell that stays */
+        nd->state = NODE_DONE;
+        nd->group = group;
+        return add_steps(step, 1, &nd->step);
     }
     /* In a tree without cycle cells, the chain from the target to the root
      * is as long as the difference of their old step numbers. */
-    nd->next = tr->group[local];
-    nd->dist = 1 + (s & ~PENDING) - rs->nodes[nd->next].old_step;
-    nd->state = NODE_NEW;
+    nd->next = group;
+    nd->dist = 1 + (step & ~PENDING) - rs->nodes[group].old_step;
     return CM_OK;
 }
 
+/* Links the nodes whose exits lead into region k: an affected region's
+ * entries were noted in pass 1, any other region is read. */
+static cm_status link_into(const resolver *rs, uint32_t k, const uint32_t *ids, uint64_t n)
+{
+    const cm_cluster_region *cr = &rs->c->regions[k];
+    const entry_value *noted = rs->affected[k] ? rs->entries[k] : NULL;
+    cm_status st = noted ? CM_OK : cm_cluster_acquire(rs->c, k, rs->msg, rs->msg_size);
+    if (st != CM_OK)
+        return st;
+    int failed = 0; /* 1: a step number overflow */
+#pragma omp parallel for schedule(static)                                                          \
+    num_threads(rs->threads) if (n >= PARALLEL_MIN_CELLS / 4) reduction(|                          \
+                                                                        : failed)
+    for (int64_t p = 0; p < (int64_t)n; p++) {
+        const uint32_t cell = rs->nodes[ids[p]].target_cell;
+        if (noted) {
+            const uint32_t *e = bsearch(&cell, cr->entries, cr->nentries, sizeof cell, u32_cmp);
+            if (!e) { /* cannot happen: every exit's cell is an entry */
+                failed |= 2;
+                continue;
+            }
+            const entry_value v = noted[e - cr->entries];
+            failed |= link_node(rs, ids[p], v.group, v.step) != CM_OK;
+        } else {
+            failed |= link_node(rs, ids[p], cr->r.group[cell], cr->r.step[cell]) != CM_OK;
+        }
+    }
+    return failed & 2 ? CM_EINVAL : failed ? CM_ETOOBIG : CM_OK;
+}
+
+/* Links every node, grouped by the region its exit leads into, from the
+ * last region to the first: pass 1 went the other way, so the regions it
+ * read last are still resident. */
 static cm_status link_nodes(resolver *rs)
 {
-    int failed = 0; /* the only failure is a step number overflow */
-#pragma omp parallel num_threads(rs->threads) if (rs->nnodes >= PARALLEL_MIN_CELLS / 4)
-    {
-        uint32_t hint = 0; /* exits mostly land in the region of the last one */
-#pragma omp for schedule(static) reduction(| : failed)
-        for (int64_t id = 0; id < (int64_t)rs->nnodes; id++)
-            failed |= link_node(rs, (uint32_t)id, &hint) != CM_OK;
+    const uint32_t nregions = rs->c->nregions;
+    uint64_t *start = calloc((size_t)nregions + 2, sizeof *start);
+    uint32_t *ids = malloc((rs->nnodes + 1) * sizeof *ids);
+    cm_status st = start && ids ? CM_OK : CM_ENOMEM;
+    for (uint64_t id = 0; st == CM_OK && id < rs->nnodes; id++) {
+        node *nd = &rs->nodes[id];
+        if (nd->target_region == NO_REGION) {
+            nd->state = NODE_DONE; /* the sequence leaves the cluster (or the world) */
+            nd->step = 1;
+        } else {
+            start[nd->target_region + 1]++;
+        }
     }
-    return failed ? CM_ETOOBIG : CM_OK;
+    for (uint32_t k = 0; st == CM_OK && k < nregions; k++)
+        start[k + 1] += start[k];
+    for (uint64_t id = 0; st == CM_OK && id < rs->nnodes; id++)
+        if (rs->nodes[id].target_region != NO_REGION)
+            ids[start[rs->nodes[id].target_region]++] = (uint32_t)id;
+    /* start[k] is now the end of region k's nodes */
+    for (uint32_t k = nregions; st == CM_OK && k-- > 0;) {
+        const uint64_t first = k ? start[k - 1] : 0;
+        if (start[k] > first)
+            st = link_into(rs, k, ids + first, start[k] - first);
+    }
+    free(start);
+    free(ids);
+    return st;
 }
 
 /* The cell after `at`, following exits into the cluster (at is on a cycle). */
@@ -276,17 +367,23 @@ static void next_cell(const cm_cluster *c, uint32_t *region, uint32_t *cell, uin
     *cell = (uint32_t)local;
 }
 
-/* Gives the cells of the cycle through node `start` group g and step 0. */
-static void mark_cycle(const resolver *rs, uint32_t start, uint32_t g)
+/* Notes the cells of the cycle through node `start` for group g; pass 2
+ * gives them group g and step 0 (the regions stay as they are till then). */
+static cm_status note_cycle(resolver *rs, uint32_t start, uint32_t g)
 {
     const node *nd = &rs->nodes[start];
     uint32_t region = nd->region, cell = nd->cell, hint = region;
     do {
-        cm_region *r = &rs->c->regions[region].r;
-        r->group[cell] = g;
-        r->step[cell] = 0;
+        cm_status st = cm_cluster_acquire(rs->c, region, rs->msg, rs->msg_size);
+        if (st == CM_OK && cm_grow((void **)&rs->cycles, &rs->cycles_cap, rs->ncycles + 1,
+                                   sizeof *rs->cycles) != CM_OK)
+            st = CM_ENOMEM;
+        if (st != CM_OK)
+            return st;
+        rs->cycles[rs->ncycles++] = (cycle_cell){region, cell, g};
         next_cell(rs->c, &region, &cell, &hint);
     } while (region != nd->region || cell != nd->cell);
+    return CM_OK;
 }
 
 /* The walk on the stack ended at node x: a cycle (new group) if x is on it. */
@@ -306,7 +403,9 @@ static cm_status close_walk(resolver *rs, uint32_t x, cm_join_stats *stats)
             y->step = 0;
             y->state = NODE_CYCLE;
         }
-        mark_cycle(rs, x, g);
+        cm_status st = note_cycle(rs, x, g);
+        if (st != CM_OK)
+            return st;
         len = from;
     }
     for (uint64_t p = len; p-- > 0;) {
@@ -347,7 +446,7 @@ static cm_status walk_nodes(resolver *rs, cm_join_stats *stats)
  * the cells of the chain on the way are resolved too. */
 static cm_status steps_to_cycle(resolver *rs, uint32_t k, uint32_t cell, uint32_t *steps)
 {
-    cm_region *r = &rs->c->regions[k].r;
+    cm_region *r = &rs->c->regions[k].r; /* resident in pass 2 */
     rs->chain.len = 0;
     while (r->step[cell] & PENDING) {
         if (push(&rs->chain, cell) != CM_OK)
@@ -366,14 +465,40 @@ static cm_status steps_to_cycle(resolver *rs, uint32_t k, uint32_t cell, uint32_
     return CM_OK;
 }
 
+static int cycle_cell_cmp(const void *a, const void *b)
+{
+    const cycle_cell *x = a, *y = b;
+    if (x->region != y->region)
+        return x->region < y->region ? -1 : 1;
+    return (x->cell > y->cell) - (x->cell < y->cell);
+}
+
+static int on_cycle(const resolver *rs, uint32_t region, uint32_t cell)
+{
+    const cycle_cell key = {region, cell, 0};
+    return bsearch(&key, rs->cycles, rs->ncycles, sizeof key, cycle_cell_cmp) != NULL;
+}
+
 /* Step number of node nd, whose exit leads into the tree of a cycle node:
- * there the chain can meet the cycle before the root, so it is walked. */
+ * there the chain can meet the cycle before the root, so it is walked
+ * (reading only: pass 2 gives the chain's cells their steps). */
 static cm_status cycle_entry_step(resolver *rs, const node *nd, uint32_t *step)
 {
-    uint32_t region = nd->region, cell = nd->cell, hint = region, steps;
+    uint32_t region = nd->region, cell = nd->cell, hint = region, steps = 1;
+    cm_region *r;
+    cm_status st = use_region(rs, region, &r);
+    if (st != CM_OK)
+        return st;
     next_cell(rs->c, &region, &cell, &hint);
-    cm_status st = steps_to_cycle(rs, region, cell, &steps);
-    return st == CM_OK ? add_steps(steps, 1, step) : st;
+    st = use_region(rs, region, &r);
+    while (st == CM_OK && !on_cycle(rs, region, cell)) {
+        if (r->image[cell] >= r->ncells) /* the tree's root is on the cycle */
+            return CM_EINVAL;
+        cell = r->image[cell];
+        st = add_steps(steps, 1, &steps);
+    }
+    *step = steps;
+    return st;
 }
 
 /* Counts the steps of the nodes that lead into cycles, chain by chain from
@@ -432,7 +557,7 @@ static uint64_t assign_region(const resolver *rs, uint32_t k, int *overflow)
  * cycle before the root, so they are walked (these trees are small). */
 static cm_status assign_cycle_trees(resolver *rs, uint32_t k)
 {
-    const cm_region *r = &rs->c->regions[k].r;
+    const cm_region *r = &rs->c->regions[k].r; /* resident: steps_to_cycle stays in k */
     uint32_t steps;
     for (uint64_t i = 0; i < r->ncells; i++)
         if (r->step[i] & PENDING) {
@@ -443,47 +568,144 @@ static cm_status assign_cycle_trees(resolver *rs, uint32_t k)
     return CM_OK;
 }
 
+/* What the links into region k need after pass 1: group and step of its
+ * entries, so that linking does not read k again. */
+static cm_status note_entries(resolver *rs, uint32_t k)
+{
+    const cm_cluster_region *cr = &rs->c->regions[k];
+    entry_value *v = malloc((cr->nentries + 1) * sizeof *v);
+    if (!v)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < cr->nentries; e++)
+        v[e] = (entry_value){cr->r.group[cr->entries[e]], cr->r.step[cr->entries[e]]};
+    rs->entries[k] = v;
+    return CM_OK;
+}
+
+/* Undoes pass 1's marks on region k (root ids in group[], PENDING in
+ * step[]): the region stays as saved, so evicting it costs no write. */
+static void unmark(const resolver *rs, uint32_t k)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    uint32_t *group = r->group, *step = r->step;
+#pragma omp parallel for schedule(static)                                                          \
+    num_threads(rs->threads) if (r->ncells >= PARALLEL_MIN_CELLS)
+    for (int64_t i = 0; i < (int64_t)r->ncells; i++)
+        if (step[i] & PENDING) {
+            group[i] = 0;
+            step[i] &= ~PENDING;
+        }
+}
+
+/* Each sink cell of region k learns its root node (both passes). */
+static cm_status find_roots(resolver *rs, uint32_t k, uint64_t *nsink)
+{
+    cm_status st = order_region(rs, k, nsink);
+    if (st == CM_OK)
+        propagate_roots(rs, k);
+    free(rs->order.cells);
+    free(rs->order.start);
+    memset(&rs->order, 0, sizeof rs->order);
+    return st;
+}
+
+/* Pass 1 on region k: its nodes and where the links into it lead. */
+static cm_status root_pass(resolver *rs, uint32_t k, cm_join_stats *stats)
+{
+    cm_region *r;
+    uint64_t nsink = 0;
+    cm_status st = use_region(rs, k, &r);
+    if (st == CM_OK)
+        st = find_roots(rs, k, &nsink);
+    if (st == CM_OK)
+        st = note_entries(rs, k);
+    if (st == CM_OK)
+        unmark(rs, k);
+    stats->resolved_cells += nsink;
+    return st;
+}
+
+/* Gives region k's cells of cross-border cycles their group and step 0. */
+static void mark_cycles(const resolver *rs, uint32_t k)
+{
+    cm_region *r = &rs->c->regions[k].r;
+    const cycle_cell key = {k, 0, 0};
+    uint64_t lo = 0, hi = rs->ncycles; /* the first of region k */
+    while (lo < hi) {
+        const uint64_t mid = lo + (hi - lo) / 2;
+        if (cycle_cell_cmp(&rs->cycles[mid], &key) < 0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (uint64_t p = lo; p < rs->ncycles && rs->cycles[p].region == k; p++) {
+        r->group[rs->cycles[p].cell] = rs->cycles[p].group;
+        r->step[rs->cycles[p].cell] = 0;
+    }
+}
+
+/* Pass 2 on region k: final groups and steps, and its links for the next
+ * joins. */
+static cm_status assign_pass(resolver *rs, uint32_t k)
+{
+    cm_region *r;
+    uint64_t nsink = 0;
+    int overflow = 0;
+    cm_status st = use_region(rs, k, &r);
+    rs->c->regions[k].dirty = 1;
+    if (st == CM_OK)
+        st = find_roots(rs, k, &nsink);
+    if (st == CM_OK) {
+        mark_cycles(rs, k);
+        if (assign_region(rs, k, &overflow) > 0)
+            st = assign_cycle_trees(rs, k);
+    }
+    if (st == CM_OK && overflow)
+        st = CM_ETOOBIG;
+    return st == CM_OK ? cm_cluster_relink(rs->c, k) : st;
+}
+
 static cm_status resolve(resolver *rs, cm_join_stats *stats)
 {
     const uint32_t nregions = rs->c->nregions;
     cm_status st = CM_OK;
-    for (uint32_t k = 0; k < nregions && st == CM_OK; k++) {
-        uint64_t nsink = 0;
+    rs->first_pass = 1;
+    for (uint32_t k = 0; k < nregions && st == CM_OK; k++)
         if (rs->affected[k])
-            st = order_region(rs, k, &nsink);
-        stats->resolved_cells += nsink;
-    }
-    for (uint32_t k = 0; k < nregions && st == CM_OK; k++) {
-        if (!rs->affected[k])
-            continue;
-        propagate_roots(rs, k);
-        free(rs->orders[k].cells); /* the step order is needed for pass 1 only */
-        rs->orders[k].cells = NULL;
-    }
+            st = root_pass(rs, k, stats);
+    rs->first_pass = 0;
     stats->nodes = rs->nnodes;
     if (st == CM_OK)
         st = link_nodes(rs);
     if (st == CM_OK)
         st = walk_nodes(rs, stats);
+    if (st == CM_OK && rs->ncycles)
+        qsort(rs->cycles, rs->ncycles, sizeof *rs->cycles, cycle_cell_cmp);
     if (st == CM_OK)
         st = count_cycle_bound(rs);
-    int overflow = 0;
-    for (uint32_t k = 0; k < nregions && st == CM_OK; k++)
-        if (rs->affected[k] && assign_region(rs, k, &overflow) > 0)
-            st = assign_cycle_trees(rs, k);
-    return st == CM_OK && overflow ? CM_ETOOBIG : st;
+    /* the regions read last in linking are resident: assign from there */
+    for (uint32_t k = nregions; k-- > 0 && st == CM_OK;)
+        if (rs->affected[k])
+            st = assign_pass(rs, k);
+    return st;
 }
 
-cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats)
+cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats,
+                                char *msg, size_t msg_size)
 {
     resolver rs = {.c = c, .affected = affected, .threads = cm_cluster_threads(c)};
-    rs.orders = calloc(c->nregions, sizeof *rs.orders);
-    cm_status st = rs.orders ? resolve(&rs, stats) : CM_ENOMEM;
-    for (uint32_t k = 0; rs.orders && k < c->nregions; k++) {
-        free(rs.orders[k].cells);
-        free(rs.orders[k].start);
-    }
-    free(rs.orders);
+    rs.msg = msg;
+    rs.msg_size = msg_size;
+    rs.entries = calloc(c->nregions, sizeof *rs.entries);
+    rs.node_base = calloc(c->nregions, sizeof *rs.node_base);
+    const cm_status st = rs.entries && rs.node_base ? resolve(&rs, stats) : CM_ENOMEM;
+    for (uint32_t k = 0; rs.entries && k < c->nregions; k++)
+        free(rs.entries[k]);
+    free(rs.entries);
+    free(rs.node_base);
+    free(rs.cycles);
+    free(rs.order.cells);
+    free(rs.order.start);
     free(rs.nodes);
     free(rs.walk.v);
     free(rs.chain.v);

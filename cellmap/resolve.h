@@ -30,8 +30,14 @@
 
 #include "cellmap/cluster.h"
 
-/* Resolves the sink cells of the regions with affected[k] != 0. New
- * straddling groups take ids from c->ngroups + 1 on, in a fixed order. */
-cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats);
+/* Resolves the sink cells of the regions with affected[k] != 0 and sets
+ * their links (cm_cluster_relink). New straddling groups take ids from
+ * c->ngroups + 1 on, in a fixed order. Regions are acquired one at a time
+ * (pass 1 in region order, the links by target region in reverse order,
+ * pass 2 in region order again) and marked dirty, so under a memory budget
+ * the others can be saved and evicted meanwhile. msg says why a region
+ * could not be read back or saved. */
+cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats,
+                                char *msg, size_t msg_size);
 
 #endif

@@ -126,8 +126,12 @@ struct cm_store {
     sqlite3 *db;
     char *path;
     int writable;
-    uint32_t saved_regions; /* regions of the cluster already in the file */
+    uint32_t inserted; /* regions with rows in the file (or the open transaction) */
     uint32_t saved_groups;
+    int in_transaction;             /* evictions in a join write into it; the commit ends it */
+    int failed;                     /* a write failed: the cluster and the file differ */
+    struct periodic_cell *periodic; /* of new groups, from the regions written */
+    uint64_t nperiodic, periodic_cap;
     uint64_t **page_hash; /* per saved region: hash of each page's grp and step as saved */
     uint64_t hash_cap, hash_len;
     unsigned char *buf, *scratch; /* encode/decode buffers */
@@ -445,6 +449,8 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
     if (!s)
         return CM_OK;
     cm_status st = CM_OK;
+    if (s->in_transaction)
+        exec(s->db, "ROLLBACK"); /* a join that did not finish */
     /* Back to one self-contained file for users and their sqlite3 shell. */
     if (s->writable && exec(s->db, "PRAGMA journal_mode=DELETE") != SQLITE_OK)
         st = db_error(s->db, "leave WAL mode", msg, msg_size);
@@ -457,6 +463,7 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
     free(s->buf);
     free(s->scratch);
     free(s->count);
+    free(s->periodic);
     free(s);
     return st;
 }
@@ -711,9 +718,12 @@ static cm_status page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t
     return st;
 }
 
+static cm_status page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
+
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
     c->page_in = page_in;
+    c->page_out = s->writable ? page_out : NULL;
     c->pager = s;
 }
 
@@ -816,7 +826,7 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
         status = db_error(s->db, "read regions", msg, msg_size);
     sqlite3_finalize(st);
     c->ngroups = (uint32_t)groups;
-    s->saved_regions = c->nregions;
+    s->inserted = c->nregions;
     s->saved_groups = c->ngroups;
     return status;
 }
@@ -975,35 +985,24 @@ static int periodic_cell_cmp(const void *a, const void *b)
                                                         : 0;
 }
 
-/* The periodic cells of the groups new since the last commit, sorted by
- * group and box order. They lie in dirty regions: a new group's cycle is
- * in the new region or crosses the borders of the regions a join changed. */
-static cm_status collect_new_periodic(const cm_store *s, const cm_cluster *c, periodic_cell **out,
-                                      uint64_t *count)
+/* Adds region k's periodic cells of groups new since the last commit to
+ * s->periodic. They lie in regions written since: a new group's cycle is in
+ * the new region or crosses the borders of the regions a join changed, and
+ * periodic cells are final when set. A region written twice adds its cells
+ * twice; write_new_groups drops the copies. */
+static cm_status collect_periodic(cm_store *s, const cm_region *r)
 {
-    uint64_t n = 0, cap = 0;
-    periodic_cell *cells = NULL;
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_region *r = &c->regions[k].r;
-        if (!c->regions[k].dirty)
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        if (!cm_is_periodic(r, i) || r->group[i] <= s->saved_groups)
             continue;
-        for (uint64_t i = 0; i < r->ncells; i++) {
-            if (!cm_is_periodic(r, i) || r->group[i] <= s->saved_groups)
-                continue;
-            if (cm_grow((void **)&cells, &cap, n + 1, sizeof *cells) != CM_OK) {
-                free(cells);
-                return CM_ENOMEM;
-            }
-            memset(&cells[n], 0, sizeof cells[n]);
-            cells[n].group = r->group[i];
-            cm_box_cell(&r->box, i, cells[n].cell);
-            n++;
-        }
+        if (cm_grow((void **)&s->periodic, &s->periodic_cap, s->nperiodic + 1,
+                    sizeof *s->periodic) != CM_OK)
+            return CM_ENOMEM;
+        periodic_cell *pc = &s->periodic[s->nperiodic++];
+        memset(pc, 0, sizeof *pc);
+        pc->group = r->group[i];
+        cm_box_cell(&r->box, i, pc->cell);
     }
-    if (n)
-        qsort(cells, n, sizeof *cells, periodic_cell_cmp);
-    *out = cells;
-    *count = n;
     return CM_OK;
 }
 
@@ -1044,13 +1043,25 @@ static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattic
     return status;
 }
 
+/* Keeps one of each run of equal cells (sorted). */
+static uint64_t unique_cells(periodic_cell *cells, uint64_t n)
+{
+    uint64_t kept = 0;
+    for (uint64_t i = 0; i < n; i++)
+        if (kept == 0 || periodic_cell_cmp(&cells[kept - 1], &cells[i]) != 0)
+            cells[kept++] = cells[i];
+    return kept;
+}
+
 /* Rows of `attractors` for groups saved_groups+1 .. c->ngroups. */
 static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
 {
-    periodic_cell *cells = NULL;
-    uint64_t n = 0;
-    if (collect_new_periodic(s, c, &cells, &n) != CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory collecting periodic cells");
+    periodic_cell *cells = s->periodic;
+    uint64_t n = s->nperiodic;
+    if (n) {
+        qsort(cells, n, sizeof *cells, periodic_cell_cmp);
+        n = unique_cells(cells, n);
+    }
     sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
     if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?)", -1, &st,
@@ -1076,7 +1087,6 @@ static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, s
                          "regions",
                          expected);
     sqlite3_finalize(st);
-    free(cells);
     return status;
 }
 
@@ -1107,26 +1117,75 @@ static cm_status write_targets(cm_store *s, uint32_t k, const cm_cluster_region 
     return status;
 }
 
-static cm_status write_dirty(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+/* Everything of region k: its row and exits if new, changed pages, cells
+ * per group, links; and its periodic cells of new groups. */
+static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                              size_t msg_size)
 {
-    cm_status st = CM_OK;
-    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++) {
-        const cm_region *r = &c->regions[k].r;
-        if (!c->regions[k].dirty)
-            continue;
-        if (!r->group)
-            return cm_fail(CM_EINVAL, msg, msg_size, "region %u is dirty but paged out", k);
-        const int is_new = k >= s->saved_regions;
-        if (is_new)
-            st = insert_region(s, k, r, msg, msg_size);
-        if (st == CM_OK)
-            st = write_pages(s, k, r, is_new, msg, msg_size);
-        if (st == CM_OK)
-            st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
-        if (st == CM_OK)
-            st = write_targets(s, k, &c->regions[k], msg, msg_size);
-        s->stats.regions_written++;
+    const cm_region *r = &c->regions[k].r;
+    if (!r->group)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is dirty but paged out", k);
+    const int is_new = k >= s->inserted;
+    cm_status st = is_new ? insert_region(s, k, r, msg, msg_size) : CM_OK;
+    if (st == CM_OK) {
+        s->inserted = is_new ? k + 1 : s->inserted;
+        st = write_pages(s, k, r, is_new, msg, msg_size);
     }
+    if (st == CM_OK)
+        st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
+    if (st == CM_OK)
+        st = write_targets(s, k, &c->regions[k], msg, msg_size);
+    if (st == CM_OK && (collect_periodic(s, r) != CM_OK || remember_hashes(s, k, r) != CM_OK))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
+    s->stats.regions_written++;
+    return st;
+}
+
+static cm_status begin(cm_store *s, char *msg, size_t msg_size)
+{
+    if (!s->writable)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s is open read-only", s->path);
+    if (s->failed)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "an earlier write to %s failed; reopen it (solve --resume) to go on",
+                       s->path);
+    if (!s->in_transaction && exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
+        return db_error(s->db, "begin", msg, msg_size);
+    s->in_transaction = 1;
+    return CM_OK;
+}
+
+/* Undoes the open transaction after a failed write. */
+static cm_status abandon(cm_store *s, cm_status st)
+{
+    if (s->in_transaction)
+        exec(s->db, "ROLLBACK");
+    s->in_transaction = 0;
+    s->failed = 1;
+    return st;
+}
+
+/* The pager's other half: saves a dirty region about to be evicted, in the
+ * transaction the next commit ends (a kill before it undoes the write). */
+static cm_status page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = seconds_now();
+    cm_status st = begin(s, msg, msg_size);
+    if (st == CM_OK)
+        st = write_region(s, c, k, msg, msg_size);
+    s->stats.regions_evicted++;
+    s->stats.evict_seconds += seconds_now() - t0;
+    return st == CM_OK ? CM_OK : abandon(s, st);
+}
+
+cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    const double t0 = seconds_now();
+    cm_status st = begin(s, msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
+        if (c->regions[k].dirty)
+            st = write_region(s, c, k, msg, msg_size);
     if (st == CM_OK)
         st = write_new_groups(s, c, msg, msg_size);
     if (st == CM_OK) {
@@ -1135,32 +1194,14 @@ static cm_status write_dirty(cm_store *s, cm_cluster *c, char *msg, size_t msg_s
         if (exec(s->db, sql) != SQLITE_OK)
             st = db_error(s->db, "write meta", msg, msg_size);
     }
-    return st;
-}
-
-cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
-{
-    if (!s->writable)
-        return cm_fail(CM_EINVAL, msg, msg_size, "%s is open read-only", s->path);
-    const double t0 = seconds_now();
-    if (exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
-        return db_error(s->db, "begin", msg, msg_size);
-    cm_status st = write_dirty(s, c, msg, msg_size);
     if (st == CM_OK && exec(s->db, "COMMIT") != SQLITE_OK)
         st = db_error(s->db, "commit", msg, msg_size);
-    if (st != CM_OK) {
-        exec(s->db, "ROLLBACK");
-        return st;
-    }
-    /* the file now holds these pages: remember them and mark them clean */
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        if (!c->regions[k].dirty)
-            continue;
-        if (remember_hashes(s, k, &c->regions[k].r) != CM_OK)
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory after a commit");
-        c->regions[k].dirty = 0;
-    }
-    s->saved_regions = c->nregions;
+    if (st != CM_OK)
+        return abandon(s, st);
+    s->in_transaction = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        c->regions[k].dirty = 0; /* the file now holds these pages */
+    s->nperiodic = 0;
     s->saved_groups = c->ngroups;
     s->stats.commit_seconds += seconds_now() - t0;
     return CM_OK;

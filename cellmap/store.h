@@ -17,9 +17,12 @@
  * a killed process leaves the cluster of the last commit. Closing switches
  * the file back to a single file (rollback journal).
  *
- * Paging: cm_store_attach makes the store the cluster's pager; committed
- * regions can then be evicted (cm_cluster_trim) and are read back on demand.
- * A store is used from one thread at a time.
+ * Paging: cm_store_attach makes the store the cluster's pager. Regions are
+ * read back on demand; committed ones can be evicted at any time, and a
+ * store open for writing also saves dirty regions for eviction in the
+ * middle of a join (cm_cluster_acquire under a budget). Those writes go into
+ * the transaction that the join's commit ends, so a kill still leaves the
+ * cluster of the last commit. A store is used from one thread at a time.
  */
 #ifndef CM_STORE_H
 #define CM_STORE_H
@@ -61,8 +64,9 @@ typedef struct cm_store_info {
 /* Paging and commit figures since the store was opened. */
 typedef struct cm_store_stats {
     uint64_t regions_read, regions_written, pages_written;
+    uint64_t regions_evicted;           /* dirty, saved by the pager in a join */
     uint64_t bytes_read, bytes_written; /* encoded */
-    double read_seconds, commit_seconds;
+    double read_seconds, evict_seconds, commit_seconds;
 } cm_store_stats;
 
 /* Creates a new, empty database at path. An existing cellmap database there
@@ -84,7 +88,7 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
 
 void cm_store_get_stats(const cm_store *s, cm_store_stats *stats);
 
-/* Makes the store the pager of c (c->page_in, c->pager). */
+/* Makes the store the pager of c (c->page_in, c->page_out, c->pager). */
 void cm_store_attach(cm_store *s, cm_cluster *c);
 
 /* Rebuilds the saved cluster into c (initialised on the file's lattice):

@@ -532,11 +532,17 @@ static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *ti
     return (int)((extra + per_tile - 1) / per_tile);
 }
 
+/* Reads every region back, whatever the budget: the extension choice
+ * follows sequences through the whole cluster at once. The next join's
+ * commit trims the cluster to the budget again. */
 static cm_status acquire_all(cm_cluster *c, char *msg, size_t msg_size)
 {
+    const uint64_t budget = c->mem_budget;
     cm_status st = CM_OK;
+    c->mem_budget = 0;
     for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
         st = cm_cluster_acquire(c, k, msg, msg_size);
+    c->mem_budget = budget;
     return st;
 }
 

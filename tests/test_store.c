@@ -150,6 +150,9 @@ static void test_budgets(const char *dir, const cm_model *m)
     CHECK_INT(st[0].regions_read, 0);
     CHECK(st[1].regions_read > 0);
     CHECK(st[2].regions_read > st[1].regions_read);
+    /* one region: joins that touch several save dirty ones in the middle */
+    CHECK_INT(st[0].regions_evicted, 0);
+    CHECK(st[2].regions_evicted > 0);
     /* same files whatever the budget and the thread count */
     const uint64_t h = cmdb_content_hash(path[0]);
     for (int k = 1; k < 4; k++)
