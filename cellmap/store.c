@@ -134,8 +134,10 @@ struct cm_store {
     uint64_t nperiodic, periodic_cap;
     uint64_t **page_hash; /* per saved region: hash of each page's grp and step as saved */
     uint64_t hash_cap, hash_len;
-    unsigned char *buf, *scratch; /* encode/decode buffers */
-    uint64_t *count;              /* per group, for region_groups */
+    unsigned char *blobs; /* a region's encoded pages, read or to write */
+    uint64_t blobs_cap;
+    int threads;     /* for encoding and decoding pages: the cluster's */
+    uint64_t *count; /* per group, for region_groups */
     uint64_t count_cap;
     cm_store_stats stats;
 };
@@ -291,24 +293,16 @@ static cm_status new_store(const char *path, sqlite3 *db, int writable, cm_store
                            size_t msg_size)
 {
     cm_store *s = calloc(1, sizeof *s);
-    const size_t raw = 8 * (size_t)CM_STORE_PAGE_CELLS * CM_MAX_DIM;
-    if (s) {
+    if (s)
         s->path = strdup(path);
-        s->buf = malloc(cm_codec_bound(raw));
-        s->scratch = malloc(raw);
-    }
-    if (!s || !s->path || !s->buf || !s->scratch) {
-        if (s) {
-            free(s->path);
-            free(s->buf);
-            free(s->scratch);
-        }
+    if (!s || !s->path) {
         free(s);
         sqlite3_close(db);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory opening %s", path);
     }
     s->db = db;
     s->writable = writable;
+    s->threads = 1;
     *out = s;
     return CM_OK;
 }
@@ -460,10 +454,9 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
         free(s->page_hash[k]);
     free(s->page_hash);
     free(s->path);
-    free(s->buf);
-    free(s->scratch);
     free(s->count);
     free(s->periodic);
+    free(s->blobs);
     free(s);
     return st;
 }
@@ -587,68 +580,130 @@ static uint64_t page_cells(uint64_t ncells, uint64_t page)
     return ncells - first < CM_STORE_PAGE_CELLS ? ncells - first : CM_STORE_PAGE_CELLS;
 }
 
-/* Remembers the hashes of region k's pages as they are on disk. */
-static cm_status remember_hashes(cm_store *s, uint32_t k, const cm_region *r)
+/* Hashes of region k's pages as they are now into out[npages]. */
+static void hash_pages(const cm_store *s, const cm_region *r, uint64_t *out)
+{
+    const int64_t n = (int64_t)npages(r->ncells);
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (n > 1)
+    for (int64_t p = 0; p < n; p++) {
+        const uint64_t first = (uint64_t)p * CM_STORE_PAGE_CELLS;
+        out[p] = page_hash(r->group + first, r->step + first, page_cells(r->ncells, (uint64_t)p));
+    }
+}
+
+/* Room for the hashes of region k's pages. */
+static uint64_t *hash_slot(cm_store *s, uint32_t k, const cm_region *r)
 {
     if (cm_grow_zeroed((void **)&s->page_hash, &s->hash_cap, &s->hash_len, (uint64_t)k + 1,
                        sizeof *s->page_hash) != CM_OK)
+        return NULL;
+    if (!s->page_hash[k])
+        s->page_hash[k] = malloc((npages(r->ncells) + 1) * sizeof(uint64_t));
+    return s->page_hash[k];
+}
+
+/* Remembers the hashes of region k's pages as they are on disk. */
+static cm_status remember_hashes(cm_store *s, uint32_t k, const cm_region *r)
+{
+    uint64_t *slot = hash_slot(s, k, r);
+    if (!slot)
         return CM_ENOMEM;
-    if (!s->page_hash[k] && !(s->page_hash[k] = malloc(npages(r->ncells) * sizeof(uint64_t))))
-        return CM_ENOMEM;
-    for (uint64_t p = 0; p < npages(r->ncells); p++) {
-        const uint64_t first = p * CM_STORE_PAGE_CELLS;
-        s->page_hash[k][p] = page_hash(r->group + first, r->step + first, page_cells(r->ncells, p));
-    }
+    hash_pages(s, r, slot);
     return CM_OK;
 }
 
-static cm_status decode_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t n, int width,
-                               int64_t first_index, void *out, char *msg, size_t msg_size)
+/* A page's column as read: where its BLOB lies in s->blobs, where it goes. */
+typedef struct column_ref {
+    uint64_t offset, len, n, first;
+    int col;
+} column_ref;
+
+/* Decodes the columns read, in parallel: a region is 3 x 16 of them. */
+static cm_status decode_columns(const cm_store *s, cm_region *r, const column_ref *refs,
+                                uint64_t nrefs)
 {
-    const void *blob = sqlite3_column_blob(st, col);
-    const int len = sqlite3_column_bytes(st, col);
-    s->stats.bytes_read += (uint64_t)len;
-    if (!blob ||
-        cm_codec_decode(blob, (size_t)len, n, width, first_index, s->scratch, out) != CM_OK)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: a page does not decode", s->path);
+    int failed = 0;
+#pragma omp parallel num_threads(s->threads) if (nrefs > 1)
+    {
+        unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
+        failed |= !scratch;
+#pragma omp for schedule(dynamic, 1) reduction(| : failed)
+        for (int64_t t = 0; t < (int64_t)nrefs; t++) {
+            const column_ref *c = &refs[t];
+            uint32_t *const arrays[3] = {r->image, r->group, r->step};
+            failed |= !scratch || cm_codec_decode(s->blobs + c->offset, c->len, c->n, 4,
+                                                  c->col == 0 ? (int64_t)c->first : -1, scratch,
+                                                  arrays[c->col] + c->first) != CM_OK;
+        }
+        free(scratch);
+    }
+    return failed ? CM_EFORMAT : CM_OK;
+}
+
+/* Copies column col's BLOB of the current row to s->blobs. */
+static cm_status keep_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t first, uint64_t n,
+                             uint64_t *used, column_ref *ref)
+{
+    const void *blob = sqlite3_column_blob(st, 2 + col);
+    const uint64_t len = (uint64_t)sqlite3_column_bytes(st, 2 + col);
+    if (!blob || cm_grow((void **)&s->blobs, &s->blobs_cap, *used + len, sizeof *s->blobs) != CM_OK)
+        return blob ? CM_ENOMEM : CM_EFORMAT;
+    memcpy(s->blobs + *used, blob, len);
+    *ref = (column_ref){*used, len, n, first, col};
+    *used += len;
+    s->stats.bytes_read += len;
     return CM_OK;
 }
 
 static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
 {
+    const uint64_t pages = npages(r->ncells);
+    column_ref *refs = malloc((3 * pages + 1) * sizeof *refs);
     sqlite3_stmt *st = NULL;
+    if (!refs)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k + 1);
     if (sqlite3_prepare_v2(s->db,
                            "SELECT first_cell, cells, image, grp, step FROM pages WHERE region=? "
                            "ORDER BY first_cell",
-                           -1, &st, NULL))
+                           -1, &st, NULL)) {
+        free(refs);
         return db_error(s->db, "read pages", msg, msg_size);
+    }
     sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
     cm_status status = CM_OK;
-    uint64_t seen = 0;
+    uint64_t seen = 0, nrefs = 0, used = 0;
     int rc;
     while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         const uint64_t first = (uint64_t)sqlite3_column_int64(st, 0);
         const uint64_t n = (uint64_t)sqlite3_column_int64(st, 1);
-        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > r->ncells) {
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u page at %llu",
-                             s->path, k + 1, (unsigned long long)first);
+        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > r->ncells ||
+            nrefs == 3 * pages) {
+            status = CM_EFORMAT;
             break;
         }
-        status = decode_column(s, st, 2, n, 4, (int64_t)first, r->image + first, msg, msg_size);
-        if (status == CM_OK)
-            status = decode_column(s, st, 3, n, 4, -1, r->group + first, msg, msg_size);
-        if (status == CM_OK)
-            status = decode_column(s, st, 4, n, 4, -1, r->step + first, msg, msg_size);
+        for (int col = 0; col < 3 && status == CM_OK; col++)
+            status = keep_column(s, st, col, first, n, &used, &refs[nrefs++]);
         seen += n;
     }
-    if (status == CM_OK && rc != SQLITE_DONE)
+    if (status == CM_OK && rc != SQLITE_DONE) {
         status = db_error(s->db, "read pages", msg, msg_size);
+        sqlite3_finalize(st);
+        free(refs);
+        return status;
+    }
     sqlite3_finalize(st);
     if (status == CM_OK && seen != r->ncells)
-        status =
-            cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u has %llu of %llu cells",
-                    s->path, k + 1, (unsigned long long)seen, (unsigned long long)r->ncells);
-    return status;
+        status = CM_EFORMAT;
+    if (status == CM_OK)
+        status = decode_columns(s, r, refs, nrefs);
+    free(refs);
+    if (status == CM_EFORMAT)
+        return cm_fail(status, msg, msg_size,
+                       "%s is damaged: the pages of region %u are incomplete or do not decode",
+                       s->path, k + 1);
+    return status == CM_OK
+               ? CM_OK
+               : cm_fail(status, msg, msg_size, "out of memory reading region %u", k + 1);
 }
 
 /* Region k's exit targets into a new array of nexits * dim cells. */
@@ -722,6 +777,7 @@ static cm_status page_out(void *user, const cm_cluster *c, uint32_t k, char *msg
 
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
+    s->threads = cm_cluster_threads(c);
     c->page_in = page_in;
     c->page_out = s->writable ? page_out : NULL;
     c->pager = s;
@@ -833,17 +889,6 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
 
 /* ---- writing ---------------------------------------------------------- */
 
-static cm_status bind_encoded(cm_store *s, sqlite3_stmt *st, int col, const void *v, uint64_t n,
-                              int width, int64_t first_index, unsigned char *out, size_t cap)
-{
-    size_t len = 0;
-    if (cm_codec_encode(v, n, width, first_index, s->scratch, out, cap, &len) != CM_OK)
-        return CM_ENOMEM;
-    s->stats.bytes_written += len;
-    return sqlite3_bind_blob(st, col, out, (int)len, SQLITE_TRANSIENT) == SQLITE_OK ? CM_OK
-                                                                                    : CM_EDB;
-}
-
 static cm_status step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
                            size_t msg_size)
 {
@@ -896,42 +941,102 @@ static cm_status insert_region(cm_store *s, uint32_t k, const cm_region *r, char
     return status;
 }
 
-/* Writes region k's pages: all of them for a new region, else those whose
- * grp or step changed (images never change once a region is solved). */
-static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, int is_new, char *msg,
-                             size_t msg_size)
+/* Pages encoded at once: 8 x 3 columns of up to cm_codec_bound(256 KiB). */
+#define WRITE_BATCH 8
+
+/* Encodes column col (0 image, 1 grp, 2 step) of the listed pages into
+ * s->blobs, part bytes apart, in parallel; lens[t] is task t's size. */
+static cm_status encode_batch(cm_store *s, const cm_region *r, const uint64_t *pages, int npages_,
+                              int col0, int ncols, size_t part, size_t *lens)
+{
+    int failed = 0;
+    const int tasks = npages_ * ncols;
+#pragma omp parallel num_threads(s->threads) if (tasks > 1)
+    {
+        unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
+        failed |= !scratch;
+#pragma omp for schedule(dynamic, 1) reduction(| : failed)
+        for (int t = 0; t < tasks; t++) {
+            const uint64_t first = pages[t / ncols] * CM_STORE_PAGE_CELLS;
+            const int col = col0 + t % ncols;
+            const uint32_t *const arrays[3] = {r->image, r->group, r->step};
+            failed |= !scratch ||
+                      cm_codec_encode(arrays[col] + first, page_cells(r->ncells, pages[t / ncols]),
+                                      4, col == 0 ? (int64_t)first : -1, scratch,
+                                      s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
+        }
+        free(scratch);
+    }
+    return failed ? CM_ENOMEM : CM_OK;
+}
+
+/* Writes the listed pages of region k (encoded in parallel, written in order). */
+static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, const uint64_t *pages,
+                                 uint64_t n, int is_new, char *msg, size_t msg_size)
 {
     const char *sql = is_new ? "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)"
                              : "UPDATE pages SET grp = ?5, step = ?6 WHERE region = ?1 AND "
                                "first_cell = ?2 AND cells = ?3";
+    const int col0 = is_new ? 0 : 1, ncols = 3 - col0;
+    const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
+    size_t lens[WRITE_BATCH * 3];
     sqlite3_stmt *st = NULL;
+    if (cm_grow((void **)&s->blobs, &s->blobs_cap, (uint64_t)WRITE_BATCH * 3 * part, 1) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
     if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL))
         return db_error(s->db, "prepare pages", msg, msg_size);
-    const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
     cm_status status = CM_OK;
-    for (uint64_t p = 0; status == CM_OK && p < npages(r->ncells); p++) {
-        const uint64_t first = p * CM_STORE_PAGE_CELLS, n = page_cells(r->ncells, p);
-        if (!is_new && s->page_hash[k][p] == page_hash(r->group + first, r->step + first, n))
-            continue;
-        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-        sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
-        sqlite3_bind_int64(st, 3, (sqlite3_int64)n);
-        if (is_new)
-            status = bind_encoded(s, st, 4, r->image + first, n, 4, (int64_t)first, s->buf, part);
-        if (status == CM_OK)
-            status = bind_encoded(s, st, 5, r->group + first, n, 4, -1, s->buf + part, part);
-        if (status == CM_OK)
-            status = bind_encoded(s, st, 6, r->step + first, n, 4, -1, s->buf + 2 * part, part);
-        if (status == CM_OK)
+    for (uint64_t b = 0; status == CM_OK && b < n; b += WRITE_BATCH) {
+        const int batch = (int)(n - b < WRITE_BATCH ? n - b : WRITE_BATCH);
+        if (encode_batch(s, r, pages + b, batch, col0, ncols, part, lens) != CM_OK)
+            status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding a page of region %u", k + 1);
+        for (int p = 0; status == CM_OK && p < batch; p++) {
+            const uint64_t first = pages[b + (uint64_t)p] * CM_STORE_PAGE_CELLS;
+            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+            sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)page_cells(r->ncells, pages[b + (uint64_t)p]));
+            for (int c = 0; c < ncols; c++) {
+                const int t = p * ncols + c;
+                sqlite3_bind_blob(st, 4 + col0 + c, s->blobs + (size_t)t * part, (int)lens[t],
+                                  SQLITE_STATIC);
+                s->stats.bytes_written += lens[t];
+            }
             status = step_done(s->db, st, "write page", msg, msg_size);
-        else
-            status = cm_fail(status, msg, msg_size, "encoding a page of region %u", k + 1);
-        if (status == CM_OK && !is_new && sqlite3_changes(s->db) != 1)
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: page %llu of region %u",
-                             s->path, (unsigned long long)p, k + 1);
-        s->stats.pages_written++;
+            if (status == CM_OK && !is_new && sqlite3_changes(s->db) != 1)
+                status = cm_fail(CM_EFORMAT, msg, msg_size,
+                                 "%s is damaged: page at cell %llu of region %u", s->path,
+                                 (unsigned long long)first, k + 1);
+            s->stats.pages_written++;
+        }
     }
     sqlite3_finalize(st);
+    return status;
+}
+
+/* Writes region k's pages: all of them for a new region, else those whose
+ * grp or step changed (images never change once a region is solved), and
+ * remembers their hashes. */
+static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, int is_new, char *msg,
+                             size_t msg_size)
+{
+    const uint64_t pages = npages(r->ncells);
+    uint64_t *hash = malloc((pages + 1) * sizeof *hash), *list = malloc((pages + 1) * sizeof *list);
+    const uint64_t *saved = is_new || k >= s->hash_len ? NULL : s->page_hash[k];
+    uint64_t *slot = hash && list ? hash_slot(s, k, r) : NULL;
+    cm_status status =
+        slot ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
+    uint64_t n = 0;
+    if (status == CM_OK) {
+        hash_pages(s, r, hash);
+        for (uint64_t p = 0; p < pages; p++)
+            if (!saved || saved[p] != hash[p])
+                list[n++] = p;
+        status = write_page_list(s, k, r, list, n, is_new, msg, msg_size);
+    }
+    if (status == CM_OK)
+        memcpy(slot, hash, pages * sizeof *hash);
+    free(hash);
+    free(list);
     return status;
 }
 
@@ -1135,7 +1240,7 @@ static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char
         st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
     if (st == CM_OK)
         st = write_targets(s, k, &c->regions[k], msg, msg_size);
-    if (st == CM_OK && (collect_periodic(s, r) != CM_OK || remember_hashes(s, k, r) != CM_OK))
+    if (st == CM_OK && collect_periodic(s, r) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
     s->stats.regions_written++;
     return st;
