@@ -157,6 +157,7 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
     cm_status st = make_room(c, k, cm_region_bytes(&cr->r), msg, msg_size);
     if (st == CM_OK)
         st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
+    cr->read_at = c->clock;
     if (st == CM_OK && !is_resident(cr))
         st = cm_fail(CM_EIO, msg, msg_size, "region %u was not read back", k);
     return st;

@@ -40,6 +40,7 @@ typedef struct cm_cluster_region {
     uint64_t nentries, entries_cap;
     int dirty;          /* cells changed since the owner last saved them */
     uint64_t last_used; /* paging clock of the last acquire */
+    uint64_t read_at;   /* paging clock when it was last read back */
 } cm_cluster_region;
 
 /* Reads back the arrays of a paged-out region: r has box, ncells, nexits

@@ -62,6 +62,7 @@ typedef struct resolver {
     step_order order;      /* of the region being ordered */
     entry_value **entries; /* per affected region, of its entries after pass 1 */
     uint32_t *node_base;   /* per affected region, the id of its first node */
+    uint64_t *marked_at;   /* per region: read_at + 1 while pass 1's marks stay */
     cycle_cell *cycles;    /* ascending by region and cell once walked */
     uint64_t ncycles, cycles_cap;
     node *nodes;
@@ -583,7 +584,7 @@ static cm_status note_entries(resolver *rs, uint32_t k)
 }
 
 /* Undoes pass 1's marks on region k (root ids in group[], PENDING in
- * step[]): the region stays as saved, so evicting it costs no write. */
+ * step[]). */
 static void unmark(const resolver *rs, uint32_t k)
 {
     cm_region *r = &rs->c->regions[k].r;
@@ -619,10 +620,23 @@ static cm_status root_pass(resolver *rs, uint32_t k, cm_join_stats *stats)
         st = find_roots(rs, k, &nsink);
     if (st == CM_OK)
         st = note_entries(rs, k);
-    if (st == CM_OK)
+    /* A clean region keeps the marks for pass 2 while it stays resident:
+     * evicted, it is read back as saved. A dirty one is left as it was, so
+     * that evicting it never saves the marks. */
+    const cm_cluster_region *cr = &rs->c->regions[k];
+    if (st == CM_OK && cr->dirty && rs->c->page_out && rs->c->mem_budget)
         unmark(rs, k);
+    else if (st == CM_OK)
+        rs->marked_at[k] = cr->read_at + 1;
     stats->resolved_cells += nsink;
     return st;
+}
+
+/* Whether region k still holds pass 1's marks. */
+static int has_marks(const resolver *rs, uint32_t k)
+{
+    const cm_cluster_region *cr = &rs->c->regions[k];
+    return rs->marked_at[k] && cr->r.group && rs->marked_at[k] == cr->read_at + 1;
 }
 
 /* Gives region k's cells of cross-border cycles their group and step 0. */
@@ -651,9 +665,10 @@ static cm_status assign_pass(resolver *rs, uint32_t k)
     cm_region *r;
     uint64_t nsink = 0;
     int overflow = 0;
+    const int marked = has_marks(rs, k);
     cm_status st = use_region(rs, k, &r);
     rs->c->regions[k].dirty = 1;
-    if (st == CM_OK)
+    if (st == CM_OK && !marked)
         st = find_roots(rs, k, &nsink);
     if (st == CM_OK) {
         mark_cycles(rs, k);
@@ -663,6 +678,20 @@ static cm_status assign_pass(resolver *rs, uint32_t k)
     if (st == CM_OK && overflow)
         st = CM_ETOOBIG;
     return st == CM_OK ? cm_cluster_relink(rs->c, k) : st;
+}
+
+/* The regions pass 2 must change: those with a node whose sequence no
+ * longer leaves the cluster, or leaves it in another number of steps (the
+ * other regions' sink cells stay as they are), and the new region, whose
+ * links it sets. */
+static void mark_changed(const resolver *rs, uint8_t *changed)
+{
+    for (uint64_t id = 0; id < rs->nnodes; id++) {
+        const node *nd = &rs->nodes[id];
+        changed[nd->region] |= nd->group != 0 || nd->step != nd->old_step;
+    }
+    const uint32_t added = rs->c->nregions - 1;
+    changed[added] |= rs->affected[added];
 }
 
 static cm_status resolve(resolver *rs, cm_join_stats *stats)
@@ -683,10 +712,18 @@ static cm_status resolve(resolver *rs, cm_join_stats *stats)
         qsort(rs->cycles, rs->ncycles, sizeof *rs->cycles, cycle_cell_cmp);
     if (st == CM_OK)
         st = count_cycle_bound(rs);
+    uint8_t *changed = st == CM_OK ? calloc(nregions, 1) : NULL;
+    if (st == CM_OK && !changed)
+        st = CM_ENOMEM;
+    if (st == CM_OK)
+        mark_changed(rs, changed);
     /* the regions read last in linking are resident: assign from there */
     for (uint32_t k = nregions; k-- > 0 && st == CM_OK;)
-        if (rs->affected[k])
+        if (changed[k])
             st = assign_pass(rs, k);
+        else if (rs->affected[k] && has_marks(rs, k))
+            unmark(rs, k);
+    free(changed);
     return st;
 }
 
@@ -698,11 +735,14 @@ cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_
     rs.msg_size = msg_size;
     rs.entries = calloc(c->nregions, sizeof *rs.entries);
     rs.node_base = calloc(c->nregions, sizeof *rs.node_base);
-    const cm_status st = rs.entries && rs.node_base ? resolve(&rs, stats) : CM_ENOMEM;
+    rs.marked_at = calloc(c->nregions, sizeof *rs.marked_at);
+    const cm_status st =
+        rs.entries && rs.node_base && rs.marked_at ? resolve(&rs, stats) : CM_ENOMEM;
     for (uint32_t k = 0; rs.entries && k < c->nregions; k++)
         free(rs.entries[k]);
     free(rs.entries);
     free(rs.node_base);
+    free(rs.marked_at);
     free(rs.cycles);
     free(rs.order.cells);
     free(rs.order.start);

@@ -8,20 +8,26 @@
  * sorting them by step number orders every cell after its image. The join
  * works on these trees, not on the cells one by one:
  *   1. per region, each cell learns its tree's node, by one pass over the
- *      cells in step order (parallel within a step);
+ *      cells in step order (parallel within a step). The pass notes the
+ *      nodes and the values at the region's entries (the cells that other
+ *      regions' exits lead into), then leaves the region as it was;
  *   2. each node follows its exit into the cluster: to a classified cell
  *      (Stage 1 of the thesis), out of the cluster (still the sink), or into
  *      the tree of another node. Walking this small graph of nodes finds the
  *      cycles that cross region borders: the new straddling groups (Stage 2);
- *   3. the cells of those cycles are marked, and every node gets its group
+ *   3. the cells of those cycles are noted, and every node gets its group
  *      and step number;
- *   4. one parallel pass over each region gives every cell its node's group,
- *      its step number moved by as much as its node's; cells in the trees of
- *      cycle nodes, whose chains can meet the cycle before the node, are
- *      walked instead (such trees are small).
+ *   4. in each region with a node that changed, the pass of 1 is repeated
+ *      and every cell takes its node's group, its step number moved by as
+ *      much as its node's; cells in the trees of cycle nodes, whose chains
+ *      can meet the cycle before the node, are walked instead (such trees
+ *      are small). Regions whose nodes all still leave the cluster in as
+ *      many steps are left alone.
  * Each sink cell is read and written a fixed number of times, with
  * independent memory accesses, instead of walking dependent chains; the
- * result does not depend on the thread count.
+ * result does not depend on the thread count. Only step 4 changes regions,
+ * and every step needs one region's arrays at a time, so a join fits any
+ * memory budget (cm_cluster.mem_budget).
  */
 #ifndef CM_RESOLVE_H
 #define CM_RESOLVE_H
@@ -31,12 +37,12 @@
 #include "cellmap/cluster.h"
 
 /* Resolves the sink cells of the regions with affected[k] != 0 and sets
- * their links (cm_cluster_relink). New straddling groups take ids from
- * c->ngroups + 1 on, in a fixed order. Regions are acquired one at a time
- * (pass 1 in region order, the links by target region in reverse order,
- * pass 2 in region order again) and marked dirty, so under a memory budget
- * the others can be saved and evicted meanwhile. msg says why a region
- * could not be read back or saved. */
+ * the links of those it changes (cm_cluster_relink), which it marks dirty.
+ * New straddling groups take ids from c->ngroups + 1 on, in a fixed order.
+ * Regions are acquired one at a time (step 1 in region order, the links by
+ * target region in reverse order, step 4 in reverse order too, so that
+ * each step starts with the regions the last one left resident). msg says
+ * why a region could not be read back or saved. */
 cm_status cm_resolve_sink_cells(cm_cluster *c, const uint8_t *affected, cm_join_stats *stats,
                                 char *msg, size_t msg_size);
 
