@@ -707,10 +707,11 @@ static void print_database(const solve_args *a, const run *rn, const summary *su
     cm_store_stats ss;
     cm_store_get_stats(rn->store, &ss);
     printf("database %s: %u region%s, %.2f bytes/cell written; paging: %llu regions read "
-           "back (%.3f s), commits %.3f s\n",
+           "back (%.3f s), %llu changed ones saved to evict them (%.3f s); commits %.3f s\n",
            a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s",
            (double)ss.bytes_written / (double)sum->cells, (unsigned long long)ss.regions_read,
-           ss.read_seconds, ss.commit_seconds);
+           ss.read_seconds, (unsigned long long)ss.regions_evicted, ss.evict_seconds,
+           ss.commit_seconds);
 }
 
 static cm_status finish_store(run *rn, char *msg, size_t msg_size)

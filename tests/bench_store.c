@@ -41,26 +41,6 @@ static void die(const char *what, const char *msg)
     exit(1);
 }
 
-static cm_status trace_join(void *user, cm_cluster *c, uint32_t box, const cm_join_stats *js,
-                            char *msg, size_t msg_size)
-{
-    cm_store_stats a, b;
-    cm_store_get_stats(user, &a);
-    const double t0 = now();
-    cm_status st = cm_store_commit_join(user, c, box, js, msg, msg_size);
-    cm_store_get_stats(user, &b);
-    if (getenv("TRACE"))
-        fprintf(stderr,
-                "join %u aff %u resolved %llu nodes %llu reads %llu written %llu pages %llu commit "
-                "%.3f resident %.0fM\n",
-                box, js->affected_regions, (unsigned long long)js->resolved_cells,
-                (unsigned long long)js->nodes, (unsigned long long)b.regions_read,
-                (unsigned long long)(b.regions_written - a.regions_written),
-                (unsigned long long)(b.pages_written - a.pages_written), now() - t0,
-                cm_cluster_resident_bytes(c) / 1048576.0);
-    return st;
-}
-
 /* One run (in a child process): prints its figures. */
 static void run(const config *cf, const char *name, const char *db, uint64_t budget)
 {
@@ -90,7 +70,7 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     }
     const cm_scm_options opt = {100000, 2, NULL, NULL, 1};
     const double t0 = now();
-    if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? trace_join : NULL, s, NULL, msg,
+    if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? cm_store_commit_join : NULL, s, NULL, msg,
                                sizeof msg) != CM_OK)
         die("solve", msg);
     const double total = now() - t0;
