@@ -246,6 +246,12 @@ static void sort_entries(cm_cluster_region *cr)
     cr->nentries = kept;
 }
 
+int64_t cm_cluster_entry(const cm_cluster_region *cr, uint32_t cell)
+{
+    const uint32_t *e = bsearch(&cell, cr->entries, cr->nentries, sizeof cell, u32_cmp);
+    return e ? e - cr->entries : -1;
+}
+
 /* Escapes of the older regions that land in the new region `added` become
  * region links and entries of `added`; the new region's exits become links
  * and entries of older regions, or escapes. Escapes keep their target

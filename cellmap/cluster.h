@@ -133,6 +133,10 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
  * fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);
 
+/* The position of `cell` in region k's entries, or -1 if no exit of another
+ * region leads to it. */
+int64_t cm_cluster_entry(const cm_cluster_region *cr, uint32_t cell);
+
 /* Sets region k's links (targets) to the regions that the exits of its
  * sink cells lead into; k must be resident. Joins call it for every region
  * whose sink cells they resolved: only those cells can change later, so a

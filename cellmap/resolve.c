@@ -75,9 +75,8 @@ typedef struct resolver {
 
 /* Makes region k resident. Other regions may be evicted: the resolver
  * holds one region's arrays at a time. */
-static cm_status use_region(const resolver *rs, uint32_t k, cm_region **r)
+static cm_status acquire(const resolver *rs, uint32_t k)
 {
-    *r = &rs->c->regions[k].r;
     return cm_cluster_acquire(rs->c, k, rs->msg, rs->msg_size);
 }
 
@@ -88,12 +87,6 @@ static cm_status add_steps(uint32_t a, uint32_t b, uint32_t *sum)
         return CM_ETOOBIG;
     *sum = a + b;
     return CM_OK;
-}
-
-static int u32_cmp(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
 }
 
 static cm_status push(u32_stack *stack, uint32_t value)
@@ -305,12 +298,12 @@ static cm_status link_into(const resolver *rs, uint32_t k, const uint32_t *ids, 
     for (int64_t p = 0; p < (int64_t)n; p++) {
         const uint32_t cell = rs->nodes[ids[p]].target_cell;
         if (noted) {
-            const uint32_t *e = bsearch(&cell, cr->entries, cr->nentries, sizeof cell, u32_cmp);
-            if (!e) { /* cannot happen: every exit's cell is an entry */
+            const int64_t e = cm_cluster_entry(cr, cell);
+            if (e < 0) { /* cannot happen: every exit's cell is an entry */
                 failed |= 2;
                 continue;
             }
-            const entry_value v = noted[e - cr->entries];
+            const entry_value v = noted[e];
             failed |= link_node(rs, ids[p], v.group, v.step) != CM_OK;
         } else {
             failed |= link_node(rs, ids[p], cr->r.group[cell], cr->r.step[cell]) != CM_OK;
@@ -327,8 +320,12 @@ static cm_status link_nodes(resolver *rs)
     const uint32_t nregions = rs->c->nregions;
     uint64_t *start = calloc((size_t)nregions + 2, sizeof *start);
     uint32_t *ids = malloc((rs->nnodes + 1) * sizeof *ids);
-    cm_status st = start && ids ? CM_OK : CM_ENOMEM;
-    for (uint64_t id = 0; st == CM_OK && id < rs->nnodes; id++) {
+    if (!start || !ids) {
+        free(start);
+        free(ids);
+        return CM_ENOMEM;
+    }
+    for (uint64_t id = 0; id < rs->nnodes; id++) {
         node *nd = &rs->nodes[id];
         if (nd->target_region == NO_REGION) {
             nd->state = NODE_DONE; /* the sequence leaves the cluster (or the world) */
@@ -337,12 +334,13 @@ static cm_status link_nodes(resolver *rs)
             start[nd->target_region + 1]++;
         }
     }
-    for (uint32_t k = 0; st == CM_OK && k < nregions; k++)
+    for (uint32_t k = 0; k < nregions; k++)
         start[k + 1] += start[k];
-    for (uint64_t id = 0; st == CM_OK && id < rs->nnodes; id++)
+    for (uint64_t id = 0; id < rs->nnodes; id++)
         if (rs->nodes[id].target_region != NO_REGION)
             ids[start[rs->nodes[id].target_region]++] = (uint32_t)id;
     /* start[k] is now the end of region k's nodes */
+    cm_status st = CM_OK;
     for (uint32_t k = nregions; st == CM_OK && k-- > 0;) {
         const uint64_t first = k ? start[k - 1] : 0;
         if (start[k] > first)
@@ -486,12 +484,12 @@ static int on_cycle(const resolver *rs, uint32_t region, uint32_t cell)
 static cm_status cycle_entry_step(resolver *rs, const node *nd, uint32_t *step)
 {
     uint32_t region = nd->region, cell = nd->cell, hint = region, steps = 1;
-    cm_region *r;
-    cm_status st = use_region(rs, region, &r);
+    cm_status st = acquire(rs, region);
     if (st != CM_OK)
         return st;
     next_cell(rs->c, &region, &cell, &hint);
-    st = use_region(rs, region, &r);
+    st = acquire(rs, region);
+    const cm_region *r = &rs->c->regions[region].r;
     while (st == CM_OK && !on_cycle(rs, region, cell)) {
         if (r->image[cell] >= r->ncells) /* the tree's root is on the cycle */
             return CM_EINVAL;
@@ -613,9 +611,8 @@ static cm_status find_roots(resolver *rs, uint32_t k, uint64_t *nsink)
 /* Pass 1 on region k: its nodes and where the links into it lead. */
 static cm_status root_pass(resolver *rs, uint32_t k, cm_join_stats *stats)
 {
-    cm_region *r;
     uint64_t nsink = 0;
-    cm_status st = use_region(rs, k, &r);
+    cm_status st = acquire(rs, k);
     if (st == CM_OK)
         st = find_roots(rs, k, &nsink);
     if (st == CM_OK)
@@ -636,7 +633,7 @@ static cm_status root_pass(resolver *rs, uint32_t k, cm_join_stats *stats)
 static int has_marks(const resolver *rs, uint32_t k)
 {
     const cm_cluster_region *cr = &rs->c->regions[k];
-    return rs->marked_at[k] && cr->r.group && rs->marked_at[k] == cr->read_at + 1;
+    return cr->r.group && rs->marked_at[k] == cr->read_at + 1;
 }
 
 /* Gives region k's cells of cross-border cycles their group and step 0. */
@@ -662,11 +659,10 @@ static void mark_cycles(const resolver *rs, uint32_t k)
  * joins. */
 static cm_status assign_pass(resolver *rs, uint32_t k)
 {
-    cm_region *r;
     uint64_t nsink = 0;
     int overflow = 0;
     const int marked = has_marks(rs, k);
-    cm_status st = use_region(rs, k, &r);
+    cm_status st = acquire(rs, k);
     rs->c->regions[k].dirty = 1;
     if (st == CM_OK && !marked)
         st = find_roots(rs, k, &nsink);

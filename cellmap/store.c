@@ -1021,6 +1021,7 @@ static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, int is
 {
     const uint64_t pages = npages(r->ncells);
     uint64_t *hash = malloc((pages + 1) * sizeof *hash), *list = malloc((pages + 1) * sizeof *list);
+    /* the hashes on disk, taken before hash_slot makes room for a new region's */
     const uint64_t *saved = is_new || k >= s->hash_len ? NULL : s->page_hash[k];
     uint64_t *slot = hash && list ? hash_slot(s, k, r) : NULL;
     cm_status status =
