@@ -177,14 +177,6 @@ void cm_cluster_trim(cm_cluster *c)
     }
 }
 
-static bool boxes_overlap(const cm_box *a, const cm_box *b)
-{
-    for (int d = 0; d < a->dim; d++)
-        if (a->hi[d] <= b->lo[d] || b->hi[d] <= a->lo[d])
-            return false;
-    return true;
-}
-
 static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg, size_t msg_size)
 {
     if (r->box.dim != c->lat.dim)
@@ -194,8 +186,9 @@ static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions in one cluster");
     if (c->ngroups > CM_MAX_GROUPS - r->ngroups)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups in one cluster");
+    cm_box both;
     for (uint32_t k = 0; k < c->nregions; k++)
-        if (boxes_overlap(&c->regions[k].r.box, &r->box))
+        if (cm_box_intersect(&c->regions[k].r.box, &r->box, &both))
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "the new region overlaps region %u of the cluster; regions of a "
                            "cluster must not share cells",
@@ -417,6 +410,14 @@ static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box
                         const cm_scm_options *one, int threads, cm_region *solved,
                         cm_status *status, char (*msgs)[256])
 {
+    if (n == 1) { /* a lone box (a strip uncovered by panning) takes every thread for its images */
+        cm_scm_options all = *one;
+        all.threads = threads;
+        status[0] = cm_region_alloc(&solved[0], &boxes[0], msgs[0], sizeof msgs[0]);
+        if (status[0] == CM_OK)
+            status[0] = cm_scm_solve(model, &c->lat, &all, &solved[0], msgs[0], sizeof msgs[0]);
+        return;
+    }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int64_t k = 0; k < (int64_t)n; k++) {
         status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
@@ -489,6 +490,26 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
     return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
 }
 
+/* Copies the cells of region r inside `both` (their intersection) into
+ * out, one row along dimension 0 at a time: rows are contiguous in both. */
+static void flatten_part(const cm_region *r, const cm_box *both, cm_region *out)
+{
+    const int64_t width = both->hi[0] - both->lo[0];
+    const int64_t rows = (int64_t)(cm_box_cells(both) / (uint64_t)width);
+#pragma omp parallel for schedule(static)
+    for (int64_t q = 0; q < rows; q++) {
+        int64_t cell[CM_MAX_DIM];
+        cm_box row = *both;
+        row.hi[0] = row.lo[0] + 1;
+        cm_box_cell(&row, (uint64_t)q, cell);
+        const uint64_t from = cm_box_index(&r->box, cell), to = cm_box_index(&out->box, cell);
+        memcpy(out->group + to, r->group + from, (size_t)width * sizeof *out->group);
+        memcpy(out->step + to, r->step + from, (size_t)width * sizeof *out->step);
+        for (int64_t i = 0; i < width; i++)
+            out->image[to + (uint64_t)i] = flat_image(r, from + (uint64_t)i, &out->box);
+    }
+}
+
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
@@ -502,24 +523,15 @@ cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, c
         out->step[i] = 0;
     }
     for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_region *r = &c->regions[k].r;
-        int64_t cell[CM_MAX_DIM];
-        if (!boxes_overlap(&r->box, box))
+        cm_box both;
+        if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
             continue;
         st = cm_cluster_acquire(c, k, msg, msg_size);
         if (st != CM_OK) {
             cm_region_free(out);
             return st;
         }
-        for (uint64_t i = 0; i < r->ncells; i++) {
-            cm_box_cell(&r->box, i, cell);
-            if (!cm_box_contains(box, cell))
-                continue;
-            const uint64_t j = cm_box_index(box, cell);
-            out->image[j] = flat_image(r, i, box);
-            out->group[j] = r->group[i];
-            out->step[j] = r->step[i];
-        }
+        flatten_part(&c->regions[k].r, &both, out);
         cm_cluster_trim(c);
     }
     return CM_OK;

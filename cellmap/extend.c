@@ -10,7 +10,8 @@
 typedef struct tile_ref {
     int64_t index[CM_MAX_DIM];
     cm_box box;
-    uint64_t escaping;
+    uint64_t covered;  /* cells of the tile in the cluster (cluster tiles) */
+    uint64_t escaping; /* sequences escaping into it (candidates) */
 } tile_ref;
 
 typedef struct tile_list {
@@ -75,29 +76,64 @@ static cm_status add_tile(tile_list *list, const int64_t *index, const cm_box *b
     return CM_OK;
 }
 
-/* The tiles holding the cluster's regions, in join order. */
+/* Adds every tile that region box `rb` overlaps (in index order) that the
+ * list does not hold yet. */
+static cm_status add_region_tiles(const cm_box *tile, const cm_box *rb, tile_list *tiles)
+{
+    int64_t first[CM_MAX_DIM], last[CM_MAX_DIM], index[CM_MAX_DIM] = {0}, top[CM_MAX_DIM];
+    for (int d = 0; d < tile->dim; d++)
+        top[d] = rb->hi[d] - 1;
+    tile_of(tile, rb->lo, first);
+    tile_of(tile, top, last);
+    memcpy(index, first, sizeof first);
+    for (;;) {
+        cm_box box;
+        tile_box(tile, NULL, index, &box);
+        if (find_tile(tiles, index, tile->dim) < 0 && add_tile(tiles, index, &box) != CM_OK)
+            return CM_ENOMEM;
+        int d = 0;
+        while (d < tile->dim && index[d] == last[d]) {
+            index[d] = first[d];
+            d++;
+        }
+        if (d == tile->dim)
+            return CM_OK;
+        index[d]++;
+    }
+}
+
+/* The tiles the cluster's regions overlap, in join order, with the cells
+ * of each that the cluster covers. */
 static cm_status cluster_tiles(const cm_cluster *c, const cm_box *tile, tile_list *tiles)
 {
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        int64_t index[CM_MAX_DIM] = {0};
-        tile_of(tile, c->regions[k].r.box.lo, index);
-        if (find_tile(tiles, index, tile->dim) < 0 &&
-            add_tile(tiles, index, &c->regions[k].r.box) != CM_OK)
+    for (uint32_t k = 0; k < c->nregions; k++)
+        if (add_region_tiles(tile, &c->regions[k].r.box, tiles) != CM_OK)
             return CM_ENOMEM;
-    }
+    for (uint64_t t = 0; t < tiles->n; t++)
+        for (uint32_t k = 0; k < c->nregions; k++) {
+            cm_box both;
+            if (cm_box_intersect(&tiles->items[t].box, &c->regions[k].r.box, &both))
+                tiles->items[t].covered += cm_box_cells(&both);
+        }
     return CM_OK;
 }
 
-/* Tiles sharing a face with a cluster tile, not in the cluster, within bounds. */
+/* Candidates: each cluster tile the cluster does not cover whole (regions
+ * need not be aligned to the grid), then the tiles sharing a face with it
+ * that hold no cluster cell; all within bounds. */
 static cm_status neighbour_tiles(const tile_list *tiles, const cm_box *tile, const cm_box *bounds,
                                  tile_list *candidates)
 {
-    for (uint64_t k = 0; k < tiles->n; k++)
+    for (uint64_t k = 0; k < tiles->n; k++) {
+        const tile_ref *t = &tiles->items[k];
+        cm_box box;
+        if (tile_box(tile, bounds, t->index, &box) && t->covered < cm_box_cells(&box) &&
+            add_tile(candidates, t->index, &box) != CM_OK)
+            return CM_ENOMEM;
         for (int d = 0; d < tile->dim; d++)
             for (int side = -1; side <= 1; side += 2) {
                 int64_t index[CM_MAX_DIM];
-                cm_box box;
-                memcpy(index, tiles->items[k].index, sizeof index);
+                memcpy(index, t->index, sizeof index);
                 index[d] += side;
                 if (find_tile(tiles, index, tile->dim) >= 0 ||
                     find_tile(candidates, index, tile->dim) >= 0 ||
@@ -106,6 +142,7 @@ static cm_status neighbour_tiles(const tile_list *tiles, const cm_box *tile, con
                 if (add_tile(candidates, index, &box) != CM_OK)
                     return CM_ENOMEM;
             }
+    }
     return CM_OK;
 }
 

@@ -2,15 +2,19 @@
  * Fig. 4.25): solve next where the sequences that leave the cluster go.
  *
  * The state space is cut into tiles of one size on a grid aligned to a
- * given tile (normally the first region solved). Among the tiles that share
- * a face with a tile of the cluster and are not in it, clipped to optional
+ * given tile (the first region solved, or the view of an explore session).
+ * Among the tiles that the cluster holds only in part and those that share
+ * a face with a tile of the cluster and hold none of it, clipped to optional
  * bounds, the next one is the tile where the most sequences escape: the
  * sequences of cluster cells are followed (in step order, linear time) to
  * where they leave the cluster, and each escape into the world counts the
  * cells whose sequences take it, as the thesis chooses "the adjacent region
  * to where most of the trajectories escape" (4.6.2). Ties go to the first candidate in a
- * fixed order (cluster tiles in join order, then dimension, lower side
- * first), so the choice is deterministic.
+ * fixed order (cluster tiles in join order, each itself before its
+ * neighbours, by dimension, lower side first), so the choice is
+ * deterministic. Regions need not be aligned to the grid; the caller
+ * computes the part of the chosen tile that the cluster lacks
+ * (cellmap/cover.h).
  */
 #ifndef CM_EXTEND_H
 #define CM_EXTEND_H

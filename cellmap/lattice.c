@@ -77,6 +77,19 @@ bool cm_box_contains(const cm_box *box, const int64_t *cell)
     return true;
 }
 
+bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out)
+{
+    cm_box both = *a;
+    for (int d = 0; d < a->dim; d++) {
+        both.lo[d] = a->lo[d] > b->lo[d] ? a->lo[d] : b->lo[d];
+        both.hi[d] = a->hi[d] < b->hi[d] ? a->hi[d] : b->hi[d];
+        if (both.lo[d] >= both.hi[d])
+            return false;
+    }
+    *out = both;
+    return true;
+}
+
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell)
 {
     uint64_t index = 0;

@@ -54,6 +54,10 @@ uint64_t cm_box_cells(const cm_box *box);
 /* true when cell c is inside the box. */
 bool cm_box_contains(const cm_box *box, const int64_t *cell);
 
+/* The cells both boxes hold, into *out (which may be a or b); false, and
+ * *out untouched, when they share none. */
+bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out);
+
 /* Local row-major index of a cell inside the box (caller checked contains). */
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 

@@ -1313,6 +1313,58 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
     return CM_OK;
 }
 
+static cm_status check_note_key(const char *key, char *msg, size_t msg_size)
+{
+    if (strncmp(key, "note.", 5) != 0 || strlen(key) > 64)
+        return cm_fail(CM_EINVAL, msg, msg_size, "note keys begin with \"note.\" (got '%s')", key);
+    return CM_OK;
+}
+
+cm_status cm_store_set_note(cm_store *s, const char *key, const char *value, char *msg,
+                            size_t msg_size)
+{
+    cm_status st = check_note_key(key, msg, msg_size);
+    const int own = st == CM_OK && !s->in_transaction;
+    if (st == CM_OK)
+        st = begin(s, msg, msg_size);
+    sqlite3_stmt *ins = NULL;
+    if (st == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO meta(key, value) VALUES(?, ?)", -1, &ins,
+                           NULL) != SQLITE_OK)
+        st = db_error(s->db, "prepare note", msg, msg_size);
+    if (st == CM_OK) {
+        sqlite3_bind_text(ins, 1, key, -1, SQLITE_STATIC);
+        sqlite3_bind_text(ins, 2, value, -1, SQLITE_STATIC);
+        if (sqlite3_step(ins) != SQLITE_DONE)
+            st = db_error(s->db, "write note", msg, msg_size);
+    }
+    sqlite3_finalize(ins);
+    if (st == CM_OK && own && exec(s->db, "COMMIT") != SQLITE_OK)
+        st = db_error(s->db, "commit note", msg, msg_size);
+    if (st == CM_OK && own)
+        s->in_transaction = 0;
+    return st == CM_OK || st == CM_EINVAL ? st : abandon(s, st);
+}
+
+cm_status cm_store_get_note(cm_store *s, const char *key, char *out, size_t size, char *msg,
+                            size_t msg_size)
+{
+    cm_status st = check_note_key(key, msg, msg_size);
+    sqlite3_stmt *q = NULL;
+    if (st != CM_OK)
+        return st;
+    if (sqlite3_prepare_v2(s->db, "SELECT value FROM meta WHERE key = ?", -1, &q, NULL) !=
+        SQLITE_OK)
+        return db_error(s->db, "prepare note", msg, msg_size);
+    sqlite3_bind_text(q, 1, key, -1, SQLITE_STATIC);
+    if (sqlite3_step(q) == SQLITE_ROW && sqlite3_column_text(q, 0))
+        snprintf(out, size, "%s", (const char *)sqlite3_column_text(q, 0));
+    else
+        st = cm_fail(CM_ENOTFOUND, msg, msg_size, "%s has no %s", s->path, key);
+    sqlite3_finalize(q);
+    return st;
+}
+
 cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
                                char *msg, size_t msg_size)
 {

@@ -110,6 +110,14 @@ cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const c
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
                           char *msg, size_t msg_size);
 
+/* Application notes kept with the cluster (e.g. an explore session's
+ * view), under keys that begin with "note.": set (in its own transaction,
+ * or in the open one) and get; CM_ENOTFOUND when the key is not there. */
+cm_status cm_store_set_note(cm_store *s, const char *key, const char *value, char *msg,
+                            size_t msg_size);
+cm_status cm_store_get_note(cm_store *s, const char *key, char *out, size_t size, char *msg,
+                            size_t msg_size);
+
 /* Parameters as a JSON object text, e.g. {"alpha":0.078,"mode":"output"}. */
 void cm_params_json(const cm_params *p, char *buf, size_t size);
 

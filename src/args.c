@@ -192,3 +192,11 @@ void join_argv(int argc, char **argv, char *buf, size_t size)
     for (int i = 0; i < argc && used + 1 < size; i++)
         used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? " " : "", argv[i]);
 }
+
+int64_t border_cell(double x, double origin, double width, int round_up)
+{
+    const double c = (x - origin) / width, nearest = floor(c + 0.5);
+    if (fabs(c - nearest) < 1e-9 * (fabs(c) + 1))
+        return (int64_t)nearest;
+    return (int64_t)(round_up ? ceil(c) : floor(c));
+}

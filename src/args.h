@@ -57,6 +57,10 @@ bool model_opts_take(cli *c, model_opts *mo, int *error);
 /* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);
 
+/* The lattice coordinate of the cell border at or beyond state x (below
+ * it, or above it if round_up), snapped to a border within rounding of x. */
+int64_t border_cell(double x, double origin, double width, int round_up);
+
 /* Command line joined by spaces (for provenance). */
 void join_argv(int argc, char **argv, char *buf, size_t size);
 

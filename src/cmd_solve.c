@@ -14,9 +14,8 @@
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
-#include "render/basin.h"
-#include "render/png_out.h"
 #include "src/args.h"
+#include "src/basin_png.h"
 #include "src/commands.h"
 
 static const char solve_help[] =
@@ -195,16 +194,6 @@ static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm
     return EXIT_OK;
 }
 
-/* A lattice coordinate of state x, rounded to the nearest cell border when
- * it lies within rounding of one. */
-static int64_t border_cell(double x, double origin, double width, int round_up)
-{
-    const double c = (x - origin) / width, nearest = floor(c + 0.5);
-    if (fabs(c - nearest) < 1e-9 * (fabs(c) + 1))
-        return (int64_t)nearest;
-    return (int64_t)(round_up ? ceil(c) : floor(c));
-}
-
 /* --bounds as a box of cells (the cells the bounds touch); it must hold
  * the region. */
 static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat, const cm_box *box,
@@ -257,17 +246,6 @@ static int larger_basin_first(const void *a, const void *b)
 /* The text summary lists the groups with the largest basins first; --json
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
-
-/* The box in state coordinates, "x0:x1,y0:y1,...". */
-static void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size)
-{
-    size_t used = 0;
-    out[0] = 0;
-    for (int d = 0; d < box->dim && used < size; d++)
-        used += (size_t)snprintf(out + used, size - used, "%s%.9g:%.9g", d ? "," : "",
-                                 lat->origin[d] + (double)box->lo[d] * lat->width[d],
-                                 lat->origin[d] + (double)box->hi[d] * lat->width[d]);
-}
 
 /* One step of --extend, as reported. */
 typedef struct extend_step {
@@ -380,52 +358,6 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const summary *
         printf("]}");
     }
     printf("]}\n");
-}
-
-static int write_png(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                     const cm_region *r, const cm_group_info *g)
-{
-    cm_render_options ro;
-    memset(&ro, 0, sizeof ro);
-    const cm_box *b = &r->box;
-    const uint64_t nx = (uint64_t)(b->hi[0] - b->lo[0]);
-    const uint64_t ny = lat->dim > 1 ? (uint64_t)(b->hi[1] - b->lo[1]) : 64;
-    const double shrink = nx > 4096 || ny > 4096 ? 4096.0 / (double)(nx > ny ? nx : ny) : 1.0;
-    ro.width = a->width ? a->width : (int)((double)nx * shrink + 0.5);
-    ro.height = a->height ? a->height : (int)((double)ny * shrink + 0.5);
-    ro.width = ro.width < 1 ? 1 : ro.width;
-    ro.height = ro.height < 1 ? 1 : ro.height;
-    ro.markers = 1;
-    uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
-    char msg[512];
-    if (!rgba) {
-        fprintf(stderr, "cellmap solve: out of memory for a %dx%d image\n", ro.width, ro.height);
-        return EXIT_FAIL;
-    }
-    cm_status st = cm_render_basin(lat, r, g, &ro, rgba, msg, sizeof msg);
-    if (st == CM_OK) {
-        char params[2048], lattice[512], view[CM_MAX_DIM * 64 + 64];
-        cm_params_json(&m->values, params, sizeof params);
-        snprintf(lattice, sizeof lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
-                 lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
-                 lat->dim > 1 ? lat->width[1] : 0.0);
-        char box[CM_MAX_DIM * 64];
-        format_box(lat, b, box, sizeof box);
-        snprintf(view, sizeof view, "box %s cells %lldx%lld", box, (long long)nx,
-                 lat->dim > 1 ? (long long)ny : 1LL);
-        const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},
-                                     {"Model", m->name},
-                                     {"Parameters", params},
-                                     {"Lattice", lattice},
-                                     {"View", view}};
-        st = cm_png_write(a->png, rgba, ro.width, ro.height, texts, 5, msg, sizeof msg);
-    }
-    free(rgba);
-    if (st != CM_OK) {
-        fprintf(stderr, "cellmap solve: %s\n", msg);
-        return EXIT_FAIL;
-    }
-    return EXIT_OK;
 }
 
 static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
@@ -782,7 +714,8 @@ int cmd_solve(int argc, char **argv)
         print_database(&a, &rn, &sum);
     if (a.png && !r.group && cm_cluster_flatten(&rn.c, &sum.box, &r, msg, sizeof msg) != CM_OK)
         goto fail;
-    if (a.png && write_png(&a, &m, &lat, &r, sum.groups) != EXIT_OK)
+    const basin_png png = {a.png, &m, &lat, &r, sum.groups, a.width, a.height, {0, 0}, {0, 0}};
+    if (a.png && write_basin_png("solve", &png) != EXIT_OK)
         goto done;
     if (rn.store && finish_store(&rn, msg, sizeof msg) != CM_OK)
         goto fail;

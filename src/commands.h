@@ -9,5 +9,6 @@ int cmd_orbit(int argc, char **argv);
 int cmd_fixed_points(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
+int cmd_explore(int argc, char **argv);
 
 #endif

@@ -1,0 +1,166 @@
+/* cellmap explore: a session of view, pan, zoom ... commands on a cluster
+ * database, from a script, from stdin, or at a prompt with line editing
+ * (libedit) when stdin is a terminal. */
+#include <editline/readline.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/explore.h"
+
+static const char explore_help_head[] =
+    "usage: cellmap explore FILE.cmdb [SCRIPT|-] [--threads T] [--mem BYTES]\n"
+    "       cellmap explore FILE.cmdb [SCRIPT|-] --model NAME [--param k=v,...]\n"
+    "                       --cell-size DX[,DY...] [--origin X,Y...] [--depth LO:HI,...]\n"
+    "                       [--max-steps K] [--threads T] [--mem BYTES]\n\n"
+    "Explores basins by moving a view over the state space. Each command that\n"
+    "uncovers cells computes exactly those cells as new regions and joins them\n"
+    "into the cluster in FILE.cmdb (clustered SCM, thesis 4.6.4); nothing is\n"
+    "computed twice, and every join is saved as it happens. A new FILE is\n"
+    "created from --model, --param and the lattice (--cell-size, --origin,\n"
+    "default 0); an existing one (also one made by `cellmap solve --db`) goes on\n"
+    "with its model, lattice and last view. Commands come from SCRIPT, from\n"
+    "stdin (- or no SCRIPT), or from a prompt when stdin is a terminal. In a\n"
+    "script, a bad line stops the session with exit status 1 after saving all\n"
+    "done so far; at the prompt the session goes on.\n\n"
+    "  --depth LO:HI,...  models of more than two dimensions: the ranges of\n"
+    "                     dimensions 3.. that every view computes (default: the\n"
+    "                     model's example region)\n"
+    "  --max-steps K      re-step while the image stays in its own cell (default 1)\n"
+    "  --threads T        OpenMP threads (default: all cores)\n"
+    "  --mem BYTES        bound the cell arrays held in memory (regions are paged)\n\n"
+    "commands (one per line, # starts a comment):\n";
+
+typedef struct explore_args {
+    session_options o;
+    const char *script;
+} explore_args;
+
+static int parse_explore(cli *c, explore_args *a)
+{
+    int err = 0;
+    session_options *o = &a->o;
+    while (cli_next(c) && !err) {
+        int64_t v;
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(explore_help_head, stdout);
+            fputs(session_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &o->mo, &err)) {
+        } else if (cli_is(c, "--cell-size", true, &err)) {
+            if (c->value && !parse_doubles(c->value, o->cell_size, &o->n_cell_size, CM_MAX_DIM))
+                err = cli_usage_error(c, "--cell-size: '%s' is not DX[,DY...]", c->value);
+        } else if (cli_is(c, "--origin", true, &err)) {
+            if (c->value && !parse_doubles(c->value, o->origin, &o->n_origin, CM_MAX_DIM))
+                err = cli_usage_error(c, "--origin: '%s' is not X[,Y...]", c->value);
+        } else if (cli_is(c, "--depth", true, &err)) {
+            o->depth_text = c->value;
+        } else if (cli_is(c, "--max-steps", true, &err)) {
+            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
+                err = cli_usage_error(c, "--max-steps: '%s' must be an integer in 1..1000000",
+                                      c->value);
+            o->max_steps = (int)v;
+        } else if (cli_is(c, "--threads", true, &err)) {
+            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1024))
+                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024", c->value);
+            o->threads = (int)v;
+        } else if (cli_take_mem(c, &o->mem, &err)) {
+        } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !o->path) {
+            o->path = c->opt;
+        } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !a->script) {
+            a->script = c->opt;
+        } else {
+            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+        }
+    }
+    if (!err && !o->path)
+        err = cli_usage_error(c, "which file? usage: cellmap explore FILE.cmdb [SCRIPT|-]");
+    if (!err && !o->mo.name && (o->mo.n_texts || o->depth_text))
+        err = cli_usage_error(c, "--param and --depth describe a new file; add --model NAME");
+    return err;
+}
+
+/* Runs the lines of f; a bad line stops the session (exit 1). */
+static int run_script(session *s, FILE *f, const char *name)
+{
+    char line[8192], msg[1024];
+    for (long lineno = 1; !s->quit && fgets(line, sizeof line, f); lineno++) {
+        if (!strchr(line, '\n') && !feof(f)) {
+            fprintf(stderr, "%s:%ld: the line is longer than %zu characters\n", name, lineno,
+                    sizeof line - 2);
+            return EXIT_FAIL;
+        }
+        if (session_exec(s, line, msg, sizeof msg) != CM_OK) {
+            fprintf(stderr, "%s:%ld: %s\n", name, lineno, msg);
+            return EXIT_FAIL;
+        }
+    }
+    if (ferror(f)) {
+        fprintf(stderr, "cellmap explore: cannot read %s\n", name);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+/* The prompt: errors are reported and the session goes on. */
+static int run_prompt(session *s)
+{
+    char msg[1024];
+    printf("cellmap explore %s: type help for the commands, quit to end\n", s->path);
+    for (long lineno = 1; !s->quit; lineno++) {
+        char *line = readline("explore> ");
+        if (!line)
+            break; /* end of input */
+        if (line[strspn(line, " \t")])
+            add_history(line);
+        if (session_exec(s, line, msg, sizeof msg) != CM_OK)
+            fprintf(stderr, "line %ld: %s\n", lineno, msg);
+        free(line);
+    }
+    return EXIT_OK;
+}
+
+static int run_input(session *s, const char *script)
+{
+    if (script && strcmp(script, "-") != 0) {
+        FILE *f = fopen(script, "r");
+        if (!f) {
+            fprintf(stderr, "cellmap explore: cannot open the script %s (check the path)\n",
+                    script);
+            return EXIT_FAIL;
+        }
+        const int rc = run_script(s, f, script);
+        fclose(f);
+        return rc;
+    }
+    if (!script && isatty(STDIN_FILENO))
+        return run_prompt(s);
+    return run_script(s, stdin, "stdin");
+}
+
+int cmd_explore(int argc, char **argv)
+{
+    cli c = {"explore", argc, argv, 0, NULL, NULL};
+    explore_args a;
+    char command[4096], msg[1024];
+    memset(&a, 0, sizeof a);
+    int rc = parse_explore(&c, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+    join_argv(argc + 1, argv - 1, command, sizeof command);
+    a.o.command = command;
+    a.o.out = stdout;
+    session s;
+    rc = session_open(&s, &a.o);
+    if (rc == EXIT_OK)
+        rc = run_input(&s, a.script);
+    /* what the session did is saved in any case */
+    if (session_close(&s, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap explore: %s\n", msg);
+        rc = EXIT_FAIL;
+    }
+    return rc;
+}

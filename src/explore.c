@@ -1,0 +1,1002 @@
+#include "src/explore.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "cellmap/cover.h"
+#include "cellmap/extend.h"
+#include "models/registry.h"
+#include "src/basin_png.h"
+#include "src/commands.h"
+#include "src/dbfile.h"
+
+const char session_help[] =
+    "  view X0:X1 [Y0:Y1] [at Z[,W...]]   look at this box of state space (and, for\n"
+    "                                     models of more than two dimensions, the slice\n"
+    "                                     through Z, W, ...)\n"
+    "  pan left|right|up|down AMOUNT      move the view by 25% (of the view), 120c (cells)\n"
+    "                                     or a length in state coordinates\n"
+    "  zoom FACTOR                        2: twice as close, 0.5: twice as far (about the\n"
+    "                                     centre)\n"
+    "  goto X [Y]                         centre the view on a point\n"
+    "  extend auto [N]                    N times (default 1), add the tile of the view's\n"
+    "                                     size where the most sequences escape (4.6.4)\n"
+    "  render FILE.png [WxH]              the view as a basin image (default: a pixel\n"
+    "                                     per cell, at most 4096)\n"
+    "  stats                              groups and attractors in view, cells, memory, disk\n"
+    "  export --groups|--cells|--flat ... as `cellmap export` (--window: the view)\n"
+    "  save                               save the view (joins are saved as they happen)\n"
+    "  quit                               end the session\n"
+    "  help                               this list\n";
+
+/* A command may compute at most this many new cells (12 bytes each). */
+#define MAX_NEW_CELLS (UINT64_C(1) << 28)
+enum { MAX_TOKENS = 24, VIEW_TEXT = 512 };
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the view ------------------------------------------------------------ */
+
+/* The cells the view touches: dimensions 0 and 1 from the view, the others
+ * the session's depth. */
+static void view_box(const session *s, const double *lo, const double *hi, cm_box *box)
+{
+    const cm_lattice *lat = &s->c.lat;
+    memset(box, 0, sizeof *box);
+    box->dim = s->dim;
+    for (int d = 0; d < s->dim; d++) {
+        if (d < s->view_dims) {
+            box->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
+            box->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+        } else {
+            box->lo[d] = s->depth_lo[d];
+            box->hi[d] = s->depth_hi[d];
+        }
+    }
+}
+
+/* The one layer of the view's box that is drawn (the slice). */
+static void shown_box(const session *s, cm_box *box)
+{
+    view_box(s, s->lo, s->hi, box);
+    for (int d = 2; d < s->dim; d++) {
+        box->lo[d] = s->slice[d];
+        box->hi[d] = s->slice[d] + 1;
+    }
+}
+
+static void format_view(const session *s, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 0; d < s->view_dims && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%.9g:%.9g", d ? " " : "", s->lo[d],
+                                 s->hi[d]);
+    for (int d = 2; d < s->dim && used < size; d++)
+        used +=
+            (size_t)snprintf(out + used, size - used, "%s%.9g", d == 2 ? " at " : ",",
+                             s->c.lat.origin[d] + ((double)s->slice[d] + 0.5) * s->c.lat.width[d]);
+}
+
+/* A view must be finite, inside the world and at least a cell wide. */
+static cm_status check_view(const session *s, const double *lo, const double *hi, const char *verb,
+                            char *msg, size_t msg_size)
+{
+    const cm_lattice *lat = &s->c.lat;
+    for (int d = 0; d < s->view_dims; d++) {
+        const double cells = (hi[d] - lo[d]) / lat->width[d];
+        const double far = fmax(fabs(lo[d] - lat->origin[d]), fabs(hi[d] - lat->origin[d]));
+        if (!isfinite(lo[d]) || !isfinite(hi[d]) || !(lo[d] < hi[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "%s: the view needs LO < HI, both finite",
+                           verb);
+        if (far / lat->width[d] > (double)CM_WORLD_LIMIT / 2)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s: the view would leave the world (more than 2^39 cells from the "
+                           "origin in %s)",
+                           verb, axis_name(d));
+        if (cells < 1.0)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s: the view would be %.3g cells wide in %s, below the lattice's "
+                           "resolution (cells %.6g wide); stay at least one cell wide",
+                           verb, cells, axis_name(d), lat->width[d]);
+    }
+    return CM_OK;
+}
+
+/* ---- computing what the view uncovers -------------------------------------- */
+
+typedef struct computed {
+    uint64_t cells;
+    uint32_t regions, new_groups, straddling, affected;
+    double seconds;
+} computed;
+
+/* Solves the boxes as new regions and joins them, one commit per join. */
+static cm_status compute_boxes(session *s, const cm_box *boxes, uint32_t n, computed *done,
+                               char *msg, size_t msg_size)
+{
+    const cm_scm_options opt = {s->max_steps, s->threads, NULL, NULL, 1};
+    cm_join_stats stats;
+    const double t0 = now_seconds();
+    cm_status st = cm_cluster_solve_boxes(&s->c, &s->model, boxes, n, &opt, cm_store_commit_join,
+                                          s->store, &stats, msg, msg_size);
+    done->seconds += now_seconds() - t0;
+    if (st != CM_OK)
+        return st;
+    done->cells += cm_boxes_cells(boxes, n);
+    done->regions += n;
+    done->new_groups += stats.new_groups;
+    done->straddling += stats.straddling_groups;
+    done->affected += stats.affected_regions;
+    return CM_OK;
+}
+
+/* Computes the cells of `box` the cluster lacks. */
+static cm_status cover_box(session *s, const cm_box *box, const char *verb, computed *done,
+                           char *msg, size_t msg_size)
+{
+    cm_box *boxes = NULL;
+    uint32_t n = 0;
+    cm_status st = cm_cluster_uncovered(&s->c, box, &boxes, &n, msg, msg_size);
+    const uint64_t cells = cm_boxes_cells(boxes, n);
+    if (st == CM_OK && cells > MAX_NEW_CELLS)
+        st = cm_fail(CM_ETOOBIG, msg, msg_size,
+                     "%s would compute %llu new cells, more than %llu at once; zoom out or pan "
+                     "in smaller steps",
+                     verb, (unsigned long long)cells, (unsigned long long)MAX_NEW_CELLS);
+    if (st == CM_OK && n > 0)
+        st = compute_boxes(s, boxes, n, done, msg, msg_size);
+    free(boxes);
+    return st;
+}
+
+static cm_status save_view(session *s, char *msg, size_t msg_size)
+{
+    char text[VIEW_TEXT];
+    if (!s->have_view)
+        return CM_OK;
+    format_view(s, text, sizeof text);
+    return cm_store_set_note(s->store, "note.explore.view", text, msg, msg_size);
+}
+
+static void report(const session *s, const char *what, const computed *done)
+{
+    if (!s->out)
+        return;
+    char view[VIEW_TEXT];
+    format_view(s, view, sizeof view);
+    fprintf(s->out, "%s: view %s; ", what, view);
+    if (done->regions == 0)
+        fprintf(s->out, "nothing new to compute\n");
+    else
+        fprintf(s->out,
+                "computed %llu cells in %u new region%s, joined (%u region%s resolved again), "
+                "%u new group%s (%u across borders); %.1f ms\n",
+                (unsigned long long)done->cells, done->regions, done->regions == 1 ? "" : "s",
+                done->affected, done->affected == 1 ? "" : "s", done->new_groups,
+                done->new_groups == 1 ? "" : "s", done->straddling, 1e3 * done->seconds);
+    fflush(s->out);
+}
+
+/* Moves the view to lo..hi and computes what it uncovers. */
+static cm_status move_view(session *s, const double *lo, const double *hi, const char *what,
+                           char *msg, size_t msg_size)
+{
+    cm_status st = check_view(s, lo, hi, what, msg, msg_size);
+    cm_box box;
+    computed done = {0};
+    if (st != CM_OK)
+        return st;
+    view_box(s, lo, hi, &box);
+    st = cover_box(s, &box, what, &done, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    memcpy(s->lo, lo, sizeof s->lo);
+    memcpy(s->hi, hi, sizeof s->hi);
+    s->have_view = 1;
+    s->last_compute_s = done.seconds;
+    st = save_view(s, msg, msg_size);
+    if (st == CM_OK)
+        report(s, what, &done);
+    return st;
+}
+
+/* ---- parsing --------------------------------------------------------------- */
+
+/* Splits a line into words ("double quotes" keep spaces); drops a # comment. */
+static int tokenize(char *line, char **tokens, int max, char *msg, size_t msg_size)
+{
+    int n = 0;
+    char *p = line;
+    for (;;) {
+        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
+            p++;
+        if (!*p || *p == '#')
+            return n;
+        if (n == max) {
+            cm_fail(CM_EINVAL, msg, msg_size, "too many words (at most %d)", max);
+            return -1;
+        }
+        if (*p == '"') {
+            tokens[n++] = ++p;
+            while (*p && *p != '"')
+                p++;
+            if (!*p) {
+                cm_fail(CM_EINVAL, msg, msg_size, "a \" is not closed");
+                return -1;
+            }
+        } else {
+            tokens[n++] = p;
+            while (*p && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
+                p++;
+        }
+        if (*p)
+            *p++ = 0;
+    }
+}
+
+static cm_status need_view(const session *s, const char *verb, char *msg, size_t msg_size)
+{
+    return s->have_view ? CM_OK
+                        : cm_fail(CM_EINVAL, msg, msg_size,
+                                  "%s: there is no view yet; start with `view X0:X1%s`", verb,
+                                  s->view_dims > 1 ? " Y0:Y1" : "");
+}
+
+static cm_status words(int n, int lo, int hi, const char *usage, char *msg, size_t msg_size)
+{
+    return n >= lo && n <= hi ? CM_OK : cm_fail(CM_EINVAL, msg, msg_size, "usage: %s", usage);
+}
+
+/* "at Z,W,..." of a view: the slice, in cells, inside the depth. */
+static cm_status parse_slice(session *s, const char *text, int64_t *slice, char *msg,
+                             size_t msg_size)
+{
+    double v[CM_MAX_DIM];
+    int n = 0;
+    if (s->dim <= 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "view: `at` chooses a slice of models of more than two dimensions");
+    if (!parse_doubles(text, v, &n, CM_MAX_DIM) || n != s->dim - 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "view: `at %s` needs %d number(s), one per "
+                       "dimension from the third on",
+                       text, s->dim - 2);
+    for (int d = 2; d < s->dim; d++) {
+        const double c = floor((v[d - 2] - s->c.lat.origin[d]) / s->c.lat.width[d]);
+        if (!(c >= (double)s->depth_lo[d] && c < (double)s->depth_hi[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "view: %s = %g is outside the session's depth (--depth)", axis_name(d),
+                           v[d - 2]);
+        slice[d] = (int64_t)c;
+    }
+    return CM_OK;
+}
+
+static cm_status cmd_view(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    const int ranges = s->view_dims;
+    const char *usage = ranges > 1 ? "view X0:X1 Y0:Y1" : "view X0:X1";
+    double lo[2] = {0, 0}, hi[2] = {0, 0};
+    int64_t slice[CM_MAX_DIM];
+    memcpy(slice, s->slice, sizeof slice);
+    cm_status st = words(n, 1 + ranges, 1 + ranges + 2, usage, msg, msg_size);
+    if (st == CM_OK && n != 1 + ranges && (n != 3 + ranges || strcmp(t[1 + ranges], "at") != 0))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "usage: %s [at Z,...]", usage);
+    for (int d = 0; d < ranges && st == CM_OK; d++) {
+        int count = 0;
+        if (!parse_ranges(t[1 + d], &lo[d], &hi[d], &count, 1) || count != 1)
+            st =
+                cm_fail(CM_EINVAL, msg, msg_size, "view: '%s' is not LO:HI with LO < HI", t[1 + d]);
+    }
+    if (st == CM_OK && n == 3 + ranges)
+        st = parse_slice(s, t[2 + ranges], slice, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    memcpy(s->slice, slice, sizeof slice);
+    return move_view(s, lo, hi, "view", msg, msg_size);
+}
+
+/* AMOUNT of a pan along dimension d: "25%", "120c" or a length. */
+static cm_status parse_amount(const session *s, const char *text, int d, double *out, char *msg,
+                              size_t msg_size)
+{
+    char number[64];
+    const size_t len = strlen(text);
+    double v = 0, unit = 1;
+    snprintf(number, sizeof number, "%s", text);
+    if (len > 1 && text[len - 1] == '%') {
+        number[len - 1] = 0;
+        unit = (s->hi[d] - s->lo[d]) / 100;
+    } else if (len > 1 && text[len - 1] == 'c') {
+        number[len - 1] = 0;
+        unit = s->c.lat.width[d];
+    }
+    if (len >= sizeof number || !parse_double(number, &v) || !(v > 0) || !isfinite(v * unit))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "pan: '%s' is not a positive amount: 25%% (of the view), 120c (cells) or "
+                       "a length",
+                       text);
+    *out = v * unit;
+    return CM_OK;
+}
+
+static cm_status cmd_pan(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    static const char *const dirs[] = {"left", "right", "down", "up"};
+    cm_status st = words(n, 3, 3, "pan left|right|up|down AMOUNT", msg, msg_size);
+    int dir = -1;
+    for (int k = 0; k < 4 && st == CM_OK; k++)
+        if (strcmp(t[1], dirs[k]) == 0)
+            dir = k;
+    if (st == CM_OK && dir < 0)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "pan: '%s' is not left, right, up or down", t[1]);
+    if (st == CM_OK && dir >= 2 && s->view_dims < 2)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "pan %s: a one-dimensional view pans left or right",
+                     t[1]);
+    if (st == CM_OK)
+        st = need_view(s, "pan", msg, msg_size);
+    const int d = dir / 2;
+    double amount = 0;
+    if (st == CM_OK)
+        st = parse_amount(s, t[2], d, &amount, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    double lo[2], hi[2];
+    memcpy(lo, s->lo, sizeof lo);
+    memcpy(hi, s->hi, sizeof hi);
+    const double shift = dir % 2 ? amount : -amount;
+    lo[d] += shift;
+    hi[d] += shift;
+    char what[96];
+    snprintf(what, sizeof what, "pan %s %s", t[1], t[2]);
+    return move_view(s, lo, hi, what, msg, msg_size);
+}
+
+static cm_status cmd_zoom(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    double factor = 0;
+    cm_status st = words(n, 2, 2, "zoom FACTOR (2: closer, 0.5: farther)", msg, msg_size);
+    if (st == CM_OK && (!parse_double(t[1], &factor) || !(factor > 0) || !isfinite(factor)))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "zoom: '%s' is not a positive factor", t[1]);
+    if (st == CM_OK)
+        st = need_view(s, "zoom", msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    double lo[2] = {0, 0}, hi[2] = {0, 0};
+    for (int d = 0; d < s->view_dims; d++) {
+        const double mid = 0.5 * (s->lo[d] + s->hi[d]), half = 0.5 * (s->hi[d] - s->lo[d]) / factor;
+        lo[d] = mid - half;
+        hi[d] = mid + half;
+    }
+    char what[96];
+    snprintf(what, sizeof what, "zoom %s", t[1]);
+    return move_view(s, lo, hi, what, msg, msg_size);
+}
+
+static cm_status cmd_goto(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    const char *usage = s->view_dims > 1 ? "goto X Y" : "goto X";
+    cm_status st = words(n, 1 + s->view_dims, 1 + s->view_dims, usage, msg, msg_size);
+    if (st == CM_OK)
+        st = need_view(s, "goto", msg, msg_size);
+    double lo[2] = {0, 0}, hi[2] = {0, 0};
+    for (int d = 0; d < s->view_dims && st == CM_OK; d++) {
+        double x;
+        if (!parse_double(t[1 + d], &x) || !isfinite(x)) {
+            st = cm_fail(CM_EINVAL, msg, msg_size, "goto: '%s' is not a number", t[1 + d]);
+            break;
+        }
+        const double half = 0.5 * (s->hi[d] - s->lo[d]);
+        lo[d] = x - half;
+        hi[d] = x + half;
+    }
+    return st == CM_OK ? move_view(s, lo, hi, "goto", msg, msg_size) : st;
+}
+
+/* ---- extend auto ----------------------------------------------------------- */
+
+/* Reads every region back, whatever the budget: the extension follows
+ * sequences through the whole cluster at once. The next join's commit
+ * trims the cluster to the budget again. */
+static cm_status acquire_all(cm_cluster *c, char *msg, size_t msg_size)
+{
+    const uint64_t budget = c->mem_budget;
+    cm_status st = CM_OK;
+    c->mem_budget = 0;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
+        st = cm_cluster_acquire(c, k, msg, msg_size);
+    c->mem_budget = budget;
+    return st;
+}
+
+static cm_status extend_step(session *s, const cm_box *tile, int step, char *msg, size_t msg_size)
+{
+    cm_extend_choice choice;
+    computed done = {0};
+    const double t0 = now_seconds();
+    cm_status st = acquire_all(&s->c, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
+    if (st == CM_OK)
+        st = cover_box(s, &choice.box, "extend auto", &done, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (s->out) {
+        char box[CM_MAX_DIM * 64];
+        format_box(&s->c.lat, &choice.box, box, sizeof box);
+        fprintf(s->out,
+                "extend auto %d: tile %s, where %llu of the %llu escaping sequences go; computed "
+                "%llu cells in %u new region%s, %u new group%s (%u across borders); %.1f ms\n",
+                step, box, (unsigned long long)choice.escaping,
+                (unsigned long long)choice.all_escaping, (unsigned long long)done.cells,
+                done.regions, done.regions == 1 ? "" : "s", done.new_groups,
+                done.new_groups == 1 ? "" : "s", done.straddling, 1e3 * (now_seconds() - t0));
+        fflush(s->out);
+    }
+    return CM_OK;
+}
+
+static cm_status cmd_extend(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    int64_t steps = 1;
+    cm_status st = words(n, 2, 3, "extend auto [N]", msg, msg_size);
+    if (st == CM_OK && strcmp(t[1], "auto") != 0)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "usage: extend auto [N] (not '%s')", t[1]);
+    if (st == CM_OK && n == 3 && (!parse_int64(t[2], &steps) || steps < 1 || steps > 1000))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "extend auto: '%s' must be an integer in 1..1000",
+                     t[2]);
+    if (st == CM_OK)
+        st = need_view(s, "extend", msg, msg_size);
+    cm_box tile;
+    if (st == CM_OK)
+        view_box(s, s->lo, s->hi, &tile);
+    for (int64_t k = 0; k < steps && st == CM_OK; k++) {
+        st = extend_step(s, &tile, (int)k + 1, msg, msg_size);
+        if (st == CM_ENOTFOUND) { /* nothing escapes next to the cluster: done, not an error */
+            if (s->out)
+                fprintf(s->out, "extend auto: stopped, %s\n", msg);
+            return CM_OK;
+        }
+    }
+    return st;
+}
+
+/* ---- render, stats, export, save --------------------------------------------- */
+
+/* The shown layer of the view, flattened, and the cluster's groups. */
+static cm_status shown_cells(session *s, cm_region *flat, cm_group_info **groups, char *msg,
+                             size_t msg_size)
+{
+    cm_box box;
+    uint64_t sink = 0;
+    shown_box(s, &box);
+    *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
+    if (!*groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", s->c.ngroups);
+    cm_status st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
+    return st;
+}
+
+static cm_status cmd_render(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    int64_t wh[2] = {0, 0};
+    int count = 0;
+    cm_status st = words(n, 2, 3, "render FILE.png [WIDTHxHEIGHT]", msg, msg_size);
+    if (st == CM_OK && n == 3 &&
+        (!parse_counts(t[2], wh, &count, 2) || count != 2 || wh[0] > 16384 || wh[1] > 16384))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be WIDTHxHEIGHT, each 1..16384",
+                     t[2]);
+    if (st == CM_OK)
+        st = need_view(s, "render", msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const double t0 = now_seconds();
+    cm_region flat;
+    cm_group_info *groups = NULL;
+    memset(&flat, 0, sizeof flat);
+    st = shown_cells(s, &flat, &groups, msg, msg_size);
+    const basin_png png = {t[1],
+                           &s->model,
+                           &s->c.lat,
+                           &flat,
+                           groups,
+                           (int)wh[0],
+                           (int)wh[1],
+                           {s->lo[0], s->lo[1]},
+                           {s->hi[0], s->hi[1]}};
+    if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
+        st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
+    if (st == CM_OK && s->out) {
+        fprintf(s->out, "render %s: %.1f ms\n", t[1], 1e3 * (now_seconds() - t0));
+        fflush(s->out);
+    }
+    cm_region_free(&flat);
+    free(groups);
+    return st;
+}
+
+static void print_attractors(const session *s, const cm_region *flat, const cm_group_info *g,
+                             const uint64_t *in_view)
+{
+    fprintf(s->out, "%6s %8s %12s %12s  %s\n", "group", "period", "in view", "basin", "centre");
+    for (uint32_t k = 0; k < flat->ngroups; k++) {
+        const cm_group_info *gi = &g[k];
+        int inside = 1;
+        for (int d = 0; d < s->view_dims; d++)
+            inside &= gi->hi[d] >= s->lo[d] && gi->lo[d] <= s->hi[d];
+        if (!inside || !in_view[k + 1])
+            continue;
+        fprintf(s->out, "%6u %8u %12llu %12llu  (", gi->id, gi->period,
+                (unsigned long long)in_view[k + 1], (unsigned long long)gi->basin_cells);
+        for (int d = 0; d < s->dim; d++)
+            fprintf(s->out, "%s%.9g", d ? ", " : "", gi->centre[d]);
+        fprintf(s->out, ")\n");
+    }
+}
+
+static cm_status cmd_stats(session *s, int n, char *msg, size_t msg_size)
+{
+    cm_status st = words(n, 1, 1, "stats", msg, msg_size);
+    if (st == CM_OK)
+        st = need_view(s, "stats", msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_region flat;
+    cm_group_info *groups = NULL;
+    memset(&flat, 0, sizeof flat);
+    st = shown_cells(s, &flat, &groups, msg, msg_size);
+    uint64_t *in_view = st == CM_OK ? calloc((size_t)flat.ngroups + 2, sizeof *in_view) : NULL;
+    if (st == CM_OK && !in_view)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups in view");
+    if (st == CM_OK && s->out) {
+        uint64_t missing = 0, cells = 0, groups_in_view = 0;
+        for (uint64_t i = 0; i < flat.ncells; i++) {
+            if (flat.group[i] == CM_GROUP_NONE)
+                missing++;
+            else
+                groups_in_view += in_view[flat.group[i]]++ == 0 && flat.group[i] != 0;
+        }
+        for (uint32_t k = 0; k < s->c.nregions; k++)
+            cells += s->c.regions[k].r.ncells;
+        char view[VIEW_TEXT];
+        format_view(s, view, sizeof view);
+        fprintf(s->out,
+                "view %s: %llu cells, %llu not computed, %llu in the sink's domain, "
+                "%llu groups\n",
+                view, (unsigned long long)flat.ncells, (unsigned long long)missing,
+                (unsigned long long)in_view[0], (unsigned long long)groups_in_view);
+        print_attractors(s, &flat, groups, in_view);
+        cm_store_info info;
+        cm_store_stats ss;
+        cm_store_get_stats(s->store, &ss);
+        if (cm_store_read_info(s->store, &info, msg, msg_size) != CM_OK)
+            info.file_bytes = 0;
+        fprintf(s->out,
+                "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays "
+                "resident %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
+                s->c.nregions, (unsigned long long)cells, s->c.ngroups,
+                (double)cm_cluster_bytes(&s->c) / 1048576.0,
+                (double)cm_cluster_resident_bytes(&s->c) / 1048576.0,
+                s->c.mem_budget ? ", within --mem" : "", (double)info.file_bytes / 1048576.0,
+                cells ? (double)info.file_bytes / (double)cells : 0.0);
+        fflush(s->out);
+    }
+    free(in_view);
+    cm_region_free(&flat);
+    free(groups);
+    return st;
+}
+
+/* `export ...` runs `cellmap export FILE ...` on the saved cluster; cells
+ * default to the view's. */
+static cm_status cmd_export_view(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    char *argv[MAX_TOKENS + 4], window[CM_MAX_DIM * 64];
+    int argc = 0, has_window = 0, has_cells = 0;
+    argv[argc++] = "export";
+    argv[argc++] = (char *)s->path;
+    for (int k = 1; k < n; k++) {
+        has_window |= strcmp(t[k], "--window") == 0 || strncmp(t[k], "--window=", 9) == 0;
+        has_cells |= strncmp(t[k], "--cells", 7) == 0 || strncmp(t[k], "--flat", 6) == 0;
+        argv[argc++] = t[k];
+    }
+    if (has_cells && !has_window && s->have_view) {
+        cm_box box;
+        view_box(s, s->lo, s->hi, &box);
+        format_box(&s->c.lat, &box, window, sizeof window);
+        argv[argc++] = "--window";
+        argv[argc++] = window;
+    }
+    argv[argc] = NULL;
+    fflush(s->out);
+    const int rc = cmd_export(argc, argv);
+    return rc == EXIT_OK ? CM_OK : cm_fail(CM_EINVAL, msg, msg_size, "export failed (see above)");
+}
+
+static cm_status cmd_save(session *s, int n, char *msg, size_t msg_size)
+{
+    cm_status st = words(n, 1, 1, "save", msg, msg_size);
+    if (st == CM_OK)
+        st = save_view(s, msg, msg_size);
+    if (st == CM_OK && s->out) {
+        fprintf(s->out, "saved %s: %u regions, %u groups\n", s->path, s->c.nregions, s->c.ngroups);
+        fflush(s->out);
+    }
+    return st;
+}
+
+cm_status session_exec(session *s, const char *line, char *msg, size_t msg_size)
+{
+    char copy[4096], *t[MAX_TOKENS];
+    if (strlen(line) >= sizeof copy)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the line is longer than %zu characters",
+                       sizeof copy - 1);
+    snprintf(copy, sizeof copy, "%s", line);
+    const int n = tokenize(copy, t, MAX_TOKENS, msg, msg_size);
+    if (n < 0)
+        return CM_EINVAL;
+    if (n == 0)
+        return CM_OK;
+    if (strcmp(t[0], "view") == 0)
+        return cmd_view(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "pan") == 0)
+        return cmd_pan(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "zoom") == 0)
+        return cmd_zoom(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "goto") == 0)
+        return cmd_goto(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "extend") == 0)
+        return cmd_extend(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "render") == 0)
+        return cmd_render(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "stats") == 0)
+        return cmd_stats(s, n, msg, msg_size);
+    if (strcmp(t[0], "export") == 0)
+        return cmd_export_view(s, t, n, msg, msg_size);
+    if (strcmp(t[0], "save") == 0)
+        return cmd_save(s, n, msg, msg_size);
+    if (strcmp(t[0], "quit") == 0 || strcmp(t[0], "exit") == 0) {
+        s->quit = 1;
+        return words(n, 1, 1, t[0], msg, msg_size);
+    }
+    if (strcmp(t[0], "help") == 0) {
+        if (s->out)
+            fputs(session_help, s->out);
+        return CM_OK;
+    }
+    return cm_fail(CM_EINVAL, msg, msg_size,
+                   "unknown command '%s' (commands: view, pan, zoom, goto, extend, render, stats, "
+                   "export, save, quit, help)",
+                   t[0]);
+}
+
+/* ---- opening and closing ------------------------------------------------------ */
+
+static int open_error(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "cellmap explore: ");
+    fprintf(stderr, fmt, a, b);
+    fputc('\n', stderr);
+    return EXIT_FAIL;
+}
+
+/* The parameters JSON of a file ({"k":1.5,"mode":"output","K":[1,2]}) as
+ * the "k=v,..." text models are built from. False if it is not such JSON. */
+static bool params_text(const char *json, char *out, size_t size)
+{
+    size_t used = 0;
+    const char *p = json;
+    if (*p++ != '{')
+        return false;
+    while (*p && *p != '}') {
+        const char *key = p + 1, *end = *p == '"' ? strchr(key, '"') : NULL;
+        if (!end || end[1] != ':')
+            return false;
+        used += (size_t)snprintf(out + used, size > used ? size - used : 0,
+                                 "%s%.*s=", used ? "," : "", (int)(end - key), key);
+        p = end + 2;
+        const char *stop = *p == '[' ? "]" : *p == '"' ? "\"" : ",}";
+        if (*p == '[' || *p == '"')
+            p++;
+        const size_t len = strcspn(p, stop);
+        for (size_t i = 0; i < len && used + 1 < size; i++)
+            out[used++] = p[i] == ',' ? ':' : p[i];
+        out[used < size ? used : size - 1] = 0;
+        p += len;
+        if (*stop != ',' && *p++ == 0)
+            return false;
+        if (*p == ',')
+            p++;
+    }
+    return *p == '}' && used < size;
+}
+
+/* The file's model, rebuilt from its name and parameters. */
+static int model_of_file(session *s, const cm_store_info *info)
+{
+    char text[4096], msg[512], again[4096];
+    const char *texts[1] = {text};
+    if (!params_text(info->params, text, sizeof text))
+        return open_error("%s: its parameters '%s' are not readable", s->path, info->params);
+    if (cm_model_create(info->model, texts, 1, &s->model, msg, sizeof msg) != CM_OK)
+        return open_error("%s: %s", s->path, msg);
+    s->have_model = 1;
+    cm_params_json(&s->model.values, again, sizeof again);
+    if (strcmp(again, info->params) != 0)
+        return open_error("%s: its parameters %s do not rebuild exactly; this cellmap reads "
+                          "them as something else",
+                          s->path, info->params);
+    return EXIT_OK;
+}
+
+/* max-steps from a file's plan ("... max-steps K ..."); 1 if it has none. */
+static int plan_max_steps(const char *plan)
+{
+    const char *p = strstr(plan, "max-steps ");
+    return p ? atoi(p + 10) : 1;
+}
+
+static void format_depth(const session *s, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 2; d < s->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%lld:%lld", d > 2 ? "," : "",
+                                 (long long)s->depth_lo[d], (long long)s->depth_hi[d]);
+}
+
+/* The depth (cells of dimensions 3..) from the file's note, or the
+ * cluster's bounds; the slice in its middle. */
+static int restore_depth(session *s)
+{
+    char text[512], msg[256];
+    if (s->dim <= 2)
+        return EXIT_OK;
+    if (cm_store_get_note(s->store, "note.explore.depth", text, sizeof text, msg, sizeof msg) ==
+        CM_OK) {
+        char *p = text;
+        for (int d = 2; d < s->dim; d++) {
+            char *end;
+            s->depth_lo[d] = strtoll(p, &end, 10);
+            s->depth_hi[d] = *end == ':' ? strtoll(end + 1, &end, 10) : s->depth_lo[d];
+            p = *end == ',' ? end + 1 : end;
+        }
+    } else if (s->c.nregions > 0) {
+        cm_box bounds;
+        cm_cluster_bounds(&s->c, &bounds);
+        memcpy(s->depth_lo, bounds.lo, sizeof bounds.lo);
+        memcpy(s->depth_hi, bounds.hi, sizeof bounds.hi);
+    } else {
+        return open_error("%s has no depth for dimensions 3.. (it was not made by explore)%s",
+                          s->path, "");
+    }
+    for (int d = 2; d < s->dim; d++) {
+        if (s->depth_lo[d] >= s->depth_hi[d])
+            return open_error("%s: damaged depth note '%s'", s->path, text);
+        s->slice[d] = s->depth_lo[d] + (s->depth_hi[d] - s->depth_lo[d]) / 2;
+    }
+    return EXIT_OK;
+}
+
+/* The view saved by the last session, or the cluster's bounding box. */
+static int restore_view(session *s)
+{
+    char text[VIEW_TEXT], msg[256], *t[MAX_TOKENS];
+    if (cm_store_get_note(s->store, "note.explore.view", text, sizeof text, msg, sizeof msg) ==
+        CM_OK) {
+        const int n = tokenize(text, t, MAX_TOKENS, msg, sizeof msg);
+        for (int d = 0; d < s->view_dims; d++) {
+            int count = 0;
+            if (d >= n || !parse_ranges(t[d], &s->lo[d], &s->hi[d], &count, 1))
+                return open_error("%s: damaged view note%s", s->path, "");
+        }
+        if (n == s->view_dims + 2 && parse_slice(s, t[n - 1], s->slice, msg, sizeof msg) != CM_OK)
+            return open_error("%s: %s", s->path, msg);
+        s->have_view = 1;
+    } else if (s->c.nregions > 0) {
+        cm_box b;
+        cm_cluster_bounds(&s->c, &b);
+        for (int d = 0; d < s->view_dims; d++) {
+            s->lo[d] = s->c.lat.origin[d] + (double)b.lo[d] * s->c.lat.width[d];
+            s->hi[d] = s->c.lat.origin[d] + (double)b.hi[d] * s->c.lat.width[d];
+        }
+        s->have_view = 1;
+    }
+    return EXIT_OK;
+}
+
+static int same_lattice(const cm_lattice *a, const cm_lattice *b)
+{
+    if (a->dim != b->dim)
+        return 0;
+    for (int d = 0; d < a->dim; d++)
+        if (a->origin[d] != b->origin[d] || a->width[d] != b->width[d])
+            return 0;
+    return 1;
+}
+
+/* The lattice of the options (--cell-size, --origin) for a model. */
+static int options_lattice(const session_options *o, int dim, cm_lattice *lat)
+{
+    char msg[256];
+    memset(lat, 0, sizeof *lat);
+    lat->dim = dim;
+    if (o->n_cell_size != dim) {
+        fprintf(stderr,
+                "cellmap explore: --cell-size needs %d width(s) DX[,DY...] for this model\n", dim);
+        return EXIT_USAGE;
+    }
+    if (o->n_origin && o->n_origin != dim) {
+        fprintf(stderr, "cellmap explore: --origin needs %d coordinate(s) for this model\n", dim);
+        return EXIT_USAGE;
+    }
+    for (int d = 0; d < dim; d++) {
+        lat->width[d] = o->cell_size[d];
+        lat->origin[d] = o->n_origin ? o->origin[d] : 0.0;
+    }
+    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap explore: --cell-size/--origin: %s\n", msg);
+        return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
+/* Options given for an existing file must describe it. */
+static int check_same(const session *s, const session_options *o, const cm_store_info *info)
+{
+    cm_model m;
+    char msg[512], params[4096];
+    if (o->mo.name) {
+        if (cm_model_create(o->mo.name, o->mo.texts, o->mo.n_texts, &m, msg, sizeof msg) != CM_OK)
+            return open_error("%s%s", msg, "");
+        cm_params_json(&m.values, params, sizeof params);
+        const int differs = strcmp(m.name, info->model) != 0 || strcmp(params, info->params) != 0;
+        cm_model_release(&m);
+        if (differs)
+            return open_error("%s holds model %s; drop --model/--param to go on with it, or "
+                              "choose another file",
+                              s->path, info->model);
+    }
+    cm_lattice lat;
+    if (o->n_cell_size && (options_lattice(o, info->lattice.dim, &lat) != EXIT_OK ||
+                           !same_lattice(&lat, &info->lattice)))
+        return open_error("%s has another lattice; drop --cell-size/--origin to go on with "
+                          "it%s",
+                          s->path, "");
+    if (o->max_steps && o->max_steps != s->max_steps)
+        return open_error("%s was computed with another --max-steps; drop it to go on with "
+                          "the file's%s",
+                          s->path, "");
+    return EXIT_OK;
+}
+
+static int open_existing(session *s, const session_options *o)
+{
+    char msg[1024];
+    cm_store_info info;
+    cm_status st = cm_store_open(s->path, 1, &s->store, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_read_info(s->store, &info, msg, sizeof msg);
+    if (st != CM_OK)
+        return open_error("%s%s", msg, "");
+    s->max_steps = plan_max_steps(info.plan);
+    int rc = model_of_file(s, &info);
+    if (rc == EXIT_OK)
+        rc = check_same(s, o, &info);
+    if (rc != EXIT_OK)
+        return rc;
+    cm_cluster_init(&s->c, &info.lattice);
+    if (cm_store_load_cluster(s->store, &s->c, msg, sizeof msg) != CM_OK)
+        return open_error("%s%s", msg, "");
+    s->dim = info.lattice.dim;
+    s->view_dims = s->dim < 2 ? s->dim : 2;
+    if ((rc = restore_depth(s)) != EXIT_OK)
+        return rc;
+    return restore_view(s);
+}
+
+/* The depth of a new file's models of more than two dimensions: --depth
+ * or the model's example region. */
+static int new_depth(session *s, const session_options *o)
+{
+    const cm_model_entry *e = cm_model_find(s->model.name);
+    const char *text = o->depth_text;
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    if (s->dim <= 2)
+        return EXIT_OK;
+    if (!text && e && e->region) {
+        if (!parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != s->dim)
+            return open_error("model %s: bad example region %s", s->model.name, e->region);
+    } else if (!text || !parse_ranges(text, lo + 2, hi + 2, &n, CM_MAX_DIM - 2) ||
+               n != s->dim - 2) {
+        fprintf(stderr,
+                "cellmap explore: model %s has %d dimensions: --depth LO:HI,... gives the "
+                "ranges of dimensions 3..%d that every view computes\n",
+                s->model.name, s->dim, s->dim);
+        return EXIT_USAGE;
+    }
+    for (int d = 2; d < s->dim; d++) {
+        s->depth_lo[d] = border_cell(lo[d], s->c.lat.origin[d], s->c.lat.width[d], 0);
+        s->depth_hi[d] = border_cell(hi[d], s->c.lat.origin[d], s->c.lat.width[d], 1);
+        s->slice[d] = s->depth_lo[d] + (s->depth_hi[d] - s->depth_lo[d]) / 2;
+    }
+    char depth[512], msg[512];
+    format_depth(s, depth, sizeof depth);
+    if (cm_store_set_note(s->store, "note.explore.depth", depth, msg, sizeof msg) != CM_OK)
+        return open_error("%s%s", msg, "");
+    return EXIT_OK;
+}
+
+static int create_new(session *s, const session_options *o)
+{
+    char msg[1024];
+    cm_lattice lat;
+    if (!o->mo.name) {
+        fprintf(stderr,
+                "cellmap explore: %s does not exist; create it with --model NAME "
+                "[--param k=v,...] --cell-size DX[,DY...] [--origin X,Y...]\n",
+                s->path);
+        return EXIT_USAGE;
+    }
+    if (cm_model_create(o->mo.name, o->mo.texts, o->mo.n_texts, &s->model, msg, sizeof msg) !=
+        CM_OK) {
+        fprintf(stderr, "cellmap explore: %s\n", msg);
+        return EXIT_USAGE;
+    }
+    s->have_model = 1;
+    s->dim = s->model.dim;
+    s->view_dims = s->dim < 2 ? s->dim : 2;
+    s->max_steps = o->max_steps ? o->max_steps : 1;
+    int rc = options_lattice(o, s->dim, &lat);
+    if (rc != EXIT_OK)
+        return rc;
+    char plan[64];
+    snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
+    const char *epoch = getenv("SOURCE_DATE_EPOCH");
+    const cm_store_meta meta = {
+        &s->model, &lat, o->command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
+    cm_cluster_init(&s->c, &lat);
+    if (cm_store_create(s->path, &meta, &s->store, msg, sizeof msg) != CM_OK)
+        return open_error("%s%s", msg, "");
+    return new_depth(s, o);
+}
+
+int session_open(session *s, const session_options *o)
+{
+    struct stat sb;
+    memset(s, 0, sizeof *s);
+    s->path = o->path;
+    s->out = o->out;
+    s->threads = o->threads;
+    const int rc = stat(o->path, &sb) == 0 ? open_existing(s, o) : create_new(s, o);
+    if (rc != EXIT_OK)
+        return rc;
+    cm_store_attach(s->store, &s->c);
+    s->c.threads = o->threads;
+    s->c.mem_budget = o->mem;
+    return EXIT_OK;
+}
+
+cm_status session_close(session *s, char *msg, size_t msg_size)
+{
+    cm_status st = s->store ? save_view(s, msg, msg_size) : CM_OK;
+    const cm_status closed = cm_store_close(s->store, msg, msg_size);
+    s->store = NULL;
+    cm_cluster_free(&s->c);
+    if (s->have_model)
+        cm_model_release(&s->model);
+    s->have_model = 0;
+    return st != CM_OK ? st : closed;
+}
