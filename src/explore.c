@@ -526,23 +526,46 @@ static cm_status cmd_render(session *s, char **t, int n, char *msg, size_t msg_s
     return st;
 }
 
-static void print_attractors(const session *s, const cm_region *flat, const cm_group_info *g,
-                             const uint64_t *in_view)
+/* Most attractors `stats` lists (those with the most cells in view). */
+enum { STATS_GROUPS = 20 };
+
+typedef struct group_count {
+    uint64_t cells;
+    uint32_t id;
+} group_count;
+
+static int more_in_view(const void *a, const void *b)
 {
+    const group_count *x = a, *y = b;
+    if (x->cells != y->cells)
+        return x->cells > y->cells ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+/* The groups with cells in view, the most first. */
+static void print_groups(const session *s, uint32_t ngroups, const cm_group_info *g,
+                         const uint64_t *in_view)
+{
+    group_count *ids = malloc(((size_t)ngroups + 1) * sizeof *ids);
+    uint32_t n = 0;
+    if (!ids)
+        return;
+    for (uint32_t k = 1; k <= ngroups; k++)
+        if (in_view[k])
+            ids[n++] = (group_count){in_view[k], k};
+    qsort(ids, n, sizeof *ids, more_in_view);
     fprintf(s->out, "%6s %8s %12s %12s  %s\n", "group", "period", "in view", "basin", "centre");
-    for (uint32_t k = 0; k < flat->ngroups; k++) {
-        const cm_group_info *gi = &g[k];
-        int inside = 1;
-        for (int d = 0; d < s->view_dims; d++)
-            inside &= gi->hi[d] >= s->lo[d] && gi->lo[d] <= s->hi[d];
-        if (!inside || !in_view[k + 1])
-            continue;
+    for (uint32_t k = 0; k < n && k < STATS_GROUPS; k++) {
+        const cm_group_info *gi = &g[ids[k].id - 1];
         fprintf(s->out, "%6u %8u %12llu %12llu  (", gi->id, gi->period,
-                (unsigned long long)in_view[k + 1], (unsigned long long)gi->basin_cells);
+                (unsigned long long)ids[k].cells, (unsigned long long)gi->basin_cells);
         for (int d = 0; d < s->dim; d++)
             fprintf(s->out, "%s%.9g", d ? ", " : "", gi->centre[d]);
         fprintf(s->out, ")\n");
     }
+    if (n > STATS_GROUPS)
+        fprintf(s->out, "... and %u groups with fewer cells in view\n", n - STATS_GROUPS);
+    free(ids);
 }
 
 static cm_status cmd_stats(session *s, int n, char *msg, size_t msg_size)
@@ -576,7 +599,7 @@ static cm_status cmd_stats(session *s, int n, char *msg, size_t msg_size)
                 "%llu groups\n",
                 view, (unsigned long long)flat.ncells, (unsigned long long)missing,
                 (unsigned long long)in_view[0], (unsigned long long)groups_in_view);
-        print_attractors(s, &flat, groups, in_view);
+        print_groups(s, flat.ngroups, groups, in_view);
         cm_store_info info;
         cm_store_stats ss;
         cm_store_get_stats(s->store, &ss);

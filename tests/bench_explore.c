@@ -1,0 +1,124 @@
+/* bench_explore: issue 5's panning benchmark. A session views a 1000x1000
+ * cell window, then pans it right by 10 % twenty times, rendering the view
+ * (1000x1000 PNG) after each pan; a full recompute solves the final view
+ * from scratch in a fresh database and renders it the same way.
+ *
+ *   bench_explore [463|421] [DIR]
+ *
+ * 463: the thesis' C-SCM example (4.6.3, panning right from the left
+ * region); 421: the Fig. 4.21 parameters (max-steps 100000). Prints each
+ * pan's time (compute + join + commit, render), the medians and the ratio
+ * of a pan to the full recompute. */
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bench_util.h"
+#include "src/explore.h"
+
+enum { PANS = 20 };
+
+typedef struct preset {
+    const char *name, *params, *view;
+    double cell[2], origin[2];
+    int max_steps;
+} preset;
+
+static const preset presets[] = {
+    {"463", "alpha=0.078,beta=0,P=0.007,D=0.02", "view 0:500 -40:40", {0.5, 0.08}, {0, -40}, 1},
+    {"421",
+     "alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3",
+     "view -125000:125000 -600:600",
+     {250, 1.2},
+     {-125000, -600},
+     100000},
+};
+
+static session open_session(const preset *p, const char *path)
+{
+    session_options o;
+    memset(&o, 0, sizeof o);
+    unlink(path);
+    o.path = path;
+    o.mo.name = "microchaos-pd";
+    o.mo.texts[0] = p->params;
+    o.mo.n_texts = 1;
+    memcpy(o.cell_size, p->cell, sizeof p->cell);
+    memcpy(o.origin, p->origin, sizeof p->origin);
+    o.n_cell_size = o.n_origin = 2;
+    o.max_steps = p->max_steps;
+    o.command = "bench_explore";
+    session s;
+    if (session_open(&s, &o) != 0)
+        exit(1);
+    return s;
+}
+
+/* Runs a line and returns its time. */
+static double timed(session *s, const char *line)
+{
+    char msg[1024];
+    const double t0 = now();
+    if (session_exec(s, line, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "bench_explore: %s: %s\n", line, msg);
+        exit(1);
+    }
+    return now() - t0;
+}
+
+static void close_session(session *s)
+{
+    char msg[512];
+    if (session_close(s, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "bench_explore: %s\n", msg);
+        exit(1);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const preset *p = &presets[0];
+    const char *dir = argc > 2 ? argv[2] : "/tmp";
+    if (argc > 1 && strcmp(argv[1], "421") == 0)
+        p = &presets[1];
+    char db[4096], png[4200], render[4300];
+    snprintf(db, sizeof db, "%s/bench_explore.cmdb", dir);
+    snprintf(png, sizeof png, "%s/bench_explore.png", dir);
+    snprintf(render, sizeof render, "render %s 1000x1000", png);
+
+    session s = open_session(p, db);
+    const double first = timed(&s, p->view), first_render = timed(&s, render);
+    double pan[PANS], draw[PANS], total[PANS];
+    printf("preset %s (%s, max-steps %d): first view %.1f ms + render %.1f ms\n", p->name,
+           p->params, p->max_steps, 1e3 * first, 1e3 * first_render);
+    printf("%4s %12s %12s %12s\n", "pan", "compute ms", "render ms", "total ms");
+    for (int k = 0; k < PANS; k++) {
+        pan[k] = timed(&s, "pan right 10%");
+        draw[k] = timed(&s, render);
+        total[k] = pan[k] + draw[k];
+        printf("%4d %12.1f %12.1f %12.1f\n", k + 1, 1e3 * pan[k], 1e3 * draw[k], 1e3 * total[k]);
+    }
+    char final_view[256];
+    snprintf(final_view, sizeof final_view, "view %.17g:%.17g %.17g:%.17g", s.lo[0], s.hi[0],
+             s.lo[1], s.hi[1]);
+    close_session(&s);
+
+    /* the same view from scratch, three times */
+    double full[3], full_compute[3];
+    for (int k = 0; k < 3; k++) {
+        session f = open_session(p, db);
+        full_compute[k] = timed(&f, final_view);
+        full[k] = full_compute[k] + timed(&f, render);
+        close_session(&f);
+    }
+    const double mc = median(pan, PANS), mr = median(draw, PANS), mt = median(total, PANS);
+    const double fc = median(full_compute, 3), ft = median(full, 3);
+    printf("median pan: compute+join %.1f ms, render %.1f ms, total %.1f ms\n", 1e3 * mc, 1e3 * mr,
+           1e3 * mt);
+    printf("full recompute of the view: compute %.1f ms, with render %.1f ms\n", 1e3 * fc,
+           1e3 * ft);
+    printf("ratio pan/full: %.3f (with render in both), %.3f (compute only)\n", mt / ft, mc / fc);
+    unlink(db);
+    unlink(png);
+    return 0;
+}
