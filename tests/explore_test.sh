@@ -1,0 +1,192 @@
+#!/usr/bin/env bash
+# Integration tests of `cellmap explore` (issue 5): the example sessions and
+# their pictures, a session against a single solve of the union cell by
+# cell, thread counts, kill and replay, malformed commands, the prompt.
+# usage: explore_test.sh PATH/TO/cellmap SOURCE_DIR
+set -u
+CM=$1
+SRC=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+cd "$work"
+
+# --- the example sessions of assets/examples, pixels checked ---------------
+for script in "$SRC"/assets/examples/*.explore; do
+  name=$(basename "$script" .explore)
+  read -r -a opts <<<"$(sed -n 's/^# options://p' "$script")"
+  "$CM" explore "$name.cmdb" "$script" "${opts[@]}" > "$name.out" || fail "example $name failed"
+  python3 "$SRC/tests/pngcheck.py" "$name.png" "$SRC/assets/examples/$name.check.json" ||
+    fail "example $name: pixels"
+done
+
+# --- a session equals a single solve of the union of its views ------------
+# Views inside 100:300 x -16:16 with pans and zooms, then the whole box.
+pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
+lattice="--cell-size 0.5,0.08 --origin 100,-16"
+cat > union.explore <<'S'
+view 150:200 -4:4
+pan right 25%
+pan right 30c
+pan up 2.5
+pan left 50%
+zoom 0.5
+goto 150 -8
+zoom 4
+# the whole box: every remaining strip
+view 100:300 -16:16
+S
+for t in 1 2; do
+  rm -f "union$t.cmdb"
+  "$CM" explore "union$t.cmdb" union.explore $pd $lattice --threads $t > "union$t.out" ||
+    fail "union session ($t threads) failed"
+  "$CM" export "union$t.cmdb" --cells "union$t.csv" || fail "export union$t"
+done
+cmp -s union1.csv union2.csv || fail "the session's cells differ between 1 and 2 threads"
+grep -q "computed" union1.out || fail "the session computed nothing"
+"$CM" solve $pd --region 100:300,-16:16 --cells 400x400 --db whole.cmdb > /dev/null ||
+  fail "single solve failed"
+"$CM" export whole.cmdb --cells whole.csv || fail "export whole"
+python3 - union1.csv whole.csv <<'PY' || fail "session and single solve differ"
+import csv, sys
+def cells(path):
+    rows = {}
+    for r in csv.DictReader(open(path)):
+        rows[(int(r["ix"]), int(r["iy"]))] = (int(r["grp"]), int(r["step"]), int(r["periodic"]))
+    return rows
+a, b = cells(sys.argv[1]), cells(sys.argv[2])
+assert len(a) == 400 * 400, len(a)
+assert set(a) == set(b), "different cells"
+fwd, back, bad = {}, {}, 0
+for k in a:
+    (ga, sa, pa), (gb, sb, pb) = a[k], b[k]
+    if sa != sb or pa != pb or fwd.setdefault(ga, gb) != gb or back.setdefault(gb, ga) != ga or (ga == 0) != (gb == 0):
+        bad += 1
+assert bad == 0, "%d cells differ" % bad
+print("union: %d cells equal, %d groups" % (len(a), len(fwd)))
+PY
+
+# --- a session killed at random moments and replayed ----------------------
+cat > long.explore <<'S'
+view 0:250 -40:40
+pan right 20%
+pan right 20%
+pan up 10%
+zoom 0.5
+pan left 25%
+pan down 100c
+zoom 0.8
+S
+"$CM" explore ref.cmdb long.explore $pd $lattice > /dev/null || fail "reference session failed"
+"$CM" export ref.cmdb --cells ref.csv --groups ref-groups.csv || fail "export ref"
+for delay in 0.15 0.35 0.6 0.9 1.3; do
+  "$CM" explore killed.cmdb long.explore $pd $lattice > /dev/null 2>&1 &
+  pid=$!
+  sleep "$delay"
+  kill -9 "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+done
+"$CM" explore killed.cmdb long.explore $pd $lattice > replay.out ||
+  fail "the replay after kills failed"
+"$CM" export killed.cmdb --cells killed.csv --groups killed-groups.csv || fail "export killed"
+cmp -s ref.csv killed.csv || fail "cells after kills and replay differ from an uninterrupted session"
+cmp -s ref-groups.csv killed-groups.csv || fail "groups after kills and replay differ"
+# a finished session replayed computes nothing
+"$CM" explore killed.cmdb long.explore > again.out || fail "second replay failed"
+grep -q "computed" again.out && fail "a replay of a finished session computed cells again"
+# adaptive extension from the view adds the tile of the view's size where
+# the most sequences escape, and only the cells the cluster lacks
+printf 'view 100:150 -4:4\nextend auto 2\n' > extend.explore
+"$CM" explore extend.cmdb extend.explore $pd $lattice > extend.out || fail "extend auto failed"
+[ "$(grep -c '^extend auto [12]: tile .*computed 10000 cells' extend.out)" -eq 2 ] ||
+  fail "extend auto: $(cat extend.out)"
+
+# --- malformed commands: line number, message, exit 1, work kept ---------
+check_bad() { # check_bad 'line' 'needle'
+  rm -f bad.cmdb
+  printf 'view 100:150 -4:4\n%s\nview 150:200 -4:4\n' "$1" > bad.explore
+  local out rc
+  out=$("$CM" explore bad.cmdb bad.explore $pd $lattice 2>&1 >/dev/null); rc=$?
+  [ "$rc" -eq 1 ] || fail "'$1' exited $rc, expected 1"
+  grep -qF -- "bad.explore:2: " <<<"$out" || fail "'$1': no line number in '$out'"
+  grep -qF -- "$2" <<<"$out" || fail "'$1': message '$out' lacks '$2'"
+  "$CM" info bad.cmdb | grep -q "regions 1, cells 10000" || fail "'$1': the first view was not kept"
+}
+check_bad "fly away" "unknown command 'fly'"
+check_bad "pan sideways 10%" "not left, right, up or down"
+check_bad "pan left" "usage: pan"
+check_bad "pan left -3" "not a positive amount"
+check_bad "pan left 10x" "not a positive amount"
+check_bad "zoom 0" "not a positive factor"
+check_bad "zoom 1000" "below the lattice's resolution"
+check_bad "view 5:1 0:1" "not LO:HI"
+check_bad "view 0:1" "usage: view"
+check_bad "view 0:1 0:1 at 3" "more than two dimensions"
+check_bad "view 0:1e300 0:1" "leave the world"
+check_bad "view 0:100000000 -4:4" "new cells, more than"
+check_bad "goto 1" "usage: goto"
+check_bad "goto x y" "not a number"
+check_bad "extend manual" "usage: extend auto"
+check_bad "extend auto 0" "integer in 1..1000"
+check_bad "render" "usage: render"
+check_bad "render out.png 0x5" "WIDTHxHEIGHT"
+check_bad "stats now" "usage: stats"
+check_bad 'render "out.png' "is not closed"
+check_bad "export --bogus" "export failed"
+# before the first view
+rm -f fresh.cmdb
+printf 'pan left 10%%\n' > first.explore
+out=$("$CM" explore fresh.cmdb first.explore $pd $lattice 2>&1); rc=$?
+[ "$rc" -eq 1 ] && grep -qF "first.explore:1: pan: there is no view yet" <<<"$out" ||
+  fail "pan before view: rc $rc, '$out'"
+# bad options
+out=$("$CM" explore nofile.cmdb first.explore 2>&1); rc=$?
+[ "$rc" -eq 2 ] && grep -qF "does not exist; create it with --model" <<<"$out" ||
+  fail "missing file without --model: rc $rc, '$out'"
+out=$("$CM" explore union1.cmdb first.explore --model microchaos-1d 2>&1); rc=$?
+[ "$rc" -eq 1 ] && grep -qF "holds model microchaos-pd" <<<"$out" ||
+  fail "another model for an existing file: rc $rc, '$out'"
+out=$("$CM" explore x.cmdb --model microchaos-pd 2>&1); rc=$?
+[ "$rc" -eq 2 ] && grep -qF -- "--cell-size needs 2" <<<"$out" || fail "no --cell-size: rc $rc, '$out'"
+out=$("$CM" explore x.cmdb missing.explore $pd $lattice 2>&1); rc=$?
+[ "$rc" -eq 1 ] && grep -qF "cannot open the script missing.explore" <<<"$out" ||
+  fail "missing script: rc $rc, '$out'"
+
+# --- stdin, a file made by solve, and export in a session ----------------
+printf 'pan right 10%%\nstats\nexport --groups g.csv\nsave\nquit\npan right 10%%\n' |
+  "$CM" explore whole.cmdb - > solvefile.out || fail "exploring a solve file from stdin failed"
+grep -q "^pan right 10%: view 120:320 -16:16; computed 16000 cells" solvefile.out ||
+  fail "pan of a solve file: $(head -1 solvefile.out)"
+[ "$(grep -c '^pan' solvefile.out)" -eq 1 ] || fail "quit did not end the session"
+[ -s g.csv ] || fail "export in a session wrote nothing"
+"$CM" explore whole.cmdb - <<<"stats" | grep -q "^view 120:320 -16:16" ||
+  fail "the saved view was not restored"
+
+# --- the prompt goes on after an error ---------------------------------
+python3 - "$CM" <<'PY' || fail "prompt session"
+import os, pty, sys, time
+pid, fd = pty.fork()
+if pid == 0:
+    os.execv(sys.argv[1], [sys.argv[1], "explore", "whole.cmdb"])
+out = b""
+def read_until(token, limit=20):
+    global out
+    end = time.time() + limit
+    while token not in out and time.time() < end:
+        try:
+            out += os.read(fd, 4096)
+        except OSError:
+            break
+    return token in out
+assert read_until(b"explore> "), out
+os.write(fd, b"pan nowhere 1\n")
+assert read_until(b"line 1: pan: 'nowhere'"), out
+os.write(fd, b"pan left 10%\n")
+assert read_until(b"pan left 10%: view"), out
+os.write(fd, b"quit\n")
+_, status = os.waitpid(pid, 0)
+assert os.WEXITSTATUS(status) == 0, status
+PY
+
+[ "$fails" -eq 0 ] && echo "explore_test: all passed" || { echo "explore_test: $fails failed"; exit 1; }
