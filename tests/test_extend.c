@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/cover.h"
 #include "cellmap/extend.h"
 #include "check.h"
 #include "models/registry.h"
@@ -32,10 +33,7 @@ static void add_boxes(cm_cluster *c, const cm_model *m, const cm_box *boxes, uin
     CHECK(cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
 }
 
-static int64_t floor_div(int64_t a, int64_t b)
-{
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
+static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 /* Escaping sequences per tile, following each sink cell's sequence. */
 static uint64_t brute_force(const cm_cluster *c, const cm_box *tile, uint64_t *per_tile)
@@ -104,8 +102,8 @@ static void test_brute_force(void)
     CHECK_INT(choice.escaping, tile_count(per_tile, &tile, &choice.box));
     CHECK(choice.escaping > 0);
     /* face neighbours of the L: none receives more than the chosen one */
-    static const int64_t neighbours[][2] = {{-1, 0}, {0, 1}, {0, -1}, {1, 1}, {2, 0}, {2, -1},
-                                            {1, -2}, {0, -1}};
+    static const int64_t neighbours[][2] = {{-1, 0}, {0, 1},  {0, -1}, {1, 1},
+                                            {2, 0},  {2, -1}, {1, -2}, {0, -1}};
     for (size_t n = 0; n < sizeof neighbours / sizeof neighbours[0]; n++) {
         const cm_box b = {2,
                           {neighbours[n][0] * 250, neighbours[n][1] * 250},
@@ -114,6 +112,108 @@ static void test_brute_force(void)
     }
     cm_cluster_free(&c);
     cm_model_release(&m);
+}
+
+/* Regions not aligned to the grid (what panning leaves): the chosen tile's
+ * count equals brute force, and the part of it the cluster lacks is what a
+ * session computes. */
+static void test_unaligned(void)
+{
+    cm_model m = fig_model();
+    const cm_lattice lat = {2, {85.4, -12.5}, {0.8, 0.1}};
+    const cm_box tile = {2, {0, 0}, {200, 200}};
+    /* a view, then a pan right by 70 cells and up by 30 */
+    const cm_box boxes[3] = {tile, {2, {200, 0}, {270, 200}}, {2, {70, 200}, {270, 230}}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    add_boxes(&c, &m, boxes, 3);
+    cm_extend_choice choice;
+    char msg[256];
+    CHECK(cm_extend_choose(&c, &tile, NULL, &choice, msg, sizeof msg) == CM_OK);
+    static uint64_t per_tile[4 * SPAN * SPAN];
+    CHECK_INT(choice.all_escaping, brute_force(&c, &tile, per_tile));
+    CHECK_INT(choice.escaping, tile_count(per_tile, &tile, &choice.box));
+    CHECK_INT(cm_box_cells(&choice.box), 200 * 200); /* a whole tile of the grid */
+    CHECK_INT(choice.box.lo[0] % 200, 0);
+    CHECK_INT(choice.box.lo[1] % 200, 0);
+    cm_box *rest = NULL;
+    uint32_t n = 0;
+    CHECK(cm_cluster_uncovered(&c, &choice.box, &rest, &n, msg, sizeof msg) == CM_OK);
+    uint64_t covered = 0;
+    for (uint32_t k = 0; k < c.nregions; k++) {
+        cm_box both;
+        if (cm_box_intersect(&c.regions[k].r.box, &choice.box, &both))
+            covered += cm_box_cells(&both);
+    }
+    CHECK_INT(cm_boxes_cells(rest, n) + covered, 200 * 200);
+    free(rest);
+    cm_cluster_free(&c);
+    cm_model_release(&m);
+}
+
+/* cm_cluster_uncovered on random disjoint regions: the pieces are disjoint,
+ * miss every region and, with the regions, cover the box exactly (checked
+ * cell by cell); a pan right leaves one strip of the view's height. */
+static void test_uncovered(void)
+{
+    enum { W = 40 };
+    cm_cluster c;
+    cm_cluster_init(&c, &(cm_lattice){2, {0, 0}, {1, 1}});
+    c.regions = calloc(64, sizeof *c.regions);
+    static uint8_t owner[W][W];
+    memset(owner, 0, sizeof owner);
+    srand(7);
+    for (int tries = 0; tries < 400 && c.nregions < 64; tries++) {
+        const int64_t x = rand() % W, y = rand() % W, w = 1 + rand() % 12, h = 1 + rand() % 12;
+        if (x + w > W || y + h > W)
+            continue;
+        int free_cells = 1;
+        for (int64_t i = x; i < x + w; i++)
+            for (int64_t j = y; j < y + h; j++)
+                free_cells &= owner[i][j] == 0;
+        if (!free_cells)
+            continue;
+        for (int64_t i = x; i < x + w; i++)
+            for (int64_t j = y; j < y + h; j++)
+                owner[i][j] = 1;
+        c.regions[c.nregions++].r.box = (cm_box){2, {x, y}, {x + w, y + h}};
+    }
+    const cm_box view = {2, {3, 5}, {37, 33}};
+    cm_box *pieces = NULL;
+    uint32_t n = 0;
+    char msg[256];
+    CHECK(cm_cluster_uncovered(&c, &view, &pieces, &n, msg, sizeof msg) == CM_OK);
+    for (uint32_t k = 0; k < n; k++)
+        for (int64_t i = pieces[k].lo[0]; i < pieces[k].hi[0]; i++)
+            for (int64_t j = pieces[k].lo[1]; j < pieces[k].hi[1]; j++)
+                owner[i][j] += 2; /* a region's cell becomes 3, a twice-covered one 4 */
+    int wrong = 0;
+    for (int64_t i = 0; i < W; i++)
+        for (int64_t j = 0; j < W; j++) {
+            const int inside =
+                i >= view.lo[0] && i < view.hi[0] && j >= view.lo[1] && j < view.hi[1];
+            wrong += inside ? owner[i][j] != 1 && owner[i][j] != 2 : owner[i][j] > 1;
+        }
+    CHECK_INT(wrong, 0);
+    free(pieces);
+    /* a pan right of a view the cluster holds: one strip */
+    cm_cluster strip;
+    cm_cluster_init(&strip, &c.lat);
+    strip.regions = calloc(1, sizeof *strip.regions);
+    strip.regions[0].r.box = (cm_box){2, {0, 0}, {100, 80}};
+    strip.nregions = 1;
+    const cm_box panned = {2, {10, 0}, {110, 80}};
+    CHECK(cm_cluster_uncovered(&strip, &panned, &pieces, &n, msg, sizeof msg) == CM_OK);
+    CHECK_INT(n, 1);
+    CHECK(n == 1 && pieces[0].lo[0] == 100 && pieces[0].hi[0] == 110 && pieces[0].lo[1] == 0 &&
+          pieces[0].hi[1] == 80);
+    free(pieces);
+    /* nothing uncovered: no pieces */
+    const cm_box inside = {2, {5, 5}, {50, 50}};
+    CHECK(cm_cluster_uncovered(&strip, &inside, &pieces, &n, msg, sizeof msg) == CM_OK);
+    CHECK(n == 0 && pieces == NULL);
+    free(strip.regions);
+    free(c.regions);
 }
 
 /* Fig. 4.25: from the left region x in [85.4, 285.4], x' in [-12.5, 12.5]
@@ -138,8 +238,8 @@ static void test_fig_4_25(void)
     CHECK(2 * choice.escaping > choice.all_escaping); /* most of them */
     cm_join_stats stats;
     const cm_scm_options opt = {1, 0, NULL, NULL, 1};
-    CHECK(cm_cluster_solve_boxes(&c, &m, &choice.box, 1, &opt, NULL, NULL, &stats, msg, sizeof msg) ==
-          CM_OK);
+    CHECK(cm_cluster_solve_boxes(&c, &m, &choice.box, 1, &opt, NULL, NULL, &stats, msg,
+                                 sizeof msg) == CM_OK);
     CHECK(stats.straddling_groups > 0);
     cm_region flat;
     const cm_box whole = {2, {0, 0}, {2000, 1000}};
@@ -170,6 +270,8 @@ static void test_fig_4_25(void)
 int main(void)
 {
     test_brute_force();
+    test_unaligned();
+    test_uncovered();
     test_fig_4_25();
     CHECK_DONE();
 }
