@@ -128,6 +128,11 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64
  * regions' arrays are invalid after it. */
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
 
+/* Makes every region resident, whatever the budget (for work that follows
+ * sequences through the whole cluster at once, such as cm_extend_choose);
+ * the next cm_cluster_trim or commit brings it back within the budget. */
+cm_status cm_cluster_acquire_all(cm_cluster *c, char *msg, size_t msg_size);
+
 /* Evicts clean resident regions, those no sequence leaves (all neighbours
  * known) first, then the least recently used, until the resident arrays
  * fit c->mem_budget. Does nothing without a pager. */

@@ -77,6 +77,16 @@ bool cm_box_contains(const cm_box *box, const int64_t *cell)
     return true;
 }
 
+bool cm_lattice_equal(const cm_lattice *a, const cm_lattice *b)
+{
+    if (a->dim != b->dim)
+        return false;
+    for (int d = 0; d < a->dim; d++)
+        if (a->origin[d] != b->origin[d] || a->width[d] != b->width[d])
+            return false;
+    return true;
+}
+
 bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out)
 {
     cm_box both = *a;

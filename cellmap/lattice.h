@@ -39,6 +39,9 @@ typedef struct cm_box {
 /* Validates dimension and widths; fills msg on failure. */
 cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size);
 
+/* true when both lattices have the same dimension, origin and widths. */
+bool cm_lattice_equal(const cm_lattice *a, const cm_lattice *b);
+
 /* Cell of point x. Returns false (cell untouched) when x is outside the world. */
 bool cm_lattice_cell(const cm_lattice *lat, const double *x, int64_t *cell);
 

@@ -464,20 +464,6 @@ static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *ti
     return (int)((extra + per_tile - 1) / per_tile);
 }
 
-/* Reads every region back, whatever the budget: the extension choice
- * follows sequences through the whole cluster at once. The next join's
- * commit trims the cluster to the budget again. */
-static cm_status acquire_all(cm_cluster *c, char *msg, size_t msg_size)
-{
-    const uint64_t budget = c->mem_budget;
-    cm_status st = CM_OK;
-    c->mem_budget = 0;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
-        st = cm_cluster_acquire(c, k, msg, msg_size);
-    c->mem_budget = budget;
-    return st;
-}
-
 /* Adds the neighbouring tile where the most sequences escape, step by step,
  * until --extend steps are done, the escaping fraction is below
  * --escape-below, or no sequence escapes into a neighbour. */
@@ -497,7 +483,7 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
         cm_extend_choice choice;
         const double t0 = now_seconds();
         /* the choice follows every escaping sequence: it needs every region */
-        st = acquire_all(c, msg, msg_size);
+        st = cm_cluster_acquire_all(c, msg, msg_size);
         if (st == CM_OK)
             st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
         const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
@@ -541,16 +527,6 @@ static void make_plan(const solve_args *a, const cm_box *box, char *out, size_t 
                  a->max_steps, a->extend, a->escape_below, a->bounds_text ? a->bounds_text : "-");
 }
 
-static int same_lattice(const cm_lattice *a, const cm_lattice *b)
-{
-    if (a->dim != b->dim)
-        return 0;
-    for (int d = 0; d < a->dim; d++)
-        if (a->origin[d] != b->origin[d] || a->width[d] != b->width[d])
-            return 0;
-    return 1;
-}
-
 /* The database of --db: a new one, or (--resume) the saved cluster, which
  * must come from the same model, parameters, lattice and plan. */
 static cm_status open_store(const solve_args *a, const char *command, const cm_model *m,
@@ -575,11 +551,11 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
         st = cm_store_read_info(rn->store, &info, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const char *differs = strcmp(info.model, m->name)         ? "model"
-                          : strcmp(info.params, params)       ? "parameters"
-                          : !same_lattice(&info.lattice, lat) ? "lattice (--region, --cells)"
-                          : strcmp(info.plan, plan)           ? "plan (--split, --extend, ...)"
-                                                              : NULL;
+    const char *differs = strcmp(info.model, m->name)             ? "model"
+                          : strcmp(info.params, params)           ? "parameters"
+                          : !cm_lattice_equal(&info.lattice, lat) ? "lattice (--region, --cells)"
+                          : strcmp(info.plan, plan)               ? "plan (--split, --extend, ...)"
+                                                                  : NULL;
     if (differs)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "%s was made by another solve (its %s differs): resume with the options "

@@ -404,26 +404,12 @@ static cm_status cmd_goto(session *s, char **t, int n, char *msg, size_t msg_siz
 
 /* ---- extend auto ----------------------------------------------------------- */
 
-/* Reads every region back, whatever the budget: the extension follows
- * sequences through the whole cluster at once. The next join's commit
- * trims the cluster to the budget again. */
-static cm_status acquire_all(cm_cluster *c, char *msg, size_t msg_size)
-{
-    const uint64_t budget = c->mem_budget;
-    cm_status st = CM_OK;
-    c->mem_budget = 0;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
-        st = cm_cluster_acquire(c, k, msg, msg_size);
-    c->mem_budget = budget;
-    return st;
-}
-
 static cm_status extend_step(session *s, const cm_box *tile, int step, char *msg, size_t msg_size)
 {
     cm_extend_choice choice;
     computed done = {0};
     const double t0 = now_seconds();
-    cm_status st = acquire_all(&s->c, msg, msg_size);
+    cm_status st = cm_cluster_acquire_all(&s->c, msg, msg_size);
     if (st == CM_OK)
         st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
     if (st == CM_OK)
@@ -839,16 +825,6 @@ static int restore_view(session *s)
     return EXIT_OK;
 }
 
-static int same_lattice(const cm_lattice *a, const cm_lattice *b)
-{
-    if (a->dim != b->dim)
-        return 0;
-    for (int d = 0; d < a->dim; d++)
-        if (a->origin[d] != b->origin[d] || a->width[d] != b->width[d])
-            return 0;
-    return 1;
-}
-
 /* The lattice of the options (--cell-size, --origin) for a model. */
 static int options_lattice(const session_options *o, int dim, cm_lattice *lat)
 {
@@ -893,7 +869,7 @@ static int check_same(const session *s, const session_options *o, const cm_store
     }
     cm_lattice lat;
     if (o->n_cell_size && (options_lattice(o, info->lattice.dim, &lat) != EXIT_OK ||
-                           !same_lattice(&lat, &info->lattice)))
+                           !cm_lattice_equal(&lat, &info->lattice)))
         return open_error("%s has another lattice; drop --cell-size/--origin to go on with "
                           "it%s",
                           s->path, "");
