@@ -202,7 +202,6 @@ static cm_status move_view(session *s, const double *lo, const double *hi, const
     memcpy(s->lo, lo, sizeof s->lo);
     memcpy(s->hi, hi, sizeof s->hi);
     s->have_view = 1;
-    s->last_compute_s = done.seconds;
     st = save_view(s, msg, msg_size);
     if (st == CM_OK)
         report(s, what, &done);

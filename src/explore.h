@@ -47,7 +47,6 @@ typedef struct session {
     int64_t slice[CM_MAX_DIM]; /* dimensions >= 2: the cell shown */
     int quit;
     FILE *out;
-    double last_compute_s; /* of the last command that computed cells */
 } session;
 
 /* Opens path (creating it from the model options if it does not exist).
