@@ -87,6 +87,19 @@ bool cli_take_mem(cli *c, uint64_t *mem, int *error)
     return true;
 }
 
+bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error)
+{
+    int64_t v = 0;
+    if (!cli_is(c, name, true, error))
+        return false;
+    if (c->value && (!parse_int64(c->value, &v) || v < lo || v > hi))
+        *error =
+            cli_usage_error(c, "%s: '%s' must be an integer in %d..%d", name, c->value, lo, hi);
+    else if (c->value)
+        *out = (int)v;
+    return true;
+}
+
 bool parse_double(const char *s, double *out)
 {
     char *end = NULL;

@@ -38,6 +38,11 @@ bool parse_double(const char *s, double *out);
 bool parse_bytes(const char *s, uint64_t *out);
 /* Handles --mem BYTES (at least 1M); true if the current option was it. */
 bool cli_take_mem(cli *c, uint64_t *mem, int *error);
+/* Handles option `name` with an integer in lo..hi; true if the current
+ * option was it. */
+bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error);
+/* The limits of --max-steps and --threads, which several commands take. */
+enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
 /* "LO:HI,LO:HI,..." -> lo[], hi[], count. */
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
 /* "NxMx..." -> counts, count. */

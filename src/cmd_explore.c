@@ -44,7 +44,6 @@ static int parse_explore(cli *c, explore_args *a)
     int err = 0;
     session_options *o = &a->o;
     while (cli_next(c) && !err) {
-        int64_t v;
         if (strcmp(c->opt, "--help") == 0) {
             fputs(explore_help_head, stdout);
             fputs(session_help, stdout);
@@ -58,15 +57,8 @@ static int parse_explore(cli *c, explore_args *a)
                 err = cli_usage_error(c, "--origin: '%s' is not X[,Y...]", c->value);
         } else if (cli_is(c, "--depth", true, &err)) {
             o->depth_text = c->value;
-        } else if (cli_is(c, "--max-steps", true, &err)) {
-            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
-                err = cli_usage_error(c, "--max-steps: '%s' must be an integer in 1..1000000",
-                                      c->value);
-            o->max_steps = (int)v;
-        } else if (cli_is(c, "--threads", true, &err)) {
-            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1024))
-                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024", c->value);
-            o->threads = (int)v;
+        } else if (cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &o->max_steps, &err)) {
+        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &o->threads, &err)) {
         } else if (cli_take_mem(c, &o->mem, &err)) {
         } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !o->path) {
             o->path = c->opt;

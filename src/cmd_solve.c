@@ -101,15 +101,8 @@ static int parse_solve(cli *c, solve_args *a)
                     cli_usage_error(c, "--escape-below: '%s' must be a fraction in 0..1", c->value);
         } else if (cli_is(c, "--bounds", true, &err)) {
             a->bounds_text = c->value;
-        } else if (cli_is(c, "--max-steps", true, &err)) {
-            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1000000))
-                err = cli_usage_error(c, "--max-steps: '%s' must be an integer in 1..1000000",
-                                      c->value);
-            a->max_steps = (int)v;
-        } else if (cli_is(c, "--threads", true, &err)) {
-            if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > 1024))
-                err = cli_usage_error(c, "--threads: '%s' must be an integer in 1..1024", c->value);
-            a->threads = (int)v;
+        } else if (cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &a->max_steps, &err)) {
+        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (cli_is(c, "--size", true, &err)) {
             int64_t wh[2];
             int n = 0;

@@ -1,6 +1,7 @@
 #include "src/explore.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -553,8 +554,9 @@ static void print_groups(const session *s, uint32_t ngroups, const cm_group_info
     free(ids);
 }
 
-static cm_status cmd_stats(session *s, int n, char *msg, size_t msg_size)
+static cm_status cmd_stats(session *s, char **t, int n, char *msg, size_t msg_size)
 {
+    (void)t;
     cm_status st = words(n, 1, 1, "stats", msg, msg_size);
     if (st == CM_OK)
         st = need_view(s, "stats", msg, msg_size);
@@ -627,13 +629,15 @@ static cm_status cmd_export_view(session *s, char **t, int n, char *msg, size_t 
         argv[argc++] = window;
     }
     argv[argc] = NULL;
-    fflush(s->out);
+    if (s->out)
+        fflush(s->out); /* status lines before export's own output */
     const int rc = cmd_export(argc, argv);
     return rc == EXIT_OK ? CM_OK : cm_fail(CM_EINVAL, msg, msg_size, "export failed (see above)");
 }
 
-static cm_status cmd_save(session *s, int n, char *msg, size_t msg_size)
+static cm_status cmd_save(session *s, char **t, int n, char *msg, size_t msg_size)
 {
+    (void)t;
     cm_status st = words(n, 1, 1, "save", msg, msg_size);
     if (st == CM_OK)
         st = save_view(s, msg, msg_size);
@@ -643,6 +647,35 @@ static cm_status cmd_save(session *s, int n, char *msg, size_t msg_size)
     }
     return st;
 }
+
+static cm_status cmd_quit(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    s->quit = 1;
+    return words(n, 1, 1, t[0], msg, msg_size);
+}
+
+static cm_status cmd_help(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    (void)t;
+    (void)n;
+    (void)msg;
+    (void)msg_size;
+    if (s->out)
+        fputs(session_help, s->out);
+    return CM_OK;
+}
+
+static const struct {
+    const char *name;
+    cm_status (*run)(session *s, char **t, int n, char *msg, size_t msg_size);
+} commands[] = {
+    {"view", cmd_view},     {"pan", cmd_pan},
+    {"zoom", cmd_zoom},     {"goto", cmd_goto},
+    {"extend", cmd_extend}, {"render", cmd_render},
+    {"stats", cmd_stats},   {"export", cmd_export_view},
+    {"save", cmd_save},     {"quit", cmd_quit},
+    {"exit", cmd_quit},     {"help", cmd_help},
+};
 
 cm_status session_exec(session *s, const char *line, char *msg, size_t msg_size)
 {
@@ -656,46 +689,29 @@ cm_status session_exec(session *s, const char *line, char *msg, size_t msg_size)
         return CM_EINVAL;
     if (n == 0)
         return CM_OK;
-    if (strcmp(t[0], "view") == 0)
-        return cmd_view(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "pan") == 0)
-        return cmd_pan(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "zoom") == 0)
-        return cmd_zoom(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "goto") == 0)
-        return cmd_goto(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "extend") == 0)
-        return cmd_extend(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "render") == 0)
-        return cmd_render(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "stats") == 0)
-        return cmd_stats(s, n, msg, msg_size);
-    if (strcmp(t[0], "export") == 0)
-        return cmd_export_view(s, t, n, msg, msg_size);
-    if (strcmp(t[0], "save") == 0)
-        return cmd_save(s, n, msg, msg_size);
-    if (strcmp(t[0], "quit") == 0 || strcmp(t[0], "exit") == 0) {
-        s->quit = 1;
-        return words(n, 1, 1, t[0], msg, msg_size);
-    }
-    if (strcmp(t[0], "help") == 0) {
-        if (s->out)
-            fputs(session_help, s->out);
-        return CM_OK;
-    }
-    return cm_fail(CM_EINVAL, msg, msg_size,
-                   "unknown command '%s' (commands: view, pan, zoom, goto, extend, render, stats, "
-                   "export, save, quit, help)",
-                   t[0]);
+    for (size_t k = 0; k < sizeof commands / sizeof commands[0]; k++)
+        if (strcmp(t[0], commands[k].name) == 0)
+            return commands[k].run(s, t, n, msg, msg_size);
+    char names[256];
+    size_t used = 0;
+    for (size_t k = 0; k < sizeof commands / sizeof commands[0] && used < sizeof names; k++)
+        used += (size_t)snprintf(names + used, sizeof names - used, "%s%s", k ? ", " : "",
+                                 commands[k].name);
+    return cm_fail(CM_EINVAL, msg, msg_size, "unknown command '%s' (commands: %s)", t[0], names);
 }
 
 /* ---- opening and closing ------------------------------------------------------ */
 
-static int open_error(const char *fmt, const char *a, const char *b)
+static int open_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+static int open_error(const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
     fprintf(stderr, "cellmap explore: ");
-    fprintf(stderr, fmt, a, b);
+    vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
+    va_end(ap);
     return EXIT_FAIL;
 }
 
@@ -786,8 +802,8 @@ static int restore_depth(session *s)
         memcpy(s->depth_lo, bounds.lo, sizeof bounds.lo);
         memcpy(s->depth_hi, bounds.hi, sizeof bounds.hi);
     } else {
-        return open_error("%s has no depth for dimensions 3.. (it was not made by explore)%s",
-                          s->path, "");
+        return open_error("%s has no depth for dimensions 3.. (it was not made by explore)",
+                          s->path);
     }
     for (int d = 2; d < s->dim; d++) {
         if (s->depth_lo[d] >= s->depth_hi[d])
@@ -807,7 +823,7 @@ static int restore_view(session *s)
         for (int d = 0; d < s->view_dims; d++) {
             int count = 0;
             if (d >= n || !parse_ranges(t[d], &s->lo[d], &s->hi[d], &count, 1))
-                return open_error("%s: damaged view note%s", s->path, "");
+                return open_error("%s: damaged view note", s->path);
         }
         if (n == s->view_dims + 2 && parse_slice(s, t[n - 1], s->slice, msg, sizeof msg) != CM_OK)
             return open_error("%s: %s", s->path, msg);
@@ -857,7 +873,7 @@ static int check_same(const session *s, const session_options *o, const cm_store
     char msg[512], params[4096];
     if (o->mo.name) {
         if (cm_model_create(o->mo.name, o->mo.texts, o->mo.n_texts, &m, msg, sizeof msg) != CM_OK)
-            return open_error("%s%s", msg, "");
+            return open_error("%s", msg);
         cm_params_json(&m.values, params, sizeof params);
         const int differs = strcmp(m.name, info->model) != 0 || strcmp(params, info->params) != 0;
         cm_model_release(&m);
@@ -870,12 +886,12 @@ static int check_same(const session *s, const session_options *o, const cm_store
     if (o->n_cell_size && (options_lattice(o, info->lattice.dim, &lat) != EXIT_OK ||
                            !cm_lattice_equal(&lat, &info->lattice)))
         return open_error("%s has another lattice; drop --cell-size/--origin to go on with "
-                          "it%s",
-                          s->path, "");
+                          "it",
+                          s->path);
     if (o->max_steps && o->max_steps != s->max_steps)
         return open_error("%s was computed with another --max-steps; drop it to go on with "
-                          "the file's%s",
-                          s->path, "");
+                          "the file's",
+                          s->path);
     return EXIT_OK;
 }
 
@@ -887,7 +903,7 @@ static int open_existing(session *s, const session_options *o)
     if (st == CM_OK)
         st = cm_store_read_info(s->store, &info, msg, sizeof msg);
     if (st != CM_OK)
-        return open_error("%s%s", msg, "");
+        return open_error("%s", msg);
     s->max_steps = plan_max_steps(info.plan);
     int rc = model_of_file(s, &info);
     if (rc == EXIT_OK)
@@ -896,7 +912,7 @@ static int open_existing(session *s, const session_options *o)
         return rc;
     cm_cluster_init(&s->c, &info.lattice);
     if (cm_store_load_cluster(s->store, &s->c, msg, sizeof msg) != CM_OK)
-        return open_error("%s%s", msg, "");
+        return open_error("%s", msg);
     s->dim = info.lattice.dim;
     s->view_dims = s->dim < 2 ? s->dim : 2;
     if ((rc = restore_depth(s)) != EXIT_OK)
@@ -933,7 +949,7 @@ static int new_depth(session *s, const session_options *o)
     char depth[512], msg[512];
     format_depth(s, depth, sizeof depth);
     if (cm_store_set_note(s->store, "note.explore.depth", depth, msg, sizeof msg) != CM_OK)
-        return open_error("%s%s", msg, "");
+        return open_error("%s", msg);
     return EXIT_OK;
 }
 
@@ -967,7 +983,7 @@ static int create_new(session *s, const session_options *o)
         &s->model, &lat, o->command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
     cm_cluster_init(&s->c, &lat);
     if (cm_store_create(s->path, &meta, &s->store, msg, sizeof msg) != CM_OK)
-        return open_error("%s%s", msg, "");
+        return open_error("%s", msg);
     return new_depth(s, o);
 }
 
