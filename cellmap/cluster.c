@@ -321,21 +321,9 @@ static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affe
     return count;
 }
 
-cm_status cm_cluster_relink(cm_cluster *c, uint32_t k)
+cm_status cm_cluster_add_target(cm_cluster *c, uint32_t k, uint32_t target)
 {
-    cm_cluster_region *cr = &c->regions[k];
-    const cm_region *r = &cr->r;
-    uint32_t hint = k;
-    cr->ntargets = 0;
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        const int64_t e = r->group[i] == 0 ? cm_image_exit_index(r->image[i]) : -1;
-        uint64_t local;
-        const int64_t t =
-            e < 0 ? -1 : cm_cluster_locate(c, cm_region_exit(r, (uint64_t)e), &hint, &local);
-        if (t >= 0 && add_target(cr, (uint32_t)t) != CM_OK)
-            return CM_ENOMEM;
-    }
-    return CM_OK;
+    return add_target(&c->regions[k], target);
 }
 
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,

@@ -142,12 +142,12 @@ void cm_cluster_trim(cm_cluster *c);
  * region leads to it. */
 int64_t cm_cluster_entry(const cm_cluster_region *cr, uint32_t cell);
 
-/* Sets region k's links (targets) to the regions that the exits of its
- * sink cells lead into; k must be resident. Joins call it for every region
+/* Adds `target` to region k's links (the regions the exits of its sink
+ * cells lead into) unless it is there. Joins set the links of every region
  * whose sink cells they resolved: only those cells can change later, so a
  * region none of whose sink cells leads towards a new region is neither
  * resolved nor read back when it is joined. */
-cm_status cm_cluster_relink(cm_cluster *c, uint32_t k);
+cm_status cm_cluster_add_target(cm_cluster *c, uint32_t k, uint32_t target);
 
 /* Bytes held by the resident regions' cell arrays and exit tables. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);

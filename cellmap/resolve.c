@@ -282,13 +282,23 @@ static cm_status link_node(const resolver *rs, uint32_t id, uint32_t group, uint
     return CM_OK;
 }
 
+/* Whether region k still holds pass 1's marks. */
+static int has_marks(const resolver *rs, uint32_t k)
+{
+    const cm_cluster_region *cr = &rs->c->regions[k];
+    return cr->r.group && rs->marked_at[k] == cr->read_at + 1;
+}
+
 /* Links the nodes whose exits lead into region k: an affected region's
- * entries were noted in pass 1, any other region is read. */
+ * entries were noted in pass 1 (or still hold pass 1's values), any other
+ * region is read. */
 static cm_status link_into(const resolver *rs, uint32_t k, const uint32_t *ids, uint64_t n)
 {
     const cm_cluster_region *cr = &rs->c->regions[k];
-    const entry_value *noted = rs->affected[k] ? rs->entries[k] : NULL;
-    cm_status st = noted ? CM_OK : cm_cluster_acquire(rs->c, k, rs->msg, rs->msg_size);
+    /* A region that keeps pass 1's marks holds the noted values itself */
+    const entry_value *noted = rs->affected[k] && !has_marks(rs, k) ? rs->entries[k] : NULL;
+    cm_status st =
+        noted || rs->affected[k] ? CM_OK : cm_cluster_acquire(rs->c, k, rs->msg, rs->msg_size);
     if (st != CM_OK)
         return st;
     int failed = 0; /* 1: a step number overflow */
@@ -629,13 +639,6 @@ static cm_status root_pass(resolver *rs, uint32_t k, cm_join_stats *stats)
     return st;
 }
 
-/* Whether region k still holds pass 1's marks. */
-static int has_marks(const resolver *rs, uint32_t k)
-{
-    const cm_cluster_region *cr = &rs->c->regions[k];
-    return cr->r.group && rs->marked_at[k] == cr->read_at + 1;
-}
-
 /* Gives region k's cells of cross-border cycles their group and step 0. */
 static void mark_cycles(const resolver *rs, uint32_t k)
 {
@@ -653,6 +656,21 @@ static void mark_cycles(const resolver *rs, uint32_t k)
         r->group[rs->cycles[p].cell] = rs->cycles[p].group;
         r->step[rs->cycles[p].cell] = 0;
     }
+}
+
+/* Sets region k's links for the next joins from its nodes (the sink cells
+ * whose images leave it, in cell order): the regions their exits lead into,
+ * for those still in the sink's domain. */
+static cm_status relink(const resolver *rs, uint32_t k)
+{
+    cm_status st = CM_OK;
+    rs->c->regions[k].ntargets = 0;
+    for (uint64_t id = rs->node_base[k]; id < rs->nnodes && rs->nodes[id].region == k; id++) {
+        const node *nd = &rs->nodes[id];
+        if (st == CM_OK && nd->group == 0 && nd->target_region != NO_REGION)
+            st = cm_cluster_add_target(rs->c, k, nd->target_region);
+    }
+    return st;
 }
 
 /* Pass 2 on region k: final groups and steps, and its links for the next
@@ -673,7 +691,7 @@ static cm_status assign_pass(resolver *rs, uint32_t k)
     }
     if (st == CM_OK && overflow)
         st = CM_ETOOBIG;
-    return st == CM_OK ? cm_cluster_relink(rs->c, k) : st;
+    return st == CM_OK ? relink(rs, k) : st;
 }
 
 /* The regions pass 2 must change: those with a node whose sequence no
