@@ -70,6 +70,11 @@ typedef struct cm_model {
      * has no enumerable fixed points (a message then goes to msg). */
     int (*fixed_points)(const struct cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                         size_t cap, size_t *count, char *msg, size_t msg_size);
+    /* Optional, for models with dry friction. Whether y is a rest state held
+     * by static friction (step(y) = y because the system sticks): groups
+     * whose periodic cells map to rest states are sticking zones, not
+     * attractors of the motion. Pure, like step(). */
+    bool (*at_rest)(const struct cm_model *m, const double *y);
     void (*destroy)(void *ctx);
 } cm_model;
 

@@ -18,6 +18,7 @@ extern const cm_param_spec cm_microchaos_1d_friction_spec[];
 extern const cm_param_spec cm_microchaos_delay_spec[];
 extern const cm_param_spec cm_microchaos_pd_spec[];
 extern const cm_param_spec cm_microchaos_pd_twofold_spec[];
+extern const cm_param_spec cm_microchaos_pd_friction_spec[];
 extern const cm_param_spec cm_microchaos_general_spec[];
 
 cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
@@ -27,6 +28,8 @@ cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg,
 cm_status cm_microchaos_pd_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char *msg,
                                           size_t msg_size);
+cm_status cm_microchaos_pd_friction_create(const cm_params *p, cm_model *m, char *msg,
+                                           size_t msg_size);
 cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg,
                                        size_t msg_size);
 

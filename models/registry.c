@@ -9,6 +9,9 @@
 /* The left region of the thesis' C-SCM example (4.6.3): it holds the chaotic
  * attractors at SW_1..SW_3 on the x-axis (x = m/P). */
 #define CM_PD_EXAMPLE_REGION "0:500,-40:40"
+/* Fig. 4.30: the attractors at SW_-4..SW_4 (x = m/P, |m/P| < 73000) and
+ * the sticking zones around the fixed points between them. */
+#define CM_PD_FRICTION_REGION "-100000:100000,-300:300"
 
 static const cm_model_entry entries[] = {
     {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15", cm_microchaos_1d_spec,
@@ -22,6 +25,9 @@ static const cm_model_entry entries[] = {
      cm_microchaos_pd_spec, cm_microchaos_pd_create},
     {"microchaos-pd-twofold", "x, x'", "PD map with twofold (input and output) quantisation (4.84)", CM_PD_EXAMPLE_REGION,
      cm_microchaos_pd_twofold_spec, cm_microchaos_pd_twofold_create},
+    {"microchaos-pd-friction", "x, x'",
+     "PD map with dry friction: hybrid micro-chaos map, sticking zones (4.81)", CM_PD_FRICTION_REGION,
+     cm_microchaos_pd_friction_spec, cm_microchaos_pd_friction_create},
     {"microchaos-general", "x_{j-d}, ..., x_j",
      "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
      NULL,
