@@ -246,3 +246,38 @@ cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info
         *sink_cells = sink;
     return CM_OK;
 }
+
+const char *cm_group_kind_name(int kind)
+{
+    return kind == CM_GROUP_STICKING ? "sticking" : "attractor";
+}
+
+bool cm_cell_at_rest(const cm_model *model, const cm_lattice *lat, const int64_t *cell)
+{
+    double x[CM_MAX_DIM], y[CM_MAX_DIM];
+    if (!model->at_rest)
+        return false;
+    cm_lattice_centre(lat, cell, x);
+    return model->step(model, x, y) == CM_STEP_OK && model->at_rest(model, y);
+}
+
+cm_status cm_scm_label_groups(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                              cm_group_info *groups, uint32_t n, char *msg, size_t msg_size)
+{
+    /* per group: 1 while every periodic cell seen is at rest, 2 once one moves */
+    uint8_t *rest = calloc((size_t)n + 1, 1);
+    if (!rest)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory labelling %u groups", n);
+    for (uint64_t i = 0; model->at_rest && i < r->ncells; i++) {
+        const uint32_t g = r->group[i];
+        if (g == CM_GROUP_NONE || g == 0 || g > n || r->step[i] != 0 || rest[g] == 2)
+            continue;
+        int64_t cell[CM_MAX_DIM];
+        cm_box_cell(&r->box, i, cell);
+        rest[g] = cm_cell_at_rest(model, lat, cell) ? 1 : 2;
+    }
+    for (uint32_t k = 0; k < n; k++)
+        groups[k].kind = rest[k + 1] == 1 ? CM_GROUP_STICKING : CM_GROUP_ATTRACTOR;
+    free(rest);
+    return CM_OK;
+}

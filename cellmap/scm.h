@@ -86,6 +86,13 @@ typedef struct cm_scm_options {
 } cm_scm_options;
 
 /* Summary of one periodic group. */
+/* What a periodic group is. A sticking zone is a set of rest states held
+ * by static friction (cm_model.at_rest): its cells do not move at all. */
+enum cm_group_kind { CM_GROUP_ATTRACTOR = 0, CM_GROUP_STICKING = 1 };
+
+/* "attractor" or "sticking", as the database and the summaries write it. */
+const char *cm_group_kind_name(int kind);
+
 typedef struct cm_group_info {
     uint32_t id;
     uint32_t period;                       /* number of periodic cells */
@@ -94,6 +101,7 @@ typedef struct cm_group_info {
     int64_t anchor[CM_MAX_DIM];            /* lexicographically smallest periodic cell:
                                               the group's identity, whatever its id */
     double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* bounding box of periodic cells' centres */
+    int kind;                              /* enum cm_group_kind */
 } cm_group_info;
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size);
@@ -126,5 +134,15 @@ void cm_group_finish(cm_group_info *gi, int dim);
  * (entry k describes group k+1). Also counts the sink's cells if sink_cells. */
 cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info *groups,
                         uint64_t *sink_cells);
+
+/* Whether the image of the cell's centre is a rest state of the model
+ * (false for models without cm_model.at_rest). */
+bool cm_cell_at_rest(const cm_model *model, const cm_lattice *lat, const int64_t *cell);
+
+/* Sets groups[k].kind for the groups with periodic cells in r (ids 1..n,
+ * entry k for group k+1): CM_GROUP_STICKING when every such cell is at
+ * rest (cm_cell_at_rest), else CM_GROUP_ATTRACTOR. */
+cm_status cm_scm_label_groups(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                              cm_group_info *groups, uint32_t n, char *msg, size_t msg_size);
 
 #endif

@@ -90,6 +90,19 @@ static int pragma_int(sqlite3 *db, const char *sql, int *value)
     return rc;
 }
 
+/* The view of the groups, with the sink as group 0; `kind` is "sink",
+ * "attractor" or "sticking" (a sticking zone: rest states held by static
+ * friction). */
+#define GROUPS_VIEW_SQL(TEMP, KIND)                                                                \
+    "CREATE " TEMP "VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor,"         \
+    " periodic_cells, kind) AS"                                                                    \
+    " SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1,"            \
+    "  NULL, NULL, NULL, NULL, NULL, 'sink'"                                                       \
+    " UNION ALL"                                                                                   \
+    " SELECT a.id, a.period,"                                                                      \
+    "  (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = a.id), 0,"                     \
+    "  a.centre, a.lo, a.hi, a.anchor, a.periodic_cells, " KIND " FROM main.attractors a;"
+
 static const char *const schema_sql =
     "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
     "CREATE TABLE regions(id INTEGER PRIMARY KEY, lo TEXT NOT NULL, hi TEXT NOT NULL,"
@@ -106,15 +119,20 @@ static const char *const schema_sql =
     "CREATE INDEX region_groups_grp ON region_groups(grp);"
     "CREATE TABLE attractors(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
     " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
-    " periodic_cells BLOB NOT NULL);"
-    "CREATE VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor,"
-    " periodic_cells) AS"
-    " SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1,"
-    "  NULL, NULL, NULL, NULL, NULL"
-    " UNION ALL"
-    " SELECT a.id, a.period,"
-    "  (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = a.id), 0,"
-    "  a.centre, a.lo, a.hi, a.anchor, a.periodic_cells FROM attractors a;";
+    " periodic_cells BLOB NOT NULL,"
+    " kind TEXT NOT NULL DEFAULT 'attractor' CHECK(kind IN ('attractor', "
+    "'sticking')));" GROUPS_VIEW_SQL("", "a.kind");
+
+/* Version 2 had no kinds: every group of such a file is an attractor (no
+ * model with rest states existed). Opened for writing, the file is
+ * upgraded in place; read-only, a temporary view shadows the old one. */
+static const char *const upgrade_v2_sql =
+    "BEGIN;"
+    "ALTER TABLE attractors ADD COLUMN kind TEXT NOT NULL DEFAULT 'attractor'"
+    " CHECK(kind IN ('attractor', 'sticking'));"
+    "DROP VIEW groups;" GROUPS_VIEW_SQL("", "a.kind") "PRAGMA user_version=3;"
+                                                      "COMMIT;";
+static const char *const shadow_v2_sql = GROUPS_VIEW_SQL("TEMP ", "'attractor'");
 
 /* Tables a file of this version must have; their absence means corruption. */
 static const char *const check_sql =
@@ -124,6 +142,7 @@ static const char *const check_sql =
 
 struct cm_store {
     sqlite3 *db;
+    const cm_model *model; /* labels new groups (cm_store_set_model), may be NULL */
     char *path;
     int writable;
     uint32_t inserted; /* regions with rows in the file (or the open transaction) */
@@ -178,7 +197,7 @@ static cm_status check_ids(const char *path, int app, int version, char *msg, si
                        "%s has format version %d, newer than this cellmap reads (%d): use a "
                        "newer cellmap",
                        path, version, CM_STORE_VERSION);
-    if (version < CM_STORE_VERSION)
+    if (version < 2)
         return cm_fail(CM_EFORMAT, msg, msg_size,
                        "%s has format version %d (single region, no exits), which cannot be "
                        "migrated to version %d: solve it again with --db",
@@ -272,6 +291,13 @@ static cm_status open_checked(const char *path, int full, int writable, sqlite3 
     if (st != CM_OK && !writable && db && (sqlite3_errcode(db) & 0xff) == SQLITE_READONLY) {
         sqlite3_close(db);
         return open_checked(path, full, 1, out, msg, msg_size);
+    }
+    int version = CM_STORE_VERSION;
+    if (st == CM_OK && pragma_int(db, "PRAGMA user_version", &version) == SQLITE_OK &&
+        version == 2 && exec(db, writable ? upgrade_v2_sql : shadow_v2_sql) != SQLITE_OK) {
+        st = cm_fail(CM_EDB, msg, msg_size, "cannot read %s of format version 2: %s", path,
+                     sqlite3_errmsg(db));
+        exec(db, "ROLLBACK");
     }
     if (st != CM_OK) {
         sqlite3_close(db);
@@ -1122,7 +1148,9 @@ static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattic
     if (!blob) {
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing groups");
     }
+    bool at_rest = s->model && s->model->at_rest;
     for (uint64_t i = 0; i < n; i++) {
+        at_rest = at_rest && cm_cell_at_rest(s->model, lat, cells[i].cell);
         cm_group_add_periodic(&gi, lat, cells[i].cell);
         for (int d = 0; d < lat->dim; d++) {
             const uint64_t v = (uint64_t)cells[i].cell[d];
@@ -1144,6 +1172,8 @@ static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattic
     sqlite3_bind_text(st, 5, hi, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 6, anchor, -1, SQLITE_TRANSIENT);
     sqlite3_bind_blob(st, 7, blob, (int)(n * (uint64_t)lat->dim * 8), SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 8, cm_group_kind_name(at_rest ? CM_GROUP_STICKING : CM_GROUP_ATTRACTOR),
+                      -1, SQLITE_STATIC);
     const cm_status status = step_done(s->db, st, "write group", msg, msg_size);
     free(blob);
     return status;
@@ -1170,7 +1200,7 @@ static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, s
     }
     sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?)", -1, &st,
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
                            NULL))
         status = db_error(s->db, "prepare groups", msg, msg_size);
     uint32_t expected = s->saved_groups + 1;
@@ -1375,6 +1405,8 @@ cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const c
     return st;
 }
 
+void cm_store_set_model(cm_store *s, const cm_model *model) { s->model = model; }
+
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
                           char *msg, size_t msg_size)
 {
@@ -1382,10 +1414,11 @@ cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64
     cm_status status = read_lattice(s->db, &lat, msg, msg_size);
     sqlite3_stmt *st = NULL;
     if (status == CM_OK &&
-        sqlite3_prepare_v2(s->db,
-                           "SELECT id, period, basin_cells, centre, lo, hi, anchor FROM groups "
-                           "ORDER BY id",
-                           -1, &st, NULL))
+        sqlite3_prepare_v2(
+            s->db,
+            "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
+            "ORDER BY id",
+            -1, &st, NULL))
         status = db_error(s->db, "read groups", msg, msg_size);
     uint32_t seen = 0;
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
@@ -1415,6 +1448,10 @@ cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64
         }
         for (int d = 0; d < lat.dim; d++)
             g->anchor[d] = (int64_t)anchor[d];
+        const unsigned char *kind = sqlite3_column_text(st, 7);
+        g->kind = kind && strcmp((const char *)kind, cm_group_kind_name(CM_GROUP_STICKING)) == 0
+                      ? CM_GROUP_STICKING
+                      : CM_GROUP_ATTRACTOR;
         seen++;
     }
     sqlite3_finalize(st);

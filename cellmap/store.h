@@ -10,7 +10,9 @@
  *
  * The file carries application_id CM_STORE_APP_ID and user_version
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
- * version or corrupt are refused (CM_EFORMAT) and never modified.
+ * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
+ * version 2 (groups without kinds, all attractors) are read, and upgraded
+ * in place when opened for writing.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
  * cm_store_commit writes everything a join changed in one transaction, so
@@ -32,7 +34,7 @@
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 2
+#define CM_STORE_VERSION 3
 #define CM_STORE_PAGE_CELLS 65536
 
 typedef struct cm_store cm_store;
@@ -105,8 +107,14 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
 cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
                                char *msg, size_t msg_size);
 
+/* The model whose rest states (cm_model.at_rest) label the groups the next
+ * commits write: a group whose periodic cells all map to rest states is
+ * saved as a sticking zone (kind 'sticking'). Without it every group is an
+ * attractor. The model must outlive the store's commits. */
+void cm_store_set_model(cm_store *s, const cm_model *model);
+
 /* Summaries of the saved groups 1..n into a caller array (entry k: group
- * k+1), n = the info's groups, and the sink's cell count. */
+ * k+1, kind included), n = the info's groups, and the sink's cell count. */
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
                           char *msg, size_t msg_size);
 

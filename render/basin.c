@@ -98,17 +98,20 @@ static cm_status draw_raster(const cm_region *r, const slice_geometry *g, const 
     return CM_OK;
 }
 
-/* Periodic cells as black squares of at least 3x3 pixels. */
-static void draw_markers(const cm_region *r, const slice_geometry *g, double px, double py)
+/* The periodic cells of the groups of one kind as squares of at least 3x3
+ * pixels. */
+static void draw_markers(const cm_region *r, const cm_group_info *groups, int kind,
+                         const slice_geometry *g, double px, double py)
 {
     const double hx = g->dx / 2 > 1.5 * px ? g->dx / 2 : 1.5 * px;
     const double hy = g->dy / 2 > 1.5 * py ? g->dy / 2 : 1.5 * py;
-    glColor3ub(cm_colour_marker.r, cm_colour_marker.g, cm_colour_marker.b);
+    const cm_rgb c = kind == CM_GROUP_STICKING ? cm_colour_sticking_marker : cm_colour_marker;
+    glColor3ub(c.r, c.g, c.b);
     glBegin(GL_QUADS);
     for (uint64_t j = 0; j < g->ny; j++)
         for (uint64_t i = 0; i < g->nx; i++) {
             const uint64_t k = g->base + j * g->row_stride + i;
-            if (!cm_is_periodic(r, k))
+            if (!cm_is_periodic(r, k) || groups[r->group[k] - 1].kind != kind)
                 continue;
             const double cx = g->x0 + ((double)i + 0.5) * g->dx;
             const double cy = g->y0 + ((double)j + 0.5) * g->dy;
@@ -170,8 +173,12 @@ cm_status cm_render_basin(const cm_lattice *lat, const cm_region *r, const cm_gr
         glClearColor(bg.r / 255.0f, bg.g / 255.0f, bg.b / 255.0f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         st = draw_raster(r, &g, colours, msg, msg_size);
-        if (st == CM_OK && opt->markers)
-            draw_markers(r, &g, (hi[0] - lo[0]) / opt->width, (hi[1] - lo[1]) / opt->height);
+        const double px = (hi[0] - lo[0]) / opt->width, py = (hi[1] - lo[1]) / opt->height;
+        /* attractors last: their black dots stay visible beside sticking zones */
+        if (st == CM_OK && opt->markers) {
+            draw_markers(r, groups, CM_GROUP_STICKING, &g, px, py);
+            draw_markers(r, groups, CM_GROUP_ATTRACTOR, &g, px, py);
+        }
         glFinish(); /* the buffer is complete only now */
         if (glGetError() != GL_NO_ERROR && st == CM_OK)
             st = cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");

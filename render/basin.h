@@ -19,15 +19,14 @@
 #include "cellmap/scm.h"
 
 typedef struct cm_render_options {
-    int width, height;          /* pixels */
-    double lo[2], hi[2];        /* view in state coordinates; all zero: the region */
-    int64_t slice[CM_MAX_DIM];  /* cells of dimensions >= 2; used when set_slice */
-    int set_slice;              /* 0: the middle of the region */
-    int markers;                /* draw periodic cells */
+    int width, height;         /* pixels */
+    double lo[2], hi[2];       /* view in state coordinates; all zero: the region */
+    int64_t slice[CM_MAX_DIM]; /* cells of dimensions >= 2; used when set_slice */
+    int set_slice;             /* 0: the middle of the region */
+    int markers;               /* draw periodic cells */
 } cm_render_options;
 
 cm_status cm_render_basin(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          const cm_render_options *opt, uint8_t *rgba, char *msg,
-                          size_t msg_size);
+                          const cm_render_options *opt, uint8_t *rgba, char *msg, size_t msg_size);
 
 #endif

@@ -7,9 +7,11 @@
 const cm_rgb cm_colour_sink = {214, 39, 40};
 const cm_rgb cm_colour_not_computed = {255, 255, 255};
 const cm_rgb cm_colour_marker = {0, 0, 0};
+const cm_rgb cm_colour_sticking = {180, 180, 180};
+const cm_rgb cm_colour_sticking_marker = {96, 96, 96};
 
 /* Well-separated categorical colours (no red: red is the sink; no black: the
- * markers; no white: not computed). */
+ * markers; no white: not computed; no grey: sticking zones). */
 static const cm_rgb palette[] = {
     {31, 119, 180},  {44, 160, 44},   {255, 127, 14},  {148, 103, 189}, {140, 86, 75},
     {227, 119, 194}, {188, 189, 34},  {23, 190, 207},  {174, 199, 232}, {152, 223, 138},
@@ -56,11 +58,19 @@ void cm_palette_assign(const cm_group_info *groups, uint32_t n, int dim, cm_rgb 
     ranked *order = malloc((size_t)n * sizeof *order);
     if (!order) { /* fall back to plain hashing */
         for (uint32_t k = 0; k < n; k++)
-            colours[k] = palette[anchor_hash(groups[k].anchor, dim) % PALETTE_SIZE];
+            colours[k] = groups[k].kind == CM_GROUP_STICKING
+                             ? cm_colour_sticking
+                             : palette[anchor_hash(groups[k].anchor, dim) % PALETTE_SIZE];
         return;
     }
-    for (uint32_t k = 0; k < n; k++)
-        order[k] = (ranked){groups[k].anchor, dim, k};
+    uint32_t coloured = 0; /* sticking zones are all grey, as in Fig. 4.30 */
+    for (uint32_t k = 0; k < n; k++) {
+        if (groups[k].kind == CM_GROUP_STICKING)
+            colours[k] = cm_colour_sticking;
+        else
+            order[coloured++] = (ranked){groups[k].anchor, dim, k};
+    }
+    n = coloured;
     qsort(order, n, sizeof *order, compare_anchor);
     bool taken[PALETTE_SIZE];
     memset(taken, 0, sizeof taken);

@@ -13,7 +13,7 @@
 #include "cellmap/status.h"
 
 typedef struct cm_png_text {
-    const char *key;   /* 1..79 Latin-1 characters */
+    const char *key; /* 1..79 Latin-1 characters */
     const char *value;
 } cm_png_text;
 

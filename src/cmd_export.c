@@ -16,7 +16,8 @@ static const char export_help[] =
     "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
     "                      [--flat OUT.sqlite] [--window X0:X1[,Y0:Y1...]] [--mem BYTES]\n\n"
     "  --groups OUT.csv    one row per group: id, period, basin_cells, is_sink (group 0),\n"
-    "                      centre, bounds of the periodic cells' centres, anchor cell\n"
+    "                      centre, bounds of the periodic cells' centres, anchor cell,\n"
+    "                      kind (attractor, sticking zone or the sink)\n"
     "  --cells OUT         one row per computed cell: lattice indices ix, iy, ..., cell\n"
     "                      centre x, y, ..., grp, step, periodic; CSV with a header, or\n"
     "                      .npy (a structured array with those fields, little-endian)\n"
@@ -318,10 +319,10 @@ static int export_groups(const char *path, const cm_lattice *lat, const cm_group
     for (int p = 0; p < 4; p++)
         for (int d = 0; d < lat->dim; d++)
             fprintf(o.f, ",%s%s", parts[p], axis_name(d));
-    fprintf(o.f, "\n0,1,%llu,1", (unsigned long long)sink);
+    fprintf(o.f, ",kind\n0,1,%llu,1", (unsigned long long)sink);
     for (int k = 0; k < 4 * lat->dim; k++)
         fprintf(o.f, ",");
-    fprintf(o.f, "\n");
+    fprintf(o.f, ",sink\n");
     for (uint32_t k = 0; k < n; k++) {
         fprintf(o.f, "%u,%u,%llu,0", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells);
         const double *v[3] = {g[k].centre, g[k].lo, g[k].hi};
@@ -330,7 +331,7 @@ static int export_groups(const char *path, const cm_lattice *lat, const cm_group
                 fprintf(o.f, ",%.17g", v[p][d]);
         for (int d = 0; d < lat->dim; d++)
             fprintf(o.f, ",%lld", (long long)g[k].anchor[d]);
-        fprintf(o.f, "\n");
+        fprintf(o.f, ",%s\n", cm_group_kind_name(g[k].kind));
     }
     return out_end(&o, !ferror(o.f));
 }

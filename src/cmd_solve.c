@@ -294,11 +294,12 @@ static void print_text(const cm_model *m, const summary *sum, const timing *t,
         return;
     memcpy(sorted, g, ngroups * sizeof *sorted);
     qsort(sorted, ngroups, sizeof *sorted, larger_basin_first);
-    printf("%6s %8s %12s %12s  %s\n", "group", "period", "basin", "doa", "centre");
+    printf("%6s %8s %12s %12s  %-9s  %s\n", "group", "period", "basin", "doa", "kind", "centre");
     for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
-        printf("%6u %8u %12llu %12llu  (", sorted[k].id, sorted[k].period,
+        printf("%6u %8u %12llu %12llu  %-9s  (", sorted[k].id, sorted[k].period,
                (unsigned long long)sorted[k].basin_cells,
-               (unsigned long long)(sorted[k].basin_cells - sorted[k].period));
+               (unsigned long long)(sorted[k].basin_cells - sorted[k].period),
+               cm_group_kind_name(sorted[k].kind));
         print_vector(sorted[k].centre, m->dim, ", ");
         printf(")\n");
     }
@@ -344,9 +345,10 @@ static void print_json(const cm_model *m, const cm_lattice *lat, const summary *
         print_json_extension(lat, log);
     printf(",\"groups\":[");
     for (uint32_t k = 0; k < sum->ngroups; k++) {
-        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"centre\":[", k ? "," : "",
-               g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
-               (unsigned long long)(g[k].basin_cells - g[k].period));
+        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"kind\":\"%s\","
+               "\"centre\":[",
+               k ? "," : "", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
+               (unsigned long long)(g[k].basin_cells - g[k].period), cm_group_kind_name(g[k].kind));
         print_vector(g[k].centre, m->dim, ",");
         printf("]}");
     }
@@ -532,8 +534,10 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
             m, lat, command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
         cm_cluster_init(&rn->c, lat);
         cm_status st = cm_store_create(a->db, &meta, &rn->store, msg, msg_size);
-        if (st == CM_OK)
+        if (st == CM_OK) {
             cm_store_attach(rn->store, &rn->c);
+            cm_store_set_model(rn->store, m);
+        }
         return st;
     }
     cm_store_info info;
@@ -554,6 +558,7 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
                        "%s was made by another solve (its %s differs): resume with the options "
                        "of: %s",
                        a->db, differs, info.command);
+    cm_store_set_model(rn->store, m);
     return cm_store_load_cluster(rn->store, &rn->c, msg, msg_size);
 }
 
@@ -583,8 +588,8 @@ static cm_status solve_cluster(const solve_args *a, const char *command, const c
 
 /* The summary of a cluster: from the database when there is one (no cell
  * is read back), else from the flattened bounding box. */
-static cm_status summarise_cluster(run *rn, cm_region *flat, summary *sum, char *msg,
-                                   size_t msg_size)
+static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, summary *sum,
+                                   char *msg, size_t msg_size)
 {
     cm_cluster *c = &rn->c;
     cm_cluster_bounds(c, &sum->box);
@@ -600,7 +605,9 @@ static cm_status summarise_cluster(run *rn, cm_region *flat, summary *sum, char 
     cm_status st = cm_cluster_flatten(c, &sum->box, flat, msg, msg_size);
     if (st == CM_OK)
         cm_scm_groups(flat, &c->lat, sum->groups, &sum->sink);
-    return st;
+    return st == CM_OK
+               ? cm_scm_label_groups(m, &c->lat, flat, sum->groups, c->ngroups, msg, msg_size)
+               : st;
 }
 
 static void print_database(const solve_args *a, const run *rn, const summary *sum)
@@ -659,7 +666,7 @@ int cmd_solve(int argc, char **argv)
         const double t0 = now_seconds();
         if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
                 CM_OK ||
-            summarise_cluster(&rn, &r, &sum, msg, sizeof msg) != CM_OK)
+            summarise_cluster(&rn, &m, &r, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
         t.t2 = now_seconds() - t0 - t.t1;
     } else {
@@ -673,6 +680,8 @@ int cmd_solve(int argc, char **argv)
             goto fail;
         }
         cm_scm_groups(&r, &lat, sum.groups, &sum.sink);
+        if (cm_scm_label_groups(&m, &lat, &r, sum.groups, r.ngroups, msg, sizeof msg) != CM_OK)
+            goto fail;
     }
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)

@@ -998,6 +998,7 @@ int session_open(session *s, const session_options *o)
     if (rc != EXIT_OK)
         return rc;
     cm_store_attach(s->store, &s->c);
+    cm_store_set_model(s->store, &s->model);
     s->c.threads = o->threads;
     s->c.mem_budget = o->mem;
     return EXIT_OK;

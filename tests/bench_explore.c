@@ -34,7 +34,8 @@ static const preset presets[] = {
      100000},
 };
 
-static session open_session(const preset *p, const char *path)
+/* Opens s in place: the session's store keeps a pointer to its model. */
+static void open_session(session *s, const preset *p, const char *path)
 {
     session_options o;
     memset(&o, 0, sizeof o);
@@ -48,10 +49,8 @@ static session open_session(const preset *p, const char *path)
     o.n_cell_size = o.n_origin = 2;
     o.max_steps = p->max_steps;
     o.command = "bench_explore";
-    session s;
-    if (session_open(&s, &o) != 0)
+    if (session_open(s, &o) != 0)
         exit(1);
-    return s;
 }
 
 /* Runs a line and returns its time. */
@@ -86,7 +85,8 @@ int main(int argc, char **argv)
     snprintf(png, sizeof png, "%s/bench_explore.png", dir);
     snprintf(render, sizeof render, "render %s 1000x1000", png);
 
-    session s = open_session(p, db);
+    session s;
+    open_session(&s, p, db);
     const double first = timed(&s, p->view), first_render = timed(&s, render);
     double pan[PANS], draw[PANS], total[PANS];
     printf("preset %s (%s, max-steps %d): first view %.1f ms + render %.1f ms\n", p->name,
@@ -106,7 +106,8 @@ int main(int argc, char **argv)
     /* the same view from scratch, three times */
     double full[3], full_compute[3];
     for (int k = 0; k < 3; k++) {
-        session f = open_session(p, db);
+        session f;
+        open_session(&f, p, db);
         full_compute[k] = timed(&f, final_view);
         full[k] = full_compute[k] + timed(&f, render);
         close_session(&f);

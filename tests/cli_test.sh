@@ -195,5 +195,33 @@ expect_usage "needs 4 values" solve --model microchaos-general --param n=2,A=1 -
 "$CM" fixed-points --model microchaos-general --param mode=input > /dev/null 2>&1
 [ $? -eq 1 ] || fail "fixed points of input quantisation should fail with 1"
 
+# --- dry friction: sticking zones are labelled in the summary and the file --
+"$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-601.5:601.5 \
+  --cells 800x401 --max-steps 100000 --db friction.cmdb --png friction.png --json > friction.json \
+  || fail "friction solve failed"
+json_sticking=$(python3 -c 'import json,sys; print(sum(g["kind"] == "sticking" for g in json.load(open(sys.argv[1]))["groups"]))' friction.json)
+db_sticking=$(sqlite3 friction.cmdb "SELECT COUNT(*) FROM groups WHERE kind = 'sticking'")
+[ "$json_sticking" -gt 100 ] && [ "$json_sticking" = "$db_sticking" ] \
+  || fail "sticking zones: $json_sticking in the summary, $db_sticking in the database"
+[ "$(sqlite3 friction.cmdb "SELECT kind FROM groups WHERE id = 0")" = sink ] || fail "sink kind"
+"$CM" info friction.cmdb > /dev/null || fail "info on a friction file"
+
+# --- a file of format version 2 (no kinds): read as is, upgraded by writing --
+cp basin.cmdb v2.cmdb
+sqlite3 v2.cmdb "DROP VIEW groups; ALTER TABLE attractors DROP COLUMN kind;
+  CREATE VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor, periodic_cells) AS
+  SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1, NULL, NULL, NULL, NULL, NULL
+  UNION ALL SELECT a.id, a.period, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = a.id), 0,
+  a.centre, a.lo, a.hi, a.anchor, a.periodic_cells FROM attractors a; PRAGMA user_version = 2;"
+sum_v2=$(sha256sum v2.cmdb)
+"$CM" export v2.cmdb --groups v2-groups.csv > /dev/null || fail "export of a version 2 file"
+[ "$(sha256sum v2.cmdb)" = "$sum_v2" ] || fail "reading a version 2 file changed it"
+"$CM" export basin.cmdb --groups v3-groups.csv > /dev/null
+cmp -s v2-groups.csv v3-groups.csv || fail "a version 2 file reads differently"
+"$CM" explore v2.cmdb - <<< "stats" > /dev/null || fail "explore of a version 2 file"
+[ "$(sqlite3 v2.cmdb "PRAGMA user_version")" = 3 ] || fail "version 2 file not upgraded"
+[ "$(sqlite3 v2.cmdb "SELECT COUNT(*) FROM groups WHERE kind = 'attractor'")" = \
+  "$(sqlite3 basin.cmdb "SELECT COUNT(*) FROM attractors")" ] || fail "upgraded kinds"
+
 [ $fails -eq 0 ] && echo "cli tests passed" || echo "$fails cli test(s) failed"
 exit $fails

@@ -5,8 +5,10 @@
  * on random states that slide, stick, reverse and graze. */
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/scm.h"
 #include "check.h"
 #include "mix.h"
 #include "models/microchaos_pd_friction.h"
@@ -302,6 +304,55 @@ static void test_registry(void)
     CHECK(strstr(msg, "mu_s") != NULL);
 }
 
+/* Cell mapping with the Fig. 4.30 parameters: the groups labelled sticking
+ * zones are exactly those whose periodic cells lie on the x-axis inside the
+ * analytic sticking zones; without friction there are none. */
+static void test_sticking_groups(void)
+{
+    const cm_lattice lat = {2, {-1e5, -601.5}, {250, 3}}; /* a row centred on x' = 0 */
+    const cm_box box = {2, {0, 0}, {800, 401}};
+    const char *texts[2] = {"mu=0", "mu=0.095"};
+    for (int t = 0; t < 2; t++) {
+        cm_model m;
+        cm_region r;
+        char msg[256];
+        const cm_scm_options opt = {100000, 0, NULL, NULL, 0};
+        CHECK(cm_model_create("microchaos-pd-friction", &texts[t], 1, &m, msg, sizeof msg) ==
+              CM_OK);
+        CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
+        CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+        cm_group_info *g = calloc(r.ngroups + 1, sizeof *g);
+        CHECK(g != NULL);
+        cm_scm_groups(&r, &lat, g, NULL);
+        CHECK(cm_scm_label_groups(&m, &lat, &r, g, r.ngroups, msg, sizeof msg) == CM_OK);
+        const cm_pdf_coef c = coef(t ? &fig430 : &(params){6.53e-3, 0, 5.5e-5, 2.5e-3, 0, 0});
+        long sticking = 0, misplaced = 0;
+        for (uint64_t i = 0; i < r.ncells; i++) {
+            if (!cm_is_periodic(&r, i))
+                continue;
+            int64_t cell[2];
+            double x[2], lo, hi;
+            cm_box_cell(&r.box, i, cell);
+            cm_lattice_centre(&lat, cell, x);
+            double level;
+            const int in_zone = x[1] == 0 && cm_int_part(c.P * x[0], &level) &&
+                                cm_pdf_sticking_zone(&c, (int64_t)level, &lo, &hi) && lo <= x[0] &&
+                                x[0] <= hi;
+            const int labelled = g[r.group[i] - 1].kind == CM_GROUP_STICKING;
+            sticking += labelled;
+            misplaced += labelled != in_zone;
+        }
+        printf("%s: %ld periodic cells of sticking zones, %ld labelled against the analytic "
+               "zones\n",
+               texts[t], sticking, misplaced);
+        CHECK_INT(misplaced, 0);
+        CHECK(t ? sticking > 100 : sticking == 0);
+        free(g);
+        cm_region_free(&r);
+        cm_model_release(&m);
+    }
+}
+
 int main(void)
 {
     test_frictionless_equals_pd();
@@ -311,5 +362,6 @@ int main(void)
     test_grazing(&damped);
     test_sticking_zones();
     test_registry();
+    test_sticking_groups();
     CHECK_DONE();
 }
