@@ -85,7 +85,6 @@ typedef struct cm_scm_options {
                          (needed to join regions into a cluster) */
 } cm_scm_options;
 
-/* Summary of one periodic group. */
 /* What a periodic group is. A sticking zone is a set of rest states held
  * by static friction (cm_model.at_rest): its cells do not move at all. */
 enum cm_group_kind { CM_GROUP_ATTRACTOR = 0, CM_GROUP_STICKING = 1 };
@@ -93,6 +92,7 @@ enum cm_group_kind { CM_GROUP_ATTRACTOR = 0, CM_GROUP_STICKING = 1 };
 /* "attractor" or "sticking", as the database and the summaries write it. */
 const char *cm_group_kind_name(int kind);
 
+/* Summary of one periodic group. */
 typedef struct cm_group_info {
     uint32_t id;
     uint32_t period;                       /* number of periodic cells */

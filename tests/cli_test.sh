@@ -3,6 +3,7 @@
 # usage: cli_test.sh PATH/TO/cellmap
 set -u
 CM=$1
+HERE=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
@@ -204,6 +205,17 @@ db_sticking=$(sqlite3 friction.cmdb "SELECT COUNT(*) FROM groups WHERE kind = 's
 [ "$json_sticking" -gt 100 ] && [ "$json_sticking" = "$db_sticking" ] \
   || fail "sticking zones: $json_sticking in the summary, $db_sticking in the database"
 [ "$(sqlite3 friction.cmdb "SELECT kind FROM groups WHERE id = 0")" = sink ] || fail "sink kind"
+# the rest cells of the zones of levels 1..3 dark grey at x_m* = m/alpha^2, black
+# attractor markers at SW_1..SW_3 (x = m/P)
+python3 - friction.check.json <<'PY'
+import json, sys
+a2, P = 6.53e-3 ** 2, 5.5e-5
+rest = [[m / a2, 0, [96, 96, 96]] for m in (-3, -2, -1, 1, 2, 3)]
+black = [[m / P, 0, 4] for m in (-3, -2, -1, 1, 2, 3)]
+json.dump({"view": [-1e5, 1e5, -601.5, 601.5], "size": [800, 401], "colour_at": rest,
+           "black_near": black}, open(sys.argv[1], "w"))
+PY
+python3 "$HERE/pngcheck.py" friction.png friction.check.json || fail "friction.png pixels"
 "$CM" info friction.cmdb > /dev/null || fail "info on a friction file"
 
 # --- a file of format version 2 (no kinds): read as is, upgraded by writing --
