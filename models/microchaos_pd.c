@@ -119,24 +119,30 @@ static int step_pd(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
-/* (4.71): x_m* = [m/alpha^2, 0], regular iff Int(P x + D 0) = m. */
+size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fixed_point *out,
+                          size_t cap)
+{
+    size_t count = 0;
+    for (int64_t k = m0; k <= m1 && count < cap; k++) {
+        cm_fixed_point *fp = &out[count++];
+        double band;
+        memset(fp, 0, sizeof *fp);
+        fp->level = k;
+        fp->x[0] = (double)k / alpha2;
+        fp->x[1] = 0.0;
+        fp->band = cm_int_part(P * fp->x[0] + 0.0, &band) ? (int64_t)band : INT64_MIN;
+        fp->regular = fp->band == k;
+    }
+    return count;
+}
+
 static int fixed_points_pd(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                            size_t cap, size_t *count, char *msg, size_t msg_size)
 {
     const pd_map *c = m->ctx;
     (void)msg;
     (void)msg_size;
-    *count = 0;
-    for (int64_t k = m0; k <= m1 && *count < cap; k++) {
-        cm_fixed_point *fp = &out[(*count)++];
-        double band;
-        memset(fp, 0, sizeof *fp);
-        fp->level = k;
-        fp->x[0] = (double)k / c->alpha2;
-        fp->x[1] = 0.0;
-        fp->band = cm_int_part(c->P * fp->x[0] + c->D * 0.0, &band) ? (int64_t)band : INT64_MIN;
-        fp->regular = fp->band == k;
-    }
+    *count = cm_pd_fixed_points(c->alpha2, c->P, m0, m1, out, cap);
     return 0;
 }
 

@@ -4,16 +4,19 @@
 #ifndef CM_MODELS_MICROCHAOS_PD_H
 #define CM_MODELS_MICROCHAOS_PD_H
 
+#include <stddef.h>
 #include <stdint.h>
+
+#include "cellmap/model.h"
 
 typedef struct cm_pd_coef {
     double alpha, beta, P, D;
-    double gamma;          /* sqrt(alpha^2 + beta^2) */
-    double A[4];           /* (4.67), row-major */
-    double b[2];           /* (4.67) */
-    double S[4];           /* A + b [P, D] (4.62) */
+    double gamma;              /* sqrt(alpha^2 + beta^2) */
+    double A[4];               /* (4.67), row-major */
+    double b[2];               /* (4.67) */
+    double S[4];               /* A + b [P, D] (4.62) */
     double lambda_u, lambda_s; /* eigenvalues of A: exp(+-gamma - beta) */
-    double e_u[2], e_s[2]; /* eigenvectors (4.68), first component 1 */
+    double e_u[2], e_s[2];     /* eigenvectors (4.68), first component 1 */
 } cm_pd_coef;
 
 /* Matrices of (4.66)/(4.67) and the eigen-structure of A. */
@@ -25,9 +28,9 @@ void cm_pd_switching_line(double P, double D, int64_t m, double *slope, double *
 
 /* Stability of the quantisation-free loop (C.43)-(C.47). */
 typedef struct cm_pd_stability {
-    double p, q;        /* characteristic polynomial mu^2 + p mu + q of S */
-    double b0, b1, b2;  /* (C.44); stable iff all three are positive */
-    double D_b0, D_b1;  /* (C.45): stable iff P > alpha^2 and D_b1 < D < D_b0 */
+    double p, q;       /* characteristic polynomial mu^2 + p mu + q of S */
+    double b0, b1, b2; /* (C.44); stable iff all three are positive */
+    double D_b0, D_b1; /* (C.45): stable iff P > alpha^2 and D_b1 < D < D_b0 */
     int stable;
 } cm_pd_stability;
 
@@ -42,5 +45,11 @@ double cm_pd_D_at_P_max(double alpha, double beta);
  * m_fix,max + 1. Return -1 when P <= alpha^2 (unbounded). */
 int64_t cm_pd_m_fix_max(double alpha, double P);
 int64_t cm_pd_m_max(double alpha, double P);
+
+/* (4.71): the fixed points x_m* = [m/alpha^2, 0] for levels m0..m1 into
+ * out (at most cap); x_m* is regular iff Int(P x_m*) = m (the band test of
+ * MODELS.md 6.4). Returns how many were written. */
+size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fixed_point *out,
+                          size_t cap);
 
 #endif

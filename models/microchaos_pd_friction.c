@@ -181,16 +181,7 @@ static int fixed_points_pdf(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_
     const pdf_model *f = m->ctx;
     (void)msg;
     (void)msg_size;
-    *count = 0;
-    for (int64_t k = m0; k <= m1 && *count < cap; k++) {
-        cm_fixed_point *fp = &out[(*count)++];
-        double band;
-        memset(fp, 0, sizeof *fp);
-        fp->level = k;
-        fp->x[0] = (double)k / f->c.alpha2;
-        fp->band = cm_int_part(f->c.P * fp->x[0], &band) ? (int64_t)band : INT64_MIN;
-        fp->regular = fp->band == k;
-    }
+    *count = cm_pd_fixed_points(f->c.alpha2, f->c.P, m0, m1, out, cap);
     return 0;
 }
 

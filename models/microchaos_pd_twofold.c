@@ -73,8 +73,9 @@ cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char 
     cm_pd_coefficients(cm_params_get(p, "alpha"), cm_params_get(p, "beta"), cm_params_get(p, "P"),
                        cm_params_get(p, "D"), &k);
     twofold_map *c = m->ctx;
-    *c = (twofold_map){k.A[0], k.A[1], k.A[2], k.A[3], k.b[0], k.b[1],
-                       k.P,    k.D,    cm_params_get(p, "rho"), k.alpha * k.alpha};
+    *c = (twofold_map){
+        k.A[0],           k.A[1], k.A[2], k.A[3], k.b[0], k.b[1], k.P, k.D, cm_params_get(p, "rho"),
+        k.alpha * k.alpha};
     m->step = step_twofold;
     m->fixed_points = fixed_points_twofold;
     return CM_OK;
