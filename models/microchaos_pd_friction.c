@@ -82,14 +82,14 @@ bool cm_pdf_step(const cm_pdf_coef *c, double x, double v, cm_pdf_result *out)
         sigma = sign(F);
     } else {
         sigma = sign(v);
-        const double t = velocity_zero(c, level + c->mu * sigma, x, v);
+        const double q = level + c->mu * sigma; /* the constant force is -q */
+        const double t = velocity_zero(c, q, x, v);
         if (t < 0) { /* the sign of the friction force holds: (4.81) */
-            const double q = level + c->mu * sigma;
             out->x = c->A[0] * x + c->A[1] * v + c->b[0] * q;
             out->v = c->A[2] * x + c->A[3] * v + c->b[1] * q;
             return true;
         }
-        slide(c, level + c->mu * sigma, t, &x, &v);
+        slide(c, q, t, &x, &v);
         v = 0;
         out->event_time = t;
         out->event_x = x;

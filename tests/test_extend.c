@@ -81,20 +81,28 @@ static uint64_t tile_count(const uint64_t *per_tile, const cm_box *tile, const c
     return per_tile[(ty + SPAN) * 2 * SPAN + tx + SPAN];
 }
 
+/* The cluster of the boxes on the Fig. 4.16 lattice, and the extension
+ * it chooses for `tile`. */
+static void choose_for(cm_cluster *c, const cm_model *m, const cm_box *boxes, uint32_t n,
+                       const cm_box *tile, cm_extend_choice *choice)
+{
+    const cm_lattice lat = {2, {85.4, -12.5}, {0.8, 0.1}};
+    char msg[256];
+    cm_cluster_init(c, &lat);
+    add_boxes(c, m, boxes, n);
+    CHECK(cm_extend_choose(c, tile, NULL, choice, msg, sizeof msg) == CM_OK);
+}
+
 /* A cluster of three tiles (an L shape): the chosen tile's count and the
  * total equal brute force, and no face neighbour receives more. */
 static void test_brute_force(void)
 {
     cm_model m = fig_model();
-    const cm_lattice lat = {2, {85.4, -12.5}, {0.8, 0.1}};
     const cm_box tile = {2, {0, 0}, {250, 250}};
     const cm_box boxes[3] = {tile, {2, {250, 0}, {500, 250}}, {2, {250, -250}, {500, 0}}};
     cm_cluster c;
-    cm_cluster_init(&c, &lat);
-    add_boxes(&c, &m, boxes, 3);
     cm_extend_choice choice;
-    char msg[256];
-    CHECK(cm_extend_choose(&c, &tile, NULL, &choice, msg, sizeof msg) == CM_OK);
+    choose_for(&c, &m, boxes, 3, &tile, &choice);
     static uint64_t per_tile[4 * SPAN * SPAN];
     const uint64_t all = brute_force(&c, &tile, per_tile);
     CHECK_INT(choice.all_escaping, all);
@@ -120,16 +128,12 @@ static void test_brute_force(void)
 static void test_unaligned(void)
 {
     cm_model m = fig_model();
-    const cm_lattice lat = {2, {85.4, -12.5}, {0.8, 0.1}};
     const cm_box tile = {2, {0, 0}, {200, 200}};
     /* a view, then a pan right by 70 cells and up by 30 */
     const cm_box boxes[3] = {tile, {2, {200, 0}, {270, 200}}, {2, {70, 200}, {270, 230}}};
     cm_cluster c;
-    cm_cluster_init(&c, &lat);
-    add_boxes(&c, &m, boxes, 3);
     cm_extend_choice choice;
-    char msg[256];
-    CHECK(cm_extend_choose(&c, &tile, NULL, &choice, msg, sizeof msg) == CM_OK);
+    choose_for(&c, &m, boxes, 3, &tile, &choice);
     static uint64_t per_tile[4 * SPAN * SPAN];
     CHECK_INT(choice.all_escaping, brute_force(&c, &tile, per_tile));
     CHECK_INT(choice.escaping, tile_count(per_tile, &tile, &choice.box));
@@ -138,6 +142,7 @@ static void test_unaligned(void)
     CHECK_INT(choice.box.lo[1] % 200, 0);
     cm_box *rest = NULL;
     uint32_t n = 0;
+    char msg[256];
     CHECK(cm_cluster_uncovered(&c, &choice.box, &rest, &n, msg, sizeof msg) == CM_OK);
     uint64_t covered = 0;
     for (uint32_t k = 0; k < c.nregions; k++) {
