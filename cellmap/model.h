@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "cellmap/lattice.h"
+#include "cellmap/overlay.h"
 
 #define CM_MAX_PARAMS 16
 #define CM_PARAM_MAX_VALUES 64
@@ -75,6 +76,15 @@ typedef struct cm_model {
      * whose periodic cells map to rest states are sticking zones, not
      * attractors of the motion. Pure, like step(). */
     bool (*at_rest)(const struct cm_model *m, const double *y);
+    /* Optional. Appends what the renderer should draw over the basins in the
+     * view rectangle lo..hi (dimensions 0 and 1; for 1-D models the plane of
+     * the map's graph): switching lines, fixed points, manifolds, sticking
+     * zones. Pure, like step(). */
+    void (*overlays)(const struct cm_model *m, const double lo[2], const double hi[2],
+                     cm_overlay_list *out);
+    /* Optional. Names of the state coordinates (dim entries) for axis labels;
+     * NULL: x0, x1, ... */
+    const char *const *coord_names;
     void (*destroy)(void *ctx);
 } cm_model;
 

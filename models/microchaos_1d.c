@@ -48,6 +48,33 @@ static int fixed_points_1d(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_p
     return 0;
 }
 
+/* The fixed points in view, on the diagonal of the graph plane. */
+static void overlays_1d(const cm_model *m, const double lo[2], const double hi[2],
+                        cm_overlay_list *out)
+{
+    const map1d *c = m->ctx;
+    if (c->a == 1.0 || c->b == 0.0)
+        return;
+    const double s = (c->a - 1.0) / c->b; /* level of the fixed point at x: x s */
+    double m0 = lo[0] * s, m1 = hi[0] * s;
+    if (m0 > m1) {
+        const double t = m0;
+        m0 = m1;
+        m1 = t;
+    }
+    if (!(m0 > -4e18 && m1 < 4e18))
+        return;
+    for (int64_t k = (int64_t)ceil(m0); k <= (int64_t)floor(m1) && !out->truncated; k++) {
+        cm_fixed_point fp;
+        size_t n = 0;
+        fixed_points_1d(m, k, k, &fp, 1, &n, NULL, 0);
+        const double p[2] = {fp.x[0], fp.x[0]};
+        if (cm_overlay_in_view(p, lo, hi))
+            cm_overlay_add(out, fp.regular ? CM_OVERLAY_FIXED_REGULAR : CM_OVERLAY_FIXED_VIRTUAL, p,
+                           NULL);
+    }
+}
+
 cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
 {
     cm_status st = cm_model_setup(m, "microchaos-1d", 1, p, sizeof(map1d), msg, msg_size);
@@ -58,5 +85,6 @@ cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, si
     c->b = cm_params_get(p, "b");
     m->step = step_1d;
     m->fixed_points = fixed_points_1d;
+    m->overlays = overlays_1d;
     return CM_OK;
 }

@@ -129,8 +129,7 @@ static cm_status take(const cm_params *p, const char *name, int want, bool broad
                    want == 1 ? "" : "s", v->count);
 }
 
-cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg,
-                                       size_t msg_size)
+cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
 {
     general_map g;
     memset(&g, 0, sizeof g);

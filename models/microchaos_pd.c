@@ -105,7 +105,7 @@ int64_t cm_pd_m_max(double alpha, double P)
 }
 
 typedef struct pd_map {
-    double a11, a12, a21, a22, b1, b2, P, D, alpha2;
+    double a11, a12, a21, a22, b1, b2, P, D, alpha2, beta;
 } pd_map;
 
 static int step_pd(const cm_model *m, const double *x, double *y)
@@ -136,6 +136,71 @@ size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fi
     return count;
 }
 
+/* The band of level m as z_lo <= P x + D x' <= z_hi (MODELS.md 1.1; band 0
+ * is twice as wide). */
+static void band_of(int64_t m, double *z_lo, double *z_hi)
+{
+    *z_lo = m > 0 ? (double)m : (double)m - 1.0;
+    *z_hi = m < 0 ? (double)m : (double)m + 1.0;
+}
+
+static void add_switching_lines(double P, double D, const double lo[2], const double hi[2],
+                                cm_overlay_list *out)
+{
+    const double n[2] = {P, D}, nn = P * P + D * D;
+    if (nn == 0.0)
+        return;
+    double z_min = INFINITY, z_max = -INFINITY;
+    for (int k = 0; k < 4; k++) {
+        const double z = P * (k & 1 ? hi[0] : lo[0]) + D * (k & 2 ? hi[1] : lo[1]);
+        z_min = z < z_min ? z : z_min;
+        z_max = z > z_max ? z : z_max;
+    }
+    if (!(z_min > -4e18 && z_max < 4e18))
+        return;
+    const double d[2] = {-D, P};
+    for (double z = ceil(z_min); z <= z_max && !out->truncated; z++) {
+        if (z == 0.0)
+            continue;
+        const double p[2] = {z * n[0] / nn, z * n[1] / nn};
+        cm_overlay_add_line(out, CM_OVERLAY_SWITCHING_LINE, p, d, lo, hi, NULL, 0, 0);
+    }
+}
+
+void cm_pd_overlays(double alpha2, double beta, double P, double D, const double lo[2],
+                    const double hi[2], cm_overlay_list *out)
+{
+    add_switching_lines(P, D, lo, hi, out);
+    if (!(lo[1] <= 0.0 && hi[1] >= 0.0)) /* every fixed point lies on x' = 0 */
+        return;
+    const double gamma = sqrt(alpha2 + beta * beta);
+    const double e_u[2] = {1.0, gamma - beta}, e_s[2] = {1.0, -gamma - beta}, n[2] = {P, D};
+    const double m0 = ceil(lo[0] * alpha2), m1 = floor(hi[0] * alpha2);
+    if (!(m0 > -4e18 && m1 < 4e18))
+        return;
+    for (int64_t m = (int64_t)m0; m <= (int64_t)m1 && !out->truncated; m++) {
+        cm_fixed_point fp;
+        cm_pd_fixed_points(alpha2, P, m, m, &fp, 1);
+        cm_overlay_add(out, fp.regular ? CM_OVERLAY_FIXED_REGULAR : CM_OVERLAY_FIXED_VIRTUAL, fp.x,
+                       NULL);
+        if (!fp.regular)
+            continue;
+        double z_lo, z_hi;
+        band_of(m, &z_lo, &z_hi);
+        cm_overlay_add_line(out, CM_OVERLAY_UNSTABLE_MANIFOLD, fp.x, e_u, lo, hi, n, z_lo, z_hi);
+        cm_overlay_add_line(out, CM_OVERLAY_STABLE_MANIFOLD, fp.x, e_s, lo, hi, n, z_lo, z_hi);
+    }
+}
+
+static void overlays_pd(const cm_model *m, const double lo[2], const double hi[2],
+                        cm_overlay_list *out)
+{
+    const pd_map *c = m->ctx;
+    cm_pd_overlays(c->alpha2, c->beta, c->P, c->D, lo, hi, out);
+}
+
+const char *const cm_pd_coord_names[] = {"x", "x'"};
+
 static int fixed_points_pd(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                            size_t cap, size_t *count, char *msg, size_t msg_size)
 {
@@ -155,8 +220,11 @@ cm_status cm_microchaos_pd_create(const cm_params *p, cm_model *m, char *msg, si
     cm_pd_coefficients(cm_params_get(p, "alpha"), cm_params_get(p, "beta"), cm_params_get(p, "P"),
                        cm_params_get(p, "D"), &k);
     pd_map *c = m->ctx;
-    *c = (pd_map){k.A[0], k.A[1], k.A[2], k.A[3], k.b[0], k.b[1], k.P, k.D, k.alpha * k.alpha};
+    *c = (pd_map){k.A[0], k.A[1], k.A[2], k.A[3], k.b[0], k.b[1], k.P, k.D, k.alpha * k.alpha,
+                  k.beta};
     m->step = step_pd;
     m->fixed_points = fixed_points_pd;
+    m->overlays = overlays_pd;
+    m->coord_names = cm_pd_coord_names;
     return CM_OK;
 }

@@ -52,4 +52,14 @@ int64_t cm_pd_m_max(double alpha, double P);
 size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fixed_point *out,
                           size_t cap);
 
+/* Axis names of the pendulum's state: x and x'. */
+extern const char *const cm_pd_coord_names[];
+
+/* The overlays of the view lo..hi (MODELS.md 6.4): the switching lines
+ * SW_m, the fixed points x_m* (regular or virtual) and, through each regular
+ * one, its unstable and stable manifolds (the lines along e_u and e_s) within
+ * its band. Shared by microchaos-pd and microchaos-pd-friction. */
+void cm_pd_overlays(double alpha2, double beta, double P, double D, const double lo[2],
+                    const double hi[2], cm_overlay_list *out);
+
 #endif

@@ -185,6 +185,30 @@ static int fixed_points_pdf(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_
     return 0;
 }
 
+/* As the PD map, plus each level's sticking zone on x' = 0. */
+static void overlays_pdf(const cm_model *m, const double lo[2], const double hi[2],
+                         cm_overlay_list *out)
+{
+    const pdf_model *f = m->ctx;
+    const cm_pdf_coef *c = &f->c;
+    cm_pd_overlays(c->alpha2, c->beta, c->P, c->D, lo, hi, out);
+    if (!(lo[1] <= 0.0 && hi[1] >= 0.0))
+        return;
+    /* the zone of level k lies within mu_s/alpha^2 of its fixed point k/alpha^2 */
+    const double reach = c->mu_s + 1.0;
+    const double k0 = floor(lo[0] * c->alpha2 - reach), k1 = ceil(hi[0] * c->alpha2 + reach);
+    if (!(k0 > -4e18 && k1 < 4e18))
+        return;
+    for (int64_t k = (int64_t)k0; k <= (int64_t)k1 && !out->truncated; k++) {
+        double x_lo, x_hi;
+        if (!cm_pdf_sticking_zone(c, k, &x_lo, &x_hi) || x_hi < lo[0] || x_lo > hi[0])
+            continue;
+        const double a[2] = {x_lo > lo[0] ? x_lo : lo[0], 0.0};
+        const double b[2] = {x_hi < hi[0] ? x_hi : hi[0], 0.0};
+        cm_overlay_add(out, CM_OVERLAY_STICKING_ZONE, a, b);
+    }
+}
+
 cm_status cm_microchaos_pd_friction_create(const cm_params *p, cm_model *m, char *msg,
                                            size_t msg_size)
 {
@@ -207,5 +231,7 @@ cm_status cm_microchaos_pd_friction_create(const cm_params *p, cm_model *m, char
     m->step = step_pdf;
     m->at_rest = at_rest_pdf;
     m->fixed_points = fixed_points_pdf;
+    m->overlays = overlays_pdf;
+    m->coord_names = cm_pd_coord_names;
     return CM_OK;
 }

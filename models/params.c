@@ -50,8 +50,7 @@ static cm_status parse_value(const cm_param_spec *s, const char *text, size_t le
     }
     char buf[2048];
     if (len == 0 || len >= sizeof buf)
-        return cm_fail(CM_EINVAL, msg, msg_size, "parameter %s: empty or overlong value",
-                       s->name);
+        return cm_fail(CM_EINVAL, msg, msg_size, "parameter %s: empty or overlong value", s->name);
     memcpy(buf, text, len);
     buf[len] = '\0';
     int count = 0;
@@ -88,8 +87,8 @@ cm_status cm_params_defaults(const cm_param_spec *spec, cm_params *p, char *msg,
     for (int i = 0; spec[i].name; i++) {
         if (i >= CM_MAX_PARAMS)
             return cm_fail(CM_EINVAL, msg, msg_size, "too many parameters in a model spec");
-        cm_status st = parse_value(&spec[i], spec[i].def, strlen(spec[i].def), &p->value[i], msg,
-                                   msg_size);
+        cm_status st =
+            parse_value(&spec[i], spec[i].def, strlen(spec[i].def), &p->value[i], msg, msg_size);
         if (st != CM_OK)
             return st;
         p->count = i + 1;

@@ -14,24 +14,22 @@
 #define CM_PD_FRICTION_REGION "-100000:100000,-300:300"
 
 static const cm_model_entry entries[] = {
-    {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15", cm_microchaos_1d_spec,
-     cm_microchaos_1d_create},
-    {"microchaos-1d-friction", "x_j",
-     "1D transient micro-chaos map with Coulomb friction (4.23)", "-2:2", cm_microchaos_1d_friction_spec,
-     cm_microchaos_1d_friction_create},
+    {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
+     cm_microchaos_1d_spec, cm_microchaos_1d_create},
+    {"microchaos-1d-friction", "x_j", "1D transient micro-chaos map with Coulomb friction (4.23)",
+     "-2:2", cm_microchaos_1d_friction_spec, cm_microchaos_1d_friction_create},
     {"microchaos-delay", "x_{j-1}, x_j", "2D micro-chaos map with delay (4.37)", "-6:6,-6:6",
      cm_microchaos_delay_spec, cm_microchaos_delay_create},
-    {"microchaos-pd", "x, x'", "PD-controlled inverted pendulum, output quantisation (4.66)", CM_PD_EXAMPLE_REGION,
-     cm_microchaos_pd_spec, cm_microchaos_pd_create},
-    {"microchaos-pd-twofold", "x, x'", "PD map with twofold (input and output) quantisation (4.84)", CM_PD_EXAMPLE_REGION,
-     cm_microchaos_pd_twofold_spec, cm_microchaos_pd_twofold_create},
+    {"microchaos-pd", "x, x'", "PD-controlled inverted pendulum, output quantisation (4.66)",
+     CM_PD_EXAMPLE_REGION, cm_microchaos_pd_spec, cm_microchaos_pd_create},
+    {"microchaos-pd-twofold", "x, x'", "PD map with twofold (input and output) quantisation (4.84)",
+     CM_PD_EXAMPLE_REGION, cm_microchaos_pd_twofold_spec, cm_microchaos_pd_twofold_create},
     {"microchaos-pd-friction", "x, x'",
-     "PD map with dry friction: hybrid micro-chaos map, sticking zones (4.81)", CM_PD_FRICTION_REGION,
-     cm_microchaos_pd_friction_spec, cm_microchaos_pd_friction_create},
+     "PD map with dry friction: hybrid micro-chaos map, sticking zones (4.81)",
+     CM_PD_FRICTION_REGION, cm_microchaos_pd_friction_spec, cm_microchaos_pd_friction_create},
     {"microchaos-general", "x_{j-d}, ..., x_j",
      "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
-     NULL,
-     cm_microchaos_general_spec, cm_microchaos_general_create},
+     NULL, cm_microchaos_general_spec, cm_microchaos_general_create},
 };
 
 size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }

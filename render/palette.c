@@ -53,29 +53,49 @@ static int compare_anchor(const void *a, const void *b)
     return 0;
 }
 
-void cm_palette_assign(const cm_group_info *groups, uint32_t n, int dim, cm_rgb *colours)
+int cm_class_count(void) { return CM_CLASS_FIRST_GROUP + PALETTE_SIZE; }
+
+cm_rgb cm_class_colour(int cls)
+{
+    switch (cls) {
+    case CM_CLASS_NOT_COMPUTED:
+        return cm_colour_not_computed;
+    case CM_CLASS_SINK:
+        return cm_colour_sink;
+    case CM_CLASS_MARKER:
+        return cm_colour_marker;
+    case CM_CLASS_STICKING:
+        return cm_colour_sticking;
+    case CM_CLASS_STICKING_MARKER:
+        return cm_colour_sticking_marker;
+    default:
+        return palette[(cls - CM_CLASS_FIRST_GROUP) % PALETTE_SIZE];
+    }
+}
+
+void cm_palette_classes(const cm_group_info *groups, uint32_t n, int dim, uint8_t *classes)
 {
     ranked *order = malloc((size_t)n * sizeof *order);
     if (!order) { /* fall back to plain hashing */
         for (uint32_t k = 0; k < n; k++)
-            colours[k] = groups[k].kind == CM_GROUP_STICKING
-                             ? cm_colour_sticking
-                             : palette[anchor_hash(groups[k].anchor, dim) % PALETTE_SIZE];
+            classes[k] = groups[k].kind == CM_GROUP_STICKING
+                             ? CM_CLASS_STICKING
+                             : (uint8_t)(CM_CLASS_FIRST_GROUP +
+                                         anchor_hash(groups[k].anchor, dim) % PALETTE_SIZE);
         return;
     }
     uint32_t coloured = 0; /* sticking zones are all grey, as in Fig. 4.30 */
     for (uint32_t k = 0; k < n; k++) {
         if (groups[k].kind == CM_GROUP_STICKING)
-            colours[k] = cm_colour_sticking;
+            classes[k] = CM_CLASS_STICKING;
         else
             order[coloured++] = (ranked){groups[k].anchor, dim, k};
     }
-    n = coloured;
-    qsort(order, n, sizeof *order, compare_anchor);
+    qsort(order, coloured, sizeof *order, compare_anchor);
     bool taken[PALETTE_SIZE];
     memset(taken, 0, sizeof taken);
     uint32_t used = 0;
-    for (uint32_t r = 0; r < n; r++) {
+    for (uint32_t r = 0; r < coloured; r++) {
         if (used == PALETTE_SIZE) { /* every colour taken: start a new round */
             memset(taken, 0, sizeof taken);
             used = 0;
@@ -85,7 +105,7 @@ void cm_palette_assign(const cm_group_info *groups, uint32_t n, int dim, cm_rgb 
             c = (c + 1) % PALETTE_SIZE;
         taken[c] = true;
         used++;
-        colours[order[r].index] = palette[c];
+        classes[order[r].index] = (uint8_t)(CM_CLASS_FIRST_GROUP + c);
     }
     free(order);
 }

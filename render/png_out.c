@@ -15,15 +15,30 @@ typedef struct png_job {
     uint8_t *row;
 } png_job;
 
-static cm_status encode(png_job *job, const uint8_t *rgba, int width, int height,
-                        const cm_png_text *texts, int n_texts)
+/* The pixels to write: RGBA (stored as RGB), or palette indices. */
+typedef struct png_pixels {
+    const uint8_t *data;
+    int width, height;
+    const uint8_t *palette; /* NULL: RGBA; else n_colours RGB triples */
+    int n_colours;
+} png_pixels;
+
+static cm_status encode(png_job *job, const png_pixels *px, const cm_png_text *texts, int n_texts)
 {
     if (setjmp(png_jmpbuf(job->png)))
         return CM_EIO;
+    const int width = px->width, height = px->height;
     png_init_io(job->png, job->file);
     png_set_IHDR(job->png, job->info, (png_uint_32)width, (png_uint_32)height, 8,
-                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
+                 px->palette ? PNG_COLOR_TYPE_PALETTE : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    if (px->palette) {
+        png_color colours[256];
+        for (int k = 0; k < px->n_colours; k++)
+            colours[k] =
+                (png_color){px->palette[3 * k], px->palette[3 * k + 1], px->palette[3 * k + 2]};
+        png_set_PLTE(job->png, job->info, colours, px->n_colours);
+    }
     /* Basins are flat areas of colour: the Sub filter and zlib level 3 write
      * them about 4x faster than libpng's defaults (a 1000x1000 view in ~7 ms
      * instead of ~27 ms, which a pan's render can afford), in files about
@@ -40,7 +55,11 @@ static cm_status encode(png_job *job, const uint8_t *rgba, int width, int height
     }
     png_write_info(job->png, job->info);
     for (int y = 0; y < height; y++) {
-        const uint8_t *src = rgba + (size_t)y * (size_t)width * 4;
+        if (px->palette) {
+            png_write_row(job->png, px->data + (size_t)y * (size_t)width);
+            continue;
+        }
+        const uint8_t *src = px->data + (size_t)y * (size_t)width * 4;
         for (int x = 0; x < width; x++)
             memcpy(job->row + 3 * (size_t)x, src + 4 * (size_t)x, 3);
         png_write_row(job->png, job->row);
@@ -49,9 +68,10 @@ static cm_status encode(png_job *job, const uint8_t *rgba, int width, int height
     return CM_OK;
 }
 
-cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
-                       const cm_png_text *texts, int n_texts, char *msg, size_t msg_size)
+static cm_status write_file(const char *path, const png_pixels *px, const cm_png_text *texts,
+                            int n_texts, char *msg, size_t msg_size)
 {
+    const int width = px->width;
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
     png_job job;
@@ -65,9 +85,7 @@ cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int hei
     job.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
     job.info = job.png ? png_create_info_struct(job.png) : NULL;
     job.row = malloc(3 * (size_t)width);
-    cm_status st = job.png && job.info && job.row
-                       ? encode(&job, rgba, width, height, texts, n_texts)
-                       : CM_ENOMEM;
+    cm_status st = job.png && job.info && job.row ? encode(&job, px, texts, n_texts) : CM_ENOMEM;
     png_destroy_write_struct(&job.png, &job.info);
     free(job.row);
     if (fclose(job.file) != 0 && st == CM_OK)
@@ -79,4 +97,22 @@ cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int hei
         return cm_fail(st, msg, msg_size, "cannot write PNG %s: %s", path, cm_strerror(st));
     }
     return CM_OK;
+}
+
+cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
+                       const cm_png_text *texts, int n_texts, char *msg, size_t msg_size)
+{
+    const png_pixels px = {rgba, width, height, NULL, 0};
+    return write_file(path, &px, texts, n_texts, msg, msg_size);
+}
+
+cm_status cm_png_write_indexed(const char *path, const uint8_t *index, int width, int height,
+                               const uint8_t *palette, int n_colours, const cm_png_text *texts,
+                               int n_texts, char *msg, size_t msg_size)
+{
+    if (n_colours < 1 || n_colours > 256)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a PNG palette holds 1..256 colours, not %d",
+                       n_colours);
+    const png_pixels px = {index, width, height, palette, n_colours};
+    return write_file(path, &px, texts, n_texts, msg, msg_size);
 }

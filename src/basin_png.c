@@ -1,15 +1,123 @@
 #include "src/basin_png.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cellmap/store.h"
-#include "render/basin.h"
+#include "render/figure.h"
+#include "render/palette.h"
 #include "render/png_out.h"
-#include "src/args.h"
+#include "render/raster.h"
 
-enum { MAX_DEFAULT_SIDE = 4096 };
+enum { MAX_DEFAULT_SIDE = 4096, FIGURE_SIDE = 1000 };
+
+static const struct {
+    const char *name;
+    unsigned bit;
+} layer_names[] = {
+    {"basin", CM_LAYER_BASIN},       {"steps", CM_LAYER_STEPS}, {"attractors", CM_LAYER_ATTRACTORS},
+    {"overlays", CM_LAYER_OVERLAYS}, {"axes", CM_LAYER_AXES},   {"legend", CM_LAYER_LEGEND},
+    {"title", CM_LAYER_TITLE},
+};
+
+static const unsigned all_layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS |
+                                   CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
+static const unsigned text_layers = CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
+
+bool parse_layers(const char *s, unsigned *layers, char *bad, size_t bad_size)
+{
+    *layers = 0;
+    while (*s) {
+        const size_t n = strcspn(s, ",");
+        unsigned bit = 0;
+        if (n == 3 && strncmp(s, "all", 3) == 0)
+            bit = all_layers;
+        for (size_t k = 0; k < sizeof layer_names / sizeof layer_names[0] && !bit; k++)
+            if (strlen(layer_names[k].name) == n && strncmp(s, layer_names[k].name, n) == 0)
+                bit = layer_names[k].bit;
+        if (!bit) {
+            snprintf(bad, bad_size, "%.*s", (int)n, s);
+            return false;
+        }
+        *layers |= bit;
+        s += n + (s[n] == ',');
+    }
+    if (*layers)
+        return true;
+    snprintf(bad, bad_size, "(empty)");
+    return false;
+}
+
+bool parse_png_mode(const char *s, int *indexed)
+{
+    *indexed = strcmp(s, "indexed") == 0;
+    return *indexed || strcmp(s, "rgb") == 0;
+}
+
+bool png_opts_take(cli *c, png_opts *po, int *err)
+{
+    if (cli_is(c, "--png", true, err)) {
+        po->path = c->value;
+    } else if (cli_is(c, "--size", true, err)) {
+        int64_t wh[2];
+        int n = 0;
+        if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 ||
+                         wh[0] > CM_RENDER_MAX_SIDE || wh[1] > CM_RENDER_MAX_SIDE))
+            *err = cli_usage_error(c, "--size: '%s' must be WxH, each 1..%d", c->value,
+                                   CM_RENDER_MAX_SIDE);
+        else if (c->value) {
+            po->width = (int)wh[0];
+            po->height = (int)wh[1];
+        }
+    } else if (cli_is(c, "--layers", true, err)) {
+        char bad[64];
+        if (c->value && !parse_layers(c->value, &po->layers, bad, sizeof bad))
+            *err = cli_usage_error(c,
+                                   "--layers: unknown layer '%s' (use basin, steps, attractors, "
+                                   "overlays, axes, legend, title or all, separated by commas)",
+                                   bad);
+    } else if (cli_is(c, "--png-mode", true, err)) {
+        if (c->value && !parse_png_mode(c->value, &po->indexed))
+            *err = cli_usage_error(c, "--png-mode: '%s' must be rgb or indexed", c->value);
+    } else if (cli_is(c, "--view", true, err)) {
+        int n = 0;
+        if (c->value && (!parse_ranges(c->value, po->lo, po->hi, &n, 2) || n != 2 ||
+                         !(po->lo[0] < po->hi[0] && po->lo[1] < po->hi[1])))
+            *err = cli_usage_error(c, "--view: '%s' must be X0:X1,Y0:Y1 with X0 < X1, Y0 < Y1",
+                                   c->value);
+        po->has_view = 1;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+int png_opts_check(const cli *c, const png_opts *po)
+{
+    if (!po->path && (po->width || po->layers || po->indexed))
+        return cli_usage_error(c, "--size, --layers and --png-mode describe the image; add --png "
+                                  "FILE");
+    if (po->indexed && (po->width || po->layers))
+        return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
+                                  "classes; leave out --size and --layers");
+    return EXIT_OK;
+}
+
+void view_cells(const cm_lattice *lat, const double lo[2], const double hi[2], const cm_box *within,
+                cm_box *out)
+{
+    *out = *within;
+    for (int d = 0; d < lat->dim && d < 2; d++) {
+        out->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
+        out->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+    }
+    for (int d = 2; d < lat->dim; d++) {
+        out->lo[d] = within->lo[d] + (within->hi[d] - within->lo[d]) / 2;
+        out->hi[d] = out->lo[d] + 1;
+    }
+}
 
 void default_image_size(const cm_lattice *lat, const cm_box *box, int *width, int *height)
 {
@@ -23,6 +131,22 @@ void default_image_size(const cm_lattice *lat, const cm_box *box, int *width, in
     *height = *height < 1 ? 1 : *height;
 }
 
+/* A figure with text gets FIGURE_SIDE pixels on its longer side (keeping
+ * the cells' aspect) when the cells would make it smaller. */
+static void figure_size(const cm_lattice *lat, const cm_box *box, unsigned layers, int *w, int *h)
+{
+    default_image_size(lat, box, w, h);
+    if (lat->dim == 1 && (layers & (CM_LAYER_OVERLAYS | text_layers)))
+        *h = *w; /* room for the map's graph */
+    const int most = *w > *h ? *w : *h;
+    if (!(layers & text_layers) || most >= FIGURE_SIDE)
+        return;
+    *w = (int)lround((double)*w * FIGURE_SIDE / most);
+    *h = (int)lround((double)*h * FIGURE_SIDE / most);
+    *w = *w < 200 ? 200 : *w;
+    *h = *h < 200 ? 200 : *h;
+}
+
 void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size)
 {
     size_t used = 0;
@@ -33,54 +157,155 @@ void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size
                                  lat->origin[d] + (double)box->hi[d] * lat->width[d]);
 }
 
-static cm_status write_file(const basin_png *b, const cm_render_options *ro, const uint8_t *rgba,
-                            char *msg, size_t msg_size)
+const char *figure_font(void)
+{
+    const char *env = getenv("CELLMAP_FONT");
+    return env && *env ? env : CELLMAP_FONT_PATH;
+}
+
+static void layers_text(unsigned layers, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (size_t k = 0; k < sizeof layer_names / sizeof layer_names[0] && used < size; k++)
+        if (layers & layer_names[k].bit)
+            used += (size_t)snprintf(out + used, size - used, "%s%s", used ? "," : "",
+                                     layer_names[k].name);
+}
+
+/* The provenance texts every basin PNG carries; `view` says what was drawn. */
+typedef struct provenance {
+    char params[2048], lattice[512], view[CM_MAX_DIM * 64 + 256], layers[128];
+    cm_png_text texts[8];
+    int n;
+} provenance;
+
+static void make_provenance(const basin_png *b, const char *view, unsigned layers, provenance *p)
 {
     const cm_lattice *lat = b->lat;
     const cm_box *box = &b->cells->box;
-    char params[2048], lattice[512], view[CM_MAX_DIM * 64 + 128], cells[CM_MAX_DIM * 64];
-    cm_params_json(&b->model->values, params, sizeof params);
-    snprintf(lattice, sizeof lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
+    char cells[CM_MAX_DIM * 64];
+    cm_params_json(&b->model->values, p->params, sizeof p->params);
+    snprintf(p->lattice, sizeof p->lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
              lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
              lat->dim > 1 ? lat->width[1] : 0.0);
     format_box(lat, box, cells, sizeof cells);
-    snprintf(view, sizeof view, "box %s cells %lldx%lld", cells,
+    snprintf(p->view, sizeof p->view, "box %s cells %lldx%lld%s", cells,
              (long long)(box->hi[0] - box->lo[0]),
-             lat->dim > 1 ? (long long)(box->hi[1] - box->lo[1]) : 1LL);
-    if (ro->lo[0] != ro->hi[0]) {
-        const size_t used = strlen(view);
-        snprintf(view + used, sizeof view - used, " view %.9g:%.9g,%.9g:%.9g", ro->lo[0], ro->hi[0],
-                 ro->lo[1], ro->hi[1]);
-    }
+             lat->dim > 1 ? (long long)(box->hi[1] - box->lo[1]) : 1LL, view);
+    layers_text(layers, p->layers, sizeof p->layers);
     const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},
                                  {"Model", b->model->name},
-                                 {"Parameters", params},
-                                 {"Lattice", lattice},
-                                 {"View", view}};
-    return cm_png_write(b->path, rgba, ro->width, ro->height, texts, 5, msg, msg_size);
+                                 {"Parameters", p->params},
+                                 {"Lattice", p->lattice},
+                                 {"View", p->view},
+                                 {"Layers", p->layers}};
+    p->n = 6;
+    memcpy(p->texts, texts, sizeof texts);
+}
+
+static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
+{
+    const png_opts *po = b->opts;
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.layers = po->layers ? po->layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    ro.width = po->width;
+    ro.height = po->height;
+    if (!ro.width || !ro.height)
+        figure_size(b->lat, &b->cells->box, ro.layers, &ro.width, &ro.height);
+    memcpy(ro.lo, b->lo, sizeof ro.lo);
+    memcpy(ro.hi, b->hi, sizeof ro.hi);
+    ro.model = b->model;
+    ro.font_path = figure_font();
+    uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
+    if (!rgba)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", ro.width,
+                       ro.height);
+    cm_render_info info;
+    cm_status st = cm_render_figure(b->lat, b->cells, b->groups, &ro, rgba, &info, msg, msg_size);
+    if (st == CM_OK && info.overlays_truncated)
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "the view holds too many overlay lines to draw; zoom in or leave out the "
+                     "overlays layer");
+    if (st == CM_OK) {
+        char view[256];
+        provenance p;
+        snprintf(view, sizeof view, " view %.9g:%.9g,%.9g:%.9g plot %d,%d %dx%d", info.lo[0],
+                 info.hi[0], info.lo[1], info.hi[1], info.plot_x, info.plot_y, info.plot_w,
+                 info.plot_h);
+        make_provenance(b, view, ro.layers, &p);
+        st = cm_png_write(po->path, rgba, ro.width, ro.height, p.texts, p.n, msg, msg_size);
+    }
+    free(rgba);
+    return st;
+}
+
+/* "id:class ..." for the groups with cells in the image. */
+static char *group_classes(const cm_raster *ras, uint32_t ngroups)
+{
+    size_t size = 64 + 24 * (size_t)ngroups, used = 0;
+    char *out = malloc(size);
+    if (!out)
+        return NULL;
+    out[0] = 0;
+    for (uint32_t g = 1; g <= ngroups; g++)
+        if (ras->group_cells[g])
+            used += (size_t)snprintf(out + used, size - used, "%s%u:%u", used ? " " : "", g,
+                                     ras->classes[g]);
+    return out;
+}
+
+/* One pixel per cell of the slice, its colour class; row 0 at the top. */
+static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
+{
+    cm_slice s;
+    cm_raster ras;
+    cm_slice_of(b->lat, b->cells, NULL, 0, &s);
+    if (s.nx > CM_RENDER_MAX_SIDE || s.ny > CM_RENDER_MAX_SIDE)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "an indexed image has one pixel per cell: %llux%llu cells exceed %d a "
+                       "side; choose a smaller --view",
+                       (unsigned long long)s.nx, (unsigned long long)s.ny, CM_RENDER_MAX_SIDE);
+    cm_status st =
+        cm_raster_build(b->lat, b->cells, b->groups, &s, CM_RASTER_CLASSES, &ras, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = cm_class_count();
+    uint8_t palette[3 * 256];
+    for (int k = 0; k < n; k++) {
+        const cm_rgb c = cm_class_colour(k);
+        palette[3 * k] = c.r;
+        palette[3 * k + 1] = c.g;
+        palette[3 * k + 2] = c.b;
+    }
+    uint8_t *rows = malloc(s.nx * s.ny);
+    char *groups = group_classes(&ras, b->cells->ngroups);
+    if (!rows || !groups)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for an indexed image");
+    if (st == CM_OK) {
+        for (uint64_t j = 0; j < s.ny; j++) /* the raster's row 0 is the lowest */
+            memcpy(rows + (s.ny - 1 - j) * s.nx, ras.pixels + j * s.nx, s.nx);
+        provenance p;
+        make_provenance(b, " mode indexed", 0, &p);
+        p.texts[p.n++] = (cm_png_text){"Classes", "0 not computed, 1 sink, 2 periodic cell of an "
+                                                  "attractor, 3 sticking-zone basin, 4 rest cell, "
+                                                  "5.. group colours"};
+        p.texts[p.n++] = (cm_png_text){"Group classes", groups};
+        st = cm_png_write_indexed(b->opts->path, rows, (int)s.nx, (int)s.ny, palette, n, p.texts,
+                                  p.n, msg, msg_size);
+    }
+    free(rows);
+    free(groups);
+    cm_raster_free(&ras);
+    return st;
 }
 
 int write_basin_png(const char *cmd, const basin_png *b)
 {
-    cm_render_options ro;
-    memset(&ro, 0, sizeof ro);
-    ro.width = b->width;
-    ro.height = b->height;
-    if (!ro.width || !ro.height)
-        default_image_size(b->lat, &b->cells->box, &ro.width, &ro.height);
-    memcpy(ro.lo, b->lo, sizeof ro.lo);
-    memcpy(ro.hi, b->hi, sizeof ro.hi);
-    ro.markers = 1;
-    uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
     char msg[512];
-    if (!rgba) {
-        fprintf(stderr, "cellmap %s: out of memory for a %dx%d image\n", cmd, ro.width, ro.height);
-        return EXIT_FAIL;
-    }
-    cm_status st = cm_render_basin(b->lat, b->cells, b->groups, &ro, rgba, msg, sizeof msg);
-    if (st == CM_OK)
-        st = write_file(b, &ro, rgba, msg, sizeof msg);
-    free(rgba);
+    const cm_status st =
+        b->opts->indexed ? write_indexed(b, msg, sizeof msg) : write_figure(b, msg, sizeof msg);
     if (st != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         return EXIT_FAIL;

@@ -1,19 +1,55 @@
-/* src/basin_png.h - the basin PNG that solve and explore write: the image
- * of a flattened region with the provenance text chunks. */
+/* src/basin_png.h - the basin PNG that solve, explore and render write, and
+ * the options they share: --png, --size, --layers, --png-mode, --view. */
 #ifndef CM_SRC_BASIN_PNG_H
 #define CM_SRC_BASIN_PNG_H
 
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
+#include "src/args.h"
+
+typedef struct png_opts {
+    const char *path;  /* --png FILE */
+    int width, height; /* --size WxH; 0: one pixel per cell, at most 4096 a side */
+    unsigned layers;   /* --layers; 0: basin and attractors */
+    int indexed;       /* --png-mode indexed: one pixel per cell, value = colour class */
+    int has_view;      /* --view X0:X1,Y0:Y1 */
+    double lo[2], hi[2];
+} png_opts;
+
+#define PNG_OPTIONS_HELP                                                                           \
+    "  --size WxH          image size in pixels (default: one pixel per cell, at most 4096;\n"     \
+    "                      1000 on the longer side for figures with text)\n"                       \
+    "  --layers L,...      what to draw: basin, steps (shading by transient length; alone:\n"      \
+    "                      step numbers only), attractors, overlays (switching lines, fixed\n"     \
+    "                      points, manifolds, sticking zones), axes, legend, title; or all\n"      \
+    "                      (default: basin,attractors)\n"                                          \
+    "  --png-mode MODE     rgb (a figure) or indexed (one pixel per cell, its value the\n"         \
+    "                      colour class; the classes of groups are in the PNG's texts)\n"          \
+    "  --view X0:X1,Y0:Y1  the rectangle of state space to draw (default: all cells)\n"
+
+/* Handles the shared options; true if the current option was one of them. */
+bool png_opts_take(cli *c, png_opts *po, int *error);
+/* Checks the options together (e.g. indexed images take no --size). */
+int png_opts_check(const cli *c, const png_opts *po);
+
+/* "basin,steps,..." or "all" -> enum cm_layer bits. On a bad word, false
+ * with the word in bad. */
+bool parse_layers(const char *s, unsigned *layers, char *bad, size_t bad_size);
+/* "rgb" or "indexed". */
+bool parse_png_mode(const char *s, int *indexed);
+
+/* The cells a view covers: the view rectangle in dims 0 and 1, and the
+ * middle cell of within in the others (a slice). */
+void view_cells(const cm_lattice *lat, const double lo[2], const double hi[2], const cm_box *within,
+                cm_box *out);
 
 typedef struct basin_png {
-    const char *path;
+    const png_opts *opts;
     const cm_model *model;
     const cm_lattice *lat;
     const cm_region *cells;      /* the cells to draw (group, step) */
     const cm_group_info *groups; /* the groups' summaries, for the colours */
-    int width, height;           /* 0: one pixel per cell, at most 4096 */
-    double lo[2], hi[2];         /* view in state coordinates; all 0: the cells' box */
+    double lo[2], hi[2];         /* the view; all 0: the cells' box */
 } basin_png;
 
 /* Renders and writes the PNG (temporary file, then rename). Prints
@@ -26,5 +62,8 @@ void default_image_size(const cm_lattice *lat, const cm_box *box, int *width, in
 
 /* The box in state coordinates, "x0:x1,y0:y1,...". */
 void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size);
+
+/* The font for figure text: $CELLMAP_FONT, else the build's default. */
+const char *figure_font(void);
 
 #endif

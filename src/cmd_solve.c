@@ -23,8 +23,8 @@ static const char solve_help[] =
     "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
     "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
-    "                     [--png FILE] [--size WxH] [--db FILE [--resume] [--mem BYTES]]\n"
-    "                     [--json]\n\n"
+    "                     [--png FILE [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
+    "                      [--view X0:X1,Y0:Y1]] [--db FILE [--resume] [--mem BYTES]] [--json]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
     "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
     "centre). Without options it solves the thesis' C-SCM example (4.6.3):\n"
@@ -43,8 +43,8 @@ static const char solve_help[] =
     "  --bounds LO:HI,...  extend only within this box of state space (default: anywhere)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
     "  --threads T         OpenMP threads for the images (default: all cores)\n"
-    "  --png FILE          write the basin image (written to a temporary file, renamed)\n"
-    "  --size WxH          image size in pixels (default: one pixel per cell, at most 4096)\n"
+    "  --png FILE          write the basin image (written to a temporary file, "
+    "renamed)\n" PNG_OPTIONS_HELP
     "  --db FILE           write the cluster to a .cmdb SQLite database as it is solved,\n"
     "                      one transaction per region (replaces an older .cmdb only)\n"
     "  --resume            continue the solve saved in --db FILE (same options) after\n"
@@ -61,11 +61,12 @@ typedef struct solve_args {
     const char *region_text;
     int64_t cells[CM_MAX_DIM], split[CM_MAX_DIM];
     int n_cells, n_split;
-    int max_steps, threads, width, height, json;
+    int max_steps, threads, json;
     int extend;
     double escape_below;
     const char *bounds_text;
-    const char *png, *db;
+    png_opts png;
+    const char *db;
     int resume;
     uint64_t mem;
 } solve_args;
@@ -103,18 +104,7 @@ static int parse_solve(cli *c, solve_args *a)
             a->bounds_text = c->value;
         } else if (cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &a->max_steps, &err)) {
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
-        } else if (cli_is(c, "--size", true, &err)) {
-            int64_t wh[2];
-            int n = 0;
-            if (c->value &&
-                (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] > 16384 || wh[1] > 16384))
-                err = cli_usage_error(c, "--size: '%s' must be WxH, each 1..16384", c->value);
-            else if (c->value) {
-                a->width = (int)wh[0];
-                a->height = (int)wh[1];
-            }
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
+        } else if (png_opts_take(c, &a->png, &err)) {
         } else if (cli_is(c, "--db", true, &err)) {
             a->db = c->value;
         } else if (cli_is(c, "--resume", false, &err)) {
@@ -126,6 +116,8 @@ static int parse_solve(cli *c, solve_args *a)
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
+    if (!err)
+        err = png_opts_check(c, &a->png);
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
         err = cli_usage_error(c, "--bounds and --escape-below apply to --extend; add --extend N");
     if (!err && !a->db && (a->resume || a->mem))
@@ -610,6 +602,31 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, 
                : st;
 }
 
+/* The PNG of the solved cells, or of --view (cells outside the cluster are
+ * drawn as not computed). */
+static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_lattice *lat, run *rn,
+                          const summary *sum, cm_region *r, char *msg, size_t msg_size)
+{
+    basin_png png = {&a->png, m, lat, r, sum->groups, {0, 0}, {0, 0}};
+    if (a->png.has_view) {
+        cm_box box;
+        view_cells(lat, a->png.lo, a->png.hi, &sum->box, &box);
+        cm_region_free(r);
+        memcpy(png.lo, a->png.lo, sizeof png.lo);
+        memcpy(png.hi, a->png.hi, sizeof png.hi);
+        cm_status st = cm_cluster_flatten(&rn->c, &box, r, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+    } else if (!r->group) {
+        cm_status st = cm_cluster_flatten(&rn->c, &sum->box, r, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+    }
+    if (write_basin_png("solve", &png) != EXIT_OK)
+        return cm_fail(CM_ERENDER, msg, msg_size, "%s was not written (see above)", a->png.path);
+    return CM_OK;
+}
+
 static void print_database(const solve_args *a, const run *rn, const summary *sum)
 {
     cm_store_stats ss;
@@ -662,7 +679,7 @@ int cmd_solve(int argc, char **argv)
         goto done;
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
-    if (a.n_split || a.extend || a.db) {
+    if (a.n_split || a.extend || a.db || a.png.has_view) { /* a view is cut from a cluster */
         const double t0 = now_seconds();
         if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
                 CM_OK ||
@@ -690,11 +707,8 @@ int cmd_solve(int argc, char **argv)
         print_text(&m, &sum, &t, shown);
     if (rn.store && !a.json)
         print_database(&a, &rn, &sum);
-    if (a.png && !r.group && cm_cluster_flatten(&rn.c, &sum.box, &r, msg, sizeof msg) != CM_OK)
+    if (a.png.path && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)
         goto fail;
-    const basin_png png = {a.png, &m, &lat, &r, sum.groups, a.width, a.height, {0, 0}, {0, 0}};
-    if (a.png && write_basin_png("solve", &png) != EXIT_OK)
-        goto done;
     if (rn.store && finish_store(&rn, msg, sizeof msg) != CM_OK)
         goto fail;
     rc = EXIT_OK;

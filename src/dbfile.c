@@ -1,7 +1,10 @@
 #include "src/dbfile.h"
 
+#include <stdbool.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "models/registry.h"
 #include "src/args.h"
 
 int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
@@ -37,4 +40,56 @@ const char *axis_name(int d)
 {
     static const char *const names[CM_MAX_DIM] = {"x", "y", "z", "w", "v", "u"};
     return d >= 0 && d < CM_MAX_DIM ? names[d] : "?";
+}
+
+/* The parameters JSON of a file ({"k":1.5,"mode":"output","K":[1,2]}) as
+ * the "k=v,..." text models are built from. False if it is not such JSON. */
+static bool params_text(const char *json, char *out, size_t size)
+{
+    size_t used = 0;
+    const char *p = json;
+    if (*p++ != '{')
+        return false;
+    while (*p && *p != '}') {
+        const char *key = p + 1, *end = *p == '"' ? strchr(key, '"') : NULL;
+        if (!end || end[1] != ':')
+            return false;
+        used += (size_t)snprintf(out + used, size > used ? size - used : 0,
+                                 "%s%.*s=", used ? "," : "", (int)(end - key), key);
+        p = end + 2;
+        const char *stop = *p == '[' ? "]" : *p == '"' ? "\"" : ",}";
+        if (*p == '[' || *p == '"')
+            p++;
+        const size_t len = strcspn(p, stop);
+        for (size_t i = 0; i < len && used + 1 < size; i++)
+            out[used++] = p[i] == ',' ? ':' : p[i];
+        out[used < size ? used : size - 1] = 0;
+        p += len;
+        if (*stop != ',' && *p++ == 0)
+            return false;
+        if (*p == ',')
+            p++;
+    }
+    return *p == '}' && used < size;
+}
+
+cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size_t msg_size)
+{
+    char text[4096], again[4096];
+    const char *texts[1] = {text};
+    if (!params_text(info->params, text, sizeof text))
+        return cm_fail(CM_EINVAL, msg, msg_size, "its parameters '%s' are not readable",
+                       info->params);
+    cm_status st = cm_model_create(info->model, texts, 1, m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_params_json(&m->values, again, sizeof again);
+    if (strcmp(again, info->params) != 0) {
+        cm_model_release(m);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "its parameters %s do not rebuild exactly; this cellmap reads them as "
+                       "something else",
+                       info->params);
+    }
+    return CM_OK;
 }

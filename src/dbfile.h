@@ -3,6 +3,7 @@
 #define CM_SRC_DBFILE_H
 
 #include "cellmap/cluster.h"
+#include "cellmap/model.h"
 #include "cellmap/store.h"
 
 /* Opens path read-only, reads what it says about itself and restores its
@@ -14,6 +15,10 @@ int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm
 
 /* Closes what open_cluster_file opened. */
 void close_cluster_file(cm_store *s, cm_cluster *c);
+
+/* The model a file was made with, rebuilt from its name and parameters
+ * (which must rebuild exactly). */
+cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size_t msg_size);
 
 /* The name of coordinate d: x, y, z, w, v, u. */
 const char *axis_name(int d);

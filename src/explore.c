@@ -10,6 +10,7 @@
 #include "cellmap/cover.h"
 #include "cellmap/extend.h"
 #include "models/registry.h"
+#include "render/figure.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
 #include "src/dbfile.h"
@@ -474,15 +475,52 @@ static cm_status shown_cells(session *s, cm_region *flat, cm_group_info **groups
     return st;
 }
 
-static cm_status cmd_render(session *s, char **t, int n, char *msg, size_t msg_size)
+/* The words after "render FILE.png": [WIDTHxHEIGHT] [--layers L,...]
+ * [--png-mode rgb|indexed], as solve's options. */
+static cm_status render_words(char **t, int n, png_opts *po, char *msg, size_t msg_size)
 {
-    int64_t wh[2] = {0, 0};
-    int count = 0;
-    cm_status st = words(n, 2, 3, "render FILE.png [WIDTHxHEIGHT]", msg, msg_size);
-    if (st == CM_OK && n == 3 &&
-        (!parse_counts(t[2], wh, &count, 2) || count != 2 || wh[0] > 16384 || wh[1] > 16384))
-        st = cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be WIDTHxHEIGHT, each 1..16384",
-                     t[2]);
+    for (int k = 2; k < n; k++) {
+        int64_t wh[2];
+        int count = 0;
+        char bad[64];
+        const bool has_value = k + 1 < n;
+        if (strcmp(t[k], "--layers") == 0 && has_value) {
+            if (!parse_layers(t[++k], &po->layers, bad, sizeof bad))
+                return cm_fail(CM_EINVAL, msg, msg_size,
+                               "render: unknown layer '%s' (use basin, steps, attractors, "
+                               "overlays, axes, legend, title or all)",
+                               bad);
+        } else if (strcmp(t[k], "--png-mode") == 0 && has_value) {
+            if (!parse_png_mode(t[++k], &po->indexed))
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be rgb or indexed",
+                               t[k]);
+        } else if (k == 2 && parse_counts(t[k], wh, &count, 2) && count == 2 &&
+                   wh[0] <= CM_RENDER_MAX_SIDE && wh[1] <= CM_RENDER_MAX_SIDE) {
+            po->width = (int)wh[0];
+            po->height = (int)wh[1];
+        } else {
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "render: '%s' is not WIDTHxHEIGHT (each 1..%d), --layers L,... or "
+                           "--png-mode MODE",
+                           t[k], CM_RENDER_MAX_SIDE);
+        }
+    }
+    if (po->indexed && (po->width || po->layers))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "render: an indexed image has one pixel per cell; leave out the size and "
+                       "--layers");
+    return CM_OK;
+}
+
+static cm_status session_render(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    png_opts po;
+    memset(&po, 0, sizeof po);
+    po.path = t[1];
+    cm_status st = words(n, 2, 7, "render FILE.png [WIDTHxHEIGHT] [--layers L,...] [--png-mode M]",
+                         msg, msg_size);
+    if (st == CM_OK)
+        st = render_words(t, n, &po, msg, msg_size);
     if (st == CM_OK)
         st = need_view(s, "render", msg, msg_size);
     if (st != CM_OK)
@@ -492,15 +530,8 @@ static cm_status cmd_render(session *s, char **t, int n, char *msg, size_t msg_s
     cm_group_info *groups = NULL;
     memset(&flat, 0, sizeof flat);
     st = shown_cells(s, &flat, &groups, msg, msg_size);
-    const basin_png png = {t[1],
-                           &s->model,
-                           &s->c.lat,
-                           &flat,
-                           groups,
-                           (int)wh[0],
-                           (int)wh[1],
-                           {s->lo[0], s->lo[1]},
-                           {s->hi[0], s->hi[1]}};
+    const basin_png png = {
+        &po, &s->model, &s->c.lat, &flat, groups, {s->lo[0], s->lo[1]}, {s->hi[0], s->hi[1]}};
     if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
         st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
     if (st == CM_OK && s->out) {
@@ -671,7 +702,7 @@ static const struct {
 } commands[] = {
     {"view", cmd_view},     {"pan", cmd_pan},
     {"zoom", cmd_zoom},     {"goto", cmd_goto},
-    {"extend", cmd_extend}, {"render", cmd_render},
+    {"extend", cmd_extend}, {"render", session_render},
     {"stats", cmd_stats},   {"export", cmd_export_view},
     {"save", cmd_save},     {"quit", cmd_quit},
     {"exit", cmd_quit},     {"help", cmd_help},
@@ -715,52 +746,13 @@ static int open_error(const char *fmt, ...)
     return EXIT_FAIL;
 }
 
-/* The parameters JSON of a file ({"k":1.5,"mode":"output","K":[1,2]}) as
- * the "k=v,..." text models are built from. False if it is not such JSON. */
-static bool params_text(const char *json, char *out, size_t size)
-{
-    size_t used = 0;
-    const char *p = json;
-    if (*p++ != '{')
-        return false;
-    while (*p && *p != '}') {
-        const char *key = p + 1, *end = *p == '"' ? strchr(key, '"') : NULL;
-        if (!end || end[1] != ':')
-            return false;
-        used += (size_t)snprintf(out + used, size > used ? size - used : 0,
-                                 "%s%.*s=", used ? "," : "", (int)(end - key), key);
-        p = end + 2;
-        const char *stop = *p == '[' ? "]" : *p == '"' ? "\"" : ",}";
-        if (*p == '[' || *p == '"')
-            p++;
-        const size_t len = strcspn(p, stop);
-        for (size_t i = 0; i < len && used + 1 < size; i++)
-            out[used++] = p[i] == ',' ? ':' : p[i];
-        out[used < size ? used : size - 1] = 0;
-        p += len;
-        if (*stop != ',' && *p++ == 0)
-            return false;
-        if (*p == ',')
-            p++;
-    }
-    return *p == '}' && used < size;
-}
-
 /* The file's model, rebuilt from its name and parameters. */
 static int model_of_file(session *s, const cm_store_info *info)
 {
-    char text[4096], msg[512], again[4096];
-    const char *texts[1] = {text};
-    if (!params_text(info->params, text, sizeof text))
-        return open_error("%s: its parameters '%s' are not readable", s->path, info->params);
-    if (cm_model_create(info->model, texts, 1, &s->model, msg, sizeof msg) != CM_OK)
+    char msg[1024];
+    if (model_of_store(info, &s->model, msg, sizeof msg) != CM_OK)
         return open_error("%s: %s", s->path, msg);
     s->have_model = 1;
-    cm_params_json(&s->model.values, again, sizeof again);
-    if (strcmp(again, info->params) != 0)
-        return open_error("%s: its parameters %s do not rebuild exactly; this cellmap reads "
-                          "them as something else",
-                          s->path, info->params);
     return EXIT_OK;
 }
 

@@ -13,6 +13,7 @@ static const struct {
     {"models", cmd_models, "list the models, their parameters and defaults"},
     {"solve", cmd_solve, "simple cell mapping of a region: summary, PNG, database"},
     {"explore", cmd_explore, "explore basins by panning and zooming a view (script or prompt)"},
+    {"render", cmd_render, "draw a figure or an indexed image of a .cmdb file's basins"},
     {"info", cmd_info, "what a .cmdb cluster database holds; its size on disk and in memory"},
     {"export", cmd_export, "a .cmdb file's groups and cells as CSV, .npy or a flat SQLite table"},
     {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},

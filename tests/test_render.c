@@ -5,7 +5,7 @@
 
 #include "cellmap/scm.h"
 #include "check.h"
-#include "render/basin.h"
+#include "render/figure.h"
 #include "render/palette.h"
 #include "render/png_out.h"
 
@@ -45,7 +45,11 @@ int main(void)
     cm_group_info *g = calloc(r.ngroups, sizeof *g);
     cm_scm_groups(&r, &lat, g, NULL);
     cm_rgb *colours = calloc(r.ngroups, sizeof *colours);
-    cm_palette_assign(g, r.ngroups, 2, colours);
+    uint8_t *classes = calloc(r.ngroups, 1);
+    cm_palette_classes(g, r.ngroups, 2, classes);
+    for (uint32_t k = 0; k < r.ngroups; k++)
+        colours[k] = cm_class_colour(classes[k]);
+    cm_render_info ri;
 
     enum { W = 200, H = 100 };
     uint8_t *a = calloc(W * H, 4), *b = calloc(W * H, 4);
@@ -53,8 +57,8 @@ int main(void)
     memset(&ro, 0, sizeof ro);
     ro.width = W;
     ro.height = H;
-    ro.markers = 0;
-    CHECK(cm_render_basin(&lat, &r, g, &ro, a, msg, sizeof msg) == CM_OK);
+    ro.layers = CM_LAYER_BASIN;
+    CHECK(cm_render_figure(&lat, &r, g, &ro, a, &ri, msg, sizeof msg) == CM_OK);
     /* Row 0 is the top: high y, the sink. Pixels are 0.005 x 0.01 of state. */
     CHECK(same_rgb(pixel(a, W, 10, 5), cm_colour_sink));
     CHECK(!same_rgb(pixel(a, W, 10, 95), cm_colour_sink));
@@ -68,8 +72,8 @@ int main(void)
     CHECK(same_rgb(pixel(a, W, 30, 85), colours[g11 - 1]));
 
     /* markers: the fixed cell (0.35, 0.25) becomes black */
-    ro.markers = 1;
-    CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
+    ro.layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    CHECK(cm_render_figure(&lat, &r, g, &ro, b, &ri, msg, sizeof msg) == CM_OK);
     CHECK(same_rgb(pixel(b, W, 70, 75), cm_colour_marker));
     CHECK(same_rgb(pixel(b, W, 70, 5), cm_colour_sink)); /* no marker in the sink */
     /* a sub-pixel cell still gets a visible marker: a view 50x wider */
@@ -77,7 +81,7 @@ int main(void)
     ro.hi[0] = 10;
     ro.lo[1] = -5;
     ro.hi[1] = 5;
-    CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
+    CHECK(cm_render_figure(&lat, &r, g, &ro, b, &ri, msg, sizeof msg) == CM_OK);
     CHECK(same_rgb(pixel(b, W, 101, 49), cm_colour_marker)); /* (0.15, 0.15) is a fixed cell */
     CHECK(same_rgb(pixel(b, W, 2, 2), cm_colour_not_computed));
 
@@ -87,16 +91,16 @@ int main(void)
     const uint32_t kept_group = r.group[0], kept_step = r.step[0];
     r.group[0] = CM_GROUP_NONE;
     r.step[0] = 0;
-    CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
+    CHECK(cm_render_figure(&lat, &r, g, &ro, b, &ri, msg, sizeof msg) == CM_OK);
     CHECK(same_rgb(pixel(b, W, 10, 95), cm_colour_not_computed));
     CHECK(same_rgb(pixel(b, W, 30, 95), cm_colour_marker)); /* its neighbour, fixed */
     r.group[0] = kept_group;
     r.step[0] = kept_step;
-    ro.markers = 0;
+    ro.layers = CM_LAYER_BASIN;
 
     /* deterministic */
-    CHECK(cm_render_basin(&lat, &r, g, &ro, a, msg, sizeof msg) == CM_OK);
-    CHECK(cm_render_basin(&lat, &r, g, &ro, b, msg, sizeof msg) == CM_OK);
+    CHECK(cm_render_figure(&lat, &r, g, &ro, a, &ri, msg, sizeof msg) == CM_OK);
+    CHECK(cm_render_figure(&lat, &r, g, &ro, b, &ri, msg, sizeof msg) == CM_OK);
     CHECK(memcmp(a, b, (size_t)W * H * 4) == 0);
 
     /* PNG: decoded back with libpng, with our text chunks; no temp left */
@@ -135,6 +139,7 @@ int main(void)
     free(b);
     free(g);
     free(colours);
+    free(classes);
     cm_region_free(&r);
     CHECK_DONE();
 }

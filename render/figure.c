@@ -1,0 +1,495 @@
+#include "render/figure.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "render/palette.h"
+#include "render/text.h"
+
+enum {
+    OVERLAY_CAP = 1 << 16, /* more lines than this would paint the view over */
+    MAX_TICKS = 32,
+    LABEL = 96
+};
+
+static const cm_rgb ink = {0, 0, 0};
+static const cm_rgb paper = {255, 255, 255};
+
+static double seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* ---- pixels --------------------------------------------------------------------- */
+
+typedef struct canvas {
+    uint8_t *rgba;
+    int w, h;
+} canvas;
+
+static void fill_rect(const canvas *c, int x, int y, int w, int h, cm_rgb col)
+{
+    for (int j = y < 0 ? 0 : y; j < y + h && j < c->h; j++)
+        for (int i = x < 0 ? 0 : x; i < x + w && i < c->w; i++) {
+            uint8_t *p = c->rgba + 4 * ((size_t)j * (size_t)c->w + (size_t)i);
+            p[0] = col.r;
+            p[1] = col.g;
+            p[2] = col.b;
+            p[3] = 255;
+        }
+}
+
+/* ---- ticks ---------------------------------------------------------------------- */
+
+typedef struct ticks {
+    int n;
+    double v[MAX_TICKS];
+    char label[MAX_TICKS][32];
+} ticks;
+
+/* Round values 1, 2 or 5 times a power of ten apart, about six in range. */
+static void make_ticks(double lo, double hi, ticks *t)
+{
+    t->n = 0;
+    const double raw = (hi - lo) / 6;
+    if (!(raw > 0) || !isfinite(raw))
+        return;
+    const double mag = pow(10, floor(log10(raw)));
+    const double step = raw <= mag       ? mag
+                        : raw <= 2 * mag ? 2 * mag
+                        : raw <= 5 * mag ? 5 * mag
+                                         : 10 * mag;
+    const double biggest = fmax(fabs(lo), fabs(hi));
+    const bool fixed = biggest < 1e7 && step >= 1e-4;
+    const int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
+    const int digits = (int)ceil(log10(biggest / step) + 1e-9) + 1;
+    for (double k = ceil(lo / step); k * step <= hi && t->n < MAX_TICKS; k++) {
+        const double v = k == 0 ? 0.0 : k * step;
+        t->v[t->n] = v;
+        if (fixed)
+            snprintf(t->label[t->n], sizeof t->label[0], "%.*f", decimals, v);
+        else
+            snprintf(t->label[t->n], sizeof t->label[0], "%.*e", digits > 1 ? digits - 1 : 0, v);
+        t->n++;
+    }
+}
+
+static int widest(const cm_font *f, const ticks *t)
+{
+    int w = 0;
+    for (int k = 0; k < t->n; k++)
+        w = cm_font_width(f, t->label[k]) > w ? cm_font_width(f, t->label[k]) : w;
+    return w;
+}
+
+/* ---- legend --------------------------------------------------------------------- */
+
+typedef struct entry {
+    char text[LABEL];
+    cm_rgb swatch;
+    bool has_swatch;
+} entry;
+
+typedef struct legend {
+    int n;
+    entry *e;
+} legend;
+
+typedef struct group_cells {
+    uint64_t cells;
+    uint32_t id;
+} group_cells;
+
+static int more_cells_first(const void *a, const void *b)
+{
+    const group_cells *x = a, *y = b;
+    if (x->cells != y->cells)
+        return x->cells > y->cells ? -1 : 1;
+    return x->id < y->id ? -1 : x->id > y->id;
+}
+
+static double share(uint64_t cells, uint64_t all) { return all ? 100.0 * cells / all : 0.0; }
+
+static entry *add_entry(legend *lg, cm_rgb swatch, bool has_swatch)
+{
+    entry *e = &lg->e[lg->n++];
+    e->swatch = swatch;
+    e->has_swatch = has_swatch;
+    return e;
+}
+
+/* Entries for the sink, the groups in view with the most cells (as many as
+ * `room` lines allow) and the cells not computed. */
+static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, uint32_t ngroups,
+                             int room, legend *lg, char *msg, size_t msg_size)
+{
+    const uint64_t all = ras->s.nx * ras->s.ny;
+    group_cells *order = malloc(((size_t)ngroups + 1) * sizeof *order);
+    lg->e = calloc((size_t)(room > 0 ? room : 1), sizeof *lg->e);
+    lg->n = 0;
+    if (!order || !lg->e) {
+        free(order);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
+    }
+    uint32_t shown = 0;
+    for (uint32_t g = 1; g <= ngroups; g++)
+        if (ras->group_cells[g])
+            order[shown++] = (group_cells){ras->group_cells[g], g};
+    qsort(order, shown, sizeof *order, more_cells_first);
+    const bool missing = ras->computed < all;
+    int slots = room - (ras->group_cells[0] ? 1 : 0) - (missing ? 1 : 0);
+    if (ras->group_cells[0] && lg->n < room)
+        snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "sink  %.1f%%",
+                 share(ras->group_cells[0], all));
+    for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
+        if (slots == 1 && k + 1 < shown) {
+            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more groups", shown - k);
+            break;
+        }
+        const uint32_t g = order[k].id;
+        const cm_group_info *gi = &groups[g - 1];
+        snprintf(add_entry(lg, cm_class_colour(ras->classes[g]), true)->text, LABEL,
+                 "#%u%s p=%u  %.1f%%", gi->id, gi->kind == CM_GROUP_STICKING ? " sticking" : "",
+                 gi->period, share(order[k].cells, all));
+    }
+    if (missing && lg->n < room)
+        snprintf(add_entry(lg, cm_colour_not_computed, true)->text, LABEL, "not computed  %.1f%%",
+                 share(all - ras->computed, all));
+    free(order);
+    return CM_OK;
+}
+
+/* ---- title ---------------------------------------------------------------------- */
+
+static void format_title(const cm_model *m, char *out, size_t size)
+{
+    size_t used = (size_t)snprintf(out, size, "%s ", m->name);
+    const cm_params *p = &m->values;
+    for (int k = 0; k < p->count && p->spec && p->spec[k].name && used < size; k++) {
+        used += (size_t)snprintf(out + used, size - used, " %s=", p->spec[k].name);
+        for (int i = 0; i < p->value[k].count && used < size; i++)
+            used +=
+                (size_t)snprintf(out + used, size - used, "%s%.6g", i ? ":" : "", p->value[k].v[i]);
+    }
+}
+
+/* Draws text cut to max_w pixels (with "..." when cut). */
+static void draw_fitted(const cm_font *f, const char *text, int x, int y, int max_w,
+                        const canvas *c)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", text);
+    size_t n = strlen(buf);
+    while (n > 3 && cm_font_width(f, buf) > max_w) {
+        n--;
+        memcpy(buf + n - 3, "...", 4);
+    }
+    cm_font_draw(f, buf, x, y, ink, c->rgba, c->w, c->h);
+}
+
+/* ---- layout --------------------------------------------------------------------- */
+
+typedef struct layout {
+    int fs, pad, tick, line, ascent;
+    int left, right, top, bottom;
+    ticks tx, ty;
+    const char *xname, *yname;
+    char yname_buf[64];
+} layout;
+
+static bool has_text(unsigned layers)
+{
+    return layers & (CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE);
+}
+
+/* Margins of everything but the legend's width. */
+static void margins(const cm_render_options *o, const cm_font *f, int dim, layout *L)
+{
+    const bool axes = o->layers & CM_LAYER_AXES;
+    L->ascent = f ? cm_font_ascent(f) : 0;
+    L->line = f ? cm_font_height(f) : 0;
+    L->pad = L->fs / 2;
+    L->tick = L->fs / 3 + 1;
+    const char *const *names = o->model ? o->model->coord_names : NULL;
+    L->xname = names ? names[0] : dim == 1 ? "x" : "x0";
+    if (dim == 1)
+        snprintf(L->yname_buf, sizeof L->yname_buf, "f(%s)", L->xname);
+    else
+        snprintf(L->yname_buf, sizeof L->yname_buf, "%s", names ? names[1] : "x1");
+    L->yname = L->yname_buf;
+    L->top = o->layers & CM_LAYER_TITLE ? L->line + 2 * L->pad : f ? L->pad + L->ascent / 2 : 0;
+    L->bottom = axes ? L->tick + 2 * L->line + L->pad : f ? L->pad : 0;
+    L->left = axes ? 2 * L->pad + cm_font_width(f, L->yname) + widest(f, &L->ty) + L->tick
+              : f  ? L->pad
+                   : 0;
+    L->right = f ? 2 * L->pad : 0;
+}
+
+/* ---- axes ----------------------------------------------------------------------- */
+
+static int to_px(double v, double lo, double hi, int n)
+{
+    return (int)floor((v - lo) / (hi - lo) * n);
+}
+
+static void x_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm_font *f,
+                   const canvas *c)
+{
+    const int base = oy + pn->y + pn->h;
+    int last_right = INT32_MIN / 2;
+    for (int k = 0; k < L->tx.n; k++) {
+        const int x = ox + pn->x + to_px(L->tx.v[k], pn->lo[0], pn->hi[0], pn->w);
+        fill_rect(c, x, base, 1, L->tick, ink);
+        const int w = cm_font_width(f, L->tx.label[k]);
+        if (x - w / 2 <= last_right + L->pad)
+            continue; /* no overlapping labels */
+        cm_font_draw(f, L->tx.label[k], x - w / 2, base + L->tick + L->ascent, ink, c->rgba, c->w,
+                     c->h);
+        last_right = x - w / 2 + w;
+    }
+    const int nw = cm_font_width(f, L->xname);
+    cm_font_draw(f, L->xname, ox + pn->x + pn->w / 2 - nw / 2, base + L->tick + L->line + L->ascent,
+                 ink, c->rgba, c->w, c->h);
+}
+
+static void y_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm_font *f,
+                   const canvas *c)
+{
+    const int x0 = ox + pn->x;
+    for (int k = 0; k < L->ty.n; k++) {
+        const int y = oy + pn->y + pn->h - 1 - to_px(L->ty.v[k], pn->lo[1], pn->hi[1], pn->h);
+        fill_rect(c, x0 - L->tick, y, L->tick, 1, ink);
+        const int w = cm_font_width(f, L->ty.label[k]);
+        cm_font_draw(f, L->ty.label[k], x0 - L->tick - 2 - w, y + L->ascent / 2 - 1, ink, c->rgba,
+                     c->w, c->h);
+    }
+    cm_font_draw(f, L->yname, L->pad, oy + pn->y + pn->h / 2 + L->ascent / 2, ink, c->rgba, c->w,
+                 c->h);
+}
+
+static void frame(const cm_panel *pn, int ox, int oy, const canvas *c)
+{
+    const int x = ox + pn->x, y = oy + pn->y;
+    fill_rect(c, x - 1, y - 1, pn->w + 2, 1, ink);
+    fill_rect(c, x - 1, y + pn->h, pn->w + 2, 1, ink);
+    fill_rect(c, x - 1, y - 1, 1, pn->h + 2, ink);
+    fill_rect(c, x + pn->w, y - 1, 1, pn->h + 2, ink);
+}
+
+static void draw_legend(const legend *lg, const layout *L, int x, int y, const cm_font *f,
+                        const canvas *c)
+{
+    const int box = L->ascent;
+    for (int k = 0; k < lg->n; k++) {
+        const int base = y + (k + 1) * L->line;
+        if (lg->e[k].has_swatch) {
+            fill_rect(c, x, base - box, box, box, ink);
+            fill_rect(c, x + 1, base - box + 1, box - 2, box - 2, lg->e[k].swatch);
+        }
+        cm_font_draw(f, lg->e[k].text, x + box + L->pad, base, ink, c->rgba, c->w, c->h);
+    }
+}
+
+/* ---- the figure ----------------------------------------------------------------- */
+
+static void default_view(const cm_slice *s, int dim, const cm_render_options *o, double lo[2],
+                         double hi[2])
+{
+    lo[0] = o->lo[0];
+    hi[0] = o->hi[0];
+    lo[1] = o->lo[1];
+    hi[1] = o->hi[1];
+    if (lo[0] == hi[0]) {
+        lo[0] = s->x0;
+        hi[0] = s->x0 + (double)s->nx * s->dx;
+    }
+    if (lo[1] == hi[1] || dim == 1) {
+        lo[1] = s->y0;
+        hi[1] = s->y0 + (double)s->ny * s->dy;
+    }
+}
+
+static int raster_mode(unsigned layers)
+{
+    if (layers & CM_LAYER_STEPS)
+        return layers & CM_LAYER_BASIN ? CM_RASTER_SHADED : CM_RASTER_STEPS;
+    return CM_RASTER_BASIN;
+}
+
+/* Splits the plot into panels: 2-D, one basin panel; 1-D, the map's graph
+ * above a basin strip. */
+static void make_panels(cm_plot *p, int dim, const double lo[2], const double hi[2], int gap)
+{
+    memset(&p->basin, 0, sizeof p->basin);
+    memset(&p->graph, 0, sizeof p->graph);
+    p->basin = (cm_panel){0, 0, p->w, p->h, {lo[0], lo[1]}, {hi[0], hi[1]}};
+    if (dim != 1 || !p->model || p->h < 8)
+        return;
+    const int strip = p->h / 5 > 1 ? p->h / 5 : 1;
+    gap = gap < p->h - strip - 1 ? gap : 0;
+    p->graph = (cm_panel){0, 0, p->w, p->h - strip - gap, {lo[0], lo[0]}, {hi[0], hi[0]}};
+    p->basin.y = p->h - strip;
+    p->basin.h = strip;
+}
+
+typedef struct work {
+    cm_raster ras;
+    cm_overlay_list ov;
+    cm_font *font;
+    legend lg;
+} work;
+
+static void work_free(work *w)
+{
+    cm_raster_free(&w->ras);
+    free(w->ov.items);
+    cm_font_close(w->font);
+    free(w->lg.e);
+}
+
+static cm_status check_options(const cm_render_options *o, char *msg, size_t msg_size)
+{
+    if (o->width < 1 || o->height < 1 || o->width > CM_RENDER_MAX_SIDE ||
+        o->height > CM_RENDER_MAX_SIDE)
+        return cm_fail(CM_EINVAL, msg, msg_size, "image size %dx%d: each side must be 1..%d",
+                       o->width, o->height, CM_RENDER_MAX_SIDE);
+    if (has_text(o->layers) && !o->font_path)
+        return cm_fail(CM_EINVAL, msg, msg_size, "axes, legend and title need a font");
+    if ((o->layers & CM_LAYER_TITLE) && !o->model)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a title needs the model");
+    return CM_OK;
+}
+
+/* Everything computed before pixels: raster, overlays, font, margins. */
+static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                         const cm_render_options *o, const double lo[2], const double hi[2],
+                         work *w, layout *L, char *msg, size_t msg_size)
+{
+    const int dim = r->box.dim;
+    cm_slice s;
+    cm_slice_of(lat, r, o->slice, o->set_slice, &s);
+    cm_status st =
+        cm_raster_build(lat, r, groups, &s, raster_mode(o->layers), &w->ras, msg, msg_size);
+    if (st == CM_OK && o->model && o->model->overlays && (o->layers & CM_LAYER_OVERLAYS)) {
+        w->ov.items = malloc(OVERLAY_CAP * sizeof *w->ov.items);
+        w->ov.cap = w->ov.items ? OVERLAY_CAP : 0;
+        const double glo[2] = {lo[0], dim == 1 ? lo[0] : lo[1]};
+        const double ghi[2] = {hi[0], dim == 1 ? hi[0] : hi[1]};
+        if (!w->ov.items)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for overlays");
+        else
+            o->model->overlays(o->model, glo, ghi, &w->ov);
+    }
+    const int small = o->width < o->height ? o->width : o->height;
+    L->fs = small / 45 < 10 ? 10 : small / 45 > 48 ? 48 : small / 45;
+    if (st == CM_OK && has_text(o->layers))
+        st = cm_font_open(o->font_path, L->fs, &w->font, msg, msg_size);
+    if (st == CM_OK) {
+        make_ticks(lo[0], hi[0], &L->tx);
+        make_ticks(dim == 1 ? lo[0] : lo[1], dim == 1 ? hi[0] : hi[1], &L->ty);
+        margins(o, w->font, dim, L);
+    }
+    if (st == CM_OK && (o->layers & CM_LAYER_LEGEND)) {
+        const int room = (o->height - L->top - L->bottom) / (L->line > 0 ? L->line : 1);
+        st = make_legend(&w->ras, groups, r->ngroups, room, &w->lg, msg, msg_size);
+        int widest_entry = 0;
+        for (int k = 0; k < w->lg.n; k++) {
+            const int ew = cm_font_width(w->font, w->lg.e[k].text);
+            widest_entry = ew > widest_entry ? ew : widest_entry;
+        }
+        L->right = 3 * L->pad + L->ascent + widest_entry;
+    }
+    if (st == CM_OK && (o->width - L->left - L->right < 16 || o->height - L->top - L->bottom < 16))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "%dx%d leaves no room for the plot beside axes, legend and title; enlarge "
+                     "--size or leave those layers out",
+                     o->width, o->height);
+    return st;
+}
+
+static void draw_text_layers(const cm_render_options *o, const work *w, const layout *L,
+                             const cm_plot *p, const canvas *c)
+{
+    if (o->layers & CM_LAYER_AXES) {
+        frame(&p->basin, p->x, p->y, c);
+        x_axis(L, &p->basin, p->x, p->y, w->font, c);
+        const cm_panel *yp = p->graph.w > 0 ? &p->graph : &p->basin;
+        if (p->graph.w > 0)
+            frame(&p->graph, p->x, p->y, c);
+        y_axis(L, yp, p->x, p->y, w->font, c);
+    }
+    if (o->layers & CM_LAYER_LEGEND)
+        draw_legend(&w->lg, L, p->x + p->w + 2 * L->pad, p->y, w->font, c);
+    if (o->layers & CM_LAYER_TITLE) {
+        char title[1024];
+        format_title(o->model, title, sizeof title);
+        draw_fitted(w->font, title, L->pad, L->pad + L->ascent, c->w - 2 * L->pad, c);
+    }
+}
+
+cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                           const cm_render_options *opt, uint8_t *rgba, cm_render_info *info,
+                           char *msg, size_t msg_size)
+{
+    cm_render_options o = *opt;
+    o.layers = o.layers ? o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    memset(info, 0, sizeof *info);
+    cm_status st = check_options(&o, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_slice s;
+    cm_slice_of(lat, r, o.slice, o.set_slice, &s);
+    double lo[2], hi[2];
+    default_view(&s, r->box.dim, &o, lo, hi);
+    work w;
+    layout L;
+    memset(&w, 0, sizeof w);
+    memset(&L, 0, sizeof L);
+    double t0 = seconds();
+    st = prepare(lat, r, groups, &o, lo, hi, &w, &L, msg, msg_size);
+    info->raster_s = seconds() - t0;
+    const canvas c = {rgba, o.width, o.height};
+    cm_plot p = {&w.ras,
+                 groups,
+                 w.ov.items ? &w.ov : NULL,
+                 o.model,
+                 o.layers,
+                 L.left,
+                 L.top,
+                 o.width - L.left - L.right,
+                 o.height - L.top - L.bottom,
+                 {0},
+                 {0},
+                 0};
+    if (st == CM_OK) {
+        const int small = p.w < p.h ? p.w : p.h;
+        p.line_width = small / 700 > 1 ? small / 700 : 1;
+        make_panels(&p, r->box.dim, lo, hi, L.line ? L.line / 2 : 4);
+        if (L.left || L.right || L.top || L.bottom)
+            fill_rect(&c, 0, 0, o.width, o.height, paper);
+        t0 = seconds();
+        st = cm_plot_draw(&p, rgba, o.width, &info->tiles, msg, msg_size);
+        info->gl_s = seconds() - t0;
+    }
+    if (st == CM_OK && w.font) {
+        t0 = seconds();
+        draw_text_layers(&o, &w, &L, &p, &c);
+        info->text_s = seconds() - t0;
+    }
+    if (st == CM_OK) {
+        info->plot_x = p.x + p.basin.x;
+        info->plot_y = p.y + p.basin.y;
+        info->plot_w = p.basin.w;
+        info->plot_h = p.basin.h;
+        memcpy(info->lo, lo, sizeof info->lo);
+        memcpy(info->hi, hi, sizeof info->hi);
+        info->overlays_truncated = w.ov.truncated;
+    }
+    work_free(&w);
+    return st;
+}

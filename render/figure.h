@@ -1,0 +1,49 @@
+/* render/figure.h - basin and attractor figures, drawn off-screen.
+ *
+ * A figure is the plot of a view (basin raster, attractor markers, the
+ * model's overlays; for 1-D models the map's graph with cobwebs above a basin
+ * strip) and, when their layers are asked for, axes with ticks in state
+ * coordinates, a legend of the groups in view and a title with the model and
+ * its parameters. The caller's RGBA buffer holds width*height*4 bytes, row 0
+ * at the top. Without axes, legend and title the plot fills the image.
+ *
+ * The view is a rectangle of state space in dimensions 0 and 1; models of
+ * more than two dimensions are drawn as the slice through slice[d] (cell
+ * coordinates) in the others. Deterministic: the same inputs give the same
+ * bytes whatever the thread count. Not thread-safe.
+ */
+#ifndef CM_RENDER_FIGURE_H
+#define CM_RENDER_FIGURE_H
+
+#include <stdint.h>
+
+#include "cellmap/model.h"
+#include "cellmap/scm.h"
+#include "render/plot.h"
+
+enum { CM_RENDER_MAX_SIDE = 16384 };
+
+typedef struct cm_render_options {
+    int width, height;         /* pixels, 1..CM_RENDER_MAX_SIDE */
+    double lo[2], hi[2];       /* view in state coordinates; all zero: the region */
+    int64_t slice[CM_MAX_DIM]; /* cells of dimensions >= 2; used when set_slice */
+    int set_slice;             /* 0: the middle of the region */
+    unsigned layers;           /* enum cm_layer; 0: basin and attractors */
+    const cm_model *model;     /* overlays, title, axis names, the 1-D graph; may be NULL */
+    const char *font_path;     /* TrueType font for axes, legend and title */
+} cm_render_options;
+
+/* What was drawn: for provenance, tests and benchmarks. */
+typedef struct cm_render_info {
+    int plot_x, plot_y, plot_w, plot_h; /* the basin panel's pixels, row 0 at the top */
+    double lo[2], hi[2];                /* the state rectangle it shows */
+    int tiles;                          /* GL tiles drawn */
+    int overlays_truncated;             /* the model had more overlays than were drawn */
+    double raster_s, gl_s, text_s;      /* seconds: cells to colours, OpenGL, labels */
+} cm_render_info;
+
+cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                           const cm_render_options *opt, uint8_t *rgba, cm_render_info *info,
+                           char *msg, size_t msg_size);
+
+#endif

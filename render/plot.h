@@ -1,0 +1,56 @@
+/* render/plot.h - the OpenGL part of a figure: the basin raster, the
+ * attractor markers, the model's overlays and, for 1-D models, the map's
+ * graph with a cobweb of each attractor, drawn off-screen with OSMesa.
+ *
+ * The plot is drawn straight into its rectangle of the caller's RGBA figure
+ * (row 0 at the top), in tiles of at most PLOT_TILE pixels a side, so the
+ * figure may be larger than OSMesa's largest viewport and GL never holds
+ * more than one tile. Deterministic: the tiling depends on sizes only.
+ * Not thread-safe (one OSMesa context at a time per thread).
+ */
+#ifndef CM_RENDER_PLOT_H
+#define CM_RENDER_PLOT_H
+
+#include <stdint.h>
+
+#include "cellmap/model.h"
+#include "render/raster.h"
+
+enum { CM_PLOT_TILE = 4096 };
+
+/* Layers of a figure (render options and the command line's --layers). */
+enum cm_layer {
+    CM_LAYER_BASIN = 1 << 0,
+    CM_LAYER_STEPS = 1 << 1, /* with BASIN: shading; alone: step numbers only */
+    CM_LAYER_ATTRACTORS = 1 << 2,
+    CM_LAYER_OVERLAYS = 1 << 3,
+    CM_LAYER_AXES = 1 << 4,
+    CM_LAYER_LEGEND = 1 << 5,
+    CM_LAYER_TITLE = 1 << 6
+};
+
+/* A rectangle of pixels (relative to the plot, row 0 at the top) showing a
+ * rectangle of state space. */
+typedef struct cm_panel {
+    int x, y, w, h;
+    double lo[2], hi[2];
+} cm_panel;
+
+typedef struct cm_plot {
+    const cm_raster *ras;
+    const cm_group_info *groups;     /* ids 1..n */
+    const cm_overlay_list *overlays; /* NULL: none */
+    const cm_model *model;           /* for the 1-D graph */
+    unsigned layers;
+    int x, y, w, h; /* the plot's rectangle in the figure */
+    cm_panel basin; /* where the cells go */
+    cm_panel graph; /* 1-D models: the map's graph (w == 0: none) */
+    int line_width; /* pixels */
+} cm_plot;
+
+/* Draws the plot into rgba, a figure of fig_width columns (and at least
+ * y + h rows). Returns the number of GL tiles drawn in *tiles. */
+cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tiles, char *msg,
+                       size_t msg_size);
+
+#endif

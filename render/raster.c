@@ -1,0 +1,212 @@
+#include "render/raster.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/palette.h"
+
+enum { STEP_BINS = 4096 }; /* step numbers above are counted as the last bin */
+
+void cm_slice_of(const cm_lattice *lat, const cm_region *r, const int64_t *slice, int set_slice,
+                 cm_slice *g)
+{
+    const cm_box *b = &r->box;
+    int64_t cell[CM_MAX_DIM];
+    for (int d = 0; d < b->dim; d++)
+        cell[d] = d >= 2 && set_slice ? slice[d] : b->lo[d] + (b->hi[d] - b->lo[d]) / 2;
+    cell[0] = b->lo[0];
+    if (b->dim > 1)
+        cell[1] = b->lo[1];
+    g->nx = (uint64_t)(b->hi[0] - b->lo[0]);
+    g->ny = b->dim > 1 ? (uint64_t)(b->hi[1] - b->lo[1]) : 1;
+    g->base = cm_box_index(b, cell);
+    g->row_stride = g->nx;
+    g->x0 = lat->origin[0] + (double)b->lo[0] * lat->width[0];
+    g->dx = lat->width[0];
+    g->y0 = b->dim > 1 ? lat->origin[1] + (double)b->lo[1] * lat->width[1] : 0.0;
+    g->dy = b->dim > 1 ? lat->width[1] : 1.0;
+}
+
+/* The step number at or below which 99 % of the computed cells lie: one
+ * long transient must not wash out the shading of the rest. */
+static uint32_t step_cap_of(const cm_region *r, const cm_slice *s)
+{
+    uint64_t *hist = calloc(STEP_BINS, sizeof *hist);
+    if (!hist)
+        return 1;
+#pragma omp parallel for reduction(+ : hist[:STEP_BINS]) schedule(static)
+    for (uint64_t j = 0; j < s->ny; j++)
+        for (uint64_t i = 0; i < s->nx; i++) {
+            const uint64_t k = s->base + j * s->row_stride + i;
+            if (r->group[k] != CM_GROUP_NONE)
+                hist[r->step[k] < STEP_BINS ? r->step[k] : STEP_BINS - 1]++;
+        }
+    uint64_t sum = 0, computed = 0;
+    uint32_t cap = 1;
+    for (uint32_t b = 0; b < STEP_BINS; b++)
+        computed += hist[b];
+    for (uint32_t b = 0; b < STEP_BINS && computed; b++) {
+        sum += hist[b];
+        if (100 * sum >= 99 * computed) {
+            cap = b > 1 ? b : 1;
+            break;
+        }
+    }
+    free(hist);
+    return cap;
+}
+
+/* Shade factors in 1/256 for steps 0..cap (logarithmic: transients are
+ * mostly short, and the eye compares ratios). */
+static void shade_table(uint32_t cap, int mode, uint16_t *table)
+{
+    for (uint32_t t = 0; t <= cap; t++) {
+        const double f = log1p((double)t) / log1p((double)cap);
+        table[t] =
+            (uint16_t)lround(mode == CM_RASTER_STEPS ? 235.0 - 200.0 * f : 256.0 * (1.0 - 0.6 * f));
+    }
+}
+
+static void put_rgb(uint8_t *p, cm_rgb c)
+{
+    p[0] = c.r;
+    p[1] = c.g;
+    p[2] = c.b;
+}
+
+static void colour_cell(const cm_region *r, const cm_raster *ras, uint64_t k, int mode,
+                        const uint16_t *shade, uint8_t *p)
+{
+    const uint32_t grp = r->group[k];
+    if (grp == CM_GROUP_NONE) {
+        if (mode == CM_RASTER_CLASSES)
+            *p = CM_CLASS_NOT_COMPUTED;
+        else
+            put_rgb(p, cm_colour_not_computed);
+        return;
+    }
+    const int cls = grp == 0 ? CM_CLASS_SINK : ras->classes[grp];
+    if (mode == CM_RASTER_CLASSES) {
+        const int marker = cls == CM_CLASS_STICKING ? CM_CLASS_STICKING_MARKER : CM_CLASS_MARKER;
+        *p = (uint8_t)(cm_is_periodic(r, k) ? marker : cls);
+        return;
+    }
+    const uint32_t t = r->step[k] < ras->step_cap ? r->step[k] : ras->step_cap;
+    if (mode == CM_RASTER_STEPS) {
+        p[0] = p[1] = p[2] = (uint8_t)shade[t];
+        return;
+    }
+    const cm_rgb c = cm_class_colour(cls);
+    if (mode == CM_RASTER_BASIN) {
+        put_rgb(p, c);
+        return;
+    }
+    p[0] = (uint8_t)((c.r * shade[t]) >> 8);
+    p[1] = (uint8_t)((c.g * shade[t]) >> 8);
+    p[2] = (uint8_t)((c.b * shade[t]) >> 8);
+}
+
+/* Pixels and the cells of each group, in parallel over rows. */
+static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *shade)
+{
+    const cm_slice *s = &ras->s;
+    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
+    const uint32_t n = r->ngroups + 1;
+    uint64_t computed = 0;
+#pragma omp parallel reduction(+ : computed)
+    {
+        uint64_t *mine = calloc(n, sizeof *mine); /* NULL: counted below instead */
+#pragma omp for schedule(static)
+        for (uint64_t j = 0; j < s->ny; j++)
+            for (uint64_t i = 0; i < s->nx; i++) {
+                const uint64_t k = s->base + j * s->row_stride + i;
+                colour_cell(r, ras, k, mode, shade, ras->pixels + bytes * (j * s->nx + i));
+                if (r->group[k] != CM_GROUP_NONE) {
+                    computed++;
+                    if (mine)
+                        mine[r->group[k]]++;
+                }
+            }
+#pragma omp critical
+        {
+            for (uint32_t g = 0; mine && g < n; g++)
+                ras->group_cells[g] += mine[g];
+            if (!mine)
+                ras->group_cells[0] = UINT64_MAX; /* marks the counts invalid */
+        }
+        free(mine);
+    }
+    ras->computed = computed;
+}
+
+/* The periodic cells in slice order (serial: they are few and the order
+ * must not depend on threads). */
+static cm_status collect_periodic(const cm_region *r, cm_raster *ras, char *msg, size_t msg_size)
+{
+    const cm_slice *s = &ras->s;
+    uint64_t cap = 0;
+    for (uint64_t j = 0; j < s->ny; j++)
+        for (uint64_t i = 0; i < s->nx; i++) {
+            const uint64_t k = s->base + j * s->row_stride + i;
+            if (!cm_is_periodic(r, k))
+                continue;
+            if (ras->nperiodic == cap) {
+                cap = cap ? 2 * cap : 1024;
+                cm_periodic_cell *p = realloc(ras->periodic, cap * sizeof *p);
+                if (!p)
+                    return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for periodic cells");
+                ras->periodic = p;
+            }
+            ras->periodic[ras->nperiodic++] =
+                (cm_periodic_cell){(uint32_t)i, (uint32_t)j, r->group[k]};
+        }
+    return CM_OK;
+}
+
+cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                          const cm_slice *s, int mode, cm_raster *ras, char *msg, size_t msg_size)
+{
+    memset(ras, 0, sizeof *ras);
+    ras->s = *s;
+    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
+    if (s->nx > UINT32_MAX || s->ny > UINT32_MAX)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the slice is too large to draw");
+    ras->pixels = malloc(s->nx * s->ny * bytes);
+    ras->group_cells = calloc((size_t)r->ngroups + 1, sizeof *ras->group_cells);
+    ras->classes = calloc((size_t)r->ngroups + 1, 1);
+    uint16_t *shade = NULL;
+    cm_status st = CM_OK;
+    if (!ras->pixels || !ras->group_cells || !ras->classes)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
+                     (unsigned long long)s->nx, (unsigned long long)s->ny);
+    if (st == CM_OK) {
+        ras->classes[0] = CM_CLASS_SINK;
+        cm_palette_classes(groups, r->ngroups, lat->dim, ras->classes + 1);
+        ras->step_cap = mode == CM_RASTER_SHADED || mode == CM_RASTER_STEPS ? step_cap_of(r, s) : 1;
+        shade = malloc(((size_t)ras->step_cap + 1) * sizeof *shade);
+        if (!shade)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
+    }
+    if (st == CM_OK) {
+        shade_table(ras->step_cap, mode, shade);
+        fill(r, ras, mode, shade);
+        if (ras->group_cells[0] == UINT64_MAX)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for basin counts");
+    }
+    if (st == CM_OK)
+        st = collect_periodic(r, ras, msg, msg_size);
+    free(shade);
+    if (st != CM_OK)
+        cm_raster_free(ras);
+    return st;
+}
+
+void cm_raster_free(cm_raster *ras)
+{
+    free(ras->pixels);
+    free(ras->periodic);
+    free(ras->group_cells);
+    free(ras->classes);
+    memset(ras, 0, sizeof *ras);
+}

@@ -1,0 +1,57 @@
+/* render/raster.h - the cells of a view's 2-D slice as colours or colour
+ * classes, computed on the CPU in parallel before anything is drawn.
+ *
+ * The slice is dimensions 0 and 1 of a region (one row for 1-D models)
+ * through a point of the other dimensions. The raster also collects what the
+ * figure needs besides pixels: the periodic cells (drawn as markers), the
+ * cells of each group in the slice (the legend's basin shares) and the step
+ * number that the shading saturates at.
+ */
+#ifndef CM_RENDER_RASTER_H
+#define CM_RENDER_RASTER_H
+
+#include <stdint.h>
+
+#include "cellmap/scm.h"
+
+typedef struct cm_slice {
+    uint64_t nx, ny;       /* cells in dims 0 and 1 (ny = 1 for 1-D) */
+    uint64_t base;         /* local index of the slice's first cell */
+    uint64_t row_stride;   /* local index step along dim 1 */
+    double x0, y0, dx, dy; /* state coordinates of the lower corner, cell size */
+} cm_slice;
+
+/* The slice through slice[d] (cells, dims >= 2) or, when !set_slice, the
+ * middle of the region. */
+void cm_slice_of(const cm_lattice *lat, const cm_region *r, const int64_t *slice, int set_slice,
+                 cm_slice *out);
+
+typedef struct cm_periodic_cell {
+    uint32_t i, j;  /* slice coordinates */
+    uint32_t group; /* its group id */
+} cm_periodic_cell;
+
+enum cm_raster_mode {
+    CM_RASTER_BASIN,  /* group colours */
+    CM_RASTER_SHADED, /* group colours darkened with the step number */
+    CM_RASTER_STEPS,  /* the step number only, light (short) to dark (long) */
+    CM_RASTER_CLASSES /* colour classes (an indexed image), periodic cells marked */
+};
+
+typedef struct cm_raster {
+    cm_slice s;
+    uint8_t *pixels; /* nx*ny*3 RGB, or nx*ny classes; row 0 is the lowest */
+    cm_periodic_cell *periodic;
+    uint64_t nperiodic;
+    uint64_t *group_cells; /* cells of each group in the slice; [0] the sink */
+    uint64_t computed;     /* cells of the slice inside the regions */
+    uint32_t step_cap;     /* step numbers from here up are shaded darkest */
+    uint8_t *classes;      /* class of each group; [0] the sink */
+} cm_raster;
+
+/* Builds the raster of r's slice. Deterministic whatever the thread count. */
+cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                          const cm_slice *s, int mode, cm_raster *out, char *msg, size_t msg_size);
+void cm_raster_free(cm_raster *ras);
+
+#endif

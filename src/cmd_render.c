@@ -1,0 +1,167 @@
+/* cellmap render: a figure (or an indexed image) of any view of a .cmdb
+ * cluster database, without computing anything. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "src/args.h"
+#include "src/basin_png.h"
+#include "src/commands.h"
+#include "src/dbfile.h"
+
+static const char render_help[] =
+    "usage: cellmap render FILE.cmdb --png OUT.png [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
+    "                      [--size WxH] [--layers L,...] [--png-mode rgb|indexed] [--mem BYTES]\n\n"
+    "Draws the basins of a cluster database (made by solve --db or explore). Cells of the\n"
+    "view that were never computed are drawn as not computed.\n\n"
+    "  --png FILE          the image (written to a temporary file, renamed)\n" PNG_OPTIONS_HELP
+    "                      (default here: the view the last explore session saved, else\n"
+    "                      the cluster's bounding box)\n"
+    "  --slice Z,...       models of more than two dimensions: the point of dimensions\n"
+    "                      3.. the 2-D slice passes through (default: the cluster's middle)\n"
+    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n";
+
+typedef struct render_args {
+    const char *file;
+    png_opts png;
+    const char *slice_text;
+    uint64_t mem;
+} render_args;
+
+static int parse_render(cli *c, render_args *a)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(render_help, stdout);
+            return -1;
+        } else if (png_opts_take(c, &a->png, &err)) {
+        } else if (cli_is(c, "--slice", true, &err)) {
+            a->slice_text = c->value;
+        } else if (cli_take_mem(c, &a->mem, &err)) {
+        } else if (c->opt[0] != '-' && !a->file) {
+            a->file = c->opt;
+        } else {
+            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+        }
+    }
+    if (!err && !a->file)
+        err = cli_usage_error(c, "which file? usage: cellmap render FILE.cmdb --png OUT.png");
+    if (!err && !a->png.path)
+        err = cli_usage_error(c, "where to? add --png OUT.png");
+    if (!err)
+        err = png_opts_check(c, &a->png);
+    return err;
+}
+
+/* The view explore saved ("X0:X1 Y0:Y1 ..."), if any and readable. */
+static bool saved_view(cm_store *s, int dims, double lo[2], double hi[2])
+{
+    char text[1024], msg[256];
+    if (cm_store_get_note(s, "note.explore.view", text, sizeof text, msg, sizeof msg) != CM_OK)
+        return false;
+    char *p = text;
+    for (int d = 0; d < dims; d++) {
+        const size_t n = strcspn(p, " ");
+        char range[256];
+        int count = 0;
+        snprintf(range, sizeof range, "%.*s", (int)n, p);
+        if (!parse_ranges(range, &lo[d], &hi[d], &count, 1) || count != 1)
+            return false;
+        p += n + (p[n] == ' ');
+    }
+    return true;
+}
+
+/* The cells to draw: the view's rectangle, and the slice in dims 3... */
+static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const cm_cluster *cl,
+                         double lo[2], double hi[2], cm_box *box)
+{
+    const cm_lattice *lat = &cl->lat;
+    cm_box bounds;
+    cm_cluster_bounds(cl, &bounds);
+    const int dims = lat->dim < 2 ? lat->dim : 2;
+    if (a->png.has_view && lat->dim == 1)
+        return cli_usage_error(c, "--view: a 1-D model's view is X0:X1 only; use --view "
+                                  "X0:X1,0:1");
+    if (a->png.has_view) {
+        memcpy(lo, a->png.lo, 2 * sizeof *lo);
+        memcpy(hi, a->png.hi, 2 * sizeof *hi);
+    } else if (!saved_view(s, dims, lo, hi)) {
+        for (int d = 0; d < dims; d++) {
+            lo[d] = lat->origin[d] + (double)bounds.lo[d] * lat->width[d];
+            hi[d] = lat->origin[d] + (double)bounds.hi[d] * lat->width[d];
+        }
+    }
+    if (lat->dim == 1)
+        lo[1] = hi[1] = 0;
+    view_cells(lat, lo, hi, &bounds, box);
+    if (!a->slice_text)
+        return EXIT_OK;
+    double v[CM_MAX_DIM];
+    int n = 0;
+    if (!parse_doubles(a->slice_text, v, &n, CM_MAX_DIM) || n != lat->dim - 2)
+        return cli_usage_error(c, "--slice: '%s' must be %d coordinate(s) of dimensions 3..",
+                               a->slice_text, lat->dim > 2 ? lat->dim - 2 : 0);
+    for (int d = 2; d < lat->dim; d++) {
+        box->lo[d] = (int64_t)floor((v[d - 2] - lat->origin[d]) / lat->width[d]);
+        box->hi[d] = box->lo[d] + 1;
+    }
+    return EXIT_OK;
+}
+
+static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_store_info *info,
+                      cm_cluster *cl)
+{
+    char msg[1024];
+    cm_model m;
+    cm_region flat;
+    cm_box box;
+    double lo[2], hi[2];
+    uint64_t sink = 0;
+    memset(&flat, 0, sizeof flat);
+    int rc = cells_to_draw(c, a, s, cl, lo, hi, &box);
+    if (rc != EXIT_OK)
+        return rc;
+    if (model_of_store(info, &m, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap render: %s: %s\n", a->file, msg);
+        return EXIT_FAIL;
+    }
+    cm_group_info *groups = calloc((size_t)cl->ngroups + 1, sizeof *groups);
+    cm_status st = groups ? cm_store_groups(s, groups, cl->ngroups, &sink, msg, sizeof msg)
+                          : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for groups");
+    if (st == CM_OK)
+        st = cm_cluster_flatten(cl, &box, &flat, msg, sizeof msg);
+    rc = EXIT_FAIL;
+    if (st != CM_OK) {
+        fprintf(stderr, "cellmap render: %s\n", msg);
+    } else {
+        const basin_png png = {&a->png,       &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
+                               {hi[0], hi[1]}};
+        rc = write_basin_png("render", &png);
+    }
+    cm_region_free(&flat);
+    free(groups);
+    cm_model_release(&m);
+    return rc;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    cli c = {"render", argc, argv, 0, NULL, NULL};
+    render_args a;
+    memset(&a, 0, sizeof a);
+    a.mem = UINT64_C(256) << 20;
+    const int rc = parse_render(&c, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_cluster cl;
+    if (open_cluster_file("render", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+        return EXIT_FAIL;
+    const int result = run_render(&c, &a, s, &info, &cl);
+    close_cluster_file(s, &cl);
+    return result;
+}
