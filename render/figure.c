@@ -486,6 +486,12 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
         info->plot_y = p.y + p.basin.y;
         info->plot_w = p.basin.w;
         info->plot_h = p.basin.h;
+        if (p.graph.w > 0) {
+            info->graph_x = p.x + p.graph.x;
+            info->graph_y = p.y + p.graph.y;
+            info->graph_w = p.graph.w;
+            info->graph_h = p.graph.h;
+        }
         memcpy(info->lo, lo, sizeof info->lo);
         memcpy(info->hi, hi, sizeof info->hi);
         info->overlays_truncated = w.ov.truncated;
