@@ -235,5 +235,47 @@ cmp -s v2-groups.csv v3-groups.csv || fail "a version 2 file reads differently"
 [ "$(sqlite3 v2.cmdb "SELECT COUNT(*) FROM groups WHERE kind = 'attractor'")" = \
   "$(sqlite3 basin.cmdb "SELECT COUNT(*) FROM attractors")" ] || fail "upgraded kinds"
 
+# --- render: figures and indexed images of a database ------------------------
+"$CM" render basin.cmdb --png rendered.png || fail "render of basin.cmdb"
+cmp -s rendered.png basin.png || fail "render of the solve's file differs from the solve's PNG"
+"$CM" render basin.cmdb --layers all --size 1000x700 --png figure.png || fail "render --layers all"
+# switching lines SW_1..SW_3 (white) cross x' = 20 at x = (m - 20 D)/P; the
+# attractors sit where they cross x' = 0 (x = m/P)
+python3 - figure.check.json <<'PY'
+import json, sys
+P, D = 0.007, 0.02
+white = [[(m - 20 * D) / P, 20, 1, [255, 255, 255]] for m in (1, 2, 3)]
+black = [[m / P, 0, 4] for m in (1, 2, 3)]
+json.dump({"view": [0, 500, -40, 40], "size": [1000, 700], "colour_near": white,
+           "black_near": black, "not_colour_at": [[(1.5 - 20 * D) / P, 20, [255, 255, 255]]],
+           "texts": {"Model": "microchaos-pd", "Layers": "basin,attractors,overlays,axes,legend,title",
+                     "Parameters": '{"alpha":0.078', "View": "box 0:500,-40:40 cells 1000x1000 view"}},
+          open(sys.argv[1], "w"))
+PY
+python3 "$HERE/pngcheck.py" figure.png figure.check.json || fail "figure.png pixels and texts"
+"$CM" render basin.cmdb --png-mode indexed --view 100:400,-20:20 --png indexed.png \
+  || fail "render --png-mode indexed"
+python3 - indexed.check.json <<'PY'
+import json, sys
+json.dump({"view": [100, 400, -20, 20], "size": [600, 500], "black_near": [[m / 0.007, 0, 4] for m in (1, 2)],
+           "texts": {"Group classes": "", "Classes": "0 not computed, 1 sink"}}, open(sys.argv[1], "w"))
+PY
+python3 "$HERE/pngcheck.py" indexed.png indexed.check.json || fail "indexed.png pixels and texts"
+"$CM" explore basin.cmdb - <<< "render session.png 600x400 --layers all" > /dev/null \
+  || fail "explore render with layers"
+[ -s session.png ] || fail "explore render wrote nothing"
+expect_usage "unknown layer 'foo'" render basin.cmdb --layers basin,foo --png x.png
+expect_usage "leave out --size" render basin.cmdb --png-mode indexed --size 10x10 --png x.png
+expect_usage "add --png" render basin.cmdb
+expect_usage "add --png" solve --layers all
+expect_usage "--png-mode: 'gif'" solve --png x.png --png-mode gif
+out=$("$CM" render missing.cmdb --png x.png 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q missing.cmdb <<<"$out" || fail "render of a missing file: $rc $out"
+out=$("$CM" render basin.cmdb --png nodir/x.png 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "nodir/x.png" <<<"$out" || fail "render into a missing directory: $rc $out"
+out=$(CELLMAP_FONT=/nonexistent.ttf "$CM" render basin.cmdb --layers axes --png nofont.png 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "fonts-dejavu-core" <<<"$out" && [ ! -e nofont.png ] \
+  || fail "render without its font: $rc $out"
+
 [ $fails -eq 0 ] && echo "cli tests passed" || echo "$fails cli test(s) failed"
 exit $fails
