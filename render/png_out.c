@@ -1,6 +1,7 @@
 #include "render/png_out.h"
 
 #include <png.h>
+#include <zlib.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,6 +46,7 @@ static cm_status encode(png_job *job, const png_pixels *px, const cm_png_text *t
      * twice as large, still tens of kilobytes. */
     png_set_compression_level(job->png, 3);
     png_set_filter(job->png, 0, PNG_FILTER_SUB);
+    png_set_compression_strategy(job->png, Z_RLE);
     for (int i = 0; i < n_texts; i++) {
         png_text t;
         memset(&t, 0, sizeof t);
