@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Makes the thesis' figures in this directory (or in OUT_DIR) with cellmap:
+#   assets/examples/make-figures.sh build/cellmap [OUT_DIR]
+# Each image is a basin figure with every layer: basins, attractors (black),
+# switching lines (white), fixed points (white discs regular, rings virtual),
+# manifolds (dashed), axes, legend and title.
+set -euo pipefail
+CM=$(realpath "$1")
+OUT=${2:-$(cd "$(dirname "$0")" && pwd)}
+cd "$OUT"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pd=microchaos-pd
+
+# Fig. 4.13: alpha = 0.8, beta = 0.3, P = 0.9, D = 0.4; x_0*..x_2* regular,
+# x_3* virtual, switching lines SW_1..SW_5
+"$CM" solve --model $pd --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --region=-1:6.5,-2.5:2.5 \
+  --cells 750x500 --png fig-4.13.png --layers all --size 1200x800 > /dev/null
+
+# Fig. 4.21: twelve tiny attractors at the switching lines (real device)
+"$CM" solve --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
+  --region=-125000:125000,-600:600 --cells 1000x400 --max-steps 100000 \
+  --png fig-4.21-figure.png --layers all --size 1400x600 > /dev/null
+
+# Figs. 4.26 and 4.28 (thesis 4.6.3): the two regions solved apart, then the
+# cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
+ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
+"$CM" solve $ex --region 0:500,-40:40 --cells 1000x1000 --png fig-4.26-left.png \
+  --layers all --size 700x700 > /dev/null
+"$CM" solve $ex --region 500:1000,-40:40 --cells 1000x1000 --png fig-4.26-right.png \
+  --layers all --size 700x700 > /dev/null
+"$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --db "$tmp/c.cmdb" \
+  > /dev/null
+"$CM" render "$tmp/c.cmdb" --png fig-4.28.png --layers all --size 1400x700
+
+# Fig. 4.30: the hybrid map with dry friction, mu = 0.095 (sticking zones grey)
+"$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-301.5:301.5 \
+  --cells 800x201 --max-steps 100000 --png fig-4.30-figure.png --layers all --size 1400x600 \
+  > /dev/null
+
+# Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip
+"$CM" solve --model microchaos-1d --param a=3.5,b=2.8 --region=-4:4 --cells 800 \
+  --png fig-4.2.png --layers all --size 800x800 > /dev/null
