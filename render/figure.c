@@ -202,10 +202,7 @@ typedef struct layout {
     char yname_buf[64];
 } layout;
 
-static bool has_text(unsigned layers)
-{
-    return layers & (CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE);
-}
+static bool has_text(unsigned layers) { return layers & CM_LAYERS_TEXT; }
 
 /* Margins of everything but the legend's width. */
 static void margins(const cm_render_options *o, const cm_font *f, int dim, layout *L)
@@ -367,14 +364,12 @@ static cm_status check_options(const cm_render_options *o, char *msg, size_t msg
 
 /* Everything computed before pixels: raster, overlays, font, margins. */
 static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                         const cm_render_options *o, const double lo[2], const double hi[2],
-                         work *w, layout *L, char *msg, size_t msg_size)
+                         const cm_render_options *o, const cm_slice *s, const double lo[2],
+                         const double hi[2], work *w, layout *L, char *msg, size_t msg_size)
 {
     const int dim = r->box.dim;
-    cm_slice s;
-    cm_slice_of(lat, r, o->slice, o->set_slice, &s);
     cm_status st =
-        cm_raster_build(lat, r, groups, &s, raster_mode(o->layers), &w->ras, msg, msg_size);
+        cm_raster_build(lat, r, groups, s, raster_mode(o->layers), &w->ras, msg, msg_size);
     if (st == CM_OK && o->model && o->model->overlays && (o->layers & CM_LAYER_OVERLAYS)) {
         w->ov.items = malloc(OVERLAY_CAP * sizeof *w->ov.items);
         w->ov.cap = w->ov.items ? OVERLAY_CAP : 0;
@@ -451,7 +446,7 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
     memset(&w, 0, sizeof w);
     memset(&L, 0, sizeof L);
     double t0 = seconds();
-    st = prepare(lat, r, groups, &o, lo, hi, &w, &L, msg, msg_size);
+    st = prepare(lat, r, groups, &o, &s, lo, hi, &w, &L, msg, msg_size);
     info->raster_s = seconds() - t0;
     const canvas c = {rgba, o.width, o.height};
     cm_plot p = {&w.ras,

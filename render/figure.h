@@ -35,13 +35,13 @@ typedef struct cm_render_options {
 
 /* What was drawn: for provenance, tests and benchmarks. */
 typedef struct cm_render_info {
-    int plot_x, plot_y, plot_w, plot_h; /* the basin panel's pixels, row 0 at the top */
-    double lo[2], hi[2];                /* the state rectangle it shows */
+    int plot_x, plot_y, plot_w, plot_h;     /* the basin panel's pixels, row 0 at the top */
+    double lo[2], hi[2];                    /* the state rectangle it shows */
     int graph_x, graph_y, graph_w, graph_h; /* 1-D models: the graph panel (x_j, x_j+1 both
                                                over lo[0]..hi[0]); else all 0 */
-    int tiles;                          /* GL tiles drawn */
-    int overlays_truncated;             /* the model had more overlays than were drawn */
-    double raster_s, gl_s, text_s;      /* seconds: cells to colours, OpenGL, labels */
+    int tiles;                              /* GL tiles drawn */
+    int overlays_truncated;                 /* the model had more overlays than were drawn */
+    double raster_s, gl_s, text_s;          /* seconds: cells to colours, OpenGL, labels */
 } cm_render_info;
 
 cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,

@@ -28,6 +28,8 @@ enum cm_layer {
     CM_LAYER_LEGEND = 1 << 5,
     CM_LAYER_TITLE = 1 << 6
 };
+/* The layers drawn with text, which need a font and margins. */
+#define CM_LAYERS_TEXT (CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE)
 
 /* A rectangle of pixels (relative to the plot, row 0 at the top) showing a
  * rectangle of state space. */

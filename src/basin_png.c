@@ -24,7 +24,6 @@ static const struct {
 
 static const unsigned all_layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS |
                                    CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
-static const unsigned text_layers = CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
 
 bool parse_layers(const char *s, unsigned *layers, char *bad, size_t bad_size)
 {
@@ -136,10 +135,10 @@ void default_image_size(const cm_lattice *lat, const cm_box *box, int *width, in
 static void figure_size(const cm_lattice *lat, const cm_box *box, unsigned layers, int *w, int *h)
 {
     default_image_size(lat, box, w, h);
-    if (lat->dim == 1 && (layers & (CM_LAYER_OVERLAYS | text_layers)))
+    if (lat->dim == 1 && (layers & (CM_LAYER_OVERLAYS | CM_LAYERS_TEXT)))
         *h = *w; /* room for the map's graph */
     const int most = *w > *h ? *w : *h;
-    if (!(layers & text_layers) || most >= FIGURE_SIDE)
+    if (!(layers & CM_LAYERS_TEXT) || most >= FIGURE_SIDE)
         return;
     *w = (int)lround((double)*w * FIGURE_SIDE / most);
     *h = (int)lround((double)*h * FIGURE_SIDE / most);
