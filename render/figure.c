@@ -82,8 +82,10 @@ static void make_ticks(double lo, double hi, ticks *t)
 static int widest(const cm_font *f, const ticks *t)
 {
     int w = 0;
-    for (int k = 0; k < t->n; k++)
-        w = cm_font_width(f, t->label[k]) > w ? cm_font_width(f, t->label[k]) : w;
+    for (int k = 0; k < t->n; k++) {
+        const int lw = cm_font_width(f, t->label[k]);
+        w = lw > w ? lw : w;
+    }
     return w;
 }
 
@@ -322,7 +324,6 @@ static int raster_mode(unsigned layers)
  * above a basin strip. */
 static void make_panels(cm_plot *p, int dim, const double lo[2], const double hi[2], int gap)
 {
-    memset(&p->basin, 0, sizeof p->basin);
     memset(&p->graph, 0, sizeof p->graph);
     p->basin = (cm_panel){0, 0, p->w, p->h, {lo[0], lo[1]}, {hi[0], hi[1]}};
     if (dim != 1 || !p->model || p->h < 8)
@@ -465,8 +466,11 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
         const int small = p.w < p.h ? p.w : p.h;
         p.line_width = small / 700 > 1 ? small / 700 : 1;
         make_panels(&p, r->box.dim, lo, hi, L.line ? L.line / 2 : 4);
-        if (L.left || L.right || L.top || L.bottom)
-            fill_rect(&c, 0, 0, o.width, o.height, paper);
+        /* the margins; GL paints the plot itself */
+        fill_rect(&c, 0, 0, o.width, p.y, paper);
+        fill_rect(&c, 0, p.y + p.h, o.width, o.height - p.y - p.h, paper);
+        fill_rect(&c, 0, p.y, p.x, p.h, paper);
+        fill_rect(&c, p.x + p.w, p.y, o.width - p.x - p.w, p.h, paper);
         t0 = seconds();
         st = cm_plot_draw(&p, rgba, o.width, &info->tiles, msg, msg_size);
         info->gl_s = seconds() - t0;
