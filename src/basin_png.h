@@ -25,7 +25,8 @@ typedef struct png_opts {
     "                      (default: basin,attractors)\n"                                          \
     "  --png-mode MODE     rgb (a figure) or indexed (one pixel per cell, its value the\n"         \
     "                      colour class; the classes of groups are in the PNG's texts)\n"          \
-    "  --view X0:X1,Y0:Y1  the rectangle of state space to draw (default: all cells)\n"
+    "  --view X0:X1,Y0:Y1  the rectangle of state space to draw (default: all cells;\n"            \
+    "                      1-D models ignore Y0:Y1)\n"
 
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);

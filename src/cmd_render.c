@@ -82,9 +82,6 @@ static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const 
     cm_box bounds;
     cm_cluster_bounds(cl, &bounds);
     const int dims = lat->dim < 2 ? lat->dim : 2;
-    if (a->png.has_view && lat->dim == 1)
-        return cli_usage_error(c, "--view: a 1-D model's view is X0:X1 only; use --view "
-                                  "X0:X1,0:1");
     if (a->png.has_view) {
         memcpy(lo, a->png.lo, 2 * sizeof *lo);
         memcpy(hi, a->png.hi, 2 * sizeof *hi);
