@@ -1,4 +1,4 @@
-/* models/models.h - constructors of the micro-chaos models.
+/* models/models.h - constructors of the models.
  *
  * Each constructor validates the parameter values (already range-checked
  * against the spec by models/params.c), precomputes the coefficients and
@@ -20,6 +20,7 @@ extern const cm_param_spec cm_microchaos_pd_spec[];
 extern const cm_param_spec cm_microchaos_pd_twofold_spec[];
 extern const cm_param_spec cm_microchaos_pd_friction_spec[];
 extern const cm_param_spec cm_microchaos_general_spec[];
+extern const cm_param_spec cm_friction_oscillator_spec[];
 
 cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char *msg,
@@ -30,8 +31,9 @@ cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char 
                                           size_t msg_size);
 cm_status cm_microchaos_pd_friction_create(const cm_params *p, cm_model *m, char *msg,
                                            size_t msg_size);
-cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg,
-                                       size_t msg_size);
+cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
+cm_status cm_friction_oscillator_create(const cm_params *p, cm_model *m, char *msg,
+                                        size_t msg_size);
 
 /* Shared by the constructors: allocates a zeroed context of `size` bytes and
  * fills the common fields of *m. */

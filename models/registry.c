@@ -12,6 +12,8 @@
 /* Fig. 4.30: the attractors at SW_-4..SW_4 (x = m/P, |m/P| < 73000) and
  * the sticking zones around the fixed points between them. */
 #define CM_PD_FRICTION_REGION "-100000:100000,-300:300"
+/* The attractors of the thesis' parameter points (|x| < 2 at Omega = 0.5). */
+#define CM_FO_REGION "-3:3,-3:3"
 
 static const cm_model_entry entries[] = {
     {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
@@ -30,6 +32,9 @@ static const cm_model_entry entries[] = {
     {"microchaos-general", "x_{j-d}, ..., x_j",
      "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
      NULL, cm_microchaos_general_spec, cm_microchaos_general_create},
+    {"friction-oscillator", "x, v",
+     "Poincare map of the harmonically excited oscillator with dry friction (2.3), MODELS.md 9",
+     CM_FO_REGION, cm_friction_oscillator_spec, cm_friction_oscillator_create},
 };
 
 size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }
