@@ -6,12 +6,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "render/axes.h"
 #include "render/palette.h"
 #include "render/text.h"
 
 enum {
     OVERLAY_CAP = 1 << 16, /* more lines than this would paint the view over */
-    MAX_TICKS = 32,
     LABEL = 96
 };
 
@@ -23,70 +23,6 @@ static double seconds(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-/* ---- pixels --------------------------------------------------------------------- */
-
-typedef struct canvas {
-    uint8_t *rgba;
-    int w, h;
-} canvas;
-
-static void fill_rect(const canvas *c, int x, int y, int w, int h, cm_rgb col)
-{
-    for (int j = y < 0 ? 0 : y; j < y + h && j < c->h; j++)
-        for (int i = x < 0 ? 0 : x; i < x + w && i < c->w; i++) {
-            uint8_t *p = c->rgba + 4 * ((size_t)j * (size_t)c->w + (size_t)i);
-            p[0] = col.r;
-            p[1] = col.g;
-            p[2] = col.b;
-            p[3] = 255;
-        }
-}
-
-/* ---- ticks ---------------------------------------------------------------------- */
-
-typedef struct ticks {
-    int n;
-    double v[MAX_TICKS];
-    char label[MAX_TICKS][32];
-} ticks;
-
-/* Round values 1, 2 or 5 times a power of ten apart, about six in range. */
-static void make_ticks(double lo, double hi, ticks *t)
-{
-    t->n = 0;
-    const double raw = (hi - lo) / 6;
-    if (!(raw > 0) || !isfinite(raw))
-        return;
-    const double mag = pow(10, floor(log10(raw)));
-    const double step = raw <= mag       ? mag
-                        : raw <= 2 * mag ? 2 * mag
-                        : raw <= 5 * mag ? 5 * mag
-                                         : 10 * mag;
-    const double biggest = fmax(fabs(lo), fabs(hi));
-    const bool fixed = biggest < 1e7 && step >= 1e-4;
-    const int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
-    const int digits = (int)ceil(log10(biggest / step) + 1e-9) + 1;
-    for (double k = ceil(lo / step); k * step <= hi && t->n < MAX_TICKS; k++) {
-        const double v = k == 0 ? 0.0 : k * step;
-        t->v[t->n] = v;
-        if (fixed)
-            snprintf(t->label[t->n], sizeof t->label[0], "%.*f", decimals, v);
-        else
-            snprintf(t->label[t->n], sizeof t->label[0], "%.*e", digits > 1 ? digits - 1 : 0, v);
-        t->n++;
-    }
-}
-
-static int widest(const cm_font *f, const ticks *t)
-{
-    int w = 0;
-    for (int k = 0; k < t->n; k++) {
-        const int lw = cm_font_width(f, t->label[k]);
-        w = lw > w ? lw : w;
-    }
-    return w;
 }
 
 /* ---- legend --------------------------------------------------------------------- */
@@ -182,7 +118,7 @@ static void format_title(const cm_model *m, char *out, size_t size)
 
 /* Draws text cut to max_w pixels (with "..." when cut). */
 static void draw_fitted(const cm_font *f, const char *text, int x, int y, int max_w,
-                        const canvas *c)
+                        const cm_canvas *c)
 {
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", text);
@@ -199,7 +135,7 @@ static void draw_fitted(const cm_font *f, const char *text, int x, int y, int ma
 typedef struct layout {
     int fs, pad, tick, line, ascent;
     int left, right, top, bottom;
-    ticks tx, ty;
+    cm_ticks tx, ty;
     const char *xname, *yname;
     char yname_buf[64];
 } layout;
@@ -223,7 +159,7 @@ static void margins(const cm_render_options *o, const cm_font *f, int dim, layou
     L->yname = L->yname_buf;
     L->top = o->layers & CM_LAYER_TITLE ? L->line + 2 * L->pad : f ? L->pad + L->ascent / 2 : 0;
     L->bottom = axes ? L->tick + 2 * L->line + L->pad : f ? L->pad : 0;
-    L->left = axes ? 2 * L->pad + cm_font_width(f, L->yname) + widest(f, &L->ty) + L->tick
+    L->left = axes ? 2 * L->pad + cm_font_width(f, L->yname) + cm_ticks_widest(f, &L->ty) + L->tick
               : f  ? L->pad
                    : 0;
     L->right = f ? 2 * L->pad : 0;
@@ -231,19 +167,14 @@ static void margins(const cm_render_options *o, const cm_font *f, int dim, layou
 
 /* ---- axes ----------------------------------------------------------------------- */
 
-static int to_px(double v, double lo, double hi, int n)
-{
-    return (int)floor((v - lo) / (hi - lo) * n);
-}
-
 static void x_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm_font *f,
-                   const canvas *c)
+                   const cm_canvas *c)
 {
     const int base = oy + pn->y + pn->h;
     int last_right = INT32_MIN / 2;
     for (int k = 0; k < L->tx.n; k++) {
-        const int x = ox + pn->x + to_px(L->tx.v[k], pn->lo[0], pn->hi[0], pn->w);
-        fill_rect(c, x, base, 1, L->tick, ink);
+        const int x = ox + pn->x + cm_axis_px(L->tx.v[k], pn->lo[0], pn->hi[0], pn->w);
+        cm_fill_rect(c, x, base, 1, L->tick, ink);
         const int w = cm_font_width(f, L->tx.label[k]);
         if (x - w / 2 <= last_right + L->pad)
             continue; /* no overlapping labels */
@@ -257,12 +188,12 @@ static void x_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm
 }
 
 static void y_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm_font *f,
-                   const canvas *c)
+                   const cm_canvas *c)
 {
     const int x0 = ox + pn->x;
     for (int k = 0; k < L->ty.n; k++) {
-        const int y = oy + pn->y + pn->h - 1 - to_px(L->ty.v[k], pn->lo[1], pn->hi[1], pn->h);
-        fill_rect(c, x0 - L->tick, y, L->tick, 1, ink);
+        const int y = oy + pn->y + pn->h - 1 - cm_axis_px(L->ty.v[k], pn->lo[1], pn->hi[1], pn->h);
+        cm_fill_rect(c, x0 - L->tick, y, L->tick, 1, ink);
         const int w = cm_font_width(f, L->ty.label[k]);
         cm_font_draw(f, L->ty.label[k], x0 - L->tick - 2 - w, y + L->ascent / 2 - 1, ink, c->rgba,
                      c->w, c->h);
@@ -271,24 +202,24 @@ static void y_axis(const layout *L, const cm_panel *pn, int ox, int oy, const cm
                  c->h);
 }
 
-static void frame(const cm_panel *pn, int ox, int oy, const canvas *c)
+static void frame(const cm_panel *pn, int ox, int oy, const cm_canvas *c)
 {
     const int x = ox + pn->x, y = oy + pn->y;
-    fill_rect(c, x - 1, y - 1, pn->w + 2, 1, ink);
-    fill_rect(c, x - 1, y + pn->h, pn->w + 2, 1, ink);
-    fill_rect(c, x - 1, y - 1, 1, pn->h + 2, ink);
-    fill_rect(c, x + pn->w, y - 1, 1, pn->h + 2, ink);
+    cm_fill_rect(c, x - 1, y - 1, pn->w + 2, 1, ink);
+    cm_fill_rect(c, x - 1, y + pn->h, pn->w + 2, 1, ink);
+    cm_fill_rect(c, x - 1, y - 1, 1, pn->h + 2, ink);
+    cm_fill_rect(c, x + pn->w, y - 1, 1, pn->h + 2, ink);
 }
 
 static void draw_legend(const legend *lg, const layout *L, int x, int y, const cm_font *f,
-                        const canvas *c)
+                        const cm_canvas *c)
 {
     const int box = L->ascent;
     for (int k = 0; k < lg->n; k++) {
         const int base = y + (k + 1) * L->line;
         if (lg->e[k].has_swatch) {
-            fill_rect(c, x, base - box, box, box, ink);
-            fill_rect(c, x + 1, base - box + 1, box - 2, box - 2, lg->e[k].swatch);
+            cm_fill_rect(c, x, base - box, box, box, ink);
+            cm_fill_rect(c, x + 1, base - box + 1, box - 2, box - 2, lg->e[k].swatch);
         }
         cm_font_draw(f, lg->e[k].text, x + box + L->pad, base, ink, c->rgba, c->w, c->h);
     }
@@ -386,8 +317,8 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
     if (st == CM_OK && has_text(o->layers))
         st = cm_font_open(o->font_path, L->fs, &w->font, msg, msg_size);
     if (st == CM_OK) {
-        make_ticks(lo[0], hi[0], &L->tx);
-        make_ticks(dim == 1 ? lo[0] : lo[1], dim == 1 ? hi[0] : hi[1], &L->ty);
+        cm_make_ticks(lo[0], hi[0], &L->tx);
+        cm_make_ticks(dim == 1 ? lo[0] : lo[1], dim == 1 ? hi[0] : hi[1], &L->ty);
         margins(o, w->font, dim, L);
     }
     if (st == CM_OK && (o->layers & CM_LAYER_LEGEND)) {
@@ -409,7 +340,7 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
 }
 
 static void draw_text_layers(const cm_render_options *o, const work *w, const layout *L,
-                             const cm_plot *p, const canvas *c)
+                             const cm_plot *p, const cm_canvas *c)
 {
     if (o->layers & CM_LAYER_AXES) {
         frame(&p->basin, p->x, p->y, c);
@@ -449,7 +380,7 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
     double t0 = seconds();
     st = prepare(lat, r, groups, &o, &s, lo, hi, &w, &L, msg, msg_size);
     info->raster_s = seconds() - t0;
-    const canvas c = {rgba, o.width, o.height};
+    const cm_canvas c = {rgba, o.width, o.height};
     cm_plot p = {&w.ras,
                  groups,
                  w.ov.items ? &w.ov : NULL,
@@ -467,10 +398,10 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
         p.line_width = small / 700 > 1 ? small / 700 : 1;
         make_panels(&p, r->box.dim, lo, hi, L.line ? L.line / 2 : 4);
         /* the margins; GL paints the plot itself */
-        fill_rect(&c, 0, 0, o.width, p.y, paper);
-        fill_rect(&c, 0, p.y + p.h, o.width, o.height - p.y - p.h, paper);
-        fill_rect(&c, 0, p.y, p.x, p.h, paper);
-        fill_rect(&c, p.x + p.w, p.y, o.width - p.x - p.w, p.h, paper);
+        cm_fill_rect(&c, 0, 0, o.width, p.y, paper);
+        cm_fill_rect(&c, 0, p.y + p.h, o.width, o.height - p.y - p.h, paper);
+        cm_fill_rect(&c, 0, p.y, p.x, p.h, paper);
+        cm_fill_rect(&c, p.x + p.w, p.y, o.width - p.x - p.w, p.h, paper);
         t0 = seconds();
         st = cm_plot_draw(&p, rgba, o.width, &info->tiles, msg, msg_size);
         info->gl_s = seconds() - t0;
