@@ -639,6 +639,8 @@ static void overlays_fo(const cm_model *m, const double lo[2], const double hi[2
                         c + o->S0);
 }
 
+const cm_fo *cm_fo_of_model(const cm_model *m) { return m->step == step_fo ? m->ctx : NULL; }
+
 cm_status cm_friction_oscillator_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
 {
     const double S = cm_params_get(p, "S"), S0 = cm_params_get(p, "S0");

@@ -99,4 +99,9 @@ bool cm_fo_symmetric_amplitude(double S, double Omega, double *x0, double *phase
  * when the two trajectories merge. */
 bool cm_fo_lyapunov(const cm_fo *o, double x0, double v0, double d0, int periods, double *lambda);
 
+/* The oscillator behind a `friction-oscillator` model, or NULL for any
+ * other model. */
+struct cm_model;
+const cm_fo *cm_fo_of_model(const struct cm_model *m);
+
 #endif

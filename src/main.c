@@ -18,6 +18,7 @@ static const struct {
     {"export", cmd_export, "a .cmdb file's groups and cells as CSV, .npy or a flat SQLite table"},
     {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},
     {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
+    {"lyapunov", cmd_lyapunov, "largest Lyapunov exponent of the friction oscillator over a grid"},
 };
 
 static void usage(FILE *out)

@@ -1,0 +1,259 @@
+#include "render/chart.h"
+
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "render/axes.h"
+#include "render/text.h"
+
+static const cm_rgb ink = {0, 0, 0};
+static const cm_rgb paper = {255, 255, 255};
+static const cm_rgb not_computed = {225, 225, 225};
+
+/* A sequential scale from pale yellow through orange and red to dark
+ * purple: small positive exponents stay visible against white. */
+static const cm_rgb scale[] = {
+    {255, 237, 160}, {254, 178, 76}, {240, 59, 32}, {189, 0, 38}, {84, 0, 90}};
+
+cm_rgb cm_heat_colour(double v, double max)
+{
+    const int n = (int)(sizeof scale / sizeof scale[0]) - 1;
+    double f = max > 0 ? v / max : 1;
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    const int k = f >= 1 ? n - 1 : (int)(f * n);
+    const double t = f * n - k;
+    const cm_rgb a = scale[k], b = scale[k + 1];
+    return (cm_rgb){(uint8_t)lround(a.r + t * (b.r - a.r)), (uint8_t)lround(a.g + t * (b.g - a.g)),
+                    (uint8_t)lround(a.b + t * (b.b - a.b))};
+}
+
+static double heat_max(const cm_heat *h)
+{
+    if (h->max > 0)
+        return h->max;
+    double m = 0;
+    for (size_t k = 0; k < (size_t)h->nx * (size_t)h->ny; k++)
+        m = h->v[k] > m ? h->v[k] : m;
+    return m;
+}
+
+typedef struct layout {
+    int left, right, top, bottom, pad, tick, line, ascent, bar;
+    cm_ticks tx, ty, tbar;
+} layout;
+
+static void plan(const cm_chart *c, const cm_font *f, double hmax, layout *L)
+{
+    L->ascent = cm_font_ascent(f);
+    L->line = cm_font_height(f);
+    L->pad = L->line / 3;
+    L->tick = L->line / 4 + 1;
+    cm_make_ticks(c->lo[0], c->hi[0], &L->tx);
+    cm_make_ticks(c->lo[1], c->hi[1], &L->ty);
+    L->top = (c->title ? L->line : 0) + 2 * L->pad;
+    L->bottom = L->tick + 2 * L->line + L->pad;
+    L->left = 2 * L->pad + cm_font_width(f, c->y_name) + cm_ticks_widest(f, &L->ty) + L->tick;
+    L->right = 2 * L->pad + cm_font_width(f, "0") / 2;
+    L->bar = 0;
+    if (c->heat) {
+        cm_make_ticks(0, hmax, &L->tbar);
+        L->bar = L->line;
+        const int name_w = c->heat->name ? cm_font_width(f, c->heat->name) : 0;
+        const int labels = L->tick + 2 + cm_ticks_widest(f, &L->tbar);
+        L->right += 2 * L->pad + L->bar + (labels > name_w ? labels : name_w);
+    }
+}
+
+/* ---- the plot, with OpenGL ---- */
+
+static void gl_colour(cm_rgb c) { glColor3ub(c.r, c.g, c.b); }
+
+static void draw_heat(const cm_chart *c, double hmax)
+{
+    const cm_heat *h = c->heat;
+    const double dx = (c->hi[0] - c->lo[0]) / h->nx, dy = (c->hi[1] - c->lo[1]) / h->ny;
+    glBegin(GL_QUADS);
+    for (int j = 0; j < h->ny; j++)
+        for (int i = 0; i < h->nx; i++) {
+            const double v = h->v[(size_t)j * (size_t)h->nx + (size_t)i];
+            if (v > 0)
+                gl_colour(cm_heat_colour(v, hmax));
+            else
+                gl_colour(isnan(v) ? not_computed : paper);
+            const double x0 = c->lo[0] + i * dx, y0 = c->lo[1] + j * dy;
+            glVertex2d(x0, y0);
+            glVertex2d(x0 + dx, y0);
+            glVertex2d(x0 + dx, y0 + dy);
+            glVertex2d(x0, y0 + dy);
+        }
+    glEnd();
+}
+
+static void draw_series(const cm_series *s)
+{
+    gl_colour(s->colour);
+    const float size = s->size > 0 ? s->size : 1;
+    if (s->kind == CM_SERIES_POINTS) {
+        glPointSize(size);
+        glBegin(GL_POINTS);
+        for (size_t k = 0; k < s->n; k++)
+            glVertex2d(s->x[k], s->y[k]);
+        glEnd();
+        return;
+    }
+    glLineWidth(size);
+    if (s->kind == CM_SERIES_SEGMENTS) {
+        glBegin(GL_LINES);
+        for (size_t k = 0; k + 1 < s->n; k += 2) {
+            glVertex2d(s->x[k], s->y[k]);
+            glVertex2d(s->x[k + 1], s->y[k + 1]);
+        }
+        glEnd();
+        return;
+    }
+    glBegin(GL_LINE_STRIP);
+    for (size_t k = 0; k < s->n; k++) {
+        if (isnan(s->x[k]) || isnan(s->y[k])) { /* a break in the line */
+            glEnd();
+            glBegin(GL_LINE_STRIP);
+            continue;
+        }
+        glVertex2d(s->x[k], s->y[k]);
+    }
+    glEnd();
+}
+
+static cm_status draw_plot(const cm_chart *c, double hmax, int px, int py, int pw, int ph,
+                           uint8_t *rgba, char *msg, size_t msg_size)
+{
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, NULL);
+    if (!ctx)
+        return cm_fail(CM_ERENDER, msg, msg_size, "cannot create an OSMesa context");
+    cm_status st = CM_OK;
+    uint8_t *origin = rgba + 4 * ((size_t)py * (size_t)c->width + (size_t)px);
+    if (!OSMesaMakeCurrent(ctx, origin, GL_UNSIGNED_BYTE, pw, ph)) {
+        st = cm_fail(CM_ERENDER, msg, msg_size, "OSMesaMakeCurrent failed for %dx%d", pw, ph);
+    } else {
+        OSMesaPixelStore(OSMESA_ROW_LENGTH, c->width);
+        OSMesaPixelStore(OSMESA_Y_UP, 0);
+        glViewport(0, 0, pw, ph);
+        glClearColor(1, 1, 1, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glMatrixMode(GL_PROJECTION);
+        glLoadIdentity();
+        glOrtho(c->lo[0], c->hi[0], c->lo[1], c->hi[1], -1, 1);
+        glMatrixMode(GL_MODELVIEW);
+        glLoadIdentity();
+        if (c->heat)
+            draw_heat(c, hmax);
+        for (int k = 0; k < c->n_series; k++)
+            draw_series(&c->series[k]);
+        glFinish();
+        if (glGetError() != GL_NO_ERROR)
+            st = cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");
+    }
+    OSMesaDestroyContext(ctx);
+    return st;
+}
+
+/* ---- axes, title, colour bar ---- */
+
+static void frame(const cm_canvas *cv, int x, int y, int w, int h)
+{
+    cm_fill_rect(cv, x - 1, y - 1, w + 2, 1, ink);
+    cm_fill_rect(cv, x - 1, y + h, w + 2, 1, ink);
+    cm_fill_rect(cv, x - 1, y - 1, 1, h + 2, ink);
+    cm_fill_rect(cv, x + w, y - 1, 1, h + 2, ink);
+}
+
+static void axes(const cm_chart *c, const layout *L, const cm_font *f, const cm_chart_info *in,
+                 const cm_canvas *cv)
+{
+    const int base = in->plot_y + in->plot_h;
+    int last_right = -1000000;
+    for (int k = 0; k < L->tx.n; k++) {
+        const int x = in->plot_x + cm_axis_px(L->tx.v[k], c->lo[0], c->hi[0], in->plot_w);
+        cm_fill_rect(cv, x, base, 1, L->tick, ink);
+        const int w = cm_font_width(f, L->tx.label[k]);
+        if (x - w / 2 <= last_right + L->pad)
+            continue;
+        cm_font_draw(f, L->tx.label[k], x - w / 2, base + L->tick + L->ascent, ink, cv->rgba, cv->w,
+                     cv->h);
+        last_right = x - w / 2 + w;
+    }
+    const int nw = cm_font_width(f, c->x_name);
+    cm_font_draw(f, c->x_name, in->plot_x + in->plot_w / 2 - nw / 2,
+                 base + L->tick + L->line + L->ascent, ink, cv->rgba, cv->w, cv->h);
+    for (int k = 0; k < L->ty.n; k++) {
+        const int y =
+            in->plot_y + in->plot_h - 1 - cm_axis_px(L->ty.v[k], c->lo[1], c->hi[1], in->plot_h);
+        cm_fill_rect(cv, in->plot_x - L->tick, y, L->tick, 1, ink);
+        const int w = cm_font_width(f, L->ty.label[k]);
+        cm_font_draw(f, L->ty.label[k], in->plot_x - L->tick - 2 - w, y + L->ascent / 2 - 1, ink,
+                     cv->rgba, cv->w, cv->h);
+    }
+    cm_font_draw(f, c->y_name, L->pad, in->plot_y + in->plot_h / 2 + L->ascent / 2, ink, cv->rgba,
+                 cv->w, cv->h);
+}
+
+static void colour_bar(const cm_chart *c, const layout *L, const cm_font *f, double hmax,
+                       const cm_chart_info *in, const cm_canvas *cv)
+{
+    const int x = in->plot_x + in->plot_w + 3 * L->pad, y = in->plot_y + L->line,
+              h = in->plot_h - L->line;
+    for (int j = 0; j < h; j++) /* top = max */
+        cm_fill_rect(cv, x, y + j, L->bar, 1, cm_heat_colour(hmax * (h - 1 - j) / (h - 1), hmax));
+    frame(cv, x, y, L->bar, h);
+    for (int k = 0; k < L->tbar.n; k++) {
+        const int ty = y + h - 1 - cm_axis_px(L->tbar.v[k], 0, hmax, h - 1);
+        cm_fill_rect(cv, x + L->bar, ty, L->tick, 1, ink);
+        cm_font_draw(f, L->tbar.label[k], x + L->bar + L->tick + 2, ty + L->ascent / 2 - 1, ink,
+                     cv->rgba, cv->w, cv->h);
+    }
+    if (c->heat->name)
+        cm_font_draw(f, c->heat->name, x, in->plot_y + L->ascent, ink, cv->rgba, cv->w, cv->h);
+}
+
+cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,
+                        size_t msg_size)
+{
+    memset(info, 0, sizeof *info);
+    if (!(c->hi[0] > c->lo[0]) || !(c->hi[1] > c->lo[1]) || !isfinite(c->hi[0] - c->lo[0]) ||
+        !isfinite(c->hi[1] - c->lo[1]))
+        return cm_fail(CM_EINVAL, msg, msg_size, "the chart's ranges must be finite and not empty");
+    const int side = c->width < c->height ? c->width : c->height;
+    cm_font *f = NULL;
+    cm_status st = cm_font_open(c->font_path, side / 45 > 10 ? side / 45 : 10, &f, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const double hmax = c->heat ? heat_max(c->heat) : 0;
+    info->heat_max = hmax;
+    layout L;
+    plan(c, f, hmax > 0 ? hmax : 1, &L);
+    info->plot_x = L.left;
+    info->plot_y = L.top;
+    info->plot_w = c->width - L.left - L.right;
+    info->plot_h = c->height - L.top - L.bottom;
+    if (info->plot_w < 16 || info->plot_h < 16 || c->width > 4096 || c->height > 4096)
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "a %dx%d chart leaves no room for its plot (charts take 200x150 to 4096x4096)",
+                     c->width, c->height);
+    const cm_canvas cv = {rgba, c->width, c->height};
+    if (st == CM_OK) {
+        cm_fill_rect(&cv, 0, 0, c->width, c->height, paper);
+        st = draw_plot(c, hmax > 0 ? hmax : 1, info->plot_x, info->plot_y, info->plot_w,
+                       info->plot_h, rgba, msg, msg_size);
+    }
+    if (st == CM_OK) {
+        frame(&cv, info->plot_x, info->plot_y, info->plot_w, info->plot_h);
+        axes(c, &L, f, info, &cv);
+        if (c->heat)
+            colour_bar(c, &L, f, hmax > 0 ? hmax : 1, info, &cv);
+        if (c->title)
+            cm_font_draw(f, c->title, L.pad, L.pad + L.ascent, ink, rgba, c->width, c->height);
+    }
+    cm_font_close(f);
+    return st;
+}

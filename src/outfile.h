@@ -1,0 +1,30 @@
+/* src/outfile.h - output files of the analysis commands (CSV and chart
+ * PNGs), written to PATH.tmp-PID and renamed over PATH when complete, so
+ * that a failed run never leaves a half-written file. */
+#ifndef CM_SRC_OUTFILE_H
+#define CM_SRC_OUTFILE_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "render/chart.h"
+#include "render/png_out.h"
+
+typedef struct outfile {
+    const char *path;
+    char tmp[4200];
+    FILE *f;
+} outfile;
+
+/* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
+bool outfile_open(const char *cmd, const char *path, outfile *o);
+/* Closes and renames it when ok (and every write succeeded), else removes
+ * it. Returns whether the file is in place. */
+bool outfile_close(const char *cmd, outfile *o, bool ok);
+
+/* Draws the chart and writes it as a PNG with the given texts (plus
+ * Software); prints the problem and returns false on failure. */
+bool write_chart_png(const char *cmd, const char *path, const cm_chart *chart,
+                     const cm_png_text *texts, int n_texts);
+
+#endif
