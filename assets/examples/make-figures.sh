@@ -41,3 +41,19 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 # Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip
 "$CM" solve --model microchaos-1d --param a=3.5,b=2.8 --region=-4:4 --cells 800 \
   --png fig-4.2.png --layers all --size 800x800 > /dev/null
+
+# Ch. 2: the dry friction oscillator's Poincare map at S = 0.32, S0 = 0.4,
+# Omega = 0.5: the mirror pair of one-stick asymmetric solutions 1a and
+# their basins, at the section phi = 0 and at phi = pi. The mirror symmetry
+# maps one onto the other by (x, v) -> (-x, -v); the lattice is symmetric
+# about the origin (cell 0 centred on it).
+fo="--model friction-oscillator --region=-3.00375:3.00375,-3.00375:3.00375 --cells 801x801"
+fo="$fo --max-steps 200"
+"$CM" solve $fo --param S=0.32,S0=0.4,Omega=0.5,phi=0 --png fig-2-1a-phi0.png --layers all \
+  --size 800x700 > /dev/null
+"$CM" solve $fo --param S=0.32,S0=0.4,Omega=0.5,phi=3.141592653589793 --png fig-2-1a-phipi.png \
+  --layers all --size 800x700 > /dev/null
+
+# Fig. 2.20 (right): largest Lyapunov exponent over Omega and S at S0 = 0.4
+"$CM" lyapunov --param S0=0.4 --grid Omega=0.2:0.7:60,S=0.005:0.4:48 --periods 600 \
+  --png fig-2.20-lyapunov.png --size 900x700 > /dev/null
