@@ -576,8 +576,7 @@ bool cm_fo_lyapunov(const cm_fo *o, double x0, double v0, double d0, int periods
     const double dt = o->T / per;
     cm_fo_state a = {0, x0, v0, cm_fo_mode_of(o, 0, x0, v0)};
     cm_fo_state b = {0, x0 + d0, v0, cm_fo_mode_of(o, 0, x0 + d0, v0)};
-    double acc = 0, t_last = 0;
-    bool accepted = false;
+    double acc = 0, t_last = 0; /* t_last > 0 once a sample was accepted */
     for (long k = 0; k < periods; k++) {
         for (int i = 1; i <= per; i++) {
             const double s_end = i < per ? i * dt : o->T;
@@ -593,13 +592,12 @@ bool cm_fo_lyapunov(const cm_fo *o, double x0, double v0, double d0, int periods
             }
             acc += log(d / d0);
             t_last = (double)k * o->T + s_end;
-            accepted = true;
             b.x = a.x + dx * d0 / d;
             b.v = a.v + dv * d0 / d;
         }
         a.s = b.s = 0; /* the next period starts at the same forcing phase */
     }
-    if (!accepted)
+    if (!(t_last > 0))
         return false;
     *lambda = acc / t_last;
     return true;
