@@ -132,11 +132,10 @@ static void slip_state(const slip *g, double tau, double *x, double *v, double *
     const double k = sinc_d(g, &t);
     const double G1 = tau * t.sh * k * g->inv1p;
     const double G2 = (sin_t - tau * t.ch * k) * g->inv1p;
-    const double G1d = (sin_wt + tau * t.ch * k) * g->inv1p;
     /* 1 - cos tau without cancellation for small tau */
     const double omc = cos_t > 0 ? sin_t * sin_t / (1 + cos_t) : 1 - cos_t;
     *x = g->x0 * cos_t + g->v0 * sin_t - g->sS * omc + g->C * G1 - g->Sn * G2;
-    *v = -(g->x0 + g->sS) * sin_t + g->v0 * cos_t + g->C * G1d - g->Sn * g->Omega * G1;
+    *v = g->sigma * slip_g(g, &t); /* sigma is +-1: exact */
     if (a)
         *a = g->C * cos_wt - g->Sn * sin_wt - *x - g->sS;
 }

@@ -7,16 +7,7 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
-fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
-
-# expect_usage "needle" args...: exit 2 and a message containing needle
-expect_usage() {
-  local needle=$1; shift
-  local out rc
-  out=$("$CM" "$@" 2>&1 >/dev/null); rc=$?
-  [ "$rc" -eq 2 ] || fail "cellmap $* exited $rc, expected 2"
-  grep -qF -- "$needle" <<<"$out" || fail "cellmap $*: message '$out' lacks '$needle'"
-}
+. "$HERE/testlib.sh"
 
 # --- the default job: the thesis 4.6.3 example, PNG + database ------------
 cd "$work"

@@ -9,7 +9,7 @@ SRC=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
-fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+. "$SRC/tests/testlib.sh"
 cd "$work"
 
 # --- the example sessions of assets/examples, pixels checked ---------------

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Integration tests of the dry friction oscillator's commands: solve with
-# the friction-oscillator model, lyapunov (CSV, heat map, determinism across
-# thread counts, errors).
+# Integration tests of the dry friction oscillator's commands: lyapunov
+# (values at thesis points, CSV, heat map, determinism across thread
+# counts, errors). Its basins are checked by figures_test.
 # usage: oscillator_test.sh PATH/TO/cellmap
 set -u
 CM=$1
@@ -9,14 +9,7 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
-fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
-expect_usage() {
-  local needle=$1; shift
-  local out rc
-  out=$("$CM" "$@" 2>&1 >/dev/null); rc=$?
-  [ "$rc" -eq 2 ] || fail "cellmap $* exited $rc, expected 2"
-  grep -qF -- "$needle" <<<"$out" || fail "cellmap $*: message '$out' lacks '$needle'"
-}
+. "$HERE/testlib.sh"
 cd "$work"
 
 # --- lyapunov: the chaotic point of Sec. 2.6.1 and the 1a orbit ------------
