@@ -453,6 +453,31 @@ bool cm_fo_poincare(const cm_fo *o, const double z[2], double out[2], cm_fo_tall
     return true;
 }
 
+static void run_enter_period(const cm_fo *o, long k, cm_fo_run *r)
+{
+    r->k = k;
+    r->t_section = (o->phi + TWO_PI * (double)k) / o->Omega;
+}
+
+void cm_fo_run_start(const cm_fo *o, double t0, double x, double v, cm_fo_run *r)
+{
+    run_enter_period(o, (long)floor((o->Omega * t0 - o->phi) / TWO_PI), r);
+    /* rounding may put t0 a hair outside [t_section, t_section + T) */
+    double s = t0 - r->t_section;
+    s = s < 0 ? 0 : s >= o->T ? nextafter(o->T, 0) : s;
+    r->st = (cm_fo_state){s, x, v, cm_fo_mode_of(o, s, x, v)};
+}
+
+bool cm_fo_run_period(const cm_fo *o, cm_fo_run *r, cm_fo_tally *tally, cm_fo_event_fn on_event,
+                      void *user)
+{
+    if (!cm_fo_propagate(o, &r->st, o->T, tally, on_event, user))
+        return false;
+    run_enter_period(o, r->k + 1, r);
+    r->st.s = 0;
+    return true;
+}
+
 /* ---- linearisation (MODELS.md 9.7) ---- */
 
 typedef struct event_log {

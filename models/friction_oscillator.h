@@ -75,6 +75,26 @@ bool cm_fo_propagate(const cm_fo *o, cm_fo_state *st, double s_end, cm_fo_tally 
 bool cm_fo_poincare(const cm_fo *o, const double z[2], double out[2], cm_fo_tally *tally,
                     cm_fo_event_fn on_event, void *user);
 
+/* A simulation on the thesis' time axis t, on which the forcing is
+ * cos(Omega t): the state in the local time of the current forcing period,
+ * which began at the section instant t_section = (phi + 2 pi k)/Omega.
+ * Restarting local time every period keeps the phase exact over any
+ * number of periods. */
+typedef struct cm_fo_run {
+    cm_fo_state st;
+    long k;           /* the period's index */
+    double t_section; /* the time at which it began */
+} cm_fo_run;
+
+/* Starts a run at time t0 from (x, v); the mode by cm_fo_mode_of. */
+void cm_fo_run_start(const cm_fo *o, double t0, double x, double v, cm_fo_run *r);
+
+/* Follows the run to the end of its period (the next section instant) and
+ * starts the next period; events as for cm_fo_propagate, with times local
+ * to the period that ends. Returns false when the motion is lost. */
+bool cm_fo_run_period(const cm_fo *o, cm_fo_run *r, cm_fo_tally *tally, cm_fo_event_fn on_event,
+                      void *user);
+
 /* The Jacobian of P_phi at z (row-major) from the events of one period:
  * the free-flight rotations and the saltation matrices of turns, sticks and
  * breakaways (MODELS.md 9.7). Returns false where P_phi is not followed. */

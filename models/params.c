@@ -143,21 +143,29 @@ static void choice_name(const char *choices, int k, char *buf, size_t size)
     snprintf(buf, size, "%.*s", (int)(end ? (size_t)(end - c) : strlen(c)), c);
 }
 
-void cm_params_format(const cm_params *p, char *buf, size_t size)
+void cm_params_format_with(const cm_params *p, int digits, const char *skip, char *buf, size_t size)
 {
     size_t used = 0;
     buf[0] = '\0';
     for (int i = 0; i < p->count && used < size; i++) {
-        used += (size_t)snprintf(buf + used, size - used, "%s%s=", i ? "," : "", p->spec[i].name);
+        if (skip && strcmp(p->spec[i].name, skip) == 0)
+            continue;
+        used +=
+            (size_t)snprintf(buf + used, size - used, "%s%s=", used ? "," : "", p->spec[i].name);
         for (int k = 0; k < p->value[i].count && used < size; k++) {
             if (p->spec[i].choices) {
                 char word[64];
                 choice_name(p->spec[i].choices, (int)p->value[i].v[k], word, sizeof word);
                 used += (size_t)snprintf(buf + used, size - used, "%s", word);
             } else {
-                used += (size_t)snprintf(buf + used, size - used, "%s%.17g", k ? ":" : "",
+                used += (size_t)snprintf(buf + used, size - used, "%s%.*g", k ? ":" : "", digits,
                                          p->value[i].v[k]);
             }
         }
     }
+}
+
+void cm_params_format(const cm_params *p, char *buf, size_t size)
+{
+    cm_params_format_with(p, 17, NULL, buf, size);
 }

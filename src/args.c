@@ -100,6 +100,23 @@ bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error
     return true;
 }
 
+bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error)
+{
+    int64_t wh[2];
+    int n = 0;
+    if (!cli_is(c, "--size", true, error))
+        return false;
+    if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] < min_w ||
+                     wh[1] < min_h || wh[0] > max_side || wh[1] > max_side))
+        *error = cli_usage_error(c, "--size: '%s' must be WxH within %dx%d..%dx%d", c->value, min_w,
+                                 min_h, max_side, max_side);
+    else if (c->value) {
+        *w = (int)wh[0];
+        *h = (int)wh[1];
+    }
+    return true;
+}
+
 bool parse_double(const char *s, double *out)
 {
     char *end = NULL;

@@ -41,6 +41,9 @@ bool cli_take_mem(cli *c, uint64_t *mem, int *error);
 /* Handles option `name` with an integer in lo..hi; true if the current
  * option was it. */
 bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error);
+/* Handles --size WxH with W in min_w..max_side and H in min_h..max_side;
+ * true if the current option was it. */
+bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error);
 /* The limits of --max-steps and --threads, which several commands take. */
 enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
 /* "LO:HI,LO:HI,..." -> lo[], hi[], count. */

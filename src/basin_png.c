@@ -59,17 +59,7 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 {
     if (cli_is(c, "--png", true, err)) {
         po->path = c->value;
-    } else if (cli_is(c, "--size", true, err)) {
-        int64_t wh[2];
-        int n = 0;
-        if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 ||
-                         wh[0] > CM_RENDER_MAX_SIDE || wh[1] > CM_RENDER_MAX_SIDE))
-            *err = cli_usage_error(c, "--size: '%s' must be WxH, each 1..%d", c->value,
-                                   CM_RENDER_MAX_SIDE);
-        else if (c->value) {
-            po->width = (int)wh[0];
-            po->height = (int)wh[1];
-        }
+    } else if (cli_take_size(c, 1, 1, CM_RENDER_MAX_SIDE, &po->width, &po->height, err)) {
     } else if (cli_is(c, "--layers", true, err)) {
         char bad[64];
         if (c->value && !parse_layers(c->value, &po->layers, bad, sizeof bad))

@@ -8,12 +8,11 @@
 #include <string.h>
 
 #include "models/friction_oscillator.h"
-#include "models/params.h"
-#include "models/registry.h"
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
 #include "src/outfile.h"
+#include "src/param_grid.h"
 
 static const char lyapunov_help[] =
     "usage: cellmap lyapunov [--model friction-oscillator] [--param k=v[,k=v]]\n"
@@ -34,49 +33,13 @@ static const char lyapunov_help[] =
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
 
-typedef struct grid_axis {
-    char name[32];
-    double lo, hi;
-    int n;
-} grid_axis;
-
 typedef struct lyap_args {
     model_opts mo;
-    grid_axis ax[2];
+    param_axis ax[2];
     int has_grid, periods, threads, width, height, has_from;
     double d0, from[2];
     const char *csv, *png;
 } lyap_args;
-
-static double axis_value(const grid_axis *a, int i)
-{
-    return a->lo + (i + 0.5) * (a->hi - a->lo) / a->n;
-}
-
-/* "NAME=LO:HI:N" */
-static bool parse_axis(const char *s, size_t len, grid_axis *a)
-{
-    char buf[128];
-    if (len >= sizeof buf)
-        return false;
-    memcpy(buf, s, len);
-    buf[len] = 0;
-    char *eq = strchr(buf, '=');
-    if (!eq || eq == buf || (size_t)(eq - buf) >= sizeof a->name)
-        return false;
-    *eq = 0;
-    memcpy(a->name, buf, (size_t)(eq - buf) + 1);
-    char *end;
-    a->lo = strtod(eq + 1, &end);
-    if (*end != ':')
-        return false;
-    a->hi = strtod(end + 1, &end);
-    if (*end != ':')
-        return false;
-    const long n = strtol(end + 1, &end, 10);
-    a->n = (int)n;
-    return *end == 0 && n >= 1 && n <= 2000 && isfinite(a->lo) && isfinite(a->hi) && a->lo < a->hi;
-}
 
 static int parse_args(cli *c, lyap_args *a)
 {
@@ -89,8 +52,8 @@ static int parse_args(cli *c, lyap_args *a)
         } else if (cli_is(c, "--grid", true, &err)) {
             const char *comma = c->value ? strchr(c->value, ',') : NULL;
             if (c->value &&
-                (!comma || !parse_axis(c->value, (size_t)(comma - c->value), &a->ax[0]) ||
-                 !parse_axis(comma + 1, strlen(comma + 1), &a->ax[1])))
+                (!comma || !param_axis_parse(c->value, (size_t)(comma - c->value), &a->ax[0]) ||
+                 !param_axis_parse(comma + 1, strlen(comma + 1), &a->ax[1])))
                 err = cli_usage_error(c,
                                       "--grid: '%s' is not X=LO:HI:N,Y=LO:HI:M with LO < HI and "
                                       "1 <= N, M <= 2000 (e.g. Omega=0.3:0.7:100,S=0.02:0.4:100)",
@@ -111,17 +74,7 @@ static int parse_args(cli *c, lyap_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
-        } else if (cli_is(c, "--size", true, &err)) {
-            int64_t wh[2];
-            int n = 0;
-            if (c->value && (!parse_counts(c->value, wh, &n, 2) || n != 2 || wh[0] < 200 ||
-                             wh[1] < 150 || wh[0] > 4096 || wh[1] > 4096))
-                err = cli_usage_error(c, "--size: '%s' must be WxH within 200x150..4096x4096",
-                                      c->value);
-            else if (c->value) {
-                a->width = (int)wh[0];
-                a->height = (int)wh[1];
-            }
+        } else if (cli_take_size(c, 200, 150, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
@@ -137,17 +90,9 @@ static int parse_args(cli *c, lyap_args *a)
  * (S > S0) or no sample was accepted. */
 static double point_exponent(const lyap_args *a, int i, int j, int *invalid)
 {
-    const char *texts[MAX_PARAM_TEXTS + 1];
-    char grid_text[160];
-    int n = 0;
-    for (int k = 0; k < a->mo.n_texts; k++)
-        texts[n++] = a->mo.texts[k];
-    snprintf(grid_text, sizeof grid_text, "%s=%.17g,%s=%.17g", a->ax[0].name,
-             axis_value(&a->ax[0], i), a->ax[1].name, axis_value(&a->ax[1], j));
-    texts[n++] = grid_text;
+    const int idx[2] = {i, j};
     cm_model m;
-    char msg[256];
-    if (cm_model_create(a->mo.name, texts, n, &m, msg, sizeof msg) != CM_OK) {
+    if (!model_at_point(&a->mo, a->ax, idx, 2, &m)) {
         *invalid = 1;
         return NAN;
     }
@@ -168,8 +113,8 @@ static bool write_csv(const lyap_args *a, const double *v)
     fprintf(o.f, "%s,%s,lambda\n", a->ax[0].name, a->ax[1].name);
     for (int j = 0; j < a->ax[1].n; j++)
         for (int i = 0; i < a->ax[0].n; i++)
-            fprintf(o.f, "%.17g,%.17g,%.17g\n", axis_value(&a->ax[0], i), axis_value(&a->ax[1], j),
-                    v[(size_t)j * (size_t)a->ax[0].n + (size_t)i]);
+            fprintf(o.f, "%.17g,%.17g,%.17g\n", param_axis_value(&a->ax[0], i),
+                    param_axis_value(&a->ax[1], j), v[(size_t)j * (size_t)a->ax[0].n + (size_t)i]);
     return outfile_close("lyapunov", &o, true);
 }
 
@@ -177,8 +122,7 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
 {
     char title[512], params[400], grid[200];
     cm_params_format(p, params, sizeof params);
-    snprintf(grid, sizeof grid, "%s=%.17g:%.17g:%d,%s=%.17g:%.17g:%d", a->ax[0].name, a->ax[0].lo,
-             a->ax[0].hi, a->ax[0].n, a->ax[1].name, a->ax[1].lo, a->ax[1].hi, a->ax[1].n);
+    param_axes_format(a->ax, 2, grid, sizeof grid);
     snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d periods", model, a->periods);
     const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};
     const cm_chart chart = {a->width,
@@ -199,7 +143,7 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                                  {"Grid", grid},
                                  {"Periods", periods},
                                  {"Estimator", "MODELS.md 9.8 (renormalised two trajectories)"}};
-    return write_chart_png("lyapunov", a->png, &chart, texts, 5);
+    return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 
 int cmd_lyapunov(int argc, char **argv)
@@ -214,23 +158,10 @@ int cmd_lyapunov(int argc, char **argv)
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
     /* the parameters without the grid's; S0 >= S is checked per point */
-    const cm_model_entry *e = cm_model_find(a.mo.name);
-    if (!e || strcmp(e->name, "friction-oscillator") != 0)
-        return cli_usage_error(&c,
-                               "model %s: the Lyapunov estimator is implemented for "
-                               "friction-oscillator only",
-                               a.mo.name);
     cm_params base;
-    char msg[256];
-    cm_status st = cm_params_defaults(e->params, &base, msg, sizeof msg);
-    for (int k = 0; k < a.mo.n_texts && st == CM_OK; k++)
-        st = cm_params_set(&base, a.mo.texts[k], msg, sizeof msg);
-    if (st != CM_OK)
-        return cli_usage_error(&c, "%s", msg);
-    for (int k = 0; k < 2; k++)
-        if (cm_params_find(&base, a.ax[k].name) < 0)
-            return cli_usage_error(&c, "--grid: '%s' is not a parameter of %s (`cellmap models`)",
-                                   a.ax[k].name, e->name);
+    const int verr = fo_sweep_check(&c, &a.mo, a.ax, 2, &base);
+    if (verr)
+        return verr;
     const size_t nx = (size_t)a.ax[0].n, n = nx * (size_t)a.ax[1].n;
     double *v = malloc(n * sizeof *v);
     if (!v) {
@@ -256,8 +187,8 @@ int cmd_lyapunov(int argc, char **argv)
            positive);
     if (!isnan(v[best]))
         printf("; largest %.6g at %s = %.6g, %s = %.6g", v[best], a.ax[0].name,
-               axis_value(&a.ax[0], (int)(best % nx)), a.ax[1].name,
-               axis_value(&a.ax[1], (int)(best / nx)));
+               param_axis_value(&a.ax[0], (int)(best % nx)), a.ax[1].name,
+               param_axis_value(&a.ax[1], (int)(best / nx)));
     printf("\n");
     if (invalid)
         printf("points where the model cannot be built (S > S0) are not computed\n");
@@ -268,7 +199,7 @@ int cmd_lyapunov(int argc, char **argv)
     if (ok && a.csv)
         ok = write_csv(&a, v);
     if (ok && a.png)
-        ok = write_png(&a, e->name, &base, v);
+        ok = write_png(&a, a.mo.name, &base, v);
     free(v);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -12,5 +12,7 @@ int cmd_export(int argc, char **argv);
 int cmd_explore(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_lyapunov(int argc, char **argv);
+int cmd_simulate(int argc, char **argv);
+int cmd_bifurcation(int argc, char **argv);
 
 #endif

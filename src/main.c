@@ -19,6 +19,10 @@ static const struct {
     {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},
     {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
     {"lyapunov", cmd_lyapunov, "largest Lyapunov exponent of the friction oscillator over a grid"},
+    {"simulate", cmd_simulate,
+     "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
+    {"bifurcation", cmd_bifurcation,
+     "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
 };
 
 static void usage(FILE *out)

@@ -30,21 +30,31 @@ bool outfile_close(const char *cmd, outfile *o, bool ok)
     return ok;
 }
 
-bool write_chart_png(const char *cmd, const char *path, const cm_chart *chart,
+bool write_chart_png(const char *cmd, const char *path, const cm_chart *charts, int n_charts,
                      const cm_png_text *texts, int n_texts)
 {
     char msg[512];
-    uint8_t *rgba = malloc((size_t)chart->width * (size_t)chart->height * 4);
+    const int width = charts[0].width;
+    int height = 0;
+    for (int k = 0; k < n_charts; k++)
+        height += charts[k].height;
+    uint8_t *rgba = malloc((size_t)width * (size_t)height * 4);
     cm_png_text all[16];
     int n = 0;
     all[n++] = (cm_png_text){"Software", "cellmap " CELLMAP_VERSION};
     for (int k = 0; k < n_texts && n < 16; k++)
         all[n++] = texts[k];
-    cm_chart_info info;
-    cm_status st = rgba ? cm_chart_draw(chart, rgba, &info, msg, sizeof msg)
-                        : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the image");
+    cm_status st =
+        rgba ? CM_OK : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the image");
+    /* row 0 is the top: each panel is the next block of rows */
+    size_t row = 0;
+    for (int k = 0; k < n_charts && st == CM_OK; k++) {
+        cm_chart_info info;
+        st = cm_chart_draw(&charts[k], rgba + row * (size_t)width * 4, &info, msg, sizeof msg);
+        row += (size_t)charts[k].height;
+    }
     if (st == CM_OK)
-        st = cm_png_write(path, rgba, chart->width, chart->height, all, n, msg, sizeof msg);
+        st = cm_png_write(path, rgba, width, height, all, n, msg, sizeof msg);
     free(rgba);
     if (st != CM_OK)
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);

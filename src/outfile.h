@@ -22,9 +22,10 @@ bool outfile_open(const char *cmd, const char *path, outfile *o);
  * it. Returns whether the file is in place. */
 bool outfile_close(const char *cmd, outfile *o, bool ok);
 
-/* Draws the chart and writes it as a PNG with the given texts (plus
- * Software); prints the problem and returns false on failure. */
-bool write_chart_png(const char *cmd, const char *path, const cm_chart *chart,
+/* Draws the charts one below the other (all of the first one's width) and
+ * writes them as a PNG with the given texts (plus Software); prints the
+ * problem and returns false on failure. */
+bool write_chart_png(const char *cmd, const char *path, const cm_chart *charts, int n_charts,
                      const cm_png_text *texts, int n_texts);
 
 #endif

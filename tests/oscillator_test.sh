@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Integration tests of the dry friction oscillator's commands: lyapunov
-# (values at thesis points, CSV, heat map, determinism across thread
-# counts, errors). Its basins are checked by figures_test.
+# Integration tests of the dry friction oscillator's commands: lyapunov,
+# simulate and bifurcation (values at thesis points, CSV, pictures,
+# determinism across thread counts, errors). Its basins are checked by
+# figures_test.
 # usage: oscillator_test.sh PATH/TO/cellmap
 set -u
 CM=$1
@@ -59,6 +60,116 @@ out=$("$CM" lyapunov --param S0=0.1 --grid Omega=0.3:0.7:2,S=0.2:0.3:2 --csv non
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "all points invalid: $rc $out"
 out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S=0.1:0.2:2 --periods 10 --csv nodir/x.csv 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "nodir/x.csv" <<<"$out" || fail "lyapunov into a missing directory: $rc $out"
+
+# --- simulate: the 1a orbit (S = 0.32) from its fixed point stuck at the section
+"$CM" simulate --param S=0.32 --from 1.242560606171,0 --periods 5 --csv a1.csv --png a1.png \
+  > a1.out || fail "simulate 1a"
+grep -q "last period: 1 sticks, 1 turns, 1 breakaways" a1.out || fail "1a summary: $(cat a1.out)"
+grep -q "a fixed point of the map" a1.out || fail "1a is a fixed point: $(cat a1.out)"
+python3 - a1.csv <<'PY' || fail "simulate 1a events"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+kinds = [r["kind"] for r in rows]
+assert kinds == ["start"] + ["break", "turn", "stick", "section"] * 5, kinds
+T = 4 * math.pi                                    # Omega = 0.5
+for k, r in enumerate(r for r in rows if r["kind"] == "section"):
+    assert abs(float(r["t"]) - (k + 1) * T) < 1e-12, r
+    assert abs(float(r["x"]) - 1.242560606171) < 1e-9 and float(r["v"]) == 0, r
+for r in rows:
+    if r["kind"] in ("break", "turn", "stick"):
+        assert float(r["v"]) == 0, r
+    if r["kind"] == "stick":                       # stuck before the section, at the same place
+        assert abs(float(r["x"]) - 1.242560606171) < 1e-9, r
+PY
+
+# --- simulate from a random start mid-period (t0 < 0): 2s at S = 0.4 --------
+"$CM" simulate --param S=0.4 --from 0.2,-0.4 --t0 -3.3 --periods 1000 --skip 995 --csv s2.csv \
+  > s2.out || fail "simulate 2s"
+grep -q "last period: 2 sticks, 0 turns, 2 breakaways" s2.out || fail "2s summary: $(cat s2.out)"
+python3 - s2.csv s2.out <<'PY' || fail "simulate 2s events"
+import csv, math, re, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert rows[0]["kind"] == "start" and len([r for r in rows if r["kind"] == "section"]) == 5
+T = 4 * math.pi
+assert abs(float(rows[0]["t"]) - 994 * T) < 1e-9, rows[0]   # the 995th section after -3.3
+last = rows[-1]
+assert abs(float(last["x"]) - 1.327985521085) < 1e-9, last  # the 2s fixed point
+assert abs(float(last["v"]) - 0.033944334843) < 1e-9, last
+psi = float(re.search(r"Psi over the 5 periods shown = (\S+)", open(sys.argv[2]).read()).group(1))
+assert psi < 1e-9, psi                                      # symmetric: Psi = 0
+PY
+
+# --- simulate pictures: sticks are drawn green, and only where the block sticks
+"$CM" simulate --param S=0.05,S0=0.05,Omega=0.8 --periods 5 --skip 2 --png slide.png \
+  > /dev/null || fail "simulate without sticking"
+python3 - "$HERE" a1.png slide.png <<'PY' || fail "simulate PNGs"
+import sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+def greens(path):
+    w, h, bpp, rows, texts = read_png(path)
+    assert (w, h) == (900, 1000), (w, h)
+    assert texts["Model"] == "friction-oscillator" and texts["Start"].startswith("t0="), texts
+    return sum(1 for row in rows for i in range(0, len(row), bpp)
+               if tuple(row[i:i + 3]) == (0, 150, 40))
+g1a, gslide = greens(sys.argv[2]), greens(sys.argv[3])
+assert g1a > 100 and gslide == 0, (g1a, gslide)
+PY
+
+# --- bifurcation: 1a (S = 0.32) and 2s (S = 0.40) at S0 = 0.4, Omega = 0.5 ---
+bif=(--param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 600 --record 20 --size 600x600)
+"$CM" bifurcation "${bif[@]}" --threads 1 --csv b1.csv --runs-csv r1.csv --png b1.png \
+  > b1.out || fail "bifurcation, 1 thread"
+"$CM" bifurcation "${bif[@]}" --threads 2 --csv b2.csv --runs-csv r2.csv --png b2.png \
+  > /dev/null || fail "bifurcation, 2 threads"
+for f in b r; do cmp -s ${f}1.csv ${f}2.csv || fail "bifurcation $f CSV differs between 1 and 2 threads"; done
+cmp -s b1.png b2.png || fail "bifurcation PNG differs between 1 and 2 threads"
+"$CM" bifurcation "${bif[@]}" --seed 2 --runs-csv r3.csv > /dev/null || fail "bifurcation, seed 2"
+cmp -s r1.csv r3.csv && fail "another seed gave the same runs"
+grep -q "2 values of S x 10 runs" b1.out || fail "bifurcation summary: $(cat b1.out)"
+python3 - r1.csv b1.csv b1.png "$HERE" <<'PY' || fail "bifurcation results"
+import csv, math, sys
+runs = list(csv.DictReader(open(sys.argv[1])))
+assert len(runs) == 20 and all(r["status"] == "ok" for r in runs), runs
+for r in runs:
+    S, x0, v0, t0 = (float(r[k]) for k in ("S", "x0", "v0", "t0"))
+    assert -1 <= x0 <= 1 and -1 <= v0 <= 1 and abs(t0) <= 4 * math.pi, r   # thesis' ranges
+    if abs(S - 0.32) < 1e-12:   # 1a: one stick a period, Psi = |x_stick + x_turn| per period
+        assert float(r["sticks_per_period"]) == 1 and abs(float(r["psi_per_period"]) - 0.181657) < 1e-5, r
+    else:                       # 2s: symmetric, two sticks
+        assert abs(S - 0.40) < 1e-12 and float(r["sticks_per_period"]) == 2, r
+        assert float(r["psi_per_period"]) < 1e-9, r
+points = list(csv.DictReader(open(sys.argv[2])))
+assert len(points) == 20 * (10 + 20), len(points)           # ten stops, twenty sections a run
+sticks32 = {round(float(p["x"]), 9) for p in points if p["kind"] == "stick" and float(p["S"]) < 0.35}
+assert sticks32 == {1.242560606, -1.242560606}, sticks32     # both mirror copies of 1a found
+for p in points:
+    if p["kind"] == "section" and float(p["S"]) > 0.35:        # the 2s fixed point
+        assert abs(float(p["x"]) - 1.327985521085) < 1e-9 and abs(float(p["v"]) - 0.033944334843) < 1e-9, p
+sys.path.insert(0, sys.argv[4])
+from pngcheck import read_png
+w, h, bpp, rows, texts = read_png(sys.argv[3])
+assert (w, h) == (600, 600), (w, h)
+assert texts["Sweep"] == "S=0.28000000000000003:0.44:2" and "S=" not in texts["Parameters"], texts
+PY
+ls | grep -q tmp- && fail "temporary files left behind"
+
+# --- simulate and bifurcation errors ----------------------------------------
+expect_usage "--skip 5 leaves nothing" simulate --periods 5 --skip 5 --csv x.csv
+expect_usage "--from: '1' is not X,V" simulate --from 1 --csv x.csv
+expect_usage "simulate follows friction-oscillator only" simulate --model microchaos-pd --csv x.csv
+expect_usage "S0" simulate --param S=0.5,S0=0.4 --csv x.csv
+expect_usage "--sweep NAME=LO:HI:N is required" bifurcation --csv x.csv
+expect_usage "--sweep: 'S=0.4:0.1:3'" bifurcation --sweep S=0.4:0.1:3 --csv x.csv
+expect_usage "'Q' is not a parameter" bifurcation --sweep Q=0.1:0.4:3 --csv x.csv
+expect_usage "nothing to write" bifurcation --sweep S=0.1:0.4:3
+expect_usage "more than 1e7" bifurcation --sweep S=0.1:0.4:2000 --runs 1000 --record 10 --csv x.csv
+expect_usage "friction-oscillator only" bifurcation --model microchaos-pd --sweep P=0.1:0.2:2 --csv x.csv
+out=$("$CM" bifurcation --param S0=0.1 --sweep S=0.2:0.3:2 --csv none.csv 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "bifurcation, all values invalid: $rc $out"
+out=$("$CM" simulate --periods 2 --png nodir/x.png 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "nodir/x.png" <<<"$out" || fail "simulate into a missing directory: $rc $out"
+ls | grep -q tmp- && fail "temporary files left behind"
 
 [ $fails -eq 0 ] && echo "oscillator tests passed" || echo "$fails oscillator test(s) failed"
 exit $fails

@@ -391,6 +391,60 @@ static void test_2s_and_1a(void)
     CHECK_NEAR(spectral_radius(J), spectral_radius(F), 1e-6);
 }
 
+/* A run started mid-period at any time (t0 < 0 too, as the thesis' random
+ * starts) reaches the section instants (phi + 2 pi k)/Omega, restarting
+ * local time every period, and stays on the 1a orbit; the simulation form
+ * of Psi (thesis 2.6.1) vanishes on 2s and not on 1a. */
+static void test_runs(void)
+{
+    const double phis[2] = {0, 1.1};
+    for (int f = 0; f < 2; f++) {
+        cm_fo o;
+        cm_fo_init(&o, 0.32, 0.4, 0.5, phis[f]);
+        double z[2] = {1.36, 0}, res;
+        for (int k = 0; k < 400; k++)
+            CHECK(cm_fo_poincare(&o, z, z, NULL, NULL, NULL));
+        CHECK(cm_fo_fixed_point(&o, z, 20, &res));
+        cm_fo_state q = {0, z[0], z[1], cm_fo_mode_of(&o, 0, z[0], z[1])};
+        CHECK(cm_fo_propagate(&o, &q, 0.3 * o.T, NULL, NULL, NULL));
+        const long ks[3] = {5, -7, 0};
+        for (int i = 0; i < 3; i++) {
+            const double t_section = (phis[f] + 2 * PI * (double)ks[i]) / o.Omega;
+            cm_fo_run r;
+            cm_fo_run_start(&o, t_section + 0.3 * o.T, q.x, q.v, &r);
+            CHECK_INT(r.k, ks[i]);
+            CHECK_NEAR(r.st.s, 0.3 * o.T, 1e-12);
+            CHECK(cm_fo_run_period(&o, &r, NULL, NULL, NULL));
+            CHECK_INT(r.k, ks[i] + 1);
+            CHECK_NEAR(r.t_section, t_section + o.T, 1e-12);
+            CHECK_NEAR(r.st.s, 0, 0);
+            CHECK(hypot(r.st.x - z[0], r.st.v - z[1]) <= 1e-9);
+        }
+    }
+    const double S[2] = {0.4, 0.32};
+    double psi[2];
+    for (int k = 0; k < 2; k++) {
+        cm_fo o;
+        cm_fo_init(&o, S[k], 0.4, 0.5, 0);
+        cm_fo_run r;
+        cm_fo_run_start(&o, -3.3, 0.2, -0.4, &r);
+        for (int p = 0; p < 1000; p++)
+            CHECK(cm_fo_run_period(&o, &r, NULL, NULL, NULL));
+        double sum = 0;
+        for (int p = 0; p < 20; p++) {
+            cm_fo_tally t;
+            cm_fo_tally_start(&t, r.st.x);
+            CHECK(cm_fo_run_period(&o, &r, &t, NULL, NULL));
+            sum += t.x_zero_sum;
+        }
+        psi[k] = fabs(sum) / 20;
+    }
+    CHECK(psi[0] < 1e-9);
+    CHECK(psi[1] > 0.1);
+    printf("Psi per period (2.6.1) after 1000 periods from a random start: 2s %.1e, 1a %.4f\n",
+           psi[0], psi[1]);
+}
+
 /* Sec. 2.6.1: S0 = 0.4, S = 0.05, Omega = 0.5 is chaotic; the thesis'
  * synchronisation estimate 0.0073 is an upper bound. */
 static void test_chaotic_lyapunov(void)
@@ -515,6 +569,7 @@ int main(void)
     test_slipping_limit();
     test_resonant_family();
     test_2s_and_1a();
+    test_runs();
     test_chaotic_lyapunov();
     test_sticking_counts();
     test_mirror_basins();

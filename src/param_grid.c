@@ -1,0 +1,86 @@
+#include "src/param_grid.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models/registry.h"
+
+bool param_axis_parse(const char *s, size_t len, param_axis *a)
+{
+    char buf[128];
+    if (len >= sizeof buf)
+        return false;
+    memcpy(buf, s, len);
+    buf[len] = 0;
+    char *eq = strchr(buf, '=');
+    if (!eq || eq == buf || (size_t)(eq - buf) >= sizeof a->name)
+        return false;
+    *eq = 0;
+    memcpy(a->name, buf, (size_t)(eq - buf) + 1);
+    char *end;
+    a->lo = strtod(eq + 1, &end);
+    if (*end != ':')
+        return false;
+    a->hi = strtod(end + 1, &end);
+    if (*end != ':')
+        return false;
+    const long n = strtol(end + 1, &end, 10);
+    a->n = (int)n;
+    return *end == 0 && n >= 1 && n <= PARAM_AXIS_MAX && isfinite(a->lo) && isfinite(a->hi) &&
+           a->lo < a->hi;
+}
+
+double param_axis_value(const param_axis *a, int i)
+{
+    return a->lo + (i + 0.5) * (a->hi - a->lo) / a->n;
+}
+
+void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int k = 0; k < n_ax && used < size; k++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s=%.17g:%.17g:%d", k ? "," : "",
+                                 ax[k].name, ax[k].lo, ax[k].hi, ax[k].n);
+}
+
+int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
+                   cm_params *base)
+{
+    const cm_model_entry *e = cm_model_find(mo->name);
+    if (!e)
+        return cli_usage_error(c, "unknown model '%s' (`cellmap models` lists them)", mo->name);
+    if (strcmp(e->name, "friction-oscillator") != 0)
+        return cli_usage_error(
+            c, "model %s: this command is implemented for friction-oscillator only", e->name);
+    char msg[256];
+    cm_status st = cm_params_defaults(e->params, base, msg, sizeof msg);
+    for (int k = 0; k < mo->n_texts && st == CM_OK; k++)
+        st = cm_params_set(base, mo->texts[k], msg, sizeof msg);
+    if (st != CM_OK)
+        return cli_usage_error(c, "%s", msg);
+    for (int k = 0; k < n_ax; k++)
+        if (cm_params_find(base, ax[k].name) < 0)
+            return cli_usage_error(c, "'%s' is not a parameter of %s (`cellmap models`)",
+                                   ax[k].name, e->name);
+    return EXIT_OK;
+}
+
+bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
+                    cm_model *m)
+{
+    const char *texts[MAX_PARAM_TEXTS + 2];
+    char point_text[2][80];
+    int n = 0;
+    for (int k = 0; k < mo->n_texts; k++)
+        texts[n++] = mo->texts[k];
+    for (int k = 0; k < n_ax && k < 2; k++) {
+        snprintf(point_text[k], sizeof point_text[k], "%s=%.17g", ax[k].name,
+                 param_axis_value(&ax[k], idx[k]));
+        texts[n++] = point_text[k];
+    }
+    char msg[256];
+    return cm_model_create(mo->name, texts, n, m, msg, sizeof msg) == CM_OK;
+}

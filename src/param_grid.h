@@ -1,0 +1,44 @@
+/* src/param_grid.h - the parameter axes of the analysis commands that
+ * sweep a model's parameters (lyapunov's --grid, bifurcation's --sweep):
+ * "NAME=LO:HI:N" is N values at the centres of N equal cells of LO..HI. */
+#ifndef CM_SRC_PARAM_GRID_H
+#define CM_SRC_PARAM_GRID_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "cellmap/model.h"
+#include "models/params.h"
+#include "src/args.h"
+
+#define PARAM_AXIS_MAX 2000
+
+typedef struct param_axis {
+    char name[32];
+    double lo, hi;
+    int n;
+} param_axis;
+
+/* Parses the len characters at s as NAME=LO:HI:N (LO < HI, 1 <= N <= PARAM_AXIS_MAX). */
+bool param_axis_parse(const char *s, size_t len, param_axis *a);
+
+/* The value of point i: the centre of cell i. */
+double param_axis_value(const param_axis *a, int i);
+
+/* "NAME=LO:HI:N[,NAME=LO:HI:N]" for messages and PNG texts. */
+void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size);
+
+/* Checks the command's model options for a sweep of the friction
+ * oscillator's parameters: the model is friction-oscillator, the --param
+ * values are valid and each axis names a parameter. *base receives the
+ * parameters without the axes' values (for the PNG texts). Prints the
+ * problem and returns EXIT_USAGE, or EXIT_OK. */
+int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
+                   cm_params *base);
+
+/* The model at axis point idx[k] of each axis k; false where it cannot be
+ * built (e.g. S > S0). */
+bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
+                    cm_model *m);
+
+#endif
