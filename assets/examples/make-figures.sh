@@ -57,3 +57,16 @@ fo="$fo --max-steps 200"
 # Fig. 2.20 (right): largest Lyapunov exponent over Omega and S at S0 = 0.4
 "$CM" lyapunov --param S0=0.4 --grid Omega=0.2:0.7:60,S=0.005:0.4:48 --periods 600 \
   --png fig-2.20-lyapunov.png --size 900x700 > /dev/null
+
+# Figs. 2.3 (upper panel) and 2.16: trajectories over the sticking region
+# |x - cos(Omega t)| < S0; slips red, sticks green. 2.16 starts from rest
+# at S = S0 = 0.4 and settles on the symmetric two-stick solution 2s.
+"$CM" simulate --param S=0.15,S0=0.15,Omega=0.45 --periods 4 --png fig-2.3-simulate.png \
+  --size 900x900 > /dev/null
+"$CM" simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 12 --png fig-2.16-simulate.png \
+  --size 900x900 > /dev/null
+
+# Fig. 2.22: Monte Carlo bifurcation diagram over S at S0 = 0.4, Omega = 0.5:
+# 10 random starts per value, 1000 periods of transients, 50 recorded
+"$CM" bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.02:0.4:190 --png fig-2.22-bifurcation.png \
+  > /dev/null
