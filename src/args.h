@@ -65,6 +65,21 @@ bool model_opts_take(cli *c, model_opts *mo, int *error);
 /* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);
 
+/* --region LO:HI[,LO:HI...] and --cells N[xM...]: a lattice whose origin
+ * is the region's lower corner, and the box of the region's cells. */
+typedef struct lattice_opts {
+    const char *region_text; /* NULL: the model's default region */
+    int64_t cells[CM_MAX_DIM];
+    int n_cells; /* 0: 1000 a side in 1-D and 2-D, else 100 */
+} lattice_opts;
+
+/* Handles --region and --cells; true if the current option was one. */
+bool lattice_opts_take(cli *c, lattice_opts *lo, int *error);
+/* Builds the lattice and box for the model; prints the problem and returns
+ * EXIT_USAGE on failure. */
+int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m, cm_lattice *lat,
+                       cm_box *box);
+
 /* The lattice coordinate of the cell border at or beyond state x (below
  * it, or above it if round_up), snapped to a border within rounding of x. */
 int64_t border_cell(double x, double origin, double width, int round_up);

@@ -22,7 +22,8 @@ static const char export_help[] =
     "                      centre x, y, ..., grp, step, periodic; CSV with a header, or\n"
     "                      .npy (a structured array with those fields, little-endian)\n"
     "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iy, ..., x, y, ...,\n"
-    "                      grp, step, periodic), with tables groups and meta\n"
+    "                      grp, step, periodic), with tables groups (as --groups, kind\n"
+    "                      included) and meta\n"
     "  --window X0:X1,...  only cells whose centre lies in this box of state space\n"
     "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n";
 
@@ -144,7 +145,7 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     snprintf(sql + used, sizeof sql - used,
              "grp INTEGER, step INTEGER, periodic INTEGER);"
              "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
-             " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT);"
+             " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT, kind TEXT);"
              "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT);");
     if (sqlite3_open(o->tmp, &o->db) != SQLITE_OK ||
         sqlite3_exec(o->db, "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF; BEGIN", NULL, NULL,
@@ -245,7 +246,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
                          uint64_t sink)
 {
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(o->db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
+    if (sqlite3_prepare_v2(o->db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
                            NULL) != SQLITE_OK)
         return 0;
     int ok = 1;
@@ -258,6 +259,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             sqlite3_bind_int(st, 4, 1);
             for (int c = 5; c <= 8; c++)
                 sqlite3_bind_null(st, c);
+            sqlite3_bind_text(st, 9, "sink", -1, SQLITE_STATIC);
         } else {
             const cm_group_info *gi = &g[k - 1];
             double a[CM_MAX_DIM];
@@ -275,6 +277,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             sqlite3_bind_text(st, 6, lo, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 7, hi, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 8, anchor, -1, SQLITE_TRANSIENT);
+            sqlite3_bind_text(st, 9, cm_group_kind_name(gi->kind), -1, SQLITE_STATIC);
         }
         ok = sqlite3_step(st) == SQLITE_DONE;
         sqlite3_reset(st);

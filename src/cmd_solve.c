@@ -58,9 +58,9 @@ enum { MAX_SPLIT = 4096, MAX_EXTEND = 1000 };
 
 typedef struct solve_args {
     model_opts mo;
-    const char *region_text;
-    int64_t cells[CM_MAX_DIM], split[CM_MAX_DIM];
-    int n_cells, n_split;
+    lattice_opts lat;
+    int64_t split[CM_MAX_DIM];
+    int n_split;
     int max_steps, threads, json;
     int extend;
     double escape_below;
@@ -80,12 +80,7 @@ static int parse_solve(cli *c, solve_args *a)
             fputs(solve_help, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
-        } else if (cli_is(c, "--region", true, &err)) {
-            a->region_text = c->value;
-        } else if (cli_is(c, "--cells", true, &err)) {
-            if (c->value && !parse_counts(c->value, a->cells, &a->n_cells, CM_MAX_DIM))
-                err = cli_usage_error(c, "--cells: '%s' is not N[xM...] with positive integers",
-                                      c->value);
+        } else if (lattice_opts_take(c, &a->lat, &err)) {
         } else if (cli_is(c, "--split", true, &err)) {
             if (c->value && !parse_counts(c->value, a->split, &a->n_split, CM_MAX_DIM))
                 err = cli_usage_error(c, "--split: '%s' is not K[xL...] with positive integers",
@@ -125,37 +120,13 @@ static int parse_solve(cli *c, solve_args *a)
     return err;
 }
 
-/* Lattice and box from --region and --cells: the region's lower corner is
- * the lattice origin, cells are (HI-LO)/N wide. */
+/* Lattice and box from --region and --cells, checked against --split. */
 static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm_lattice *lat,
                         cm_box *box)
 {
-    const cm_model_entry *e = cm_model_find(m->name);
-    const char *text = a->region_text ? a->region_text : e->region;
-    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
-    int n = 0;
-    if (!text)
-        return cli_usage_error(c, "--region is required for model %s (one LO:HI per dimension)",
-                               m->name);
-    if (!parse_ranges(text, lo, hi, &n, CM_MAX_DIM))
-        return cli_usage_error(c, "--region: '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
-    if (n != m->dim)
-        return cli_usage_error(c, "--region has %d range(s) but model %s has dimension %d", n,
-                               m->name, m->dim);
-    if (a->n_cells && a->n_cells != m->dim)
-        return cli_usage_error(c, "--cells has %d count(s) but model %s has dimension %d",
-                               a->n_cells, m->name, m->dim);
-    memset(lat, 0, sizeof *lat);
-    memset(box, 0, sizeof *box);
-    lat->dim = box->dim = m->dim;
-    double total = 1.0;
-    for (int d = 0; d < m->dim; d++) {
-        const int64_t cells = a->n_cells ? a->cells[d] : (m->dim <= 2 ? 1000 : 100);
-        lat->origin[d] = lo[d];
-        lat->width[d] = (hi[d] - lo[d]) / (double)cells;
-        box->hi[d] = cells;
-        total *= (double)cells;
-    }
+    const int err = lattice_opts_build(c, &a->lat, m, lat, box);
+    if (err)
+        return err;
     if (a->n_split && a->n_split != m->dim)
         return cli_usage_error(c, "--split has %d count(s) but model %s has dimension %d",
                                a->n_split, m->name, m->dim);
@@ -170,12 +141,6 @@ static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm
     }
     if (parts > MAX_SPLIT)
         return cli_usage_error(c, "--split asks for %.0f regions; at most %d", parts, MAX_SPLIT);
-    if (total > (double)CM_REGION_MAX_CELLS)
-        return cli_usage_error(c, "--cells asks for %.0f cells; one region holds at most %llu",
-                               total, (unsigned long long)CM_REGION_MAX_CELLS);
-    char msg[256];
-    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK)
-        return cli_usage_error(c, "%s", msg);
     return EXIT_OK;
 }
 

@@ -12,6 +12,8 @@ static const struct {
 } commands[] = {
     {"models", cmd_models, "list the models, their parameters and defaults"},
     {"solve", cmd_solve, "simple cell mapping of a region: summary, PNG, database"},
+    {"sweep", cmd_sweep,
+     "solve a region for several values of a parameter; where attractors are absorbed"},
     {"explore", cmd_explore, "explore basins by panning and zooming a view (script or prompt)"},
     {"render", cmd_render, "draw a figure or an indexed image of a .cmdb file's basins"},
     {"info", cmd_info, "what a .cmdb cluster database holds; its size on disk and in memory"},

@@ -68,19 +68,30 @@ int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int
     return EXIT_OK;
 }
 
+bool model_with_values(const model_opts *mo, const char *const *names, const double *values, int n,
+                       cm_model *m, char *msg, size_t msg_size)
+{
+    const char *texts[MAX_PARAM_TEXTS + 2];
+    char value_text[2][80];
+    int k = 0;
+    for (int i = 0; i < mo->n_texts; i++)
+        texts[k++] = mo->texts[i];
+    for (int i = 0; i < n && i < 2; i++) {
+        snprintf(value_text[i], sizeof value_text[i], "%s=%.17g", names[i], values[i]);
+        texts[k++] = value_text[i];
+    }
+    return cm_model_create(mo->name, texts, k, m, msg, msg_size) == CM_OK;
+}
+
 bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m)
 {
-    const char *texts[MAX_PARAM_TEXTS + 2];
-    char point_text[2][80];
-    int n = 0;
-    for (int k = 0; k < mo->n_texts; k++)
-        texts[n++] = mo->texts[k];
+    const char *names[2];
+    double values[2];
     for (int k = 0; k < n_ax && k < 2; k++) {
-        snprintf(point_text[k], sizeof point_text[k], "%s=%.17g", ax[k].name,
-                 param_axis_value(&ax[k], idx[k]));
-        texts[n++] = point_text[k];
+        names[k] = ax[k].name;
+        values[k] = param_axis_value(&ax[k], idx[k]);
     }
     char msg[256];
-    return cm_model_create(mo->name, texts, n, m, msg, sizeof msg) == CM_OK;
+    return model_with_values(mo, names, values, n_ax < 2 ? n_ax : 2, m, msg, sizeof msg);
 }

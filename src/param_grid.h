@@ -36,8 +36,13 @@ void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size);
 int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
                    cm_params *base);
 
-/* The model at axis point idx[k] of each axis k; false where it cannot be
- * built (e.g. S > S0). */
+/* The model of the command's --model and --param with parameters names[k]
+ * set to values[k] (n <= 2); false, with the reason in msg, where it
+ * cannot be built (e.g. S > S0). */
+bool model_with_values(const model_opts *mo, const char *const *names, const double *values, int n,
+                       cm_model *m, char *msg, size_t msg_size);
+
+/* The model at axis point idx[k] of each axis k (n_ax <= 2). */
 bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m);
 

@@ -208,6 +208,38 @@ json.dump({"view": [-1e5, 1e5, -601.5, 601.5], "size": [800, 401], "colour_at": 
 PY
 python3 "$HERE/pngcheck.py" friction.png friction.check.json || fail "friction.png pixels"
 "$CM" info friction.cmdb > /dev/null || fail "info on a friction file"
+"$CM" export friction.cmdb --flat friction.sqlite || fail "flat export of a friction file"
+[ "$(sqlite3 friction.sqlite "SELECT COUNT(*) FROM groups WHERE kind = 'sticking'")" = "$db_sticking" ] \
+  && [ "$(sqlite3 friction.sqlite "SELECT kind FROM groups WHERE id = 0")" = sink ] \
+  || fail "the flat export's group kinds"
+
+# --- sweep: where the sticking zone of level 3 absorbs the attractor at SW_4 --
+# (x = 4/P = 72727) on the figure's lattice: the one-cell attractor centred at
+# x = 72625 comes to rest at mu = 72625 alpha^2 - 3 = 0.09680 (README)
+"$CM" sweep --model microchaos-pd-friction --vary mu=0.095,0.1 --region=-100000:100000,-601.5:601.5 \
+  --cells 800x401 --max-steps 100000 --near 71818:73636 --refine 8 --csv sweep.csv > sweep.out \
+  || fail "sweep failed"
+python3 - sweep.csv sweep.out friction.json <<'PY' || fail "sweep results"
+import csv, json, re, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+mus = [float(r["mu"]) for r in rows]
+assert len(rows) == 10 and mus == sorted(mus) and mus[0] == 0.095 and mus[-1] == 0.1, mus
+lo, hi = map(float, re.search(r"change: 4 attractor\(s\) at mu = (\S+), 3 at (\S+) ", open(sys.argv[2]).read()).groups())
+a2 = 6.53e-3 ** 2
+assert lo < 72625 * a2 - 3 < hi and hi - lo < 2e-5, (lo, hi)
+for r in rows:   # four attractors below the change, three above
+    assert int(r["attractors"]) == (4 if float(r["mu"]) <= lo + 1e-9 else 3), r
+# the same count as solve's summary at mu = 0.095, group by group
+groups = json.load(open(sys.argv[3]))["groups"]
+near = [g for g in groups if 71818 <= g["centre"][0] <= 73636]
+assert int(rows[0]["attractors"]) == sum(g["kind"] == "attractor" for g in near), near
+assert int(rows[0]["sticking"]) == sum(g["kind"] == "sticking" for g in near), near
+PY
+expect_usage "--vary NAME=V1,V2,... is required" sweep --model microchaos-pd-friction
+expect_usage "--vary: 'mu=0.1,0.09'" sweep --model microchaos-pd-friction --vary mu=0.1,0.09
+expect_usage "'Q' is not a parameter" sweep --model microchaos-pd-friction --vary Q=1,2
+expect_usage "--near has 3 range(s)" sweep --model microchaos-pd-friction --vary mu=0,1 --near 0:1,0:1,0:1
+expect_usage "--vary: mu = -1" sweep --model microchaos-pd-friction --vary mu=-1,0.1
 
 # --- a file of format version 2 (no kinds): read as is, upgraded by writing --
 cp basin.cmdb v2.cmdb

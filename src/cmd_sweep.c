@@ -1,0 +1,310 @@
+/* cellmap sweep: simple cell mapping of one region for a list of values of
+ * one parameter, counting the attractors and sticking zones (and their
+ * basins) whose periodic cells lie in a window, and locating by bisection
+ * where those counts change: e.g. the friction level at which sticking
+ * zones absorb the outermost micro-chaotic attractors (thesis Fig. 4.30,
+ * MODELS.md 8.4). */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cellmap/scm.h"
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/outfile.h"
+#include "src/param_grid.h"
+
+static const char sweep_help[] =
+    "usage: cellmap sweep --model NAME [--param k=v[,k=v]] --vary NAME=V1,V2,...\n"
+    "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
+    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE]\n\n"
+    "Simple cell mapping of the region for each value of one parameter (as\n"
+    "`cellmap solve` would, one value after another). For each value it counts\n"
+    "the attractors and the sticking groups (rest cells: a sticking zone is\n"
+    "one group per rest cell) whose periodic cells' centre lies in the --near\n"
+    "window (default: anywhere), and their basin cells. Where the number of\n"
+    "attractors differs between neighbouring values, --refine K bisects the\n"
+    "interval K times and reports where it changes: e.g. where a sticking\n"
+    "zone absorbs an attractor.\n\n"
+    "  --vary NAME=V1,...  the parameter and its values (2..200, increasing)\n"
+    "  --near LO:HI,...    the window of periodic cells counted (one range per\n"
+    "                      dimension; fewer ranges leave the other dimensions free)\n"
+    "  --refine K          bisection steps per change, 0..40 (default 0)\n"
+    "  --csv FILE          every value solved, sorted: NAME,attractors,sticking,\n"
+    "                      attractor_cells,sticking_cells,groups,sink_cells,seconds\n"
+    "  --max-steps, --threads, --region, --cells: as for solve\n";
+
+enum { MAX_VALUES = 200, MAX_REFINE = 40 };
+
+typedef struct sweep_args {
+    model_opts mo;
+    lattice_opts lat;
+    char name[32];
+    double values[MAX_VALUES];
+    int n_values, max_steps, threads, refine, n_near;
+    double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
+    const char *csv;
+} sweep_args;
+
+/* "NAME=V1,V2,..." with increasing values */
+static bool parse_vary(const char *s, sweep_args *a)
+{
+    const char *eq = strchr(s, '=');
+    if (!eq || eq == s || (size_t)(eq - s) >= sizeof a->name)
+        return false;
+    memcpy(a->name, s, (size_t)(eq - s));
+    a->name[eq - s] = 0;
+    if (!parse_doubles(eq + 1, a->values, &a->n_values, MAX_VALUES) || a->n_values < 2)
+        return false;
+    for (int k = 0; k < a->n_values; k++)
+        if (!isfinite(a->values[k]) || (k > 0 && !(a->values[k] > a->values[k - 1])))
+            return false;
+    return true;
+}
+
+static int parse_args(cli *c, sweep_args *a)
+{
+    int err = 0, has_vary = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(sweep_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (lattice_opts_take(c, &a->lat, &err)) {
+        } else if (cli_is(c, "--vary", true, &err)) {
+            if (c->value && !parse_vary(c->value, a))
+                err = cli_usage_error(c,
+                                      "--vary: '%s' is not NAME=V1,V2,... with 2..%d increasing "
+                                      "values (e.g. mu=0.09,0.095,0.1,0.105)",
+                                      c->value, MAX_VALUES);
+            has_vary = 1;
+        } else if (cli_is(c, "--near", true, &err)) {
+            if (c->value && !parse_ranges(c->value, a->near_lo, a->near_hi, &a->n_near, CM_MAX_DIM))
+                err = cli_usage_error(c, "--near: '%s' is not LO:HI[,LO:HI...] with LO < HI",
+                                      c->value);
+        } else if (cli_take_int(c, "--refine", 0, MAX_REFINE, &a->refine, &err)) {
+        } else if (cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &a->max_steps, &err)) {
+        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else {
+            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+        }
+    }
+    if (!err && !has_vary)
+        err = cli_usage_error(c, "--vary NAME=V1,V2,... is required (e.g. --vary mu=0.09,0.1)");
+    return err;
+}
+
+/* ---- one value ---- */
+
+typedef struct sweep_point {
+    double value;
+    uint32_t attractors, sticking, groups; /* attractors and sticking zones in the window */
+    uint64_t attractor_cells, sticking_cells, sink_cells;
+    double seconds;
+} sweep_point;
+
+static double seconds_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static bool in_window(const sweep_args *a, const cm_group_info *g)
+{
+    for (int d = 0; d < a->n_near; d++)
+        if (!(g->centre[d] >= a->near_lo[d] && g->centre[d] <= a->near_hi[d]))
+            return false;
+    return true;
+}
+
+static void count_groups(const sweep_args *a, const cm_group_info *groups, uint32_t n,
+                         sweep_point *pt)
+{
+    pt->groups = n;
+    for (uint32_t k = 0; k < n; k++) {
+        if (!in_window(a, &groups[k]))
+            continue;
+        if (groups[k].kind == CM_GROUP_STICKING) {
+            pt->sticking++;
+            pt->sticking_cells += groups[k].basin_cells;
+        } else {
+            pt->attractors++;
+            pt->attractor_cells += groups[k].basin_cells;
+        }
+    }
+}
+
+static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                          double value, sweep_point *pt, char *msg, size_t msg_size)
+{
+    memset(pt, 0, sizeof *pt);
+    pt->value = value;
+    const double t0 = seconds_now();
+    cm_model m;
+    const char *name = a->name;
+    if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
+        return CM_EINVAL;
+    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 0};
+    cm_region r;
+    memset(&r, 0, sizeof r);
+    cm_group_info *groups = NULL;
+    cm_status st = cm_region_alloc(&r, box, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_images(&m, lat, &opt, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_classify(&r, msg, msg_size);
+    if (st == CM_OK && !(groups = calloc(r.ngroups + 1, sizeof *groups)))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", r.ngroups);
+    if (st == CM_OK)
+        st = cm_scm_groups(&r, lat, groups, &pt->sink_cells);
+    if (st == CM_OK)
+        st = cm_scm_label_groups(&m, lat, &r, groups, r.ngroups, msg, msg_size);
+    if (st == CM_OK)
+        count_groups(a, groups, r.ngroups, pt);
+    free(groups);
+    cm_region_free(&r);
+    cm_model_release(&m);
+    pt->seconds = seconds_now() - t0;
+    return st;
+}
+
+/* ---- the sweep ---- */
+
+/* Changes are changes of the number of attractors: sticking zones are sets
+ * of rest cells whose count grows with the zones' width. */
+static bool same_counts(const sweep_point *x, const sweep_point *y)
+{
+    return x->attractors == y->attractors;
+}
+
+static void print_point(const char *name, const sweep_point *pt)
+{
+    printf("%s = %-12.9g %3u attractor(s), %3u sticking group(s) in the window; basins %llu and "
+           "%llu cells; %u groups; %.2f s\n",
+           name, pt->value, pt->attractors, pt->sticking, (unsigned long long)pt->attractor_cells,
+           (unsigned long long)pt->sticking_cells, pt->groups, pt->seconds);
+}
+
+/* Bisects between lo and hi (whose counts differ) `refine` times; the
+ * solved midpoints are appended to pts. */
+static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                               sweep_point lo, sweep_point hi, sweep_point *pts, int *n_pts,
+                               char *msg, size_t msg_size)
+{
+    const bool several = lo.attractors > hi.attractors + 1 || hi.attractors > lo.attractors + 1;
+    for (int k = 0; k < a->refine; k++) {
+        sweep_point *mid = &pts[*n_pts];
+        const cm_status st = solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        ++*n_pts;
+        if (same_counts(mid, &lo))
+            lo = *mid;
+        else
+            hi = *mid;
+    }
+    printf("change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n", lo.attractors,
+           a->name, lo.value, hi.attractors, hi.value, hi.value - lo.value,
+           several ? "; the interval held more than one change, bisection followed one" : "");
+    return CM_OK;
+}
+
+static int by_value(const void *x, const void *y)
+{
+    const double u = ((const sweep_point *)x)->value, v = ((const sweep_point *)y)->value;
+    return (u > v) - (u < v);
+}
+
+static bool write_csv(const sweep_args *a, sweep_point *pts, int n)
+{
+    qsort(pts, (size_t)n, sizeof *pts, by_value);
+    outfile o;
+    if (!outfile_open("sweep", a->csv, &o))
+        return false;
+    fprintf(o.f,
+            "%s,attractors,sticking,attractor_cells,sticking_cells,groups,sink_cells,seconds\n",
+            a->name);
+    for (int k = 0; k < n; k++)
+        fprintf(o.f, "%.17g,%u,%u,%llu,%llu,%u,%llu,%.3f\n", pts[k].value, pts[k].attractors,
+                pts[k].sticking, (unsigned long long)pts[k].attractor_cells,
+                (unsigned long long)pts[k].sticking_cells, pts[k].groups,
+                (unsigned long long)pts[k].sink_cells, pts[k].seconds);
+    return outfile_close("sweep", &o, true);
+}
+
+/* Checks the model, the parameter, the window, the lattice and every value. */
+static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_box *box)
+{
+    cm_model m;
+    int err = model_opts_build(c, &a->mo, &m);
+    if (err)
+        return err;
+    cm_params p = m.values;
+    if (cm_params_find(&p, a->name) < 0)
+        err = cli_usage_error(c, "--vary: '%s' is not a parameter of %s (`cellmap models`)",
+                              a->name, m.name);
+    if (!err && a->n_near > m.dim)
+        err = cli_usage_error(c, "--near has %d range(s) but model %s has dimension %d", a->n_near,
+                              m.name, m.dim);
+    if (!err)
+        err = lattice_opts_build(c, &a->lat, &m, lat, box);
+    cm_model_release(&m);
+    for (int k = 0; k < a->n_values && !err; k++) {
+        const char *name = a->name;
+        char msg[256];
+        if (!model_with_values(&a->mo, &name, &a->values[k], 1, &m, msg, sizeof msg))
+            err = cli_usage_error(c, "--vary: %s = %.17g: %s", a->name, a->values[k], msg);
+        else
+            cm_model_release(&m);
+    }
+    return err;
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+    cli c = {"sweep", argc, argv, 0, NULL, NULL};
+    sweep_args a;
+    memset(&a, 0, sizeof a);
+    a.mo.name = "microchaos-pd";
+    int rc = parse_args(&c, &a);
+    if (rc)
+        return rc < 0 ? EXIT_OK : rc;
+    cm_lattice lat;
+    cm_box box;
+    if ((rc = check_setup(&c, &a, &lat, &box)))
+        return rc;
+    sweep_point *pts = malloc((size_t)(a.n_values * (1 + a.refine)) * sizeof *pts);
+    if (!pts) {
+        fprintf(stderr, "cellmap sweep: out of memory\n");
+        return EXIT_FAIL;
+    }
+    char msg[512];
+    int n = 0, changes = 0;
+    cm_status st = CM_OK;
+    for (int k = 0; k < a.n_values && st == CM_OK; k++) {
+        st = solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
+        if (st == CM_OK)
+            print_point(a.name, &pts[n++]);
+    }
+    /* the listed values are pts[0 .. n_values-1]; refinements follow them */
+    for (int k = 1; k < a.n_values && st == CM_OK; k++)
+        if (!same_counts(&pts[k - 1], &pts[k])) {
+            changes++;
+            if (a.refine)
+                st = refine_change(&a, &lat, &box, pts[k - 1], pts[k], pts, &n, msg, sizeof msg);
+        }
+    if (st == CM_OK && !changes)
+        printf("no change of the counts between %s = %.9g and %.9g\n", a.name, a.values[0],
+               a.values[a.n_values - 1]);
+    if (st != CM_OK)
+        fprintf(stderr, "cellmap sweep: %s = %.17g: %s\n", a.name, pts[n].value, msg);
+    const bool ok = st == CM_OK && (!a.csv || write_csv(&a, pts, n));
+    free(pts);
+    return ok ? EXIT_OK : EXIT_FAIL;
+}
