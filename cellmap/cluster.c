@@ -509,29 +509,42 @@ static void flatten_part(const cm_region *r, const cm_box *both, cm_region *out)
     }
 }
 
-cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
-                             size_t msg_size)
+cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, char *msg,
+                        size_t msg_size)
 {
     cm_status st = cm_region_alloc(out, box, msg, msg_size);
     if (st != CM_OK)
         return st;
-    out->ngroups = c->ngroups;
+    out->ngroups = ngroups;
     for (uint64_t i = 0; i < out->ncells; i++) {
         out->image[i] = CM_IMAGE_SINK;
         out->group[i] = CM_GROUP_NONE;
         out->step[i] = 0;
     }
-    for (uint32_t k = 0; k < c->nregions; k++) {
+    return CM_OK;
+}
+
+void cm_flat_copy(const cm_region *r, cm_region *out)
+{
+    cm_box both;
+    if (cm_box_intersect(&r->box, &out->box, &both))
+        flatten_part(r, &both, out);
+}
+
+cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
+                             size_t msg_size)
+{
+    cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
         cm_box both;
         if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
             continue;
         st = cm_cluster_acquire(c, k, msg, msg_size);
-        if (st != CM_OK) {
-            cm_region_free(out);
-            return st;
-        }
-        flatten_part(&c->regions[k].r, &both, out);
+        if (st == CM_OK)
+            flatten_part(&c->regions[k].r, &both, out);
         cm_cluster_trim(c);
     }
-    return CM_OK;
+    if (st != CM_OK)
+        cm_region_free(out);
+    return st;
 }

@@ -159,6 +159,14 @@ void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
  * every region's escape, target and entry lists. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
+/* A flat region over box with no cell computed (group CM_GROUP_NONE,
+ * image CM_IMAGE_SINK) and ngroups groups, for cm_flat_copy. */
+cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, char *msg,
+                        size_t msg_size);
+/* Copies the cells of region r inside out's box into out: groups, steps,
+ * images as out's indices (exits and cells beyond it as CM_IMAGE_EXIT). */
+void cm_flat_copy(const cm_region *r, cm_region *out);
+
 /* The cluster as one region over `box`: group and step of every cell (group
  * CM_GROUP_NONE outside every region), images as box indices (exits and
  * cells beyond the box as CM_IMAGE_EXIT). out->ngroups is the cluster's. */

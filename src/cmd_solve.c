@@ -11,6 +11,7 @@
 
 #include "cellmap/cluster.h"
 #include "cellmap/extend.h"
+#include "cellmap/join_stage1.h"
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
@@ -24,7 +25,8 @@ static const char solve_help[] =
     "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
     "                     [--png FILE [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
-    "                      [--view X0:X1,Y0:Y1]] [--db FILE [--resume] [--mem BYTES]] [--json]\n\n"
+    "                      [--view X0:X1,Y0:Y1]] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
+    "                     [--stage1]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
     "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
     "centre). Without options it solves the thesis' C-SCM example (4.6.3):\n"
@@ -51,7 +53,11 @@ static const char solve_help[] =
     "                      it was interrupted; a finished file is only summarised\n"
     "  --mem BYTES         bound the cell arrays held in memory (e.g. 512M, 2G); regions\n"
     "                      are paged to and from --db FILE (same results)\n"
-    "  --json              print the summary as JSON\n";
+    "  --json              print the summary as JSON\n"
+    "  --stage1            stop the join of the --split regions after Stage 1 (thesis\n"
+    "                      Alg. C.5, Fig. 4.27): sink cells leading into another region's\n"
+    "                      groups take their group; those leading into its sink domain\n"
+    "                      (pending, left to Stage 2) stay in the sink\n";
 
 /* Most regions --split may cut the box into; most --extend steps. */
 enum { MAX_SPLIT = 4096, MAX_EXTEND = 1000 };
@@ -61,7 +67,7 @@ typedef struct solve_args {
     lattice_opts lat;
     int64_t split[CM_MAX_DIM];
     int n_split;
-    int max_steps, threads, json;
+    int max_steps, threads, json, stage1;
     int extend;
     double escape_below;
     const char *bounds_text;
@@ -107,6 +113,8 @@ static int parse_solve(cli *c, solve_args *a)
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = 1;
+        } else if (cli_is(c, "--stage1", false, &err)) {
+            a->stage1 = 1;
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
@@ -115,6 +123,9 @@ static int parse_solve(cli *c, solve_args *a)
         err = png_opts_check(c, &a->png);
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
         err = cli_usage_error(c, "--bounds and --escape-below apply to --extend; add --extend N");
+    if (!err && a->stage1 && (!a->n_split || a->extend || a->db || a->png.has_view))
+        err = cli_usage_error(c, "--stage1 shows the regions of --split after Stage 1 of their "
+                                 "join; it takes --split and no --extend, --db or --view");
     if (!err && !a->db && (a->resume || a->mem))
         err = cli_usage_error(c, "--resume and --mem need a database to page to; add --db FILE");
     return err;
@@ -352,6 +363,49 @@ static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxe
         }
     }
     return n;
+}
+
+/* --stage1: the regions of --split solved alone and taken through Stage 1
+ * of their join only (thesis Fig. 4.27), flattened into r. */
+static cm_status solve_stage1(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                              const cm_box *box, cm_region *r, timing *t, char *msg,
+                              size_t msg_size)
+{
+    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
+    const uint32_t n = split_boxes(a, box, NULL);
+    cm_box *boxes = malloc(n * sizeof *boxes);
+    cm_region *parts = calloc(n, sizeof *parts);
+    cm_status st =
+        boxes && parts ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
+    *t = (timing){"regions", "stage 1", 0, 0};
+    const double t0 = now_seconds();
+    if (st == CM_OK)
+        split_boxes(a, box, boxes);
+    for (uint32_t k = 0; k < n && st == CM_OK; k++) {
+        st = cm_region_alloc(&parts[k], &boxes[k], msg, msg_size);
+        if (st == CM_OK)
+            st = cm_scm_solve(m, lat, &opt, &parts[k], msg, msg_size);
+    }
+    const double t1 = now_seconds();
+    cm_stage1_stats stats;
+    if (st == CM_OK)
+        st = cm_join_stage1(parts, n, NULL, &stats, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_flat_alloc(box, parts[0].ngroups, r, msg, msg_size);
+    for (uint32_t k = 0; k < n && st == CM_OK; k++)
+        cm_flat_copy(&parts[k], r);
+    t->t1 = t1 - t0;
+    t->t2 = now_seconds() - t1;
+    if (st == CM_OK && !a->json)
+        printf("stage 1 of the join of %u regions: of %llu sink cells, %llu now lead to groups, "
+               "%llu leave every region, %llu are pending (left to Stage 2, drawn as the sink)\n",
+               n, (unsigned long long)stats.sink_cells, (unsigned long long)stats.to_group,
+               (unsigned long long)stats.to_sink, (unsigned long long)stats.pending);
+    for (uint32_t k = 0; parts && k < n; k++)
+        cm_region_free(&parts[k]);
+    free(parts);
+    free(boxes);
+    return st;
 }
 
 /* The cluster being solved and the database it is saved to (may be NULL). */
@@ -644,7 +698,8 @@ int cmd_solve(int argc, char **argv)
         goto done;
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
-    if (a.n_split || a.extend || a.db || a.png.has_view) { /* a view is cut from a cluster */
+    if (!a.stage1 && (a.n_split || a.extend || a.db || a.png.has_view)) {
+        /* a view is cut from a cluster */
         const double t0 = now_seconds();
         if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
                 CM_OK ||
@@ -652,7 +707,8 @@ int cmd_solve(int argc, char **argv)
             goto fail;
         t.t2 = now_seconds() - t0 - t.t1;
     } else {
-        if (solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg) != CM_OK)
+        if ((a.stage1 ? solve_stage1(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)
+                      : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
             goto fail;
         sum.box = r.box;
         sum.cells = r.ncells;

@@ -187,6 +187,27 @@ expect_usage "needs 4 values" solve --model microchaos-general --param n=2,A=1 -
 "$CM" fixed-points --model microchaos-general --param mode=input > /dev/null 2>&1
 [ $? -eq 1 ] || fail "fixed points of input quantisation should fail with 1"
 
+# --- solve --stage1: the regions of --split after Stage 1 of their join -----
+st1=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --cells 200x100)
+"$CM" solve "${st1[@]}" --region 0:1000,-40:40 --split 2x1 --stage1 > stage1.out || fail "solve --stage1"
+"$CM" solve "${st1[@]}" --region 0:1000,-40:40 --split 2x1 --stage1 --json > stage1.json || fail "stage1 json"
+"$CM" solve --param alpha=0.078,beta=0,P=0.007,D=0.02 --cells 100x100 --region 0:500,-40:40 --json > left.json
+"$CM" solve --param alpha=0.078,beta=0,P=0.007,D=0.02 --cells 100x100 --region 500:1000,-40:40 --json > right.json
+python3 - stage1.out stage1.json left.json right.json <<'PY' || fail "stage 1 summary"
+import json, re, sys
+n = list(map(int, re.search(r"of (\d+) sink cells, (\d+) now lead to groups, (\d+) leave every "
+                            r"region, (\d+) are pending", open(sys.argv[1]).read()).groups()))
+assert n[0] == n[1] + n[2] + n[3] and n[1] > 0 and n[3] > 0, n
+s1, left, right = (json.load(open(f)) for f in sys.argv[2:5])
+# Stage 1 makes no groups: those of the regions solved alone, in one id space
+assert len(s1["groups"]) == len(left["groups"]) + len(right["groups"]), len(s1["groups"])
+# the regions alone had n[0] sink cells; Stage 1 moved n[1] of them to groups
+assert left["sink_cells"] + right["sink_cells"] == n[0], (left["sink_cells"], right["sink_cells"], n)
+assert s1["sink_cells"] == n[2] + n[3], (s1["sink_cells"], n)
+PY
+expect_usage "--stage1 shows the regions of --split" solve --stage1
+expect_usage "--stage1 shows the regions of --split" solve --split 2x1 --stage1 --db x.cmdb
+
 # --- dry friction: sticking zones are labelled in the summary and the file --
 "$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-601.5:601.5 \
   --cells 800x401 --max-steps 100000 --db friction.cmdb --png friction.png --json > friction.json \

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cellmap/cluster.h"
+#include "cellmap/join_stage1.h"
 #include "check.h"
 #include "mix.h"
 #include "models/registry.h"
@@ -84,8 +85,8 @@ static uint64_t compare_regions(const char *what, const cm_region *a, const cm_r
     return bad;
 }
 
-static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *box,
-                        int max_steps, cm_region *r)
+static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *box, int max_steps,
+                        cm_region *r)
 {
     char msg[256];
     const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
@@ -95,8 +96,8 @@ static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *
 
 /* Solves the boxes one by one, joins them in `order`, flattens over whole. */
 static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_box *whole,
-                            const cm_box *boxes, const uint32_t *order, uint32_t n,
-                            int max_steps, cm_region *flat, uint32_t *straddling)
+                            const cm_box *boxes, const uint32_t *order, uint32_t n, int max_steps,
+                            cm_region *flat, uint32_t *straddling)
 {
     char msg[256];
     cm_cluster c;
@@ -132,8 +133,8 @@ static uint32_t check_invariant(const char *name, const cm_model *m, const cm_la
         if (whole->dim == 1 && tilings[t].nfy > 0)
             continue;
         cm_box boxes[9];
-        const uint32_t n = tile(whole, tilings[t].fx, tilings[t].nfx, tilings[t].fy,
-                                tilings[t].nfy, boxes);
+        const uint32_t n =
+            tile(whole, tilings[t].fx, tilings[t].nfx, tilings[t].fy, tilings[t].nfy, boxes);
         uint32_t orders[3][9];
         for (uint32_t k = 0; k < n; k++) {
             orders[0][k] = k;
@@ -336,7 +337,8 @@ static void test_threads_identical(void)
         cm_cluster_init(&c, &lat);
         c.threads = t + 1;
         const cm_scm_options opt = {1, t + 1, NULL, NULL, 1};
-        CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
+        CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) ==
+              CM_OK);
         CHECK(cm_cluster_flatten(&c, &whole, &flat[t], msg, sizeof msg) == CM_OK);
         cm_cluster_free(&c);
     }
@@ -389,10 +391,12 @@ static void test_figs_4_26_to_4_28(void)
     cm_scm_groups(&flat, &lat, g, NULL);
     int near_sw2_joined = 0;
     for (uint32_t i = 0; i < flat.ngroups; i++)
-        near_sw2_joined += fabs(g[i].centre[0] - sw2) < 1.0 && g[i].lo[0] < 285.4 &&
-                           g[i].hi[0] > 285.4;
-    fprintf(stderr, "Figs 4.26-4.28: %d groups near SW_2 in the regions alone, %d straddling "
-            "ones after the join\n", near_sw2_alone, near_sw2_joined);
+        near_sw2_joined +=
+            fabs(g[i].centre[0] - sw2) < 1.0 && g[i].lo[0] < 285.4 && g[i].hi[0] > 285.4;
+    fprintf(stderr,
+            "Figs 4.26-4.28: %d groups near SW_2 in the regions alone, %d straddling "
+            "ones after the join\n",
+            near_sw2_alone, near_sw2_joined);
     CHECK_INT(near_sw2_alone, 0);
     CHECK(near_sw2_joined > 0);
     solve_whole(&m, &lat, &whole, 1, &union_r);
@@ -401,6 +405,88 @@ static void test_figs_4_26_to_4_28(void)
     cm_region_free(&flat);
     cm_region_free(&union_r);
     cm_cluster_free(&c);
+    cm_model_release(&m);
+}
+
+/* Fig. 4.27: Stage 1 alone on the regions of Figs. 4.26-4.28. Whatever
+ * Stage 1 decides is final: a cell it sends to a group is in that group
+ * (same anchor) after the whole join, and a cell it leaves in the sink
+ * without a pending chain is in the sink; only the pending cells (Case 2,
+ * the red bands of Fig. 4.27) are left to Stage 2. */
+static void test_join_stage1(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.07,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {85.4, -12.5}, {0.2, 0.025}};
+    const cm_box boxes[2] = {{2, {0, 0}, {1000, 1000}}, {2, {1000, 0}, {2000, 1000}}};
+    const cm_box whole = {2, {0, 0}, {2000, 1000}};
+    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    char msg[256];
+    cm_region parts[2], flat;
+    uint8_t *pending[2];
+    cm_group_info *alone[2];
+    uint32_t uids = 0;
+    for (int k = 0; k < 2; k++) {
+        CHECK(cm_region_alloc(&parts[k], &boxes[k], msg, sizeof msg) == CM_OK);
+        CHECK(cm_scm_solve(&m, &lat, &opt, &parts[k], msg, sizeof msg) == CM_OK);
+        alone[k] = calloc(parts[k].ngroups + 1, sizeof *alone[k]);
+        cm_scm_groups(&parts[k], &lat, alone[k], NULL);
+        pending[k] = malloc(parts[k].ncells);
+        uids += parts[k].ngroups;
+    }
+    const uint32_t n_left = parts[0].ngroups;
+    cm_stage1_stats stats;
+    CHECK(cm_join_stage1(parts, 2, pending, &stats, msg, sizeof msg) == CM_OK);
+    CHECK_INT(parts[0].ngroups, uids);
+    CHECK_INT(stats.to_group + stats.to_sink + stats.pending, stats.sink_cells);
+    CHECK(stats.to_group > 0 && stats.pending > 0);
+
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    for (int k = 0; k < 2; k++) {
+        cm_region r;
+        cm_join_stats js;
+        CHECK(cm_region_alloc(&r, &boxes[k], msg, sizeof msg) == CM_OK);
+        CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+        CHECK(cm_cluster_join(&c, &r, &js, msg, sizeof msg) == CM_OK);
+    }
+    CHECK(cm_cluster_flatten(&c, &whole, &flat, msg, sizeof msg) == CM_OK);
+    cm_group_info *joined = calloc(flat.ngroups + 1, sizeof *joined);
+    cm_scm_groups(&flat, &lat, joined, NULL);
+    uint64_t wrong = 0, pending_cells = 0, pending_to_groups = 0;
+    for (int k = 0; k < 2; k++)
+        for (uint64_t i = 0; i < parts[k].ncells; i++) {
+            int64_t cell[CM_MAX_DIM];
+            cm_box_cell(&boxes[k], i, cell);
+            const uint32_t g = parts[k].group[i], fin = flat.group[cm_box_index(&whole, cell)];
+            if (pending[k][i]) {
+                pending_cells++;
+                pending_to_groups += fin != 0;
+                continue;
+            }
+            if (g == 0) {
+                wrong += fin != 0;
+                continue;
+            }
+            const cm_group_info *gi = g <= n_left ? &alone[0][g - 1] : &alone[1][g - n_left - 1];
+            wrong += fin == 0 || memcmp(gi->anchor, joined[fin - 1].anchor, 2 * sizeof(int64_t));
+        }
+    fprintf(stderr,
+            "Fig. 4.27: Stage 1 sends %llu sink cells to groups, %llu to the sink, leaves "
+            "%llu pending (%llu of them reach groups in Stage 2); %llu cells disagree\n",
+            (unsigned long long)stats.to_group, (unsigned long long)stats.to_sink,
+            (unsigned long long)stats.pending, (unsigned long long)pending_to_groups,
+            (unsigned long long)wrong);
+    CHECK_INT(wrong, 0);
+    CHECK_INT(pending_cells, stats.pending);
+    CHECK(pending_to_groups > 0);
+    free(joined);
+    cm_region_free(&flat);
+    cm_cluster_free(&c);
+    for (int k = 0; k < 2; k++) {
+        free(alone[k]);
+        free(pending[k]);
+        cm_region_free(&parts[k]);
+    }
     cm_model_release(&m);
 }
 
@@ -413,5 +499,6 @@ int main(void)
     test_ids_stable();
     test_threads_identical();
     test_figs_4_26_to_4_28();
+    test_join_stage1();
     CHECK_DONE();
 }

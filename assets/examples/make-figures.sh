@@ -22,8 +22,8 @@ pd=microchaos-pd
   --region=-125000:125000,-600:600 --cells 1000x400 --max-steps 100000 \
   --png fig-4.21-figure.png --layers all --size 1400x600 > /dev/null
 
-# Figs. 4.26 and 4.28 (thesis 4.6.3): the two regions solved apart, then the
-# cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
+# Figs. 4.26-4.28 (thesis 4.6.3): the two regions solved apart, after Stage 1
+# of their join, and the cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
 ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 "$CM" solve $ex --region 0:500,-40:40 --cells 1000x1000 --png fig-4.26-left.png \
   --layers all --size 700x700 > /dev/null
@@ -32,6 +32,9 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 "$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --db "$tmp/c.cmdb" \
   > /dev/null
 "$CM" render "$tmp/c.cmdb" --png fig-4.28.png --layers all --size 1400x700
+# Fig. 4.27: the same two regions after Stage 1 of the join only
+"$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --stage1 \
+  --png fig-4.27.png --layers all --size 1400x700 > /dev/null
 
 # Fig. 4.30: the hybrid map with dry friction, mu = 0.095 (sticking zones grey)
 "$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-301.5:301.5 \
