@@ -187,6 +187,58 @@ expect_usage "needs 4 values" solve --model microchaos-general --param n=2,A=1 -
 "$CM" fixed-points --model microchaos-general --param mode=input > /dev/null 2>&1
 [ $? -eq 1 ] || fail "fixed points of input quantisation should fail with 1"
 
+# --- an 8192 x 8192 figure with every layer (GL tiles; pixels in test_figure)
+"$CM" render basin.cmdb --png big.png --size 8192x8192 --layers all || fail "8192x8192 render"
+python3 - big.png <<'PY' || fail "8192x8192 PNG"
+import re, struct, sys
+data = open(sys.argv[1], "rb").read()
+assert struct.unpack(">II", data[16:24]) == (8192, 8192)
+w, h = map(int, re.search(rb"plot \d+,\d+ (\d+)x(\d+)", data).groups())
+assert w > 4096 and h > 4096, (w, h)    # the plot spans more than one GL tile each way
+PY
+rm -f big.png
+
+# --- render --slice: a 3-D model's slices, pixel by pixel against its cells --
+"$CM" solve --model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 \
+  --region=-6:6,-6:6,-6:6 --cells 24x24x24 --db s3.cmdb > /dev/null || fail "3-D solve"
+"$CM" export s3.cmdb --cells s3.csv 2> /dev/null || fail "3-D export"
+for z in 0.25 -3.25; do
+  "$CM" render s3.cmdb --png "s3$z.png" --png-mode indexed --slice "$z" || fail "render --slice $z"
+done
+python3 - "$HERE" s3.csv s3-3.25.png s30.25.png <<'PY' || fail "3-D slices"
+import csv, struct, sys, zlib
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+cells = {(int(r["ix"]), int(r["iy"]), int(r["iz"])): r for r in csv.DictReader(open(sys.argv[2]))}
+def palette(path):
+    data, pos = open(path, "rb").read(), 8
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"PLTE":
+            body = data[pos + 8:pos + 8 + n]
+            return {tuple(body[i:i + 3]): i // 3 for i in range(0, n, 3)}
+        pos += 12 + n
+images = []
+for path, iz in ((sys.argv[3], 5), (sys.argv[4], 12)):   # z = -3.25 and 0.25: cells 5 and 12
+    w, h, bpp, rows, texts = read_png(path)
+    assert (w, h) == (24, 24), (w, h)
+    inverse = palette(path)
+    classes = dict(map(int, kv.split(":")) for kv in texts["Group classes"].split())
+    bad = 0
+    for iy in range(24):
+        for ix in range(24):
+            row = rows[23 - iy]
+            got = inverse[tuple(row[3 * ix:3 * ix + 3])]
+            c = cells[(ix, iy, iz)]
+            g = int(c["grp"])
+            want = 1 if g == 0 else 2 if c["periodic"] == "1" else classes[g]
+            bad += got != want
+    assert bad == 0, (path, bad)
+    images.append(rows)
+assert images[0] != images[1]    # the slices differ: --slice is obeyed
+PY
+expect_usage "--slice" render s3.cmdb --png x.png --slice 1,2
+
 # --- solve --stage1: the regions of --split after Stage 1 of their join -----
 st1=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --cells 200x100)
 "$CM" solve "${st1[@]}" --region 0:1000,-40:40 --split 2x1 --stage1 > stage1.out || fail "solve --stage1"

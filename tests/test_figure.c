@@ -253,6 +253,13 @@ static void test_pd_figure(void)
     CHECK(draw(&s, &ro, &a, &fa) == CM_OK);
     CHECK_INT(fa.tiles, 4);
     CHECK_INT(wrong_pixels(&s, a, ro.width, ro.height, 0.5), 0);
+
+    /* the largest size the issue asks for, 8192 x 8192: still every pixel its cell's */
+    ro.width = ro.height = 8192;
+    CHECK(draw(&s, &ro, &a, &fa) == CM_OK);
+    CHECK_INT(fa.tiles, (8192 + CM_PLOT_TILE - 1) / CM_PLOT_TILE *
+                            ((8192 + CM_PLOT_TILE - 1) / CM_PLOT_TILE));
+    CHECK_INT(wrong_pixels(&s, a, ro.width, ro.height, 0.5), 0);
     free(a);
     free(b);
     scene_free(&s);
