@@ -281,3 +281,15 @@ cm_status cm_scm_label_groups(const cm_model *model, const cm_lattice *lat, cons
     free(rest);
     return CM_OK;
 }
+
+cm_status cm_scm_describe(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                          cm_group_info **groups, uint64_t *sink_cells, char *msg, size_t msg_size)
+{
+    *groups = calloc((size_t)r->ngroups + 1, sizeof **groups);
+    if (!*groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", r->ngroups);
+    cm_status st = cm_scm_groups(r, lat, *groups, sink_cells);
+    if (st == CM_OK)
+        st = cm_scm_label_groups(model, lat, r, *groups, r->ngroups, msg, msg_size);
+    return st;
+}

@@ -145,4 +145,9 @@ bool cm_cell_at_rest(const cm_model *model, const cm_lattice *lat, const int64_t
 cm_status cm_scm_label_groups(const cm_model *model, const cm_lattice *lat, const cm_region *r,
                               cm_group_info *groups, uint32_t n, char *msg, size_t msg_size);
 
+/* Both: the labelled summaries of r's groups in *groups, a new array of
+ * r->ngroups + 1 entries that the caller frees (also on failure). */
+cm_status cm_scm_describe(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                          cm_group_info **groups, uint64_t *sink_cells, char *msg, size_t msg_size);
+
 #endif

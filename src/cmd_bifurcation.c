@@ -188,12 +188,12 @@ static double stop_at(const run_result *res, int j)
     return res->stops[(res->sticks - res->n_stops + j) % LAST_STOPS];
 }
 
-static bool write_points_csv(const bif_args *a, const sweep_results *s)
+/* What a followed run recorded, one point at a time, value by value. */
+enum point_kind { POINT_STICK, POINT_SECTION, POINT_PSI };
+typedef void (*point_fn)(void *user, int kind, double p, int run, double x, double v);
+
+static void visit_points(const bif_args *a, const sweep_results *s, point_fn fn, void *user)
 {
-    outfile o;
-    if (!outfile_open("bifurcation", a->csv, &o))
-        return false;
-    fprintf(o.f, "%s,run,kind,x,v\n", a->sweep.name);
     for (int i = 0; i < s->n_values; i++)
         for (int r = 0; r < s->runs; r++) {
             const run_result *res = result_at(s, i, r);
@@ -201,10 +201,27 @@ static bool write_points_csv(const bif_args *a, const sweep_results *s)
                 continue;
             const double p = param_axis_value(&a->sweep, i), *z = sections_at(s, i, r);
             for (int j = 0; j < res->n_stops; j++)
-                fprintf(o.f, "%.17g,%d,stick,%.17g,0\n", p, r, stop_at(res, j));
+                fn(user, POINT_STICK, p, r, stop_at(res, j), 0);
             for (int k = 0; k < s->record; k++)
-                fprintf(o.f, "%.17g,%d,section,%.17g,%.17g\n", p, r, z[2 * k], z[2 * k + 1]);
+                fn(user, POINT_SECTION, p, r, z[2 * k], z[2 * k + 1]);
+            fn(user, POINT_PSI, p, r, res->psi / s->record, 0);
         }
+}
+
+static void print_point(void *user, int kind, double p, int run, double x, double v)
+{
+    if (kind != POINT_PSI)
+        fprintf(user, "%.17g,%d,%s,%.17g,%.17g\n", p, run,
+                kind == POINT_STICK ? "stick" : "section", x, v);
+}
+
+static bool write_points_csv(const bif_args *a, const sweep_results *s)
+{
+    outfile o;
+    if (!outfile_open("bifurcation", a->csv, &o))
+        return false;
+    fprintf(o.f, "%s,run,kind,x,v\n", a->sweep.name);
+    visit_points(a, s, print_point, o.f);
     return outfile_close("bifurcation", &o, true);
 }
 
@@ -242,6 +259,14 @@ static void cloud_add(cloud *c, double x, double y)
         c->hi = y;
 }
 
+/* A panel's point: panels 0, 1 and 2 are the point kinds. */
+static void add_to_cloud(void *user, int kind, double p, int run, double x, double v)
+{
+    (void)run;
+    (void)v;
+    cloud_add(&((cloud *)user)[kind], p, x);
+}
+
 /* The three panels' points: sticking displacements, Poincare x, Psi per period. */
 static bool collect_clouds(const bif_args *a, const sweep_results *s, cloud c[3])
 {
@@ -252,18 +277,8 @@ static bool collect_clouds(const bif_args *a, const sweep_results *s, cloud c[3]
         c[k] = (cloud){malloc(cap[k] * sizeof(double)), malloc(cap[k] * sizeof(double)), 0, 0, 0};
         ok = ok && c[k].x && c[k].y;
     }
-    for (int i = 0; i < s->n_values && ok; i++)
-        for (int r = 0; r < s->runs; r++) {
-            const run_result *res = result_at(s, i, r);
-            if (!res->valid || !res->ok)
-                continue;
-            const double p = param_axis_value(&a->sweep, i), *z = sections_at(s, i, r);
-            for (int j = 0; j < res->n_stops; j++)
-                cloud_add(&c[0], p, stop_at(res, j));
-            for (int k = 0; k < s->record; k++)
-                cloud_add(&c[1], p, z[2 * k]);
-            cloud_add(&c[2], p, res->psi / s->record);
-        }
+    if (ok)
+        visit_points(a, s, add_to_cloud, c);
     return ok;
 }
 

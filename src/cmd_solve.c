@@ -608,17 +608,15 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, 
     for (uint32_t k = 0; k < c->nregions; k++)
         sum->cells += c->regions[k].r.ncells;
     sum->ngroups = c->ngroups;
-    sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
-    if (!sum->groups)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
-    if (rn->store)
+    if (rn->store) {
+        sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
+        if (!sum->groups)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
         return cm_store_groups(rn->store, sum->groups, c->ngroups, &sum->sink, msg, msg_size);
+    }
     cm_status st = cm_cluster_flatten(c, &sum->box, flat, msg, msg_size);
-    if (st == CM_OK)
-        cm_scm_groups(flat, &c->lat, sum->groups, &sum->sink);
-    return st == CM_OK
-               ? cm_scm_label_groups(m, &c->lat, flat, sum->groups, c->ngroups, msg, msg_size)
-               : st;
+    return st == CM_OK ? cm_scm_describe(m, &c->lat, flat, &sum->groups, &sum->sink, msg, msg_size)
+                       : st;
 }
 
 /* The PNG of the solved cells, or of --view (cells outside the cluster are
@@ -713,12 +711,7 @@ int cmd_solve(int argc, char **argv)
         sum.box = r.box;
         sum.cells = r.ncells;
         sum.ngroups = r.ngroups;
-        if (!(sum.groups = calloc(r.ngroups + 1, sizeof *sum.groups))) {
-            snprintf(msg, sizeof msg, "out of memory for %u groups", r.ngroups);
-            goto fail;
-        }
-        cm_scm_groups(&r, &lat, sum.groups, &sum.sink);
-        if (cm_scm_label_groups(&m, &lat, &r, sum.groups, r.ngroups, msg, sizeof msg) != CM_OK)
+        if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }
     const extend_log *shown = a.extend ? log : NULL;

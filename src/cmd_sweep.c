@@ -159,12 +159,8 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
         st = cm_scm_images(&m, lat, &opt, &r, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_classify(&r, msg, msg_size);
-    if (st == CM_OK && !(groups = calloc(r.ngroups + 1, sizeof *groups)))
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", r.ngroups);
     if (st == CM_OK)
-        st = cm_scm_groups(&r, lat, groups, &pt->sink_cells);
-    if (st == CM_OK)
-        st = cm_scm_label_groups(&m, lat, &r, groups, r.ngroups, msg, msg_size);
+        st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
     if (st == CM_OK)
         count_groups(a, groups, r.ngroups, pt);
     free(groups);
