@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/grow.h"
 #include "models/friction_oscillator.h"
 #include "models/params.h"
 #include "src/args.h"
@@ -93,30 +94,17 @@ typedef struct track {
     const cm_fo_run *run;
     int recording;
     row *rows;
-    size_t n_rows, cap_rows;
+    uint64_t n_rows, cap_rows;
     sample *samples;
-    size_t n_samples, cap_samples;
+    uint64_t n_samples, cap_samples;
     double psi_sum; /* x at the velocity zeros while recording (Psi, thesis 2.6.1) */
     bool out_of_memory;
 } track;
 
-static bool grow(void **p, size_t *cap, size_t n, size_t size)
-{
-    if (n < *cap)
-        return true;
-    const size_t cap2 = *cap ? 2 * *cap : 1024;
-    void *q = realloc(*p, cap2 * size);
-    if (!q)
-        return false;
-    *p = q;
-    *cap = cap2;
-    return true;
-}
-
 /* False only when out of memory. */
 static bool add_row(track *tr, double t, double x, double v, int kind)
 {
-    if (!grow((void **)&tr->rows, &tr->cap_rows, tr->n_rows, sizeof *tr->rows))
+    if (cm_grow((void **)&tr->rows, &tr->cap_rows, tr->n_rows + 1, sizeof *tr->rows) != CM_OK)
         return false;
     tr->rows[tr->n_rows++] = (row){t, x, v, kind};
     return true;
@@ -124,7 +112,8 @@ static bool add_row(track *tr, double t, double x, double v, int kind)
 
 static bool add_sample(track *tr, double t, double x, double v, int stuck)
 {
-    if (!grow((void **)&tr->samples, &tr->cap_samples, tr->n_samples, sizeof *tr->samples))
+    if (cm_grow((void **)&tr->samples, &tr->cap_samples, tr->n_samples + 1, sizeof *tr->samples) !=
+        CM_OK)
         return false;
     tr->samples[tr->n_samples++] = (sample){t, x, v, stuck};
     return true;
