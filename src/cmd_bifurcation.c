@@ -126,19 +126,22 @@ static void random_start(long long seed, int value, int run, double u[3])
 
 typedef struct run_result {
     double x0, v0, t0, psi;
-    double stops[LAST_STOPS]; /* a ring: the last n_stops sticking displacements */
-    int n_stops, sticks;      /* sticks counts all of the recorded periods */
+    double stops[LAST_STOPS]; /* a ring: the last sticking displacements */
+    int sticks;               /* in all of the recorded periods */
     bool ok, valid;           /* valid: the parameter value admits the model */
 } run_result;
 
 static void on_event(void *user, const cm_fo_event *e)
 {
     run_result *res = user;
-    if (e->kind == CM_FO_EV_BREAK)
-        return;
-    res->psi += e->x;
     if (e->kind == CM_FO_EV_STICK)
         res->stops[res->sticks++ % LAST_STOPS] = e->x;
+}
+
+/* How many of the sticking displacements the ring holds. */
+static int stops_kept(const run_result *res)
+{
+    return res->sticks < LAST_STOPS ? res->sticks : LAST_STOPS;
 }
 
 /* Runs from the random start; sections[2 k], [2 k + 1]: the k-th recorded Poincare point. */
@@ -155,13 +158,16 @@ static void run(const bif_args *a, const cm_fo *o, int value, int r, run_result 
     res->ok = true;
     for (int p = 0; p < a->transient && res->ok; p++)
         res->ok = cm_fo_run_period(o, &fr, NULL, NULL, NULL);
+    double zero_sum = 0;
     for (int p = 0; p < a->record && res->ok; p++) {
-        res->ok = cm_fo_run_period(o, &fr, NULL, on_event, res);
+        cm_fo_tally t;
+        cm_fo_tally_start(&t, fr.st.x);
+        res->ok = cm_fo_run_period(o, &fr, &t, on_event, res);
+        zero_sum += t.x_zero_sum;
         sections[2 * p] = fr.st.x;
         sections[2 * p + 1] = fr.st.v;
     }
-    res->psi = fabs(res->psi);
-    res->n_stops = res->sticks < LAST_STOPS ? res->sticks : LAST_STOPS;
+    res->psi = fabs(zero_sum);
 }
 
 /* ---- output ---- */
@@ -185,7 +191,7 @@ static const double *sections_at(const sweep_results *s, int value, int r)
 /* The recorded sticking displacements of a run in time order. */
 static double stop_at(const run_result *res, int j)
 {
-    return res->stops[(res->sticks - res->n_stops + j) % LAST_STOPS];
+    return res->stops[(res->sticks - stops_kept(res) + j) % LAST_STOPS];
 }
 
 /* What a followed run recorded, one point at a time, value by value. */
@@ -200,7 +206,7 @@ static void visit_points(const bif_args *a, const sweep_results *s, point_fn fn,
             if (!res->valid || !res->ok)
                 continue;
             const double p = param_axis_value(&a->sweep, i), *z = sections_at(s, i, r);
-            for (int j = 0; j < res->n_stops; j++)
+            for (int j = 0; j < stops_kept(res); j++)
                 fn(user, POINT_STICK, p, r, stop_at(res, j), 0);
             for (int k = 0; k < s->record; k++)
                 fn(user, POINT_SECTION, p, r, z[2 * k], z[2 * k + 1]);

@@ -127,8 +127,6 @@ static void on_event(void *user, const cm_fo_event *e)
     static const int kinds[] = {
         [CM_FO_EV_STICK] = ROW_STICK, [CM_FO_EV_BREAK] = ROW_BREAK, [CM_FO_EV_TURN] = ROW_TURN};
     const double t = tr->run->t_section + e->s;
-    if (e->kind != CM_FO_EV_BREAK)
-        tr->psi_sum += e->x;
     if (!add_row(tr, t, e->x, 0, kinds[e->kind]) ||
         !add_sample(tr, t, e->x, 0, e->mode == CM_FO_STICK))
         tr->out_of_memory = true;
@@ -178,8 +176,10 @@ static bool follow(const cm_fo *o, const sim_args *a, cm_fo_run *r, track *tr, c
         }
         if (!cm_fo_run_period(o, r, last, on_event, tr))
             return false;
-        if (tr->recording)
+        if (tr->recording) {
             record_state(tr, r, ROW_SECTION);
+            tr->psi_sum += last->x_zero_sum;
+        }
     }
     return true;
 }

@@ -5,11 +5,11 @@
  * zones absorb the outermost micro-chaotic attractors (thesis Fig. 4.30,
  * MODELS.md 8.4). */
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "cellmap/scm.h"
 #include "src/args.h"
@@ -108,13 +108,6 @@ typedef struct sweep_point {
     double seconds;
 } sweep_point;
 
-static double seconds_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static bool in_window(const sweep_args *a, const cm_group_info *g)
 {
     for (int d = 0; d < a->n_near; d++)
@@ -145,7 +138,7 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
 {
     memset(pt, 0, sizeof *pt);
     pt->value = value;
-    const double t0 = seconds_now();
+    const double t0 = omp_get_wtime();
     cm_model m;
     const char *name = a->name;
     if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
@@ -156,9 +149,7 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     cm_group_info *groups = NULL;
     cm_status st = cm_region_alloc(&r, box, msg, msg_size);
     if (st == CM_OK)
-        st = cm_scm_images(&m, lat, &opt, &r, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_scm_classify(&r, msg, msg_size);
+        st = cm_scm_solve(&m, lat, &opt, &r, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
     if (st == CM_OK)
@@ -166,7 +157,7 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     free(groups);
     cm_region_free(&r);
     cm_model_release(&m);
-    pt->seconds = seconds_now() - t0;
+    pt->seconds = omp_get_wtime() - t0;
     return st;
 }
 
@@ -241,8 +232,7 @@ static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_bo
     int err = model_opts_build(c, &a->mo, &m);
     if (err)
         return err;
-    cm_params p = m.values;
-    if (cm_params_find(&p, a->name) < 0)
+    if (cm_params_find(&m.values, a->name) < 0)
         err = cli_usage_error(c, "--vary: '%s' is not a parameter of %s (`cellmap models`)",
                               a->name, m.name);
     if (!err && a->n_near > m.dim)
