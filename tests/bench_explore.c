@@ -1,12 +1,15 @@
 /* bench_explore: issue 5's panning benchmark. A session views a 1000x1000
- * cell window, then pans it right by 10 % twenty times, rendering the view
- * (1000x1000 PNG) after each pan; a full recompute solves the final view
- * from scratch in a fresh database and renders it the same way.
+ * cell window, then pans it right by 10 % PANS times (20 unless given),
+ * rendering the view (1000x1000 PNG) after each pan; a full recompute
+ * solves the final view from scratch in a fresh database and renders it
+ * the same way.
  *
- *   bench_explore [463|421] [DIR]
+ *   bench_explore [463|421|osc] [DIR] [PANS]
  *
  * 463: the thesis' C-SCM example (4.6.3, panning right from the left
- * region); 421: the Fig. 4.21 parameters (max-steps 100000). Prints each
+ * region); 421: the Fig. 4.21 parameters (max-steps 100000); osc: the dry
+ * friction oscillator's Poincare map (Ch. 2, the 1a pair at S = 0.32), a
+ * model whose images cost about a thousand times more. Prints each
  * pan's time (compute + join + commit, render), the medians and the ratio
  * of a pan to the full recompute. */
 #include <stdio.h>
@@ -16,22 +19,36 @@
 #include "bench_util.h"
 #include "src/explore.h"
 
-enum { PANS = 20 };
+enum { MAX_PANS = 1000 };
 
 typedef struct preset {
-    const char *name, *params, *view;
+    const char *name, *model, *params, *view;
     double cell[2], origin[2];
     int max_steps;
 } preset;
 
 static const preset presets[] = {
-    {"463", "alpha=0.078,beta=0,P=0.007,D=0.02", "view 0:500 -40:40", {0.5, 0.08}, {0, -40}, 1},
+    {"463",
+     "microchaos-pd",
+     "alpha=0.078,beta=0,P=0.007,D=0.02",
+     "view 0:500 -40:40",
+     {0.5, 0.08},
+     {0, -40},
+     1},
     {"421",
+     "microchaos-pd",
      "alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3",
      "view -125000:125000 -600:600",
      {250, 1.2},
      {-125000, -600},
      100000},
+    {"osc",
+     "friction-oscillator",
+     "S=0.32,S0=0.4,Omega=0.5,phi=0",
+     "view -3:3 -3:3",
+     {0.006, 0.006},
+     {-3, -3},
+     200},
 };
 
 /* Opens s in place: the session's store keeps a pointer to its model. */
@@ -41,7 +58,7 @@ static void open_session(session *s, const preset *p, const char *path)
     memset(&o, 0, sizeof o);
     unlink(path);
     o.path = path;
-    o.mo.name = "microchaos-pd";
+    o.mo.name = p->model;
     o.mo.texts[0] = p->params;
     o.mo.n_texts = 1;
     memcpy(o.cell_size, p->cell, sizeof p->cell);
@@ -78,8 +95,9 @@ int main(int argc, char **argv)
 {
     const preset *p = &presets[0];
     const char *dir = argc > 2 ? argv[2] : "/tmp";
-    if (argc > 1 && strcmp(argv[1], "421") == 0)
-        p = &presets[1];
+    for (size_t k = 0; argc > 1 && k < sizeof presets / sizeof presets[0]; k++)
+        if (strcmp(argv[1], presets[k].name) == 0)
+            p = &presets[k];
     char db[4096], png[4200], render[4300];
     snprintf(db, sizeof db, "%s/bench_explore.cmdb", dir);
     snprintf(png, sizeof png, "%s/bench_explore.png", dir);
@@ -88,11 +106,16 @@ int main(int argc, char **argv)
     session s;
     open_session(&s, p, db);
     const double first = timed(&s, p->view), first_render = timed(&s, render);
-    double pan[PANS], draw[PANS], total[PANS];
-    printf("preset %s (%s, max-steps %d): first view %.1f ms + render %.1f ms\n", p->name,
-           p->params, p->max_steps, 1e3 * first, 1e3 * first_render);
+    const int pans = argc > 3 ? atoi(argv[3]) : 20;
+    if (pans < 1 || pans > MAX_PANS) {
+        fprintf(stderr, "bench_explore: PANS must be 1..%d\n", MAX_PANS);
+        return 2;
+    }
+    double pan[MAX_PANS], draw[MAX_PANS], total[MAX_PANS];
+    printf("preset %s (%s %s, max-steps %d): first view %.1f ms + render %.1f ms\n", p->name,
+           p->model, p->params, p->max_steps, 1e3 * first, 1e3 * first_render);
     printf("%4s %12s %12s %12s\n", "pan", "compute ms", "render ms", "total ms");
-    for (int k = 0; k < PANS; k++) {
+    for (int k = 0; k < pans; k++) {
         pan[k] = timed(&s, "pan right 10%");
         draw[k] = timed(&s, render);
         total[k] = pan[k] + draw[k];
@@ -112,7 +135,7 @@ int main(int argc, char **argv)
         full[k] = full_compute[k] + timed(&f, render);
         close_session(&f);
     }
-    const double mc = median(pan, PANS), mr = median(draw, PANS), mt = median(total, PANS);
+    const double mc = median(pan, pans), mr = median(draw, pans), mt = median(total, pans);
     const double fc = median(full_compute, 3), ft = median(full, 3);
     printf("median pan: compute+join %.1f ms, render %.1f ms, total %.1f ms\n", 1e3 * mc, 1e3 * mr,
            1e3 * mt);
