@@ -31,14 +31,20 @@ void cm_make_ticks(double lo, double hi, cm_ticks *t)
     const double biggest = fmax(fabs(lo), fabs(hi));
     const bool fixed = biggest < 1e7 && step >= 1e-4;
     const int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
-    const int digits = (int)ceil(log10(biggest / step) + 1e-9) + 1;
-    for (double k = ceil(lo / step); k * step <= hi && t->n < CM_MAX_TICKS; k++) {
+    const double wanted = ceil(log10(biggest / step) + 1e-9); /* digits above the step's */
+    const int precision = wanted < 0 ? 0 : wanted > 16 ? 16 : (int)wanted;
+    /* Whole multiples of step in lo..hi, the ends included although lo / step
+     * may round to just above an integer and k * step to just above hi
+     * (-0.3 / 0.1 = -2.9999999999999996, 3 * 0.1 = 0.30000000000000004). */
+    const double slack = 1e-9;
+    const double k_last = floor(hi / step + slack);
+    for (double k = ceil(lo / step - slack); k <= k_last && t->n < CM_MAX_TICKS; k++) {
         const double v = k == 0 ? 0.0 : k * step;
         t->v[t->n] = v;
         if (fixed)
             snprintf(t->label[t->n], sizeof t->label[0], "%.*f", decimals, v);
         else
-            snprintf(t->label[t->n], sizeof t->label[0], "%.*e", digits > 1 ? digits - 1 : 0, v);
+            snprintf(t->label[t->n], sizeof t->label[0], "%.*e", precision, v);
         t->n++;
     }
 }

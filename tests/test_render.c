@@ -5,9 +5,31 @@
 
 #include "cellmap/scm.h"
 #include "check.h"
+#include "render/axes.h"
 #include "render/figure.h"
 #include "render/palette.h"
 #include "render/png_out.h"
+
+/* Ticks at both ends of a range whose ends are multiples of the step that
+ * floating point does not hit exactly. */
+static void check_ticks(void)
+{
+    cm_ticks t;
+    cm_make_ticks(-0.3, 0.3, &t); /* step 0.1: -0.3 / 0.1 and 3 * 0.1 both round */
+    CHECK_INT(t.n, 7);
+    CHECK(strcmp(t.label[0], "-0.3") == 0 && strcmp(t.label[6], "0.3") == 0);
+    CHECK(strcmp(t.label[3], "0.0") == 0);
+    cm_make_ticks(0.1, 0.7, &t); /* step 0.1: 0.7 / 0.1 = 6.999999999999999 */
+    CHECK_INT(t.n, 7);
+    CHECK(strcmp(t.label[0], "0.1") == 0 && strcmp(t.label[6], "0.7") == 0);
+    cm_make_ticks(0.05, 0.95, &t); /* step 0.2: both ends between ticks */
+    CHECK_INT(t.n, 4);
+    CHECK(strcmp(t.label[0], "0.2") == 0 && strcmp(t.label[3], "0.8") == 0);
+    cm_make_ticks(-3, 3, &t); /* step 1: exact */
+    CHECK_INT(t.n, 7);
+    cm_make_ticks(1, 1, &t); /* an empty range has none */
+    CHECK_INT(t.n, 0);
+}
 
 /* Upper half (y > 0.5) has no image (the sink); the lower half: every cell
  * is fixed, except x > 0.75, which moves to the fixed cell (1, 1). */
@@ -30,6 +52,7 @@ static int same_rgb(const uint8_t *p, cm_rgb c) { return p[0] == c.r && p[1] == 
 
 int main(void)
 {
+    check_ticks();
     cm_model m;
     memset(&m, 0, sizeof m);
     m.name = "test";
