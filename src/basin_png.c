@@ -173,15 +173,22 @@ static void make_provenance(const basin_png *b, const char *view, unsigned layer
 {
     const cm_lattice *lat = b->lat;
     const cm_box *box = &b->cells->box;
-    char cells[CM_MAX_DIM * 64];
+    char state[CM_MAX_DIM * 64], origin[CM_MAX_DIM * 32], width[CM_MAX_DIM * 32],
+        counts[CM_MAX_DIM * 24];
+    size_t used[3] = {0, 0, 0};
+    for (int d = 0; d < lat->dim; d++) { /* every dimension, not only the drawn two */
+        const char *sep = d ? "," : "";
+        used[0] += (size_t)snprintf(origin + used[0], sizeof origin - used[0], "%s%.17g", sep,
+                                    lat->origin[d]);
+        used[1] += (size_t)snprintf(width + used[1], sizeof width - used[1], "%s%.17g", sep,
+                                    lat->width[d]);
+        used[2] += (size_t)snprintf(counts + used[2], sizeof counts - used[2], "%s%lld",
+                                    d ? "x" : "", (long long)(box->hi[d] - box->lo[d]));
+    }
     cm_params_json(&b->model->values, p->params, sizeof p->params);
-    snprintf(p->lattice, sizeof p->lattice, "origin %.17g,%.17g width %.17g,%.17g", lat->origin[0],
-             lat->dim > 1 ? lat->origin[1] : 0.0, lat->width[0],
-             lat->dim > 1 ? lat->width[1] : 0.0);
-    format_box(lat, box, cells, sizeof cells);
-    snprintf(p->view, sizeof p->view, "box %s cells %lldx%lld%s", cells,
-             (long long)(box->hi[0] - box->lo[0]),
-             lat->dim > 1 ? (long long)(box->hi[1] - box->lo[1]) : 1LL, view);
+    snprintf(p->lattice, sizeof p->lattice, "origin %s width %s", origin, width);
+    format_box(lat, box, state, sizeof state);
+    snprintf(p->view, sizeof p->view, "box %s cells %s%s", state, counts, view);
     layers_text(layers, p->layers, sizeof p->layers);
     const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},
                                  {"Model", b->model->name},

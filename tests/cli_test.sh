@@ -222,6 +222,11 @@ images = []
 for path, iz in ((sys.argv[3], 5), (sys.argv[4], 12)):   # z = -3.25 and 0.25: cells 5 and 12
     w, h, bpp, rows, texts = read_png(path)
     assert (w, h) == (24, 24), (w, h)
+    # provenance names all three dimensions, and the layer drawn
+    assert texts["Lattice"] == "origin -6,-6,-6 width 0.5,0.5,0.5", texts["Lattice"]
+    z0 = -6 + 0.5 * iz
+    assert texts["View"] == "box -6:6,-6:6,%g:%g cells 24x24x1 mode indexed" % (z0, z0 + 0.5), \
+        texts["View"]
     inverse = palette(path)
     classes = dict(map(int, kv.split(":")) for kv in texts["Group classes"].split())
     bad = 0
