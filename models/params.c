@@ -143,12 +143,21 @@ static void choice_name(const char *choices, int k, char *buf, size_t size)
     snprintf(buf, size, "%.*s", (int)(end ? (size_t)(end - c) : strlen(c)), c);
 }
 
-void cm_params_format_with(const cm_params *p, int digits, const char *skip, char *buf, size_t size)
+static bool listed(const char *name, const char *const *names)
+{
+    for (; names && *names; names++)
+        if (strcmp(name, *names) == 0)
+            return true;
+    return false;
+}
+
+void cm_params_format_with(const cm_params *p, int digits, const char *const *skip, char *buf,
+                           size_t size)
 {
     size_t used = 0;
     buf[0] = '\0';
     for (int i = 0; i < p->count && used < size; i++) {
-        if (skip && strcmp(p->spec[i].name, skip) == 0)
+        if (listed(p->spec[i].name, skip))
             continue;
         used +=
             (size_t)snprintf(buf + used, size - used, "%s%s=", used ? "," : "", p->spec[i].name);

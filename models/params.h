@@ -26,8 +26,9 @@ double cm_params_get(const cm_params *p, const char *name);
 void cm_params_format(const cm_params *p, char *buf, size_t size);
 
 /* The same with doubles to `digits` significant digits (6 for titles),
- * leaving out the parameter named skip (a swept one; may be NULL). */
-void cm_params_format_with(const cm_params *p, int digits, const char *skip, char *buf,
+ * leaving out the parameters named in skip, a NULL-terminated list (the
+ * swept ones; skip itself may be NULL). */
+void cm_params_format_with(const cm_params *p, int digits, const char *const *skip, char *buf,
                            size_t size);
 
 #endif

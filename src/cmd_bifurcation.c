@@ -298,8 +298,9 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
     static const float sizes[3] = {2, 1, 3};
     static const char *const y_names[3] = {"x stick", "x", "Psi/n"};
     char params[400], title_params[200], sweep[200], runs[160], titles[3][600];
-    cm_params_format_with(base, 17, a->sweep.name, params, sizeof params);
-    cm_params_format_with(base, 6, a->sweep.name, title_params, sizeof title_params);
+    const char *const swept[] = {a->sweep.name, NULL};
+    cm_params_format_with(base, 17, swept, params, sizeof params);
+    cm_params_format_with(base, 6, swept, title_params, sizeof title_params);
     param_axes_format(&a->sweep, 1, sweep, sizeof sweep);
     snprintf(titles[0], sizeof titles[0], "sticking displacements (last %d per run), %s %s",
              LAST_STOPS, a->mo.name, title_params);

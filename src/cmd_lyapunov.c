@@ -121,7 +121,8 @@ static bool write_csv(const lyap_args *a, const double *v)
 static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v)
 {
     char title[512], params[400], grid[200];
-    cm_params_format(p, params, sizeof params);
+    const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
+    cm_params_format_with(p, 17, swept, params, sizeof params);
     param_axes_format(a->ax, 2, grid, sizeof grid);
     snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d periods", model, a->periods);
     const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};

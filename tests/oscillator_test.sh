@@ -36,7 +36,7 @@ grid=(--param S0=0.4 --grid Omega=0.3:0.7:8,S=0.02:0.5:6 --periods 150 --size 60
 cmp -s g1.csv g2.csv || fail "lyapunov CSV differs between 1 and 2 threads"
 cmp -s g1.png g2.png || fail "lyapunov PNG differs between 1 and 2 threads"
 grep -q "48 grid points" g1.out || fail "summary line: $(cat g1.out)"
-python3 - g1.csv g1.png <<'PY' || fail "grid CSV and PNG"
+python3 - g1.csv g1.png "$HERE" <<'PY' || fail "grid CSV and PNG"
 import csv, struct, sys, zlib
 rows = list(csv.DictReader(open(sys.argv[1])))
 assert len(rows) == 48, len(rows)
@@ -47,6 +47,11 @@ data = open(sys.argv[2], "rb").read()
 w, h = struct.unpack(">II", data[16:24])
 assert (w, h) == (600, 450), (w, h)
 assert b"Grid" in data and b"Omega=0.29999999999999999:0.69999999999999996:8" in data
+sys.path.insert(0, sys.argv[3])
+from pngcheck import read_png
+params = read_png(sys.argv[2])[4]["Parameters"]
+assert "S0=0.40000000000000002" in params, params          # the fixed ones are named,
+assert "Omega=" not in params and "S=" not in params, params  # the grid's are in Grid only
 PY
 ls | grep -q tmp- && fail "temporary files left behind"
 
