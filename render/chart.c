@@ -216,41 +216,62 @@ static void colour_bar(const cm_chart *c, const layout *L, const cm_font *f, dou
         cm_font_draw(f, c->heat->name, x, in->plot_y + L->ascent, ink, cv->rgba, cv->w, cv->h);
 }
 
-cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,
-                        size_t msg_size)
+/* Opens the chart's font and plans its layout: info gets the plot's place. */
+static cm_status measure(const cm_chart *c, cm_font **f, layout *L, cm_chart_info *info, char *msg,
+                         size_t msg_size)
 {
     memset(info, 0, sizeof *info);
     if (!(c->hi[0] > c->lo[0]) || !(c->hi[1] > c->lo[1]) || !isfinite(c->hi[0] - c->lo[0]) ||
         !isfinite(c->hi[1] - c->lo[1]))
         return cm_fail(CM_EINVAL, msg, msg_size, "the chart's ranges must be finite and not empty");
     const int side = c->width < c->height ? c->width : c->height;
-    cm_font *f = NULL;
-    cm_status st = cm_font_open(c->font_path, side / 45 > 10 ? side / 45 : 10, &f, msg, msg_size);
+    cm_status st = cm_font_open(c->font_path, side / 45 > 10 ? side / 45 : 10, f, msg, msg_size);
     if (st != CM_OK)
         return st;
     const double hmax = c->heat ? heat_max(c->heat) : 0;
     info->heat_max = hmax;
-    layout L;
-    plan(c, f, hmax > 0 ? hmax : 1, &L);
-    info->plot_x = L.left;
-    info->plot_y = L.top;
-    info->plot_w = c->width - L.left - L.right;
-    info->plot_h = c->height - L.top - L.bottom;
+    plan(c, *f, hmax > 0 ? hmax : 1, L);
+    if (c->min_left > L->left)
+        L->left = c->min_left;
+    info->plot_x = L->left;
+    info->plot_y = L->top;
+    info->plot_w = c->width - L->left - L->right;
+    info->plot_h = c->height - L->top - L->bottom;
     if (info->plot_w < 16 || info->plot_h < 16 || c->width > 4096 || c->height > 4096)
-        st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "a %dx%d chart leaves no room for its plot (charts take 200x150 to 4096x4096)",
-                     c->width, c->height);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a %dx%d chart leaves no room for its plot (charts take 200x150 to "
+                       "4096x4096)",
+                       c->width, c->height);
+    return CM_OK;
+}
+
+cm_status cm_chart_layout(const cm_chart *c, cm_chart_info *info, char *msg, size_t msg_size)
+{
+    cm_font *f = NULL;
+    layout L;
+    const cm_status st = measure(c, &f, &L, info, msg, msg_size);
+    cm_font_close(f);
+    return st;
+}
+
+cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,
+                        size_t msg_size)
+{
+    cm_font *f = NULL;
+    layout L;
+    cm_status st = measure(c, &f, &L, info, msg, msg_size);
+    const double hmax = info->heat_max > 0 ? info->heat_max : 1;
     const cm_canvas cv = {rgba, c->width, c->height};
     if (st == CM_OK) {
         cm_fill_rect(&cv, 0, 0, c->width, c->height, paper);
-        st = draw_plot(c, hmax > 0 ? hmax : 1, info->plot_x, info->plot_y, info->plot_w,
-                       info->plot_h, rgba, msg, msg_size);
+        st = draw_plot(c, hmax, info->plot_x, info->plot_y, info->plot_w, info->plot_h, rgba, msg,
+                       msg_size);
     }
     if (st == CM_OK) {
         frame(&cv, info->plot_x, info->plot_y, info->plot_w, info->plot_h);
         axes(c, &L, f, info, &cv);
         if (c->heat)
-            colour_bar(c, &L, f, hmax > 0 ? hmax : 1, info, &cv);
+            colour_bar(c, &L, f, hmax, info, &cv);
         if (c->title)
             cm_font_draw(f, c->title, L.pad, L.pad + L.ascent, ink, rgba, c->width, c->height);
     }

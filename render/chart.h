@@ -46,6 +46,9 @@ typedef struct cm_chart {
     const cm_series *series;
     int n_series;
     const char *font_path;
+    int min_left; /* the plot starts at least this many pixels from the left
+                     edge (stacked charts share their x axis); 0: as the
+                     labels need */
 } cm_chart;
 
 /* Where the plot went, so that callers and tests can map pixels. */
@@ -56,6 +59,9 @@ typedef struct cm_chart_info {
 
 /* The colour of a heat value on the scale 0..max. */
 cm_rgb cm_heat_colour(double v, double max);
+
+/* Where cm_chart_draw would put the plot (info's plot_*), without drawing. */
+cm_status cm_chart_layout(const cm_chart *c, cm_chart_info *info, char *msg, size_t msg_size);
 
 /* Draws into rgba (width*height*4 bytes, row 0 at the top). */
 cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,

@@ -326,7 +326,8 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
                                NULL,
                                &series[k],
                                1,
-                               figure_font()};
+                               figure_font(),
+                               0};
     }
     snprintf(runs, sizeof runs,
              "%d runs per value, seed %lld; %d transient and %d recorded periods", a->runs, a->seed,

@@ -136,7 +136,8 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                             &heat,
                             NULL,
                             0,
-                            figure_font()};
+                            figure_font(),
+                            0};
     char periods[32];
     snprintf(periods, sizeof periods, "%d", a->periods);
     const cm_png_text texts[] = {{"Model", model},

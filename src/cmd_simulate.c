@@ -375,7 +375,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          NULL,
          top,
          5,
-         figure_font()},
+         figure_font(),
+         0},
         {a->width,
          a->height - h_top,
          {lo_p[0], lo_p[1]},
@@ -386,7 +387,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          NULL,
          bottom,
          4,
-         figure_font()},
+         figure_font(),
+         0},
     };
     snprintf(start, sizeof start, "t0=%.17g,x=%.17g,v=%.17g", a->t0, a->from[0], a->from[1]);
     snprintf(periods, sizeof periods, "%d (the first %d not shown)", a->periods, a->skip);

@@ -46,11 +46,21 @@ bool write_chart_png(const char *cmd, const char *path, const cm_chart *charts, 
         all[n++] = texts[k];
     cm_status st =
         rgba ? CM_OK : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the image");
+    /* Stacked panels start their plots at the same x, the widest labels'
+     * margin, so that a parameter value lines up in every panel. */
+    int left = 0;
+    for (int k = 0; k < n_charts && st == CM_OK; k++) {
+        cm_chart_info info;
+        st = cm_chart_layout(&charts[k], &info, msg, sizeof msg);
+        left = info.plot_x > left ? info.plot_x : left;
+    }
     /* row 0 is the top: each panel is the next block of rows */
     size_t row = 0;
     for (int k = 0; k < n_charts && st == CM_OK; k++) {
+        cm_chart panel = charts[k];
         cm_chart_info info;
-        st = cm_chart_draw(&charts[k], rgba + row * (size_t)width * 4, &info, msg, sizeof msg);
+        panel.min_left = left;
+        st = cm_chart_draw(&panel, rgba + row * (size_t)width * 4, &info, msg, sizeof msg);
         row += (size_t)charts[k].height;
     }
     if (st == CM_OK)

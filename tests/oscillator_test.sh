@@ -156,6 +156,15 @@ from pngcheck import read_png
 w, h, bpp, rows, texts = read_png(sys.argv[3])
 assert (w, h) == (600, 600), (w, h)
 assert texts["Sweep"] == "S=0.28000000000000003:0.44:2" and "S=" not in texts["Parameters"], texts
+# the three stacked panels share the parameter axis: their frames' left
+# sides (the first column inked down most of the panel) are one column
+def frame_left(top, bottom):
+    for x in range(w):
+        inked = sum(rows[y][bpp * x:bpp * x + 3] == b"\0\0\0" for y in range(top, bottom))
+        if inked > 0.6 * (bottom - top):
+            return x
+lefts = [frame_left(k * 200, k * 200 + 200) for k in range(3)]
+assert lefts[0] is not None and lefts == [lefts[0]] * 3, lefts
 PY
 ls | grep -q tmp- && fail "temporary files left behind"
 
