@@ -392,7 +392,8 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
                  o.height - L.top - L.bottom,
                  {0},
                  {0},
-                 0};
+                 0,
+                 o.gl};
     if (st == CM_OK) {
         const int small = p.w < p.h ? p.w : p.h;
         p.line_width = small / 700 > 1 ? small / 700 : 1;

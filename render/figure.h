@@ -31,6 +31,7 @@ typedef struct cm_render_options {
     unsigned layers;           /* enum cm_layer; 0: basin and attractors */
     const cm_model *model;     /* overlays, title, axis names, the 1-D graph; may be NULL */
     const char *font_path;     /* TrueType font for axes, legend and title */
+    cm_gl *gl;                 /* a kept OSMesa context (render/gl.h); NULL: a new one */
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

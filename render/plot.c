@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/gl.h"
 #include "render/palette.h"
 
 enum { TEX_TILE = 2048, COBWEBS = 12, CIRCLE_SIDES = 24 };
@@ -341,10 +342,11 @@ cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tile
                        size_t msg_size)
 {
     *tiles = 0;
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, NULL);
-    if (!ctx)
-        return cm_fail(CM_ERENDER, msg, msg_size, "cannot create an OSMesa context");
-    cm_status st = CM_OK;
+    cm_gl *own = NULL;
+    cm_status st = p->gl ? CM_OK : cm_gl_open(&own, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const OSMesaContext ctx = cm_gl_context(p->gl ? p->gl : own);
     for (int y = 0; y < p->h && st == CM_OK; y += CM_PLOT_TILE)
         for (int x = 0; x < p->w && st == CM_OK; x += CM_PLOT_TILE) {
             const tile t = {x, y, p->w - x < CM_PLOT_TILE ? p->w - x : CM_PLOT_TILE,
@@ -352,6 +354,6 @@ cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tile
             st = draw_tile(ctx, p, &t, rgba, fig_width, msg, msg_size);
             ++*tiles;
         }
-    OSMesaDestroyContext(ctx);
+    cm_gl_close(own);
     return st;
 }

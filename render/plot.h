@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "cellmap/model.h"
+#include "render/gl.h"
 #include "render/raster.h"
 
 enum { CM_PLOT_TILE = 4096 };
@@ -48,6 +49,7 @@ typedef struct cm_plot {
     cm_panel basin; /* where the cells go */
     cm_panel graph; /* 1-D models: the map's graph (w == 0: none) */
     int line_width; /* pixels */
+    cm_gl *gl;      /* the context to draw with; NULL: one of its own */
 } cm_plot;
 
 /* Draws the plot into rgba, a figure of fig_width columns (and at least

@@ -214,6 +214,7 @@ static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
     memcpy(ro.hi, b->hi, sizeof ro.hi);
     ro.model = b->model;
     ro.font_path = figure_font();
+    ro.gl = b->gl;
     uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
     if (!rgba)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", ro.width,

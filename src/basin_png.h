@@ -5,6 +5,7 @@
 
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
+#include "render/gl.h"
 #include "src/args.h"
 
 typedef struct png_opts {
@@ -51,6 +52,7 @@ typedef struct basin_png {
     const cm_region *cells;      /* the cells to draw (group, step) */
     const cm_group_info *groups; /* the groups' summaries, for the colours */
     double lo[2], hi[2];         /* the view; all 0: the cells' box */
+    cm_gl *gl;                   /* a kept OSMesa context, or NULL */
 } basin_png;
 
 /* Renders and writes the PNG (temporary file, then rename). Prints

@@ -134,8 +134,8 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     if (st != CM_OK) {
         fprintf(stderr, "cellmap render: %s\n", msg);
     } else {
-        const basin_png png = {&a->png,       &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
-                               {hi[0], hi[1]}};
+        const basin_png png = {&a->png,        &m,  &cl->lat, &flat, groups, {lo[0], lo[1]},
+                               {hi[0], hi[1]}, NULL};
         rc = write_basin_png("render", &png);
     }
     cm_region_free(&flat);

@@ -624,7 +624,7 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, 
 static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_lattice *lat, run *rn,
                           const summary *sum, cm_region *r, char *msg, size_t msg_size)
 {
-    basin_png png = {&a->png, m, lat, r, sum->groups, {0, 0}, {0, 0}};
+    basin_png png = {&a->png, m, lat, r, sum->groups, {0, 0}, {0, 0}, NULL};
     if (a->png.has_view) {
         cm_box box;
         view_cells(lat, a->png.lo, a->png.hi, &sum->box, &box);

@@ -530,8 +530,11 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     cm_group_info *groups = NULL;
     memset(&flat, 0, sizeof flat);
     st = shown_cells(s, &flat, &groups, msg, msg_size);
+    if (st == CM_OK && !s->gl && !po.indexed)
+        st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {
-        &po, &s->model, &s->c.lat, &flat, groups, {s->lo[0], s->lo[1]}, {s->hi[0], s->hi[1]}};
+        &po,  &s->model, &s->c.lat, &flat, groups, {s->lo[0], s->lo[1]}, {s->hi[0], s->hi[1]},
+        s->gl};
     if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
         st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
     if (st == CM_OK && s->out) {
@@ -1002,6 +1005,8 @@ cm_status session_close(session *s, char *msg, size_t msg_size)
     const cm_status closed = cm_store_close(s->store, msg, msg_size);
     s->store = NULL;
     cm_cluster_free(&s->c);
+    cm_gl_close(s->gl);
+    s->gl = NULL;
     if (s->have_model)
         cm_model_release(&s->model);
     s->have_model = 0;

@@ -16,6 +16,7 @@
 
 #include "cellmap/cluster.h"
 #include "cellmap/store.h"
+#include "render/gl.h"
 #include "src/args.h"
 
 /* How to open (or create) the session's database. */
@@ -47,6 +48,7 @@ typedef struct session {
     int64_t slice[CM_MAX_DIM]; /* dimensions >= 2: the cell shown */
     int quit;
     FILE *out;
+    cm_gl *gl; /* kept between renders (made by the first); NULL until then */
 } session;
 
 /* Opens path (creating it from the model options if it does not exist).

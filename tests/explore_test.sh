@@ -21,6 +21,31 @@ for script in "$SRC"/assets/examples/*.explore; do
     fail "example $name: pixels"
 done
 
+# --- a session keeps one GL context: its renders equal fresh ones ----------
+# Figures with other layers and sizes in between must not leave GL state
+# behind: each render's bytes equal those of a new process drawing it.
+pd_opts="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02 --cell-size 0.5,0.08"
+"$CM" explore gl.cmdb - $pd_opts > /dev/null <<'S' || fail "session with several renders"
+view 100:200 -8:8
+render first.png 500x300
+render all.png 700x500 --layers all
+pan right 20%
+render panned.png 400x400 --layers basin,steps,axes
+pan left 20%
+render again.png 500x300
+S
+cmp -s first.png again.png || fail "the same view rendered twice in a session differs"
+for f in all panned; do
+  case $f in
+    all) cmd="view 100:200 -8:8
+render fresh-$f.png 700x500 --layers all" ;;
+    panned) cmd="view 120:220 -8:8
+render fresh-$f.png 400x400 --layers basin,steps,axes" ;;
+  esac
+  "$CM" explore gl.cmdb - > /dev/null <<<"$cmd" || fail "fresh render $f"
+  cmp -s "$f.png" "fresh-$f.png" || fail "render $f in a session differs from a fresh process's"
+done
+
 # --- a session equals a single solve of the union of its views ------------
 # Views inside 100:300 x -16:16 with pans and zooms, then the whole box.
 pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"

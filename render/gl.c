@@ -1,0 +1,32 @@
+#include "render/gl.h"
+
+#include <GL/osmesa.h>
+#include <stdlib.h>
+
+struct cm_gl {
+    OSMesaContext ctx;
+};
+
+cm_status cm_gl_open(cm_gl **out, char *msg, size_t msg_size)
+{
+    *out = calloc(1, sizeof **out);
+    if (!*out)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for an OSMesa context");
+    (*out)->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, NULL);
+    if (!(*out)->ctx) {
+        free(*out);
+        *out = NULL;
+        return cm_fail(CM_ERENDER, msg, msg_size, "cannot create an OSMesa context");
+    }
+    return CM_OK;
+}
+
+void cm_gl_close(cm_gl *gl)
+{
+    if (!gl)
+        return;
+    OSMesaDestroyContext(gl->ctx);
+    free(gl);
+}
+
+void *cm_gl_context(const cm_gl *gl) { return gl->ctx; }
