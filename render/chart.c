@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "render/axes.h"
+#include "render/gl.h"
 #include "render/text.h"
 
 static const cm_rgb ink = {0, 0, 0};
@@ -128,10 +129,11 @@ static void draw_series(const cm_series *s)
 static cm_status draw_plot(const cm_chart *c, double hmax, int px, int py, int pw, int ph,
                            uint8_t *rgba, char *msg, size_t msg_size)
 {
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, NULL);
-    if (!ctx)
-        return cm_fail(CM_ERENDER, msg, msg_size, "cannot create an OSMesa context");
-    cm_status st = CM_OK;
+    cm_gl *gl = NULL;
+    cm_status st = cm_gl_open(&gl, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const OSMesaContext ctx = cm_gl_context(gl);
     uint8_t *origin = rgba + 4 * ((size_t)py * (size_t)c->width + (size_t)px);
     if (!OSMesaMakeCurrent(ctx, origin, GL_UNSIGNED_BYTE, pw, ph)) {
         st = cm_fail(CM_ERENDER, msg, msg_size, "OSMesaMakeCurrent failed for %dx%d", pw, ph);
@@ -154,7 +156,7 @@ static cm_status draw_plot(const cm_chart *c, double hmax, int px, int py, int p
         if (glGetError() != GL_NO_ERROR)
             st = cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");
     }
-    OSMesaDestroyContext(ctx);
+    cm_gl_close(gl);
     return st;
 }
 
