@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "render/axes.h"
-#include "render/gl.h"
 #include "render/text.h"
 
 static const cm_rgb ink = {0, 0, 0};
@@ -126,14 +125,14 @@ static void draw_series(const cm_series *s)
     glEnd();
 }
 
-static cm_status draw_plot(const cm_chart *c, double hmax, int px, int py, int pw, int ph,
-                           uint8_t *rgba, char *msg, size_t msg_size)
+static cm_status draw_plot(const cm_chart *c, cm_gl *gl, double hmax, int px, int py, int pw,
+                           int ph, uint8_t *rgba, char *msg, size_t msg_size)
 {
-    cm_gl *gl = NULL;
-    cm_status st = cm_gl_open(&gl, msg, msg_size);
+    cm_gl *own = NULL;
+    cm_status st = gl ? CM_OK : cm_gl_open(&own, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const OSMesaContext ctx = cm_gl_context(gl);
+    const OSMesaContext ctx = cm_gl_context(gl ? gl : own);
     uint8_t *origin = rgba + 4 * ((size_t)py * (size_t)c->width + (size_t)px);
     if (!OSMesaMakeCurrent(ctx, origin, GL_UNSIGNED_BYTE, pw, ph)) {
         st = cm_fail(CM_ERENDER, msg, msg_size, "OSMesaMakeCurrent failed for %dx%d", pw, ph);
@@ -156,7 +155,7 @@ static cm_status draw_plot(const cm_chart *c, double hmax, int px, int py, int p
         if (glGetError() != GL_NO_ERROR)
             st = cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");
     }
-    cm_gl_close(gl);
+    cm_gl_close(own);
     return st;
 }
 
@@ -256,7 +255,7 @@ cm_status cm_chart_layout(const cm_chart *c, cm_chart_info *info, char *msg, siz
     return st;
 }
 
-cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,
+cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_info *info, char *msg,
                         size_t msg_size)
 {
     cm_font *f = NULL;
@@ -266,8 +265,8 @@ cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, c
     const cm_canvas cv = {rgba, c->width, c->height};
     if (st == CM_OK) {
         cm_fill_rect(&cv, 0, 0, c->width, c->height, paper);
-        st = draw_plot(c, hmax, info->plot_x, info->plot_y, info->plot_w, info->plot_h, rgba, msg,
-                       msg_size);
+        st = draw_plot(c, gl, hmax, info->plot_x, info->plot_y, info->plot_w, info->plot_h, rgba,
+                       msg, msg_size);
     }
     if (st == CM_OK) {
         frame(&cv, info->plot_x, info->plot_y, info->plot_w, info->plot_h);

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "cellmap/status.h"
+#include "render/gl.h"
 #include "render/palette.h"
 
 enum cm_series_kind {
@@ -63,8 +64,9 @@ cm_rgb cm_heat_colour(double v, double max);
 /* Where cm_chart_draw would put the plot (info's plot_*), without drawing. */
 cm_status cm_chart_layout(const cm_chart *c, cm_chart_info *info, char *msg, size_t msg_size);
 
-/* Draws into rgba (width*height*4 bytes, row 0 at the top). */
-cm_status cm_chart_draw(const cm_chart *c, uint8_t *rgba, cm_chart_info *info, char *msg,
+/* Draws into rgba (width*height*4 bytes, row 0 at the top) with the
+ * context gl (render/gl.h), or a new one when gl is NULL. */
+cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_info *info, char *msg,
                         size_t msg_size);
 
 #endif

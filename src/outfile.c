@@ -54,15 +54,20 @@ bool write_chart_png(const char *cmd, const char *path, const cm_chart *charts, 
         st = cm_chart_layout(&charts[k], &info, msg, sizeof msg);
         left = info.plot_x > left ? info.plot_x : left;
     }
-    /* row 0 is the top: each panel is the next block of rows */
+    /* row 0 is the top: each panel is the next block of rows, all drawn
+     * with one GL context */
+    cm_gl *gl = NULL;
+    if (st == CM_OK)
+        st = cm_gl_open(&gl, msg, sizeof msg);
     size_t row = 0;
     for (int k = 0; k < n_charts && st == CM_OK; k++) {
         cm_chart panel = charts[k];
         cm_chart_info info;
         panel.min_left = left;
-        st = cm_chart_draw(&panel, rgba + row * (size_t)width * 4, &info, msg, sizeof msg);
+        st = cm_chart_draw(&panel, gl, rgba + row * (size_t)width * 4, &info, msg, sizeof msg);
         row += (size_t)charts[k].height;
     }
+    cm_gl_close(gl);
     if (st == CM_OK)
         st = cm_png_write(path, rgba, width, height, all, n, msg, sizeof msg);
     free(rgba);
