@@ -50,6 +50,7 @@ typedef struct classifier {
     uint32_t *group, *step;
     uint32_t cursor;  /* every cell below it has been started or visited */
     uint32_t ngroups; /* provisional groups found so far */
+    int node_refs;    /* paths into recorded exits take CM_NODE_REF | exit */
     lane lanes[LANES];
 } classifier;
 
@@ -139,8 +140,10 @@ static walk_result advance(classifier *c, int k, cm_status *st)
 {
     lane *l = &c->lanes[k];
     const uint32_t cell = l->next;
-    if (cell >= c->n) { /* the sink's domain */
-        label(c, l, 0, UINT32_MAX, 0);
+    if (cell >= c->n) { /* the sink's domain, through the node on the path's end */
+        const uint32_t exit = cell - UINT32_C(0x80000000);
+        const bool node = c->node_refs && cell >= UINT32_C(0x80000000) && cell < 0xFFFFFFFEu;
+        label(c, l, node ? CM_NODE_REF | exit : 0, UINT32_MAX, 0);
         return WALK_DONE;
     }
     const uint32_t s = c->step[cell];
@@ -188,6 +191,8 @@ static cm_status renumber(classifier *c, char *msg, size_t msg_size)
     uint32_t next_id = 1;
     for (uint32_t i = 0; i < c->n; i++) {
         uint32_t *g = &c->group[i];
+        if (*g & CM_NODE_REF)
+            continue;
         if (final_id[*g] == UINT32_MAX)
             final_id[*g] = next_id++;
         *g = final_id[*g];
@@ -197,9 +202,9 @@ static cm_status renumber(classifier *c, char *msg, size_t msg_size)
 }
 
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
-                      uint32_t *ngroups, char *msg, size_t msg_size)
+                      uint32_t *ngroups, int node_refs, char *msg, size_t msg_size)
 {
-    classifier c = {n, image, group, step, 0, 0, {{0}}};
+    classifier c = {n, image, group, step, 0, 0, node_refs, {{0}}};
     uint32_t *buffers = malloc((size_t)LANES * LANE_BUFFER * sizeof *buffers);
     if (!buffers)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffers");

@@ -7,6 +7,7 @@
  * local index of each group's domain; step[i] is 0 for periodic cells, else
  * the number of steps to the periodic group (or to leaving: a cell whose
  * image is >= n has step 1). Linear time; deterministic; needs n < 2^31.
+ * Group ids stay below CM_NODE_REF.
  */
 #ifndef CM_CLASSIFY_H
 #define CM_CLASSIFY_H
@@ -22,9 +23,21 @@
  * again with CM_STEP_ON_PATH too). Group ids stay at most CM_MAX_GROUPS. */
 #define CM_STEP_UNVISITED UINT32_C(0xFFFFFFFF)
 #define CM_STEP_ON_PATH UINT32_C(0x80000000)
-#define CM_MAX_GROUPS UINT32_C(0xFFFFFEFF)
+#define CM_MAX_GROUPS UINT32_C(0x7FFFFFFF)
+/* group[] of a cell whose sequence leaves the region through recorded exit
+ * k (image CM_IMAGE_EXIT_BASE + k of the chain's last cell, its *node*):
+ * CM_NODE_REF | k. Such cells are in the sink's domain as far as the region
+ * knows; a cluster resolves them through its node table. */
+#define CM_NODE_REF UINT32_C(0x80000000)
 
+static inline int cm_is_node_ref(uint32_t group)
+{
+    return (group & CM_NODE_REF) && group != UINT32_C(0xFFFFFFFF);
+}
+
+/* node_refs: cells whose chains end in a recorded exit get CM_NODE_REF | k
+ * instead of group 0 (image values CM_IMAGE_EXIT_BASE + k, cellmap/scm.h). */
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
-                      uint32_t *ngroups, char *msg, size_t msg_size);
+                      uint32_t *ngroups, int node_refs, char *msg, size_t msg_size);
 
 #endif

@@ -1,8 +1,6 @@
 #include "cellmap/cluster.h"
 
-#include "cellmap/classify.h"
 #include "cellmap/grow.h"
-#include "cellmap/resolve.h"
 
 #include <stdbool.h>
 #include <stdlib.h>
@@ -31,24 +29,33 @@ void cm_cluster_free(cm_cluster *c)
 {
     if (!c)
         return;
-    for (uint32_t k = 0; k < c->nregions; k++) {
+    for (uint32_t k = 0; k < c->nregions; k++)
         cm_region_free(&c->regions[k].r);
-        free(c->regions[k].escapes);
-        free(c->regions[k].targets);
-        free(c->regions[k].entries);
-    }
     free(c->regions);
+    free(c->nodes);
+    free(c->basin);
+    free(c->basin_dirty);
+    free(c->new_periodic);
+    free(c->big);
+    cm_bricks_free(c->region_bricks);
+    cm_bricks_free(c->escape_bricks);
     memset(c, 0, sizeof *c);
 }
 
-int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint, uint64_t *local)
+/* ---- where cells and nodes are ------------------------------------------ */
+
+int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local)
 {
-    for (uint32_t n = 0; n < c->nregions; n++) {
-        /* try the region of the last hit first: exits mostly land next door */
-        const uint32_t k = (*hint + n) % c->nregions;
+    if (!c->region_bricks)
+        return -1;
+    int64_t key[CM_MAX_DIM];
+    uint64_t n;
+    cm_bricks_of(c->region_bricks, cell, key);
+    const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &n);
+    for (uint64_t p = 0; p < n + c->nbig; p++) {
+        const uint32_t k = p < n ? in_brick[p] : c->big[p - n];
         const cm_box *box = &c->regions[k].r.box;
         if (cm_box_contains(box, cell)) {
-            *hint = k;
             *local = cm_box_index(box, cell);
             return k;
         }
@@ -56,17 +63,137 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hi
     return -1;
 }
 
-void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
+uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
 {
-    *box = c->regions[0].r.box;
-    for (uint32_t k = 1; k < c->nregions; k++) {
-        const cm_box *b = &c->regions[k].r.box;
-        for (int d = 0; d < box->dim; d++) {
-            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
-            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
-        }
+    uint32_t lo = 0, hi = c->nregions; /* the last region whose node_base <= id */
+    while (hi - lo > 1) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (c->regions[mid].node_base <= id)
+            lo = mid;
+        else
+            hi = mid;
     }
+    /* regions without nodes share their successor's base: take the one holding id */
+    while (lo + 1 < c->nregions && c->regions[lo + 1].node_base <= id)
+        lo++;
+    return lo;
 }
+
+void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
+{
+    c->regions[cm_cluster_node_region(c, id)].nodes_dirty = 1;
+}
+
+cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
+{
+    cm_escape e;
+    memset(&e, 0, sizeof e);
+    e.node = id;
+    memcpy(e.cell, cell, (size_t)c->lat.dim * sizeof *cell);
+    return cm_bricks_add(c->escape_bricks, cell, &e);
+}
+
+static int escape_cmp(const void *a, const void *b)
+{
+    const uint32_t x = ((const cm_escape *)a)->node, y = ((const cm_escape *)b)->node;
+    return (x > y) - (x < y);
+}
+
+cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n)
+{
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM], last[CM_MAX_DIM];
+    const int dim = c->lat.dim;
+    uint64_t cap = 0;
+    *out = NULL;
+    *n = 0;
+    for (int d = 0; d < dim; d++)
+        last[d] = box->hi[d] - 1;
+    cm_bricks_of(c->escape_bricks, box->lo, lo);
+    cm_bricks_of(c->escape_bricks, last, hi);
+    memcpy(key, lo, sizeof key);
+    for (;;) {
+        uint64_t count;
+        cm_escape *e = cm_bricks_find(c->escape_bricks, key, &count);
+        for (uint64_t i = count; i-- > 0;) {
+            if (!cm_box_contains(box, e[i].cell))
+                continue;
+            if (cm_grow((void **)out, &cap, *n + 1, sizeof **out) != CM_OK)
+                return CM_ENOMEM;
+            (*out)[(*n)++] = e[i];
+            cm_bricks_remove(c->escape_bricks, key, i);
+        }
+        int d = 0;
+        while (d < dim && key[d] == hi[d]) {
+            key[d] = lo[d];
+            d++;
+        }
+        if (d == dim)
+            break;
+        key[d]++;
+    }
+    if (*n > 1)
+        qsort(*out, *n, sizeof **out, escape_cmp);
+    return CM_OK;
+}
+
+/* ---- resolution ----------------------------------------------------------- */
+
+cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
+                             uint32_t *open)
+{
+    cm_node *nodes = c->nodes;
+    uint64_t total = 0;
+    uint32_t y = id;
+    while (nodes[y].up != CM_NODE_FINAL && nodes[y].up != CM_NODE_OPEN) {
+        total += nodes[y].up_dist;
+        y = nodes[y].up;
+    }
+    const bool final = nodes[y].up == CM_NODE_FINAL;
+    const uint64_t end = final ? nodes[y].up_dist : 1; /* an open node's image leaves */
+    if (total + end >= CM_STEP_ON_PATH)
+        return CM_ETOOBIG;
+    /* every node on the way now points at the end, or is final */
+    uint64_t done = 0;
+    for (uint32_t x = id; x != y;) {
+        cm_node *nd = &nodes[x];
+        const uint32_t next = nd->up, d = nd->up_dist;
+        if (final) {
+            nd->up = CM_NODE_FINAL;
+            nd->group = nodes[y].group;
+            nd->up_dist = (uint32_t)(total - done + end);
+        } else {
+            nd->up = y;
+            nd->up_dist = (uint32_t)(total - done);
+        }
+        done += d;
+        x = next;
+    }
+    *group = final ? nodes[y].group : 0;
+    *step = (uint32_t)(total + end);
+    if (open)
+        *open = final ? CM_NODE_OPEN : y;
+    return CM_OK;
+}
+
+uint32_t cm_cluster_cycle_steps(const cm_cluster *c, uint32_t k, uint32_t id, uint32_t t)
+{
+    const cm_region *r = &c->regions[k].r;
+    const uint32_t *image = r->image, *step = r->step;
+    uint32_t a = t, b = c->nodes[id].dist, da = step[a], db = step[b], count = 0;
+    /* the cycle runs down the tree from its entry b to the node: t's chain
+     * meets it where it meets b's chain */
+    for (; da > db; da--, count++)
+        a = image[a];
+    for (; db > da; db--)
+        b = image[b];
+    for (; a != b; count++) {
+        a = image[a];
+        b = image[b];
+    }
+    return count;
+}
+
+/* ---- paging ----------------------------------------------------------- */
 
 static int is_resident(const cm_cluster_region *cr) { return cr->r.group != NULL; }
 
@@ -81,13 +208,10 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
-    uint64_t bytes = cm_cluster_resident_bytes(c);
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_cluster_region *cr = &c->regions[k];
-        bytes += cr->nescapes * (uint64_t)c->lat.dim * sizeof *cr->escapes +
-                 cr->targets_cap * sizeof *cr->targets + cr->entries_cap * sizeof *cr->entries;
-    }
-    return bytes;
+    return cm_cluster_resident_bytes(c) + c->nodes_cap * sizeof *c->nodes +
+           c->basin_cap * (sizeof *c->basin + 1) + c->periodic_cap * sizeof *c->new_periodic +
+           c->cap * sizeof *c->regions + cm_bricks_bytes(c->region_bricks) +
+           cm_bricks_bytes(c->escape_bricks);
 }
 
 static void evict(cm_cluster_region *cr)
@@ -100,24 +224,19 @@ static void evict(cm_cluster_region *cr)
     cr->r.exit_target = NULL;
 }
 
-/* The resident region to evict next, other than `keep`, or -1: clean ones
- * before dirty ones (which only with_dirty allows), then those no sequence
- * leaves (all neighbours known), then the least recently used. */
-static int64_t eviction_victim(const cm_cluster *c, int64_t keep, int with_dirty)
+/* The resident region to evict next, other than `keep`, or -1: saved ones
+ * before unsaved ones (which only with_unsaved allows), then the least
+ * recently used. */
+static int64_t eviction_victim(const cm_cluster *c, int64_t keep, int with_unsaved)
 {
     int64_t best = -1;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
-        if (!is_resident(cr) || (int64_t)k == keep || (cr->dirty && !with_dirty))
+        if (!is_resident(cr) || (int64_t)k == keep || (!cr->written && !with_unsaved))
             continue;
-        if (best < 0) {
-            best = k;
-            continue;
-        }
-        const cm_cluster_region *b = &c->regions[best];
-        const int rank = 2 * !cr->dirty + (cr->nescapes == 0),
-                  best_rank = 2 * !b->dirty + (b->nescapes == 0);
-        if (rank > best_rank || (rank == best_rank && cr->last_used < b->last_used))
+        const cm_cluster_region *b = best >= 0 ? &c->regions[best] : NULL;
+        if (!b || cr->written > b->written ||
+            (cr->written == b->written && cr->last_used < b->last_used))
             best = k;
     }
     return best;
@@ -134,11 +253,11 @@ static cm_status make_room(cm_cluster *c, int64_t keep, uint64_t extra, char *ms
         if (k < 0)
             return CM_OK;
         cm_cluster_region *cr = &c->regions[k];
-        if (cr->dirty) {
+        if (!cr->written) {
             cm_status st = c->page_out(c->pager, c, (uint32_t)k, msg, msg_size);
             if (st != CM_OK)
                 return st;
-            cr->dirty = 0;
+            cr->written = 1;
         }
         bytes -= cm_region_bytes(&cr->r);
         evict(cr);
@@ -157,7 +276,6 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
     cm_status st = make_room(c, k, cm_region_bytes(&cr->r), msg, msg_size);
     if (st == CM_OK)
         st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
-    cr->read_at = c->clock;
     if (st == CM_OK && !is_resident(cr))
         st = cm_fail(CM_EIO, msg, msg_size, "region %u was not read back", k);
     return st;
@@ -188,291 +306,336 @@ void cm_cluster_trim(cm_cluster *c)
     }
 }
 
-static cm_status check_region(const cm_cluster *c, const cm_region *r, char *msg, size_t msg_size)
+void cm_cluster_saved(cm_cluster *c)
 {
-    if (r->box.dim != c->lat.dim)
-        return cm_fail(CM_EINVAL, msg, msg_size, "region of %d dimensions, lattice of %d",
-                       r->box.dim, c->lat.dim);
-    if (c->nregions == UINT32_MAX)
-        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions in one cluster");
-    if (c->ngroups > CM_MAX_GROUPS - r->ngroups)
-        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups in one cluster");
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        c->regions[k].written = 1;
+        c->regions[k].nodes_dirty = 0;
+    }
+    if (c->basin_dirty)
+        memset(c->basin_dirty, 0, (size_t)c->ngroups + 1);
+    c->nnew_periodic = 0;
+    c->saved_groups = c->ngroups;
+}
+
+uint64_t cm_cluster_sink_cells(const cm_cluster *c)
+{
+    uint64_t in_groups = 0;
+    for (uint32_t g = 1; g <= c->ngroups; g++)
+        in_groups += c->basin[g];
+    return c->cells - in_groups;
+}
+
+void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
+{
+    *box = c->regions[0].r.box;
+    for (uint32_t k = 1; k < c->nregions; k++) {
+        const cm_box *b = &c->regions[k].r.box;
+        for (int d = 0; d < box->dim; d++) {
+            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
+            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
+        }
+    }
+}
+
+/* ---- adding regions -------------------------------------------------------- */
+
+/* A region that shares cells with box, or -1: the regions of the bricks
+ * the box meets (all regions for a box of very many bricks). */
+static int64_t overlapping_region(const cm_cluster *c, const cm_box *box)
+{
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM], last[CM_MAX_DIM];
+    const int dim = c->lat.dim;
     cm_box both;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        if (cm_box_intersect(&c->regions[k].r.box, &r->box, &both))
-            return cm_fail(CM_EINVAL, msg, msg_size,
-                           "the new region overlaps region %u of the cluster; regions of a "
-                           "cluster must not share cells",
-                           k);
+    uint64_t span = 1;
+    if (c->region_bricks) {
+        for (int d = 0; d < dim; d++)
+            last[d] = box->hi[d] - 1;
+        cm_bricks_of(c->region_bricks, box->lo, lo);
+        cm_bricks_of(c->region_bricks, last, hi);
+        for (int d = 0; d < dim && span <= CM_BRICKS_MAX_SPAN; d++)
+            span *= (uint64_t)(hi[d] - lo[d] + 1);
+    }
+    if (!c->region_bricks || span > CM_BRICKS_MAX_SPAN) {
+        for (uint32_t k = 0; k < c->nregions; k++)
+            if (cm_box_intersect(&c->regions[k].r.box, box, &both))
+                return k;
+        return -1;
+    }
+    for (uint64_t b = 0; b < c->nbig; b++)
+        if (cm_box_intersect(&c->regions[c->big[b]].r.box, box, &both))
+            return c->big[b];
+    memcpy(key, lo, sizeof key);
+    for (;;) {
+        uint64_t n;
+        const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &n);
+        for (uint64_t p = 0; p < n; p++)
+            if (cm_box_intersect(&c->regions[in_brick[p]].r.box, box, &both))
+                return in_brick[p];
+        int d = 0;
+        while (d < dim && key[d] == hi[d]) {
+            key[d] = lo[d];
+            d++;
+        }
+        if (d == dim)
+            return -1;
+        key[d]++;
+    }
+}
+
+static cm_status check_region(const cm_cluster *c, const cm_box *box, uint64_t nexits,
+                              uint32_t ngroups, char *msg, size_t msg_size)
+{
+    if (box->dim != c->lat.dim)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region of %d dimensions, lattice of %d",
+                       box->dim, c->lat.dim);
+    if (c->nregions == UINT32_MAX - 1)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions in one cluster");
+    if (c->ngroups > CM_MAX_GROUPS - ngroups)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many periodic groups in one cluster");
+    if (c->nnodes + nexits >= CM_NODE_MAX)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "too many exits in one cluster");
+    const int64_t k = overlapping_region(c, box);
+    if (k >= 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the new region overlaps region %u of the cluster; regions of a "
+                       "cluster must not share cells",
+                       (unsigned)k);
+    return CM_OK;
+}
+
+/* Room for a region, its nodes and its groups; the brick maps on the first. */
+static cm_status make_space(cm_cluster *c, const cm_box *box, uint64_t nexits, uint32_t ngroups)
+{
+    if (!c->region_bricks) {
+        int shift[CM_MAX_DIM];
+        cm_bricks_shift_for(box, shift);
+        if (cm_bricks_alloc(c->lat.dim, shift, sizeof(uint32_t), &c->region_bricks) != CM_OK ||
+            cm_bricks_alloc(c->lat.dim, shift, sizeof(cm_escape), &c->escape_bricks) != CM_OK)
+            return CM_ENOMEM;
+    }
+    const uint64_t groups = (uint64_t)c->ngroups + ngroups + 1, had = c->basin_cap;
+    if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK ||
+        cm_grow((void **)&c->nodes, &c->nodes_cap, c->nnodes + nexits, sizeof *c->nodes) != CM_OK ||
+        cm_grow((void **)&c->basin, &c->basin_cap, groups, sizeof *c->basin) != CM_OK)
+        return CM_ENOMEM;
+    uint8_t *dirty = realloc(c->basin_dirty, c->basin_cap);
+    if (!dirty)
+        return CM_ENOMEM;
+    c->basin_dirty = dirty;
+    memset(c->basin + had, 0, (c->basin_cap - had) * sizeof *c->basin);
+    memset(c->basin_dirty + had, 0, c->basin_cap - had);
+    return CM_OK;
+}
+
+cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g)
+{
+    if (c->ngroups >= CM_MAX_GROUPS)
+        return CM_ETOOBIG;
+    if (make_space(c, &c->regions[0].r.box, 0, 1) != CM_OK)
+        return CM_ENOMEM;
+    *g = ++c->ngroups;
+    c->basin[*g] = 0;
+    c->basin_dirty[*g] = 1;
+    return CM_OK;
+}
+
+/* Indexes region k by the bricks it meets (or as a big one). */
+static cm_status index_region(cm_cluster *c, uint32_t k)
+{
+    cm_status st = cm_bricks_add_box(c->region_bricks, &c->regions[k].r.box, &k);
+    if (st != CM_ETOOBIG)
+        return st;
+    if (cm_grow((void **)&c->big, &c->big_cap, c->nbig + 1, sizeof *c->big) != CM_OK)
+        return CM_ENOMEM;
+    c->big[c->nbig++] = k;
+    return CM_OK;
+}
+
+/* Appends region k's nodes as given (or open, with their tree sizes). */
+static void init_nodes(cm_cluster *c, uint64_t n, const cm_node *saved)
+{
+    for (uint64_t e = 0; e < n; e++) {
+        cm_node *nd = &c->nodes[c->nnodes + e];
+        memset(nd, 0, sizeof *nd);
+        if (saved) {
+            nd->next = saved[e].next;
+            nd->dist = saved[e].dist;
+            nd->group = saved[e].group;
+            nd->target = saved[e].target;
+            nd->tree = saved[e].tree;
+        } else {
+            nd->next = CM_NODE_OPEN;
+        }
+        nd->up = CM_NODE_OPEN;
+        nd->ring = (uint32_t)(c->nnodes + e);
+    }
+    c->nnodes += n;
+}
+
+static cm_status note_periodic(cm_cluster *c, uint32_t group, const cm_box *box, uint64_t i)
+{
+    if (cm_grow((void **)&c->new_periodic, &c->periodic_cap, c->nnew_periodic + 1,
+                sizeof *c->new_periodic) != CM_OK)
+        return CM_ENOMEM;
+    cm_group_cell *pc = &c->new_periodic[c->nnew_periodic++];
+    memset(pc, 0, sizeof *pc);
+    pc->group = group;
+    cm_box_cell(box, i, pc->cell);
+    return CM_OK;
+}
+
+cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64_t local)
+{
+    return note_periodic(c, g, &c->regions[k].r.box, local);
+}
+
+/* The new region's own groups take ids from base + 1: one pass that also
+ * counts the cells of each group and of each node's tree and notes the
+ * periodic cells. */
+static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes)
+{
+    uint32_t *group = r->group;
+    const uint32_t *step = r->step;
+    uint64_t *basin = c->basin;
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        const uint32_t g = group[i];
+        if (cm_is_node_ref(g)) {
+            nodes[g & ~CM_NODE_REF].tree++;
+        } else if (g != 0) {
+            group[i] = g + base;
+            basin[g + base]++;
+            if (step[i] == 0 && note_periodic(c, g + base, &r->box, i) != CM_OK)
+                return CM_ENOMEM;
+        }
+    }
+    for (uint64_t e = 0; e < r->nexits; e++)
+        nodes[e].weight = nodes[e].tree;
+    for (uint32_t g = 1; g <= r->ngroups; g++)
+        c->basin_dirty[base + g] = 1;
+    return CM_OK;
+}
+
+cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t msg_size)
+{
     if (!r->exits_recorded)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the region was solved without record_exits; its exits cannot be "
                        "followed into the cluster");
-    return CM_OK;
-}
-
-static cm_status add_target(cm_cluster_region *cr, uint32_t region)
-{
-    for (uint32_t t = 0; t < cr->ntargets; t++)
-        if (cr->targets[t] == region)
-            return CM_OK;
-    if (cm_grow((void **)&cr->targets, &cr->targets_cap, cr->ntargets + 1, sizeof *cr->targets) !=
-        CM_OK)
-        return CM_ENOMEM;
-    cr->targets[cr->ntargets++] = region;
-    return CM_OK;
-}
-
-static cm_status add_entry(cm_cluster_region *cr, uint64_t cell)
-{
-    if (cm_grow((void **)&cr->entries, &cr->entries_cap, cr->nentries + 1, sizeof *cr->entries) !=
-        CM_OK)
-        return CM_ENOMEM;
-    cr->entries[cr->nentries++] = (uint32_t)cell;
-    return CM_OK;
-}
-
-static int u32_cmp(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static void sort_entries(cm_cluster_region *cr)
-{
-    if (cr->nentries == 0)
-        return;
-    qsort(cr->entries, cr->nentries, sizeof *cr->entries, u32_cmp);
-    uint64_t kept = 1;
-    for (uint64_t e = 1; e < cr->nentries; e++)
-        if (cr->entries[e] != cr->entries[kept - 1])
-            cr->entries[kept++] = cr->entries[e];
-    cr->nentries = kept;
-}
-
-int64_t cm_cluster_entry(const cm_cluster_region *cr, uint32_t cell)
-{
-    const uint32_t *e = bsearch(&cell, cr->entries, cr->nentries, sizeof cell, u32_cmp);
-    return e ? e - cr->entries : -1;
-}
-
-/* Escapes of the older regions that land in the new region `added` become
- * region links and entries of `added`; the new region's exits become links
- * and entries of older regions, or escapes. Escapes keep their target
- * cells, so this works on paged-out regions too. */
-static cm_status update_links(cm_cluster *c, uint32_t added)
-{
-    cm_cluster_region *nr = &c->regions[added];
-    const cm_box *new_box = &nr->r.box;
-    const size_t dim = (size_t)c->lat.dim;
-    for (uint32_t k = 0; k < added; k++) {
-        cm_cluster_region *cr = &c->regions[k];
-        uint64_t kept = 0;
-        for (uint64_t e = 0; e < cr->nescapes; e++) {
-            const int64_t *cell = cr->escapes + e * dim;
-            if (!cm_box_contains(new_box, cell))
-                memmove(cr->escapes + kept++ * dim, cell, dim * sizeof *cell);
-            else if (add_target(cr, added) != CM_OK ||
-                     add_entry(nr, cm_box_index(new_box, cell)) != CM_OK)
-                return CM_ENOMEM;
-        }
-        cr->nescapes = kept;
-    }
-    nr->escapes = malloc((nr->r.nexits + 1) * dim * sizeof *nr->escapes);
-    if (!nr->escapes)
-        return CM_ENOMEM;
-    uint32_t hint = 0;
-    for (uint64_t e = 0; e < nr->r.nexits; e++) {
-        uint64_t local;
-        const int64_t *cell = cm_region_exit(&nr->r, e);
-        const int64_t k = cm_cluster_locate(c, cell, &hint, &local);
-        if (k < 0)
-            memcpy(nr->escapes + nr->nescapes++ * dim, cell, dim * sizeof *cell);
-        else if (add_target(nr, (uint32_t)k) != CM_OK || add_entry(&c->regions[k], local) != CM_OK)
-            return CM_ENOMEM;
-    }
-    sort_entries(nr);
-    for (uint32_t t = 0; t < nr->ntargets; t++)
-        sort_entries(&c->regions[nr->targets[t]]);
-    return CM_OK;
-}
-
-/* Marks the regions whose sink cells can change: those from which the
- * region `added` can be reached through exits, and `added` itself if its
- * exits lead into the cluster (if not, its sink cells keep leaving it). */
-static uint32_t mark_affected(const cm_cluster *c, uint32_t added, uint8_t *affected)
-{
-    uint8_t *reaches = affected; /* reaches[k]: region k leads into `added` */
-    memset(reaches, 0, c->nregions);
-    reaches[added] = 1;
-    for (bool grew = true; grew;) {
-        grew = false;
-        for (uint32_t k = 0; k < c->nregions; k++) {
-            const cm_cluster_region *cr = &c->regions[k];
-            for (uint32_t t = 0; t < cr->ntargets && !reaches[k]; t++)
-                if (reaches[cr->targets[t]])
-                    reaches[k] = grew = true;
-        }
-    }
-    affected[added] = c->regions[added].ntargets > 0;
-    uint32_t count = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        count += affected[k];
-    return count;
-}
-
-cm_status cm_cluster_add_target(cm_cluster *c, uint32_t k, uint32_t target)
-{
-    return add_target(&c->regions[k], target);
-}
-
-cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
-                          size_t msg_size)
-{
-    cm_join_stats local_stats;
-    if (!stats)
-        stats = &local_stats;
-    memset(stats, 0, sizeof *stats);
-    cm_status st = check_region(c, r, msg, msg_size);
+    cm_status st = check_region(c, &r->box, r->nexits, r->ngroups, msg, msg_size);
+    if (st == CM_OK && make_space(c, &r->box, r->nexits, r->ngroups) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region");
     if (st != CM_OK)
         return st;
-    if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
-    /* the region's own groups take the next cluster-wide ids */
-    const uint32_t base = c->ngroups;
-    uint32_t *group = r->group;
-#pragma omp parallel for schedule(static) num_threads(cm_cluster_threads(c)) if (r->ncells >= 65536)
-    for (int64_t i = 0; i < (int64_t)r->ncells; i++)
-        if (group[i] != 0)
-            group[i] += base;
-    const uint32_t added = c->nregions++;
-    memset(&c->regions[added], 0, sizeof c->regions[added]);
-    c->regions[added].r = *r;
+    const uint32_t k = c->nregions, base = c->ngroups;
+    cm_cluster_region *cr = &c->regions[k];
+    memset(cr, 0, sizeof *cr);
+    cr->node_base = (uint32_t)c->nnodes;
+    init_nodes(c, r->nexits, NULL);
+    if (take_cells(c, r, base, c->nodes + cr->node_base) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for periodic cells");
+    cr->r = *r;
     memset(r, 0, sizeof *r);
-    c->ngroups += c->regions[added].r.ngroups;
-    stats->new_groups = c->regions[added].r.ngroups;
-    c->regions[added].dirty = 1;
-    c->regions[added].last_used = ++c->clock;
-    uint8_t *affected = malloc(c->nregions);
-    char detail[256] = "";
-    st = affected ? update_links(c, added) : CM_ENOMEM;
-    if (st == CM_OK) {
-        stats->affected_regions = mark_affected(c, added, affected);
-        st = cm_resolve_sink_cells(c, affected, stats, detail, sizeof detail);
-    }
-    free(affected);
-    stats->new_groups += stats->straddling_groups;
-    if (st != CM_OK)
-        return cm_fail(st, msg, msg_size, "joining region %u: %s", added,
-                       detail[0] ? detail : cm_strerror(st));
+    cr->nodes_dirty = 1;
+    cr->last_used = ++c->clock;
+    c->nregions++;
+    c->ngroups += cr->r.ngroups;
+    c->cells += cr->r.ncells;
+    if (index_region(c, k) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
     return CM_OK;
 }
 
-cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
-                             const uint32_t *targets, uint32_t ntargets, char *msg, size_t msg_size)
+cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_node *nodes,
+                             char *msg, size_t msg_size)
 {
-    if (record->box.dim != c->lat.dim)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "region of %d dimensions, lattice of %d",
-                       record->box.dim, c->lat.dim);
-    if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region list");
-    const uint32_t added = c->nregions++;
-    cm_cluster_region *cr = &c->regions[added];
+    cm_status st = check_region(c, &record->box, record->nexits, 0, msg, msg_size);
+    if (st == CM_OK && make_space(c, &record->box, record->nexits, 0) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region");
+    if (st != CM_OK)
+        return st;
+    const uint32_t k = c->nregions++;
+    cm_cluster_region *cr = &c->regions[k];
     memset(cr, 0, sizeof *cr);
     cr->r.box = record->box;
     cr->r.ncells = record->ncells;
     cr->r.nexits = record->nexits;
     cr->r.ngroups = record->ngroups;
     cr->r.exits_recorded = 1;
-    cr->r.exit_target = (int64_t *)exit_target; /* borrowed for update_links only */
-    cm_status st = update_links(c, added);
-    cr->r.exit_target = NULL;
-    cr->ntargets = 0; /* the saved links: those of sink cells only */
-    for (uint32_t t = 0; t < ntargets && st == CM_OK; t++)
-        st = add_target(cr, targets[t]);
-    return st == CM_OK
+    cr->node_base = (uint32_t)c->nnodes;
+    cr->written = 1;
+    init_nodes(c, record->nexits, nodes);
+    c->cells += record->ncells;
+    return index_region(c, k) == CM_OK
                ? CM_OK
-               : cm_fail(st, msg, msg_size, "restoring region %u: %s", added, cm_strerror(st));
+               : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
 }
 
-static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
+/* Resolution state from a node's saved fields. */
+static void start_resolution(cm_node *nd)
 {
-    sum->affected_regions += one->affected_regions;
-    sum->resolved_cells += one->resolved_cells;
-    sum->nodes += one->nodes;
-    sum->new_groups += one->new_groups;
-    sum->straddling_groups += one->straddling_groups;
+    if (nd->next == CM_NODE_OPEN) {
+        nd->up = CM_NODE_OPEN;
+    } else if (nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE) {
+        nd->up = CM_NODE_FINAL;
+        nd->up_dist = nd->next == CM_NODE_CYCLE ? 0 : nd->dist;
+    } else {
+        nd->up = nd->next;
+        nd->up_dist = nd->dist;
+    }
 }
 
-/* Solves boxes[0..n) concurrently, one region per thread. */
-static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box *boxes, uint32_t n,
-                        const cm_scm_options *one, int threads, cm_region *solved,
-                        cm_status *status, char (*msgs)[256])
+static cm_status check_saved_nodes(const cm_cluster *c, uint32_t groups)
 {
-    if (n == 1) { /* a lone box (a strip uncovered by panning) takes every thread for its images */
-        cm_scm_options all = *one;
-        all.threads = threads;
-        status[0] = cm_region_alloc(&solved[0], &boxes[0], msgs[0], sizeof msgs[0]);
-        if (status[0] == CM_OK)
-            status[0] = cm_scm_solve(model, &c->lat, &all, &solved[0], msgs[0], sizeof msgs[0]);
-        return;
+    for (uint64_t id = 0; id < c->nnodes; id++) {
+        const cm_node *nd = &c->nodes[id];
+        const bool known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+        if ((nd->next < CM_NODE_MAX && nd->next >= c->nnodes) ||
+            (nd->next >= CM_NODE_MAX && !known && nd->next != CM_NODE_OPEN) ||
+            (known && nd->group > groups) || (nd->next == CM_NODE_CYCLE && nd->group == 0))
+            return CM_EFORMAT;
     }
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int64_t k = 0; k < (int64_t)n; k++) {
-        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
-        if (status[k] == CM_OK)
-            status[k] = cm_scm_solve(model, &c->lat, one, &solved[k], msgs[k], sizeof msgs[k]);
-    }
-    (void)threads;
+    return CM_OK;
 }
 
-cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
-                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size)
+cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
+                              int64_t *const *exits, char *msg, size_t msg_size)
 {
-    int threads = 1;
-#ifdef _OPENMP
-    threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
-#endif
-    cm_region *solved = calloc((size_t)threads, sizeof *solved);
-    cm_status *status = calloc((size_t)threads, sizeof *status);
-    char(*msgs)[256] = calloc((size_t)threads, sizeof *msgs);
-    if (!solved || !status || !msgs) {
-        free(solved);
-        free(status);
-        free(msgs);
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d regions", threads);
-    }
-    cm_scm_options one = opt ? *opt : (cm_scm_options){0};
-    one.record_exits = 1;
-    one.threads = 1;
-    if (stats)
-        memset(stats, 0, sizeof *stats);
-    /* One region per thread: classification is sequential, so this is how
-     * a big box uses every core. Each region's result depends on its box
-     * alone, and the joins run in a fixed order. */
-    cm_status st = CM_OK;
-    for (uint32_t first = 0; first < nboxes && st == CM_OK; first += (uint32_t)threads) {
-        const uint32_t n = nboxes - first < (uint32_t)threads ? nboxes - first : (uint32_t)threads;
-        solve_batch(c, model, boxes + first, n, &one, threads, solved, status, msgs);
-        for (uint32_t k = 0; k < n; k++) {
-            cm_join_stats one_join;
-            if (st == CM_OK && status[k] != CM_OK)
-                st = cm_fail(status[k], msg, msg_size, "region %u: %s", first + k, msgs[k]);
-            if (st == CM_OK)
-                st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
-            if (st == CM_OK && stats)
-                add_join_stats(stats, &one_join);
-            if (st == CM_OK && joined)
-                st = joined(user, c, first + k, &one_join, msg, msg_size);
-            cm_region_free(&solved[k]);
+    if (check_saved_nodes(c, groups) != CM_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "the node table is damaged");
+    if (make_space(c, &c->regions[0].r.box, 0, groups) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
+    c->ngroups = groups;
+    memcpy(c->basin + 1, basin + 1, (size_t)groups * sizeof *basin);
+    for (uint64_t id = 0; id < c->nnodes; id++)
+        start_resolution(&c->nodes[id]);
+    /* open components: weights and member rings */
+    for (uint64_t id = 0; id < c->nnodes; id++) {
+        uint32_t g, s, open;
+        if (cm_cluster_resolve(c, (uint32_t)id, &g, &s, &open) != CM_OK)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "the node table is damaged: steps overflow");
+        if (open == CM_NODE_OPEN)
+            continue;
+        cm_node *root = &c->nodes[open];
+        root->weight += c->nodes[id].tree;
+        if (open != id) {
+            c->nodes[id].ring = root->ring;
+            root->ring = (uint32_t)id;
         }
     }
-    free(solved);
-    free(status);
-    free(msgs);
-    return st;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        for (uint64_t e = 0; e < cr->r.nexits; e++)
+            if (c->nodes[cr->node_base + e].next == CM_NODE_OPEN &&
+                cm_cluster_add_escape(c, cr->node_base + (uint32_t)e,
+                                      exits[k] + e * (uint64_t)c->lat.dim) != CM_OK)
+                return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
+    }
+    c->saved_groups = groups;
+    return CM_OK;
 }
+
+/* ---- readers ---------------------------------------------------------- */
 
 /* Image of a cluster cell as an index of `box`, or CM_IMAGE_EXIT beyond it. */
 static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
@@ -489,23 +652,52 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
     return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
 }
 
+/* What a region's nodes resolve to, for copying its cells: group and step
+ * of each node's cell, and whether it is on a straddling cycle. */
+typedef struct node_values {
+    const cm_cluster *c; /* NULL: the region has no node references */
+    uint32_t region;
+    const uint32_t *group, *step;
+    const uint8_t *cycle;
+} node_values;
+
+/* Group and step of cell i of r. */
+static void resolved_cell(const cm_region *r, uint64_t i, const node_values *nv, uint32_t *group,
+                          uint32_t *step)
+{
+    const uint32_t g = r->group[i];
+    if (!nv->c || !cm_is_node_ref(g)) {
+        *group = g;
+        *step = r->step[i];
+        return;
+    }
+    const uint32_t e = g & ~CM_NODE_REF;
+    *group = nv->group[e];
+    *step = nv->cycle[e] ? cm_cluster_cycle_steps(nv->c, nv->region,
+                                                  nv->c->regions[nv->region].node_base + e,
+                                                  (uint32_t)i)
+                         : nv->step[e] + r->step[i] - 1;
+}
+
 /* Copies the cells of region r inside `both` (their intersection) into
  * out, one row along dimension 0 at a time: rows are contiguous in both. */
-static void flatten_part(const cm_region *r, const cm_box *both, cm_region *out)
+static void flatten_part(const cm_region *r, const node_values *nv, const cm_box *both,
+                         cm_region *out, int threads)
 {
     const int64_t width = both->hi[0] - both->lo[0];
     const int64_t rows = (int64_t)(cm_box_cells(both) / (uint64_t)width);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t q = 0; q < rows; q++) {
         int64_t cell[CM_MAX_DIM];
         cm_box row = *both;
         row.hi[0] = row.lo[0] + 1;
         cm_box_cell(&row, (uint64_t)q, cell);
         const uint64_t from = cm_box_index(&r->box, cell), to = cm_box_index(&out->box, cell);
-        memcpy(out->group + to, r->group + from, (size_t)width * sizeof *out->group);
-        memcpy(out->step + to, r->step + from, (size_t)width * sizeof *out->step);
-        for (int64_t i = 0; i < width; i++)
+        for (int64_t i = 0; i < width; i++) {
+            resolved_cell(r, from + (uint64_t)i, nv, &out->group[to + (uint64_t)i],
+                          &out->step[to + (uint64_t)i]);
             out->image[to + (uint64_t)i] = flat_image(r, from + (uint64_t)i, &out->box);
+        }
     }
 }
 
@@ -527,23 +719,61 @@ cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, cha
 void cm_flat_copy(const cm_region *r, cm_region *out)
 {
     cm_box both;
+    const node_values none = {NULL, 0, NULL, NULL, NULL};
     if (cm_box_intersect(&r->box, &out->box, &both))
-        flatten_part(r, &both, out);
+        flatten_part(r, &none, &both, out, 1);
+}
+
+/* Resolves region k's nodes into nv (arrays of the region's nexits). */
+static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group, uint32_t *step,
+                                      uint8_t *cycle)
+{
+    const cm_cluster_region *cr = &c->regions[k];
+    for (uint64_t e = 0; e < cr->r.nexits; e++) {
+        const uint32_t id = cr->node_base + (uint32_t)e;
+        cycle[e] = c->nodes[id].next == CM_NODE_CYCLE;
+        if (cm_cluster_resolve(c, id, &group[e], &step[e], NULL) != CM_OK)
+            return CM_ETOOBIG;
+    }
+    return CM_OK;
 }
 
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
     cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
+    uint32_t *group = NULL, *step = NULL;
+    uint8_t *cycle = NULL;
+    uint64_t cap = 0;
     for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
         cm_box both;
         if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
             continue;
+        const uint64_t n = c->regions[k].r.nexits + 1;
+        if (n > cap) {
+            free(group);
+            free(step);
+            free(cycle);
+            group = malloc(n * sizeof *group);
+            step = malloc(n * sizeof *step);
+            cycle = malloc(n);
+            cap = n;
+            if (!group || !step || !cycle) {
+                st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
+                break;
+            }
+        }
         st = cm_cluster_acquire(c, k, msg, msg_size);
+        if (st == CM_OK && resolve_region_nodes(c, k, group, step, cycle) != CM_OK)
+            st = cm_fail(CM_ETOOBIG, msg, msg_size, "a step number overflows");
+        const node_values nv = {c, k, group, step, cycle};
         if (st == CM_OK)
-            flatten_part(&c->regions[k].r, &both, out);
+            flatten_part(&c->regions[k].r, &nv, &both, out, cm_cluster_threads(c));
         cm_cluster_trim(c);
     }
+    free(group);
+    free(step);
+    free(cycle);
     if (st != CM_OK)
         cm_region_free(out);
     return st;

@@ -1,25 +1,33 @@
-/* cellmap/cluster.h - clustered simple cell mapping (thesis 4.6.2,
- * Algorithms C.3-C.7, generalised from two solutions to any number of
- * regions in any dimension).
+/* cellmap/cluster.h - a cluster of regions on one lattice: immutable region
+ * arrays, the node graph that joins them, paging, and readers that resolve
+ * cells (thesis 4.6.2, Algorithms C.3-C.7, generalised from two solutions
+ * to any number of regions in any dimension).
  *
- * A cluster is a set of non-overlapping regions on one lattice. Each region
- * keeps its own image[] (local indices, and exits into its exit table);
- * group[] holds cluster-wide group ids (0: the sink, i.e. the sequence leaves
- * the cluster or the world) and step[] the cluster-wide step numbers.
+ * A region's arrays (cellmap/scm.h) are written by its SCM and never change
+ * afterwards. Its *nodes* are the cells whose image leaves the region: node
+ * k of a region is the cell of its exit k (image CM_IMAGE_EXIT_BASE + k).
+ * Every other cell whose chain ends there (the node's tree) holds
+ * group = CM_NODE_REF | k and step = its depth in the tree + 1 (the node
+ * itself has step 1). Cells of the region's own groups hold cluster-wide
+ * group ids (the region's group g becomes base + g when it joins) and final
+ * steps; cells whose chains end in the world's sink hold group 0.
  *
- * Joining a region changes only cells whose sequences used to leave the
- * cluster into the new region: the cells of the sink's domain in the regions
- * from which the new one can be reached through exits, and the new region's
- * own. These are resolved again across region borders (cellmap/resolve.h):
- * a sequence that reaches a classified cell takes its group (Stage 1 of the
- * thesis); sequences that close a cycle across borders create the groups
- * that straddle them (Stage 2). Existing group ids never change; groups of
- * the new region and straddling groups get the next ids in a fixed order.
+ * Nodes have cluster-wide ids: a region's node k is node_base + k. The node
+ * table says where each node's exit leads once a region holds its target
+ * cell, and what that means: a final group and step, or the tree of another
+ * node (a link, with the steps to that node's cell), or a cycle through
+ * several regions (a straddling group). A cell is resolved when read: its
+ * node's outcome plus its depth. Links never change once set, so resolution
+ * shortens chains of links as it follows them (cm_cluster_resolve).
  *
- * The invariant (tests/test_cluster.c): for regions tiling a box, the result
- * equals cm_scm_solve on the box, cell by cell, up to the numbering of groups.
- * A join uses c->threads threads; the result does not depend on them. One
- * cluster must not be joined into from two threads at once.
+ * Cells in the tree of a node on a straddling cycle count their steps to the
+ * cycle, which can enter the tree above the node: such a node records the
+ * cell where the cycle enters its tree, and readers walk (cm_cluster_flatten).
+ *
+ * The invariant (tests/test_cluster.c): for regions tiling a box, the
+ * flattened cluster equals cm_scm_solve on the box, cell by cell, up to the
+ * numbering of groups. One cluster is used from one thread at a time; joins
+ * and readers use c->threads threads and give the same result for any.
  */
 #ifndef CM_CLUSTER_H
 #define CM_CLUSTER_H
@@ -27,127 +35,176 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cellmap/bricks.h"
+#include "cellmap/classify.h"
 #include "cellmap/scm.h"
 
+/* cm_node.next values other than a node id */
+#define CM_NODE_OPEN UINT32_C(0xFFFFFFFF)  /* the exit leads out of the cluster */
+#define CM_NODE_FINAL UINT32_C(0xFFFFFFFE) /* group and step of the cell are known */
+#define CM_NODE_CYCLE UINT32_C(0xFFFFFFFD) /* the cell is on a straddling cycle */
+#define CM_NODE_MAX UINT32_C(0xFFFFFFF0)   /* node ids stay below */
+
+/* One node (public: read by the store and the readers; written by joins). */
+typedef struct cm_node {
+    uint32_t next;   /* a node id: the exit lands in that node's tree; or a mark above */
+    uint32_t dist;   /* next a node: steps from this cell to next's cell; FINAL: this
+                        cell's step; CYCLE: local index of the cell where the cycle
+                        enters this node's tree */
+    uint32_t group;  /* FINAL, CYCLE: the cell's group */
+    uint32_t target; /* local index of the exit's target cell in its region, once linked */
+    uint32_t tree;   /* cells of the node's tree, itself included */
+    /* private: resolution state, rebuilt from the above when a file is read */
+    uint32_t up, up_dist; /* a node further along the chain, or CM_NODE_FINAL/OPEN */
+    uint32_t ring;        /* next member of the component of the open node it reaches */
+    uint64_t weight;      /* open node: cells whose sequences leave the cluster through it */
+} cm_node;
+
 typedef struct cm_cluster_region {
-    cm_region r;      /* arrays NULL while the region is paged out */
-    int64_t *escapes; /* target cells of the exits that leave the cluster */
-    uint64_t nescapes;
-    uint32_t *targets; /* regions that exits lead into (no duplicates) */
-    uint32_t ntargets;
-    uint64_t targets_cap;
-    uint32_t *entries; /* cells that exits of other regions lead into, ascending */
-    uint64_t nentries, entries_cap;
-    int dirty;          /* cells changed since the owner last saved them */
-    uint64_t last_used; /* paging clock of the last acquire */
-    uint64_t read_at;   /* paging clock when it was last read back */
+    cm_region r;        /* arrays NULL while the region is paged out */
+    uint32_t node_base; /* id of the node of exit 0 */
+    int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
+    int nodes_dirty;    /* read-only: node records changed since the owner saved them */
+    uint64_t last_used; /* private: paging clock of the last acquire */
 } cm_cluster_region;
+
+/* A periodic cell of a group made since the owner last took them. */
+typedef struct cm_group_cell {
+    uint32_t group;
+    int64_t cell[CM_MAX_DIM];
+} cm_group_cell;
 
 /* Reads back the arrays of a paged-out region: r has box, ncells, nexits
  * and ngroups set and NULL arrays; the pager allocates and fills image,
- * group, step and exit_target exactly as they were when last saved. */
+ * group, step and exit_target exactly as they were saved. */
 typedef cm_status (*cm_page_in_fn)(void *user, uint32_t region, cm_region *r, char *msg,
                                    size_t msg_size);
 
 struct cm_cluster;
 
-/* Saves region `region`'s arrays as they are now, so that it can be evicted
- * while dirty, also in the middle of a join: the owner keeps such writes
- * uncommitted until the cluster is consistent again (the next commit). */
+/* Saves a region that was never saved, so that it can be evicted (also in
+ * the middle of a join: the owner keeps the write in the transaction that
+ * its next commit ends). */
 typedef cm_status (*cm_page_out_fn)(void *user, const struct cm_cluster *c, uint32_t region,
                                     char *msg, size_t msg_size);
 
 typedef struct cm_cluster {
-    cm_lattice lat;
-    cm_cluster_region *regions; /* in the order they were joined */
-    uint32_t nregions;
-    uint64_t cap;
-    uint32_t ngroups; /* cluster-wide group ids 1..ngroups */
-    int threads;      /* OpenMP threads for joins; 0: the OpenMP default */
+    cm_lattice lat;                   /* read-only */
+    cm_cluster_region *regions;       /* read-only: in the order they were joined */
+    uint32_t nregions;                /* read-only */
+    uint32_t ngroups;                 /* read-only: cluster-wide group ids 1..ngroups */
+    int threads;                      /* public: OpenMP threads; 0: the OpenMP default */
+    cm_node *nodes;                   /* read-only: nnodes entries */
+    uint64_t nnodes;                  /* read-only */
+    uint64_t cells;                   /* read-only: cells of all regions */
+    uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */
+    uint8_t *basin_dirty;             /* read-only: basin[g] changed since cm_cluster_saved */
+    cm_group_cell *new_periodic;   /* read-only: of groups made since cm_cluster_saved */
+    uint64_t nnew_periodic;           /* read-only */
+    uint32_t saved_groups;            /* read-only: ngroups at cm_cluster_saved */
     /* Paging, off while page_in is NULL. cm_cluster_acquire reads regions
      * back through page_in and first evicts others, least recently used
      * first, so that the resident arrays take at most mem_budget bytes
-     * (more only while one region alone is bigger): clean ones (dirty == 0,
-     * their cells are saved) are freed, dirty ones saved through page_out
-     * if there is one. A join holds only the region it works on, so a
-     * cluster whose joins touch more than the budget still fits in it. */
-    cm_page_in_fn page_in;
-    cm_page_out_fn page_out; /* may be NULL: dirty regions then stay */
-    void *pager;
-    uint64_t mem_budget; /* 0: no limit */
-    uint64_t clock;
+     * (more only while one region alone is bigger); a region never saved is
+     * saved through page_out first (kept resident if there is none). */
+    cm_page_in_fn page_in;   /* public */
+    cm_page_out_fn page_out; /* public */
+    void *pager;             /* public */
+    uint64_t mem_budget;     /* public: 0: no limit */
+    /* private */
+    uint64_t cap, nodes_cap, basin_cap, periodic_cap, clock;
+    cm_bricks *region_bricks; /* brick -> regions meeting it */
+    cm_bricks *escape_bricks; /* brick of the target -> open nodes */
+    uint32_t *big;            /* regions too big for the brick index */
+    uint64_t nbig, big_cap;
 } cm_cluster;
 
-typedef struct cm_join_stats {
-    uint32_t affected_regions; /* regions whose sink cells were resolved again */
-    uint64_t resolved_cells;   /* sink cells of those regions resolved again */
-    uint64_t nodes;            /* of those, cells whose image leaves their region */
-    uint32_t new_groups;       /* groups of the new region plus straddling ones */
-    uint32_t straddling_groups;
-} cm_join_stats;
+/* An open node by the brick of its exit's target (records of escape_bricks). */
+typedef struct cm_escape {
+    uint32_t node;
+    int64_t cell[CM_MAX_DIM];
+} cm_escape;
 
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
 void cm_cluster_free(cm_cluster *c);
 
-/* Threads a join uses: c->threads, or the OpenMP default. */
+/* Threads a join or reader uses: c->threads, or the OpenMP default. */
 int cm_cluster_threads(const cm_cluster *c);
 
-/* Joins a region solved with record_exits on the cluster's lattice. The
- * cluster takes the region's arrays (r is zeroed). CM_EINVAL if its box
- * overlaps a region of the cluster. stats may be NULL. */
-cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
-                          size_t msg_size);
+/* Adds region r (solved with record_exits on the cluster's lattice; the
+ * cluster takes its arrays, r is zeroed) without linking anything: its own
+ * groups take the next ids, its nodes are open, its periodic cells are
+ * noted as new. CM_EINVAL if it overlaps a region. The join module
+ * (cellmap/join.h) then links. */
+cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t msg_size);
 
-/* Called after each join of cm_cluster_solve_boxes (box is its index);
- * a status other than CM_OK stops the solve with it. */
-typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
-                                  const cm_join_stats *stats, char *msg, size_t msg_size);
+/* Restores a region saved by an owner, paged out: its record (box, ncells,
+ * nexits, ngroups) and its nodes' saved fields (next, dist, group, target,
+ * tree for each of nexits nodes). Call cm_cluster_restored once all are in. */
+cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_node *nodes,
+                             char *msg, size_t msg_size);
 
-/* Solves the boxes in batches of one box per thread (images included) and
- * joins each batch in the given order, calling joined (may be NULL) after
- * every join, so at most a batch of unjoined regions is held at once.
- * stats (may be NULL) sums the joins'. */
-cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
-                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
-                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size);
+/* After the last cm_cluster_restore: rebuilds the resolution state, the
+ * basin counts and the open nodes' index from the exit tables (exits[k]:
+ * region k's, nexits * dim cells), which the caller keeps. groups: the saved
+ * group count; basin: the saved cells per group (groups + 1 entries, [0]
+ * unused). */
+cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
+                              int64_t *const *exits, char *msg, size_t msg_size);
 
-/* The region holding the cell and the cell's local index, or -1. *hint is
- * the region tried first (any value will do) and is set to the one found. */
-int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint32_t *hint,
-                          uint64_t *local);
+/* The region holding the cell and the cell's local index, or -1. O(1). */
+int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
 
-/* Restores a region from its record (box, ncells, nexits, ngroups), the
- * target cells of its exits and its targets list as saved, paged out: a
- * cluster reopened from a file. Regions must be restored in join order. */
-cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const int64_t *exit_target,
-                             const uint32_t *targets, uint32_t ntargets, char *msg,
-                             size_t msg_size);
+/* Adds open node id, whose exit leads to `cell` outside the cluster, to the
+ * index of open nodes. */
+cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell);
+
+/* Takes the open nodes whose exits lead into `box` out of the index: a new
+ * array of *n of them (ascending by node id) that the caller frees. */
+cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
+
+/* The region of node id (binary search). */
+uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
+
+/* Group and step of node id's cell, following and shortening its chain of
+ * links; *open (may be NULL) is the open node the sequence leaves the
+ * cluster through (CM_NODE_OPEN if it does not). CM_ETOOBIG if a step
+ * number overflows. */
+cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
+                             uint32_t *open);
+
+/* Steps from cell t of region k, in the tree of cycle node id, to the cycle
+ * (0 on it). Region k must be resident. */
+uint32_t cm_cluster_cycle_steps(const cm_cluster *c, uint32_t k, uint32_t id, uint32_t t);
+
+/* A new group id (a straddling group) into *g; CM_ETOOBIG past CM_MAX_GROUPS. */
+cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g);
+
+/* Notes cell `local` of region k as a periodic cell of new group g. */
+cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64_t local);
+
+/* Marks node id's record changed (for the owner's next save). */
+void cm_cluster_touch_node(cm_cluster *c, uint32_t id);
 
 /* Makes region k resident (reading it back if paged out) and marks it used.
  * Under a budget it may evict other regions (never k): pointers into other
  * regions' arrays are invalid after it. */
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
 
-/* Makes every region resident, whatever the budget (for work that follows
- * sequences through the whole cluster at once, such as cm_extend_choose);
- * the next cm_cluster_trim or commit brings it back within the budget. */
+/* Makes every region resident, whatever the budget; the next cm_cluster_trim
+ * brings it back within the budget. */
 cm_status cm_cluster_acquire_all(cm_cluster *c, char *msg, size_t msg_size);
 
-/* Evicts clean resident regions, those no sequence leaves (all neighbours
- * known) first, then the least recently used, until the resident arrays
- * fit c->mem_budget. Does nothing without a pager. */
+/* Evicts saved resident regions, least recently used first, until the
+ * resident arrays fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);
 
-/* The position of `cell` in region k's entries, or -1 if no exit of another
- * region leads to it. */
-int64_t cm_cluster_entry(const cm_cluster_region *cr, uint32_t cell);
+/* The owner saved everything: regions and node records are clean, the new
+ * groups' periodic cells and the changed basin counts are taken. */
+void cm_cluster_saved(cm_cluster *c);
 
-/* Adds `target` to region k's links (the regions the exits of its sink
- * cells lead into) unless it is there. Joins set the links of every region
- * whose sink cells they resolved: only those cells can change later, so a
- * region none of whose sink cells leads towards a new region is neither
- * resolved nor read back when it is joined. */
-cm_status cm_cluster_add_target(cm_cluster *c, uint32_t k, uint32_t target);
+/* Cells in the sink's domain: those whose sequences leave the cluster or the world. */
+uint64_t cm_cluster_sink_cells(const cm_cluster *c);
 
 /* Bytes held by the resident regions' cell arrays and exit tables. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
@@ -155,21 +212,22 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 /* The smallest box holding every region (the cluster must have one). */
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
-/* Bytes held by the resident regions' arrays and exit tables, and by
- * every region's escape, target and entry lists. */
+/* Bytes held by the resident arrays, the node table, the indexes and counts. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
 /* A flat region over box with no cell computed (group CM_GROUP_NONE,
  * image CM_IMAGE_SINK) and ngroups groups, for cm_flat_copy. */
 cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, char *msg,
                         size_t msg_size);
-/* Copies the cells of region r inside out's box into out: groups, steps,
- * images as out's indices (exits and cells beyond it as CM_IMAGE_EXIT). */
+/* Copies the cells of a resolved region r (no node references) inside out's
+ * box into out: groups, steps, images as out's indices (exits and cells
+ * beyond it as CM_IMAGE_EXIT). */
 void cm_flat_copy(const cm_region *r, cm_region *out);
 
-/* The cluster as one region over `box`: group and step of every cell (group
- * CM_GROUP_NONE outside every region), images as box indices (exits and
- * cells beyond the box as CM_IMAGE_EXIT). out->ngroups is the cluster's. */
+/* The cluster as one region over `box`: resolved group and step of every
+ * cell (group CM_GROUP_NONE outside every region), images as box indices
+ * (exits and cells beyond the box as CM_IMAGE_EXIT). out->ngroups is the
+ * cluster's. Reads only the regions that meet the box. */
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size);
 

@@ -146,101 +146,38 @@ static cm_status neighbour_tiles(const tile_list *tiles, const cm_box *tile, con
     return CM_OK;
 }
 
-/* A sink cell of the cluster. */
-typedef struct sink_ref {
-    uint32_t region, cell;
-} sink_ref;
+typedef struct escape_count {
+    const cm_cluster *c;
+    const cm_box *tile;
+    tile_list *candidates;
+    cm_extend_choice *choice;
+} escape_count;
 
-/* The cluster's sink cells in decreasing order of step number: every cell
- * comes before the next cell of its sequence (a counting sort). */
-static cm_status order_sink_cells(const cm_cluster *c, sink_ref **order, uint64_t *n)
+/* An open node: the cells whose sequences leave the cluster through it
+ * (its weight) count for the candidate tile its exit lands in. */
+static void count_escape(void *user, const void *record)
 {
-    uint64_t *start = NULL, nsteps = 0, cap = 0;
-    *order = NULL;
-    *n = 0;
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_region *r = &c->regions[k].r;
-        for (uint64_t i = 0; i < r->ncells; i++) {
-            if (r->group[i] != 0)
-                continue;
-            const uint64_t s = r->step[i];
-            if (s >= nsteps &&
-                cm_grow_zeroed((void **)&start, &cap, &nsteps, s + 1, sizeof *start) != CM_OK) {
-                free(start);
-                return CM_ENOMEM;
-            }
-            start[s]++;
-            (*n)++;
-        }
-    }
-    *order = malloc((*n + 1) * sizeof **order);
-    if (!*order) {
-        free(start);
-        return CM_ENOMEM;
-    }
-    uint64_t pos = 0; /* the highest step first */
-    for (uint64_t s = nsteps; s-- > 0;) {
-        const uint64_t count = start[s];
-        start[s] = pos;
-        pos += count;
-    }
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_region *r = &c->regions[k].r;
-        for (uint64_t i = 0; i < r->ncells; i++)
-            if (r->group[i] == 0)
-                (*order)[start[r->step[i]]++] = (sink_ref){k, (uint32_t)i};
-    }
-    free(start);
-    return CM_OK;
+    const escape_count *ec = user;
+    const cm_escape *e = record;
+    const uint64_t w = ec->c->nodes[e->node].weight;
+    int64_t index[CM_MAX_DIM] = {0};
+    ec->choice->all_escaping += w;
+    tile_of(ec->tile, e->cell, index);
+    const int64_t t = find_tile(ec->candidates, index, ec->tile->dim);
+    if (t >= 0 && cm_box_contains(&ec->candidates->items[t].box, e->cell))
+        ec->candidates->items[t].escaping += w;
 }
 
-/* Follows every sink cell's sequence to where it leaves the cluster: each
- * cell passes its weight (itself plus the cells that lead through it) to
- * the next one, in step order. Weights arriving outside the cluster but in
- * the world count for the candidate tile they land in. */
+/* Where the sequences that leave the cluster go, from the node table alone:
+ * each open node carries the cells whose sequences reach it. */
 static cm_status count_escapes(const cm_cluster *c, const cm_box *tile, tile_list *candidates,
                                cm_extend_choice *choice)
 {
-    sink_ref *order = NULL;
-    uint64_t n = 0;
-    uint64_t **weight = calloc(c->nregions, sizeof *weight);
-    cm_status st = weight ? order_sink_cells(c, &order, &n) : CM_ENOMEM;
-    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++) {
-        choice->cluster_cells += c->regions[k].r.ncells;
-        weight[k] = calloc(c->regions[k].r.ncells + 1, sizeof **weight);
-        st = weight[k] ? CM_OK : CM_ENOMEM;
-    }
-    uint32_t hint = 0;
-    for (uint64_t p = 0; st == CM_OK && p < n; p++) {
-        const cm_region *r = &c->regions[order[p].region].r;
-        const uint32_t i = order[p].cell, v = r->image[i];
-        const uint64_t w = ++weight[order[p].region][i]; /* the cell itself */
-        const int64_t e = cm_image_exit_index(v);
-        uint64_t local;
-        if (v < r->ncells) {
-            weight[order[p].region][v] += w;
-            continue;
-        }
-        if (e < 0)
-            continue; /* leaves the world */
-        const int64_t *cell = cm_region_exit(r, (uint64_t)e);
-        const int64_t k = cm_cluster_locate(c, cell, &hint, &local);
-        if (k >= 0) {
-            weight[k][local] += w;
-            continue;
-        }
-        choice->all_escaping += w;
-        int64_t index[CM_MAX_DIM] = {0};
-        tile_of(tile, cell, index);
-        const int64_t t = find_tile(candidates, index, tile->dim);
-        if (t >= 0 && cm_box_contains(&candidates->items[t].box, cell))
-            candidates->items[t].escaping += w;
-    }
-    for (uint32_t k = 0; weight && k < c->nregions; k++)
-        free(weight[k]);
-    free(weight);
-    free(order);
-    return st;
+    escape_count ec = {c, tile, candidates, choice};
+    choice->cluster_cells = c->cells;
+    if (c->escape_bricks)
+        cm_bricks_each(c->escape_bricks, count_escape, &ec);
+    return CM_OK;
 }
 
 cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,

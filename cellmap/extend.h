@@ -23,7 +23,7 @@
 
 #include <stdbool.h>
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 
 typedef struct cm_extend_choice {
     cm_box box;            /* the chosen tile, clipped to the bounds */

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/classify.h"
 #include "cellmap/lattice.h"
 
 /* Stage-1 values of a cell besides group ids */
@@ -19,7 +20,7 @@ static uint32_t exit_value(const cm_region *regions, uint32_t n, const uint32_t 
         if (m == self || !cm_box_contains(&regions[m].box, t))
             continue;
         const uint32_t g = regions[m].group[cm_box_index(&regions[m].box, t)];
-        return g ? base[m] + g : PENDING;
+        return g && !cm_is_node_ref(g) ? base[m] + g : PENDING;
     }
     return 0;
 }
@@ -33,7 +34,7 @@ static void region_values(const cm_region *regions, uint32_t n, const uint32_t *
 {
     const cm_region *r = &regions[k];
     for (uint64_t i = 0; i < r->ncells; i++)
-        val[i] = r->group[i] ? base[k] + r->group[i] : UNSET;
+        val[i] = r->group[i] && !cm_is_node_ref(r->group[i]) ? base[k] + r->group[i] : UNSET;
     for (uint64_t i = 0; i < r->ncells; i++) {
         uint64_t len = 0, j = i;
         uint32_t v;
@@ -94,7 +95,7 @@ cm_status cm_join_stage1(cm_region *regions, uint32_t n, uint8_t **pending, cm_s
         cm_region *r = &regions[k];
         for (uint64_t i = 0; i < r->ncells; i++) {
             const uint32_t v = vals[k][i];
-            if (r->group[i] == 0)
+            if (r->group[i] == 0 || cm_is_node_ref(r->group[i]))
                 count_case(v, stats);
             if (pending)
                 pending[k][i] = v == PENDING;

@@ -173,8 +173,8 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
 
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
 {
-    return cm_classify((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups, msg,
-                       msg_size);
+    return cm_classify((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups,
+                       r->exits_recorded, msg, msg_size);
 }
 
 cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
@@ -228,7 +228,7 @@ cm_status cm_scm_groups(const cm_region *r, const cm_lattice *lat, cm_group_info
         const uint32_t g = r->group[i];
         if (g == CM_GROUP_NONE)
             continue;
-        if (g == 0) {
+        if (g == 0 || cm_is_node_ref(g)) {
             sink++;
             continue;
         }

@@ -92,8 +92,18 @@ static int pragma_int(sqlite3 *db, const char *sql, int *value)
 
 /* The view of the groups, with the sink as group 0; `kind` is "sink",
  * "attractor" or "sticking" (a sticking zone: rest states held by static
- * friction). */
+ * friction). Version 4 counts cells per group in `basins`; versions 2 and
+ * 3 per region and group in `region_groups`. */
 #define GROUPS_VIEW_SQL(TEMP, KIND)                                                                \
+    "CREATE " TEMP "VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor,"         \
+    " periodic_cells, kind) AS"                                                                    \
+    " SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM regions) -"                                  \
+    "  (SELECT IFNULL(SUM(cells), 0) FROM basins), 1,"                                             \
+    "  NULL, NULL, NULL, NULL, NULL, 'sink'"                                                       \
+    " UNION ALL"                                                                                   \
+    " SELECT a.id, a.period, IFNULL((SELECT cells FROM basins WHERE grp = a.id), 0), 0,"           \
+    "  a.centre, a.lo, a.hi, a.anchor, a.periodic_cells, " KIND " FROM main.attractors a;"
+#define GROUPS_VIEW_V3_SQL(TEMP, KIND)                                                             \
     "CREATE " TEMP "VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor,"         \
     " periodic_cells, kind) AS"                                                                    \
     " SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1,"            \
@@ -107,16 +117,16 @@ static const char *const schema_sql =
     "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
     "CREATE TABLE regions(id INTEGER PRIMARY KEY, lo TEXT NOT NULL, hi TEXT NOT NULL,"
     " cells INTEGER NOT NULL, exits INTEGER NOT NULL, own_groups INTEGER NOT NULL,"
-    " status TEXT NOT NULL, targets TEXT NOT NULL);"
+    " status TEXT NOT NULL);"
     "CREATE TABLE pages(region INTEGER NOT NULL REFERENCES regions(id),"
     " first_cell INTEGER NOT NULL, cells INTEGER NOT NULL,"
     " image BLOB NOT NULL, grp BLOB NOT NULL, step BLOB NOT NULL,"
     " PRIMARY KEY(region, first_cell));"
     "CREATE TABLE exits(region INTEGER PRIMARY KEY REFERENCES regions(id),"
     " count INTEGER NOT NULL, targets BLOB NOT NULL);"
-    "CREATE TABLE region_groups(region INTEGER NOT NULL REFERENCES regions(id),"
-    " grp INTEGER NOT NULL, cells INTEGER NOT NULL, PRIMARY KEY(region, grp));"
-    "CREATE INDEX region_groups_grp ON region_groups(grp);"
+    "CREATE TABLE nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"
+    " count INTEGER NOT NULL, data BLOB NOT NULL);"
+    "CREATE TABLE basins(grp INTEGER PRIMARY KEY, cells INTEGER NOT NULL);"
     "CREATE TABLE attractors(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
     " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
     " periodic_cells BLOB NOT NULL,"
@@ -124,18 +134,18 @@ static const char *const schema_sql =
     "'sticking')));" GROUPS_VIEW_SQL("", "a.kind");
 
 /* Version 2 had no kinds: every group of such a file is an attractor (no
- * model with rest states existed). Opened for writing, the file is
- * upgraded in place; read-only, a temporary view shadows the old one. */
-static const char *const upgrade_v2_sql =
-    "BEGIN;"
-    "ALTER TABLE attractors ADD COLUMN kind TEXT NOT NULL DEFAULT 'attractor'"
-    " CHECK(kind IN ('attractor', 'sticking'));"
-    "DROP VIEW groups;" GROUPS_VIEW_SQL("", "a.kind") "PRAGMA user_version=3;"
-                                                      "COMMIT;";
-static const char *const shadow_v2_sql = GROUPS_VIEW_SQL("TEMP ", "'attractor'");
+ * model with rest states existed); read-only, a temporary view shadows the
+ * old one. */
+static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor'");
 
-/* Tables a file of this version must have; their absence means corruption. */
+/* Tables a file of this version (or of version 2 or 3) must have; their
+ * absence means corruption. */
 static const char *const check_sql =
+    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
+    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
+    " (SELECT COUNT(*) FROM nodes), (SELECT COUNT(*) FROM basins),"
+    " (SELECT COUNT(*) FROM pages WHERE region = 1)";
+static const char *const check_v3_sql =
     "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
     " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
     " (SELECT COUNT(*) FROM region_groups), (SELECT COUNT(*) FROM pages WHERE region = 1)";
@@ -145,19 +155,12 @@ struct cm_store {
     const cm_model *model; /* labels new groups (cm_store_set_model), may be NULL */
     char *path;
     int writable;
-    uint32_t inserted; /* regions with rows in the file (or the open transaction) */
-    uint32_t saved_groups;
+    int version; /* of the file: 2 and 3 are read (regions resolved, no node table) */
     int in_transaction;             /* evictions in a join write into it; the commit ends it */
     int failed;                     /* a write failed: the cluster and the file differ */
-    struct periodic_cell *periodic; /* of new groups, from the regions written */
-    uint64_t nperiodic, periodic_cap;
-    uint64_t **page_hash; /* per saved region: hash of each page's grp and step as saved */
-    uint64_t hash_cap, hash_len;
     unsigned char *blobs; /* a region's encoded pages, read or to write */
     uint64_t blobs_cap;
     int threads;     /* for encoding and decoding pages: the cluster's */
-    uint64_t *count; /* per group, for region_groups */
-    uint64_t count_cap;
     cm_store_stats stats;
 };
 
@@ -221,7 +224,7 @@ static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, 
     if (ids != CM_OK)
         return ids;
     sqlite3_stmt *st = NULL;
-    int rc = sqlite3_prepare_v2(db, check_sql, -1, &st, NULL);
+    int rc = sqlite3_prepare_v2(db, version >= 4 ? check_sql : check_v3_sql, -1, &st, NULL);
     if (rc == SQLITE_OK)
         rc = sqlite3_step(st) == SQLITE_ROW ? SQLITE_OK : SQLITE_CORRUPT;
     sqlite3_finalize(st);
@@ -293,12 +296,17 @@ static cm_status open_checked(const char *path, int full, int writable, sqlite3 
         return open_checked(path, full, 1, out, msg, msg_size);
     }
     int version = CM_STORE_VERSION;
-    if (st == CM_OK && pragma_int(db, "PRAGMA user_version", &version) == SQLITE_OK &&
-        version == 2 && exec(db, writable ? upgrade_v2_sql : shadow_v2_sql) != SQLITE_OK) {
+    if (st == CM_OK && pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
+        st = db_error(db, "read the version", msg, msg_size);
+    if (st == CM_OK && writable && version < CM_STORE_VERSION)
+        st = cm_fail(CM_EFORMAT, msg, msg_size,
+                     "%s has format version %d, which this cellmap reads but cannot extend "
+                     "(version %d keeps regions unchanged and joins them through node tables): "
+                     "render and export it as it is, or solve again with --db",
+                     path, version, CM_STORE_VERSION);
+    if (st == CM_OK && version == 2 && exec(db, shadow_v2_sql) != SQLITE_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "cannot read %s of format version 2: %s", path,
                      sqlite3_errmsg(db));
-        exec(db, "ROLLBACK");
-    }
     if (st != CM_OK) {
         sqlite3_close(db);
         return st;
@@ -328,6 +336,8 @@ static cm_status new_store(const char *path, sqlite3 *db, int writable, cm_store
     }
     s->db = db;
     s->writable = writable;
+    s->version = CM_STORE_VERSION;
+    pragma_int(db, "PRAGMA user_version", &s->version);
     s->threads = 1;
     *out = s;
     return CM_OK;
@@ -476,12 +486,7 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
         st = db_error(s->db, "leave WAL mode", msg, msg_size);
     if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
-    for (uint64_t k = 0; k < s->hash_len; k++)
-        free(s->page_hash[k]);
-    free(s->page_hash);
     free(s->path);
-    free(s->count);
-    free(s->periodic);
     free(s->blobs);
     free(s);
     return st;
@@ -584,17 +589,6 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
     return CM_OK;
 }
 
-/* Hash of a page's grp and step arrays: a page is rewritten when it changes. */
-static uint64_t page_hash(const uint32_t *group, const uint32_t *step, uint64_t n)
-{
-    uint64_t h = UINT64_C(0x9E3779B97F4A7C15) ^ n;
-    for (uint64_t i = 0; i < n; i++) {
-        h = (h ^ ((uint64_t)group[i] << 32 | step[i])) * UINT64_C(0xFF51AFD7ED558CCD);
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 static uint64_t npages(uint64_t ncells)
 {
     return (ncells + CM_STORE_PAGE_CELLS - 1) / CM_STORE_PAGE_CELLS;
@@ -604,38 +598,6 @@ static uint64_t page_cells(uint64_t ncells, uint64_t page)
 {
     const uint64_t first = page * CM_STORE_PAGE_CELLS;
     return ncells - first < CM_STORE_PAGE_CELLS ? ncells - first : CM_STORE_PAGE_CELLS;
-}
-
-/* Hashes of region k's pages as they are now into out[npages]. */
-static void hash_pages(const cm_store *s, const cm_region *r, uint64_t *out)
-{
-    const int64_t n = (int64_t)npages(r->ncells);
-#pragma omp parallel for schedule(static) num_threads(s->threads) if (n > 1)
-    for (int64_t p = 0; p < n; p++) {
-        const uint64_t first = (uint64_t)p * CM_STORE_PAGE_CELLS;
-        out[p] = page_hash(r->group + first, r->step + first, page_cells(r->ncells, (uint64_t)p));
-    }
-}
-
-/* Room for the hashes of region k's pages. */
-static uint64_t *hash_slot(cm_store *s, uint32_t k, const cm_region *r)
-{
-    if (cm_grow_zeroed((void **)&s->page_hash, &s->hash_cap, &s->hash_len, (uint64_t)k + 1,
-                       sizeof *s->page_hash) != CM_OK)
-        return NULL;
-    if (!s->page_hash[k])
-        s->page_hash[k] = malloc((npages(r->ncells) + 1) * sizeof(uint64_t));
-    return s->page_hash[k];
-}
-
-/* Remembers the hashes of region k's pages as they are on disk. */
-static cm_status remember_hashes(cm_store *s, uint32_t k, const cm_region *r)
-{
-    uint64_t *slot = hash_slot(s, k, r);
-    if (!slot)
-        return CM_ENOMEM;
-    hash_pages(s, r, slot);
-    return CM_OK;
 }
 
 /* A page's column as read: where its BLOB lies in s->blobs, where it goes. */
@@ -786,8 +748,6 @@ static cm_status page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t
         st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
-    if (st == CM_OK && (k >= s->hash_len || !s->page_hash[k]) && remember_hashes(s, k, r) != CM_OK)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
     if (st != CM_OK) {
         free(r->image);
         free(r->group);
@@ -825,34 +785,141 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
     return CM_OK;
 }
 
-/* A JSON array of 1-based region ids as 0-based indices. */
-static cm_status parse_links(const cm_store *s, const char *text, uint32_t **out, uint32_t *n,
-                             char *msg, size_t msg_size)
+/* Node records as saved: five little-endian uint32 columns of n entries
+ * (next, dist, group, target, tree), encoded as one BLOB. */
+#define NODE_FIELDS 5
+
+static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node **out, char *msg,
+                            size_t msg_size)
 {
-    const char *p = text ? strchr(text, '[') : NULL;
-    size_t cap = 1;
-    for (const char *q = p; q && *q; q++)
-        cap += *q == ',';
-    uint32_t *links = malloc(cap * sizeof *links);
-    *n = 0;
-    while (p && links && *++p && *p != ']') {
-        char *end = NULL;
-        const unsigned long v = strtoul(p, &end, 10);
-        if (end == p || v < 1 || v > UINT32_MAX || *n >= cap)
-            break;
-        links[(*n)++] = (uint32_t)(v - 1);
-        p = end;
-        if (*p == ']')
-            break;
-        if (*p != ',')
-            p = NULL;
+    cm_node *nodes = calloc(n + 1, sizeof *nodes);
+    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
+    sqlite3_stmt *st = NULL;
+    cm_status status = nodes && cols && scratch
+                           ? CM_OK
+                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu nodes",
+                                     (unsigned long long)n);
+    if (status == CM_OK && s->version < 4) {
+        /* regions of version 2 and 3 hold resolved cells: no node is referenced */
+        for (uint64_t e = 0; e < n; e++)
+            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1};
+    } else if (status == CM_OK) {
+        if (sqlite3_prepare_v2(s->db, "SELECT count, data FROM nodes WHERE region=?", -1, &st,
+                               NULL))
+            status = db_error(s->db, "read nodes", msg, msg_size);
+        const void *blob = NULL;
+        int len = 0;
+        if (status == CM_OK) {
+            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+            if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == n) {
+                blob = sqlite3_column_blob(st, 1);
+                len = sqlite3_column_bytes(st, 1);
+            }
+            if ((n > 0 && !blob) || (blob && cm_codec_decode(blob, (size_t)len, NODE_FIELDS * n,
+                                                             4, -1, scratch, cols) != CM_OK))
+                status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
+                                 s->path, k + 1);
+            s->stats.bytes_read += (uint64_t)len;
+        }
+        for (uint64_t e = 0; status == CM_OK && e < n; e++)
+            nodes[e] = (cm_node){.next = cols[e],
+                                 .dist = cols[n + e],
+                                 .group = cols[2 * n + e],
+                                 .target = cols[3 * n + e],
+                                 .tree = cols[4 * n + e]};
     }
-    if (!links || !p || *p != ']') {
-        free(links);
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region links", s->path);
+    sqlite3_finalize(st);
+    free(cols);
+    free(scratch);
+    if (status != CM_OK) {
+        free(nodes);
+        return status;
     }
-    *out = links;
+    *out = nodes;
     return CM_OK;
+}
+
+/* Cells per group 1..groups from the groups view (every version has it). */
+static cm_status read_basins(cm_store *s, uint32_t groups, uint64_t **out, char *msg,
+                             size_t msg_size)
+{
+    uint64_t *basin = calloc((size_t)groups + 1, sizeof *basin);
+    sqlite3_stmt *st = NULL;
+    if (!basin)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
+    if (sqlite3_prepare_v2(s->db, "SELECT id, basin_cells FROM groups WHERE id > 0", -1, &st,
+                           NULL)) {
+        free(basin);
+        return db_error(s->db, "read groups", msg, msg_size);
+    }
+    cm_status status = CM_OK;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t id = sqlite3_column_int64(st, 0), cells = sqlite3_column_int64(st, 1);
+        if (id < 1 || id > groups || cells < 0)
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
+                             (long long)id);
+        else
+            basin[id] = (uint64_t)cells;
+    }
+    sqlite3_finalize(st);
+    if (status != CM_OK) {
+        free(basin);
+        return status;
+    }
+    *out = basin;
+    return CM_OK;
+}
+
+/* Region row k into rec, checked. */
+static cm_status region_record(const cm_store *s, sqlite3_stmt *st, uint32_t k, int dim,
+                               cm_region *rec, char *msg, size_t msg_size)
+{
+    memset(rec, 0, sizeof *rec);
+    rec->ncells = (uint64_t)sqlite3_column_int64(st, 3);
+    rec->nexits = (uint64_t)sqlite3_column_int64(st, 4);
+    rec->ngroups = (uint32_t)sqlite3_column_int64(st, 5);
+    if (sqlite3_column_int64(st, 0) != (sqlite3_int64)k + 1 ||
+        parse_box((const char *)sqlite3_column_text(st, 1),
+                  (const char *)sqlite3_column_text(st, 2), dim, &rec->box) != CM_OK ||
+        rec->ncells != cm_box_cells(&rec->box) || rec->ncells > CM_REGION_MAX_CELLS ||
+        rec->nexits > rec->ncells)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u", s->path, k + 1);
+    return CM_OK;
+}
+
+static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char *msg,
+                              size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    uint64_t cap = 0;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
+                           -1, &st, NULL))
+        return db_error(s->db, "read regions", msg, msg_size);
+    cm_status status = CM_OK;
+    int rc;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        cm_region rec;
+        cm_node *nodes = NULL;
+        const uint32_t k = c->nregions;
+        status = region_record(s, st, k, c->lat.dim, &rec, msg, msg_size);
+        if (status == CM_OK && cm_grow((void **)exits, &cap, (uint64_t)k + 1, sizeof **exits))
+            status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
+        if (status == CM_OK) {
+            (*exits)[k] = NULL;
+            status = read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
+        }
+        if (status == CM_OK)
+            status = read_nodes(s, k, rec.nexits, &nodes, msg, msg_size);
+        if (status == CM_OK)
+            status = cm_cluster_restore(c, &rec, nodes, msg, msg_size);
+        free(nodes);
+    }
+    if (status == CM_OK && rc != SQLITE_DONE)
+        status = db_error(s->db, "read regions", msg, msg_size);
+    sqlite3_finalize(st);
+    return status;
 }
 
 cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
@@ -864,52 +931,27 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
     cm_cluster_init(c, &lat);
     cm_store_attach(s, c);
     const int64_t groups = query_int(s->db, "SELECT COUNT(*) FROM attractors");
-    if (groups < 0 || groups > CM_MAX_GROUPS)
+    if (groups < 0 || groups > CM_MAX_GROUPS ||
+        query_int(s->db, "SELECT IFNULL(MAX(id), 0) FROM attractors") != groups)
         return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: attractors", s->path);
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(
-            s->db, "SELECT id, lo, hi, cells, exits, own_groups, targets FROM regions ORDER BY id",
-            -1, &st, NULL))
-        return db_error(s->db, "read regions", msg, msg_size);
-    int rc;
-    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
-        cm_region rec;
-        memset(&rec, 0, sizeof rec);
-        rec.ncells = (uint64_t)sqlite3_column_int64(st, 3);
-        rec.nexits = (uint64_t)sqlite3_column_int64(st, 4);
-        rec.ngroups = (uint32_t)sqlite3_column_int64(st, 5);
-        if (sqlite3_column_int64(st, 0) != (sqlite3_int64)c->nregions + 1 ||
-            parse_box((const char *)sqlite3_column_text(st, 1),
-                      (const char *)sqlite3_column_text(st, 2), lat.dim, &rec.box) != CM_OK ||
-            rec.ncells != cm_box_cells(&rec.box) || rec.ncells > CM_REGION_MAX_CELLS ||
-            rec.nexits > rec.ncells) {
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u", s->path,
-                             c->nregions + 1);
-            break;
-        }
-        int64_t *exits = NULL;
-        uint32_t *links = NULL, nlinks = 0;
-        status = read_exits(s, c->nregions, rec.nexits, lat.dim, &exits, msg, msg_size);
-        if (status == CM_OK)
-            status = parse_links(s, (const char *)sqlite3_column_text(st, 6), &links, &nlinks, msg,
-                                 msg_size);
-        if (status == CM_OK)
-            status = cm_cluster_restore(c, &rec, exits, links, nlinks, msg, msg_size);
-        free(exits);
-        free(links);
+    int64_t **exits = NULL;
+    uint64_t *basin = NULL;
+    status = load_regions(s, c, &exits, msg, msg_size);
+    if (status == CM_OK)
+        status = read_basins(s, (uint32_t)groups, &basin, msg, msg_size);
+    if (status == CM_OK && c->nregions > 0)
+        status = cm_cluster_restored(c, (uint32_t)groups, basin, exits, msg, msg_size);
+    if (status == CM_EFORMAT && !strstr(msg, s->path)) {
+        char detail[256];
+        snprintf(detail, sizeof detail, "%s", msg);
+        cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, detail);
     }
-    for (uint32_t k = 0; status == CM_OK && k < c->nregions; k++)
-        for (uint32_t t = 0; t < c->regions[k].ntargets; t++)
-            if (c->regions[k].targets[t] >= c->nregions)
-                status = cm_fail(CM_EFORMAT, msg, msg_size,
-                                 "%s is damaged: region %u links to region %u", s->path, k + 1,
-                                 c->regions[k].targets[t] + 1);
-    if (status == CM_OK && rc != SQLITE_DONE)
-        status = db_error(s->db, "read regions", msg, msg_size);
-    sqlite3_finalize(st);
-    c->ngroups = (uint32_t)groups;
-    s->inserted = c->nregions;
-    s->saved_groups = c->ngroups;
+    for (uint32_t k = 0; exits && k < c->nregions; k++)
+        free(exits[k]);
+    free(exits);
+    free(basin);
+    if (status == CM_OK)
+        cm_cluster_saved(c);
     return status;
 }
 
@@ -930,7 +972,7 @@ static cm_status insert_region(cm_store *s, uint32_t k, const cm_region *r, char
     json_ints(lo, sizeof lo, r->box.lo, r->box.dim);
     json_ints(hi, sizeof hi, r->box.hi, r->box.dim);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined', '[]')",
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined')",
                            -1, &st, NULL))
         return db_error(s->db, "prepare regions", msg, msg_size);
     sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
@@ -998,12 +1040,10 @@ static cm_status encode_batch(cm_store *s, const cm_region *r, const uint64_t *p
 
 /* Writes the listed pages of region k (encoded in parallel, written in order). */
 static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, const uint64_t *pages,
-                                 uint64_t n, int is_new, char *msg, size_t msg_size)
+                                 uint64_t n, char *msg, size_t msg_size)
 {
-    const char *sql = is_new ? "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)"
-                             : "UPDATE pages SET grp = ?5, step = ?6 WHERE region = ?1 AND "
-                               "first_cell = ?2 AND cells = ?3";
-    const int col0 = is_new ? 0 : 1, ncols = 3 - col0;
+    const char *sql = "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)";
+    const int col0 = 0, ncols = 3;
     const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
     size_t lens[WRITE_BATCH * 3];
     sqlite3_stmt *st = NULL;
@@ -1028,10 +1068,6 @@ static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, co
                 s->stats.bytes_written += lens[t];
             }
             status = step_done(s->db, st, "write page", msg, msg_size);
-            if (status == CM_OK && !is_new && sqlite3_changes(s->db) != 1)
-                status = cm_fail(CM_EFORMAT, msg, msg_size,
-                                 "%s is damaged: page at cell %llu of region %u", s->path,
-                                 (unsigned long long)first, k + 1);
             s->stats.pages_written++;
         }
     }
@@ -1039,77 +1075,92 @@ static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, co
     return status;
 }
 
-/* Writes region k's pages: all of them for a new region, else those whose
- * grp or step changed (images never change once a region is solved), and
- * remembers their hashes. */
-static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, int is_new, char *msg,
+/* Writes all of region k's pages: once, as the region never changes. */
+static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
                              size_t msg_size)
 {
     const uint64_t pages = npages(r->ncells);
-    uint64_t *hash = malloc((pages + 1) * sizeof *hash), *list = malloc((pages + 1) * sizeof *list);
-    /* the hashes on disk, taken before hash_slot makes room for a new region's */
-    const uint64_t *saved = is_new || k >= s->hash_len ? NULL : s->page_hash[k];
-    uint64_t *slot = hash && list ? hash_slot(s, k, r) : NULL;
-    cm_status status =
-        slot ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
-    uint64_t n = 0;
-    if (status == CM_OK) {
-        hash_pages(s, r, hash);
-        for (uint64_t p = 0; p < pages; p++)
-            if (!saved || saved[p] != hash[p])
-                list[n++] = p;
-        status = write_page_list(s, k, r, list, n, is_new, msg, msg_size);
-    }
-    if (status == CM_OK)
-        memcpy(slot, hash, pages * sizeof *hash);
-    free(hash);
+    uint64_t *list = malloc((pages + 1) * sizeof *list);
+    if (!list)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
+    for (uint64_t p = 0; p < pages; p++)
+        list[p] = p;
+    const cm_status status = write_page_list(s, k, r, list, pages, msg, msg_size);
     free(list);
     return status;
 }
 
-/* Replaces region k's row counts per group. */
-static cm_status write_region_groups(cm_store *s, uint32_t k, const cm_region *r, uint32_t ngroups,
-                                     char *msg, size_t msg_size)
+/* Replaces region k's node records (five columns, see read_nodes). Only the
+ * fields that say what a node's exit leads to are saved: a final group is
+ * kept for final and cycle nodes only, so the file does not depend on what
+ * readers resolved. */
+static cm_status write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                             size_t msg_size)
 {
-    if (cm_grow((void **)&s->count, &s->count_cap, (uint64_t)ngroups + 1, sizeof *s->count) !=
-        CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory counting groups");
-    memset(s->count, 0, ((size_t)ngroups + 1) * sizeof *s->count);
-    for (uint64_t i = 0; i < r->ncells; i++)
-        if (r->group[i] <= ngroups)
-            s->count[r->group[i]]++;
-    sqlite3_stmt *del = NULL, *ins = NULL;
+    const cm_cluster_region *cr = &c->regions[k];
+    const uint64_t n = cr->r.nexits;
+    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
+    const size_t bound = cm_codec_bound(4 * (NODE_FIELDS * n + 1));
+    unsigned char *blob = malloc(bound);
+    size_t len = 0;
     cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(s->db, "DELETE FROM region_groups WHERE region = ?", -1, &del, NULL) ||
-        sqlite3_prepare_v2(s->db, "INSERT INTO region_groups VALUES(?, ?, ?)", -1, &ins, NULL))
-        status = db_error(s->db, "prepare region_groups", msg, msg_size);
+    if (!cols || !scratch || !blob)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
+    for (uint64_t e = 0; status == CM_OK && e < n; e++) {
+        const cm_node *nd = &c->nodes[cr->node_base + e];
+        const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+        cols[e] = nd->next;
+        cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
+        cols[2 * n + e] = known ? nd->group : 0;
+        cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
+        cols[4 * n + e] = nd->tree;
+    }
+    if (status == CM_OK &&
+        cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?)", -1, &st, NULL))
+        status = db_error(s->db, "prepare nodes", msg, msg_size);
     if (status == CM_OK) {
-        sqlite3_bind_int64(del, 1, (sqlite3_int64)k + 1);
-        status = step_done(s->db, del, "clear region_groups", msg, msg_size);
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)n);
+        sqlite3_bind_blob(st, 3, blob, (int)len, SQLITE_STATIC);
+        status = step_done(s->db, st, "write nodes", msg, msg_size);
+        s->stats.bytes_written += len;
+        s->stats.node_tables_written++;
     }
-    for (uint32_t g = 0; status == CM_OK && g <= ngroups; g++) {
-        if (!s->count[g])
-            continue;
-        sqlite3_bind_int64(ins, 1, (sqlite3_int64)k + 1);
-        sqlite3_bind_int64(ins, 2, g);
-        sqlite3_bind_int64(ins, 3, (sqlite3_int64)s->count[g]);
-        status = step_done(s->db, ins, "write region_groups", msg, msg_size);
-    }
-    sqlite3_finalize(del);
-    sqlite3_finalize(ins);
+    sqlite3_finalize(st);
+    free(cols);
+    free(scratch);
+    free(blob);
     return status;
 }
 
-typedef struct periodic_cell {
-    uint32_t group;
-    int64_t cell[CM_MAX_DIM];
-} periodic_cell;
+/* The cell counts of the groups whose counts changed. */
+static cm_status write_basins(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO basins VALUES(?, ?)", -1, &st, NULL))
+        return db_error(s->db, "prepare basins", msg, msg_size);
+    cm_status status = CM_OK;
+    for (uint32_t g = 1; status == CM_OK && g <= c->ngroups; g++) {
+        if (!c->basin_dirty[g])
+            continue;
+        sqlite3_bind_int64(st, 1, g);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)c->basin[g]);
+        status = step_done(s->db, st, "write basins", msg, msg_size);
+    }
+    sqlite3_finalize(st);
+    return status;
+}
 
 /* Group first, then box order; unused coordinates are zero, so comparing
  * all CM_MAX_DIM of them is box order in any dimension. */
 static int periodic_cell_cmp(const void *a, const void *b)
 {
-    const periodic_cell *x = a, *y = b;
+    const cm_group_cell *x = a, *y = b;
     if (x->group != y->group)
         return x->group < y->group ? -1 : 1;
     return cm_cell_less(x->cell, y->cell, CM_MAX_DIM)   ? -1
@@ -1117,37 +1168,15 @@ static int periodic_cell_cmp(const void *a, const void *b)
                                                         : 0;
 }
 
-/* Adds region k's periodic cells of groups new since the last commit to
- * s->periodic. They lie in regions written since: a new group's cycle is in
- * the new region or crosses the borders of the regions a join changed, and
- * periodic cells are final when set. A region written twice adds its cells
- * twice; write_new_groups drops the copies. */
-static cm_status collect_periodic(cm_store *s, const cm_region *r)
-{
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        if (!cm_is_periodic(r, i) || r->group[i] <= s->saved_groups)
-            continue;
-        if (cm_grow((void **)&s->periodic, &s->periodic_cap, s->nperiodic + 1,
-                    sizeof *s->periodic) != CM_OK)
-            return CM_ENOMEM;
-        periodic_cell *pc = &s->periodic[s->nperiodic++];
-        memset(pc, 0, sizeof *pc);
-        pc->group = r->group[i];
-        cm_box_cell(&r->box, i, pc->cell);
-    }
-    return CM_OK;
-}
-
 static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattice *lat,
-                                  const periodic_cell *cells, uint64_t n, char *msg,
+                                  const cm_group_cell *cells, uint64_t n, char *msg,
                                   size_t msg_size)
 {
     cm_group_info gi;
     memset(&gi, 0, sizeof gi);
     unsigned char *blob = malloc(n * (size_t)lat->dim * 8);
-    if (!blob) {
+    if (!blob)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing groups");
-    }
     bool at_rest = s->model && s->model->at_rest;
     for (uint64_t i = 0; i < n; i++) {
         at_rest = at_rest && cm_cell_at_rest(s->model, lat, cells[i].cell);
@@ -1179,100 +1208,48 @@ static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattic
     return status;
 }
 
-/* Keeps one of each run of equal cells (sorted). */
-static uint64_t unique_cells(periodic_cell *cells, uint64_t n)
+/* Rows of `attractors` for the groups made since the last commit, from
+ * the periodic cells the cluster noted (sorted here: the order is the
+ * file's, whatever the order they were found in). */
+static cm_status write_new_groups(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
-    uint64_t kept = 0;
-    for (uint64_t i = 0; i < n; i++)
-        if (kept == 0 || periodic_cell_cmp(&cells[kept - 1], &cells[i]) != 0)
-            cells[kept++] = cells[i];
-    return kept;
-}
-
-/* Rows of `attractors` for groups saved_groups+1 .. c->ngroups. */
-static cm_status write_new_groups(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
-{
-    periodic_cell *cells = s->periodic;
-    uint64_t n = s->nperiodic;
-    if (n) {
+    cm_group_cell *cells = c->new_periodic;
+    const uint64_t n = c->nnew_periodic;
+    if (n)
         qsort(cells, n, sizeof *cells, periodic_cell_cmp);
-        n = unique_cells(cells, n);
-    }
     sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
     if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
                            NULL))
         status = db_error(s->db, "prepare groups", msg, msg_size);
-    uint32_t expected = s->saved_groups + 1;
+    uint32_t expected = c->saved_groups + 1;
     for (uint64_t i = 0; status == CM_OK && i < n;) {
         uint64_t j = i;
         while (j < n && cells[j].group == cells[i].group)
             j++;
         if (cells[i].group != expected++)
-            status = cm_fail(CM_EINVAL, msg, msg_size,
-                             "group %u has no periodic cell in the "
-                             "changed regions",
+            status = cm_fail(CM_EINVAL, msg, msg_size, "group %u has no periodic cell",
                              expected - 1);
         else
             status = insert_attractor(s, st, &c->lat, cells + i, j - i, msg, msg_size);
         i = j;
     }
     if (status == CM_OK && expected != c->ngroups + 1)
-        status = cm_fail(CM_EINVAL, msg, msg_size,
-                         "group %u has no periodic cell in the changed "
-                         "regions",
-                         expected);
+        status = cm_fail(CM_EINVAL, msg, msg_size, "group %u has no periodic cell", expected);
     sqlite3_finalize(st);
     return status;
 }
 
-/* The regions that exits of region k's sink cells lead into (1-based ids). */
-static cm_status write_targets(cm_store *s, uint32_t k, const cm_cluster_region *cr, char *msg,
-                               size_t msg_size)
-{
-    const size_t size = 16 + 12 * (size_t)cr->ntargets;
-    char *text = malloc(size);
-    if (!text)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing links");
-    size_t used = 0;
-    append(text, size, &used, "[");
-    for (uint32_t t = 0; t < cr->ntargets; t++)
-        append(text, size, &used, "%s%u", t ? "," : "", cr->targets[t] + 1);
-    append(text, size, &used, "]");
-    sqlite3_stmt *st = NULL;
-    cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(s->db, "UPDATE regions SET targets = ? WHERE id = ?", -1, &st, NULL))
-        status = db_error(s->db, "prepare links", msg, msg_size);
-    if (status == CM_OK) {
-        sqlite3_bind_text(st, 1, text, -1, SQLITE_STATIC);
-        sqlite3_bind_int64(st, 2, (sqlite3_int64)k + 1);
-        status = step_done(s->db, st, "write links", msg, msg_size);
-    }
-    sqlite3_finalize(st);
-    free(text);
-    return status;
-}
-
-/* Everything of region k: its row and exits if new, changed pages, cells
- * per group, links; and its periodic cells of new groups. */
+/* A region never saved: its row, exit table and pages. */
 static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                               size_t msg_size)
 {
     const cm_region *r = &c->regions[k].r;
     if (!r->group)
-        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is dirty but paged out", k);
-    const int is_new = k >= s->inserted;
-    cm_status st = is_new ? insert_region(s, k, r, msg, msg_size) : CM_OK;
-    if (st == CM_OK) {
-        s->inserted = is_new ? k + 1 : s->inserted;
-        st = write_pages(s, k, r, is_new, msg, msg_size);
-    }
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
+    cm_status st = insert_region(s, k, r, msg, msg_size);
     if (st == CM_OK)
-        st = write_region_groups(s, k, r, c->ngroups, msg, msg_size);
-    if (st == CM_OK)
-        st = write_targets(s, k, &c->regions[k], msg, msg_size);
-    if (st == CM_OK && collect_periodic(s, r) != CM_OK)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
+        st = write_pages(s, k, r, msg, msg_size);
     s->stats.regions_written++;
     return st;
 }
@@ -1320,8 +1297,13 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
     const double t0 = seconds_now();
     cm_status st = begin(s, msg, msg_size);
     for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
-        if (c->regions[k].dirty)
+        if (!c->regions[k].written)
             st = write_region(s, c, k, msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
+        if (c->regions[k].nodes_dirty)
+            st = write_nodes(s, c, k, msg, msg_size);
+    if (st == CM_OK)
+        st = write_basins(s, c, msg, msg_size);
     if (st == CM_OK)
         st = write_new_groups(s, c, msg, msg_size);
     if (st == CM_OK) {
@@ -1335,10 +1317,7 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
     if (st != CM_OK)
         return abandon(s, st);
     s->in_transaction = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        c->regions[k].dirty = 0; /* the file now holds these pages */
-    s->nperiodic = 0;
-    s->saved_groups = c->ngroups;
+    cm_cluster_saved(c); /* the file now holds everything */
     s->stats.commit_seconds += seconds_now() - t0;
     return CM_OK;
 }

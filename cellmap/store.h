@@ -29,12 +29,12 @@
 #ifndef CM_STORE_H
 #define CM_STORE_H
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 3
+#define CM_STORE_VERSION 4
 #define CM_STORE_PAGE_CELLS 65536
 
 typedef struct cm_store cm_store;
@@ -65,8 +65,8 @@ typedef struct cm_store_info {
 
 /* Paging and commit figures since the store was opened. */
 typedef struct cm_store_stats {
-    uint64_t regions_read, regions_written, pages_written;
-    uint64_t regions_evicted;           /* dirty, saved by the pager in a join */
+    uint64_t regions_read, regions_written, pages_written, node_tables_written;
+    uint64_t regions_evicted;           /* unsaved, saved by the pager in a join */
     uint64_t bytes_read, bytes_written; /* encoded */
     double read_seconds, evict_seconds, commit_seconds;
 } cm_store_stats;

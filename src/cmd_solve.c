@@ -9,7 +9,7 @@
 #include <omp.h>
 #endif
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "cellmap/extend.h"
 #include "cellmap/join_stage1.h"
 #include "cellmap/scm.h"

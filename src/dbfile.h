@@ -2,7 +2,7 @@
 #ifndef CM_SRC_DBFILE_H
 #define CM_SRC_DBFILE_H
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/store.h"
 

@@ -14,7 +14,7 @@
 
 #include <stdio.h>
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "cellmap/store.h"
 #include "render/gl.h"
 #include "src/args.h"

@@ -13,7 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "bench_util.h"
 #include "models/registry.h"
 

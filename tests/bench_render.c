@@ -16,7 +16,7 @@
 #include <unistd.h>
 
 #include "bench_util.h"
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "models/registry.h"
 #include "render/figure.h"
 #include "render/png_out.h"

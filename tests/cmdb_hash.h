@@ -1,5 +1,5 @@
 /* tests/cmdb_hash.h - a hash of every row of a .cmdb file's cluster
- * (regions, pages, exits, group counts, attractors, metadata but the command
+ * (regions, pages, exits, node tables, group counts, attractors, metadata but the command
  * line): equal hashes, equal clusters. */
 #ifndef CM_TESTS_CMDB_HASH_H
 #define CM_TESTS_CMDB_HASH_H
@@ -15,7 +15,8 @@ static inline uint64_t cmdb_content_hash(const char *path)
         "SELECT * FROM regions ORDER BY id",
         "SELECT * FROM pages ORDER BY region, first_cell",
         "SELECT * FROM exits ORDER BY region",
-        "SELECT * FROM region_groups ORDER BY region, grp",
+        "SELECT * FROM nodes ORDER BY region",
+        "SELECT * FROM basins ORDER BY grp",
         "SELECT * FROM attractors ORDER BY id",
         "SELECT * FROM meta WHERE key NOT IN ('command') ORDER BY key"};
     sqlite3 *db = NULL;

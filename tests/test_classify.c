@@ -66,7 +66,7 @@ static uint32_t compare(const char *what, uint32_t n, const uint32_t *image)
     uint32_t *g2 = malloc((size_t)n * 4), *s2 = malloc((size_t)n * 4);
     uint32_t ng1 = 0;
     char msg[128];
-    CHECK(cm_classify(n, image, g1, s1, &ng1, msg, sizeof msg) == CM_OK);
+    CHECK(cm_classify(n, image, g1, s1, &ng1, 0, msg, sizeof msg) == CM_OK);
     const uint32_t ng2 = reference(n, image, g2, s2);
     CHECK_INT(ng1, ng2);
     uint32_t bad = 0;

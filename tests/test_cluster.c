@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/cluster.h"
+#include "cellmap/join.h"
 #include "cellmap/join_stage1.h"
 #include "check.h"
 #include "mix.h"

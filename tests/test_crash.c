@@ -68,7 +68,7 @@ static int run_to_end(const char *cellmap, const char *db, int resume)
 }
 
 /* Opens the file as a cluster and checks it cell by cell: every region
- * reads back, its group counts match its cells, every group id is known,
+ * resolves, the group counts match its cells, every group id is known,
  * and every group's periodic cells are periodic cells of that group.
  * Returns the number of regions. */
 static uint32_t check_consistent(const char *path)
@@ -87,25 +87,31 @@ static uint32_t check_consistent(const char *path)
     cm_store_info info;
     CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_OK);
     CHECK_INT(info.groups, c.ngroups);
-    uint64_t periodic = 0;
-    for (uint32_t k = 0; k < c.nregions; k++) {
-        CHECK(cm_cluster_acquire(&c, k, msg, sizeof msg) == CM_OK);
-        const cm_region *r = &c.regions[k].r;
-        for (uint64_t i = 0; r->group && i < r->ncells; i++) {
-            CHECK(r->group[i] <= c.ngroups);
-            periodic += cm_is_periodic(r, i);
+    uint64_t periodic = 0, *counted = calloc(c.ngroups + 1, sizeof *counted);
+    for (uint32_t k = 0; k < c.nregions; k++) { /* each region resolved on its own */
+        cm_region flat;
+        const cm_box box = c.regions[k].r.box;
+        CHECK(cm_cluster_flatten(&c, &box, &flat, msg, sizeof msg) == CM_OK);
+        for (uint64_t i = 0; flat.group && i < flat.ncells; i++) {
+            CHECK(flat.group[i] <= c.ngroups);
+            if (flat.group[i] <= c.ngroups)
+                counted[flat.group[i]]++;
+            periodic += cm_is_periodic(&flat, i);
         }
-        cm_cluster_trim(&c);
+        cm_region_free(&flat);
     }
     cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
     uint64_t sink = 0, cells = 0, period = 0;
     CHECK(cm_store_groups(s, g, c.ngroups, &sink, msg, sizeof msg) == CM_OK);
     cells = sink;
+    CHECK_INT(sink, counted[0]);
     for (uint32_t k = 0; k < c.ngroups; k++) {
         cells += g[k].basin_cells;
         period += g[k].period;
+        CHECK_INT(g[k].basin_cells, counted[k + 1]);
         CHECK(g[k].period >= 1 && g[k].basin_cells >= g[k].period);
     }
+    free(counted);
     CHECK_INT(cells, info.cells);
     CHECK_INT(period, periodic);
     free(g);

@@ -38,18 +38,19 @@ static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a +
 /* Escaping sequences per tile, following each sink cell's sequence. */
 static uint64_t brute_force(const cm_cluster *c, const cm_box *tile, uint64_t *per_tile)
 {
-    uint64_t all = 0;
-    uint32_t hint = 0;
+    uint64_t all = 0, cells = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        cells += c->regions[k].r.ncells;
     memset(per_tile, 0, sizeof(uint64_t) * 4 * SPAN * SPAN);
     for (uint32_t k0 = 0; k0 < c->nregions; k0++)
         for (uint64_t i0 = 0; i0 < c->regions[k0].r.ncells; i0++) {
-            if (c->regions[k0].r.group[i0] != 0)
-                continue;
             uint32_t k = k0;
             uint64_t i = i0;
-            for (;;) {
+            for (uint64_t steps = 0; steps <= cells; steps++) {
                 const cm_region *r = &c->regions[k].r;
-                const uint32_t v = r->image[i];
+                const uint32_t g = r->group[i], v = r->image[i];
+                if (g != 0 && !cm_is_node_ref(g))
+                    break; /* a group of the region: the sequence stays */
                 if (v < r->ncells) {
                     i = v;
                     continue;
@@ -58,7 +59,7 @@ static uint64_t brute_force(const cm_cluster *c, const cm_box *tile, uint64_t *p
                 if (e < 0)
                     break;
                 const int64_t *cell = cm_region_exit(r, (uint64_t)e);
-                const int64_t next = cm_cluster_locate(c, cell, &hint, &i);
+                const int64_t next = cm_cluster_locate(c, cell, &i);
                 if (next >= 0) {
                     k = (uint32_t)next;
                     continue;

@@ -1,0 +1,55 @@
+/* cellmap/bricks.h - a coarse grid over the lattice ("bricks") mapping each
+ * brick to a list of fixed-size records: the regions that meet a brick, so
+ * that finding the region of a cell is O(1), and the exits that leave a
+ * cluster, by the brick of their target cell, so that a join finds the
+ * exits leading into a new region without looking at the others.
+ *
+ * Bricks are boxes of 2^shift[d] cells aligned to the lattice's cell 0. The
+ * map is a hash table of the bricks that hold records; a brick's records
+ * keep the order they were added in (removal moves the last one into the
+ * gap). Not thread-safe; cm_bricks_free is NULL-safe.
+ */
+#ifndef CM_BRICKS_H
+#define CM_BRICKS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cellmap/lattice.h"
+
+typedef struct cm_bricks cm_bricks;
+
+/* A map of bricks 2^shift[d] cells wide whose records take record_size bytes. */
+cm_status cm_bricks_alloc(int dim, const int *shift, size_t record_size, cm_bricks **out);
+void cm_bricks_free(cm_bricks *b);
+
+/* Shifts for bricks about half the size of `box` in every dimension. */
+void cm_bricks_shift_for(const cm_box *box, int *shift);
+
+/* The brick holding `cell` into brick[dim]. */
+void cm_bricks_of(const cm_bricks *b, const int64_t *cell, int64_t *brick);
+
+/* Adds a record to the brick holding `cell`. */
+cm_status cm_bricks_add(cm_bricks *b, const int64_t *cell, const void *record);
+
+/* Adds a record to every brick that meets `box`; CM_ETOOBIG when that is
+ * more than CM_BRICKS_MAX_SPAN bricks (the caller keeps such boxes aside). */
+#define CM_BRICKS_MAX_SPAN 65536
+cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record);
+
+/* The records of the brick with coordinates `brick`: *n records at the
+ * returned address (NULL when the brick has none). The pointer stays valid
+ * until the map changes. */
+void *cm_bricks_find(const cm_bricks *b, const int64_t *brick, uint64_t *n);
+
+/* Removes record i of brick `brick` (the brick's last record takes its place). */
+void cm_bricks_remove(cm_bricks *b, const int64_t *brick, uint64_t i);
+
+/* Calls fn for every record of every brick, bricks in the order they were
+ * first used, records in their order. */
+void cm_bricks_each(const cm_bricks *b, void (*fn)(void *user, const void *record), void *user);
+
+/* Bytes held. */
+uint64_t cm_bricks_bytes(const cm_bricks *b);
+
+#endif

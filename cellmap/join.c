@@ -1,0 +1,397 @@
+#include "cellmap/join.h"
+
+#include "cellmap/grow.h"
+
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* A link to make: node `node`'s exit leads to cell `cell` of region `region`,
+ * whose group and step are read before linking. */
+typedef struct link_job {
+    uint32_t node, region, cell, group, step;
+} link_job;
+
+typedef struct joiner {
+    cm_cluster *c;
+    cm_join_stats *stats;
+    uint8_t *touched; /* per region: a node record of it changed */
+    uint32_t *stack;  /* nodes of a chain */
+    uint64_t stack_cap;
+    char *msg;
+    size_t msg_size;
+} joiner;
+
+static void touch(joiner *j, uint32_t id)
+{
+    const uint32_t k = cm_cluster_node_region(j->c, id);
+    j->c->regions[k].nodes_dirty = 1;
+    j->stats->affected_regions += !j->touched[k];
+    j->touched[k] = 1;
+}
+
+/* The sequences through open node id take group g; its cell's step is s. */
+static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s)
+{
+    if (s >= CM_STEP_ON_PATH)
+        return CM_ETOOBIG;
+    cm_node *nd = &j->c->nodes[id];
+    if (nd->next == CM_NODE_OPEN) { /* the exit lands on a cell whose outcome is final */
+        nd->next = CM_NODE_FINAL;
+        nd->dist = (uint32_t)s;
+        nd->group = g;
+    }
+    nd->up = CM_NODE_FINAL;
+    nd->up_dist = (uint32_t)s;
+    nd->group = g;
+    if (g != 0) {
+        j->c->basin[g] += nd->weight;
+        j->c->basin_dirty[g] = 1;
+        j->stats->resolved_cells += nd->weight;
+    }
+    touch(j, id);
+    return CM_OK;
+}
+
+static cm_status push(joiner *j, uint64_t *len, uint32_t id)
+{
+    if (cm_grow((void **)&j->stack, &j->stack_cap, *len + 1, sizeof *j->stack) != CM_OK)
+        return CM_ENOMEM;
+    j->stack[(*len)++] = id;
+    return CM_OK;
+}
+
+/* Steps from node p's exit target, in the tree of cycle node q, to the cycle, plus one. */
+static cm_status into_cycle(joiner *j, uint32_t p, uint32_t q, uint64_t *steps)
+{
+    const uint32_t k = cm_cluster_node_region(j->c, q);
+    cm_status st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
+    if (st == CM_OK)
+        *steps = 1 + (uint64_t)cm_cluster_cycle_steps(j->c, k, q, j->c->nodes[p].target);
+    return st;
+}
+
+/* A node of a new straddling group's component: its final step, and those
+ * of the nodes on its chain, counted back from where the chain meets the
+ * cycle's trees. */
+static cm_status settle_member(joiner *j, uint32_t y, uint32_t g)
+{
+    cm_node *nodes = j->c->nodes;
+    uint64_t len = 0;
+    for (uint32_t x = y; nodes[x].next != CM_NODE_FINAL && nodes[x].next != CM_NODE_CYCLE;
+         x = nodes[x].next)
+        if (push(j, &len, x) != CM_OK)
+            return CM_ENOMEM;
+    while (len > 0) {
+        const uint32_t p = j->stack[--len], q = nodes[p].next;
+        uint64_t s;
+        if (nodes[q].next == CM_NODE_CYCLE) {
+            cm_status st = into_cycle(j, p, q, &s);
+            if (st != CM_OK)
+                return st;
+            nodes = j->c->nodes;
+        } else {
+            s = (uint64_t)nodes[p].dist + nodes[q].dist;
+        }
+        if (s >= CM_STEP_ON_PATH)
+            return CM_ETOOBIG;
+        nodes[p] = (cm_node){CM_NODE_FINAL, (uint32_t)s, g, nodes[p].target, nodes[p].tree,
+                             CM_NODE_FINAL, (uint32_t)s, nodes[p].ring, nodes[p].weight};
+        touch(j, p);
+    }
+    return CM_OK;
+}
+
+/* Notes the periodic cells of cycle node x, from where the cycle enters its
+ * tree down to the node's cell. */
+static cm_status trace_cycle_cells(joiner *j, uint32_t x, uint32_t entry, uint32_t g)
+{
+    const uint32_t k = cm_cluster_node_region(j->c, x);
+    cm_status st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
+    const cm_region *r = &j->c->regions[k].r;
+    for (uint32_t a = entry; st == CM_OK; a = r->image[a]) {
+        if (cm_cluster_note_periodic(j->c, g, k, a) != CM_OK)
+            return CM_ENOMEM;
+        if (r->image[a] >= r->ncells)
+            break; /* the node's own cell */
+    }
+    return st;
+}
+
+/* Linking open node n closed a chain of links on itself: a new group whose
+ * cycle crosses region borders. Its nodes and every node whose sequence
+ * reaches them become final. */
+static cm_status close_cycle(joiner *j, uint32_t n)
+{
+    uint32_t g;
+    cm_status st = cm_cluster_new_group(j->c, &g);
+    if (st != CM_OK)
+        return st;
+    j->stats->straddling_groups++;
+    uint64_t len = 0;
+    uint32_t x = n;
+    do {
+        if (push(j, &len, x) != CM_OK)
+            return CM_ENOMEM;
+        x = j->c->nodes[x].next;
+    } while (x != n);
+    /* where the cycle enters each node's tree: its predecessor's target */
+    uint32_t *entry = malloc(len * sizeof *entry), *cycle = malloc(len * sizeof *cycle);
+    if (!entry || !cycle) {
+        free(entry);
+        free(cycle);
+        return CM_ENOMEM;
+    }
+    for (uint64_t i = 0; i < len; i++) {
+        cycle[i] = j->stack[i];
+        entry[(i + 1) % len] = j->c->nodes[j->stack[i]].target;
+    }
+    for (uint64_t i = 0; i < len && st == CM_OK; i++) {
+        cm_node *nd = &j->c->nodes[cycle[i]];
+        nd->next = CM_NODE_CYCLE;
+        nd->dist = entry[i];
+        nd->group = g;
+        nd->up = CM_NODE_FINAL;
+        nd->up_dist = 0;
+        touch(j, cycle[i]);
+        st = trace_cycle_cells(j, cycle[i], entry[i], g);
+    }
+    free(entry);
+    free(cycle);
+    /* every member of n's component now leads into the cycle */
+    x = n;
+    do {
+        if (st == CM_OK)
+            st = settle_member(j, x, g);
+        x = j->c->nodes[x].ring;
+    } while (x != n);
+    const uint64_t weight = j->c->nodes[n].weight;
+    j->c->basin[g] += weight;
+    j->stats->resolved_cells += weight;
+    return st;
+}
+
+/* Links open node job->node to the cell its exit leads to. */
+static cm_status link_node(joiner *j, const link_job *job)
+{
+    cm_cluster *c = j->c;
+    c->nodes[job->node].target = job->cell;
+    if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
+        return finish(j, job->node, job->group, (uint64_t)job->step + 1);
+    const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
+    if (c->nodes[m].next == CM_NODE_CYCLE) { /* its tree holds a cycle that can enter above m */
+        uint64_t s;
+        cm_status st = into_cycle(j, job->node, m, &s);
+        return st == CM_OK ? finish(j, job->node, c->nodes[m].group, s) : st;
+    }
+    uint32_t g, s, open;
+    cm_status st = cm_cluster_resolve(c, m, &g, &s, &open);
+    if (st != CM_OK)
+        return st;
+    cm_node *nd = &c->nodes[job->node];
+    nd->next = m;
+    nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
+    if (open == CM_NODE_OPEN)
+        return finish(j, job->node, g, (uint64_t)job->step + s);
+    if (open == job->node)
+        return close_cycle(j, job->node);
+    if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
+        return CM_ETOOBIG;
+    cm_node *root = &c->nodes[open];
+    nd->up = open;
+    nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
+    root->weight += nd->weight;
+    const uint32_t ring = nd->ring;
+    nd->ring = root->ring;
+    root->ring = ring;
+    touch(j, job->node);
+    return CM_OK;
+}
+
+static int by_region(const void *a, const void *b)
+{
+    const link_job *x = a, *y = b;
+    if (x->region != y->region)
+        return x->region < y->region ? -1 : 1;
+    return (x->node > y->node) - (x->node < y->node);
+}
+
+static int by_node(const void *a, const void *b)
+{
+    const link_job *x = a, *y = b;
+    return (x->node > y->node) - (x->node < y->node);
+}
+
+/* The group and step of every job's target cell, reading each target
+ * region once. */
+static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
+{
+    qsort(jobs, n, sizeof *jobs, by_region);
+    for (uint64_t i = 0; i < n;) {
+        const uint32_t k = jobs[i].region;
+        cm_status st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
+        if (st != CM_OK)
+            return st;
+        const cm_region *r = &j->c->regions[k].r;
+        for (; i < n && jobs[i].region == k; i++) {
+            jobs[i].group = r->group[jobs[i].cell];
+            jobs[i].step = r->step[jobs[i].cell];
+        }
+    }
+    qsort(jobs, n, sizeof *jobs, by_node);
+    return CM_OK;
+}
+
+/* The links to make: the new region's exits into the cluster (the others
+ * join the index of open nodes) and the open nodes whose exits lead into it. */
+static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64_t *n)
+{
+    cm_cluster *c = j->c;
+    const cm_cluster_region *cr = &c->regions[added];
+    cm_escape *in = NULL;
+    uint64_t nin = 0, cap = 0;
+    cm_status st = cm_cluster_take_escapes(c, &cr->r.box, &in, &nin);
+    if (st == CM_OK &&
+        cm_grow((void **)jobs, &cap, nin + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
+        st = CM_ENOMEM;
+    for (uint64_t i = 0; i < nin && st == CM_OK; i++)
+        (*jobs)[(*n)++] = (link_job){in[i].node, added,
+                                     (uint32_t)cm_box_index(&cr->r.box, in[i].cell), 0, 0};
+    free(in);
+    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
+        const int64_t *cell = cm_region_exit(&cr->r, e);
+        const uint32_t id = cr->node_base + (uint32_t)e;
+        uint64_t local;
+        const int64_t k = cm_cluster_locate(c, cell, &local);
+        if (k < 0)
+            st = cm_cluster_add_escape(c, id, cell);
+        else
+            (*jobs)[(*n)++] = (link_job){id, (uint32_t)k, (uint32_t)local, 0, 0};
+    }
+    return st;
+}
+
+static cm_status link_all(joiner *j)
+{
+    const uint32_t added = j->c->nregions - 1;
+    link_job *jobs = NULL;
+    uint64_t n = 0;
+    cm_status st = collect_jobs(j, added, &jobs, &n);
+    if (st == CM_OK)
+        st = read_targets(j, jobs, n);
+    for (uint64_t i = 0; i < n && st == CM_OK; i++)
+        st = link_node(j, &jobs[i]);
+    j->stats->nodes = n;
+    free(jobs);
+    return st;
+}
+
+cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
+                          size_t msg_size)
+{
+    cm_join_stats local_stats;
+    if (!stats)
+        stats = &local_stats;
+    memset(stats, 0, sizeof *stats);
+    cm_status st = cm_cluster_add_region(c, r, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const uint32_t added = c->nregions - 1;
+    stats->new_groups = c->regions[added].r.ngroups;
+    char detail[256] = "";
+    joiner j = {c, stats, calloc(c->nregions, 1), NULL, 0, detail, sizeof detail};
+    st = j.touched ? CM_OK : CM_ENOMEM;
+    if (st == CM_OK) {
+        j.touched[added] = 1;
+        stats->affected_regions = 1;
+        st = link_all(&j);
+    }
+    free(j.touched);
+    free(j.stack);
+    stats->new_groups += stats->straddling_groups;
+    if (st != CM_OK)
+        return cm_fail(st, msg, msg_size, "joining region %u: %s", added,
+                       detail[0] ? detail : cm_strerror(st));
+    return CM_OK;
+}
+
+static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
+{
+    sum->affected_regions += one->affected_regions;
+    sum->resolved_cells += one->resolved_cells;
+    sum->nodes += one->nodes;
+    sum->new_groups += one->new_groups;
+    sum->straddling_groups += one->straddling_groups;
+}
+
+/* Solves boxes[0..n) concurrently, one region per thread. */
+static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box *boxes, uint32_t n,
+                        const cm_scm_options *one, int threads, cm_region *solved,
+                        cm_status *status, char (*msgs)[256])
+{
+    if (n == 1) { /* a lone box (a strip uncovered by panning) takes every thread for its images */
+        cm_scm_options all = *one;
+        all.threads = threads;
+        status[0] = cm_region_alloc(&solved[0], &boxes[0], msgs[0], sizeof msgs[0]);
+        if (status[0] == CM_OK)
+            status[0] = cm_scm_solve(model, &c->lat, &all, &solved[0], msgs[0], sizeof msgs[0]);
+        return;
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int64_t k = 0; k < (int64_t)n; k++) {
+        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
+        if (status[k] == CM_OK)
+            status[k] = cm_scm_solve(model, &c->lat, one, &solved[k], msgs[k], sizeof msgs[k]);
+    }
+    (void)threads;
+}
+
+cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
+                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
+                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    int threads = 1;
+#ifdef _OPENMP
+    threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+#endif
+    cm_region *solved = calloc((size_t)threads, sizeof *solved);
+    cm_status *status = calloc((size_t)threads, sizeof *status);
+    char(*msgs)[256] = calloc((size_t)threads, sizeof *msgs);
+    if (!solved || !status || !msgs) {
+        free(solved);
+        free(status);
+        free(msgs);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d regions", threads);
+    }
+    cm_scm_options one = opt ? *opt : (cm_scm_options){0};
+    one.record_exits = 1;
+    one.threads = 1;
+    if (stats)
+        memset(stats, 0, sizeof *stats);
+    /* One region per thread: classification is sequential, so this is how
+     * a big box uses every core. Each region's result depends on its box
+     * alone, and the joins run in a fixed order. */
+    cm_status st = CM_OK;
+    for (uint32_t first = 0; first < nboxes && st == CM_OK; first += (uint32_t)threads) {
+        const uint32_t n = nboxes - first < (uint32_t)threads ? nboxes - first : (uint32_t)threads;
+        solve_batch(c, model, boxes + first, n, &one, threads, solved, status, msgs);
+        for (uint32_t k = 0; k < n; k++) {
+            cm_join_stats one_join;
+            if (st == CM_OK && status[k] != CM_OK)
+                st = cm_fail(status[k], msg, msg_size, "region %u: %s", first + k, msgs[k]);
+            if (st == CM_OK)
+                st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
+            if (st == CM_OK && stats)
+                add_join_stats(stats, &one_join);
+            if (st == CM_OK && joined)
+                st = joined(user, c, first + k, &one_join, msg, msg_size);
+            cm_region_free(&solved[k]);
+        }
+    }
+    free(solved);
+    free(status);
+    free(msgs);
+    return st;
+}

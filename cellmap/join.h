@@ -1,0 +1,51 @@
+/* cellmap/join.h - joining solved regions into a cluster (thesis 4.6.2,
+ * Algorithms C.3-C.7) through the cluster's node table alone.
+ *
+ * Only sequences that left the cluster can change when a region joins: the
+ * exits of the new region, and the open nodes of the cluster whose exits
+ * lead into it. Each gets its link, read once from the target cell (which
+ * never changes): a final group and step (Stage 1 of the thesis), or the
+ * tree of another node. Links that close a chain of nodes on itself make a
+ * group that straddles region borders (Stage 2); its cycle is traced
+ * through the regions it crosses, the only cells a join reads besides the
+ * new region's and the target cells of its links. No region's cells are
+ * ever written again, so a join costs what its new cells and its border
+ * cost, whatever the size of the cluster.
+ *
+ * Existing group ids never change; the new region's groups take the next
+ * ids, then straddling groups in the order their cycles close (links in
+ * order of node id: the new region's, then the open nodes it receives).
+ */
+#ifndef CM_JOIN_H
+#define CM_JOIN_H
+
+#include "cellmap/cluster.h"
+
+typedef struct cm_join_stats {
+    uint32_t affected_regions; /* regions whose node records changed, the new one included */
+    uint64_t resolved_cells;   /* cells whose sequences stopped leaving the cluster */
+    uint64_t nodes;            /* links made */
+    uint32_t new_groups;       /* groups of the new region plus straddling ones */
+    uint32_t straddling_groups;
+} cm_join_stats;
+
+/* Joins a region solved with record_exits on the cluster's lattice. The
+ * cluster takes the region's arrays (r is zeroed). CM_EINVAL if its box
+ * overlaps a region of the cluster. stats may be NULL. */
+cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
+                          size_t msg_size);
+
+/* Called after each join of cm_cluster_solve_boxes (box is its index);
+ * a status other than CM_OK stops the solve with it. */
+typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
+                                  const cm_join_stats *stats, char *msg, size_t msg_size);
+
+/* Solves the boxes in batches of one box per thread (images included) and
+ * joins each batch in the given order, calling joined (may be NULL) after
+ * every join, so at most a batch of unjoined regions is held at once.
+ * stats (may be NULL) sums the joins'. */
+cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
+                                 uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
+                                 void *user, cm_join_stats *stats, char *msg, size_t msg_size);
+
+#endif
