@@ -71,12 +71,19 @@ static uint64_t hash_key(const cm_bricks *b, const int64_t *key)
     return h;
 }
 
+static int same_key(const cm_bricks *b, const int64_t *x, const int64_t *y)
+{
+    for (int d = 0; d < b->dim; d++)
+        if (x[d] != y[d])
+            return 0;
+    return 1;
+}
+
 /* The slot holding key, or the empty slot where it would go. */
 static uint64_t probe(const cm_bricks *b, const int64_t *key)
 {
     uint64_t s = hash_key(b, key) & (b->nslots - 1);
-    while (b->slots[s] &&
-           memcmp(b->bricks[b->slots[s] - 1].key, key, (size_t)b->dim * sizeof *key) != 0)
+    while (b->slots[s] && !same_key(b, b->bricks[b->slots[s] - 1].key, key))
         s = (s + 1) & (b->nslots - 1);
     return s;
 }

@@ -2,6 +2,7 @@
 
 #include "cellmap/grow.h"
 
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -11,7 +12,8 @@
 /* A link to make: node `node`'s exit leads to cell `cell` of region `region`,
  * whose group and step are read before linking. */
 typedef struct link_job {
-    uint32_t node, region, cell, group, step;
+    uint32_t node, from; /* the node and its region */
+    uint32_t region, cell, group, step;
 } link_job;
 
 typedef struct joiner {
@@ -24,16 +26,18 @@ typedef struct joiner {
     size_t msg_size;
 } joiner;
 
-static void touch(joiner *j, uint32_t id)
+/* Node id of region k changed. */
+static void touch_in(joiner *j, uint32_t k)
 {
-    const uint32_t k = cm_cluster_node_region(j->c, id);
     j->c->regions[k].nodes_dirty = 1;
     j->stats->affected_regions += !j->touched[k];
     j->touched[k] = 1;
 }
 
+static void touch(joiner *j, uint32_t id) { touch_in(j, cm_cluster_node_region(j->c, id)); }
+
 /* The sequences through open node id take group g; its cell's step is s. */
-static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s)
+static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uint64_t s)
 {
     if (s >= CM_STEP_ON_PATH)
         return CM_ETOOBIG;
@@ -51,7 +55,7 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s)
         j->c->basin_dirty[g] = 1;
         j->stats->resolved_cells += nd->weight;
     }
-    touch(j, id);
+    touch_in(j, region);
     return CM_OK;
 }
 
@@ -179,12 +183,12 @@ static cm_status link_node(joiner *j, const link_job *job)
     cm_cluster *c = j->c;
     c->nodes[job->node].target = job->cell;
     if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
-        return finish(j, job->node, job->group, (uint64_t)job->step + 1);
+        return finish(j, job->node, job->from, job->group, (uint64_t)job->step + 1);
     const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
     if (c->nodes[m].next == CM_NODE_CYCLE) { /* its tree holds a cycle that can enter above m */
         uint64_t s;
         cm_status st = into_cycle(j, job->node, m, &s);
-        return st == CM_OK ? finish(j, job->node, c->nodes[m].group, s) : st;
+        return st == CM_OK ? finish(j, job->node, job->from, c->nodes[m].group, s) : st;
     }
     uint32_t g, s, open;
     cm_status st = cm_cluster_resolve(c, m, &g, &s, &open);
@@ -194,7 +198,7 @@ static cm_status link_node(joiner *j, const link_job *job)
     nd->next = m;
     nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
     if (open == CM_NODE_OPEN)
-        return finish(j, job->node, g, (uint64_t)job->step + s);
+        return finish(j, job->node, job->from, g, (uint64_t)job->step + s);
     if (open == job->node)
         return close_cycle(j, job->node);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
@@ -206,42 +210,49 @@ static cm_status link_node(joiner *j, const link_job *job)
     const uint32_t ring = nd->ring;
     nd->ring = root->ring;
     root->ring = ring;
-    touch(j, job->node);
+    touch_in(j, job->from);
     return CM_OK;
 }
 
-static int by_region(const void *a, const void *b)
-{
-    const link_job *x = a, *y = b;
-    if (x->region != y->region)
-        return x->region < y->region ? -1 : 1;
-    return (x->node > y->node) - (x->node < y->node);
-}
-
-static int by_node(const void *a, const void *b)
-{
-    const link_job *x = a, *y = b;
-    return (x->node > y->node) - (x->node < y->node);
-}
-
-/* The group and step of every job's target cell, reading each target
- * region once. */
+/* The group and step of every job's target cell. Jobs stay in node order;
+ * when some target regions are paged out, they are visited region by
+ * region (a counting sort of the jobs' positions) so that each is read once. */
 static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
 {
-    qsort(jobs, n, sizeof *jobs, by_region);
-    for (uint64_t i = 0; i < n;) {
-        const uint32_t k = jobs[i].region;
-        cm_status st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
-        if (st != CM_OK)
-            return st;
-        const cm_region *r = &j->c->regions[k].r;
-        for (; i < n && jobs[i].region == k; i++) {
-            jobs[i].group = r->group[jobs[i].cell];
-            jobs[i].step = r->step[jobs[i].cell];
-        }
+    cm_cluster *c = j->c;
+    bool resident = true;
+    for (uint64_t i = 0; i < n && resident; i++)
+        resident = c->regions[jobs[i].region].r.group != NULL;
+    uint64_t *start = resident ? NULL : calloc((size_t)c->nregions + 1, sizeof *start);
+    uint64_t *order = resident ? NULL : malloc((n + 1) * sizeof *order);
+    if (!resident && (!start || !order)) {
+        free(start);
+        free(order);
+        return CM_ENOMEM;
     }
-    qsort(jobs, n, sizeof *jobs, by_node);
-    return CM_OK;
+    if (!resident) {
+        for (uint64_t i = 0; i < n; i++)
+            start[jobs[i].region + 1]++;
+        for (uint32_t k = 0; k < c->nregions; k++)
+            start[k + 1] += start[k];
+        for (uint64_t i = 0; i < n; i++)
+            order[start[jobs[i].region]++] = i;
+    }
+    cm_status st = CM_OK;
+    uint32_t held = UINT32_MAX;
+    for (uint64_t p = 0; p < n && st == CM_OK; p++) {
+        link_job *job = &jobs[order ? order[p] : p];
+        if (job->region != held) {
+            st = cm_cluster_acquire(c, job->region, j->msg, j->msg_size);
+            held = job->region;
+        }
+        const cm_region *r = &c->regions[job->region].r;
+        job->group = st == CM_OK ? r->group[job->cell] : 0;
+        job->step = st == CM_OK ? r->step[job->cell] : 0;
+    }
+    free(start);
+    free(order);
+    return st;
 }
 
 /* The links to make: the new region's exits into the cluster (the others
@@ -257,8 +268,9 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
         cm_grow((void **)jobs, &cap, nin + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
         st = CM_ENOMEM;
     for (uint64_t i = 0; i < nin && st == CM_OK; i++)
-        (*jobs)[(*n)++] = (link_job){in[i].node, added,
-                                     (uint32_t)cm_box_index(&cr->r.box, in[i].cell), 0, 0};
+        (*jobs)[(*n)++] =
+            (link_job){in[i].node, cm_cluster_node_region(c, in[i].node), added,
+                       (uint32_t)cm_box_index(&cr->r.box, in[i].cell), 0, 0};
     free(in);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
         const int64_t *cell = cm_region_exit(&cr->r, e);
@@ -268,7 +280,7 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
         if (k < 0)
             st = cm_cluster_add_escape(c, id, cell);
         else
-            (*jobs)[(*n)++] = (link_job){id, (uint32_t)k, (uint32_t)local, 0, 0};
+            (*jobs)[(*n)++] = (link_job){id, added, (uint32_t)k, (uint32_t)local, 0, 0};
     }
     return st;
 }

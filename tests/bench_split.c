@@ -1,0 +1,106 @@
+#define _DEFAULT_SOURCE
+/* bench_split: what splitting a solve into regions costs, from the command
+ * line (issue: joins in O(boundary)). For each configuration, `cellmap
+ * solve --cells 4000x2000` (8 M cells, 2 threads) runs whole and with
+ * --split 2x1, 4x4 and 16x16; the program prints the median wall time of
+ * REPS runs and the largest peak RSS, and their ratios to the whole solve.
+ * usage: bench_split PATH/TO/cellmap [REPS]   (REPS default 3) */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench_util.h"
+
+static const char *const configs[][3] = {
+    {"4.6.3", "alpha=0.078,beta=0,P=0.007,D=0.02", "0:500,-40:40"},
+    {"a.07", "alpha=0.07,beta=0,P=0.007,D=0.02", "85.4:485.4,-12.5:12.5"},
+    {"wide", "alpha=0.078,beta=0,P=0.007,D=0.02", "-50:1050,-12.5:12.5"},
+    {"4.21", "alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3", "-125000:125000,-600:600"},
+};
+static const char *const max_steps[] = {NULL, "20", NULL, "100000"};
+static const char *const splits[] = {NULL, "2x1", "4x4", "16x16"};
+
+/* One run: wall seconds and peak RSS in MiB of the child. */
+static int run(const char *cm, int c, int s, double *wall, double *rss_mib)
+{
+    const char *argv[16];
+    int n = 0;
+    argv[n++] = cm;
+    argv[n++] = "solve";
+    argv[n++] = "--param";
+    argv[n++] = configs[c][1];
+    argv[n++] = "--region";
+    argv[n++] = configs[c][2];
+    argv[n++] = "--cells";
+    argv[n++] = "4000x2000";
+    argv[n++] = "--threads";
+    argv[n++] = "2";
+    if (max_steps[c]) {
+        argv[n++] = "--max-steps";
+        argv[n++] = max_steps[c];
+    }
+    if (splits[s]) {
+        argv[n++] = "--split";
+        argv[n++] = splits[s];
+    }
+    argv[n] = NULL;
+    fflush(stdout); /* the child must not inherit unwritten lines */
+    const double t0 = now();
+    const pid_t pid = fork();
+    if (pid == 0) {
+        if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))
+            _exit(127);
+        execv(cm, (char *const *)argv);
+        _exit(127);
+    }
+    int status = 0;
+    struct rusage ru;
+    if (pid < 0 || wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) ||
+        WEXITSTATUS(status) != 0)
+        return -1;
+    *wall = now() - t0;
+    *rss_mib = (double)ru.ru_maxrss / 1024.0;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: bench_split PATH/TO/cellmap [REPS]\n");
+        return 2;
+    }
+    const int reps = argc > 2 ? atoi(argv[2]) : 3;
+    if (reps < 1 || reps > 50) {
+        fprintf(stderr, "bench_split: REPS must be 1..50\n");
+        return 2;
+    }
+    printf("%-6s %-6s %10s %8s %10s %8s\n", "config", "split", "wall_s", "x_whole", "rss_MiB",
+           "x_whole");
+    for (int c = 0; c < 4; c++) {
+        double whole_wall = 0, whole_rss = 0;
+        for (int s = 0; s < 4; s++) {
+            double walls[50], rss = 0;
+            for (int r = 0; r < reps; r++) {
+                double one_rss;
+                if (run(argv[1], c, s, &walls[r], &one_rss) != 0) {
+                    fprintf(stderr, "bench_split: %s %s failed\n", configs[c][0],
+                            splits[s] ? splits[s] : "whole");
+                    return 1;
+                }
+                rss = one_rss > rss ? one_rss : rss;
+            }
+            const double wall = median(walls, reps);
+            if (s == 0) {
+                whole_wall = wall;
+                whole_rss = rss;
+            }
+            printf("%-6s %-6s %10.3f %8.2f %10.1f %8.2f\n", configs[c][0],
+                   splits[s] ? splits[s] : "whole", wall, wall / whole_wall, rss, rss / whole_rss);
+            fflush(stdout);
+        }
+    }
+    return 0;
+}
