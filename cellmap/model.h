@@ -91,7 +91,7 @@ typedef struct cm_model {
 /* Releases the model's context; NULL-safe; leaves the struct zeroed. */
 void cm_model_release(cm_model *m);
 
-/* Integer part rounding toward zero, as the thesis' Int (MODELS.md 1.1).
+/* Integer part rounding toward zero, as the thesis' Int (docs/models.md 1.1).
  * Returns false for NaN, infinities and |z| >= 2^62, where no level exists. */
 static inline bool cm_int_part(double z, double *level)
 {

@@ -1,5 +1,5 @@
 /* The dry friction oscillator of thesis Chapter 2: exact stick-slip
- * motion and its stroboscopic Poincare map (MODELS.md 9). */
+ * motion and its stroboscopic Poincare map (docs/models.md 9). */
 #include "models/friction_oscillator.h"
 
 #include <float.h>
@@ -15,7 +15,7 @@
 /* Resampled from libm after this many recurrence steps, so that the
  * rotation recurrences never drift by more than a few ulps times this. */
 #define RESEED_EVERY 16
-/* Absolute precision of event times (MODELS.md 9.4 asks for 1e-12). */
+/* Absolute precision of event times (docs/models.md 9.4 asks for 1e-12). */
 #define TAU_TOL 1e-14
 #define MIN_XTOL 1e-13
 /* A breakaway computed up to this much phase before the stick began is
@@ -61,7 +61,7 @@ static void tally_x(cm_fo_tally *t, double x)
         t->x_min = x;
 }
 
-/* ---- the slip phase in closed form (MODELS.md 9.2) ---- */
+/* ---- the slip phase in closed form (docs/models.md 9.2) ---- */
 
 /* A slip phase from (x0, v0) at local time s0 in direction sigma. */
 typedef struct slip {
@@ -147,7 +147,7 @@ static double g_at(const slip *g, double tau)
     return slip_g(g, &t);
 }
 
-/* ---- the first velocity zero (MODELS.md 9.4) ---- */
+/* ---- the first velocity zero (docs/models.md 9.4) ---- */
 
 /* A zero of g in [a, b] with g(a) > 0 >= g(b): Newton steps on the
  * analytic derivative, bisection whenever a step leaves the bracket. */
@@ -174,7 +174,7 @@ static double refine_zero(const slip *g, double a, double b, double ga, double g
     return b;
 }
 
-/* The minimum of g on [a, b] by golden section (MODELS.md 9.4: it must
+/* The minimum of g on [a, b] by golden section (docs/models.md 9.4: it must
  * not miss a dip of g below zero between two samples). */
 static double minimise(const slip *g, double a, double b, double *g_min)
 {
@@ -325,7 +325,7 @@ static double first_velocity_zero(const slip *g, double tau_max, double step)
     return -1;
 }
 
-/* ---- sticking and breakaway (MODELS.md 9.3) ---- */
+/* ---- sticking and breakaway (docs/models.md 9.3) ---- */
 
 /* The first phase > psi (or >= psi - PHASE_TOL if allow_now) of the series
  * base + 2 pi k. */
@@ -366,7 +366,7 @@ static bool breakaway(const cm_fo *o, double s, double x, bool allow_now, double
     return true;
 }
 
-/* ---- propagation (MODELS.md 9.5, 9.6) ---- */
+/* ---- propagation (docs/models.md 9.5, 9.6) ---- */
 
 static void emit(cm_fo_event_fn on_event, void *user, double s, double x, int kind, int mode)
 {
@@ -421,7 +421,7 @@ bool cm_fo_propagate(const cm_fo *o, cm_fo_state *st, double s_end, cm_fo_tally 
         allow_now = true;
         if (tau_e == 0 || (fabs(F) >= o->S0 && turn_to == st->mode)) {
             /* degenerate (S0 = S at a tangency): stuck instead, and not
-             * released again at this instant (MODELS.md 9.5) */
+             * released again at this instant (docs/models.md 9.5) */
             st->mode = CM_FO_STICK;
             allow_now = false;
         } else if (fabs(F) < o->S0) {
@@ -478,7 +478,7 @@ bool cm_fo_run_period(const cm_fo *o, cm_fo_run *r, cm_fo_tally *tally, cm_fo_ev
     return true;
 }
 
-/* ---- linearisation (MODELS.md 9.7) ---- */
+/* ---- linearisation (docs/models.md 9.7) ---- */
 
 typedef struct event_log {
     cm_fo_event e[64];
@@ -592,7 +592,7 @@ bool cm_fo_symmetric_amplitude(double S, double Omega, double *x0, double *phase
     return true;
 }
 
-/* ---- Lyapunov exponent (MODELS.md 9.8) ---- */
+/* ---- Lyapunov exponent (docs/models.md 9.8) ---- */
 
 bool cm_fo_lyapunov(const cm_fo *o, double x0, double v0, double d0, int periods, double *lambda)
 {
@@ -636,7 +636,7 @@ const cm_param_spec cm_friction_oscillator_spec[] = {
     {"phi", "0", 0, 6.283185307179586, 1, NULL,
      "section phase: states at Omega t = phi mod 2 pi (0: forcing maximum)"},
     {"alpha", "0", 0, 0, 1, NULL,
-     "viscous damping 2 alpha x' of (2.3); only 0 is implemented (MODELS.md 9.1)"},
+     "viscous damping 2 alpha x' of (2.3); only 0 is implemented (docs/models.md 9.1)"},
     {NULL, NULL, 0, 0, 0, NULL, NULL},
 };
 

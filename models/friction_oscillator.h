@@ -1,11 +1,11 @@
 /* models/friction_oscillator.h - the harmonically excited oscillator with
  * Coulomb friction and different static and kinetic coefficients (thesis
- * Chapter 2, eq. (2.3) with alpha = 0; MODELS.md 9):
+ * Chapter 2, eq. (2.3) with alpha = 0; docs/models.md 9):
  *
  *     x'' + x = cos(Omega t) - S f(x'),   f = sgn(x'), or in [-S0/S, S0/S] at rest.
  *
  * Between events the motion is known in closed form; only the velocity
- * zeros are found numerically (MODELS.md 9.4). Time inside the integrator
+ * zeros are found numerically (docs/models.md 9.4). Time inside the integrator
  * is local: s is measured from a section instant at which the forcing phase
  * is phi, so cos(Omega t) is evaluated as cos(phi + Omega s) and never loses
  * digits to a large t. All functions are pure; S0 >= S > 0, Omega > 0. */
@@ -18,7 +18,7 @@ typedef struct cm_fo {
     double S, S0, Omega;
     double phi;  /* forcing phase at s = 0: the section phase of the Poincare map */
     double T;    /* forcing period 2 pi/Omega */
-    double step; /* velocity sampling step (2 pi/96)/max(1, Omega) (MODELS.md 9.4) */
+    double step; /* velocity sampling step (2 pi/96)/max(1, Omega) (docs/models.md 9.4) */
 } cm_fo;
 
 void cm_fo_init(cm_fo *o, double S, double S0, double Omega, double phi);
@@ -31,7 +31,7 @@ typedef struct cm_fo_state {
     int mode;
 } cm_fo_state;
 
-/* The mode of a state by MODELS.md 9.1: the sign of v, or at rest stuck
+/* The mode of a state by docs/models.md 9.1: the sign of v, or at rest stuck
  * iff |cos(phi + Omega s) - x| < S0, else sliding along the net force. */
 int cm_fo_mode_of(const cm_fo *o, double s, double x, double v);
 
@@ -47,7 +47,7 @@ typedef struct cm_fo_event {
     int mode;    /* the mode after the event */
 } cm_fo_event;
 
-/* What happened during a propagation (MODELS.md 9.6). */
+/* What happened during a propagation (docs/models.md 9.6). */
 typedef struct cm_fo_tally {
     int n_stick, n_turn, n_break;
     double x_max, x_min; /* over the start, the events and the end */
@@ -97,11 +97,11 @@ bool cm_fo_run_period(const cm_fo *o, cm_fo_run *r, cm_fo_tally *tally, cm_fo_ev
 
 /* The Jacobian of P_phi at z (row-major) from the events of one period:
  * the free-flight rotations and the saltation matrices of turns, sticks and
- * breakaways (MODELS.md 9.7). Returns false where P_phi is not followed. */
+ * breakaways (docs/models.md 9.7). Returns false where P_phi is not followed. */
 bool cm_fo_monodromy(const cm_fo *o, const double z[2], double J[4]);
 
 /* A fixed point of P_phi by Newton's method from z (in place), with
- * central-difference Jacobians (step 1e-7) as MODELS.md 9.6 prescribes.
+ * central-difference Jacobians (step 1e-7) as docs/models.md 9.6 prescribes.
  * *residual receives |P(z) - z|. Returns false if it did not converge to
  * 1e-10 within max_iter iterations. */
 bool cm_fo_fixed_point(const cm_fo *o, double z[2], int max_iter, double *residual);
@@ -113,7 +113,7 @@ bool cm_fo_fixed_point(const cm_fo *o, double z[2], int max_iter, double *residu
 bool cm_fo_symmetric_amplitude(double S, double Omega, double *x0, double *phase);
 
 /* The largest Lyapunov exponent by the renormalised two-trajectory
- * estimator of MODELS.md 9.8: separation d0 in x from (x0, v0) at local
+ * estimator of docs/models.md 9.8: separation d0 in x from (x0, v0) at local
  * time 0, samples every T/32 for `periods` periods. Returns false if no
  * sample was accepted or the motion was lost; *lambda may be -INFINITY
  * when the two trajectories merge. */

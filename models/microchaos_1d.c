@@ -1,4 +1,4 @@
-/* 1D micro-chaos map (4.1): x_{j+1} = a x_j - b Int(x_j). MODELS.md 3. */
+/* 1D micro-chaos map (4.1): x_{j+1} = a x_j - b Int(x_j). docs/models.md 3. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

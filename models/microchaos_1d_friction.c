@@ -1,4 +1,4 @@
-/* 1D transient micro-chaos map with Coulomb friction (4.23). MODELS.md 4. */
+/* 1D transient micro-chaos map with Coulomb friction (4.23). docs/models.md 4. */
 #include <math.h>
 #include <string.h>
 

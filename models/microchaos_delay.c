@@ -1,5 +1,5 @@
 /* 2D micro-chaos map with delay (4.37): [x_{j-1}, x_j] ->
- * [x_j, a x_j - b Int(x_{j-1})]. MODELS.md 5. */
+ * [x_j, a x_j - b Int(x_{j-1})]. docs/models.md 5. */
 #include <math.h>
 #include <string.h>
 

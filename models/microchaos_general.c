@@ -1,4 +1,4 @@
-/* General n-D micro-chaos map with delay (MODELS.md 2.2):
+/* General n-D micro-chaos map with delay (docs/models.md 2.2):
  *   u_j = sum_i K_i X_{j-i},  X = Q_I(x) for input/twofold quantisation,
  *   u^q = Q_O(u) for output/twofold,  x_{j+1} = A x_j + B u^q.
  * State: the history [x_{j-d}, ..., x_j], oldest first, (d+1) n <= 6. */
@@ -15,7 +15,7 @@ const cm_param_spec cm_microchaos_general_spec[] = {
     {"n", "1", 1, 6, 1, NULL, "number of physical state variables"},
     {"l", "1", 1, 6, 1, NULL, "number of control signals"},
     {"d", "0", 0, 5, 1, NULL, "largest delay in sampling periods; (d+1) n <= 6"},
-    {"mode", "output", 0, 0, 1, "none|output|input|twofold", "quantisation (MODELS.md 2.2)"},
+    {"mode", "output", 0, 0, 1, "none|output|input|twofold", "quantisation (docs/models.md 2.2)"},
     {"A", "3.5", -1e12, 1e12, 36, NULL, "n x n sampled open-loop matrix, row-major, a:b:..."},
     {"B", "-2.8", -1e12, 1e12, 36, NULL, "n x l input matrix, row-major"},
     {"K", "1", -1e12, 1e12, 36, NULL,
@@ -77,7 +77,7 @@ static int step_general(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
-/* MODELS.md 2.4 for one control signal: x* = (I - A)^-1 B u*, u* = r_O m;
+/* docs/models.md 2.4 for one control signal: x* = (I - A)^-1 B u*, u* = r_O m;
  * regular iff the quantised law at the constant history returns u*. */
 static int fixed_points_general(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                                 size_t cap, size_t *count, char *msg, size_t msg_size)

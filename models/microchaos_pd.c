@@ -1,5 +1,5 @@
 /* 2D micro-chaos map of the PD-controlled inverted pendulum (4.66).
- * MODELS.md 6. */
+ * docs/models.md 6. */
 #include "models/microchaos_pd.h"
 
 #include <math.h>
@@ -136,7 +136,7 @@ size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fi
     return count;
 }
 
-/* The band of level m as z_lo <= P x + D x' <= z_hi (MODELS.md 1.1; band 0
+/* The band of level m as z_lo <= P x + D x' <= z_hi (docs/models.md 1.1; band 0
  * is twice as wide). */
 static void band_of(int64_t m, double *z_lo, double *z_hi)
 {

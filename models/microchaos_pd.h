@@ -1,5 +1,5 @@
 /* models/microchaos_pd.h - analytic results for the 2D micro-chaos map of the
- * PD-controlled inverted pendulum (thesis 4.5, App. C.4; MODELS.md 6).
+ * PD-controlled inverted pendulum (thesis 4.5, App. C.4; docs/models.md 6).
  * All functions are pure. alpha > 0 is required throughout. */
 #ifndef CM_MODELS_MICROCHAOS_PD_H
 #define CM_MODELS_MICROCHAOS_PD_H
@@ -41,21 +41,21 @@ double cm_pd_P_max(double alpha, double beta);
 double cm_pd_D_at_P_max(double alpha, double beta);
 
 /* (4.75) m_fix,max = Int(alpha^2/(P - alpha^2)), with the border rule of
- * MODELS.md 6.4 (a colliding fixed point is virtual); (4.76) m_max =
+ * docs/models.md 6.4 (a colliding fixed point is virtual); (4.76) m_max =
  * m_fix,max + 1. Return -1 when P <= alpha^2 (unbounded). */
 int64_t cm_pd_m_fix_max(double alpha, double P);
 int64_t cm_pd_m_max(double alpha, double P);
 
 /* (4.71): the fixed points x_m* = [m/alpha^2, 0] for levels m0..m1 into
  * out (at most cap); x_m* is regular iff Int(P x_m*) = m (the band test of
- * MODELS.md 6.4). Returns how many were written. */
+ * docs/models.md 6.4). Returns how many were written. */
 size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fixed_point *out,
                           size_t cap);
 
 /* Axis names of the pendulum's state: x and x'. */
 extern const char *const cm_pd_coord_names[];
 
-/* The overlays of the view lo..hi (MODELS.md 6.4): the switching lines
+/* The overlays of the view lo..hi (docs/models.md 6.4): the switching lines
  * SW_m, the fixed points x_m* (regular or virtual) and, through each regular
  * one, its unstable and stable manifolds (the lines along e_u and e_s) within
  * its band. Shared by microchaos-pd and microchaos-pd-friction. */

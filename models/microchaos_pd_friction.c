@@ -1,4 +1,4 @@
-/* Hybrid micro-chaos map with dry friction (4.81). MODELS.md 8. */
+/* Hybrid micro-chaos map with dry friction (4.81). docs/models.md 8. */
 #include "models/microchaos_pd_friction.h"
 
 #include <math.h>
@@ -39,7 +39,7 @@ void cm_pdf_coefficients(double alpha, double beta, double P, double D, double m
     c->tanh_gamma = tanh(pd.gamma);
 }
 
-/* Slides for local time tau under the constant force -q (MODELS.md 6.2). */
+/* Slides for local time tau under the constant force -q (docs/models.md 6.2). */
 static void slide(const cm_pdf_coef *c, double q, double tau, double *x, double *v)
 {
     const double xq = q / c->alpha2, xi = *x - xq, v0 = *v;
@@ -50,7 +50,7 @@ static void slide(const cm_pdf_coef *c, double q, double tau, double *x, double 
 }
 
 /* Local time in (0, 1] at which the velocity of a block sliding from (x, v)
- * under -q reaches zero, or -1 if it keeps its sign (MODELS.md 8.2). */
+ * under -q reaches zero, or -1 if it keeps its sign (docs/models.md 8.2). */
 static double velocity_zero(const cm_pdf_coef *c, double q, double x, double v)
 {
     const double den = c->alpha2 * (x - q / c->alpha2) - c->beta * v;
@@ -109,7 +109,7 @@ bool cm_pdf_step(const cm_pdf_coef *c, double x, double v, cm_pdf_result *out)
         }
     }
     /* From rest with |F| > mu_s >= mu the velocity keeps sigma's sign to the
-     * end of the interval (MODELS.md 8.2): no further event. */
+     * end of the interval (docs/models.md 8.2): no further event. */
     const double tau = out->event ? 1 - out->event_time : 1;
     slide(c, level + c->mu * sigma, tau, &x, &v);
     out->x = x;

@@ -1,6 +1,6 @@
 /* models/microchaos_pd_friction.h - the hybrid micro-chaos map: the
  * PD-controlled inverted pendulum (4.65) with Coulomb friction (thesis
- * 4.7.1, (4.81); MODELS.md 8). The control level switches at sampling
+ * 4.7.1, (4.81); docs/models.md 8). The control level switches at sampling
  * instants only (map-like); friction switches whenever the velocity
  * changes sign (flow-like), and the block can stick between samples.
  * All functions are pure; alpha > 0 and mu_s >= mu >= 0 are required. */
@@ -20,7 +20,7 @@ typedef struct cm_pdf_coef {
 void cm_pdf_coefficients(double alpha, double beta, double P, double D, double mu, double mu_s,
                          cm_pdf_coef *c);
 
-/* What happens within one sampling interval (MODELS.md 8.3). */
+/* What happens within one sampling interval (docs/models.md 8.3). */
 enum cm_pdf_event_kind {
     CM_PDF_NONE = 0,
     CM_PDF_STUCK_WHOLE, /* at rest at the sample and held by static friction */

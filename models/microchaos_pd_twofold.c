@@ -1,5 +1,5 @@
 /* Twofold quantisation of the PD map (4.84): u = Int(rho (P Int(x/rho) +
- * D Int(x'/rho))), [x, x'] -> A [x, x'] + b u. MODELS.md 7. */
+ * D Int(x'/rho))), [x, x'] -> A [x, x'] + b u. docs/models.md 7. */
 #include <math.h>
 #include <string.h>
 
@@ -41,7 +41,7 @@ static int step_twofold(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
-/* MODELS.md 2.4 (twofold): x* = [u/alpha^2, 0] for control value u, regular
+/* docs/models.md 2.4 (twofold): x* = [u/alpha^2, 0] for control value u, regular
  * iff the control law at x* returns u. */
 static int fixed_points_twofold(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                                 size_t cap, size_t *count, char *msg, size_t msg_size)

@@ -33,7 +33,7 @@ static const cm_model_entry entries[] = {
      "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
      NULL, cm_microchaos_general_spec, cm_microchaos_general_create},
     {"friction-oscillator", "x, v",
-     "Poincare map of the harmonically excited oscillator with dry friction (2.3), MODELS.md 9",
+     "Poincare map of the harmonically excited oscillator with dry friction (2.3), docs/models.md 9",
      CM_FO_REGION, cm_friction_oscillator_spec, cm_friction_oscillator_create},
 };
 

@@ -11,7 +11,7 @@ static const char fp_help[] =
     "Prints, for every control level m in M0..M1 (default -10:10), the candidate\n"
     "fixed point x_m* as CSV: level,band,kind,x0,x1,... where band is the level\n"
     "actually produced at the point and kind is 'regular' (band = level) or\n"
-    "'virtual' (thesis (4.16)-(4.17), MODELS.md 2.4).\n";
+    "'virtual' (thesis (4.16)-(4.17), docs/models.md 2.4).\n";
 
 int cmd_fixed_points(int argc, char **argv)
 {

@@ -1,6 +1,6 @@
 /* cellmap lyapunov: the largest Lyapunov exponent of the dry friction
  * oscillator over a grid of two parameters (thesis Figs. 2.20-2.21), by
- * the renormalised two-trajectory estimator of MODELS.md 9.8. */
+ * the renormalised two-trajectory estimator of docs/models.md 9.8. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -21,7 +21,7 @@ static const char lyapunov_help[] =
     "The largest Lyapunov exponent of the dry friction oscillator (thesis 2.5.3)\n"
     "at the centres of an N x M grid of parameters X and Y (e.g. Omega and S at\n"
     "fixed S0, as Figs. 2.20-2.21), by the renormalised two-trajectory\n"
-    "estimator of MODELS.md 9.8: separation D in x, samples every T/32, P\n"
+    "estimator of docs/models.md 9.8: separation D in x, samples every T/32, P\n"
     "excitation periods. Grid points run in parallel; the results do not\n"
     "depend on the thread count. Points with S > S0 are not computed.\n\n"
     "  --grid X=LO:HI:N,Y=LO:HI:M  the two parameters and their ranges (N, M <= 2000)\n"
@@ -64,7 +64,7 @@ static int parse_args(cli *c, lyap_args *a)
         } else if (cli_is(c, "--d0", true, &err)) {
             if (c->value && (!parse_double(c->value, &a->d0) || !(a->d0 >= 1e-9 && a->d0 <= 1e-3)))
                 err = cli_usage_error(
-                    c, "--d0: '%s' must be a number in 1e-9..1e-3 (MODELS.md 9.8)", c->value);
+                    c, "--d0: '%s' must be a number in 1e-9..1e-3 (docs/models.md 9.8)", c->value);
         } else if (cli_is(c, "--from", true, &err)) {
             int n = 0;
             if (c->value && (!parse_doubles(c->value, a->from, &n, 2) || n != 2))
@@ -144,7 +144,7 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                                  {"Parameters", params},
                                  {"Grid", grid},
                                  {"Periods", periods},
-                                 {"Estimator", "MODELS.md 9.8 (renormalised two trajectories)"}};
+                                 {"Estimator", "docs/models.md 9.8 (renormalised two trajectories)"}};
     return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 

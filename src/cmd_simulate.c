@@ -1,5 +1,5 @@
 /* cellmap simulate: one trajectory of the dry friction oscillator, followed
- * exactly (MODELS.md 9), as a CSV of its events and as the thesis' pictures
+ * exactly (docs/models.md 9), as a CSV of its events and as the thesis' pictures
  * of it: x(t) over the sticking region and the phase portrait (Figs. 2.3,
  * 2.9, 2.16). */
 #include <math.h>
@@ -21,7 +21,7 @@ static const char simulate_help[] =
     "                        [--size WxH]\n\n"
     "A trajectory of the dry friction oscillator x'' + x = cos(Omega t) - S f(x')\n"
     "(thesis eq. (2.3)) from (x, x') = (X, V) at time T0, followed exactly\n"
-    "(MODELS.md 9) up to the N-th section instant (forcing phase phi) after T0.\n"
+    "(docs/models.md 9) up to the N-th section instant (forcing phase phi) after T0.\n"
     "Prints what the last period did, its Poincare point and Psi.\n\n"
     "  --from X,V          the initial state (default 0,0)\n"
     "  --t0 T0             the initial time (default phi/Omega, a section instant)\n"

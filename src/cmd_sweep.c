@@ -3,7 +3,7 @@
  * basins) whose periodic cells lie in a window, and locating by bisection
  * where those counts change: e.g. the friction level at which sticking
  * zones absorb the outermost micro-chaotic attractors (thesis Fig. 4.30,
- * MODELS.md 8.4). */
+ * docs/models.md 8.4). */
 #include <math.h>
 #include <omp.h>
 #include <stdint.h>

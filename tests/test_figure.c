@@ -1,5 +1,5 @@
 /* Figures against what is known analytically: switching lines through
- * x = m/P (MODELS.md 6.4), regular and virtual fixed points (Fig. 4.13's
+ * x = m/P (docs/models.md 6.4), regular and virtual fixed points (Fig. 4.13's
  * parameters: x_3* is virtual), markers at the periodic cells, basin colours
  * cell by cell (also across GL tiles), the 1-D graph, determinism across
  * thread counts, and indexed PNGs read back with libpng. */

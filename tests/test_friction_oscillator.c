@@ -1,4 +1,4 @@
-/* Tests of the dry friction oscillator (thesis Chapter 2, MODELS.md 9)
+/* Tests of the dry friction oscillator (thesis Chapter 2, docs/models.md 9)
  * against the thesis' analytic results: the slip solution in its textbook
  * form (2.5)/(2.6) and by RK4 at resonance, the symmetric amplitude (2.25)
  * with its slipping limits (2.27), (2.36), the resonant asymmetric family
@@ -141,7 +141,7 @@ static void test_slip_closed_form(void)
 }
 
 /* A slip whose velocity dips 1e-9 below zero between two samples: the zero
- * must not be missed (MODELS.md 9.4, interior and start minima). */
+ * must not be missed (docs/models.md 9.4, interior and start minima). */
 static void test_grazing_dip(void)
 {
     const double S = 0.2, W = 0.8, eps = 1e-9;
@@ -325,11 +325,11 @@ typedef struct orbit {
     double z[2];
     cm_fo_tally t;
     double psi;     /* (2.90) */
-    double lambda;  /* Benettin, MODELS.md 9.8 */
+    double lambda;  /* Benettin, docs/models.md 9.8 */
     double floquet; /* ln(spectral radius of the saltation monodromy)/T */
 } orbit;
 
-/* The steady state from z0 (400 periods, MODELS.md 9.6), refined by
+/* The steady state from z0 (400 periods, docs/models.md 9.6), refined by
  * Newton, with its asymmetry, counters and exponents. */
 static void steady_orbit(const cm_fo *o, double x0, double v0, orbit *r)
 {

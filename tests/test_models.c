@@ -62,7 +62,7 @@ static void fig_4_13(void)
     cm_model_release(&m);
 }
 
-/* The band test wins at a border collision (MODELS.md 6.4): P = 3/2 alpha^2
+/* The band test wins at a border collision (docs/models.md 6.4): P = 3/2 alpha^2
  * puts x_2* exactly on SW_3 ... if the arithmetic is exact; either way the
  * count must match the fixed points the model calls regular. */
 static void border_collision(void)

@@ -1,4 +1,4 @@
-/* Tests of the hybrid micro-chaos map with dry friction (MODELS.md 8):
+/* Tests of the hybrid micro-chaos map with dry friction (docs/models.md 8):
  * without friction it is the PD map (4.66); with friction it agrees with an
  * independent fine-step integration of the equation of motion, written
  * here (RK4 with a bisected velocity zero and the stick/slide rule of 8.1),
@@ -198,7 +198,7 @@ static void compare_random(const params *p, double xmax, double vmax, int n)
 }
 
 /* A state whose velocity reaches zero at local time `at` while sliding
- * (MODELS.md 8.2 solved for v0), or 0 if none is consistent with its band. */
+ * (docs/models.md 8.2 solved for v0), or 0 if none is consistent with its band. */
 static int state_with_zero_at(const cm_pdf_coef *c, double x, double sigma, double at, double *v)
 {
     const double th = tanh(c->gamma * at);
@@ -254,7 +254,7 @@ static void test_grazing(const params *p)
 }
 
 /* Sticking fixed points: the rest states held by static friction, on the
- * zones of MODELS.md 8.3; the fixed points x_m* lie inside them. */
+ * zones of docs/models.md 8.3; the fixed points x_m* lie inside them. */
 static void test_sticking_zones(void)
 {
     const cm_pdf_coef c = coef(&fig430);

@@ -1,4 +1,4 @@
-/* Simple cell mapping reproduces the thesis' published pictures (MODELS.md
+/* Simple cell mapping reproduces the thesis' published pictures (docs/models.md
  * 6.7): where the attractors are, and how many. */
 #include <stdlib.h>
 #include <string.h>
