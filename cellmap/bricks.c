@@ -136,9 +136,9 @@ cm_status cm_bricks_add(cm_bricks *b, const int64_t *cell, const void *record)
     return add_to(b, key, record);
 }
 
-cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record)
+bool cm_bricks_span(const cm_bricks *b, const cm_box *box, int64_t *lo, int64_t *hi)
 {
-    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM], last[CM_MAX_DIM];
+    int64_t last[CM_MAX_DIM];
     for (int d = 0; d < b->dim; d++)
         last[d] = box->hi[d] - 1;
     cm_bricks_of(b, box->lo, lo);
@@ -147,22 +147,26 @@ cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record)
     for (int d = 0; d < b->dim; d++) {
         span *= (uint64_t)(hi[d] - lo[d] + 1);
         if (span > CM_BRICKS_MAX_SPAN)
-            return CM_ETOOBIG;
+            return false;
     }
+    return true;
+}
+
+uint64_t cm_bricks_count(const cm_bricks *b) { return b->nbricks; }
+
+const int64_t *cm_bricks_key(const cm_bricks *b, uint64_t i) { return b->bricks[i].key; }
+
+cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record)
+{
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
+    if (!cm_bricks_span(b, box, lo, hi))
+        return CM_ETOOBIG;
     memcpy(key, lo, sizeof key);
-    for (;;) {
-        cm_status st = add_to(b, key, record);
-        if (st != CM_OK)
-            return st;
-        int d = 0;
-        while (d < b->dim && key[d] == hi[d]) {
-            key[d] = lo[d];
-            d++;
-        }
-        if (d == b->dim)
-            return CM_OK;
-        key[d]++;
-    }
+    cm_status st = CM_OK;
+    do
+        st = add_to(b, key, record);
+    while (st == CM_OK && cm_index_next(b->dim, lo, hi, key));
+    return st;
 }
 
 void *cm_bricks_find(const cm_bricks *b, const int64_t *key, uint64_t *n)

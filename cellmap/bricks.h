@@ -12,6 +12,7 @@
 #ifndef CM_BRICKS_H
 #define CM_BRICKS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -29,12 +30,21 @@ void cm_bricks_shift_for(const cm_box *box, int *shift);
 /* The brick holding `cell` into brick[dim]. */
 void cm_bricks_of(const cm_bricks *b, const int64_t *cell, int64_t *brick);
 
+/* The bricks that meet `box`, as an inclusive box [lo, hi] of brick
+ * coordinates; false when they are more than CM_BRICKS_MAX_SPAN. */
+#define CM_BRICKS_MAX_SPAN 65536
+bool cm_bricks_span(const cm_bricks *b, const cm_box *box, int64_t *lo, int64_t *hi);
+
+/* The bricks that hold records or held some: n of them, brick i's
+ * coordinates at cm_bricks_key(b, i). */
+uint64_t cm_bricks_count(const cm_bricks *b);
+const int64_t *cm_bricks_key(const cm_bricks *b, uint64_t i);
+
 /* Adds a record to the brick holding `cell`. */
 cm_status cm_bricks_add(cm_bricks *b, const int64_t *cell, const void *record);
 
 /* Adds a record to every brick that meets `box`; CM_ETOOBIG when that is
  * more than CM_BRICKS_MAX_SPAN bricks (the caller keeps such boxes aside). */
-#define CM_BRICKS_MAX_SPAN 65536
 cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record);
 
 /* The records of the brick with coordinates `brick`: *n records at the

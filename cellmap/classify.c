@@ -22,6 +22,8 @@
  */
 #include "cellmap/classify.h"
 
+#include "cellmap/scm.h"
+
 #include <stdbool.h>
 #include <stdlib.h>
 
@@ -141,9 +143,8 @@ static walk_result advance(classifier *c, int k, cm_status *st)
     lane *l = &c->lanes[k];
     const uint32_t cell = l->next;
     if (cell >= c->n) { /* the sink's domain, through the node on the path's end */
-        const uint32_t exit = cell - UINT32_C(0x80000000);
-        const bool node = c->node_refs && cell >= UINT32_C(0x80000000) && cell < 0xFFFFFFFEu;
-        label(c, l, node ? CM_NODE_REF | exit : 0, UINT32_MAX, 0);
+        const int64_t exit = c->node_refs ? cm_image_exit_index(cell) : -1;
+        label(c, l, exit >= 0 ? CM_NODE_REF | (uint32_t)exit : 0, UINT32_MAX, 0);
         return WALK_DONE;
     }
     const uint32_t s = c->step[cell];

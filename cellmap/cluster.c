@@ -79,11 +79,6 @@ uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
     return lo;
 }
 
-void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
-{
-    c->regions[cm_cluster_node_region(c, id)].nodes_dirty = 1;
-}
-
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
 {
     cm_escape e;
@@ -99,38 +94,41 @@ static int escape_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Moves the open nodes of brick `key` whose exits lead into box to out. */
+static cm_status take_from_brick(cm_cluster *c, const int64_t *key, const cm_box *box,
+                                 cm_escape **out, uint64_t *n, uint64_t *cap)
+{
+    uint64_t count;
+    cm_escape *e = cm_bricks_find(c->escape_bricks, key, &count);
+    for (uint64_t i = count; i-- > 0;) {
+        if (!cm_box_contains(box, e[i].cell))
+            continue;
+        if (cm_grow((void **)out, cap, *n + 1, sizeof **out) != CM_OK)
+            return CM_ENOMEM;
+        (*out)[(*n)++] = e[i];
+        cm_bricks_remove(c->escape_bricks, key, i);
+    }
+    return CM_OK;
+}
+
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n)
 {
-    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM], last[CM_MAX_DIM];
-    const int dim = c->lat.dim;
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
     uint64_t cap = 0;
+    cm_status st = CM_OK;
     *out = NULL;
     *n = 0;
-    for (int d = 0; d < dim; d++)
-        last[d] = box->hi[d] - 1;
-    cm_bricks_of(c->escape_bricks, box->lo, lo);
-    cm_bricks_of(c->escape_bricks, last, hi);
-    memcpy(key, lo, sizeof key);
-    for (;;) {
-        uint64_t count;
-        cm_escape *e = cm_bricks_find(c->escape_bricks, key, &count);
-        for (uint64_t i = count; i-- > 0;) {
-            if (!cm_box_contains(box, e[i].cell))
-                continue;
-            if (cm_grow((void **)out, &cap, *n + 1, sizeof **out) != CM_OK)
-                return CM_ENOMEM;
-            (*out)[(*n)++] = e[i];
-            cm_bricks_remove(c->escape_bricks, key, i);
-        }
-        int d = 0;
-        while (d < dim && key[d] == hi[d]) {
-            key[d] = lo[d];
-            d++;
-        }
-        if (d == dim)
-            break;
-        key[d]++;
+    if (cm_bricks_span(c->escape_bricks, box, lo, hi)) {
+        memcpy(key, lo, sizeof key);
+        do
+            st = take_from_brick(c, key, box, out, n, &cap);
+        while (st == CM_OK && cm_index_next(c->lat.dim, lo, hi, key));
+    } else { /* a box of very many bricks: look at the bricks there are */
+        for (uint64_t b = 0; b < cm_bricks_count(c->escape_bricks) && st == CM_OK; b++)
+            st = take_from_brick(c, cm_bricks_key(c->escape_bricks, b), box, out, n, &cap);
     }
+    if (st != CM_OK)
+        return st;
     if (*n > 1)
         qsort(*out, *n, sizeof **out, escape_cmp);
     return CM_OK;
@@ -344,19 +342,9 @@ void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
  * the box meets (all regions for a box of very many bricks). */
 static int64_t overlapping_region(const cm_cluster *c, const cm_box *box)
 {
-    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM], last[CM_MAX_DIM];
-    const int dim = c->lat.dim;
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
     cm_box both;
-    uint64_t span = 1;
-    if (c->region_bricks) {
-        for (int d = 0; d < dim; d++)
-            last[d] = box->hi[d] - 1;
-        cm_bricks_of(c->region_bricks, box->lo, lo);
-        cm_bricks_of(c->region_bricks, last, hi);
-        for (int d = 0; d < dim && span <= CM_BRICKS_MAX_SPAN; d++)
-            span *= (uint64_t)(hi[d] - lo[d] + 1);
-    }
-    if (!c->region_bricks || span > CM_BRICKS_MAX_SPAN) {
+    if (!c->region_bricks || !cm_bricks_span(c->region_bricks, box, lo, hi)) {
         for (uint32_t k = 0; k < c->nregions; k++)
             if (cm_box_intersect(&c->regions[k].r.box, box, &both))
                 return k;
@@ -366,21 +354,14 @@ static int64_t overlapping_region(const cm_cluster *c, const cm_box *box)
         if (cm_box_intersect(&c->regions[c->big[b]].r.box, box, &both))
             return c->big[b];
     memcpy(key, lo, sizeof key);
-    for (;;) {
+    do {
         uint64_t n;
         const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &n);
         for (uint64_t p = 0; p < n; p++)
             if (cm_box_intersect(&c->regions[in_brick[p]].r.box, box, &both))
                 return in_brick[p];
-        int d = 0;
-        while (d < dim && key[d] == hi[d]) {
-            key[d] = lo[d];
-            d++;
-        }
-        if (d == dim)
-            return -1;
-        key[d]++;
-    }
+    } while (cm_index_next(c->lat.dim, lo, hi, key));
+    return -1;
 }
 
 static cm_status check_region(const cm_cluster *c, const cm_box *box, uint64_t nexits,

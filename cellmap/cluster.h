@@ -183,9 +183,6 @@ cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g);
 /* Notes cell `local` of region k as a periodic cell of new group g. */
 cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64_t local);
 
-/* Marks node id's record changed (for the owner's next save). */
-void cm_cluster_touch_node(cm_cluster *c, uint32_t id);
-
 /* Makes region k resident (reading it back if paged out) and marks it used.
  * Under a budget it may evict other regions (never k): pointers into other
  * regions' arrays are invalid after it. */

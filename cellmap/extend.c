@@ -86,20 +86,13 @@ static cm_status add_region_tiles(const cm_box *tile, const cm_box *rb, tile_lis
     tile_of(tile, rb->lo, first);
     tile_of(tile, top, last);
     memcpy(index, first, sizeof first);
-    for (;;) {
+    do {
         cm_box box;
         tile_box(tile, NULL, index, &box);
         if (find_tile(tiles, index, tile->dim) < 0 && add_tile(tiles, index, &box) != CM_OK)
             return CM_ENOMEM;
-        int d = 0;
-        while (d < tile->dim && index[d] == last[d]) {
-            index[d] = first[d];
-            d++;
-        }
-        if (d == tile->dim)
-            return CM_OK;
-        index[d]++;
-    }
+    } while (cm_index_next(tile->dim, first, last, index));
+    return CM_OK;
 }
 
 /* The tiles the cluster's regions overlap, in join order, with the cells

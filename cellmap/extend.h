@@ -5,10 +5,9 @@
  * given tile (the first region solved, or the view of an explore session).
  * Among the tiles that the cluster holds only in part and those that share
  * a face with a tile of the cluster and hold none of it, clipped to optional
- * bounds, the next one is the tile where the most sequences escape: the
- * sequences of cluster cells are followed (in step order, linear time) to
- * where they leave the cluster, and each escape into the world counts the
- * cells whose sequences take it, as the thesis chooses "the adjacent region
+ * bounds, the next one is the tile where the most sequences escape: every
+ * exit that leaves the cluster (an open node, cellmap/cluster.h) counts the
+ * cells whose sequences take it for the tile it lands in, as the thesis chooses "the adjacent region
  * to where most of the trajectories escape" (4.6.2). Ties go to the first candidate in a
  * fixed order (cluster tiles in join order, each itself before its
  * neighbours, by dimension, lower side first), so the choice is
@@ -41,7 +40,7 @@ bool cm_extend_tile(const cm_box *tile, const cm_box *bounds, const int64_t *cel
 /* Chooses the next tile. `tile` is the grid's tile (0, 0, ...); `bounds`
  * may be NULL (unbounded). Fills choice->all_escaping and cluster_cells in
  * any case; CM_ENOTFOUND when no sequence escapes into a neighbouring tile.
- * Temporary memory: 8 bytes per cluster cell and per sink cell. */
+ * Reads the node table only, no region's cells. */
 cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,
                            cm_extend_choice *choice, char *msg, size_t msg_size);
 

@@ -116,3 +116,15 @@ void cm_box_cell(const cm_box *box, uint64_t index, int64_t *cell)
         index /= side;
     }
 }
+
+bool cm_index_next(int dim, const int64_t *lo, const int64_t *hi, int64_t *index)
+{
+    for (int d = 0; d < dim; d++) {
+        if (index[d] < hi[d]) {
+            index[d]++;
+            return true;
+        }
+        index[d] = lo[d];
+    }
+    return false;
+}

@@ -67,4 +67,8 @@ uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 /* Cell coordinates of local index i. */
 void cm_box_cell(const cm_box *box, uint64_t index, int64_t *cell);
 
+/* Steps index[0..dim) to the next point of the inclusive box [lo, hi],
+ * dimension 0 fastest; false (index back at lo) after the last one. */
+bool cm_index_next(int dim, const int64_t *lo, const int64_t *hi, int64_t *index);
+
 #endif

@@ -9,6 +9,8 @@
  *             CM_IMAGE_EXIT; CM_IMAGE_SINK when the model gives no image or
  *             the image is outside the world;
  *   group[i]  0 for the sink's domain of attraction, else a group id 1..G;
+ *             with exits recorded, a cell whose chain leaves the box holds
+ *             CM_NODE_REF | k instead of 0, k its chain's exit (classify.h);
  *   step[i]   steps to the periodic group (0 for periodic cells; a cell whose
  *             image is the sink has step 1).
  *

@@ -1012,25 +1012,26 @@ static cm_status insert_region(cm_store *s, uint32_t k, const cm_region *r, char
 /* Pages encoded at once: 8 x 3 columns of up to cm_codec_bound(256 KiB). */
 #define WRITE_BATCH 8
 
-/* Encodes column col (0 image, 1 grp, 2 step) of the listed pages into
- * s->blobs, part bytes apart, in parallel; lens[t] is task t's size. */
-static cm_status encode_batch(cm_store *s, const cm_region *r, const uint64_t *pages, int npages_,
-                              int col0, int ncols, size_t part, size_t *lens)
+/* Encodes the three columns (image, grp, step) of pages first .. first +
+ * n - 1 into s->blobs, part bytes apart, in parallel; lens[t] is task t's
+ * size (task t: page t / 3, column t % 3). */
+static cm_status encode_batch(cm_store *s, const cm_region *r, uint64_t first, int n, size_t part,
+                              size_t *lens)
 {
     int failed = 0;
-    const int tasks = npages_ * ncols;
+    const int tasks = 3 * n;
 #pragma omp parallel num_threads(s->threads) if (tasks > 1)
     {
         unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
         failed |= !scratch;
 #pragma omp for schedule(dynamic, 1) reduction(| : failed)
         for (int t = 0; t < tasks; t++) {
-            const uint64_t first = pages[t / ncols] * CM_STORE_PAGE_CELLS;
-            const int col = col0 + t % ncols;
+            const uint64_t page = first + (uint64_t)(t / 3), cell = page * CM_STORE_PAGE_CELLS;
+            const int col = t % 3;
             const uint32_t *const arrays[3] = {r->image, r->group, r->step};
             failed |= !scratch ||
-                      cm_codec_encode(arrays[col] + first, page_cells(r->ncells, pages[t / ncols]),
-                                      4, col == 0 ? (int64_t)first : -1, scratch,
+                      cm_codec_encode(arrays[col] + cell, page_cells(r->ncells, page), 4,
+                                      col == 0 ? (int64_t)cell : -1, scratch,
                                       s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
         }
         free(scratch);
@@ -1038,32 +1039,33 @@ static cm_status encode_batch(cm_store *s, const cm_region *r, const uint64_t *p
     return failed ? CM_ENOMEM : CM_OK;
 }
 
-/* Writes the listed pages of region k (encoded in parallel, written in order). */
-static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, const uint64_t *pages,
-                                 uint64_t n, char *msg, size_t msg_size)
+/* Writes all of region k's pages, once: a region never changes. Pages are
+ * encoded in parallel a batch at a time and written in order. */
+static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                             size_t msg_size)
 {
-    const char *sql = "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)";
-    const int col0 = 0, ncols = 3;
+    const uint64_t pages = npages(r->ncells);
     const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
     size_t lens[WRITE_BATCH * 3];
     sqlite3_stmt *st = NULL;
     if (cm_grow((void **)&s->blobs, &s->blobs_cap, (uint64_t)WRITE_BATCH * 3 * part, 1) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
-    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL))
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)", -1, &st,
+                           NULL))
         return db_error(s->db, "prepare pages", msg, msg_size);
     cm_status status = CM_OK;
-    for (uint64_t b = 0; status == CM_OK && b < n; b += WRITE_BATCH) {
-        const int batch = (int)(n - b < WRITE_BATCH ? n - b : WRITE_BATCH);
-        if (encode_batch(s, r, pages + b, batch, col0, ncols, part, lens) != CM_OK)
+    for (uint64_t b = 0; status == CM_OK && b < pages; b += WRITE_BATCH) {
+        const int batch = (int)(pages - b < WRITE_BATCH ? pages - b : WRITE_BATCH);
+        if (encode_batch(s, r, b, batch, part, lens) != CM_OK)
             status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding a page of region %u", k + 1);
         for (int p = 0; status == CM_OK && p < batch; p++) {
-            const uint64_t first = pages[b + (uint64_t)p] * CM_STORE_PAGE_CELLS;
+            const uint64_t page = b + (uint64_t)p;
             sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-            sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
-            sqlite3_bind_int64(st, 3, (sqlite3_int64)page_cells(r->ncells, pages[b + (uint64_t)p]));
-            for (int c = 0; c < ncols; c++) {
-                const int t = p * ncols + c;
-                sqlite3_bind_blob(st, 4 + col0 + c, s->blobs + (size_t)t * part, (int)lens[t],
+            sqlite3_bind_int64(st, 2, (sqlite3_int64)(page * CM_STORE_PAGE_CELLS));
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)page_cells(r->ncells, page));
+            for (int c = 0; c < 3; c++) {
+                const int t = p * 3 + c;
+                sqlite3_bind_blob(st, 4 + c, s->blobs + (size_t)t * part, (int)lens[t],
                                   SQLITE_STATIC);
                 s->stats.bytes_written += lens[t];
             }
@@ -1072,21 +1074,6 @@ static cm_status write_page_list(cm_store *s, uint32_t k, const cm_region *r, co
         }
     }
     sqlite3_finalize(st);
-    return status;
-}
-
-/* Writes all of region k's pages: once, as the region never changes. */
-static cm_status write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
-                             size_t msg_size)
-{
-    const uint64_t pages = npages(r->ncells);
-    uint64_t *list = malloc((pages + 1) * sizeof *list);
-    if (!list)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
-    for (uint64_t p = 0; p < pages; p++)
-        list[p] = p;
-    const cm_status status = write_page_list(s, k, r, list, pages, msg, msg_size);
-    free(list);
     return status;
 }
 

@@ -11,8 +11,8 @@
  * The file carries application_id CM_STORE_APP_ID and user_version
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
  * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
- * version 2 (groups without kinds, all attractors) are read, and upgraded
- * in place when opened for writing.
+ * versions 2 and 3 (regions stored resolved, no node tables; version 2
+ * without group kinds) are read as they are and refused for writing.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
  * cm_store_commit writes everything a join changed in one transaction, so
@@ -20,9 +20,9 @@
  * the file back to a single file (rollback journal).
  *
  * Paging: cm_store_attach makes the store the cluster's pager. Regions are
- * read back on demand; committed ones can be evicted at any time, and a
- * store open for writing also saves dirty regions for eviction in the
- * middle of a join (cm_cluster_acquire under a budget). Those writes go into
+ * read back on demand; saved ones can be evicted at any time, and a store
+ * open for writing also saves a region never saved when it must be evicted
+ * in the middle of a join (cm_cluster_acquire under a budget). Those writes go into
  * the transaction that the join's commit ends, so a kill still leaves the
  * cluster of the last commit. A store is used from one thread at a time.
  */
@@ -97,9 +97,10 @@ void cm_store_attach(cm_store *s, cm_cluster *c);
  * every region restored paged out, the store attached as pager. */
 cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
 
-/* Writes, in one transaction, every dirty region of c (new regions whole,
- * changed pages of older ones), the group counts of those regions and the
- * groups new since the last commit; then marks the regions clean. */
+/* Writes, in one transaction, every region of c never saved (row, exit
+ * table, pages: each page once), the node records that changed, the cell
+ * counts of the groups that changed and the groups new since the last
+ * commit; then tells the cluster (cm_cluster_saved). */
 cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
 
 /* A cm_joined_fn for cm_cluster_solve_boxes with the store as user: commits
