@@ -23,6 +23,11 @@ struct cm_bricks {
 
 cm_status cm_bricks_alloc(int dim, const int *shift, size_t record_size, cm_bricks **out)
 {
+    int bits = 0;
+    for (int d = 0; d < dim; d++)
+        bits += shift[d] >= 0 && shift[d] <= 31 ? shift[d] : 32;
+    if (bits > 31) /* offsets must fit 31 bits */
+        return CM_EINVAL;
     cm_bricks *b = calloc(1, sizeof *b);
     if (!b)
         return CM_ENOMEM;
@@ -192,11 +197,30 @@ void cm_bricks_remove(cm_bricks *b, const int64_t *key, uint64_t i)
                b->record_size);
 }
 
-void cm_bricks_each(const cm_bricks *b, void (*fn)(void *user, const void *record), void *user)
+uint32_t cm_bricks_offset(const cm_bricks *b, const int64_t *cell)
+{
+    uint64_t offset = 0;
+    for (int d = b->dim - 1; d >= 0; d--)
+        offset = (offset << b->shift[d]) |
+                 ((uint64_t)cell[d] & ((UINT64_C(1) << b->shift[d]) - 1));
+    return (uint32_t)offset;
+}
+
+void cm_bricks_cell(const cm_bricks *b, const int64_t *brick, uint32_t offset, int64_t *cell)
+{
+    for (int d = 0; d < b->dim; d++) {
+        cell[d] = (brick[d] * ((int64_t)1 << b->shift[d])) +
+                  (int64_t)(offset & ((UINT32_C(1) << b->shift[d]) - 1));
+        offset >>= b->shift[d];
+    }
+}
+
+void cm_bricks_each(const cm_bricks *b,
+                    void (*fn)(void *user, const int64_t *brick, const void *record), void *user)
 {
     for (uint64_t i = 0; i < b->nbricks; i++)
         for (uint64_t r = 0; r < b->bricks[i].n; r++)
-            fn(user, b->bricks[i].records + r * b->record_size);
+            fn(user, b->bricks[i].key, b->bricks[i].records + r * b->record_size);
 }
 
 uint64_t cm_bricks_bytes(const cm_bricks *b)

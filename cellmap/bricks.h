@@ -24,7 +24,8 @@ typedef struct cm_bricks cm_bricks;
 cm_status cm_bricks_alloc(int dim, const int *shift, size_t record_size, cm_bricks **out);
 void cm_bricks_free(cm_bricks *b);
 
-/* Shifts for bricks about half the size of `box` in every dimension. */
+/* Shifts for bricks about half the size of `box` in every dimension (at
+ * most 2^31 cells in a brick for a box of at most 2^32 cells). */
 void cm_bricks_shift_for(const cm_box *box, int *shift);
 
 /* The brick holding `cell` into brick[dim]. */
@@ -55,9 +56,16 @@ void *cm_bricks_find(const cm_bricks *b, const int64_t *brick, uint64_t *n);
 /* Removes record i of brick `brick` (the brick's last record takes its place). */
 void cm_bricks_remove(cm_bricks *b, const int64_t *brick, uint64_t i);
 
-/* Calls fn for every record of every brick, bricks in the order they were
- * first used, records in their order. */
-void cm_bricks_each(const cm_bricks *b, void (*fn)(void *user, const void *record), void *user);
+/* A cell's place in its brick (below 2^31: bricks hold fewer cells), and
+ * back: the cell at `offset` in the brick with coordinates `brick`. Records
+ * keep a cell in 4 bytes this way. */
+uint32_t cm_bricks_offset(const cm_bricks *b, const int64_t *cell);
+void cm_bricks_cell(const cm_bricks *b, const int64_t *brick, uint32_t offset, int64_t *cell);
+
+/* Calls fn for every record of every brick (with the brick's coordinates),
+ * bricks in the order they were first used, records in their order. */
+void cm_bricks_each(const cm_bricks *b,
+                    void (*fn)(void *user, const int64_t *brick, const void *record), void *user);
 
 /* Bytes held. */
 uint64_t cm_bricks_bytes(const cm_bricks *b);

@@ -79,13 +79,38 @@ uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
     return lo;
 }
 
+/* A record of escape_bricks: an open node and its exit's target as an
+ * offset in the brick (8 bytes, however many dimensions). */
+typedef struct escape_record {
+    uint32_t node, offset;
+} escape_record;
+
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
 {
-    cm_escape e;
-    memset(&e, 0, sizeof e);
-    e.node = id;
-    memcpy(e.cell, cell, (size_t)c->lat.dim * sizeof *cell);
+    const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
     return cm_bricks_add(c->escape_bricks, cell, &e);
+}
+
+typedef struct escape_visit {
+    const cm_cluster *c;
+    cm_escape_fn fn;
+    void *user;
+} escape_visit;
+
+static void visit_escape(void *user, const int64_t *brick, const void *record)
+{
+    const escape_visit *v = user;
+    const escape_record *e = record;
+    int64_t cell[CM_MAX_DIM];
+    cm_bricks_cell(v->c->escape_bricks, brick, e->offset, cell);
+    v->fn(v->user, e->node, cell);
+}
+
+void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user)
+{
+    escape_visit v = {c, fn, user};
+    if (c->escape_bricks)
+        cm_bricks_each(c->escape_bricks, visit_escape, &v);
 }
 
 static int escape_cmp(const void *a, const void *b)
@@ -99,13 +124,17 @@ static cm_status take_from_brick(cm_cluster *c, const int64_t *key, const cm_box
                                  cm_escape **out, uint64_t *n, uint64_t *cap)
 {
     uint64_t count;
-    cm_escape *e = cm_bricks_find(c->escape_bricks, key, &count);
+    escape_record *e = cm_bricks_find(c->escape_bricks, key, &count);
     for (uint64_t i = count; i-- > 0;) {
-        if (!cm_box_contains(box, e[i].cell))
+        cm_escape esc;
+        memset(&esc, 0, sizeof esc);
+        esc.node = e[i].node;
+        cm_bricks_cell(c->escape_bricks, key, e[i].offset, esc.cell);
+        if (!cm_box_contains(box, esc.cell))
             continue;
         if (cm_grow((void **)out, cap, *n + 1, sizeof **out) != CM_OK)
             return CM_ENOMEM;
-        (*out)[(*n)++] = e[i];
+        (*out)[(*n)++] = esc;
         cm_bricks_remove(c->escape_bricks, key, i);
     }
     return CM_OK;
@@ -392,7 +421,7 @@ static cm_status make_space(cm_cluster *c, const cm_box *box, uint64_t nexits, u
         int shift[CM_MAX_DIM];
         cm_bricks_shift_for(box, shift);
         if (cm_bricks_alloc(c->lat.dim, shift, sizeof(uint32_t), &c->region_bricks) != CM_OK ||
-            cm_bricks_alloc(c->lat.dim, shift, sizeof(cm_escape), &c->escape_bricks) != CM_OK)
+            cm_bricks_alloc(c->lat.dim, shift, sizeof(escape_record), &c->escape_bricks) != CM_OK)
             return CM_ENOMEM;
     }
     const uint64_t groups = (uint64_t)c->ngroups + ngroups + 1, had = c->basin_cap;
@@ -613,6 +642,52 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
     }
     c->saved_groups = groups;
+    return CM_OK;
+}
+
+/* ---- group summaries --------------------------------------------------- */
+
+/* Group first, then box order; unused coordinates are zero, so comparing
+ * all CM_MAX_DIM of them is box order in any dimension. */
+static int periodic_cell_cmp(const void *a, const void *b)
+{
+    const cm_group_cell *x = a, *y = b;
+    if (x->group != y->group)
+        return x->group < y->group ? -1 : 1;
+    return cm_cell_less(x->cell, y->cell, CM_MAX_DIM)   ? -1
+           : cm_cell_less(y->cell, x->cell, CM_MAX_DIM) ? 1
+                                                        : 0;
+}
+
+cm_status cm_cluster_describe_new(cm_cluster *c, const cm_model *model, cm_group_info *groups,
+                                  char *msg, size_t msg_size)
+{
+    cm_group_cell *cells = c->new_periodic;
+    const uint64_t n = c->nnew_periodic;
+    const uint32_t first = c->saved_groups + 1;
+    if (n > 1)
+        qsort(cells, n, sizeof *cells, periodic_cell_cmp);
+    for (uint32_t g = first; g <= c->ngroups; g++) {
+        cm_group_info *gi = &groups[g - first];
+        memset(gi, 0, sizeof *gi);
+        gi->id = g;
+        gi->basin_cells = c->basin[g];
+        gi->kind = model && model->at_rest ? CM_GROUP_STICKING : CM_GROUP_ATTRACTOR;
+    }
+    for (uint64_t i = 0; i < n; i++) {
+        const uint32_t g = cells[i].group;
+        if (g < first || g > c->ngroups)
+            return cm_fail(CM_EINVAL, msg, msg_size, "periodic cell of unknown group %u", g);
+        cm_group_info *gi = &groups[g - first];
+        if (gi->kind == CM_GROUP_STICKING && !cm_cell_at_rest(model, &c->lat, cells[i].cell))
+            gi->kind = CM_GROUP_ATTRACTOR;
+        cm_group_add_periodic(gi, &c->lat, cells[i].cell);
+    }
+    for (uint32_t g = first; g <= c->ngroups; g++) {
+        if (groups[g - first].period == 0)
+            return cm_fail(CM_EINVAL, msg, msg_size, "group %u has no periodic cell", g);
+        cm_group_finish(&groups[g - first], c->lat.dim);
+    }
     return CM_OK;
 }
 

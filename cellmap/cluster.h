@@ -119,7 +119,7 @@ typedef struct cm_cluster {
     uint64_t nbig, big_cap;
 } cm_cluster;
 
-/* An open node by the brick of its exit's target (records of escape_bricks). */
+/* An open node and the target of its exit. */
 typedef struct cm_escape {
     uint32_t node;
     int64_t cell[CM_MAX_DIM];
@@ -163,6 +163,10 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
  * array of *n of them (ascending by node id) that the caller frees. */
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
 
+/* Calls fn for every open node with the target of its exit. */
+typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
+void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
+
 /* The region of node id (binary search). */
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
 
@@ -199,6 +203,16 @@ void cm_cluster_trim(cm_cluster *c);
 /* The owner saved everything: regions and node records are clean, the new
  * groups' periodic cells and the changed basin counts are taken. */
 void cm_cluster_saved(cm_cluster *c);
+
+/* Summaries of the groups made since cm_cluster_saved (saved_groups + 1 ..
+ * ngroups) into a caller array of ngroups - saved_groups entries, from the
+ * periodic cells noted for them, which it sorts by group, then box order
+ * (the order a file keeps them in): period, anchor, bounds and centre as
+ * cm_scm_groups gives them, cells from c->basin, kinds as
+ * cm_scm_label_groups gives them (model may be NULL: attractors). No cell
+ * is read. CM_EINVAL if a group has no periodic cell. */
+cm_status cm_cluster_describe_new(cm_cluster *c, const cm_model *model, cm_group_info *groups,
+                                  char *msg, size_t msg_size);
 
 /* Cells in the sink's domain: those whose sequences leave the cluster or the world. */
 uint64_t cm_cluster_sink_cells(const cm_cluster *c);

@@ -148,16 +148,15 @@ typedef struct escape_count {
 
 /* An open node: the cells whose sequences leave the cluster through it
  * (its weight) count for the candidate tile its exit lands in. */
-static void count_escape(void *user, const void *record)
+static void count_escape(void *user, uint32_t node, const int64_t *cell)
 {
     const escape_count *ec = user;
-    const cm_escape *e = record;
-    const uint64_t w = ec->c->nodes[e->node].weight;
+    const uint64_t w = ec->c->nodes[node].weight;
     int64_t index[CM_MAX_DIM] = {0};
     ec->choice->all_escaping += w;
-    tile_of(ec->tile, e->cell, index);
+    tile_of(ec->tile, cell, index);
     const int64_t t = find_tile(ec->candidates, index, ec->tile->dim);
-    if (t >= 0 && cm_box_contains(&ec->candidates->items[t].box, e->cell))
+    if (t >= 0 && cm_box_contains(&ec->candidates->items[t].box, cell))
         ec->candidates->items[t].escaping += w;
 }
 
@@ -168,8 +167,7 @@ static cm_status count_escapes(const cm_cluster *c, const cm_box *tile, tile_lis
 {
     escape_count ec = {c, tile, candidates, choice};
     choice->cluster_cells = c->cells;
-    if (c->escape_bricks)
-        cm_bricks_each(c->escape_bricks, count_escape, &ec);
+    cm_cluster_each_escape(c, count_escape, &ec);
     return CM_OK;
 }
 

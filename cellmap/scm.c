@@ -1,6 +1,7 @@
 #include "cellmap/scm.h"
 
 #include "cellmap/classify.h"
+#include "cellmap/grow.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -72,11 +73,26 @@ static int image_cell(const cm_model *model, const cm_lattice *lat, const int64_
     }
 }
 
-/* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1. */
+/* Exit targets one thread found, rows in the order it did them. */
+typedef struct exit_buf {
+    int64_t *cells; /* dim coordinates per exit */
+    uint64_t n, cap;
+    int failed; /* out of memory */
+} exit_buf;
+
+/* Where the exits of each row were kept: thread and first entry. */
+typedef struct row_exits {
+    uint32_t *thread;
+    uint64_t *first;
+} row_exits;
+
+/* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1.
+ * With eb, the targets of images that leave the box are appended to it. */
 static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_region *r,
-                         int max_steps, uint64_t row)
+                         int max_steps, uint64_t row, exit_buf *eb)
 {
     const cm_box *box = &r->box;
+    const int dim = box->dim;
     const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
     uint32_t *image = r->image + row * nx;
     int64_t from[CM_MAX_DIM], cell[CM_MAX_DIM];
@@ -88,56 +104,103 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
         const int rc = image_cell(model, lat, from, max_steps, x, cell, &in_world);
         if (rc < 0)
             return rc;
-        if (!in_world)
+        if (!in_world) {
             image[i] = CM_IMAGE_SINK;
-        else if (cm_box_contains(box, cell))
+        } else if (cm_box_contains(box, cell)) {
             image[i] = (uint32_t)cm_box_index(box, cell);
-        else
+        } else {
             image[i] = CM_IMAGE_EXIT;
+            if (eb && cm_grow((void **)&eb->cells, &eb->cap, (eb->n + 1) * (uint64_t)dim,
+                              sizeof *eb->cells) != CM_OK)
+                eb->failed = 1;
+            else if (eb && !eb->failed)
+                memcpy(eb->cells + eb->n++ * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
+        }
     }
     return 0;
 }
 
-/* Numbers the exits in local index order and stores their target cells. The
- * targets are computed again (the step is pure), which costs a step per exit
- * but keeps the parallel image loop free of shared output. */
-static cm_status record_exits(const cm_model *model, const cm_lattice *lat, int max_steps,
-                              int threads, cm_region *r, char *msg, size_t msg_size)
+/* Numbers the exits in local index order and moves their targets, kept by
+ * the threads that found them, into the region's exit table. */
+static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
+                              const row_exits *rows, uint64_t nrows, char *msg, size_t msg_size)
 {
     uint64_t nexits = 0;
-    for (uint64_t i = 0; i < r->ncells; i++)
-        nexits += r->image[i] == CM_IMAGE_EXIT;
+    for (int t = 0; t < threads; t++) {
+        if (bufs[t].failed)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
+        nexits += bufs[t].n;
+    }
     if (nexits > CM_IMAGE_EXIT - CM_IMAGE_EXIT_BASE)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many exits; split the region");
-    const int dim = r->box.dim;
-    uint64_t *cells = malloc((nexits + 1) * sizeof *cells);
-    r->exit_target = malloc((nexits + 1) * (uint64_t)dim * sizeof *r->exit_target);
-    if (!cells || !r->exit_target) {
-        free(cells);
+    const size_t dim = (size_t)r->box.dim;
+    r->exit_target = malloc((nexits + 1) * dim * sizeof *r->exit_target);
+    if (!r->exit_target)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                        (unsigned long long)nexits);
-    }
+    const uint64_t nx = r->ncells / nrows;
     uint64_t k = 0;
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        if (r->image[i] == CM_IMAGE_EXIT) {
-            cells[k] = i;
+    for (uint64_t row = 0; row < nrows; row++) {
+        const int64_t *from = bufs[rows->thread[row]].cells + rows->first[row] * dim;
+        for (uint64_t i = row * nx; i < (row + 1) * nx; i++) {
+            if (r->image[i] != CM_IMAGE_EXIT)
+                continue;
+            memcpy(r->exit_target + k * dim, from, dim * sizeof *from);
+            from += dim;
             r->image[i] = CM_IMAGE_EXIT_BASE + (uint32_t)k++;
         }
     }
     r->nexits = nexits;
     r->exits_recorded = 1;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t e = 0; e < (int64_t)nexits; e++) {
-        int64_t from[CM_MAX_DIM];
-        double x[CM_MAX_DIM];
-        bool in_world;
-        cm_box_cell(&r->box, cells[e], from);
-        cm_lattice_centre(lat, from, x);
-        image_cell(model, lat, from, max_steps, x, r->exit_target + e * dim, &in_world);
-    }
-    (void)threads;
-    free(cells);
     return CM_OK;
+}
+
+/* The image loop: rows are independent and every image depends on its cell
+ * alone, so the result is the same whatever the schedule or thread count. */
+static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, int max_steps,
+                                int threads, bool record_exits, cm_region *r, char *msg,
+                                size_t msg_size)
+{
+    const uint64_t nrows = r->ncells / (uint64_t)(r->box.hi[0] - r->box.lo[0]);
+    exit_buf *bufs = record_exits ? calloc((size_t)threads, sizeof *bufs) : NULL;
+    row_exits rows = {NULL, NULL};
+    if (record_exits) {
+        rows.thread = malloc(nrows * sizeof *rows.thread);
+        rows.first = malloc(nrows * sizeof *rows.first);
+    }
+    cm_status st = CM_OK;
+    if (record_exits && (!bufs || !rows.thread || !rows.first))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
+    int aborted = 0;
+    if (st == CM_OK) {
+#pragma omp parallel num_threads(threads) reduction(| : aborted)
+    {
+        int t = 0;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+#endif
+        exit_buf *eb = bufs ? &bufs[t] : NULL;
+#pragma omp for schedule(static)
+        for (int64_t row = 0; row < (int64_t)nrows; row++) {
+            if (eb) {
+                rows.thread[row] = (uint32_t)t;
+                rows.first[row] = eb->n;
+            }
+            if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row, eb) < 0)
+                aborted = 1;
+        }
+    }
+    }
+    if (st == CM_OK && aborted)
+        st = cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
+    if (st == CM_OK && record_exits)
+        st = number_exits(r, bufs, threads, &rows, nrows, msg, msg_size);
+    for (int t = 0; bufs && t < threads; t++)
+        free(bufs[t].cells);
+    free(bufs);
+    free(rows.thread);
+    free(rows.first);
+    return st;
 }
 
 cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
@@ -145,30 +208,17 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
 {
     if (!model || !model->step || model->dim != lat->dim || r->box.dim != lat->dim)
         return cm_fail(CM_EINVAL, msg, msg_size, "model, lattice and region dimensions differ");
-    const uint64_t nx = (uint64_t)(r->box.hi[0] - r->box.lo[0]);
-    const int64_t rows = (int64_t)(r->ncells / nx);
     const int max_steps = opt && opt->max_steps > 1 ? opt->max_steps : 1;
     int threads = 1;
 #ifdef _OPENMP
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
-    int aborted = 0;
-    /* Rows are independent and every image depends on its cell alone, so the
-     * result is the same whatever the schedule or thread count. */
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(| : aborted)
-    for (int64_t row = 0; row < rows; row++) {
-        if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row) < 0)
-            aborted = 1;
-    }
-    if (aborted)
-        return cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
     free(r->exit_target);
     r->exit_target = NULL;
     r->nexits = 0;
     r->exits_recorded = 0;
-    if (opt && opt->record_exits)
-        return record_exits(model, lat, max_steps, threads, r, msg, msg_size);
-    return CM_OK;
+    return images_of_rows(model, lat, max_steps, threads, opt && opt->record_exits, r, msg,
+                          msg_size);
 }
 
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)

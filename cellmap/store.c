@@ -1143,87 +1143,61 @@ static cm_status write_basins(cm_store *s, const cm_cluster *c, char *msg, size_
     return status;
 }
 
-/* Group first, then box order; unused coordinates are zero, so comparing
- * all CM_MAX_DIM of them is box order in any dimension. */
-static int periodic_cell_cmp(const void *a, const void *b)
-{
-    const cm_group_cell *x = a, *y = b;
-    if (x->group != y->group)
-        return x->group < y->group ? -1 : 1;
-    return cm_cell_less(x->cell, y->cell, CM_MAX_DIM)   ? -1
-           : cm_cell_less(y->cell, x->cell, CM_MAX_DIM) ? 1
-                                                        : 0;
-}
-
 static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattice *lat,
-                                  const cm_group_cell *cells, uint64_t n, char *msg,
-                                  size_t msg_size)
+                                  const cm_group_info *gi, const cm_group_cell *cells,
+                                  char *msg, size_t msg_size)
 {
-    cm_group_info gi;
-    memset(&gi, 0, sizeof gi);
+    const uint64_t n = gi->period;
     unsigned char *blob = malloc(n * (size_t)lat->dim * 8);
     if (!blob)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing groups");
-    bool at_rest = s->model && s->model->at_rest;
-    for (uint64_t i = 0; i < n; i++) {
-        at_rest = at_rest && cm_cell_at_rest(s->model, lat, cells[i].cell);
-        cm_group_add_periodic(&gi, lat, cells[i].cell);
+    for (uint64_t i = 0; i < n; i++)
         for (int d = 0; d < lat->dim; d++) {
             const uint64_t v = (uint64_t)cells[i].cell[d];
             for (int b = 0; b < 8; b++)
                 blob[(i * (uint64_t)lat->dim + (uint64_t)d) * 8 + (uint64_t)b] =
                     (unsigned char)(v >> (8 * b));
         }
-    }
-    cm_group_finish(&gi, lat->dim);
     char centre[512], lo[512], hi[512], anchor[512];
-    json_doubles(centre, sizeof centre, gi.centre, lat->dim);
-    json_doubles(lo, sizeof lo, gi.lo, lat->dim);
-    json_doubles(hi, sizeof hi, gi.hi, lat->dim);
-    json_ints(anchor, sizeof anchor, gi.anchor, lat->dim);
-    sqlite3_bind_int64(st, 1, cells[0].group);
-    sqlite3_bind_int64(st, 2, gi.period);
+    json_doubles(centre, sizeof centre, gi->centre, lat->dim);
+    json_doubles(lo, sizeof lo, gi->lo, lat->dim);
+    json_doubles(hi, sizeof hi, gi->hi, lat->dim);
+    json_ints(anchor, sizeof anchor, gi->anchor, lat->dim);
+    sqlite3_bind_int64(st, 1, gi->id);
+    sqlite3_bind_int64(st, 2, gi->period);
     sqlite3_bind_text(st, 3, centre, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 4, lo, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 5, hi, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 6, anchor, -1, SQLITE_TRANSIENT);
     sqlite3_bind_blob(st, 7, blob, (int)(n * (uint64_t)lat->dim * 8), SQLITE_TRANSIENT);
-    sqlite3_bind_text(st, 8, cm_group_kind_name(at_rest ? CM_GROUP_STICKING : CM_GROUP_ATTRACTOR),
-                      -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 8, cm_group_kind_name(gi->kind), -1, SQLITE_STATIC);
     const cm_status status = step_done(s->db, st, "write group", msg, msg_size);
     free(blob);
     return status;
 }
 
 /* Rows of `attractors` for the groups made since the last commit, from
- * the periodic cells the cluster noted (sorted here: the order is the
- * file's, whatever the order they were found in). */
+ * the periodic cells the cluster noted (in the order the cluster sorts
+ * them, whatever the order they were found in). */
 static cm_status write_new_groups(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
-    cm_group_cell *cells = c->new_periodic;
-    const uint64_t n = c->nnew_periodic;
-    if (n)
-        qsort(cells, n, sizeof *cells, periodic_cell_cmp);
+    const uint32_t n = c->ngroups - c->saved_groups;
+    if (n == 0)
+        return CM_OK;
+    cm_group_info *groups = malloc((size_t)n * sizeof *groups);
+    if (!groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", n);
+    cm_status status = cm_cluster_describe_new(c, s->model, groups, msg, msg_size);
     sqlite3_stmt *st = NULL;
-    cm_status status = CM_OK;
-    if (sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
                            NULL))
         status = db_error(s->db, "prepare groups", msg, msg_size);
-    uint32_t expected = c->saved_groups + 1;
-    for (uint64_t i = 0; status == CM_OK && i < n;) {
-        uint64_t j = i;
-        while (j < n && cells[j].group == cells[i].group)
-            j++;
-        if (cells[i].group != expected++)
-            status = cm_fail(CM_EINVAL, msg, msg_size, "group %u has no periodic cell",
-                             expected - 1);
-        else
-            status = insert_attractor(s, st, &c->lat, cells + i, j - i, msg, msg_size);
-        i = j;
-    }
-    if (status == CM_OK && expected != c->ngroups + 1)
-        status = cm_fail(CM_EINVAL, msg, msg_size, "group %u has no periodic cell", expected);
+    const cm_group_cell *cells = c->new_periodic;
+    for (uint32_t g = 0; g < n && status == CM_OK; cells += groups[g++].period)
+        status = insert_attractor(s, st, &c->lat, &groups[g], cells, msg, msg_size);
     sqlite3_finalize(st);
+    free(groups);
     return status;
 }
 

@@ -597,9 +597,10 @@ static cm_status solve_cluster(const solve_args *a, const char *command, const c
     return st;
 }
 
-/* The summary of a cluster: from the database when there is one (no cell
- * is read back), else from the flattened bounding box. */
-static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, summary *sum,
+/* The summary of a cluster: from the database when there is one, else
+ * from the periodic cells the cluster noted and its basin counts (no cell
+ * is read either way). */
+static cm_status summarise_cluster(run *rn, const cm_model *m, summary *sum,
                                    char *msg, size_t msg_size)
 {
     cm_cluster *c = &rn->c;
@@ -608,15 +609,13 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, cm_region *flat, 
     for (uint32_t k = 0; k < c->nregions; k++)
         sum->cells += c->regions[k].r.ncells;
     sum->ngroups = c->ngroups;
-    if (rn->store) {
-        sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
-        if (!sum->groups)
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
+    sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
+    if (!sum->groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
+    if (rn->store)
         return cm_store_groups(rn->store, sum->groups, c->ngroups, &sum->sink, msg, msg_size);
-    }
-    cm_status st = cm_cluster_flatten(c, &sum->box, flat, msg, msg_size);
-    return st == CM_OK ? cm_scm_describe(m, &c->lat, flat, &sum->groups, &sum->sink, msg, msg_size)
-                       : st;
+    sum->sink = cm_cluster_sink_cells(c);
+    return cm_cluster_describe_new(c, m, sum->groups, msg, msg_size);
 }
 
 /* The PNG of the solved cells, or of --view (cells outside the cluster are
@@ -701,7 +700,7 @@ int cmd_solve(int argc, char **argv)
         const double t0 = now_seconds();
         if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
                 CM_OK ||
-            summarise_cluster(&rn, &m, &r, &sum, msg, sizeof msg) != CM_OK)
+            summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
         t.t2 = now_seconds() - t0 - t.t1;
     } else {
