@@ -187,14 +187,11 @@ void *cm_bricks_find(const cm_bricks *b, const int64_t *key, uint64_t *n)
     return br->n ? br->records : NULL;
 }
 
-void cm_bricks_remove(cm_bricks *b, const int64_t *key, uint64_t i)
+void cm_bricks_truncate(cm_bricks *b, const int64_t *key, uint64_t n)
 {
-    const uint64_t s = probe(b, key);
-    brick *br = &b->bricks[b->slots[s] - 1];
-    br->n--;
-    if (i != br->n)
-        memcpy(br->records + i * b->record_size, br->records + br->n * b->record_size,
-               b->record_size);
+    brick *br = &b->bricks[b->slots[probe(b, key)] - 1];
+    if (n < br->n)
+        br->n = n;
 }
 
 uint32_t cm_bricks_offset(const cm_bricks *b, const int64_t *cell)

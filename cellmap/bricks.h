@@ -6,8 +6,7 @@
  *
  * Bricks are boxes of 2^shift[d] cells aligned to the lattice's cell 0. The
  * map is a hash table of the bricks that hold records; a brick's records
- * keep the order they were added in (removal moves the last one into the
- * gap). Not thread-safe; cm_bricks_free is NULL-safe.
+ * keep the order they were added in. Not thread-safe; cm_bricks_free is NULL-safe.
  */
 #ifndef CM_BRICKS_H
 #define CM_BRICKS_H
@@ -53,8 +52,8 @@ cm_status cm_bricks_add_box(cm_bricks *b, const cm_box *box, const void *record)
  * until the map changes. */
 void *cm_bricks_find(const cm_bricks *b, const int64_t *brick, uint64_t *n);
 
-/* Removes record i of brick `brick` (the brick's last record takes its place). */
-void cm_bricks_remove(cm_bricks *b, const int64_t *brick, uint64_t i);
+/* Keeps the first n records of brick `brick` (which must hold records). */
+void cm_bricks_truncate(cm_bricks *b, const int64_t *brick, uint64_t n);
 
 /* A cell's place in its brick (below 2^31: bricks hold fewer cells), and
  * back: the cell at `offset` in the brick with coordinates `brick`. Records

@@ -113,30 +113,49 @@ void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user)
         cm_bricks_each(c->escape_bricks, visit_escape, &v);
 }
 
-static int escape_cmp(const void *a, const void *b)
-{
-    const uint32_t x = ((const cm_escape *)a)->node, y = ((const cm_escape *)b)->node;
-    return (x > y) - (x < y);
-}
-
-/* Moves the open nodes of brick `key` whose exits lead into box to out. */
+/* Moves the open nodes of brick `key` whose exits lead into box to out,
+ * keeping the others in order: records are added in order of node id, so
+ * every brick's list stays sorted. */
 static cm_status take_from_brick(cm_cluster *c, const int64_t *key, const cm_box *box,
                                  cm_escape **out, uint64_t *n, uint64_t *cap)
 {
-    uint64_t count;
+    uint64_t count, kept = 0;
     escape_record *e = cm_bricks_find(c->escape_bricks, key, &count);
-    for (uint64_t i = count; i-- > 0;) {
-        cm_escape esc;
-        memset(&esc, 0, sizeof esc);
-        esc.node = e[i].node;
-        cm_bricks_cell(c->escape_bricks, key, e[i].offset, esc.cell);
-        if (!cm_box_contains(box, esc.cell))
+    for (uint64_t i = 0; i < count; i++) {
+        int64_t cell[CM_MAX_DIM];
+        cm_bricks_cell(c->escape_bricks, key, e[i].offset, cell);
+        if (!cm_box_contains(box, cell)) {
+            e[kept++] = e[i];
             continue;
+        }
         if (cm_grow((void **)out, cap, *n + 1, sizeof **out) != CM_OK)
             return CM_ENOMEM;
-        (*out)[(*n)++] = esc;
-        cm_bricks_remove(c->escape_bricks, key, i);
+        (*out)[(*n)++] = (cm_escape){e[i].node, (uint32_t)cm_box_index(box, cell)};
     }
+    if (kept < count)
+        cm_bricks_truncate(c->escape_bricks, key, kept);
+    return CM_OK;
+}
+
+/* Sorts escapes by node id: LSD radix sort, 8 bits a pass. */
+static cm_status sort_escapes(cm_escape *e, uint64_t n)
+{
+    cm_escape *tmp = malloc(n * sizeof *tmp);
+    if (!tmp)
+        return CM_ENOMEM;
+    for (int shift = 0; shift < 32; shift += 8) {
+        uint64_t start[257] = {0};
+        for (uint64_t i = 0; i < n; i++)
+            start[((e[i].node >> shift) & 0xFF) + 1]++;
+        if (start[((e[0].node >> shift) & 0xFF) + 1] == n)
+            continue; /* one bucket: nothing moves */
+        for (int b = 0; b < 256; b++)
+            start[b + 1] += start[b];
+        for (uint64_t i = 0; i < n; i++)
+            tmp[start[(e[i].node >> shift) & 0xFF]++] = e[i];
+        memcpy(e, tmp, n * sizeof *e);
+    }
+    free(tmp);
     return CM_OK;
 }
 
@@ -156,11 +175,9 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
         for (uint64_t b = 0; b < cm_bricks_count(c->escape_bricks) && st == CM_OK; b++)
             st = take_from_brick(c, cm_bricks_key(c->escape_bricks, b), box, out, n, &cap);
     }
-    if (st != CM_OK)
-        return st;
-    if (*n > 1)
-        qsort(*out, *n, sizeof **out, escape_cmp);
-    return CM_OK;
+    if (st == CM_OK && *n > 1)
+        st = sort_escapes(*out, *n);
+    return st;
 }
 
 /* ---- resolution ----------------------------------------------------------- */

@@ -119,10 +119,10 @@ typedef struct cm_cluster {
     uint64_t nbig, big_cap;
 } cm_cluster;
 
-/* An open node and the target of its exit. */
+/* An open node whose exit leads into a box, and the local index of the
+ * exit's target cell in the box. */
 typedef struct cm_escape {
-    uint32_t node;
-    int64_t cell[CM_MAX_DIM];
+    uint32_t node, cell;
 } cm_escape;
 
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
@@ -159,8 +159,9 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *lo
  * index of open nodes. */
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell);
 
-/* Takes the open nodes whose exits lead into `box` out of the index: a new
- * array of *n of them (ascending by node id) that the caller frees. */
+/* Takes the open nodes whose exits lead into `box` (at most 2^32 cells)
+ * out of the index: a new array of *n of them (ascending by node id) that
+ * the caller frees. */
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
 
 /* Calls fn for every open node with the target of its exit. */

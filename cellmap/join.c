@@ -267,10 +267,12 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
     if (st == CM_OK &&
         cm_grow((void **)jobs, &cap, nin + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
         st = CM_ENOMEM;
-    for (uint64_t i = 0; i < nin && st == CM_OK; i++)
-        (*jobs)[(*n)++] =
-            (link_job){in[i].node, cm_cluster_node_region(c, in[i].node), added,
-                       (uint32_t)cm_box_index(&cr->r.box, in[i].cell), 0, 0};
+    uint32_t from = 0; /* the region of in[i].node: ids ascend, so it only moves on */
+    for (uint64_t i = 0; i < nin && st == CM_OK; i++) {
+        while (from + 1 < c->nregions && c->regions[from + 1].node_base <= in[i].node)
+            from++;
+        (*jobs)[(*n)++] = (link_job){in[i].node, from, added, in[i].cell, 0, 0};
+    }
     free(in);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
         const int64_t *cell = cm_region_exit(&cr->r, e);
