@@ -86,13 +86,24 @@ typedef struct row_exits {
     uint64_t *first;
 } row_exits;
 
+static void keep_exit(exit_buf *eb, const int64_t *cell, int dim)
+{
+    if (eb->failed || cm_grow((void **)&eb->cells, &eb->cap, (eb->n + 1) * (uint64_t)dim,
+                              sizeof *eb->cells) != CM_OK) {
+        eb->failed = 1;
+        return;
+    }
+    for (int d = 0; d < dim; d++) /* a loop: dim is small, a memcpy call is not */
+        eb->cells[eb->n * (uint64_t)dim + (uint64_t)d] = cell[d];
+    eb->n++;
+}
+
 /* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1.
  * With eb, the targets of images that leave the box are appended to it. */
 static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_region *r,
                          int max_steps, uint64_t row, exit_buf *eb)
 {
     const cm_box *box = &r->box;
-    const int dim = box->dim;
     const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
     uint32_t *image = r->image + row * nx;
     int64_t from[CM_MAX_DIM], cell[CM_MAX_DIM];
@@ -110,11 +121,8 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
             image[i] = (uint32_t)cm_box_index(box, cell);
         } else {
             image[i] = CM_IMAGE_EXIT;
-            if (eb && cm_grow((void **)&eb->cells, &eb->cap, (eb->n + 1) * (uint64_t)dim,
-                              sizeof *eb->cells) != CM_OK)
-                eb->failed = 1;
-            else if (eb && !eb->failed)
-                memcpy(eb->cells + eb->n++ * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
+            if (eb)
+                keep_exit(eb, cell, box->dim);
         }
     }
     return 0;
@@ -145,8 +153,8 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
         for (uint64_t i = row * nx; i < (row + 1) * nx; i++) {
             if (r->image[i] != CM_IMAGE_EXIT)
                 continue;
-            memcpy(r->exit_target + k * dim, from, dim * sizeof *from);
-            from += dim;
+            for (size_t d = 0; d < dim; d++)
+                r->exit_target[k * dim + d] = *from++;
             r->image[i] = CM_IMAGE_EXIT_BASE + (uint32_t)k++;
         }
     }
