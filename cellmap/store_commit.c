@@ -1,0 +1,248 @@
+/* cellmap/store_commit.c - writing what joins changed: groups, basin counts,
+ * node records and new regions, one transaction per commit. */
+#include "cellmap/store_db.h"
+
+#include "cellmap/classify.h"
+#include "cellmap/codec.h"
+#include "cellmap/grow.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
+                           size_t msg_size)
+{
+    const int rc = sqlite3_step(st);
+    sqlite3_reset(st);
+    return rc == SQLITE_DONE ? CM_OK : store_db_error(db, what, msg, msg_size);
+}
+
+/* The cell counts of the groups whose counts changed. */
+static cm_status write_basins(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO basins VALUES(?, ?)", -1, &st, NULL))
+        return store_db_error(s->db, "prepare basins", msg, msg_size);
+    cm_status status = CM_OK;
+    for (uint32_t g = 1; status == CM_OK && g <= c->ngroups; g++) {
+        if (!c->basin_dirty[g])
+            continue;
+        sqlite3_bind_int64(st, 1, g);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)c->basin[g]);
+        status = store_step_done(s->db, st, "write basins", msg, msg_size);
+    }
+    sqlite3_finalize(st);
+    return status;
+}
+
+static cm_status insert_attractor(cm_store *s, sqlite3_stmt *st, const cm_lattice *lat,
+                                  const cm_group_info *gi, const cm_group_cell *cells,
+                                  char *msg, size_t msg_size)
+{
+    const uint64_t n = gi->period;
+    unsigned char *blob = malloc(n * (size_t)lat->dim * 8);
+    if (!blob)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing groups");
+    for (uint64_t i = 0; i < n; i++)
+        for (int d = 0; d < lat->dim; d++) {
+            const uint64_t v = (uint64_t)cells[i].cell[d];
+            for (int b = 0; b < 8; b++)
+                blob[(i * (uint64_t)lat->dim + (uint64_t)d) * 8 + (uint64_t)b] =
+                    (unsigned char)(v >> (8 * b));
+        }
+    char centre[512], lo[512], hi[512], anchor[512];
+    store_json_doubles(centre, sizeof centre, gi->centre, lat->dim);
+    store_json_doubles(lo, sizeof lo, gi->lo, lat->dim);
+    store_json_doubles(hi, sizeof hi, gi->hi, lat->dim);
+    store_json_ints(anchor, sizeof anchor, gi->anchor, lat->dim);
+    sqlite3_bind_int64(st, 1, gi->id);
+    sqlite3_bind_int64(st, 2, gi->period);
+    sqlite3_bind_text(st, 3, centre, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 4, lo, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 5, hi, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 6, anchor, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_blob(st, 7, blob, (int)(n * (uint64_t)lat->dim * 8), SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 8, cm_group_kind_name(gi->kind), -1, SQLITE_STATIC);
+    const cm_status status = store_step_done(s->db, st, "write group", msg, msg_size);
+    free(blob);
+    return status;
+}
+
+/* Rows of `attractors` for the groups made since the last commit, from
+ * the periodic cells the cluster noted (in the order the cluster sorts
+ * them, whatever the order they were found in). */
+static cm_status write_new_groups(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    const uint32_t n = c->ngroups - c->saved_groups;
+    if (n == 0)
+        return CM_OK;
+    cm_group_info *groups = malloc((size_t)n * sizeof *groups);
+    if (!groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", n);
+    cm_status status = cm_cluster_describe_new(c, s->model, groups, msg, msg_size);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT INTO attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
+                           NULL))
+        status = store_db_error(s->db, "prepare groups", msg, msg_size);
+    const cm_group_cell *cells = c->new_periodic;
+    for (uint32_t g = 0; g < n && status == CM_OK; cells += groups[g++].period)
+        status = insert_attractor(s, st, &c->lat, &groups[g], cells, msg, msg_size);
+    sqlite3_finalize(st);
+    free(groups);
+    return status;
+}
+
+/* A region never saved: its row, exit table and pages. */
+static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                              size_t msg_size)
+{
+    const cm_region *r = &c->regions[k].r;
+    if (!r->group)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
+    cm_status st = store_insert_region(s, k, r, msg, msg_size);
+    if (st == CM_OK)
+        st = store_write_pages(s, k, r, msg, msg_size);
+    s->stats.regions_written++;
+    return st;
+}
+
+cm_status store_begin(cm_store *s, char *msg, size_t msg_size)
+{
+    if (!s->writable)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s is open read-only", s->path);
+    if (s->failed)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "an earlier write to %s failed; reopen it (solve --resume) to go on",
+                       s->path);
+    if (!s->in_transaction && store_exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
+        return store_db_error(s->db, "begin", msg, msg_size);
+    s->in_transaction = 1;
+    return CM_OK;
+}
+
+/* Undoes the open transaction after a failed write. */
+cm_status store_abandon(cm_store *s, cm_status st)
+{
+    if (s->in_transaction)
+        store_exec(s->db, "ROLLBACK");
+    s->in_transaction = 0;
+    s->failed = 1;
+    return st;
+}
+
+/* The pager's other half: saves a dirty region about to be evicted, in the
+ * transaction the next commit ends (a kill before it undoes the write). */
+cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = store_seconds_now();
+    cm_status st = store_begin(s, msg, msg_size);
+    if (st == CM_OK)
+        st = write_region(s, c, k, msg, msg_size);
+    s->stats.regions_evicted++;
+    s->stats.evict_seconds += store_seconds_now() - t0;
+    return st == CM_OK ? CM_OK : store_abandon(s, st);
+}
+
+cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
+        if (!c->regions[k].written)
+            st = write_region(s, c, k, msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
+        if (c->regions[k].nodes_dirty)
+            st = store_write_nodes(s, c, k, msg, msg_size);
+    if (st == CM_OK)
+        st = write_basins(s, c, msg, msg_size);
+    if (st == CM_OK)
+        st = write_new_groups(s, c, msg, msg_size);
+    if (st == CM_OK) {
+        char sql[96];
+        snprintf(sql, sizeof sql, "UPDATE meta SET value = '%u' WHERE key = 'groups'", c->ngroups);
+        if (store_exec(s->db, sql) != SQLITE_OK)
+            st = store_db_error(s->db, "write meta", msg, msg_size);
+    }
+    return st;
+}
+
+cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    const double t0 = store_seconds_now();
+    cm_status st = store_begin(s, msg, msg_size);
+    if (st == CM_OK)
+        st = store_write_changes(s, c, msg, msg_size);
+    if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)
+        st = store_db_error(s->db, "commit", msg, msg_size);
+    if (st != CM_OK)
+        return store_abandon(s, st);
+    s->in_transaction = 0;
+    cm_cluster_saved(c); /* the file now holds everything */
+    s->stats.commit_seconds += store_seconds_now() - t0;
+    return CM_OK;
+}
+
+cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                               char *msg, size_t msg_size)
+{
+    (void)box;
+    (void)stats;
+    const cm_status st = cm_store_commit(store, c, msg, msg_size);
+    cm_cluster_trim(c);
+    return st;
+}
+
+cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
+                          char *msg, size_t msg_size)
+{
+    cm_lattice lat;
+    cm_status status = store_read_lattice(s->db, &lat, msg, msg_size);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(
+            s->db,
+            "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
+            "ORDER BY id",
+            -1, &st, NULL))
+        status = store_db_error(s->db, "read groups", msg, msg_size);
+    uint32_t seen = 0;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t id = sqlite3_column_int64(st, 0);
+        if (id == 0) {
+            *sink_cells = (uint64_t)sqlite3_column_int64(st, 2);
+            continue;
+        }
+        double anchor[CM_MAX_DIM];
+        cm_group_info *g = &groups[seen];
+        memset(g, 0, sizeof *g);
+        g->id = (uint32_t)id;
+        g->period = (uint32_t)sqlite3_column_int64(st, 1);
+        g->basin_cells = (uint64_t)sqlite3_column_int64(st, 2);
+        if (id != (int64_t)seen + 1 || seen >= n ||
+            store_parse_json_numbers((const char *)sqlite3_column_text(st, 3), g->centre, CM_MAX_DIM) !=
+                lat.dim ||
+            store_parse_json_numbers((const char *)sqlite3_column_text(st, 4), g->lo, CM_MAX_DIM) !=
+                lat.dim ||
+            store_parse_json_numbers((const char *)sqlite3_column_text(st, 5), g->hi, CM_MAX_DIM) !=
+                lat.dim ||
+            store_parse_json_numbers((const char *)sqlite3_column_text(st, 6), anchor, CM_MAX_DIM) !=
+                lat.dim) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
+                             (long long)id);
+            break;
+        }
+        for (int d = 0; d < lat.dim; d++)
+            g->anchor[d] = (int64_t)anchor[d];
+        const unsigned char *kind = sqlite3_column_text(st, 7);
+        g->kind = kind && strcmp((const char *)kind, cm_group_kind_name(CM_GROUP_STICKING)) == 0
+                      ? CM_GROUP_STICKING
+                      : CM_GROUP_ATTRACTOR;
+        seen++;
+    }
+    sqlite3_finalize(st);
+    if (status == CM_OK && seen != n)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s holds %u groups, not %u", s->path, seen, n);
+    return status;
+}

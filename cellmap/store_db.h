@@ -1,0 +1,78 @@
+/* cellmap/store_db.h - private to the store's modules, not part of the
+ * engine's API: the store itself and the helpers its files share.
+ *   store.c         schema, opening and creating files, metadata, notes
+ *   store_pages.c   region rows, cell pages, exit and node tables; the
+ *                   pager; loading a saved cluster
+ *   store_commit.c  groups, basins and commits
+ *   store_upgrade.c files of versions 2 and 3 to version 4
+ */
+#ifndef CM_STORE_DB_H
+#define CM_STORE_DB_H
+
+#include <sqlite3.h>
+
+#include "cellmap/store.h"
+
+struct cm_store {
+    sqlite3 *db;
+    const cm_model *model; /* labels new groups (cm_store_set_model), may be NULL */
+    char *path;
+    int writable;
+    int version; /* of the file: 2 and 3 are read (regions resolved, no node table) */
+    int in_transaction;             /* evictions in a join write into it; the commit ends it */
+    int failed;                     /* a write failed: the cluster and the file differ */
+    unsigned char *blobs; /* a region's encoded pages, read or to write */
+    uint64_t blobs_cap;
+    int threads;     /* for encoding and decoding pages: the cluster's */
+    cm_store_stats stats;
+};
+
+/* Node records as saved: five little-endian uint32 columns of n entries
+ * (next, dist, group, target, tree), encoded as one BLOB. */
+#define NODE_FIELDS 5
+
+/* The tables and view of a version 4 file, meta excepted. */
+extern const char *const store_tables_sql;
+
+double store_seconds_now(void);
+int store_exec(sqlite3 *db, const char *sql);
+int store_pragma_int(sqlite3 *db, const char *sql, int *value);
+int64_t store_query_int(sqlite3 *db, const char *sql);
+cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_size);
+/* Steps a statement that returns no row, and resets it. */
+cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
+                          size_t msg_size);
+void store_json_doubles(char *buf, size_t size, const double *v, int n);
+void store_json_ints(char *buf, size_t size, const int64_t *v, int n);
+/* Numbers of a JSON array text into out (at most cap); how many, or -1. */
+int store_parse_json_numbers(const char *text, double *out, int cap);
+cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size);
+
+/* Opens and checks an existing file (full: every page too); old: a file of
+ * version 2 or 3 may be opened for writing (to upgrade it). */
+cm_status store_open_checked(const char *path, int full, int writable, int old, sqlite3 **out,
+                             char *msg, size_t msg_size);
+cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
+                    size_t msg_size);
+
+/* Transactions: begin one unless open; abandon rolls back after a failed write. */
+cm_status store_begin(cm_store *s, char *msg, size_t msg_size);
+cm_status store_abandon(cm_store *s, cm_status st);
+
+/* Region k's row and exit table; its pages (each once). */
+cm_status store_insert_region(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                              size_t msg_size);
+cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                            size_t msg_size);
+/* Region k's node records (replacing the saved ones). */
+cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                            size_t msg_size);
+/* The pager (cm_page_in_fn and cm_page_out_fn with the store as user). */
+cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size);
+cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg,
+                         size_t msg_size);
+/* Everything the cluster changed since it was last saved, in the open
+ * transaction (cm_store_commit without BEGIN and COMMIT). */
+cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
+
+#endif

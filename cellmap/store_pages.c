@@ -1,0 +1,535 @@
+/* cellmap/store_pages.c - a region in the file and back: its row, cell pages,
+ * exit and node tables; the pager; loading a saved cluster. */
+#include "cellmap/store_db.h"
+
+#include "cellmap/classify.h"
+#include "cellmap/codec.h"
+#include "cellmap/grow.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t npages(uint64_t ncells)
+{
+    return (ncells + CM_STORE_PAGE_CELLS - 1) / CM_STORE_PAGE_CELLS;
+}
+
+static uint64_t page_cells(uint64_t ncells, uint64_t page)
+{
+    const uint64_t first = page * CM_STORE_PAGE_CELLS;
+    return ncells - first < CM_STORE_PAGE_CELLS ? ncells - first : CM_STORE_PAGE_CELLS;
+}
+
+/* A page's column as read: where its BLOB lies in s->blobs, where it goes. */
+typedef struct column_ref {
+    uint64_t offset, len, n, first;
+    int col;
+} column_ref;
+
+/* Decodes the columns read, in parallel: a region is 3 x 16 of them. */
+static cm_status decode_columns(const cm_store *s, cm_region *r, const column_ref *refs,
+                                uint64_t nrefs)
+{
+    int failed = 0;
+#pragma omp parallel num_threads(s->threads) if (nrefs > 1)
+    {
+        unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
+        failed |= !scratch;
+#pragma omp for schedule(dynamic, 1) reduction(| : failed)
+        for (int64_t t = 0; t < (int64_t)nrefs; t++) {
+            const column_ref *c = &refs[t];
+            uint32_t *const arrays[3] = {r->image, r->group, r->step};
+            failed |= !scratch || cm_codec_decode(s->blobs + c->offset, c->len, c->n, 4,
+                                                  c->col == 0 ? (int64_t)c->first : -1, scratch,
+                                                  arrays[c->col] + c->first) != CM_OK;
+        }
+        free(scratch);
+    }
+    return failed ? CM_EFORMAT : CM_OK;
+}
+
+/* Copies column col's BLOB of the current row to s->blobs. */
+static cm_status keep_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t first, uint64_t n,
+                             uint64_t *used, column_ref *ref)
+{
+    const void *blob = sqlite3_column_blob(st, 2 + col);
+    const uint64_t len = (uint64_t)sqlite3_column_bytes(st, 2 + col);
+    if (!blob || cm_grow((void **)&s->blobs, &s->blobs_cap, *used + len, sizeof *s->blobs) != CM_OK)
+        return blob ? CM_ENOMEM : CM_EFORMAT;
+    memcpy(s->blobs + *used, blob, len);
+    *ref = (column_ref){*used, len, n, first, col};
+    *used += len;
+    s->stats.bytes_read += len;
+    return CM_OK;
+}
+
+cm_status store_read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+{
+    const uint64_t pages = npages(r->ncells);
+    column_ref *refs = malloc((3 * pages + 1) * sizeof *refs);
+    sqlite3_stmt *st = NULL;
+    if (!refs)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k + 1);
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT first_cell, cells, image, grp, step FROM pages WHERE region=? "
+                           "ORDER BY first_cell",
+                           -1, &st, NULL)) {
+        free(refs);
+        return store_db_error(s->db, "read pages", msg, msg_size);
+    }
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+    cm_status status = CM_OK;
+    uint64_t seen = 0, nrefs = 0, used = 0;
+    int rc;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        const uint64_t first = (uint64_t)sqlite3_column_int64(st, 0);
+        const uint64_t n = (uint64_t)sqlite3_column_int64(st, 1);
+        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > r->ncells ||
+            nrefs == 3 * pages) {
+            status = CM_EFORMAT;
+            break;
+        }
+        for (int col = 0; col < 3 && status == CM_OK; col++)
+            status = keep_column(s, st, col, first, n, &used, &refs[nrefs++]);
+        seen += n;
+    }
+    if (status == CM_OK && rc != SQLITE_DONE) {
+        status = store_db_error(s->db, "read pages", msg, msg_size);
+        sqlite3_finalize(st);
+        free(refs);
+        return status;
+    }
+    sqlite3_finalize(st);
+    if (status == CM_OK && seen != r->ncells)
+        status = CM_EFORMAT;
+    if (status == CM_OK)
+        status = decode_columns(s, r, refs, nrefs);
+    free(refs);
+    if (status == CM_EFORMAT)
+        return cm_fail(status, msg, msg_size,
+                       "%s is damaged: the pages of region %u are incomplete or do not decode",
+                       s->path, k + 1);
+    return status == CM_OK
+               ? CM_OK
+               : cm_fail(status, msg, msg_size, "out of memory reading region %u", k + 1);
+}
+
+/* Region k's exit targets into a new array of nexits * dim cells. */
+cm_status store_read_exits(cm_store *s, uint32_t k, uint64_t nexits, int dim, int64_t **out,
+                            char *msg, size_t msg_size)
+{
+    const uint64_t n = nexits * (uint64_t)dim;
+    int64_t *targets = malloc((n + 1) * sizeof *targets);
+    unsigned char *scratch = malloc(8 * (n + 1));
+    sqlite3_stmt *st = NULL;
+    cm_status status = CM_OK;
+    if (!targets || !scratch)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                         (unsigned long long)nexits);
+    else if (sqlite3_prepare_v2(s->db, "SELECT count, targets FROM exits WHERE region=?", -1, &st,
+                                NULL))
+        status = store_db_error(s->db, "read exits", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        const void *blob = NULL;
+        int len = 0;
+        if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == nexits) {
+            blob = sqlite3_column_blob(st, 1);
+            len = sqlite3_column_bytes(st, 1);
+        }
+        if (!blob || cm_codec_decode(blob, (size_t)len, n, 8, -1, scratch, targets) != CM_OK)
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: exits of region %u",
+                             s->path, k + 1);
+        s->stats.bytes_read += (uint64_t)len;
+    }
+    sqlite3_finalize(st);
+    free(scratch);
+    if (status != CM_OK) {
+        free(targets);
+        return status;
+    }
+    *out = targets;
+    return CM_OK;
+}
+
+/* The pager: reads region k's arrays and exit table back. */
+cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = store_seconds_now();
+    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
+    r->image = malloc(bytes + 4);
+    r->group = malloc(bytes + 4);
+    r->step = malloc(bytes + 4);
+    cm_status st = r->image && r->group && r->step
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
+    if (st == CM_OK)
+        st = store_read_pages(s, k, r, msg, msg_size);
+    if (st == CM_OK)
+        st = store_read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
+    if (st != CM_OK) {
+        free(r->image);
+        free(r->group);
+        free(r->step);
+        r->image = r->group = r->step = NULL;
+    }
+    s->stats.regions_read++;
+    s->stats.read_seconds += store_seconds_now() - t0;
+    return st;
+}
+
+void cm_store_attach(cm_store *s, cm_cluster *c)
+{
+    s->threads = cm_cluster_threads(c);
+    c->page_in = store_page_in;
+    c->page_out = s->writable ? store_page_out : NULL;
+    c->pager = s;
+}
+
+static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
+{
+    double l[CM_MAX_DIM], h[CM_MAX_DIM];
+    if (!lo || !hi || store_parse_json_numbers(lo, l, CM_MAX_DIM) != dim ||
+        store_parse_json_numbers(hi, h, CM_MAX_DIM) != dim)
+        return CM_EFORMAT;
+    box->dim = dim;
+    for (int d = 0; d < dim; d++) {
+        box->lo[d] = (int64_t)l[d];
+        box->hi[d] = (int64_t)h[d];
+        if (box->hi[d] <= box->lo[d])
+            return CM_EFORMAT;
+    }
+    return CM_OK;
+}
+
+/* Node records as saved: five little-endian uint32 columns of n entries
+ * (next, dist, group, target, tree), encoded as one BLOB. */
+#define NODE_FIELDS 5
+
+static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node **out, char *msg,
+                            size_t msg_size)
+{
+    cm_node *nodes = calloc(n + 1, sizeof *nodes);
+    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
+    sqlite3_stmt *st = NULL;
+    cm_status status = nodes && cols && scratch
+                           ? CM_OK
+                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu nodes",
+                                     (unsigned long long)n);
+    if (status == CM_OK && s->version < 4) {
+        /* regions of version 2 and 3 hold resolved cells: no node is referenced */
+        for (uint64_t e = 0; e < n; e++)
+            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1};
+    } else if (status == CM_OK) {
+        if (sqlite3_prepare_v2(s->db, "SELECT count, data FROM nodes WHERE region=?", -1, &st,
+                               NULL))
+            status = store_db_error(s->db, "read nodes", msg, msg_size);
+        const void *blob = NULL;
+        int len = 0;
+        if (status == CM_OK) {
+            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+            if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == n) {
+                blob = sqlite3_column_blob(st, 1);
+                len = sqlite3_column_bytes(st, 1);
+            }
+            if ((n > 0 && !blob) || (blob && cm_codec_decode(blob, (size_t)len, NODE_FIELDS * n,
+                                                             4, -1, scratch, cols) != CM_OK))
+                status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
+                                 s->path, k + 1);
+            s->stats.bytes_read += (uint64_t)len;
+        }
+        for (uint64_t e = 0; status == CM_OK && e < n; e++)
+            nodes[e] = (cm_node){.next = cols[e],
+                                 .dist = cols[n + e],
+                                 .group = cols[2 * n + e],
+                                 .target = cols[3 * n + e],
+                                 .tree = cols[4 * n + e]};
+    }
+    sqlite3_finalize(st);
+    free(cols);
+    free(scratch);
+    if (status != CM_OK) {
+        free(nodes);
+        return status;
+    }
+    *out = nodes;
+    return CM_OK;
+}
+
+/* Cells per group 1..groups from the groups view (every version has it). */
+static cm_status read_basins(cm_store *s, uint32_t groups, uint64_t **out, char *msg,
+                             size_t msg_size)
+{
+    uint64_t *basin = calloc((size_t)groups + 1, sizeof *basin);
+    sqlite3_stmt *st = NULL;
+    if (!basin)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
+    if (sqlite3_prepare_v2(s->db, "SELECT id, basin_cells FROM groups WHERE id > 0", -1, &st,
+                           NULL)) {
+        free(basin);
+        return store_db_error(s->db, "read groups", msg, msg_size);
+    }
+    cm_status status = CM_OK;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t id = sqlite3_column_int64(st, 0), cells = sqlite3_column_int64(st, 1);
+        if (id < 1 || id > groups || cells < 0)
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
+                             (long long)id);
+        else
+            basin[id] = (uint64_t)cells;
+    }
+    sqlite3_finalize(st);
+    if (status != CM_OK) {
+        free(basin);
+        return status;
+    }
+    *out = basin;
+    return CM_OK;
+}
+
+/* Region row k into rec, checked. */
+static cm_status region_record(const cm_store *s, sqlite3_stmt *st, uint32_t k, int dim,
+                               cm_region *rec, char *msg, size_t msg_size)
+{
+    memset(rec, 0, sizeof *rec);
+    rec->ncells = (uint64_t)sqlite3_column_int64(st, 3);
+    rec->nexits = (uint64_t)sqlite3_column_int64(st, 4);
+    rec->ngroups = (uint32_t)sqlite3_column_int64(st, 5);
+    if (sqlite3_column_int64(st, 0) != (sqlite3_int64)k + 1 ||
+        parse_box((const char *)sqlite3_column_text(st, 1),
+                  (const char *)sqlite3_column_text(st, 2), dim, &rec->box) != CM_OK ||
+        rec->ncells != cm_box_cells(&rec->box) || rec->ncells > CM_REGION_MAX_CELLS ||
+        rec->nexits > rec->ncells)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u", s->path, k + 1);
+    return CM_OK;
+}
+
+static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char *msg,
+                              size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    uint64_t cap = 0;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
+                           -1, &st, NULL))
+        return store_db_error(s->db, "read regions", msg, msg_size);
+    cm_status status = CM_OK;
+    int rc;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        cm_region rec;
+        cm_node *nodes = NULL;
+        const uint32_t k = c->nregions;
+        status = region_record(s, st, k, c->lat.dim, &rec, msg, msg_size);
+        if (status == CM_OK && cm_grow((void **)exits, &cap, (uint64_t)k + 1, sizeof **exits))
+            status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
+        if (status == CM_OK) {
+            (*exits)[k] = NULL;
+            status = store_read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
+        }
+        if (status == CM_OK)
+            status = read_nodes(s, k, rec.nexits, &nodes, msg, msg_size);
+        if (status == CM_OK)
+            status = cm_cluster_restore(c, &rec, nodes, msg, msg_size);
+        free(nodes);
+    }
+    if (status == CM_OK && rc != SQLITE_DONE)
+        status = store_db_error(s->db, "read regions", msg, msg_size);
+    sqlite3_finalize(st);
+    return status;
+}
+
+cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_lattice lat;
+    cm_status status = store_read_lattice(s->db, &lat, msg, msg_size);
+    if (status != CM_OK)
+        return status;
+    cm_cluster_init(c, &lat);
+    cm_store_attach(s, c);
+    const int64_t groups = store_query_int(s->db, "SELECT COUNT(*) FROM attractors");
+    if (groups < 0 || groups > CM_MAX_GROUPS ||
+        store_query_int(s->db, "SELECT IFNULL(MAX(id), 0) FROM attractors") != groups)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: attractors", s->path);
+    int64_t **exits = NULL;
+    uint64_t *basin = NULL;
+    status = load_regions(s, c, &exits, msg, msg_size);
+    if (status == CM_OK)
+        status = read_basins(s, (uint32_t)groups, &basin, msg, msg_size);
+    if (status == CM_OK && c->nregions > 0)
+        status = cm_cluster_restored(c, (uint32_t)groups, basin, exits, msg, msg_size);
+    if (status == CM_EFORMAT && !strstr(msg, s->path)) {
+        char detail[256];
+        snprintf(detail, sizeof detail, "%s", msg);
+        cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, detail);
+    }
+    for (uint32_t k = 0; exits && k < c->nregions; k++)
+        free(exits[k]);
+    free(exits);
+    free(basin);
+    if (status == CM_OK)
+        cm_cluster_saved(c);
+    return status;
+}
+
+cm_status store_insert_region(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                               size_t msg_size)
+{
+    char lo[512], hi[512];
+    store_json_ints(lo, sizeof lo, r->box.lo, r->box.dim);
+    store_json_ints(hi, sizeof hi, r->box.hi, r->box.dim);
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO regions VALUES(?, ?, ?, ?, ?, ?, 'joined')",
+                           -1, &st, NULL))
+        return store_db_error(s->db, "prepare regions", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+    sqlite3_bind_text(st, 2, lo, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 3, hi, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 4, (sqlite3_int64)r->ncells);
+    sqlite3_bind_int64(st, 5, (sqlite3_int64)r->nexits);
+    sqlite3_bind_int64(st, 6, (sqlite3_int64)r->ngroups);
+    cm_status status = store_step_done(s->db, st, "write region", msg, msg_size);
+    sqlite3_finalize(st);
+    if (status != CM_OK)
+        return status;
+    /* the exit table: nexits * dim little-endian int64 cell coordinates */
+    const uint64_t n = r->nexits * (uint64_t)r->box.dim;
+    unsigned char *scratch = malloc(8 * (n + 1)), *out = malloc(cm_codec_bound(8 * (n + 1)));
+    size_t len = 0;
+    if (!scratch || !out ||
+        cm_codec_encode(r->exit_target, n, 8, -1, scratch, out, cm_codec_bound(8 * (n + 1)),
+                        &len) != CM_OK)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing exits");
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT INTO exits VALUES(?, ?, ?)", -1, &st, NULL))
+        status = store_db_error(s->db, "prepare exits", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)r->nexits);
+        sqlite3_bind_blob(st, 3, out, (int)len, SQLITE_STATIC);
+        status = store_step_done(s->db, st, "write exits", msg, msg_size);
+        sqlite3_finalize(st);
+        s->stats.bytes_written += len;
+    }
+    free(scratch);
+    free(out);
+    return status;
+}
+
+/* Pages encoded at once: 8 x 3 columns of up to cm_codec_bound(256 KiB). */
+#define WRITE_BATCH 8
+
+/* Encodes the three columns (image, grp, step) of pages first .. first +
+ * n - 1 into s->blobs, part bytes apart, in parallel; lens[t] is task t's
+ * size (task t: page t / 3, column t % 3). */
+static cm_status encode_batch(cm_store *s, const cm_region *r, uint64_t first, int n, size_t part,
+                              size_t *lens)
+{
+    int failed = 0;
+    const int tasks = 3 * n;
+#pragma omp parallel num_threads(s->threads) if (tasks > 1)
+    {
+        unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
+        failed |= !scratch;
+#pragma omp for schedule(dynamic, 1) reduction(| : failed)
+        for (int t = 0; t < tasks; t++) {
+            const uint64_t page = first + (uint64_t)(t / 3), cell = page * CM_STORE_PAGE_CELLS;
+            const int col = t % 3;
+            const uint32_t *const arrays[3] = {r->image, r->group, r->step};
+            failed |= !scratch ||
+                      cm_codec_encode(arrays[col] + cell, page_cells(r->ncells, page), 4,
+                                      col == 0 ? (int64_t)cell : -1, scratch,
+                                      s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
+        }
+        free(scratch);
+    }
+    return failed ? CM_ENOMEM : CM_OK;
+}
+
+/* Writes all of region k's pages, once: a region never changes. Pages are
+ * encoded in parallel a batch at a time and written in order. */
+cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                             size_t msg_size)
+{
+    const uint64_t pages = npages(r->ncells);
+    const size_t part = cm_codec_bound(4 * (size_t)CM_STORE_PAGE_CELLS);
+    size_t lens[WRITE_BATCH * 3];
+    sqlite3_stmt *st = NULL;
+    if (cm_grow((void **)&s->blobs, &s->blobs_cap, (uint64_t)WRITE_BATCH * 3 * part, 1) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing region %u", k + 1);
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO pages VALUES(?1, ?2, ?3, ?4, ?5, ?6)", -1, &st,
+                           NULL))
+        return store_db_error(s->db, "prepare pages", msg, msg_size);
+    cm_status status = CM_OK;
+    for (uint64_t b = 0; status == CM_OK && b < pages; b += WRITE_BATCH) {
+        const int batch = (int)(pages - b < WRITE_BATCH ? pages - b : WRITE_BATCH);
+        if (encode_batch(s, r, b, batch, part, lens) != CM_OK)
+            status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding a page of region %u", k + 1);
+        for (int p = 0; status == CM_OK && p < batch; p++) {
+            const uint64_t page = b + (uint64_t)p;
+            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+            sqlite3_bind_int64(st, 2, (sqlite3_int64)(page * CM_STORE_PAGE_CELLS));
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)page_cells(r->ncells, page));
+            for (int c = 0; c < 3; c++) {
+                const int t = p * 3 + c;
+                sqlite3_bind_blob(st, 4 + c, s->blobs + (size_t)t * part, (int)lens[t],
+                                  SQLITE_STATIC);
+                s->stats.bytes_written += lens[t];
+            }
+            status = store_step_done(s->db, st, "write page", msg, msg_size);
+            s->stats.pages_written++;
+        }
+    }
+    sqlite3_finalize(st);
+    return status;
+}
+
+/* Replaces region k's node records (five columns, see read_nodes). Only the
+ * fields that say what a node's exit leads to are saved: a final group is
+ * kept for final and cycle nodes only, so the file does not depend on what
+ * readers resolved. */
+cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                             size_t msg_size)
+{
+    const cm_cluster_region *cr = &c->regions[k];
+    const uint64_t n = cr->r.nexits;
+    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
+    const size_t bound = cm_codec_bound(4 * (NODE_FIELDS * n + 1));
+    unsigned char *blob = malloc(bound);
+    size_t len = 0;
+    cm_status status = CM_OK;
+    if (!cols || !scratch || !blob)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
+    for (uint64_t e = 0; status == CM_OK && e < n; e++) {
+        const cm_node *nd = &c->nodes[cr->node_base + e];
+        const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+        cols[e] = nd->next;
+        cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
+        cols[2 * n + e] = known ? nd->group : 0;
+        cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
+        cols[4 * n + e] = nd->tree;
+    }
+    if (status == CM_OK &&
+        cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?)", -1, &st, NULL))
+        status = store_db_error(s->db, "prepare nodes", msg, msg_size);
+    if (status == CM_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)n);
+        sqlite3_bind_blob(st, 3, blob, (int)len, SQLITE_STATIC);
+        status = store_step_done(s->db, st, "write nodes", msg, msg_size);
+        s->stats.bytes_written += len;
+        s->stats.node_tables_written++;
+    }
+    sqlite3_finalize(st);
+    free(cols);
+    free(scratch);
+    free(blob);
+    return status;
+}
