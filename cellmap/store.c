@@ -1,8 +1,5 @@
 #include "cellmap/store_db.h"
 
-#include "cellmap/classify.h"
-#include "cellmap/codec.h"
-#include "cellmap/grow.h"
 
 #include <sqlite3.h>
 #include <stdarg.h>
@@ -310,7 +307,7 @@ cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
     return st;
 }
 
-cm_status store_new_store(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
+cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
                            size_t msg_size)
 {
     cm_store *s = calloc(1, sizeof *s);
@@ -459,7 +456,7 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
         sqlite3_close(db);
         return st;
     }
-    return store_new_store(path, db, writable, out, msg, msg_size);
+    return store_new(path, db, writable, out, msg, msg_size);
 }
 
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
@@ -540,6 +537,7 @@ int64_t store_query_int(sqlite3 *db, const char *sql)
 cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t msg_size)
 {
     memset(info, 0, sizeof *info);
+    info->version = s->version;
     sqlite3 *db = s->db;
     cm_status st = meta_text(db, "model", info->model, sizeof info->model, msg, msg_size);
     if (st == CM_OK)

@@ -12,7 +12,7 @@
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
  * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
  * versions 2 and 3 (regions stored resolved, no node tables; version 2
- * without group kinds) are read as they are and refused for writing.
+ * without group kinds) are read as they are; writing needs cm_store_upgrade.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
  * cm_store_commit writes everything a join changed in one transaction, so
@@ -61,6 +61,7 @@ typedef struct cm_store_info {
     uint32_t groups;     /* periodic groups (attractors) */
     uint64_t file_bytes; /* database file, WAL included */
     uint64_t page_bytes; /* encoded cell arrays */
+    int version;         /* the file's format version (2 and 3 need cm_store_upgrade to be written) */
 } cm_store_info;
 
 /* Paging and commit figures since the store was opened. */
@@ -79,6 +80,17 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
 /* Opens an existing database, read-only or for writing (to resume). Checks
  * application id, version and (for writing) integrity before any write. */
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size);
+
+/* Upgrades a file of version 2 or 3 to this version in one transaction
+ * (*upgraded = 1; 0 for a file of this version, which is left alone). Its
+ * regions are classified again from their saved images and joined again in
+ * their saved order (no model step is taken; the cluster is held in memory,
+ * 12 bytes per cell); the result must give every cell the group and step
+ * the file holds, and the same `groups` rows (model labels the groups'
+ * kinds: pass the file's), or nothing is written and the message says why.
+ * Check the file's model, parameters and plan before upgrading it. */
+cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
+                           size_t msg_size);
 
 /* Closes and frees (NULL-safe). A writable store returns to rollback mode. */
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size);

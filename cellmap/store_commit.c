@@ -2,9 +2,6 @@
  * node records and new regions, one transaction per commit. */
 #include "cellmap/store_db.h"
 
-#include "cellmap/classify.h"
-#include "cellmap/codec.h"
-#include "cellmap/grow.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -15,6 +15,7 @@
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
+#include "src/dbfile.h"
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
@@ -554,9 +555,11 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
     cm_store_info info;
     char params[4096];
     cm_params_json(&m->values, params, sizeof params);
-    cm_status st = cm_store_open(a->db, 1, &rn->store, msg, msg_size);
+    cm_store *check = NULL; /* read-only until the file proves to be this solve's */
+    cm_status st = cm_store_open(a->db, 0, &check, msg, msg_size);
     if (st == CM_OK)
-        st = cm_store_read_info(rn->store, &info, msg, msg_size);
+        st = cm_store_read_info(check, &info, msg, msg_size);
+    cm_store_close(check, NULL, 0);
     if (st != CM_OK)
         return st;
     const char *differs = strcmp(info.model, m->name)             ? "model"
@@ -569,6 +572,9 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
                        "%s was made by another solve (its %s differs): resume with the options "
                        "of: %s",
                        a->db, differs, info.command);
+    st = open_cluster_for_writing("solve", a->db, &info, m, &rn->store, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     cm_store_set_model(rn->store, m);
     return cm_store_load_cluster(rn->store, &rn->c, msg, msg_size);
 }

@@ -36,6 +36,24 @@ void close_cluster_file(cm_store *s, cm_cluster *c)
     cm_store_close(s, msg, sizeof msg);
 }
 
+cm_status open_cluster_for_writing(const char *cmd, const char *path, const cm_store_info *info,
+                                   const cm_model *model, cm_store **s, char *msg,
+                                   size_t msg_size)
+{
+    int upgraded = 0;
+    if (info->version < CM_STORE_VERSION) {
+        cm_status st = cm_store_upgrade(path, model, &upgraded, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (upgraded)
+            fprintf(stderr,
+                    "cellmap %s: upgraded %s from format version %d to %d (older cellmap "
+                    "versions cannot open it any more)\n",
+                    cmd, path, info->version, CM_STORE_VERSION);
+    }
+    return cm_store_open(path, 1, s, msg, msg_size);
+}
+
 const char *axis_name(int d)
 {
     static const char *const names[CM_MAX_DIM] = {"x", "y", "z", "w", "v", "u"};

@@ -20,6 +20,13 @@ void close_cluster_file(cm_store *s, cm_cluster *c);
  * (which must rebuild exactly). */
 cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size_t msg_size);
 
+/* Opens path for writing (to extend its cluster) once its info was
+ * checked; a file of an older format is first upgraded in place (said on
+ * stderr as "cellmap CMD: ..."). model: the file's. */
+cm_status open_cluster_for_writing(const char *cmd, const char *path, const cm_store_info *info,
+                                   const cm_model *model, cm_store **s, char *msg,
+                                   size_t msg_size);
+
 /* The name of coordinate d: x, y, z, w, v, u. */
 const char *axis_name(int d);
 

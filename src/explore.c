@@ -894,9 +894,11 @@ static int open_existing(session *s, const session_options *o)
 {
     char msg[1024];
     cm_store_info info;
-    cm_status st = cm_store_open(s->path, 1, &s->store, msg, sizeof msg);
+    cm_store *check = NULL; /* read-only until the file proves fit for the session */
+    cm_status st = cm_store_open(s->path, 0, &check, msg, sizeof msg);
     if (st == CM_OK)
-        st = cm_store_read_info(s->store, &info, msg, sizeof msg);
+        st = cm_store_read_info(check, &info, msg, sizeof msg);
+    cm_store_close(check, NULL, 0);
     if (st != CM_OK)
         return open_error("%s", msg);
     s->max_steps = plan_max_steps(info.plan);
@@ -905,6 +907,9 @@ static int open_existing(session *s, const session_options *o)
         rc = check_same(s, o, &info);
     if (rc != EXIT_OK)
         return rc;
+    if (open_cluster_for_writing("explore", s->path, &info, &s->model, &s->store, msg,
+                                 sizeof msg) != CM_OK)
+        return open_error("%s", msg);
     cm_cluster_init(&s->c, &info.lattice);
     if (cm_store_load_cluster(s->store, &s->c, msg, sizeof msg) != CM_OK)
         return open_error("%s", msg);

@@ -334,11 +334,36 @@ cmp -s v3-cells.csv v4-cells.csv || fail "a version 3 file's cells read differen
 "$CM" render v3.cmdb --png v3.png 2> /dev/null || fail "render of a version 3 file"
 "$CM" render v4.cmdb --png v4.png 2> /dev/null
 cmp -s v3.png v4.png || fail "a version 3 file renders differently"
-"$CM" explore v3.cmdb - <<< "stats" > /dev/null 2> v3.err && fail "explore extended a version 3 file"
-grep -q "format version 3, which this cellmap reads but cannot extend" v3.err || fail "v3 message: $(cat v3.err)"
+"$CM" info v3.cmdb | grep -v '^disk:' > v3-info.txt || fail "info of a version 3 file"
+"$CM" export v3.cmdb --flat flat.npz 2> /dev/null && mv flat.npz v3-flat.npz || fail "export --flat of a version 3 file"
+# a resume with other options is refused before anything is upgraded
+"$CM" solve --param alpha=0.077,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 120x72 \
+    --split 3x2 --db v3.cmdb --resume > /dev/null 2> v3.err && fail "resume with other parameters"
+grep -q "its parameters differs" v3.err || fail "v3 resume message: $(cat v3.err)"
+# an upgrade that would not give the file's groups back is refused, the file unchanged
+cp v3.cmdb v3-bad.cmdb
+sqlite3 v3-bad.cmdb "UPDATE attractors SET centre = '[1,2]' WHERE id = 7"
+sum_bad=$(sha256sum v3-bad.cmdb)
+"$CM" solve "${V3_SOLVE[@]}" --db v3-bad.cmdb --resume > /dev/null 2> v3.err && fail "upgraded a file whose groups differ"
+grep -q "could not be upgraded to version 4 (its groups would change); the file is unchanged" v3.err ||
+    fail "refused upgrade message: $(cat v3.err)"
+[ "$(sha256sum v3-bad.cmdb)" = "$sum_bad" ] || fail "a refused upgrade changed the file"
 [ "$(sha256sum v3.cmdb)" = "$sum_v3" ] || fail "reading or refusing a version 3 file changed it"
+# --resume upgrades it in one transaction; every output stays what it was
+cp v3.cmdb v3-explore.cmdb
+"$CM" solve "${V3_SOLVE[@]}" --db v3.cmdb --resume > /dev/null 2> v3.err || fail "resume of a version 3 file: $(cat v3.err)"
+grep -q "upgraded v3.cmdb from format version 3 to 4" v3.err || fail "upgrade message: $(cat v3.err)"
+[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 4 ] || fail "the resumed version 3 file was not upgraded"
+"$CM" export v3.cmdb --groups up-groups.csv --cells up-cells.csv 2> /dev/null || fail "export of an upgraded file"
+cmp -s up-groups.csv v3-groups.csv && cmp -s up-cells.csv v3-cells.csv || fail "the upgrade changed the export"
+"$CM" render v3.cmdb --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"
+"$CM" info v3.cmdb | grep -v '^disk:' | diff - v3-info.txt || fail "the upgrade changed info"
+"$CM" export v3.cmdb --flat flat.npz 2> /dev/null && cmp -s flat.npz v3-flat.npz || fail "the upgrade changed export --flat"
+# explore upgrades too, and goes on
+"$CM" explore v3-explore.cmdb - <<< "stats" > v3-stats.txt 2> v3.err || fail "explore of a version 3 file: $(cat v3.err)"
+grep -q "upgraded v3-explore.cmdb from format version 3 to 4" v3.err || fail "explore upgrade message: $(cat v3.err)"
 # version 2 had no kinds: every group is an attractor
-cp v3.cmdb v2.cmdb
+cp "$HERE/data/v3-split.cmdb" v2.cmdb
 sqlite3 v2.cmdb "DROP VIEW groups; ALTER TABLE attractors DROP COLUMN kind;
   CREATE VIEW groups(id, period, basin_cells, is_sink, centre, lo, hi, anchor, periodic_cells) AS
   SELECT 0, 1, (SELECT IFNULL(SUM(cells), 0) FROM region_groups WHERE grp = 0), 1, NULL, NULL, NULL, NULL, NULL
@@ -348,6 +373,9 @@ sum_v2=$(sha256sum v2.cmdb)
 "$CM" export v2.cmdb --groups v2-groups.csv 2> /dev/null || fail "export of a version 2 file"
 [ "$(sha256sum v2.cmdb)" = "$sum_v2" ] || fail "reading a version 2 file changed it"
 cmp -s v2-groups.csv v3-groups.csv || fail "a version 2 file reads differently"
+"$CM" solve "${V3_SOLVE[@]}" --db v2.cmdb --resume > /dev/null 2> v2.err || fail "resume of a version 2 file: $(cat v2.err)"
+"$CM" export v2.cmdb --groups v2-groups.csv --cells v2-cells.csv 2> /dev/null || fail "export of an upgraded version 2 file"
+cmp -s v2-groups.csv v3-groups.csv && cmp -s v2-cells.csv v3-cells.csv || fail "the upgrade of a version 2 file changed its export"
 
 # --- render: figures and indexed images of a database ------------------------
 "$CM" render basin.cmdb --png rendered.png || fail "render of basin.cmdb"
