@@ -1,5 +1,6 @@
 /* Clustered SCM: the invariant. For tilings of a box into 2, 3, 4 and 9
- * regions of unequal sizes, joined in several orders, the cluster equals
+ * regions of unequal sizes, and 64 and 256 equal ones, joined in several
+ * orders, and for a sequence of 200 pans, the cluster equals
  * simple cell mapping on the whole box cell by cell: the same images, the
  * same partition into groups up to renumbering, the same periodic cells and
  * step numbers. Models: the PD micro-chaos map (sec. 4.6.3 and Fig. 4.21
@@ -186,6 +187,84 @@ static void test_pd_maps(void)
     const cm_lattice lat21 = {2, {-125000, -600}, {250000.0 / 200, 1200.0 / 80}};
     const cm_box whole21 = {2, {0, 0}, {200, 80}};
     check_invariant("PD Fig. 4.21", &m, &lat21, &whole21, 1000);
+    cm_model_release(&m);
+}
+
+/* n x n equal regions over whole (the last row and column take the rest). */
+static uint32_t grid(const cm_box *whole, int64_t n, cm_box *boxes)
+{
+    const int64_t wx = (whole->hi[0] - whole->lo[0]) / n, wy = (whole->hi[1] - whole->lo[1]) / n;
+    uint32_t k = 0;
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = 0; i < n; i++) {
+            cm_box b = *whole;
+            b.lo[0] = whole->lo[0] + i * wx;
+            b.hi[0] = i == n - 1 ? whole->hi[0] : b.lo[0] + wx;
+            b.lo[1] = whole->lo[1] + j * wy;
+            b.hi[1] = j == n - 1 ? whole->hi[1] : b.lo[1] + wy;
+            boxes[k++] = b;
+        }
+    return k;
+}
+
+/* Tilings of 64 and 256 regions (most cells of a small region are nodes
+ * there), in order and scattered. */
+static void test_many_regions(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {0, -40}, {500.0 / 300, 80.0 / 240}};
+    const cm_box whole = {2, {0, 0}, {300, 240}};
+    cm_region whole_r;
+    solve_whole(&m, &lat, &whole, 1, &whole_r);
+    static cm_box boxes[256];
+    static uint32_t order[256];
+    for (int64_t n = 8; n <= 16; n += 8) {
+        const uint32_t count = grid(&whole, n, boxes);
+        for (int o = 0; o < 2; o++) {
+            for (uint32_t k = 0; k < count; k++)
+                order[k] = o == 0 ? k : (k * 37 + 11) % count; /* 37 is coprime with 64, 256 */
+            cm_region flat;
+            uint32_t straddling;
+            char what[128];
+            snprintf(what, sizeof what, "PD sec. 4.6.3, %u regions, order %d", count, o);
+            solve_clustered(&m, &lat, &whole, boxes, order, count, 1, &flat, &straddling);
+            CHECK_INT(compare_regions(what, &whole_r, &flat), 0);
+            fprintf(stderr, "%s: %u groups across borders\n", what, straddling);
+            cm_region_free(&flat);
+        }
+    }
+    cm_region_free(&whole_r);
+    cm_model_release(&m);
+}
+
+/* 200 pans of an explore session: a view 40 cells wide pans right 100
+ * times, then back and 100 times left of where it began, each pan joining
+ * the strip of 2 columns it uncovers; the cluster then equals the whole
+ * box it covers. */
+static void test_pan_sequence(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {-200, -40}, {500.0 / 300, 80.0 / 60}};
+    const cm_box whole = {2, {-200, 0}, {240, 60}};
+    static cm_box boxes[201];
+    static uint32_t order[201];
+    uint32_t n = 0;
+    boxes[n++] = (cm_box){2, {0, 0}, {40, 60}};
+    for (int k = 0; k < 100; k++)
+        boxes[n++] = (cm_box){2, {40 + 2 * k, 0}, {42 + 2 * k, 60}};
+    for (int k = 0; k < 100; k++)
+        boxes[n++] = (cm_box){2, {-2 - 2 * k, 0}, {-2 * k, 60}};
+    for (uint32_t k = 0; k < n; k++)
+        order[k] = k;
+    cm_region whole_r, flat;
+    uint32_t straddling;
+    solve_whole(&m, &lat, &whole, 1, &whole_r);
+    solve_clustered(&m, &lat, &whole, boxes, order, n, 1, &flat, &straddling);
+    CHECK_INT(compare_regions("PD sec. 4.6.3, 200 pans", &whole_r, &flat), 0);
+    fprintf(stderr, "PD sec. 4.6.3, 200 pans: %u groups, %u across borders\n", whole_r.ngroups,
+            straddling);
+    cm_region_free(&whole_r);
+    cm_region_free(&flat);
     cm_model_release(&m);
 }
 
@@ -496,6 +575,8 @@ int main(void)
     test_random_maps();
     test_pd_maps();
     test_delay_and_3d();
+    test_many_regions();
+    test_pan_sequence();
     test_ids_stable();
     test_threads_identical();
     test_figs_4_26_to_4_28();
