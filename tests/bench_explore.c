@@ -10,8 +10,9 @@
  * region); 421: the Fig. 4.21 parameters (max-steps 100000); osc: the dry
  * friction oscillator's Poincare map (Ch. 2, the 1a pair at S = 0.32), a
  * model whose images cost about a thousand times more. Prints each
- * pan's time (compute + join + commit, render), the medians and the ratio
- * of a pan to the full recompute. */
+ * pan's time (compute + join + commit, render), the medians, the ratio of
+ * the last ten pans to pans 11-20 (with 20 pans or more) and the ratio of
+ * a pan to the full recompute. */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -134,6 +135,14 @@ int main(int argc, char **argv)
         full_compute[k] = timed(&f, final_view);
         full[k] = full_compute[k] + timed(&f, render);
         close_session(&f);
+    }
+    if (pans >= 20) { /* does a pan cost more as the cluster grows? (median sorts: copies) */
+        double early[10], late[10];
+        memcpy(early, total + 10, sizeof early);
+        memcpy(late, total + pans - 10, sizeof late);
+        const double me = median(early, 10), ml = median(late, 10);
+        printf("median total of pans 11-20 %.1f ms, of pans %d-%d %.1f ms: ratio %.2f\n",
+               1e3 * me, pans - 9, pans, 1e3 * ml, ml / me);
     }
     const double mc = median(pan, pans), mr = median(draw, pans), mt = median(total, pans);
     const double fc = median(full_compute, 3), ft = median(full, 3);
