@@ -268,20 +268,41 @@ static void evict(cm_cluster_region *cr)
     cr->r.exit_target = NULL;
 }
 
+/* How soon region k will be needed: the position among c->upcoming of the
+ * first box next to it (a cell apart at most), where sequences leaving
+ * those boxes most likely land; UINT32_MAX if none is. */
+static uint32_t next_use(const cm_cluster *c, uint32_t k)
+{
+    cm_box near = c->regions[k].r.box, both;
+    for (int d = 0; d < near.dim; d++) {
+        near.lo[d]--;
+        near.hi[d]++;
+    }
+    for (uint32_t i = 0; i < c->nupcoming; i++)
+        if (cm_box_intersect(&near, &c->upcoming[i], &both))
+            return i;
+    return UINT32_MAX;
+}
+
 /* The resident region to evict next, other than `keep`, or -1: saved ones
- * before unsaved ones (which only with_unsaved allows), then the least
- * recently used. */
+ * before unsaved ones (which only with_unsaved allows), then the one needed
+ * last by the boxes to come, then the least recently used. */
 static int64_t eviction_victim(const cm_cluster *c, int64_t keep, int with_unsaved)
 {
     int64_t best = -1;
+    uint32_t best_use = 0;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
         if (!is_resident(cr) || (int64_t)k == keep || (!cr->written && !with_unsaved))
             continue;
         const cm_cluster_region *b = best >= 0 ? &c->regions[best] : NULL;
+        const uint32_t use = next_use(c, k);
         if (!b || cr->written > b->written ||
-            (cr->written == b->written && cr->last_used < b->last_used))
+            (cr->written == b->written &&
+             (use > best_use || (use == best_use && cr->last_used < b->last_used)))) {
             best = k;
+            best_use = use;
+        }
     }
     return best;
 }

@@ -111,6 +111,11 @@ typedef struct cm_cluster {
     cm_page_out_fn page_out; /* public */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
+    /* public: the boxes still to join, in order, if known (NULL: none).
+     * Eviction keeps the regions next to the first of them, where their
+     * sequences most likely land, and evicts the others first. */
+    const cm_box *upcoming;
+    uint32_t nupcoming;
     /* private */
     uint64_t cap, nodes_cap, basin_cap, periodic_cap, clock;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -197,7 +202,7 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
  * brings it back within the budget. */
 cm_status cm_cluster_acquire_all(cm_cluster *c, char *msg, size_t msg_size);
 
-/* Evicts saved resident regions, least recently used first, until the
+/* Evicts saved resident regions (in the order cm_cluster_acquire does) until the
  * resident arrays fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);
 

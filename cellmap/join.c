@@ -395,8 +395,13 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
             cm_join_stats one_join;
             if (st == CM_OK && status[k] != CM_OK)
                 st = cm_fail(status[k], msg, msg_size, "region %u: %s", first + k, msgs[k]);
+            /* its own box while it joins, the boxes after it from then on */
+            c->upcoming = boxes + first + k;
+            c->nupcoming = nboxes - first - k;
             if (st == CM_OK)
                 st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
+            c->upcoming++;
+            c->nupcoming--;
             if (st == CM_OK && stats)
                 add_join_stats(stats, &one_join);
             if (st == CM_OK && joined)
@@ -404,6 +409,8 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
             cm_region_free(&solved[k]);
         }
     }
+    c->upcoming = NULL;
+    c->nupcoming = 0;
     free(solved);
     free(status);
     free(msgs);

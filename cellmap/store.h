@@ -69,6 +69,7 @@ typedef struct cm_store_stats {
     uint64_t regions_read, regions_written, pages_written, node_tables_written;
     uint64_t regions_evicted;           /* unsaved, saved by the pager in a join */
     uint64_t bytes_read, bytes_written; /* encoded */
+    uint64_t page_bytes_written;        /* of them, cell pages */
     double read_seconds, evict_seconds, commit_seconds;
 } cm_store_stats;
 

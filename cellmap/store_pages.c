@@ -477,6 +477,7 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
                 sqlite3_bind_blob(st, 4 + c, s->blobs + (size_t)t * part, (int)lens[t],
                                   SQLITE_STATIC);
                 s->stats.bytes_written += lens[t];
+                s->stats.page_bytes_written += lens[t];
             }
             status = store_step_done(s->db, st, "write page", msg, msg_size);
             s->stats.pages_written++;

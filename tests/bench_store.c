@@ -9,8 +9,9 @@
  *   db      --db without a budget (every region stays in memory)
  *   memory  no database
  * Each prints total time, time paging (reading regions back, saving dirty
- * ones evicted in a join), time in commits, regions read and evicted, ns/cell, peak RSS and the
- * database's bytes per cell. The paged and db files must hold the same cluster (tests/cmdb_hash.h):
+ * ones evicted in a join), time in commits, regions read and evicted, ns/cell, peak RSS, the
+ * database's bytes per cell, and the bytes of cell pages written and stored
+ * (equal when every page is written once). The paged and db files must hold the same cluster (tests/cmdb_hash.h):
  * a budget changes the order of writes in the file, never its rows.
  *
  * usage: bench_store [TX TY SIDE MEM_MiB DIR]   (default 20 10 1000 256 /tmp) */
@@ -39,6 +40,25 @@ static void die(const char *what, const char *msg)
 {
     fprintf(stderr, "bench_store: %s: %s\n", what, msg);
     exit(1);
+}
+
+/* Bytes of the cell pages a file holds. */
+static uint64_t page_bytes_stored(const char *path)
+{
+    sqlite3 *db = NULL;
+    sqlite3_stmt *st = NULL;
+    int64_t bytes = -1;
+    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK &&
+        sqlite3_prepare_v2(db,
+                           "SELECT SUM(length(image) + length(grp) + length(step)) FROM pages",
+                           -1, &st, NULL) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW)
+        bytes = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    if (bytes < 0)
+        die(path, "cannot count its pages");
+    return (uint64_t)bytes;
 }
 
 /* One run (in a child process): prints its figures. */
@@ -87,9 +107,10 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     if (db) {
         struct stat sb;
         stat(db, &sb);
-        printf(" %9.3f", (double)sb.st_size / cells);
+        printf(" %9.3f %10.2f %10.2f", (double)sb.st_size / cells,
+               (double)ss.page_bytes_written / 1048576.0, (double)page_bytes_stored(db) / 1048576.0);
     } else {
-        printf(" %9s", "-");
+        printf(" %9s %10s %10s", "-", "-", "-");
     }
     fflush(stdout);
     cm_cluster_free(&c);
@@ -128,8 +149,9 @@ int main(int argc, char **argv)
     snprintf(whole, sizeof whole, "%s/bench-db.cmdb", cf.dir);
     printf("%d x %d regions of %lld x %lld cells, budget %llu MiB, 2 threads\n", cf.tx, cf.ty,
            (long long)cf.side, (long long)cf.side, (unsigned long long)cf.mem);
-    printf("%-7s %10s %9s %9s %9s %9s %6s %9s %7s %9s %9s\n", "run", "cells", "total_s", "paging_s",
-           "commit_s", "ns/cell", "groups", "reads", "evicted", "disk_B/c", "rss_MiB");
+    printf("%-7s %10s %9s %9s %9s %9s %6s %9s %7s %9s %10s %10s %9s\n", "run", "cells", "total_s",
+           "paging_s", "commit_s", "ns/cell", "groups", "reads", "evicted", "disk_B/c",
+           "pgw_MiB", "pgs_MiB", "rss_MiB");
     run_child(&cf, "paged", paged, cf.mem << 20);
     run_child(&cf, "db", whole, 0);
     run_child(&cf, "memory", NULL, 0);
