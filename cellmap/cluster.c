@@ -346,17 +346,6 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
     return st;
 }
 
-cm_status cm_cluster_acquire_all(cm_cluster *c, char *msg, size_t msg_size)
-{
-    const uint64_t budget = c->mem_budget;
-    cm_status st = CM_OK;
-    c->mem_budget = 0;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
-        st = cm_cluster_acquire(c, k, msg, msg_size);
-    c->mem_budget = budget;
-    return st;
-}
-
 void cm_cluster_trim(cm_cluster *c)
 {
     if (!c->page_in || c->mem_budget == 0)

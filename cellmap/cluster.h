@@ -198,10 +198,6 @@ cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64
  * regions' arrays are invalid after it. */
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size);
 
-/* Makes every region resident, whatever the budget; the next cm_cluster_trim
- * brings it back within the budget. */
-cm_status cm_cluster_acquire_all(cm_cluster *c, char *msg, size_t msg_size);
-
 /* Evicts saved resident regions (in the order cm_cluster_acquire does) until the
  * resident arrays fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);

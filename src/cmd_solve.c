@@ -489,10 +489,8 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
     for (log->n = 0; done + log->n < a->extend && st == CM_OK; log->n++) {
         cm_extend_choice choice;
         const double t0 = now_seconds();
-        /* the choice follows every escaping sequence: it needs every region */
-        st = cm_cluster_acquire_all(c, msg, msg_size);
-        if (st == CM_OK)
-            st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
+        /* from the open nodes' weights: no region is read */
+        st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
         const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
         if (st == CM_OK && fraction < a->escape_below) {
             snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g", fraction,

@@ -410,9 +410,7 @@ static cm_status extend_step(session *s, const cm_box *tile, int step, char *msg
     cm_extend_choice choice;
     computed done = {0};
     const double t0 = now_seconds();
-    cm_status st = cm_cluster_acquire_all(&s->c, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
+    cm_status st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
     if (st == CM_OK)
         st = cover_box(s, &choice.box, "extend auto", &done, msg, msg_size);
     if (st != CM_OK)

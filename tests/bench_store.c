@@ -4,17 +4,20 @@
  * re-stepping up to 100000 times as in the figure) cut into TX x TY regions
  * of SIDE x SIDE cells, solved two at a time and joined in row order.
  *
- * Three runs, each in its own process so each has its own peak RSS:
+ * Four runs (RUNS, a comma-separated choice of them), each in its own
+ * process so each has its own peak RSS:
  *   paged   --db with a budget of MEM MiB for the cell arrays
  *   db      --db without a budget (every region stays in memory)
  *   memory  no database
+ *   scm     the regions' SCM alone (a region per thread), no join, no file
  * Each prints total time, time paging (reading regions back, saving dirty
  * ones evicted in a join), time in commits, regions read and evicted, ns/cell, peak RSS, the
  * database's bytes per cell, and the bytes of cell pages written and stored
  * (equal when every page is written once). The paged and db files must hold the same cluster (tests/cmdb_hash.h):
  * a budget changes the order of writes in the file, never its rows.
  *
- * usage: bench_store [TX TY SIDE MEM_MiB DIR]   (default 20 10 1000 256 /tmp) */
+ * usage: bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]
+ *        (default 20 10 1000 256 /tmp paged,db,memory,scm) */
 #define _DEFAULT_SOURCE /* wait4: the peak RSS of one child */
 #include <stdio.h>
 #include <stdlib.h>
@@ -118,13 +121,56 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     cm_model_release(&m);
 }
 
+/* The regions' simple cell mapping alone, as cm_cluster_solve_boxes does
+ * it (a region per thread, two at a time), without joins or a file: what
+ * the cluster's total is measured against. Prints its time. */
+static void run_scm(const config *cf)
+{
+    char msg[1024];
+    cm_model m;
+    const char *params[1] = {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3"};
+    if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
+        die("model", msg);
+    const int64_t nx = cf->tx * cf->side, ny = cf->ty * cf->side;
+    const cm_lattice lat = {2, {-125000, -600}, {250000.0 / (double)nx, 1200.0 / (double)ny}};
+    const int64_t n = cf->tx * cf->ty;
+    const cm_scm_options opt = {100000, 1, NULL, NULL, 1};
+    int failed = 0;
+    const double t0 = now();
+    for (int64_t first = 0; first < n; first += 2) {
+        const int64_t last = first + 2 < n ? first + 2 : n;
+#pragma omp parallel for num_threads(2) reduction(| : failed)
+        for (int64_t k = first; k < last; k++) {
+            char why[256];
+            const int64_t i = k % cf->tx, j = k / cf->tx;
+            const cm_box box = {2, {i * cf->side, j * cf->side},
+                                {(i + 1) * cf->side, (j + 1) * cf->side}};
+            cm_region r;
+            failed |= cm_region_alloc(&r, &box, why, sizeof why) != CM_OK ||
+                      cm_scm_solve(&m, &lat, &opt, &r, why, sizeof why) != CM_OK;
+            cm_region_free(&r);
+        }
+    }
+    const double total = now() - t0;
+    if (failed)
+        die("scm", "a region failed");
+    printf("%-7s %10.0f %9.2f %9s %9s %9.1f %6s %9s %7s %9s %10s %10s", "scm",
+           (double)nx * (double)ny, total, "-", "-", 1e9 * total / ((double)nx * (double)ny), "-",
+           "-", "-", "-", "-", "-");
+    fflush(stdout);
+    cm_model_release(&m);
+}
+
 /* Runs one configuration in a child process and prints its peak RSS. */
 static void run_child(const config *cf, const char *name, const char *db, uint64_t budget)
 {
     fflush(stdout);
     const pid_t pid = fork();
     if (pid == 0) {
-        run(cf, name, db, budget);
+        if (strcmp(name, "scm") == 0)
+            run_scm(cf);
+        else
+            run(cf, name, db, budget);
         _exit(0);
     }
     int status = 0;
@@ -137,9 +183,10 @@ static void run_child(const config *cf, const char *name, const char *db, uint64
 int main(int argc, char **argv)
 {
     config cf = {20, 10, 1000, 256, "/tmp"};
-    if (argc > 1 && argc != 6)
-        die("usage", "bench_store [TX TY SIDE MEM_MiB DIR]");
-    if (argc == 6)
+    if (argc > 1 && argc != 6 && argc != 7)
+        die("usage", "bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]");
+    const char *runs = argc == 7 ? argv[6] : "paged,db,memory,scm";
+    if (argc >= 6)
         cf = (config){atoi(argv[1]), atoi(argv[2]), atoll(argv[3]), strtoull(argv[4], NULL, 10),
                       argv[5]};
     if (cf.tx < 1 || cf.ty < 1 || cf.side < 2 || cf.mem < 1)
@@ -152,11 +199,18 @@ int main(int argc, char **argv)
     printf("%-7s %10s %9s %9s %9s %9s %6s %9s %7s %9s %10s %10s %9s\n", "run", "cells", "total_s",
            "paging_s", "commit_s", "ns/cell", "groups", "reads", "evicted", "disk_B/c",
            "pgw_MiB", "pgs_MiB", "rss_MiB");
-    run_child(&cf, "paged", paged, cf.mem << 20);
-    run_child(&cf, "db", whole, 0);
-    run_child(&cf, "memory", NULL, 0);
-    printf("paged and db clusters %s; RSS target: %llu MiB (2 x budget + 100)\n",
-           cmdb_content_hash(paged) == cmdb_content_hash(whole) ? "identical" : "DIFFER",
+    if (strstr(runs, "paged"))
+        run_child(&cf, "paged", paged, cf.mem << 20);
+    if (strstr(runs, "db"))
+        run_child(&cf, "db", whole, 0);
+    if (strstr(runs, "memory"))
+        run_child(&cf, "memory", NULL, 0);
+    if (strstr(runs, "scm"))
+        run_child(&cf, "scm", NULL, 0);
+    if (strstr(runs, "paged") && strstr(runs, "db"))
+        printf("paged and db clusters %s\n",
+               cmdb_content_hash(paged) == cmdb_content_hash(whole) ? "identical" : "DIFFER");
+    printf("RSS target of paged: %llu MiB (2 x budget + 100)\n",
            (unsigned long long)(2 * cf.mem + 100));
     unlink(paged);
     unlink(whole);
