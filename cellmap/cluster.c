@@ -29,10 +29,13 @@ void cm_cluster_free(cm_cluster *c)
 {
     if (!c)
         return;
-    for (uint32_t k = 0; k < c->nregions; k++)
+    for (uint32_t k = 0; k < c->nregions; k++) {
         cm_region_free(&c->regions[k].r);
+        free(c->regions[k].nodes);
+    }
     free(c->regions);
-    free(c->nodes);
+    cm_idmap_free(&c->open);
+    free(c->chain);
     free(c->basin);
     free(c->basin_dirty);
     free(c->new_periodic);
@@ -84,6 +87,23 @@ uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
 typedef struct escape_record {
     uint32_t node, offset;
 } escape_record;
+
+cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size)
+{
+    const uint32_t k = cm_cluster_node_region(c, id);
+    cm_cluster_region *cr = &c->regions[k];
+    if (id >= c->nnodes || !cr->nodes)
+        return cm_fail(CM_EINVAL, msg, msg_size, "node %u is not in the cluster", id);
+    *out = &cr->nodes[id - cr->node_base];
+    return CM_OK;
+}
+
+uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
+{
+    uint64_t w = 0;
+    cm_idmap_get(&c->open, id, &w);
+    return w;
+}
 
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
 {
@@ -182,48 +202,128 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
 
 /* ---- resolution ----------------------------------------------------------- */
 
-cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
-                             uint32_t *open)
+/* The end of node id's chain of up links: a node whose up is a mark. */
+static cm_status chain_end(cm_cluster *c, uint32_t id, uint32_t *end, uint64_t *total, char *msg,
+                           size_t msg_size)
 {
-    cm_node *nodes = c->nodes;
-    uint64_t total = 0;
-    uint32_t y = id;
-    while (nodes[y].up != CM_NODE_FINAL && nodes[y].up != CM_NODE_OPEN) {
-        total += nodes[y].up_dist;
-        y = nodes[y].up;
+    cm_node *nd;
+    *total = 0;
+    for (uint32_t y = id;; y = nd->up) {
+        cm_status st = cm_cluster_node(c, y, &nd, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (nd->up >= CM_NODE_MAX) {
+            *end = y;
+            return CM_OK;
+        }
+        *total += nd->up_dist;
     }
-    const bool final = nodes[y].up == CM_NODE_FINAL;
-    const uint64_t end = final ? nodes[y].up_dist : 1; /* an open node's image leaves */
-    if (total + end >= CM_STEP_ON_PATH)
-        return CM_ETOOBIG;
+}
+
+static cm_status push_chain(cm_cluster *c, uint64_t *len, uint32_t id)
+{
+    if (cm_grow((void **)&c->chain, &c->chain_cap, *len + 1, sizeof *c->chain) != CM_OK)
+        return CM_ENOMEM;
+    c->chain[(*len)++] = id;
+    return CM_OK;
+}
+
+/* Node id's chain ends on a straddling cycle: the steps of the nodes on its
+ * chain of next links, back from a settled node or from the link into the
+ * cycle's tree (counted through that tree's cells), become final. */
+static cm_status settle(cm_cluster *c, uint32_t id, char *msg, size_t msg_size)
+{
+    uint64_t len = 0;
+    cm_node *nd;
+    cm_status st = CM_OK;
+    for (uint32_t x = id; st == CM_OK; x = nd->next) {
+        st = cm_cluster_node(c, x, &nd, msg, msg_size);
+        if (st == CM_OK && (nd->up == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE))
+            break;
+        if (st == CM_OK && nd->next >= CM_NODE_MAX)
+            st = cm_fail(CM_EFORMAT, msg, msg_size, "node %u: a chain of links is broken", x);
+        if (st == CM_OK && push_chain(c, &len, x) != CM_OK)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory settling a chain of links");
+    }
+    while (st == CM_OK && len > 0) {
+        const uint32_t p = c->chain[--len];
+        cm_node *np, *nq;
+        st = cm_cluster_node(c, p, &np, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_node(c, np->next, &nq, msg, msg_size);
+        uint64_t steps = 0;
+        if (st == CM_OK && nq->next == CM_NODE_CYCLE) {
+            const uint32_t k = cm_cluster_node_region(c, np->next);
+            st = cm_cluster_acquire(c, k, msg, msg_size);
+            if (st == CM_OK)
+                steps = 1 + (uint64_t)cm_cycle_steps(&c->regions[k].r, nq->dist, np->target);
+        } else if (st == CM_OK) {
+            steps = (uint64_t)np->dist + nq->up_dist;
+        }
+        if (st == CM_OK && steps >= CM_STEP_ON_PATH)
+            st = cm_fail(CM_ETOOBIG, msg, msg_size, "a step number overflows");
+        if (st == CM_OK) {
+            np->up = CM_NODE_FINAL;
+            np->up_dist = (uint32_t)steps;
+            np->group = nq->group;
+        }
+    }
+    return st;
+}
+
+cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
+                             uint32_t *open, char *msg, size_t msg_size)
+{
+    uint32_t y;
+    uint64_t total;
+    cm_node *end, *nd;
+    cm_status st = chain_end(c, id, &y, &total, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_node(c, y, &end, msg, msg_size);
+    if (st == CM_OK && end->up == CM_NODE_CYCLE && y != id) {
+        st = settle(c, id, msg, msg_size);
+        if (st == CM_OK)
+            st = chain_end(c, id, &y, &total, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_node(c, y, &end, msg, msg_size);
+    }
+    if (st != CM_OK)
+        return st;
+    const bool open_end = end->up == CM_NODE_OPEN;
+    const uint64_t last = end->up == CM_NODE_FINAL ? end->up_dist
+                          : open_end               ? 1 /* an open node's image leaves */
+                                                   : 0; /* a cycle node's cell is periodic */
+    if (total + last >= CM_STEP_ON_PATH)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "a step number overflows");
     /* every node on the way now points at the end, or is final */
     uint64_t done = 0;
-    for (uint32_t x = id; x != y;) {
-        cm_node *nd = &nodes[x];
+    for (uint32_t x = id; x != y && st == CM_OK;) {
+        st = cm_cluster_node(c, x, &nd, msg, msg_size);
+        if (st != CM_OK)
+            break;
         const uint32_t next = nd->up, d = nd->up_dist;
-        if (final) {
-            nd->up = CM_NODE_FINAL;
-            nd->group = nodes[y].group;
-            nd->up_dist = (uint32_t)(total - done + end);
-        } else {
+        if (open_end) {
             nd->up = y;
             nd->up_dist = (uint32_t)(total - done);
+        } else {
+            nd->up = CM_NODE_FINAL;
+            nd->group = end->group;
+            nd->up_dist = (uint32_t)(total - done + last);
         }
         done += d;
         x = next;
     }
-    *group = final ? nodes[y].group : 0;
-    *step = (uint32_t)(total + end);
+    *group = open_end ? 0 : end->group;
+    *step = (uint32_t)(total + last);
     if (open)
-        *open = final ? CM_NODE_OPEN : y;
-    return CM_OK;
+        *open = open_end ? y : CM_NODE_OPEN;
+    return st;
 }
 
-uint32_t cm_cluster_cycle_steps(const cm_cluster *c, uint32_t k, uint32_t id, uint32_t t)
+uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t)
 {
-    const cm_region *r = &c->regions[k].r;
     const uint32_t *image = r->image, *step = r->step;
-    uint32_t a = t, b = c->nodes[id].dist, da = step[a], db = step[b], count = 0;
+    uint32_t a = t, b = entry, da = step[a], db = step[b], count = 0;
     /* the cycle runs down the tree from its entry b to the node: t's chain
      * meets it where it meets b's chain */
     for (; da > db; da--, count++)
@@ -252,7 +352,10 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
-    return cm_cluster_resident_bytes(c) + c->nodes_cap * sizeof *c->nodes +
+    uint64_t nodes = 0;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        nodes += c->regions[k].nodes ? c->regions[k].r.nexits * sizeof(cm_node) : 0;
+    return cm_cluster_resident_bytes(c) + nodes + cm_idmap_bytes(&c->open) +
            c->basin_cap * (sizeof *c->basin + 1) + c->periodic_cap * sizeof *c->new_periodic +
            c->cap * sizeof *c->regions + cm_bricks_bytes(c->region_bricks) +
            cm_bricks_bytes(c->escape_bricks);
@@ -442,7 +545,7 @@ static cm_status check_region(const cm_cluster *c, const cm_box *box, uint64_t n
 }
 
 /* Room for a region, its nodes and its groups; the brick maps on the first. */
-static cm_status make_space(cm_cluster *c, const cm_box *box, uint64_t nexits, uint32_t ngroups)
+static cm_status make_space(cm_cluster *c, const cm_box *box, uint32_t ngroups)
 {
     if (!c->region_bricks) {
         int shift[CM_MAX_DIM];
@@ -453,7 +556,6 @@ static cm_status make_space(cm_cluster *c, const cm_box *box, uint64_t nexits, u
     }
     const uint64_t groups = (uint64_t)c->ngroups + ngroups + 1, had = c->basin_cap;
     if (cm_grow((void **)&c->regions, &c->cap, c->nregions + 1, sizeof *c->regions) != CM_OK ||
-        cm_grow((void **)&c->nodes, &c->nodes_cap, c->nnodes + nexits, sizeof *c->nodes) != CM_OK ||
         cm_grow((void **)&c->basin, &c->basin_cap, groups, sizeof *c->basin) != CM_OK)
         return CM_ENOMEM;
     uint8_t *dirty = realloc(c->basin_dirty, c->basin_cap);
@@ -469,7 +571,7 @@ cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g)
 {
     if (c->ngroups >= CM_MAX_GROUPS)
         return CM_ETOOBIG;
-    if (make_space(c, &c->regions[0].r.box, 0, 1) != CM_OK)
+    if (make_space(c, &c->regions[0].r.box, 1) != CM_OK)
         return CM_ENOMEM;
     *g = ++c->ngroups;
     c->basin[*g] = 0;
@@ -489,25 +591,42 @@ static cm_status index_region(cm_cluster *c, uint32_t k)
     return CM_OK;
 }
 
-/* Appends region k's nodes as given (or open, with their tree sizes). */
-static void init_nodes(cm_cluster *c, uint64_t n, const cm_node *saved)
+/* Resolution state from a node's saved fields. */
+static void start_resolution(cm_node *nd)
 {
-    for (uint64_t e = 0; e < n; e++) {
-        cm_node *nd = &c->nodes[c->nnodes + e];
-        memset(nd, 0, sizeof *nd);
-        if (saved) {
-            nd->next = saved[e].next;
-            nd->dist = saved[e].dist;
-            nd->group = saved[e].group;
-            nd->target = saved[e].target;
-            nd->tree = saved[e].tree;
-        } else {
-            nd->next = CM_NODE_OPEN;
-        }
+    if (nd->next == CM_NODE_OPEN) {
         nd->up = CM_NODE_OPEN;
-        nd->ring = (uint32_t)(c->nnodes + e);
+    } else if (nd->next == CM_NODE_FINAL) {
+        nd->up = CM_NODE_FINAL;
+        nd->up_dist = nd->dist;
+    } else if (nd->next == CM_NODE_CYCLE) {
+        nd->up = CM_NODE_CYCLE;
+        nd->up_dist = 0;
+    } else {
+        nd->up = nd->next;
+        nd->up_dist = nd->dist;
+    }
+}
+
+/* Region k's node table: its nodes as saved (next, dist, group, target,
+ * tree), or open with empty trees. */
+static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved)
+{
+    const uint64_t n = cr->r.nexits;
+    cr->nodes = calloc(n + 1, sizeof *cr->nodes);
+    if (!cr->nodes)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < n; e++) {
+        cm_node *nd = &cr->nodes[e];
+        if (saved) {
+            *nd = saved[e];
+            start_resolution(nd);
+        } else {
+            nd->next = nd->up = CM_NODE_OPEN;
+        }
     }
     c->nnodes += n;
+    return CM_OK;
 }
 
 static cm_status note_periodic(cm_cluster *c, uint32_t group, const cm_box *box, uint64_t i)
@@ -530,7 +649,8 @@ cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64
 /* The new region's own groups take ids from base + 1: one pass that also
  * counts the cells of each group and of each node's tree and notes the
  * periodic cells. */
-static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes)
+static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes,
+                            uint32_t node_base)
 {
     uint32_t *group = r->group;
     const uint32_t *step = r->step;
@@ -547,7 +667,8 @@ static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node 
         }
     }
     for (uint64_t e = 0; e < r->nexits; e++)
-        nodes[e].weight = nodes[e].tree;
+        if (cm_idmap_put(&c->open, node_base + (uint32_t)e, nodes[e].tree) != CM_OK)
+            return CM_ENOMEM;
     for (uint32_t g = 1; g <= r->ngroups; g++)
         c->basin_dirty[base + g] = 1;
     return CM_OK;
@@ -560,7 +681,7 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
                        "the region was solved without record_exits; its exits cannot be "
                        "followed into the cluster");
     cm_status st = check_region(c, &r->box, r->nexits, r->ngroups, msg, msg_size);
-    if (st == CM_OK && make_space(c, &r->box, r->nexits, r->ngroups) != CM_OK)
+    if (st == CM_OK && make_space(c, &r->box, r->ngroups) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region");
     if (st != CM_OK)
         return st;
@@ -568,9 +689,10 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
     cm_cluster_region *cr = &c->regions[k];
     memset(cr, 0, sizeof *cr);
     cr->node_base = (uint32_t)c->nnodes;
-    init_nodes(c, r->nexits, NULL);
-    if (take_cells(c, r, base, c->nodes + cr->node_base) != CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for periodic cells");
+    cr->r.nexits = r->nexits;
+    if (init_nodes(c, cr, NULL) != CM_OK ||
+        take_cells(c, r, base, cr->nodes, cr->node_base) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     cr->r = *r;
     memset(r, 0, sizeof *r);
     cr->nodes_dirty = 1;
@@ -587,7 +709,7 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
                              char *msg, size_t msg_size)
 {
     cm_status st = check_region(c, &record->box, record->nexits, 0, msg, msg_size);
-    if (st == CM_OK && make_space(c, &record->box, record->nexits, 0) != CM_OK)
+    if (st == CM_OK && make_space(c, &record->box, 0) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region");
     if (st != CM_OK)
         return st;
@@ -601,36 +723,50 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
     cr->r.exits_recorded = 1;
     cr->node_base = (uint32_t)c->nnodes;
     cr->written = 1;
-    init_nodes(c, record->nexits, nodes);
+    if (init_nodes(c, cr, nodes) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     c->cells += record->ncells;
     return index_region(c, k) == CM_OK
                ? CM_OK
                : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
 }
 
-/* Resolution state from a node's saved fields. */
-static void start_resolution(cm_node *nd)
-{
-    if (nd->next == CM_NODE_OPEN) {
-        nd->up = CM_NODE_OPEN;
-    } else if (nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE) {
-        nd->up = CM_NODE_FINAL;
-        nd->up_dist = nd->next == CM_NODE_CYCLE ? 0 : nd->dist;
-    } else {
-        nd->up = nd->next;
-        nd->up_dist = nd->dist;
-    }
-}
-
 static cm_status check_saved_nodes(const cm_cluster *c, uint32_t groups)
 {
-    for (uint64_t id = 0; id < c->nnodes; id++) {
-        const cm_node *nd = &c->nodes[id];
-        const bool known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
-        if ((nd->next < CM_NODE_MAX && nd->next >= c->nnodes) ||
-            (nd->next >= CM_NODE_MAX && !known && nd->next != CM_NODE_OPEN) ||
-            (known && nd->group > groups) || (nd->next == CM_NODE_CYCLE && nd->group == 0))
-            return CM_EFORMAT;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        for (uint64_t e = 0; e < cr->r.nexits; e++) {
+            const cm_node *nd = &cr->nodes[e];
+            const bool known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+            if ((nd->next < CM_NODE_MAX && nd->next >= c->nnodes) ||
+                (nd->next >= CM_NODE_MAX && !known && nd->next != CM_NODE_OPEN) ||
+                (known && nd->group > groups) || (nd->next == CM_NODE_CYCLE && nd->group == 0))
+                return CM_EFORMAT;
+        }
+    }
+    return CM_OK;
+}
+
+/* The weights of the open nodes: the trees of the nodes whose chains end there. */
+static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
+{
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        for (uint64_t e = 0; e < cr->r.nexits; e++) {
+            uint32_t y;
+            uint64_t total, w = 0;
+            cm_node *end;
+            cm_status st = chain_end(c, cr->node_base + (uint32_t)e, &y, &total, msg, msg_size);
+            if (st == CM_OK)
+                st = cm_cluster_node(c, y, &end, msg, msg_size);
+            if (st != CM_OK)
+                return st;
+            if (end->up != CM_NODE_OPEN)
+                continue;
+            cm_idmap_get(&c->open, y, &w);
+            if (cm_idmap_put(&c->open, y, w + cr->nodes[e].tree) != CM_OK)
+                return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+        }
     }
     return CM_OK;
 }
@@ -640,30 +776,17 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
 {
     if (check_saved_nodes(c, groups) != CM_OK)
         return cm_fail(CM_EFORMAT, msg, msg_size, "the node table is damaged");
-    if (make_space(c, &c->regions[0].r.box, 0, groups) != CM_OK)
+    if (make_space(c, &c->regions[0].r.box, groups) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
     c->ngroups = groups;
     memcpy(c->basin + 1, basin + 1, (size_t)groups * sizeof *basin);
-    for (uint64_t id = 0; id < c->nnodes; id++)
-        start_resolution(&c->nodes[id]);
-    /* open components: weights and member rings */
-    for (uint64_t id = 0; id < c->nnodes; id++) {
-        uint32_t g, s, open;
-        if (cm_cluster_resolve(c, (uint32_t)id, &g, &s, &open) != CM_OK)
-            return cm_fail(CM_EFORMAT, msg, msg_size, "the node table is damaged: steps overflow");
-        if (open == CM_NODE_OPEN)
-            continue;
-        cm_node *root = &c->nodes[open];
-        root->weight += c->nodes[id].tree;
-        if (open != id) {
-            c->nodes[id].ring = root->ring;
-            root->ring = (uint32_t)id;
-        }
-    }
+    cm_status st = weigh_open_nodes(c, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
         for (uint64_t e = 0; e < cr->r.nexits; e++)
-            if (c->nodes[cr->node_base + e].next == CM_NODE_OPEN &&
+            if (cr->nodes[e].next == CM_NODE_OPEN &&
                 cm_cluster_add_escape(c, cr->node_base + (uint32_t)e,
                                       exits[k] + e * (uint64_t)c->lat.dim) != CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
@@ -738,8 +861,7 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
 /* What a region's nodes resolve to, for copying its cells: group and step
  * of each node's cell, and whether it is on a straddling cycle. */
 typedef struct node_values {
-    const cm_cluster *c; /* NULL: the region has no node references */
-    uint32_t region;
+    const cm_node *nodes; /* the region's; NULL: the region has no node references */
     const uint32_t *group, *step;
     const uint8_t *cycle;
 } node_values;
@@ -749,16 +871,14 @@ static void resolved_cell(const cm_region *r, uint64_t i, const node_values *nv,
                           uint32_t *step)
 {
     const uint32_t g = r->group[i];
-    if (!nv->c || !cm_is_node_ref(g)) {
+    if (!nv->nodes || !cm_is_node_ref(g)) {
         *group = g;
         *step = r->step[i];
         return;
     }
     const uint32_t e = g & ~CM_NODE_REF;
     *group = nv->group[e];
-    *step = nv->cycle[e] ? cm_cluster_cycle_steps(nv->c, nv->region,
-                                                  nv->c->regions[nv->region].node_base + e,
-                                                  (uint32_t)i)
+    *step = nv->cycle[e] ? cm_cycle_steps(r, nv->nodes[e].dist, (uint32_t)i)
                          : nv->step[e] + r->step[i] - 1;
 }
 
@@ -802,23 +922,23 @@ cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, cha
 void cm_flat_copy(const cm_region *r, cm_region *out)
 {
     cm_box both;
-    const node_values none = {NULL, 0, NULL, NULL, NULL};
+    const node_values none = {NULL, NULL, NULL, NULL};
     if (cm_box_intersect(&r->box, &out->box, &both))
         flatten_part(r, &none, &both, out, 1);
 }
 
 /* Resolves region k's nodes into nv (arrays of the region's nexits). */
 static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group, uint32_t *step,
-                                      uint8_t *cycle)
+                                      uint8_t *cycle, char *msg, size_t msg_size)
 {
     const cm_cluster_region *cr = &c->regions[k];
-    for (uint64_t e = 0; e < cr->r.nexits; e++) {
-        const uint32_t id = cr->node_base + (uint32_t)e;
-        cycle[e] = c->nodes[id].next == CM_NODE_CYCLE;
-        if (cm_cluster_resolve(c, id, &group[e], &step[e], NULL) != CM_OK)
-            return CM_ETOOBIG;
+    cm_status st = CM_OK;
+    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
+        cycle[e] = cr->nodes[e].next == CM_NODE_CYCLE;
+        st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e], NULL, msg,
+                                msg_size);
     }
-    return CM_OK;
+    return st;
 }
 
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
@@ -846,10 +966,11 @@ cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, c
                 break;
             }
         }
-        st = cm_cluster_acquire(c, k, msg, msg_size);
-        if (st == CM_OK && resolve_region_nodes(c, k, group, step, cycle) != CM_OK)
-            st = cm_fail(CM_ETOOBIG, msg, msg_size, "a step number overflows");
-        const node_values nv = {c, k, group, step, cycle};
+        /* nodes first: settling one can read other regions back */
+        st = resolve_region_nodes(c, k, group, step, cycle, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_acquire(c, k, msg, msg_size);
+        const node_values nv = {c->regions[k].nodes, group, step, cycle};
         if (st == CM_OK)
             flatten_part(&c->regions[k].r, &nv, &both, out, cm_cluster_threads(c));
         cm_cluster_trim(c);

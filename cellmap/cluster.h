@@ -37,6 +37,7 @@
 
 #include "cellmap/bricks.h"
 #include "cellmap/classify.h"
+#include "cellmap/idmap.h"
 #include "cellmap/scm.h"
 
 /* cm_node.next values other than a node id */
@@ -54,14 +55,16 @@ typedef struct cm_node {
     uint32_t group;  /* FINAL, CYCLE: the cell's group */
     uint32_t target; /* local index of the exit's target cell in its region, once linked */
     uint32_t tree;   /* cells of the node's tree, itself included */
-    /* private: resolution state, rebuilt from the above when a file is read */
-    uint32_t up, up_dist; /* a node further along the chain, or CM_NODE_FINAL/OPEN */
-    uint32_t ring;        /* next member of the component of the open node it reaches */
-    uint64_t weight;      /* open node: cells whose sequences leave the cluster through it */
+    /* private: resolution state, rebuilt from the above when a table is read */
+    uint32_t up;      /* a node further along the chain, or a mark: FINAL (group and
+                         up_dist known), OPEN (this node is open), CYCLE (a cycle node:
+                         the chains that reach it are settled through next links) */
+    uint32_t up_dist; /* steps to up's cell; FINAL: this cell's step */
 } cm_node;
 
 typedef struct cm_cluster_region {
     cm_region r;        /* arrays NULL while the region is paged out */
+    cm_node *nodes;     /* read-only: its r.nexits nodes (cm_cluster_node) */
     uint32_t node_base; /* id of the node of exit 0 */
     int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
     int nodes_dirty;    /* read-only: node records changed since the owner saved them */
@@ -94,8 +97,7 @@ typedef struct cm_cluster {
     uint32_t nregions;                /* read-only */
     uint32_t ngroups;                 /* read-only: cluster-wide group ids 1..ngroups */
     int threads;                      /* public: OpenMP threads; 0: the OpenMP default */
-    cm_node *nodes;                   /* read-only: nnodes entries */
-    uint64_t nnodes;                  /* read-only */
+    uint64_t nnodes;                  /* read-only: nodes of all regions */
     uint64_t cells;                   /* read-only: cells of all regions */
     uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */
     uint8_t *basin_dirty;             /* read-only: basin[g] changed since cm_cluster_saved */
@@ -117,7 +119,10 @@ typedef struct cm_cluster {
     const cm_box *upcoming;
     uint32_t nupcoming;
     /* private */
-    uint64_t cap, nodes_cap, basin_cap, periodic_cap, clock;
+    uint64_t cap, basin_cap, periodic_cap, clock;
+    cm_idmap open;   /* open node -> cells whose sequences leave the cluster through it */
+    uint32_t *chain; /* nodes walked while settling */
+    uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
     cm_bricks *escape_bricks; /* brick of the target -> open nodes */
     uint32_t *big;            /* regions too big for the brick index */
@@ -176,16 +181,25 @@ void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 /* The region of node id (binary search). */
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
 
-/* Group and step of node id's cell, following and shortening its chain of
- * links; *open (may be NULL) is the open node the sequence leaves the
- * cluster through (CM_NODE_OPEN if it does not). CM_ETOOBIG if a step
- * number overflows. */
-cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
-                             uint32_t *open);
+/* Node id's record into *out. The pointer stays valid until the cluster
+ * adds, restores or trims regions. */
+cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size);
 
-/* Steps from cell t of region k, in the tree of cycle node id, to the cycle
- * (0 on it). Region k must be resident. */
-uint32_t cm_cluster_cycle_steps(const cm_cluster *c, uint32_t k, uint32_t id, uint32_t t);
+/* Cells whose sequences leave the cluster through open node id (0 if it is not open). */
+uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
+
+/* Group and step of node id's cell, following and shortening its chain of
+ * links (and settling it, through the cells of its region, when the chain
+ * ends on a straddling cycle); *open (may be NULL) is the open node the
+ * sequence leaves the cluster through (CM_NODE_OPEN if it does not).
+ * CM_ETOOBIG if a step number overflows. */
+cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
+                             uint32_t *open, char *msg, size_t msg_size);
+
+/* Steps from cell t of region r to a cycle that enters r's tree of a cycle
+ * node at cell `entry` (the node's dist) and runs down the tree to the node's
+ * cell (0 on it). r must be resident. */
+uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t);
 
 /* A new group id (a straddling group) into *g; CM_ETOOBIG past CM_MAX_GROUPS. */
 cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g);

@@ -151,7 +151,7 @@ typedef struct escape_count {
 static void count_escape(void *user, uint32_t node, const int64_t *cell)
 {
     const escape_count *ec = user;
-    const uint64_t w = ec->c->nodes[node].weight;
+    const uint64_t w = cm_cluster_open_weight(ec->c, node);
     int64_t index[CM_MAX_DIM] = {0};
     ec->choice->all_escaping += w;
     tile_of(ec->tile, cell, index);

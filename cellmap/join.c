@@ -26,7 +26,7 @@ typedef struct joiner {
     size_t msg_size;
 } joiner;
 
-/* Node id of region k changed. */
+/* A node of region k changed. */
 static void touch_in(joiner *j, uint32_t k)
 {
     j->c->regions[k].nodes_dirty = 1;
@@ -34,29 +34,45 @@ static void touch_in(joiner *j, uint32_t k)
     j->touched[k] = 1;
 }
 
-static void touch(joiner *j, uint32_t id) { touch_in(j, cm_cluster_node_region(j->c, id)); }
-
-/* The sequences through open node id take group g; its cell's step is s. */
+/* The sequences through open node id (of region `region`) take group g;
+ * its cell's step is s. */
 static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uint64_t s)
 {
     if (s >= CM_STEP_ON_PATH)
-        return CM_ETOOBIG;
-    cm_node *nd = &j->c->nodes[id];
+        return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
+    cm_node *nd;
+    cm_status st = cm_cluster_node(j->c, id, &nd, j->msg, j->msg_size);
+    if (st != CM_OK)
+        return st;
     if (nd->next == CM_NODE_OPEN) { /* the exit lands on a cell whose outcome is final */
         nd->next = CM_NODE_FINAL;
         nd->dist = (uint32_t)s;
-        nd->group = g;
     }
     nd->up = CM_NODE_FINAL;
     nd->up_dist = (uint32_t)s;
     nd->group = g;
+    uint64_t weight = 0;
+    cm_idmap_remove(&j->c->open, id, &weight);
     if (g != 0) {
-        j->c->basin[g] += nd->weight;
+        j->c->basin[g] += weight;
         j->c->basin_dirty[g] = 1;
-        j->stats->resolved_cells += nd->weight;
+        j->stats->resolved_cells += weight;
     }
     touch_in(j, region);
     return CM_OK;
+}
+
+/* Steps from cell t, in the tree of cycle node q, to the cycle, plus one. */
+static cm_status into_cycle(joiner *j, uint32_t q, uint32_t t, uint64_t *steps)
+{
+    const uint32_t k = cm_cluster_node_region(j->c, q);
+    cm_node *nq;
+    cm_status st = cm_cluster_node(j->c, q, &nq, j->msg, j->msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
+    if (st == CM_OK)
+        *steps = 1 + (uint64_t)cm_cycle_steps(&j->c->regions[k].r, nq->dist, t);
+    return st;
 }
 
 static cm_status push(joiner *j, uint64_t *len, uint32_t id)
@@ -64,47 +80,6 @@ static cm_status push(joiner *j, uint64_t *len, uint32_t id)
     if (cm_grow((void **)&j->stack, &j->stack_cap, *len + 1, sizeof *j->stack) != CM_OK)
         return CM_ENOMEM;
     j->stack[(*len)++] = id;
-    return CM_OK;
-}
-
-/* Steps from node p's exit target, in the tree of cycle node q, to the cycle, plus one. */
-static cm_status into_cycle(joiner *j, uint32_t p, uint32_t q, uint64_t *steps)
-{
-    const uint32_t k = cm_cluster_node_region(j->c, q);
-    cm_status st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
-    if (st == CM_OK)
-        *steps = 1 + (uint64_t)cm_cluster_cycle_steps(j->c, k, q, j->c->nodes[p].target);
-    return st;
-}
-
-/* A node of a new straddling group's component: its final step, and those
- * of the nodes on its chain, counted back from where the chain meets the
- * cycle's trees. */
-static cm_status settle_member(joiner *j, uint32_t y, uint32_t g)
-{
-    cm_node *nodes = j->c->nodes;
-    uint64_t len = 0;
-    for (uint32_t x = y; nodes[x].next != CM_NODE_FINAL && nodes[x].next != CM_NODE_CYCLE;
-         x = nodes[x].next)
-        if (push(j, &len, x) != CM_OK)
-            return CM_ENOMEM;
-    while (len > 0) {
-        const uint32_t p = j->stack[--len], q = nodes[p].next;
-        uint64_t s;
-        if (nodes[q].next == CM_NODE_CYCLE) {
-            cm_status st = into_cycle(j, p, q, &s);
-            if (st != CM_OK)
-                return st;
-            nodes = j->c->nodes;
-        } else {
-            s = (uint64_t)nodes[p].dist + nodes[q].dist;
-        }
-        if (s >= CM_STEP_ON_PATH)
-            return CM_ETOOBIG;
-        nodes[p] = (cm_node){CM_NODE_FINAL, (uint32_t)s, g, nodes[p].target, nodes[p].tree,
-                             CM_NODE_FINAL, (uint32_t)s, nodes[p].ring, nodes[p].weight};
-        touch(j, p);
-    }
     return CM_OK;
 }
 
@@ -125,53 +100,49 @@ static cm_status trace_cycle_cells(joiner *j, uint32_t x, uint32_t entry, uint32
 }
 
 /* Linking open node n closed a chain of links on itself: a new group whose
- * cycle crosses region borders. Its nodes and every node whose sequence
- * reaches them become final. */
+ * cycle crosses region borders. Its nodes become cycle nodes; the sequences
+ * through n's component all end on it, and the nodes of that component are
+ * settled when they are next resolved (cm_cluster_resolve). */
 static cm_status close_cycle(joiner *j, uint32_t n)
 {
     uint32_t g;
     cm_status st = cm_cluster_new_group(j->c, &g);
     if (st != CM_OK)
-        return st;
+        return cm_fail(st, j->msg, j->msg_size, "too many groups");
     j->stats->straddling_groups++;
     uint64_t len = 0;
     uint32_t x = n;
     do {
+        cm_node *nd;
+        if ((st = cm_cluster_node(j->c, x, &nd, j->msg, j->msg_size)) != CM_OK)
+            return st;
         if (push(j, &len, x) != CM_OK)
             return CM_ENOMEM;
-        x = j->c->nodes[x].next;
+        x = nd->next;
     } while (x != n);
     /* where the cycle enters each node's tree: its predecessor's target */
-    uint32_t *entry = malloc(len * sizeof *entry), *cycle = malloc(len * sizeof *cycle);
-    if (!entry || !cycle) {
-        free(entry);
-        free(cycle);
-        return CM_ENOMEM;
-    }
-    for (uint64_t i = 0; i < len; i++) {
-        cycle[i] = j->stack[i];
-        entry[(i + 1) % len] = j->c->nodes[j->stack[i]].target;
-    }
+    uint32_t prev_target;
+    cm_node *last;
+    if ((st = cm_cluster_node(j->c, j->stack[len - 1], &last, j->msg, j->msg_size)) != CM_OK)
+        return st;
+    prev_target = last->target;
     for (uint64_t i = 0; i < len && st == CM_OK; i++) {
-        cm_node *nd = &j->c->nodes[cycle[i]];
+        cm_node *nd;
+        st = cm_cluster_node(j->c, j->stack[i], &nd, j->msg, j->msg_size);
+        if (st != CM_OK)
+            break;
+        const uint32_t entry = prev_target;
+        prev_target = nd->target;
         nd->next = CM_NODE_CYCLE;
-        nd->dist = entry[i];
+        nd->dist = entry;
         nd->group = g;
-        nd->up = CM_NODE_FINAL;
+        nd->up = CM_NODE_CYCLE;
         nd->up_dist = 0;
-        touch(j, cycle[i]);
-        st = trace_cycle_cells(j, cycle[i], entry[i], g);
+        touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
+        st = trace_cycle_cells(j, j->stack[i], entry, g);
     }
-    free(entry);
-    free(cycle);
-    /* every member of n's component now leads into the cycle */
-    x = n;
-    do {
-        if (st == CM_OK)
-            st = settle_member(j, x, g);
-        x = j->c->nodes[x].ring;
-    } while (x != n);
-    const uint64_t weight = j->c->nodes[n].weight;
+    uint64_t weight = 0;
+    cm_idmap_remove(&j->c->open, n, &weight);
     j->c->basin[g] += weight;
     j->stats->resolved_cells += weight;
     return st;
@@ -181,20 +152,28 @@ static cm_status close_cycle(joiner *j, uint32_t n)
 static cm_status link_node(joiner *j, const link_job *job)
 {
     cm_cluster *c = j->c;
-    c->nodes[job->node].target = job->cell;
+    cm_node *nd, *nm;
+    cm_status st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
+    if (st != CM_OK)
+        return st;
+    nd->target = job->cell;
     if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
         return finish(j, job->node, job->from, job->group, (uint64_t)job->step + 1);
     const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
-    if (c->nodes[m].next == CM_NODE_CYCLE) { /* its tree holds a cycle that can enter above m */
+    if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
+        return st;
+    if (nm->next == CM_NODE_CYCLE) { /* its tree holds a cycle that can enter above m */
         uint64_t s;
-        cm_status st = into_cycle(j, job->node, m, &s);
-        return st == CM_OK ? finish(j, job->node, job->from, c->nodes[m].group, s) : st;
+        const uint32_t g = nm->group;
+        st = into_cycle(j, m, job->cell, &s);
+        return st == CM_OK ? finish(j, job->node, job->from, g, s) : st;
     }
     uint32_t g, s, open;
-    cm_status st = cm_cluster_resolve(c, m, &g, &s, &open);
+    st = cm_cluster_resolve(c, m, &g, &s, &open, j->msg, j->msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
     if (st != CM_OK)
         return st;
-    cm_node *nd = &c->nodes[job->node];
     nd->next = m;
     nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
     if (open == CM_NODE_OPEN)
@@ -202,14 +181,14 @@ static cm_status link_node(joiner *j, const link_job *job)
     if (open == job->node)
         return close_cycle(j, job->node);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
-        return CM_ETOOBIG;
-    cm_node *root = &c->nodes[open];
+        return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
-    root->weight += nd->weight;
-    const uint32_t ring = nd->ring;
-    nd->ring = root->ring;
-    root->ring = ring;
+    uint64_t weight = 0, root = 0;
+    cm_idmap_remove(&c->open, job->node, &weight);
+    cm_idmap_get(&c->open, open, &root);
+    if (cm_idmap_put(&c->open, open, root + weight) != CM_OK)
+        return CM_ENOMEM;
     touch_in(j, job->from);
     return CM_OK;
 }

@@ -505,7 +505,7 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
     if (!cols || !scratch || !blob)
         status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
     for (uint64_t e = 0; status == CM_OK && e < n; e++) {
-        const cm_node *nd = &c->nodes[cr->node_base + e];
+        const cm_node *nd = &cr->nodes[e];
         const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
         cols[e] = nd->next;
         cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;

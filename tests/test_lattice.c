@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "cellmap/lattice.h"
+#include "cellmap/idmap.h"
 #include "check.h"
 
 static void point_cell_round_trip(void)
@@ -98,8 +99,50 @@ static void box_index_round_trip(void)
     CHECK(strcmp(cm_status_name(CM_EDB), "CM_EDB") == 0);
 }
 
+/* The id map against a plain array, through random puts, gets and
+ * removals dense enough to wrap probe runs around the table. */
+static void test_idmap(void)
+{
+    enum { KEYS = 3000 };
+    static uint64_t ref[KEYS];
+    static bool in[KEYS];
+    cm_idmap m;
+    memset(&m, 0, sizeof m);
+    uint64_t state = 12345, count = 0;
+    for (int op = 0; op < 200000; op++) {
+        state = state * UINT64_C(6364136223846793005) + 1442695040888963407u;
+        const uint32_t key = (uint32_t)((state >> 33) % KEYS);
+        const int what = (int)((state >> 20) % 3);
+        uint64_t v = 0;
+        if (what == 0) {
+            CHECK(cm_idmap_put(&m, key * 977u, state) == CM_OK);
+            count += !in[key];
+            in[key] = true;
+            ref[key] = state;
+        } else if (what == 1) {
+            const bool had = cm_idmap_remove(&m, key * 977u, &v);
+            CHECK(had == in[key]);
+            if (had)
+                CHECK(v == ref[key]);
+            count -= in[key];
+            in[key] = false;
+        } else {
+            const bool has = cm_idmap_get(&m, key * 977u, &v);
+            CHECK(has == in[key]);
+            if (has)
+                CHECK(v == ref[key]);
+        }
+    }
+    CHECK_INT(m.count, count);
+    for (uint32_t k = 0; k < KEYS; k++)
+        CHECK(cm_idmap_get(&m, k * 977u, NULL) == in[k]);
+    CHECK(cm_idmap_put(&m, UINT32_MAX, 1) == CM_EINVAL);
+    cm_idmap_free(&m);
+}
+
 int main(void)
 {
+    test_idmap();
     point_cell_round_trip();
     edges();
     checks();
