@@ -35,6 +35,7 @@ void cm_cluster_free(cm_cluster *c)
     }
     free(c->regions);
     cm_idmap_free(&c->open);
+    cm_idmap_free(&c->open_changed);
     free(c->chain);
     free(c->basin);
     free(c->basin_dirty);
@@ -88,14 +89,59 @@ typedef struct escape_record {
     uint32_t node, offset;
 } escape_record;
 
+/* Resolution state from a node's saved fields. */
+static void start_resolution(cm_node *nd)
+{
+    if (nd->next == CM_NODE_OPEN) {
+        nd->up = CM_NODE_OPEN;
+    } else if (nd->next == CM_NODE_FINAL) {
+        nd->up = CM_NODE_FINAL;
+        nd->up_dist = nd->dist;
+    } else if (nd->next == CM_NODE_CYCLE) {
+        nd->up = CM_NODE_CYCLE;
+        nd->up_dist = 0;
+    } else {
+        nd->up = nd->next;
+        nd->up_dist = nd->dist;
+    }
+}
+
+cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
+                                size_t msg_size)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    cr->nodes_used = ++c->clock;
+    if (!cr->nodes) {
+        if (!c->nodes_in)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the nodes of region %u are paged out and there is no pager", k);
+        cr->nodes = calloc(cr->r.nexits + 1, sizeof *cr->nodes);
+        if (!cr->nodes)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of region %u",
+                           k);
+        cm_status st = c->nodes_in(c->pager, k, cr->nodes, cr->r.nexits, msg, msg_size);
+        if (st != CM_OK) {
+            free(cr->nodes);
+            cr->nodes = NULL;
+            return st;
+        }
+        for (uint64_t e = 0; e < cr->r.nexits; e++)
+            start_resolution(&cr->nodes[e]);
+    }
+    *out = cr->nodes;
+    return CM_OK;
+}
+
 cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size)
 {
+    if (id >= c->nnodes)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "node %u is not in the cluster", id);
     const uint32_t k = cm_cluster_node_region(c, id);
-    cm_cluster_region *cr = &c->regions[k];
-    if (id >= c->nnodes || !cr->nodes)
-        return cm_fail(CM_EINVAL, msg, msg_size, "node %u is not in the cluster", id);
-    *out = &cr->nodes[id - cr->node_base];
-    return CM_OK;
+    cm_node *table;
+    cm_status st = cm_cluster_node_table(c, k, &table, msg, msg_size);
+    if (st == CM_OK)
+        *out = &table[id - c->regions[k].node_base];
+    return st;
 }
 
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
@@ -103,6 +149,27 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
     uint64_t w = 0;
     cm_idmap_get(&c->open, id, &w);
     return w;
+}
+
+cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
+{
+    if (cm_idmap_put(&c->open, id, cm_cluster_open_weight(c, id) + w) != CM_OK ||
+        cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
+        return CM_ENOMEM;
+    return CM_OK;
+}
+
+uint64_t cm_cluster_take_open(cm_cluster *c, uint32_t id)
+{
+    uint64_t w = 0;
+    if (cm_idmap_remove(&c->open, id, &w))
+        cm_idmap_put(&c->open_changed, id, 0); /* on failure the owner rewrites it anyway */
+    return w;
+}
+
+bool cm_cluster_next_open_change(const cm_cluster *c, uint64_t *slot, uint32_t *id)
+{
+    return cm_idmap_next(&c->open_changed, slot, id, NULL);
 }
 
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
@@ -341,27 +408,29 @@ uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t)
 
 static int is_resident(const cm_cluster_region *cr) { return cr->r.group != NULL; }
 
+static uint64_t node_table_bytes(const cm_cluster_region *cr)
+{
+    return cr->nodes ? cr->r.nexits * sizeof *cr->nodes : 0;
+}
+
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 {
     uint64_t bytes = 0;
     for (uint32_t k = 0; k < c->nregions; k++)
-        if (is_resident(&c->regions[k]))
-            bytes += cm_region_bytes(&c->regions[k].r);
+        bytes += (is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0) +
+                 node_table_bytes(&c->regions[k]);
     return bytes;
 }
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
-    uint64_t nodes = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        nodes += c->regions[k].nodes ? c->regions[k].r.nexits * sizeof(cm_node) : 0;
-    return cm_cluster_resident_bytes(c) + nodes + cm_idmap_bytes(&c->open) +
+    return cm_cluster_resident_bytes(c) + cm_idmap_bytes(&c->open) +
            c->basin_cap * (sizeof *c->basin + 1) + c->periodic_cap * sizeof *c->new_periodic +
            c->cap * sizeof *c->regions + cm_bricks_bytes(c->region_bricks) +
            cm_bricks_bytes(c->escape_bricks);
 }
 
-static void evict(cm_cluster_region *cr)
+static void evict_cells(cm_cluster_region *cr)
 {
     free(cr->r.image);
     free(cr->r.group);
@@ -371,66 +440,127 @@ static void evict(cm_cluster_region *cr)
     cr->r.exit_target = NULL;
 }
 
-/* How soon region k will be needed: the position among c->upcoming of the
- * first box next to it (a cell apart at most), where sequences leaving
- * those boxes most likely land; UINT32_MAX if none is. */
-static uint32_t next_use(const cm_cluster *c, uint32_t k)
+/* How soon each region will be needed: the position among the first
+ * upcoming boxes (c->upcoming) of the first one next to it (a cell apart at
+ * most), where sequences leaving those boxes most likely land; UINT32_MAX
+ * if none is. From the brick index: O(boxes looked at). */
+#define LOOKAHEAD 4096
+static void next_uses(const cm_cluster *c, uint32_t *use)
 {
-    cm_box near = c->regions[k].r.box, both;
-    for (int d = 0; d < near.dim; d++) {
-        near.lo[d]--;
-        near.hi[d]++;
+    for (uint32_t k = 0; k < c->nregions; k++)
+        use[k] = UINT32_MAX;
+    const uint32_t n = c->nupcoming < LOOKAHEAD ? c->nupcoming : LOOKAHEAD;
+    for (uint32_t i = n; i-- > 0;) { /* the first box that needs a region wins */
+        cm_box near = c->upcoming[i], both;
+        for (int d = 0; d < near.dim; d++) {
+            near.lo[d]--;
+            near.hi[d]++;
+        }
+        int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
+        for (uint64_t b = 0; b < c->nbig; b++)
+            if (cm_box_intersect(&c->regions[c->big[b]].r.box, &near, &both))
+                use[c->big[b]] = i;
+        if (!c->region_bricks || !cm_bricks_span(c->region_bricks, &near, lo, hi))
+            continue;
+        memcpy(key, lo, sizeof key);
+        do {
+            uint64_t m;
+            const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &m);
+            for (uint64_t p = 0; p < m; p++)
+                if (cm_box_intersect(&c->regions[in_brick[p]].r.box, &near, &both))
+                    use[in_brick[p]] = i;
+        } while (cm_index_next(c->lat.dim, lo, hi, key));
     }
-    for (uint32_t i = 0; i < c->nupcoming; i++)
-        if (cm_box_intersect(&near, &c->upcoming[i], &both))
-            return i;
-    return UINT32_MAX;
 }
 
-/* The resident region to evict next, other than `keep`, or -1: saved ones
- * before unsaved ones (which only with_unsaved allows), then the one needed
- * last by the boxes to come, then the least recently used. */
-static int64_t eviction_victim(const cm_cluster *c, int64_t keep, int with_unsaved)
+/* Something resident that can be evicted: region k's cells, or its node table. */
+typedef struct victim {
+    uint32_t k;
+    int nodes;
+    int unsaved;       /* cells never saved (evicting them saves them first) */
+    uint32_t use;      /* next_uses */
+    uint64_t last_used;
+    uint64_t bytes;
+} victim;
+
+/* Saved before unsaved, then those the upcoming boxes need last, then the
+ * least recently used; node tables before cells on a tie (they are read
+ * back in one piece). */
+static int victim_cmp(const void *a, const void *b)
 {
-    int64_t best = -1;
-    uint32_t best_use = 0;
+    const victim *x = a, *y = b;
+    if (x->unsaved != y->unsaved)
+        return x->unsaved - y->unsaved;
+    if (x->use != y->use)
+        return x->use > y->use ? -1 : 1;
+    if (x->last_used != y->last_used)
+        return x->last_used < y->last_used ? -1 : 1;
+    if (x->nodes != y->nodes)
+        return y->nodes - x->nodes;
+    return (x->k > y->k) - (x->k < y->k);
+}
+
+/* The candidates for eviction, other than region `keep`'s cells, in the
+ * order to evict them: cells (unsaved ones only with_unsaved), and clean
+ * node tables when `tables` (never while a join may hold node pointers). */
+static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, int tables,
+                         victim **out, uint64_t *n)
+{
+    uint32_t *use = malloc(((size_t)c->nregions + 1) * sizeof *use);
+    victim *v = malloc(((size_t)2 * c->nregions + 1) * sizeof *v);
+    if (!use || !v) {
+        free(use);
+        free(v);
+        return CM_ENOMEM;
+    }
+    next_uses(c, use);
+    *n = 0;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
-        if (!is_resident(cr) || (int64_t)k == keep || (!cr->written && !with_unsaved))
-            continue;
-        const cm_cluster_region *b = best >= 0 ? &c->regions[best] : NULL;
-        const uint32_t use = next_use(c, k);
-        if (!b || cr->written > b->written ||
-            (cr->written == b->written &&
-             (use > best_use || (use == best_use && cr->last_used < b->last_used)))) {
-            best = k;
-            best_use = use;
-        }
+        if (is_resident(cr) && (int64_t)k != keep && (cr->written || with_unsaved))
+            v[(*n)++] = (victim){k, 0, !cr->written, use[k], cr->last_used,
+                                 cm_region_bytes(&cr->r)};
+        if (tables && cr->nodes && !cr->nodes_dirty)
+            v[(*n)++] = (victim){k, 1, 0, use[k], cr->nodes_used, node_table_bytes(cr)};
     }
-    return best;
+    free(use);
+    qsort(v, *n, sizeof *v, victim_cmp);
+    *out = v;
+    return CM_OK;
 }
 
-/* Evicts regions other than `keep` until `extra` more bytes fit the budget. */
-static cm_status make_room(cm_cluster *c, int64_t keep, uint64_t extra, char *msg, size_t msg_size)
+/* Evicts until `extra` more bytes fit the budget (see victims). */
+static cm_status shed(cm_cluster *c, int64_t keep, uint64_t extra, int tables, char *msg,
+                      size_t msg_size)
 {
     if (!c->page_in || c->mem_budget == 0)
         return CM_OK;
     uint64_t bytes = cm_cluster_resident_bytes(c) + extra;
-    while (bytes > c->mem_budget) {
-        const int64_t k = eviction_victim(c, keep, c->page_out != NULL);
-        if (k < 0)
-            return CM_OK;
-        cm_cluster_region *cr = &c->regions[k];
-        if (!cr->written) {
-            cm_status st = c->page_out(c->pager, c, (uint32_t)k, msg, msg_size);
+    if (bytes <= c->mem_budget)
+        return CM_OK;
+    victim *v = NULL;
+    uint64_t n = 0;
+    const int with_unsaved = c->page_out != NULL && keep >= 0;
+    if (victims(c, keep, with_unsaved, tables, &v, &n) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory choosing what to page out");
+    cm_status st = CM_OK;
+    for (uint64_t i = 0; i < n && bytes > c->mem_budget && st == CM_OK; i++) {
+        cm_cluster_region *cr = &c->regions[v[i].k];
+        if (v[i].nodes) {
+            free(cr->nodes);
+            cr->nodes = NULL;
+        } else {
+            if (!cr->written)
+                st = c->page_out(c->pager, c, v[i].k, msg, msg_size);
             if (st != CM_OK)
-                return st;
+                break;
             cr->written = 1;
+            evict_cells(cr);
         }
-        bytes -= cm_region_bytes(&cr->r);
-        evict(cr);
+        bytes -= v[i].bytes;
     }
-    return CM_OK;
+    free(v);
+    return st;
 }
 
 cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
@@ -441,7 +571,7 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
         return CM_OK;
     if (!c->page_in)
         return cm_fail(CM_EINVAL, msg, msg_size, "region %u is paged out and there is no pager", k);
-    cm_status st = make_room(c, k, cm_region_bytes(&cr->r), msg, msg_size);
+    cm_status st = shed(c, k, cm_region_bytes(&cr->r), 0, msg, msg_size);
     if (st == CM_OK)
         st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
     if (st == CM_OK && !is_resident(cr))
@@ -451,16 +581,8 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
 
 void cm_cluster_trim(cm_cluster *c)
 {
-    if (!c->page_in || c->mem_budget == 0)
-        return;
-    uint64_t bytes = cm_cluster_resident_bytes(c);
-    while (bytes > c->mem_budget) {
-        const int64_t k = eviction_victim(c, -1, 0);
-        if (k < 0)
-            return;
-        bytes -= cm_region_bytes(&c->regions[k].r);
-        evict(&c->regions[k]);
-    }
+    char ignored[64];
+    shed(c, -1, 0, 1, ignored, sizeof ignored);
 }
 
 void cm_cluster_saved(cm_cluster *c)
@@ -473,6 +595,7 @@ void cm_cluster_saved(cm_cluster *c)
         memset(c->basin_dirty, 0, (size_t)c->ngroups + 1);
     c->nnew_periodic = 0;
     c->saved_groups = c->ngroups;
+    cm_idmap_clear(&c->open_changed);
 }
 
 uint64_t cm_cluster_sink_cells(const cm_cluster *c)
@@ -591,23 +714,6 @@ static cm_status index_region(cm_cluster *c, uint32_t k)
     return CM_OK;
 }
 
-/* Resolution state from a node's saved fields. */
-static void start_resolution(cm_node *nd)
-{
-    if (nd->next == CM_NODE_OPEN) {
-        nd->up = CM_NODE_OPEN;
-    } else if (nd->next == CM_NODE_FINAL) {
-        nd->up = CM_NODE_FINAL;
-        nd->up_dist = nd->dist;
-    } else if (nd->next == CM_NODE_CYCLE) {
-        nd->up = CM_NODE_CYCLE;
-        nd->up_dist = 0;
-    } else {
-        nd->up = nd->next;
-        nd->up_dist = nd->dist;
-    }
-}
-
 /* Region k's node table: its nodes as saved (next, dist, group, target,
  * tree), or open with empty trees. */
 static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved)
@@ -667,7 +773,7 @@ static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node 
         }
     }
     for (uint64_t e = 0; e < r->nexits; e++)
-        if (cm_idmap_put(&c->open, node_base + (uint32_t)e, nodes[e].tree) != CM_OK)
+        if (cm_cluster_add_open_weight(c, node_base + (uint32_t)e, nodes[e].tree) != CM_OK)
             return CM_ENOMEM;
     for (uint32_t g = 1; g <= r->ngroups; g++)
         c->basin_dirty[base + g] = 1;
@@ -723,7 +829,9 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
     cr->r.exits_recorded = 1;
     cr->node_base = (uint32_t)c->nnodes;
     cr->written = 1;
-    if (init_nodes(c, cr, nodes) != CM_OK)
+    if (!nodes)
+        c->nnodes += record->nexits; /* the table stays in the file until it is used */
+    else if (init_nodes(c, cr, nodes) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     c->cells += record->ncells;
     return index_region(c, k) == CM_OK
@@ -754,7 +862,7 @@ static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
         const cm_cluster_region *cr = &c->regions[k];
         for (uint64_t e = 0; e < cr->r.nexits; e++) {
             uint32_t y;
-            uint64_t total, w = 0;
+            uint64_t total;
             cm_node *end;
             cm_status st = chain_end(c, cr->node_base + (uint32_t)e, &y, &total, msg, msg_size);
             if (st == CM_OK)
@@ -763,8 +871,8 @@ static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
                 return st;
             if (end->up != CM_NODE_OPEN)
                 continue;
-            cm_idmap_get(&c->open, y, &w);
-            if (cm_idmap_put(&c->open, y, w + cr->nodes[e].tree) != CM_OK)
+            if (cm_idmap_put(&c->open, y, cm_cluster_open_weight(c, y) + cr->nodes[e].tree) !=
+                CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
         }
     }
@@ -790,6 +898,27 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
                 cm_cluster_add_escape(c, cr->node_base + (uint32_t)e,
                                       exits[k] + e * (uint64_t)c->lat.dim) != CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
+    }
+    c->saved_groups = groups;
+    return CM_OK;
+}
+
+cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_t *basin,
+                                   const uint32_t *ids, const uint64_t *weights,
+                                   const int64_t *cells, uint64_t n, char *msg,
+                                   size_t msg_size)
+{
+    if (make_space(c, &c->regions[0].r.box, groups) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
+    c->ngroups = groups;
+    memcpy(c->basin + 1, basin + 1, (size_t)groups * sizeof *basin);
+    for (uint64_t i = 0; i < n; i++) {
+        if (ids[i] >= c->nnodes || (i > 0 && ids[i] <= ids[i - 1]))
+            return cm_fail(CM_EFORMAT, msg, msg_size, "the open nodes are damaged (node %u)",
+                           ids[i]);
+        if (cm_idmap_put(&c->open, ids[i], weights[i]) != CM_OK ||
+            cm_cluster_add_escape(c, ids[i], cells + i * (uint64_t)c->lat.dim) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     }
     c->saved_groups = groups;
     return CM_OK;
@@ -932,9 +1061,10 @@ static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group
                                       uint8_t *cycle, char *msg, size_t msg_size)
 {
     const cm_cluster_region *cr = &c->regions[k];
-    cm_status st = CM_OK;
+    cm_node *nodes;
+    cm_status st = cm_cluster_node_table(c, k, &nodes, msg, msg_size);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
-        cycle[e] = cr->nodes[e].next == CM_NODE_CYCLE;
+        cycle[e] = nodes[e].next == CM_NODE_CYCLE;
         st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e], NULL, msg,
                                 msg_size);
     }

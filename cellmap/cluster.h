@@ -68,7 +68,8 @@ typedef struct cm_cluster_region {
     uint32_t node_base; /* id of the node of exit 0 */
     int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
     int nodes_dirty;    /* read-only: node records changed since the owner saved them */
-    uint64_t last_used; /* private: paging clock of the last acquire */
+    uint64_t last_used; /* private: paging clock of the last acquire of the cells */
+    uint64_t nodes_used; /* private: and of the last use of the node table */
 } cm_cluster_region;
 
 /* A periodic cell of a group made since the owner last took them. */
@@ -82,6 +83,11 @@ typedef struct cm_group_cell {
  * group, step and exit_target exactly as they were saved. */
 typedef cm_status (*cm_page_in_fn)(void *user, uint32_t region, cm_region *r, char *msg,
                                    size_t msg_size);
+
+/* Reads back the saved fields (next, dist, group, target, tree) of region
+ * k's n nodes into nodes[0..n) exactly as they were saved. */
+typedef cm_status (*cm_nodes_in_fn)(void *user, uint32_t region, cm_node *nodes, uint64_t n,
+                                    char *msg, size_t msg_size);
 
 struct cm_cluster;
 
@@ -104,13 +110,18 @@ typedef struct cm_cluster {
     cm_group_cell *new_periodic;   /* read-only: of groups made since cm_cluster_saved */
     uint64_t nnew_periodic;           /* read-only */
     uint32_t saved_groups;            /* read-only: ngroups at cm_cluster_saved */
-    /* Paging, off while page_in is NULL. cm_cluster_acquire reads regions
-     * back through page_in and first evicts others, least recently used
-     * first, so that the resident arrays take at most mem_budget bytes
-     * (more only while one region alone is bigger); a region never saved is
-     * saved through page_out first (kept resident if there is none). */
+    /* Paging, off while page_in is NULL. Resident bytes are the regions'
+     * cell arrays and exit tables and their node tables. cm_cluster_acquire
+     * reads a region's cells back through page_in and first evicts other
+     * regions' cells (those the upcoming boxes need last, then the least
+     * recently used, first) so that the resident bytes stay within
+     * mem_budget (more only while one region alone is bigger, or while a
+     * join reads node tables back); a region never saved is saved through
+     * page_out first (kept resident if there is none). cm_cluster_trim also
+     * evicts clean node tables, read back on use through nodes_in. */
     cm_page_in_fn page_in;   /* public */
     cm_page_out_fn page_out; /* public */
+    cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
     /* public: the boxes still to join, in order, if known (NULL: none).
@@ -121,6 +132,7 @@ typedef struct cm_cluster {
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
     cm_idmap open;   /* open node -> cells whose sequences leave the cluster through it */
+    cm_idmap open_changed; /* nodes whose entry in `open` changed since cm_cluster_saved */
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -150,17 +162,26 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
 
 /* Restores a region saved by an owner, paged out: its record (box, ncells,
  * nexits, ngroups) and its nodes' saved fields (next, dist, group, target,
- * tree for each of nexits nodes). Call cm_cluster_restored once all are in. */
+ * tree for each of nexits nodes), or NULL: its node table stays paged out
+ * (read back through nodes_in). Then one of the two below. */
 cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_node *nodes,
                              char *msg, size_t msg_size);
 
-/* After the last cm_cluster_restore: rebuilds the resolution state, the
- * basin counts and the open nodes' index from the exit tables (exits[k]:
- * region k's, nexits * dim cells), which the caller keeps. groups: the saved
- * group count; basin: the saved cells per group (groups + 1 entries, [0]
- * unused). */
+/* After the last cm_cluster_restore, every node table given: the open
+ * nodes, their weights (resolving every node) and their index from the exit
+ * tables (exits[k]: region k's, nexits * dim cells, which the caller keeps).
+ * groups: the saved group count; basin: the saved cells per group (groups +
+ * 1 entries, [0] unused). */
 cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
                               int64_t *const *exits, char *msg, size_t msg_size);
+
+/* The same from the open nodes as saved: n of them, ids[i] with weight
+ * weights[i] and its exit's target cell cells[i * dim ..]. No node table is
+ * read. */
+cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_t *basin,
+                                   const uint32_t *ids, const uint64_t *weights,
+                                   const int64_t *cells, uint64_t n, char *msg,
+                                   size_t msg_size);
 
 /* The region holding the cell and the cell's local index, or -1. O(1). */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
@@ -181,12 +202,25 @@ void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 /* The region of node id (binary search). */
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
 
-/* Node id's record into *out. The pointer stays valid until the cluster
- * adds, restores or trims regions. */
+/* Node id's record into *out, region k's node table into *out (read back
+ * through nodes_in if it was paged out). The pointers stay valid until the
+ * cluster adds, restores or trims regions (joins and cm_cluster_acquire
+ * never evict node tables; cm_cluster_trim does). */
 cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size);
+cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
+                                size_t msg_size);
 
-/* Cells whose sequences leave the cluster through open node id (0 if it is not open). */
+/* Open nodes and their weights: the cells whose sequences leave the
+ * cluster through them. The weight of open node id (0 if it is not open);
+ * adds w to it (making it open); takes it out (no longer open), returning
+ * its weight. Changes are noted for the owner until cm_cluster_saved. */
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
+cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w);
+uint64_t cm_cluster_take_open(cm_cluster *c, uint32_t id);
+
+/* The open nodes whose weight or openness changed since cm_cluster_saved,
+ * in no particular order: start with *slot = 0; false when done. */
+bool cm_cluster_next_open_change(const cm_cluster *c, uint64_t *slot, uint32_t *id);
 
 /* Group and step of node id's cell, following and shortening its chain of
  * links (and settling it, through the cells of its region, when the chain

@@ -102,6 +102,27 @@ bool cm_idmap_remove(cm_idmap *m, uint32_t key, uint64_t *value)
     return true;
 }
 
+bool cm_idmap_next(const cm_idmap *m, uint64_t *slot, uint32_t *key, uint64_t *value)
+{
+    for (; *slot < m->slots; (*slot)++) {
+        if (m->keys[*slot] == EMPTY)
+            continue;
+        *key = m->keys[*slot];
+        if (value)
+            *value = m->values[*slot];
+        (*slot)++;
+        return true;
+    }
+    return false;
+}
+
+void cm_idmap_clear(cm_idmap *m)
+{
+    if (m->slots)
+        memset(m->keys, 0xFF, m->slots * sizeof *m->keys);
+    m->count = 0;
+}
+
 uint64_t cm_idmap_bytes(const cm_idmap *m)
 {
     return m->slots * (sizeof *m->keys + sizeof *m->values);

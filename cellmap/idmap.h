@@ -31,6 +31,13 @@ bool cm_idmap_get(const cm_idmap *m, uint32_t key, uint64_t *value);
 /* Removes key; whether it was there, and its value into *value (may be NULL). */
 bool cm_idmap_remove(cm_idmap *m, uint32_t key, uint64_t *value);
 
+/* Iteration in slot order: start with *slot = 0; false when done. The map
+ * must not change meanwhile. */
+bool cm_idmap_next(const cm_idmap *m, uint64_t *slot, uint32_t *key, uint64_t *value);
+
+/* Empties the map (keeps its slots). */
+void cm_idmap_clear(cm_idmap *m);
+
 /* Bytes held. */
 uint64_t cm_idmap_bytes(const cm_idmap *m);
 

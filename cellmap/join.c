@@ -51,8 +51,7 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uin
     nd->up = CM_NODE_FINAL;
     nd->up_dist = (uint32_t)s;
     nd->group = g;
-    uint64_t weight = 0;
-    cm_idmap_remove(&j->c->open, id, &weight);
+    const uint64_t weight = cm_cluster_take_open(j->c, id);
     if (g != 0) {
         j->c->basin[g] += weight;
         j->c->basin_dirty[g] = 1;
@@ -141,8 +140,7 @@ static cm_status close_cycle(joiner *j, uint32_t n)
         touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
         st = trace_cycle_cells(j, j->stack[i], entry, g);
     }
-    uint64_t weight = 0;
-    cm_idmap_remove(&j->c->open, n, &weight);
+    const uint64_t weight = cm_cluster_take_open(j->c, n);
     j->c->basin[g] += weight;
     j->stats->resolved_cells += weight;
     return st;
@@ -184,11 +182,8 @@ static cm_status link_node(joiner *j, const link_job *job)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
-    uint64_t weight = 0, root = 0;
-    cm_idmap_remove(&c->open, job->node, &weight);
-    cm_idmap_get(&c->open, open, &root);
-    if (cm_idmap_put(&c->open, open, root + weight) != CM_OK)
-        return CM_ENOMEM;
+    if (cm_cluster_add_open_weight(c, open, cm_cluster_take_open(c, job->node)) != CM_OK)
+        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     touch_in(j, job->from);
     return CM_OK;
 }

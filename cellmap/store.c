@@ -124,6 +124,8 @@ const char *const store_tables_sql =
     "CREATE TABLE nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"
     " count INTEGER NOT NULL, data BLOB NOT NULL);"
     "CREATE TABLE basins(grp INTEGER PRIMARY KEY, cells INTEGER NOT NULL);"
+    "CREATE TABLE open_nodes(node INTEGER PRIMARY KEY, weight INTEGER NOT NULL,"
+    " cell BLOB NOT NULL);"
     "CREATE TABLE attractors(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
     " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
     " periodic_cells BLOB NOT NULL,"
@@ -135,13 +137,15 @@ const char *const store_tables_sql =
  * old one. */
 static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor'");
 
-/* Tables a file of this version (or of version 2 or 3) must have; their
+/* Tables a file of this version (or of versions 2 to 4) must have; their
  * absence means corruption. */
-static const char *const check_sql =
-    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
-    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
-    " (SELECT COUNT(*) FROM nodes), (SELECT COUNT(*) FROM basins),"
-    " (SELECT COUNT(*) FROM pages WHERE region = 1)";
+#define CHECK_V4_SQL                                                                               \
+    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"                          \
+    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"                            \
+    " (SELECT COUNT(*) FROM nodes), (SELECT COUNT(*) FROM basins),"                                \
+    " (SELECT COUNT(*) FROM pages WHERE region = 1)"
+static const char *const check_sql = CHECK_V4_SQL ", (SELECT COUNT(*) FROM open_nodes)";
+static const char *const check_v4_sql = CHECK_V4_SQL;
 static const char *const check_v3_sql =
     "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
     " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
@@ -208,7 +212,8 @@ static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, 
     if (ids != CM_OK)
         return ids;
     sqlite3_stmt *st = NULL;
-    int rc = sqlite3_prepare_v2(db, version >= 4 ? check_sql : check_v3_sql, -1, &st, NULL);
+    const char *sql = version >= 5 ? check_sql : version == 4 ? check_v4_sql : check_v3_sql;
+    int rc = sqlite3_prepare_v2(db, sql, -1, &st, NULL);
     if (rc == SQLITE_OK)
         rc = sqlite3_step(st) == SQLITE_ROW ? SQLITE_OK : SQLITE_CORRUPT;
     sqlite3_finalize(st);
@@ -284,9 +289,9 @@ cm_status store_open_checked(const char *path, int full, int writable, int old, 
         st = store_db_error(db, "read the version", msg, msg_size);
     if (st == CM_OK && writable && !old && version < CM_STORE_VERSION)
         st = cm_fail(CM_EFORMAT, msg, msg_size,
-                     "%s has format version %d, which this cellmap reads but cannot extend "
-                     "(version %d keeps regions unchanged and joins them through node tables): "
-                     "render and export it as it is, or solve again with --db",
+                     "%s has format version %d, which this cellmap reads but extends only "
+                     "after upgrading it to version %d (cm_store_upgrade; solve --resume and "
+                     "explore do that)",
                      path, version, CM_STORE_VERSION);
     if (st == CM_OK && version == 2 && store_exec(db, shadow_v2_sql) != SQLITE_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "cannot read %s of format version 2: %s", path,

@@ -12,7 +12,8 @@
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
  * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
  * versions 2 and 3 (regions stored resolved, no node tables; version 2
- * without group kinds) are read as they are; writing needs cm_store_upgrade.
+ * without group kinds) and 4 (no table of open nodes: every node table is
+ * read at open) are read as they are; writing needs cm_store_upgrade.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
  * cm_store_commit writes everything a join changed in one transaction, so
@@ -34,7 +35,7 @@
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 4
+#define CM_STORE_VERSION 5
 #define CM_STORE_PAGE_CELLS 65536
 
 typedef struct cm_store cm_store;
@@ -67,6 +68,7 @@ typedef struct cm_store_info {
 /* Paging and commit figures since the store was opened. */
 typedef struct cm_store_stats {
     uint64_t regions_read, regions_written, pages_written, node_tables_written;
+    uint64_t node_tables_read; /* read back on use (files of version 5) */
     uint64_t regions_evicted;           /* unsaved, saved by the pager in a join */
     uint64_t bytes_read, bytes_written; /* encoded */
     uint64_t page_bytes_written;        /* of them, cell pages */
@@ -82,14 +84,15 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
  * application id, version and (for writing) integrity before any write. */
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size);
 
-/* Upgrades a file of version 2 or 3 to this version in one transaction
- * (*upgraded = 1; 0 for a file of this version, which is left alone). Its
- * regions are classified again from their saved images and joined again in
- * their saved order (no model step is taken; the cluster is held in memory,
- * 12 bytes per cell); the result must give every cell the group and step
- * the file holds, and the same `groups` rows (model labels the groups'
- * kinds: pass the file's), or nothing is written and the message says why.
- * Check the file's model, parameters and plan before upgrading it. */
+/* Upgrades a file of version 2, 3 or 4 to this version in one transaction
+ * (*upgraded = 1; 0 for a file of this version, which is left alone).
+ * Version 4 gets the table of its open nodes. Versions 2 and 3: the regions
+ * are classified again from their saved images and joined again in their
+ * saved order (no model step is taken; the cluster is held in memory, 12
+ * bytes per cell); the result must give every cell the group and step the
+ * file holds, and the same `groups` rows (model labels the groups' kinds:
+ * pass the file's), or nothing is written and the message says why. Check
+ * the file's model, parameters and plan before upgrading it. */
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size);
 

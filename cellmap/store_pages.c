@@ -180,11 +180,15 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
     return st;
 }
 
+static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
+                          size_t msg_size);
+
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
     s->threads = cm_cluster_threads(c);
     c->page_in = store_page_in;
     c->page_out = s->writable ? store_page_out : NULL;
+    c->nodes_in = nodes_in;
     c->pager = s;
 }
 
@@ -204,59 +208,61 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
     return CM_OK;
 }
 
-/* Node records as saved: five little-endian uint32 columns of n entries
- * (next, dist, group, target, tree), encoded as one BLOB. */
-#define NODE_FIELDS 5
-
-static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node **out, char *msg,
+/* Region k's n node records as saved (NODE_FIELDS) into nodes[0..n). */
+static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes, char *msg,
                             size_t msg_size)
 {
-    cm_node *nodes = calloc(n + 1, sizeof *nodes);
+    if (s->version < 4) { /* regions of version 2 and 3 hold resolved cells: no node is referenced */
+        for (uint64_t e = 0; e < n; e++)
+            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1};
+        return CM_OK;
+    }
     uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
     unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
     sqlite3_stmt *st = NULL;
-    cm_status status = nodes && cols && scratch
-                           ? CM_OK
-                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu nodes",
-                                     (unsigned long long)n);
-    if (status == CM_OK && s->version < 4) {
-        /* regions of version 2 and 3 hold resolved cells: no node is referenced */
-        for (uint64_t e = 0; e < n; e++)
-            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1};
-    } else if (status == CM_OK) {
-        if (sqlite3_prepare_v2(s->db, "SELECT count, data FROM nodes WHERE region=?", -1, &st,
-                               NULL))
-            status = store_db_error(s->db, "read nodes", msg, msg_size);
+    cm_status status = cols && scratch ? CM_OK
+                                       : cm_fail(CM_ENOMEM, msg, msg_size,
+                                                 "out of memory for %llu nodes",
+                                                 (unsigned long long)n);
+    if (status == CM_OK &&
+        sqlite3_prepare_v2(s->db, "SELECT count, data FROM nodes WHERE region=?", -1, &st, NULL))
+        status = store_db_error(s->db, "read nodes", msg, msg_size);
+    if (status == CM_OK) {
         const void *blob = NULL;
         int len = 0;
-        if (status == CM_OK) {
-            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-            if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == n) {
-                blob = sqlite3_column_blob(st, 1);
-                len = sqlite3_column_bytes(st, 1);
-            }
-            if ((n > 0 && !blob) || (blob && cm_codec_decode(blob, (size_t)len, NODE_FIELDS * n,
-                                                             4, -1, scratch, cols) != CM_OK))
-                status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
-                                 s->path, k + 1);
-            s->stats.bytes_read += (uint64_t)len;
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+        if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == n) {
+            blob = sqlite3_column_blob(st, 1);
+            len = sqlite3_column_bytes(st, 1);
         }
-        for (uint64_t e = 0; status == CM_OK && e < n; e++)
-            nodes[e] = (cm_node){.next = cols[e],
-                                 .dist = cols[n + e],
-                                 .group = cols[2 * n + e],
-                                 .target = cols[3 * n + e],
-                                 .tree = cols[4 * n + e]};
+        if ((n > 0 && !blob) || (blob && cm_codec_decode(blob, (size_t)len, NODE_FIELDS * n, 4,
+                                                         -1, scratch, cols) != CM_OK))
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
+                             s->path, k + 1);
+        s->stats.bytes_read += (uint64_t)len;
     }
+    for (uint64_t e = 0; status == CM_OK && e < n; e++)
+        nodes[e] = (cm_node){.next = cols[e],
+                             .dist = cols[n + e],
+                             .group = cols[2 * n + e],
+                             .target = cols[3 * n + e],
+                             .tree = cols[4 * n + e]};
     sqlite3_finalize(st);
     free(cols);
     free(scratch);
-    if (status != CM_OK) {
-        free(nodes);
-        return status;
-    }
-    *out = nodes;
-    return CM_OK;
+    return status;
+}
+
+/* The pager of node tables (cm_nodes_in_fn). */
+static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
+                          size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = store_seconds_now();
+    const cm_status st = read_nodes(s, k, n, nodes, msg, msg_size);
+    s->stats.node_tables_read++;
+    s->stats.read_seconds += store_seconds_now() - t0;
+    return st;
 }
 
 /* Cells per group 1..groups from the groups view (every version has it). */
@@ -307,11 +313,15 @@ static cm_status region_record(const cm_store *s, sqlite3_stmt *st, uint32_t k, 
     return CM_OK;
 }
 
+/* The regions' rows. Files of version 5 keep their node tables in the file
+ * (read back on use); older ones give every node table and exit table
+ * (into *exits), for cm_cluster_restored. */
 static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char *msg,
                               size_t msg_size)
 {
     sqlite3_stmt *st = NULL;
     uint64_t cap = 0;
+    const bool tables = s->version < 5;
     if (sqlite3_prepare_v2(s->db,
                            "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
                            -1, &st, NULL))
@@ -323,14 +333,18 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
         cm_node *nodes = NULL;
         const uint32_t k = c->nregions;
         status = region_record(s, st, k, c->lat.dim, &rec, msg, msg_size);
-        if (status == CM_OK && cm_grow((void **)exits, &cap, (uint64_t)k + 1, sizeof **exits))
+        if (status == CM_OK && tables &&
+            cm_grow((void **)exits, &cap, (uint64_t)k + 1, sizeof **exits))
             status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
-        if (status == CM_OK) {
+        if (status == CM_OK && tables) {
             (*exits)[k] = NULL;
             status = store_read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
+            nodes = status == CM_OK ? calloc(rec.nexits + 1, sizeof *nodes) : NULL;
+            if (status == CM_OK && !nodes)
+                status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
+            if (status == CM_OK)
+                status = read_nodes(s, k, rec.nexits, nodes, msg, msg_size);
         }
-        if (status == CM_OK)
-            status = read_nodes(s, k, rec.nexits, &nodes, msg, msg_size);
         if (status == CM_OK)
             status = cm_cluster_restore(c, &rec, nodes, msg, msg_size);
         free(nodes);
@@ -338,6 +352,59 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
     if (status == CM_OK && rc != SQLITE_DONE)
         status = store_db_error(s->db, "read regions", msg, msg_size);
     sqlite3_finalize(st);
+    return status;
+}
+
+/* The open nodes of a file of version 5 into the cluster. */
+static cm_status load_open_nodes(cm_store *s, cm_cluster *c, uint32_t groups,
+                                 const uint64_t *basin, char *msg, size_t msg_size)
+{
+    const int dim = c->lat.dim;
+    const int64_t count = store_query_int(s->db, "SELECT COUNT(*) FROM open_nodes");
+    if (count < 0 || (uint64_t)count > c->nnodes)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes", s->path);
+    const uint64_t n = (uint64_t)count;
+    uint32_t *ids = malloc((n + 1) * sizeof *ids);
+    uint64_t *weights = malloc((n + 1) * sizeof *weights);
+    int64_t *cells = malloc((n + 1) * (size_t)dim * sizeof *cells);
+    sqlite3_stmt *st = NULL;
+    cm_status status = ids && weights && cells
+                           ? CM_OK
+                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu open nodes",
+                                     (unsigned long long)n);
+    if (status == CM_OK && sqlite3_prepare_v2(s->db,
+                                              "SELECT node, weight, cell FROM open_nodes ORDER BY "
+                                              "node",
+                                              -1, &st, NULL))
+        status = store_db_error(s->db, "read open nodes", msg, msg_size);
+    uint64_t i = 0;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t id = sqlite3_column_int64(st, 0), w = sqlite3_column_int64(st, 1);
+        const unsigned char *blob = sqlite3_column_blob(st, 2);
+        if (i >= n || id < 0 || id >= (int64_t)c->nnodes || w < 0 || !blob ||
+            sqlite3_column_bytes(st, 2) != 8 * dim) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open node %lld", s->path,
+                             (long long)id);
+            break;
+        }
+        ids[i] = (uint32_t)id;
+        weights[i] = (uint64_t)w;
+        for (int d = 0; d < dim; d++) {
+            uint64_t v = 0;
+            for (int b = 7; b >= 0; b--)
+                v = v << 8 | blob[8 * d + b];
+            cells[i * (uint64_t)dim + (uint64_t)d] = (int64_t)v;
+        }
+        i++;
+    }
+    sqlite3_finalize(st);
+    if (status == CM_OK && i != n)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes", s->path);
+    if (status == CM_OK)
+        status = cm_cluster_restored_open(c, groups, basin, ids, weights, cells, n, msg, msg_size);
+    free(ids);
+    free(weights);
+    free(cells);
     return status;
 }
 
@@ -359,7 +426,9 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
     if (status == CM_OK)
         status = read_basins(s, (uint32_t)groups, &basin, msg, msg_size);
     if (status == CM_OK && c->nregions > 0)
-        status = cm_cluster_restored(c, (uint32_t)groups, basin, exits, msg, msg_size);
+        status = s->version >= 5
+                     ? load_open_nodes(s, c, (uint32_t)groups, basin, msg, msg_size)
+                     : cm_cluster_restored(c, (uint32_t)groups, basin, exits, msg, msg_size);
     if (status == CM_EFORMAT && !strstr(msg, s->path)) {
         char detail[256];
         snprintf(detail, sizeof detail, "%s", msg);

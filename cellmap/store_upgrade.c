@@ -1,8 +1,9 @@
-/* cellmap/store_upgrade.c - files of versions 2 and 3 to version 4.
+/* cellmap/store_upgrade.c - files of versions 2, 3 and 4 to version 5.
  *
- * Versions 2 and 3 stored every region resolved: cells held cluster-wide
+ * Version 4 lacks only the table of open nodes: it is added from the
+ * cluster as version 4 loads it. Versions 2 and 3 stored every region resolved: cells held cluster-wide
  * groups and steps, rewritten by every join. Version 4 keeps each region
- * as its own SCM left it and joins regions through node tables. The saved
+ * as its own SCM left it and joins regions through node tables (so does 5). The saved
  * images and exit tables are all a join needs, so the upgrade classifies
  * each region again from its images (no model step is taken) and joins the
  * regions in their saved order, which numbers groups as the old joins did.
@@ -145,6 +146,54 @@ static cm_status upgrade(cm_store *s, char *msg, size_t msg_size)
     return st;
 }
 
+typedef struct open_rows {
+    cm_store *s;
+    const cm_cluster *c;
+    sqlite3_stmt *ins;
+    cm_status st;
+    char *msg;
+    size_t msg_size;
+} open_rows;
+
+static void insert_open_row(void *user, uint32_t node, const int64_t *cell)
+{
+    open_rows *o = user;
+    unsigned char blob[8 * CM_MAX_DIM];
+    if (o->st != CM_OK)
+        return;
+    for (int d = 0; d < o->c->lat.dim; d++)
+        for (int b = 0; b < 8; b++)
+            blob[8 * d + b] = (unsigned char)((uint64_t)cell[d] >> (8 * b));
+    sqlite3_bind_int64(o->ins, 1, node);
+    sqlite3_bind_int64(o->ins, 2, (sqlite3_int64)cm_cluster_open_weight(o->c, node));
+    sqlite3_bind_blob(o->ins, 3, blob, 8 * o->c->lat.dim, SQLITE_TRANSIENT);
+    o->st = store_step_done(o->s->db, o->ins, "write an open node", o->msg, o->msg_size);
+}
+
+/* Version 4 had everything but the open nodes, which it rebuilt from every
+ * node table at each open: they get their table, from the cluster loaded
+ * that way. */
+static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
+{
+    cm_cluster c;
+    cm_status st = cm_store_load_cluster(s, &c, msg, msg_size);
+    open_rows o = {s, &c, NULL, st, msg, msg_size};
+    if (st == CM_OK &&
+        (store_exec(s->db, "CREATE TABLE open_nodes(node INTEGER PRIMARY KEY,"
+                           " weight INTEGER NOT NULL, cell BLOB NOT NULL)") != SQLITE_OK ||
+         sqlite3_prepare_v2(s->db, "INSERT INTO open_nodes VALUES(?, ?, ?)", -1, &o.ins, NULL)))
+        o.st = store_db_error(s->db, "add the open nodes", msg, msg_size);
+    if (o.st == CM_OK)
+        cm_cluster_each_escape(&c, insert_open_row, &o);
+    sqlite3_finalize(o.ins);
+    char pragma[64];
+    snprintf(pragma, sizeof pragma, "PRAGMA user_version=%d", CM_STORE_VERSION);
+    if (o.st == CM_OK && store_exec(s->db, pragma) != SQLITE_OK)
+        o.st = store_db_error(s->db, "write the version", msg, msg_size);
+    cm_cluster_free(&c);
+    return o.st;
+}
+
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size)
 {
@@ -164,7 +213,7 @@ cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgrade
     char why[1024] = "";
     st = store_begin(s, why, sizeof why);
     if (st == CM_OK)
-        st = upgrade(s, why, sizeof why);
+        st = from == 4 ? add_open_nodes(s, why, sizeof why) : upgrade(s, why, sizeof why);
     if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)
         st = store_db_error(s->db, "commit", why, sizeof why);
     if (st != CM_OK) {

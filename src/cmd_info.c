@@ -36,7 +36,7 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
                        const cm_group_info *g, uint64_t sink, uint64_t largest_region)
 {
     const cm_lattice *lat = &info->lattice;
-    printf("file %s: cellmap database format %d, written by cellmap %s\n", path, CM_STORE_VERSION,
+    printf("file %s: cellmap database format %d, written by cellmap %s\n", path, info->version,
            info->tool_version);
     printf("model %s %s\n", info->model, info->params);
     printf("lattice origin (");
@@ -78,7 +78,7 @@ static void print_json(const cm_store_info *info, const cm_box *bounds, const cm
 {
     printf("{\"format\":%d,\"tool_version\":\"%s\",\"model\":\"%s\","
            "\"params\":%s,\"regions\":%u,\"cells\":%llu,\"bounding_box\":[",
-           CM_STORE_VERSION, info->tool_version, info->model, info->params, info->regions,
+           info->version, info->tool_version, info->model, info->params, info->regions,
            (unsigned long long)info->cells);
     for (int d = 0; d < bounds->dim; d++)
         printf("%s[%lld,%lld]", d ? "," : "", (long long)bounds->lo[d], (long long)bounds->hi[d]);

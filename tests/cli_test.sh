@@ -319,7 +319,7 @@ expect_usage "'Q' is not a parameter" sweep --model microchaos-pd-friction --var
 expect_usage "--near has 3 range(s)" sweep --model microchaos-pd-friction --vary mu=0,1 --near 0:1,0:1,0:1
 expect_usage "--vary: mu = -1" sweep --model microchaos-pd-friction --vary mu=-1,0.1
 
-# --- files of format versions 3 and 2: read as they are, never changed ------
+# --- files of format versions 2 to 4: read as they are, upgraded to write --
 # tests/data/v3-split.cmdb was written by cellmap with format version 3 (the
 # last before node tables) from the solve below; it reads cell for cell as
 # that solve does today.
@@ -334,7 +334,7 @@ cmp -s v3-cells.csv v4-cells.csv || fail "a version 3 file's cells read differen
 "$CM" render v3.cmdb --png v3.png 2> /dev/null || fail "render of a version 3 file"
 "$CM" render v4.cmdb --png v4.png 2> /dev/null
 cmp -s v3.png v4.png || fail "a version 3 file renders differently"
-"$CM" info v3.cmdb | grep -v '^disk:' > v3-info.txt || fail "info of a version 3 file"
+"$CM" info v3.cmdb | grep -v '^disk:\|^file ' > v3-info.txt || fail "info of a version 3 file"
 "$CM" export v3.cmdb --flat flat.npz 2> /dev/null && mv flat.npz v3-flat.npz || fail "export --flat of a version 3 file"
 # a resume with other options is refused before anything is upgraded
 "$CM" solve --param alpha=0.077,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 120x72 \
@@ -345,23 +345,37 @@ cp v3.cmdb v3-bad.cmdb
 sqlite3 v3-bad.cmdb "UPDATE attractors SET centre = '[1,2]' WHERE id = 7"
 sum_bad=$(sha256sum v3-bad.cmdb)
 "$CM" solve "${V3_SOLVE[@]}" --db v3-bad.cmdb --resume > /dev/null 2> v3.err && fail "upgraded a file whose groups differ"
-grep -q "could not be upgraded to version 4 (its groups would change); the file is unchanged" v3.err ||
+grep -q "could not be upgraded to version 5 (its groups would change); the file is unchanged" v3.err ||
     fail "refused upgrade message: $(cat v3.err)"
 [ "$(sha256sum v3-bad.cmdb)" = "$sum_bad" ] || fail "a refused upgrade changed the file"
 [ "$(sha256sum v3.cmdb)" = "$sum_v3" ] || fail "reading or refusing a version 3 file changed it"
 # --resume upgrades it in one transaction; every output stays what it was
 cp v3.cmdb v3-explore.cmdb
 "$CM" solve "${V3_SOLVE[@]}" --db v3.cmdb --resume > /dev/null 2> v3.err || fail "resume of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3.cmdb from format version 3 to 4" v3.err || fail "upgrade message: $(cat v3.err)"
-[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 4 ] || fail "the resumed version 3 file was not upgraded"
+grep -q "upgraded v3.cmdb from format version 3 to 5" v3.err || fail "upgrade message: $(cat v3.err)"
+[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 5 ] || fail "the resumed version 3 file was not upgraded"
 "$CM" export v3.cmdb --groups up-groups.csv --cells up-cells.csv 2> /dev/null || fail "export of an upgraded file"
 cmp -s up-groups.csv v3-groups.csv && cmp -s up-cells.csv v3-cells.csv || fail "the upgrade changed the export"
 "$CM" render v3.cmdb --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"
-"$CM" info v3.cmdb | grep -v '^disk:' | diff - v3-info.txt || fail "the upgrade changed info"
+"$CM" info v3.cmdb | grep -v '^disk:\|^file ' | diff - v3-info.txt || fail "the upgrade changed info"
 "$CM" export v3.cmdb --flat flat.npz 2> /dev/null && cmp -s flat.npz v3-flat.npz || fail "the upgrade changed export --flat"
 # explore upgrades too, and goes on
 "$CM" explore v3-explore.cmdb - <<< "stats" > v3-stats.txt 2> v3.err || fail "explore of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3-explore.cmdb from format version 3 to 4" v3.err || fail "explore upgrade message: $(cat v3.err)"
+grep -q "upgraded v3-explore.cmdb from format version 3 to 5" v3.err || fail "explore upgrade message: $(cat v3.err)"
+# tests/data/v4-split.cmdb: the same solve by cellmap with format version 4
+# (node tables, no table of open nodes); read as it is, upgraded on --resume
+cp "$HERE/data/v4-split.cmdb" v4old.cmdb
+sum_v4=$(sha256sum v4old.cmdb)
+"$CM" export v4old.cmdb --groups v4old-groups.csv --cells v4old-cells.csv 2> /dev/null || fail "export of a version 4 file"
+cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || fail "a version 4 file reads differently"
+"$CM" render v4old.cmdb --png v4old.png 2> /dev/null && cmp -s v4old.png v3.png || fail "a version 4 file renders differently"
+[ "$(sha256sum v4old.cmdb)" = "$sum_v4" ] || fail "reading a version 4 file changed it"
+"$CM" solve "${V3_SOLVE[@]}" --db v4old.cmdb --resume > /dev/null 2> v4.err || fail "resume of a version 4 file: $(cat v4.err)"
+grep -q "upgraded v4old.cmdb from format version 4 to 5" v4.err || fail "v4 upgrade message: $(cat v4.err)"
+"$CM" export v4old.cmdb --groups v4old-groups.csv --cells v4old-cells.csv 2> /dev/null || fail "export of an upgraded version 4 file"
+cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || fail "the upgrade of a version 4 file changed its export"
+[ "$(sqlite3 v4old.cmdb 'SELECT COUNT(*), SUM(weight) FROM open_nodes')" = "$(sqlite3 v4.cmdb 'SELECT COUNT(*), SUM(weight) FROM open_nodes')" ] ||
+    fail "an upgraded version 4 file has other open nodes than a fresh solve"
 # version 2 had no kinds: every group is an attractor
 cp "$HERE/data/v3-split.cmdb" v2.cmdb
 sqlite3 v2.cmdb "DROP VIEW groups; ALTER TABLE attractors DROP COLUMN kind;

@@ -1,6 +1,6 @@
 /* tests/cmdb_hash.h - a hash of every row of a .cmdb file's cluster
- * (regions, pages, exits, node tables, group counts, attractors, metadata but the command
- * line): equal hashes, equal clusters. */
+ * (regions, pages, exits, node tables, group counts, open nodes, attractors, metadata but
+ * the command line): equal hashes, equal clusters. */
 #ifndef CM_TESTS_CMDB_HASH_H
 #define CM_TESTS_CMDB_HASH_H
 
@@ -17,6 +17,7 @@ static inline uint64_t cmdb_content_hash(const char *path)
         "SELECT * FROM exits ORDER BY region",
         "SELECT * FROM nodes ORDER BY region",
         "SELECT * FROM basins ORDER BY grp",
+        "SELECT * FROM open_nodes ORDER BY node",
         "SELECT * FROM attractors ORDER BY id",
         "SELECT * FROM meta WHERE key NOT IN ('command') ORDER BY key"};
     sqlite3 *db = NULL;
