@@ -144,6 +144,25 @@ cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, 
     return st;
 }
 
+/* Whether the owner saved open node id's row: changes to it must be noted. */
+static bool has_row(const cm_cluster *c, uint32_t id)
+{
+    return id < c->saved_nodes || c->regions[cm_cluster_node_region(c, id)].written;
+}
+
+/* An open node's weight: its entry, or, for a node of a region being joined
+ * that has none yet, its own tree. */
+static cm_status open_weight(cm_cluster *c, uint32_t id, uint64_t *w)
+{
+    if (cm_idmap_get(&c->open, id, w))
+        return CM_OK;
+    cm_node *nd;
+    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
+    if (st == CM_OK)
+        *w = nd->tree;
+    return st;
+}
+
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
 {
     uint64_t w = 0;
@@ -153,18 +172,22 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
 
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
 {
-    if (cm_idmap_put(&c->open, id, cm_cluster_open_weight(c, id) + w) != CM_OK ||
-        cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
-        return CM_ENOMEM;
-    return CM_OK;
+    uint64_t had;
+    cm_status st = open_weight(c, id, &had);
+    if (st == CM_OK && cm_idmap_put(&c->open, id, had + w) != CM_OK)
+        st = CM_ENOMEM;
+    if (st == CM_OK && has_row(c, id) && cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
+        st = CM_ENOMEM;
+    return st;
 }
 
-uint64_t cm_cluster_take_open(cm_cluster *c, uint32_t id)
+cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
 {
-    uint64_t w = 0;
-    if (cm_idmap_remove(&c->open, id, &w))
-        cm_idmap_put(&c->open_changed, id, 0); /* on failure the owner rewrites it anyway */
-    return w;
+    cm_status st = open_weight(c, id, w);
+    cm_idmap_remove(&c->open, id, NULL);
+    if (st == CM_OK && has_row(c, id) && cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
+        st = CM_ENOMEM;
+    return st;
 }
 
 bool cm_cluster_next_open_change(const cm_cluster *c, uint64_t *slot, uint32_t *id)
@@ -595,6 +618,7 @@ void cm_cluster_saved(cm_cluster *c)
         memset(c->basin_dirty, 0, (size_t)c->ngroups + 1);
     c->nnew_periodic = 0;
     c->saved_groups = c->ngroups;
+    c->saved_nodes = c->nnodes;
     cm_idmap_clear(&c->open_changed);
 }
 
@@ -755,8 +779,7 @@ cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64
 /* The new region's own groups take ids from base + 1: one pass that also
  * counts the cells of each group and of each node's tree and notes the
  * periodic cells. */
-static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes,
-                            uint32_t node_base)
+static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes)
 {
     uint32_t *group = r->group;
     const uint32_t *step = r->step;
@@ -772,9 +795,6 @@ static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node 
                 return CM_ENOMEM;
         }
     }
-    for (uint64_t e = 0; e < r->nexits; e++)
-        if (cm_cluster_add_open_weight(c, node_base + (uint32_t)e, nodes[e].tree) != CM_OK)
-            return CM_ENOMEM;
     for (uint32_t g = 1; g <= r->ngroups; g++)
         c->basin_dirty[base + g] = 1;
     return CM_OK;
@@ -797,7 +817,7 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
     cr->node_base = (uint32_t)c->nnodes;
     cr->r.nexits = r->nexits;
     if (init_nodes(c, cr, NULL) != CM_OK ||
-        take_cells(c, r, base, cr->nodes, cr->node_base) != CM_OK)
+        take_cells(c, r, base, cr->nodes) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     cr->r = *r;
     memset(r, 0, sizeof *r);

@@ -110,6 +110,7 @@ typedef struct cm_cluster {
     cm_group_cell *new_periodic;   /* read-only: of groups made since cm_cluster_saved */
     uint64_t nnew_periodic;           /* read-only */
     uint32_t saved_groups;            /* read-only: ngroups at cm_cluster_saved */
+    uint64_t saved_nodes;             /* read-only: nnodes at cm_cluster_saved */
     /* Paging, off while page_in is NULL. Resident bytes are the regions'
      * cell arrays and exit tables and their node tables. cm_cluster_acquire
      * reads a region's cells back through page_in and first evicts other
@@ -211,12 +212,15 @@ cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *
                                 size_t msg_size);
 
 /* Open nodes and their weights: the cells whose sequences leave the
- * cluster through them. The weight of open node id (0 if it is not open);
- * adds w to it (making it open); takes it out (no longer open), returning
- * its weight. Changes are noted for the owner until cm_cluster_saved. */
+ * cluster through them. A node of a region being joined is open with its
+ * own tree as weight until the join links it or indexes it as an escape
+ * (cm_cluster_add_open_weight with w = 0 then); only indexed and linked-into
+ * open nodes have entries. The weight of open node id (0 without an entry);
+ * adds w to it; takes it out (no longer open) with its weight into *w.
+ * Changes to nodes the owner saved are noted until cm_cluster_saved. */
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w);
-uint64_t cm_cluster_take_open(cm_cluster *c, uint32_t id);
+cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w);
 
 /* The open nodes whose weight or openness changed since cm_cluster_saved,
  * in no particular order: start with *slot = 0; false when done. */

@@ -51,7 +51,9 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uin
     nd->up = CM_NODE_FINAL;
     nd->up_dist = (uint32_t)s;
     nd->group = g;
-    const uint64_t weight = cm_cluster_take_open(j->c, id);
+    uint64_t weight;
+    if (cm_cluster_take_open(j->c, id, &weight) != CM_OK)
+        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     if (g != 0) {
         j->c->basin[g] += weight;
         j->c->basin_dirty[g] = 1;
@@ -140,7 +142,9 @@ static cm_status close_cycle(joiner *j, uint32_t n)
         touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
         st = trace_cycle_cells(j, j->stack[i], entry, g);
     }
-    const uint64_t weight = cm_cluster_take_open(j->c, n);
+    uint64_t weight = 0;
+    if (st == CM_OK && cm_cluster_take_open(j->c, n, &weight) != CM_OK)
+        st = cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     j->c->basin[g] += weight;
     j->stats->resolved_cells += weight;
     return st;
@@ -182,7 +186,9 @@ static cm_status link_node(joiner *j, const link_job *job)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
-    if (cm_cluster_add_open_weight(c, open, cm_cluster_take_open(c, job->node)) != CM_OK)
+    uint64_t weight;
+    if (cm_cluster_take_open(c, job->node, &weight) != CM_OK ||
+        cm_cluster_add_open_weight(c, open, weight) != CM_OK)
         return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     touch_in(j, job->from);
     return CM_OK;
@@ -253,8 +259,8 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
         const uint32_t id = cr->node_base + (uint32_t)e;
         uint64_t local;
         const int64_t k = cm_cluster_locate(c, cell, &local);
-        if (k < 0)
-            st = cm_cluster_add_escape(c, id, cell);
+        if (k < 0 && (st = cm_cluster_add_escape(c, id, cell)) == CM_OK)
+            st = cm_cluster_add_open_weight(c, id, 0); /* indexed: it gets its entry */
         else
             (*jobs)[(*n)++] = (link_job){id, added, (uint32_t)k, (uint32_t)local, 0, 0};
     }

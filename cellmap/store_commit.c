@@ -121,7 +121,8 @@ static cm_status update_open_node(cm_store *s, sqlite3_stmt *update, sqlite3_stm
     return store_step_done(s->db, update, "update an open node", msg, msg_size);
 }
 
-/* The open nodes of region k, written with it. */
+/* The open nodes of region k, written with it: those the join indexed as
+ * escapes (one in the middle of its join links the others before it ends). */
 static cm_status insert_open_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                                    size_t msg_size)
 {
@@ -131,7 +132,8 @@ static cm_status insert_open_nodes(cm_store *s, const cm_cluster *c, uint32_t k,
     if (sqlite3_prepare_v2(s->db, "INSERT INTO open_nodes VALUES(?, ?, ?)", -1, &put, NULL))
         return store_db_error(s->db, "prepare open nodes", msg, msg_size);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++)
-        if (cr->nodes[e].next == CM_NODE_OPEN)
+        if (cr->nodes[e].next == CM_NODE_OPEN &&
+            cm_idmap_get(&c->open, cr->node_base + (uint32_t)e, NULL)) /* indexed */
             st = insert_open_node(s, put, c, cr->node_base + (uint32_t)e,
                                   cm_region_exit(&cr->r, e), msg, msg_size);
     sqlite3_finalize(put);
