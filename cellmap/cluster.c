@@ -32,10 +32,11 @@ void cm_cluster_free(cm_cluster *c)
     for (uint32_t k = 0; k < c->nregions; k++) {
         cm_region_free(&c->regions[k].r);
         free(c->regions[k].nodes);
+        free(c->regions[k].open_local);
+        free(c->regions[k].open_cells);
     }
     free(c->regions);
     cm_idmap_free(&c->open);
-    cm_idmap_free(&c->open_changed);
     free(c->chain);
     free(c->basin);
     free(c->basin_dirty);
@@ -144,22 +145,15 @@ cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, 
     return st;
 }
 
-/* Whether the owner saved open node id's row: changes to it must be noted. */
-static bool has_row(const cm_cluster *c, uint32_t id)
-{
-    return id < c->saved_nodes || c->regions[cm_cluster_node_region(c, id)].written;
-}
-
 /* An open node's weight: its entry, or, for a node of a region being joined
  * that has none yet, its own tree. */
 static cm_status open_weight(cm_cluster *c, uint32_t id, uint64_t *w)
 {
     if (cm_idmap_get(&c->open, id, w))
         return CM_OK;
-    cm_node *nd;
+    cm_node *nd = NULL;
     cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
-    if (st == CM_OK)
-        *w = nd->tree;
+    *w = st == CM_OK ? nd->tree : 0;
     return st;
 }
 
@@ -176,29 +170,74 @@ cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
     cm_status st = open_weight(c, id, &had);
     if (st == CM_OK && cm_idmap_put(&c->open, id, had + w) != CM_OK)
         st = CM_ENOMEM;
-    if (st == CM_OK && has_row(c, id) && cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
-        st = CM_ENOMEM;
+    c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
     return st;
 }
 
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
 {
     cm_status st = open_weight(c, id, w);
-    cm_idmap_remove(&c->open, id, NULL);
-    if (st == CM_OK && has_row(c, id) && cm_idmap_put(&c->open_changed, id, 0) != CM_OK)
-        st = CM_ENOMEM;
+    if (cm_idmap_remove(&c->open, id, NULL))
+        c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
     return st;
 }
 
-bool cm_cluster_next_open_change(const cm_cluster *c, uint64_t *slot, uint32_t *id)
+cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
+                                int64_t **cells, uint64_t *n)
 {
-    return cm_idmap_next(&c->open_changed, slot, id, NULL);
+    cm_cluster_region *cr = &c->regions[k];
+    const size_t dim = (size_t)c->lat.dim;
+    uint64_t kept = 0;
+    for (uint64_t i = 0; i < cr->nopen; i++) {
+        if (!cm_idmap_get(&c->open, cr->node_base + cr->open_local[i], NULL))
+            continue;
+        cr->open_local[kept] = cr->open_local[i];
+        memmove(cr->open_cells + kept * dim, cr->open_cells + i * dim, dim * sizeof *cr->open_cells);
+        kept++;
+    }
+    cr->nopen = kept;
+    *local = malloc((kept + 1) * sizeof **local);
+    *weight = malloc((kept + 1) * sizeof **weight);
+    *cells = malloc((kept + 1) * dim * sizeof **cells);
+    if (!*local || !*weight || !*cells) {
+        free(*local);
+        free(*weight);
+        free(*cells);
+        return CM_ENOMEM;
+    }
+    for (uint64_t i = 0; i < kept; i++) {
+        (*local)[i] = cr->open_local[i];
+        (*weight)[i] = cm_cluster_open_weight(c, cr->node_base + cr->open_local[i]);
+    }
+    memcpy(*cells, cr->open_cells, kept * dim * sizeof **cells);
+    *n = kept;
+    return CM_OK;
 }
 
-cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
+cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w)
 {
     const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
-    return cm_bricks_add(c->escape_bricks, cell, &e);
+    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+    const size_t dim = (size_t)c->lat.dim;
+    if (cr->nopen == cr->open_cap) {
+        const uint64_t cap = cr->open_cap ? 2 * cr->open_cap : 16;
+        uint32_t *local = realloc(cr->open_local, cap * sizeof *local);
+        if (local)
+            cr->open_local = local;
+        int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
+        if (!cells)
+            return CM_ENOMEM;
+        cr->open_cells = cells;
+        cr->open_cap = cap;
+    }
+    if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK ||
+        cm_idmap_put(&c->open, id, w) != CM_OK)
+        return CM_ENOMEM;
+    cr->open_local[cr->nopen] = id - cr->node_base;
+    memcpy(cr->open_cells + cr->nopen * dim, cell, dim * sizeof *cell);
+    cr->nopen++;
+    cr->open_dirty = 1;
+    return CM_OK;
 }
 
 typedef struct escape_visit {
@@ -296,7 +335,7 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
 static cm_status chain_end(cm_cluster *c, uint32_t id, uint32_t *end, uint64_t *total, char *msg,
                            size_t msg_size)
 {
-    cm_node *nd;
+    cm_node *nd = NULL;
     *total = 0;
     for (uint32_t y = id;; y = nd->up) {
         cm_status st = cm_cluster_node(c, y, &nd, msg, msg_size);
@@ -618,8 +657,8 @@ void cm_cluster_saved(cm_cluster *c)
         memset(c->basin_dirty, 0, (size_t)c->ngroups + 1);
     c->nnew_periodic = 0;
     c->saved_groups = c->ngroups;
-    c->saved_nodes = c->nnodes;
-    cm_idmap_clear(&c->open_changed);
+    for (uint32_t k = 0; k < c->nregions; k++)
+        c->regions[k].open_dirty = 0;
 }
 
 uint64_t cm_cluster_sink_cells(const cm_cluster *c)
@@ -891,8 +930,7 @@ static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
                 return st;
             if (end->up != CM_NODE_OPEN)
                 continue;
-            if (cm_idmap_put(&c->open, y, cm_cluster_open_weight(c, y) + cr->nodes[e].tree) !=
-                CM_OK)
+            if (cm_idmap_put(&c->open, y, cm_cluster_open_weight(c, y) + cr->nodes[e].tree) != CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
         }
     }
@@ -916,7 +954,9 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
         for (uint64_t e = 0; e < cr->r.nexits; e++)
             if (cr->nodes[e].next == CM_NODE_OPEN &&
                 cm_cluster_add_escape(c, cr->node_base + (uint32_t)e,
-                                      exits[k] + e * (uint64_t)c->lat.dim) != CM_OK)
+                                      exits[k] + e * (uint64_t)c->lat.dim,
+                                      cm_cluster_open_weight(c, cr->node_base + (uint32_t)e)) !=
+                    CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
     }
     c->saved_groups = groups;
@@ -936,8 +976,8 @@ cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_
         if (ids[i] >= c->nnodes || (i > 0 && ids[i] <= ids[i - 1]))
             return cm_fail(CM_EFORMAT, msg, msg_size, "the open nodes are damaged (node %u)",
                            ids[i]);
-        if (cm_idmap_put(&c->open, ids[i], weights[i]) != CM_OK ||
-            cm_cluster_add_escape(c, ids[i], cells + i * (uint64_t)c->lat.dim) != CM_OK)
+        if (cm_cluster_add_escape(c, ids[i], cells + i * (uint64_t)c->lat.dim, weights[i]) !=
+            CM_OK)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     }
     c->saved_groups = groups;

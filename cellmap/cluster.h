@@ -68,6 +68,14 @@ typedef struct cm_cluster_region {
     uint32_t node_base; /* id of the node of exit 0 */
     int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
     int nodes_dirty;    /* read-only: node records changed since the owner saved them */
+    /* read-only: the region's open nodes indexed as escapes, in node order
+     * (open_local[i]: the exit, open_cells[i * dim ..]: its target), some
+     * of them linked since; open_dirty: one changed since the owner saved
+     * them (cm_cluster_open_nodes) */
+    uint32_t *open_local;
+    int64_t *open_cells;
+    uint64_t nopen, open_cap;
+    int open_dirty;
     uint64_t last_used; /* private: paging clock of the last acquire of the cells */
     uint64_t nodes_used; /* private: and of the last use of the node table */
 } cm_cluster_region;
@@ -110,7 +118,6 @@ typedef struct cm_cluster {
     cm_group_cell *new_periodic;   /* read-only: of groups made since cm_cluster_saved */
     uint64_t nnew_periodic;           /* read-only */
     uint32_t saved_groups;            /* read-only: ngroups at cm_cluster_saved */
-    uint64_t saved_nodes;             /* read-only: nnodes at cm_cluster_saved */
     /* Paging, off while page_in is NULL. Resident bytes are the regions'
      * cell arrays and exit tables and their node tables. cm_cluster_acquire
      * reads a region's cells back through page_in and first evicts other
@@ -133,7 +140,6 @@ typedef struct cm_cluster {
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
     cm_idmap open;   /* open node -> cells whose sequences leave the cluster through it */
-    cm_idmap open_changed; /* nodes whose entry in `open` changed since cm_cluster_saved */
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -176,9 +182,9 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
 cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
                               int64_t *const *exits, char *msg, size_t msg_size);
 
-/* The same from the open nodes as saved: n of them, ids[i] with weight
- * weights[i] and its exit's target cell cells[i * dim ..]. No node table is
- * read. */
+/* The same from the open nodes as saved: n of them in node order, ids[i]
+ * with weight weights[i] and its exit's target cell cells[i * dim ..]. No
+ * node table is read. */
 cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_t *basin,
                                    const uint32_t *ids, const uint64_t *weights,
                                    const int64_t *cells, uint64_t n, char *msg,
@@ -187,9 +193,10 @@ cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_
 /* The region holding the cell and the cell's local index, or -1. O(1). */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
 
-/* Adds open node id, whose exit leads to `cell` outside the cluster, to the
- * index of open nodes. */
-cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell);
+/* Indexes open node id, whose exit leads to `cell` outside the cluster, by
+ * that cell (and in its region's open list, at its end: add a region's in
+ * node order), with weight w. */
+cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w);
 
 /* Takes the open nodes whose exits lead into `box` (at most 2^32 cells)
  * out of the index: a new array of *n of them (ascending by node id) that
@@ -213,18 +220,19 @@ cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *
 
 /* Open nodes and their weights: the cells whose sequences leave the
  * cluster through them. A node of a region being joined is open with its
- * own tree as weight until the join links it or indexes it as an escape
- * (cm_cluster_add_open_weight with w = 0 then); only indexed and linked-into
- * open nodes have entries. The weight of open node id (0 without an entry);
- * adds w to it; takes it out (no longer open) with its weight into *w.
- * Changes to nodes the owner saved are noted until cm_cluster_saved. */
+ * own tree as weight until the join links it or indexes it as an escape;
+ * only indexed and linked-into open nodes have entries. The weight of open
+ * node id (0 without an entry); adds w to it; takes it out (no longer open)
+ * with its weight into *w. Both mark the node's region open_dirty. */
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w);
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w);
 
-/* The open nodes whose weight or openness changed since cm_cluster_saved,
- * in no particular order: start with *slot = 0; false when done. */
-bool cm_cluster_next_open_change(const cm_cluster *c, uint64_t *slot, uint32_t *id);
+/* Region k's open nodes now (those of its open list still open): their
+ * exits, weights and target cells into new arrays (*n of them; the caller
+ * frees them); the list drops the others. */
+cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
+                                int64_t **cells, uint64_t *n);
 
 /* Group and step of node id's cell, following and shortening its chain of
  * links (and settling it, through the cells of its region, when the chain

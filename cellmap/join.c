@@ -259,8 +259,8 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
         const uint32_t id = cr->node_base + (uint32_t)e;
         uint64_t local;
         const int64_t k = cm_cluster_locate(c, cell, &local);
-        if (k < 0 && (st = cm_cluster_add_escape(c, id, cell)) == CM_OK)
-            st = cm_cluster_add_open_weight(c, id, 0); /* indexed: it gets its entry */
+        if (k < 0)
+            st = cm_cluster_add_escape(c, id, cell, cr->nodes[e].tree);
         else
             (*jobs)[(*n)++] = (link_job){id, added, (uint32_t)k, (uint32_t)local, 0, 0};
     }

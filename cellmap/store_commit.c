@@ -2,6 +2,7 @@
  * node records and new regions, one transaction per commit. */
 #include "cellmap/store_db.h"
 
+#include "cellmap/codec.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,87 +92,66 @@ static cm_status write_new_groups(cm_store *s, cm_cluster *c, char *msg, size_t 
     return status;
 }
 
-/* open_nodes holds each open node's weight and its exit's target cell
- * (dim little-endian int64). */
-static cm_status insert_open_node(cm_store *s, sqlite3_stmt *ins, const cm_cluster *c,
-                                  uint32_t id, const int64_t *cell, char *msg, size_t msg_size)
+/* Region k's row of open_nodes: its open nodes as one encoded int64 array
+ * of count * (2 + dim) values: the exits (local), their weights, then the
+ * target cells (dim coordinates each). */
+cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *msg,
+                                 size_t msg_size)
 {
-    unsigned char blob[8 * CM_MAX_DIM];
-    for (int d = 0; d < c->lat.dim; d++)
-        for (int b = 0; b < 8; b++)
-            blob[8 * d + b] = (unsigned char)((uint64_t)cell[d] >> (8 * b));
-    sqlite3_bind_int64(ins, 1, id);
-    sqlite3_bind_int64(ins, 2, (sqlite3_int64)cm_cluster_open_weight(c, id));
-    sqlite3_bind_blob(ins, 3, blob, 8 * c->lat.dim, SQLITE_TRANSIENT);
-    return store_step_done(s->db, ins, "write an open node", msg, msg_size);
-}
-
-/* The row of node id, whose weight or openness changed: its new weight, or
- * none once it is not open. */
-static cm_status update_open_node(cm_store *s, sqlite3_stmt *update, sqlite3_stmt *drop,
-                                  const cm_cluster *c, uint32_t id, char *msg, size_t msg_size)
-{
-    uint64_t weight;
-    if (!cm_idmap_get(&c->open, id, &weight)) {
-        sqlite3_bind_int64(drop, 1, id);
-        return store_step_done(s->db, drop, "forget an open node", msg, msg_size);
+    uint32_t *local;
+    uint64_t *weight, n;
+    int64_t *cells;
+    if (cm_cluster_open_nodes(c, k, &local, &weight, &cells, &n) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
+    const size_t dim = (size_t)c->lat.dim, values = n * (2 + dim);
+    int64_t *v = malloc((values + 1) * sizeof *v);
+    unsigned char *scratch = malloc(8 * (values + 1));
+    const size_t bound = cm_codec_bound(8 * (values + 1));
+    unsigned char *blob = malloc(bound);
+    size_t len = 0;
+    cm_status st = v && scratch && blob ? CM_OK
+                                        : cm_fail(CM_ENOMEM, msg, msg_size,
+                                                  "out of memory writing open nodes");
+    for (uint64_t i = 0; st == CM_OK && i < n; i++) {
+        v[i] = local[i];
+        v[n + i] = (int64_t)weight[i];
     }
-    sqlite3_bind_int64(update, 1, (sqlite3_int64)weight);
-    sqlite3_bind_int64(update, 2, id);
-    return store_step_done(s->db, update, "update an open node", msg, msg_size);
-}
-
-/* The open nodes of region k, written with it: those the join indexed as
- * escapes (one in the middle of its join links the others before it ends). */
-static cm_status insert_open_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
-                                   size_t msg_size)
-{
-    const cm_cluster_region *cr = &c->regions[k];
-    sqlite3_stmt *put = NULL;
-    cm_status st = CM_OK;
-    if (sqlite3_prepare_v2(s->db, "INSERT INTO open_nodes VALUES(?, ?, ?)", -1, &put, NULL))
-        return store_db_error(s->db, "prepare open nodes", msg, msg_size);
-    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++)
-        if (cr->nodes[e].next == CM_NODE_OPEN &&
-            cm_idmap_get(&c->open, cr->node_base + (uint32_t)e, NULL)) /* indexed */
-            st = insert_open_node(s, put, c, cr->node_base + (uint32_t)e,
-                                  cm_region_exit(&cr->r, e), msg, msg_size);
-    sqlite3_finalize(put);
+    if (st == CM_OK) {
+        memcpy(v + 2 * n, cells, n * dim * sizeof *v);
+        if (cm_codec_encode(v, values, 8, -1, scratch, blob, bound, &len) != CM_OK)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the open nodes of region %u", k + 1);
+    }
+    sqlite3_stmt *ins = NULL;
+    if (st == CM_OK && sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO open_nodes VALUES(?, ?, ?)",
+                                          -1, &ins, NULL))
+        st = store_db_error(s->db, "prepare open nodes", msg, msg_size);
+    if (st == CM_OK) {
+        sqlite3_bind_int64(ins, 1, (sqlite3_int64)k + 1);
+        sqlite3_bind_int64(ins, 2, (sqlite3_int64)n);
+        sqlite3_bind_blob(ins, 3, blob, (int)len, SQLITE_STATIC);
+        st = store_step_done(s->db, ins, "write open nodes", msg, msg_size);
+        s->stats.bytes_written += len;
+    }
+    sqlite3_finalize(ins);
+    free(local);
+    free(weight);
+    free(cells);
+    free(v);
+    free(scratch);
+    free(blob);
     return st;
 }
 
-/* The open nodes whose weight or openness changed since the last commit. */
-static cm_status write_open_changes(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
-{
-    sqlite3_stmt *update = NULL, *drop = NULL;
-    if (sqlite3_prepare_v2(s->db, "UPDATE open_nodes SET weight = ? WHERE node = ?", -1, &update,
-                           NULL) ||
-        sqlite3_prepare_v2(s->db, "DELETE FROM open_nodes WHERE node = ?", -1, &drop, NULL)) {
-        sqlite3_finalize(update);
-        return store_db_error(s->db, "prepare open nodes", msg, msg_size);
-    }
-    cm_status st = CM_OK;
-    uint64_t slot = 0;
-    uint32_t id;
-    while (st == CM_OK && cm_cluster_next_open_change(c, &slot, &id))
-        st = update_open_node(s, update, drop, c, id, msg, msg_size);
-    sqlite3_finalize(update);
-    sqlite3_finalize(drop);
-    return st;
-}
-
-/* A region never saved: its row, exit table, pages and open nodes. */
+/* A region never saved: its row, exit table and pages. */
 static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                               size_t msg_size)
 {
     const cm_region *r = &c->regions[k].r;
-    if (!r->group || !c->regions[k].nodes)
+    if (!r->group)
         return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
     cm_status st = store_insert_region(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = store_write_pages(s, k, r, msg, msg_size);
-    if (st == CM_OK)
-        st = insert_open_nodes(s, c, k, msg, msg_size);
     s->stats.regions_written++;
     return st;
 }
@@ -223,8 +203,9 @@ cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_
     for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
         if (c->regions[k].nodes_dirty)
             st = store_write_nodes(s, c, k, msg, msg_size);
-    if (st == CM_OK)
-        st = write_open_changes(s, c, msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
+        if (c->regions[k].open_dirty)
+            st = store_write_open_nodes(s, c, k, msg, msg_size);
     if (st == CM_OK)
         st = write_basins(s, c, msg, msg_size);
     if (st == CM_OK)

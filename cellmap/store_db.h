@@ -67,6 +67,9 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
 /* Region k's node records (replacing the saved ones). */
 cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                             size_t msg_size);
+/* Region k's open nodes (replacing the saved ones). */
+cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *msg,
+                                 size_t msg_size);
 /* The pager (cm_page_in_fn and cm_page_out_fn with the store as user). */
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size);
 cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg,

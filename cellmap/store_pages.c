@@ -355,51 +355,87 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
     return status;
 }
 
+/* Appends region k's saved open nodes (a row of open_nodes) to the arrays. */
+static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, int64_t count,
+                               const void *blob, int len, uint32_t **ids, uint64_t **weights,
+                               int64_t **cells, uint64_t *n, uint64_t *cap)
+{
+    const cm_cluster_region *cr = &c->regions[k];
+    const size_t dim = (size_t)c->lat.dim;
+    if (count < 0 || (uint64_t)count > cr->r.nexits || !blob)
+        return CM_EFORMAT;
+    const uint64_t m = (uint64_t)count, values = m * (2 + dim);
+    int64_t *v = malloc((values + 1) * sizeof *v);
+    unsigned char *scratch = malloc(8 * (values + 1));
+    cm_status st = v && scratch ? CM_OK : CM_ENOMEM;
+    if (st == CM_OK && cm_codec_decode(blob, (size_t)len, values, 8, -1, scratch, v) != CM_OK)
+        st = CM_EFORMAT;
+    s->stats.bytes_read += (uint64_t)len;
+    if (st == CM_OK && *n + m > *cap) {
+        uint64_t want = *cap ? *cap : 64;
+        while (want < *n + m)
+            want *= 2;
+        uint32_t *i2 = realloc(*ids, want * sizeof *i2);
+        if (i2)
+            *ids = i2;
+        uint64_t *w2 = i2 ? realloc(*weights, want * sizeof *w2) : NULL;
+        if (w2)
+            *weights = w2;
+        int64_t *c2 = w2 ? realloc(*cells, want * dim * sizeof *c2) : NULL;
+        if (c2)
+            *cells = c2;
+        st = c2 ? CM_OK : CM_ENOMEM;
+        if (c2)
+            *cap = want;
+    }
+    for (uint64_t i = 0; st == CM_OK && i < m; i++) {
+        if (v[i] < 0 || (uint64_t)v[i] >= cr->r.nexits || v[m + i] < 0 ||
+            (i > 0 && v[i] <= v[i - 1])) {
+            st = CM_EFORMAT;
+            break;
+        }
+        (*ids)[*n + i] = cr->node_base + (uint32_t)v[i];
+        (*weights)[*n + i] = (uint64_t)v[m + i];
+    }
+    if (st == CM_OK) {
+        memcpy(*cells + *n * dim, v + 2 * m, m * dim * sizeof *v);
+        *n += m;
+    }
+    free(v);
+    free(scratch);
+    return st;
+}
+
 /* The open nodes of a file of version 5 into the cluster. */
 static cm_status load_open_nodes(cm_store *s, cm_cluster *c, uint32_t groups,
                                  const uint64_t *basin, char *msg, size_t msg_size)
 {
-    const int dim = c->lat.dim;
-    const int64_t count = store_query_int(s->db, "SELECT COUNT(*) FROM open_nodes");
-    if (count < 0 || (uint64_t)count > c->nnodes)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes", s->path);
-    const uint64_t n = (uint64_t)count;
-    uint32_t *ids = malloc((n + 1) * sizeof *ids);
-    uint64_t *weights = malloc((n + 1) * sizeof *weights);
-    int64_t *cells = malloc((n + 1) * (size_t)dim * sizeof *cells);
+    uint32_t *ids = NULL;
+    uint64_t *weights = NULL, n = 0, cap = 0;
+    int64_t *cells = NULL;
     sqlite3_stmt *st = NULL;
-    cm_status status = ids && weights && cells
-                           ? CM_OK
-                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu open nodes",
-                                     (unsigned long long)n);
-    if (status == CM_OK && sqlite3_prepare_v2(s->db,
-                                              "SELECT node, weight, cell FROM open_nodes ORDER BY "
-                                              "node",
-                                              -1, &st, NULL))
-        status = store_db_error(s->db, "read open nodes", msg, msg_size);
-    uint64_t i = 0;
+    cm_status status = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "SELECT region, count, data FROM open_nodes ORDER BY region", -1,
+                           &st, NULL))
+        return store_db_error(s->db, "read open nodes", msg, msg_size);
+    int64_t last = 0;
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
-        const int64_t id = sqlite3_column_int64(st, 0), w = sqlite3_column_int64(st, 1);
-        const unsigned char *blob = sqlite3_column_blob(st, 2);
-        if (i >= n || id < 0 || id >= (int64_t)c->nnodes || w < 0 || !blob ||
-            sqlite3_column_bytes(st, 2) != 8 * dim) {
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open node %lld", s->path,
-                             (long long)id);
+        const int64_t region = sqlite3_column_int64(st, 0);
+        if (region <= last || region > (int64_t)c->nregions) {
+            status = CM_EFORMAT;
             break;
         }
-        ids[i] = (uint32_t)id;
-        weights[i] = (uint64_t)w;
-        for (int d = 0; d < dim; d++) {
-            uint64_t v = 0;
-            for (int b = 7; b >= 0; b--)
-                v = v << 8 | blob[8 * d + b];
-            cells[i * (uint64_t)dim + (uint64_t)d] = (int64_t)v;
-        }
-        i++;
+        last = region;
+        status = read_open_row(s, c, (uint32_t)(region - 1), sqlite3_column_int64(st, 1),
+                               sqlite3_column_blob(st, 2), sqlite3_column_bytes(st, 2), &ids,
+                               &weights, &cells, &n, &cap);
     }
     sqlite3_finalize(st);
-    if (status == CM_OK && i != n)
-        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes", s->path);
+    if (status == CM_EFORMAT)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes of region %lld",
+                         s->path, (long long)last);
+    else if (status != CM_OK)
+        status = cm_fail(status, msg, msg_size, "out of memory for the open nodes");
     if (status == CM_OK)
         status = cm_cluster_restored_open(c, groups, basin, ids, weights, cells, n, msg, msg_size);
     free(ids);

@@ -146,30 +146,6 @@ static cm_status upgrade(cm_store *s, char *msg, size_t msg_size)
     return st;
 }
 
-typedef struct open_rows {
-    cm_store *s;
-    const cm_cluster *c;
-    sqlite3_stmt *ins;
-    cm_status st;
-    char *msg;
-    size_t msg_size;
-} open_rows;
-
-static void insert_open_row(void *user, uint32_t node, const int64_t *cell)
-{
-    open_rows *o = user;
-    unsigned char blob[8 * CM_MAX_DIM];
-    if (o->st != CM_OK)
-        return;
-    for (int d = 0; d < o->c->lat.dim; d++)
-        for (int b = 0; b < 8; b++)
-            blob[8 * d + b] = (unsigned char)((uint64_t)cell[d] >> (8 * b));
-    sqlite3_bind_int64(o->ins, 1, node);
-    sqlite3_bind_int64(o->ins, 2, (sqlite3_int64)cm_cluster_open_weight(o->c, node));
-    sqlite3_bind_blob(o->ins, 3, blob, 8 * o->c->lat.dim, SQLITE_TRANSIENT);
-    o->st = store_step_done(o->s->db, o->ins, "write an open node", o->msg, o->msg_size);
-}
-
 /* Version 4 had everything but the open nodes, which it rebuilt from every
  * node table at each open: they get their table, from the cluster loaded
  * that way. */
@@ -177,21 +153,19 @@ static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
 {
     cm_cluster c;
     cm_status st = cm_store_load_cluster(s, &c, msg, msg_size);
-    open_rows o = {s, &c, NULL, st, msg, msg_size};
-    if (st == CM_OK &&
-        (store_exec(s->db, "CREATE TABLE open_nodes(node INTEGER PRIMARY KEY,"
-                           " weight INTEGER NOT NULL, cell BLOB NOT NULL)") != SQLITE_OK ||
-         sqlite3_prepare_v2(s->db, "INSERT INTO open_nodes VALUES(?, ?, ?)", -1, &o.ins, NULL)))
-        o.st = store_db_error(s->db, "add the open nodes", msg, msg_size);
-    if (o.st == CM_OK)
-        cm_cluster_each_escape(&c, insert_open_row, &o);
-    sqlite3_finalize(o.ins);
+    if (st == CM_OK && store_exec(s->db, "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY"
+                                         " REFERENCES regions(id), count INTEGER NOT NULL,"
+                                         " data BLOB NOT NULL)") != SQLITE_OK)
+        st = store_db_error(s->db, "add the open nodes", msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++)
+        if (c.regions[k].nopen > 0)
+            st = store_write_open_nodes(s, &c, k, msg, msg_size);
     char pragma[64];
     snprintf(pragma, sizeof pragma, "PRAGMA user_version=%d", CM_STORE_VERSION);
-    if (o.st == CM_OK && store_exec(s->db, pragma) != SQLITE_OK)
-        o.st = store_db_error(s->db, "write the version", msg, msg_size);
+    if (st == CM_OK && store_exec(s->db, pragma) != SQLITE_OK)
+        st = store_db_error(s->db, "write the version", msg, msg_size);
     cm_cluster_free(&c);
-    return o.st;
+    return st;
 }
 
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,

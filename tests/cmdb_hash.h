@@ -17,7 +17,7 @@ static inline uint64_t cmdb_content_hash(const char *path)
         "SELECT * FROM exits ORDER BY region",
         "SELECT * FROM nodes ORDER BY region",
         "SELECT * FROM basins ORDER BY grp",
-        "SELECT * FROM open_nodes ORDER BY node",
+        "SELECT * FROM open_nodes ORDER BY region",
         "SELECT * FROM attractors ORDER BY id",
         "SELECT * FROM meta WHERE key NOT IN ('command') ORDER BY key"};
     sqlite3 *db = NULL;
