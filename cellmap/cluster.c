@@ -535,6 +535,36 @@ static void next_uses(const cm_cluster *c, uint32_t *use)
     }
 }
 
+void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k)
+{
+    int64_t off[CM_MAX_DIM] = {0};
+    for (int d = 0; d < c->lat.dim; d++)
+        off[d] = c->regions[k].r.box.lo[d] - c->regions[joined].r.box.lo[d];
+    for (uint32_t i = 0; i < c->nreach; i++)
+        if (memcmp(c->reach[i], off, sizeof off) == 0)
+            return;
+    if (c->nreach < CM_MAX_REACH)
+        memcpy(c->reach[c->nreach++], off, sizeof off);
+}
+
+/* Regions the first upcoming boxes will likely read: where the last join
+ * read, relative to each box (use[k]: the first box that will). */
+#define REACH_LOOKAHEAD 64
+static void expected_reads(const cm_cluster *c, uint32_t *use)
+{
+    const uint32_t n = c->nupcoming < REACH_LOOKAHEAD ? c->nupcoming : REACH_LOOKAHEAD;
+    for (uint32_t i = n; i-- > 0;)
+        for (uint32_t r = 0; r < c->nreach; r++) {
+            int64_t cell[CM_MAX_DIM];
+            uint64_t local;
+            for (int d = 0; d < c->lat.dim; d++)
+                cell[d] = c->upcoming[i].lo[d] + c->reach[r][d];
+            const int64_t k = cm_cluster_locate(c, cell, &local);
+            if (k >= 0 && use[k] > i)
+                use[k] = i;
+        }
+}
+
 /* Something resident that can be evicted: region k's cells, or its node table. */
 typedef struct victim {
     uint32_t k;
@@ -576,10 +606,11 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
         return CM_ENOMEM;
     }
     next_uses(c, use);
+    expected_reads(c, use);
     *n = 0;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
-        if (is_resident(cr) && (int64_t)k != keep && (cr->written || with_unsaved))
+        if (is_resident(cr) && (int64_t)k != keep && !cr->pinned && (cr->written || with_unsaved))
             v[(*n)++] = (victim){k, 0, !cr->written, use[k], cr->last_used,
                                  cm_region_bytes(&cr->r)};
         if (tables && cr->nodes && !cr->nodes_dirty)
@@ -591,14 +622,32 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
     return CM_OK;
 }
 
-/* Evicts until `extra` more bytes fit the budget (see victims). */
-static cm_status shed(cm_cluster *c, int64_t keep, uint64_t extra, int tables, char *msg,
-                      size_t msg_size)
+/* Bytes of the resident cell arrays (and exit tables) and of the resident node tables. */
+static void resident(const cm_cluster *c, uint64_t *cells, uint64_t *tables)
+{
+    *cells = *tables = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        *cells += is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0;
+        *tables += node_table_bytes(&c->regions[k]);
+    }
+}
+
+/* Evicts until `extra` more bytes of cells fit the budget, and (with
+ * `tables`) the node tables fit a quarter of it (see victims). Region
+ * `keep` stays; a region being joined (`joining`, or -1) is not counted. */
+static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t extra, int tables,
+                      char *msg, size_t msg_size)
 {
     if (!c->page_in || c->mem_budget == 0)
         return CM_OK;
-    uint64_t bytes = cm_cluster_resident_bytes(c) + extra;
-    if (bytes <= c->mem_budget)
+    uint64_t cells, table_bytes;
+    resident(c, &cells, &table_bytes);
+    cells += extra;
+    if (joining >= 0 && is_resident(&c->regions[joining]))
+        cells -= cm_region_bytes(&c->regions[joining].r);
+    const uint64_t table_budget = c->mem_budget / 4;
+    tables = tables && table_bytes > table_budget;
+    if (cells <= c->mem_budget && !tables)
         return CM_OK;
     victim *v = NULL;
     uint64_t n = 0;
@@ -606,20 +655,21 @@ static cm_status shed(cm_cluster *c, int64_t keep, uint64_t extra, int tables, c
     if (victims(c, keep, with_unsaved, tables, &v, &n) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory choosing what to page out");
     cm_status st = CM_OK;
-    for (uint64_t i = 0; i < n && bytes > c->mem_budget && st == CM_OK; i++) {
+    for (uint64_t i = 0; i < n && st == CM_OK; i++) {
         cm_cluster_region *cr = &c->regions[v[i].k];
-        if (v[i].nodes) {
+        if (v[i].nodes && table_bytes > table_budget) {
             free(cr->nodes);
             cr->nodes = NULL;
-        } else {
+            table_bytes -= v[i].bytes;
+        } else if (!v[i].nodes && cells > c->mem_budget) {
             if (!cr->written)
                 st = c->page_out(c->pager, c, v[i].k, msg, msg_size);
             if (st != CM_OK)
                 break;
             cr->written = 1;
             evict_cells(cr);
+            cells -= v[i].bytes;
         }
-        bytes -= v[i].bytes;
     }
     free(v);
     return st;
@@ -633,7 +683,7 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
         return CM_OK;
     if (!c->page_in)
         return cm_fail(CM_EINVAL, msg, msg_size, "region %u is paged out and there is no pager", k);
-    cm_status st = shed(c, k, cm_region_bytes(&cr->r), 0, msg, msg_size);
+    cm_status st = shed(c, k, -1, cm_region_bytes(&cr->r), 0, msg, msg_size);
     if (st == CM_OK)
         st = c->page_in(c->pager, k, &cr->r, msg, msg_size);
     if (st == CM_OK && !is_resident(cr))
@@ -644,7 +694,13 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
 void cm_cluster_trim(cm_cluster *c)
 {
     char ignored[64];
-    shed(c, -1, 0, 1, ignored, sizeof ignored);
+    shed(c, -1, -1, 0, 1, ignored, sizeof ignored);
+}
+
+void cm_cluster_trim_joining(cm_cluster *c, uint32_t joining)
+{
+    char ignored[64];
+    shed(c, joining, joining, 0, 1, ignored, sizeof ignored);
 }
 
 void cm_cluster_saved(cm_cluster *c)

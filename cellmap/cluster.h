@@ -40,6 +40,9 @@
 #include "cellmap/idmap.h"
 #include "cellmap/scm.h"
 
+/* Offsets remembered from a join for eviction (cm_cluster.reach). */
+#define CM_MAX_REACH 64
+
 /* cm_node.next values other than a node id */
 #define CM_NODE_OPEN UINT32_C(0xFFFFFFFF)  /* the exit leads out of the cluster */
 #define CM_NODE_FINAL UINT32_C(0xFFFFFFFE) /* group and step of the cell are known */
@@ -78,6 +81,7 @@ typedef struct cm_cluster_region {
     int open_dirty;
     uint64_t last_used; /* private: paging clock of the last acquire of the cells */
     uint64_t nodes_used; /* private: and of the last use of the node table */
+    int pinned;          /* private: its cells are needed by the join under way */
 } cm_cluster_region;
 
 /* A periodic cell of a group made since the owner last took them. */
@@ -118,15 +122,15 @@ typedef struct cm_cluster {
     cm_group_cell *new_periodic;   /* read-only: of groups made since cm_cluster_saved */
     uint64_t nnew_periodic;           /* read-only */
     uint32_t saved_groups;            /* read-only: ngroups at cm_cluster_saved */
-    /* Paging, off while page_in is NULL. Resident bytes are the regions'
-     * cell arrays and exit tables and their node tables. cm_cluster_acquire
-     * reads a region's cells back through page_in and first evicts other
-     * regions' cells (those the upcoming boxes need last, then the least
-     * recently used, first) so that the resident bytes stay within
-     * mem_budget (more only while one region alone is bigger, or while a
-     * join reads node tables back); a region never saved is saved through
-     * page_out first (kept resident if there is none). cm_cluster_trim also
-     * evicts clean node tables, read back on use through nodes_in. */
+    /* Paging, off while page_in is NULL. cm_cluster_acquire reads a
+     * region's cells back through page_in and first evicts other regions'
+     * cells (those the upcoming boxes need last, then the least recently
+     * used, first) so that the resident cell arrays and exit tables stay
+     * within mem_budget (more only while one region alone is bigger); a
+     * region never saved is saved through page_out first (kept resident if
+     * there is none). cm_cluster_trim also evicts clean node tables, read
+     * back on use through nodes_in, to keep them within mem_budget / 4 (more
+     * only within a join, which never evicts them). */
     cm_page_in_fn page_in;   /* public */
     cm_page_out_fn page_out; /* public */
     cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
@@ -140,6 +144,10 @@ typedef struct cm_cluster {
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
     cm_idmap open;   /* open node -> cells whose sequences leave the cluster through it */
+    /* where the last join's links read, relative to its region's lower
+     * corner: eviction expects the next boxes to read there too */
+    int64_t reach[CM_MAX_REACH][CM_MAX_DIM];
+    uint32_t nreach;
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -203,6 +211,9 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
  * the caller frees. */
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
 
+/* Notes that the join of region `joined` reads region k (cm_cluster.reach). */
+void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k);
+
 /* Calls fn for every open node with the target of its exit. */
 typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
 void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
@@ -262,6 +273,10 @@ cm_status cm_cluster_acquire(cm_cluster *c, uint32_t k, char *msg, size_t msg_si
  * resident arrays fit c->mem_budget. Does nothing without a pager. */
 void cm_cluster_trim(cm_cluster *c);
 
+/* The same at the start of region `joining`'s join, whose cells are not
+ * counted (it joins with the budget the cluster had before it). */
+void cm_cluster_trim_joining(cm_cluster *c, uint32_t joining);
+
 /* The owner saved everything: regions and node records are clean, the new
  * groups' periodic cells and the changed basin counts are taken. */
 void cm_cluster_saved(cm_cluster *c);
@@ -279,7 +294,7 @@ cm_status cm_cluster_describe_new(cm_cluster *c, const cm_model *model, cm_group
 /* Cells in the sink's domain: those whose sequences leave the cluster or the world. */
 uint64_t cm_cluster_sink_cells(const cm_cluster *c);
 
-/* Bytes held by the resident regions' cell arrays and exit tables. */
+/* Bytes held by the resident regions' cell arrays and exit tables, and node tables. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 
 /* The smallest box holding every region (the cluster must have one). */

@@ -139,7 +139,8 @@ static cm_status close_cycle(joiner *j, uint32_t n)
         nd->group = g;
         nd->up = CM_NODE_CYCLE;
         nd->up_dist = 0;
-        touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
+        const uint32_t k = cm_cluster_node_region(j->c, j->stack[i]);
+        touch_in(j, k);
         st = trace_cycle_cells(j, j->stack[i], entry, g);
     }
     uint64_t weight = 0;
@@ -273,10 +274,22 @@ static cm_status link_all(joiner *j)
     link_job *jobs = NULL;
     uint64_t n = 0;
     cm_status st = collect_jobs(j, added, &jobs, &n);
+    /* the regions the links read stay; room is made among the others */
+    j->c->nreach = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        cm_cluster_region *target = &j->c->regions[jobs[i].region];
+        if (jobs[i].region != added)
+            cm_cluster_note_reach(j->c, added, jobs[i].region);
+        target->pinned = 1;
+    }
+    if (st == CM_OK)
+        cm_cluster_trim_joining(j->c, added);
     if (st == CM_OK)
         st = read_targets(j, jobs, n);
     for (uint64_t i = 0; i < n && st == CM_OK; i++)
         st = link_node(j, &jobs[i]);
+    for (uint64_t i = 0; i < n; i++)
+        j->c->regions[jobs[i].region].pinned = 0;
     j->stats->nodes = n;
     free(jobs);
     return st;
@@ -342,6 +355,18 @@ static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box
     (void)threads;
 }
 
+/* Region `next`'s exits that land in the cluster: their regions stay through
+ * the trim before the join under way reads (next joins after it). */
+static void pin_expected(cm_cluster *c, const cm_region *next, int pin)
+{
+    for (uint64_t e = 0; next && e < next->nexits; e++) {
+        uint64_t local;
+        const int64_t k = cm_cluster_locate(c, cm_region_exit(next, e), &local);
+        if (k >= 0)
+            c->regions[k].pinned = pin;
+    }
+}
+
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
                                  uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
                                  void *user, cm_join_stats *stats, char *msg, size_t msg_size)
@@ -350,9 +375,11 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 #ifdef _OPENMP
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
-    cm_region *solved = calloc((size_t)threads, sizeof *solved);
-    cm_status *status = calloc((size_t)threads, sizeof *status);
-    char(*msgs)[256] = calloc((size_t)threads, sizeof *msgs);
+    const uint32_t t = (uint32_t)threads;
+    /* two batches: the next is solved before the last of this one joins */
+    cm_region *solved = calloc(2 * t, sizeof *solved);
+    cm_status *status = calloc(2 * t, sizeof *status);
+    char(*msgs)[256] = calloc(2 * t, sizeof *msgs);
     if (!solved || !status || !msgs) {
         free(solved);
         free(status);
@@ -366,31 +393,44 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
         memset(stats, 0, sizeof *stats);
     /* One region per thread: classification is sequential, so this is how
      * a big box uses every core. Each region's result depends on its box
-     * alone, and the joins run in a fixed order. */
+     * alone, and the joins run in a fixed order. Slot b of box b is b % 2t. */
     cm_status st = CM_OK;
-    for (uint32_t first = 0; first < nboxes && st == CM_OK; first += (uint32_t)threads) {
-        const uint32_t n = nboxes - first < (uint32_t)threads ? nboxes - first : (uint32_t)threads;
-        solve_batch(c, model, boxes + first, n, &one, threads, solved, status, msgs);
-        for (uint32_t k = 0; k < n; k++) {
-            cm_join_stats one_join;
-            if (st == CM_OK && status[k] != CM_OK)
-                st = cm_fail(status[k], msg, msg_size, "region %u: %s", first + k, msgs[k]);
-            /* its own box while it joins, the boxes after it from then on */
-            c->upcoming = boxes + first + k;
-            c->nupcoming = nboxes - first - k;
-            if (st == CM_OK)
-                st = cm_cluster_join(c, &solved[k], &one_join, msg, msg_size);
-            c->upcoming++;
-            c->nupcoming--;
-            if (st == CM_OK && stats)
-                add_join_stats(stats, &one_join);
-            if (st == CM_OK && joined)
-                st = joined(user, c, first + k, &one_join, msg, msg_size);
-            cm_region_free(&solved[k]);
+    if (nboxes > 0)
+        solve_batch(c, model, boxes, nboxes < t ? nboxes : t, &one, threads, solved, status, msgs);
+    for (uint32_t b = 0; b < nboxes && st == CM_OK; b++) {
+        const uint32_t slot = b % (2 * t);
+        if (b % t == t - 1 && b + 1 < nboxes) { /* the next batch, before this box joins */
+            const uint32_t first = b + 1, n = nboxes - first < t ? nboxes - first : t;
+            const uint32_t at = first % (2 * t);
+            solve_batch(c, model, boxes + first, n, &one, threads, solved + at, status + at,
+                        msgs + at);
         }
+        cm_join_stats one_join;
+        if (status[slot] != CM_OK)
+            st = cm_fail(status[slot], msg, msg_size, "region %u: %s", b, msgs[slot]);
+        const cm_region *next = b + 1 < nboxes && status[(b + 1) % (2 * t)] == CM_OK
+                                    ? &solved[(b + 1) % (2 * t)]
+                                    : NULL;
+        /* its own box while it joins, the boxes after it from then on */
+        c->upcoming = boxes + b;
+        c->nupcoming = nboxes - b;
+        pin_expected(c, next, 1);
+        if (st == CM_OK)
+            st = cm_cluster_join(c, &solved[slot], &one_join, msg, msg_size);
+        pin_expected(c, next, 0);
+        c->upcoming++;
+        c->nupcoming--;
+        if (st == CM_OK && stats)
+            add_join_stats(stats, &one_join);
+        if (st == CM_OK && joined)
+            st = joined(user, c, b, &one_join, msg, msg_size);
+        cm_region_free(&solved[slot]);
     }
+    for (uint32_t k = 0; k < 2 * t; k++)
+        cm_region_free(&solved[k]);
     c->upcoming = NULL;
     c->nupcoming = 0;
+    cm_cluster_trim(c);
     free(solved);
     free(status);
     free(msgs);

@@ -120,7 +120,8 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
 cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);
 
 /* A cm_joined_fn for cm_cluster_solve_boxes with the store as user: commits
- * the join, then pages out what c->mem_budget cannot hold. */
+ * the join (the next join pages out what c->mem_budget cannot hold, once it
+ * knows the regions it reads). */
 cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
                                char *msg, size_t msg_size);
 

@@ -240,9 +240,7 @@ cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const c
 {
     (void)box;
     (void)stats;
-    const cm_status st = cm_store_commit(store, c, msg, msg_size);
-    cm_cluster_trim(c);
-    return st;
+    return cm_store_commit(store, c, msg, msg_size); /* the next join makes room */
 }
 
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
