@@ -848,6 +848,7 @@ static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node 
             start_resolution(nd);
         } else {
             nd->next = nd->up = CM_NODE_OPEN;
+            nd->first_in = nd->sibling = CM_NODE_OPEN;
         }
     }
     c->nnodes += n;

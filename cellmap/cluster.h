@@ -58,6 +58,11 @@ typedef struct cm_node {
     uint32_t group;  /* FINAL, CYCLE: the cell's group */
     uint32_t target; /* local index of the exit's target cell in its region, once linked */
     uint32_t tree;   /* cells of the node's tree, itself included */
+    /* the nodes linked into this node's tree while its sequences still left
+     * the cluster: a list through first_in and their sibling fields
+     * (CM_NODE_OPEN ends it), so that they can be settled when this node
+     * turns out to be on a straddling cycle */
+    uint32_t first_in, sibling;
     /* private: resolution state, rebuilt from the above when a table is read */
     uint32_t up;      /* a node further along the chain, or a mark: FINAL (group and
                          up_dist known), OPEN (this node is open), CYCLE (a cycle node:

@@ -100,6 +100,40 @@ static cm_status trace_cycle_cells(joiner *j, uint32_t x, uint32_t entry, uint32
     return st;
 }
 
+/* The nodes linked into the tree of new cycle node q (its region's cells
+ * resident) become final: their steps count through that tree to the cycle.
+ * Every sequence that reaches the cycle through q passes one of them, so
+ * the others settle from these (cm_cluster_resolve) without reading cells. */
+static cm_status settle_linked_in(joiner *j, uint32_t q, uint32_t g)
+{
+    const uint32_t k = cm_cluster_node_region(j->c, q);
+    cm_node *nq;
+    cm_status st = cm_cluster_node(j->c, q, &nq, j->msg, j->msg_size);
+    uint32_t p = st == CM_OK ? nq->first_in : CM_NODE_OPEN;
+    const uint32_t entry = st == CM_OK ? nq->dist : 0;
+    if (st == CM_OK)
+        nq->first_in = CM_NODE_OPEN;
+    while (st == CM_OK && p != CM_NODE_OPEN) {
+        cm_node *np;
+        if ((st = cm_cluster_node(j->c, p, &np, j->msg, j->msg_size)) != CM_OK)
+            break;
+        const uint32_t sibling = np->sibling;
+        if (np->next == q) { /* not itself on the cycle */
+            const uint64_t s =
+                1 + (uint64_t)cm_cycle_steps(&j->c->regions[k].r, entry, np->target);
+            if (s >= CM_STEP_ON_PATH)
+                return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
+            np->next = np->up = CM_NODE_FINAL;
+            np->dist = np->up_dist = (uint32_t)s;
+            np->group = g;
+            touch_in(j, cm_cluster_node_region(j->c, p));
+        }
+        np->sibling = CM_NODE_OPEN;
+        p = sibling;
+    }
+    return st;
+}
+
 /* Linking open node n closed a chain of links on itself: a new group whose
  * cycle crosses region borders. Its nodes become cycle nodes; the sequences
  * through n's component all end on it, and the nodes of that component are
@@ -139,9 +173,16 @@ static cm_status close_cycle(joiner *j, uint32_t n)
         nd->group = g;
         nd->up = CM_NODE_CYCLE;
         nd->up_dist = 0;
-        const uint32_t k = cm_cluster_node_region(j->c, j->stack[i]);
-        touch_in(j, k);
-        st = trace_cycle_cells(j, j->stack[i], entry, g);
+        touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
+    }
+    /* once all of them are cycle nodes: their cells, and who linked in */
+    for (uint64_t i = 0; i < len && st == CM_OK; i++) {
+        cm_node *nd;
+        st = cm_cluster_node(j->c, j->stack[i], &nd, j->msg, j->msg_size);
+        if (st == CM_OK)
+            st = trace_cycle_cells(j, j->stack[i], nd->dist, g);
+        if (st == CM_OK)
+            st = settle_linked_in(j, j->stack[i], g);
     }
     uint64_t weight = 0;
     if (st == CM_OK && cm_cluster_take_open(j->c, n, &weight) != CM_OK)
@@ -187,6 +228,13 @@ static cm_status link_node(joiner *j, const link_job *job)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
+    /* m's sequences still leave the cluster: if m turns out to be on a
+     * straddling cycle, this node is settled through m's tree */
+    if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
+        return st;
+    nd->sibling = nm->first_in;
+    nm->first_in = job->node;
+    touch_in(j, job->region);
     uint64_t weight;
     if (cm_cluster_take_open(c, job->node, &weight) != CM_OK ||
         cm_cluster_add_open_weight(c, open, weight) != CM_OK)

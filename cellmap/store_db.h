@@ -27,9 +27,11 @@ struct cm_store {
     cm_store_stats stats;
 };
 
-/* Node records as saved: five little-endian uint32 columns of n entries
- * (next, dist, group, target, tree), encoded as one BLOB. */
-#define NODE_FIELDS 5
+/* Node records as saved: little-endian uint32 columns of n entries, encoded
+ * as one BLOB: next, dist, group, target, tree, then (version 5) first_in
+ * and sibling. */
+#define NODE_FIELDS 7
+#define NODE_FIELDS_V4 5
 
 /* The tables and view of a version 4 file, meta excepted. */
 extern const char *const store_tables_sql;

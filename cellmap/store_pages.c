@@ -214,11 +214,13 @@ static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes,
 {
     if (s->version < 4) { /* regions of version 2 and 3 hold resolved cells: no node is referenced */
         for (uint64_t e = 0; e < n; e++)
-            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1};
+            nodes[e] = (cm_node){.next = CM_NODE_FINAL, .dist = 1, .first_in = CM_NODE_OPEN,
+                                 .sibling = CM_NODE_OPEN};
         return CM_OK;
     }
-    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
-    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
+    const uint64_t fields = s->version >= 5 ? NODE_FIELDS : NODE_FIELDS_V4;
+    uint32_t *cols = malloc((fields * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (fields * n + 1));
     sqlite3_stmt *st = NULL;
     cm_status status = cols && scratch ? CM_OK
                                        : cm_fail(CM_ENOMEM, msg, msg_size,
@@ -235,8 +237,8 @@ static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes,
             blob = sqlite3_column_blob(st, 1);
             len = sqlite3_column_bytes(st, 1);
         }
-        if ((n > 0 && !blob) || (blob && cm_codec_decode(blob, (size_t)len, NODE_FIELDS * n, 4,
-                                                         -1, scratch, cols) != CM_OK))
+        if ((n > 0 && !blob) ||
+            (blob && cm_codec_decode(blob, (size_t)len, fields * n, 4, -1, scratch, cols) != CM_OK))
             status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
                              s->path, k + 1);
         s->stats.bytes_read += (uint64_t)len;
@@ -246,7 +248,9 @@ static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes,
                              .dist = cols[n + e],
                              .group = cols[2 * n + e],
                              .target = cols[3 * n + e],
-                             .tree = cols[4 * n + e]};
+                             .tree = cols[4 * n + e],
+                             .first_in = fields > 5 ? cols[5 * n + e] : CM_NODE_OPEN,
+                             .sibling = fields > 5 ? cols[6 * n + e] : CM_NODE_OPEN};
     sqlite3_finalize(st);
     free(cols);
     free(scratch);
@@ -592,7 +596,7 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
     return status;
 }
 
-/* Replaces region k's node records (five columns, see read_nodes). Only the
+/* Replaces region k's node records (NODE_FIELDS columns). Only the
  * fields that say what a node's exit leads to are saved: a final group is
  * kept for final and cycle nodes only, so the file does not depend on what
  * readers resolved. */
@@ -617,6 +621,8 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
         cols[2 * n + e] = known ? nd->group : 0;
         cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
         cols[4 * n + e] = nd->tree;
+        cols[5 * n + e] = nd->first_in;
+        cols[6 * n + e] = nd->sibling;
     }
     if (status == CM_OK &&
         cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK)

@@ -146,20 +146,50 @@ static cm_status upgrade(cm_store *s, char *msg, size_t msg_size)
     return st;
 }
 
+/* Version 4 kept no lists of the nodes linked into each node's tree: those
+ * whose sequences still leave the cluster are listed now. */
+static cm_status list_linked_in(cm_cluster *c, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        cm_cluster_region *cr = &c->regions[k];
+        for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
+            const uint32_t id = cr->node_base + (uint32_t)e, m = cr->nodes[e].next;
+            uint32_t g, step, open;
+            cm_node *nm;
+            if (m >= CM_NODE_MAX)
+                continue;
+            st = cm_cluster_resolve(c, id, &g, &step, &open, msg, msg_size);
+            if (st == CM_OK && open != CM_NODE_OPEN &&
+                (st = cm_cluster_node(c, m, &nm, msg, msg_size)) == CM_OK) {
+                cr->nodes[e].sibling = nm->first_in;
+                nm->first_in = id;
+            }
+        }
+    }
+    for (uint32_t k = 0; k < c->nregions; k++)
+        c->regions[k].nodes_dirty = 1; /* every table is written again, in version 5 */
+    return st;
+}
+
 /* Version 4 had everything but the open nodes, which it rebuilt from every
- * node table at each open: they get their table, from the cluster loaded
- * that way. */
+ * node table at each open, and the lists of linked-in nodes: they are added
+ * from the cluster loaded that way. */
 static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
 {
     cm_cluster c;
     cm_status st = cm_store_load_cluster(s, &c, msg, msg_size);
+    if (st == CM_OK)
+        st = list_linked_in(&c, msg, msg_size);
     if (st == CM_OK && store_exec(s->db, "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY"
                                          " REFERENCES regions(id), count INTEGER NOT NULL,"
                                          " data BLOB NOT NULL)") != SQLITE_OK)
         st = store_db_error(s->db, "add the open nodes", msg, msg_size);
-    for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++)
-        if (c.regions[k].nopen > 0)
+    for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++) {
+        st = store_write_nodes(s, &c, k, msg, msg_size);
+        if (st == CM_OK && c.regions[k].nopen > 0)
             st = store_write_open_nodes(s, &c, k, msg, msg_size);
+    }
     char pragma[64];
     snprintf(pragma, sizeof pragma, "PRAGMA user_version=%d", CM_STORE_VERSION);
     if (st == CM_OK && store_exec(s->db, pragma) != SQLITE_OK)
