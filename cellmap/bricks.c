@@ -192,6 +192,14 @@ void cm_bricks_truncate(cm_bricks *b, const int64_t *key, uint64_t n)
     brick *br = &b->bricks[b->slots[probe(b, key)] - 1];
     if (n < br->n)
         br->n = n;
+    if (br->n < br->cap / 4 && br->cap > 16) { /* give back what a drained brick held */
+        const uint64_t cap = br->n > 16 ? br->n : 16;
+        unsigned char *records = realloc(br->records, cap * b->record_size);
+        if (records) {
+            br->records = records;
+            br->cap = cap;
+        }
+    }
 }
 
 uint32_t cm_bricks_offset(const cm_bricks *b, const int64_t *cell)

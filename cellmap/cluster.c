@@ -9,6 +9,17 @@
 #include <omp.h>
 #endif
 
+/* An open node's entry in c->open holds its weight, with INDEXED set when
+ * the node is in its region's open list (an escape). An open node's up_dist
+ * says whether it has an entry (HAS_ENTRY), so that nodes without one, the
+ * exits a join links at once, cost no lookup. */
+/* Node ids are indexed by blocks of NODE_BLOCK: the region of each block's first id. */
+#define NODE_BLOCK_BITS 10
+#define NODE_BLOCK (UINT64_C(1) << NODE_BLOCK_BITS)
+
+#define INDEXED (UINT64_C(1) << 63)
+#define HAS_ENTRY 1u
+
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
 {
     memset(c, 0, sizeof *c);
@@ -37,6 +48,7 @@ void cm_cluster_free(cm_cluster *c)
     }
     free(c->regions);
     cm_idmap_free(&c->open);
+    free(c->node_blocks);
     free(c->chain);
     free(c->basin);
     free(c->basin_dirty);
@@ -70,18 +82,28 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *lo
 
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
 {
-    uint32_t lo = 0, hi = c->nregions; /* the last region whose node_base <= id */
-    while (hi - lo > 1) {
-        const uint32_t mid = lo + (hi - lo) / 2;
-        if (c->regions[mid].node_base <= id)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    /* regions without nodes share their successor's base: take the one holding id */
-    while (lo + 1 < c->nregions && c->regions[lo + 1].node_base <= id)
-        lo++;
-    return lo;
+    /* the region of the block's first id, then on to the one holding id
+     * (regions without nodes share their successor's base) */
+    uint32_t k = c->node_blocks[id >> NODE_BLOCK_BITS];
+    while (k + 1 < c->nregions && c->regions[k + 1].node_base <= id)
+        k++;
+    return k;
+}
+
+/* Region k (the last) in the index of node blocks. */
+static cm_status index_nodes(cm_cluster *c, uint32_t k)
+{
+    const uint64_t base = c->regions[k].node_base, end = base + c->regions[k].r.nexits;
+    const uint64_t first = (base + NODE_BLOCK - 1) >> NODE_BLOCK_BITS;
+    const uint64_t last = end > 0 ? (end - 1) >> NODE_BLOCK_BITS : 0;
+    if (end == base || first > last)
+        return CM_OK;
+    if (cm_grow((void **)&c->node_blocks, &c->node_blocks_cap, last + 1, sizeof *c->node_blocks) !=
+        CM_OK)
+        return CM_ENOMEM;
+    for (uint64_t b = first; b <= last; b++)
+        c->node_blocks[b] = k;
+    return CM_OK;
 }
 
 /* A record of escape_bricks: an open node and its exit's target as an
@@ -126,8 +148,12 @@ cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *
             cr->nodes = NULL;
             return st;
         }
-        for (uint64_t e = 0; e < cr->r.nexits; e++)
+        for (uint64_t e = 0; e < cr->r.nexits; e++) {
             start_resolution(&cr->nodes[e]);
+            if (cr->nodes[e].up == CM_NODE_OPEN &&
+                cm_idmap_get(&c->open, cr->node_base + (uint32_t)e, NULL))
+                cr->nodes[e].up_dist = HAS_ENTRY;
+        }
     }
     *out = cr->nodes;
     return CM_OK;
@@ -145,47 +171,11 @@ cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, 
     return st;
 }
 
-/* An open node's weight: its entry, or, for a node of a region being joined
- * that has none yet, its own tree. */
-static cm_status open_weight(cm_cluster *c, uint32_t id, uint64_t *w)
-{
-    if (cm_idmap_get(&c->open, id, w))
-        return CM_OK;
-    cm_node *nd = NULL;
-    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
-    *w = st == CM_OK ? nd->tree : 0;
-    return st;
-}
 
-uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
+/* Drops the nodes of region k's open list that are no longer open, and the
+ * room they took. */
+static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
 {
-    uint64_t w = 0;
-    cm_idmap_get(&c->open, id, &w);
-    return w;
-}
-
-cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
-{
-    uint64_t had;
-    cm_status st = open_weight(c, id, &had);
-    if (st == CM_OK && cm_idmap_put(&c->open, id, had + w) != CM_OK)
-        st = CM_ENOMEM;
-    c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
-    return st;
-}
-
-cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
-{
-    cm_status st = open_weight(c, id, w);
-    if (cm_idmap_remove(&c->open, id, NULL))
-        c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
-    return st;
-}
-
-cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
-                                int64_t **cells, uint64_t *n)
-{
-    cm_cluster_region *cr = &c->regions[k];
     const size_t dim = (size_t)c->lat.dim;
     uint64_t kept = 0;
     for (uint64_t i = 0; i < cr->nopen; i++) {
@@ -196,6 +186,80 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
         kept++;
     }
     cr->nopen = kept;
+    cr->open_stale = 0;
+    if (kept < cr->open_cap / 4) { /* shrinking cannot fail to keep what it keeps */
+        const uint64_t cap = kept > 16 ? kept : 16;
+        uint32_t *local = realloc(cr->open_local, cap * sizeof *local);
+        if (local)
+            cr->open_local = local;
+        int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
+        if (cells) {
+            cr->open_cells = cells;
+            cr->open_cap = cap;
+        }
+    }
+}
+
+/* An open node's weight: its entry, or its own tree (a node of the region
+ * being joined that the join has not indexed or linked into). */
+static cm_status open_weight(cm_cluster *c, uint32_t id, cm_node **nd, uint64_t *w)
+{
+    cm_status st = cm_cluster_node(c, id, nd, NULL, 0);
+    if (st != CM_OK)
+        return st;
+    if (!((*nd)->up_dist & HAS_ENTRY) || !cm_idmap_get(&c->open, id, w))
+        *w = (*nd)->tree;
+    *w &= ~INDEXED;
+    return CM_OK;
+}
+
+uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
+{
+    uint64_t w = 0;
+    cm_idmap_get(&c->open, id, &w);
+    return w & ~INDEXED;
+}
+
+cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
+{
+    cm_node *nd = NULL;
+    uint64_t had, flags = 0;
+    cm_status st = open_weight(c, id, &nd, &had);
+    if (st == CM_OK && (nd->up_dist & HAS_ENTRY) && cm_idmap_get(&c->open, id, &flags))
+        flags &= INDEXED;
+    if (st == CM_OK && cm_idmap_put(&c->open, id, (had + w) | flags) != CM_OK)
+        st = CM_ENOMEM;
+    if (st == CM_OK) {
+        nd->up_dist |= HAS_ENTRY;
+        c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
+    }
+    return st;
+}
+
+cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
+{
+    cm_node *nd = NULL;
+    uint64_t entry;
+    cm_status st = open_weight(c, id, &nd, w);
+    if (st != CM_OK || !(nd->up_dist & HAS_ENTRY))
+        return st;
+    nd->up_dist &= ~HAS_ENTRY;
+    if (!cm_idmap_remove(&c->open, id, &entry))
+        return CM_OK;
+    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+    cr->open_dirty = 1;
+    if ((entry & INDEXED) && 2 * ++cr->open_stale > cr->nopen)
+        compact_open_list(c, cr);
+    return CM_OK;
+}
+
+cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
+                                int64_t **cells, uint64_t *n)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    const size_t dim = (size_t)c->lat.dim;
+    compact_open_list(c, cr);
+    const uint64_t kept = cr->nopen;
     *local = malloc((kept + 1) * sizeof **local);
     *weight = malloc((kept + 1) * sizeof **weight);
     *cells = malloc((kept + 1) * dim * sizeof **cells);
@@ -231,8 +295,10 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
         cr->open_cap = cap;
     }
     if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK ||
-        cm_idmap_put(&c->open, id, w) != CM_OK)
+        cm_idmap_put(&c->open, id, w | INDEXED) != CM_OK)
         return CM_ENOMEM;
+    if (cr->nodes) /* else it is set when the table is read back */
+        cr->nodes[id - cr->node_base].up_dist |= HAS_ENTRY;
     cr->open_local[cr->nopen] = id - cr->node_base;
     memcpy(cr->open_cells + cr->nopen * dim, cell, dim * sizeof *cell);
     cr->nopen++;
@@ -363,7 +429,7 @@ static cm_status push_chain(cm_cluster *c, uint64_t *len, uint32_t id)
 static cm_status settle(cm_cluster *c, uint32_t id, char *msg, size_t msg_size)
 {
     uint64_t len = 0;
-    cm_node *nd;
+    cm_node *nd = NULL;
     cm_status st = CM_OK;
     for (uint32_t x = id; st == CM_OK; x = nd->next) {
         st = cm_cluster_node(c, x, &nd, msg, msg_size);
@@ -922,7 +988,7 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
     c->nregions++;
     c->ngroups += cr->r.ngroups;
     c->cells += cr->r.ncells;
-    if (index_region(c, k) != CM_OK)
+    if (index_region(c, k) != CM_OK || index_nodes(c, k) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
     return CM_OK;
 }
@@ -950,7 +1016,7 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
     else if (init_nodes(c, cr, nodes) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     c->cells += record->ncells;
-    return index_region(c, k) == CM_OK
+    return index_region(c, k) == CM_OK && index_nodes(c, k) == CM_OK
                ? CM_OK
                : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
 }

@@ -82,7 +82,7 @@ typedef struct cm_cluster_region {
      * them (cm_cluster_open_nodes) */
     uint32_t *open_local;
     int64_t *open_cells;
-    uint64_t nopen, open_cap;
+    uint64_t nopen, open_cap, open_stale;
     int open_dirty;
     uint64_t last_used; /* private: paging clock of the last acquire of the cells */
     uint64_t nodes_used; /* private: and of the last use of the node table */
@@ -153,6 +153,8 @@ typedef struct cm_cluster {
      * corner: eviction expects the next boxes to read there too */
     int64_t reach[CM_MAX_REACH][CM_MAX_DIM];
     uint32_t nreach;
+    uint32_t *node_blocks; /* the region of every 1024th node id */
+    uint64_t node_blocks_cap;
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -223,7 +225,7 @@ void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k);
 typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
 void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 
-/* The region of node id (binary search). */
+/* The region of node id (O(1)). */
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
 
 /* Node id's record into *out, region k's node table into *out (read back

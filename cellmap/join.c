@@ -40,6 +40,9 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uin
 {
     if (s >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
+    uint64_t weight; /* before the record changes: it says where the weight is */
+    if (cm_cluster_take_open(j->c, id, &weight) != CM_OK)
+        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     cm_node *nd;
     cm_status st = cm_cluster_node(j->c, id, &nd, j->msg, j->msg_size);
     if (st != CM_OK)
@@ -51,9 +54,6 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uin
     nd->up = CM_NODE_FINAL;
     nd->up_dist = (uint32_t)s;
     nd->group = g;
-    uint64_t weight;
-    if (cm_cluster_take_open(j->c, id, &weight) != CM_OK)
-        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     if (g != 0) {
         j->c->basin[g] += weight;
         j->c->basin_dirty[g] = 1;
@@ -145,6 +145,9 @@ static cm_status close_cycle(joiner *j, uint32_t n)
     if (st != CM_OK)
         return cm_fail(st, j->msg, j->msg_size, "too many groups");
     j->stats->straddling_groups++;
+    uint64_t weight = 0; /* before the records change: they say where it is */
+    if (cm_cluster_take_open(j->c, n, &weight) != CM_OK)
+        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     uint64_t len = 0;
     uint32_t x = n;
     do {
@@ -184,9 +187,6 @@ static cm_status close_cycle(joiner *j, uint32_t n)
         if (st == CM_OK)
             st = settle_linked_in(j, j->stack[i], g);
     }
-    uint64_t weight = 0;
-    if (st == CM_OK && cm_cluster_take_open(j->c, n, &weight) != CM_OK)
-        st = cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     j->c->basin[g] += weight;
     j->stats->resolved_cells += weight;
     return st;
@@ -226,6 +226,10 @@ static cm_status link_node(joiner *j, const link_job *job)
         return close_cycle(j, job->node);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
+    uint64_t weight; /* its cells now leave through the open node it reaches */
+    if (cm_cluster_take_open(c, job->node, &weight) != CM_OK ||
+        cm_cluster_add_open_weight(c, open, weight) != CM_OK)
+        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
     /* m's sequences still leave the cluster: if m turns out to be on a
@@ -235,10 +239,6 @@ static cm_status link_node(joiner *j, const link_job *job)
     nd->sibling = nm->first_in;
     nm->first_in = job->node;
     touch_in(j, job->region);
-    uint64_t weight;
-    if (cm_cluster_take_open(c, job->node, &weight) != CM_OK ||
-        cm_cluster_add_open_weight(c, open, weight) != CM_OK)
-        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     touch_in(j, job->from);
     return CM_OK;
 }
