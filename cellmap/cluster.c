@@ -9,16 +9,30 @@
 #include <omp.h>
 #endif
 
-/* An open node's entry in c->open holds its weight, with INDEXED set when
- * the node is in its region's open list (an escape). An open node's up_dist
- * says whether it has an entry (HAS_ENTRY), so that nodes without one, the
- * exits a join links at once, cost no lookup. */
 /* Node ids are indexed by blocks of NODE_BLOCK: the region of each block's first id. */
 #define NODE_BLOCK_BITS 10
 #define NODE_BLOCK (UINT64_C(1) << NODE_BLOCK_BITS)
 
+/* An open node keeps its weight in its own record, in fields a link or a
+ * final outcome fills later (saved as 0 while the node is open): dist the
+ * low 32 bits, group the high ones, target the INDEXED flag (the node is in
+ * its region's open list). When its node table is evicted, the weight and
+ * the flag go to c->open (INDEXED as bit 63) and come back with the table. */
+#define INDEXED_FLAG 1u
 #define INDEXED (UINT64_C(1) << 63)
-#define HAS_ENTRY 1u
+
+static uint64_t weight_of(const cm_node *nd)
+{
+    return (uint64_t)nd->group << 32 | nd->dist;
+}
+
+static void set_weight(cm_node *nd, uint64_t w)
+{
+    nd->dist = (uint32_t)w;
+    nd->group = (uint32_t)(w >> 32);
+}
+
+static int is_open(const cm_node *nd) { return nd->next == CM_NODE_OPEN && nd->up == CM_NODE_OPEN; }
 
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
 {
@@ -149,10 +163,13 @@ cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *
             return st;
         }
         for (uint64_t e = 0; e < cr->r.nexits; e++) {
-            start_resolution(&cr->nodes[e]);
-            if (cr->nodes[e].up == CM_NODE_OPEN &&
-                cm_idmap_get(&c->open, cr->node_base + (uint32_t)e, NULL))
-                cr->nodes[e].up_dist = HAS_ENTRY;
+            cm_node *nd = &cr->nodes[e];
+            uint64_t spilled;
+            start_resolution(nd);
+            if (is_open(nd) && cm_idmap_remove(&c->open, cr->node_base + (uint32_t)e, &spilled)) {
+                set_weight(nd, spilled & ~INDEXED);
+                nd->target = spilled & INDEXED ? INDEXED_FLAG : 0;
+            }
         }
     }
     *out = cr->nodes;
@@ -172,6 +189,15 @@ cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, 
 }
 
 
+/* Whether node e of region cr, once indexed, is still open. */
+static bool still_indexed(const cm_cluster *c, const cm_cluster_region *cr, uint32_t e)
+{
+    if (cr->nodes)
+        return is_open(&cr->nodes[e]) && (cr->nodes[e].target & INDEXED_FLAG);
+    const uint64_t *v = cm_idmap_find(&c->open, cr->node_base + e);
+    return v && (*v & INDEXED);
+}
+
 /* Drops the nodes of region k's open list that are no longer open, and the
  * room they took. */
 static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
@@ -179,7 +205,7 @@ static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
     const size_t dim = (size_t)c->lat.dim;
     uint64_t kept = 0;
     for (uint64_t i = 0; i < cr->nopen; i++) {
-        if (!cm_idmap_get(&c->open, cr->node_base + cr->open_local[i], NULL))
+        if (!still_indexed(c, cr, cr->open_local[i]))
             continue;
         cr->open_local[kept] = cr->open_local[i];
         memmove(cr->open_cells + kept * dim, cr->open_cells + i * dim, dim * sizeof *cr->open_cells);
@@ -200,55 +226,41 @@ static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
     }
 }
 
-/* An open node's weight: its entry, or its own tree (a node of the region
- * being joined that the join has not indexed or linked into). */
-static cm_status open_weight(cm_cluster *c, uint32_t id, cm_node **nd, uint64_t *w)
-{
-    cm_status st = cm_cluster_node(c, id, nd, NULL, 0);
-    if (st != CM_OK)
-        return st;
-    if (!((*nd)->up_dist & HAS_ENTRY) || !cm_idmap_get(&c->open, id, w))
-        *w = (*nd)->tree;
-    *w &= ~INDEXED;
-    return CM_OK;
-}
-
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
 {
-    uint64_t w = 0;
-    cm_idmap_get(&c->open, id, &w);
-    return w & ~INDEXED;
+    const cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+    if (cr->nodes)
+        return is_open(&cr->nodes[id - cr->node_base]) ? weight_of(&cr->nodes[id - cr->node_base])
+                                                        : 0;
+    const uint64_t *v = cm_idmap_find(&c->open, id);
+    return v ? *v & ~INDEXED : 0;
 }
 
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
 {
     cm_node *nd = NULL;
-    uint64_t had, flags = 0;
-    cm_status st = open_weight(c, id, &nd, &had);
-    if (st == CM_OK && (nd->up_dist & HAS_ENTRY) && cm_idmap_get(&c->open, id, &flags))
-        flags &= INDEXED;
-    if (st == CM_OK && cm_idmap_put(&c->open, id, (had + w) | flags) != CM_OK)
-        st = CM_ENOMEM;
-    if (st == CM_OK) {
-        nd->up_dist |= HAS_ENTRY;
-        c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
-    }
-    return st;
+    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
+    if (st != CM_OK)
+        return st;
+    set_weight(nd, weight_of(nd) + w);
+    c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
+    return CM_OK;
 }
 
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
 {
     cm_node *nd = NULL;
-    uint64_t entry;
-    cm_status st = open_weight(c, id, &nd, w);
-    if (st != CM_OK || !(nd->up_dist & HAS_ENTRY))
+    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
+    if (st != CM_OK)
         return st;
-    nd->up_dist &= ~HAS_ENTRY;
-    if (!cm_idmap_remove(&c->open, id, &entry))
+    *w = weight_of(nd);
+    set_weight(nd, 0);
+    if (!(nd->target & INDEXED_FLAG))
         return CM_OK;
+    nd->target = 0;
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     cr->open_dirty = 1;
-    if ((entry & INDEXED) && 2 * ++cr->open_stale > cr->nopen)
+    if (2 * ++cr->open_stale > cr->nopen)
         compact_open_list(c, cr);
     return CM_OK;
 }
@@ -294,11 +306,14 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
         cr->open_cells = cells;
         cr->open_cap = cap;
     }
-    if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK ||
-        cm_idmap_put(&c->open, id, w | INDEXED) != CM_OK)
+    if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK)
         return CM_ENOMEM;
-    if (cr->nodes) /* else it is set when the table is read back */
-        cr->nodes[id - cr->node_base].up_dist |= HAS_ENTRY;
+    if (cr->nodes) {
+        set_weight(&cr->nodes[id - cr->node_base], w);
+        cr->nodes[id - cr->node_base].target = INDEXED_FLAG;
+    } else if (cm_idmap_put(&c->open, id, w | INDEXED) != CM_OK) { /* back with the table */
+        return CM_ENOMEM;
+    }
     cr->open_local[cr->nopen] = id - cr->node_base;
     memcpy(cr->open_cells + cr->nopen * dim, cell, dim * sizeof *cell);
     cr->nopen++;
@@ -688,6 +703,23 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
     return CM_OK;
 }
 
+/* Before region cr's node table is evicted: its open nodes' weights and
+ * flags into c->open (all or none). */
+static cm_status spill_open_weights(cm_cluster *c, cm_cluster_region *cr)
+{
+    for (uint64_t e = 0; e < cr->r.nexits; e++) {
+        const cm_node *nd = &cr->nodes[e];
+        if (is_open(nd) && cm_idmap_put(&c->open, cr->node_base + (uint32_t)e,
+                                        weight_of(nd) | (nd->target & INDEXED_FLAG ? INDEXED : 0)) !=
+                               CM_OK) {
+            while (e-- > 0)
+                cm_idmap_remove(&c->open, cr->node_base + (uint32_t)e, NULL);
+            return CM_ENOMEM;
+        }
+    }
+    return CM_OK;
+}
+
 /* Bytes of the resident cell arrays (and exit tables) and of the resident node tables. */
 static void resident(const cm_cluster *c, uint64_t *cells, uint64_t *tables)
 {
@@ -724,6 +756,8 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
         cm_cluster_region *cr = &c->regions[v[i].k];
         if (v[i].nodes && table_bytes > table_budget) {
+            if (spill_open_weights(c, cr) != CM_OK)
+                continue; /* the table stays */
             free(cr->nodes);
             cr->nodes = NULL;
             table_bytes -= v[i].bytes;
@@ -957,6 +991,8 @@ static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node 
                 return CM_ENOMEM;
         }
     }
+    for (uint64_t e = 0; e < r->nexits; e++)
+        set_weight(&nodes[e], nodes[e].tree); /* open: its own tree leaves */
     for (uint32_t g = 1; g <= r->ngroups; g++)
         c->basin_dirty[base + g] = 1;
     return CM_OK;
@@ -1053,8 +1089,7 @@ static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
                 return st;
             if (end->up != CM_NODE_OPEN)
                 continue;
-            if (cm_idmap_put(&c->open, y, cm_cluster_open_weight(c, y) + cr->nodes[e].tree) != CM_OK)
-                return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+            set_weight(end, weight_of(end) + cr->nodes[e].tree);
         }
     }
     return CM_OK;

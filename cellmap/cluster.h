@@ -23,6 +23,14 @@
  * Cells in the tree of a node on a straddling cycle count their steps to the
  * cycle, which can enter the tree above the node: such a node records the
  * cell where the cycle enters its tree, and readers walk (cm_cluster_flatten).
+ * The nodes linked into a cycle node's tree while it was open are listed
+ * with it and made final when the cycle closes, so that no later resolution
+ * needs a region's cells.
+ *
+ * Open nodes (exits that still leave the cluster) carry weights: the cells
+ * whose sequences leave through them, which basins and adaptive extension
+ * count. They stay in memory (an id map, the brick index of their targets
+ * and each region's open list); node tables, like cell arrays, are paged.
  *
  * The invariant (tests/test_cluster.c): for regions tiling a box, the
  * flattened cluster equals cm_scm_solve on the box, cell by cell, up to the

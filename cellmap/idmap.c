@@ -65,6 +65,30 @@ cm_status cm_idmap_put(cm_idmap *m, uint32_t key, uint64_t value)
     return CM_OK;
 }
 
+uint64_t *cm_idmap_find(const cm_idmap *m, uint32_t key)
+{
+    if (m->count == 0 || key == EMPTY)
+        return NULL;
+    const uint64_t s = find(m, key);
+    return m->keys[s] == EMPTY ? NULL : &m->values[s];
+}
+
+cm_status cm_idmap_upsert(cm_idmap *m, uint32_t key, uint64_t **value)
+{
+    if (key == EMPTY)
+        return CM_EINVAL;
+    if (2 * (m->count + 1) > m->slots && grow(m) != CM_OK)
+        return CM_ENOMEM;
+    const uint64_t s = find(m, key);
+    if (m->keys[s] == EMPTY) {
+        m->keys[s] = key;
+        m->values[s] = 0;
+        m->count++;
+    }
+    *value = &m->values[s];
+    return CM_OK;
+}
+
 bool cm_idmap_get(const cm_idmap *m, uint32_t key, uint64_t *value)
 {
     if (m->count == 0 || key == EMPTY)

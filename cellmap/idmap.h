@@ -25,6 +25,12 @@ void cm_idmap_free(cm_idmap *m);
 /* Sets the value of key (adding it if need be). */
 cm_status cm_idmap_put(cm_idmap *m, uint32_t key, uint64_t value);
 
+/* The value of key, in place (valid until the map changes), or NULL. */
+uint64_t *cm_idmap_find(const cm_idmap *m, uint32_t key);
+
+/* The value of key, in place, added as 0 if key was not there (one probe). */
+cm_status cm_idmap_upsert(cm_idmap *m, uint32_t key, uint64_t **value);
+
 /* Whether key is there, and its value into *value (may be NULL). */
 bool cm_idmap_get(const cm_idmap *m, uint32_t key, uint64_t *value);
 

@@ -34,15 +34,13 @@ static void touch_in(joiner *j, uint32_t k)
     j->touched[k] = 1;
 }
 
-/* The sequences through open node id (of region `region`) take group g;
- * its cell's step is s. */
-static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uint64_t s)
+/* The sequences through node id (of region `region`, open until now, the
+ * cells of weight `weight`) take group g; its cell's step is s. */
+static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uint64_t s,
+                        uint64_t weight)
 {
     if (s >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
-    uint64_t weight; /* before the record changes: it says where the weight is */
-    if (cm_cluster_take_open(j->c, id, &weight) != CM_OK)
-        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     cm_node *nd;
     cm_status st = cm_cluster_node(j->c, id, &nd, j->msg, j->msg_size);
     if (st != CM_OK)
@@ -134,20 +132,17 @@ static cm_status settle_linked_in(joiner *j, uint32_t q, uint32_t g)
     return st;
 }
 
-/* Linking open node n closed a chain of links on itself: a new group whose
- * cycle crosses region borders. Its nodes become cycle nodes; the sequences
- * through n's component all end on it, and the nodes of that component are
- * settled when they are next resolved (cm_cluster_resolve). */
-static cm_status close_cycle(joiner *j, uint32_t n)
+/* Linking node n (open until now, its component of weight `weight`) closed
+ * a chain of links on itself: a new group whose cycle crosses region
+ * borders. Its nodes become cycle nodes; the sequences through n's
+ * component all end on it. */
+static cm_status close_cycle(joiner *j, uint32_t n, uint64_t weight)
 {
     uint32_t g;
     cm_status st = cm_cluster_new_group(j->c, &g);
     if (st != CM_OK)
         return cm_fail(st, j->msg, j->msg_size, "too many groups");
     j->stats->straddling_groups++;
-    uint64_t weight = 0; /* before the records change: they say where it is */
-    if (cm_cluster_take_open(j->c, n, &weight) != CM_OK)
-        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     uint64_t len = 0;
     uint32_t x = n;
     do {
@@ -197,12 +192,15 @@ static cm_status link_node(joiner *j, const link_job *job)
 {
     cm_cluster *c = j->c;
     cm_node *nd, *nm;
-    cm_status st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
+    uint64_t weight; /* first: the open record holds it */
+    cm_status st = cm_cluster_take_open(c, job->node, &weight);
+    if (st == CM_OK)
+        st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
     if (st != CM_OK)
         return st;
     nd->target = job->cell;
     if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
-        return finish(j, job->node, job->from, job->group, (uint64_t)job->step + 1);
+        return finish(j, job->node, job->from, job->group, (uint64_t)job->step + 1, weight);
     const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
     if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
         return st;
@@ -210,7 +208,7 @@ static cm_status link_node(joiner *j, const link_job *job)
         uint64_t s;
         const uint32_t g = nm->group;
         st = into_cycle(j, m, job->cell, &s);
-        return st == CM_OK ? finish(j, job->node, job->from, g, s) : st;
+        return st == CM_OK ? finish(j, job->node, job->from, g, s, weight) : st;
     }
     uint32_t g, s, open;
     st = cm_cluster_resolve(c, m, &g, &s, &open, j->msg, j->msg_size);
@@ -221,14 +219,12 @@ static cm_status link_node(joiner *j, const link_job *job)
     nd->next = m;
     nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
     if (open == CM_NODE_OPEN)
-        return finish(j, job->node, job->from, g, (uint64_t)job->step + s);
+        return finish(j, job->node, job->from, g, (uint64_t)job->step + s, weight);
     if (open == job->node)
-        return close_cycle(j, job->node);
+        return close_cycle(j, job->node, weight);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
-    uint64_t weight; /* its cells now leave through the open node it reaches */
-    if (cm_cluster_take_open(c, job->node, &weight) != CM_OK ||
-        cm_cluster_add_open_weight(c, open, weight) != CM_OK)
+    if (cm_cluster_add_open_weight(c, open, weight) != CM_OK) /* its cells leave through it */
         return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
