@@ -403,6 +403,8 @@ static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box
  * the trim before the join under way reads (next joins after it). */
 static void pin_expected(cm_cluster *c, const cm_region *next, int pin)
 {
+    if (!c->page_in || c->mem_budget == 0)
+        return; /* nothing is evicted */
     for (uint64_t e = 0; next && e < next->nexits; e++) {
         uint64_t local;
         const int64_t k = cm_cluster_locate(c, cm_region_exit(next, e), &local);
