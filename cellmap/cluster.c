@@ -285,7 +285,8 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
         (*local)[i] = cr->open_local[i];
         (*weight)[i] = cm_cluster_open_weight(c, cr->node_base + cr->open_local[i]);
     }
-    memcpy(*cells, cr->open_cells, kept * dim * sizeof **cells);
+    if (kept > 0)
+        memcpy(*cells, cr->open_cells, kept * dim * sizeof **cells);
     *n = kept;
     return CM_OK;
 }

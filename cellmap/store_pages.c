@@ -401,7 +401,7 @@ static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, int
         (*ids)[*n + i] = cr->node_base + (uint32_t)v[i];
         (*weights)[*n + i] = (uint64_t)v[m + i];
     }
-    if (st == CM_OK) {
+    if (st == CM_OK && m > 0) {
         memcpy(*cells + *n * dim, v + 2 * m, m * dim * sizeof *v);
         *n += m;
     }
