@@ -2,9 +2,11 @@
 
 #include "cellmap/grow.h"
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -377,28 +379,6 @@ static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
     sum->straddling_groups += one->straddling_groups;
 }
 
-/* Solves boxes[0..n) concurrently, one region per thread. */
-static void solve_batch(const cm_cluster *c, const cm_model *model, const cm_box *boxes, uint32_t n,
-                        const cm_scm_options *one, int threads, cm_region *solved,
-                        cm_status *status, char (*msgs)[256])
-{
-    if (n == 1) { /* a lone box (a strip uncovered by panning) takes every thread for its images */
-        cm_scm_options all = *one;
-        all.threads = threads;
-        status[0] = cm_region_alloc(&solved[0], &boxes[0], msgs[0], sizeof msgs[0]);
-        if (status[0] == CM_OK)
-            status[0] = cm_scm_solve(model, &c->lat, &all, &solved[0], msgs[0], sizeof msgs[0]);
-        return;
-    }
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int64_t k = 0; k < (int64_t)n; k++) {
-        status[k] = cm_region_alloc(&solved[k], &boxes[k], msgs[k], sizeof msgs[k]);
-        if (status[k] == CM_OK)
-            status[k] = cm_scm_solve(model, &c->lat, one, &solved[k], msgs[k], sizeof msgs[k]);
-    }
-    (void)threads;
-}
-
 /* Region `next`'s exits that land in the cluster: their regions stay through
  * the trim before the join under way reads (next joins after it). */
 static void pin_expected(cm_cluster *c, const cm_region *next, int pin)
@@ -413,6 +393,92 @@ static void pin_expected(cm_cluster *c, const cm_region *next, int pin)
     }
 }
 
+/* The pipeline of cm_cluster_solve_boxes. Box b is solved into slot
+ * b % window by whichever thread claims it: claims go in box order, at most
+ * `window` boxes ahead of the joins. Thread 0 joins the boxes in order, and
+ * solves boxes itself while the next one is not ready, so joins and commits
+ * run while the other threads solve. A region's result depends on its box
+ * alone and the joins run in box order: the cluster is the same whatever
+ * the thread count or timing. */
+typedef struct pipeline {
+    cm_cluster *c;
+    const cm_model *model;
+    const cm_box *boxes;
+    uint32_t nboxes, window;
+    cm_scm_options one;
+    cm_region *slot;
+    cm_status *status;
+    char (*msgs)[256];
+    atomic_uint next;   /* the next box to claim */
+    atomic_uint joined; /* boxes joined (and their slots free) */
+    atomic_uint *ready; /* per slot: the box solved there, plus one; 0: none */
+    atomic_int stop;    /* a join failed: no more claims */
+} pipeline;
+
+/* Claims and solves the next box if the window allows; false if it does not. */
+static bool solve_next(pipeline *p)
+{
+    unsigned b = atomic_load(&p->next);
+    do {
+        if (b >= p->nboxes || b >= atomic_load(&p->joined) + p->window || atomic_load(&p->stop))
+            return false;
+    } while (!atomic_compare_exchange_weak(&p->next, &b, b + 1));
+    const uint32_t s = b % p->window;
+    p->status[s] = cm_region_alloc(&p->slot[s], &p->boxes[b], p->msgs[s], sizeof p->msgs[s]);
+    if (p->status[s] == CM_OK)
+        p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
+                                    sizeof p->msgs[s]);
+    atomic_store(&p->ready[s], b + 1);
+    return true;
+}
+
+static void pause_briefly(void)
+{
+    const struct timespec t = {0, 20000};
+    nanosleep(&t, NULL);
+}
+
+/* The joins, in box order (thread 0). */
+static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
+                               cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    cm_cluster *c = p->c;
+    cm_status st = CM_OK;
+    for (uint32_t b = 0; b < p->nboxes && st == CM_OK; b++) {
+        const uint32_t s = b % p->window;
+        while (atomic_load(&p->ready[s]) != b + 1)
+            if (!solve_next(p))
+                pause_briefly();
+        if (p->status[s] != CM_OK)
+            st = cm_fail(p->status[s], msg, msg_size, "region %u: %s", b, p->msgs[s]);
+        const uint32_t ns = (b + 1) % p->window;
+        const cm_region *next =
+            b + 1 < p->nboxes && atomic_load(&p->ready[ns]) == b + 2 && p->status[ns] == CM_OK
+                ? &p->slot[ns]
+                : NULL;
+        /* its own box while it joins, the boxes after it from then on */
+        c->upcoming = p->boxes + b;
+        c->nupcoming = p->nboxes - b;
+        pin_expected(c, next, 1);
+        cm_join_stats one_join;
+        if (st == CM_OK)
+            st = cm_cluster_join(c, &p->slot[s], &one_join, msg, msg_size);
+        pin_expected(c, next, 0);
+        c->upcoming++;
+        c->nupcoming--;
+        if (st == CM_OK && stats)
+            add_join_stats(stats, &one_join);
+        if (st == CM_OK && joined)
+            st = joined(user, c, b, &one_join, msg, msg_size);
+        cm_region_free(&p->slot[s]);
+        atomic_store(&p->ready[s], 0u);
+        atomic_store(&p->joined, b + 1);
+    }
+    if (st != CM_OK)
+        atomic_store(&p->stop, 1);
+    return st;
+}
+
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
                                  uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
                                  void *user, cm_join_stats *stats, char *msg, size_t msg_size)
@@ -421,64 +487,51 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 #ifdef _OPENMP
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
-    const uint32_t t = (uint32_t)threads;
-    /* two batches: the next is solved before the last of this one joins */
-    cm_region *solved = calloc(2 * t, sizeof *solved);
-    cm_status *status = calloc(2 * t, sizeof *status);
-    char(*msgs)[256] = calloc(2 * t, sizeof *msgs);
-    if (!solved || !status || !msgs) {
-        free(solved);
-        free(status);
-        free(msgs);
+    pipeline p = {c, model, boxes, nboxes, 2 * (uint32_t)threads, opt ? *opt : (cm_scm_options){0},
+                  NULL, NULL, NULL, 0, 0, NULL, 0};
+    p.one.record_exits = 1;
+    /* one region per thread: classification is sequential, so this is how
+     * a big box uses every core; a lone box (a strip uncovered by panning)
+     * takes every thread for its images instead */
+    p.one.threads = nboxes == 1 ? threads : 1;
+    p.slot = calloc(p.window, sizeof *p.slot);
+    p.status = calloc(p.window, sizeof *p.status);
+    p.msgs = calloc(p.window, sizeof *p.msgs);
+    p.ready = calloc(p.window, sizeof *p.ready);
+    if (!p.slot || !p.status || !p.msgs || !p.ready) {
+        free(p.slot);
+        free(p.status);
+        free(p.msgs);
+        free(p.ready);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d regions", threads);
     }
-    cm_scm_options one = opt ? *opt : (cm_scm_options){0};
-    one.record_exits = 1;
-    one.threads = 1;
     if (stats)
         memset(stats, 0, sizeof *stats);
-    /* One region per thread: classification is sequential, so this is how
-     * a big box uses every core. Each region's result depends on its box
-     * alone, and the joins run in a fixed order. Slot b of box b is b % 2t. */
     cm_status st = CM_OK;
-    if (nboxes > 0)
-        solve_batch(c, model, boxes, nboxes < t ? nboxes : t, &one, threads, solved, status, msgs);
-    for (uint32_t b = 0; b < nboxes && st == CM_OK; b++) {
-        const uint32_t slot = b % (2 * t);
-        if (b % t == t - 1 && b + 1 < nboxes) { /* the next batch, before this box joins */
-            const uint32_t first = b + 1, n = nboxes - first < t ? nboxes - first : t;
-            const uint32_t at = first % (2 * t);
-            solve_batch(c, model, boxes + first, n, &one, threads, solved + at, status + at,
-                        msgs + at);
+    const int team = nboxes > 1 ? threads : 1;
+#pragma omp parallel num_threads(team)
+    {
+        int t = 0;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+#endif
+        if (t == 0) {
+            st = join_in_order(&p, joined, user, stats, msg, msg_size);
+        } else {
+            while (atomic_load(&p.next) < p.nboxes && !atomic_load(&p.stop))
+                if (!solve_next(&p))
+                    pause_briefly();
         }
-        cm_join_stats one_join;
-        if (status[slot] != CM_OK)
-            st = cm_fail(status[slot], msg, msg_size, "region %u: %s", b, msgs[slot]);
-        const cm_region *next = b + 1 < nboxes && status[(b + 1) % (2 * t)] == CM_OK
-                                    ? &solved[(b + 1) % (2 * t)]
-                                    : NULL;
-        /* its own box while it joins, the boxes after it from then on */
-        c->upcoming = boxes + b;
-        c->nupcoming = nboxes - b;
-        pin_expected(c, next, 1);
-        if (st == CM_OK)
-            st = cm_cluster_join(c, &solved[slot], &one_join, msg, msg_size);
-        pin_expected(c, next, 0);
-        c->upcoming++;
-        c->nupcoming--;
-        if (st == CM_OK && stats)
-            add_join_stats(stats, &one_join);
-        if (st == CM_OK && joined)
-            st = joined(user, c, b, &one_join, msg, msg_size);
-        cm_region_free(&solved[slot]);
     }
-    for (uint32_t k = 0; k < 2 * t; k++)
-        cm_region_free(&solved[k]);
+    (void)team;
+    for (uint32_t k = 0; k < p.window; k++)
+        cm_region_free(&p.slot[k]);
     c->upcoming = NULL;
     c->nupcoming = 0;
     cm_cluster_trim(c);
-    free(solved);
-    free(status);
-    free(msgs);
+    free(p.slot);
+    free(p.status);
+    free(p.msgs);
+    free(p.ready);
     return st;
 }

@@ -40,10 +40,11 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
 typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
                                   const cm_join_stats *stats, char *msg, size_t msg_size);
 
-/* Solves the boxes in batches of one box per thread (images included) and
- * joins each batch in the given order, calling joined (may be NULL) after
- * every join, so at most a batch of unjoined regions is held at once.
- * stats (may be NULL) sums the joins'. */
+/* Solves the boxes, one per thread (a lone box with every thread), and
+ * joins them in the given order on the calling thread while the others go
+ * on solving (at most two boxes per thread ahead of the joins), calling
+ * joined (may be NULL) after every join. stats (may be NULL) sums the
+ * joins'. The cluster is the same whatever the thread count. */
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
                                  uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
                                  void *user, cm_join_stats *stats, char *msg, size_t msg_size);
