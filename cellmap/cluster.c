@@ -3,6 +3,9 @@
 #include "cellmap/grow.h"
 
 #include <stdbool.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -762,6 +765,7 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
             free(cr->nodes);
             cr->nodes = NULL;
             table_bytes -= v[i].bytes;
+            c->evicted_since_trim += v[i].bytes;
         } else if (!v[i].nodes && cells > c->mem_budget) {
             if (!cr->written)
                 st = c->page_out(c->pager, c, v[i].k, msg, msg_size);
@@ -770,9 +774,18 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
             cr->written = 1;
             evict_cells(cr);
             cells -= v[i].bytes;
+            c->evicted_since_trim += v[i].bytes;
         }
     }
     free(v);
+#ifdef __GLIBC__
+    /* evicted arrays leave holes in the heap rather than free memory: give
+     * the room back now and then (it costs a walk of the heap) */
+    if (c->evicted_since_trim > c->mem_budget) {
+        malloc_trim(0);
+        c->evicted_since_trim = 0;
+    }
+#endif
     return st;
 }
 

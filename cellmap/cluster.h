@@ -161,6 +161,7 @@ typedef struct cm_cluster {
      * corner: eviction expects the next boxes to read there too */
     int64_t reach[CM_MAX_REACH][CM_MAX_DIM];
     uint32_t nreach;
+    uint64_t evicted_since_trim; /* bytes evicted since the heap was last trimmed */
     uint32_t *node_blocks; /* the region of every 1024th node id */
     uint64_t node_blocks_cap;
     uint32_t *chain; /* nodes walked while settling */
