@@ -10,7 +10,7 @@
 
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/dbfile.h"
+#include "src/project.h"
 
 static const char export_help[] =
     "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
@@ -438,9 +438,9 @@ int cmd_export(int argc, char **argv)
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;
-    if (open_cluster_file("export", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+    if (project_open_read("export", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
         return EXIT_FAIL;
     const int result = run_export(&c, &a, s, &info, &cl);
-    close_cluster_file(s, &cl);
+    project_close(s, &cl);
     return result;
 }

@@ -6,7 +6,7 @@
 
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/dbfile.h"
+#include "src/project.h"
 
 static const char info_help[] =
     "usage: cellmap info FILE.cmdb [--json]\n\n"
@@ -115,7 +115,7 @@ int cmd_info(int argc, char **argv)
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;
-    if (open_cluster_file("info", path, 0, &s, &info, &cl) != EXIT_OK)
+    if (project_open_read("info", path, 0, &s, &info, &cl) != EXIT_OK)
         return EXIT_FAIL;
     cm_group_info *g = calloc((size_t)info.groups + 1, sizeof *g);
     uint64_t sink = 0;
@@ -143,6 +143,6 @@ int cmd_info(int argc, char **argv)
         fprintf(stderr, "cellmap info: %s\n", msg);
     }
     free(g);
-    close_cluster_file(s, &cl);
+    project_close(s, &cl);
     return rc;
 }

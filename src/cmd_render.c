@@ -8,7 +8,7 @@
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
-#include "src/dbfile.h"
+#include "src/project.h"
 
 static const char render_help[] =
     "usage: cellmap render FILE.cmdb --png OUT.png [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
@@ -156,9 +156,9 @@ int cmd_render(int argc, char **argv)
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;
-    if (open_cluster_file("render", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+    if (project_open_read("render", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
         return EXIT_FAIL;
     const int result = run_render(&c, &a, s, &info, &cl);
-    close_cluster_file(s, &cl);
+    project_close(s, &cl);
     return result;
 }

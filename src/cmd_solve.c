@@ -15,7 +15,7 @@
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
-#include "src/dbfile.h"
+#include "src/project.h"
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
@@ -533,49 +533,46 @@ static void make_plan(const solve_args *a, const cm_box *box, char *out, size_t 
                  a->max_steps, a->extend, a->escape_below, a->bounds_text ? a->bounds_text : "-");
 }
 
+/* What a resumed file must have been made with. */
+typedef struct solve_fit {
+    const cm_model *m;
+    const cm_lattice *lat;
+    const char *plan, *db;
+} solve_fit;
+
+/* A project_fits_fn: the same model, parameters, lattice and plan. */
+static cm_status same_solve(void *user, const cm_store_info *info, const cm_model **model,
+                            char *msg, size_t msg_size)
+{
+    const solve_fit *f = user;
+    char params[4096];
+    cm_params_json(&f->m->values, params, sizeof params);
+    const char *differs = strcmp(info->model, f->m->name)             ? "model"
+                          : strcmp(info->params, params)              ? "parameters"
+                          : !cm_lattice_equal(&info->lattice, f->lat) ? "lattice (--region, --cells)"
+                          : strcmp(info->plan, f->plan)               ? "plan (--split, --extend, ...)"
+                                                                      : NULL;
+    if (differs)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s was made by another solve (its %s differs): resume with the options "
+                       "of: %s",
+                       f->db, differs, info->command);
+    *model = f->m;
+    return CM_OK;
+}
+
 /* The database of --db: a new one, or (--resume) the saved cluster, which
  * must come from the same model, parameters, lattice and plan. */
 static cm_status open_store(const solve_args *a, const char *command, const cm_model *m,
                             const cm_lattice *lat, const char *plan, run *rn, char *msg,
                             size_t msg_size)
 {
-    if (!a->resume) {
-        const char *epoch = getenv("SOURCE_DATE_EPOCH");
-        const cm_store_meta meta = {
-            m, lat, command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
-        cm_cluster_init(&rn->c, lat);
-        cm_status st = cm_store_create(a->db, &meta, &rn->store, msg, msg_size);
-        if (st == CM_OK) {
-            cm_store_attach(rn->store, &rn->c);
-            cm_store_set_model(rn->store, m);
-        }
-        return st;
-    }
+    if (!a->resume)
+        return project_create(a->db, m, lat, command, plan, &rn->store, &rn->c, msg, msg_size);
+    solve_fit fit = {m, lat, plan, a->db};
     cm_store_info info;
-    char params[4096];
-    cm_params_json(&m->values, params, sizeof params);
-    cm_store *check = NULL; /* read-only until the file proves to be this solve's */
-    cm_status st = cm_store_open(a->db, 0, &check, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_store_read_info(check, &info, msg, msg_size);
-    cm_store_close(check, NULL, 0);
-    if (st != CM_OK)
-        return st;
-    const char *differs = strcmp(info.model, m->name)             ? "model"
-                          : strcmp(info.params, params)           ? "parameters"
-                          : !cm_lattice_equal(&info.lattice, lat) ? "lattice (--region, --cells)"
-                          : strcmp(info.plan, plan)               ? "plan (--split, --extend, ...)"
-                                                                  : NULL;
-    if (differs)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "%s was made by another solve (its %s differs): resume with the options "
-                       "of: %s",
-                       a->db, differs, info.command);
-    st = open_cluster_for_writing("solve", a->db, &info, m, &rn->store, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    cm_store_set_model(rn->store, m);
-    return cm_store_load_cluster(rn->store, &rn->c, msg, msg_size);
+    return project_resume("solve", a->db, same_solve, &fit, &rn->store, &info, &rn->c, msg,
+                          msg_size);
 }
 
 /* --split, --extend and --db: a cluster of regions. */

@@ -13,7 +13,7 @@
 #include "render/figure.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
-#include "src/dbfile.h"
+#include "src/project.h"
 
 const char session_help[] =
     "  view X0:X1 [Y0:Y1] [at Z[,W...]]   look at this box of state space (and, for\n"
@@ -888,29 +888,37 @@ static int check_same(const session *s, const session_options *o, const cm_store
     return EXIT_OK;
 }
 
+/* What project_resume asks explore (fits_session). */
+typedef struct explore_fit {
+    session *s;
+    const session_options *o;
+    int rc; /* a refusal already reported */
+} explore_fit;
+
+/* A project_fits_fn: the file's model rebuilds, and the options agree with it. */
+static cm_status fits_session(void *user, const cm_store_info *info, const cm_model **model,
+                              char *msg, size_t msg_size)
+{
+    explore_fit *f = user;
+    f->s->max_steps = plan_max_steps(info->plan);
+    f->rc = model_of_file(f->s, info);
+    if (f->rc == EXIT_OK)
+        f->rc = check_same(f->s, f->o, info);
+    if (f->rc != EXIT_OK)
+        return cm_fail(CM_EINVAL, msg, msg_size, "refused"); /* reported */
+    *model = &f->s->model;
+    return CM_OK;
+}
+
 static int open_existing(session *s, const session_options *o)
 {
     char msg[1024];
     cm_store_info info;
-    cm_store *check = NULL; /* read-only until the file proves fit for the session */
-    cm_status st = cm_store_open(s->path, 0, &check, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_store_read_info(check, &info, msg, sizeof msg);
-    cm_store_close(check, NULL, 0);
-    if (st != CM_OK)
-        return open_error("%s", msg);
-    s->max_steps = plan_max_steps(info.plan);
-    int rc = model_of_file(s, &info);
-    if (rc == EXIT_OK)
-        rc = check_same(s, o, &info);
-    if (rc != EXIT_OK)
-        return rc;
-    if (open_cluster_for_writing("explore", s->path, &info, &s->model, &s->store, msg,
-                                 sizeof msg) != CM_OK)
-        return open_error("%s", msg);
-    cm_cluster_init(&s->c, &info.lattice);
-    if (cm_store_load_cluster(s->store, &s->c, msg, sizeof msg) != CM_OK)
-        return open_error("%s", msg);
+    explore_fit fit = {s, o, EXIT_OK};
+    if (project_resume("explore", s->path, fits_session, &fit, &s->store, &info, &s->c, msg,
+                       sizeof msg) != CM_OK)
+        return fit.rc != EXIT_OK ? fit.rc : open_error("%s", msg);
+    int rc;
     s->dim = info.lattice.dim;
     s->view_dims = s->dim < 2 ? s->dim : 2;
     if ((rc = restore_depth(s)) != EXIT_OK)
@@ -976,11 +984,8 @@ static int create_new(session *s, const session_options *o)
         return rc;
     char plan[64];
     snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
-    const char *epoch = getenv("SOURCE_DATE_EPOCH");
-    const cm_store_meta meta = {
-        &s->model, &lat, o->command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
-    cm_cluster_init(&s->c, &lat);
-    if (cm_store_create(s->path, &meta, &s->store, msg, sizeof msg) != CM_OK)
+    if (project_create(s->path, &s->model, &lat, o->command, plan, &s->store, &s->c, msg,
+                       sizeof msg) != CM_OK)
         return open_error("%s", msg);
     return new_depth(s, o);
 }
@@ -995,8 +1000,6 @@ int session_open(session *s, const session_options *o)
     const int rc = stat(o->path, &sb) == 0 ? open_existing(s, o) : create_new(s, o);
     if (rc != EXIT_OK)
         return rc;
-    cm_store_attach(s->store, &s->c);
-    cm_store_set_model(s->store, &s->model);
     s->c.threads = o->threads;
     s->c.mem_budget = o->mem;
     return EXIT_OK;

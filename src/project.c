@@ -1,13 +1,14 @@
-#include "src/dbfile.h"
+#include "src/project.h"
 
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "models/registry.h"
 #include "src/args.h"
 
-int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
+int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
                       cm_store_info *info, cm_cluster *c)
 {
     char msg[1024];
@@ -21,7 +22,7 @@ int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm
         st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
     if (st != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-        close_cluster_file(*s, c);
+        project_close(*s, c);
         *s = NULL;
         return EXIT_FAIL;
     }
@@ -29,29 +30,57 @@ int open_cluster_file(const char *cmd, const char *path, uint64_t mem_budget, cm
     return EXIT_OK;
 }
 
-void close_cluster_file(cm_store *s, cm_cluster *c)
+void project_close(cm_store *s, cm_cluster *c)
 {
     char msg[256];
     cm_cluster_free(c);
     cm_store_close(s, msg, sizeof msg);
 }
 
-cm_status open_cluster_for_writing(const char *cmd, const char *path, const cm_store_info *info,
-                                   const cm_model *model, cm_store **s, char *msg,
-                                   size_t msg_size)
+cm_status project_create(const char *path, const cm_model *m, const cm_lattice *lat,
+                         const char *command, const char *plan, cm_store **s, cm_cluster *c,
+                         char *msg, size_t msg_size)
 {
+    const char *epoch = getenv("SOURCE_DATE_EPOCH"); /* reproducible files */
+    const cm_store_meta meta = {m, lat, command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
+    cm_cluster_init(c, lat);
+    cm_status st = cm_store_create(path, &meta, s, msg, msg_size);
+    if (st == CM_OK) {
+        cm_store_attach(*s, c);
+        cm_store_set_model(*s, m);
+    }
+    return st;
+}
+
+cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits, void *user,
+                         cm_store **s, cm_store_info *info, cm_cluster *c, char *msg,
+                         size_t msg_size)
+{
+    /* read-only until the file proves to be the caller's: a refused file
+     * is never written */
+    cm_store *check = NULL;
+    const cm_model *model = NULL;
+    cm_status st = cm_store_open(path, 0, &check, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_read_info(check, info, msg, msg_size);
+    cm_store_close(check, NULL, 0);
+    if (st == CM_OK)
+        st = fits(user, info, &model, msg, msg_size);
     int upgraded = 0;
-    if (info->version < CM_STORE_VERSION) {
-        cm_status st = cm_store_upgrade(path, model, &upgraded, msg, msg_size);
-        if (st != CM_OK)
-            return st;
-        if (upgraded)
+    if (st == CM_OK && info->version < CM_STORE_VERSION) {
+        st = cm_store_upgrade(path, model, &upgraded, msg, msg_size);
+        if (st == CM_OK && upgraded)
             fprintf(stderr,
                     "cellmap %s: upgraded %s from format version %d to %d (older cellmap "
                     "versions cannot open it any more)\n",
                     cmd, path, info->version, CM_STORE_VERSION);
     }
-    return cm_store_open(path, 1, s, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_open(path, 1, s, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_store_set_model(*s, model);
+    return cm_store_load_cluster(*s, c, msg, msg_size);
 }
 
 const char *axis_name(int d)
