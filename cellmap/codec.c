@@ -1,5 +1,6 @@
 #include "cellmap/codec.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <zstd.h>
 
@@ -56,8 +57,38 @@ static void unplanes_u32(const unsigned char *planes, size_t n, int64_t first_in
                relative * (base + (uint32_t)i);
 }
 
-cm_status cm_codec_encode(const void *v, size_t n, int width, int64_t first_index, void *scratch,
-                          void *out, size_t out_cap, size_t *len)
+struct cm_codec_ctx {
+    ZSTD_CCtx *zstd;
+};
+
+cm_status cm_codec_ctx_new(cm_codec_ctx **out)
+{
+    cm_codec_ctx *ctx = malloc(sizeof *ctx);
+    ZSTD_CCtx *zstd = ZSTD_createCCtx();
+    /* the frame's checksum makes a damaged BLOB an error when it is read */
+    if (!ctx || !zstd || ZSTD_isError(ZSTD_CCtx_setParameter(zstd, ZSTD_c_compressionLevel,
+                                                             CODEC_LEVEL)) ||
+        ZSTD_isError(ZSTD_CCtx_setParameter(zstd, ZSTD_c_checksumFlag, 1))) {
+        ZSTD_freeCCtx(zstd);
+        free(ctx);
+        return CM_ENOMEM;
+    }
+    ctx->zstd = zstd;
+    *out = ctx;
+    return CM_OK;
+}
+
+void cm_codec_ctx_free(cm_codec_ctx *ctx)
+{
+    if (!ctx)
+        return;
+    ZSTD_freeCCtx(ctx->zstd);
+    free(ctx);
+}
+
+cm_status cm_codec_encode_with(cm_codec_ctx *ctx, const void *v, size_t n, int width,
+                               int64_t first_index, void *scratch, void *out, size_t out_cap,
+                               size_t *len)
 {
     unsigned char *planes = scratch;
     if (width == 4) {
@@ -69,20 +100,23 @@ cm_status cm_codec_encode(const void *v, size_t n, int width, int64_t first_inde
                 planes[(size_t)b * n + i] = (unsigned char)(x >> (8 * b));
         }
     }
-    /* the frame's checksum makes a damaged BLOB an error when it is read */
-    ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    if (!cctx)
-        return CM_ENOMEM;
-    size_t r = ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, CODEC_LEVEL);
-    if (!ZSTD_isError(r))
-        r = ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-    if (!ZSTD_isError(r))
-        r = ZSTD_compress2(cctx, out, out_cap, planes, n * (size_t)width);
-    ZSTD_freeCCtx(cctx);
+    const size_t r = ZSTD_compress2(ctx->zstd, out, out_cap, planes, n * (size_t)width);
     if (ZSTD_isError(r))
         return CM_ENOMEM;
     *len = r;
     return CM_OK;
+}
+
+cm_status cm_codec_encode(const void *v, size_t n, int width, int64_t first_index, void *scratch,
+                          void *out, size_t out_cap, size_t *len)
+{
+    cm_codec_ctx *ctx;
+    if (cm_codec_ctx_new(&ctx) != CM_OK)
+        return CM_ENOMEM;
+    const cm_status st =
+        cm_codec_encode_with(ctx, v, n, width, first_index, scratch, out, out_cap, len);
+    cm_codec_ctx_free(ctx);
+    return st;
 }
 
 cm_status cm_codec_decode(const void *in, size_t len, size_t n, int width, int64_t first_index,

@@ -538,20 +538,23 @@ static cm_status encode_batch(cm_store *s, const cm_region *r, uint64_t first, i
 {
     int failed = 0;
     const int tasks = 3 * n;
-#pragma omp parallel num_threads(s->threads) if (tasks > 1)
+#pragma omp parallel num_threads(s->threads) if (tasks > 1) reduction(| : failed)
     {
         unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
-        failed |= !scratch;
-#pragma omp for schedule(dynamic, 1) reduction(| : failed)
+        cm_codec_ctx *ctx = NULL;
+        const int ready = scratch && cm_codec_ctx_new(&ctx) == CM_OK;
+        failed |= !ready;
+#pragma omp for schedule(dynamic, 1)
         for (int t = 0; t < tasks; t++) {
             const uint64_t page = first + (uint64_t)(t / 3), cell = page * CM_STORE_PAGE_CELLS;
             const int col = t % 3;
             const uint32_t *const arrays[3] = {r->image, r->group, r->step};
-            failed |= !scratch ||
-                      cm_codec_encode(arrays[col] + cell, page_cells(r->ncells, page), 4,
-                                      col == 0 ? (int64_t)cell : -1, scratch,
-                                      s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
+            failed |= !ready ||
+                      cm_codec_encode_with(ctx, arrays[col] + cell, page_cells(r->ncells, page),
+                                           4, col == 0 ? (int64_t)cell : -1, scratch,
+                                           s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
         }
+        cm_codec_ctx_free(ctx);
         free(scratch);
     }
     return failed ? CM_ENOMEM : CM_OK;
