@@ -60,6 +60,7 @@ void cm_cluster_free(cm_cluster *c)
     for (uint32_t k = 0; k < c->nregions; k++) {
         cm_region_free(&c->regions[k].r);
         free(c->regions[k].nodes);
+        free(c->regions[k].dirty_chunks);
         free(c->regions[k].open_local);
         free(c->regions[k].open_cells);
     }
@@ -620,6 +621,13 @@ static void next_uses(const cm_cluster *c, uint32_t *use)
     }
 }
 
+void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
+{
+    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+    cr->nodes_dirty = 1;
+    cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
+}
+
 void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k)
 {
     int64_t off[CM_MAX_DIM] = {0};
@@ -821,6 +829,8 @@ void cm_cluster_saved(cm_cluster *c)
 {
     for (uint32_t k = 0; k < c->nregions; k++) {
         c->regions[k].written = 1;
+        if (c->regions[k].nodes_dirty)
+            memset(c->regions[k].dirty_chunks, 0, c->regions[k].r.nexits / CM_NODE_CHUNK + 1);
         c->regions[k].nodes_dirty = 0;
     }
     if (c->basin_dirty)
@@ -955,6 +965,8 @@ static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node 
     cr->nodes = calloc(n + 1, sizeof *cr->nodes);
     if (!cr->nodes)
         return CM_ENOMEM;
+    if (!saved) /* a new region: every chunk is to be saved */
+        memset(cr->dirty_chunks, 1, n / CM_NODE_CHUNK + 1);
     for (uint64_t e = 0; e < n; e++) {
         cm_node *nd = &cr->nodes[e];
         if (saved) {
@@ -1028,7 +1040,8 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
     memset(cr, 0, sizeof *cr);
     cr->node_base = (uint32_t)c->nnodes;
     cr->r.nexits = r->nexits;
-    if (init_nodes(c, cr, NULL) != CM_OK ||
+    cr->dirty_chunks = calloc(r->nexits / CM_NODE_CHUNK + 1, 1);
+    if (!cr->dirty_chunks || init_nodes(c, cr, NULL) != CM_OK ||
         take_cells(c, r, base, cr->nodes) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     cr->r = *r;
@@ -1061,6 +1074,9 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
     cr->r.exits_recorded = 1;
     cr->node_base = (uint32_t)c->nnodes;
     cr->written = 1;
+    cr->dirty_chunks = calloc(record->nexits / CM_NODE_CHUNK + 1, 1);
+    if (!cr->dirty_chunks)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     if (!nodes)
         c->nnodes += record->nexits; /* the table stays in the file until it is used */
     else if (init_nodes(c, cr, nodes) != CM_OK)

@@ -48,6 +48,10 @@
 #include "cellmap/idmap.h"
 #include "cellmap/scm.h"
 
+/* Node records are saved in chunks of this many, each rewritten only when
+ * one of its nodes changed. */
+#define CM_NODE_CHUNK 4096
+
 /* Offsets remembered from a join for eviction (cm_cluster.reach). */
 #define CM_MAX_REACH 64
 
@@ -84,6 +88,7 @@ typedef struct cm_cluster_region {
     uint32_t node_base; /* id of the node of exit 0 */
     int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
     int nodes_dirty;    /* read-only: node records changed since the owner saved them */
+    uint8_t *dirty_chunks; /* read-only: per CM_NODE_CHUNK nodes, whether one of them did */
     /* read-only: the region's open nodes indexed as escapes, in node order
      * (open_local[i]: the exit, open_cells[i * dim ..]: its target), some
      * of them linked since; open_dirty: one changed since the owner saved
@@ -226,6 +231,9 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
  * out of the index: a new array of *n of them (ascending by node id) that
  * the caller frees. */
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
+
+/* Node id's record changed: its chunk is saved at the next commit. */
+void cm_cluster_touch_node(cm_cluster *c, uint32_t id);
 
 /* Notes that the join of region `joined` reads region k (cm_cluster.reach). */
 void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k);

@@ -14,8 +14,7 @@
 /* A link to make: node `node`'s exit leads to cell `cell` of region `region`,
  * whose group and step are read before linking. */
 typedef struct link_job {
-    uint32_t node, from; /* the node and its region */
-    uint32_t region, cell, group, step;
+    uint32_t node, region, cell, group, step;
 } link_job;
 
 typedef struct joiner {
@@ -28,18 +27,18 @@ typedef struct joiner {
     size_t msg_size;
 } joiner;
 
-/* A node of region k changed. */
-static void touch_in(joiner *j, uint32_t k)
+/* Node id's record changed. */
+static void touch(joiner *j, uint32_t id)
 {
-    j->c->regions[k].nodes_dirty = 1;
+    const uint32_t k = cm_cluster_node_region(j->c, id);
+    cm_cluster_touch_node(j->c, id);
     j->stats->affected_regions += !j->touched[k];
     j->touched[k] = 1;
 }
 
-/* The sequences through node id (of region `region`, open until now, the
- * cells of weight `weight`) take group g; its cell's step is s. */
-static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uint64_t s,
-                        uint64_t weight)
+/* The sequences through node id (open until now, the cells of weight
+ * `weight`) take group g; its cell's step is s. */
+static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s, uint64_t weight)
 {
     if (s >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
@@ -59,7 +58,7 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t region, uint32_t g, uin
         j->c->basin_dirty[g] = 1;
         j->stats->resolved_cells += weight;
     }
-    touch_in(j, region);
+    touch(j, id);
     return CM_OK;
 }
 
@@ -126,7 +125,7 @@ static cm_status settle_linked_in(joiner *j, uint32_t q, uint32_t g)
             np->next = np->up = CM_NODE_FINAL;
             np->dist = np->up_dist = (uint32_t)s;
             np->group = g;
-            touch_in(j, cm_cluster_node_region(j->c, p));
+            touch(j, p);
         }
         np->sibling = CM_NODE_OPEN;
         p = sibling;
@@ -173,7 +172,7 @@ static cm_status close_cycle(joiner *j, uint32_t n, uint64_t weight)
         nd->group = g;
         nd->up = CM_NODE_CYCLE;
         nd->up_dist = 0;
-        touch_in(j, cm_cluster_node_region(j->c, j->stack[i]));
+        touch(j, j->stack[i]);
     }
     /* once all of them are cycle nodes: their cells, and who linked in */
     for (uint64_t i = 0; i < len && st == CM_OK; i++) {
@@ -202,7 +201,7 @@ static cm_status link_node(joiner *j, const link_job *job)
         return st;
     nd->target = job->cell;
     if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
-        return finish(j, job->node, job->from, job->group, (uint64_t)job->step + 1, weight);
+        return finish(j, job->node, job->group, (uint64_t)job->step + 1, weight);
     const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
     if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
         return st;
@@ -210,7 +209,7 @@ static cm_status link_node(joiner *j, const link_job *job)
         uint64_t s;
         const uint32_t g = nm->group;
         st = into_cycle(j, m, job->cell, &s);
-        return st == CM_OK ? finish(j, job->node, job->from, g, s, weight) : st;
+        return st == CM_OK ? finish(j, job->node, g, s, weight) : st;
     }
     uint32_t g, s, open;
     st = cm_cluster_resolve(c, m, &g, &s, &open, j->msg, j->msg_size);
@@ -221,7 +220,7 @@ static cm_status link_node(joiner *j, const link_job *job)
     nd->next = m;
     nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
     if (open == CM_NODE_OPEN)
-        return finish(j, job->node, job->from, g, (uint64_t)job->step + s, weight);
+        return finish(j, job->node, g, (uint64_t)job->step + s, weight);
     if (open == job->node)
         return close_cycle(j, job->node, weight);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
@@ -236,8 +235,8 @@ static cm_status link_node(joiner *j, const link_job *job)
         return st;
     nd->sibling = nm->first_in;
     nm->first_in = job->node;
-    touch_in(j, job->region);
-    touch_in(j, job->from);
+    touch(j, m);
+    touch(j, job->node);
     return CM_OK;
 }
 
@@ -294,12 +293,8 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
     if (st == CM_OK &&
         cm_grow((void **)jobs, &cap, nin + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
         st = CM_ENOMEM;
-    uint32_t from = 0; /* the region of in[i].node: ids ascend, so it only moves on */
-    for (uint64_t i = 0; i < nin && st == CM_OK; i++) {
-        while (from + 1 < c->nregions && c->regions[from + 1].node_base <= in[i].node)
-            from++;
-        (*jobs)[(*n)++] = (link_job){in[i].node, from, added, in[i].cell, 0, 0};
-    }
+    for (uint64_t i = 0; i < nin && st == CM_OK; i++)
+        (*jobs)[(*n)++] = (link_job){in[i].node, added, in[i].cell, 0, 0};
     free(in);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
         const int64_t *cell = cm_region_exit(&cr->r, e);
@@ -309,7 +304,7 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
         if (k < 0)
             st = cm_cluster_add_escape(c, id, cell, cr->nodes[e].tree);
         else
-            (*jobs)[(*n)++] = (link_job){id, added, (uint32_t)k, (uint32_t)local, 0, 0};
+            (*jobs)[(*n)++] = (link_job){id, (uint32_t)k, (uint32_t)local, 0, 0};
     }
     return st;
 }

@@ -121,11 +121,9 @@ const char *const store_tables_sql =
     " PRIMARY KEY(region, first_cell));"
     "CREATE TABLE exits(region INTEGER PRIMARY KEY REFERENCES regions(id),"
     " count INTEGER NOT NULL, targets BLOB NOT NULL);"
-    "CREATE TABLE nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"
-    " count INTEGER NOT NULL, data BLOB NOT NULL);"
+    NODES_TABLE_SQL
     "CREATE TABLE basins(grp INTEGER PRIMARY KEY, cells INTEGER NOT NULL);"
-    "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"
-    " count INTEGER NOT NULL, data BLOB NOT NULL);"
+    OPEN_NODES_TABLE_SQL
     "CREATE TABLE attractors(id INTEGER PRIMARY KEY, period INTEGER NOT NULL,"
     " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
     " periodic_cells BLOB NOT NULL,"

@@ -29,12 +29,21 @@ struct cm_store {
 
 /* Node records as saved: little-endian uint32 columns of n entries, encoded
  * as one BLOB: next, dist, group, target, tree, then (version 5) first_in
- * and sibling. */
+ * and sibling. Version 5 keeps a row per CM_NODE_CHUNK nodes, version 4 one
+ * per region. */
 #define NODE_FIELDS 7
 #define NODE_FIELDS_V4 5
 
-/* The tables and view of a version 4 file, meta excepted. */
+/* The tables and view of a version 5 file, meta excepted; the two tables
+ * version 5 changed (for the upgrade of version 4). */
 extern const char *const store_tables_sql;
+#define NODES_TABLE_SQL                                                                            \
+    "CREATE TABLE nodes(region INTEGER NOT NULL REFERENCES regions(id),"                           \
+    " first INTEGER NOT NULL, count INTEGER NOT NULL, data BLOB NOT NULL,"                         \
+    " PRIMARY KEY(region, first));"
+#define OPEN_NODES_TABLE_SQL                                                                       \
+    "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"                   \
+    " count INTEGER NOT NULL, data BLOB NOT NULL);"
 
 double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);

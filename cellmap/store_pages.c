@@ -208,7 +208,32 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
     return CM_OK;
 }
 
-/* Region k's n node records as saved (NODE_FIELDS) into nodes[0..n). */
+/* Decodes one row of node records (fields columns of n entries) into nodes. */
+static cm_status decode_nodes(const void *blob, int len, uint64_t n, uint64_t fields,
+                              cm_node *nodes)
+{
+    uint32_t *cols = malloc((fields * n + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (fields * n + 1));
+    cm_status st = cols && scratch ? CM_OK : CM_ENOMEM;
+    if (st == CM_OK && ((n > 0 && !blob) ||
+                        (blob && cm_codec_decode(blob, (size_t)len, fields * n, 4, -1, scratch,
+                                                 cols) != CM_OK)))
+        st = CM_EFORMAT;
+    for (uint64_t e = 0; st == CM_OK && e < n; e++)
+        nodes[e] = (cm_node){.next = cols[e],
+                             .dist = cols[n + e],
+                             .group = cols[2 * n + e],
+                             .target = cols[3 * n + e],
+                             .tree = cols[4 * n + e],
+                             .first_in = fields > 5 ? cols[5 * n + e] : CM_NODE_OPEN,
+                             .sibling = fields > 5 ? cols[6 * n + e] : CM_NODE_OPEN};
+    free(cols);
+    free(scratch);
+    return st;
+}
+
+/* Region k's n node records as saved into nodes[0..n): version 5's rows of
+ * CM_NODE_CHUNK nodes, or version 4's one row. */
 static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes, char *msg,
                             size_t msg_size)
 {
@@ -218,43 +243,38 @@ static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes,
                                  .sibling = CM_NODE_OPEN};
         return CM_OK;
     }
-    const uint64_t fields = s->version >= 5 ? NODE_FIELDS : NODE_FIELDS_V4;
-    uint32_t *cols = malloc((fields * n + 1) * sizeof *cols);
-    unsigned char *scratch = malloc(4 * (fields * n + 1));
+    const bool chunked = s->version >= 5;
     sqlite3_stmt *st = NULL;
-    cm_status status = cols && scratch ? CM_OK
-                                       : cm_fail(CM_ENOMEM, msg, msg_size,
-                                                 "out of memory for %llu nodes",
-                                                 (unsigned long long)n);
-    if (status == CM_OK &&
-        sqlite3_prepare_v2(s->db, "SELECT count, data FROM nodes WHERE region=?", -1, &st, NULL))
-        status = store_db_error(s->db, "read nodes", msg, msg_size);
-    if (status == CM_OK) {
-        const void *blob = NULL;
-        int len = 0;
-        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-        if (sqlite3_step(st) == SQLITE_ROW && (uint64_t)sqlite3_column_int64(st, 0) == n) {
-            blob = sqlite3_column_blob(st, 1);
-            len = sqlite3_column_bytes(st, 1);
-        }
-        if ((n > 0 && !blob) ||
-            (blob && cm_codec_decode(blob, (size_t)len, fields * n, 4, -1, scratch, cols) != CM_OK))
-            status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u",
-                             s->path, k + 1);
+    if (sqlite3_prepare_v2(s->db,
+                           chunked ? "SELECT first, count, data FROM nodes WHERE region=? ORDER BY "
+                                     "first"
+                                   : "SELECT 0, count, data FROM nodes WHERE region=?",
+                           -1, &st, NULL))
+        return store_db_error(s->db, "read nodes", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+    cm_status status = CM_OK;
+    uint64_t seen = 0;
+    while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const int64_t first = sqlite3_column_int64(st, 0), count = sqlite3_column_int64(st, 1);
+        const int len = sqlite3_column_bytes(st, 2);
+        if (first != (int64_t)seen || count < 0 || (uint64_t)count > n - seen ||
+            (chunked && count > CM_NODE_CHUNK))
+            status = CM_EFORMAT;
+        else
+            status = decode_nodes(sqlite3_column_blob(st, 2), len, (uint64_t)count,
+                                  chunked ? NODE_FIELDS : NODE_FIELDS_V4, nodes + seen);
+        seen += status == CM_OK ? (uint64_t)count : 0;
         s->stats.bytes_read += (uint64_t)len;
     }
-    for (uint64_t e = 0; status == CM_OK && e < n; e++)
-        nodes[e] = (cm_node){.next = cols[e],
-                             .dist = cols[n + e],
-                             .group = cols[2 * n + e],
-                             .target = cols[3 * n + e],
-                             .tree = cols[4 * n + e],
-                             .first_in = fields > 5 ? cols[5 * n + e] : CM_NODE_OPEN,
-                             .sibling = fields > 5 ? cols[6 * n + e] : CM_NODE_OPEN};
     sqlite3_finalize(st);
-    free(cols);
-    free(scratch);
-    return status;
+    if (status == CM_OK && seen != n)
+        status = CM_EFORMAT;
+    if (status == CM_EFORMAT)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: nodes of region %u", s->path,
+                       k + 1);
+    return status == CM_OK ? CM_OK
+                           : cm_fail(status, msg, msg_size, "out of memory for %llu nodes",
+                                     (unsigned long long)n);
 }
 
 /* The pager of node tables (cm_nodes_in_fn). */
@@ -599,45 +619,51 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
     return status;
 }
 
-/* Replaces region k's node records (NODE_FIELDS columns). Only the
- * fields that say what a node's exit leads to are saved: a final group is
- * kept for final and cycle nodes only, so the file does not depend on what
- * readers resolved. */
+/* Region k's node records that changed: each chunk of CM_NODE_CHUNK nodes
+ * with a changed record, as one row (NODE_FIELDS columns). Only the fields
+ * that say what a node's exit leads to are saved: a final group is kept for
+ * final and cycle nodes only, so the file does not depend on what readers
+ * resolved. */
 cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
-                             size_t msg_size)
+                            size_t msg_size)
 {
     const cm_cluster_region *cr = &c->regions[k];
-    const uint64_t n = cr->r.nexits;
-    uint32_t *cols = malloc((NODE_FIELDS * n + 1) * sizeof *cols);
-    unsigned char *scratch = malloc(4 * (NODE_FIELDS * n + 1));
-    const size_t bound = cm_codec_bound(4 * (NODE_FIELDS * n + 1));
+    const uint64_t chunk = CM_NODE_CHUNK;
+    uint32_t *cols = malloc((NODE_FIELDS * chunk + 1) * sizeof *cols);
+    unsigned char *scratch = malloc(4 * (NODE_FIELDS * chunk + 1));
+    const size_t bound = cm_codec_bound(4 * (NODE_FIELDS * chunk + 1));
     unsigned char *blob = malloc(bound);
-    size_t len = 0;
+    sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
     if (!cols || !scratch || !blob)
         status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
-    for (uint64_t e = 0; status == CM_OK && e < n; e++) {
-        const cm_node *nd = &cr->nodes[e];
-        const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
-        cols[e] = nd->next;
-        cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
-        cols[2 * n + e] = known ? nd->group : 0;
-        cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
-        cols[4 * n + e] = nd->tree;
-        cols[5 * n + e] = nd->first_in;
-        cols[6 * n + e] = nd->sibling;
-    }
-    if (status == CM_OK &&
-        cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK)
-        status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
-    sqlite3_stmt *st = NULL;
-    if (status == CM_OK &&
-        sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?)", -1, &st, NULL))
+    else if (sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?, ?)", -1, &st,
+                                NULL))
         status = store_db_error(s->db, "prepare nodes", msg, msg_size);
-    if (status == CM_OK) {
+    for (uint64_t first = 0; status == CM_OK && first < cr->r.nexits; first += chunk) {
+        if (!cr->dirty_chunks[first / chunk])
+            continue;
+        const uint64_t n = cr->r.nexits - first < chunk ? cr->r.nexits - first : chunk;
+        for (uint64_t e = 0; e < n; e++) {
+            const cm_node *nd = &cr->nodes[first + e];
+            const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+            cols[e] = nd->next;
+            cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
+            cols[2 * n + e] = known ? nd->group : 0;
+            cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
+            cols[4 * n + e] = nd->tree;
+            cols[5 * n + e] = nd->first_in;
+            cols[6 * n + e] = nd->sibling;
+        }
+        size_t len = 0;
+        if (cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK) {
+            status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
+            break;
+        }
         sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-        sqlite3_bind_int64(st, 2, (sqlite3_int64)n);
-        sqlite3_bind_blob(st, 3, blob, (int)len, SQLITE_STATIC);
+        sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
+        sqlite3_bind_int64(st, 3, (sqlite3_int64)n);
+        sqlite3_bind_blob(st, 4, blob, (int)len, SQLITE_STATIC);
         status = store_step_done(s->db, st, "write nodes", msg, msg_size);
         s->stats.bytes_written += len;
         s->stats.node_tables_written++;

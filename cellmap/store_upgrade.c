@@ -167,23 +167,24 @@ static cm_status list_linked_in(cm_cluster *c, char *msg, size_t msg_size)
             }
         }
     }
-    for (uint32_t k = 0; k < c->nregions; k++)
-        c->regions[k].nodes_dirty = 1; /* every table is written again, in version 5 */
+    for (uint32_t k = 0; k < c->nregions; k++) { /* every table is written again, in version 5 */
+        c->regions[k].nodes_dirty = 1;
+        memset(c->regions[k].dirty_chunks, 1, c->regions[k].r.nexits / CM_NODE_CHUNK + 1);
+    }
     return st;
 }
 
 /* Version 4 had everything but the open nodes, which it rebuilt from every
- * node table at each open, and the lists of linked-in nodes: they are added
- * from the cluster loaded that way. */
+ * node table at each open, the lists of linked-in nodes and node rows by
+ * chunks: they are written from the cluster loaded that way. */
 static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
 {
     cm_cluster c;
     cm_status st = cm_store_load_cluster(s, &c, msg, msg_size);
     if (st == CM_OK)
         st = list_linked_in(&c, msg, msg_size);
-    if (st == CM_OK && store_exec(s->db, "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY"
-                                         " REFERENCES regions(id), count INTEGER NOT NULL,"
-                                         " data BLOB NOT NULL)") != SQLITE_OK)
+    if (st == CM_OK &&
+        store_exec(s->db, "DROP TABLE nodes;" NODES_TABLE_SQL OPEN_NODES_TABLE_SQL) != SQLITE_OK)
         st = store_db_error(s->db, "add the open nodes", msg, msg_size);
     for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++) {
         st = store_write_nodes(s, &c, k, msg, msg_size);

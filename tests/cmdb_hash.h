@@ -15,7 +15,7 @@ static inline uint64_t cmdb_content_hash(const char *path)
         "SELECT * FROM regions ORDER BY id",
         "SELECT * FROM pages ORDER BY region, first_cell",
         "SELECT * FROM exits ORDER BY region",
-        "SELECT * FROM nodes ORDER BY region",
+        "SELECT * FROM nodes ORDER BY region, first",
         "SELECT * FROM basins ORDER BY grp",
         "SELECT * FROM open_nodes ORDER BY region",
         "SELECT * FROM attractors ORDER BY id",
