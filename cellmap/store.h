@@ -4,9 +4,10 @@
  * A .cmdb file holds one cluster: metadata (model, parameters as JSON,
  * lattice, tool version, command line, solve plan), the regions in join
  * order, their cell arrays as compressed pages of CM_STORE_PAGE_CELLS cells
- * (cellmap/codec.h), their exit tables, each region's cell count per group,
- * and the attractors (periodic groups). The view `groups` adds basin sizes
- * and the sink. Layout: README, "The .cmdb database".
+ * (cellmap/codec.h), their exit tables, node tables and open nodes, the
+ * cell count per group, and the attractors (periodic groups). The view
+ * `groups` adds basin sizes and the sink. Layout: README, "The .cmdb
+ * format".
  *
  * The file carries application_id CM_STORE_APP_ID and user_version
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another

@@ -4,7 +4,7 @@
  *   store_pages.c   region rows, cell pages, exit and node tables; the
  *                   pager; loading a saved cluster
  *   store_commit.c  groups, basins and commits
- *   store_upgrade.c files of versions 2 and 3 to version 4
+ *   store_upgrade.c files of versions 2, 3 and 4 to version 5
  */
 #ifndef CM_STORE_DB_H
 #define CM_STORE_DB_H

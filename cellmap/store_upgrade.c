@@ -100,7 +100,7 @@ static cm_status same_cells(cm_store *s, const cm_cluster *saved, cm_cluster *c,
     return st;
 }
 
-/* The old tables out, version 4's in, written from c. */
+/* The old tables out, this version's in, written from c. */
 static cm_status rewrite(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
     if (store_exec(s->db, "DROP VIEW IF EXISTS temp.groups; DROP VIEW main.groups;"
