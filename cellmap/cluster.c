@@ -98,6 +98,35 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *lo
     return -1;
 }
 
+/* Calls found(user, k) for each region k that meets box, until it returns
+ * true (then true): the regions of the bricks the box meets and the big
+ * ones, or every region for a box of very many bricks. */
+static bool find_regions_meeting(const cm_cluster *c, const cm_box *box,
+                                 bool (*found)(void *user, uint32_t k), void *user)
+{
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
+    cm_box both;
+    if (!c->region_bricks || !cm_bricks_span(c->region_bricks, box, lo, hi)) {
+        for (uint32_t k = 0; k < c->nregions; k++)
+            if (cm_box_intersect(&c->regions[k].r.box, box, &both) && found(user, k))
+                return true;
+        return false;
+    }
+    for (uint64_t b = 0; b < c->nbig; b++)
+        if (cm_box_intersect(&c->regions[c->big[b]].r.box, box, &both) && found(user, c->big[b]))
+            return true;
+    memcpy(key, lo, sizeof key);
+    do {
+        uint64_t n;
+        const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &n);
+        for (uint64_t p = 0; p < n; p++)
+            if (cm_box_intersect(&c->regions[in_brick[p]].r.box, box, &both) &&
+                found(user, in_brick[p]))
+                return true;
+    } while (cm_index_next(c->lat.dim, lo, hi, key));
+    return false;
+}
+
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
 {
     /* the region of the block's first id, then on to the one holding id
@@ -147,8 +176,8 @@ static void start_resolution(cm_node *nd)
     }
 }
 
-cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
-                                size_t msg_size)
+/* Region k's node table, read back if it was paged out. */
+static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg, size_t msg_size)
 {
     cm_cluster_region *cr = &c->regions[k];
     cr->nodes_used = ++c->clock;
@@ -186,7 +215,7 @@ cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, 
         return cm_fail(CM_EFORMAT, msg, msg_size, "node %u is not in the cluster", id);
     const uint32_t k = cm_cluster_node_region(c, id);
     cm_node *table;
-    cm_status st = cm_cluster_node_table(c, k, &table, msg, msg_size);
+    cm_status st = node_table(c, k, &table, msg, msg_size);
     if (st == CM_OK)
         *out = &table[id - c->regions[k].node_base];
     return st;
@@ -200,6 +229,21 @@ static bool still_indexed(const cm_cluster *c, const cm_cluster_region *cr, uint
         return is_open(&cr->nodes[e]) && (cr->nodes[e].target & INDEXED_FLAG);
     const uint64_t *v = cm_idmap_find(&c->open, cr->node_base + e);
     return v && (*v & INDEXED);
+}
+
+/* Region cr's open list with room for cap nodes (at least nopen). */
+static cm_status resize_open_list(const cm_cluster *c, cm_cluster_region *cr, uint64_t cap)
+{
+    const size_t dim = (size_t)c->lat.dim;
+    uint32_t *local = realloc(cr->open_local, cap * sizeof *local);
+    if (local)
+        cr->open_local = local;
+    int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
+    if (!cells)
+        return CM_ENOMEM;
+    cr->open_cells = cells;
+    cr->open_cap = cap;
+    return CM_OK;
 }
 
 /* Drops the nodes of region k's open list that are no longer open, and the
@@ -217,17 +261,8 @@ static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
     }
     cr->nopen = kept;
     cr->open_stale = 0;
-    if (kept < cr->open_cap / 4) { /* shrinking cannot fail to keep what it keeps */
-        const uint64_t cap = kept > 16 ? kept : 16;
-        uint32_t *local = realloc(cr->open_local, cap * sizeof *local);
-        if (local)
-            cr->open_local = local;
-        int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
-        if (cells) {
-            cr->open_cells = cells;
-            cr->open_cap = cap;
-        }
-    }
+    if (kept < cr->open_cap / 4) /* a failed shrink keeps the larger room */
+        resize_open_list(c, cr, kept > 16 ? kept : 16);
 }
 
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
@@ -240,21 +275,36 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
     return v ? *v & ~INDEXED : 0;
 }
 
+/* Node id's record and its region. */
+static cm_status node_and_region(cm_cluster *c, uint32_t id, cm_node **nd, cm_cluster_region **cr)
+{
+    const uint32_t k = cm_cluster_node_region(c, id);
+    cm_node *table;
+    cm_status st = node_table(c, k, &table, NULL, 0);
+    if (st == CM_OK) {
+        *cr = &c->regions[k];
+        *nd = &table[id - (*cr)->node_base];
+    }
+    return st;
+}
+
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
 {
-    cm_node *nd = NULL;
-    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
+    cm_node *nd;
+    cm_cluster_region *cr;
+    cm_status st = node_and_region(c, id, &nd, &cr);
     if (st != CM_OK)
         return st;
     set_weight(nd, weight_of(nd) + w);
-    c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
+    cr->open_dirty = 1;
     return CM_OK;
 }
 
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
 {
-    cm_node *nd = NULL;
-    cm_status st = cm_cluster_node(c, id, &nd, NULL, 0);
+    cm_node *nd;
+    cm_cluster_region *cr;
+    cm_status st = node_and_region(c, id, &nd, &cr);
     if (st != CM_OK)
         return st;
     *w = weight_of(nd);
@@ -262,7 +312,6 @@ cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
     if (!(nd->target & INDEXED_FLAG))
         return CM_OK;
     nd->target = 0;
-    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     cr->open_dirty = 1;
     if (2 * ++cr->open_stale > cr->nopen)
         compact_open_list(c, cr);
@@ -300,17 +349,9 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
     const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     const size_t dim = (size_t)c->lat.dim;
-    if (cr->nopen == cr->open_cap) {
-        const uint64_t cap = cr->open_cap ? 2 * cr->open_cap : 16;
-        uint32_t *local = realloc(cr->open_local, cap * sizeof *local);
-        if (local)
-            cr->open_local = local;
-        int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
-        if (!cells)
-            return CM_ENOMEM;
-        cr->open_cells = cells;
-        cr->open_cap = cap;
-    }
+    if (cr->nopen == cr->open_cap &&
+        resize_open_list(c, cr, cr->open_cap ? 2 * cr->open_cap : 16) != CM_OK)
+        return CM_ENOMEM;
     if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK)
         return CM_ENOMEM;
     if (cr->nodes) {
@@ -468,10 +509,7 @@ static cm_status settle(cm_cluster *c, uint32_t id, char *msg, size_t msg_size)
             st = cm_cluster_node(c, np->next, &nq, msg, msg_size);
         uint64_t steps = 0;
         if (st == CM_OK && nq->next == CM_NODE_CYCLE) {
-            const uint32_t k = cm_cluster_node_region(c, np->next);
-            st = cm_cluster_acquire(c, k, msg, msg_size);
-            if (st == CM_OK)
-                steps = 1 + (uint64_t)cm_cycle_steps(&c->regions[k].r, nq->dist, np->target);
+            st = cm_cluster_into_cycle(c, np->next, np->target, &steps, msg, msg_size);
         } else if (st == CM_OK) {
             steps = (uint64_t)np->dist + nq->up_dist;
         }
@@ -535,7 +573,10 @@ cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32
     return st;
 }
 
-uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t)
+/* Steps from cell t of region r to a cycle that enters r's tree of a cycle
+ * node at cell `entry` (the node's dist) and runs down the tree to the
+ * node's cell (0 on it). r must be resident. */
+static uint32_t cycle_steps(const cm_region *r, uint32_t entry, uint32_t t)
 {
     const uint32_t *image = r->image, *step = r->step;
     uint32_t a = t, b = entry, da = step[a], db = step[b], count = 0;
@@ -552,6 +593,20 @@ uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t)
     return count;
 }
 
+cm_status cm_cluster_into_cycle(cm_cluster *c, uint32_t q, uint32_t t, uint64_t *steps,
+                                char *msg, size_t msg_size)
+{
+    const uint32_t k = cm_cluster_node_region(c, q);
+    cm_node *nq;
+    cm_status st = cm_cluster_node(c, q, &nq, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_acquire(c, k, msg, msg_size);
+    if (st == CM_OK)
+        *steps = 1 + (uint64_t)cycle_steps(&c->regions[k].r, nq->dist, t);
+    return st;
+}
+
+
 /* ---- paging ----------------------------------------------------------- */
 
 static int is_resident(const cm_cluster_region *cr) { return cr->r.group != NULL; }
@@ -561,13 +616,21 @@ static uint64_t node_table_bytes(const cm_cluster_region *cr)
     return cr->nodes ? cr->r.nexits * sizeof *cr->nodes : 0;
 }
 
+/* Bytes of the resident cell arrays (and exit tables) and of the resident node tables. */
+static void resident(const cm_cluster *c, uint64_t *cells, uint64_t *tables)
+{
+    *cells = *tables = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        *cells += is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0;
+        *tables += node_table_bytes(&c->regions[k]);
+    }
+}
+
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 {
-    uint64_t bytes = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        bytes += (is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0) +
-                 node_table_bytes(&c->regions[k]);
-    return bytes;
+    uint64_t cells, tables;
+    resident(c, &cells, &tables);
+    return cells + tables;
 }
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
@@ -593,31 +656,30 @@ static void evict_cells(cm_cluster_region *cr)
  * most), where sequences leaving those boxes most likely land; UINT32_MAX
  * if none is. From the brick index: O(boxes looked at). */
 #define LOOKAHEAD 4096
+typedef struct use_mark {
+    uint32_t *use, box;
+} use_mark;
+
+static bool mark_use(void *user, uint32_t k)
+{
+    const use_mark *m = user;
+    m->use[k] = m->box; /* boxes go backwards: the first that needs it wins */
+    return false;
+}
+
 static void next_uses(const cm_cluster *c, uint32_t *use)
 {
     for (uint32_t k = 0; k < c->nregions; k++)
         use[k] = UINT32_MAX;
     const uint32_t n = c->nupcoming < LOOKAHEAD ? c->nupcoming : LOOKAHEAD;
-    for (uint32_t i = n; i-- > 0;) { /* the first box that needs a region wins */
-        cm_box near = c->upcoming[i], both;
+    for (uint32_t i = n; i-- > 0;) {
+        cm_box near = c->upcoming[i];
         for (int d = 0; d < near.dim; d++) {
             near.lo[d]--;
             near.hi[d]++;
         }
-        int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
-        for (uint64_t b = 0; b < c->nbig; b++)
-            if (cm_box_intersect(&c->regions[c->big[b]].r.box, &near, &both))
-                use[c->big[b]] = i;
-        if (!c->region_bricks || !cm_bricks_span(c->region_bricks, &near, lo, hi))
-            continue;
-        memcpy(key, lo, sizeof key);
-        do {
-            uint64_t m;
-            const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &m);
-            for (uint64_t p = 0; p < m; p++)
-                if (cm_box_intersect(&c->regions[in_brick[p]].r.box, &near, &both))
-                    use[in_brick[p]] = i;
-        } while (cm_index_next(c->lat.dim, lo, hi, key));
+        use_mark m = {use, i};
+        find_regions_meeting(c, &near, mark_use, &m);
     }
 }
 
@@ -626,36 +688,6 @@ void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     cr->nodes_dirty = 1;
     cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
-}
-
-void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k)
-{
-    int64_t off[CM_MAX_DIM] = {0};
-    for (int d = 0; d < c->lat.dim; d++)
-        off[d] = c->regions[k].r.box.lo[d] - c->regions[joined].r.box.lo[d];
-    for (uint32_t i = 0; i < c->nreach; i++)
-        if (memcmp(c->reach[i], off, sizeof off) == 0)
-            return;
-    if (c->nreach < CM_MAX_REACH)
-        memcpy(c->reach[c->nreach++], off, sizeof off);
-}
-
-/* Regions the first upcoming boxes will likely read: where the last join
- * read, relative to each box (use[k]: the first box that will). */
-#define REACH_LOOKAHEAD 64
-static void expected_reads(const cm_cluster *c, uint32_t *use)
-{
-    const uint32_t n = c->nupcoming < REACH_LOOKAHEAD ? c->nupcoming : REACH_LOOKAHEAD;
-    for (uint32_t i = n; i-- > 0;)
-        for (uint32_t r = 0; r < c->nreach; r++) {
-            int64_t cell[CM_MAX_DIM];
-            uint64_t local;
-            for (int d = 0; d < c->lat.dim; d++)
-                cell[d] = c->upcoming[i].lo[d] + c->reach[r][d];
-            const int64_t k = cm_cluster_locate(c, cell, &local);
-            if (k >= 0 && use[k] > i)
-                use[k] = i;
-        }
 }
 
 /* Something resident that can be evicted: region k's cells, or its node table. */
@@ -699,7 +731,6 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
         return CM_ENOMEM;
     }
     next_uses(c, use);
-    expected_reads(c, use);
     *n = 0;
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
@@ -730,16 +761,6 @@ static cm_status spill_open_weights(cm_cluster *c, cm_cluster_region *cr)
         }
     }
     return CM_OK;
-}
-
-/* Bytes of the resident cell arrays (and exit tables) and of the resident node tables. */
-static void resident(const cm_cluster *c, uint64_t *cells, uint64_t *tables)
-{
-    *cells = *tables = 0;
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        *cells += is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0;
-        *tables += node_table_bytes(&c->regions[k]);
-    }
 }
 
 /* Evicts until `extra` more bytes of cells fit the budget, and (with
@@ -828,17 +849,16 @@ void cm_cluster_trim_joining(cm_cluster *c, uint32_t joining)
 void cm_cluster_saved(cm_cluster *c)
 {
     for (uint32_t k = 0; k < c->nregions; k++) {
-        c->regions[k].written = 1;
-        if (c->regions[k].nodes_dirty)
-            memset(c->regions[k].dirty_chunks, 0, c->regions[k].r.nexits / CM_NODE_CHUNK + 1);
-        c->regions[k].nodes_dirty = 0;
+        cm_cluster_region *cr = &c->regions[k];
+        if (cr->nodes_dirty)
+            memset(cr->dirty_chunks, 0, cr->r.nexits / CM_NODE_CHUNK + 1);
+        cr->written = 1;
+        cr->nodes_dirty = cr->open_dirty = 0;
     }
     if (c->basin_dirty)
         memset(c->basin_dirty, 0, (size_t)c->ngroups + 1);
     c->nnew_periodic = 0;
     c->saved_groups = c->ngroups;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        c->regions[k].open_dirty = 0;
 }
 
 uint64_t cm_cluster_sink_cells(const cm_cluster *c)
@@ -863,30 +883,18 @@ void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
 
 /* ---- adding regions -------------------------------------------------------- */
 
-/* A region that shares cells with box, or -1: the regions of the bricks
- * the box meets (all regions for a box of very many bricks). */
+static bool take_first(void *user, uint32_t k)
+{
+    *(int64_t *)user = k;
+    return true;
+}
+
+/* A region that shares cells with box, or -1. */
 static int64_t overlapping_region(const cm_cluster *c, const cm_box *box)
 {
-    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
-    cm_box both;
-    if (!c->region_bricks || !cm_bricks_span(c->region_bricks, box, lo, hi)) {
-        for (uint32_t k = 0; k < c->nregions; k++)
-            if (cm_box_intersect(&c->regions[k].r.box, box, &both))
-                return k;
-        return -1;
-    }
-    for (uint64_t b = 0; b < c->nbig; b++)
-        if (cm_box_intersect(&c->regions[c->big[b]].r.box, box, &both))
-            return c->big[b];
-    memcpy(key, lo, sizeof key);
-    do {
-        uint64_t n;
-        const uint32_t *in_brick = cm_bricks_find(c->region_bricks, key, &n);
-        for (uint64_t p = 0; p < n; p++)
-            if (cm_box_intersect(&c->regions[in_brick[p]].r.box, box, &both))
-                return in_brick[p];
-    } while (cm_index_next(c->lat.dim, lo, hi, key));
-    return -1;
+    int64_t k = -1;
+    find_regions_meeting(c, box, take_first, &k);
+    return k;
 }
 
 static cm_status check_region(const cm_cluster *c, const cm_box *box, uint64_t nexits,
@@ -1255,7 +1263,7 @@ static void resolved_cell(const cm_region *r, uint64_t i, const node_values *nv,
     }
     const uint32_t e = g & ~CM_NODE_REF;
     *group = nv->group[e];
-    *step = nv->cycle[e] ? cm_cycle_steps(r, nv->nodes[e].dist, (uint32_t)i)
+    *step = nv->cycle[e] ? cycle_steps(r, nv->nodes[e].dist, (uint32_t)i)
                          : nv->step[e] + r->step[i] - 1;
 }
 
@@ -1310,7 +1318,7 @@ static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group
 {
     const cm_cluster_region *cr = &c->regions[k];
     cm_node *nodes;
-    cm_status st = cm_cluster_node_table(c, k, &nodes, msg, msg_size);
+    cm_status st = node_table(c, k, &nodes, msg, msg_size);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
         cycle[e] = nodes[e].next == CM_NODE_CYCLE;
         st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e], NULL, msg,

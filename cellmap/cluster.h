@@ -52,9 +52,6 @@
  * one of its nodes changed. */
 #define CM_NODE_CHUNK 4096
 
-/* Offsets remembered from a join for eviction (cm_cluster.reach). */
-#define CM_MAX_REACH 64
-
 /* cm_node.next values other than a node id */
 #define CM_NODE_OPEN UINT32_C(0xFFFFFFFF)  /* the exit leads out of the cluster */
 #define CM_NODE_FINAL UINT32_C(0xFFFFFFFE) /* group and step of the cell are known */
@@ -161,11 +158,7 @@ typedef struct cm_cluster {
     uint32_t nupcoming;
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
-    cm_idmap open;   /* open node -> cells whose sequences leave the cluster through it */
-    /* where the last join's links read, relative to its region's lower
-     * corner: eviction expects the next boxes to read there too */
-    int64_t reach[CM_MAX_REACH][CM_MAX_DIM];
-    uint32_t nreach;
+    cm_idmap open;   /* weights of the open nodes whose node tables are paged out */
     uint64_t evicted_since_trim; /* bytes evicted since the heap was last trimmed */
     uint32_t *node_blocks; /* the region of every 1024th node id */
     uint64_t node_blocks_cap;
@@ -235,9 +228,6 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
 /* Node id's record changed: its chunk is saved at the next commit. */
 void cm_cluster_touch_node(cm_cluster *c, uint32_t id);
 
-/* Notes that the join of region `joined` reads region k (cm_cluster.reach). */
-void cm_cluster_note_reach(cm_cluster *c, uint32_t joined, uint32_t k);
-
 /* Calls fn for every open node with the target of its exit. */
 typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
 void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
@@ -245,20 +235,17 @@ void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 /* The region of node id (O(1)). */
 uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
 
-/* Node id's record into *out, region k's node table into *out (read back
- * through nodes_in if it was paged out). The pointers stay valid until the
- * cluster adds, restores or trims regions (joins and cm_cluster_acquire
- * never evict node tables; cm_cluster_trim does). */
+/* Node id's record into *out (its region's node table read back through
+ * nodes_in if it was paged out). The pointer stays valid until the cluster
+ * adds, restores or trims regions (joins and cm_cluster_acquire never evict
+ * node tables; cm_cluster_trim does). */
 cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size);
-cm_status cm_cluster_node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
-                                size_t msg_size);
 
 /* Open nodes and their weights: the cells whose sequences leave the
- * cluster through them. A node of a region being joined is open with its
- * own tree as weight until the join links it or indexes it as an escape;
- * only indexed and linked-into open nodes have entries. The weight of open
- * node id (0 without an entry); adds w to it; takes it out (no longer open)
- * with its weight into *w. Both mark the node's region open_dirty. */
+ * cluster through them (a new node starts with its own tree). The weight
+ * of open node id (0 if it is not open); adds w to it; takes it out (no
+ * longer open) with its weight into *w. Both mark the node's region
+ * open_dirty. */
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
 cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w);
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w);
@@ -277,10 +264,10 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
 cm_status cm_cluster_resolve(cm_cluster *c, uint32_t id, uint32_t *group, uint32_t *step,
                              uint32_t *open, char *msg, size_t msg_size);
 
-/* Steps from cell t of region r to a cycle that enters r's tree of a cycle
- * node at cell `entry` (the node's dist) and runs down the tree to the node's
- * cell (0 on it). r must be resident. */
-uint32_t cm_cycle_steps(const cm_region *r, uint32_t entry, uint32_t t);
+/* Steps from cell t, in the tree of cycle node q, to the cycle, plus one
+ * (t's exit step): reads q's region back if need be. */
+cm_status cm_cluster_into_cycle(cm_cluster *c, uint32_t q, uint32_t t, uint64_t *steps,
+                                char *msg, size_t msg_size);
 
 /* A new group id (a straddling group) into *g; CM_ETOOBIG past CM_MAX_GROUPS. */
 cm_status cm_cluster_new_group(cm_cluster *c, uint32_t *g);

@@ -73,32 +73,12 @@ uint64_t *cm_idmap_find(const cm_idmap *m, uint32_t key)
     return m->keys[s] == EMPTY ? NULL : &m->values[s];
 }
 
-cm_status cm_idmap_upsert(cm_idmap *m, uint32_t key, uint64_t **value)
-{
-    if (key == EMPTY)
-        return CM_EINVAL;
-    if (2 * (m->count + 1) > m->slots && grow(m) != CM_OK)
-        return CM_ENOMEM;
-    const uint64_t s = find(m, key);
-    if (m->keys[s] == EMPTY) {
-        m->keys[s] = key;
-        m->values[s] = 0;
-        m->count++;
-    }
-    *value = &m->values[s];
-    return CM_OK;
-}
-
 bool cm_idmap_get(const cm_idmap *m, uint32_t key, uint64_t *value)
 {
-    if (m->count == 0 || key == EMPTY)
-        return false;
-    const uint64_t s = find(m, key);
-    if (m->keys[s] == EMPTY)
-        return false;
-    if (value)
-        *value = m->values[s];
-    return true;
+    const uint64_t *v = cm_idmap_find(m, key);
+    if (v && value)
+        *value = *v;
+    return v != NULL;
 }
 
 bool cm_idmap_remove(cm_idmap *m, uint32_t key, uint64_t *value)
@@ -124,27 +104,6 @@ bool cm_idmap_remove(cm_idmap *m, uint32_t key, uint64_t *value)
     m->keys[s] = EMPTY;
     m->count--;
     return true;
-}
-
-bool cm_idmap_next(const cm_idmap *m, uint64_t *slot, uint32_t *key, uint64_t *value)
-{
-    for (; *slot < m->slots; (*slot)++) {
-        if (m->keys[*slot] == EMPTY)
-            continue;
-        *key = m->keys[*slot];
-        if (value)
-            *value = m->values[*slot];
-        (*slot)++;
-        return true;
-    }
-    return false;
-}
-
-void cm_idmap_clear(cm_idmap *m)
-{
-    if (m->slots)
-        memset(m->keys, 0xFF, m->slots * sizeof *m->keys);
-    m->count = 0;
 }
 
 uint64_t cm_idmap_bytes(const cm_idmap *m)

@@ -1,6 +1,6 @@
 /* cellmap/idmap.h - a hash map from 32-bit ids to 64-bit values (the
- * cluster keeps the weights of its open nodes in one: they are few, and
- * must outlive the node tables that paging drops).
+ * cluster keeps in one the weights of the open nodes whose node tables
+ * paging dropped).
  *
  * Open addressing with linear probing and backward-shift deletion, so no
  * tombstones: a map of n entries holds at most 2n slots after growth. Not
@@ -28,21 +28,11 @@ cm_status cm_idmap_put(cm_idmap *m, uint32_t key, uint64_t value);
 /* The value of key, in place (valid until the map changes), or NULL. */
 uint64_t *cm_idmap_find(const cm_idmap *m, uint32_t key);
 
-/* The value of key, in place, added as 0 if key was not there (one probe). */
-cm_status cm_idmap_upsert(cm_idmap *m, uint32_t key, uint64_t **value);
-
 /* Whether key is there, and its value into *value (may be NULL). */
 bool cm_idmap_get(const cm_idmap *m, uint32_t key, uint64_t *value);
 
 /* Removes key; whether it was there, and its value into *value (may be NULL). */
 bool cm_idmap_remove(cm_idmap *m, uint32_t key, uint64_t *value);
-
-/* Iteration in slot order: start with *slot = 0; false when done. The map
- * must not change meanwhile. */
-bool cm_idmap_next(const cm_idmap *m, uint64_t *slot, uint32_t *key, uint64_t *value);
-
-/* Empties the map (keeps its slots). */
-void cm_idmap_clear(cm_idmap *m);
 
 /* Bytes held. */
 uint64_t cm_idmap_bytes(const cm_idmap *m);

@@ -62,19 +62,6 @@ static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s, uint64_t
     return CM_OK;
 }
 
-/* Steps from cell t, in the tree of cycle node q, to the cycle, plus one. */
-static cm_status into_cycle(joiner *j, uint32_t q, uint32_t t, uint64_t *steps)
-{
-    const uint32_t k = cm_cluster_node_region(j->c, q);
-    cm_node *nq;
-    cm_status st = cm_cluster_node(j->c, q, &nq, j->msg, j->msg_size);
-    if (st == CM_OK)
-        st = cm_cluster_acquire(j->c, k, j->msg, j->msg_size);
-    if (st == CM_OK)
-        *steps = 1 + (uint64_t)cm_cycle_steps(&j->c->regions[k].r, nq->dist, t);
-    return st;
-}
-
 static cm_status push(joiner *j, uint64_t *len, uint32_t id)
 {
     if (cm_grow((void **)&j->stack, &j->stack_cap, *len + 1, sizeof *j->stack) != CM_OK)
@@ -105,11 +92,9 @@ static cm_status trace_cycle_cells(joiner *j, uint32_t x, uint32_t entry, uint32
  * the others settle from these (cm_cluster_resolve) without reading cells. */
 static cm_status settle_linked_in(joiner *j, uint32_t q, uint32_t g)
 {
-    const uint32_t k = cm_cluster_node_region(j->c, q);
     cm_node *nq;
     cm_status st = cm_cluster_node(j->c, q, &nq, j->msg, j->msg_size);
     uint32_t p = st == CM_OK ? nq->first_in : CM_NODE_OPEN;
-    const uint32_t entry = st == CM_OK ? nq->dist : 0;
     if (st == CM_OK)
         nq->first_in = CM_NODE_OPEN;
     while (st == CM_OK && p != CM_NODE_OPEN) {
@@ -117,9 +102,11 @@ static cm_status settle_linked_in(joiner *j, uint32_t q, uint32_t g)
         if ((st = cm_cluster_node(j->c, p, &np, j->msg, j->msg_size)) != CM_OK)
             break;
         const uint32_t sibling = np->sibling;
+        uint64_t s;
         if (np->next == q) { /* not itself on the cycle */
-            const uint64_t s =
-                1 + (uint64_t)cm_cycle_steps(&j->c->regions[k].r, entry, np->target);
+            if ((st = cm_cluster_into_cycle(j->c, q, np->target, &s, j->msg, j->msg_size)) !=
+                CM_OK)
+                break;
             if (s >= CM_STEP_ON_PATH)
                 return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
             np->next = np->up = CM_NODE_FINAL;
@@ -208,7 +195,7 @@ static cm_status link_node(joiner *j, const link_job *job)
     if (nm->next == CM_NODE_CYCLE) { /* its tree holds a cycle that can enter above m */
         uint64_t s;
         const uint32_t g = nm->group;
-        st = into_cycle(j, m, job->cell, &s);
+        st = cm_cluster_into_cycle(c, m, job->cell, &s, j->msg, j->msg_size);
         return st == CM_OK ? finish(j, job->node, g, s, weight) : st;
     }
     uint32_t g, s, open;
@@ -316,13 +303,8 @@ static cm_status link_all(joiner *j)
     uint64_t n = 0;
     cm_status st = collect_jobs(j, added, &jobs, &n);
     /* the regions the links read stay; room is made among the others */
-    j->c->nreach = 0;
-    for (uint64_t i = 0; i < n; i++) {
-        cm_cluster_region *target = &j->c->regions[jobs[i].region];
-        if (jobs[i].region != added)
-            cm_cluster_note_reach(j->c, added, jobs[i].region);
-        target->pinned = 1;
-    }
+    for (uint64_t i = 0; i < n; i++)
+        j->c->regions[jobs[i].region].pinned = 1;
     if (st == CM_OK)
         cm_cluster_trim_joining(j->c, added);
     if (st == CM_OK)

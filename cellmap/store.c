@@ -75,7 +75,7 @@ cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_si
     return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, db ? sqlite3_errmsg(db) : "no database");
 }
 
-int store_pragma_int(sqlite3 *db, const char *sql, int *value)
+static int pragma_int(sqlite3 *db, const char *sql, int *value)
 {
     sqlite3_stmt *st = NULL;
     int rc = sqlite3_prepare_v2(db, sql, -1, &st, NULL);
@@ -199,8 +199,8 @@ static cm_status check_ids(const char *path, int app, int version, char *msg, si
 static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, size_t msg_size)
 {
     int app = 0, version = 0;
-    if (store_pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
-        store_pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
+    if (pragma_int(db, "PRAGMA application_id", &app) != SQLITE_OK ||
+        pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
         return cm_fail(CM_EFORMAT, msg, msg_size,
                        sqlite3_errcode(db) == SQLITE_CORRUPT
                            ? "%s is a damaged database (%s); restore it from a copy or solve again"
@@ -283,7 +283,7 @@ cm_status store_open_checked(const char *path, int full, int writable, int old, 
         return store_open_checked(path, full, 1, old, out, msg, msg_size);
     }
     int version = CM_STORE_VERSION;
-    if (st == CM_OK && store_pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
+    if (st == CM_OK && pragma_int(db, "PRAGMA user_version", &version) != SQLITE_OK)
         st = store_db_error(db, "read the version", msg, msg_size);
     if (st == CM_OK && writable && !old && version < CM_STORE_VERSION)
         st = cm_fail(CM_EFORMAT, msg, msg_size,
@@ -324,7 +324,7 @@ cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out,
     s->db = db;
     s->writable = writable;
     s->version = CM_STORE_VERSION;
-    store_pragma_int(db, "PRAGMA user_version", &s->version);
+    pragma_int(db, "PRAGMA user_version", &s->version);
     s->threads = 1;
     *out = s;
     return CM_OK;

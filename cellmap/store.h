@@ -69,7 +69,6 @@ typedef struct cm_store_info {
 /* Paging and commit figures since the store was opened. */
 typedef struct cm_store_stats {
     uint64_t regions_read, regions_written, pages_written, node_tables_written;
-    uint64_t node_tables_read; /* read back on use (files of version 5) */
     uint64_t regions_evicted;           /* unsaved, saved by the pager in a join */
     uint64_t bytes_read, bytes_written; /* encoded */
     uint64_t page_bytes_written;        /* of them, cell pages */

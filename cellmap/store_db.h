@@ -47,7 +47,6 @@ extern const char *const store_tables_sql;
 
 double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);
-int store_pragma_int(sqlite3 *db, const char *sql, int *value);
 int64_t store_query_int(sqlite3 *db, const char *sql);
 cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_size);
 /* Steps a statement that returns no row, and resets it. */

@@ -64,7 +64,7 @@ static cm_status keep_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t fi
     return CM_OK;
 }
 
-cm_status store_read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
 {
     const uint64_t pages = npages(r->ncells);
     column_ref *refs = malloc((3 * pages + 1) * sizeof *refs);
@@ -116,7 +116,7 @@ cm_status store_read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, siz
 }
 
 /* Region k's exit targets into a new array of nexits * dim cells. */
-cm_status store_read_exits(cm_store *s, uint32_t k, uint64_t nexits, int dim, int64_t **out,
+static cm_status read_exits(cm_store *s, uint32_t k, uint64_t nexits, int dim, int64_t **out,
                             char *msg, size_t msg_size)
 {
     const uint64_t n = nexits * (uint64_t)dim;
@@ -166,9 +166,9 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
                        ? CM_OK
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
     if (st == CM_OK)
-        st = store_read_pages(s, k, r, msg, msg_size);
+        st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)
-        st = store_read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
+        st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
     if (st != CM_OK) {
         free(r->image);
         free(r->group);
@@ -284,7 +284,6 @@ static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, ch
     cm_store *s = user;
     const double t0 = store_seconds_now();
     const cm_status st = read_nodes(s, k, n, nodes, msg, msg_size);
-    s->stats.node_tables_read++;
     s->stats.read_seconds += store_seconds_now() - t0;
     return st;
 }
@@ -362,7 +361,7 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
             status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
         if (status == CM_OK && tables) {
             (*exits)[k] = NULL;
-            status = store_read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
+            status = read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
             nodes = status == CM_OK ? calloc(rec.nexits + 1, sizeof *nodes) : NULL;
             if (status == CM_OK && !nodes)
                 status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);

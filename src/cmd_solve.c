@@ -607,9 +607,7 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, summary *sum,
 {
     cm_cluster *c = &rn->c;
     cm_cluster_bounds(c, &sum->box);
-    sum->cells = 0;
-    for (uint32_t k = 0; k < c->nregions; k++)
-        sum->cells += c->regions[k].r.ncells;
+    sum->cells = c->cells;
     sum->ngroups = c->ngroups;
     sum->groups = calloc((size_t)c->ngroups + 1, sizeof *sum->groups);
     if (!sum->groups)

@@ -64,22 +64,36 @@ static uint64_t page_bytes_stored(const char *path)
     return (uint64_t)bytes;
 }
 
+/* The Fig. 4.21 model, its lattice for the configuration, and box k of
+ * its TX x TY regions (in row order). */
+static void setup(const config *cf, cm_model *m, cm_lattice *lat)
+{
+    char msg[1024];
+    const char *params[1] = {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3"};
+    if (cm_model_create("microchaos-pd", params, 1, m, msg, sizeof msg) != CM_OK)
+        die("model", msg);
+    const double nx = (double)(cf->tx * cf->side), ny = (double)(cf->ty * cf->side);
+    *lat = (cm_lattice){2, {-125000, -600}, {250000.0 / nx, 1200.0 / ny}};
+}
+
+static cm_box box_of(const config *cf, int64_t k)
+{
+    const int64_t i = k % cf->tx, j = k / cf->tx;
+    return (cm_box){2, {i * cf->side, j * cf->side}, {(i + 1) * cf->side, (j + 1) * cf->side}};
+}
+
 /* One run (in a child process): prints its figures. */
 static void run(const config *cf, const char *name, const char *db, uint64_t budget)
 {
     char msg[1024];
     cm_model m;
-    const char *params[1] = {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3"};
-    if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
-        die("model", msg);
+    cm_lattice lat;
+    setup(cf, &m, &lat);
     const int64_t nx = cf->tx * cf->side, ny = cf->ty * cf->side;
-    const cm_lattice lat = {2, {-125000, -600}, {250000.0 / (double)nx, 1200.0 / (double)ny}};
     const uint32_t n = (uint32_t)(cf->tx * cf->ty);
     cm_box *boxes = malloc(n * sizeof *boxes);
-    for (int j = 0; j < cf->ty; j++)
-        for (int i = 0; i < cf->tx; i++)
-            boxes[j * cf->tx + i] =
-                (cm_box){2, {i * cf->side, j * cf->side}, {(i + 1) * cf->side, (j + 1) * cf->side}};
+    for (uint32_t k = 0; k < n; k++)
+        boxes[k] = box_of(cf, k);
     cm_cluster c;
     cm_cluster_init(&c, &lat);
     c.threads = 2;
@@ -122,34 +136,26 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
 }
 
 /* The regions' simple cell mapping alone, as cm_cluster_solve_boxes does
- * it (a region per thread, two at a time), without joins or a file: what
- * the cluster's total is measured against. Prints its time. */
+ * it (a region per thread, two threads), without joins or a file: what the
+ * cluster's total is measured against. Prints its time. */
 static void run_scm(const config *cf)
 {
-    char msg[1024];
     cm_model m;
-    const char *params[1] = {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3"};
-    if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
-        die("model", msg);
+    cm_lattice lat;
+    setup(cf, &m, &lat);
     const int64_t nx = cf->tx * cf->side, ny = cf->ty * cf->side;
-    const cm_lattice lat = {2, {-125000, -600}, {250000.0 / (double)nx, 1200.0 / (double)ny}};
     const int64_t n = cf->tx * cf->ty;
     const cm_scm_options opt = {100000, 1, NULL, NULL, 1};
     int failed = 0;
     const double t0 = now();
-    for (int64_t first = 0; first < n; first += 2) {
-        const int64_t last = first + 2 < n ? first + 2 : n;
-#pragma omp parallel for num_threads(2) reduction(| : failed)
-        for (int64_t k = first; k < last; k++) {
-            char why[256];
-            const int64_t i = k % cf->tx, j = k / cf->tx;
-            const cm_box box = {2, {i * cf->side, j * cf->side},
-                                {(i + 1) * cf->side, (j + 1) * cf->side}};
-            cm_region r;
-            failed |= cm_region_alloc(&r, &box, why, sizeof why) != CM_OK ||
-                      cm_scm_solve(&m, &lat, &opt, &r, why, sizeof why) != CM_OK;
-            cm_region_free(&r);
-        }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2) reduction(| : failed)
+    for (int64_t k = 0; k < n; k++) {
+        char why[256];
+        const cm_box box = box_of(cf, k);
+        cm_region r;
+        failed |= cm_region_alloc(&r, &box, why, sizeof why) != CM_OK ||
+                  cm_scm_solve(&m, &lat, &opt, &r, why, sizeof why) != CM_OK;
+        cm_region_free(&r);
     }
     const double total = now() - t0;
     if (failed)
