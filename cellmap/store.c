@@ -1,6 +1,8 @@
 #include "cellmap/store_db.h"
 
+#include "cellmap/output.h"
 
+#include <errno.h>
 #include <sqlite3.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -384,23 +386,26 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
 }
 
 /* Checks that an existing file at path is a cellmap database (which a new
- * one may replace) and removes its WAL and shared-memory files. */
-static cm_status prepare_replace(const char *path, char *msg, size_t msg_size)
+ * one may replace once it is complete). */
+static cm_status check_replaceable(const char *path, const char *given, char *msg,
+                                   size_t msg_size)
 {
-    struct stat sb;
-    if (stat(path, &sb) != 0)
-        return CM_OK;
     char why[512];
     if (cm_store_check(path, why, sizeof why) != CM_OK)
         return cm_fail(CM_EFORMAT, msg, msg_size,
-                       "refusing to overwrite %s: %s; choose another --db file", path, why);
-    char side[4200];
+                       "refusing to overwrite %s: %s; choose another --db file", given, why);
+    return CM_OK;
+}
+
+/* Removes the journal, WAL and shared-memory files next to path. */
+static void remove_side_files(const char *path)
+{
+    char side[CM_OUTPUT_PATH_MAX + 16];
     const char *suffixes[] = {"-wal", "-shm", "-journal"};
     for (int k = 0; k < 3; k++) {
         snprintf(side, sizeof side, "%s%s", path, suffixes[k]);
         unlink(side);
     }
-    return CM_OK;
 }
 
 /* Writes the schema and metadata of an empty cluster to a new file. */
@@ -432,20 +437,40 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
                           size_t msg_size)
 {
     *out = NULL;
-    /* The empty database appears at path by a rename, so a process killed
-     * now leaves either the old file or a complete empty cluster. */
-    char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
-    cm_status st = prepare_replace(path, msg, msg_size);
-    if (st == CM_OK)
-        st = write_empty(tmp, meta, msg, msg_size);
-    if (st == CM_OK && rename(tmp, path) != 0)
-        st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s", tmp, path);
-    if (st != CM_OK) {
-        unlink(tmp);
-        return st;
+    /* The new cluster is written to a temporary file. A new name gets the
+     * empty cluster by a rename at once (a killed solve leaves a file to
+     * resume); an existing cluster is replaced only by cm_store_finish, so
+     * that until the new one is complete the old one is intact. */
+    cm_output o;
+    struct stat sb;
+    cm_status st = cm_output_begin(&o, path, true, msg, msg_size);
+    const bool replacing = st == CM_OK && stat(o.dest, &sb) == 0;
+    if (st == CM_OK && replacing)
+        st = check_replaceable(o.dest, path, msg, msg_size);
+    if (st == CM_OK) {
+        remove_side_files(o.tmp);
+        st = write_empty(o.tmp, meta, msg, msg_size);
     }
-    return cm_store_open(path, 1, out, msg, msg_size);
+    if (st == CM_OK && !replacing && rename(o.tmp, o.dest) != 0)
+        st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s: %s", o.tmp, o.dest,
+                     strerror(errno));
+    if (st == CM_OK)
+        st = cm_store_open(replacing ? o.tmp : o.dest, 1, out, msg, msg_size);
+    if (st == CM_OK && replacing) {
+        (*out)->replaces = strdup(o.dest);
+        (*out)->tmp_path = strdup(o.tmp);
+        free((*out)->path);
+        (*out)->path = strdup(path);
+        if (!(*out)->replaces || !(*out)->tmp_path || !(*out)->path)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory creating %s", path);
+    }
+    if (st != CM_OK) {
+        cm_store_close(*out, NULL, 0);
+        *out = NULL;
+        cm_output_abandon(&o);
+        remove_side_files(o.tmp);
+    }
+    return st;
 }
 
 cm_status cm_store_open(const char *path, int writable, cm_store **out, char *msg, size_t msg_size)
@@ -462,10 +487,10 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
     return store_new(path, db, writable, out, msg, msg_size);
 }
 
-cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
+/* Leaves WAL mode (one self-contained file again) and closes; frees s
+ * but for its paths. */
+static cm_status close_db(cm_store *s, char *msg, size_t msg_size)
 {
-    if (!s)
-        return CM_OK;
     cm_status st = CM_OK;
     if (s->in_transaction)
         store_exec(s->db, "ROLLBACK"); /* a join that did not finish */
@@ -474,9 +499,56 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
         st = store_db_error(s->db, "leave WAL mode", msg, msg_size);
     if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
-    free(s->path);
     free(s->blobs);
+    return st;
+}
+
+static void free_store(cm_store *s)
+{
+    free(s->path);
+    free(s->replaces);
+    free(s->tmp_path);
     free(s);
+}
+
+cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
+{
+    if (!s)
+        return CM_OK;
+    const cm_status st = close_db(s, msg, msg_size);
+    if (s->tmp_path) { /* an unfinished replacement: the old file stays */
+        unlink(s->tmp_path);
+        remove_side_files(s->tmp_path);
+    }
+    free_store(s);
+    return st;
+}
+
+cm_status cm_store_finish(cm_store *s, char *msg, size_t msg_size)
+{
+    if (!s)
+        return CM_OK;
+    if (!s->tmp_path)
+        return cm_store_close(s, msg, msg_size);
+    cm_status st = s->failed ? cm_fail(CM_EIO, msg, msg_size,
+                                       "a write to the new %s failed; the old file is unchanged",
+                                       s->path)
+                             : CM_OK;
+    const cm_status closed = close_db(s, msg, msg_size);
+    if (st == CM_OK)
+        st = closed;
+    if (st == CM_OK) {
+        /* the old file's WAL must not be applied to the new one */
+        remove_side_files(s->replaces);
+        if (rename(s->tmp_path, s->replaces) != 0)
+            st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s: %s", s->tmp_path,
+                         s->replaces, strerror(errno));
+    }
+    if (st != CM_OK) {
+        unlink(s->tmp_path);
+        remove_side_files(s->tmp_path);
+    }
+    free_store(s);
     return st;
 }
 

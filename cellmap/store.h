@@ -75,8 +75,12 @@ typedef struct cm_store_stats {
     double read_seconds, evict_seconds, commit_seconds;
 } cm_store_stats;
 
-/* Creates a new, empty database at path. An existing cellmap database there
- * is replaced; any other existing file is refused (CM_EFORMAT), untouched. */
+/* Creates a new, empty database at path (a symlink is followed; a device,
+ * FIFO, socket or directory is refused). An existing cellmap database there
+ * is replaced, but only when the new cluster is complete: until
+ * cm_store_finish the new one is written to PATH.tmp-PID and the old one is
+ * left intact (cm_store_close without cm_store_finish discards the new one).
+ * Any other existing file is refused (CM_EFORMAT), untouched. */
 cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store **out, char *msg,
                           size_t msg_size);
 
@@ -96,8 +100,13 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size);
 
-/* Closes and frees (NULL-safe). A writable store returns to rollback mode. */
+/* Closes and frees (NULL-safe). A writable store returns to rollback mode.
+ * A new cluster that was to replace an older file is discarded. */
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size);
+
+/* The cluster is complete: closes as cm_store_close does and, for a new
+ * cluster that replaces an older file, puts it in the old one's place. */
+cm_status cm_store_finish(cm_store *s, char *msg, size_t msg_size);
 
 /* Checks that path is a cellmap database this version can read. */
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size);

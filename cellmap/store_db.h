@@ -17,6 +17,9 @@ struct cm_store {
     sqlite3 *db;
     const cm_model *model; /* labels new groups (cm_store_set_model), may be NULL */
     char *path;
+    /* a new cluster that replaces the file at replaces when complete
+     * (cm_store_finish); until then it is written at tmp_path */
+    char *replaces, *tmp_path;
     int writable;
     int version; /* of the file: 2 and 3 are read (regions resolved, no node table) */
     int in_transaction;             /* evictions in a join write into it; the commit ends it */

@@ -1,11 +1,14 @@
 #include "render/png_out.h"
 
+#include <errno.h>
 #include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 #include <zlib.h>
+
+#include "cellmap/output.h"
 
 /* Everything libpng touches after setjmp lives in this struct, so nothing
  * is clobbered by longjmp. */
@@ -74,31 +77,36 @@ static cm_status write_file(const char *path, const png_pixels *px, const cm_png
                             int n_texts, char *msg, size_t msg_size)
 {
     const int width = px->width;
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    cm_output out;
+    cm_status st = cm_output_begin(&out, path, false, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     png_job job;
     memset(&job, 0, sizeof job);
-    job.file = fopen(tmp, "wb");
-    if (!job.file)
-        return cm_fail(CM_EIO, msg, msg_size,
-                       "cannot create %s (check the directory exists and "
-                       "is writable)",
-                       tmp);
+    job.file = fopen(out.tmp, "wb");
+    if (!job.file) {
+        st = cm_fail(CM_EIO, msg, msg_size, "cannot create %s: %s (check the directory exists and "
+                     "is writable)", out.tmp, strerror(errno));
+        cm_output_abandon(&out);
+        return st;
+    }
     job.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
     job.info = job.png ? png_create_info_struct(job.png) : NULL;
     job.row = malloc(3 * (size_t)width);
-    cm_status st = job.png && job.info && job.row ? encode(&job, px, texts, n_texts) : CM_ENOMEM;
+    errno = 0;
+    st = job.png && job.info && job.row ? encode(&job, px, texts, n_texts) : CM_ENOMEM;
+    int error = errno; /* why libpng's write failed, if it did */
     png_destroy_write_struct(&job.png, &job.info);
     free(job.row);
+    if (st == CM_OK && (fflush(job.file) != 0 || ferror(job.file)))
+        st = CM_EIO, error = errno;
     if (fclose(job.file) != 0 && st == CM_OK)
-        st = CM_EIO;
-    if (st == CM_OK && rename(tmp, path) != 0)
-        st = CM_EIO;
-    if (st != CM_OK) {
-        unlink(tmp);
-        return cm_fail(st, msg, msg_size, "cannot write PNG %s: %s", path, cm_strerror(st));
-    }
-    return CM_OK;
+        st = CM_EIO, error = errno;
+    if (st == CM_OK)
+        return cm_output_commit(&out, msg, msg_size);
+    cm_output_abandon(&out);
+    return cm_fail(st, msg, msg_size, "cannot write PNG %s: %s", path,
+                   st == CM_EIO && error ? strerror(error) : cm_strerror(st));
 }
 
 cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/output.h"
 #include "cellmap/scm.h"
 #include "models/registry.h"
 
@@ -129,67 +130,94 @@ bool parse_double(const char *s, double *out)
     return true;
 }
 
-/* Splits s at sep into at most max pieces of at most 255 characters. */
-static int split(const char *s, char sep, char pieces[][256], int max)
+/* Copies the piece of s up to sep (or the end) into piece, at most 255
+ * characters; returns where the next piece starts, s's end if this was
+ * the last, or NULL for an empty or too long piece. */
+static const char *take_piece(const char *s, char sep, char piece[256])
 {
+    const char *end = strchr(s, sep);
+    const size_t len = end ? (size_t)(end - s) : strlen(s);
+    if (len == 0 || len >= 256)
+        return NULL;
+    memcpy(piece, s, len);
+    piece[len] = '\0';
+    return end ? end + 1 : s + len;
+}
+
+/* Calls parse_one on each piece of s between seps, at most max pieces; the
+ * count, or -1 if a piece is malformed, empty or one too many. */
+static int parse_pieces(const char *s, char sep, int max, void *out,
+                        bool (*parse_one)(char *piece, void *out, int index))
+{
+    char piece[256];
     int n = 0;
-    while (n < max) {
-        const char *end = strchr(s, sep);
-        const size_t len = end ? (size_t)(end - s) : strlen(s);
-        if (len == 0 || len >= 256)
+    for (const char *p = s; p && *p; n++) {
+        if (n == max || !(p = take_piece(p, sep, piece)) || !parse_one(piece, out, n))
             return -1;
-        memcpy(pieces[n], s, len);
-        pieces[n++][len] = '\0';
-        if (!end)
-            return n;
-        s = end + 1;
+        if (p[-1] == sep && *p == '\0')
+            return -1; /* a trailing separator */
     }
-    return -1;
+    return n > 0 ? n : -1;
+}
+
+typedef struct ranges_out {
+    double *lo, *hi;
+} ranges_out;
+
+static bool parse_range(char *piece, void *out, int d)
+{
+    ranges_out *r = out;
+    char *colon = strchr(piece, ':');
+    if (!colon)
+        return false;
+    *colon = '\0';
+    return parse_double(piece, &r->lo[d]) && parse_double(colon + 1, &r->hi[d]) &&
+           r->lo[d] < r->hi[d];
+}
+
+static bool parse_count(char *piece, void *out, int d)
+{
+    int64_t *v = out;
+    return parse_int64(piece, &v[d]) && v[d] >= 1;
+}
+
+static bool parse_one_double(char *piece, void *out, int d)
+{
+    return parse_double(piece, (double *)out + d);
 }
 
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max)
 {
-    char pieces[CM_MAX_DIM][256];
-    const int n = split(s, ',', pieces, max);
-    if (n < 1)
-        return false;
-    for (int d = 0; d < n; d++) {
-        char *colon = strchr(pieces[d], ':');
-        if (!colon)
-            return false;
-        *colon = '\0';
-        if (!parse_double(pieces[d], &lo[d]) || !parse_double(colon + 1, &hi[d]) ||
-            !(lo[d] < hi[d]))
-            return false;
-    }
-    *count = n;
-    return true;
+    ranges_out r = {lo, hi};
+    const int n = parse_pieces(s, ',', max, &r, parse_range);
+    if (n > 0)
+        *count = n;
+    return n > 0;
 }
 
 bool parse_counts(const char *s, int64_t *v, int *count, int max)
 {
-    char pieces[CM_MAX_DIM][256];
-    const int n = split(s, 'x', pieces, max);
-    if (n < 1)
-        return false;
-    for (int d = 0; d < n; d++)
-        if (!parse_int64(pieces[d], &v[d]) || v[d] < 1)
-            return false;
-    *count = n;
-    return true;
+    const int n = parse_pieces(s, 'x', max, v, parse_count);
+    if (n > 0)
+        *count = n;
+    return n > 0;
 }
 
 bool parse_doubles(const char *s, double *v, int *count, int max)
 {
-    char pieces[CM_MAX_DIM][256];
-    const int n = split(s, ',', pieces, max);
-    if (n < 1)
-        return false;
-    for (int d = 0; d < n; d++)
-        if (!parse_double(pieces[d], &v[d]))
-            return false;
-    *count = n;
-    return true;
+    const int n = parse_pieces(s, ',', max, v, parse_one_double);
+    if (n > 0)
+        *count = n;
+    return n > 0;
+}
+
+FILE *report_stream(const char *out1, const char *out2, const char *out3)
+{
+    const char *const outs[3] = {out1, out2, out3};
+    for (int k = 0; k < 3; k++)
+        if (outs[k] && cm_output_names_stdout(outs[k]))
+            return stderr;
+    return stdout;
 }
 
 bool model_opts_take(cli *c, model_opts *mo, int *error)

@@ -5,6 +5,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "cellmap/lattice.h"
 #include "cellmap/model.h"
@@ -50,6 +51,9 @@ enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
 /* "NxMx..." -> counts, count. */
 bool parse_counts(const char *s, int64_t *n, int *count, int max);
+/* Where a command's report goes: stdout, or stderr when one of its
+ * outputs (any may be NULL) is standard output ("-", /dev/stdout). */
+FILE *report_stream(const char *out1, const char *out2, const char *out3);
 /* "X,Y,..." -> values. */
 bool parse_doubles(const char *s, double *v, int *count, int max);
 

@@ -345,6 +345,7 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
 
 static void print_summary(const bif_args *a, const sweep_results *s, double secs)
 {
+    FILE *out = report_stream(a->csv, a->runs_csv, a->png);
     int valid = 0, lost = 0;
     double psi_lo = INFINITY, psi_hi = -INFINITY;
     for (int i = 0; i < s->n_values; i++)
@@ -357,13 +358,13 @@ static void print_summary(const bif_args *a, const sweep_results *s, double secs
                 psi_hi = fmax(psi_hi, res->psi / s->record);
             }
         }
-    printf("%d values of %s x %d runs in %.2f s: %d runs followed, %d lost", s->n_values,
+    fprintf(out, "%d values of %s x %d runs in %.2f s: %d runs followed, %d lost", s->n_values,
            a->sweep.name, s->runs, secs, valid - lost, lost);
     if (psi_lo <= psi_hi)
-        printf("; Psi per period %.6g..%.6g", psi_lo, psi_hi);
-    printf("\n");
+        fprintf(out, "; Psi per period %.6g..%.6g", psi_lo, psi_hi);
+    fprintf(out, "\n");
     if (valid < s->n_values * s->runs)
-        printf("values where the model cannot be built (S > S0) are not computed\n");
+        fprintf(out, "values where the model cannot be built (S > S0) are not computed\n");
 }
 
 /* ---- the command ---- */

@@ -1,6 +1,7 @@
 /* cellmap export: a .cmdb file's groups and cells as CSV, NumPy .npy or a
  * flat SQLite table, for users' own tools. Every output is written to a
  * temporary file and renamed when complete. */
+#include <errno.h>
 #include <math.h>
 #include <sqlite3.h>
 #include <stdio.h>
@@ -8,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "cellmap/output.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/project.h"
@@ -35,7 +37,7 @@ typedef enum { OUT_CSV, OUT_NPY, OUT_SQLITE } out_kind;
 typedef struct cell_out {
     out_kind kind;
     const char *path;
-    char tmp[4200];
+    cm_output out; /* out.tmp is written, then moved to path */
     FILE *f;
     sqlite3 *db;
     sqlite3_stmt *insert;
@@ -65,8 +67,10 @@ static int parse_export(cli *c, export_args *a)
             a->groups = c->value;
         } else if (cli_is(c, "--cells", true, &err)) {
             a->cells = c->value;
-            if (a->cells && !ends_with(a->cells, ".csv") && !ends_with(a->cells, ".npy"))
-                err = cli_usage_error(c, "--cells: '%s' must end in .csv or .npy", a->cells);
+            if (a->cells && !ends_with(a->cells, ".csv") && !ends_with(a->cells, ".npy") &&
+                !cm_output_names_stdout(a->cells))
+                err = cli_usage_error(c, "--cells: '%s' must end in .csv or .npy (or be - for CSV "
+                                         "on stdout)", a->cells);
         } else if (cli_is(c, "--flat", true, &err)) {
             a->flat = c->value;
         } else if (cli_is(c, "--window", true, &err)) {
@@ -84,6 +88,12 @@ static int parse_export(cli *c, export_args *a)
         err = cli_usage_error(c, "nothing to export: add --groups, --cells or --flat");
     if (!err && a->window && !a->cells && !a->flat)
         err = cli_usage_error(c, "--window applies to --cells and --flat");
+    const char *const outs[3] = {a->groups, a->cells, a->flat};
+    int to_stdout = 0;
+    for (int k = 0; k < 3; k++)
+        to_stdout += outs[k] && cm_output_names_stdout(outs[k]);
+    if (!err && to_stdout > 1)
+        err = cli_usage_error(c, "only one of --groups, --cells and --flat can go to stdout");
     return err;
 }
 
@@ -147,7 +157,7 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
              "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
              " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT, kind TEXT);"
              "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT);");
-    if (sqlite3_open(o->tmp, &o->db) != SQLITE_OK ||
+    if (sqlite3_open(o->out.tmp, &o->db) != SQLITE_OK ||
         sqlite3_exec(o->db, "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF; BEGIN", NULL, NULL,
                      NULL) != SQLITE_OK ||
         sqlite3_exec(o->db, sql, NULL, NULL, NULL) != SQLITE_OK)
@@ -174,14 +184,18 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     return ok && sqlite3_prepare_v2(o->db, sql, -1, &o->insert, NULL) == SQLITE_OK;
 }
 
-static int out_begin(cell_out *o, int dim, const cm_store_info *info)
+/* Starts output o; on failure says why in msg. */
+static int out_begin(cell_out *o, int dim, const cm_store_info *info, char *msg, size_t msg_size)
 {
-    snprintf(o->tmp, sizeof o->tmp, "%s.tmp-%ld", o->path, (long)getpid());
-    unlink(o->tmp);
+    if (cm_output_begin(&o->out, o->path, false, msg, msg_size) != CM_OK)
+        return 0;
+    snprintf(msg, msg_size, "cannot write %s", o->path);
     if (o->kind == OUT_SQLITE)
         return sqlite_begin(o, dim, info);
-    if (!(o->f = fopen(o->tmp, "wb")))
+    if (!(o->f = fopen(o->out.tmp, "wb"))) {
+        snprintf(msg, msg_size, "cannot write %s: %s", o->path, strerror(errno));
         return 0;
+    }
     if (o->kind == OUT_NPY)
         return npy_header(o, dim);
     for (int d = 0; d < dim; d++)
@@ -286,37 +300,57 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
     return ok;
 }
 
-/* Completes the output and renames it into place; on failure removes it. */
-static int out_end(cell_out *o, int ok)
+/* Completes the output and moves it into place (cellmap/output.h); on
+ * failure removes it and, if it was the first failure (ok), says why. */
+static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 {
+    const int was_ok = ok;
+    int error = 0;
     if (o->kind == OUT_NPY && ok && o->f) {
         char shape[32];
         snprintf(shape, sizeof shape, "%20llu", (unsigned long long)o->rows);
         ok = fseek(o->f, o->shape_at, SEEK_SET) == 0 && fwrite(shape, 1, 20, o->f) == 20;
     }
-    if (o->f)
-        ok = (fclose(o->f) == 0) && ok;
+    if (o->f) {
+        errno = 0;
+        if (fflush(o->f) != 0 || ferror(o->f))
+            ok = 0, error = errno ? errno : EIO;
+        if (fclose(o->f) != 0 && !error)
+            ok = 0, error = errno;
+        o->f = NULL;
+    }
     if (o->db) {
         sqlite3_finalize(o->insert);
-        ok = ok && sqlite3_exec(o->db, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+        if (ok && sqlite3_exec(o->db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
+            ok = 0, snprintf(msg, msg_size, "cannot write %s: %s", o->path, sqlite3_errmsg(o->db));
         ok = (sqlite3_close(o->db) == SQLITE_OK) && ok;
+        o->db = NULL;
     }
-    if (ok && rename(o->tmp, o->path) != 0)
+    if (was_ok && !ok && error)
+        snprintf(msg, msg_size, "cannot write %s: %s", o->path, strerror(error));
+    else if (was_ok && !ok && !strstr(msg, o->path))
+        snprintf(msg, msg_size, "cannot complete %s", o->path);
+    if (ok && cm_output_commit(&o->out, msg, msg_size) != CM_OK)
         ok = 0;
-    if (!ok)
-        unlink(o->tmp);
+    cm_output_abandon(&o->out);
     return ok;
 }
 
 /* ---- what is exported ------------------------------------------------- */
 
 static int export_groups(const char *path, const cm_lattice *lat, const cm_group_info *g,
-                         uint32_t n, uint64_t sink)
+                         uint32_t n, uint64_t sink, char *msg, size_t msg_size)
 {
-    cell_out o = {OUT_CSV, path, "", NULL, NULL, NULL, 0, 0};
-    snprintf(o.tmp, sizeof o.tmp, "%s.tmp-%ld", path, (long)getpid());
-    if (!(o.f = fopen(o.tmp, "w")))
+    cell_out o;
+    memset(&o, 0, sizeof o);
+    o.kind = OUT_CSV;
+    o.path = path;
+    if (cm_output_begin(&o.out, path, false, msg, msg_size) != CM_OK)
         return 0;
+    if (!(o.f = fopen(o.out.tmp, "w"))) {
+        snprintf(msg, msg_size, "cannot write %s: %s", path, strerror(errno));
+        return 0;
+    }
     const char *parts[] = {"centre_", "lo_", "hi_", "anchor_i"};
     fprintf(o.f, "id,period,basin_cells,is_sink");
     for (int p = 0; p < 4; p++)
@@ -336,7 +370,7 @@ static int export_groups(const char *path, const cm_lattice *lat, const cm_group
             fprintf(o.f, ",%lld", (long long)g[k].anchor[d]);
         fprintf(o.f, ",%s\n", cm_group_kind_name(g[k].kind));
     }
-    return out_end(&o, !ferror(o.f));
+    return out_end(&o, 1, msg, msg_size);
 }
 
 /* Walks the window in slabs along the last dimension, reading regions
@@ -367,7 +401,8 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
             for (int k = 0; k < nouts && st == CM_OK; k++)
                 if (!out_row(&outs[k], dim, cell, x, flat.group[i], flat.step[i],
                              cm_is_periodic(&flat, i)))
-                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s", outs[k].tmp);
+                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s: %s", outs[k].path,
+                                 outs[k].db ? sqlite3_errmsg(outs[k].db) : strerror(errno));
         }
         cm_region_free(&flat);
         if (st != CM_OK)
@@ -380,6 +415,13 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
                       cm_cluster *c)
 {
     char msg[1024];
+    cm_box window;
+    cm_cluster_bounds(c, &window);
+    if (a->window) {
+        const int rc = window_box(cl, a->window, &c->lat, &window);
+        if (rc != EXIT_OK)
+            return rc;
+    }
     cm_group_info *g = calloc((size_t)info->groups + 1, sizeof *g);
     uint64_t sink = 0;
     if (!g || cm_store_groups(s, g, info->groups, &sink, msg, sizeof msg) != CM_OK) {
@@ -388,8 +430,8 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         return EXIT_FAIL;
     }
     int rc = EXIT_OK;
-    if (a->groups && !export_groups(a->groups, &c->lat, g, info->groups, sink)) {
-        fprintf(stderr, "cellmap export: cannot write %s\n", a->groups);
+    if (a->groups && !export_groups(a->groups, &c->lat, g, info->groups, sink, msg, sizeof msg)) {
+        fprintf(stderr, "cellmap export: %s\n", msg);
         rc = EXIT_FAIL;
     }
     cell_out outs[2];
@@ -403,21 +445,15 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         outs[nouts].kind = OUT_SQLITE;
         outs[nouts++].path = a->flat;
     }
-    cm_box window;
-    cm_cluster_bounds(c, &window);
-    if (rc == EXIT_OK && a->window && (rc = window_box(cl, a->window, &c->lat, &window)) != EXIT_OK)
-        nouts = 0;
     int ok = 1;
-    for (int k = 0; k < nouts; k++)
-        if (!(ok = out_begin(&outs[k], c->lat.dim, info) && ok))
-            snprintf(msg, sizeof msg, "cannot write %.900s", outs[k].tmp);
+    for (int k = 0; k < nouts && ok; k++)
+        ok = out_begin(&outs[k], c->lat.dim, info, msg, sizeof msg);
     if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink))
         ok = 0, snprintf(msg, sizeof msg, "cannot write %.900s", a->flat);
     if (ok && nouts)
         ok = export_cells(c, &window, outs, nouts, msg, sizeof msg) == CM_OK;
     for (int k = 0; k < nouts; k++)
-        if (!out_end(&outs[k], ok) && ok)
-            ok = 0, snprintf(msg, sizeof msg, "cannot complete %.900s", outs[k].path);
+        ok = out_end(&outs[k], ok, msg, sizeof msg) && ok;
     if (!ok) {
         fprintf(stderr, "cellmap export: %s\n", msg);
         rc = EXIT_FAIL;

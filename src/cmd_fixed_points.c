@@ -32,7 +32,7 @@ int cmd_fixed_points(int argc, char **argv)
             else if (c.value) {
                 snprintf(lo, sizeof lo, "%.*s", (int)(colon - c.value), c.value);
                 if (!parse_int64(lo, &m0) || !parse_int64(colon + 1, &m1) || m0 > m1 ||
-                    m1 - m0 > 1000000 || m0 < -(INT64_C(1) << 50) || m1 > (INT64_C(1) << 50))
+                    m0 < -(INT64_C(1) << 50) || m1 > (INT64_C(1) << 50) || m1 - m0 > 1000000)
                     err = cli_usage_error(
                         &c, "--range: '%s' must be integers M0 <= M1, at most 1e6 levels", c.value);
             }

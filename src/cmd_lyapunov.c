@@ -185,15 +185,15 @@ int cmd_lyapunov(int argc, char **argv)
         if (!(v[best] >= v[k]))
             best = k;
     }
-    printf("%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", n, secs, computed,
+    fprintf(report_stream(a.csv, a.png, NULL), "%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", n, secs, computed,
            positive);
     if (!isnan(v[best]))
-        printf("; largest %.6g at %s = %.6g, %s = %.6g", v[best], a.ax[0].name,
+        fprintf(report_stream(a.csv, a.png, NULL), "; largest %.6g at %s = %.6g, %s = %.6g", v[best], a.ax[0].name,
                param_axis_value(&a.ax[0], (int)(best % nx)), a.ax[1].name,
                param_axis_value(&a.ax[1], (int)(best / nx)));
-    printf("\n");
+    fprintf(report_stream(a.csv, a.png, NULL), "\n");
     if (invalid)
-        printf("points where the model cannot be built (S > S0) are not computed\n");
+        fprintf(report_stream(a.csv, a.png, NULL), "points where the model cannot be built (S > S0) are not computed\n");
     bool ok = computed > 0;
     if (!ok)
         fprintf(stderr,

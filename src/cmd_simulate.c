@@ -402,16 +402,17 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
 static void print_summary(const sim_args *a, const cm_fo_run *r, const cm_fo_tally *last,
                           const double z_prev[2], double psi)
 {
-    printf("followed %d periods from (x, v) = (%.17g, %.17g) at t = %.17g to t = %.17g\n",
+    FILE *out = report_stream(a->csv, a->png, NULL);
+    fprintf(out, "followed %d periods from (x, v) = (%.17g, %.17g) at t = %.17g to t = %.17g\n",
            a->periods, a->from[0], a->from[1], a->t0, r->t_section);
-    printf("last period: %d sticks, %d turns, %d breakaways; x in [%.9g, %.9g]\n", last->n_stick,
+    fprintf(out, "last period: %d sticks, %d turns, %d breakaways; x in [%.9g, %.9g]\n", last->n_stick,
            last->n_turn, last->n_break, last->x_min, last->x_max);
-    printf("Poincare point (%.17g, %.17g)", r->st.x, r->st.v);
+    fprintf(out, "Poincare point (%.17g, %.17g)", r->st.x, r->st.v);
     if (!isnan(z_prev[0])) {
         const double res = hypot(r->st.x - z_prev[0], r->st.v - z_prev[1]);
-        printf("; |P(z) - z| = %.3g%s", res, res < 1e-9 ? " (a fixed point of the map)" : "");
+        fprintf(out, "; |P(z) - z| = %.3g%s", res, res < 1e-9 ? " (a fixed point of the map)" : "");
     }
-    printf("\nPsi over the %d periods shown = %.9g (%.9g per period)\n", a->periods - a->skip, psi,
+    fprintf(out, "\nPsi over the %d periods shown = %.9g (%.9g per period)\n", a->periods - a->skip, psi,
            psi / (a->periods - a->skip));
 }
 

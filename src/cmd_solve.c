@@ -11,6 +11,7 @@
 
 #include "cellmap/join.h"
 #include "cellmap/extend.h"
+#include "cellmap/output.h"
 #include "cellmap/join_stage1.h"
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
@@ -70,6 +71,7 @@ typedef struct solve_args {
     int64_t split[CM_MAX_DIM];
     int n_split;
     int max_steps, threads, json, stage1;
+    FILE *report; /* the summary: stdout, or stderr when the PNG goes to stdout */
     int extend;
     double escape_below;
     const char *bounds_text;
@@ -130,6 +132,12 @@ static int parse_solve(cli *c, solve_args *a)
                                  "join; it takes --split and no --extend, --db or --view");
     if (!err && !a->db && (a->resume || a->mem))
         err = cli_usage_error(c, "--resume and --mem need a database to page to; add --db FILE");
+    const bool png_to_stdout = a->png.path && cm_output_names_stdout(a->png.path);
+    if (!err && png_to_stdout && a->json)
+        err = cli_usage_error(c, "--png %s and --json would both write to stdout; give the PNG "
+                                 "a file name",
+                              a->png.path);
+    a->report = png_to_stdout ? stderr : stdout;
     return err;
 }
 
@@ -192,10 +200,10 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void print_vector(const double *v, int n, const char *sep)
+static void print_vector(FILE *out, const double *v, int n, const char *sep)
 {
     for (int d = 0; d < n; d++)
-        printf("%s%.9g", d ? sep : "", v[d]);
+        fprintf(out, "%s%.9g", d ? sep : "", v[d]);
 }
 
 static int larger_basin_first(const void *a, const void *b)
@@ -240,7 +248,7 @@ typedef struct summary {
     cm_group_info *groups; /* in id order */
 } summary;
 
-static void print_text(const cm_model *m, const summary *sum, const timing *t,
+static void print_text(FILE *out, const cm_model *m, const summary *sum, const timing *t,
                        const extend_log *log)
 {
     char params[2048];
@@ -249,80 +257,80 @@ static void print_text(const cm_model *m, const summary *sum, const timing *t,
     const cm_group_info *g = sum->groups;
     const uint32_t ngroups = sum->ngroups;
     if (log)
-        printf("extension stopped: %s\n", log->stop);
-    printf("model %s %s\n", m->name, params);
-    printf("cells %llu", (unsigned long long)cells);
+        fprintf(out, "extension stopped: %s\n", log->stop);
+    fprintf(out, "model %s %s\n", m->name, params);
+    fprintf(out, "cells %llu", (unsigned long long)cells);
     if (cells != box_cells)
-        printf(" (of %llu in the bounding box; the others not computed)",
+        fprintf(out, " (of %llu in the bounding box; the others not computed)",
                (unsigned long long)box_cells);
-    printf(", periodic groups %u, sink basin %llu cells (%.1f%%)\n", ngroups,
+    fprintf(out, ", periodic groups %u, sink basin %llu cells (%.1f%%)\n", ngroups,
            (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
-    printf("time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
+    fprintf(out, "time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
            1e9 * (t->t1 + t->t2) / (double)cells);
     cm_group_info *sorted = malloc((ngroups + 1) * sizeof *sorted);
     if (!sorted)
         return;
     memcpy(sorted, g, ngroups * sizeof *sorted);
     qsort(sorted, ngroups, sizeof *sorted, larger_basin_first);
-    printf("%6s %8s %12s %12s  %-9s  %s\n", "group", "period", "basin", "doa", "kind", "centre");
+    fprintf(out, "%6s %8s %12s %12s  %-9s  %s\n", "group", "period", "basin", "doa", "kind", "centre");
     for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
-        printf("%6u %8u %12llu %12llu  %-9s  (", sorted[k].id, sorted[k].period,
+        fprintf(out, "%6u %8u %12llu %12llu  %-9s  (", sorted[k].id, sorted[k].period,
                (unsigned long long)sorted[k].basin_cells,
                (unsigned long long)(sorted[k].basin_cells - sorted[k].period),
                cm_group_kind_name(sorted[k].kind));
-        print_vector(sorted[k].centre, m->dim, ", ");
-        printf(")\n");
+        print_vector(out, sorted[k].centre, m->dim, ", ");
+        fprintf(out, ")\n");
     }
     if (ngroups > TEXT_GROUPS)
-        printf("... and %u smaller groups (--json lists all)\n", ngroups - TEXT_GROUPS);
+        fprintf(out, "... and %u smaller groups (--json lists all)\n", ngroups - TEXT_GROUPS);
     free(sorted);
 }
 
-static void print_json_extension(const cm_lattice *lat, const extend_log *log)
+static void print_json_extension(FILE *out, const cm_lattice *lat, const extend_log *log)
 {
-    printf(",\"extension\":{\"steps\":[");
+    fprintf(out, ",\"extension\":{\"steps\":[");
     for (int k = 0; k < log->n; k++) {
         const extend_step *s = &log->steps[k];
         char box[CM_MAX_DIM * 64];
         format_box(lat, &s->box, box, sizeof box);
-        printf("%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_"
+        fprintf(out, "%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_"
                "cells\":%llu,"
                "\"new_groups\":%u,\"straddling_groups\":%u,\"time_s\":%.6f}",
                k ? "," : "", box, (unsigned long long)cm_box_cells(&s->box),
                (unsigned long long)s->escaping, (unsigned long long)s->all_escaping,
                (unsigned long long)s->cluster_cells, s->new_groups, s->straddling, s->seconds);
     }
-    printf("],\"stop\":\"%s\"}", log->stop);
+    fprintf(out, "],\"stop\":\"%s\"}", log->stop);
 }
 
-static void print_json(const cm_model *m, const cm_lattice *lat, const summary *sum,
+static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, const summary *sum,
                        const timing *t, const extend_log *log)
 {
     const cm_group_info *g = sum->groups;
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
-    printf("{\"model\":\"%s\",\"params\":%s,\"lattice\":{\"origin\":[", m->name, params);
-    print_vector(lat->origin, lat->dim, ",");
-    printf("],\"width\":[");
-    print_vector(lat->width, lat->dim, ",");
+    fprintf(out, "{\"model\":\"%s\",\"params\":%s,\"lattice\":{\"origin\":[", m->name, params);
+    print_vector(out, lat->origin, lat->dim, ",");
+    fprintf(out, "],\"width\":[");
+    print_vector(out, lat->width, lat->dim, ",");
     char box[CM_MAX_DIM * 64];
     format_box(lat, &sum->box, box, sizeof box);
-    printf("]},\"box\":\"%s\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
+    fprintf(out, "]},\"box\":\"%s\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
            "\"time_s\":{\"%s\":%.6f,\"%s\":%.6f}",
            box, (unsigned long long)cm_box_cells(&sum->box), (unsigned long long)sum->cells,
            (unsigned long long)sum->sink, t->first, t->t1, t->second, t->t2);
     if (log)
-        print_json_extension(lat, log);
-    printf(",\"groups\":[");
+        print_json_extension(out, lat, log);
+    fprintf(out, ",\"groups\":[");
     for (uint32_t k = 0; k < sum->ngroups; k++) {
-        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"kind\":\"%s\","
+        fprintf(out, "%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"kind\":\"%s\","
                "\"centre\":[",
                k ? "," : "", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
                (unsigned long long)(g[k].basin_cells - g[k].period), cm_group_kind_name(g[k].kind));
-        print_vector(g[k].centre, m->dim, ",");
-        printf("]}");
+        print_vector(out, g[k].centre, m->dim, ",");
+        fprintf(out, "]}");
     }
-    printf("]}\n");
+    fprintf(out, "]}\n");
 }
 
 static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
@@ -399,7 +407,7 @@ static cm_status solve_stage1(const solve_args *a, const cm_model *m, const cm_l
     t->t1 = t1 - t0;
     t->t2 = now_seconds() - t1;
     if (st == CM_OK && !a->json)
-        printf("stage 1 of the join of %u regions: of %llu sink cells, %llu now lead to groups, "
+        fprintf(a->report, "stage 1 of the join of %u regions: of %llu sink cells, %llu now lead to groups, "
                "%llu leave every region, %llu are pending (left to Stage 2, drawn as the sink)\n",
                n, (unsigned long long)stats.sink_cells, (unsigned long long)stats.to_group,
                (unsigned long long)stats.to_sink, (unsigned long long)stats.pending);
@@ -447,11 +455,11 @@ static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *b
     return st;
 }
 
-static void print_step(const cm_lattice *lat, const extend_step *s, int k)
+static void print_step(FILE *out, const cm_lattice *lat, const extend_step *s, int k)
 {
     char box[CM_MAX_DIM * 64];
     format_box(lat, &s->box, box, sizeof box);
-    printf("extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu "
+    fprintf(out, "extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu "
            "cells led there; %u new groups (%u across borders); %.3f s\n",
            k + 1, box, (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
            (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells, s->new_groups,
@@ -512,7 +520,7 @@ static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm
                            choice.cluster_cells, stats.new_groups, stats.straddling_groups,
                            now_seconds() - t0};
         if (!a->json)
-            print_step(&c->lat, s, log->n);
+            print_step(a->report, &c->lat, s, log->n);
     }
     return st;
 }
@@ -643,11 +651,11 @@ static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_latti
     return CM_OK;
 }
 
-static void print_database(const solve_args *a, const run *rn, const summary *sum)
+static void print_database(FILE *out, const solve_args *a, const run *rn, const summary *sum)
 {
     cm_store_stats ss;
     cm_store_get_stats(rn->store, &ss);
-    printf("database %s: %u region%s, %.2f bytes/cell written; paging: %llu regions read "
+    fprintf(out, "database %s: %u region%s, %.2f bytes/cell written; paging: %llu regions read "
            "back (%.3f s), %llu changed ones saved to evict them (%.3f s); commits %.3f s\n",
            a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s",
            (double)ss.bytes_written / (double)sum->cells, (unsigned long long)ss.regions_read,
@@ -657,7 +665,7 @@ static void print_database(const solve_args *a, const run *rn, const summary *su
 
 static cm_status finish_store(run *rn, char *msg, size_t msg_size)
 {
-    cm_status st = cm_store_close(rn->store, msg, msg_size);
+    cm_status st = cm_store_finish(rn->store, msg, msg_size);
     rn->store = NULL;
     return st;
 }
@@ -715,11 +723,11 @@ int cmd_solve(int argc, char **argv)
     }
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
-        print_json(&m, &lat, &sum, &t, shown);
+        print_json(a.report, &m, &lat, &sum, &t, shown);
     else
-        print_text(&m, &sum, &t, shown);
+        print_text(a.report, &m, &sum, &t, shown);
     if (rn.store && !a.json)
-        print_database(&a, &rn, &sum);
+        print_database(a.report, &a, &rn, &sum);
     if (a.png.path && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)
         goto fail;
     if (rn.store && finish_store(&rn, msg, sizeof msg) != CM_OK)

@@ -170,9 +170,9 @@ static bool same_counts(const sweep_point *x, const sweep_point *y)
     return x->attractors == y->attractors;
 }
 
-static void print_point(const char *name, const sweep_point *pt)
+static void print_point(FILE *out, const char *name, const sweep_point *pt)
 {
-    printf("%s = %-12.9g %3u attractor(s), %3u sticking group(s) in the window; basins %llu and "
+    fprintf(out, "%s = %-12.9g %3u attractor(s), %3u sticking group(s) in the window; basins %llu and "
            "%llu cells; %u groups; %.2f s\n",
            name, pt->value, pt->attractors, pt->sticking, (unsigned long long)pt->attractor_cells,
            (unsigned long long)pt->sticking_cells, pt->groups, pt->seconds);
@@ -196,7 +196,7 @@ static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const
         else
             hi = *mid;
     }
-    printf("change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n", lo.attractors,
+    fprintf(report_stream(a->csv, NULL, NULL), "change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n", lo.attractors,
            a->name, lo.value, hi.attractors, hi.value, hi.value - lo.value,
            several ? "; the interval held more than one change, bisection followed one" : "");
     return CM_OK;
@@ -276,7 +276,7 @@ int cmd_sweep(int argc, char **argv)
     for (int k = 0; k < a.n_values && st == CM_OK; k++) {
         st = solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
         if (st == CM_OK)
-            print_point(a.name, &pts[n++]);
+            print_point(report_stream(a.csv, NULL, NULL), a.name, &pts[n++]);
     }
     /* the listed values are pts[0 .. n_values-1]; refinements follow them */
     for (int k = 1; k < a.n_values && st == CM_OK; k++)
@@ -286,7 +286,7 @@ int cmd_sweep(int argc, char **argv)
                 st = refine_change(&a, &lat, &box, pts[k - 1], pts[k], pts, &n, msg, sizeof msg);
         }
     if (st == CM_OK && !changes)
-        printf("no change of the counts between %s = %.9g and %.9g\n", a.name, a.values[0],
+        fprintf(report_stream(a.csv, NULL, NULL), "no change of the counts between %s = %.9g and %.9g\n", a.name, a.values[0],
                a.values[a.n_values - 1]);
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %.17g: %s\n", a.name, pts[n].value, msg);

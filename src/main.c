@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cellmap/output.h"
 #include "src/args.h"
 #include "src/commands.h"
 
@@ -35,6 +36,18 @@ static void usage(FILE *out)
         fprintf(out, "  %-14s %s\n", commands[i].name, commands[i].doc);
 }
 
+/* A command's status, made a failure if its standard output was lost (a
+ * full device, a closed pipe): output that did not arrive is not success. */
+static int finish(const char *name, int status)
+{
+    char msg[256];
+    if (cm_stdout_check(msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap %s: %s\n", name, msg);
+        return status == EXIT_OK ? EXIT_FAIL : status;
+    }
+    return status;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -51,7 +64,7 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(argv[1], commands[i].name) == 0)
-            return commands[i].run(argc - 1, argv + 1);
+            return finish(commands[i].name, commands[i].run(argc - 1, argv + 1));
     fprintf(stderr, "cellmap: unknown command '%s'\n", argv[1]);
     usage(stderr);
     return EXIT_USAGE;

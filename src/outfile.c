@@ -7,26 +7,38 @@
 
 bool outfile_open(const char *cmd, const char *path, outfile *o)
 {
-    o->path = path;
-    snprintf(o->tmp, sizeof o->tmp, "%s.tmp-%ld", path, (long)getpid());
-    o->f = fopen(o->tmp, "w");
-    if (!o->f)
-        fprintf(stderr, "cellmap %s: cannot write %s: %s (does the directory exist?)\n", cmd, path,
-                strerror(errno));
+    char msg[CM_OUTPUT_PATH_MAX + 256];
+    o->f = NULL;
+    if (cm_output_begin(&o->out, path, false, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+        return false;
+    }
+    o->f = fopen(o->out.tmp, "w");
+    if (!o->f) {
+        fprintf(stderr, "cellmap %s: cannot write %s: %s (does the directory exist?)\n", cmd,
+                path, strerror(errno));
+        cm_output_abandon(&o->out);
+    }
     return o->f != NULL;
 }
 
 bool outfile_close(const char *cmd, outfile *o, bool ok)
 {
-    ok = !ferror(o->f) && ok;
-    ok = fclose(o->f) == 0 && ok;
-    if (ok && rename(o->tmp, o->path) != 0) {
-        fprintf(stderr, "cellmap %s: cannot rename %s to %s: %s\n", cmd, o->tmp, o->path,
-                strerror(errno));
+    char msg[CM_OUTPUT_PATH_MAX + 256];
+    errno = 0;
+    const bool written = fflush(o->f) == 0 && !ferror(o->f);
+    const int error = errno;
+    const bool closed = fclose(o->f) == 0;
+    if (ok && (!written || !closed)) {
+        fprintf(stderr, "cellmap %s: cannot write %s: %s\n", cmd, o->out.path,
+                strerror(!written && error ? error : errno ? errno : EIO));
         ok = false;
     }
-    if (!ok)
-        remove(o->tmp);
+    if (ok && cm_output_commit(&o->out, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+        ok = false;
+    }
+    cm_output_abandon(&o->out);
     return ok;
 }
 

@@ -1,18 +1,19 @@
 /* src/outfile.h - output files of the analysis commands (CSV and chart
- * PNGs), written to PATH.tmp-PID and renamed over PATH when complete, so
- * that a failed run never leaves a half-written file. */
+ * PNGs), written to a temporary file that reaches PATH only when complete
+ * (cellmap/output.h: "-" is stdout, devices and FIFOs are written in place,
+ * never replaced), so that a failed run never leaves a half-written file. */
 #ifndef CM_SRC_OUTFILE_H
 #define CM_SRC_OUTFILE_H
 
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "cellmap/output.h"
 #include "render/chart.h"
 #include "render/png_out.h"
 
 typedef struct outfile {
-    const char *path;
-    char tmp[4200];
+    cm_output out;
     FILE *f;
 } outfile;
 

@@ -27,7 +27,8 @@ cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size
 
 /* A new file at path for model m, lattice, command line and plan (created
  * at SOURCE_DATE_EPOCH, else time 0), replacing an older cellmap database
- * there (never another file), and an empty cluster c saved into it; m
+ * there once cm_store_finish says the new cluster is complete (never
+ * another file), and an empty cluster c saved into it; m
  * labels its groups' kinds and must outlive the store. */
 cm_status project_create(const char *path, const cm_model *m, const cm_lattice *lat,
                          const char *command, const char *plan, cm_store **s, cm_cluster *c,

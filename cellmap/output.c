@@ -1,0 +1,178 @@
+#define _DEFAULT_SOURCE /* readlink, mkstemp */
+#include "cellmap/output.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+bool cm_output_names_stdout(const char *path)
+{
+    return strcmp(path, "-") == 0 || strcmp(path, "/dev/stdout") == 0 ||
+           strcmp(path, "/dev/fd/1") == 0 || strcmp(path, "/proc/self/fd/1") == 0;
+}
+
+/* Follows the symlinks at path into out (at most 40, as the kernel does).
+ * Paths under /proc are kept as they are: their links name open files
+ * ("pipe:[..]"), not paths. */
+static cm_status follow_links(const char *path, char *out, char *msg, size_t msg_size)
+{
+    snprintf(out, CM_OUTPUT_PATH_MAX, "%s", path);
+    for (int hops = 0; hops < 40; hops++) {
+        struct stat sb;
+        if (strncmp(out, "/proc/", 6) == 0 || lstat(out, &sb) != 0 || !S_ISLNK(sb.st_mode))
+            return CM_OK;
+        char target[CM_OUTPUT_PATH_MAX];
+        const ssize_t n = readlink(out, target, sizeof target - 1);
+        if (n < 0)
+            return cm_fail(CM_EIO, msg, msg_size, "cannot read the symlink %s: %s", out,
+                           strerror(errno));
+        target[n] = '\0';
+        if (target[0] == '/') {
+            snprintf(out, CM_OUTPUT_PATH_MAX, "%s", target);
+            continue;
+        }
+        char *slash = strrchr(out, '/'); /* relative to the link's directory */
+        char joined[2 * CM_OUTPUT_PATH_MAX];
+        snprintf(joined, sizeof joined, "%.*s%s", slash ? (int)(slash - out + 1) : 0, out, target);
+        if (strlen(joined) >= CM_OUTPUT_PATH_MAX)
+            return cm_fail(CM_EINVAL, msg, msg_size, "the symlink %s leads to too long a path",
+                           path);
+        memcpy(out, joined, strlen(joined) + 1);
+    }
+    return cm_fail(CM_EINVAL, msg, msg_size, "%s: too many levels of symlinks", path);
+}
+
+/* A temporary file in $TMPDIR (or /tmp) for an output copied in place. */
+static cm_status make_temp(cm_output *o, char *msg, size_t msg_size)
+{
+    const char *dir = getenv("TMPDIR");
+    snprintf(o->tmp, sizeof o->tmp, "%s/cellmap-XXXXXX", dir && *dir ? dir : "/tmp");
+    const int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        const int e = errno;
+        o->tmp[0] = '\0';
+        return cm_fail(CM_EIO, msg, msg_size,
+                       "cannot create a temporary file for %s in %s: %s (set TMPDIR to a "
+                       "writable directory)",
+                       o->path, dir && *dir ? dir : "/tmp", strerror(e));
+    }
+    close(fd);
+    return CM_OK;
+}
+
+cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, char *msg,
+                          size_t msg_size)
+{
+    memset(o, 0, sizeof *o);
+    o->path = path;
+    if (!path || !*path)
+        return cm_fail(CM_EINVAL, msg, msg_size, "an output file name is empty");
+    if (strlen(path) + 32 >= CM_OUTPUT_PATH_MAX)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the output file name %.64s... is too long",
+                       path);
+    if (cm_output_names_stdout(path)) {
+        if (needs_regular)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s cannot be standard output: this output is a database file; give "
+                           "a file name",
+                           path);
+        o->to_stdout = o->in_place = true;
+        snprintf(o->dest, sizeof o->dest, "standard output");
+        return make_temp(o, msg, msg_size);
+    }
+    cm_status st = follow_links(path, o->dest, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    struct stat sb;
+    if (stat(o->dest, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s is a directory; give a file name in it",
+                       path);
+    const bool exists = stat(o->dest, &sb) == 0;
+    if ((exists && !S_ISREG(sb.st_mode)) || strncmp(o->dest, "/proc/", 6) == 0) {
+        if (needs_regular)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s is not a regular file (a device, FIFO or socket); this output is "
+                           "a database file: give a file name",
+                           path);
+        o->in_place = true; /* never replaced: the bytes are copied in */
+        return make_temp(o, msg, msg_size);
+    }
+    if (strlen(o->dest) + 32 >= sizeof o->tmp)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the output path of %.64s... is too long", path);
+    snprintf(o->tmp, sizeof o->tmp, "%.4150s.tmp-%ld", o->dest, (long)getpid());
+    unlink(o->tmp); /* left by a killed run of a process with our id */
+    return CM_OK;
+}
+
+/* Copies the temporary file into the open destination f. */
+static cm_status copy_into(const cm_output *o, FILE *f, char *msg, size_t msg_size)
+{
+    FILE *in = fopen(o->tmp, "rb");
+    if (!in)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot read back %s: %s", o->tmp, strerror(errno));
+    char buf[1 << 16];
+    size_t n;
+    int error = 0;
+    while (!error && (n = fread(buf, 1, sizeof buf, in)) > 0)
+        if (fwrite(buf, 1, n, f) != n)
+            error = errno ? errno : EIO;
+    if (!error && ferror(in))
+        error = EIO;
+    fclose(in);
+    if (!error && fflush(f) != 0)
+        error = errno ? errno : EIO;
+    if (error)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->dest, strerror(error));
+    return CM_OK;
+}
+
+cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    if (!o->in_place) {
+        if (rename(o->tmp, o->dest) != 0)
+            st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s: %s", o->tmp, o->dest,
+                         strerror(errno));
+    } else if (o->to_stdout) {
+        errno = 0;
+        st = copy_into(o, stdout, msg, msg_size);
+    } else {
+        /* O_WRONLY without O_CREAT: a device or FIFO, never a new file */
+        const int fd = open(o->dest, O_WRONLY | O_TRUNC);
+        FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+        if (!f) {
+            st = cm_fail(CM_EIO, msg, msg_size, "cannot open %s: %s", o->dest, strerror(errno));
+            if (fd >= 0)
+                close(fd);
+        } else {
+            errno = 0;
+            st = copy_into(o, f, msg, msg_size);
+            if (fclose(f) != 0 && st == CM_OK)
+                st = cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->dest,
+                             strerror(errno));
+        }
+    }
+    cm_output_abandon(o);
+    return st;
+}
+
+void cm_output_abandon(cm_output *o)
+{
+    if (o && o->tmp[0]) {
+        unlink(o->tmp);
+        o->tmp[0] = '\0';
+    }
+}
+
+cm_status cm_stdout_check(char *msg, size_t msg_size)
+{
+    errno = 0;
+    if (fflush(stdout) != 0 || ferror(stdout))
+        return cm_fail(CM_EIO, msg, msg_size, "cannot write standard output: %s",
+                       strerror(errno ? errno : EIO));
+    return CM_OK;
+}

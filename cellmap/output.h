@@ -1,0 +1,56 @@
+/* cellmap/output.h - where an output file goes, and how it gets there
+ * without clobbering what is not its own.
+ *
+ * Every output is written to a temporary file first; only a complete one
+ * reaches its destination:
+ *   - a regular file, or a name that does not exist yet: the temporary file
+ *     PATH.tmp-PID is renamed over it (a symlink is followed: its target is
+ *     replaced, the link stays);
+ *   - "-": standard output; a device, FIFO or socket (also through a
+ *     symlink, as /dev/stdout is): the destination is opened in place and
+ *     the bytes are copied into it; the temporary file is in $TMPDIR (or
+ *     /tmp). Such a destination is never replaced, and an output that must
+ *     be a regular file (a database) is refused there;
+ *   - a directory: refused.
+ * Writers write cm_output.tmp however they like (stdio, libpng, SQLite).
+ * Failed writes (a full disk, a full device, a closed pipe) are reported
+ * with their reason. */
+#ifndef CM_OUTPUT_H
+#define CM_OUTPUT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "cellmap/status.h"
+
+#define CM_OUTPUT_PATH_MAX 4200
+
+typedef struct cm_output {
+    const char *path;              /* as the user gave it */
+    char dest[CM_OUTPUT_PATH_MAX]; /* the file renamed over or copied into */
+    char tmp[CM_OUTPUT_PATH_MAX];  /* the file the writer writes */
+    bool in_place;                 /* copied into dest (stdout, device, FIFO, socket) */
+    bool to_stdout;
+} cm_output;
+
+/* Whether path names standard output: "-", /dev/stdout, /dev/fd/1 or
+ * /proc/self/fd/1 (commands then print their reports to stderr). */
+bool cm_output_names_stdout(const char *path);
+
+/* Checks path and prepares o (no file is created yet: the writer creates
+ * o->tmp). needs_regular: the output must be a regular file (e.g. an
+ * SQLite database), so stdout and devices are refused. */
+cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, char *msg,
+                          size_t msg_size);
+
+/* Moves the complete temporary file to its destination and removes it. */
+cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size);
+
+/* Removes the temporary file (after a failure; NULL-safe). */
+void cm_output_abandon(cm_output *o);
+
+/* Flushes stdout; CM_EIO with the reason if anything written to it was
+ * lost (a full device, a closed pipe). */
+cm_status cm_stdout_check(char *msg, size_t msg_size);
+
+#endif
