@@ -176,6 +176,27 @@ static void start_resolution(cm_node *nd)
     }
 }
 
+cm_status cm_cluster_check_nodes(const cm_cluster *c, uint32_t k, const cm_node *nodes,
+                                 uint32_t groups, char *msg, size_t msg_size)
+{
+    const cm_cluster_region *cr = &c->regions[k];
+    for (uint64_t e = 0; e < cr->r.nexits; e++) {
+        const cm_node *nd = &nodes[e];
+        const bool known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+        const bool linked = nd->next < CM_NODE_MAX;
+        const bool bad_list = (nd->first_in != CM_NODE_OPEN && nd->first_in >= c->nnodes) ||
+                              (nd->sibling != CM_NODE_OPEN && nd->sibling >= c->nnodes);
+        if ((linked && (nd->next >= c->nnodes ||
+                        nd->target >= c->regions[cm_cluster_node_region(c, nd->next)].r.ncells)) ||
+            (!linked && !known && nd->next != CM_NODE_OPEN) || (known && nd->group > groups) ||
+            (nd->next == CM_NODE_CYCLE && (nd->group == 0 || nd->dist >= cr->r.ncells)) ||
+            nd->tree > cr->r.ncells || bad_list)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "node %llu of region %u is damaged",
+                           (unsigned long long)e, k + 1);
+    }
+    return CM_OK;
+}
+
 /* Region k's node table, read back if it was paged out. */
 static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg, size_t msg_size)
 {
@@ -1095,22 +1116,6 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
                : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the region index");
 }
 
-static cm_status check_saved_nodes(const cm_cluster *c, uint32_t groups)
-{
-    for (uint32_t k = 0; k < c->nregions; k++) {
-        const cm_cluster_region *cr = &c->regions[k];
-        for (uint64_t e = 0; e < cr->r.nexits; e++) {
-            const cm_node *nd = &cr->nodes[e];
-            const bool known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
-            if ((nd->next < CM_NODE_MAX && nd->next >= c->nnodes) ||
-                (nd->next >= CM_NODE_MAX && !known && nd->next != CM_NODE_OPEN) ||
-                (known && nd->group > groups) || (nd->next == CM_NODE_CYCLE && nd->group == 0))
-                return CM_EFORMAT;
-        }
-    }
-    return CM_OK;
-}
-
 /* The weights of the open nodes: the trees of the nodes whose chains end there. */
 static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
 {
@@ -1136,8 +1141,12 @@ static cm_status weigh_open_nodes(cm_cluster *c, char *msg, size_t msg_size)
 cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
                               int64_t *const *exits, char *msg, size_t msg_size)
 {
-    if (check_saved_nodes(c, groups) != CM_OK)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "the node table is damaged");
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_status st =
+            cm_cluster_check_nodes(c, k, c->regions[k].nodes, groups, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+    }
     if (make_space(c, &c->regions[0].r.box, groups) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
     c->ngroups = groups;

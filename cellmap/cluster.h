@@ -196,6 +196,14 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t m
 cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_node *nodes,
                              char *msg, size_t msg_size);
 
+/* Checks region k's node records as read from a file (nodes[0..nexits)):
+ * links to nodes of the cluster (with a target cell in that node's
+ * region), marks the format knows, groups up to groups, trees within the
+ * region, lists of linked nodes through nodes of the cluster.
+ * CM_EFORMAT naming the node otherwise. */
+cm_status cm_cluster_check_nodes(const cm_cluster *c, uint32_t k, const cm_node *nodes,
+                                 uint32_t groups, char *msg, size_t msg_size);
+
 /* After the last cm_cluster_restore, every node table given: the open
  * nodes, their weights (resolving every node) and their index from the exit
  * tables (exits[k]: region k's, nexits * dim cells, which the caller keeps).

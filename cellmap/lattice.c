@@ -1,5 +1,6 @@
 #include "cellmap/lattice.h"
 
+#include <float.h>
 #include <math.h>
 
 cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
@@ -9,10 +10,19 @@ cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
     for (int d = 0; d < lat->dim; d++) {
         if (!isfinite(lat->origin[d]))
             return cm_fail(CM_EINVAL, msg, msg_size, "lattice origin[%d] is not finite", d);
-        if (!(lat->width[d] > 0.0) || !isfinite(lat->width[d]))
+        if (!(lat->width[d] >= DBL_MIN) || !isfinite(lat->width[d]))
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "cell width in dimension %d must be positive and finite (got %g)", d,
                            lat->width[d]);
+        /* every cell of the world must have a finite centre, distinct from
+         * its neighbours' */
+        const double reach = fabs(lat->origin[d]) + lat->width[d] * (double)CM_WORLD_LIMIT;
+        if (!isfinite(reach) || fabs(lat->origin[d]) / lat->width[d] > 0x1p50)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the lattice in dimension %d (origin %g, cell width %g) cannot be "
+                           "resolved in double precision: make the cells wider or the "
+                           "coordinates smaller",
+                           d, lat->origin[d], lat->width[d]);
     }
     return CM_OK;
 }

@@ -351,3 +351,68 @@ cm_status cm_scm_describe(const cm_model *model, const cm_lattice *lat, const cm
         st = cm_scm_label_groups(model, lat, r, *groups, r->ngroups, msg, msg_size);
     return st;
 }
+
+/* What is wrong with cell i's group alone, or NULL. */
+static const char *bad_group(const cm_region *r, uint32_t g, uint32_t max_group, bool node_refs)
+{
+    if (g == 0 || (g < CM_NODE_REF && g <= max_group))
+        return NULL;
+    if (node_refs && g >= CM_NODE_REF && g - CM_NODE_REF < r->nexits)
+        return NULL;
+    return "its group is no group of the file";
+}
+
+/* What is wrong with cell i given its image, or NULL; *next_exit is the
+ * exit the next exit cell must have. */
+static const char *bad_cell(const cm_region *r, uint64_t i, uint32_t max_group, bool node_refs,
+                            uint64_t *next_exit)
+{
+    const uint32_t m = r->image[i], g = r->group[i], s = r->step[i];
+    const char *why = bad_group(r, g, max_group, node_refs);
+    if (why)
+        return why;
+    if (m == CM_IMAGE_SINK)
+        return g == 0 && s == 1 ? NULL : "its image is the sink but its group or step is not";
+    if (m < r->ncells) {
+        if (s == 0)
+            return g != 0 && g < CM_NODE_REF && r->step[m] == 0 && r->group[m] == g
+                       ? NULL
+                       : "a periodic cell whose image is not on its cycle";
+        return r->group[m] == g && r->step[m] == s - 1 ? NULL
+                                                       : "its group or step is not its image's";
+    }
+    const int64_t e = cm_image_exit_index(m);
+    if (e < 0 || (uint64_t)e != *next_exit || (uint64_t)e >= r->nexits)
+        return "its image is no cell of the region and not the region's next exit";
+    ++*next_exit;
+    if (node_refs && (g != (CM_NODE_REF | (uint32_t)e) || s != 1))
+        return "an exit cell that is not its own node";
+    return NULL;
+}
+
+cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, char *msg,
+                          size_t msg_size)
+{
+    uint64_t next_exit = 0;
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        const char *why = bad_cell(r, i, max_group, node_refs, &next_exit);
+        if (why)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "cell %llu: %s", (unsigned long long)i,
+                           why);
+    }
+    if (next_exit != r->nexits)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%llu exits recorded, %llu found in the cells",
+                       (unsigned long long)r->nexits, (unsigned long long)next_exit);
+    const int dim = r->box.dim;
+    for (uint64_t e = 0; e < r->nexits; e++) {
+        const int64_t *t = r->exit_target + e * (uint64_t)dim;
+        bool inside_world = true;
+        for (int d = 0; d < dim; d++)
+            inside_world = inside_world && t[d] > -CM_WORLD_LIMIT && t[d] < CM_WORLD_LIMIT;
+        if (!inside_world || cm_box_contains(&r->box, t))
+            return cm_fail(CM_EFORMAT, msg, msg_size,
+                           "exit %llu: its target is %s", (unsigned long long)e,
+                           inside_world ? "inside the region" : "outside the world");
+    }
+    return CM_OK;
+}

@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -312,6 +314,27 @@ cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
     return st;
 }
 
+/* Takes an exclusive flock on path (held in *fd until the store closes):
+ * a second process that wants to write the file is refused at once. flock
+ * and SQLite's POSIX locks do not interact. */
+static cm_status lock_file(const char *path, int *fd, char *msg, size_t msg_size)
+{
+    *fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (*fd < 0)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot open %s: %s", path, strerror(errno));
+    if (flock(*fd, LOCK_EX | LOCK_NB) == 0)
+        return CM_OK;
+    const int e = errno;
+    close(*fd);
+    *fd = -1;
+    if (e == EWOULDBLOCK)
+        return cm_fail(CM_EIO, msg, msg_size,
+                       "%s is in use by another cellmap process (writing it); wait for it to "
+                       "finish, or read the file meanwhile (info, render, export)",
+                       path);
+    return cm_fail(CM_EIO, msg, msg_size, "cannot lock %s: %s", path, strerror(e));
+}
+
 cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
                            size_t msg_size)
 {
@@ -325,6 +348,16 @@ cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out,
     }
     s->db = db;
     s->writable = writable;
+    s->lock_fd = s->replaces_lock_fd = -1;
+    if (writable) {
+        const cm_status st = lock_file(path, &s->lock_fd, msg, msg_size);
+        if (st != CM_OK) {
+            sqlite3_close(db);
+            free(s->path);
+            free(s);
+            return st;
+        }
+    }
     s->version = CM_STORE_VERSION;
     pragma_int(db, "PRAGMA user_version", &s->version);
     s->threads = 1;
@@ -332,15 +365,20 @@ cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out,
     return CM_OK;
 }
 
-static cm_status use_wal(sqlite3 *db, const char *path, char *msg, size_t msg_size)
+cm_status store_use_wal(cm_store *s, char *msg, size_t msg_size)
 {
     /* NORMAL: in WAL mode a commit survives the process being killed; only
-     * an operating-system crash may lose the last commits, never consistency. */
+     * an operating-system crash may lose the last commits, never consistency.
+     * Entered at the first write, so that a file opened for writing and
+     * refused (or left alone) stays byte-identical. */
     char mode[16] = "";
-    if (read_text(db, "PRAGMA journal_mode=WAL", mode, sizeof mode, msg, msg_size) != CM_OK ||
-        strcmp(mode, "wal") != 0 || store_exec(db, "PRAGMA synchronous=NORMAL") != SQLITE_OK)
-        return cm_fail(CM_EDB, msg, msg_size, "cannot put %s in WAL mode: %s", path,
-                       sqlite3_errmsg(db));
+    if (s->wal)
+        return CM_OK;
+    if (read_text(s->db, "PRAGMA journal_mode=WAL", mode, sizeof mode, msg, msg_size) != CM_OK ||
+        strcmp(mode, "wal") != 0 || store_exec(s->db, "PRAGMA synchronous=NORMAL") != SQLITE_OK)
+        return cm_fail(CM_EDB, msg, msg_size, "cannot put %s in WAL mode: %s", s->path,
+                       sqlite3_errmsg(s->db));
+    s->wal = 1;
     return CM_OK;
 }
 
@@ -445,8 +483,11 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
     struct stat sb;
     cm_status st = cm_output_begin(&o, path, true, msg, msg_size);
     const bool replacing = st == CM_OK && stat(o.dest, &sb) == 0;
+    int old_lock = -1;
     if (st == CM_OK && replacing)
         st = check_replaceable(o.dest, path, msg, msg_size);
+    if (st == CM_OK && replacing)
+        st = lock_file(o.dest, &old_lock, msg, msg_size);
     if (st == CM_OK) {
         remove_side_files(o.tmp);
         st = write_empty(o.tmp, meta, msg, msg_size);
@@ -457,6 +498,8 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
     if (st == CM_OK)
         st = cm_store_open(replacing ? o.tmp : o.dest, 1, out, msg, msg_size);
     if (st == CM_OK && replacing) {
+        (*out)->replaces_lock_fd = old_lock;
+        old_lock = -1;
         (*out)->replaces = strdup(o.dest);
         (*out)->tmp_path = strdup(o.tmp);
         free((*out)->path);
@@ -470,6 +513,8 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         cm_output_abandon(&o);
         remove_side_files(o.tmp);
     }
+    if (old_lock >= 0)
+        close(old_lock);
     return st;
 }
 
@@ -478,8 +523,6 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
     *out = NULL;
     sqlite3 *db = NULL;
     cm_status st = store_open_checked(path, writable, writable, 0, &db, msg, msg_size);
-    if (st == CM_OK && writable)
-        st = use_wal(db, path, msg, msg_size);
     if (st != CM_OK) {
         sqlite3_close(db);
         return st;
@@ -495,16 +538,20 @@ static cm_status close_db(cm_store *s, char *msg, size_t msg_size)
     if (s->in_transaction)
         store_exec(s->db, "ROLLBACK"); /* a join that did not finish */
     /* Back to one self-contained file for users and their sqlite3 shell. */
-    if (s->writable && store_exec(s->db, "PRAGMA journal_mode=DELETE") != SQLITE_OK)
+    if (s->wal && store_exec(s->db, "PRAGMA journal_mode=DELETE") != SQLITE_OK)
         st = store_db_error(s->db, "leave WAL mode", msg, msg_size);
     if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
+    if (s->lock_fd >= 0)
+        close(s->lock_fd); /* after SQLite's: its locks live while the file is open */
     free(s->blobs);
     return st;
 }
 
 static void free_store(cm_store *s)
 {
+    if (s->replaces_lock_fd >= 0)
+        close(s->replaces_lock_fd);
     free(s->path);
     free(s->replaces);
     free(s->tmp_path);
@@ -557,6 +604,48 @@ void cm_store_get_stats(const cm_store *s, cm_store_stats *stats) { *stats = s->
 /* ---- reading ---------------------------------------------------------- */
 
 /* Parses a JSON array of numbers written by this module. */
+static cm_status meta_text(sqlite3 *db, const char *key, char *out, size_t size, char *msg,
+                           size_t msg_size)
+{
+    char sql[128];
+    snprintf(sql, sizeof sql, "SELECT value FROM meta WHERE key='%s'", key);
+    if (read_text(db, sql, out, size, NULL, 0) == CM_OK)
+        return CM_OK;
+    return cm_fail(CM_EFORMAT, msg, msg_size, "its meta table has no '%s'", key);
+}
+
+cm_status store_damaged(const cm_store *s, cm_status st, char *msg, size_t msg_size)
+{
+    if (st != CM_EFORMAT || !msg || strstr(msg, s->path))
+        return st;
+    char detail[512];
+    snprintf(detail, sizeof detail, "%s", msg);
+    return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, detail);
+}
+
+cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size)
+{
+    sqlite3 *db = s->db;
+    const int64_t groups = store_query_int(db, "SELECT COUNT(*) FROM attractors");
+    if (groups < 0 || groups > CM_MAX_GROUPS ||
+        store_query_int(db, "SELECT IFNULL(MAX(id), 0) FROM attractors") != groups ||
+        store_query_int(db, "SELECT COUNT(*) FROM attractors WHERE period < 1") != 0)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "its attractors are not numbered 1..N with periods of 1 or more");
+    char text[32];
+    if (meta_text(db, "groups", text, sizeof text, NULL, 0) == CM_OK &&
+        strtoll(text, NULL, 10) != groups)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "it says it holds %s groups but has %lld",
+                       text, (long long)groups);
+    if (s->version >= 4 &&
+        store_query_int(db, "SELECT COUNT(*) FROM basins WHERE grp < 1 OR grp > "
+                            "(SELECT COUNT(*) FROM attractors) OR cells < 0") != 0)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its basins name groups it does not have");
+    if (store_query_int(db, "SELECT COUNT(*) FROM groups WHERE basin_cells < 0") != 0)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its basins hold more cells than its regions");
+    return CM_OK;
+}
+
 int store_parse_json_numbers(const char *text, double *out, int cap)
 {
     int n = 0;
@@ -576,13 +665,6 @@ int store_parse_json_numbers(const char *text, double *out, int cap)
     return *p == ']' ? n : -1;
 }
 
-static cm_status meta_text(sqlite3 *db, const char *key, char *out, size_t size, char *msg,
-                           size_t msg_size)
-{
-    char sql[128];
-    snprintf(sql, sizeof sql, "SELECT value FROM meta WHERE key='%s'", key);
-    return read_text(db, sql, out, size, msg, msg_size);
-}
 
 cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size)
 {
@@ -595,8 +677,11 @@ cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg
     if ((st = meta_text(db, "lattice_width", text, sizeof text, msg, msg_size)) != CM_OK)
         return st;
     if (lat->dim < 1 || store_parse_json_numbers(text, lat->width, CM_MAX_DIM) != lat->dim)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "corrupt lattice metadata");
-    return cm_lattice_check(lat, msg, msg_size);
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its lattice is not a list of numbers");
+    char why[256];
+    if (cm_lattice_check(lat, why, sizeof why) != CM_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its lattice: %s", why);
+    return CM_OK;
 }
 
 int64_t store_query_int(sqlite3 *db, const char *sql)
@@ -626,8 +711,10 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
                        msg_size);
     if (st == CM_OK)
         st = store_read_lattice(db, &info->lattice, msg, msg_size);
+    if (st == CM_OK)
+        st = store_check_groups(s, msg, msg_size);
     if (st != CM_OK)
-        return st;
+        return store_damaged(s, st, msg, msg_size);
     const int64_t regions = store_query_int(db, "SELECT COUNT(*) FROM regions");
     const int64_t cells = store_query_int(db, "SELECT IFNULL(SUM(cells), 0) FROM regions");
     const int64_t groups = store_query_int(db, "SELECT COUNT(*) FROM attractors");

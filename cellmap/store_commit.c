@@ -164,8 +164,13 @@ cm_status store_begin(cm_store *s, char *msg, size_t msg_size)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "an earlier write to %s failed; reopen it (solve --resume) to go on",
                        s->path);
-    if (!s->in_transaction && store_exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
-        return store_db_error(s->db, "begin", msg, msg_size);
+    if (!s->in_transaction) {
+        const cm_status st = store_use_wal(s, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (store_exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
+            return store_db_error(s->db, "begin", msg, msg_size);
+    }
     s->in_transaction = 1;
     return CM_OK;
 }

@@ -16,11 +16,15 @@
 struct cm_store {
     sqlite3 *db;
     const cm_model *model; /* labels new groups (cm_store_set_model), may be NULL */
+    const cm_cluster *cluster; /* the cluster it pages for (cm_store_attach), may be NULL */
     char *path;
     /* a new cluster that replaces the file at replaces when complete
      * (cm_store_finish); until then it is written at tmp_path */
     char *replaces, *tmp_path;
+    int replaces_lock_fd; /* an flock on the file it replaces, or -1 */
     int writable;
+    int lock_fd; /* writable: an flock on the file, so that a second writer is refused */
+    int wal;     /* in WAL mode since the first write (store_begin) */
     int version; /* of the file: 2 and 3 are read (regions resolved, no node table) */
     int in_transaction;             /* evictions in a join write into it; the commit ends it */
     int failed;                     /* a write failed: the cluster and the file differ */
@@ -58,6 +62,17 @@ cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char 
 void store_json_doubles(char *buf, size_t size, const double *v, int n);
 void store_json_ints(char *buf, size_t size, const int64_t *v, int n);
 /* Numbers of a JSON array text into out (at most cap); how many, or -1. */
+/* A CM_EFORMAT message prefixed "PATH is damaged: " unless it names the
+ * file already; other statuses as they are. */
+/* Puts the file in WAL mode for writing (once: the first store_begin). */
+cm_status store_use_wal(cm_store *s, char *msg, size_t msg_size);
+
+cm_status store_damaged(const cm_store *s, cm_status st, char *msg, size_t msg_size);
+
+/* Checks the groups: attractors numbered 1..N with periods, N what the
+ * meta table says, basins of those groups only and within the cells. */
+cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size);
+
 int store_parse_json_numbers(const char *text, double *out, int cap);
 cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size);
 

@@ -6,6 +6,7 @@
 #include "cellmap/codec.h"
 #include "cellmap/grow.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -153,6 +154,19 @@ static cm_status read_exits(cm_store *s, uint32_t k, uint64_t nexits, int dim, i
     return CM_OK;
 }
 
+/* Checks region k's cells as read (cm_region_check): pages that decode but
+ * are damaged, or belong to another region, are found here. */
+static cm_status check_cells(const cm_store *s, uint32_t k, const cm_region *r, char *msg,
+                             size_t msg_size)
+{
+    char why[256];
+    const uint32_t groups = s->cluster ? s->cluster->ngroups : 0;
+    if (cm_region_check(r, groups, s->version >= 4, why, sizeof why) == CM_OK)
+        return CM_OK;
+    return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u, %s", s->path, k + 1,
+                   why);
+}
+
 /* The pager: reads region k's arrays and exit table back. */
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size)
 {
@@ -169,6 +183,8 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
         st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
+    if (st == CM_OK)
+        st = check_cells(s, k, r, msg, msg_size);
     if (st != CM_OK) {
         free(r->image);
         free(r->group);
@@ -186,12 +202,14 @@ static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, ch
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
     s->threads = cm_cluster_threads(c);
+    s->cluster = c;
     c->page_in = store_page_in;
     c->page_out = s->writable ? store_page_out : NULL;
     c->nodes_in = nodes_in;
     c->pager = s;
 }
 
+/* A region's bounds: whole numbers inside the world, lo < hi. */
 static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
 {
     double l[CM_MAX_DIM], h[CM_MAX_DIM];
@@ -199,7 +217,10 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
         store_parse_json_numbers(hi, h, CM_MAX_DIM) != dim)
         return CM_EFORMAT;
     box->dim = dim;
+    const double limit = (double)CM_WORLD_LIMIT;
     for (int d = 0; d < dim; d++) {
+        if (!(l[d] >= -limit && h[d] <= limit) || l[d] != floor(l[d]) || h[d] != floor(h[d]))
+            return CM_EFORMAT;
         box->lo[d] = (int64_t)l[d];
         box->hi[d] = (int64_t)h[d];
         if (box->hi[d] <= box->lo[d])
@@ -283,7 +304,11 @@ static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, ch
 {
     cm_store *s = user;
     const double t0 = store_seconds_now();
-    const cm_status st = read_nodes(s, k, n, nodes, msg, msg_size);
+    cm_status st = read_nodes(s, k, n, nodes, msg, msg_size);
+    char why[256];
+    if (st == CM_OK && s->cluster &&
+        cm_cluster_check_nodes(s->cluster, k, nodes, s->cluster->ngroups, why, sizeof why) != CM_OK)
+        st = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, why);
     s->stats.read_seconds += store_seconds_now() - t0;
     return st;
 }
@@ -327,12 +352,19 @@ static cm_status region_record(const cm_store *s, sqlite3_stmt *st, uint32_t k, 
     rec->ncells = (uint64_t)sqlite3_column_int64(st, 3);
     rec->nexits = (uint64_t)sqlite3_column_int64(st, 4);
     rec->ngroups = (uint32_t)sqlite3_column_int64(st, 5);
-    if (sqlite3_column_int64(st, 0) != (sqlite3_int64)k + 1 ||
-        parse_box((const char *)sqlite3_column_text(st, 1),
-                  (const char *)sqlite3_column_text(st, 2), dim, &rec->box) != CM_OK ||
-        rec->ncells != cm_box_cells(&rec->box) || rec->ncells > CM_REGION_MAX_CELLS ||
-        rec->nexits > rec->ncells)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u", s->path, k + 1);
+    const char *why = NULL;
+    if (sqlite3_column_int64(st, 0) != (sqlite3_int64)k + 1)
+        why = "regions are not numbered 1..N";
+    else if (parse_box((const char *)sqlite3_column_text(st, 1),
+                       (const char *)sqlite3_column_text(st, 2), dim, &rec->box) != CM_OK)
+        why = "its bounds are not whole numbers lo < hi inside the world";
+    else if (rec->ncells != cm_box_cells(&rec->box) || rec->ncells > CM_REGION_MAX_CELLS)
+        why = "its cell count is not its box's";
+    else if (rec->nexits > rec->ncells)
+        why = "it has more exits than cells";
+    if (why)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u: %s", s->path, k + 1,
+                       why);
     return CM_OK;
 }
 
@@ -475,10 +507,10 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
         return status;
     cm_cluster_init(c, &lat);
     cm_store_attach(s, c);
+    status = store_check_groups(s, msg, msg_size);
+    if (status != CM_OK)
+        return store_damaged(s, status, msg, msg_size);
     const int64_t groups = store_query_int(s->db, "SELECT COUNT(*) FROM attractors");
-    if (groups < 0 || groups > CM_MAX_GROUPS ||
-        store_query_int(s->db, "SELECT IFNULL(MAX(id), 0) FROM attractors") != groups)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: attractors", s->path);
     int64_t **exits = NULL;
     uint64_t *basin = NULL;
     status = load_regions(s, c, &exits, msg, msg_size);
@@ -488,11 +520,7 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
         status = s->version >= 5
                      ? load_open_nodes(s, c, (uint32_t)groups, basin, msg, msg_size)
                      : cm_cluster_restored(c, (uint32_t)groups, basin, exits, msg, msg_size);
-    if (status == CM_EFORMAT && !strstr(msg, s->path)) {
-        char detail[256];
-        snprintf(detail, sizeof detail, "%s", msg);
-        cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, detail);
-    }
+    status = store_damaged(s, status, msg, msg_size);
     for (uint32_t k = 0; exits && k < c->nregions; k++)
         free(exits[k]);
     free(exits);

@@ -216,7 +216,11 @@ cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgrade
     const int from = s->version;
     s->model = model;
     char why[1024] = "";
-    st = store_begin(s, why, sizeof why);
+    /* one transaction in the rollback journal, not WAL mode: a refused
+     * upgrade leaves the file byte-identical */
+    if (store_exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
+        st = store_db_error(s->db, "begin", why, sizeof why);
+    s->in_transaction = st == CM_OK;
     if (st == CM_OK)
         st = from == 4 ? add_open_nodes(s, why, sizeof why) : upgrade(s, why, sizeof why);
     if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)

@@ -160,13 +160,17 @@ static cm_status cover_box(session *s, const cm_box *box, const char *verb, comp
     return st;
 }
 
+/* Writes the view to the file if it changed since it was last written. A
+ * file found damaged is never written again. */
 static cm_status save_view(session *s, char *msg, size_t msg_size)
 {
     char text[VIEW_TEXT];
-    if (!s->have_view)
+    if (!s->have_view || !s->view_unsaved || s->damaged)
         return CM_OK;
     format_view(s, text, sizeof text);
-    return cm_store_set_note(s->store, "note.explore.view", text, msg, msg_size);
+    const cm_status st = cm_store_set_note(s->store, "note.explore.view", text, msg, msg_size);
+    s->view_unsaved = st != CM_OK;
+    return st;
 }
 
 static void report(const session *s, const char *what, const computed *done)
@@ -204,7 +208,10 @@ static cm_status move_view(session *s, const double *lo, const double *hi, const
     memcpy(s->lo, lo, sizeof s->lo);
     memcpy(s->hi, hi, sizeof s->hi);
     s->have_view = 1;
-    st = save_view(s, msg, msg_size);
+    s->view_unsaved = 1;
+    /* with the cells it computed (written already), else when the session
+     * ends: a file is not written before its cells have been read */
+    st = done.regions ? save_view(s, msg, msg_size) : CM_OK;
     if (st == CM_OK)
         report(s, what, &done);
     return st;
@@ -722,8 +729,11 @@ cm_status session_exec(session *s, const char *line, char *msg, size_t msg_size)
     if (n == 0)
         return CM_OK;
     for (size_t k = 0; k < sizeof commands / sizeof commands[0]; k++)
-        if (strcmp(t[0], commands[k].name) == 0)
-            return commands[k].run(s, t, n, msg, msg_size);
+        if (strcmp(t[0], commands[k].name) == 0) {
+            const cm_status st = commands[k].run(s, t, n, msg, msg_size);
+            s->damaged |= st == CM_EFORMAT;
+            return st;
+        }
     char names[256];
     size_t used = 0;
     for (size_t k = 0; k < sizeof commands / sizeof commands[0] && used < sizeof names; k++)
