@@ -294,6 +294,43 @@ static cm_status check_options(const cm_render_options *o, char *msg, size_t msg
     return CM_OK;
 }
 
+/* Text needs a plot of 16 pixels a side beside it; a bare image any size. */
+static cm_status check_room(const cm_render_options *o, const layout *L, char *msg,
+                            size_t msg_size)
+{
+    const int least = has_text(o->layers) ? 16 : 1;
+    if (o->width - L->left - L->right < least || o->height - L->top - L->bottom < least)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%dx%d leaves no room for the plot beside axes, legend and title; enlarge "
+                       "--size or leave those layers out",
+                       o->width, o->height);
+    return CM_OK;
+}
+
+cm_status cm_render_check(const cm_render_options *opt, int dim, char *msg, size_t msg_size)
+{
+    cm_render_options o = *opt;
+    o.layers = o.layers ? o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    cm_status st = check_options(&o, msg, msg_size);
+    if (st != CM_OK || !has_text(o.layers))
+        return st;
+    layout L;
+    memset(&L, 0, sizeof L);
+    const int small = o.width < o.height ? o.width : o.height;
+    L.fs = small / 45 < 10 ? 10 : small / 45 > 48 ? 48 : small / 45;
+    cm_font *font = NULL;
+    st = cm_font_open(o.font_path, L.fs, &font, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_make_ticks(o.lo[0], o.hi[0], &L.tx);
+    cm_make_ticks(dim == 1 ? o.lo[0] : o.lo[1], dim == 1 ? o.hi[0] : o.hi[1], &L.ty);
+    margins(&o, font, dim, &L);
+    if (o.layers & CM_LAYER_LEGEND) /* at least the sink's entry */
+        L.right = 3 * L.pad + L.ascent + cm_font_width(font, "sink");
+    cm_font_close(font);
+    return check_room(&o, &L, msg, msg_size);
+}
+
 /* Everything computed before pixels: raster, overlays, font, margins. */
 static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                          const cm_render_options *o, const cm_slice *s, const double lo[2],
@@ -331,12 +368,7 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
         }
         L->right = 3 * L->pad + L->ascent + widest_entry;
     }
-    if (st == CM_OK && (o->width - L->left - L->right < 16 || o->height - L->top - L->bottom < 16))
-        st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "%dx%d leaves no room for the plot beside axes, legend and title; enlarge "
-                     "--size or leave those layers out",
-                     o->width, o->height);
-    return st;
+    return st == CM_OK ? check_room(o, L, msg, msg_size) : st;
 }
 
 static void draw_text_layers(const cm_render_options *o, const work *w, const layout *L,

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/output.h"
 #include "cellmap/store.h"
 #include "render/figure.h"
 #include "render/palette.h"
@@ -296,6 +297,39 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
     free(groups);
     cm_raster_free(&ras);
     return st;
+}
+
+int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
+                    const cm_lattice *lat, const cm_box *box)
+{
+    char msg[CM_OUTPUT_PATH_MAX + 256];
+    cm_output out;
+    cm_status st = cm_output_begin(&out, po->path, false, msg, sizeof msg);
+    cm_output_abandon(&out);
+    if (st == CM_OK && !po->indexed) {
+        cm_render_options ro;
+        memset(&ro, 0, sizeof ro);
+        ro.layers = po->layers ? po->layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+        ro.width = po->width;
+        ro.height = po->height;
+        cm_box shown = *box;
+        if (po->has_view)
+            view_cells(lat, po->lo, po->hi, box, &shown);
+        if (!ro.width || !ro.height)
+            figure_size(lat, &shown, ro.layers, &ro.width, &ro.height);
+        for (int d = 0; d < 2 && d < lat->dim; d++) {
+            ro.lo[d] = po->has_view ? po->lo[d] : lat->origin[d] + (double)box->lo[d] * lat->width[d];
+            ro.hi[d] = po->has_view ? po->hi[d] : lat->origin[d] + (double)box->hi[d] * lat->width[d];
+        }
+        ro.model = m;
+        ro.font_path = figure_font();
+        st = cm_render_check(&ro, lat->dim, msg, sizeof msg);
+    }
+    if (st != CM_OK) {
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
 }
 
 int write_basin_png(const char *cmd, const basin_png *b)

@@ -55,6 +55,13 @@ typedef struct basin_png {
     cm_gl *gl;                   /* a kept OSMesa context, or NULL */
 } basin_png;
 
+/* Checks before anything is computed that the PNG of these options can be
+ * written: its path (cellmap/output.h) and, for a figure, its size and
+ * room for the text layers over box (or the --view). Prints "cellmap CMD:
+ * problem" and returns EXIT_FAIL if not. */
+int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
+                    const cm_lattice *lat, const cm_box *box);
+
 /* Renders and writes the PNG (temporary file, then rename). Prints
  * "cellmap CMD: problem" and returns EXIT_FAIL on failure. */
 int write_basin_png(const char *cmd, const basin_png *b);

@@ -11,6 +11,7 @@
 
 #include "cellmap/output.h"
 #include "src/args.h"
+#include "src/outfile.h"
 #include "src/commands.h"
 #include "src/project.h"
 
@@ -471,6 +472,9 @@ int cmd_export(int argc, char **argv)
     const int rc = parse_export(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
+    if (!outfile_check("export", a.groups) || !outfile_check("export", a.cells) ||
+        !outfile_check("export", a.flat))
+        return EXIT_FAIL;
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;

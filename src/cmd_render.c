@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "src/args.h"
+#include "src/outfile.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
 #include "src/project.h"
@@ -153,6 +154,8 @@ int cmd_render(int argc, char **argv)
     const int rc = parse_render(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
+    if (!outfile_check("render", a.png.path))
+        return EXIT_FAIL;
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;

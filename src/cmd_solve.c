@@ -699,7 +699,8 @@ int cmd_solve(int argc, char **argv)
         goto done;
     }
     if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK ||
-        (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK)
+        (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK ||
+        (a.png.path && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
         goto done;
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};

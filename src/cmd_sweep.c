@@ -261,6 +261,8 @@ int cmd_sweep(int argc, char **argv)
     int rc = parse_args(&c, &a);
     if (rc)
         return rc < 0 ? EXIT_OK : rc;
+    if (!outfile_check("sweep", a.csv))
+        return EXIT_FAIL;
     cm_lattice lat;
     cm_box box;
     if ((rc = check_setup(&c, &a, &lat, &box)))

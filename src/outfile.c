@@ -5,6 +5,19 @@
 #include <string.h>
 #include <unistd.h>
 
+bool outfile_check(const char *cmd, const char *path)
+{
+    char msg[CM_OUTPUT_PATH_MAX + 256];
+    cm_output o;
+    if (!path)
+        return true;
+    const cm_status st = cm_output_begin(&o, path, false, msg, sizeof msg);
+    cm_output_abandon(&o);
+    if (st != CM_OK)
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return st == CM_OK;
+}
+
 bool outfile_open(const char *cmd, const char *path, outfile *o)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];

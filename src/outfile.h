@@ -17,6 +17,10 @@ typedef struct outfile {
     FILE *f;
 } outfile;
 
+/* Checks an output path before the work that fills it (NULL: none): a
+ * directory, or a device where a database must go, is refused at once.
+ * Prints "cellmap CMD: ..." and returns false then. */
+bool outfile_check(const char *cmd, const char *path);
 /* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
 bool outfile_open(const char *cmd, const char *path, outfile *o);
 /* Closes and renames it when ok (and every write succeeded), else removes
