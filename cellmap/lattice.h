@@ -51,7 +51,7 @@ void cm_lattice_centre(const cm_lattice *lat, const int64_t *cell, double *x);
 /* Validates a box (dim matches, lo < hi, inside the world). */
 cm_status cm_box_check(const cm_box *box, char *msg, size_t msg_size);
 
-/* Number of cells in a box; 0 if the count overflows uint64. */
+/* Number of cells in a box; 0 if it is empty or the count overflows uint64. */
 uint64_t cm_box_cells(const cm_box *box);
 
 /* true when cell c is inside the box. */

@@ -219,7 +219,8 @@ static cm_status parse_box(const char *lo, const char *hi, int dim, cm_box *box)
     box->dim = dim;
     const double limit = (double)CM_WORLD_LIMIT;
     for (int d = 0; d < dim; d++) {
-        if (!(l[d] >= -limit && h[d] <= limit) || l[d] != floor(l[d]) || h[d] != floor(h[d]))
+        if (!(l[d] >= -limit && l[d] <= limit && h[d] >= -limit && h[d] <= limit) ||
+            l[d] != floor(l[d]) || h[d] != floor(h[d]))
             return CM_EFORMAT;
         box->lo[d] = (int64_t)l[d];
         box->hi[d] = (int64_t)h[d];
