@@ -124,10 +124,7 @@ uint64_t cm_box_index(const cm_box *box, const int64_t *cell)
 void cm_box_cell(const cm_box *box, uint64_t index, int64_t *cell)
 {
     for (int d = 0; d < box->dim; d++) {
-        if (box->hi[d] <= box->lo[d])
-            return 0;
-        /* in unsigned arithmetic: exact for any lo < hi, never overflowing */
-        const uint64_t side = (uint64_t)box->hi[d] - (uint64_t)box->lo[d];
+        const uint64_t side = (uint64_t)(box->hi[d] - box->lo[d]);
         cell[d] = box->lo[d] + (int64_t)(index % side);
         index /= side;
     }
