@@ -172,13 +172,23 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
 {
     cm_store *s = user;
     const double t0 = store_seconds_now();
+    /* the rows must hold the region's cells before they are allocated */
+    char sql[160];
+    snprintf(sql, sizeof sql,
+             "SELECT COUNT(*) = %llu AND IFNULL(SUM(cells), 0) = %llu FROM pages WHERE region = %u",
+             (unsigned long long)npages(r->ncells), (unsigned long long)r->ncells, k + 1);
+    if (store_query_int(s->db, sql) != 1)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "%s is damaged: the pages of region %u do not hold its %llu cells",
+                       s->path, k + 1, (unsigned long long)r->ncells);
     const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
     r->image = malloc(bytes + 4);
     r->group = malloc(bytes + 4);
     r->step = malloc(bytes + 4);
     cm_status st = r->image && r->group && r->step
                        ? CM_OK
-                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k);
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u",
+                                 k + 1);
     if (st == CM_OK)
         st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)

@@ -34,7 +34,7 @@ const char session_help[] =
     "  quit                               end the session\n"
     "  help                               this list\n";
 
-/* A command may compute at most this many new cells (12 bytes each). */
+/* By default a command may compute at most this many new cells (12 bytes each). */
 #define MAX_NEW_CELLS (UINT64_C(1) << 28)
 enum { MAX_TOKENS = 24, VIEW_TEXT = 512 };
 
@@ -149,11 +149,11 @@ static cm_status cover_box(session *s, const cm_box *box, const char *verb, comp
     uint32_t n = 0;
     cm_status st = cm_cluster_uncovered(&s->c, box, &boxes, &n, msg, msg_size);
     const uint64_t cells = cm_boxes_cells(boxes, n);
-    if (st == CM_OK && cells > MAX_NEW_CELLS)
+    if (st == CM_OK && cells > s->max_new_cells)
         st = cm_fail(CM_ETOOBIG, msg, msg_size,
                      "%s would compute %llu new cells, more than %llu at once; zoom out or pan "
                      "in smaller steps",
-                     verb, (unsigned long long)cells, (unsigned long long)MAX_NEW_CELLS);
+                     verb, (unsigned long long)cells, (unsigned long long)s->max_new_cells);
     if (st == CM_OK && n > 0)
         st = compute_boxes(s, boxes, n, done, msg, msg_size);
     free(boxes);
@@ -1007,6 +1007,7 @@ int session_open(session *s, const session_options *o)
     s->path = o->path;
     s->out = o->out;
     s->threads = o->threads;
+    s->max_new_cells = o->max_new_cells ? o->max_new_cells : MAX_NEW_CELLS;
     const int rc = stat(o->path, &sb) == 0 ? open_existing(s, o) : create_new(s, o);
     if (rc != EXIT_OK)
         return rc;

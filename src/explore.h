@@ -29,6 +29,7 @@ typedef struct session_options {
     int max_steps;          /* 0: 1 for a new file */
     int threads;            /* 0: every core */
     uint64_t mem;           /* 0: no budget */
+    uint64_t max_new_cells; /* most cells one command may compute; 0: 2^28 */
     const char *command;    /* for provenance */
     FILE *out;              /* status lines; NULL: quiet */
 } session_options;
@@ -49,6 +50,7 @@ typedef struct session {
     int64_t depth_hi[CM_MAX_DIM];
     int64_t slice[CM_MAX_DIM]; /* dimensions >= 2: the cell shown */
     int quit;
+    uint64_t max_new_cells;
     FILE *out;
     cm_gl *gl; /* kept between renders (made by the first); NULL until then */
 } session;
