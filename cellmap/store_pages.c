@@ -397,6 +397,7 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
     while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         cm_region rec;
         cm_node *nodes = NULL;
+        int64_t *region_exits = NULL; /* the cluster's once restored (the caller frees them) */
         const uint32_t k = c->nregions;
         status = region_record(s, st, k, c->lat.dim, &rec, msg, msg_size);
         if (status == CM_OK && tables &&
@@ -404,7 +405,7 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
             status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
         if (status == CM_OK && tables) {
             (*exits)[k] = NULL;
-            status = read_exits(s, k, rec.nexits, c->lat.dim, &(*exits)[k], msg, msg_size);
+            status = read_exits(s, k, rec.nexits, c->lat.dim, &region_exits, msg, msg_size);
             nodes = status == CM_OK ? calloc(rec.nexits + 1, sizeof *nodes) : NULL;
             if (status == CM_OK && !nodes)
                 status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for region %u", k + 1);
@@ -413,6 +414,10 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
         }
         if (status == CM_OK)
             status = cm_cluster_restore(c, &rec, nodes, msg, msg_size);
+        if (c->nregions > k && tables)
+            (*exits)[k] = region_exits;
+        else
+            free(region_exits);
         free(nodes);
     }
     if (status == CM_OK && rc != SQLITE_DONE)

@@ -85,7 +85,8 @@ int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m, 
                        cm_box *box);
 
 /* The lattice coordinate of the cell border at or beyond state x (below
- * it, or above it if round_up), snapped to a border within rounding of x. */
+ * it, or above it if round_up), snapped to a border within rounding of x;
+ * beyond the world (or NaN), the world's edge (+-CM_WORLD_LIMIT). */
 int64_t border_cell(double x, double origin, double width, int round_up);
 
 /* Command line joined by spaces (for provenance). */

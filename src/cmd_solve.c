@@ -99,7 +99,8 @@ static int parse_solve(cli *c, solve_args *a)
             if (c->value && (!parse_int64(c->value, &v) || v < 1 || v > MAX_EXTEND))
                 err = cli_usage_error(c, "--extend: '%s' must be an integer in 1..%d", c->value,
                                       MAX_EXTEND);
-            a->extend = (int)v;
+            else if (c->value)
+                a->extend = (int)v;
         } else if (cli_is(c, "--escape-below", true, &err)) {
             if (c->value && (!parse_double(c->value, &a->escape_below) ||
                              !(a->escape_below >= 0 && a->escape_below <= 1)))
