@@ -243,6 +243,36 @@ for path, iz in ((sys.argv[3], 5), (sys.argv[4], 12)):   # z = -3.25 and 0.25: c
 assert images[0] != images[1]    # the slices differ: --slice is obeyed
 PY
 expect_usage "--slice" render s3.cmdb --png x.png --slice 1,2
+# --- 2-D indexed PNGs: row 0 is the top (high y), column 0 the left (low x) --
+"$CM" solve --cells 40x30 --split 2x1 --db o2.cmdb --png o2.png --png-mode indexed > /dev/null \
+  || fail "2-D indexed solve"
+"$CM" export o2.cmdb --cells o2.csv 2> /dev/null || fail "2-D export"
+python3 - "$HERE" o2.csv o2.png <<'PY' || fail "2-D PNG orientation"
+import csv, struct, sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+cells = {(int(r["ix"]), int(r["iy"])): r for r in csv.DictReader(open(sys.argv[2]))}
+data, pos, inverse = open(sys.argv[3], "rb").read(), 8, None
+while pos < len(data):
+    n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+    if kind == b"PLTE":
+        body = data[pos + 8:pos + 8 + n]
+        inverse = {tuple(body[i:i + 3]): i // 3 for i in range(0, n, 3)}
+    pos += 12 + n
+w, h, bpp, rows, texts = read_png(sys.argv[3])
+assert (w, h) == (40, 30), (w, h)
+classes = dict(map(int, kv.split(":")) for kv in texts["Group classes"].split())
+seen = set()
+for iy in range(30):
+    for ix in range(40):
+        got = inverse[tuple(rows[29 - iy][3 * ix:3 * ix + 3])]
+        c = cells[(ix, iy)]
+        g = int(c["grp"])
+        want = 1 if g == 0 else 2 if c["periodic"] == "1" else classes[g]
+        assert got == want, (ix, iy, got, want)
+        seen.add(want)
+assert len(seen) > 2    # sink, periodic cells and basins: a flip would show
+PY
 
 # --- solve --stage1: the regions of --split after Stage 1 of their join -----
 st1=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --cells 200x100)

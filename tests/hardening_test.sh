@@ -4,9 +4,10 @@
 # clobbered devices and symlinks, files modified although refused, lost
 # stdout, unclear messages, a second writer) reproduced and checked.
 # Under the sanitizer build an overflow also fails the test by aborting.
-# usage: hardening_test.sh PATH/TO/cellmap
+# usage: hardening_test.sh PATH/TO/cellmap PATH/TO/libsync_counter.so
 set -u
 CM=$1
+SYNC_COUNTER=$2
 HERE=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -171,6 +172,14 @@ rm -f old.cmdb.tmp-*
 "$CM" solve --cells 60x60 --db old.cmdb > /dev/null || fail "solve --db over an older cluster"
 [ "$(sqlite3 old.cmdb 'SELECT SUM(cells) FROM regions')" = 3600 ] || fail "the new cluster is not in place"
 ls | grep -q 'tmp-' && fail "temporary files left behind"
+
+# --- durability: commits are synced to the disk (the WAL is synced: SQLite's
+# synchronous is not OFF)
+# (ASan wants to be first among the libraries; the counter only wraps two calls)
+SYNC_COUNT_FILE=$work/syncs.txt LD_PRELOAD=$SYNC_COUNTER \
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}verify_asan_link_order=0 \
+  "$CM" solve $small --db synced.cmdb > /dev/null || fail "solve under the sync counter"
+[ "$(cat syncs.txt 2> /dev/null || echo 0)" -gt 0 ] || fail "solve --db never synced its write-ahead log"
 
 # --- messages ------------------------------------------------------------------------
 cp good.cmdb nometa.cmdb

@@ -273,8 +273,65 @@ static void test_fig_4_25(void)
     cm_model_release(&m);
 }
 
+/* Tie-breaks (extend.h): a map that moves the left half of a 10 x 10 tile
+ * one tile along first_dim (first_dir: +1 or -1) and the right half one tile
+ * along second_dim (second_dir) gives two neighbours equal counts. */
+typedef struct tie_map {
+    int first_dim, first_dir, second_dim, second_dir;
+} tie_map;
+
+static int tie_step(const cm_model *m, const double *x, double *y)
+{
+    const tie_map *t = m->ctx;
+    y[0] = x[0];
+    y[1] = x[1];
+    if (x[0] < 5) /* the left half of the tile [0, 10) x [0, 10) */
+        y[t->first_dim] += 10 * t->first_dir;
+    else
+        y[t->second_dim] += 10 * t->second_dir;
+    return 0;
+}
+
+static cm_box tie_choice(tie_map t)
+{
+    cm_model m;
+    memset(&m, 0, sizeof m);
+    m.name = "tie";
+    m.dim = 2;
+    m.step = tie_step;
+    m.ctx = &t;
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    const cm_box tile = {2, {0, 0}, {10, 10}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    add_boxes(&c, &m, &tile, 1);
+    cm_extend_choice choice;
+    char msg[256];
+    CHECK(cm_extend_choose(&c, &tile, NULL, &choice, msg, sizeof msg) == CM_OK);
+    CHECK(choice.escaping == 50 && choice.all_escaping == 100);
+    cm_cluster_free(&c);
+    return choice.box;
+}
+
+/* Equal counts go to the neighbour first in the promised order: by
+ * dimension, the lower side first. */
+static void test_ties(void)
+{
+    const cm_box left = {2, {-10, 0}, {0, 10}}, right = {2, {10, 0}, {20, 10}};
+    const cm_box below = {2, {0, -10}, {10, 0}};
+    cm_box b = tie_choice((tie_map){0, 1, 0, -1}); /* right and left */
+    CHECK(memcmp(&b, &left, sizeof b) == 0);
+    b = tie_choice((tie_map){0, -1, 0, 1}); /* the same, the other way round */
+    CHECK(memcmp(&b, &left, sizeof b) == 0);
+    b = tie_choice((tie_map){1, 1, 1, -1}); /* up and down */
+    CHECK(memcmp(&b, &below, sizeof b) == 0);
+    b = tie_choice((tie_map){1, -1, 0, 1}); /* down and right: dimension 0 first */
+    CHECK(memcmp(&b, &right, sizeof b) == 0);
+}
+
 int main(void)
 {
+    test_ties();
     test_brute_force();
     test_unaligned();
     test_uncovered();

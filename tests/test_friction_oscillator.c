@@ -561,8 +561,32 @@ static void test_mirror_basins(void)
     cm_region_free(&r[1]);
 }
 
+/* A block stuck where the forcing touches +S0 exactly at its maximum
+ * (x + S0 = 1): with S0 > S it breaks away upwards there; with S0 = S the
+ * tangency does not release it (docs/models.md 9.5), and it breaks away
+ * downwards when the forcing falls through -S0 (phase 2 pi + pi / 3). */
+static void test_tangency(void)
+{
+    const double phi = PI / 2; /* the forcing falls through 0 at s = 0 */
+    const double cases[2][2] = {{0.2, 0.25}, {0.25, 0.25}}; /* S, S0; x + S0 = 1 exactly */
+    for (int k = 0; k < 2; k++) {
+        cm_fo o;
+        cm_fo_init(&o, cases[k][0], cases[k][1], 1.0, phi);
+        cm_fo_state st = {0, 1 - cases[k][1], 0, CM_FO_STICK};
+        event_list l = {.n = 0};
+        CHECK(cm_fo_propagate(&o, &st, 8.0, NULL, collect, &l));
+        CHECK(l.n >= 1);
+        if (l.n < 1)
+            continue;
+        CHECK_INT(l.e[0].kind, CM_FO_EV_BREAK);
+        CHECK_INT(l.e[0].mode, k == 0 ? CM_FO_UP : CM_FO_DOWN);
+        CHECK_NEAR(l.e[0].s, k == 0 ? 2 * PI - phi : 2 * PI + PI / 3 - phi, 1e-12);
+    }
+}
+
 int main(void)
 {
+    test_tangency();
     test_slip_closed_form();
     test_grazing_dip();
     test_symmetric_amplitude();

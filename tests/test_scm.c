@@ -269,6 +269,24 @@ static void test_max_steps(void)
     CHECK(solve(&m, &lat, &box, 1, 3, &r) == CM_OK);
     CHECK_INT(r.image[2], 2); /* three steps are not enough */
     cm_region_free(&r);
+    /* the exact step: the n steps that take cell 2's centre out of it are
+     * allowed by max_steps = n, not by n - 1 */
+    double x = 0.25, y;
+    int64_t cell = 2;
+    int n = 0;
+    while (cell == 2 && n < 100) {
+        m.step(&m, &x, &y);
+        x = y;
+        n++;
+        CHECK(cm_lattice_cell(&lat, &x, &cell));
+    }
+    CHECK(n > 3 && cell == 3);
+    CHECK(solve(&m, &lat, &box, 1, n, &r) == CM_OK);
+    CHECK_INT(r.image[2], 3);
+    cm_region_free(&r);
+    CHECK(solve(&m, &lat, &box, 1, n - 1, &r) == CM_OK);
+    CHECK_INT(r.image[2], 2);
+    cm_region_free(&r);
 }
 
 static void test_random_maps(void)
