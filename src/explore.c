@@ -809,8 +809,11 @@ static int restore_depth(session *s)
                           s->path);
     }
     for (int d = 2; d < s->dim; d++) {
-        if (s->depth_lo[d] >= s->depth_hi[d])
-            return open_error("%s: damaged depth note '%s'", s->path, text);
+        if (s->depth_lo[d] >= s->depth_hi[d] || s->depth_lo[d] < -CM_WORLD_LIMIT ||
+            s->depth_hi[d] > CM_WORLD_LIMIT)
+            return open_error("%s is damaged: its depth note '%s' is not LO:HI,... cells of "
+                              "the world",
+                              s->path, text);
         s->slice[d] = s->depth_lo[d] + (s->depth_hi[d] - s->depth_lo[d]) / 2;
     }
     return EXIT_OK;
@@ -823,13 +826,18 @@ static int restore_view(session *s)
     if (cm_store_get_note(s->store, "note.explore.view", text, sizeof text, msg, sizeof msg) ==
         CM_OK) {
         const int n = tokenize(text, t, MAX_TOKENS, msg, sizeof msg);
+        double lo[2], hi[2];
         for (int d = 0; d < s->view_dims; d++) {
             int count = 0;
-            if (d >= n || !parse_ranges(t[d], &s->lo[d], &s->hi[d], &count, 1))
-                return open_error("%s: damaged view note", s->path);
+            if (d >= n || !parse_ranges(t[d], &lo[d], &hi[d], &count, 1))
+                return open_error("%s is damaged: its view note is not a view", s->path);
         }
+        if (check_view(s, lo, hi, "the view note", msg, sizeof msg) != CM_OK)
+            return open_error("%s is damaged: %s", s->path, msg);
+        memcpy(s->lo, lo, sizeof lo);
+        memcpy(s->hi, hi, sizeof hi);
         if (n == s->view_dims + 2 && parse_slice(s, t[n - 1], s->slice, msg, sizeof msg) != CM_OK)
-            return open_error("%s: %s", s->path, msg);
+            return open_error("%s is damaged: its view note: %s", s->path, msg);
         s->have_view = 1;
     } else if (s->c.nregions > 0) {
         cm_box b;

@@ -83,6 +83,15 @@ cp good.cmdb bigpage.cmdb
 sqlite3 bigpage.cmdb "UPDATE pages SET cells = 70000 WHERE region = 1"
 expect_damaged bigpage.cmdb "region 1" export bigpage.cmdb --cells c.csv
 
+# explore's notes: a view or depth out of the world
+"$CM" explore notes.cmdb - --model microchaos-pd --cell-size 5,1 > /dev/null <<< "view 0:50 -10:10" \
+  || fail "explore notes.cmdb"
+for view in "0:1e300 -10:10" "0:50" "nan:1 0:1" "5:1 0:1"; do
+  cp notes.cmdb view.cmdb
+  sqlite3 view.cmdb "UPDATE meta SET value = '$view' WHERE key = 'note.explore.view'"
+  expect_damaged view.cmdb "view note" explore view.cmdb stats.txt
+done
+
 # --- undefined behaviour: values out of range in a file or an argument -------
 for bound in "lo|[-9223372036854775808,0]" "lo|[1e300,0]" "lo|[-1e300,0]" "lo|[0.5,0]" \
              "lo|[NaN,0]" "hi|[9223372036854775807,40]" "hi|[-1e300,40]" "hi|[1e300,40]"; do

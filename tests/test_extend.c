@@ -82,16 +82,24 @@ static uint64_t tile_count(const uint64_t *per_tile, const cm_box *tile, const c
     return per_tile[(ty + SPAN) * 2 * SPAN + tx + SPAN];
 }
 
-/* The cluster of the boxes on the Fig. 4.16 lattice, and the extension
- * it chooses for `tile`. */
+/* The cluster of the boxes on the lattice, and the extension it chooses
+ * for `tile`. */
+static void choose_on(const cm_lattice *lat, cm_cluster *c, const cm_model *m,
+                      const cm_box *boxes, uint32_t n, const cm_box *tile,
+                      cm_extend_choice *choice)
+{
+    char msg[256];
+    cm_cluster_init(c, lat);
+    add_boxes(c, m, boxes, n);
+    CHECK(cm_extend_choose(c, tile, NULL, choice, msg, sizeof msg) == CM_OK);
+}
+
+/* The same on the Fig. 4.16 lattice. */
 static void choose_for(cm_cluster *c, const cm_model *m, const cm_box *boxes, uint32_t n,
                        const cm_box *tile, cm_extend_choice *choice)
 {
     const cm_lattice lat = {2, {85.4, -12.5}, {0.8, 0.1}};
-    char msg[256];
-    cm_cluster_init(c, &lat);
-    add_boxes(c, m, boxes, n);
-    CHECK(cm_extend_choose(c, tile, NULL, choice, msg, sizeof msg) == CM_OK);
+    choose_on(&lat, c, m, boxes, n, tile, choice);
 }
 
 /* A cluster of three tiles (an L shape): the chosen tile's count and the
@@ -303,11 +311,8 @@ static cm_box tie_choice(tie_map t)
     const cm_lattice lat = {2, {0, 0}, {1, 1}};
     const cm_box tile = {2, {0, 0}, {10, 10}};
     cm_cluster c;
-    cm_cluster_init(&c, &lat);
-    add_boxes(&c, &m, &tile, 1);
     cm_extend_choice choice;
-    char msg[256];
-    CHECK(cm_extend_choose(&c, &tile, NULL, &choice, msg, sizeof msg) == CM_OK);
+    choose_on(&lat, &c, &m, &tile, 1, &tile, &choice);
     CHECK(choice.escaping == 50 && choice.all_escaping == 100);
     cm_cluster_free(&c);
     return choice.box;

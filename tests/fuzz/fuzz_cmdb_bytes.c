@@ -23,13 +23,7 @@ static void remove_side_files(void)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!path[0]) {
-        snprintf(path, sizeof path, "/tmp/cellmap-fuzz-XXXXXX");
-        const int fd = mkstemp(path);
-        if (fd < 0)
-            fuzz_fail("cannot create a temporary file");
-        close(fd);
-    }
+    fuzz_temp_path(path);
     FILE *f = fopen(path, "wb");
     if (!f || fwrite(data, 1, size, f) != size || fclose(f) != 0)
         fuzz_fail("cannot write the temporary file");

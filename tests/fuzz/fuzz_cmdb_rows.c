@@ -134,13 +134,7 @@ static void change_row(sqlite3 *db, const char *table, const char *column, unsig
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!path[0]) {
-        snprintf(path, sizeof path, "/tmp/cellmap-fuzz-XXXXXX");
-        const int fd = mkstemp(path);
-        if (fd < 0)
-            fuzz_fail("cannot create a temporary file");
-        close(fd);
-    }
+    fuzz_temp_path(path);
     copy_seed();
     sqlite3 *db = NULL;
     if (sqlite3_open(path, &db) != SQLITE_OK)

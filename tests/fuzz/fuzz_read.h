@@ -5,7 +5,9 @@
 #define CM_FUZZ_READ_H
 
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include "cellmap/store.h"
 
@@ -18,6 +20,18 @@ static void fuzz_fail(const char *what)
 {
     fprintf(stderr, "fuzz target: %s\n", what);
     abort();
+}
+
+/* A temporary file's name in path, made at the first call. */
+static void fuzz_temp_path(char path[64])
+{
+    if (path[0])
+        return;
+    snprintf(path, 64, "/tmp/cellmap-fuzz-XXXXXX");
+    const int fd = mkstemp(path);
+    if (fd < 0)
+        fuzz_fail("cannot create a temporary file");
+    close(fd);
 }
 
 /* Every cell of the cluster resolved: groups in range, steps of the sink's
