@@ -362,10 +362,9 @@ static const char *bad_group(const cm_region *r, uint32_t g, uint32_t max_group,
     return "its group is no group of the file";
 }
 
-/* What is wrong with cell i given its image, or NULL; *next_exit is the
- * exit the next exit cell must have. */
-static const char *bad_cell(const cm_region *r, uint64_t i, uint32_t max_group, bool node_refs,
-                            uint64_t *next_exit)
+/* What is wrong with cell i given its image, or NULL. Exit cells are
+ * checked for their own node here; their numbering by the caller. */
+static const char *bad_cell(const cm_region *r, uint64_t i, uint32_t max_group, bool node_refs)
 {
     const uint32_t m = r->image[i], g = r->group[i], s = r->step[i];
     const char *why = bad_group(r, g, max_group, node_refs);
@@ -382,27 +381,47 @@ static const char *bad_cell(const cm_region *r, uint64_t i, uint32_t max_group, 
                                                        : "its group or step is not its image's";
     }
     const int64_t e = cm_image_exit_index(m);
-    if (e < 0 || (uint64_t)e != *next_exit || (uint64_t)e >= r->nexits)
-        return "its image is no cell of the region and not the region's next exit";
-    ++*next_exit;
+    if (e < 0 || (uint64_t)e >= r->nexits)
+        return "its image is no cell of the region and none of its exits";
     if (node_refs && (g != (CM_NODE_REF | (uint32_t)e) || s != 1))
         return "an exit cell that is not its own node";
     return NULL;
 }
 
-cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, char *msg,
-                          size_t msg_size)
+/* The cells of one part of a region checked: the first bad one (or
+ * UINT64_MAX) and why; its exits must be numbered consecutively from its
+ * first (*first_exit, or -1 if it has none; *exits of them). */
+typedef struct check_part {
+    uint64_t bad, exits;
+    int64_t first_exit;
+    const char *why;
+} check_part;
+
+static void check_cells(const cm_region *r, uint64_t from, uint64_t to, uint32_t max_group,
+                        bool node_refs, check_part *p)
 {
-    uint64_t next_exit = 0;
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        const char *why = bad_cell(r, i, max_group, node_refs, &next_exit);
-        if (why)
-            return cm_fail(CM_EFORMAT, msg, msg_size, "cell %llu: %s", (unsigned long long)i,
-                           why);
+    *p = (check_part){UINT64_MAX, 0, -1, NULL};
+    for (uint64_t i = from; i < to; i++) {
+        const char *why = bad_cell(r, i, max_group, node_refs);
+        const int64_t e = cm_image_exit_index(r->image[i]);
+        if (!why && e >= 0) {
+            if (p->first_exit < 0)
+                p->first_exit = e;
+            else if (e != p->first_exit + (int64_t)p->exits)
+                why = "its exit is not the region's next one (exits are numbered in cell order)";
+            p->exits++;
+        }
+        if (why) {
+            p->bad = i;
+            p->why = why;
+            return;
+        }
     }
-    if (next_exit != r->nexits)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "%llu exits recorded, %llu found in the cells",
-                       (unsigned long long)r->nexits, (unsigned long long)next_exit);
+}
+
+/* Exit targets: outside the box, inside the world. */
+static cm_status check_exit_targets(const cm_region *r, char *msg, size_t msg_size)
+{
     const int dim = r->box.dim;
     for (uint64_t e = 0; e < r->nexits; e++) {
         const int64_t *t = r->exit_target + e * (uint64_t)dim;
@@ -410,9 +429,40 @@ cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs
         for (int d = 0; d < dim; d++)
             inside_world = inside_world && t[d] > -CM_WORLD_LIMIT && t[d] < CM_WORLD_LIMIT;
         if (!inside_world || cm_box_contains(&r->box, t))
-            return cm_fail(CM_EFORMAT, msg, msg_size,
-                           "exit %llu: its target is %s", (unsigned long long)e,
+            return cm_fail(CM_EFORMAT, msg, msg_size, "exit %llu: its target is %s",
+                           (unsigned long long)e,
                            inside_world ? "inside the region" : "outside the world");
     }
     return CM_OK;
+}
+
+enum { CHECK_PARTS = 64 };
+
+cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, int threads,
+                          char *msg, size_t msg_size)
+{
+    check_part parts[CHECK_PARTS];
+    const uint64_t n = r->ncells, per = n / CHECK_PARTS + 1;
+#pragma omp parallel for num_threads(threads > 0 ? threads : 1) schedule(dynamic, 1) if (n > 65536)
+    for (int k = 0; k < CHECK_PARTS; k++) {
+        const uint64_t from = (uint64_t)k * per < n ? (uint64_t)k * per : n;
+        const uint64_t to = from + per < n ? from + per : n;
+        check_cells(r, from, to, max_group, node_refs, &parts[k]);
+    }
+    uint64_t next_exit = 0;
+    for (int k = 0; k < CHECK_PARTS; k++) { /* the first damage in cell order */
+        const check_part *p = &parts[k];
+        if (!p->why && p->exits && p->first_exit != (int64_t)next_exit)
+            return cm_fail(CM_EFORMAT, msg, msg_size,
+                           "exit %lld follows exit %lld (exits are numbered in cell order)",
+                           (long long)p->first_exit, (long long)next_exit - 1);
+        if (p->why)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "cell %llu: %s", (unsigned long long)p->bad,
+                           p->why);
+        next_exit += p->exits;
+    }
+    if (next_exit != r->nexits)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%llu exits recorded, %llu found in the cells",
+                       (unsigned long long)r->nexits, (unsigned long long)next_exit);
+    return check_exit_targets(r, msg, msg_size);
 }

@@ -117,10 +117,10 @@ cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg
  * on a cycle; a cell whose image is the sink has group 0, step 1; with
  * node_refs an exit's cell is its own node's, step 1). A region of
  * resolved cells (node_refs false) holds cluster-wide groups and steps at
- * its exits, which only a cluster can check. CM_EFORMAT with what is wrong
- * where ("cell 17: ...") in msg. */
-cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, char *msg,
-                          size_t msg_size);
+ * its exits, which only a cluster can check. Runs on `threads` threads.
+ * CM_EFORMAT with what is wrong where ("cell 17: ...") in msg. */
+cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, int threads,
+                          char *msg, size_t msg_size);
 void cm_region_free(cm_region *r);
 /* Bytes held by the region's per-cell arrays and its exit table. */
 uint64_t cm_region_bytes(const cm_region *r);

@@ -161,7 +161,7 @@ static cm_status check_cells(const cm_store *s, uint32_t k, const cm_region *r, 
 {
     char why[256];
     const uint32_t groups = s->cluster ? s->cluster->ngroups : 0;
-    if (cm_region_check(r, groups, s->version >= 4, why, sizeof why) == CM_OK)
+    if (cm_region_check(r, groups, s->version >= 4, s->threads, why, sizeof why) == CM_OK)
         return CM_OK;
     return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u, %s", s->path, k + 1,
                    why);
