@@ -36,6 +36,11 @@ cm_status cm_fail(cm_status status, char *msg, size_t msg_size, const char *fmt,
         va_start(ap, fmt);
         vsnprintf(msg, msg_size, fmt, ap);
         va_end(ap);
+        /* messages quote what files and arguments hold: control characters
+         * (a terminal's escape sequences) are shown as '?' */
+        for (char *p = msg; *p; p++)
+            if ((unsigned char)*p < 0x20 ? *p != '\n' && *p != '\t' : *p == 0x7f)
+                *p = '?';
     }
     return status;
 }

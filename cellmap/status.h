@@ -35,7 +35,8 @@ const char *cm_strerror(cm_status s);
 /* Symbolic name of a status, e.g. "CM_EINVAL". */
 const char *cm_status_name(cm_status s);
 
-/* Writes a printf-style message into msg (may be NULL) and returns status.
+/* Writes a printf-style message into msg (may be NULL; control characters
+ * but newline and tab become '?') and returns status.
  * Lets a function report "what went wrong and how to fix it" in one line. */
 cm_status cm_fail(cm_status status, char *msg, size_t msg_size, const char *fmt, ...)
 #if defined(__GNUC__)

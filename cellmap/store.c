@@ -632,11 +632,15 @@ cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size)
         store_query_int(db, "SELECT COUNT(*) FROM attractors WHERE period < 1") != 0)
         return cm_fail(CM_EFORMAT, msg, msg_size,
                        "its attractors are not numbered 1..N with periods of 1 or more");
-    char text[32];
-    if (meta_text(db, "groups", text, sizeof text, NULL, 0) == CM_OK &&
-        strtoll(text, NULL, 10) != groups)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "it says it holds %s groups but has %lld",
-                       text, (long long)groups);
+    char text[32], *end = NULL;
+    if (meta_text(db, "groups", text, sizeof text, NULL, 0) == CM_OK) {
+        const long long said = strtoll(text, &end, 10);
+        if (end == text || *end)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "its meta value 'groups' is not a number");
+        if (said != groups)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "it says it holds %lld groups but has %lld",
+                           said, (long long)groups);
+    }
     if (s->version >= 4 &&
         store_query_int(db, "SELECT COUNT(*) FROM basins WHERE grp < 1 OR grp > "
                             "(SELECT COUNT(*) FROM attractors) OR cells < 0") != 0)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite from scratch: install the Debian packages, build a
-# release and an ASan+UBSan build, run ctest in both, then run each fuzz
-# target for 25 s. Exit status 0 = green.
+# release and an ASan+UBSan build, run ctest in both, run a campaign of
+# damaged files against the sanitizer build, then each fuzz target for 25 s.
+# Exit status 0 = green.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 .ci/install-deps
@@ -16,6 +17,8 @@ cmake --build build-sanitize -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs"
+# an attacker's campaign of damaged files against every command (sanitizer build)
+python3 tests/campaign.py build-sanitize/cellmap 100
 # libFuzzer targets (clang), each for a fixed budget
 tests/run_fuzz.sh 25
 echo "all tests passed (release and sanitizer builds, fuzz targets)"
