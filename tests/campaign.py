@@ -6,7 +6,7 @@ sanitizer report, and every file a command refuses (status 1) must be left
 byte-identical.
 
 usage: campaign.py CELLMAP RUNS [SEED]   (prints a summary; exit 1 on a finding)"""
-import hashlib, os, random, sqlite3, struct, subprocess, sys, tempfile
+import hashlib, os, random, shutil, sqlite3, subprocess, sys, tempfile
 
 cm, runs = sys.argv[1], int(sys.argv[2])
 rng = random.Random(int(sys.argv[3]) if len(sys.argv) > 3 else 1)
@@ -116,5 +116,8 @@ for k in range(runs):
     counts[rc] = counts.get(rc, 0) + 1
     for f in ("victim.cmdb-wal", "victim.cmdb-shm", "victim.cmdb-journal"):
         if os.path.exists(f): os.remove(f)
-print("campaign: %d runs, exit statuses %s, %d findings (work in %s)" % (runs, counts, findings, work))
+print("campaign: %d runs, exit statuses %s, %d findings%s" %
+      (runs, counts, findings, " (the files are in %s)" % work if findings else ""))
+if not findings:
+    shutil.rmtree(work)
 sys.exit(1 if findings else 0)
