@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A small mutation runner: applies each mutant of a list (FILE | SED SCRIPT
-# | what it breaks) to a copy of the tracked sources, one at a time, builds
+# | what it breaks; fields split at the first and last " | ") to a copy of the tracked sources, one at a time, builds
 # it (release) and runs the test suite (ctest, stopping at the first
 # failure). A mutant is killed when a test fails, survives when all pass.
 # Prints each outcome and the score.
@@ -16,11 +16,13 @@ cmake -S "$tree" -B "$tree/build" -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build "$tree/build" -j "$(nproc)" > /dev/null || { echo "the unmutated tree does not build"; exit 1; }
 killed=0 survived=0 total=0
 trim() { sed 's/^ *//; s/ *$//' <<<"$1"; }
-while IFS='|' read -r file script what; do
-  file=$(trim "$file")
-  case $file in '' | '#'*) continue ;; esac
-  script=$(trim "$script")
-  what=$(trim "$what")
+while IFS= read -r line; do
+  case $line in '' | '#'*) continue ;; esac
+  # FILE | SCRIPT | WHAT: split at the first and the last " | " (scripts may hold "||")
+  file=$(trim "${line%% | *}")
+  rest=${line#* | }
+  what=$(trim "${rest##* | }")
+  script=$(trim "${rest% | *}")
   cp "$tree/$file" "$tree/$file.orig"
   sed -i -e "$script" "$tree/$file"
   if cmp -s "$tree/$file" "$tree/$file.orig"; then
