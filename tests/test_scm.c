@@ -1,6 +1,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/classify.h"
 #include "cellmap/scm.h"
 #include "check.h"
 #include "mix.h"
@@ -334,8 +335,74 @@ static void test_threads_identical(void)
     cm_model_release(&m);
 }
 
+static int leap(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] + 5000;
+    return 0;
+}
+
+static int drift(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] + 1;
+    return 0;
+}
+
+/* 1000 cells of a 1-D lattice solved with their exits recorded. */
+static void solve_recorded(int (*step)(const cm_model *, const double *, double *), cm_region *r)
+{
+    const cm_model m = hand_model(1, step);
+    const cm_lattice lat = {1, {0}, {1}};
+    const cm_box box = {1, {0}, {1000}};
+    const cm_scm_options opt = {1, 2, NULL, NULL, 1};
+    char msg[256];
+    CHECK(cm_region_alloc(r, &box, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, r, msg, sizeof msg) == CM_OK);
+}
+
+/* cm_region_check: a region as solved passes; each kind of damage a file
+ * can hold is found, with the cell it is in. */
+static void test_region_check(void)
+{
+    char msg[256];
+    cm_region r;
+    solve_recorded(leap, &r); /* every cell its own exit: exits 0..999 in cell order */
+    CHECK_INT(r.nexits, 1000);
+    CHECK(cm_region_check(&r, 0, true, 2, msg, sizeof msg) == CM_OK);
+    /* exit 3 twice (cells 2 and 3), each cell still its own node: the numbering is wrong */
+    r.image[2] = CM_IMAGE_EXIT_BASE + 3;
+    r.group[2] = CM_NODE_REF | 3;
+    CHECK(cm_region_check(&r, 0, true, 2, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "cell 2:") != NULL); /* it holds exit 3 where exit 2 is due */
+    r.image[2] = CM_IMAGE_EXIT_BASE + 2;
+    r.group[2] = CM_NODE_REF | 2;
+    r.exit_target[7] = 500; /* an exit whose target is inside the region */
+    CHECK(cm_region_check(&r, 0, true, 2, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "exit 7:") != NULL);
+    cm_region_free(&r);
+
+    solve_recorded(drift, &r); /* one exit (cell 999); every cell in its tree */
+    CHECK_INT(r.nexits, 1);
+    CHECK(cm_region_check(&r, 0, true, 1, msg, sizeof msg) == CM_OK);
+    r.step[500]++;
+    CHECK(cm_region_check(&r, 0, true, 1, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "cell 499:") != NULL); /* 499's image, 500, now disagrees with it */
+    r.step[500]--;
+    r.group[10] = 5; /* a group the file does not have */
+    CHECK(cm_region_check(&r, 4, true, 1, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "cell 9:") != NULL || strstr(msg, "cell 10:") != NULL);
+    CHECK(cm_region_check(&r, 5, false, 1, msg, sizeof msg) == CM_EFORMAT); /* no node refs */
+    r.group[10] = CM_NODE_REF;
+    r.image[20] = CM_IMAGE_SINK; /* the sink, with a node's group and step */
+    CHECK(cm_region_check(&r, 0, true, 1, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "cell 19:") != NULL || strstr(msg, "cell 20:") != NULL);
+    cm_region_free(&r);
+}
+
 int main(void)
 {
+    test_region_check();
     test_contraction();
     test_rotation(1);
     test_rotation(0);
