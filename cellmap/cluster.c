@@ -485,16 +485,20 @@ static cm_status chain_end(cm_cluster *c, uint32_t id, uint32_t *end, uint64_t *
 {
     cm_node *nd = NULL;
     *total = 0;
-    for (uint32_t y = id;; y = nd->up) {
-        cm_status st = cm_cluster_node(c, y, &nd, msg, msg_size);
+    *end = id;
+    /* a chain visits each node once at most: more hops mean a loop of links,
+     * which only a damaged file holds */
+    for (uint64_t hops = 0, y = id; hops <= c->nnodes; hops++, y = nd->up) {
+        cm_status st = cm_cluster_node(c, (uint32_t)y, &nd, msg, msg_size);
         if (st != CM_OK)
             return st;
         if (nd->up >= CM_NODE_MAX) {
-            *end = y;
+            *end = (uint32_t)y;
             return CM_OK;
         }
         *total += nd->up_dist;
     }
+    return cm_fail(CM_EFORMAT, msg, msg_size, "the links from node %u form a loop", id);
 }
 
 static cm_status push_chain(cm_cluster *c, uint64_t *len, uint32_t id)
@@ -514,6 +518,8 @@ static cm_status settle(cm_cluster *c, uint32_t id, char *msg, size_t msg_size)
     cm_node *nd = NULL;
     cm_status st = CM_OK;
     for (uint32_t x = id; st == CM_OK; x = nd->next) {
+        if (len > c->nnodes) /* a loop of links: a damaged file */
+            return cm_fail(CM_EFORMAT, msg, msg_size, "the links from node %u form a loop", id);
         st = cm_cluster_node(c, x, &nd, msg, msg_size);
         if (st == CM_OK && (nd->up == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE))
             break;

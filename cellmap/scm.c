@@ -149,12 +149,14 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
     const uint64_t nx = r->ncells / nrows;
     uint64_t k = 0;
     for (uint64_t row = 0; row < nrows; row++) {
-        const int64_t *from = bufs[rows->thread[row]].cells + rows->first[row] * dim;
+        /* indexed, not a pointer: a thread that found no exit has no array */
+        const int64_t *from = bufs[rows->thread[row]].cells;
+        uint64_t at = rows->first[row] * dim;
         for (uint64_t i = row * nx; i < (row + 1) * nx; i++) {
             if (r->image[i] != CM_IMAGE_EXIT)
                 continue;
             for (size_t d = 0; d < dim; d++)
-                r->exit_target[k * dim + d] = *from++;
+                r->exit_target[k * dim + d] = from[at++];
             r->image[i] = CM_IMAGE_EXIT_BASE + (uint32_t)k++;
         }
     }
