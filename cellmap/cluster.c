@@ -898,6 +898,11 @@ uint64_t cm_cluster_sink_cells(const cm_cluster *c)
 
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
 {
+    if (c->nregions == 0) { /* an empty box */
+        memset(box, 0, sizeof *box);
+        box->dim = c->lat.dim;
+        return;
+    }
     *box = c->regions[0].r.box;
     for (uint32_t k = 1; k < c->nregions; k++) {
         const cm_box *b = &c->regions[k].r.box;

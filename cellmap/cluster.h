@@ -316,7 +316,7 @@ uint64_t cm_cluster_sink_cells(const cm_cluster *c);
 /* Bytes held by the resident regions' cell arrays and exit tables, and node tables. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 
-/* The smallest box holding every region (the cluster must have one). */
+/* The smallest box holding every region (an empty box: none). */
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
 /* Bytes held by the resident arrays, the node table, the indexes and counts. */
