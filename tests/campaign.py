@@ -8,7 +8,7 @@ byte-identical.
 usage: campaign.py CELLMAP RUNS [SEED]   (prints a summary; exit 1 on a finding)"""
 import hashlib, os, random, shutil, sqlite3, subprocess, sys, tempfile
 
-cm, runs = sys.argv[1], int(sys.argv[2])
+cm, runs = os.path.abspath(sys.argv[1]), int(sys.argv[2])
 rng = random.Random(int(sys.argv[3]) if len(sys.argv) > 3 else 1)
 work = tempfile.mkdtemp(prefix="cellmap-campaign-")
 os.chdir(work)
