@@ -5,12 +5,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/output.h"
 #include "cellmap/store.h"
 #include "render/figure.h"
 #include "render/palette.h"
 #include "render/png_out.h"
 #include "render/raster.h"
+#include "src/outfile.h"
 
 enum { MAX_DEFAULT_SIDE = 4096, FIGURE_SIDE = 1000 };
 
@@ -302,11 +302,11 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
 int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
                     const cm_lattice *lat, const cm_box *box)
 {
-    char msg[CM_OUTPUT_PATH_MAX + 256];
-    cm_output out;
-    cm_status st = cm_output_begin(&out, po->path, false, msg, sizeof msg);
-    cm_output_abandon(&out);
-    if (st == CM_OK && !po->indexed) {
+    char msg[512];
+    if (!outfile_check(cmd, po->path))
+        return EXIT_FAIL;
+    cm_status st = CM_OK;
+    if (!po->indexed) {
         cm_render_options ro;
         memset(&ro, 0, sizeof ro);
         ro.layers = po->layers ? po->layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
