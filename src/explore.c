@@ -320,6 +320,8 @@ static cm_status parse_amount(const session *s, const char *text, int d, double 
     char number[64];
     const size_t len = strlen(text);
     double v = 0, unit = 1;
+    if (len >= sizeof number)
+        return cm_fail(CM_EINVAL, msg, msg_size, "pan: the amount '%.32s...' is too long", text);
     snprintf(number, sizeof number, "%s", text);
     if (len > 1 && text[len - 1] == '%') {
         number[len - 1] = 0;
@@ -328,7 +330,7 @@ static cm_status parse_amount(const session *s, const char *text, int d, double 
         number[len - 1] = 0;
         unit = s->c.lat.width[d];
     }
-    if (len >= sizeof number || !parse_double(number, &v) || !(v > 0) || !isfinite(v * unit))
+    if (!parse_double(number, &v) || !(v > 0) || !isfinite(v * unit))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "pan: '%s' is not a positive amount: 25%% (of the view), 120c (cells) or "
                        "a length",

@@ -51,6 +51,13 @@ small="--cells 100x80 --split 2x2 --threads 2"
 [ "$(grep -c '^alpha = ' sweep.out)" = 7 ] || fail "sweep with 7 values: $(cat sweep.out)"
 expect_usage "--vary" sweep --vary alpha=0.07,0.071, --cells 10x10
 expect_usage "--cells" solve --cells 10x10x10x10x10x10x10x10
+# a pan amount longer than explore's buffer, ending in % (found by fuzz_session)
+long_amount="$(printf '1%.0s' $(seq 1 80))%"
+"$CM" explore pan.cmdb - --model microchaos-pd --cell-size 5,1 > /dev/null 2> err.txt <<EOS
+view 0:100 -20:20
+pan right $long_amount
+EOS
+[ $? -eq 1 ] && grep -q "is too long" err.txt || fail "a long pan amount: $(cat err.txt)"
 # export --window 0 read before a stack array
 expect_usage "--window: '0'" export good.cmdb --flat f.sqlite --window 0
 [ -e f.sqlite ] && fail "export --window 0 left f.sqlite"
