@@ -335,24 +335,19 @@ static void test_threads_identical(void)
     cm_model_release(&m);
 }
 
-static int leap(const cm_model *m, const double *x, double *y)
+/* x -> x + (the model's ctx, a double) */
+static int shift(const cm_model *m, const double *x, double *y)
 {
-    (void)m;
-    y[0] = x[0] + 5000;
+    y[0] = x[0] + *(const double *)m->ctx;
     return 0;
 }
 
-static int drift(const cm_model *m, const double *x, double *y)
+/* 1000 cells of a 1-D lattice of unit cells, moved by `by`, solved with
+ * their exits recorded. */
+static void solve_recorded(double by, cm_region *r)
 {
-    (void)m;
-    y[0] = x[0] + 1;
-    return 0;
-}
-
-/* 1000 cells of a 1-D lattice solved with their exits recorded. */
-static void solve_recorded(int (*step)(const cm_model *, const double *, double *), cm_region *r)
-{
-    const cm_model m = hand_model(1, step);
+    cm_model m = hand_model(1, shift);
+    m.ctx = &by;
     const cm_lattice lat = {1, {0}, {1}};
     const cm_box box = {1, {0}, {1000}};
     const cm_scm_options opt = {1, 2, NULL, NULL, 1};
@@ -367,7 +362,7 @@ static void test_region_check(void)
 {
     char msg[256];
     cm_region r;
-    solve_recorded(leap, &r); /* every cell its own exit: exits 0..999 in cell order */
+    solve_recorded(5000, &r); /* every cell its own exit: exits 0..999 in cell order */
     CHECK_INT(r.nexits, 1000);
     CHECK(cm_region_check(&r, 0, true, 2, msg, sizeof msg) == CM_OK);
     /* exit 3 twice (cells 2 and 3), each cell still its own node: the numbering is wrong */
@@ -382,7 +377,7 @@ static void test_region_check(void)
     CHECK(strstr(msg, "exit 7:") != NULL);
     cm_region_free(&r);
 
-    solve_recorded(drift, &r); /* one exit (cell 999); every cell in its tree */
+    solve_recorded(1, &r); /* one exit (cell 999); every cell in its tree */
     CHECK_INT(r.nexits, 1);
     CHECK(cm_region_check(&r, 0, true, 1, msg, sizeof msg) == CM_OK);
     r.step[500]++;
