@@ -88,10 +88,10 @@ cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, ch
     if (st != CM_OK)
         return st;
     struct stat sb;
-    if (stat(o->dest, &sb) == 0 && S_ISDIR(sb.st_mode))
+    const bool exists = stat(o->dest, &sb) == 0;
+    if (exists && S_ISDIR(sb.st_mode))
         return cm_fail(CM_EINVAL, msg, msg_size, "%s is a directory; give a file name in it",
                        path);
-    const bool exists = stat(o->dest, &sb) == 0;
     if ((exists && !S_ISREG(sb.st_mode)) || strncmp(o->dest, "/proc/", 6) == 0) {
         if (needs_regular)
             return cm_fail(CM_EINVAL, msg, msg_size,
@@ -128,6 +128,16 @@ static cm_status copy_into(const cm_output *o, FILE *f, char *msg, size_t msg_si
     if (error)
         return cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->dest, strerror(error));
     return CM_OK;
+}
+
+cm_status cm_output_close_stream(const cm_output *o, FILE *f, char *msg, size_t msg_size)
+{
+    errno = 0;
+    int error = fflush(f) != 0 || ferror(f) ? (errno ? errno : EIO) : 0;
+    if (fclose(f) != 0 && !error)
+        error = errno ? errno : EIO;
+    return error ? cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->path, strerror(error))
+                 : CM_OK;
 }
 
 cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size)

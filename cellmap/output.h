@@ -20,6 +20,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "cellmap/status.h"
 
@@ -42,6 +43,10 @@ bool cm_output_names_stdout(const char *path);
  * SQLite database), so stdout and devices are refused. */
 cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, char *msg,
                           size_t msg_size);
+
+/* Flushes and closes f, the writer's stream on o->tmp: CM_EIO naming
+ * o->path and the reason if a write failed (a full disk, a full device). */
+cm_status cm_output_close_stream(const cm_output *o, FILE *f, char *msg, size_t msg_size);
 
 /* Moves the complete temporary file to its destination and removes it. */
 cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size);

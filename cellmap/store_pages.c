@@ -104,6 +104,11 @@ static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, si
     sqlite3_finalize(st);
     if (status == CM_OK && seen != r->ncells)
         status = CM_EFORMAT;
+    /* the arrays only once the rows are known to hold the region's cells */
+    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
+    if (status == CM_OK && (!(r->image = malloc(bytes + 4)) || !(r->group = malloc(bytes + 4)) ||
+                            !(r->step = malloc(bytes + 4))))
+        status = CM_ENOMEM;
     if (status == CM_OK)
         status = decode_columns(s, r, refs, nrefs);
     free(refs);
@@ -172,25 +177,7 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
 {
     cm_store *s = user;
     const double t0 = store_seconds_now();
-    /* the rows must hold the region's cells before they are allocated */
-    char sql[160];
-    snprintf(sql, sizeof sql,
-             "SELECT COUNT(*) = %llu AND IFNULL(SUM(cells), 0) = %llu FROM pages WHERE region = %u",
-             (unsigned long long)npages(r->ncells), (unsigned long long)r->ncells, k + 1);
-    if (store_query_int(s->db, sql) != 1)
-        return cm_fail(CM_EFORMAT, msg, msg_size,
-                       "%s is damaged: the pages of region %u do not hold its %llu cells",
-                       s->path, k + 1, (unsigned long long)r->ncells);
-    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
-    r->image = malloc(bytes + 4);
-    r->group = malloc(bytes + 4);
-    r->step = malloc(bytes + 4);
-    cm_status st = r->image && r->group && r->step
-                       ? CM_OK
-                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u",
-                                 k + 1);
-    if (st == CM_OK)
-        st = read_pages(s, k, r, msg, msg_size);
+    cm_status st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
     if (st == CM_OK)

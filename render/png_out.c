@@ -95,16 +95,15 @@ static cm_status write_file(const char *path, const png_pixels *px, const cm_png
     job.row = malloc(3 * (size_t)width);
     errno = 0;
     st = job.png && job.info && job.row ? encode(&job, px, texts, n_texts) : CM_ENOMEM;
-    int error = errno; /* why libpng's write failed, if it did */
+    const int error = errno; /* why libpng's write failed, if it did */
     png_destroy_write_struct(&job.png, &job.info);
     free(job.row);
-    if (st == CM_OK && (fflush(job.file) != 0 || ferror(job.file)))
-        st = CM_EIO, error = errno;
-    if (fclose(job.file) != 0 && st == CM_OK)
-        st = CM_EIO, error = errno;
-    if (st == CM_OK)
+    const cm_status closed = cm_output_close_stream(&out, job.file, msg, msg_size);
+    if (st == CM_OK && closed == CM_OK)
         return cm_output_commit(&out, msg, msg_size);
     cm_output_abandon(&out);
+    if (st == CM_OK)
+        return closed; /* its message names the reason */
     return cm_fail(st, msg, msg_size, "cannot write PNG %s: %s", path,
                    st == CM_EIO && error ? strerror(error) : cm_strerror(st));
 }

@@ -306,18 +306,16 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
 static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 {
     const int was_ok = ok;
-    int error = 0;
     if (o->kind == OUT_NPY && ok && o->f) {
         char shape[32];
         snprintf(shape, sizeof shape, "%20llu", (unsigned long long)o->rows);
         ok = fseek(o->f, o->shape_at, SEEK_SET) == 0 && fwrite(shape, 1, 20, o->f) == 20;
     }
-    if (o->f) {
-        errno = 0;
-        if (fflush(o->f) != 0 || ferror(o->f))
-            ok = 0, error = errno ? errno : EIO;
-        if (fclose(o->f) != 0 && !error)
-            ok = 0, error = errno;
+    if (o->f) { /* the reason of a failure, unless an earlier one was given */
+        char ignored[8];
+        if (cm_output_close_stream(&o->out, o->f, ok ? msg : ignored,
+                                   ok ? msg_size : sizeof ignored) != CM_OK)
+            ok = 0;
         o->f = NULL;
     }
     if (o->db) {
@@ -327,9 +325,7 @@ static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
         ok = (sqlite3_close(o->db) == SQLITE_OK) && ok;
         o->db = NULL;
     }
-    if (was_ok && !ok && error)
-        snprintf(msg, msg_size, "cannot write %s: %s", o->path, strerror(error));
-    else if (was_ok && !ok && !strstr(msg, o->path))
+    if (was_ok && !ok && !strstr(msg, o->path))
         snprintf(msg, msg_size, "cannot complete %s", o->path);
     if (ok && cm_output_commit(&o->out, msg, msg_size) != CM_OK)
         ok = 0;

@@ -38,16 +38,10 @@ bool outfile_open(const char *cmd, const char *path, outfile *o)
 bool outfile_close(const char *cmd, outfile *o, bool ok)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];
-    errno = 0;
-    const bool written = fflush(o->f) == 0 && !ferror(o->f);
-    const int error = errno;
-    const bool closed = fclose(o->f) == 0;
-    if (ok && (!written || !closed)) {
-        fprintf(stderr, "cellmap %s: cannot write %s: %s\n", cmd, o->out.path,
-                strerror(!written && error ? error : errno ? errno : EIO));
-        ok = false;
-    }
-    if (ok && cm_output_commit(&o->out, msg, sizeof msg) != CM_OK) {
+    cm_status st = cm_output_close_stream(&o->out, o->f, msg, sizeof msg);
+    if (ok && st == CM_OK)
+        st = cm_output_commit(&o->out, msg, sizeof msg);
+    if (ok && st != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         ok = false;
     }
