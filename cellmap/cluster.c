@@ -12,9 +12,7 @@
 #include <omp.h>
 #endif
 
-/* Node ids are indexed by blocks of NODE_BLOCK: the region of each block's first id. */
-#define NODE_BLOCK_BITS 10
-#define NODE_BLOCK (UINT64_C(1) << NODE_BLOCK_BITS)
+#define NODE_BLOCK (UINT64_C(1) << CM_NODE_BLOCK_BITS)
 
 /* An open node keeps its weight in its own record, in fields a link or a
  * final outcome fills later (saved as 0 while the node is open): dist the
@@ -127,22 +125,12 @@ static bool find_regions_meeting(const cm_cluster *c, const cm_box *box,
     return false;
 }
 
-uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
-{
-    /* the region of the block's first id, then on to the one holding id
-     * (regions without nodes share their successor's base) */
-    uint32_t k = c->node_blocks[id >> NODE_BLOCK_BITS];
-    while (k + 1 < c->nregions && c->regions[k + 1].node_base <= id)
-        k++;
-    return k;
-}
-
 /* Region k (the last) in the index of node blocks. */
 static cm_status index_nodes(cm_cluster *c, uint32_t k)
 {
     const uint64_t base = c->regions[k].node_base, end = base + c->regions[k].r.nexits;
-    const uint64_t first = (base + NODE_BLOCK - 1) >> NODE_BLOCK_BITS;
-    const uint64_t last = end > 0 ? (end - 1) >> NODE_BLOCK_BITS : 0;
+    const uint64_t first = (base + NODE_BLOCK - 1) >> CM_NODE_BLOCK_BITS;
+    const uint64_t last = end > 0 ? (end - 1) >> CM_NODE_BLOCK_BITS : 0;
     if (end == base || first > last)
         return CM_OK;
     if (cm_grow((void **)&c->node_blocks, &c->node_blocks_cap, last + 1, sizeof *c->node_blocks) !=
@@ -230,7 +218,8 @@ static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
     return CM_OK;
 }
 
-cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size)
+cm_status cm_cluster_node_load(cm_cluster *c, uint32_t id, cm_node **out, char *msg,
+                               size_t msg_size)
 {
     if (id >= c->nnodes)
         return cm_fail(CM_EFORMAT, msg, msg_size, "node %u is not in the cluster", id);
@@ -708,13 +697,6 @@ static void next_uses(const cm_cluster *c, uint32_t *use)
         use_mark m = {use, i};
         find_regions_meeting(c, &near, mark_use, &m);
     }
-}
-
-void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
-{
-    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
-    cr->nodes_dirty = 1;
-    cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
 }
 
 /* Something resident that can be evicted: region k's cells, or its node table. */

@@ -233,21 +233,53 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
  * the caller frees. */
 cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
 
-/* Node id's record changed: its chunk is saved at the next commit. */
-void cm_cluster_touch_node(cm_cluster *c, uint32_t id);
-
 /* Calls fn for every open node with the target of its exit. */
 typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
 void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 
-/* The region of node id (O(1)). */
-uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id);
+/* Node ids are indexed by blocks of 2^CM_NODE_BLOCK_BITS: the region of each
+ * block's first id (c->node_blocks). */
+#define CM_NODE_BLOCK_BITS 10
+
+/* The region of node id (O(1): its block's region, then on to the one
+ * holding id; regions without nodes share their successor's base). */
+static inline uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
+{
+    uint32_t k = c->node_blocks[id >> CM_NODE_BLOCK_BITS];
+    while (k + 1 < c->nregions && c->regions[k + 1].node_base <= id)
+        k++;
+    return k;
+}
+
+/* Node id's record changed: its chunk is saved at the next commit. */
+static inline void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
+{
+    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+    cr->nodes_dirty = 1;
+    cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
+}
 
 /* Node id's record into *out (its region's node table read back through
  * nodes_in if it was paged out). The pointer stays valid until the cluster
  * adds, restores or trims regions (joins and cm_cluster_acquire never evict
  * node tables; cm_cluster_trim does). */
-cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg, size_t msg_size);
+cm_status cm_cluster_node_load(cm_cluster *c, uint32_t id, cm_node **out, char *msg,
+                               size_t msg_size);
+/* Joins and resolution look nodes up several times per link: the common
+ * case (a resident table) is inline, the rest is cm_cluster_node_load. */
+static inline cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **out, char *msg,
+                                        size_t msg_size)
+{
+    if (id < c->nnodes) {
+        cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
+        if (cr->nodes) {
+            cr->nodes_used = ++c->clock;
+            *out = &cr->nodes[id - cr->node_base];
+            return CM_OK;
+        }
+    }
+    return cm_cluster_node_load(c, id, out, msg, msg_size);
+}
 
 /* Open nodes and their weights: the cells whose sequences leave the
  * cluster through them (a new node starts with its own tree). The weight

@@ -227,6 +227,46 @@ static cm_status link_node(joiner *j, const link_job *job)
     return CM_OK;
 }
 
+/* How many links ahead of the one being made their records are fetched:
+ * links touch random nodes and cells of the cluster, each a likely cache
+ * miss, so the misses of several links are overlapped. */
+#define PREFETCH 8
+
+static void prefetch_target(const cm_cluster *c, const link_job *job)
+{
+    const cm_region *r = &c->regions[job->region].r;
+    __builtin_prefetch(&r->group[job->cell]);
+    __builtin_prefetch(&r->step[job->cell]);
+}
+
+/* The records link_node reads first: the node's, and that of the node whose
+ * tree its exit lands in. */
+static void prefetch_nodes(const cm_cluster *c, const link_job *job)
+{
+    const cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, job->node)];
+    if (cr->nodes)
+        __builtin_prefetch(&cr->nodes[job->node - cr->node_base], 1);
+    if (cm_is_node_ref(job->group)) {
+        const cm_cluster_region *tr = &c->regions[job->region];
+        if (tr->nodes)
+            __builtin_prefetch(&tr->nodes[job->group & ~CM_NODE_REF], 1);
+    }
+}
+
+/* Then the node the chain of the target's node goes on to (fetched by now). */
+static void prefetch_chain(const cm_cluster *c, const link_job *job)
+{
+    const cm_cluster_region *tr = &c->regions[job->region];
+    if (!cm_is_node_ref(job->group) || !tr->nodes)
+        return;
+    const uint32_t up = tr->nodes[job->group & ~CM_NODE_REF].up;
+    if (up >= CM_NODE_MAX)
+        return;
+    const cm_cluster_region *ur = &c->regions[cm_cluster_node_region(c, up)];
+    if (ur->nodes)
+        __builtin_prefetch(&ur->nodes[up - ur->node_base], 1);
+}
+
 /* The group and step of every job's target cell. Jobs stay in node order;
  * when some target regions are paged out, they are visited region by
  * region (a counting sort of the jobs' positions) so that each is read once. */
@@ -259,6 +299,8 @@ static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
             st = cm_cluster_acquire(c, job->region, j->msg, j->msg_size);
             held = job->region;
         }
+        if (resident && p + PREFETCH < n) /* targets are random cells: overlap the misses */
+            prefetch_target(c, &jobs[p + PREFETCH]);
         const cm_region *r = &c->regions[job->region].r;
         job->group = st == CM_OK ? r->group[job->cell] : 0;
         job->step = st == CM_OK ? r->step[job->cell] : 0;
@@ -309,8 +351,13 @@ static cm_status link_all(joiner *j)
         cm_cluster_trim_joining(j->c, added);
     if (st == CM_OK)
         st = read_targets(j, jobs, n);
-    for (uint64_t i = 0; i < n && st == CM_OK; i++)
+    for (uint64_t i = 0; i < n && st == CM_OK; i++) {
+        if (i + PREFETCH < n)
+            prefetch_nodes(j->c, &jobs[i + PREFETCH]);
+        if (i + PREFETCH / 2 < n)
+            prefetch_chain(j->c, &jobs[i + PREFETCH / 2]);
         st = link_node(j, &jobs[i]);
+    }
     for (uint64_t i = 0; i < n; i++)
         j->c->regions[jobs[i].region].pinned = 0;
     j->stats->nodes = n;
