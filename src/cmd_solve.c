@@ -10,7 +10,6 @@
 #endif
 
 #include "cellmap/join.h"
-#include "cellmap/extend.h"
 #include "cellmap/output.h"
 #include "cellmap/join_stage1.h"
 #include "cellmap/scm.h"
@@ -219,16 +218,8 @@ static int larger_basin_first(const void *a, const void *b)
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
 
-/* One step of --extend, as reported. */
-typedef struct extend_step {
-    cm_box box;
-    uint64_t escaping, all_escaping, cluster_cells;
-    uint32_t new_groups, straddling;
-    double seconds;
-} extend_step;
-
 typedef struct extend_log {
-    extend_step steps[MAX_EXTEND];
+    project_step steps[MAX_EXTEND];
     int n;
     char stop[1100]; /* why the extension ended */
 } extend_log;
@@ -291,7 +282,7 @@ static void print_json_extension(FILE *out, const cm_lattice *lat, const extend_
 {
     fprintf(out, ",\"extension\":{\"steps\":[");
     for (int k = 0; k < log->n; k++) {
-        const extend_step *s = &log->steps[k];
+        const project_step *s = &log->steps[k];
         char box[CM_MAX_DIM * 64];
         format_box(lat, &s->box, box, sizeof box);
         fprintf(out, "%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_"
@@ -351,39 +342,14 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     return st;
 }
 
-/* The box cut into a->split[d] nearly equal parts per dimension (fewer
- * where the box has fewer cells). Returns the number of boxes; with boxes
- * NULL only counts them. */
-static uint32_t split_boxes(const solve_args *a, const cm_box *box, cm_box *boxes)
-{
-    int64_t parts[CM_MAX_DIM];
-    uint32_t n = 1;
-    for (int d = 0; d < box->dim; d++) {
-        const int64_t size = box->hi[d] - box->lo[d];
-        parts[d] = d < a->n_split ? (a->split[d] < size ? a->split[d] : size) : 1;
-        n *= (uint32_t)parts[d];
-    }
-    for (uint32_t k = 0; boxes && k < n; k++) {
-        uint32_t rest = k;
-        boxes[k] = *box;
-        for (int d = 0; d < box->dim; d++) {
-            const int64_t i = rest % (uint32_t)parts[d], size = box->hi[d] - box->lo[d];
-            rest /= (uint32_t)parts[d];
-            boxes[k].lo[d] = box->lo[d] + size * i / parts[d];
-            boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts[d];
-        }
-    }
-    return n;
-}
-
 /* --stage1: the regions of --split solved alone and taken through Stage 1
  * of their join only (thesis Fig. 4.27), flattened into r. */
-static cm_status solve_stage1(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                              const cm_box *box, cm_region *r, timing *t, char *msg,
-                              size_t msg_size)
+static cm_status solve_stage1(const solve_args *a, const project_plan *plan, const cm_model *m,
+                              const cm_lattice *lat, const cm_box *box, cm_region *r, timing *t,
+                              char *msg, size_t msg_size)
 {
-    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
-    const uint32_t n = split_boxes(a, box, NULL);
+    const cm_scm_options opt = plan->opt;
+    const uint32_t n = project_split(plan, box, NULL);
     cm_box *boxes = malloc(n * sizeof *boxes);
     cm_region *parts = calloc(n, sizeof *parts);
     cm_status st =
@@ -391,7 +357,7 @@ static cm_status solve_stage1(const solve_args *a, const cm_model *m, const cm_l
     *t = (timing){"regions", "stage 1", 0, 0};
     const double t0 = now_seconds();
     if (st == CM_OK)
-        split_boxes(a, box, boxes);
+        project_split(plan, box, boxes);
     for (uint32_t k = 0; k < n && st == CM_OK; k++) {
         st = cm_region_alloc(&parts[k], &boxes[k], msg, msg_size);
         if (st == CM_OK)
@@ -425,121 +391,27 @@ typedef struct run {
     cm_store *store;
 } run;
 
-static int has_box(const cm_cluster *c, const cm_box *box)
-{
-    for (uint32_t k = 0; k < c->nregions; k++)
-        if (memcmp(c->regions[k].r.box.lo, box->lo, sizeof box->lo) == 0 &&
-            memcmp(c->regions[k].r.box.hi, box->hi, sizeof box->hi) == 0)
-            return 1;
-    return 0;
-}
+/* A project_step_fn: notes the step for the summary and says it as it ends. */
+typedef struct step_report {
+    const solve_args *a;
+    const cm_lattice *lat;
+    extend_log *log;
+} step_report;
 
-/* Solves the box (split as --split says) and joins it into the cluster;
- * parts a resumed cluster already has are skipped. */
-static cm_status add_box(const solve_args *a, const cm_model *m, const cm_box *box, run *rn,
-                         cm_join_stats *stats, char *msg, size_t msg_size)
+static void report_step(void *user, const project_step *s, int k)
 {
-    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1};
-    const uint32_t n = split_boxes(a, box, NULL);
-    cm_box *boxes = malloc(n * sizeof *boxes);
-    if (!boxes)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
-    split_boxes(a, box, boxes);
-    uint32_t todo = 0;
-    for (uint32_t k = 0; k < n; k++)
-        if (!has_box(&rn->c, &boxes[k]))
-            boxes[todo++] = boxes[k];
-    cm_status st = cm_cluster_solve_boxes(&rn->c, m, boxes, todo, &opt,
-                                          rn->store ? cm_store_commit_join : NULL, rn->store, stats,
-                                          msg, msg_size);
-    free(boxes);
-    return st;
-}
-
-static void print_step(FILE *out, const cm_lattice *lat, const extend_step *s, int k)
-{
+    const step_report *rep = user;
+    rep->log->steps[k] = *s;
+    if (rep->a->json)
+        return;
     char box[CM_MAX_DIM * 64];
-    format_box(lat, &s->box, box, sizeof box);
-    fprintf(out, "extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu "
-           "cells led there; %u new groups (%u across borders); %.3f s\n",
-           k + 1, box, (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
+    format_box(rep->lat, &s->box, box, sizeof box);
+    fprintf(rep->a->report,
+            "extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu cells "
+            "led there; %u new groups (%u across borders); %.3f s\n",
+            k + 1, box, (unsigned long long)cm_box_cells(&s->box), (unsigned long long)s->escaping,
            (unsigned long long)s->all_escaping, (unsigned long long)s->cluster_cells, s->new_groups,
            s->straddling, s->seconds);
-}
-
-/* Extension steps a resumed cluster has done, and the tile of a step that
- * was interrupted between its regions (or the empty box). */
-static int steps_done(const solve_args *a, const cm_cluster *c, const cm_box *tile,
-                      const cm_box *bounds, cm_box *partial)
-{
-    const uint32_t per_tile = split_boxes(a, tile, NULL);
-    const uint32_t extra = c->nregions > per_tile ? c->nregions - per_tile : 0;
-    memset(partial, 0, sizeof *partial);
-    if (extra % per_tile)
-        cm_extend_tile(tile, a->bounds_text ? bounds : NULL, c->regions[c->nregions - 1].r.box.lo,
-                       partial);
-    return (int)((extra + per_tile - 1) / per_tile);
-}
-
-/* Adds the neighbouring tile where the most sequences escape, step by step,
- * until --extend steps are done, the escaping fraction is below
- * --escape-below, or no sequence escapes into a neighbour. */
-static cm_status extend_cluster(const solve_args *a, const cm_model *m, const cm_box *tile,
-                                const cm_box *bounds, run *rn, extend_log *log, char *msg,
-                                size_t msg_size)
-{
-    cm_cluster *c = &rn->c;
-    cm_box partial;
-    const int done = steps_done(a, c, tile, bounds, &partial);
-    cm_status st = CM_OK;
-    /* a step interrupted between its regions is finished first */
-    if (partial.dim)
-        st = add_box(a, m, &partial, rn, NULL, msg, msg_size);
-    snprintf(log->stop, sizeof log->stop, "%d extension steps done", a->extend);
-    for (log->n = 0; done + log->n < a->extend && st == CM_OK; log->n++) {
-        cm_extend_choice choice;
-        const double t0 = now_seconds();
-        /* from the open nodes' weights: no region is read */
-        st = cm_extend_choose(c, tile, a->bounds_text ? bounds : NULL, &choice, msg, msg_size);
-        const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
-        if (st == CM_OK && fraction < a->escape_below) {
-            snprintf(log->stop, sizeof log->stop, "escaping fraction %.4g is below %.4g", fraction,
-                     a->escape_below);
-            break;
-        }
-        if (st == CM_ENOTFOUND) {
-            snprintf(log->stop, sizeof log->stop, "%s", msg);
-            return CM_OK;
-        }
-        cm_join_stats stats;
-        if (st == CM_OK)
-            st = add_box(a, m, &choice.box, rn, &stats, msg, msg_size);
-        if (st != CM_OK)
-            break;
-        extend_step *s = &log->steps[log->n];
-        *s = (extend_step){choice.box,           choice.escaping,  choice.all_escaping,
-                           choice.cluster_cells, stats.new_groups, stats.straddling_groups,
-                           now_seconds() - t0};
-        if (!a->json)
-            print_step(a->report, &c->lat, s, log->n);
-    }
-    return st;
-}
-
-/* What a resumed solve must repeat exactly: the box, the split, the steps. */
-static void make_plan(const solve_args *a, const cm_box *box, char *out, size_t size)
-{
-    size_t used = 0;
-    used += (size_t)snprintf(out + used, size - used, "box");
-    for (int d = 0; d < box->dim && used < size; d++)
-        used += (size_t)snprintf(out + used, size - used, " %lld:%lld", (long long)box->lo[d],
-                                 (long long)box->hi[d]);
-    for (int d = 0; d < a->n_split && used < size; d++)
-        used += (size_t)snprintf(out + used, size - used, "%s%lld", d ? "x" : " split ",
-                                 (long long)a->split[d]);
-    if (used < size)
-        snprintf(out + used, size - used, " max-steps %d extend %d escape-below %.17g bounds %s",
-                 a->max_steps, a->extend, a->escape_below, a->bounds_text ? a->bounds_text : "-");
 }
 
 /* What a resumed file must have been made with. */
@@ -584,16 +456,30 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
                           msg_size);
 }
 
+/* The project's plan from --split, --max-steps, --threads, --extend,
+ * --escape-below and --bounds. */
+static void make_plan(const solve_args *a, const cm_box *bounds, project_plan *p)
+{
+    memset(p, 0, sizeof *p);
+    p->nsplit = a->n_split;
+    memcpy(p->split, a->split, sizeof p->split);
+    p->opt = (cm_scm_options){a->max_steps, a->threads, NULL, NULL, 1};
+    p->extend = a->extend;
+    p->escape_below = a->escape_below;
+    p->bounds = a->bounds_text ? bounds : NULL;
+    p->bounds_text = a->bounds_text;
+}
+
 /* --split, --extend and --db: a cluster of regions. */
-static cm_status solve_cluster(const solve_args *a, const char *command, const cm_model *m,
-                               const cm_lattice *lat, const cm_box *box, const cm_box *bounds,
+static cm_status solve_cluster(const solve_args *a, const project_plan *plan, const char *command,
+                               const cm_model *m, const cm_lattice *lat, const cm_box *box,
                                run *rn, timing *t, extend_log *log, char *msg, size_t msg_size)
 {
-    char plan[1024];
-    make_plan(a, box, plan, sizeof plan);
+    char plan_text[1024];
+    project_plan_text(plan, box, plan_text, sizeof plan_text);
     cm_status st = CM_OK;
     if (a->db)
-        st = open_store(a, command, m, lat, plan, rn, msg, msg_size);
+        st = open_store(a, command, m, lat, plan_text, rn, msg, msg_size);
     else
         cm_cluster_init(&rn->c, lat);
     rn->c.threads = a->threads;
@@ -601,9 +487,11 @@ static cm_status solve_cluster(const solve_args *a, const char *command, const c
     *t = (timing){"regions and joins", "summary", 0, 0};
     const double t0 = now_seconds();
     if (st == CM_OK)
-        st = add_box(a, m, box, rn, NULL, msg, msg_size);
+        st = project_add_box(&rn->c, rn->store, m, plan, box, NULL, msg, msg_size);
+    step_report rep = {a, lat, log};
     if (st == CM_OK && a->extend > 0)
-        st = extend_cluster(a, m, box, bounds, rn, log, msg, msg_size);
+        st = project_extend(&rn->c, rn->store, m, plan, box, report_step, &rep, &log->n,
+                            log->stop, sizeof log->stop, msg, msg_size);
     t->t1 = now_seconds() - t0;
     return st;
 }
@@ -703,18 +591,20 @@ int cmd_solve(int argc, char **argv)
         (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK ||
         (a.png.path && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
         goto done;
+    project_plan plan;
+    make_plan(&a, &bounds, &plan);
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
     if (!a.stage1 && (a.n_split || a.extend || a.db || a.png.has_view)) {
         /* a view is cut from a cluster */
         const double t0 = now_seconds();
-        if (solve_cluster(&a, command, &m, &lat, &box, &bounds, &rn, &t, log, msg, sizeof msg) !=
+        if (solve_cluster(&a, &plan, command, &m, &lat, &box, &rn, &t, log, msg, sizeof msg) !=
                 CM_OK ||
             summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
         t.t2 = now_seconds() - t0 - t.t1;
     } else {
-        if ((a.stage1 ? solve_stage1(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)
+        if ((a.stage1 ? solve_stage1(&a, &plan, &m, &lat, &box, &r, &t, msg, sizeof msg)
                       : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
             goto fail;
         sum.box = r.box;

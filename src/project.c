@@ -4,7 +4,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "cellmap/extend.h"
 #include "models/registry.h"
 #include "src/args.h"
 
@@ -139,4 +141,131 @@ cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size
                        info->params);
     }
     return CM_OK;
+}
+
+/* ---- growing a project: regions and extension ---------------------------- */
+
+void project_plan_text(const project_plan *p, const cm_box *box, char *out, size_t size)
+{
+    size_t used = 0;
+    used += (size_t)snprintf(out + used, size - used, "box");
+    for (int d = 0; d < box->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, " %lld:%lld", (long long)box->lo[d],
+                                 (long long)box->hi[d]);
+    for (int d = 0; d < p->nsplit && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%lld", d ? "x" : " split ",
+                                 (long long)p->split[d]);
+    if (used < size)
+        snprintf(out + used, size - used, " max-steps %d extend %d escape-below %.17g bounds %s",
+                 p->opt.max_steps, p->extend, p->escape_below,
+                 p->bounds_text ? p->bounds_text : "-");
+}
+
+uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes)
+{
+    int64_t parts[CM_MAX_DIM];
+    uint32_t n = 1;
+    for (int d = 0; d < box->dim; d++) {
+        const int64_t size = box->hi[d] - box->lo[d];
+        parts[d] = d < p->nsplit ? (p->split[d] < size ? p->split[d] : size) : 1;
+        n *= (uint32_t)parts[d];
+    }
+    for (uint32_t k = 0; boxes && k < n; k++) {
+        uint32_t rest = k;
+        boxes[k] = *box;
+        for (int d = 0; d < box->dim; d++) {
+            const int64_t i = rest % (uint32_t)parts[d], size = box->hi[d] - box->lo[d];
+            rest /= (uint32_t)parts[d];
+            boxes[k].lo[d] = box->lo[d] + size * i / parts[d];
+            boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts[d];
+        }
+    }
+    return n;
+}
+
+static bool has_box(const cm_cluster *c, const cm_box *box)
+{
+    for (uint32_t k = 0; k < c->nregions; k++)
+        if (memcmp(c->regions[k].r.box.lo, box->lo, sizeof box->lo) == 0 &&
+            memcmp(c->regions[k].r.box.hi, box->hi, sizeof box->hi) == 0)
+            return true;
+    return false;
+}
+
+cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
+                          const cm_box *box, cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    cm_scm_options opt = p->opt;
+    opt.record_exits = 1;
+    const uint32_t n = project_split(p, box, NULL);
+    cm_box *boxes = malloc(n * sizeof *boxes);
+    if (!boxes)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
+    project_split(p, box, boxes);
+    uint32_t todo = 0; /* parts a resumed cluster has are skipped */
+    for (uint32_t k = 0; k < n; k++)
+        if (!has_box(c, &boxes[k]))
+            boxes[todo++] = boxes[k];
+    cm_status st = cm_cluster_solve_boxes(c, m, boxes, todo, &opt, s ? cm_store_commit_join : NULL,
+                                          s, stats, msg, msg_size);
+    free(boxes);
+    return st;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Extension steps a resumed cluster has done, and the tile of a step that
+ * was interrupted between its regions (or the empty box). */
+static int steps_done(const project_plan *p, const cm_cluster *c, const cm_box *tile,
+                      cm_box *partial)
+{
+    const uint32_t per_tile = project_split(p, tile, NULL);
+    const uint32_t extra = c->nregions > per_tile ? c->nregions - per_tile : 0;
+    memset(partial, 0, sizeof *partial);
+    if (extra % per_tile)
+        cm_extend_tile(tile, p->bounds, c->regions[c->nregions - 1].r.box.lo, partial);
+    return (int)((extra + per_tile - 1) / per_tile);
+}
+
+cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
+                         const cm_box *tile, project_step_fn step_done, void *user, int *steps,
+                         char *stop, size_t stop_size, char *msg, size_t msg_size)
+{
+    cm_box partial;
+    const int done = steps_done(p, c, tile, &partial);
+    cm_status st = CM_OK;
+    if (partial.dim) /* a step interrupted between its regions is finished first */
+        st = project_add_box(c, s, m, p, &partial, NULL, msg, msg_size);
+    snprintf(stop, stop_size, "%d extension steps done", p->extend);
+    for (*steps = 0; done + *steps < p->extend && st == CM_OK; ++*steps) {
+        cm_extend_choice choice;
+        const double t0 = now_seconds();
+        st = cm_extend_choose(c, tile, p->bounds, &choice, msg, msg_size);
+        const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
+        if (st == CM_OK && fraction < p->escape_below) {
+            snprintf(stop, stop_size, "escaping fraction %.4g is below %.4g", fraction,
+                     p->escape_below);
+            break;
+        }
+        if (st == CM_ENOTFOUND) {
+            snprintf(stop, stop_size, "%s", msg);
+            return CM_OK;
+        }
+        cm_join_stats stats;
+        if (st == CM_OK)
+            st = project_add_box(c, s, m, p, &choice.box, &stats, msg, msg_size);
+        if (st != CM_OK)
+            break;
+        const project_step step = {choice.box,           choice.escaping,  choice.all_escaping,
+                                   choice.cluster_cells, stats.new_groups, stats.straddling_groups,
+                                   now_seconds() - t0};
+        if (step_done)
+            step_done(user, &step, *steps);
+    }
+    return st;
 }

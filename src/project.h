@@ -49,6 +49,52 @@ cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits
                          cm_store **s, cm_store_info *info, cm_cluster *c, char *msg,
                          size_t msg_size);
 
+/* How a solve grows its project: each box cut into split[d] nearly equal
+ * parts per dimension (fewer where it has fewer cells), solved with opt and
+ * joined in order; then up to `extend` extension steps (thesis 4.6.4), each
+ * the neighbouring tile where most sequences escape, clipped to bounds
+ * (NULL: anywhere), until fewer than escape_below of the cells escape. */
+typedef struct project_plan {
+    int nsplit;
+    int64_t split[CM_MAX_DIM];
+    cm_scm_options opt;
+    int extend;
+    double escape_below;
+    const cm_box *bounds;
+    const char *bounds_text; /* as the user gave them, for the plan's text */
+} project_plan;
+
+/* The plan as text: what a resumed solve must repeat exactly (the box, the
+ * split, the steps). */
+void project_plan_text(const project_plan *p, const cm_box *box, char *out, size_t size);
+
+/* The box cut as the plan says: returns the number of parts; boxes (may be
+ * NULL: only counted) receives them. */
+uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes);
+
+/* Solves the parts of box that the cluster lacks and joins them (committing
+ * each join to s, which may be NULL); stats (may be NULL) sums the joins. */
+cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
+                          const cm_box *box, cm_join_stats *stats, char *msg, size_t msg_size);
+
+/* One extension step, as done. */
+typedef struct project_step {
+    cm_box box;
+    uint64_t escaping, all_escaping, cluster_cells;
+    uint32_t new_groups, straddling;
+    double seconds;
+} project_step;
+typedef void (*project_step_fn)(void *user, const project_step *step, int k);
+
+/* The extension of a cluster whose first tile is `tile`: finishes a step a
+ * resumed cluster had begun, then adds tiles (calling step_done after each,
+ * which may be NULL) until the plan's steps are done, too few sequences
+ * escape or none escapes into a neighbour; *steps: the steps done now;
+ * stop: why it ended. No region's cells are read to choose a tile. */
+cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
+                         const cm_box *tile, project_step_fn step_done, void *user, int *steps,
+                         char *stop, size_t stop_size, char *msg, size_t msg_size);
+
 /* The name of coordinate d: x, y, z, w, v, u. */
 const char *axis_name(int d);
 
