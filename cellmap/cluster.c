@@ -354,15 +354,12 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
     return CM_OK;
 }
 
-cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w)
+cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w)
 {
-    const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     const size_t dim = (size_t)c->lat.dim;
     if (cr->nopen == cr->open_cap &&
         resize_open_list(c, cr, cr->open_cap ? 2 * cr->open_cap : 16) != CM_OK)
-        return CM_ENOMEM;
-    if (cm_bricks_add(c->escape_bricks, cell, &e) != CM_OK)
         return CM_ENOMEM;
     if (cr->nodes) {
         set_weight(&cr->nodes[id - cr->node_base], w);
@@ -375,6 +372,18 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
     cr->nopen++;
     cr->open_dirty = 1;
     return CM_OK;
+}
+
+cm_status cm_cluster_index_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
+{
+    const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
+    return cm_bricks_add(c->escape_bricks, cell, &e);
+}
+
+cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w)
+{
+    cm_status st = cm_cluster_index_escape(c, id, cell);
+    return st == CM_OK ? cm_cluster_add_open(c, id, cell, w) : st;
 }
 
 typedef struct escape_visit {

@@ -228,6 +228,13 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *lo
  * node order), with weight w. */
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w);
 
+/* The two halves of cm_cluster_add_escape: the open list and weight, and
+ * the index by target cell. cm_cluster_solve_boxes indexes only the exits
+ * that lead outside the boxes it solves (it hands the others to their
+ * boxes' joins itself), and the rest if it stops early. */
+cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w);
+cm_status cm_cluster_index_escape(cm_cluster *c, uint32_t id, const int64_t *cell);
+
 /* Takes the open nodes whose exits lead into `box` (at most 2^32 cells)
  * out of the index: a new array of *n of them (ascending by node id) that
  * the caller frees. */

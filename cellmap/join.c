@@ -17,9 +17,37 @@ typedef struct link_job {
     uint32_t node, region, cell, group, step;
 } link_job;
 
+/* Where an exit of a region that cm_cluster_solve_boxes solves leads among
+ * its boxes: the box and the target's local index there, found by the
+ * thread that solved the region (box PLAN_NONE: in none of them). */
+typedef struct plan_target {
+    uint32_t box, cell;
+} plan_target;
+#define PLAN_NONE UINT32_MAX
+
+/* The open nodes whose exits lead into a box still to join, handed over by
+ * the joins of the boxes before it (in order of node id). */
+typedef struct handover {
+    cm_escape *v;
+    uint64_t n, cap;
+} handover;
+
+/* The boxes cm_cluster_solve_boxes joins, beyond what the cluster knows:
+ * box b becomes region first + b. Exits between them never enter the
+ * cluster's index of escapes, whose upkeep would fall on the joining thread. */
+typedef struct plan {
+    const cm_box *boxes;
+    uint32_t nboxes, first;
+    cm_bricks *index; /* box ids by brick; read-only while the threads solve */
+    handover *in;     /* per box */
+} plan;
+
 typedef struct joiner {
     cm_cluster *c;
     cm_join_stats *stats;
+    const plan *plan;            /* NULL: a join on its own */
+    uint32_t box;                /* with plan: the box joining */
+    const plan_target *targets;  /* with plan: where the region's exits lead */
     uint8_t *touched; /* per region: a node record of it changed */
     uint32_t *stack;  /* nodes of a chain */
     uint64_t stack_cap;
@@ -310,31 +338,68 @@ static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
     return st;
 }
 
-/* The links to make: the new region's exits into the cluster (the others
- * join the index of open nodes) and the open nodes whose exits lead into it. */
+/* Exit `id` leads into a box of the plan still to join: its join takes it. */
+static cm_status hand_over(joiner *j, const plan_target *t, uint32_t id, uint64_t weight)
+{
+    handover *h = &j->plan->in[t->box];
+    int64_t cell[CM_MAX_DIM];
+    cm_box_cell(&j->plan->boxes[t->box], t->cell, cell);
+    if (cm_grow((void **)&h->v, &h->cap, h->n + 1, sizeof *h->v) != CM_OK)
+        return CM_ENOMEM;
+    h->v[h->n++] = (cm_escape){id, t->cell};
+    return cm_cluster_add_open(j->c, id, cell, weight);
+}
+
+/* Where exit e of the new region (node id) leads: a link to make, an open
+ * node handed to a later box of the plan, or an escape from the cluster. */
+static cm_status place_exit(joiner *j, const cm_cluster_region *cr, uint64_t e, link_job *jobs,
+                            uint64_t *n)
+{
+    cm_cluster *c = j->c;
+    const uint32_t id = cr->node_base + (uint32_t)e;
+    const plan_target *t = j->targets ? &j->targets[e] : NULL;
+    if (t && t->box != PLAN_NONE && t->box < j->box) {
+        jobs[(*n)++] = (link_job){id, j->plan->first + t->box, t->cell, 0, 0};
+        return CM_OK;
+    }
+    if (t && t->box != PLAN_NONE)
+        return hand_over(j, t, id, cr->nodes[e].tree);
+    const int64_t *cell = cm_region_exit(&cr->r, e);
+    uint64_t local;
+    const int64_t k = cm_cluster_locate(c, cell, &local);
+    if (k < 0)
+        return cm_cluster_add_escape(c, id, cell, cr->nodes[e].tree);
+    jobs[(*n)++] = (link_job){id, (uint32_t)k, (uint32_t)local, 0, 0};
+    return CM_OK;
+}
+
+/* The links to make, in order of node id: the open nodes whose exits lead
+ * into the new region (from the index of escapes, then those the plan
+ * handed over, all of them newer), and the new region's exits into the
+ * cluster (the others stay open). */
 static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64_t *n)
 {
     cm_cluster *c = j->c;
     const cm_cluster_region *cr = &c->regions[added];
+    handover *h = j->plan ? &j->plan->in[j->box] : NULL;
+    const uint64_t nh = h ? h->n : 0;
     cm_escape *in = NULL;
     uint64_t nin = 0, cap = 0;
     cm_status st = cm_cluster_take_escapes(c, &cr->r.box, &in, &nin);
     if (st == CM_OK &&
-        cm_grow((void **)jobs, &cap, nin + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
+        cm_grow((void **)jobs, &cap, nin + nh + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
         st = CM_ENOMEM;
     for (uint64_t i = 0; i < nin && st == CM_OK; i++)
         (*jobs)[(*n)++] = (link_job){in[i].node, added, in[i].cell, 0, 0};
     free(in);
-    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
-        const int64_t *cell = cm_region_exit(&cr->r, e);
-        const uint32_t id = cr->node_base + (uint32_t)e;
-        uint64_t local;
-        const int64_t k = cm_cluster_locate(c, cell, &local);
-        if (k < 0)
-            st = cm_cluster_add_escape(c, id, cell, cr->nodes[e].tree);
-        else
-            (*jobs)[(*n)++] = (link_job){id, (uint32_t)k, (uint32_t)local, 0, 0};
+    for (uint64_t i = 0; i < nh && st == CM_OK; i++)
+        (*jobs)[(*n)++] = (link_job){h->v[i].node, added, h->v[i].cell, 0, 0};
+    if (h && st == CM_OK) {
+        free(h->v);
+        *h = (handover){NULL, 0, 0};
     }
+    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++)
+        st = place_exit(j, cr, e, *jobs, n);
     return st;
 }
 
@@ -365,8 +430,11 @@ static cm_status link_all(joiner *j)
     return st;
 }
 
-cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
-                          size_t msg_size)
+/* Joins region r, box `box` of the plan p (NULL: a join on its own, box
+ * and targets unused). */
+static cm_status join_region(cm_cluster *c, cm_region *r, const plan *p, uint32_t box,
+                             const plan_target *targets, cm_join_stats *stats, char *msg,
+                             size_t msg_size)
 {
     cm_join_stats local_stats;
     if (!stats)
@@ -378,7 +446,8 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
     const uint32_t added = c->nregions - 1;
     stats->new_groups = c->regions[added].r.ngroups;
     char detail[256] = "";
-    joiner j = {c, stats, calloc(c->nregions, 1), NULL, 0, detail, sizeof detail};
+    joiner j = {c,    stats, p, box, targets, calloc(c->nregions, 1), NULL, 0, detail,
+                sizeof detail};
     st = j.touched ? CM_OK : CM_ENOMEM;
     if (st == CM_OK) {
         j.touched[added] = 1;
@@ -392,6 +461,12 @@ cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, cha
         return cm_fail(st, msg, msg_size, "joining region %u: %s", added,
                        detail[0] ? detail : cm_strerror(st));
     return CM_OK;
+}
+
+cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
+                          size_t msg_size)
+{
+    return join_region(c, r, NULL, 0, NULL, stats, msg, msg_size);
 }
 
 static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
@@ -437,7 +512,34 @@ typedef struct pipeline {
     atomic_uint joined; /* boxes joined (and their slots free) */
     atomic_uint *ready; /* per slot: the box solved there, plus one; 0: none */
     atomic_int stop;    /* a join failed: no more claims */
+    plan pl;            /* pl.index NULL: the joins go without it */
+    plan_target **targets; /* per slot: where its region's exits lead */
 } pipeline;
+
+/* Where region r's exits lead among the boxes of the plan (on the thread
+ * that solved it: the plan's index is only read). */
+static cm_status locate_exits(const plan *pl, const cm_region *r, plan_target **out)
+{
+    plan_target *t = malloc((r->nexits + 1) * sizeof *t);
+    if (!t)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < r->nexits; e++) {
+        const int64_t *cell = cm_region_exit(r, e);
+        int64_t key[CM_MAX_DIM];
+        uint64_t n;
+        cm_bricks_of(pl->index, cell, key);
+        const uint32_t *in_brick = cm_bricks_find(pl->index, key, &n);
+        t[e] = (plan_target){PLAN_NONE, 0};
+        for (uint64_t i = 0; i < n; i++)
+            if (cm_box_contains(&pl->boxes[in_brick[i]], cell)) {
+                t[e] = (plan_target){in_brick[i],
+                                     (uint32_t)cm_box_index(&pl->boxes[in_brick[i]], cell)};
+                break;
+            }
+    }
+    *out = t;
+    return CM_OK;
+}
 
 /* Claims and solves the next box if the window allows; false if it does not. */
 static bool solve_next(pipeline *p)
@@ -452,6 +554,10 @@ static bool solve_next(pipeline *p)
     if (p->status[s] == CM_OK)
         p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
                                     sizeof p->msgs[s]);
+    if (p->status[s] == CM_OK && p->pl.index &&
+        locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)
+        p->status[s] = cm_fail(CM_ENOMEM, p->msgs[s], sizeof p->msgs[s],
+                               "out of memory for its exits");
     atomic_store(&p->ready[s], b + 1);
     return true;
 }
@@ -486,7 +592,8 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         pin_expected(c, next, 1);
         cm_join_stats one_join;
         if (st == CM_OK)
-            st = cm_cluster_join(c, &p->slot[s], &one_join, msg, msg_size);
+            st = join_region(c, &p->slot[s], p->pl.index ? &p->pl : NULL, b, p->targets[s],
+                             &one_join, msg, msg_size);
         pin_expected(c, next, 0);
         c->upcoming++;
         c->nupcoming--;
@@ -495,12 +602,68 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         if (st == CM_OK && joined)
             st = joined(user, c, b, &one_join, msg, msg_size);
         cm_region_free(&p->slot[s]);
+        free(p->targets[s]);
+        p->targets[s] = NULL;
         atomic_store(&p->ready[s], 0u);
         atomic_store(&p->joined, b + 1);
     }
     if (st != CM_OK)
         atomic_store(&p->stop, 1);
     return st;
+}
+
+/* The plan of boxes[0..n) joining a cluster of `first` regions: pl->index
+ * stays NULL (joins without it) for a lone box or boxes too big to index. */
+static cm_status plan_boxes(plan *pl, const cm_cluster *c, const cm_box *boxes, uint32_t n)
+{
+    *pl = (plan){boxes, n, c->nregions, NULL, NULL};
+    if (n < 2)
+        return CM_OK;
+    int shift[CM_MAX_DIM];
+    cm_bricks_shift_for(&boxes[0], shift);
+    pl->in = calloc(n, sizeof *pl->in);
+    if (!pl->in || cm_bricks_alloc(c->lat.dim, shift, sizeof(uint32_t), &pl->index) != CM_OK)
+        return CM_ENOMEM;
+    for (uint32_t b = 0; b < n; b++) {
+        const cm_status st = cm_bricks_add_box(pl->index, &boxes[b], &b);
+        if (st != CM_OK) { /* CM_ETOOBIG: without the plan */
+            cm_bricks_free(pl->index);
+            pl->index = NULL;
+            return st == CM_ETOOBIG ? CM_OK : st;
+        }
+    }
+    return CM_OK;
+}
+
+/* Open nodes handed over to boxes that a failed solve did not join go to
+ * the cluster's index of escapes, where any later join finds them. */
+static cm_status free_plan(plan *pl, cm_cluster *c)
+{
+    cm_status st = CM_OK;
+    for (uint32_t b = 0; pl->in && b < pl->nboxes; b++) {
+        for (uint64_t i = 0; i < pl->in[b].n && st == CM_OK; i++) {
+            int64_t cell[CM_MAX_DIM];
+            cm_box_cell(&pl->boxes[b], pl->in[b].v[i].cell, cell);
+            st = cm_cluster_index_escape(c, pl->in[b].v[i].node, cell);
+        }
+        free(pl->in[b].v);
+    }
+    free(pl->in);
+    cm_bricks_free(pl->index);
+    return st;
+}
+
+static void free_pipeline(pipeline *p)
+{
+    for (uint32_t k = 0; p->slot && k < p->window; k++)
+        cm_region_free(&p->slot[k]);
+    for (uint32_t k = 0; p->targets && k < p->window; k++)
+        free(p->targets[k]);
+    free(p->slot);
+    free(p->status);
+    free(p->msgs);
+    free(p->ready);
+    free(p->targets);
 }
 
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
@@ -512,7 +675,7 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
     pipeline p = {c, model, boxes, nboxes, 2 * (uint32_t)threads, opt ? *opt : (cm_scm_options){0},
-                  NULL, NULL, NULL, 0, 0, NULL, 0};
+                  NULL, NULL, NULL, 0, 0, NULL, 0, {0}, NULL};
     p.one.record_exits = 1;
     /* one region per thread: classification is sequential, so this is how
      * a big box uses every core; a lone box (a strip uncovered by panning)
@@ -522,12 +685,12 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     p.status = calloc(p.window, sizeof *p.status);
     p.msgs = calloc(p.window, sizeof *p.msgs);
     p.ready = calloc(p.window, sizeof *p.ready);
-    if (!p.slot || !p.status || !p.msgs || !p.ready) {
-        free(p.slot);
-        free(p.status);
-        free(p.msgs);
-        free(p.ready);
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d regions", threads);
+    p.targets = calloc(p.window, sizeof *p.targets);
+    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets ||
+        plan_boxes(&p.pl, c, boxes, nboxes) != CM_OK) {
+        free_pipeline(&p);
+        free_plan(&p.pl, c);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u regions", nboxes);
     }
     if (stats)
         memset(stats, 0, sizeof *stats);
@@ -548,14 +711,11 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
         }
     }
     (void)team;
-    for (uint32_t k = 0; k < p.window; k++)
-        cm_region_free(&p.slot[k]);
+    free_pipeline(&p);
+    if (free_plan(&p.pl, c) != CM_OK && st == CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     c->upcoming = NULL;
     c->nupcoming = 0;
     cm_cluster_trim(c);
-    free(p.slot);
-    free(p.status);
-    free(p.msgs);
-    free(p.ready);
     return st;
 }

@@ -237,6 +237,81 @@ static void test_many_regions(void)
     cm_model_release(&m);
 }
 
+/* A joined callback that fails after `left` joins. */
+static cm_status stop_after(void *user, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                            char *msg, size_t msg_size)
+{
+    int *left = user;
+    (void)c, (void)box, (void)stats;
+    return --*left > 0 ? CM_OK : cm_fail(CM_EINVAL, msg, msg_size, "stopped on purpose");
+}
+
+/* cm_cluster_solve_boxes hands exits between its boxes over without the
+ * index of escapes: the cluster it makes equals joins one by one in the
+ * same order, byte for byte, on a cluster that already has a region (whose
+ * open nodes lead into the boxes), for grids of 64 and 256 regions in
+ * order and scattered; and a solve stopped half-way leaves the exits handed
+ * to the boxes it did not join where later joins find them. */
+static void test_solve_boxes_equals_joins(void)
+{
+    cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
+    const cm_lattice lat = {2, {0, -40}, {500.0 / 300, 80.0 / 240}};
+    const cm_box whole = {2, {0, 0}, {300, 240}};
+    const cm_scm_options opt = {1, 2, NULL, NULL, 1};
+    cm_region whole_r;
+    solve_whole(&m, &lat, &whole, 1, &whole_r);
+    static cm_box boxes[256], ordered[256];
+    char msg[256];
+    for (int64_t n = 8; n <= 16; n += 8) {
+        const uint32_t count = grid(&whole, n, boxes);
+        for (int o = 0; o < 2; o++) {
+            for (uint32_t k = 0; k < count; k++)
+                ordered[k] = boxes[o == 0 ? k : (k * 37 + 11) % count];
+            cm_region flat[3];
+            for (int way = 0; way < 3; way++) {
+                cm_cluster c;
+                cm_cluster_init(&c, &lat);
+                c.threads = 2;
+                for (uint32_t k = 0; k < count; k++) {
+                    /* the first region joins alone; the rest as the way says:
+                     * one solve_boxes, joins one by one, or a solve_boxes that
+                     * stops half-way followed by joins */
+                    if (k > 0 && way != 1) {
+                        int left = way == 0 ? INT32_MAX : (int)count / 2;
+                        const cm_status st = cm_cluster_solve_boxes(
+                            &c, &m, ordered + 1, count - 1, &opt, stop_after, &left, NULL, msg,
+                            sizeof msg);
+                        CHECK(way == 0 ? st == CM_OK : st == CM_EINVAL);
+                        k = c.nregions;
+                        if (k >= count)
+                            break;
+                    }
+                    cm_region r;
+                    CHECK(cm_region_alloc(&r, &ordered[k], msg, sizeof msg) == CM_OK);
+                    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+                    CHECK(cm_cluster_join(&c, &r, NULL, msg, sizeof msg) == CM_OK);
+                }
+                CHECK_INT(c.nregions, count);
+                CHECK(cm_cluster_flatten(&c, &whole, &flat[way], msg, sizeof msg) == CM_OK);
+                cm_cluster_free(&c);
+            }
+            char what[128];
+            snprintf(what, sizeof what, "solve_boxes, %u regions, order %d", count, o);
+            CHECK_INT(compare_regions(what, &whole_r, &flat[0]), 0);
+            for (int way = 1; way < 3; way++) {
+                CHECK_INT(flat[way].ngroups, flat[0].ngroups);
+                CHECK(memcmp(flat[0].group, flat[way].group, flat[0].ncells * 4) == 0);
+                CHECK(memcmp(flat[0].step, flat[way].step, flat[0].ncells * 4) == 0);
+                CHECK(memcmp(flat[0].image, flat[way].image, flat[0].ncells * 4) == 0);
+            }
+            for (int way = 0; way < 3; way++)
+                cm_region_free(&flat[way]);
+        }
+    }
+    cm_region_free(&whole_r);
+    cm_model_release(&m);
+}
+
 /* 200 pans of an explore session: a view 40 cells wide pans right 100
  * times, then back and 100 times left of where it began, each pan joining
  * the strip of 2 columns it uncovers; the cluster then equals the whole
@@ -576,6 +651,7 @@ int main(void)
     test_pd_maps();
     test_delay_and_3d();
     test_many_regions();
+    test_solve_boxes_equals_joins();
     test_pan_sequence();
     test_ids_stable();
     test_threads_identical();
