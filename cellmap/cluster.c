@@ -39,6 +39,7 @@ void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
 {
     memset(c, 0, sizeof *c);
     c->lat = *lat;
+    c->open_lists = 1;
 }
 
 int cm_cluster_threads(const cm_cluster *c)
@@ -65,6 +66,7 @@ void cm_cluster_free(cm_cluster *c)
     free(c->regions);
     cm_idmap_free(&c->open);
     free(c->node_blocks);
+    free(c->node_bases);
     free(c->chain);
     free(c->basin);
     free(c->basin_dirty);
@@ -129,6 +131,10 @@ static bool find_regions_meeting(const cm_cluster *c, const cm_box *box,
 static cm_status index_nodes(cm_cluster *c, uint32_t k)
 {
     const uint64_t base = c->regions[k].node_base, end = base + c->regions[k].r.nexits;
+    if (cm_grow((void **)&c->node_bases, &c->node_bases_cap, (uint64_t)k + 1,
+                sizeof *c->node_bases) != CM_OK)
+        return CM_ENOMEM;
+    c->node_bases[k] = (uint32_t)base;
     const uint64_t first = (base + NODE_BLOCK - 1) >> CM_NODE_BLOCK_BITS;
     const uint64_t last = end > 0 ? (end - 1) >> CM_NODE_BLOCK_BITS : 0;
     if (end == base || first > last)
@@ -358,6 +364,11 @@ cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, u
 {
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     const size_t dim = (size_t)c->lat.dim;
+    if (!c->open_lists) { /* the weight only */
+        if (cr->nodes)
+            set_weight(&cr->nodes[id - cr->node_base], w);
+        return cr->nodes || cm_idmap_put(&c->open, id, w) == CM_OK ? CM_OK : CM_ENOMEM;
+    }
     if (cr->nopen == cr->open_cap &&
         resize_open_list(c, cr, cr->open_cap ? 2 * cr->open_cap : 16) != CM_OK)
         return CM_ENOMEM;

@@ -130,6 +130,10 @@ typedef struct cm_cluster {
     uint32_t nregions;                /* read-only */
     uint32_t ngroups;                 /* read-only: cluster-wide group ids 1..ngroups */
     int threads;                      /* public: OpenMP threads; 0: the OpenMP default */
+    /* public: whether each region lists its open nodes with their exits'
+     * targets for an owner to save (cm_cluster_open_nodes); 1 after
+     * cm_cluster_init. A cluster no one saves sets 0 and spares the upkeep. */
+    int open_lists;
     uint64_t nnodes;                  /* read-only: nodes of all regions */
     uint64_t cells;                   /* read-only: cells of all regions */
     uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */
@@ -162,6 +166,8 @@ typedef struct cm_cluster {
     uint64_t evicted_since_trim; /* bytes evicted since the heap was last trimmed */
     uint32_t *node_blocks; /* the region of every 1024th node id */
     uint64_t node_blocks_cap;
+    uint32_t *node_bases; /* regions[k].node_base for every k, packed for cm_cluster_node_region */
+    uint64_t node_bases_cap;
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
@@ -253,7 +259,7 @@ void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
 static inline uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
 {
     uint32_t k = c->node_blocks[id >> CM_NODE_BLOCK_BITS];
-    while (k + 1 < c->nregions && c->regions[k + 1].node_base <= id)
+    while (k + 1 < c->nregions && c->node_bases[k + 1] <= id)
         k++;
     return k;
 }

@@ -338,12 +338,12 @@ static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
     return st;
 }
 
-/* Exit `id` leads into a box of the plan still to join: its join takes it. */
-static cm_status hand_over(joiner *j, const plan_target *t, uint32_t id, uint64_t weight)
+/* Exit `id` (to `cell`) leads into a box of the plan still to join: its
+ * join takes it. */
+static cm_status hand_over(joiner *j, const plan_target *t, uint32_t id, const int64_t *cell,
+                           uint64_t weight)
 {
     handover *h = &j->plan->in[t->box];
-    int64_t cell[CM_MAX_DIM];
-    cm_box_cell(&j->plan->boxes[t->box], t->cell, cell);
     if (cm_grow((void **)&h->v, &h->cap, h->n + 1, sizeof *h->v) != CM_OK)
         return CM_ENOMEM;
     h->v[h->n++] = (cm_escape){id, t->cell};
@@ -362,9 +362,9 @@ static cm_status place_exit(joiner *j, const cm_cluster_region *cr, uint64_t e, 
         jobs[(*n)++] = (link_job){id, j->plan->first + t->box, t->cell, 0, 0};
         return CM_OK;
     }
-    if (t && t->box != PLAN_NONE)
-        return hand_over(j, t, id, cr->nodes[e].tree);
     const int64_t *cell = cm_region_exit(&cr->r, e);
+    if (t && t->box != PLAN_NONE)
+        return hand_over(j, t, id, cell, cr->nodes[e].tree);
     uint64_t local;
     const int64_t k = cm_cluster_locate(c, cell, &local);
     if (k < 0)
