@@ -291,42 +291,20 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
     return v ? *v & ~INDEXED : 0;
 }
 
-/* Node id's record and its region. */
-static cm_status node_and_region(cm_cluster *c, uint32_t id, cm_node **nd, cm_cluster_region **cr)
+void cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t w)
 {
-    const uint32_t k = cm_cluster_node_region(c, id);
-    cm_node *table;
-    cm_status st = node_table(c, k, &table, NULL, 0);
-    if (st == CM_OK) {
-        *cr = &c->regions[k];
-        *nd = &table[id - (*cr)->node_base];
-    }
-    return st;
-}
-
-cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w)
-{
-    cm_node *nd;
-    cm_cluster_region *cr;
-    cm_status st = node_and_region(c, id, &nd, &cr);
-    if (st != CM_OK)
-        return st;
     set_weight(nd, weight_of(nd) + w);
-    cr->open_dirty = 1;
-    return CM_OK;
+    if (c->open_lists) /* its open record is to be saved again */
+        c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
 }
 
-cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w)
+cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t *w)
 {
-    cm_node *nd;
-    cm_cluster_region *cr;
-    cm_status st = node_and_region(c, id, &nd, &cr);
-    if (st != CM_OK)
-        return st;
     *w = weight_of(nd);
     set_weight(nd, 0);
     if (!(nd->target & INDEXED_FLAG))
         return CM_OK;
+    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     nd->target = 0;
     cr->open_dirty = 1;
     if (2 * ++cr->open_stale > cr->nopen)

@@ -264,14 +264,6 @@ static inline uint32_t cm_cluster_node_region(const cm_cluster *c, uint32_t id)
     return k;
 }
 
-/* Node id's record changed: its chunk is saved at the next commit. */
-static inline void cm_cluster_touch_node(cm_cluster *c, uint32_t id)
-{
-    cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
-    cr->nodes_dirty = 1;
-    cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
-}
-
 /* Node id's record into *out (its region's node table read back through
  * nodes_in if it was paged out). The pointer stays valid until the cluster
  * adds, restores or trims regions (joins and cm_cluster_acquire never evict
@@ -297,11 +289,11 @@ static inline cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **ou
 /* Open nodes and their weights: the cells whose sequences leave the
  * cluster through them (a new node starts with its own tree). The weight
  * of open node id (0 if it is not open); adds w to it; takes it out (no
- * longer open) with its weight into *w. Both mark the node's region
- * open_dirty. */
+ * longer open) with its weight into *w. nd is id's record
+ * (cm_cluster_node). Both mark the node's region open_dirty. */
 uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
-cm_status cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, uint64_t w);
-cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, uint64_t *w);
+void cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t w);
+cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t *w);
 
 /* Region k's open nodes now (those of its open list still open): their
  * exits, weights and target cells into new arrays (*n of them; the caller

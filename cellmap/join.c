@@ -55,25 +55,25 @@ typedef struct joiner {
     size_t msg_size;
 } joiner;
 
-/* Node id's record changed. */
+/* Node id's record changed: its chunk is saved at the next commit. */
 static void touch(joiner *j, uint32_t id)
 {
-    const uint32_t k = cm_cluster_node_region(j->c, id);
-    cm_cluster_touch_node(j->c, id);
+    cm_cluster *c = j->c;
+    const uint32_t k = cm_cluster_node_region(c, id);
+    cm_cluster_region *cr = &c->regions[k];
+    cr->nodes_dirty = 1;
+    cr->dirty_chunks[(id - cr->node_base) / CM_NODE_CHUNK] = 1;
     j->stats->affected_regions += !j->touched[k];
     j->touched[k] = 1;
 }
 
-/* The sequences through node id (open until now, the cells of weight
- * `weight`) take group g; its cell's step is s. */
-static cm_status finish(joiner *j, uint32_t id, uint32_t g, uint64_t s, uint64_t weight)
+/* The sequences through node id (record nd, open until now, the cells of
+ * weight `weight`) take group g; its cell's step is s. */
+static cm_status finish(joiner *j, uint32_t id, cm_node *nd, uint32_t g, uint64_t s,
+                        uint64_t weight)
 {
     if (s >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
-    cm_node *nd;
-    cm_status st = cm_cluster_node(j->c, id, &nd, j->msg, j->msg_size);
-    if (st != CM_OK)
-        return st;
     if (nd->next == CM_NODE_OPEN) { /* the exit lands on a cell whose outcome is final */
         nd->next = CM_NODE_FINAL;
         nd->dist = (uint32_t)s;
@@ -207,16 +207,16 @@ static cm_status close_cycle(joiner *j, uint32_t n, uint64_t weight)
 static cm_status link_node(joiner *j, const link_job *job)
 {
     cm_cluster *c = j->c;
-    cm_node *nd, *nm;
+    cm_node *nd, *nm, *end;
     uint64_t weight; /* first: the open record holds it */
-    cm_status st = cm_cluster_take_open(c, job->node, &weight);
+    cm_status st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
     if (st == CM_OK)
-        st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
+        st = cm_cluster_take_open(c, job->node, nd, &weight);
     if (st != CM_OK)
         return st;
     nd->target = job->cell;
     if (!cm_is_node_ref(job->group)) /* a cell whose group is final */
-        return finish(j, job->node, job->group, (uint64_t)job->step + 1, weight);
+        return finish(j, job->node, nd, job->group, (uint64_t)job->step + 1, weight);
     const uint32_t m = c->regions[job->region].node_base + (job->group & ~CM_NODE_REF);
     if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
         return st;
@@ -224,30 +224,26 @@ static cm_status link_node(joiner *j, const link_job *job)
         uint64_t s;
         const uint32_t g = nm->group;
         st = cm_cluster_into_cycle(c, m, job->cell, &s, j->msg, j->msg_size);
-        return st == CM_OK ? finish(j, job->node, g, s, weight) : st;
+        return st == CM_OK ? finish(j, job->node, nd, g, s, weight) : st;
     }
     uint32_t g, s, open;
-    st = cm_cluster_resolve(c, m, &g, &s, &open, j->msg, j->msg_size);
-    if (st == CM_OK)
-        st = cm_cluster_node(c, job->node, &nd, j->msg, j->msg_size);
-    if (st != CM_OK)
+    if ((st = cm_cluster_resolve(c, m, &g, &s, &open, j->msg, j->msg_size)) != CM_OK)
         return st;
     nd->next = m;
     nd->dist = job->step; /* 1 to the target, then its depth in m's tree */
     if (open == CM_NODE_OPEN)
-        return finish(j, job->node, g, (uint64_t)job->step + s, weight);
+        return finish(j, job->node, nd, g, (uint64_t)job->step + s, weight);
     if (open == job->node)
         return close_cycle(j, job->node, weight);
     if ((uint64_t)job->step + s - 1 >= CM_STEP_ON_PATH)
         return cm_fail(CM_ETOOBIG, j->msg, j->msg_size, "a step number overflows");
-    if (cm_cluster_add_open_weight(c, open, weight) != CM_OK) /* its cells leave through it */
-        return cm_fail(CM_ENOMEM, j->msg, j->msg_size, "out of memory for the open nodes");
+    if ((st = cm_cluster_node(c, open, &end, j->msg, j->msg_size)) != CM_OK)
+        return st;
+    cm_cluster_add_open_weight(c, open, end, weight); /* its cells leave through it */
     nd->up = open;
     nd->up_dist = job->step + s - 1; /* s counts the open node's own step */
     /* m's sequences still leave the cluster: if m turns out to be on a
      * straddling cycle, this node is settled through m's tree */
-    if ((st = cm_cluster_node(c, m, &nm, j->msg, j->msg_size)) != CM_OK)
-        return st;
     nd->sibling = nm->first_in;
     nm->first_in = job->node;
     touch(j, m);
