@@ -977,27 +977,43 @@ static cm_status index_region(cm_cluster *c, uint32_t k)
     return CM_OK;
 }
 
-/* Region k's node table: its nodes as saved (next, dist, group, target,
- * tree), or open with empty trees. */
-static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved)
+/* Region k's node table from its nodes as saved (next, dist, group,
+ * target, tree), or the nodes of a new region (cm_region_nodes). */
+static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved,
+                            cm_node *fresh)
 {
     const uint64_t n = cr->r.nexits;
+    if (fresh) {
+        cr->nodes = fresh;
+        memset(cr->dirty_chunks, 1, n / CM_NODE_CHUNK + 1); /* every chunk is to be saved */
+        c->nnodes += n;
+        return CM_OK;
+    }
     cr->nodes = calloc(n + 1, sizeof *cr->nodes);
     if (!cr->nodes)
         return CM_ENOMEM;
-    if (!saved) /* a new region: every chunk is to be saved */
-        memset(cr->dirty_chunks, 1, n / CM_NODE_CHUNK + 1);
     for (uint64_t e = 0; e < n; e++) {
-        cm_node *nd = &cr->nodes[e];
-        if (saved) {
-            *nd = saved[e];
-            start_resolution(nd);
-        } else {
-            nd->next = nd->up = CM_NODE_OPEN;
-            nd->first_in = nd->sibling = CM_NODE_OPEN;
-        }
+        cr->nodes[e] = saved[e];
+        start_resolution(&cr->nodes[e]);
     }
     c->nnodes += n;
+    return CM_OK;
+}
+
+cm_status cm_region_nodes(const cm_region *r, cm_node **out)
+{
+    cm_node *nodes = calloc(r->nexits + 1, sizeof *nodes);
+    if (!nodes)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < r->nexits; e++)
+        nodes[e] = (cm_node){.next = CM_NODE_OPEN, .up = CM_NODE_OPEN, .first_in = CM_NODE_OPEN,
+                             .sibling = CM_NODE_OPEN};
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (cm_is_node_ref(r->group[i]))
+            nodes[r->group[i] & ~CM_NODE_REF].tree++;
+    for (uint64_t e = 0; e < r->nexits; e++)
+        set_weight(&nodes[e], nodes[e].tree); /* open: its own tree leaves */
+    *out = nodes;
     return CM_OK;
 }
 
@@ -1019,51 +1035,61 @@ cm_status cm_cluster_note_periodic(cm_cluster *c, uint32_t g, uint32_t k, uint64
 }
 
 /* The new region's own groups take ids from base + 1: one pass that also
- * counts the cells of each group and of each node's tree and notes the
- * periodic cells. */
-static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base, cm_node *nodes)
+ * counts the cells of each group and notes the periodic cells. */
+static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base)
 {
     uint32_t *group = r->group;
     const uint32_t *step = r->step;
     uint64_t *basin = c->basin;
     for (uint64_t i = 0; i < r->ncells; i++) {
         const uint32_t g = group[i];
-        if (cm_is_node_ref(g)) {
-            nodes[g & ~CM_NODE_REF].tree++;
-        } else if (g != 0) {
+        if (g != 0 && !cm_is_node_ref(g)) {
             group[i] = g + base;
             basin[g + base]++;
             if (step[i] == 0 && note_periodic(c, g + base, &r->box, i) != CM_OK)
                 return CM_ENOMEM;
         }
     }
-    for (uint64_t e = 0; e < r->nexits; e++)
-        set_weight(&nodes[e], nodes[e].tree); /* open: its own tree leaves */
     for (uint32_t g = 1; g <= r->ngroups; g++)
         c->basin_dirty[base + g] = 1;
     return CM_OK;
 }
 
-cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t msg_size)
+cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, cm_node *nodes, char *msg,
+                                size_t msg_size)
 {
-    if (!r->exits_recorded)
+    if (!r->exits_recorded) {
+        free(nodes);
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the region was solved without record_exits; its exits cannot be "
                        "followed into the cluster");
+    }
     cm_status st = check_region(c, &r->box, r->nexits, r->ngroups, msg, msg_size);
     if (st == CM_OK && make_space(c, &r->box, r->ngroups) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region");
-    if (st != CM_OK)
+    if (st == CM_OK && !nodes && cm_region_nodes(r, &nodes) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
+    if (st != CM_OK) {
+        free(nodes);
         return st;
+    }
     const uint32_t k = c->nregions, base = c->ngroups;
     cm_cluster_region *cr = &c->regions[k];
     memset(cr, 0, sizeof *cr);
     cr->node_base = (uint32_t)c->nnodes;
     cr->r.nexits = r->nexits;
     cr->dirty_chunks = calloc(r->nexits / CM_NODE_CHUNK + 1, 1);
-    if (!cr->dirty_chunks || init_nodes(c, cr, NULL) != CM_OK ||
-        take_cells(c, r, base, cr->nodes) != CM_OK)
+    if (!cr->dirty_chunks) {
+        free(nodes);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
+    }
+    init_nodes(c, cr, NULL, nodes);
+    if (take_cells(c, r, base) != CM_OK) {
+        free(cr->nodes);
+        free(cr->dirty_chunks);
+        c->nnodes -= r->nexits;
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the periodic cells");
+    }
     cr->r = *r;
     memset(r, 0, sizeof *r);
     cr->nodes_dirty = 1;
@@ -1099,7 +1125,7 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     if (!nodes)
         c->nnodes += record->nexits; /* the table stays in the file until it is used */
-    else if (init_nodes(c, cr, nodes) != CM_OK)
+    else if (init_nodes(c, cr, nodes, NULL) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     c->cells += record->ncells;
     return index_region(c, k) == CM_OK && index_nodes(c, k) == CM_OK

@@ -188,12 +188,20 @@ void cm_cluster_free(cm_cluster *c);
 /* Threads a join or reader uses: c->threads, or the OpenMP default. */
 int cm_cluster_threads(const cm_cluster *c);
 
+/* The node table of a region solved with record_exits, before it joins a
+ * cluster: every node open, weighing its tree (r->nexits + 1 records, the
+ * caller's to free or hand to cm_cluster_add_region). Reads r only, so
+ * another thread can make it while the cluster joins. */
+cm_status cm_region_nodes(const cm_region *r, cm_node **out);
+
 /* Adds region r (solved with record_exits on the cluster's lattice; the
  * cluster takes its arrays, r is zeroed) without linking anything: its own
  * groups take the next ids, its nodes are open, its periodic cells are
- * noted as new. CM_EINVAL if it overlaps a region. The join module
- * (cellmap/join.h) then links. */
-cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, char *msg, size_t msg_size);
+ * noted as new. nodes: its node table from cm_region_nodes, which the
+ * cluster takes in any case, or NULL: made here. CM_EINVAL if it overlaps a
+ * region. The join module (cellmap/join.h) then links. */
+cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, cm_node *nodes, char *msg,
+                                size_t msg_size);
 
 /* Restores a region saved by an owner, paged out: its record (box, ncells,
  * nexits, ngroups) and its nodes' saved fields (next, dist, group, target,

@@ -426,17 +426,17 @@ static cm_status link_all(joiner *j)
     return st;
 }
 
-/* Joins region r, box `box` of the plan p (NULL: a join on its own, box
- * and targets unused). */
-static cm_status join_region(cm_cluster *c, cm_region *r, const plan *p, uint32_t box,
-                             const plan_target *targets, cm_join_stats *stats, char *msg,
-                             size_t msg_size)
+/* Joins region r (its node table `nodes`, or NULL: made here), box `box`
+ * of the plan p (NULL: a join on its own, box and targets unused). */
+static cm_status join_region(cm_cluster *c, cm_region *r, cm_node *nodes, const plan *p,
+                             uint32_t box, const plan_target *targets, cm_join_stats *stats,
+                             char *msg, size_t msg_size)
 {
     cm_join_stats local_stats;
     if (!stats)
         stats = &local_stats;
     memset(stats, 0, sizeof *stats);
-    cm_status st = cm_cluster_add_region(c, r, msg, msg_size);
+    cm_status st = cm_cluster_add_region(c, r, nodes, msg, msg_size);
     if (st != CM_OK)
         return st;
     const uint32_t added = c->nregions - 1;
@@ -462,7 +462,7 @@ static cm_status join_region(cm_cluster *c, cm_region *r, const plan *p, uint32_
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
                           size_t msg_size)
 {
-    return join_region(c, r, NULL, 0, NULL, stats, msg, msg_size);
+    return join_region(c, r, NULL, NULL, 0, NULL, stats, msg, msg_size);
 }
 
 static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
@@ -510,6 +510,7 @@ typedef struct pipeline {
     atomic_int stop;    /* a join failed: no more claims */
     plan pl;            /* pl.index NULL: the joins go without it */
     plan_target **targets; /* per slot: where its region's exits lead */
+    cm_node **nodes;       /* per slot: its region's node table */
 } pipeline;
 
 /* Where region r's exits lead among the boxes of the plan (on the thread
@@ -550,10 +551,12 @@ static bool solve_next(pipeline *p)
     if (p->status[s] == CM_OK)
         p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
                                     sizeof p->msgs[s]);
-    if (p->status[s] == CM_OK && p->pl.index &&
-        locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)
+    /* what the join needs of the region alone is made here, off the joining thread */
+    if (p->status[s] == CM_OK &&
+        (cm_region_nodes(&p->slot[s], &p->nodes[s]) != CM_OK ||
+         (p->pl.index && locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)))
         p->status[s] = cm_fail(CM_ENOMEM, p->msgs[s], sizeof p->msgs[s],
-                               "out of memory for its exits");
+                               "out of memory for its nodes");
     atomic_store(&p->ready[s], b + 1);
     return true;
 }
@@ -587,9 +590,11 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         c->nupcoming = p->nboxes - b;
         pin_expected(c, next, 1);
         cm_join_stats one_join;
-        if (st == CM_OK)
-            st = join_region(c, &p->slot[s], p->pl.index ? &p->pl : NULL, b, p->targets[s],
-                             &one_join, msg, msg_size);
+        if (st == CM_OK) {
+            st = join_region(c, &p->slot[s], p->nodes[s], p->pl.index ? &p->pl : NULL, b,
+                             p->targets[s], &one_join, msg, msg_size);
+            p->nodes[s] = NULL; /* the cluster took it */
+        }
         pin_expected(c, next, 0);
         c->upcoming++;
         c->nupcoming--;
@@ -655,6 +660,9 @@ static void free_pipeline(pipeline *p)
         cm_region_free(&p->slot[k]);
     for (uint32_t k = 0; p->targets && k < p->window; k++)
         free(p->targets[k]);
+    for (uint32_t k = 0; p->nodes && k < p->window; k++)
+        free(p->nodes[k]);
+    free(p->nodes);
     free(p->slot);
     free(p->status);
     free(p->msgs);
@@ -671,7 +679,7 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
     pipeline p = {c, model, boxes, nboxes, 2 * (uint32_t)threads, opt ? *opt : (cm_scm_options){0},
-                  NULL, NULL, NULL, 0, 0, NULL, 0, {0}, NULL};
+                  NULL, NULL, NULL, 0, 0, NULL, 0, {0}, NULL, NULL};
     p.one.record_exits = 1;
     /* one region per thread: classification is sequential, so this is how
      * a big box uses every core; a lone box (a strip uncovered by panning)
@@ -682,7 +690,8 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     p.msgs = calloc(p.window, sizeof *p.msgs);
     p.ready = calloc(p.window, sizeof *p.ready);
     p.targets = calloc(p.window, sizeof *p.targets);
-    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets ||
+    p.nodes = calloc(p.window, sizeof *p.nodes);
+    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets || !p.nodes ||
         plan_boxes(&p.pl, c, boxes, nboxes) != CM_OK) {
         free_pipeline(&p);
         free_plan(&p.pl, c);
