@@ -2,8 +2,9 @@
 /* bench_split: what splitting a solve into regions costs, from the command
  * line (issue: joins in O(boundary)). For each configuration, `cellmap
  * solve --cells 4000x2000` (8 M cells, 2 threads) runs whole and with
- * --split 2x1, 4x4 and 16x16; the program prints the median wall time of
- * REPS runs and the largest peak RSS, and their ratios to the whole solve.
+ * --split 2x1, 4x4 and 16x16, in turns; the program prints the median wall
+ * time of REPS runs, the median of its ratios to the whole solve of the
+ * same turn, the largest peak RSS and its ratio to the whole solve's.
  * usage: bench_split PATH/TO/cellmap [REPS]   (REPS default 3) */
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,25 +81,25 @@ int main(int argc, char **argv)
     printf("%-6s %-6s %10s %8s %10s %8s\n", "config", "split", "wall_s", "x_whole", "rss_MiB",
            "x_whole");
     for (int c = 0; c < 4; c++) {
-        double whole_wall = 0, whole_rss = 0;
-        for (int s = 0; s < 4; s++) {
-            double walls[50], rss = 0;
-            for (int r = 0; r < reps; r++) {
+        /* the splits take turns within each repetition, and a split's time
+         * ratio is the median of its ratios to the whole solve of the same
+         * repetition: load that drifts on a shared machine cancels out */
+        double walls[4][50], ratios[4][50], rss[4] = {0};
+        for (int r = 0; r < reps; r++)
+            for (int s = 0; s < 4; s++) {
                 double one_rss;
-                if (run(argv[1], c, s, &walls[r], &one_rss) != 0) {
+                if (run(argv[1], c, s, &walls[s][r], &one_rss) != 0) {
                     fprintf(stderr, "bench_split: %s %s failed\n", configs[c][0],
                             splits[s] ? splits[s] : "whole");
                     return 1;
                 }
-                rss = one_rss > rss ? one_rss : rss;
+                rss[s] = one_rss > rss[s] ? one_rss : rss[s];
+                ratios[s][r] = walls[s][r] / walls[0][r];
             }
-            const double wall = median(walls, reps);
-            if (s == 0) {
-                whole_wall = wall;
-                whole_rss = rss;
-            }
+        for (int s = 0; s < 4; s++) {
             printf("%-6s %-6s %10.3f %8.2f %10.1f %8.2f\n", configs[c][0],
-                   splits[s] ? splits[s] : "whole", wall, wall / whole_wall, rss, rss / whole_rss);
+                   splits[s] ? splits[s] : "whole", median(walls[s], reps),
+                   median(ratios[s], reps), rss[s], rss[s] / rss[0]);
             fflush(stdout);
         }
     }
