@@ -39,7 +39,7 @@ void cm_cluster_init(cm_cluster *c, const cm_lattice *lat)
 {
     memset(c, 0, sizeof *c);
     c->lat = *lat;
-    c->open_lists = 1;
+    c->keep_exits = 1;
 }
 
 int cm_cluster_threads(const cm_cluster *c)
@@ -294,7 +294,7 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
 void cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t w)
 {
     set_weight(nd, weight_of(nd) + w);
-    if (c->open_lists) /* its open record is to be saved again */
+    if (c->keep_exits) /* its open record is to be saved again */
         c->regions[cm_cluster_node_region(c, id)].open_dirty = 1;
 }
 
@@ -342,7 +342,7 @@ cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, u
 {
     cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     const size_t dim = (size_t)c->lat.dim;
-    if (!c->open_lists) { /* the weight only */
+    if (!c->keep_exits) { /* the weight only */
         if (cr->nodes)
             set_weight(&cr->nodes[id - cr->node_base], w);
         return cr->nodes || cm_idmap_put(&c->open, id, w) == CM_OK ? CM_OK : CM_ENOMEM;
@@ -1262,8 +1262,10 @@ static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
     const int64_t e = cm_image_exit_index(v);
     if (v < r->ncells)
         cm_box_cell(&r->box, v, cell);
-    else if (e >= 0)
+    else if (e >= 0 && r->exit_target)
         memcpy(cell, cm_region_exit(r, (uint64_t)e), (size_t)box->dim * sizeof *cell);
+    else if (e >= 0)
+        return CM_IMAGE_EXIT; /* a cluster that kept no exit table (keep_exits 0) */
     else
         return CM_IMAGE_SINK;
     return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;

@@ -130,10 +130,13 @@ typedef struct cm_cluster {
     uint32_t nregions;                /* read-only */
     uint32_t ngroups;                 /* read-only: cluster-wide group ids 1..ngroups */
     int threads;                      /* public: OpenMP threads; 0: the OpenMP default */
-    /* public: whether each region lists its open nodes with their exits'
-     * targets for an owner to save (cm_cluster_open_nodes); 1 after
-     * cm_cluster_init. A cluster no one saves sets 0 and spares the upkeep. */
-    int open_lists;
+    /* public: 1 after cm_cluster_init: each region keeps its exit table
+     * and lists its open nodes with their targets, for an owner to save
+     * (cm_cluster_open_nodes) and for the images of cm_cluster_flatten. A
+     * cluster that no one saves and whose images no one reads (solve
+     * without a database) sets 0: a joined region then drops its exit
+     * table (16 bytes per exit in 2-D) and open lists are not kept. */
+    int keep_exits;
     uint64_t nnodes;                  /* read-only: nodes of all regions */
     uint64_t cells;                   /* read-only: cells of all regions */
     uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */

@@ -452,6 +452,10 @@ static cm_status join_region(cm_cluster *c, cm_region *r, cm_node *nodes, const 
     }
     free(j.touched);
     free(j.stack);
+    if (st == CM_OK && !c->keep_exits) { /* linked or indexed: the targets are not read again */
+        free(c->regions[added].r.exit_target);
+        c->regions[added].r.exit_target = NULL;
+    }
     stats->new_groups += stats->straddling_groups;
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "joining region %u: %s", added,

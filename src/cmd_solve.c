@@ -482,7 +482,7 @@ static cm_status solve_cluster(const solve_args *a, const project_plan *plan, co
         st = open_store(a, command, m, lat, plan_text, rn, msg, msg_size);
     else
         cm_cluster_init(&rn->c, lat);
-    rn->c.open_lists = a->db != NULL; /* only a database saves them */
+    rn->c.keep_exits = a->db != NULL; /* only a database saves them; no image is read */
     rn->c.threads = a->threads;
     rn->c.mem_budget = a->mem;
     *t = (timing){"regions and joins", "summary", 0, 0};
