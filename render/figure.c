@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "render/axes.h"
+#include "render/gl_loader.h"
 #include "render/palette.h"
 #include "render/text.h"
 
@@ -312,6 +313,8 @@ cm_status cm_render_check(const cm_render_options *opt, int dim, char *msg, size
     cm_render_options o = *opt;
     o.layers = o.layers ? o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
     cm_status st = check_options(&o, msg, msg_size);
+    if (st == CM_OK) /* a missing OSMesa stops the command before its work */
+        st = cm_gl_load(msg, msg_size);
     if (st != CM_OK || !has_text(o.layers))
         return st;
     layout L;

@@ -48,7 +48,8 @@ typedef struct cm_render_info {
 /* Checks, before anything is computed, that an image of these options can
  * be drawn (size, font, and room for the plot beside the text layers of a
  * view of o->lo..o->hi in a model of dimension dim); cm_render_figure may
- * still find a legend too wide for it. */
+ * still find a legend too wide for it. Loads OSMesa (render/gl_loader.h),
+ * so that a missing library stops a command before its work. */
 cm_status cm_render_check(const cm_render_options *o, int dim, char *msg, size_t msg_size);
 
 cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,

@@ -393,7 +393,7 @@ int cmd_bifurcation(int argc, char **argv)
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
     if (!outfile_check("bifurcation", a.csv) || !outfile_check("bifurcation", a.runs_csv) ||
-        !outfile_check("bifurcation", a.png))
+        !chart_png_check("bifurcation", a.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr = fo_sweep_check(&c, &a.mo, &a.sweep, 1, &base);

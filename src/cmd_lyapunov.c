@@ -159,7 +159,7 @@ int cmd_lyapunov(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("lyapunov", a.csv) || !outfile_check("lyapunov", a.png))
+    if (!outfile_check("lyapunov", a.csv) || !chart_png_check("lyapunov", a.png))
         return EXIT_FAIL;
     /* the parameters without the grid's; S0 >= S is checked per point */
     cm_params base;

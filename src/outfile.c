@@ -5,6 +5,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "render/gl_loader.h"
+
 bool outfile_check(const char *cmd, const char *path)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];
@@ -16,6 +18,18 @@ bool outfile_check(const char *cmd, const char *path)
     if (st != CM_OK)
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
     return st == CM_OK;
+}
+
+bool chart_png_check(const char *cmd, const char *path)
+{
+    char msg[1024];
+    if (!outfile_check(cmd, path))
+        return false;
+    if (path && cm_gl_load(msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+        return false;
+    }
+    return true;
 }
 
 bool outfile_open(const char *cmd, const char *path, outfile *o)

@@ -21,6 +21,10 @@ typedef struct outfile {
  * directory, or a device where a database must go, is refused at once.
  * Prints "cellmap CMD: ..." and returns false then. */
 bool outfile_check(const char *cmd, const char *path);
+/* The same for a chart PNG, which also needs OSMesa: loaded now
+ * (render/gl_loader.h), so that a missing library stops the command
+ * before its work. */
+bool chart_png_check(const char *cmd, const char *path);
 /* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
 bool outfile_open(const char *cmd, const char *path, outfile *o);
 /* Closes and renames it when ok (and every write succeeded), else removes
