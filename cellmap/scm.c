@@ -167,6 +167,9 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
 
 /* The image loop: rows are independent and every image depends on its cell
  * alone, so the result is the same whatever the schedule or thread count. */
+/* Regions below this many cells compute their images on one thread. */
+#define PARALLEL_CELLS 1024
+
 static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, int max_steps,
                                 int threads, bool record_exits, cm_region *r, char *msg,
                                 size_t msg_size)
@@ -183,7 +186,8 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
     int aborted = 0;
     if (st == CM_OK) {
-#pragma omp parallel num_threads(threads) reduction(| : aborted)
+    /* a few cells are quicker on one thread than waking others */
+#pragma omp parallel num_threads(threads) reduction(| : aborted) if (r->ncells >= PARALLEL_CELLS)
     {
         int t = 0;
 #ifdef _OPENMP

@@ -530,6 +530,24 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
     return store_new(path, db, writable, out, msg, msg_size);
 }
 
+cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size)
+{
+    if (s->writable || s->in_transaction)
+        return CM_OK; /* a writer's transactions are its commits */
+    if (store_exec(s->db, "BEGIN") != SQLITE_OK)
+        return store_db_error(s->db, "read", msg, msg_size);
+    s->in_transaction = 1;
+    return CM_OK;
+}
+
+void cm_store_snapshot_end(cm_store *s)
+{
+    if (!s || s->writable || !s->in_transaction)
+        return;
+    store_exec(s->db, "COMMIT"); /* nothing was written: it cannot fail to apply */
+    s->in_transaction = 0;
+}
+
 /* Leaves WAL mode (one self-contained file again) and closes; frees s
  * but for its paths. */
 static cm_status close_db(cm_store *s, char *msg, size_t msg_size)

@@ -100,6 +100,13 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size);
 
+/* A read-only store reads one snapshot from cm_store_snapshot_begin to
+ * cm_store_snapshot_end: its statements share one lock of the file, where
+ * each would otherwise take and drop it and look for a journal. Keep
+ * snapshots short: in rollback mode they hold a writer off. */
+cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size);
+void cm_store_snapshot_end(cm_store *s);
+
 /* Closes and frees (NULL-safe). A writable store returns to rollback mode.
  * A new cluster that was to replace an older file is discarded. */
 cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size);

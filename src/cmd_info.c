@@ -123,8 +123,10 @@ int cmd_info(int argc, char **argv)
     int rc = EXIT_FAIL;
     if (!g)
         snprintf(msg, sizeof msg, "out of memory for %u groups", info.groups);
-    else if (cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK)
+    else if (cm_store_snapshot_begin(s, msg, sizeof msg) == CM_OK &&
+             cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK)
         rc = EXIT_OK;
+    cm_store_snapshot_end(s);
     if (rc == EXIT_OK) {
         cm_box bounds;
         cm_cluster_bounds(&cl, &bounds);

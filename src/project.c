@@ -17,9 +17,12 @@ int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm
     cm_cluster_init(c, &(cm_lattice){1, {0}, {1}});
     cm_status st = cm_store_open(path, 0, s, msg, sizeof msg);
     if (st == CM_OK)
+        st = cm_store_snapshot_begin(*s, msg, sizeof msg);
+    if (st == CM_OK)
         st = cm_store_read_info(*s, info, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_store_load_cluster(*s, c, msg, sizeof msg);
+    cm_store_snapshot_end(*s);
     if (st == CM_OK && c->nregions == 0)
         st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
     if (st != CM_OK) {

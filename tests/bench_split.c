@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#define CM_BENCH_RUN_COMMAND
 #include "bench_util.h"
 
 static const char *const configs[][3] = {
@@ -48,23 +49,7 @@ static int run(const char *cm, int c, int s, double *wall, double *rss_mib)
         argv[n++] = splits[s];
     }
     argv[n] = NULL;
-    fflush(stdout); /* the child must not inherit unwritten lines */
-    const double t0 = now();
-    const pid_t pid = fork();
-    if (pid == 0) {
-        if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))
-            _exit(127);
-        execv(cm, (char *const *)argv);
-        _exit(127);
-    }
-    int status = 0;
-    struct rusage ru;
-    if (pid < 0 || wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) ||
-        WEXITSTATUS(status) != 0)
-        return -1;
-    *wall = now() - t0;
-    *rss_mib = (double)ru.ru_maxrss / 1024.0;
-    return 0;
+    return run_command(argv, wall, rss_mib);
 }
 
 int main(int argc, char **argv)
