@@ -1,3 +1,4 @@
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -395,8 +396,63 @@ static void test_region_check(void)
     cm_region_free(&r);
 }
 
+/* ---- today's results, as digests ------------------------------------------ */
+
+static uint64_t digest_u32(uint64_t h, const uint32_t *v, uint64_t n)
+{
+    for (uint64_t i = 0; i < n; i++)
+        h = mix(h ^ v[i]);
+    return h;
+}
+
+/* The images, groups, steps and exit targets of the configurations of the
+ * speed issue's table (on 1000 x 500 cells), with 1 and 2 threads, equal
+ * the digests of the results the engine gave before its image loop was
+ * made faster: a faster loop must give the same cells, bit for bit. */
+static void test_digests(void)
+{
+    static const struct {
+        const char *params, *region;
+        int max_steps;
+        uint64_t digest;
+    } configs[] = {
+        {"alpha=0.078,beta=0,P=0.007,D=0.02", "0:500,-40:40", 1, UINT64_C(0xe077f93dba3929d1)},
+        {"alpha=0.07,beta=0,P=0.007,D=0.02", "85.4:485.4,-12.5:12.5", 20, UINT64_C(0x3e2895765ceb84db)},
+        {"alpha=0.078,beta=0,P=0.007,D=0.02", "-50:1050,-12.5:12.5", 1, UINT64_C(0xe5fed8ab2821e227)},
+        {"alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3", "-125000:125000,-600:600", 100000, UINT64_C(0x5645f63dd76dff71)},
+    };
+    for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
+        double lo[2], hi[2];
+        CHECK(sscanf(configs[k].region, "%lf:%lf,%lf:%lf", &lo[0], &hi[0], &lo[1], &hi[1]) == 4);
+        cm_model m;
+        char msg[256];
+        const char *texts[1] = {configs[k].params};
+        CHECK(cm_model_create("microchaos-pd", texts, 1, &m, msg, sizeof msg) == CM_OK);
+        const cm_lattice lat = {2, {lo[0], lo[1]}, {(hi[0] - lo[0]) / 1000, (hi[1] - lo[1]) / 500}};
+        const cm_box box = {2, {0, 0}, {1000, 500}};
+        for (int threads = 1; threads <= 2; threads++) {
+            cm_region r;
+            const cm_scm_options opt = {configs[k].max_steps, threads, NULL, NULL, 1};
+            CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
+            CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+            uint64_t h = digest_u32(1, r.image, r.ncells);
+            h = digest_u32(h, r.group, r.ncells);
+            h = digest_u32(h, r.step, r.ncells);
+            for (uint64_t e = 0; e < 2 * r.nexits; e++)
+                h = mix(h ^ (uint64_t)r.exit_target[e]);
+            if (h != configs[k].digest)
+                fprintf(stderr, "digest of %s on %s: 0x%016llx\n", configs[k].params,
+                        configs[k].region, (unsigned long long)h);
+            CHECK(h == configs[k].digest);
+            cm_region_free(&r);
+        }
+        cm_model_release(&m);
+    }
+}
+
 int main(void)
 {
+    test_digests();
     test_region_check();
     test_contraction();
     test_rotation(1);
