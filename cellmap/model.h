@@ -66,6 +66,12 @@ typedef struct cm_model {
     void *ctx;        /* derived coefficients; owned by the model */
     /* 0: image in y; >0: no image (the sink); <0: abort the run. */
     int (*step)(const struct cm_model *m, const double *x, double *y);
+    /* Optional: step for n points at once, in arrays by coordinate (point
+     * i is x[0][i], x[1][i], ...; its image goes to y[d][i], its status to
+     * rc[i]), so that a loop the compiler vectorises does the work. Gives,
+     * point by point and bit for bit, what step gives. Pure, like step(). */
+    void (*step_n)(const struct cm_model *m, size_t n, const double *const *x, double *const *y,
+                   int *rc);
     /* Optional. Fixed points for levels m0..m1 into out (cap entries);
      * *count receives how many were written. Returns 0, or -1 when the model
      * has no enumerable fixed points (a message then goes to msg). */

@@ -128,6 +128,145 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
     return 0;
 }
 
+/* Cells a batch of images takes (models with step_n). */
+#define BATCH 256
+
+/* floor(u) for |u| < 2^51 in double arithmetic (vectorisable): adding and
+ * taking away 1.5 * 2^52 rounds to an integer, and stepping down where that
+ * went up gives the floor, as cm_lattice_cell's truncation does. */
+static inline double floor_exact(double u)
+{
+    const double magic = 0x1.8p52;
+    const double t = (u + magic) - magic;
+    return t - (t > u ? 1.0 : 0.0);
+}
+
+/* Whether coordinate d of the images (at) lies in the box (lo..hi) and
+ * equals the cell's own (here, plus i along the row: step 1 in dimension
+ * 0), and the local index so far (dimensions from the last down). */
+static void place_coordinate(const double *restrict at, double lo, double hi, double here,
+                             double step, int n, double *restrict in_box,
+                             double *restrict stays, double *restrict local)
+{
+    const double side = hi - lo;
+    for (int i = 0; i < n; i++) { /* an int: SSE2 converts no 64-bit integer to double */
+        const double f = at[i];
+        in_box[i] *= (f >= lo) & (f < hi) ? 1.0 : 0.0;
+        stays[i] *= f == here + step * (double)i ? 1.0 : 0.0;
+        local[i] = local[i] * side + (f - lo);
+    }
+}
+
+/* A batch of images in arrays: the steps of cells first .. first + n - 1
+ * of a row (step_n), where each lands as a lattice cell (floored doubles),
+ * whether it is in the world, and, when inside the box, its local index
+ * (exact in doubles: a box has fewer than 2^53 cells). */
+typedef struct batch {
+    double x[CM_MAX_DIM][BATCH], y[CM_MAX_DIM][BATCH], at[CM_MAX_DIM][BATCH];
+    /* 1 or 0 (doubles, so that the loops vectorise): every coordinate in
+     * the world, in the box, equal to the cell's own */
+    double world[BATCH], in_box[BATCH], stays[BATCH];
+    double local[BATCH];
+    int rc[BATCH];
+} batch;
+
+/* Lattice coordinate d of the images, floored (vectorised: locals and
+ * restrict keep the loop free of reloads). */
+static void floor_coordinates(const double *restrict y, double origin, double width, size_t n,
+                              double *restrict at, double *restrict world)
+{
+    const double limit = (double)CM_WORLD_LIMIT;
+    for (size_t i = 0; i < n; i++) {
+        const double u = (y[i] - origin) / width;
+        const double inside = (u >= -limit) & (u < limit) ? 1.0 : 0.0; /* 0 for NaN */
+        at[i] = floor_exact(inside != 0.0 ? u : 0.0);
+        world[i] *= inside;
+    }
+}
+
+static void step_batch(const cm_model *model, const cm_lattice *lat, const cm_box *box,
+                       const int64_t *from, size_t n, batch *b)
+{
+    const int dim = lat->dim;
+    const double *xs[CM_MAX_DIM];
+    double *ys[CM_MAX_DIM];
+    double centre[CM_MAX_DIM];
+    cm_lattice_centre(lat, from, centre);
+    for (int d = 0; d < dim; d++) {
+        xs[d] = b->x[d];
+        ys[d] = b->y[d];
+    }
+    /* centres as cm_lattice_centre computes them: (double)cell is exact */
+    const double first = (double)from[0];
+    for (size_t i = 0; i < n; i++)
+        b->x[0][i] = lat->origin[0] + ((first + (double)i) + 0.5) * lat->width[0];
+    for (int d = 1; d < dim; d++)
+        for (size_t i = 0; i < n; i++)
+            b->x[d][i] = centre[d];
+    model->step_n(model, n, xs, ys, b->rc);
+    for (size_t i = 0; i < n; i++) {
+        b->world[i] = b->rc[i] == 0 ? 1.0 : 0.0;
+        b->in_box[i] = 1.0;
+        b->stays[i] = 1.0;
+        b->local[i] = 0.0;
+    }
+    for (int d = 0; d < dim; d++)
+        floor_coordinates(b->y[d], lat->origin[d], lat->width[d], n, b->at[d], b->world);
+    for (int d = dim - 1; d >= 0; d--)
+        place_coordinate(b->at[d], (double)box->lo[d], (double)box->hi[d], (double)from[d],
+                         d == 0 ? 1.0 : 0.0, (int)n, b->in_box, b->stays, b->local);
+}
+
+/* Images of one row with the model's step_n: as images_of_row gives them,
+ * cell for cell. A cell whose image stays in it takes the scalar path
+ * (image_cell re-steps it). */
+static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, const cm_region *r,
+                                 int max_steps, uint64_t row, exit_buf *eb, batch *b)
+{
+    const cm_box *box = &r->box;
+    const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
+    uint32_t *image = r->image + row * nx;
+    int64_t from[CM_MAX_DIM], cell[CM_MAX_DIM];
+    cm_box_cell(box, row * nx, from);
+    for (uint64_t i0 = 0; i0 < nx; i0 += BATCH) {
+        const size_t n = nx - i0 < BATCH ? (size_t)(nx - i0) : BATCH;
+        step_batch(model, lat, box, from, n, b);
+        for (size_t i = 0; i < n; i++) {
+            if (b->rc[i] < 0)
+                return b->rc[i];
+            if (b->world[i] != 0.0 && b->stays[i] != 0.0 && max_steps > 1) {
+                int64_t here[CM_MAX_DIM];
+                double x[CM_MAX_DIM];
+                bool in_world;
+                memcpy(here, from, sizeof here);
+                here[0] += (int64_t)i;
+                cm_lattice_centre(lat, here, x);
+                const int rc = image_cell(model, lat, here, max_steps, x, cell, &in_world);
+                if (rc < 0)
+                    return rc;
+                image[i0 + i] = !in_world                   ? CM_IMAGE_SINK
+                                : cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell)
+                                                             : CM_IMAGE_EXIT;
+                if (image[i0 + i] == CM_IMAGE_EXIT && eb)
+                    keep_exit(eb, cell, box->dim);
+            } else if (b->world[i] == 0.0) {
+                image[i0 + i] = CM_IMAGE_SINK;
+            } else if (b->in_box[i] != 0.0) {
+                image[i0 + i] = (uint32_t)b->local[i];
+            } else {
+                image[i0 + i] = CM_IMAGE_EXIT;
+                if (eb) {
+                    for (int d = 0; d < box->dim; d++)
+                        cell[d] = (int64_t)b->at[d][i];
+                    keep_exit(eb, cell, box->dim);
+                }
+            }
+        }
+        from[0] += (int64_t)n;
+    }
+    return 0;
+}
+
 /* Numbers the exits in local index order and moves their targets, kept by
  * the threads that found them, into the region's exit table. */
 static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
@@ -194,15 +333,20 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
         t = omp_get_thread_num();
 #endif
         exit_buf *eb = bufs ? &bufs[t] : NULL;
+        batch *b = model->step_n ? malloc(sizeof *b) : NULL; /* NULL: the scalar path */
 #pragma omp for schedule(static)
         for (int64_t row = 0; row < (int64_t)nrows; row++) {
             if (eb) {
                 rows.thread[row] = (uint32_t)t;
                 rows.first[row] = eb->n;
             }
-            if (!aborted && images_of_row(model, lat, r, max_steps, (uint64_t)row, eb) < 0)
-                aborted = 1;
+            const int rc = aborted ? 0
+                           : b     ? images_of_row_batched(model, lat, r, max_steps,
+                                                           (uint64_t)row, eb, b)
+                                   : images_of_row(model, lat, r, max_steps, (uint64_t)row, eb);
+            aborted |= rc < 0;
         }
+        free(b);
     }
     }
     if (st == CM_OK && aborted)
