@@ -58,6 +58,16 @@ typedef struct cm_fixed_point {
 /* Return values of step(), SUNDIALS style. */
 enum { CM_STEP_OK = 0, CM_STEP_NO_IMAGE = 1, CM_STEP_ABORT = -1 };
 
+/* Marks a function whose loops the compiler vectorises (a model's step_n,
+ * the engine's image loops): on x86-64 it is built twice, for AVX2 and for
+ * the baseline, and the processor picks at load time. Same results either
+ * way: neither build contracts or reorders floating-point operations. */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__)
+#define CM_VECTOR_LOOP __attribute__((target_clones("avx2", "default")))
+#else
+#define CM_VECTOR_LOOP
+#endif
+
 typedef struct cm_model {
     const char *name;
     int dim;

@@ -144,6 +144,7 @@ static inline double floor_exact(double u)
 /* Whether coordinate d of the images (at) lies in the box (lo..hi) and
  * equals the cell's own (here, plus i along the row: step 1 in dimension
  * 0), and the local index so far (dimensions from the last down). */
+CM_VECTOR_LOOP
 static void place_coordinate(const double *restrict at, double lo, double hi, double here,
                              double step, int n, double *restrict in_box,
                              double *restrict stays, double *restrict local)
@@ -151,7 +152,7 @@ static void place_coordinate(const double *restrict at, double lo, double hi, do
     const double side = hi - lo;
     for (int i = 0; i < n; i++) { /* an int: SSE2 converts no 64-bit integer to double */
         const double f = at[i];
-        in_box[i] *= (f >= lo) & (f < hi) ? 1.0 : 0.0;
+        in_box[i] *= ((f >= lo) & (f < hi)) ? 1.0 : 0.0;
         stays[i] *= f == here + step * (double)i ? 1.0 : 0.0;
         local[i] = local[i] * side + (f - lo);
     }
@@ -172,13 +173,14 @@ typedef struct batch {
 
 /* Lattice coordinate d of the images, floored (vectorised: locals and
  * restrict keep the loop free of reloads). */
+CM_VECTOR_LOOP
 static void floor_coordinates(const double *restrict y, double origin, double width, size_t n,
                               double *restrict at, double *restrict world)
 {
     const double limit = (double)CM_WORLD_LIMIT;
     for (size_t i = 0; i < n; i++) {
         const double u = (y[i] - origin) / width;
-        const double inside = (u >= -limit) & (u < limit) ? 1.0 : 0.0; /* 0 for NaN */
+        const double inside = ((u >= -limit) & (u < limit)) ? 1.0 : 0.0; /* 0 for NaN */
         at[i] = floor_exact(inside != 0.0 ? u : 0.0);
         world[i] *= inside;
     }

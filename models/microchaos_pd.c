@@ -132,6 +132,7 @@ static inline double int_part_exact(double z)
     return copysign(a < big ? t : a, z) + 0.0;
 }
 
+CM_VECTOR_LOOP
 static void step_n_pd(const cm_model *m, size_t n, const double *const *x, double *const *y,
                       int *rc)
 {
