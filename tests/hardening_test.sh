@@ -203,11 +203,12 @@ sqlite3 nometa.cmdb "DELETE FROM meta WHERE key = 'model'"
 expect_damaged nometa.cmdb "its meta table has no 'model'" info nometa.cmdb
 # a second writer is refused at once; readers go on
 mkfifo hold
-"$CM" explore good.cmdb hold > /dev/null 2>&1 &
+"$CM" explore good.cmdb hold > holder.txt 2>&1 &
 holder=$!
 exec 3> hold
 echo "view 0:50 -40:40" >&3
-sleep 0.5
+# until the session answered, so holds its lock (a loaded machine may take a while)
+for _ in $(seq 200); do [ -s holder.txt ] && break; sleep 0.05; done
 "$CM" solve $small --db good.cmdb --resume > /dev/null 2> err.txt; rc=$?
 [ $rc -eq 1 ] && grep -q "good.cmdb is in use by another cellmap process" err.txt \
   || fail "a second writer: $rc $(cat err.txt)"
