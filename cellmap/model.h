@@ -11,6 +11,7 @@
 #ifndef CM_MODEL_H
 #define CM_MODEL_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -115,6 +116,26 @@ static inline bool cm_int_part(double z, double *level)
         return false;
     *level = (double)(int64_t)z; /* conversion truncates toward zero */
     return true;
+}
+
+/* What cm_int_part gives z, for |z| < 2^62, and whether z is in that range,
+ * in double arithmetic only, for step_n loops (SSE2 and AVX2 convert no
+ * 64-bit integer): below 2^52, adding and taking away 2^52 rounds |z| to an
+ * integer and stepping down where that went up truncates; from 2^52 on
+ * every double is an integer. Adding 0 turns -0 into the +0 the conversion
+ * gives. */
+static inline double cm_int_part_value(double z)
+{
+    const double a = fabs(z), big = 0x1p52;
+    double t = (a + big) - big;
+    t -= t > a ? 1.0 : 0.0;
+    return copysign(a < big ? t : a, z) + 0.0;
+}
+
+static inline int cm_int_part_status(double z)
+{
+    return z > -4611686018427387904.0 && z < 4611686018427387904.0 ? CM_STEP_OK
+                                                                   : CM_STEP_NO_IMAGE;
 }
 
 #endif

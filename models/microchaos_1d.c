@@ -26,6 +26,20 @@ static int step_1d(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
+CM_VECTOR_LOOP
+static void step_n_1d(const cm_model *m, size_t n, const double *const *x, double *const *y,
+                      int *rc)
+{
+    const map1d *c = m->ctx;
+    const double a = c->a, b = c->b;
+    const double *restrict x0 = x[0];
+    double *restrict y0 = y[0];
+    for (size_t i = 0; i < n; i++)
+        y0[i] = a * x0[i] - b * cm_int_part_value(x0[i]);
+    for (size_t i = 0; i < n; i++)
+        rc[i] = cm_int_part_status(x0[i]);
+}
+
 /* (4.2): x_m* = b m/(a-1), regular iff Int(x_m*) = m. */
 static int fixed_points_1d(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                            size_t cap, size_t *count, char *msg, size_t msg_size)
@@ -84,6 +98,7 @@ cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, si
     c->a = cm_params_get(p, "a");
     c->b = cm_params_get(p, "b");
     m->step = step_1d;
+    m->step_n = step_n_1d;
     m->fixed_points = fixed_points_1d;
     m->overlays = overlays_1d;
     return CM_OK;

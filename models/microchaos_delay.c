@@ -27,6 +27,22 @@ static int step_delay(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
+CM_VECTOR_LOOP
+static void step_n_delay(const cm_model *m, size_t n, const double *const *x, double *const *y,
+                         int *rc)
+{
+    const delay_map *c = m->ctx;
+    const double a = c->a, b = c->b;
+    const double *restrict x0 = x[0], *restrict x1 = x[1];
+    double *restrict y0 = y[0], *restrict y1 = y[1];
+    for (size_t i = 0; i < n; i++) {
+        y0[i] = x1[i];
+        y1[i] = a * x1[i] - b * cm_int_part_value(x0[i]);
+    }
+    for (size_t i = 0; i < n; i++)
+        rc[i] = cm_int_part_status(x0[i]);
+}
+
 /* (4.40): y_m* = [x, x], x = m b/(a-1), regular iff Int(x) = m. */
 static int fixed_points_delay(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                               size_t cap, size_t *count, char *msg, size_t msg_size)
@@ -58,6 +74,7 @@ cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg,
     c->a = cm_params_get(p, "a");
     c->b = cm_params_get(p, "b");
     m->step = step_delay;
+    m->step_n = step_n_delay;
     m->fixed_points = fixed_points_delay;
     return CM_OK;
 }

@@ -119,19 +119,6 @@ static int step_pd(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
-/* (double)(int64_t)z for |z| < 2^62, as cm_int_part gives it, in double
- * arithmetic only (vectorisable; SSE2 has no int64 conversion): below
- * 2^52, adding and taking away 2^52 rounds |z| to an integer, and stepping
- * down where that went up truncates; from 2^52 on every double is an
- * integer. Adding 0 turns -0 into the +0 the conversion gives. */
-static inline double int_part_exact(double z)
-{
-    const double a = fabs(z), big = 0x1p52;
-    double t = (a + big) - big;
-    t -= t > a ? 1.0 : 0.0;
-    return copysign(a < big ? t : a, z) + 0.0;
-}
-
 CM_VECTOR_LOOP
 static void step_n_pd(const cm_model *m, size_t n, const double *const *x, double *const *y,
                       int *rc)
@@ -144,15 +131,12 @@ static void step_n_pd(const cm_model *m, size_t n, const double *const *x, doubl
     const double *restrict x0 = x[0], *restrict x1 = x[1];
     double *restrict y0 = y[0], *restrict y1 = y[1];
     for (size_t i = 0; i < n; i++) {
-        const double level = int_part_exact(P * x0[i] + D * x1[i]);
+        const double level = cm_int_part_value(P * x0[i] + D * x1[i]);
         y0[i] = a11 * x0[i] + a12 * x1[i] + b1 * level;
         y1[i] = a21 * x0[i] + a22 * x1[i] + b2 * level;
     }
-    for (size_t i = 0; i < n; i++) { /* apart: the loop above vectorises only in doubles */
-        const double z = P * x0[i] + D * x1[i];
-        rc[i] = z > -4611686018427387904.0 && z < 4611686018427387904.0 ? CM_STEP_OK
-                                                                       : CM_STEP_NO_IMAGE;
-    }
+    for (size_t i = 0; i < n; i++) /* apart: the loop above vectorises only in doubles */
+        rc[i] = cm_int_part_status(P * x0[i] + D * x1[i]);
 }
 
 size_t cm_pd_fixed_points(double alpha2, double P, int64_t m0, int64_t m1, cm_fixed_point *out,

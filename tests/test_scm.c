@@ -450,9 +450,55 @@ static void test_digests(void)
     }
 }
 
+/* Every model with step_n gives through it exactly what step gives: images
+ * of regions on several lattices (cells whose centres are 0 or beyond the
+ * range of Int, where steps have no image), with and without step_n. */
+static void test_step_n_equals_step(void)
+{
+    for (size_t k = 0; k < cm_model_count(); k++) {
+        const cm_model_entry *e = cm_model_at(k);
+        cm_model m;
+        char msg[256];
+        CHECK(cm_model_create(e->name, NULL, 0, &m, msg, sizeof msg) == CM_OK);
+        if (!m.step_n) {
+            cm_model_release(&m);
+            continue;
+        }
+        cm_model scalar = m;
+        scalar.step_n = NULL;
+        /* widths from coarse to ones where Int overflows; an origin that puts
+         * a centre on 0 */
+        const double widths[] = {0.37, 1.0, 3.1e14, 7.7e17};
+        for (size_t w = 0; w < sizeof widths / sizeof widths[0]; w++) {
+            cm_lattice lat = {m.dim, {0}, {0}};
+            cm_box box = {m.dim, {0}, {0}};
+            for (int d = 0; d < m.dim; d++) {
+                lat.origin[d] = -60.5 * widths[w];
+                lat.width[d] = widths[w] * (d ? 0.61 : 1.0);
+                box.lo[d] = d ? -3 : -7;
+                box.hi[d] = d ? 90 : 300; /* rows of more than one batch */
+            }
+            cm_region a, b;
+            const cm_scm_options opt = {5, 2, NULL, NULL, 1};
+            CHECK(cm_region_alloc(&a, &box, msg, sizeof msg) == CM_OK);
+            CHECK(cm_region_alloc(&b, &box, msg, sizeof msg) == CM_OK);
+            CHECK(cm_scm_images(&m, &lat, &opt, &a, msg, sizeof msg) == CM_OK);
+            CHECK(cm_scm_images(&scalar, &lat, &opt, &b, msg, sizeof msg) == CM_OK);
+            CHECK(memcmp(a.image, b.image, a.ncells * sizeof *a.image) == 0);
+            CHECK_INT(a.nexits, b.nexits);
+            CHECK(memcmp(a.exit_target, b.exit_target,
+                         a.nexits * (size_t)m.dim * sizeof *a.exit_target) == 0);
+            cm_region_free(&a);
+            cm_region_free(&b);
+        }
+        cm_model_release(&m);
+    }
+}
+
 int main(void)
 {
     test_digests();
+    test_step_n_equals_step();
     test_region_check();
     test_contraction();
     test_rotation(1);
