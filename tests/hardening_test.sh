@@ -178,10 +178,11 @@ grep -q "leaves no room" err.txt || fail "image size message: $(cat err.txt)"
 # solve --db over an older cluster: the old one stays until the new one is complete
 cp good.cmdb old.cmdb
 sum=$(sha256sum < old.cmdb)
-"$CM" solve --cells 1500x1500 --split 6x6 --threads 1 --db old.cmdb > /dev/null 2>&1 &
+"$CM" solve --cells 3000x3000 --split 30x30 --threads 1 --db old.cmdb > /dev/null 2>&1 &
 solver=$!
-sleep 0.3
-kill -9 $solver 2> /dev/null
+# killed once it writes the new cluster beside the old one
+for _ in $(seq 200); do compgen -G "old.cmdb.tmp-*" > /dev/null && break; sleep 0.02; done
+kill -9 $solver 2> /dev/null || fail "the solve over old.cmdb ended before it could be interrupted"
 wait $solver 2> /dev/null
 [ "$(sha256sum < old.cmdb)" = "$sum" ] || fail "an interrupted solve --db changed the older cluster"
 rm -f old.cmdb.tmp-*
