@@ -780,7 +780,7 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
         return CM_OK;
     uint64_t cells, table_bytes;
     resident(c, &cells, &table_bytes);
-    cells += extra;
+    cells += extra + c->mem_reserved;
     if (joining >= 0 && is_resident(&c->regions[joining]))
         cells -= cm_region_bytes(&c->regions[joining].r);
     const uint64_t table_budget = c->mem_budget / 4;
@@ -817,7 +817,7 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
 #ifdef __GLIBC__
     /* evicted arrays leave holes in the heap rather than free memory: give
      * the room back now and then (it costs a walk of the heap) */
-    if (c->evicted_since_trim > c->mem_budget) {
+    if (c->evicted_since_trim > c->mem_budget / 4) {
         malloc_trim(0);
         c->evicted_since_trim = 0;
     }

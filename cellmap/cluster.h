@@ -158,6 +158,9 @@ typedef struct cm_cluster {
     cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
+    /* public: bytes its owner holds for regions still to join (solved
+     * ahead of their joins), which the budget makes room for too */
+    uint64_t mem_reserved;
     /* public: the boxes still to join, in order, if known (NULL: none).
      * Eviction keeps the regions next to the first of them, where their
      * sequences most likely land, and evicts the others first. */

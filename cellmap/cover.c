@@ -1,6 +1,8 @@
 #include "cellmap/cover.h"
 
+#include <stdbool.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cellmap/grow.h"
 
@@ -81,4 +83,87 @@ uint64_t cm_boxes_cells(const cm_box *boxes, uint32_t n)
     for (uint32_t k = 0; k < n; k++)
         cells += cm_box_cells(&boxes[k]);
     return cells;
+}
+
+/* The place of v among the n sorted distinct values. */
+static uint64_t rank_of(const int64_t *values, uint32_t n, int64_t v)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (values[mid] < v)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+static int compare_int64(const void *a, const void *b)
+{
+    const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+typedef struct z_entry {
+    uint64_t key;
+    uint32_t at;
+} z_entry;
+
+static int compare_z(const void *a, const void *b)
+{
+    const z_entry *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return (x->at > y->at) - (x->at < y->at);
+}
+
+cm_status cm_boxes_z_order(cm_box *boxes, uint32_t n)
+{
+    if (n < 2)
+        return CM_OK;
+    const int dim = boxes[0].dim, bits = 64 / dim;
+    int64_t *lo = malloc((size_t)n * (size_t)dim * sizeof *lo);
+    uint32_t distinct[CM_MAX_DIM];
+    z_entry *z = malloc(n * sizeof *z);
+    cm_box *sorted = malloc(n * sizeof *sorted);
+    if (!lo || !z || !sorted) {
+        free(lo);
+        free(z);
+        free(sorted);
+        return CM_ENOMEM;
+    }
+    /* each dimension's distinct lower bounds, sorted: a box's place is its rank */
+    for (int d = 0; d < dim; d++) {
+        int64_t *v = lo + (size_t)d * n;
+        for (uint32_t k = 0; k < n; k++)
+            v[k] = boxes[k].lo[d];
+        qsort(v, n, sizeof *v, compare_int64);
+        distinct[d] = 0;
+        for (uint32_t k = 0; k < n; k++)
+            if (distinct[d] == 0 || v[k] != v[distinct[d] - 1])
+                v[distinct[d]++] = v[k];
+    }
+    bool fits = true;
+    for (int d = 0; d < dim; d++)
+        fits = fits && (bits >= 32 || distinct[d] <= (UINT32_C(1) << bits));
+    for (uint32_t k = 0; k < n && fits; k++) {
+        uint64_t key = 0;
+        for (int d = 0; d < dim; d++) {
+            const uint64_t r = rank_of(lo + (size_t)d * n, distinct[d], boxes[k].lo[d]);
+            for (int b = 0; b < bits; b++)
+                key |= ((r >> b) & 1) << (b * dim + d);
+        }
+        z[k] = (z_entry){key, k};
+    }
+    if (fits) {
+        qsort(z, n, sizeof *z, compare_z);
+        for (uint32_t k = 0; k < n; k++)
+            sorted[k] = boxes[z[k].at];
+        memcpy(boxes, sorted, n * sizeof *boxes);
+    }
+    free(lo);
+    free(z);
+    free(sorted);
+    return CM_OK;
 }

@@ -25,4 +25,10 @@ cm_status cm_cluster_uncovered(const cm_cluster *c, const cm_box *box, cm_box **
 /* Cells of the boxes together. */
 uint64_t cm_boxes_cells(const cm_box *boxes, uint32_t n);
 
+/* Puts the boxes of a grid (a split of a box) in Z order (Morton order of
+ * their places in the grid, dimension 0 fastest): neighbours are joined a
+ * few boxes apart, so that under a memory budget the regions a join reads
+ * are still resident. Deterministic; CM_ENOMEM only (then the order stays). */
+cm_status cm_boxes_z_order(cm_box *boxes, uint32_t n);
+
 #endif

@@ -571,6 +571,24 @@ static void pause_briefly(void)
     nanosleep(&t, NULL);
 }
 
+/* Bytes of the regions after box b that are solved or being solved ahead
+ * of their joins: the cluster's budget makes room for them. Their cell
+ * arrays from their boxes; the exits, nodes and targets of those solved
+ * (complete once their ready flag says so). */
+static uint64_t solved_ahead(pipeline *p, uint32_t b)
+{
+    uint64_t bytes = 0;
+    const uint32_t claimed = atomic_load(&p->next);
+    for (uint32_t k = b + 1; k < claimed && k < p->nboxes; k++) {
+        const uint32_t s = k % p->window;
+        bytes += 3 * sizeof(uint32_t) * cm_box_cells(&p->boxes[k]);
+        if (atomic_load(&p->ready[s]) == k + 1 && p->status[s] == CM_OK)
+            bytes += p->slot[s].nexits * (p->slot[s].box.dim * sizeof(int64_t) +
+                                          sizeof(cm_node) + sizeof(plan_target));
+    }
+    return bytes;
+}
+
 /* The joins, in box order (thread 0). */
 static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
                                cm_join_stats *stats, char *msg, size_t msg_size)
@@ -592,6 +610,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         /* its own box while it joins, the boxes after it from then on */
         c->upcoming = p->boxes + b;
         c->nupcoming = p->nboxes - b;
+        c->mem_reserved = solved_ahead(p, b);
         pin_expected(c, next, 1);
         cm_join_stats one_join;
         if (st == CM_OK) {
@@ -725,6 +744,7 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     c->upcoming = NULL;
     c->nupcoming = 0;
+    c->mem_reserved = 0;
     cm_cluster_trim(c);
     return st;
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "cellmap/cover.h"
 #include "cellmap/extend.h"
 #include "models/registry.h"
 #include "src/args.h"
@@ -164,6 +165,9 @@ void project_plan_text(const project_plan *p, const cm_box *box, char *out, size
                  p->bounds_text ? p->bounds_text : "-");
 }
 
+/* Splits into more boxes than this are joined in Z order. */
+#define Z_ORDER_FROM 64
+
 uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes)
 {
     int64_t parts[CM_MAX_DIM];
@@ -183,6 +187,10 @@ uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes)
             boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts[d];
         }
     }
+    /* many regions go in Z order, so that neighbours join close together
+     * (paging keeps them); fewer keep the row order earlier files have */
+    if (boxes && n > Z_ORDER_FROM)
+        cm_boxes_z_order(boxes, n); /* unsorted if out of memory */
     return n;
 }
 

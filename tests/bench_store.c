@@ -19,6 +19,7 @@
  * usage: bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]
  *        (default 20 10 1000 256 /tmp paged,db,memory,scm) */
 #define _DEFAULT_SOURCE /* wait4: the peak RSS of one child */
+#include <malloc.h> /* glibc: the benchmark runs where cellmap's tests do */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +29,7 @@
 #include <unistd.h>
 
 #include "bench_util.h"
+#include "cellmap/cover.h"
 #include "cellmap/store.h"
 #include "cmdb_hash.h"
 #include "models/registry.h"
@@ -94,6 +96,8 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     cm_box *boxes = malloc(n * sizeof *boxes);
     for (uint32_t k = 0; k < n; k++)
         boxes[k] = box_of(cf, k);
+    if (n > 64)
+        cm_boxes_z_order(boxes, n); /* as solve --split orders more than 64 regions */
     cm_cluster c;
     cm_cluster_init(&c, &lat);
     c.threads = 2;
@@ -188,6 +192,7 @@ static void run_child(const config *cf, const char *name, const char *db, uint64
 
 int main(int argc, char **argv)
 {
+    mallopt(M_MMAP_THRESHOLD, 1 << 20); /* as cellmap's main: see there */
     config cf = {20, 10, 1000, 256, "/tmp"};
     if (argc > 1 && argc != 6 && argc != 7)
         die("usage", "bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]");
