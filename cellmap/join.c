@@ -323,8 +323,8 @@ static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
             st = cm_cluster_acquire(c, job->region, j->msg, j->msg_size);
             held = job->region;
         }
-        if (resident && p + PREFETCH < n) /* targets are random cells: overlap the misses */
-            prefetch_target(c, &jobs[p + PREFETCH]);
+        if (resident && p + 4 * PREFETCH < n) /* random cells: overlap the misses */
+            prefetch_target(c, &jobs[p + 4 * PREFETCH]);
         const cm_region *r = &c->regions[job->region].r;
         job->group = st == CM_OK ? r->group[job->cell] : 0;
         job->step = st == CM_OK ? r->step[job->cell] : 0;
@@ -413,10 +413,10 @@ static cm_status link_all(joiner *j)
     if (st == CM_OK)
         st = read_targets(j, jobs, n);
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
+        if (i + 2 * PREFETCH < n)
+            prefetch_nodes(j->c, &jobs[i + 2 * PREFETCH]);
         if (i + PREFETCH < n)
-            prefetch_nodes(j->c, &jobs[i + PREFETCH]);
-        if (i + PREFETCH / 2 < n)
-            prefetch_chain(j->c, &jobs[i + PREFETCH / 2]);
+            prefetch_chain(j->c, &jobs[i + PREFETCH]);
         st = link_node(j, &jobs[i]);
     }
     for (uint64_t i = 0; i < n; i++)
