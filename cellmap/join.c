@@ -571,20 +571,18 @@ static void pause_briefly(void)
     nanosleep(&t, NULL);
 }
 
-/* Bytes of the regions after box b that are solved or being solved ahead
- * of their joins: the cluster's budget makes room for them. Their cell
- * arrays from their boxes; the exits, nodes and targets of those solved
- * (complete once their ready flag says so). */
+/* Bytes of the regions after box b solved ahead of their joins (complete
+ * once their ready flag says so), with their node tables and exit
+ * targets: the cluster's budget makes room for them. */
 static uint64_t solved_ahead(pipeline *p, uint32_t b)
 {
     uint64_t bytes = 0;
     const uint32_t claimed = atomic_load(&p->next);
     for (uint32_t k = b + 1; k < claimed && k < p->nboxes; k++) {
         const uint32_t s = k % p->window;
-        bytes += 3 * sizeof(uint32_t) * cm_box_cells(&p->boxes[k]);
         if (atomic_load(&p->ready[s]) == k + 1 && p->status[s] == CM_OK)
-            bytes += p->slot[s].nexits * (p->slot[s].box.dim * sizeof(int64_t) +
-                                          sizeof(cm_node) + sizeof(plan_target));
+            bytes += cm_region_bytes(&p->slot[s]) +
+                     p->slot[s].nexits * (sizeof(cm_node) + sizeof(plan_target));
     }
     return bytes;
 }
