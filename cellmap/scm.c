@@ -186,6 +186,7 @@ static void floor_coordinates(const double *restrict y, double origin, double wi
     }
 }
 
+/* Fills b for the n cells of a row from cell `from` on. */
 static void step_batch(const cm_model *model, const cm_lattice *lat, const cm_box *box,
                        const int64_t *from, size_t n, batch *b)
 {
