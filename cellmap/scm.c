@@ -3,6 +3,7 @@
 #include "cellmap/classify.h"
 #include "cellmap/grow.h"
 
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -312,10 +313,15 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
 /* Regions below this many cells compute their images on one thread. */
 #define PARALLEL_CELLS 1024
 
+/* Rows between two calls of the progress callback (on the calling thread). */
+#define PROGRESS_ROWS 64
+
 static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, int max_steps,
-                                int threads, bool record_exits, cm_region *r, char *msg,
+                                int threads, const cm_scm_options *opt, cm_region *r, char *msg,
                                 size_t msg_size)
 {
+    const bool record_exits = opt && opt->record_exits;
+    const cm_progress_fn progress = opt ? opt->progress : NULL;
     const uint64_t nrows = r->ncells / (uint64_t)(r->box.hi[0] - r->box.lo[0]);
     exit_buf *bufs = record_exits ? calloc((size_t)threads, sizeof *bufs) : NULL;
     row_exits rows = {NULL, NULL};
@@ -326,34 +332,45 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
     cm_status st = CM_OK;
     if (record_exits && (!bufs || !rows.thread || !rows.first))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
-    int aborted = 0;
+    atomic_int stop = 0; /* 1: the model aborted; 2: the progress callback cancelled */
     if (st == CM_OK) {
     /* a few cells are quicker on one thread than waking others */
-#pragma omp parallel num_threads(threads) reduction(| : aborted) if (r->ncells >= PARALLEL_CELLS)
+#pragma omp parallel num_threads(threads) if (r->ncells >= PARALLEL_CELLS)
     {
-        int t = 0;
+        int t = 0, team = 1;
 #ifdef _OPENMP
         t = omp_get_thread_num();
+        team = omp_get_num_threads();
 #endif
         exit_buf *eb = bufs ? &bufs[t] : NULL;
         batch *b = model->step_n ? malloc(sizeof *b) : NULL; /* NULL: the scalar path */
+        uint64_t mine = 0; /* rows this thread did */
 #pragma omp for schedule(static)
         for (int64_t row = 0; row < (int64_t)nrows; row++) {
             if (eb) {
                 rows.thread[row] = (uint32_t)t;
                 rows.first[row] = eb->n;
             }
-            const int rc = aborted ? 0
-                           : b     ? images_of_row_batched(model, lat, r, max_steps,
-                                                           (uint64_t)row, eb, b)
-                                   : images_of_row(model, lat, r, max_steps, (uint64_t)row, eb);
-            aborted |= rc < 0;
+            if (atomic_load_explicit(&stop, memory_order_relaxed))
+                continue;
+            const int rc = b ? images_of_row_batched(model, lat, r, max_steps, (uint64_t)row,
+                                                     eb, b)
+                             : images_of_row(model, lat, r, max_steps, (uint64_t)row, eb);
+            if (rc < 0)
+                atomic_store(&stop, 1);
+            /* the calling thread reports, for the rows of a static share */
+            if (t == 0 && progress && ++mine % PROGRESS_ROWS == 0 &&
+                progress(opt->user, "images",
+                         (double)mine * (double)team / (double)(nrows + 1)) != 0)
+                atomic_store(&stop, 2);
         }
         free(b);
     }
     }
-    if (st == CM_OK && aborted)
+    if (st == CM_OK && stop == 1)
         st = cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
+    if (st == CM_OK && stop == 2)
+        st = cm_fail(CM_ECANCELED, msg, msg_size, "cancelled");
     if (st == CM_OK && record_exits)
         st = number_exits(r, bufs, threads, &rows, nrows, msg, msg_size);
     for (int t = 0; bufs && t < threads; t++)
@@ -378,8 +395,7 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     r->exit_target = NULL;
     r->nexits = 0;
     r->exits_recorded = 0;
-    return images_of_rows(model, lat, max_steps, threads, opt && opt->record_exits, r, msg,
-                          msg_size);
+    return images_of_rows(model, lat, max_steps, threads, opt, r, msg, msg_size);
 }
 
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
@@ -392,6 +408,10 @@ cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_sc
                        cm_region *r, char *msg, size_t msg_size)
 {
     cm_status st = cm_scm_images(model, lat, opt, r, msg, msg_size);
+    /* classification is one pass that cannot stop half-way: a cancel
+     * between the two phases is the last one honoured */
+    if (st == CM_OK && opt && opt->progress && opt->progress(opt->user, "classification", 0) != 0)
+        st = cm_fail(CM_ECANCELED, msg, msg_size, "cancelled");
     if (st == CM_OK)
         st = cm_scm_classify(r, msg, msg_size);
     return st;

@@ -73,7 +73,9 @@ static inline const int64_t *cm_region_exit(const cm_region *r, uint64_t k)
     return r->exit_target + k * (uint64_t)r->box.dim;
 }
 
-/* Progress callback: fraction done in [0, 1]; return nonzero to cancel. */
+/* Progress callback, called on the calling thread: phase "images" with the
+ * fraction of them done in [0, 1], then (cm_scm_solve) "classification"
+ * with 0 as it starts. Nonzero cancels: the call returns CM_ECANCELED. */
 typedef int (*cm_progress_fn)(void *user, const char *phase, double fraction);
 
 typedef struct cm_scm_options {

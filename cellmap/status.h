@@ -21,7 +21,8 @@
     X(CM_EDB, "database error")                                                                    \
     X(CM_EFORMAT, "not a valid cellmap file")                                                      \
     X(CM_ERENDER, "rendering error")                                                               \
-    X(CM_ENOTFOUND, "not found")
+    X(CM_ENOTFOUND, "not found")                                                                   \
+    X(CM_ECANCELED, "cancelled")
 
 typedef enum cm_status {
 #define CM_STATUS_ENUM(code, msg) code,

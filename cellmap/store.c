@@ -589,6 +589,8 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size)
     return st;
 }
 
+bool cm_store_replacing(const cm_store *s) { return s && s->tmp_path; }
+
 cm_status cm_store_finish(cm_store *s, char *msg, size_t msg_size)
 {
     if (!s)

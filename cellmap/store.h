@@ -31,6 +31,8 @@
 #ifndef CM_STORE_H
 #define CM_STORE_H
 
+#include <stdbool.h>
+
 #include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
@@ -114,6 +116,10 @@ cm_status cm_store_close(cm_store *s, char *msg, size_t msg_size);
 /* The cluster is complete: closes as cm_store_close does and, for a new
  * cluster that replaces an older file, puts it in the old one's place. */
 cm_status cm_store_finish(cm_store *s, char *msg, size_t msg_size);
+
+/* Whether the store writes a new cluster that is to replace an older file
+ * (so that closing it without cm_store_finish leaves the old one). */
+bool cm_store_replacing(const cm_store *s);
 
 /* Checks that path is a cellmap database this version can read. */
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size);

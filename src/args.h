@@ -10,7 +10,8 @@
 #include "cellmap/lattice.h"
 #include "cellmap/model.h"
 
-enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2 };
+/* EXIT_INTERRUPTED: stopped by Ctrl-C (128 + SIGINT, as shells report it). */
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
 #define MAX_PARAM_TEXTS 32
 
 /* Cursor over argv; options are "--name VALUE" or "--name=VALUE". */

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -15,6 +16,7 @@
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
+#include "src/interrupt.h"
 #include "src/project.h"
 #include "src/args.h"
 #include "src/basin_png.h"
@@ -56,6 +58,7 @@ static const char solve_help[] =
     "                      tables take a quarter more); regions are paged to and from\n"
     "                      --db FILE (same results)\n"
     "  --json              print the summary as JSON\n"
+    "  --quiet             no progress line and no summary (--json still prints)\n"
     "  --stage1            stop the join of the --split regions after Stage 1 (thesis\n"
     "                      Alg. C.5, Fig. 4.27): sink cells leading into another region's\n"
     "                      groups take their group; those leading into its sink domain\n"
@@ -69,7 +72,7 @@ typedef struct solve_args {
     lattice_opts lat;
     int64_t split[CM_MAX_DIM];
     int n_split;
-    int max_steps, threads, json, stage1;
+    int max_steps, threads, json, stage1, quiet;
     FILE *report; /* the summary: stdout, or stderr when the PNG goes to stdout */
     int extend;
     double escape_below;
@@ -117,6 +120,8 @@ static int parse_solve(cli *c, solve_args *a)
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = 1;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = 1;
         } else if (cli_is(c, "--stage1", false, &err)) {
             a->stage1 = 1;
         } else {
@@ -325,16 +330,74 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     fprintf(out, "]}\n");
 }
 
-static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
-                             const cm_box *box, cm_region *r, timing *t, char *msg, size_t msg_size)
+/* The progress line on stderr (a terminal only; not with --quiet), and
+ * Ctrl-C: the callbacks below stop the solve when it came. */
+typedef struct progress {
+    bool show;
+    double t0, last;
+    uint64_t total; /* cells the solve is to compute, 0: not known (extension) */
+    bool shown;     /* a line is on the terminal */
+} progress;
+
+static void progress_say(progress *p, uint64_t done, const char *what)
 {
-    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 0};
+    const double t = now_seconds();
+    if (!p->show || t - p->last < 0.2)
+        return;
+    p->last = t;
+    const double rate = done / (t - p->t0 + 1e-9);
+    char eta[64] = "";
+    if (p->total > done && rate > 0)
+        snprintf(eta, sizeof eta, ", about %.0f s left", (double)(p->total - done) / rate);
+    fprintf(stderr, "\rsolve: %s, %.1f M cells, %.1f M cells/s%s   ", what, done / 1e6,
+            rate / 1e6, eta);
+    fflush(stderr);
+    p->shown = true;
+}
+
+static void progress_end(progress *p)
+{
+    if (p->shown)
+        fputc('\n', stderr);
+    p->shown = false;
+}
+
+/* A cm_progress_fn for a solve in one region. */
+static int whole_progress(void *user, const char *phase, double fraction)
+{
+    progress *p = user;
+    char what[64];
+    snprintf(what, sizeof what, "%s %.0f%%", phase, 100 * fraction);
+    progress_say(p, (uint64_t)(fraction * (double)p->total), what);
+    return interrupt_requested();
+}
+
+/* A cm_joined_fn for a cluster (after the join's commit): the line, and
+ * Ctrl-C, which stops the solve with what is committed. */
+static cm_status cluster_progress(void *user, cm_cluster *c, uint32_t box,
+                                  const cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    progress *p = user;
+    (void)box, (void)stats;
+    char what[64];
+    snprintf(what, sizeof what, "%u region%s joined", c->nregions, c->nregions == 1 ? "" : "s");
+    progress_say(p, c->cells, what);
+    return interrupt_requested() ? cm_fail(CM_ECANCELED, msg, msg_size, "interrupted") : CM_OK;
+}
+
+static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_lattice *lat,
+                             const cm_box *box, cm_region *r, timing *t, progress *p, char *msg,
+                             size_t msg_size)
+{
+    const cm_scm_options opt = {a->max_steps, a->threads, whole_progress, p, 0};
     *t = (timing){"images", "classification", 0, 0};
     cm_status st = cm_region_alloc(r, box, msg, msg_size);
     const double t0 = now_seconds();
     if (st == CM_OK)
         st = cm_scm_images(m, lat, &opt, r, msg, msg_size);
     const double t1 = now_seconds();
+    if (st == CM_OK && whole_progress(p, "classification", 1.0) != 0)
+        st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     if (st == CM_OK)
         st = cm_scm_classify(r, msg, msg_size);
     t->t1 = t1 - t0;
@@ -560,6 +623,22 @@ static cm_status finish_store(run *rn, char *msg, size_t msg_size)
     return st;
 }
 
+/* After Ctrl-C: what is kept and how to go on. */
+static int say_interrupted(const solve_args *a, const char *command, const run *rn)
+{
+    if (rn->store && cm_store_replacing(rn->store))
+        fprintf(stderr, "cellmap solve: interrupted; %s is unchanged (the new cluster is "
+                        "discarded)\n",
+                a->db);
+    else if (rn->store)
+        fprintf(stderr, "cellmap solve: interrupted; %s keeps the %u regions joined so far. "
+                        "To finish it: %s%s\n",
+                a->db, rn->c.nregions, command, a->resume ? "" : " --resume");
+    else
+        fprintf(stderr, "cellmap solve: interrupted\n");
+    return EXIT_INTERRUPTED;
+}
+
 int cmd_solve(int argc, char **argv)
 {
     cli c = {"solve", argc, argv, 0, NULL, NULL};
@@ -592,21 +671,36 @@ int cmd_solve(int argc, char **argv)
         (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK ||
         (a.png.path && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
         goto done;
+    progress pr = {!a.quiet && isatty(STDERR_FILENO), now_seconds(), 0, cm_box_cells(&box), false};
     project_plan plan;
     make_plan(&a, &bounds, &plan);
+    plan.joined = cluster_progress;
+    plan.joined_user = &pr;
+    interrupt_catch();
     rc = EXIT_FAIL;
     timing t = {"images", "classification", 0, 0};
+    cm_status st;
     if (!a.stage1 && (a.n_split || a.extend || a.db || a.png.has_view)) {
         /* a view is cut from a cluster */
         const double t0 = now_seconds();
-        if (solve_cluster(&a, &plan, command, &m, &lat, &box, &rn, &t, log, msg, sizeof msg) !=
-                CM_OK ||
-            summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
+        st = solve_cluster(&a, &plan, command, &m, &lat, &box, &rn, &t, log, msg, sizeof msg);
+        progress_end(&pr);
+        if (st == CM_ECANCELED) {
+            rc = say_interrupted(&a, command, &rn);
+            goto done;
+        }
+        if (st != CM_OK || summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
         t.t2 = now_seconds() - t0 - t.t1;
     } else {
-        if ((a.stage1 ? solve_stage1(&a, &plan, &m, &lat, &box, &r, &t, msg, sizeof msg)
-                      : solve_whole(&a, &m, &lat, &box, &r, &t, msg, sizeof msg)) != CM_OK)
+        st = a.stage1 ? solve_stage1(&a, &plan, &m, &lat, &box, &r, &t, msg, sizeof msg)
+                      : solve_whole(&a, &m, &lat, &box, &r, &t, &pr, msg, sizeof msg);
+        progress_end(&pr);
+        if (st == CM_ECANCELED) {
+            rc = say_interrupted(&a, command, &rn);
+            goto done;
+        }
+        if (st != CM_OK)
             goto fail;
         sum.box = r.box;
         sum.cells = r.ncells;
@@ -617,9 +711,9 @@ int cmd_solve(int argc, char **argv)
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
         print_json(a.report, &m, &lat, &sum, &t, shown);
-    else
+    else if (!a.quiet)
         print_text(a.report, &m, &sum, &t, shown);
-    if (rn.store && !a.json)
+    if (rn.store && !a.json && !a.quiet)
         print_database(a.report, &a, &rn, &sum);
     if (a.png.path && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)
         goto fail;

@@ -203,6 +203,22 @@ static bool has_box(const cm_cluster *c, const cm_box *box)
     return false;
 }
 
+/* What project_add_box does after each join: commit, then the plan's callback. */
+typedef struct after_join {
+    cm_store *s;
+    const project_plan *p;
+} after_join;
+
+static cm_status joined(void *user, cm_cluster *c, uint32_t box, const cm_join_stats *stats,
+                        char *msg, size_t msg_size)
+{
+    const after_join *a = user;
+    cm_status st = a->s ? cm_store_commit_join(a->s, c, box, stats, msg, msg_size) : CM_OK;
+    if (st == CM_OK && a->p->joined)
+        st = a->p->joined(a->p->joined_user, c, box, stats, msg, msg_size);
+    return st;
+}
+
 cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
                           const cm_box *box, cm_join_stats *stats, char *msg, size_t msg_size)
 {
@@ -217,8 +233,8 @@ cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const p
     for (uint32_t k = 0; k < n; k++)
         if (!has_box(c, &boxes[k]))
             boxes[todo++] = boxes[k];
-    cm_status st = cm_cluster_solve_boxes(c, m, boxes, todo, &opt, s ? cm_store_commit_join : NULL,
-                                          s, stats, msg, msg_size);
+    after_join a = {s, p};
+    cm_status st = cm_cluster_solve_boxes(c, m, boxes, todo, &opt, joined, &a, stats, msg, msg_size);
     free(boxes);
     return st;
 }

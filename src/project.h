@@ -62,6 +62,10 @@ typedef struct project_plan {
     double escape_below;
     const cm_box *bounds;
     const char *bounds_text; /* as the user gave them, for the plan's text */
+    /* optional: called after each join, once it is committed to the store;
+     * anything but CM_OK stops the solve with it (cm_joined_fn) */
+    cm_joined_fn joined;
+    void *joined_user;
 } project_plan;
 
 /* The plan as text: what a resumed solve must repeat exactly (the box, the

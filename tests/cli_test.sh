@@ -463,5 +463,48 @@ out=$(CELLMAP_FONT=/nonexistent.ttf "$CM" render basin.cmdb --layers axes --png 
 [ $rc -eq 1 ] && grep -q "fonts-dejavu-core" <<<"$out" && [ ! -e nofont.png ] \
   || fail "render without its font: $rc $out"
 
+# --- progress and Ctrl-C --------------------------------------------------------
+LONG=(--param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 --region -125000:125000,-600:600
+      --max-steps 100000 --cells 8000x4000 --split 16x16 --threads 2)
+# a progress line on a terminal's stderr only, none with --quiet or into a file
+script -qfec "$CM solve ${LONG[*]} --db tty.cmdb > /dev/null" /dev/null > tty.txt
+grep -q "regions joined, .* M cells/s" tty.txt || fail "no progress line on a terminal: $(head -c 300 tty.txt)"
+script -qfec "$CM solve --cells 3000x3000 --quiet" /dev/null > quiet.txt
+[ -s quiet.txt ] && fail "--quiet printed: $(head -c 300 quiet.txt)"
+"$CM" solve --cells 3000x3000 > /dev/null 2> notty.txt
+[ -s notty.txt ] && fail "progress into a file: $(head -c 300 notty.txt)"
+# Ctrl-C once some regions are committed: exit 130, the file says how to go
+# on, and --resume gives what an uninterrupted run gives
+rm -f int.cmdb
+"$CM" solve "${LONG[@]}" --db int.cmdb > /dev/null 2> int.txt &
+solver=$!
+for _ in $(seq 400); do
+  [ "$(sqlite3 int.cmdb "SELECT count(*) FROM regions" 2> /dev/null || echo 0)" -gt 2 ] && break
+  sleep 0.01
+done
+kill -INT $solver 2> /dev/null || fail "the solve ended before Ctrl-C"
+wait $solver; rc=$?
+[ $rc -eq 130 ] && grep -q "interrupted; int.cmdb keeps the [0-9]* regions joined so far.*--resume" int.txt \
+  || fail "Ctrl-C: exit $rc, $(cat int.txt)"
+"$CM" solve "${LONG[@]}" --db int.cmdb --resume > /dev/null || fail "resume after Ctrl-C"
+# the same rows, the command line and creation notes aside
+cluster_rows() {
+  sqlite3 -cmd ".mode quote" "$1" "SELECT * FROM regions ORDER BY id; SELECT * FROM pages ORDER BY region, first_cell;
+    SELECT * FROM exits ORDER BY region; SELECT * FROM nodes ORDER BY region, first;
+    SELECT * FROM basins ORDER BY grp; SELECT * FROM open_nodes ORDER BY region;
+    SELECT * FROM attractors ORDER BY id" | sha256sum
+}
+[ "$(cluster_rows int.cmdb)" = "$(cluster_rows tty.cmdb)" ] \
+  || fail "interrupted and resumed differs from an uninterrupted solve"
+# over an older cluster: Ctrl-C keeps the older one
+sum=$(sha256sum < tty.cmdb)
+"$CM" solve "${LONG[@]}" --db tty.cmdb > /dev/null 2> int.txt &
+solver=$!
+for _ in $(seq 400); do compgen -G "tty.cmdb.tmp-*" > /dev/null && break; sleep 0.01; done
+kill -INT $solver 2> /dev/null || fail "the replacing solve ended before Ctrl-C"
+wait $solver; rc=$?
+[ $rc -eq 130 ] && grep -q "interrupted; tty.cmdb is unchanged" int.txt || fail "Ctrl-C over an older cluster: exit $rc, $(cat int.txt)"
+[ "$(sha256sum < tty.cmdb)" = "$sum" ] || fail "Ctrl-C changed the older cluster"
+
 [ $fails -eq 0 ] && echo "cli tests passed" || echo "$fails cli test(s) failed"
 exit $fails

@@ -1,0 +1,16 @@
+/* src/interrupt.h - Ctrl-C as a request to stop cleanly: a long command
+ * checks for it between units of work (a region joined and committed, a
+ * row of images), stops there and says how to go on. A second Ctrl-C ends
+ * the process at once, as usual. */
+#ifndef CM_SRC_INTERRUPT_H
+#define CM_SRC_INTERRUPT_H
+
+#include <stdbool.h>
+
+/* From now on SIGINT sets the request instead of ending the process (once). */
+void interrupt_catch(void);
+
+/* Whether SIGINT came since interrupt_catch. */
+bool interrupt_requested(void);
+
+#endif
