@@ -478,8 +478,9 @@ script -qfec "$CM solve --cells 3000x3000 --quiet" /dev/null > quiet.txt
 rm -f int.cmdb
 "$CM" solve "${LONG[@]}" --db int.cmdb > /dev/null 2> int.txt &
 solver=$!
-for _ in $(seq 400); do
-  [ "$(sqlite3 int.cmdb "SELECT count(*) FROM regions" 2> /dev/null || echo 0)" -gt 2 ] && break
+for _ in $(seq 2000); do # read-only: a probe must not create the file before the solve
+  [ -s int.cmdb ] && [ "$(sqlite3 -readonly int.cmdb "SELECT count(*) FROM regions" 2> /dev/null ||
+                          echo 0)" -gt 2 ] && break
   sleep 0.01
 done
 kill -INT $solver 2> /dev/null || fail "the solve ended before Ctrl-C"
@@ -500,7 +501,7 @@ cluster_rows() {
 sum=$(sha256sum < tty.cmdb)
 "$CM" solve "${LONG[@]}" --db tty.cmdb > /dev/null 2> int.txt &
 solver=$!
-for _ in $(seq 400); do compgen -G "tty.cmdb.tmp-*" > /dev/null && break; sleep 0.01; done
+for _ in $(seq 2000); do compgen -G "tty.cmdb.tmp-*" > /dev/null && break; sleep 0.01; done
 kill -INT $solver 2> /dev/null || fail "the replacing solve ended before Ctrl-C"
 wait $solver; rc=$?
 [ $rc -eq 130 ] && grep -q "interrupted; tty.cmdb is unchanged" int.txt || fail "Ctrl-C over an older cluster: exit $rc, $(cat int.txt)"
