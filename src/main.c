@@ -1,5 +1,6 @@
 /* cellmap - cell mapping and global dynamics from the command line. */
 #include <stdio.h> /* first: it says whether the C library is glibc */
+#include <stdbool.h>
 #include <string.h>
 #ifdef __GLIBC__
 #include <malloc.h>
@@ -33,7 +34,8 @@ static const struct {
 
 static void usage(FILE *out)
 {
-    fprintf(out, "usage: cellmap COMMAND [OPTIONS]   (cellmap COMMAND --help for details)\n\n"
+    fprintf(out, "usage: cellmap COMMAND [OPTIONS]   (cellmap help COMMAND, or COMMAND --help "
+                 "or -h, for details)\n\n"
                  "commands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         fprintf(out, "  %-14s %s\n", commands[i].name, commands[i].doc);
@@ -72,10 +74,27 @@ int main(int argc, char **argv)
         printf("cellmap %s\n", CELLMAP_VERSION);
         return EXIT_OK;
     }
+    /* "cellmap help CMD" is "cellmap CMD --help" */
+    char help_flag[] = "--help";
+    char *help_argv[3] = {argc > 2 ? argv[2] : NULL, help_flag, NULL};
+    const bool asks_help = strcmp(argv[1], "help") == 0;
+    if (asks_help && argc == 2) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    if (asks_help && argc > 3) {
+        fprintf(stderr, "cellmap help: one command at a time\n");
+        return EXIT_USAGE;
+    }
+    const char *name = asks_help ? argv[2] : argv[1];
+    for (int i = 2; i < argc; i++) /* -h is --help, for every command */
+        if (strcmp(argv[i], "-h") == 0)
+            argv[i] = help_flag;
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (strcmp(argv[1], commands[i].name) == 0)
-            return finish(commands[i].name, commands[i].run(argc - 1, argv + 1));
-    fprintf(stderr, "cellmap: unknown command '%s'\n", argv[1]);
+        if (strcmp(name, commands[i].name) == 0)
+            return finish(name, asks_help ? commands[i].run(2, help_argv)
+                                          : commands[i].run(argc - 1, argv + 1));
+    fprintf(stderr, "cellmap: unknown command '%s'\n", name);
     usage(stderr);
     return EXIT_USAGE;
 }

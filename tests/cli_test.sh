@@ -463,6 +463,16 @@ out=$(CELLMAP_FONT=/nonexistent.ttf "$CM" render basin.cmdb --layers axes --png 
 [ $rc -eq 1 ] && grep -q "fonts-dejavu-core" <<<"$out" && [ ! -e nofont.png ] \
   || fail "render without its font: $rc $out"
 
+# --- help: "help CMD", "CMD --help" and "CMD -h" say the same ---------------------
+for cmd in $("$CM" help | awk '/^commands:/ {on = 1; next} on && NF {print $1}'); do
+  a=$("$CM" help "$cmd") || fail "cellmap help $cmd failed"
+  [ -n "$a" ] && [ "$a" = "$("$CM" "$cmd" --help)" ] && [ "$a" = "$("$CM" "$cmd" -h)" ] \
+    || fail "help of $cmd differs between 'help $cmd', '--help' and '-h'"
+done
+[ "$("$CM" solve --cells 10x10 -h)" = "$("$CM" help solve)" ] || fail "solve ... -h is not help"
+"$CM" help nosuch > /dev/null 2> err.txt; rc=$?
+[ $rc -eq 2 ] && grep -q "unknown command 'nosuch'" err.txt || fail "help nosuch: $rc $(cat err.txt)"
+
 # --- progress and Ctrl-C --------------------------------------------------------
 LONG=(--param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 --region -125000:125000,-600:600
       --max-steps 100000 --cells 8000x4000 --split 16x16 --threads 2)
