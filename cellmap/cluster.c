@@ -978,17 +978,10 @@ static cm_status index_region(cm_cluster *c, uint32_t k)
 }
 
 /* Region k's node table from its nodes as saved (next, dist, group,
- * target, tree), or the nodes of a new region (cm_region_nodes). */
-static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved,
-                            cm_node *fresh)
+ * target, tree). */
+static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node *saved)
 {
     const uint64_t n = cr->r.nexits;
-    if (fresh) {
-        cr->nodes = fresh;
-        memset(cr->dirty_chunks, 1, n / CM_NODE_CHUNK + 1); /* every chunk is to be saved */
-        c->nnodes += n;
-        return CM_OK;
-    }
     cr->nodes = calloc(n + 1, sizeof *cr->nodes);
     if (!cr->nodes)
         return CM_ENOMEM;
@@ -1083,7 +1076,9 @@ cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, cm_node *nodes, cha
         free(nodes);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     }
-    init_nodes(c, cr, NULL, nodes);
+    cr->nodes = nodes;
+    memset(cr->dirty_chunks, 1, r->nexits / CM_NODE_CHUNK + 1); /* every chunk is to be saved */
+    c->nnodes += r->nexits;
     if (take_cells(c, r, base) != CM_OK) {
         free(cr->nodes);
         free(cr->dirty_chunks);
@@ -1125,7 +1120,7 @@ cm_status cm_cluster_restore(cm_cluster *c, const cm_region *record, const cm_no
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     if (!nodes)
         c->nnodes += record->nexits; /* the table stays in the file until it is used */
-    else if (init_nodes(c, cr, nodes, NULL) != CM_OK)
+    else if (init_nodes(c, cr, nodes) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of a region");
     c->cells += record->ncells;
     return index_region(c, k) == CM_OK && index_nodes(c, k) == CM_OK

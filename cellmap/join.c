@@ -251,10 +251,14 @@ static cm_status link_node(joiner *j, const link_job *job)
     return CM_OK;
 }
 
-/* How many links ahead of the one being made their records are fetched:
- * links touch random nodes and cells of the cluster, each a likely cache
- * miss, so the misses of several links are overlapped. */
-#define PREFETCH 8
+/* How far ahead of the one being read or linked the records of later jobs
+ * are fetched: jobs touch random cells and nodes of the cluster, each a
+ * likely cache miss, so the misses of several jobs overlap. The loops are
+ * short next to a miss, hence the distances; the chain's node is read from
+ * the target's node, which must have arrived by then. */
+#define TARGETS_AHEAD 32
+#define NODES_AHEAD 16
+#define CHAINS_AHEAD 8
 
 static void prefetch_target(const cm_cluster *c, const link_job *job)
 {
@@ -263,32 +267,43 @@ static void prefetch_target(const cm_cluster *c, const link_job *job)
     __builtin_prefetch(&r->step[job->cell]);
 }
 
-/* The records link_node reads first: the node's, and that of the node whose
- * tree its exit lands in. */
-static void prefetch_nodes(const cm_cluster *c, const link_job *job)
+/* The record of node id in region k's table, or NULL if it is paged out. */
+static const cm_node *resident_node(const cm_cluster *c, uint32_t k, uint32_t id)
 {
-    const cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, job->node)];
-    if (cr->nodes)
-        __builtin_prefetch(&cr->nodes[job->node - cr->node_base], 1);
-    if (cm_is_node_ref(job->group)) {
-        const cm_cluster_region *tr = &c->regions[job->region];
-        if (tr->nodes)
-            __builtin_prefetch(&tr->nodes[job->group & ~CM_NODE_REF], 1);
-    }
+    const cm_cluster_region *cr = &c->regions[k];
+    return cr->nodes ? &cr->nodes[id - cr->node_base] : NULL;
 }
 
-/* Then the node the chain of the target's node goes on to (fetched by now). */
+/* The node whose tree the job's exit lands in, or NULL (a final cell, or
+ * a paged-out table). */
+static const cm_node *target_node(const cm_cluster *c, const link_job *job)
+{
+    if (!cm_is_node_ref(job->group))
+        return NULL;
+    return resident_node(c, job->region,
+                         c->regions[job->region].node_base + (job->group & ~CM_NODE_REF));
+}
+
+/* The records link_node reads first: the node's, and the target's node. */
+static void prefetch_nodes(const cm_cluster *c, const link_job *job)
+{
+    const cm_node *nd = resident_node(c, cm_cluster_node_region(c, job->node), job->node);
+    const cm_node *nm = target_node(c, job);
+    if (nd)
+        __builtin_prefetch(nd, 1);
+    if (nm)
+        __builtin_prefetch(nm, 1);
+}
+
+/* Then the node the target's node's chain goes on to. */
 static void prefetch_chain(const cm_cluster *c, const link_job *job)
 {
-    const cm_cluster_region *tr = &c->regions[job->region];
-    if (!cm_is_node_ref(job->group) || !tr->nodes)
-        return;
-    const uint32_t up = tr->nodes[job->group & ~CM_NODE_REF].up;
-    if (up >= CM_NODE_MAX)
-        return;
-    const cm_cluster_region *ur = &c->regions[cm_cluster_node_region(c, up)];
-    if (ur->nodes)
-        __builtin_prefetch(&ur->nodes[up - ur->node_base], 1);
+    const cm_node *nm = target_node(c, job);
+    const cm_node *up = nm && nm->up < CM_NODE_MAX
+                            ? resident_node(c, cm_cluster_node_region(c, nm->up), nm->up)
+                            : NULL;
+    if (up)
+        __builtin_prefetch(up, 1);
 }
 
 /* The group and step of every job's target cell. Jobs stay in node order;
@@ -323,8 +338,8 @@ static cm_status read_targets(joiner *j, link_job *jobs, uint64_t n)
             st = cm_cluster_acquire(c, job->region, j->msg, j->msg_size);
             held = job->region;
         }
-        if (resident && p + 4 * PREFETCH < n) /* random cells: overlap the misses */
-            prefetch_target(c, &jobs[p + 4 * PREFETCH]);
+        if (resident && p + TARGETS_AHEAD < n)
+            prefetch_target(c, &jobs[p + TARGETS_AHEAD]);
         const cm_region *r = &c->regions[job->region].r;
         job->group = st == CM_OK ? r->group[job->cell] : 0;
         job->step = st == CM_OK ? r->step[job->cell] : 0;
@@ -413,10 +428,10 @@ static cm_status link_all(joiner *j)
     if (st == CM_OK)
         st = read_targets(j, jobs, n);
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
-        if (i + 2 * PREFETCH < n)
-            prefetch_nodes(j->c, &jobs[i + 2 * PREFETCH]);
-        if (i + PREFETCH < n)
-            prefetch_chain(j->c, &jobs[i + PREFETCH]);
+        if (i + NODES_AHEAD < n)
+            prefetch_nodes(j->c, &jobs[i + NODES_AHEAD]);
+        if (i + CHAINS_AHEAD < n)
+            prefetch_chain(j->c, &jobs[i + CHAINS_AHEAD]);
         st = link_node(j, &jobs[i]);
     }
     for (uint64_t i = 0; i < n; i++)
@@ -479,12 +494,22 @@ static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
 }
 
 /* Region `next`'s exits that land in the cluster: their regions stay through
- * the trim before the join under way reads (next joins after it). */
-static void pin_expected(cm_cluster *c, const cm_region *next, int pin)
+ * the trim before the join under way (box b of the plan pl, which may be
+ * NULL) reads; next joins after it. Where the exits land among the boxes
+ * of the plan was found when next was solved (targets); the others are
+ * looked up. */
+static void pin_expected(cm_cluster *c, const cm_region *next, const plan *pl,
+                         const plan_target *targets, uint32_t b, int pin)
 {
     if (!c->page_in || c->mem_budget == 0)
         return; /* nothing is evicted */
     for (uint64_t e = 0; next && e < next->nexits; e++) {
+        const plan_target *t = pl && targets ? &targets[e] : NULL;
+        if (t && t->box != PLAN_NONE) { /* box b and later ones are not regions yet */
+            if (t->box < b)
+                c->regions[pl->first + t->box].pinned = pin;
+            continue;
+        }
         uint64_t local;
         const int64_t k = cm_cluster_locate(c, cm_region_exit(next, e), &local);
         if (k >= 0)
@@ -609,14 +634,15 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         c->upcoming = p->boxes + b;
         c->nupcoming = p->nboxes - b;
         c->mem_reserved = solved_ahead(p, b);
-        pin_expected(c, next, 1);
+        const plan *pl = p->pl.index ? &p->pl : NULL;
+        pin_expected(c, next, pl, next ? p->targets[ns] : NULL, b, 1);
         cm_join_stats one_join;
         if (st == CM_OK) {
-            st = join_region(c, &p->slot[s], p->nodes[s], p->pl.index ? &p->pl : NULL, b,
-                             p->targets[s], &one_join, msg, msg_size);
+            st = join_region(c, &p->slot[s], p->nodes[s], pl, b, p->targets[s], &one_join, msg,
+                             msg_size);
             p->nodes[s] = NULL; /* the cluster took it */
         }
-        pin_expected(c, next, 0);
+        pin_expected(c, next, pl, next ? p->targets[ns] : NULL, b, 0);
         c->upcoming++;
         c->nupcoming--;
         if (st == CM_OK && stats)

@@ -99,32 +99,44 @@ static void keep_exit(exit_buf *eb, const int64_t *cell, int dim)
     eb->n++;
 }
 
-/* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1.
- * With eb, the targets of images that leave the box are appended to it. */
+/* The image of cell `from` of the box into *image, by single steps; with
+ * eb, the target of an image that leaves the box is appended to it.
+ * Returns the model's status. */
+static int image_of_cell(const cm_model *model, const cm_lattice *lat, const cm_box *box,
+                         int max_steps, const int64_t *from, exit_buf *eb, uint32_t *image)
+{
+    int64_t cell[CM_MAX_DIM];
+    double x[CM_MAX_DIM];
+    bool in_world;
+    cm_lattice_centre(lat, from, x);
+    const int rc = image_cell(model, lat, from, max_steps, x, cell, &in_world);
+    if (rc < 0)
+        return rc;
+    if (!in_world) {
+        *image = CM_IMAGE_SINK;
+    } else if (cm_box_contains(box, cell)) {
+        *image = (uint32_t)cm_box_index(box, cell);
+    } else {
+        *image = CM_IMAGE_EXIT;
+        if (eb)
+            keep_exit(eb, cell, box->dim);
+    }
+    return 0;
+}
+
+/* Images of one row of the box: cells with local index row*nx .. row*nx+nx-1. */
 static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_region *r,
                          int max_steps, uint64_t row, exit_buf *eb)
 {
     const cm_box *box = &r->box;
     const uint64_t nx = (uint64_t)(box->hi[0] - box->lo[0]);
-    uint32_t *image = r->image + row * nx;
-    int64_t from[CM_MAX_DIM], cell[CM_MAX_DIM];
-    double x[CM_MAX_DIM];
+    int64_t from[CM_MAX_DIM];
     cm_box_cell(box, row * nx, from);
     for (uint64_t i = 0; i < nx; i++, from[0]++) {
-        bool in_world;
-        cm_lattice_centre(lat, from, x);
-        const int rc = image_cell(model, lat, from, max_steps, x, cell, &in_world);
+        const int rc =
+            image_of_cell(model, lat, box, max_steps, from, eb, &r->image[row * nx + i]);
         if (rc < 0)
             return rc;
-        if (!in_world) {
-            image[i] = CM_IMAGE_SINK;
-        } else if (cm_box_contains(box, cell)) {
-            image[i] = (uint32_t)cm_box_index(box, cell);
-        } else {
-            image[i] = CM_IMAGE_EXIT;
-            if (eb)
-                keep_exit(eb, cell, box->dim);
-        }
     }
     return 0;
 }
@@ -223,7 +235,7 @@ static void step_batch(const cm_model *model, const cm_lattice *lat, const cm_bo
 
 /* Images of one row with the model's step_n: as images_of_row gives them,
  * cell for cell. A cell whose image stays in it takes the scalar path
- * (image_cell re-steps it). */
+ * (image_of_cell re-steps it). */
 static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, const cm_region *r,
                                  int max_steps, uint64_t row, exit_buf *eb, batch *b)
 {
@@ -240,19 +252,11 @@ static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, c
                 return b->rc[i];
             if (b->world[i] != 0.0 && b->stays[i] != 0.0 && max_steps > 1) {
                 int64_t here[CM_MAX_DIM];
-                double x[CM_MAX_DIM];
-                bool in_world;
                 memcpy(here, from, sizeof here);
                 here[0] += (int64_t)i;
-                cm_lattice_centre(lat, here, x);
-                const int rc = image_cell(model, lat, here, max_steps, x, cell, &in_world);
+                const int rc = image_of_cell(model, lat, box, max_steps, here, eb, &image[i0 + i]);
                 if (rc < 0)
                     return rc;
-                image[i0 + i] = !in_world                   ? CM_IMAGE_SINK
-                                : cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell)
-                                                             : CM_IMAGE_EXIT;
-                if (image[i0 + i] == CM_IMAGE_EXIT && eb)
-                    keep_exit(eb, cell, box->dim);
             } else if (b->world[i] == 0.0) {
                 image[i0 + i] = CM_IMAGE_SINK;
             } else if (b->in_box[i] != 0.0) {

@@ -335,7 +335,8 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
 typedef struct progress {
     bool show;
     double t0, last;
-    uint64_t total; /* cells the solve is to compute, 0: not known (extension) */
+    uint64_t total; /* cells of the box asked for (extension steps add more:
+                       past them no time left is shown) */
     bool shown;     /* a line is on the terminal */
 } progress;
 
@@ -396,7 +397,7 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     if (st == CM_OK)
         st = cm_scm_images(m, lat, &opt, r, msg, msg_size);
     const double t1 = now_seconds();
-    if (st == CM_OK && whole_progress(p, "classification", 1.0) != 0)
+    if (st == CM_OK && interrupt_requested()) /* classification cannot stop half-way */
         st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     if (st == CM_OK)
         st = cm_scm_classify(r, msg, msg_size);
