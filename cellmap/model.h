@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "cellmap/lattice.h"
+#include "cellmap/numtext.h" /* models print their parameters with it */
 #include "cellmap/overlay.h"
 
 #define CM_MAX_PARAMS 16

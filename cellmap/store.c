@@ -1,5 +1,6 @@
 #include "cellmap/store_db.h"
 
+#include "cellmap/numtext.h"
 #include "cellmap/output.h"
 
 #include <errno.h>
@@ -33,8 +34,9 @@ void store_json_doubles(char *buf, size_t size, const double *v, int n)
 {
     size_t used = 0;
     append(buf, size, &used, "[");
+    char text[CM_NUM_TEXT];
     for (int i = 0; i < n; i++)
-        append(buf, size, &used, "%s%.17g", i ? "," : "", v[i]);
+        append(buf, size, &used, "%s%s", i ? "," : "", cm_num_text(v[i], text));
     append(buf, size, &used, "]");
 }
 
@@ -64,7 +66,8 @@ void cm_params_json(const cm_params *p, char *buf, size_t size)
             append(buf, size, &used, "\"%.*s\"", w ? (int)(end ? (size_t)(end - w) : strlen(w)) : 0,
                    w ? w : "");
         } else if (s->max_count == 1) {
-            append(buf, size, &used, "%.17g", v->v[0]);
+            char text[CM_NUM_TEXT];
+            append(buf, size, &used, "%s", cm_num_text(v->v[0], text));
         } else {
             char tmp[2048];
             store_json_doubles(tmp, sizeof tmp, v->v, v->count);
@@ -718,6 +721,15 @@ int64_t store_query_int(sqlite3 *db, const char *sql)
     return v;
 }
 
+static cm_status shortest_params(char *params, size_t size, char *msg, size_t msg_size)
+{
+    char out[sizeof ((cm_store_info *)0)->params];
+    if (size > sizeof out || !cm_json_numbers_shortest(params, out, size))
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its parameters '%.200s' are too long", params);
+    memcpy(params, out, strlen(out) + 1);
+    return CM_OK;
+}
+
 cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t msg_size)
 {
     memset(info, 0, sizeof *info);
@@ -726,6 +738,8 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
     cm_status st = meta_text(db, "model", info->model, sizeof info->model, msg, msg_size);
     if (st == CM_OK)
         st = meta_text(db, "params", info->params, sizeof info->params, msg, msg_size);
+    if (st == CM_OK) /* older files hold 17 digits; read them as printed now */
+        st = shortest_params(info->params, sizeof info->params, msg, msg_size);
     if (st == CM_OK)
         st = meta_text(db, "command", info->command, sizeof info->command, msg, msg_size);
     if (st == CM_OK)

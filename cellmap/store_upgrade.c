@@ -14,6 +14,7 @@
 
 #include "cellmap/grow.h"
 #include "cellmap/join.h"
+#include "cellmap/numtext.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +35,9 @@ static cm_status groups_text(cm_store *s, char **out, char *msg, size_t msg_size
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
         for (int col = 0; col < 9 && status == CM_OK; col++) {
             const char *v = (const char *)sqlite3_column_text(st, col);
+            char shortest[1024]; /* older versions wrote 17 digits: compare values */
+            if (v && v[0] == '[' && cm_json_numbers_shortest(v, shortest, sizeof shortest))
+                v = shortest;
             const uint64_t n = (v ? strlen(v) : 0) + 1;
             if (cm_grow((void **)&text, &cap, len + n + 1, 1) != CM_OK) {
                 status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading groups");

@@ -151,8 +151,7 @@ static bool listed(const char *name, const char *const *names)
     return false;
 }
 
-void cm_params_format_with(const cm_params *p, int digits, const char *const *skip, char *buf,
-                           size_t size)
+void cm_params_format_with(const cm_params *p, const char *const *skip, char *buf, size_t size)
 {
     size_t used = 0;
     buf[0] = '\0';
@@ -167,8 +166,9 @@ void cm_params_format_with(const cm_params *p, int digits, const char *const *sk
                 choice_name(p->spec[i].choices, (int)p->value[i].v[k], word, sizeof word);
                 used += (size_t)snprintf(buf + used, size - used, "%s", word);
             } else {
-                used += (size_t)snprintf(buf + used, size - used, "%s%.*g", k ? ":" : "", digits,
-                                         p->value[i].v[k]);
+                char text[CM_NUM_TEXT];
+                used += (size_t)snprintf(buf + used, size - used, "%s%s", k ? ":" : "",
+                                         cm_num_text(p->value[i].v[k], text));
             }
         }
     }
@@ -176,5 +176,5 @@ void cm_params_format_with(const cm_params *p, int digits, const char *const *sk
 
 void cm_params_format(const cm_params *p, char *buf, size_t size)
 {
-    cm_params_format_with(p, 17, NULL, buf, size);
+    cm_params_format_with(p, NULL, buf, size);
 }

@@ -22,13 +22,12 @@ int cm_params_find(const cm_params *p, const char *name);
 /* Scalar value of parameter `name` (first element). The name must exist. */
 double cm_params_get(const cm_params *p, const char *name);
 
-/* Writes the values as "name=value,..." (doubles with %.17g) into buf. */
+/* Writes the values as "name=value,..." into buf, each number the shortest
+ * text that reads back as the same double (cm_num_text). */
 void cm_params_format(const cm_params *p, char *buf, size_t size);
 
-/* The same with doubles to `digits` significant digits (6 for titles),
- * leaving out the parameters named in skip, a NULL-terminated list (the
- * swept ones; skip itself may be NULL). */
-void cm_params_format_with(const cm_params *p, int digits, const char *const *skip, char *buf,
-                           size_t size);
+/* The same, leaving out the parameters named in skip, a NULL-terminated
+ * list (the swept ones; skip itself may be NULL). */
+void cm_params_format_with(const cm_params *p, const char *const *skip, char *buf, size_t size);
 
 #endif

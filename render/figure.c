@@ -113,7 +113,7 @@ static void format_title(const cm_model *m, char *out, size_t size)
         used += (size_t)snprintf(out + used, size - used, " %s=", p->spec[k].name);
         for (int i = 0; i < p->value[k].count && used < size; i++)
             used +=
-                (size_t)snprintf(out + used, size - used, "%s%.6g", i ? ":" : "", p->value[k].v[i]);
+                (size_t)snprintf(out + used, size - used, "%s%s", i ? ":" : "", CM_NUM(p->value[k].v[i]));
     }
 }
 

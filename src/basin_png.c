@@ -179,10 +179,10 @@ static void make_provenance(const basin_png *b, const char *view, unsigned layer
     size_t used[3] = {0, 0, 0};
     for (int d = 0; d < lat->dim; d++) { /* every dimension, not only the drawn two */
         const char *sep = d ? "," : "";
-        used[0] += (size_t)snprintf(origin + used[0], sizeof origin - used[0], "%s%.17g", sep,
-                                    lat->origin[d]);
-        used[1] += (size_t)snprintf(width + used[1], sizeof width - used[1], "%s%.17g", sep,
-                                    lat->width[d]);
+        used[0] += (size_t)snprintf(origin + used[0], sizeof origin - used[0], "%s%s", sep,
+                                    CM_NUM(lat->origin[d]));
+        used[1] += (size_t)snprintf(width + used[1], sizeof width - used[1], "%s%s", sep,
+                                    CM_NUM(lat->width[d]));
         used[2] += (size_t)snprintf(counts + used[2], sizeof counts - used[2], "%s%lld",
                                     d ? "x" : "", (long long)(box->hi[d] - box->lo[d]));
     }

@@ -297,13 +297,12 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
     static const cm_rgb colours[3] = {{0, 0, 0}, {30, 60, 200}, {200, 30, 30}};
     static const float sizes[3] = {2, 1, 3};
     static const char *const y_names[3] = {"x stick", "x", "Psi/n"};
-    char params[400], title_params[200], sweep[200], runs[160], titles[3][600];
+    char params[400], sweep[200], runs[160], titles[3][600];
     const char *const swept[] = {a->sweep.name, NULL};
-    cm_params_format_with(base, 17, swept, params, sizeof params);
-    cm_params_format_with(base, 6, swept, title_params, sizeof title_params);
+    cm_params_format_with(base, swept, params, sizeof params);
     param_axes_format(&a->sweep, 1, sweep, sizeof sweep);
     snprintf(titles[0], sizeof titles[0], "sticking displacements (last %d per run), %s %s",
-             LAST_STOPS, a->mo.name, title_params);
+             LAST_STOPS, a->mo.name, params);
     snprintf(titles[1], sizeof titles[1], "Poincare points (phase phi), %d periods per run",
              a->record);
     snprintf(titles[2], sizeof titles[2], "asymmetry Psi per period (thesis 2.6.1)");

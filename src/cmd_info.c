@@ -41,10 +41,10 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     printf("model %s %s\n", info->model, info->params);
     printf("lattice origin (");
     for (int d = 0; d < lat->dim; d++)
-        printf("%s%.17g", d ? ", " : "", lat->origin[d]);
+        printf("%s%s", d ? ", " : "", CM_NUM(lat->origin[d]));
     printf(") cell width (");
     for (int d = 0; d < lat->dim; d++)
-        printf("%s%.17g", d ? ", " : "", lat->width[d]);
+        printf("%s%s", d ? ", " : "", CM_NUM(lat->width[d]));
     printf(")\nmade by: %s\n", info->command);
     printf("regions %u, cells %llu, bounding box", info->regions, (unsigned long long)info->cells);
     for (int d = 0; d < lat->dim; d++)

@@ -122,7 +122,7 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
 {
     char title[512], params[400], grid[200];
     const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
-    cm_params_format_with(p, 17, swept, params, sizeof params);
+    cm_params_format_with(p, swept, params, sizeof params);
     param_axes_format(a->ax, 2, grid, sizeof grid);
     snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d periods", model, a->periods);
     const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};
@@ -190,9 +190,9 @@ int cmd_lyapunov(int argc, char **argv)
     fprintf(report_stream(a.csv, a.png, NULL), "%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", n, secs, computed,
            positive);
     if (!isnan(v[best]))
-        fprintf(report_stream(a.csv, a.png, NULL), "; largest %.6g at %s = %.6g, %s = %.6g", v[best], a.ax[0].name,
-               param_axis_value(&a.ax[0], (int)(best % nx)), a.ax[1].name,
-               param_axis_value(&a.ax[1], (int)(best / nx)));
+        fprintf(report_stream(a.csv, a.png, NULL), "; largest %.6g at %s = %s, %s = %s", v[best], a.ax[0].name,
+               CM_NUM(param_axis_value(&a.ax[0], (int)(best % nx))), a.ax[1].name,
+               CM_NUM(param_axis_value(&a.ax[1], (int)(best / nx))));
     fprintf(report_stream(a.csv, a.png, NULL), "\n");
     if (invalid)
         fprintf(report_stream(a.csv, a.png, NULL), "points where the model cannot be built (S > S0) are not computed\n");

@@ -24,7 +24,7 @@ int cmd_models(int argc, char **argv)
             if (s->choices)
                 printf("    %-6s = %-20s one of %s; %s\n", s->name, s->def, s->choices, s->doc);
             else
-                printf("    %-6s = %-20s [%g, %g]%s; %s\n", s->name, s->def, s->min, s->max,
+                printf("    %-6s = %-20s [%s, %s]%s; %s\n", s->name, s->def, CM_NUM(s->min), CM_NUM(s->max),
                        s->max_count > 1 ? " (vector)" : "", s->doc);
         }
         printf("\n");

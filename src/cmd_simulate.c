@@ -359,10 +359,9 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
         {CM_SERIES_POINTS, d.stop_x, d.stop_v, d.n_stop, stick_green, 7},
         {CM_SERIES_POINTS, d.sec_x, d.sec_v, d.n_sec, black, 5},
     };
-    char params[400], title_params[200], title_top[512], start[160], periods[64];
+    char params[400], title_top[512], start[160], periods[64];
     cm_params_format(&m->values, params, sizeof params);
-    cm_params_format_with(&m->values, 6, NULL, title_params, sizeof title_params);
-    snprintf(title_top, sizeof title_top, "x(t), %s %s", m->name, title_params);
+    snprintf(title_top, sizeof title_top, "x(t), %s %s", m->name, params);
     const int h_top = a->height / 2;
     const cm_chart charts[2] = {
         {a->width,
@@ -390,7 +389,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          figure_font(),
          0},
     };
-    snprintf(start, sizeof start, "t0=%.17g,x=%.17g,v=%.17g", a->t0, a->from[0], a->from[1]);
+    snprintf(start, sizeof start, "t0=%s,x=%s,v=%s", CM_NUM(a->t0), CM_NUM(a->from[0]),
+             CM_NUM(a->from[1]));
     snprintf(periods, sizeof periods, "%d (the first %d not shown)", a->periods, a->skip);
     const cm_png_text texts[] = {
         {"Model", m->name}, {"Parameters", params}, {"Start", start}, {"Periods", periods}};
@@ -403,11 +403,11 @@ static void print_summary(const sim_args *a, const cm_fo_run *r, const cm_fo_tal
                           const double z_prev[2], double psi)
 {
     FILE *out = report_stream(a->csv, a->png, NULL);
-    fprintf(out, "followed %d periods from (x, v) = (%.17g, %.17g) at t = %.17g to t = %.17g\n",
-           a->periods, a->from[0], a->from[1], a->t0, r->t_section);
+    fprintf(out, "followed %d periods from (x, v) = (%s, %s) at t = %s to t = %s\n", a->periods,
+            CM_NUM(a->from[0]), CM_NUM(a->from[1]), CM_NUM(a->t0), CM_NUM(r->t_section));
     fprintf(out, "last period: %d sticks, %d turns, %d breakaways; x in [%.9g, %.9g]\n", last->n_stick,
            last->n_turn, last->n_break, last->x_min, last->x_max);
-    fprintf(out, "Poincare point (%.17g, %.17g)", r->st.x, r->st.v);
+    fprintf(out, "Poincare point (%s, %s)", CM_NUM(r->st.x), CM_NUM(r->st.v));
     if (!isnan(z_prev[0])) {
         const double res = hypot(r->st.x - z_prev[0], r->st.v - z_prev[1]);
         fprintf(out, "; |P(z) - z| = %.3g%s", res, res < 1e-9 ? " (a fixed point of the map)" : "");
@@ -448,9 +448,9 @@ int cmd_simulate(int argc, char **argv)
         fprintf(stderr, "cellmap simulate: out of memory for the trajectory\n");
     else if (!ok)
         fprintf(stderr,
-                "cellmap simulate: the motion could not be followed beyond t = %.17g (more "
+                "cellmap simulate: the motion could not be followed beyond t = %s (more "
                 "than %d events in a period)\n",
-                r.t_section + r.st.s, CM_FO_MAX_EVENTS);
+                CM_NUM(r.t_section + r.st.s), CM_FO_MAX_EVENTS);
     if (ok) {
         print_summary(&a, &r, &last, z_prev, fabs(tr.psi_sum));
         if (a.csv)

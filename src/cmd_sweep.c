@@ -245,7 +245,7 @@ static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_bo
         const char *name = a->name;
         char msg[256];
         if (!model_with_values(&a->mo, &name, &a->values[k], 1, &m, msg, sizeof msg))
-            err = cli_usage_error(c, "--vary: %s = %.17g: %s", a->name, a->values[k], msg);
+            err = cli_usage_error(c, "--vary: %s = %s: %s", a->name, CM_NUM(a->values[k]), msg);
         else
             cm_model_release(&m);
     }
@@ -288,10 +288,10 @@ int cmd_sweep(int argc, char **argv)
                 st = refine_change(&a, &lat, &box, pts[k - 1], pts[k], pts, &n, msg, sizeof msg);
         }
     if (st == CM_OK && !changes)
-        fprintf(report_stream(a.csv, NULL, NULL), "no change of the counts between %s = %.9g and %.9g\n", a.name, a.values[0],
-               a.values[a.n_values - 1]);
+        fprintf(report_stream(a.csv, NULL, NULL), "no change of the counts between %s = %s and %s\n", a.name, CM_NUM(a.values[0]),
+               CM_NUM(a.values[a.n_values - 1]));
     if (st != CM_OK)
-        fprintf(stderr, "cellmap sweep: %s = %.17g: %s\n", a.name, pts[n].value, msg);
+        fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);
     const bool ok = st == CM_OK && (!a.csv || write_csv(&a, pts, n));
     free(pts);
     return ok ? EXIT_OK : EXIT_FAIL;

@@ -282,8 +282,8 @@ static cm_status parse_slice(session *s, const char *text, int64_t *slice, char 
         const double c = floor((v[d - 2] - s->c.lat.origin[d]) / s->c.lat.width[d]);
         if (!(c >= (double)s->depth_lo[d] && c < (double)s->depth_hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "view: %s = %g is outside the session's depth (--depth)", axis_name(d),
-                           v[d - 2]);
+                           "view: %s = %s is outside the session's depth (--depth)", axis_name(d),
+                           CM_NUM(v[d - 2]));
         slice[d] = (int64_t)c;
     }
     return CM_OK;

@@ -42,8 +42,8 @@ void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size)
     size_t used = 0;
     out[0] = 0;
     for (int k = 0; k < n_ax && used < size; k++)
-        used += (size_t)snprintf(out + used, size - used, "%s%s=%.17g:%.17g:%d", k ? "," : "",
-                                 ax[k].name, ax[k].lo, ax[k].hi, ax[k].n);
+        used += (size_t)snprintf(out + used, size - used, "%s%s=%s:%s:%d", k ? "," : "",
+                                 ax[k].name, CM_NUM(ax[k].lo), CM_NUM(ax[k].hi), ax[k].n);
 }
 
 int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
@@ -77,7 +77,7 @@ bool model_with_values(const model_opts *mo, const char *const *names, const dou
     for (int i = 0; i < mo->n_texts; i++)
         texts[k++] = mo->texts[i];
     for (int i = 0; i < n && i < 2; i++) {
-        snprintf(value_text[i], sizeof value_text[i], "%s=%.17g", names[i], values[i]);
+        snprintf(value_text[i], sizeof value_text[i], "%s=%s", names[i], CM_NUM(values[i]));
         texts[k++] = value_text[i];
     }
     return cm_model_create(mo->name, texts, k, m, msg, msg_size) == CM_OK;
