@@ -8,15 +8,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-static bool reads_back(double v, int digits, char buf[CM_NUM_TEXT])
+static bool reads_back(double v, double tol, int digits, char buf[CM_NUM_TEXT])
 {
     snprintf(buf, CM_NUM_TEXT, "%.*g", digits, v);
-    return strtod(buf, NULL) == v;
+    return fabs(strtod(buf, NULL) - v) <= tol;
 }
 
 char *cm_num_text(double v, char buf[CM_NUM_TEXT])
 {
-    if (!isfinite(v) || v == 0) {
+    return cm_num_text_near(v, 0, buf);
+}
+
+char *cm_num_text_near(double v, double tol, char buf[CM_NUM_TEXT])
+{
+    if (tol > 0 && fabs(v) <= tol)
+        v = 0;
+    if (!isfinite(v) || v == 0 || !(tol >= 0)) {
         snprintf(buf, CM_NUM_TEXT, "%g", v);
         return buf;
     }
@@ -25,16 +32,16 @@ char *cm_num_text(double v, char buf[CM_NUM_TEXT])
      * just below a power of two, where a double's rounding interval is
      * lopsided.) 17 digits always read back. */
     int digits = 1;
-    while (digits < 17 && !reads_back(v, digits, buf))
+    while (digits < 17 && !reads_back(v, tol, digits, buf))
         digits++;
-    reads_back(v, digits, buf);
+    reads_back(v, tol, digits, buf);
     /* Whole numbers as people write them: 125000, not 1.25e+05 (%g uses an
      * exponent once it exceeds the digits). Below 2^53 such a number is an
      * exact integer, so printing all its digits adds only zeros. */
     const char *e = strchr(buf, 'e');
     const int exponent = e ? atoi(e + 1) : 0;
     if (e && exponent >= digits && fabs(v) < 9007199254740992.0)
-        reads_back(v, exponent + 1, buf);
+        reads_back(v, tol, exponent + 1, buf);
     return buf;
 }
 

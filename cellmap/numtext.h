@@ -16,6 +16,12 @@ enum { CM_NUM_TEXT = 32 };
 /* Writes the shortest round-trip text of v into buf and returns buf. */
 char *cm_num_text(double v, char buf[CM_NUM_TEXT]);
 
+/* The shortest text of a number within tol of v (tol >= 0; 0: exactly
+ * v): for values known only to a resolution, such as a box's edges
+ * computed from cell indices (0 + 60 * (500 / 60) is 500.00000000000006;
+ * within a billionth of a cell it prints 500) or a duration. */
+char *cm_num_text_near(double v, double tol, char buf[CM_NUM_TEXT]);
+
 /* cm_num_text with a buffer that lives as long as the enclosing block:
  * printf("%s", CM_NUM(x)). */
 #define CM_NUM(v) cm_num_text((v), (char[CM_NUM_TEXT]){0})

@@ -34,7 +34,7 @@ typedef struct cm_output {
     bool to_stdout;
 } cm_output;
 
-/* Whether path names standard output: "-", /dev/stdout, /dev/fd/1 or
+/* Whether path (NULL: none) names standard output: "-", /dev/stdout, /dev/fd/1 or
  * /proc/self/fd/1 (commands then print their reports to stderr). */
 bool cm_output_names_stdout(const char *path);
 

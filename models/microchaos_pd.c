@@ -219,7 +219,7 @@ static void overlays_pd(const cm_model *m, const double lo[2], const double hi[2
     cm_pd_overlays(c->alpha2, c->beta, c->P, c->D, lo, hi, out);
 }
 
-const char *const cm_pd_coord_names[] = {"x", "x'"};
+const char *const cm_pd_coord_names[] = {"x", "v"}; /* v: x', the dimensionless velocity */
 
 static int fixed_points_pd(const cm_model *m, int64_t m0, int64_t m1, cm_fixed_point *out,
                            size_t cap, size_t *count, char *msg, size_t msg_size)

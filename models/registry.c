@@ -16,23 +16,23 @@
 #define CM_FO_REGION "-3:3,-3:3"
 
 static const cm_model_entry entries[] = {
-    {"microchaos-1d", "x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
+    {"microchaos-1d", "x = x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
      cm_microchaos_1d_spec, cm_microchaos_1d_create},
-    {"microchaos-1d-friction", "x_j", "1D transient micro-chaos map with Coulomb friction (4.23)",
+    {"microchaos-1d-friction", "x = x_j", "1D transient micro-chaos map with Coulomb friction (4.23)",
      "-2:2", cm_microchaos_1d_friction_spec, cm_microchaos_1d_friction_create},
-    {"microchaos-delay", "x_{j-1}, x_j", "2D micro-chaos map with delay (4.37)", "-6:6,-6:6",
+    {"microchaos-delay", "x_lag1 = x_{j-1}, x = x_j", "2D micro-chaos map with delay (4.37)", "-6:6,-6:6",
      cm_microchaos_delay_spec, cm_microchaos_delay_create},
-    {"microchaos-pd", "x, x'", "PD-controlled inverted pendulum, output quantisation (4.66)",
+    {"microchaos-pd", "x, v = x' (dimensionless velocity)", "PD-controlled inverted pendulum, output quantisation (4.66)",
      CM_PD_EXAMPLE_REGION, cm_microchaos_pd_spec, cm_microchaos_pd_create},
-    {"microchaos-pd-twofold", "x, x'", "PD map with twofold (input and output) quantisation (4.84)",
+    {"microchaos-pd-twofold", "x, v = x' (dimensionless velocity)", "PD map with twofold (input and output) quantisation (4.84)",
      CM_PD_EXAMPLE_REGION, cm_microchaos_pd_twofold_spec, cm_microchaos_pd_twofold_create},
-    {"microchaos-pd-friction", "x, x'",
+    {"microchaos-pd-friction", "x, v = x' (dimensionless velocity)",
      "PD map with dry friction: hybrid micro-chaos map, sticking zones (4.81)",
      CM_PD_FRICTION_REGION, cm_microchaos_pd_friction_spec, cm_microchaos_pd_friction_create},
-    {"microchaos-general", "x_{j-d}, ..., x_j",
+    {"microchaos-general", "x_lagd = x_{j-d}, ..., x_lag1 = x_{j-1}, x = x_j (d: the delay)",
      "n-D micro-chaos map with delays; output, input or twofold quantisation (4.9, C.14, C.17)",
      NULL, cm_microchaos_general_spec, cm_microchaos_general_create},
-    {"friction-oscillator", "x, v",
+    {"friction-oscillator", "x, v (position and velocity at the section)",
      "Poincare map of the harmonically excited oscillator with dry friction (2.3), docs/models.md 9",
      CM_FO_REGION, cm_friction_oscillator_spec, cm_friction_oscillator_create},
 };
@@ -78,6 +78,11 @@ cm_status cm_model_create(const char *name, const char *const *texts, int n_text
         st = cm_params_set(&p, texts[i], msg, msg_size);
     if (st == CM_OK)
         st = e->create(&p, m, msg, msg_size);
+    /* Maps of delayed values name their state after the lags: ..., x_lag1, x */
+    static const char *const lag_names[CM_MAX_DIM] = {"x_lag5", "x_lag4", "x_lag3",
+                                                      "x_lag2", "x_lag1", "x"};
+    if (st == CM_OK && !m->coord_names && m->dim >= 1 && m->dim <= CM_MAX_DIM)
+        m->coord_names = lag_names + (CM_MAX_DIM - m->dim);
     if (st != CM_OK)
         cm_model_release(m);
     return st;

@@ -6,7 +6,7 @@
 
 typedef struct cm_model_entry {
     const char *name;
-    const char *state;   /* what the state vector holds */
+    const char *state;   /* what the state vector holds, by its coordinates' names */
     const char *doc;     /* one line, with the thesis equation */
     const char *region;  /* default region LO:HI,... for the defaults, or NULL */
     const cm_param_spec *params;

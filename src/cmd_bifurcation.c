@@ -21,8 +21,8 @@
 static const char bifurcation_help[] =
     "usage: cellmap bifurcation [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                           --sweep NAME=LO:HI:N [--runs R] [--transient P] [--record n]\n"
-    "                           [--seed K] [--csv FILE] [--runs-csv FILE] [--png FILE]\n"
-    "                           [--size WxH] [--threads T]\n\n"
+    "                           [--seed K] [--csv FILE|-] [--runs-csv FILE|-] [--png FILE]\n"
+    "                           [--json] [--size WxH] [--threads T]\n\n"
     "The Monte Carlo bifurcation diagram of the dry friction oscillator (thesis\n"
     "2.6.1, Fig. 2.22). Parameter NAME takes N values, the centres of N equal\n"
     "cells of LO..HI. For each, R runs start from random x(t0) in [-1, 1],\n"
@@ -37,6 +37,7 @@ static const char bifurcation_help[] =
     "  --transient P       periods left out, 0..1000000 (default 1000)\n"
     "  --record n          periods recorded, 1..10000 (default 50)\n"
     "  --seed K            seed of the initial conditions (default 1)\n"
+    "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
     "  --csv FILE          NAME,run,kind,x,v: kind stick (the last ten sticking\n"
     "                      displacements, v = 0) or section (the Poincare points)\n"
     "  --runs-csv FILE     NAME,run,x0,v0,t0,psi,psi_per_period,sticks_per_period,status\n"
@@ -54,6 +55,7 @@ typedef struct bif_args {
     int has_sweep, runs, transient, record, threads, width, height;
     long long seed;
     const char *csv, *runs_csv, *png;
+    bool json;
 } bif_args;
 
 static int parse_args(cli *c, bif_args *a)
@@ -86,6 +88,8 @@ static int parse_args(cli *c, bif_args *a)
             a->runs_csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
         } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
@@ -93,8 +97,13 @@ static int parse_args(cli *c, bif_args *a)
     }
     if (!err && !a->has_sweep)
         err = cli_usage_error(c, "--sweep NAME=LO:HI:N is required (e.g. --sweep S=0.02:0.4:190)");
-    if (!err && !a->csv && !a->runs_csv && !a->png)
-        err = cli_usage_error(c, "nothing to write: give --csv, --runs-csv and/or --png FILE");
+    if (!err && !a->csv && !a->runs_csv && !a->png && !a->json)
+        err = cli_usage_error(c,
+                              "nothing to write: give --csv, --runs-csv and/or --png FILE, or --json");
+    if (!err && a->json &&
+        (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->runs_csv) ||
+         cm_output_names_stdout(a->png)))
+        err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && (double)a->sweep.n * a->runs * a->record > 1e7)
         err = cli_usage_error(c,
                               "%d values x %d runs x %d recorded periods is more than 1e7 "
@@ -342,9 +351,9 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
     return ok;
 }
 
-static void print_summary(const bif_args *a, const sweep_results *s, double secs)
+static void print_summary(const bif_args *a, const cm_params *base, const sweep_results *s,
+                          double secs)
 {
-    FILE *out = report_stream(a->csv, a->runs_csv, a->png);
     int valid = 0, lost = 0;
     double psi_lo = INFINITY, psi_hi = -INFINITY;
     for (int i = 0; i < s->n_values; i++)
@@ -357,6 +366,25 @@ static void print_summary(const bif_args *a, const sweep_results *s, double secs
                 psi_hi = fmax(psi_hi, res->psi / s->record);
             }
         }
+    if (a->json) {
+        json j;
+        json_begin(&j, stdout, "bifurcation");
+        param_base_json(&j, a->mo.name, base);
+        param_axes_json(&j, "sweep", &a->sweep, 1);
+        json_int(&j, "runs", s->runs);
+        json_int(&j, "transient", a->transient);
+        json_int(&j, "record", a->record);
+        json_int(&j, "seed", a->seed);
+        json_int(&j, "followed", valid - lost);
+        json_int(&j, "lost", lost);
+        json_int(&j, "not_computed", s->n_values * s->runs - valid);
+        if (psi_lo <= psi_hi)
+            json_nums(&j, "psi_per_period", (const double[2]){psi_lo, psi_hi}, 2);
+        json_seconds(&j, "seconds", secs);
+        json_end(&j);
+        return;
+    }
+    FILE *out = report_stream(a->csv, a->runs_csv, a->png);
     fprintf(out, "%d values of %s x %d runs in %.2f s: %d runs followed, %d lost", s->n_values,
            a->sweep.name, s->runs, secs, valid - lost, lost);
     if (psi_lo <= psi_hi)
@@ -427,7 +455,7 @@ int cmd_bifurcation(int argc, char **argv)
             run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k],
                 s.sections + k * 2 * (size_t)a.record);
     }
-    print_summary(&a, &s, omp_get_wtime() - t0);
+    print_summary(&a, &base, &s, omp_get_wtime() - t0);
     bool ok = n_valid > 0;
     if (!ok)
         fprintf(stderr,

@@ -44,6 +44,7 @@ typedef struct cell_out {
     sqlite3_stmt *insert;
     uint64_t rows;
     long shape_at; /* .npy: where the row count is written at the end */
+    const char *const *names; /* the state coordinates' names */
 } cell_out;
 
 typedef struct export_args {
@@ -126,10 +127,10 @@ static int npy_header(cell_out *o, int dim)
     size_t used = 0;
     for (int d = 0; d < dim; d++)
         used +=
-            (size_t)snprintf(descr + used, sizeof descr - used, "('i%s', '<i8'), ", axis_name(d));
+            (size_t)snprintf(descr + used, sizeof descr - used, "('i%s', '<i8'), ", o->names[d]);
     for (int d = 0; d < dim; d++)
         used +=
-            (size_t)snprintf(descr + used, sizeof descr - used, "('%s', '<f8'), ", axis_name(d));
+            (size_t)snprintf(descr + used, sizeof descr - used, "('%s', '<f8'), ", o->names[d]);
     snprintf(descr + used, sizeof descr - used,
              "('grp', '<u4'), ('step', '<u4'), ('periodic', '|u1')");
     char header[1024];
@@ -150,9 +151,9 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     char sql[1024];
     size_t used = (size_t)snprintf(sql, sizeof sql, "CREATE TABLE cells(");
     for (int d = 0; d < dim; d++)
-        used += (size_t)snprintf(sql + used, sizeof sql - used, "i%s INTEGER, ", axis_name(d));
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "i%s INTEGER, ", o->names[d]);
     for (int d = 0; d < dim; d++)
-        used += (size_t)snprintf(sql + used, sizeof sql - used, "%s REAL, ", axis_name(d));
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "%s REAL, ", o->names[d]);
     snprintf(sql + used, sizeof sql - used,
              "grp INTEGER, step INTEGER, periodic INTEGER);"
              "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
@@ -200,9 +201,9 @@ static int out_begin(cell_out *o, int dim, const cm_store_info *info, char *msg,
     if (o->kind == OUT_NPY)
         return npy_header(o, dim);
     for (int d = 0; d < dim; d++)
-        fprintf(o->f, "i%s,", axis_name(d));
+        fprintf(o->f, "i%s,", o->names[d]);
     for (int d = 0; d < dim; d++)
-        fprintf(o->f, "%s,", axis_name(d));
+        fprintf(o->f, "%s,", o->names[d]);
     return fprintf(o->f, "grp,step,periodic\n") > 0;
 }
 
@@ -335,13 +336,15 @@ static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 
 /* ---- what is exported ------------------------------------------------- */
 
-static int export_groups(const char *path, const cm_lattice *lat, const cm_group_info *g,
-                         uint32_t n, uint64_t sink, char *msg, size_t msg_size)
+static int export_groups(const char *path, const char *const *names, const cm_lattice *lat,
+                         const cm_group_info *g, uint32_t n, uint64_t sink, char *msg,
+                         size_t msg_size)
 {
     cell_out o;
     memset(&o, 0, sizeof o);
     o.kind = OUT_CSV;
     o.path = path;
+    o.names = names;
     if (cm_output_begin(&o.out, path, false, msg, msg_size) != CM_OK)
         return 0;
     if (!(o.f = fopen(o.out.tmp, "w"))) {
@@ -352,7 +355,7 @@ static int export_groups(const char *path, const cm_lattice *lat, const cm_group
     fprintf(o.f, "id,period,basin_cells,is_sink");
     for (int p = 0; p < 4; p++)
         for (int d = 0; d < lat->dim; d++)
-            fprintf(o.f, ",%s%s", parts[p], axis_name(d));
+            fprintf(o.f, ",%s%s", parts[p], names[d]);
     fprintf(o.f, ",kind\n0,1,%llu,1", (unsigned long long)sink);
     for (int k = 0; k < 4 * lat->dim; k++)
         fprintf(o.f, ",");
@@ -426,14 +429,17 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         free(g);
         return EXIT_FAIL;
     }
+    const char *names[CM_MAX_DIM];
+    project_state_names(info, names);
     int rc = EXIT_OK;
-    if (a->groups && !export_groups(a->groups, &c->lat, g, info->groups, sink, msg, sizeof msg)) {
+    if (a->groups && !export_groups(a->groups, names, &c->lat, g, info->groups, sink, msg, sizeof msg)) {
         fprintf(stderr, "cellmap export: %s\n", msg);
         rc = EXIT_FAIL;
     }
     cell_out outs[2];
     int nouts = 0;
     memset(outs, 0, sizeof outs);
+    outs[0].names = outs[1].names = names;
     if (a->cells) {
         outs[nouts].kind = ends_with(a->cells, ".npy") ? OUT_NPY : OUT_CSV;
         outs[nouts++].path = a->cells;

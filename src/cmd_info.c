@@ -6,6 +6,7 @@
 
 #include "src/args.h"
 #include "src/commands.h"
+#include "src/json.h"
 #include "src/project.h"
 
 static const char info_help[] =
@@ -73,22 +74,34 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
            (double)(info->cells * 12) / 1048576.0, (double)largest_region / 1048576.0);
 }
 
-static void print_json(const cm_store_info *info, const cm_box *bounds, const cm_group_info *g,
-                       uint64_t sink)
+static void print_json(const char *path, const cm_store_info *info, const cm_box *bounds,
+                       const cm_group_info *g, uint64_t sink)
 {
-    printf("{\"format\":%d,\"tool_version\":\"%s\",\"model\":\"%s\","
-           "\"params\":%s,\"regions\":%u,\"cells\":%llu,\"bounding_box\":[",
-           info->version, info->tool_version, info->model, info->params, info->regions,
-           (unsigned long long)info->cells);
-    for (int d = 0; d < bounds->dim; d++)
-        printf("%s[%lld,%lld]", d ? "," : "", (long long)bounds->lo[d], (long long)bounds->hi[d]);
-    printf("],\"sink_cells\":%llu,\"file_bytes\":%llu,\"page_bytes\":%llu,\"groups\":[",
-           (unsigned long long)sink, (unsigned long long)info->file_bytes,
-           (unsigned long long)info->page_bytes);
-    for (uint32_t k = 0; k < info->groups; k++)
-        printf("%s{\"id\":%u,\"period\":%u,\"basin\":%llu}", k ? "," : "", g[k].id, g[k].period,
-               (unsigned long long)g[k].basin_cells);
-    printf("]}\n");
+    json j;
+    json_begin(&j, stdout, "info");
+    json_str(&j, "file", path);
+    json_int(&j, "format", info->version);
+    json_str(&j, "tool_version", info->tool_version);
+    cm_model m;
+    char msg[512];
+    if (model_of_store(info, &m, msg, sizeof msg) == CM_OK) {
+        json_model(&j, &m);
+        cm_model_release(&m);
+    } else { /* a model this cellmap does not know: its name and parameters as written */
+        json_str(&j, "model", info->model);
+        json_raw(&j, "params", info->params);
+    }
+    json_lattice(&j, &info->lattice);
+    json_str(&j, "made_by", info->command);
+    json_uint(&j, "regions", info->regions);
+    json_uint(&j, "cells", info->cells);
+    json_box(&j, "box", &info->lattice, bounds);
+    json_uint(&j, "box_cells", cm_box_cells(bounds));
+    json_uint(&j, "sink_cells", sink);
+    json_uint(&j, "file_bytes", info->file_bytes);
+    json_uint(&j, "page_bytes", info->page_bytes);
+    json_groups(&j, g, info->groups, &info->lattice);
+    json_end(&j);
 }
 
 int cmd_info(int argc, char **argv)
@@ -136,7 +149,7 @@ int cmd_info(int argc, char **argv)
             largest = bytes > largest ? bytes : largest;
         }
         if (json) {
-            print_json(&info, &bounds, g, sink);
+            print_json(path, &info, &bounds, g, sink);
         } else {
             qsort(g, info.groups, sizeof *g, larger_basin_first);
             print_text(path, &info, &bounds, g, sink, largest);

@@ -17,7 +17,7 @@
 static const char lyapunov_help[] =
     "usage: cellmap lyapunov [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X,V]\n"
-    "                        [--csv FILE] [--png FILE] [--size WxH] [--threads T]\n\n"
+    "                        [--csv FILE|-] [--png FILE] [--json] [--size WxH] [--threads T]\n\n"
     "The largest Lyapunov exponent of the dry friction oscillator (thesis 2.5.3)\n"
     "at the centres of an N x M grid of parameters X and Y (e.g. Omega and S at\n"
     "fixed S0, as Figs. 2.20-2.21), by the renormalised two-trajectory\n"
@@ -28,7 +28,8 @@ static const char lyapunov_help[] =
     "  --periods P         excitation periods per point (default 600, the thesis')\n"
     "  --d0 D              initial separation, >= 1e-9 (default 1e-8)\n"
     "  --from X,V          start at phase 0 (default the thesis': 1 + 0.9 S0, 0)\n"
-    "  --csv FILE          X,Y,lambda per grid point (%.17g; nan: not computed)\n"
+    "  --csv FILE|-        X,Y,lambda per grid point (%.17g; nan: not computed)\n"
+    "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
     "  --png FILE          heat map; only positive exponents are coloured\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
@@ -39,6 +40,7 @@ typedef struct lyap_args {
     int has_grid, periods, threads, width, height, has_from;
     double d0, from[2];
     const char *csv, *png;
+    bool json;
 } lyap_args;
 
 static int parse_args(cli *c, lyap_args *a)
@@ -74,6 +76,8 @@ static int parse_args(cli *c, lyap_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
         } else if (cli_take_size(c, 200, 150, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
@@ -81,8 +85,10 @@ static int parse_args(cli *c, lyap_args *a)
     }
     if (!err && !a->has_grid)
         err = cli_usage_error(c, "--grid X=LO:HI:N,Y=LO:HI:M is required");
-    if (!err && !a->csv && !a->png)
-        err = cli_usage_error(c, "nothing to write: give --csv FILE and/or --png FILE");
+    if (!err && !a->csv && !a->png && !a->json)
+        err = cli_usage_error(c, "nothing to write: give --csv FILE, --png FILE and/or --json");
+    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
+        err = cli_usage_error(c, "--json and an output to standard output: choose one");
     return err;
 }
 
@@ -148,6 +154,50 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
     return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 
+typedef struct summary {
+    size_t points, computed, positive, best;
+    double seconds;
+    bool invalid; /* some points could not be built (S > S0) */
+} summary;
+
+static void print_text(const lyap_args *a, const double *v, const summary *s)
+{
+    FILE *out = report_stream(a->csv, a->png, NULL);
+    const size_t nx = (size_t)a->ax[0].n;
+    fprintf(out, "%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", s->points,
+            s->seconds, s->computed, s->positive);
+    if (!isnan(v[s->best]))
+        fprintf(out, "; largest %.6g at %s = %s, %s = %s", v[s->best], a->ax[0].name,
+                CM_NUM(param_axis_value(&a->ax[0], (int)(s->best % nx))), a->ax[1].name,
+                CM_NUM(param_axis_value(&a->ax[1], (int)(s->best / nx))));
+    fprintf(out, "\n");
+    if (s->invalid)
+        fprintf(out, "points where the model cannot be built (S > S0) are not computed\n");
+}
+
+static void print_json(const lyap_args *a, const cm_params *base, const double *v,
+                       const summary *s)
+{
+    const size_t nx = (size_t)a->ax[0].n;
+    json j;
+    json_begin(&j, stdout, "lyapunov");
+    param_base_json(&j, a->mo.name, base);
+    param_axes_json(&j, "grid", a->ax, 2);
+    json_int(&j, "periods", a->periods);
+    json_uint(&j, "points", s->points);
+    json_uint(&j, "computed", s->computed);
+    json_uint(&j, "positive", s->positive);
+    if (!isnan(v[s->best])) {
+        json_object(&j, "largest");
+        json_num(&j, "lambda", v[s->best]);
+        json_num(&j, a->ax[0].name, param_axis_value(&a->ax[0], (int)(s->best % nx)));
+        json_num(&j, a->ax[1].name, param_axis_value(&a->ax[1], (int)(s->best / nx)));
+        json_object_end(&j);
+    }
+    json_seconds(&j, "seconds", s->seconds);
+    json_end(&j);
+}
+
 int cmd_lyapunov(int argc, char **argv)
 {
     cli c = {"lyapunov", argc, argv, 0, NULL, NULL};
@@ -187,15 +237,11 @@ int cmd_lyapunov(int argc, char **argv)
         if (!(v[best] >= v[k]))
             best = k;
     }
-    fprintf(report_stream(a.csv, a.png, NULL), "%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", n, secs, computed,
-           positive);
-    if (!isnan(v[best]))
-        fprintf(report_stream(a.csv, a.png, NULL), "; largest %.6g at %s = %s, %s = %s", v[best], a.ax[0].name,
-               CM_NUM(param_axis_value(&a.ax[0], (int)(best % nx))), a.ax[1].name,
-               CM_NUM(param_axis_value(&a.ax[1], (int)(best / nx))));
-    fprintf(report_stream(a.csv, a.png, NULL), "\n");
-    if (invalid)
-        fprintf(report_stream(a.csv, a.png, NULL), "points where the model cannot be built (S > S0) are not computed\n");
+    const summary sum = {n, computed, positive, best, secs, invalid != 0};
+    if (a.json)
+        print_json(&a, &base, v, &sum);
+    else
+        print_text(&a, v, &sum);
     bool ok = computed > 0;
     if (!ok)
         fprintf(stderr,

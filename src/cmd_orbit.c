@@ -1,76 +1,152 @@
+/* cellmap orbit: x_0 .. x_N of a model, at full precision. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "models/registry.h"
 #include "src/args.h"
 #include "src/commands.h"
+#include "src/json.h"
+#include "src/outfile.h"
 
 static const char orbit_help[] =
-    "usage: cellmap orbit --model NAME [--param k=v[,k=v]] --from X[,Y...] --steps N\n\n"
-    "Prints the orbit x_0 .. x_N as CSV (j,x0,x1,...) with %.17g, so any\n"
-    "implementation can be checked against it. Stops early (exit 0) when the\n"
-    "map has no image (the sink); the last line then says so in a comment.\n";
+    "usage: cellmap orbit --model NAME [--param k=v[,k=v]] --from X[,Y...] --steps N\n"
+    "                     [--csv FILE|-] [--json]\n\n"
+    "Prints the orbit x_0 .. x_N as CSV (j and the state's coordinates, named as\n"
+    "`cellmap models` gives them) with %.17g, so any implementation can be checked\n"
+    "against it: to standard output, or to FILE with --csv. --json prints one JSON\n"
+    "document instead (\"points\", and \"end\": \"steps\" or \"sink\"). Stops early\n"
+    "(exit 0) when the map has no image (the sink); the CSV's last line then says\n"
+    "so in a comment.\n";
 
-int cmd_orbit(int argc, char **argv)
-{
-    cli c = {"orbit", argc, argv, 0, NULL, NULL};
-    model_opts mo = {"microchaos-pd", {0}, 0};
+typedef struct orbit_args {
+    model_opts mo;
     double from[CM_MAX_DIM];
-    int n_from = 0, err = 0;
-    int64_t steps = -1;
-    while (cli_next(&c) && !err) {
-        if (strcmp(c.opt, "--help") == 0) {
+    int n_from;
+    int64_t steps;
+    const char *csv;
+    bool json;
+} orbit_args;
+
+/* 0: go on; -1: --help was printed; else the usage error. */
+static int parse_args(cli *c, orbit_args *a)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
             fputs(orbit_help, stdout);
-            return EXIT_OK;
-        } else if (model_opts_take(&c, &mo, &err)) {
-        } else if (cli_is(&c, "--from", true, &err)) {
-            if (c.value && !parse_doubles(c.value, from, &n_from, CM_MAX_DIM))
-                err =
-                    cli_usage_error(&c, "--from: '%s' is not a list of numbers X[,Y...]", c.value);
-        } else if (cli_is(&c, "--steps", true, &err)) {
-            if (c.value && (!parse_int64(c.value, &steps) || steps < 0 || steps > 100000000))
-                err = cli_usage_error(&c, "--steps: '%s' must be an integer in 0..1e8", c.value);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (cli_is(c, "--from", true, &err)) {
+            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
+                err = cli_usage_error(c, "--from: '%s' is not a list of numbers X[,Y...]",
+                                      c->value);
+        } else if (cli_is(c, "--steps", true, &err)) {
+            if (c->value &&
+                (!parse_int64(c->value, &a->steps) || a->steps < 0 || a->steps > 100000000))
+                err = cli_usage_error(c, "--steps: '%s' must be an integer in 0..1e8", c->value);
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
         } else {
-            err = cli_usage_error(&c, "unknown option '%s'", c.opt);
+            err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
-    if (err)
-        return err;
-    if (n_from == 0 || steps < 0)
-        return cli_usage_error(&c, "--from and --steps are required");
-    cm_model m;
-    if ((err = model_opts_build(&c, &mo, &m)) != EXIT_OK)
-        return err;
-    if (n_from != m.dim) {
-        cm_model_release(&m);
-        return cli_usage_error(&c, "--from has %d value(s) but model %s has dimension %d", n_from,
-                               m.name ? m.name : mo.name, m.dim);
-    }
+    if (!err && (a->n_from == 0 || a->steps < 0))
+        err = cli_usage_error(c, "--from and --steps are required");
+    if (!err && a->json && a->csv)
+        err = cli_usage_error(c, "--json and --csv: choose one");
+    return err;
+}
+
+/* Follows the orbit, writing CSV to f or JSON points to j. */
+static int follow(const orbit_args *a, const cm_model *m, FILE *f, json *j)
+{
     double x[CM_MAX_DIM], y[CM_MAX_DIM];
-    memcpy(x, from, sizeof x);
-    printf("j");
-    for (int d = 0; d < m.dim; d++)
-        printf(",x%d", d);
-    printf("\n");
+    memcpy(x, a->from, sizeof x);
+    if (f) {
+        fprintf(f, "j");
+        for (int d = 0; d < m->dim; d++)
+            fprintf(f, ",%s", cm_model_coord_name(m, d));
+        fprintf(f, "\n");
+    } else {
+        json_array(j, "points");
+    }
+    const char *end = "steps";
     int status = EXIT_OK;
-    for (int64_t j = 0; j <= steps; j++) {
-        printf("%lld", (long long)j);
-        for (int d = 0; d < m.dim; d++)
-            printf(",%.17g", x[d]);
-        printf("\n");
-        if (j == steps)
+    for (int64_t step = 0; step <= a->steps; step++) {
+        if (f) {
+            fprintf(f, "%lld", (long long)step);
+            for (int d = 0; d < m->dim; d++)
+                fprintf(f, ",%.17g", x[d]);
+            fprintf(f, "\n");
+        } else {
+            json_nums(j, NULL, x, m->dim);
+        }
+        if (step == a->steps)
             break;
-        const int rc = m.step(&m, x, y);
+        const int rc = m->step(m, x, y);
         if (rc > 0) {
-            printf("# no image after step %lld (the sink)\n", (long long)j);
+            end = "sink";
+            if (f)
+                fprintf(f, "# no image after step %lld (the sink)\n", (long long)step);
             break;
         }
         if (rc < 0) {
-            fprintf(stderr, "cellmap orbit: the model aborted at step %lld\n", (long long)j);
+            fprintf(stderr, "cellmap orbit: the model aborted at step %lld\n", (long long)step);
             status = EXIT_FAIL;
             break;
         }
         memcpy(x, y, sizeof x);
+    }
+    if (j) {
+        json_array_end(j);
+        json_str(j, "end", end);
+    }
+    return status;
+}
+
+int cmd_orbit(int argc, char **argv)
+{
+    cli c = {"orbit", argc, argv, 0, NULL, NULL};
+    orbit_args a;
+    memset(&a, 0, sizeof a);
+    a.mo.name = "microchaos-pd";
+    a.steps = -1;
+    int err = parse_args(&c, &a);
+    if (err)
+        return err < 0 ? EXIT_OK : err;
+    if (!outfile_check("orbit", a.csv))
+        return EXIT_FAIL;
+    cm_model m;
+    if ((err = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
+        return err;
+    if (a.n_from != m.dim) {
+        err = cli_usage_error(&c, "--from has %d value(s) but model %s has dimension %d",
+                              a.n_from, m.name, m.dim);
+        cm_model_release(&m);
+        return err;
+    }
+    int status;
+    if (a.json) {
+        json j;
+        json_begin(&j, stdout, "orbit");
+        json_model(&j, &m);
+        json_nums(&j, "from", a.from, m.dim);
+        json_int(&j, "steps", a.steps);
+        status = follow(&a, &m, NULL, &j);
+        json_end(&j);
+    } else if (!a.csv) {
+        status = follow(&a, &m, stdout, NULL);
+    } else {
+        outfile o;
+        status = EXIT_FAIL;
+        if (outfile_open("orbit", a.csv, &o)) {
+            status = follow(&a, &m, o.f, NULL);
+            if (!outfile_close("orbit", &o, status == EXIT_OK))
+                status = EXIT_FAIL;
+        }
     }
     cm_model_release(&m);
     return status;

@@ -13,12 +13,13 @@
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
+#include "src/json.h"
 #include "src/outfile.h"
 
 static const char simulate_help[] =
     "usage: cellmap simulate [--model friction-oscillator] [--param k=v[,k=v]] [--from X,V]\n"
-    "                        [--t0 T0] [--periods N] [--skip P] [--csv FILE] [--png FILE]\n"
-    "                        [--size WxH]\n\n"
+    "                        [--t0 T0] [--periods N] [--skip P] [--csv FILE|-] [--png FILE]\n"
+    "                        [--json] [--size WxH]\n\n"
     "A trajectory of the dry friction oscillator x'' + x = cos(Omega t) - S f(x')\n"
     "(thesis eq. (2.3)) from (x, x') = (X, V) at time T0, followed exactly\n"
     "(docs/models.md 9) up to the N-th section instant (forcing phase phi) after T0.\n"
@@ -27,6 +28,7 @@ static const char simulate_help[] =
     "  --t0 T0             the initial time (default phi/Omega, a section instant)\n"
     "  --periods N         periods to follow, 1..100000 (default 20)\n"
     "  --skip P            periods left out of the CSV, the PNG and Psi (transients)\n"
+    "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
     "  --csv FILE          t,x,v,kind: the start, every stick, breakaway and turn, and\n"
     "                      the section point ending each period (%.17g)\n"
     "  --png FILE          top: x(t) with the sticking region |x - cos(Omega t)| < S0\n"
@@ -39,6 +41,7 @@ typedef struct sim_args {
     double from[2], t0;
     int has_t0, periods, skip, width, height;
     const char *csv, *png;
+    bool json;
 } sim_args;
 
 static int parse_args(cli *c, sim_args *a)
@@ -64,11 +67,15 @@ static int parse_args(cli *c, sim_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
         } else if (cli_take_size(c, 300, 400, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
+    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
+        err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && a->skip >= a->periods)
         err = cli_usage_error(c, "--skip %d leaves nothing of %d periods to show", a->skip,
                               a->periods);
@@ -399,9 +406,38 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
     return ok;
 }
 
-static void print_summary(const sim_args *a, const cm_fo_run *r, const cm_fo_tally *last,
-                          const double z_prev[2], double psi)
+static void print_json(const sim_args *a, const cm_model *m, const cm_fo_run *r,
+                       const cm_fo_tally *last, const double z_prev[2], double psi)
 {
+    json j;
+    json_begin(&j, stdout, "simulate");
+    json_model(&j, m);
+    json_nums(&j, "from", a->from, 2);
+    json_num(&j, "t0", a->t0);
+    json_int(&j, "periods", a->periods);
+    json_int(&j, "skip", a->skip);
+    json_num(&j, "t_end", r->t_section);
+    json_object(&j, "last_period");
+    json_int(&j, "sticks", last->n_stick);
+    json_int(&j, "turns", last->n_turn);
+    json_int(&j, "breakaways", last->n_break);
+    json_nums(&j, "x_range", (const double[2]){last->x_min, last->x_max}, 2);
+    json_object_end(&j);
+    json_nums(&j, "poincare_point", (const double[2]){r->st.x, r->st.v}, 2);
+    if (!isnan(z_prev[0]))
+        json_num(&j, "fixed_point_residual", hypot(r->st.x - z_prev[0], r->st.v - z_prev[1]));
+    json_num(&j, "psi", psi);
+    json_num(&j, "psi_per_period", psi / (a->periods - a->skip));
+    json_end(&j);
+}
+
+static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run *r,
+                          const cm_fo_tally *last, const double z_prev[2], double psi)
+{
+    if (a->json) {
+        print_json(a, m, r, last, z_prev, psi);
+        return;
+    }
     FILE *out = report_stream(a->csv, a->png, NULL);
     fprintf(out, "followed %d periods from (x, v) = (%s, %s) at t = %s to t = %s\n", a->periods,
             CM_NUM(a->from[0]), CM_NUM(a->from[1]), CM_NUM(a->t0), CM_NUM(r->t_section));
@@ -452,7 +488,7 @@ int cmd_simulate(int argc, char **argv)
                 "than %d events in a period)\n",
                 CM_NUM(r.t_section + r.st.s), CM_FO_MAX_EVENTS);
     if (ok) {
-        print_summary(&a, &r, &last, z_prev, fabs(tr.psi_sum));
+        print_summary(&a, &m, &r, &last, z_prev, fabs(tr.psi_sum));
         if (a.csv)
             ok = write_csv(a.csv, &tr);
         if (ok && a.png)

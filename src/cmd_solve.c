@@ -17,6 +17,7 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 #include "src/interrupt.h"
+#include "src/json.h"
 #include "src/project.h"
 #include "src/args.h"
 #include "src/basin_png.h"
@@ -283,51 +284,47 @@ static void print_text(FILE *out, const cm_model *m, const summary *sum, const t
     free(sorted);
 }
 
-static void print_json_extension(FILE *out, const cm_lattice *lat, const extend_log *log)
+static void print_json_extension(json *j, const cm_lattice *lat, const extend_log *log)
 {
-    fprintf(out, ",\"extension\":{\"steps\":[");
+    json_object(j, "extension");
+    json_array(j, "steps");
     for (int k = 0; k < log->n; k++) {
         const project_step *s = &log->steps[k];
-        char box[CM_MAX_DIM * 64];
-        format_box(lat, &s->box, box, sizeof box);
-        fprintf(out, "%s{\"box\":\"%s\",\"cells\":%llu,\"escaping\":%llu,\"all_escaping\":%llu,\"cluster_"
-               "cells\":%llu,"
-               "\"new_groups\":%u,\"straddling_groups\":%u,\"time_s\":%.6f}",
-               k ? "," : "", box, (unsigned long long)cm_box_cells(&s->box),
-               (unsigned long long)s->escaping, (unsigned long long)s->all_escaping,
-               (unsigned long long)s->cluster_cells, s->new_groups, s->straddling, s->seconds);
+        json_object(j, NULL);
+        json_box(j, "box", lat, &s->box);
+        json_uint(j, "cells", cm_box_cells(&s->box));
+        json_uint(j, "escaping", s->escaping);
+        json_uint(j, "all_escaping", s->all_escaping);
+        json_uint(j, "cluster_cells", s->cluster_cells);
+        json_uint(j, "new_groups", s->new_groups);
+        json_uint(j, "straddling_groups", s->straddling);
+        json_seconds(j, "time_s", s->seconds);
+        json_object_end(j);
     }
-    fprintf(out, "],\"stop\":\"%s\"}", log->stop);
+    json_array_end(j);
+    json_str(j, "stop", log->stop);
+    json_object_end(j);
 }
 
 static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, const summary *sum,
                        const timing *t, const extend_log *log)
 {
-    const cm_group_info *g = sum->groups;
-    char params[2048];
-    cm_params_json(&m->values, params, sizeof params);
-    fprintf(out, "{\"model\":\"%s\",\"params\":%s,\"lattice\":{\"origin\":[", m->name, params);
-    print_vector(out, lat->origin, lat->dim, ",");
-    fprintf(out, "],\"width\":[");
-    print_vector(out, lat->width, lat->dim, ",");
-    char box[CM_MAX_DIM * 64];
-    format_box(lat, &sum->box, box, sizeof box);
-    fprintf(out, "]},\"box\":\"%s\",\"box_cells\":%llu,\"cells\":%llu,\"sink_cells\":%llu,"
-           "\"time_s\":{\"%s\":%.6f,\"%s\":%.6f}",
-           box, (unsigned long long)cm_box_cells(&sum->box), (unsigned long long)sum->cells,
-           (unsigned long long)sum->sink, t->first, t->t1, t->second, t->t2);
+    json j;
+    json_begin(&j, out, "solve");
+    json_model(&j, m);
+    json_lattice(&j, lat);
+    json_box(&j, "box", lat, &sum->box);
+    json_uint(&j, "box_cells", cm_box_cells(&sum->box));
+    json_uint(&j, "cells", sum->cells);
+    json_uint(&j, "sink_cells", sum->sink);
+    json_object(&j, "time_s");
+    json_seconds(&j, t->first, t->t1);
+    json_seconds(&j, t->second, t->t2);
+    json_object_end(&j);
     if (log)
-        print_json_extension(out, lat, log);
-    fprintf(out, ",\"groups\":[");
-    for (uint32_t k = 0; k < sum->ngroups; k++) {
-        fprintf(out, "%s{\"id\":%u,\"period\":%u,\"basin\":%llu,\"doa\":%llu,\"kind\":\"%s\","
-               "\"centre\":[",
-               k ? "," : "", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells,
-               (unsigned long long)(g[k].basin_cells - g[k].period), cm_group_kind_name(g[k].kind));
-        print_vector(out, g[k].centre, m->dim, ",");
-        fprintf(out, "]}");
-    }
-    fprintf(out, "]}\n");
+        print_json_extension(&j, lat, log);
+    json_groups(&j, sum->groups, sum->ngroups, lat);
+    json_end(&j);
 }
 
 /* The progress line on stderr (a terminal only; not with --quiet), and

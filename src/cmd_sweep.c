@@ -14,13 +14,14 @@
 #include "cellmap/scm.h"
 #include "src/args.h"
 #include "src/commands.h"
+#include "src/json.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
 
 static const char sweep_help[] =
-    "usage: cellmap sweep --model NAME [--param k=v[,k=v]] --vary NAME=V1,V2,...\n"
+    "usage: cellmap sweep --model NAME [--param k=v[,k=v]] --vary NAME=V1,V2,...|NAME=LO:HI:N\n"
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
-    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE]\n\n"
+    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE|-] [--json]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
     "the attractors and the sticking groups (rest cells: a sticking zone is\n"
@@ -29,12 +30,15 @@ static const char sweep_help[] =
     "attractors differs between neighbouring values, --refine K bisects the\n"
     "interval K times and reports where it changes: e.g. where a sticking\n"
     "zone absorbs an attractor.\n\n"
-    "  --vary NAME=V1,...  the parameter and its values (2..200, increasing)\n"
+    "  --vary NAME=V1,...  the parameter and its values (2..200, increasing); or\n"
+    "  --vary NAME=LO:HI:N N values at the centres of N equal steps of LO..HI\n"
     "  --near LO:HI,...    the window of periodic cells counted (one range per\n"
     "                      dimension; fewer ranges leave the other dimensions free)\n"
     "  --refine K          bisection steps per change, 0..40 (default 0)\n"
-    "  --csv FILE          every value solved, sorted: NAME,attractors,sticking,\n"
+    "  --csv FILE|-        every value solved, sorted: NAME,attractors,sticking,\n"
     "                      attractor_cells,sticking_cells,groups,sink_cells,seconds\n"
+    "  --json              the values solved and the changes found as one JSON\n"
+    "                      document on standard output (docs/cellmap.schema.json)\n"
     "  --max-steps, --threads, --region, --cells: as for solve\n";
 
 enum { MAX_VALUES = 200, MAX_REFINE = 40 };
@@ -47,6 +51,7 @@ typedef struct sweep_args {
     int n_values, max_steps, threads, refine, n_near;
     double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
     const char *csv;
+    bool json;
 } sweep_args;
 
 /* "NAME=V1,V2,..." with increasing values */
@@ -57,7 +62,14 @@ static bool parse_vary(const char *s, sweep_args *a)
         return false;
     memcpy(a->name, s, (size_t)(eq - s));
     a->name[eq - s] = 0;
-    if (!parse_doubles(eq + 1, a->values, &a->n_values, MAX_VALUES) || a->n_values < 2)
+    param_axis ax;
+    if (strchr(eq, ':')) { /* NAME=LO:HI:N, as lyapunov's --grid */
+        if (!param_axis_parse(s, strlen(s), &ax) || ax.n < 2 || ax.n > MAX_VALUES)
+            return false;
+        a->n_values = ax.n;
+        for (int k = 0; k < ax.n; k++)
+            a->values[k] = param_axis_value(&ax, k);
+    } else if (!parse_doubles(eq + 1, a->values, &a->n_values, MAX_VALUES) || a->n_values < 2)
         return false;
     for (int k = 0; k < a->n_values; k++)
         if (!isfinite(a->values[k]) || (k > 0 && !(a->values[k] > a->values[k - 1])))
@@ -78,7 +90,8 @@ static int parse_args(cli *c, sweep_args *a)
             if (c->value && !parse_vary(c->value, a))
                 err = cli_usage_error(c,
                                       "--vary: '%s' is not NAME=V1,V2,... with 2..%d increasing "
-                                      "values (e.g. mu=0.09,0.095,0.1,0.105)",
+                                      "values (e.g. mu=0.09,0.095,0.1,0.105) nor NAME=LO:HI:N "
+                                      "(e.g. mu=0.09:0.11:5)",
                                       c->value, MAX_VALUES);
             has_vary = 1;
         } else if (cli_is(c, "--near", true, &err)) {
@@ -90,10 +103,14 @@ static int parse_args(cli *c, sweep_args *a)
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
+    if (!err && a->json && a->csv && cm_output_names_stdout(a->csv))
+        err = cli_usage_error(c, "--json and --csv - both go to standard output: choose one");
     if (!err && !has_vary)
         err = cli_usage_error(c, "--vary NAME=V1,V2,... is required (e.g. --vary mu=0.09,0.1)");
     return err;
@@ -178,13 +195,19 @@ static void print_point(FILE *out, const char *name, const sweep_point *pt)
            (unsigned long long)pt->sticking_cells, pt->groups, pt->seconds);
 }
 
-/* Bisects between lo and hi (whose counts differ) `refine` times; the
- * solved midpoints are appended to pts. */
+/* Where the count of attractors changes: between lo and hi. */
+typedef struct sweep_change {
+    sweep_point lo, hi;
+    bool several; /* by more than one: bisection followed one of the changes */
+} sweep_change;
+
+/* Bisects between ch->lo and ch->hi (whose counts differ) `refine` times;
+ * the solved midpoints are appended to pts. */
 static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
-                               sweep_point lo, sweep_point hi, sweep_point *pts, int *n_pts,
-                               char *msg, size_t msg_size)
+                               sweep_change *ch, sweep_point *pts, int *n_pts, char *msg,
+                               size_t msg_size)
 {
-    const bool several = lo.attractors > hi.attractors + 1 || hi.attractors > lo.attractors + 1;
+    sweep_point lo = ch->lo, hi = ch->hi;
     for (int k = 0; k < a->refine; k++) {
         sweep_point *mid = &pts[*n_pts];
         const cm_status st = solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
@@ -196,10 +219,60 @@ static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const
         else
             hi = *mid;
     }
-    fprintf(report_stream(a->csv, NULL, NULL), "change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n", lo.attractors,
-           a->name, lo.value, hi.attractors, hi.value, hi.value - lo.value,
-           several ? "; the interval held more than one change, bisection followed one" : "");
+    ch->lo = lo;
+    ch->hi = hi;
     return CM_OK;
+}
+
+static void print_change(FILE *out, const char *name, const sweep_change *ch)
+{
+    fprintf(out, "change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n",
+            ch->lo.attractors, name, ch->lo.value, ch->hi.attractors, ch->hi.value,
+            ch->hi.value - ch->lo.value,
+            ch->several ? "; the interval held more than one change, bisection followed one"
+                        : "");
+}
+
+static void print_json(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                       const sweep_point *pts, int n, const sweep_change *changes, int n_changes)
+{
+    cm_model m;
+    char msg[256];
+    if (!model_with_values(&a->mo, NULL, NULL, 0, &m, msg, sizeof msg))
+        return; /* checked before the sweep */
+    json j;
+    json_begin(&j, stdout, "sweep");
+    json_model(&j, &m);
+    cm_model_release(&m);
+    json_lattice(&j, lat);
+    json_box(&j, "box", lat, box);
+    json_str(&j, "parameter", a->name);
+    json_array(&j, "points");
+    for (int k = 0; k < n; k++) {
+        json_object(&j, NULL);
+        json_num(&j, "value", pts[k].value);
+        json_uint(&j, "attractors", pts[k].attractors);
+        json_uint(&j, "sticking", pts[k].sticking);
+        json_uint(&j, "attractor_cells", pts[k].attractor_cells);
+        json_uint(&j, "sticking_cells", pts[k].sticking_cells);
+        json_uint(&j, "groups", pts[k].groups);
+        json_uint(&j, "sink_cells", pts[k].sink_cells);
+        json_seconds(&j, "seconds", pts[k].seconds);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_array(&j, "changes");
+    for (int k = 0; k < n_changes; k++) {
+        json_object(&j, NULL);
+        json_num(&j, "from", changes[k].lo.value);
+        json_num(&j, "to", changes[k].hi.value);
+        json_uint(&j, "attractors_from", changes[k].lo.attractors);
+        json_uint(&j, "attractors_to", changes[k].hi.attractors);
+        json_bool(&j, "several", changes[k].several);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_end(&j);
 }
 
 static int by_value(const void *x, const void *y)
@@ -208,9 +281,8 @@ static int by_value(const void *x, const void *y)
     return (u > v) - (u < v);
 }
 
-static bool write_csv(const sweep_args *a, sweep_point *pts, int n)
+static bool write_csv(const sweep_args *a, const sweep_point *pts, int n)
 {
-    qsort(pts, (size_t)n, sizeof *pts, by_value);
     outfile o;
     if (!outfile_open("sweep", a->csv, &o))
         return false;
@@ -268,31 +340,47 @@ int cmd_sweep(int argc, char **argv)
     if ((rc = check_setup(&c, &a, &lat, &box)))
         return rc;
     sweep_point *pts = malloc((size_t)(a.n_values * (1 + a.refine)) * sizeof *pts);
-    if (!pts) {
+    sweep_change *changes = malloc((size_t)a.n_values * sizeof *changes);
+    if (!pts || !changes) {
         fprintf(stderr, "cellmap sweep: out of memory\n");
+        free(pts);
+        free(changes);
         return EXIT_FAIL;
     }
+    /* the text report goes where no other output goes; not with --json */
+    FILE *text = a.json ? NULL : report_stream(a.csv, NULL, NULL);
     char msg[512];
-    int n = 0, changes = 0;
+    int n = 0, n_changes = 0;
     cm_status st = CM_OK;
     for (int k = 0; k < a.n_values && st == CM_OK; k++) {
         st = solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
-        if (st == CM_OK)
-            print_point(report_stream(a.csv, NULL, NULL), a.name, &pts[n++]);
+        if (st == CM_OK && text)
+            print_point(text, a.name, &pts[n]);
+        n += st == CM_OK;
     }
     /* the listed values are pts[0 .. n_values-1]; refinements follow them */
     for (int k = 1; k < a.n_values && st == CM_OK; k++)
         if (!same_counts(&pts[k - 1], &pts[k])) {
-            changes++;
+            sweep_change *ch = &changes[n_changes++];
+            ch->lo = pts[k - 1];
+            ch->hi = pts[k];
+            ch->several = ch->lo.attractors > ch->hi.attractors + 1 ||
+                          ch->hi.attractors > ch->lo.attractors + 1;
             if (a.refine)
-                st = refine_change(&a, &lat, &box, pts[k - 1], pts[k], pts, &n, msg, sizeof msg);
+                st = refine_change(&a, &lat, &box, ch, pts, &n, msg, sizeof msg);
+            if (st == CM_OK && a.refine && text)
+                print_change(text, a.name, ch);
         }
-    if (st == CM_OK && !changes)
-        fprintf(report_stream(a.csv, NULL, NULL), "no change of the counts between %s = %s and %s\n", a.name, CM_NUM(a.values[0]),
-               CM_NUM(a.values[a.n_values - 1]));
+    if (st == CM_OK && !n_changes && text)
+        fprintf(text, "no change of the counts between %s = %s and %s\n", a.name,
+                CM_NUM(a.values[0]), CM_NUM(a.values[a.n_values - 1]));
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);
+    qsort(pts, (size_t)n, sizeof *pts, by_value);
     const bool ok = st == CM_OK && (!a.csv || write_csv(&a, pts, n));
+    if (ok && a.json)
+        print_json(&a, &lat, &box, pts, n, changes, n_changes);
     free(pts);
+    free(changes);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -1,4 +1,5 @@
 #include "src/explore.h"
+#include "src/json.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -28,7 +29,7 @@ const char session_help[] =
     "                                     size where the most sequences escape (4.6.4)\n"
     "  render FILE.png [WxH]              the view as a basin image (default: a pixel\n"
     "                                     per cell, at most 4096)\n"
-    "  stats                              groups and attractors in view, cells, memory, disk\n"
+    "  stats [--json]                     groups and attractors in view, cells, memory, disk\n"
     "  export --groups|--cells|--flat ... as `cellmap export` (--window: the view)\n"
     "  save                               save the view (joins are saved as they happen)\n"
     "  quit                               end the session\n"
@@ -103,12 +104,12 @@ static cm_status check_view(const session *s, const double *lo, const double *hi
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "%s: the view would leave the world (more than 2^39 cells from the "
                            "origin in %s)",
-                           verb, axis_name(d));
+                           verb, cm_model_coord_name(&s->model, d));
         if (cells < 1.0)
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "%s: the view would be %.3g cells wide in %s, below the lattice's "
                            "resolution (cells %.6g wide); stay at least one cell wide",
-                           verb, cells, axis_name(d), lat->width[d]);
+                           verb, cells, cm_model_coord_name(&s->model, d), lat->width[d]);
     }
     return CM_OK;
 }
@@ -282,7 +283,7 @@ static cm_status parse_slice(session *s, const char *text, int64_t *slice, char 
         const double c = floor((v[d - 2] - s->c.lat.origin[d]) / s->c.lat.width[d]);
         if (!(c >= (double)s->depth_lo[d] && c < (double)s->depth_hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "view: %s = %s is outside the session's depth (--depth)", axis_name(d),
+                           "view: %s = %s is outside the session's depth (--depth)", cm_model_coord_name(&s->model, d),
                            CM_NUM(v[d - 2]));
         slice[d] = (int64_t)c;
     }
@@ -595,10 +596,79 @@ static void print_groups(const session *s, uint32_t ngroups, const cm_group_info
     free(ids);
 }
 
+/* What `stats` counts in the view. */
+typedef struct view_counts {
+    uint64_t cells, missing, groups_in_view, cluster_cells, file_bytes;
+    const uint64_t *in_view; /* cells per group id; [0]: the sink's domain */
+} view_counts;
+
+static void print_stats_text(const session *s, const view_counts *v, const cm_region *flat,
+                             const cm_group_info *groups)
+{
+    char view[VIEW_TEXT];
+    format_view(s, view, sizeof view);
+    fprintf(s->out,
+            "view %s: %llu cells, %llu not computed, %llu in the sink's domain, %llu groups\n",
+            view, (unsigned long long)v->cells, (unsigned long long)v->missing,
+            (unsigned long long)v->in_view[0], (unsigned long long)v->groups_in_view);
+    print_groups(s, flat->ngroups, groups, v->in_view);
+    fprintf(s->out,
+            "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays "
+            "resident %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
+            s->c.nregions, (unsigned long long)v->cluster_cells, s->c.ngroups,
+            (double)cm_cluster_bytes(&s->c) / 1048576.0,
+            (double)cm_cluster_resident_bytes(&s->c) / 1048576.0,
+            s->c.mem_budget ? ", within --mem" : "", (double)v->file_bytes / 1048576.0,
+            v->cluster_cells ? (double)v->file_bytes / (double)v->cluster_cells : 0.0);
+}
+
+/* The same as one JSON document (docs/cellmap.schema.json), every group
+ * in view in id order. */
+static void print_stats_json(const session *s, const view_counts *v, const cm_region *flat,
+                             const cm_group_info *groups)
+{
+    json j;
+    json_begin(&j, s->out, "stats");
+    json_model(&j, &s->model);
+    json_lattice(&j, &s->c.lat);
+    json_box(&j, "box", &s->c.lat, &flat->box);
+    json_uint(&j, "cells", v->cells);
+    json_uint(&j, "not_computed", v->missing);
+    json_uint(&j, "sink_cells", v->in_view[0]);
+    json_array(&j, "groups");
+    for (uint32_t k = 1; k <= flat->ngroups; k++) {
+        if (!v->in_view[k])
+            continue;
+        const cm_group_info *g = &groups[k - 1];
+        json_object(&j, NULL);
+        json_uint(&j, "id", g->id);
+        json_str(&j, "kind", cm_group_kind_name(g->kind));
+        json_uint(&j, "period", g->period);
+        json_uint(&j, "basin_cells", g->basin_cells);
+        json_array(&j, "centre");
+        for (int d = 0; d < s->dim; d++)
+            json_num_near(&j, NULL, g->centre[d], JSON_CELL_TOLERANCE * s->c.lat.width[d]);
+        json_array_end(&j);
+        json_uint(&j, "in_view", v->in_view[k]);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_object(&j, "cluster");
+    json_uint(&j, "regions", s->c.nregions);
+    json_uint(&j, "cells", v->cluster_cells);
+    json_uint(&j, "groups", s->c.ngroups);
+    json_uint(&j, "memory_bytes", cm_cluster_bytes(&s->c));
+    json_uint(&j, "resident_bytes", cm_cluster_resident_bytes(&s->c));
+    json_uint(&j, "file_bytes", v->file_bytes);
+    json_object_end(&j);
+    json_end(&j);
+}
+
 static cm_status cmd_stats(session *s, char **t, int n, char *msg, size_t msg_size)
 {
-    (void)t;
-    cm_status st = words(n, 1, 1, "stats", msg, msg_size);
+    const bool as_json = n == 2 && strcmp(t[1], "--json") == 0;
+    cm_status st = n == 2 && !as_json ? cm_fail(CM_EINVAL, msg, msg_size, "usage: stats [--json]")
+                                      : words(n, 1, 2, "stats [--json]", msg, msg_size);
     if (st == CM_OK)
         st = need_view(s, "stats", msg, msg_size);
     if (st != CM_OK)
@@ -611,36 +681,22 @@ static cm_status cmd_stats(session *s, char **t, int n, char *msg, size_t msg_si
     if (st == CM_OK && !in_view)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups in view");
     if (st == CM_OK && s->out) {
-        uint64_t missing = 0, cells = 0, groups_in_view = 0;
+        view_counts v = {flat.ncells, 0, 0, 0, 0, in_view};
         for (uint64_t i = 0; i < flat.ncells; i++) {
             if (flat.group[i] == CM_GROUP_NONE)
-                missing++;
+                v.missing++;
             else
-                groups_in_view += in_view[flat.group[i]]++ == 0 && flat.group[i] != 0;
+                v.groups_in_view += in_view[flat.group[i]]++ == 0 && flat.group[i] != 0;
         }
         for (uint32_t k = 0; k < s->c.nregions; k++)
-            cells += s->c.regions[k].r.ncells;
-        char view[VIEW_TEXT];
-        format_view(s, view, sizeof view);
-        fprintf(s->out,
-                "view %s: %llu cells, %llu not computed, %llu in the sink's domain, "
-                "%llu groups\n",
-                view, (unsigned long long)flat.ncells, (unsigned long long)missing,
-                (unsigned long long)in_view[0], (unsigned long long)groups_in_view);
-        print_groups(s, flat.ngroups, groups, in_view);
+            v.cluster_cells += s->c.regions[k].r.ncells;
         cm_store_info info;
-        cm_store_stats ss;
-        cm_store_get_stats(s->store, &ss);
-        if (cm_store_read_info(s->store, &info, msg, msg_size) != CM_OK)
-            info.file_bytes = 0;
-        fprintf(s->out,
-                "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays "
-                "resident %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
-                s->c.nregions, (unsigned long long)cells, s->c.ngroups,
-                (double)cm_cluster_bytes(&s->c) / 1048576.0,
-                (double)cm_cluster_resident_bytes(&s->c) / 1048576.0,
-                s->c.mem_budget ? ", within --mem" : "", (double)info.file_bytes / 1048576.0,
-                cells ? (double)info.file_bytes / (double)cells : 0.0);
+        if (cm_store_read_info(s->store, &info, msg, msg_size) == CM_OK)
+            v.file_bytes = info.file_bytes;
+        if (as_json)
+            print_stats_json(s, &v, &flat, groups);
+        else
+            print_stats_text(s, &v, &flat, groups);
         fflush(s->out);
     }
     free(in_view);

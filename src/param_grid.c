@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/store.h"
 #include "models/registry.h"
 
 bool param_axis_parse(const char *s, size_t len, param_axis *a)
@@ -44,6 +45,28 @@ void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size)
     for (int k = 0; k < n_ax && used < size; k++)
         used += (size_t)snprintf(out + used, size - used, "%s%s=%s:%s:%d", k ? "," : "",
                                  ax[k].name, CM_NUM(ax[k].lo), CM_NUM(ax[k].hi), ax[k].n);
+}
+
+void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax)
+{
+    json_array(j, key);
+    for (int k = 0; k < n_ax; k++) {
+        json_object(j, NULL);
+        json_str(j, "name", ax[k].name);
+        json_num(j, "lo", ax[k].lo);
+        json_num(j, "hi", ax[k].hi);
+        json_uint(j, "n", (uint64_t)ax[k].n);
+        json_object_end(j);
+    }
+    json_array_end(j);
+}
+
+void param_base_json(json *j, const char *model, const cm_params *base)
+{
+    char params[4096];
+    cm_params_json(base, params, sizeof params);
+    json_str(j, "model", model);
+    json_raw(j, "params", params);
 }
 
 int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,

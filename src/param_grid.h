@@ -10,6 +10,7 @@
 #include "cellmap/model.h"
 #include "models/params.h"
 #include "src/args.h"
+#include "src/json.h"
 
 #define PARAM_AXIS_MAX 2000
 
@@ -27,6 +28,12 @@ double param_axis_value(const param_axis *a, int i);
 
 /* "NAME=LO:HI:N[,NAME=LO:HI:N]" for messages and PNG texts. */
 void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size);
+
+/* key: [{"name", "lo", "hi", "n"}, ...] for --json. */
+void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax);
+
+/* "model":NAME,"params":{...}: the parameters besides the axes'. */
+void param_base_json(json *j, const char *model, const cm_params *base);
 
 /* Checks the command's model options for a sweep of the friction
  * oscillator's parameters: the model is friction-oscillator, the --param

@@ -89,10 +89,17 @@ cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits
     return cm_store_load_cluster(*s, c, msg, msg_size);
 }
 
-const char *axis_name(int d)
+void project_state_names(const cm_store_info *info, const char **names)
 {
-    static const char *const names[CM_MAX_DIM] = {"x", "y", "z", "w", "v", "u"};
-    return d >= 0 && d < CM_MAX_DIM ? names[d] : "?";
+    cm_model m;
+    char msg[256];
+    const bool known = model_of_store(info, &m, msg, sizeof msg) == CM_OK;
+    if (!known)
+        memset(&m, 0, sizeof m); /* a model this cellmap lacks: x0, x1, ... */
+    for (int d = 0; d < CM_MAX_DIM; d++)
+        names[d] = cm_model_coord_name(&m, d); /* static strings: they outlive m */
+    if (known)
+        cm_model_release(&m);
 }
 
 /* The parameters JSON of a file ({"k":1.5,"mode":"output","K":[1,2]}) as

@@ -99,7 +99,9 @@ cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const pr
                          const cm_box *tile, project_step_fn step_done, void *user, int *steps,
                          char *stop, size_t stop_size, char *msg, size_t msg_size);
 
-/* The name of coordinate d: x, y, z, w, v, u. */
-const char *axis_name(int d);
+/* The names of the file's state coordinates (CM_MAX_DIM entries): its
+ * model's (cm_model_coord_name), or x0, x1, ... for a model this cellmap
+ * does not know. */
+void project_state_names(const cm_store_info *info, const char **names);
 
 #endif

@@ -19,7 +19,7 @@ python3 - summary.json <<'PY' || fail "JSON summary"
 import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["model"] == "microchaos-pd" and s["cells"] == 1000000, s
-big = [g for g in s["groups"] if g["basin"] > 5000]
+big = [g for g in s["groups"] if g["basin_cells"] > 5000]
 xs = sorted(round(g["centre"][0] / (1 / 0.007)) for g in big)
 assert set(xs) == {1, 2, 3}, xs        # attractors at SW_1..SW_3 (x = m/P)
 PY
@@ -72,11 +72,11 @@ grep -q "^regions 6, cells 60000" info.txt || fail "info regions: $(cat info.txt
 grep -q "^disk: .* bytes/cell" info.txt || fail "info disk"
 "$CM" export paged.cmdb --groups g.csv --cells c.csv --flat flat.sqlite --window 0:250,-40:0 \
   2> export.txt || fail "export"
-head -1 c.csv | grep -qx "ix,iy,x,y,grp,step,periodic" || fail "cells CSV header"
+head -1 c.csv | grep -qx "ix,iv,x,v,grp,step,periodic" || fail "cells CSV header"  # the model's names
 [ "$(($(wc -l < c.csv) - 1))" = "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" ] \
   || fail "CSV and flat table differ"
 [ "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" = 15000 ] || fail "window 150x100 cells"
-[ "$(sqlite3 flat.sqlite 'SELECT MIN(ix)||":"||MAX(ix)||":"||MIN(iy)||":"||MAX(iy) FROM cells')" = \
+[ "$(sqlite3 flat.sqlite 'SELECT MIN(ix)||":"||MAX(ix)||":"||MIN(iv)||":"||MAX(iv) FROM cells')" = \
   "0:149:0:99" ] || fail "window bounds"
 [ "$(($(wc -l < g.csv) - 1))" = "$(sqlite3 paged.cmdb 'SELECT COUNT(*) FROM groups')" ] \
   || fail "groups CSV rows"
@@ -150,7 +150,7 @@ python3 - extend.json <<'PY' || fail "JSON of --extend"
 import json, sys
 s = json.load(open(sys.argv[1]))
 steps = s["extension"]["steps"]
-assert len(steps) == 2 and steps[0]["box"] == "285.4:485.4,-12.5:12.5", steps
+assert len(steps) == 2 and steps[0]["box"] == [[285.4, 485.4], [-12.5, 12.5]], steps
 assert steps[0]["straddling_groups"] > 0 and 2 * steps[0]["escaping"] > steps[0]["all_escaping"], steps
 assert s["cells"] == 3 * 160000, s["cells"]
 PY
@@ -209,7 +209,7 @@ python3 - "$HERE" s3.csv s3-3.25.png s30.25.png <<'PY' || fail "3-D slices"
 import csv, struct, sys, zlib
 sys.path.insert(0, sys.argv[1])
 from pngcheck import read_png
-cells = {(int(r["ix"]), int(r["iy"]), int(r["iz"])): r for r in csv.DictReader(open(sys.argv[2]))}
+cells = {(int(r["ix_lag2"]), int(r["ix_lag1"]), int(r["ix"])): r for r in csv.DictReader(open(sys.argv[2]))}
 def palette(path):
     data, pos = open(path, "rb").read(), 8
     while pos < len(data):
@@ -251,7 +251,7 @@ python3 - "$HERE" o2.csv o2.png <<'PY' || fail "2-D PNG orientation"
 import csv, struct, sys
 sys.path.insert(0, sys.argv[1])
 from pngcheck import read_png
-cells = {(int(r["ix"]), int(r["iy"])): r for r in csv.DictReader(open(sys.argv[2]))}
+cells = {(int(r["ix"]), int(r["iv"])): r for r in csv.DictReader(open(sys.argv[2]))}
 data, pos, inverse = open(sys.argv[3], "rb").read(), 8, None
 while pos < len(data):
     n, kind = struct.unpack(">I4s", data[pos:pos + 8])

@@ -78,7 +78,7 @@ import csv, sys
 def cells(path):
     rows = {}
     for r in csv.DictReader(open(path)):
-        rows[(int(r["ix"]), int(r["iy"]))] = (int(r["grp"]), int(r["step"]), int(r["periodic"]))
+        rows[(int(r["ix"]), int(r["iv"]))] = (int(r["grp"]), int(r["step"]), int(r["periodic"]))
     return rows
 a, b = cells(sys.argv[1]), cells(sys.argv[2])
 assert len(a) == 400 * 400, len(a)
