@@ -20,19 +20,21 @@
 
 static const char bifurcation_help[] =
     "usage: cellmap bifurcation [--model friction-oscillator] [--param k=v[,k=v]]\n"
-    "                           --sweep NAME=LO:HI:N [--runs R] [--transient P] [--record n]\n"
+    "                           --sweep NAME=LO:HI:N|NAME=V1,V2,... [--runs R] [--transient P]\n"
+    "                           [--record n]\n"
     "                           [--seed K] [--csv FILE|-] [--runs-csv FILE|-] [--png FILE]\n"
     "                           [--json] [--size WxH] [--threads T]\n\n"
     "The Monte Carlo bifurcation diagram of the dry friction oscillator (thesis\n"
     "2.6.1, Fig. 2.22). Parameter NAME takes N values, the centres of N equal\n"
-    "cells of LO..HI. For each, R runs start from random x(t0) in [-1, 1],\n"
+    "cells of LO..HI, or the listed ones. For each, R runs start from random x(t0) in [-1, 1],\n"
     "x'(t0) in [-1, 1], t0 in [-2 pi/Omega, 2 pi/Omega] (as the thesis), are\n"
     "followed exactly through P periods of transients, and are recorded for n\n"
     "periods: the Poincare points (phase phi), the last ten displacements where\n"
     "the block stuck, and Psi = |sum of x at the velocity zeros| over the n\n"
     "periods. Runs are spread over the threads; the results do not depend on the\n"
     "thread count, and the same seed gives the same initial conditions.\n\n"
-    "  --sweep NAME=LO:HI:N the parameter and its values (N <= 2000), e.g. S=0.02:0.4:190\n"
+    "  --sweep NAME=LO:HI:N the parameter and its values (N <= 2000), e.g. S=0.02:0.4:190,\n"
+    "                      or NAME=V1,V2,... (increasing), e.g. S=0.32,0.4\n"
     "  --runs R            runs per value, 1..1000 (default 10)\n"
     "  --transient P       periods left out, 0..1000000 (default 1000)\n"
     "  --record n          periods recorded, 1..10000 (default 50)\n"
@@ -70,7 +72,8 @@ static int parse_args(cli *c, bif_args *a)
             if (c->value && !param_axis_parse(c->value, strlen(c->value), &a->sweep))
                 err = cli_usage_error(c,
                                       "--sweep: '%s' is not NAME=LO:HI:N with LO < HI and "
-                                      "1 <= N <= %d (e.g. S=0.02:0.4:190)",
+                                      "1 <= N <= %d (e.g. S=0.02:0.4:190) nor NAME=V1,V2,... "
+                                      "with increasing values",
                                       c->value, PARAM_AXIS_MAX);
             a->has_sweep = 1;
         } else if (cli_take_int(c, "--runs", 1, 1000, &a->runs, &err)) {

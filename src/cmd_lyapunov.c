@@ -24,7 +24,8 @@ static const char lyapunov_help[] =
     "estimator of docs/models.md 9.8: separation D in x, samples every T/32, P\n"
     "excitation periods. Grid points run in parallel; the results do not\n"
     "depend on the thread count. Points with S > S0 are not computed.\n\n"
-    "  --grid X=LO:HI:N,Y=LO:HI:M  the two parameters and their ranges (N, M <= 2000)\n"
+    "  --grid X=LO:HI:N,Y=LO:HI:M  the two parameters and their ranges (N, M <= 2000);\n"
+    "                      evenly spaced lists X=V1,V2,...,Y=V1,V2,... also do\n"
     "  --periods P         excitation periods per point (default 600, the thesis')\n"
     "  --d0 D              initial separation, >= 1e-9 (default 1e-8)\n"
     "  --from X,V          start at phase 0 (default the thesis': 1 + 0.9 S0, 0)\n"
@@ -52,14 +53,19 @@ static int parse_args(cli *c, lyap_args *a)
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
         } else if (cli_is(c, "--grid", true, &err)) {
-            const char *comma = c->value ? strchr(c->value, ',') : NULL;
-            if (c->value &&
-                (!comma || !param_axis_parse(c->value, (size_t)(comma - c->value), &a->ax[0]) ||
-                 !param_axis_parse(comma + 1, strlen(comma + 1), &a->ax[1])))
+            if (c->value && !param_axes_parse2(c->value, a->ax))
                 err = cli_usage_error(c,
                                       "--grid: '%s' is not X=LO:HI:N,Y=LO:HI:M with LO < HI and "
-                                      "1 <= N, M <= 2000 (e.g. Omega=0.3:0.7:100,S=0.02:0.4:100)",
+                                      "1 <= N, M <= 2000 (e.g. Omega=0.3:0.7:100,S=0.02:0.4:100), "
+                                      "nor lists X=V1,V2,...,Y=V1,V2,...",
                                       c->value);
+            for (int k = 0; k < 2 && c->value && !err; k++)
+                if (!param_axis_even(&a->ax[k]))
+                    err = cli_usage_error(c,
+                                          "--grid: the values of %s are not evenly spaced, and "
+                                          "the heat map's cells would not sit on them; give "
+                                          "%s=LO:HI:N",
+                                          a->ax[k].name, a->ax[k].name);
             a->has_grid = 1;
         } else if (cli_take_int(c, "--periods", 1, 1000000, &a->periods, &err)) {
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {

@@ -54,26 +54,17 @@ typedef struct sweep_args {
     bool json;
 } sweep_args;
 
-/* "NAME=V1,V2,..." with increasing values */
+/* "NAME=V1,V2,..." (increasing) or "NAME=LO:HI:N", 2..MAX_VALUES values */
 static bool parse_vary(const char *s, sweep_args *a)
 {
-    const char *eq = strchr(s, '=');
-    if (!eq || eq == s || (size_t)(eq - s) >= sizeof a->name)
-        return false;
-    memcpy(a->name, s, (size_t)(eq - s));
-    a->name[eq - s] = 0;
     param_axis ax;
-    if (strchr(eq, ':')) { /* NAME=LO:HI:N, as lyapunov's --grid */
-        if (!param_axis_parse(s, strlen(s), &ax) || ax.n < 2 || ax.n > MAX_VALUES)
-            return false;
-        a->n_values = ax.n;
-        for (int k = 0; k < ax.n; k++)
-            a->values[k] = param_axis_value(&ax, k);
-    } else if (!parse_doubles(eq + 1, a->values, &a->n_values, MAX_VALUES) || a->n_values < 2)
+    if (!param_axis_parse(s, strlen(s), &ax) || ax.n < 2 || ax.n > MAX_VALUES ||
+        strlen(ax.name) >= sizeof a->name)
         return false;
-    for (int k = 0; k < a->n_values; k++)
-        if (!isfinite(a->values[k]) || (k > 0 && !(a->values[k] > a->values[k - 1])))
-            return false;
+    strcpy(a->name, ax.name);
+    a->n_values = ax.n;
+    for (int k = 0; k < ax.n; k++)
+        a->values[k] = param_axis_value(&ax, k);
     return true;
 }
 

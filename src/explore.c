@@ -19,7 +19,8 @@
 const char session_help[] =
     "  view X0:X1 [Y0:Y1] [at Z[,W...]]   look at this box of state space (and, for\n"
     "                                     models of more than two dimensions, the slice\n"
-    "                                     through Z, W, ...)\n"
+    "                                     through Z, W, ...); X0:X1,Y0:Y1 as --region\n"
+    "                                     writes it works too\n"
     "  pan left|right|up|down AMOUNT      move the view by 25% (of the view), 120c (cells)\n"
     "                                     or a length in state coordinates\n"
     "  zoom FACTOR                        2: twice as close, 0.5: twice as far (about the\n"
@@ -290,24 +291,44 @@ static cm_status parse_slice(session *s, const char *text, int64_t *slice, char 
     return CM_OK;
 }
 
-static cm_status cmd_view(session *s, char **t, int n, char *msg, size_t msg_size)
+/* The view's ranges from words t[0..]: "X0:X1 Y0:Y1", or as --region
+ * gives them, "X0:X1,Y0:Y1". *used receives the words taken. */
+static cm_status parse_view_ranges(const session *s, char **t, int n, double *lo, double *hi,
+                                   int *used, char *msg, size_t msg_size)
 {
     const int ranges = s->view_dims;
-    const char *usage = ranges > 1 ? "view X0:X1 Y0:Y1" : "view X0:X1";
+    int count = 0;
+    if (ranges > 1 && n >= 1 && strchr(t[0], ',')) {
+        *used = 1;
+        if (!parse_ranges(t[0], lo, hi, &count, ranges) || count != ranges)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "view: '%s' is not X0:X1,Y0:Y1 with X0 < X1, Y0 < Y1", t[0]);
+        return CM_OK;
+    }
+    *used = ranges;
+    if (n < ranges)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "usage: view X0:X1 Y0:Y1 (or X0:X1,Y0:Y1): a range per dimension");
+    for (int d = 0; d < ranges; d++)
+        if (!parse_ranges(t[d], &lo[d], &hi[d], &count, 1) || count != 1)
+            return cm_fail(CM_EINVAL, msg, msg_size, "view: '%s' is not LO:HI with LO < HI", t[d]);
+    return CM_OK;
+}
+
+static cm_status cmd_view(session *s, char **t, int n, char *msg, size_t msg_size)
+{
+    const char *usage = s->view_dims > 1 ? "view X0:X1 Y0:Y1 (or X0:X1,Y0:Y1)" : "view X0:X1";
     double lo[2] = {0, 0}, hi[2] = {0, 0};
     int64_t slice[CM_MAX_DIM];
     memcpy(slice, s->slice, sizeof slice);
-    cm_status st = words(n, 1 + ranges, 1 + ranges + 2, usage, msg, msg_size);
-    if (st == CM_OK && n != 1 + ranges && (n != 3 + ranges || strcmp(t[1 + ranges], "at") != 0))
+    int used = 0;
+    cm_status st = words(n, 2, 2 + s->view_dims + 2, usage, msg, msg_size);
+    if (st == CM_OK)
+        st = parse_view_ranges(s, t + 1, n - 1, lo, hi, &used, msg, msg_size);
+    if (st == CM_OK && n != 1 + used && (n != 3 + used || strcmp(t[1 + used], "at") != 0))
         st = cm_fail(CM_EINVAL, msg, msg_size, "usage: %s [at Z,...]", usage);
-    for (int d = 0; d < ranges && st == CM_OK; d++) {
-        int count = 0;
-        if (!parse_ranges(t[1 + d], &lo[d], &hi[d], &count, 1) || count != 1)
-            st =
-                cm_fail(CM_EINVAL, msg, msg_size, "view: '%s' is not LO:HI with LO < HI", t[1 + d]);
-    }
-    if (st == CM_OK && n == 3 + ranges)
-        st = parse_slice(s, t[2 + ranges], slice, msg, msg_size);
+    if (st == CM_OK && n == 3 + used)
+        st = parse_slice(s, t[2 + used], slice, msg, msg_size);
     if (st != CM_OK)
         return st;
     memcpy(s->slice, slice, sizeof slice);

@@ -8,9 +8,27 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 
+/* NAME=V1,V2,... after the '=' */
+static bool parse_list(const char *text, param_axis *a)
+{
+    if (!parse_doubles(text, a->values, &a->n, PARAM_AXIS_MAX) || a->n < 1)
+        return false;
+    for (int k = 0; k < a->n; k++)
+        if (!isfinite(a->values[k]) || (k > 0 && !(a->values[k] > a->values[k - 1])))
+            return false;
+    const double *v = a->values;
+    const int n = a->n;
+    const double first = n > 1 ? v[1] - v[0] : fmax(fabs(v[0]) * 1e-3, 1e-9);
+    const double last = n > 1 ? v[n - 1] - v[n - 2] : first;
+    a->lo = v[0] - first / 2;
+    a->hi = v[n - 1] + last / 2;
+    a->listed = true;
+    return true;
+}
+
 bool param_axis_parse(const char *s, size_t len, param_axis *a)
 {
-    char buf[128];
+    char buf[PARAM_AXIS_MAX * 32];
     if (len >= sizeof buf)
         return false;
     memcpy(buf, s, len);
@@ -20,6 +38,9 @@ bool param_axis_parse(const char *s, size_t len, param_axis *a)
         return false;
     *eq = 0;
     memcpy(a->name, buf, (size_t)(eq - buf) + 1);
+    a->listed = false;
+    if (!strchr(eq + 1, ':'))
+        return parse_list(eq + 1, a);
     char *end;
     a->lo = strtod(eq + 1, &end);
     if (*end != ':')
@@ -33,18 +54,47 @@ bool param_axis_parse(const char *s, size_t len, param_axis *a)
            a->lo < a->hi;
 }
 
+bool param_axes_parse2(const char *s, param_axis ax[2])
+{
+    const char *eq = strchr(s, '='), *second = eq ? strchr(eq + 1, '=') : NULL;
+    const char *comma = second ? second : NULL;
+    while (comma && comma > s && *comma != ',')
+        comma--;
+    return comma && *comma == ',' && param_axis_parse(s, (size_t)(comma - s), &ax[0]) &&
+           param_axis_parse(comma + 1, strlen(comma + 1), &ax[1]);
+}
+
 double param_axis_value(const param_axis *a, int i)
 {
+    if (a->listed)
+        return a->values[i];
     return a->lo + (i + 0.5) * (a->hi - a->lo) / a->n;
+}
+
+bool param_axis_even(const param_axis *a)
+{
+    if (!a->listed || a->n < 3)
+        return true;
+    const double step = (a->values[a->n - 1] - a->values[0]) / (a->n - 1);
+    for (int k = 1; k < a->n; k++)
+        if (fabs(a->values[k] - a->values[k - 1] - step) > 1e-9 * step)
+            return false;
+    return true;
 }
 
 void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size)
 {
     size_t used = 0;
     out[0] = 0;
-    for (int k = 0; k < n_ax && used < size; k++)
-        used += (size_t)snprintf(out + used, size - used, "%s%s=%s:%s:%d", k ? "," : "",
-                                 ax[k].name, CM_NUM(ax[k].lo), CM_NUM(ax[k].hi), ax[k].n);
+    for (int k = 0; k < n_ax && used < size; k++) {
+        used += (size_t)snprintf(out + used, size - used, "%s%s=", k ? "," : "", ax[k].name);
+        if (!ax[k].listed)
+            used += (size_t)snprintf(out + used, used < size ? size - used : 0, "%s:%s:%d",
+                                     CM_NUM(ax[k].lo), CM_NUM(ax[k].hi), ax[k].n);
+        for (int i = 0; ax[k].listed && i < ax[k].n && used < size; i++)
+            used += (size_t)snprintf(out + used, size - used, "%s%s", i ? "," : "",
+                                     CM_NUM(ax[k].values[i]));
+    }
 }
 
 void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax)
@@ -56,6 +106,8 @@ void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax)
         json_num(j, "lo", ax[k].lo);
         json_num(j, "hi", ax[k].hi);
         json_uint(j, "n", (uint64_t)ax[k].n);
+        if (ax[k].listed)
+            json_nums(j, "values", ax[k].values, ax[k].n);
         json_object_end(j);
     }
     json_array_end(j);

@@ -1,6 +1,7 @@
-/* src/param_grid.h - the parameter axes of the analysis commands that
- * sweep a model's parameters (lyapunov's --grid, bifurcation's --sweep):
- * "NAME=LO:HI:N" is N values at the centres of N equal cells of LO..HI. */
+/* src/param_grid.h - the parameter axes of the commands that vary a
+ * model's parameters (lyapunov's --grid, bifurcation's --sweep, sweep's
+ * --vary), in one syntax: "NAME=LO:HI:N" is N values at the centres of N
+ * equal cells of LO..HI; "NAME=V1,V2,..." lists increasing values. */
 #ifndef CM_SRC_PARAM_GRID_H
 #define CM_SRC_PARAM_GRID_H
 
@@ -16,17 +17,30 @@
 
 typedef struct param_axis {
     char name[32];
-    double lo, hi;
+    double lo, hi; /* the span the values' cells cover: a picture's axis */
     int n;
+    bool listed;                   /* given as NAME=V1,V2,... */
+    double values[PARAM_AXIS_MAX]; /* the listed values */
 } param_axis;
 
-/* Parses the len characters at s as NAME=LO:HI:N (LO < HI, 1 <= N <= PARAM_AXIS_MAX). */
+/* Parses the len characters at s as NAME=LO:HI:N (LO < HI, 1 <= N <=
+ * PARAM_AXIS_MAX) or NAME=V1,V2,... (increasing, finite). A list's span
+ * reaches half a spacing beyond its ends. */
 bool param_axis_parse(const char *s, size_t len, param_axis *a);
 
-/* The value of point i: the centre of cell i. */
+/* Splits "X=...,Y=..." (two axes, either syntax) at the comma before the
+ * second name. */
+bool param_axes_parse2(const char *s, param_axis ax[2]);
+
+/* The value of point i: the centre of cell i, or the i-th listed value. */
 double param_axis_value(const param_axis *a, int i);
 
-/* "NAME=LO:HI:N[,NAME=LO:HI:N]" for messages and PNG texts. */
+/* Whether the values are evenly spaced (a list may be): a heat map's cells
+ * are then where its values are. */
+bool param_axis_even(const param_axis *a);
+
+/* "NAME=LO:HI:N" or "NAME=V1,V2,..." joined by commas, for messages and
+ * PNG texts. */
 void param_axes_format(const param_axis *ax, int n_ax, char *out, size_t size);
 
 /* key: [{"name", "lo", "hi", "n"}, ...] for --json. */

@@ -148,6 +148,15 @@ check_bad "zoom 1000" "below the lattice's resolution"
 check_bad "view 5:1 0:1" "not LO:HI"
 check_bad "view 0:1" "usage: view"
 check_bad "view 0:1 0:1 at 3" "more than two dimensions"
+check_bad "view 0:1,0:1,0:1" "not X0:X1,Y0:Y1"
+# the command line's box form, X0:X1,Y0:Y1, is the same view
+printf 'view 100:200,-16:16\nstats --json\n' | "$CM" explore comma.cmdb - $pd $lattice 2>/dev/null \
+  | grep '^{' > comma.json || fail "view X0:X1,Y0:Y1"
+printf 'view 100:200 -16:16\nstats --json\n' | "$CM" explore words.cmdb - $pd $lattice 2>/dev/null \
+  | grep '^{' > words.json || fail "view X0:X1 Y0:Y1"
+[ -s comma.json ] && python3 -c "import json,sys; a,b=(json.load(open(f)) for f in sys.argv[1:]); \
+a['cluster'].pop('file_bytes'); b['cluster'].pop('file_bytes'); assert a == b and a['box'] == [[100,200],[-16,16]]" \
+  comma.json words.json || fail "the two view forms differ"
 check_bad "view 0:1e300 0:1" "leave the world"
 check_bad "view 0:100000000 -4:4" "new cells, more than"
 check_bad "goto 1" "usage: goto"

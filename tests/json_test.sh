@@ -37,6 +37,7 @@ run orbit orbit --from 10,0 --steps 5 --json
 run orbit-sink orbit --model microchaos-1d --from 1e300 --steps 5 --json
 run lyapunov lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --periods 50 --json
 run bifurcation bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 20 --record 5 --json
+run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json
 run simulate simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 3 --json
 printf 'view 0:500 -40:40\nstats --json\n' | "$CM" explore ex.cmdb --model microchaos-pd --cell-size 4,1 \
   2> /dev/null | grep '^{' > stats.json || fail "explore stats --json"
