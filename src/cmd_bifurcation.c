@@ -15,15 +15,17 @@
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
+#include "src/interrupt.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
+#include "src/progress.h"
 
 static const char bifurcation_help[] =
     "usage: cellmap bifurcation [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                           --sweep NAME=LO:HI:N|NAME=V1,V2,... [--runs R] [--transient P]\n"
     "                           [--record n]\n"
     "                           [--seed K] [--csv FILE|-] [--runs-csv FILE|-] [--png FILE]\n"
-    "                           [--json] [--size WxH] [--threads T]\n\n"
+    "                           [--json] [--quiet] [--size WxH] [--threads T]\n\n"
     "The Monte Carlo bifurcation diagram of the dry friction oscillator (thesis\n"
     "2.6.1, Fig. 2.22). Parameter NAME takes N values, the centres of N equal\n"
     "cells of LO..HI, or the listed ones. For each, R runs start from random x(t0) in [-1, 1],\n"
@@ -40,6 +42,7 @@ static const char bifurcation_help[] =
     "  --record n          periods recorded, 1..10000 (default 50)\n"
     "  --seed K            seed of the initial conditions (default 1)\n"
     "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
+    "  --quiet             no progress line and no summary\n"
     "  --csv FILE          NAME,run,kind,x,v: kind stick (the last ten sticking\n"
     "                      displacements, v = 0) or section (the Poincare points)\n"
     "  --runs-csv FILE     NAME,run,x0,v0,t0,psi,psi_per_period,sticks_per_period,status\n"
@@ -57,7 +60,7 @@ typedef struct bif_args {
     int has_sweep, runs, transient, record, threads, width, height;
     long long seed;
     const char *csv, *runs_csv, *png;
-    bool json;
+    bool json, quiet;
 } bif_args;
 
 static int parse_args(cli *c, bif_args *a)
@@ -93,6 +96,8 @@ static int parse_args(cli *c, bif_args *a)
             a->png = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
@@ -450,15 +455,33 @@ int cmd_bifurcation(int argc, char **argv)
             s.res[(size_t)i * (size_t)a.runs + (size_t)r].valid = true;
     }
     const double t0 = omp_get_wtime();
+    progress pr;
+    progress_start(&pr, "bifurcation", "runs", n_runs, a.quiet);
+    interrupt_catch();
+    uint64_t done = 0;
 #pragma omp parallel for schedule(dynamic, 1)                                                      \
     num_threads(a.threads ? a.threads : omp_get_max_threads())
     for (size_t k = 0; k < n_runs; k++) {
         const int i = (int)(k / (size_t)a.runs), r = (int)(k % (size_t)a.runs);
-        if (s.res[k].valid)
-            run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k],
-                s.sections + k * 2 * (size_t)a.record);
+        if (!s.res[k].valid || interrupt_requested()) /* Ctrl-C: the runs left are skipped */
+            continue;
+        run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k], s.sections + k * 2 * (size_t)a.record);
+        uint64_t now;
+#pragma omp atomic capture
+        now = ++done;
+        if (omp_get_thread_num() == 0) /* the line is the first thread's alone */
+            progress_say(&pr, now, NULL);
     }
-    print_summary(&a, &base, &s, omp_get_wtime() - t0);
+    progress_end(&pr);
+    if (interrupt_requested()) {
+        fprintf(stderr, "cellmap bifurcation: interrupted (Ctrl-C) after %llu of %zu runs; "
+                        "nothing written\n",
+                (unsigned long long)done, n_runs);
+        sweep_free(&s, models);
+        return EXIT_INTERRUPTED;
+    }
+    if (!a.quiet || a.json)
+        print_summary(&a, &base, &s, omp_get_wtime() - t0);
     bool ok = n_valid > 0;
     if (!ok)
         fprintf(stderr,

@@ -13,22 +13,28 @@
 #include "src/args.h"
 #include "src/outfile.h"
 #include "src/commands.h"
+#include "src/interrupt.h"
+#include "src/progress.h"
 #include "src/project.h"
 
 static const char export_help[] =
     "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
-    "                      [--flat OUT.sqlite] [--window X0:X1[,Y0:Y1...]] [--mem BYTES]\n\n"
+    "                      [--flat OUT.sqlite] [--window X0:X1[,Y0:Y1...]] [--mem BYTES]\n"
+    "                      [--quiet]\n\n"
+    "Writes only complete files: Ctrl-C stops it and leaves no partial file (exit 130).\n\n"
     "  --groups OUT.csv    one row per group: id, period, basin_cells, is_sink (group 0),\n"
     "                      centre, bounds of the periodic cells' centres, anchor cell,\n"
     "                      kind (attractor, sticking zone or the sink)\n"
-    "  --cells OUT         one row per computed cell: lattice indices ix, iy, ..., cell\n"
-    "                      centre x, y, ..., grp, step, periodic; CSV with a header, or\n"
-    "                      .npy (a structured array with those fields, little-endian)\n"
-    "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iy, ..., x, y, ...,\n"
+    "  --cells OUT         one row per computed cell: lattice indices ix, iv, ..., cell\n"
+    "                      centre x, v, ... (i and the model's state names, as `cellmap\n"
+    "                      models` lists them), grp, step, periodic; CSV with a header,\n"
+    "                      or .npy (a structured array with those fields, little-endian)\n"
+    "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iv, ..., x, v, ...,\n"
     "                      grp, step, periodic), with tables groups (as --groups, kind\n"
     "                      included) and meta\n"
     "  --window X0:X1,...  only cells whose centre lies in this box of state space\n"
-    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n";
+    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n"
+    "  --quiet             no progress line and no count of the cells written\n";
 
 enum { SLAB_CELLS = 1 << 22 }; /* cells flattened at a time */
 
@@ -50,6 +56,7 @@ typedef struct cell_out {
 typedef struct export_args {
     const char *file, *groups, *cells, *flat, *window;
     uint64_t mem;
+    bool quiet;
 } export_args;
 
 static int ends_with(const char *s, const char *suffix)
@@ -78,6 +85,8 @@ static int parse_export(cli *c, export_args *a)
         } else if (cli_is(c, "--window", true, &err)) {
             a->window = c->value;
         } else if (cli_take_mem(c, &a->mem, &err)) {
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else if (c->opt[0] != '-' && !a->file) {
             a->file = c->opt;
         } else {
@@ -376,8 +385,9 @@ static int export_groups(const char *path, const char *const *names, const cm_la
 /* Walks the window in slabs along the last dimension, reading regions
  * back as needed, and writes every computed cell to each output. */
 static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *outs, int nouts,
-                              char *msg, size_t msg_size)
+                              progress *pr, char *msg, size_t msg_size)
 {
+    uint64_t done = 0;
     const int dim = c->lat.dim, last = dim - 1;
     const uint64_t row =
         cm_box_cells(window) /
@@ -404,9 +414,14 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
                     st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s: %s", outs[k].path,
                                  outs[k].db ? sqlite3_errmsg(outs[k].db) : strerror(errno));
         }
+        done += flat.ncells;
         cm_region_free(&flat);
+        if (st == CM_OK && interrupt_requested())
+            st = cm_fail(CM_ECANCELED, msg, msg_size,
+                         "interrupted (Ctrl-C): --cells and --flat were not written");
         if (st != CM_OK)
             return st;
+        progress_say(pr, done, NULL);
     }
     return CM_OK;
 }
@@ -453,14 +468,19 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         ok = out_begin(&outs[k], c->lat.dim, info, msg, sizeof msg);
     if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink))
         ok = 0, snprintf(msg, sizeof msg, "cannot write %.900s", a->flat);
+    progress pr;
+    progress_start(&pr, "export", "cells", cm_box_cells(&window), a->quiet);
+    interrupt_catch();
+    cm_status st = CM_OK;
     if (ok && nouts)
-        ok = export_cells(c, &window, outs, nouts, msg, sizeof msg) == CM_OK;
+        ok = (st = export_cells(c, &window, outs, nouts, &pr, msg, sizeof msg)) == CM_OK;
+    progress_end(&pr);
     for (int k = 0; k < nouts; k++)
         ok = out_end(&outs[k], ok, msg, sizeof msg) && ok;
     if (!ok) {
         fprintf(stderr, "cellmap export: %s\n", msg);
-        rc = EXIT_FAIL;
-    } else if (nouts) {
+        rc = st == CM_ECANCELED ? EXIT_INTERRUPTED : EXIT_FAIL;
+    } else if (nouts && !a->quiet) {
         fprintf(stderr, "cellmap export: %llu cells\n", (unsigned long long)outs[0].rows);
     }
     free(g);
@@ -470,7 +490,7 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
 int cmd_export(int argc, char **argv)
 {
     cli c = {"export", argc, argv, 0, NULL, NULL};
-    export_args a = {NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20};
+    export_args a = {NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20, false};
     const int rc = parse_export(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;

@@ -11,13 +11,16 @@
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
+#include "src/interrupt.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
+#include "src/progress.h"
 
 static const char lyapunov_help[] =
     "usage: cellmap lyapunov [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X,V]\n"
-    "                        [--csv FILE|-] [--png FILE] [--json] [--size WxH] [--threads T]\n\n"
+    "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n"
+    "                        [--threads T]\n\n"
     "The largest Lyapunov exponent of the dry friction oscillator (thesis 2.5.3)\n"
     "at the centres of an N x M grid of parameters X and Y (e.g. Omega and S at\n"
     "fixed S0, as Figs. 2.20-2.21), by the renormalised two-trajectory\n"
@@ -31,6 +34,7 @@ static const char lyapunov_help[] =
     "  --from X,V          start at phase 0 (default the thesis': 1 + 0.9 S0, 0)\n"
     "  --csv FILE|-        X,Y,lambda per grid point (%.17g; nan: not computed)\n"
     "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
+    "  --quiet             no progress line and no summary\n"
     "  --png FILE          heat map; only positive exponents are coloured\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
@@ -41,7 +45,7 @@ typedef struct lyap_args {
     int has_grid, periods, threads, width, height, has_from;
     double d0, from[2];
     const char *csv, *png;
-    bool json;
+    bool json, quiet;
 } lyap_args;
 
 static int parse_args(cli *c, lyap_args *a)
@@ -84,6 +88,8 @@ static int parse_args(cli *c, lyap_args *a)
             a->png = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else if (cli_take_size(c, 200, 150, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
@@ -230,11 +236,33 @@ int cmd_lyapunov(int argc, char **argv)
     }
     int invalid = 0;
     const double t0 = omp_get_wtime();
+    progress pr;
+    progress_start(&pr, "lyapunov", "grid points", n, a.quiet);
+    interrupt_catch();
+    uint64_t done = 0;
 #pragma omp parallel for schedule(dynamic, 1)                                                      \
     num_threads(a.threads ? a.threads : omp_get_max_threads()) reduction(|                         \
                                                                          : invalid)
-    for (size_t k = 0; k < n; k++)
+    for (size_t k = 0; k < n; k++) {
+        if (interrupt_requested()) { /* Ctrl-C: the points left are skipped */
+            v[k] = NAN;
+            continue;
+        }
         v[k] = point_exponent(&a, (int)(k % nx), (int)(k / nx), &invalid);
+        uint64_t now;
+#pragma omp atomic capture
+        now = ++done;
+        if (omp_get_thread_num() == 0) /* the line is the first thread's alone */
+            progress_say(&pr, now, NULL);
+    }
+    progress_end(&pr);
+    if (interrupt_requested()) {
+        fprintf(stderr, "cellmap lyapunov: interrupted (Ctrl-C) after %llu of %zu grid points; "
+                        "nothing written\n",
+                (unsigned long long)done, n);
+        free(v);
+        return EXIT_INTERRUPTED;
+    }
     const double secs = omp_get_wtime() - t0;
     size_t positive = 0, computed = 0, best = 0;
     for (size_t k = 0; k < n; k++) {
@@ -246,7 +274,7 @@ int cmd_lyapunov(int argc, char **argv)
     const summary sum = {n, computed, positive, best, secs, invalid != 0};
     if (a.json)
         print_json(&a, &base, v, &sum);
-    else
+    else if (!a.quiet)
         print_text(&a, v, &sum);
     bool ok = computed > 0;
     if (!ok)

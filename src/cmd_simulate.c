@@ -19,7 +19,7 @@
 static const char simulate_help[] =
     "usage: cellmap simulate [--model friction-oscillator] [--param k=v[,k=v]] [--from X,V]\n"
     "                        [--t0 T0] [--periods N] [--skip P] [--csv FILE|-] [--png FILE]\n"
-    "                        [--json] [--size WxH]\n\n"
+    "                        [--json] [--quiet] [--size WxH]\n\n"
     "A trajectory of the dry friction oscillator x'' + x = cos(Omega t) - S f(x')\n"
     "(thesis eq. (2.3)) from (x, x') = (X, V) at time T0, followed exactly\n"
     "(docs/models.md 9) up to the N-th section instant (forcing phase phi) after T0.\n"
@@ -29,6 +29,7 @@ static const char simulate_help[] =
     "  --periods N         periods to follow, 1..100000 (default 20)\n"
     "  --skip P            periods left out of the CSV, the PNG and Psi (transients)\n"
     "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
+    "  --quiet             no summary\n"
     "  --csv FILE          t,x,v,kind: the start, every stick, breakaway and turn, and\n"
     "                      the section point ending each period (%.17g)\n"
     "  --png FILE          top: x(t) with the sticking region |x - cos(Omega t)| < S0\n"
@@ -41,7 +42,7 @@ typedef struct sim_args {
     double from[2], t0;
     int has_t0, periods, skip, width, height;
     const char *csv, *png;
-    bool json;
+    bool json, quiet;
 } sim_args;
 
 static int parse_args(cli *c, sim_args *a)
@@ -69,6 +70,8 @@ static int parse_args(cli *c, sim_args *a)
             a->png = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else if (cli_take_size(c, 300, 400, 4096, &a->width, &a->height, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
@@ -438,6 +441,8 @@ static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run 
         print_json(a, m, r, last, z_prev, psi);
         return;
     }
+    if (a->quiet)
+        return;
     FILE *out = report_stream(a->csv, a->png, NULL);
     fprintf(out, "followed %d periods from (x, v) = (%s, %s) at t = %s to t = %s\n", a->periods,
             CM_NUM(a->from[0]), CM_NUM(a->from[1]), CM_NUM(a->t0), CM_NUM(r->t_section));

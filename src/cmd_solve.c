@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -18,6 +17,7 @@
 #include "models/registry.h"
 #include "src/interrupt.h"
 #include "src/json.h"
+#include "src/progress.h"
 #include "src/project.h"
 #include "src/args.h"
 #include "src/basin_png.h"
@@ -199,13 +199,6 @@ static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat,
     return EXIT_OK;
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void print_vector(FILE *out, const double *v, int n, const char *sep)
 {
     for (int d = 0; d < n; d++)
@@ -327,38 +320,8 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     json_end(&j);
 }
 
-/* The progress line on stderr (a terminal only; not with --quiet), and
- * Ctrl-C: the callbacks below stop the solve when it came. */
-typedef struct progress {
-    bool show;
-    double t0, last;
-    uint64_t total; /* cells of the box asked for (extension steps add more:
-                       past them no time left is shown) */
-    bool shown;     /* a line is on the terminal */
-} progress;
-
-static void progress_say(progress *p, uint64_t done, const char *what)
-{
-    const double t = now_seconds();
-    if (!p->show || t - p->last < 0.2)
-        return;
-    p->last = t;
-    const double rate = done / (t - p->t0 + 1e-9);
-    char eta[64] = "";
-    if (p->total > done && rate > 0)
-        snprintf(eta, sizeof eta, ", about %.0f s left", (double)(p->total - done) / rate);
-    fprintf(stderr, "\rsolve: %s, %.1f M cells, %.1f M cells/s%s   ", what, done / 1e6,
-            rate / 1e6, eta);
-    fflush(stderr);
-    p->shown = true;
-}
-
-static void progress_end(progress *p)
-{
-    if (p->shown)
-        fputc('\n', stderr);
-    p->shown = false;
-}
+/* The progress line (src/progress.h) and Ctrl-C: the callbacks below stop
+ * the solve when it came. */
 
 /* A cm_progress_fn for a solve in one region. */
 static int whole_progress(void *user, const char *phase, double fraction)
@@ -390,16 +353,16 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     const cm_scm_options opt = {a->max_steps, a->threads, whole_progress, p, 0};
     *t = (timing){"images", "classification", 0, 0};
     cm_status st = cm_region_alloc(r, box, msg, msg_size);
-    const double t0 = now_seconds();
+    const double t0 = progress_now();
     if (st == CM_OK)
         st = cm_scm_images(m, lat, &opt, r, msg, msg_size);
-    const double t1 = now_seconds();
+    const double t1 = progress_now();
     if (st == CM_OK && interrupt_requested()) /* classification cannot stop half-way */
         st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     if (st == CM_OK)
         st = cm_scm_classify(r, msg, msg_size);
     t->t1 = t1 - t0;
-    t->t2 = now_seconds() - t1;
+    t->t2 = progress_now() - t1;
     return st;
 }
 
@@ -416,7 +379,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
     cm_status st =
         boxes && parts ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
     *t = (timing){"regions", "stage 1", 0, 0};
-    const double t0 = now_seconds();
+    const double t0 = progress_now();
     if (st == CM_OK)
         project_split(plan, box, boxes);
     for (uint32_t k = 0; k < n && st == CM_OK; k++) {
@@ -424,7 +387,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
         if (st == CM_OK)
             st = cm_scm_solve(m, lat, &opt, &parts[k], msg, msg_size);
     }
-    const double t1 = now_seconds();
+    const double t1 = progress_now();
     cm_stage1_stats stats;
     if (st == CM_OK)
         st = cm_join_stage1(parts, n, NULL, &stats, msg, msg_size);
@@ -433,7 +396,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
     for (uint32_t k = 0; k < n && st == CM_OK; k++)
         cm_flat_copy(&parts[k], r);
     t->t1 = t1 - t0;
-    t->t2 = now_seconds() - t1;
+    t->t2 = progress_now() - t1;
     if (st == CM_OK && !a->json)
         fprintf(a->report, "stage 1 of the join of %u regions: of %llu sink cells, %llu now lead to groups, "
                "%llu leave every region, %llu are pending (left to Stage 2, drawn as the sink)\n",
@@ -547,14 +510,14 @@ static cm_status solve_cluster(const solve_args *a, const project_plan *plan, co
     rn->c.threads = a->threads;
     rn->c.mem_budget = a->mem;
     *t = (timing){"regions and joins", "summary", 0, 0};
-    const double t0 = now_seconds();
+    const double t0 = progress_now();
     if (st == CM_OK)
         st = project_add_box(&rn->c, rn->store, m, plan, box, NULL, msg, msg_size);
     step_report rep = {a, lat, log};
     if (st == CM_OK && a->extend > 0)
         st = project_extend(&rn->c, rn->store, m, plan, box, report_step, &rep, &log->n,
                             log->stop, sizeof log->stop, msg, msg_size);
-    t->t1 = now_seconds() - t0;
+    t->t1 = progress_now() - t0;
     return st;
 }
 
@@ -669,7 +632,8 @@ int cmd_solve(int argc, char **argv)
         (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK ||
         (a.png.path && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
         goto done;
-    progress pr = {!a.quiet && isatty(STDERR_FILENO), now_seconds(), 0, cm_box_cells(&box), false};
+    progress pr;
+    progress_start(&pr, "solve", "cells", cm_box_cells(&box), a.quiet);
     project_plan plan;
     make_plan(&a, &bounds, &plan);
     plan.joined = cluster_progress;
@@ -680,7 +644,7 @@ int cmd_solve(int argc, char **argv)
     cm_status st;
     if (!a.stage1 && (a.n_split || a.extend || a.db || a.png.has_view)) {
         /* a view is cut from a cluster */
-        const double t0 = now_seconds();
+        const double t0 = progress_now();
         st = solve_cluster(&a, &plan, command, &m, &lat, &box, &rn, &t, log, msg, sizeof msg);
         progress_end(&pr);
         if (st == CM_ECANCELED) {
@@ -689,7 +653,7 @@ int cmd_solve(int argc, char **argv)
         }
         if (st != CM_OK || summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
-        t.t2 = now_seconds() - t0 - t.t1;
+        t.t2 = progress_now() - t0 - t.t1;
     } else {
         st = a.stage1 ? solve_stage1(&a, &plan, &m, &lat, &box, &r, &t, msg, sizeof msg)
                       : solve_whole(&a, &m, &lat, &box, &r, &t, &pr, msg, sizeof msg);

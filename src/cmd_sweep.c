@@ -15,13 +15,16 @@
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/json.h"
+#include "src/interrupt.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
+#include "src/progress.h"
 
 static const char sweep_help[] =
     "usage: cellmap sweep --model NAME [--param k=v[,k=v]] --vary NAME=V1,V2,...|NAME=LO:HI:N\n"
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
-    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE|-] [--json]\n\n"
+    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE|-] [--json]\n"
+    "                     [--quiet]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
     "the attractors and the sticking groups (rest cells: a sticking zone is\n"
@@ -39,6 +42,7 @@ static const char sweep_help[] =
     "                      attractor_cells,sticking_cells,groups,sink_cells,seconds\n"
     "  --json              the values solved and the changes found as one JSON\n"
     "                      document on standard output (docs/cellmap.schema.json)\n"
+    "  --quiet             no progress line and no report\n"
     "  --max-steps, --threads, --region, --cells: as for solve\n";
 
 enum { MAX_VALUES = 200, MAX_REFINE = 40 };
@@ -51,7 +55,7 @@ typedef struct sweep_args {
     int n_values, max_steps, threads, refine, n_near;
     double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
     const char *csv;
-    bool json;
+    bool json, quiet;
 } sweep_args;
 
 /* "NAME=V1,V2,..." (increasing) or "NAME=LO:HI:N", 2..MAX_VALUES values */
@@ -96,6 +100,8 @@ static int parse_args(cli *c, sweep_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
@@ -200,6 +206,8 @@ static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const
 {
     sweep_point lo = ch->lo, hi = ch->hi;
     for (int k = 0; k < a->refine; k++) {
+        if (interrupt_requested())
+            return cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
         sweep_point *mid = &pts[*n_pts];
         const cm_status st = solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
         if (st != CM_OK)
@@ -339,15 +347,21 @@ int cmd_sweep(int argc, char **argv)
         return EXIT_FAIL;
     }
     /* the text report goes where no other output goes; not with --json */
-    FILE *text = a.json ? NULL : report_stream(a.csv, NULL, NULL);
+    FILE *text = a.json || a.quiet ? NULL : report_stream(a.csv, NULL, NULL);
     char msg[512];
     int n = 0, n_changes = 0;
     cm_status st = CM_OK;
+    progress pr;
+    progress_start(&pr, "sweep", "values", (uint64_t)a.n_values, a.quiet);
+    interrupt_catch();
     for (int k = 0; k < a.n_values && st == CM_OK; k++) {
-        st = solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
+        st = interrupt_requested() ? cm_fail(CM_ECANCELED, msg, sizeof msg, "interrupted")
+                                   : solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
+        progress_end(&pr); /* the report's line goes below the progress line */
         if (st == CM_OK && text)
             print_point(text, a.name, &pts[n]);
         n += st == CM_OK;
+        progress_say(&pr, (uint64_t)n, NULL);
     }
     /* the listed values are pts[0 .. n_values-1]; refinements follow them */
     for (int k = 1; k < a.n_values && st == CM_OK; k++)
@@ -365,6 +379,14 @@ int cmd_sweep(int argc, char **argv)
     if (st == CM_OK && !n_changes && text)
         fprintf(text, "no change of the counts between %s = %s and %s\n", a.name,
                 CM_NUM(a.values[0]), CM_NUM(a.values[a.n_values - 1]));
+    progress_end(&pr);
+    if (st == CM_ECANCELED) {
+        fprintf(stderr, "cellmap sweep: interrupted (Ctrl-C) after %d value(s); nothing written\n",
+                n);
+        free(pts);
+        free(changes);
+        return EXIT_INTERRUPTED;
+    }
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);
     qsort(pts, (size_t)n, sizeof *pts, by_value);
