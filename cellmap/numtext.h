@@ -22,6 +22,10 @@ char *cm_num_text(double v, char buf[CM_NUM_TEXT]);
  * within a billionth of a cell it prints 500) or a duration. */
 char *cm_num_text_near(double v, double tol, char buf[CM_NUM_TEXT]);
 
+/* A billionth of a cell: what positions computed from cells are known to
+ * (the tol of cm_num_text_near for box edges and group centres). */
+#define CM_CELL_TOLERANCE 1e-9
+
 /* cm_num_text with a buffer that lives as long as the enclosing block:
  * printf("%s", CM_NUM(x)). */
 #define CM_NUM(v) cm_num_text((v), (char[CM_NUM_TEXT]){0})

@@ -141,10 +141,26 @@ void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size
 {
     size_t used = 0;
     out[0] = 0;
-    for (int d = 0; d < box->dim && used < size; d++)
-        used += (size_t)snprintf(out + used, size - used, "%s%.9g:%.9g", d ? "," : "",
-                                 lat->origin[d] + (double)box->lo[d] * lat->width[d],
-                                 lat->origin[d] + (double)box->hi[d] * lat->width[d]);
+    for (int d = 0; d < box->dim && used < size; d++) {
+        const double tol = CM_CELL_TOLERANCE * lat->width[d];
+        used += (size_t)snprintf(
+            out + used, size - used, "%s%s:%s", d ? "," : "",
+            cm_num_text_near(lat->origin[d] + (double)box->lo[d] * lat->width[d], tol,
+                             (char[CM_NUM_TEXT]){0}),
+            cm_num_text_near(lat->origin[d] + (double)box->hi[d] * lat->width[d], tol,
+                             (char[CM_NUM_TEXT]){0}));
+    }
+}
+
+void format_point(const cm_lattice *lat, const double *x, const char *sep, char *out,
+                  size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 0; d < lat->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", d ? sep : "",
+                                 cm_num_text_near(x[d], CM_CELL_TOLERANCE * lat->width[d],
+                                                  (char[CM_NUM_TEXT]){0}));
 }
 
 const char *figure_font(void)

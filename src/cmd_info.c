@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "src/args.h"
+#include "src/basin_png.h"
 #include "src/commands.h"
 #include "src/json.h"
 #include "src/project.h"
@@ -28,9 +29,10 @@ static int larger_basin_first(const void *a, const void *b)
 static void print_cells(const cm_lattice *lat, const int64_t *cell)
 {
     double x[CM_MAX_DIM];
+    char text[CM_MAX_DIM * CM_NUM_TEXT];
     cm_lattice_centre(lat, cell, x);
-    for (int d = 0; d < lat->dim; d++)
-        printf("%s%.9g", d ? ", " : "", x[d]);
+    format_point(lat, x, ", ", text, sizeof text);
+    fputs(text, stdout);
 }
 
 static void print_text(const char *path, const cm_store_info *info, const cm_box *bounds,
@@ -47,19 +49,18 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     for (int d = 0; d < lat->dim; d++)
         printf("%s%s", d ? ", " : "", CM_NUM(lat->width[d]));
     printf(")\nmade by: %s\n", info->command);
-    printf("regions %u, cells %llu, bounding box", info->regions, (unsigned long long)info->cells);
-    for (int d = 0; d < lat->dim; d++)
-        printf("%s%.9g:%.9g", d ? "," : " ", lat->origin[d] + (double)bounds->lo[d] * lat->width[d],
-               lat->origin[d] + (double)bounds->hi[d] * lat->width[d]);
-    printf(" (%llu cells)\n", (unsigned long long)cm_box_cells(bounds));
+    char box[CM_MAX_DIM * 2 * CM_NUM_TEXT];
+    format_box(lat, bounds, box, sizeof box);
+    printf("regions %u, cells %llu, bounding box %s (%llu cells)\n", info->regions,
+           (unsigned long long)info->cells, box, (unsigned long long)cm_box_cells(bounds));
     printf("groups %u periodic, sink basin %llu cells (%.1f%%)\n", info->groups,
            (unsigned long long)sink, 100.0 * (double)sink / (double)info->cells);
     printf("%6s %8s %12s  %s\n", "group", "period", "basin", "centre");
     for (uint32_t k = 0; k < info->groups && k < SHOWN_GROUPS; k++) {
-        printf("%6u %8u %12llu  (", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells);
-        for (int d = 0; d < lat->dim; d++)
-            printf("%s%.9g", d ? ", " : "", g[k].centre[d]);
-        printf(")  anchor cell centre (");
+        char centre[CM_MAX_DIM * CM_NUM_TEXT];
+        format_point(lat, g[k].centre, ", ", centre, sizeof centre);
+        printf("%6u %8u %12llu  (%s)  anchor cell centre (", g[k].id, g[k].period,
+               (unsigned long long)g[k].basin_cells, centre);
         print_cells(lat, g[k].anchor);
         printf(")\n");
     }

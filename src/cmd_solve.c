@@ -199,12 +199,6 @@ static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat,
     return EXIT_OK;
 }
 
-static void print_vector(FILE *out, const double *v, int n, const char *sep)
-{
-    for (int d = 0; d < n; d++)
-        fprintf(out, "%s%.9g", d ? sep : "", v[d]);
-}
-
 static int larger_basin_first(const void *a, const void *b)
 {
     const cm_group_info *x = a, *y = b;
@@ -239,8 +233,19 @@ typedef struct summary {
     cm_group_info *groups; /* in id order */
 } summary;
 
-static void print_text(FILE *out, const cm_model *m, const summary *sum, const timing *t,
-                       const extend_log *log)
+/* Groups of one fixed cell without a basin of its own: in micro-chaos maps
+ * mostly spurious fixed cells of the centre-point method (the README's
+ * glossary), not attractors. */
+static uint32_t single_cells(const cm_group_info *g, uint32_t n)
+{
+    uint32_t count = 0;
+    for (uint32_t k = 0; k < n; k++)
+        count += g[k].period == 1 && g[k].basin_cells == 1;
+    return count;
+}
+
+static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, const summary *sum,
+                       const timing *t, const extend_log *log)
 {
     char params[2048];
     cm_params_json(&m->values, params, sizeof params);
@@ -263,17 +268,21 @@ static void print_text(FILE *out, const cm_model *m, const summary *sum, const t
         return;
     memcpy(sorted, g, ngroups * sizeof *sorted);
     qsort(sorted, ngroups, sizeof *sorted, larger_basin_first);
-    fprintf(out, "%6s %8s %12s %12s  %-9s  %s\n", "group", "period", "basin", "doa", "kind", "centre");
+    fprintf(out, "%6s %8s %12s  %-9s  %s\n", "group", "period", "basin", "kind", "centre");
     for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
-        fprintf(out, "%6u %8u %12llu %12llu  %-9s  (", sorted[k].id, sorted[k].period,
-               (unsigned long long)sorted[k].basin_cells,
-               (unsigned long long)(sorted[k].basin_cells - sorted[k].period),
-               cm_group_kind_name(sorted[k].kind));
-        print_vector(out, sorted[k].centre, m->dim, ", ");
-        fprintf(out, ")\n");
+        char centre[CM_MAX_DIM * CM_NUM_TEXT];
+        format_point(lat, sorted[k].centre, ", ", centre, sizeof centre);
+        fprintf(out, "%6u %8u %12llu  %-9s  (%s)\n", sorted[k].id, sorted[k].period,
+                (unsigned long long)sorted[k].basin_cells, cm_group_kind_name(sorted[k].kind),
+                centre);
     }
     if (ngroups > TEXT_GROUPS)
         fprintf(out, "... and %u smaller groups (--json lists all)\n", ngroups - TEXT_GROUPS);
+    const uint32_t singles = single_cells(g, ngroups);
+    if (singles)
+        fprintf(out, "%u of the %u groups are single fixed cells with no other cell in their "
+                     "basin: usually artefacts of the cell size, not attractors\n",
+                singles, ngroups);
     free(sorted);
 }
 
@@ -674,7 +683,7 @@ int cmd_solve(int argc, char **argv)
     if (a.json)
         print_json(a.report, &m, &lat, &sum, &t, shown);
     else if (!a.quiet)
-        print_text(a.report, &m, &sum, &t, shown);
+        print_text(a.report, &m, &lat, &sum, &t, shown);
     if (rn.store && !a.json && !a.quiet)
         print_database(a.report, &a, &rn, &sum);
     if (a.png.path && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)

@@ -606,11 +606,10 @@ static void print_groups(const session *s, uint32_t ngroups, const cm_group_info
     fprintf(s->out, "%6s %8s %12s %12s  %s\n", "group", "period", "in view", "basin", "centre");
     for (uint32_t k = 0; k < n && k < STATS_GROUPS; k++) {
         const cm_group_info *gi = &g[ids[k].id - 1];
-        fprintf(s->out, "%6u %8u %12llu %12llu  (", gi->id, gi->period,
-                (unsigned long long)ids[k].cells, (unsigned long long)gi->basin_cells);
-        for (int d = 0; d < s->dim; d++)
-            fprintf(s->out, "%s%.9g", d ? ", " : "", gi->centre[d]);
-        fprintf(s->out, ")\n");
+        char centre[CM_MAX_DIM * CM_NUM_TEXT];
+        format_point(&s->c.lat, gi->centre, ", ", centre, sizeof centre);
+        fprintf(s->out, "%6u %8u %12llu %12llu  (%s)\n", gi->id, gi->period,
+                (unsigned long long)ids[k].cells, (unsigned long long)gi->basin_cells, centre);
     }
     if (n > STATS_GROUPS)
         fprintf(s->out, "... and %u groups with fewer cells in view\n", n - STATS_GROUPS);
@@ -668,7 +667,7 @@ static void print_stats_json(const session *s, const view_counts *v, const cm_re
         json_uint(&j, "basin_cells", g->basin_cells);
         json_array(&j, "centre");
         for (int d = 0; d < s->dim; d++)
-            json_num_near(&j, NULL, g->centre[d], JSON_CELL_TOLERANCE * s->c.lat.width[d]);
+            json_num_near(&j, NULL, g->centre[d], CM_CELL_TOLERANCE * s->c.lat.width[d]);
         json_array_end(&j);
         json_uint(&j, "in_view", v->in_view[k]);
         json_object_end(&j);

@@ -151,7 +151,7 @@ void json_box(json *j, const char *key, const cm_lattice *lat, const cm_box *box
 {
     json_array(j, key);
     for (int d = 0; d < box->dim; d++) {
-        const double tol = JSON_CELL_TOLERANCE * lat->width[d];
+        const double tol = CM_CELL_TOLERANCE * lat->width[d];
         json_array(j, NULL);
         json_num_near(j, NULL, lat->origin[d] + (double)box->lo[d] * lat->width[d], tol);
         json_num_near(j, NULL, lat->origin[d] + (double)box->hi[d] * lat->width[d], tol);
@@ -171,7 +171,7 @@ void json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *
         json_uint(j, "basin_cells", g[k].basin_cells);
         json_array(j, "centre");
         for (int d = 0; d < lat->dim; d++)
-            json_num_near(j, NULL, g[k].centre[d], JSON_CELL_TOLERANCE * lat->width[d]);
+            json_num_near(j, NULL, g[k].centre[d], CM_CELL_TOLERANCE * lat->width[d]);
         json_array_end(j);
         json_object_end(j);
     }

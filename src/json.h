@@ -65,7 +65,5 @@ void json_box(json *j, const char *key, const cm_lattice *lat, const cm_box *box
  * the lattice's resolution. */
 void json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat);
 
-/* A billionth of a cell: what positions computed from cells are known to. */
-#define JSON_CELL_TOLERANCE 1e-9
 
 #endif
