@@ -281,7 +281,8 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     const uint32_t singles = single_cells(g, ngroups);
     if (singles)
         fprintf(out, "%u of the %u groups are single fixed cells with no other cell in their "
-                     "basin: usually artefacts of the cell size, not attractors\n",
+                     "basin: usually cells the map moves by less than a cell, not attractors "
+                     "(--max-steps removes them)\n",
                 singles, ngroups);
     free(sorted);
 }

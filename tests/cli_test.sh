@@ -323,7 +323,7 @@ python3 "$HERE/pngcheck.py" friction.png friction.check.json || fail "friction.p
 
 # --- sweep: where the sticking zone of level 3 absorbs the attractor at SW_4 --
 # (x = 4/P = 72727) on the figure's lattice: the one-cell attractor centred at
-# x = 72625 comes to rest at mu = 72625 alpha^2 - 3 = 0.09680 (README)
+# x = 72625 comes to rest at mu = 72625 alpha^2 - 3 = 0.09680 (docs/gallery.md)
 "$CM" sweep --model microchaos-pd-friction --vary mu=0.095,0.1 --region=-100000:100000,-601.5:601.5 \
   --cells 800x401 --max-steps 100000 --near 71818:73636 --refine 8 --csv sweep.csv > sweep.out \
   || fail "sweep failed"

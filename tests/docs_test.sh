@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# What the documentation promises: the README's quick start and glossary
+# followed to the letter on a fresh directory, every documented spelling of
+# the one vocabulary, the man page against the help texts, the bash
+# completion, and what `cmake --install` installs.
+# usage: docs_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
+set -u
+CM=$(realpath "$1")
+SRC=$(realpath "$2")
+BUILD=$(realpath "$3")
+HERE=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+. "$HERE/testlib.sh"
+cd "$work"
+mkdir bin && ln -s "$CM" bin/cellmap
+export PATH="$work/bin:$PATH"
+
+# --- the newcomer's path: the README's quick start and glossary -------------
+# Each ```sh block of "Quick start" and "Glossary" runs as written; the
+# ```text block after the first is what it must print, times aside.
+python3 - "$SRC/README.md" <<'PY' || fail "the README's quick start"
+import re, subprocess, sys
+text = open(sys.argv[1]).read()
+quick = text[text.index("## Quick start"):text.index("## One vocabulary")]
+blocks = re.findall(r"```(\w+)\n(.*?)```", quick, re.S)
+assert [b[0] for b in blocks[:3]] == ["sh", "text", "sh"], [b[0] for b in blocks]
+def run(cmd):
+    return subprocess.run(cmd, shell=True, capture_output=True, text=True, check=True).stdout
+times = lambda s: re.sub(r"\d+\.\d+ (s|ns/cell)", "T", s)
+got, promised = run(blocks[0][1]), blocks[1][1]
+if times(got) != times(promised):
+    for a, b in zip(times(got).splitlines(), times(promised).splitlines()):
+        if a != b:
+            print("printed:  " + a + "\npromised: " + b)
+    sys.exit(1)
+for lang, cmd in blocks[2:]:          # the render and glossary commands
+    if lang == "sh":
+        run(cmd)
+m = re.search(r"```sh\n\s*(sqlite3 basin\.cmdb .*?)\n\s*```\s*\n\s*prints `(\d+)`", text)
+assert m, "the glossary's count of single-cell groups"
+assert run(m.group(1)).strip() == m.group(2), run(m.group(1))
+PY
+[ -s basin.png ] && [ -s fig.png ] || fail "the quick start made no basin.png or fig.png"
+
+# --- every documented spelling of the vocabulary works ------------------------
+spell() { "$CM" "$@" > /dev/null 2>&1 || fail "documented spelling: cellmap $*"; }
+spell solve --model microchaos-pd --param alpha=0.078 --param beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 40x20
+spell solve --model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 --region=-6:6,-6:6,-6:6 --cells 8x8x8
+spell sweep --vary P=0.006,0.007 --cells 40x20
+spell sweep --vary P=0.006:0.008:2 --cells 40x20 --csv -
+spell lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --periods 5 --csv -
+spell lyapunov --param S0=0.4 --grid Omega=0.49,0.5,0.51,S=0.3,0.4 --periods 5 --csv -
+spell bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 5 --record 2 --csv -
+spell bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 5 --record 2 --runs-csv -
+spell simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 2 --csv -
+spell orbit --from 10,0 --steps 3
+spell orbit --from 10,0 --steps 3 --csv -
+spell fixed-points --range 0:2 --csv -
+spell export basin.cmdb --groups - --quiet
+spell render basin.cmdb --png - --view 100:200,-10:10
+for c in solve sweep explore render info export models orbit fixed-points lyapunov simulate bifurcation; do
+  spell help $c
+  spell $c -h
+done
+printf 'view 100:200,-10:10\nview 100:200 -10:10\nstats --json\n' | "$CM" explore basin.cmdb - > /dev/null \
+  || fail "explore's two box spellings"
+[ "$("$CM" orbit --from 10,0 --steps 1 --csv - | head -1)" = "j,x,v" ] || fail "state names in orbit's CSV"
+
+# --- the man page is the help texts ------------------------------------------
+[ -s "$BUILD/cellmap.1" ] || fail "the build made no cellmap.1"
+"$SRC/docs/make-man.sh" "$CM" now.1 || fail "make-man.sh"
+cmp -s now.1 "$BUILD/cellmap.1" || fail "build/cellmap.1 is not what the help texts give now"
+python3 - now.1 "$CM" <<'PY' || fail "the man page and --help disagree"
+import re, subprocess, sys
+man = open(sys.argv[1]).read()
+unescape = lambda s: re.sub(r"^\\&", "", s, flags=re.M).replace("\\e", "\\")
+commands = re.findall(r"^  ([a-z][a-z-]*) ", subprocess.run([sys.argv[2], "--help"], capture_output=True, text=True).stdout, re.M)
+assert len(commands) == 12, commands
+for c in commands:
+    section = re.search(r"^\.SS " + re.escape(c) + r"\n\.nf\n(.*?)^\.fi$", man, re.S | re.M)
+    assert section, c
+    helptext = subprocess.run([sys.argv[2], "help", c], capture_output=True, text=True).stdout
+    assert unescape(section.group(1)) == helptext, c
+PY
+MANWIDTH=100 man -l now.1 > man.txt 2> man.err || fail "man cannot show the page: $(cat man.err)"
+grep -q "cellmap help COMMAND" man.txt || fail "man page text"
+
+# --- bash completion -----------------------------------------------------------
+bash -c '
+  source "$1"
+  t() { COMP_WORDS=("$@"); COMP_CWORD=$(($# - 1)); _cellmap; echo "${COMPREPLY[*]}"; }
+  [ "$(t cellmap so)" = solve ] || exit 1
+  [ "$(t cellmap solve --re)" = "--region --resume" ] || exit 2
+  [ "$(t cellmap solve --model microchaos-pd-f)" = microchaos-pd-friction ] || exit 3
+  [ "$(t cellmap help fi)" = fixed-points ] || exit 4
+  [ "$(t cellmap lyapunov --qu)" = --quiet ] || exit 5
+' _ "$SRC/assets/completion/cellmap.bash" || fail "bash completion (case $?)"
+
+# --- cmake --install ------------------------------------------------------------
+cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "cmake --install: $(cat install.log)"
+for f in bin/cellmap share/man/man1/cellmap.1 share/bash-completion/completions/cellmap; do
+  [ -s "$work/prefix/$f" ] || fail "cmake --install did not install $f"
+done
+"$work/prefix/bin/cellmap" --version | grep -q "^cellmap " || fail "the installed cellmap does not run"
+
+[ $fails -eq 0 ] && echo "docs tests passed"
+exit $fails
