@@ -106,8 +106,9 @@ typedef struct cm_model {
     void (*destroy)(void *ctx);
 } cm_model;
 
-/* The name of state coordinate d: the model's own (coord_names), else x0,
- * x1, ... The same names head CSV columns, JSON arrays and SQL columns. */
+/* The name of state coordinate d: the model's own (coord_names, d < dim),
+ * else x0, x1, ... (d < CM_MAX_DIM). The same names head CSV columns, JSON
+ * arrays and SQL columns. */
 const char *cm_model_coord_name(const cm_model *m, int d);
 
 /* Releases the model's context; NULL-safe; leaves the struct zeroed. */

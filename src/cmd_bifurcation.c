@@ -466,19 +466,12 @@ int cmd_bifurcation(int argc, char **argv)
         if (!s.res[k].valid || interrupt_requested()) /* Ctrl-C: the runs left are skipped */
             continue;
         run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k], s.sections + k * 2 * (size_t)a.record);
-        uint64_t now;
-#pragma omp atomic capture
-        now = ++done;
-        if (omp_get_thread_num() == 0) /* the line is the first thread's alone */
-            progress_say(&pr, now, NULL);
+        progress_tick(&pr, &done);
     }
     progress_end(&pr);
     if (interrupt_requested()) {
-        fprintf(stderr, "cellmap bifurcation: interrupted (Ctrl-C) after %llu of %zu runs; "
-                        "nothing written\n",
-                (unsigned long long)done, n_runs);
         sweep_free(&s, models);
-        return EXIT_INTERRUPTED;
+        return interrupt_stopped("bifurcation", done, n_runs, "runs");
     }
     if (!a.quiet || a.json)
         print_summary(&a, &base, &s, omp_get_wtime() - t0);

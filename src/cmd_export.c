@@ -481,7 +481,8 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         fprintf(stderr, "cellmap export: %s\n", msg);
         rc = st == CM_ECANCELED ? EXIT_INTERRUPTED : EXIT_FAIL;
     } else if (nouts && !a->quiet) {
-        fprintf(stderr, "cellmap export: %llu cells\n", (unsigned long long)outs[0].rows);
+        fprintf(report_stream(a->groups, a->cells, a->flat), "exported %llu cells\n",
+                (unsigned long long)outs[0].rows);
     }
     free(g);
     return rc;

@@ -249,19 +249,12 @@ int cmd_lyapunov(int argc, char **argv)
             continue;
         }
         v[k] = point_exponent(&a, (int)(k % nx), (int)(k / nx), &invalid);
-        uint64_t now;
-#pragma omp atomic capture
-        now = ++done;
-        if (omp_get_thread_num() == 0) /* the line is the first thread's alone */
-            progress_say(&pr, now, NULL);
+        progress_tick(&pr, &done);
     }
     progress_end(&pr);
     if (interrupt_requested()) {
-        fprintf(stderr, "cellmap lyapunov: interrupted (Ctrl-C) after %llu of %zu grid points; "
-                        "nothing written\n",
-                (unsigned long long)done, n);
         free(v);
-        return EXIT_INTERRUPTED;
+        return interrupt_stopped("lyapunov", done, n, "grid points");
     }
     const double secs = omp_get_wtime() - t0;
     size_t positive = 0, computed = 0, best = 0;

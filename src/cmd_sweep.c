@@ -381,11 +381,10 @@ int cmd_sweep(int argc, char **argv)
                 CM_NUM(a.values[0]), CM_NUM(a.values[a.n_values - 1]));
     progress_end(&pr);
     if (st == CM_ECANCELED) {
-        fprintf(stderr, "cellmap sweep: interrupted (Ctrl-C) after %d value(s); nothing written\n",
-                n);
         free(pts);
         free(changes);
-        return EXIT_INTERRUPTED;
+        return interrupt_stopped("sweep", (uint64_t)n, (uint64_t)(n > a.n_values ? n : a.n_values),
+                                 "values");
     }
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);

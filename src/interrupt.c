@@ -1,6 +1,9 @@
 #include "src/interrupt.h"
 
+#include "src/args.h"
+
 #include <signal.h>
+#include <stdio.h>
 #include <string.h>
 
 /* The one thing a signal handler may set: the process's own request. */
@@ -23,3 +26,10 @@ void interrupt_catch(void)
 }
 
 bool interrupt_requested(void) { return requested != 0; }
+
+int interrupt_stopped(const char *cmd, uint64_t done, uint64_t total, const char *unit)
+{
+    fprintf(stderr, "cellmap %s: interrupted (Ctrl-C) after %llu of %llu %s; nothing written\n",
+            cmd, (unsigned long long)done, (unsigned long long)total, unit);
+    return EXIT_INTERRUPTED;
+}

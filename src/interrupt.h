@@ -6,11 +6,16 @@
 #define CM_SRC_INTERRUPT_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 /* From now on SIGINT sets the request instead of ending the process (once). */
 void interrupt_catch(void);
 
 /* Whether SIGINT came since interrupt_catch. */
 bool interrupt_requested(void);
+
+/* Says that CMD stopped after `done` of `total` UNITs and wrote nothing;
+ * returns EXIT_INTERRUPTED. */
+int interrupt_stopped(const char *cmd, uint64_t done, uint64_t total, const char *unit);
 
 #endif

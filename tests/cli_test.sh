@@ -519,9 +519,9 @@ wait $solver; rc=$?
 
 # the analysis commands: a progress line on a terminal, Ctrl-C stops them
 # with exit 130 and leaves no file
-LYAP=(lyapunov --param S0=0.4 --grid Omega=0.3:0.7:30,S=0.02:0.4:30 --periods 600 --threads 2)
+LYAP=(lyapunov --param S0=0.4 --grid Omega=0.3:0.7:24,S=0.02:0.4:24 --periods 400 --threads 2)
 script -qfec "$CM ${LYAP[*]} --csv l.csv" /dev/null > tty.txt
-grep -q "lyapunov: [0-9]* of 900 grid points, .* grid points/s" tty.txt \
+grep -q "lyapunov: [0-9]* of 576 grid points, .* grid points/s" tty.txt \
   || fail "no lyapunov progress line: $(head -c 300 tty.txt)"
 script -qfec "$CM ${LYAP[*]} --csv l.csv --quiet" /dev/null > quiet.txt
 [ -s quiet.txt ] && fail "lyapunov --quiet printed: $(head -c 300 quiet.txt)"
@@ -531,7 +531,7 @@ job=$!
 sleep 1
 kill -INT $job 2> /dev/null || fail "lyapunov ended before Ctrl-C"
 wait $job; rc=$?
-[ $rc -eq 130 ] && grep -q "interrupted (Ctrl-C) after [0-9]* of 900 grid points; nothing written" int.txt \
+[ $rc -eq 130 ] && grep -q "interrupted (Ctrl-C) after [0-9]* of 576 grid points; nothing written" int.txt \
   || fail "lyapunov Ctrl-C: exit $rc, $(cat int.txt)"
 [ -e l.csv ] || compgen -G "l.csv.tmp-*" > /dev/null && fail "lyapunov left a file after Ctrl-C"
 
