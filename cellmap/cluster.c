@@ -1353,6 +1353,15 @@ static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
+    return cm_cluster_flatten_progress(c, box, out, NULL, NULL, msg, msg_size);
+}
+
+cm_status cm_cluster_flatten_progress(cm_cluster *c, const cm_box *box, cm_region *out,
+                                      cm_progress_fn progress, void *user, char *msg,
+                                      size_t msg_size)
+{
+    const double total = (double)cm_box_cells(box);
+    uint64_t done = 0;
     cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
     uint32_t *group = NULL, *step = NULL;
     uint8_t *cycle = NULL;
@@ -1383,6 +1392,9 @@ cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, c
         if (st == CM_OK)
             flatten_part(&c->regions[k].r, &nv, &both, out, cm_cluster_threads(c));
         cm_cluster_trim(c);
+        done += cm_box_cells(&both);
+        if (st == CM_OK && progress && progress(user, "cells", total > 0 ? done / total : 1))
+            st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     }
     free(group);
     free(step);

@@ -389,4 +389,11 @@ void cm_flat_copy(const cm_region *r, cm_region *out);
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size);
 
+/* The same, calling progress(user, "cells", fraction of the box's cells
+ * read) after each region it reads; nonzero from it cancels (CM_ECANCELED,
+ * out freed). */
+cm_status cm_cluster_flatten_progress(cm_cluster *c, const cm_box *box, cm_region *out,
+                                      cm_progress_fn progress, void *user, char *msg,
+                                      size_t msg_size);
+
 #endif

@@ -9,11 +9,14 @@
 #include "src/outfile.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
+#include "src/interrupt.h"
+#include "src/progress.h"
 #include "src/project.h"
 
 static const char render_help[] =
     "usage: cellmap render FILE.cmdb --png OUT.png [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
-    "                      [--size WxH] [--layers L,...] [--png-mode rgb|indexed] [--mem BYTES]\n\n"
+    "                      [--size WxH] [--layers L,...] [--png-mode rgb|indexed] [--mem BYTES]\n"
+    "                      [--quiet]\n\n"
     "Draws the basins of a cluster database (made by solve --db or explore). Cells of the\n"
     "view that were never computed are drawn as not computed.\n\n"
     "  --png FILE          the image (written to a temporary file, renamed)\n" PNG_OPTIONS_HELP
@@ -21,13 +24,15 @@ static const char render_help[] =
     "                      the cluster's bounding box)\n"
     "  --slice Z,...       models of more than two dimensions: the point of dimensions\n"
     "                      3.. the 2-D slice passes through (default: the cluster's middle)\n"
-    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n";
+    "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n"
+    "  --quiet             no progress line while the view's cells are read\n";
 
 typedef struct render_args {
     const char *file;
     png_opts png;
     const char *slice_text;
     uint64_t mem;
+    bool quiet;
 } render_args;
 
 static int parse_render(cli *c, render_args *a)
@@ -41,6 +46,8 @@ static int parse_render(cli *c, render_args *a)
         } else if (cli_is(c, "--slice", true, &err)) {
             a->slice_text = c->value;
         } else if (cli_take_mem(c, &a->mem, &err)) {
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
         } else if (c->opt[0] != '-' && !a->file) {
             a->file = c->opt;
         } else {
@@ -109,6 +116,15 @@ static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const 
     return EXIT_OK;
 }
 
+/* The progress line while the view's cells are read, and Ctrl-C. */
+static int reading(void *user, const char *phase, double fraction)
+{
+    progress *p = user;
+    (void)phase;
+    progress_say(p, (uint64_t)(fraction * (double)p->total), "reading the view");
+    return interrupt_requested();
+}
+
 static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_store_info *info,
                       cm_cluster *cl)
 {
@@ -129,10 +145,18 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     cm_group_info *groups = calloc((size_t)cl->ngroups + 1, sizeof *groups);
     cm_status st = groups ? cm_store_groups(s, groups, cl->ngroups, &sink, msg, sizeof msg)
                           : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for groups");
+    progress pr;
+    progress_start(&pr, "render", "cells", cm_box_cells(&box), a->quiet);
+    interrupt_catch();
     if (st == CM_OK)
-        st = cm_cluster_flatten(cl, &box, &flat, msg, sizeof msg);
+        st = cm_cluster_flatten_progress(cl, &box, &flat, reading, &pr, msg, sizeof msg);
+    progress_end(&pr);
     rc = EXIT_FAIL;
-    if (st != CM_OK) {
+    if (st == CM_ECANCELED) {
+        fprintf(stderr, "cellmap render: interrupted (Ctrl-C) while reading the view; nothing "
+                        "written\n");
+        rc = EXIT_INTERRUPTED;
+    } else if (st != CM_OK) {
         fprintf(stderr, "cellmap render: %s\n", msg);
     } else {
         const basin_png png = {&a->png,        &m,  &cl->lat, &flat, groups, {lo[0], lo[1]},

@@ -534,6 +534,17 @@ wait $job; rc=$?
 [ $rc -eq 130 ] && grep -q "interrupted (Ctrl-C) after [0-9]* of 576 grid points; nothing written" int.txt \
   || fail "lyapunov Ctrl-C: exit $rc, $(cat int.txt)"
 [ -e l.csv ] || compgen -G "l.csv.tmp-*" > /dev/null && fail "lyapunov left a file after Ctrl-C"
+# render: the line while the view's cells are read (paged through a small
+# budget, so that it lasts), then Ctrl-C: exit 130 and no PNG
+script -qfec "$CM render tty.cmdb --png ctrlc.png --mem 4M; echo rc=\$?" /dev/null > render.txt &
+job=$!
+for _ in $(seq 500); do grep -q "render: reading the view" render.txt 2> /dev/null && break; sleep 0.01; done
+pkill -INT -f "^$CM render tty.cmdb --png ctrlc.png" || fail "render ended before Ctrl-C"
+wait $job
+grep -q "render: reading the view, .* of 32.0 M cells" render.txt || fail "no render progress line: $(head -c 300 render.txt)"
+grep -q "interrupted (Ctrl-C) while reading the view; nothing written" render.txt && grep -q "rc=130" render.txt \
+  || fail "render Ctrl-C: $(tail -c 300 render.txt)"
+[ -e ctrlc.png ] || compgen -G "ctrlc.png.tmp-*" > /dev/null && fail "render left a file after Ctrl-C"
 
 [ $fails -eq 0 ] && echo "cli tests passed" || echo "$fails cli test(s) failed"
 exit $fails
