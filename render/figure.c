@@ -62,10 +62,34 @@ static entry *add_entry(legend *lg, cm_rgb swatch, bool has_swatch)
     return e;
 }
 
+enum { LEGEND_GROUPS = 12 }; /* the default of cm_render_options.legend_groups */
+
+/* The entries after the groups: those folded into "other", colours that
+ * repeat, cells not computed. */
+static void closing_entries(const cm_raster *ras, uint64_t all, int room, legend *lg)
+{
+    if (ras->other_groups && lg->n < room) {
+        entry *e = add_entry(lg, cm_colour_other, true);
+        if (ras->min_basin == 2)
+            snprintf(e->text, LABEL, "%u single-cell groups  %.1f%%", ras->other_groups,
+                     share(ras->other_cells, all));
+        else
+            snprintf(e->text, LABEL, "%u groups < %llu cells  %.1f%%", ras->other_groups,
+                     (unsigned long long)ras->min_basin, share(ras->other_cells, all));
+    }
+    if (ras->colour_repeats && lg->n < room)
+        snprintf(add_entry(lg, paper, false)->text, LABEL, "colours repeat: %u groups too many",
+                 ras->colour_repeats);
+    if (ras->computed < all && lg->n < room)
+        snprintf(add_entry(lg, cm_colour_not_computed, true)->text, LABEL, "not computed  %.1f%%",
+                 share(all - ras->computed, all));
+}
+
 /* Entries for the sink, the groups in view with the most cells (as many as
- * `room` lines allow) and the cells not computed. */
+ * `room` lines and max_groups allow; the rest summed up in one line), the
+ * groups folded into "other", and the cells not computed. */
 static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, uint32_t ngroups,
-                             int room, legend *lg, char *msg, size_t msg_size)
+                             int room, int max_groups, legend *lg, char *msg, size_t msg_size)
 {
     const uint64_t all = ras->s.nx * ras->s.ny;
     group_cells *order = malloc(((size_t)ngroups + 1) * sizeof *order);
@@ -77,17 +101,23 @@ static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, 
     }
     uint32_t shown = 0;
     for (uint32_t g = 1; g <= ngroups; g++)
-        if (ras->group_cells[g])
+        if (ras->group_cells[g] && ras->classes[g] != CM_CLASS_OTHER)
             order[shown++] = (group_cells){ras->group_cells[g], g};
     qsort(order, shown, sizeof *order, more_cells_first);
-    const bool missing = ras->computed < all;
-    int slots = room - (ras->group_cells[0] ? 1 : 0) - (missing ? 1 : 0);
+    const int closing = (ras->other_groups ? 1 : 0) + (ras->colour_repeats ? 1 : 0) +
+                        (ras->computed < all ? 1 : 0);
+    int slots = room - (ras->group_cells[0] ? 1 : 0) - closing;
+    slots = slots < max_groups + 1 ? slots : max_groups + 1;
     if (ras->group_cells[0] && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "sink  %.1f%%",
                  share(ras->group_cells[0], all));
     for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
-        if (slots == 1 && k + 1 < shown) {
-            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more groups", shown - k);
+        if (slots == 1 && k + 1 < shown) { /* the rest in one line */
+            uint64_t rest = 0;
+            for (uint32_t r = k; r < shown; r++)
+                rest += order[r].cells;
+            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more groups  %.1f%%",
+                     shown - k, share(rest, all));
             break;
         }
         const uint32_t g = order[k].id;
@@ -96,9 +126,7 @@ static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, 
                  "#%u%s p=%u  %.1f%%", gi->id, gi->kind == CM_GROUP_STICKING ? " sticking" : "",
                  gi->period, share(order[k].cells, all));
     }
-    if (missing && lg->n < room)
-        snprintf(add_entry(lg, cm_colour_not_computed, true)->text, LABEL, "not computed  %.1f%%",
-                 share(all - ras->computed, all));
+    closing_entries(ras, all, room, lg);
     free(order);
     return CM_OK;
 }
@@ -341,7 +369,8 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
 {
     const int dim = r->box.dim;
     cm_status st =
-        cm_raster_build(lat, r, groups, s, raster_mode(o->layers), &w->ras, msg, msg_size);
+        cm_raster_build(lat, r, groups, s, raster_mode(o->layers), o->min_basin, &w->ras, msg,
+                        msg_size);
     if (st == CM_OK && o->model && o->model->overlays && (o->layers & CM_LAYER_OVERLAYS)) {
         w->ov.items = malloc(OVERLAY_CAP * sizeof *w->ov.items);
         w->ov.cap = w->ov.items ? OVERLAY_CAP : 0;
@@ -363,7 +392,9 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
     }
     if (st == CM_OK && (o->layers & CM_LAYER_LEGEND)) {
         const int room = (o->height - L->top - L->bottom) / (L->line > 0 ? L->line : 1);
-        st = make_legend(&w->ras, groups, r->ngroups, room, &w->lg, msg, msg_size);
+        st = make_legend(&w->ras, groups, r->ngroups, room,
+                         o->legend_groups > 0 ? o->legend_groups : LEGEND_GROUPS, &w->lg, msg,
+                         msg_size);
         int widest_entry = 0;
         for (int k = 0; k < w->lg.n; k++) {
             const int ew = cm_font_width(w->font, w->lg.e[k].text);

@@ -1,5 +1,8 @@
 /* render/palette.h - colours of basins. A group's colour follows from its
- * identity (its anchor cell), not from its id, so re-solving keeps colours. */
+ * identity (its anchor cell on the lattice), not from its id or the other
+ * groups of the file, so the same attractor has the same colour in every
+ * file, view and pan; only a larger group of the same view whose anchor
+ * hashes to the same colour can move it (see cm_palette_classes). */
 #ifndef CM_RENDER_PALETTE_H
 #define CM_RENDER_PALETTE_H
 
@@ -16,6 +19,7 @@ extern const cm_rgb cm_colour_not_computed;    /* cells outside every region */
 extern const cm_rgb cm_colour_marker;          /* periodic cells (black dots) */
 extern const cm_rgb cm_colour_sticking;        /* basins of sticking zones (grey, Fig. 4.30) */
 extern const cm_rgb cm_colour_sticking_marker; /* the sticking zones' rest cells */
+extern const cm_rgb cm_colour_other;           /* basins folded into "other" (--min-basin) */
 
 /* Colour classes: the figure's colours, numbered. An indexed PNG stores
  * the class of each cell; its palette is cm_class_colour of each class. */
@@ -25,15 +29,26 @@ enum cm_colour_class {
     CM_CLASS_MARKER,          /* periodic cells of attractors */
     CM_CLASS_STICKING,        /* basins of sticking zones */
     CM_CLASS_STICKING_MARKER, /* rest cells of sticking zones */
+    CM_CLASS_OTHER,           /* groups whose basins are below --min-basin */
     CM_CLASS_FIRST_GROUP      /* then one class per categorical colour */
 };
 int cm_class_count(void);
 cm_rgb cm_class_colour(int cls);
 
-/* Classes of groups 1..n (entry k for group k+1). Sticking zones are grey;
- * every other group takes the palette colour its anchor hashes to, or the
- * next one not yet taken by a group with a smaller anchor, so up to the
- * palette size all groups differ. */
-void cm_palette_classes(const cm_group_info *groups, uint32_t n, int dim, uint8_t *classes);
+/* The number of categorical colours (classes CM_CLASS_FIRST_GROUP on). */
+int cm_palette_size(void);
+
+/* Classes of groups 1..n (entry k for group k+1) in one view. Sticking
+ * zones are grey. Groups in view (in_view[k] cells; in_view NULL: all, by
+ * basin) whose basins have at least min_basin cells take the palette
+ * colour their anchor hashes to; where two collide, the one with more
+ * cells in view keeps it and the other takes the next free colour, so up
+ * to the palette's size no two groups in view share a colour, and beyond
+ * it the largest groups still differ. A group keeps its colour in every
+ * file and view unless a larger group of the same view hashes to it.
+ * Smaller groups are CM_CLASS_OTHER. Returns how many coloured groups
+ * exceed the palette (0: every colour in view is one group's). */
+uint32_t cm_palette_classes(const cm_group_info *groups, uint32_t n, const cm_lattice *lat,
+                            const uint64_t *in_view, uint64_t min_basin, uint8_t *classes);
 
 #endif

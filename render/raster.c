@@ -107,11 +107,11 @@ static void colour_cell(const cm_region *r, const cm_raster *ras, uint64_t k, in
     p[2] = (uint8_t)((c.b * shade[t]) >> 8);
 }
 
-/* Pixels and the cells of each group, in parallel over rows. */
-static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *shade)
+/* The cells of each group in the slice, in parallel over rows: the
+ * colours depend on which groups are in view. */
+static void count_cells(const cm_region *r, cm_raster *ras)
 {
     const cm_slice *s = &ras->s;
-    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
     const uint32_t n = r->ngroups + 1;
     uint64_t computed = 0;
 #pragma omp parallel reduction(+ : computed)
@@ -120,12 +120,11 @@ static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *s
 #pragma omp for schedule(static)
         for (uint64_t j = 0; j < s->ny; j++)
             for (uint64_t i = 0; i < s->nx; i++) {
-                const uint64_t k = s->base + j * s->row_stride + i;
-                colour_cell(r, ras, k, mode, shade, ras->pixels + bytes * (j * s->nx + i));
-                if (r->group[k] != CM_GROUP_NONE) {
+                const uint32_t g = r->group[s->base + j * s->row_stride + i];
+                if (g != CM_GROUP_NONE) {
                     computed++;
                     if (mine)
-                        mine[r->group[k]]++;
+                        mine[g]++;
                 }
             }
 #pragma omp critical
@@ -138,6 +137,32 @@ static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *s
         free(mine);
     }
     ras->computed = computed;
+}
+
+/* The pixels, in parallel over rows. */
+static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *shade)
+{
+    const cm_slice *s = &ras->s;
+    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
+#pragma omp parallel for schedule(static)
+    for (uint64_t j = 0; j < s->ny; j++)
+        for (uint64_t i = 0; i < s->nx; i++)
+            colour_cell(r, ras, s->base + j * s->row_stride + i, mode, shade,
+                        ras->pixels + bytes * (j * s->nx + i));
+}
+
+/* The classes of the groups in view, and what was folded into "other". */
+static void classify_groups(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                            cm_raster *ras)
+{
+    ras->classes[0] = CM_CLASS_SINK;
+    ras->colour_repeats = cm_palette_classes(groups, r->ngroups, lat, ras->group_cells + 1,
+                                             ras->min_basin, ras->classes + 1);
+    for (uint32_t g = 1; g <= r->ngroups; g++)
+        if (ras->group_cells[g] && ras->classes[g] == CM_CLASS_OTHER) {
+            ras->other_groups++;
+            ras->other_cells += ras->group_cells[g];
+        }
 }
 
 /* The periodic cells in slice order (serial: they are few and the order
@@ -165,10 +190,12 @@ static cm_status collect_periodic(const cm_region *r, cm_raster *ras, char *msg,
 }
 
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          const cm_slice *s, int mode, cm_raster *ras, char *msg, size_t msg_size)
+                          const cm_slice *s, int mode, uint64_t min_basin, cm_raster *ras,
+                          char *msg, size_t msg_size)
 {
     memset(ras, 0, sizeof *ras);
     ras->s = *s;
+    ras->min_basin = min_basin;
     const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
     if (s->nx > UINT32_MAX || s->ny > UINT32_MAX)
         return cm_fail(CM_EINVAL, msg, msg_size, "the slice is too large to draw");
@@ -181,8 +208,12 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
                      (unsigned long long)s->nx, (unsigned long long)s->ny);
     if (st == CM_OK) {
-        ras->classes[0] = CM_CLASS_SINK;
-        cm_palette_classes(groups, r->ngroups, lat->dim, ras->classes + 1);
+        count_cells(r, ras);
+        if (ras->group_cells[0] == UINT64_MAX)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for basin counts");
+    }
+    if (st == CM_OK) {
+        classify_groups(lat, r, groups, ras);
         ras->step_cap = mode == CM_RASTER_SHADED || mode == CM_RASTER_STEPS ? step_cap_of(r, s) : 1;
         shade = malloc(((size_t)ras->step_cap + 1) * sizeof *shade);
         if (!shade)
@@ -191,8 +222,6 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
     if (st == CM_OK) {
         shade_table(ras->step_cap, mode, shade);
         fill(r, ras, mode, shade);
-        if (ras->group_cells[0] == UINT64_MAX)
-            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for basin counts");
     }
     if (st == CM_OK)
         st = collect_periodic(r, ras, msg, msg_size);

@@ -47,11 +47,18 @@ typedef struct cm_raster {
     uint64_t computed;     /* cells of the slice inside the regions */
     uint32_t step_cap;     /* step numbers from here up are shaded darkest */
     uint8_t *classes;      /* class of each group; [0] the sink */
+    uint64_t min_basin;    /* groups with smaller basins are drawn as "other" */
+    uint32_t other_groups; /* groups in the slice drawn as "other" */
+    uint64_t other_cells;  /* their cells in the slice */
+    uint32_t colour_repeats; /* coloured groups in the slice beyond the palette's size */
 } cm_raster;
 
-/* Builds the raster of r's slice. Deterministic whatever the thread count. */
+/* Builds the raster of r's slice; groups with basins of fewer than
+ * min_basin cells are drawn as "other" (render/palette.h). Deterministic
+ * whatever the thread count. */
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          const cm_slice *s, int mode, cm_raster *out, char *msg, size_t msg_size);
+                          const cm_slice *s, int mode, uint64_t min_basin, cm_raster *out,
+                          char *msg, size_t msg_size);
 void cm_raster_free(cm_raster *ras);
 
 #endif

@@ -23,7 +23,7 @@ static const struct {
     {"title", CM_LAYER_TITLE},
 };
 
-static const unsigned all_layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS |
+const unsigned all_layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS |
                                    CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
 
 bool parse_layers(const char *s, unsigned *layers, char *bad, size_t bad_size)
@@ -71,6 +71,13 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
     } else if (cli_is(c, "--png-mode", true, err)) {
         if (c->value && !parse_png_mode(c->value, &po->indexed))
             *err = cli_usage_error(c, "--png-mode: '%s' must be rgb or indexed", c->value);
+    } else if (cli_is(c, "--min-basin", true, err)) {
+        int64_t v = 0;
+        if (c->value && (!parse_int64(c->value, &v) || v < 1))
+            *err = cli_usage_error(c, "--min-basin: '%s' must be a whole number of cells, 1 or more",
+                                   c->value);
+        po->min_basin = (uint64_t)v;
+    } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
     } else if (cli_is(c, "--view", true, err)) {
         int n = 0;
         if (c->value && (!parse_ranges(c->value, po->lo, po->hi, &n, 2) || n != 2 ||
@@ -86,9 +93,9 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 
 int png_opts_check(const cli *c, const png_opts *po)
 {
-    if (!po->path && (po->width || po->layers || po->indexed))
-        return cli_usage_error(c, "--size, --layers and --png-mode describe the image; add --png "
-                                  "FILE");
+    if (!po->path && (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups))
+        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin and --legend "
+                                  "describe the image; add --png FILE");
     if (po->indexed && (po->width || po->layers))
         return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
                                   "classes; leave out --size and --layers");
@@ -217,12 +224,29 @@ static void make_provenance(const basin_png *b, const char *view, unsigned layer
     memcpy(p->texts, texts, sizeof texts);
 }
 
+/* --min-basin, or its default: single-cell groups fold where a legend
+ * would otherwise list hundreds of them; machine images fold nothing. */
+static uint64_t min_basin_of(const png_opts *po, unsigned layers)
+{
+    return po->min_basin ? po->min_basin : (layers & CM_LAYER_LEGEND) ? 2 : 1;
+}
+
+/* --layers, or the command's default. */
+static unsigned layers_of(const png_opts *po)
+{
+    return po->layers           ? po->layers
+           : po->default_layers ? po->default_layers
+                                : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+}
+
 static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
 {
     const png_opts *po = b->opts;
     cm_render_options ro;
     memset(&ro, 0, sizeof ro);
-    ro.layers = po->layers ? po->layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    ro.layers = layers_of(po);
+    ro.min_basin = min_basin_of(po, ro.layers);
+    ro.legend_groups = po->legend_groups;
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -282,7 +306,8 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
                        "side; choose a smaller --view",
                        (unsigned long long)s.nx, (unsigned long long)s.ny, CM_RENDER_MAX_SIDE);
     cm_status st =
-        cm_raster_build(b->lat, b->cells, b->groups, &s, CM_RASTER_CLASSES, &ras, msg, msg_size);
+        cm_raster_build(b->lat, b->cells, b->groups, &s, CM_RASTER_CLASSES,
+                        min_basin_of(b->opts, 0), &ras, msg, msg_size);
     if (st != CM_OK)
         return st;
     const int n = cm_class_count();
@@ -325,7 +350,7 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
     if (!po->indexed) {
         cm_render_options ro;
         memset(&ro, 0, sizeof ro);
-        ro.layers = po->layers ? po->layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+        ro.layers = layers_of(po);
         ro.width = po->width;
         ro.height = po->height;
         cm_box shown = *box;

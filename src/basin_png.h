@@ -11,11 +11,17 @@
 typedef struct png_opts {
     const char *path;  /* --png FILE */
     int width, height; /* --size WxH; 0: one pixel per cell, at most 4096 a side */
-    unsigned layers;   /* --layers; 0: basin and attractors */
+    unsigned layers;   /* --layers; 0: default_layers */
+    unsigned default_layers; /* the command's default (0: basin and attractors) */
     int indexed;       /* --png-mode indexed: one pixel per cell, value = colour class */
     int has_view;      /* --view X0:X1,Y0:Y1 */
     double lo[2], hi[2];
+    uint64_t min_basin; /* --min-basin N; 0: 2 in figures with a legend, else 1 */
+    int legend_groups;  /* --legend K; 0: the renderer's default */
 } png_opts;
+
+/* What `all` draws: every layer but steps. */
+extern const unsigned all_layers;
 
 #define PNG_OPTIONS_HELP                                                                           \
     "  --size WxH          image size in pixels (default: one pixel per cell, at most 4096;\n"     \
@@ -27,7 +33,13 @@ typedef struct png_opts {
     "  --png-mode MODE     rgb (a figure) or indexed (one pixel per cell, its value the\n"         \
     "                      colour class; the classes of groups are in the PNG's texts)\n"          \
     "  --view X0:X1,Y0:Y1  the rectangle of state space to draw (default: all cells;\n"            \
-    "                      1-D models ignore Y0:Y1)\n"
+    "                      1-D models ignore Y0:Y1)\n"                                             \
+    "  --min-basin N       draw groups whose basins have fewer than N cells as 'other' (one\n"   \
+    "                      muted colour, one legend line); default 2 in figures with a\n"         \
+    "                      legend (single-cell groups folded), else 1 (none)\n"                    \
+    "  --legend K          list at most K groups in the legend (default 12), the rest in one\n"   \
+    "                      line; colours follow each attractor's anchor cell, so the same\n"     \
+    "                      attractor has the same colour in every file and view\n"
 
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);

@@ -32,8 +32,8 @@ static const char solve_help[] =
     "                      [--view X0:X1,Y0:Y1]] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
     "                     [--stage1]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
-    "cells; prints each periodic group (period, basin cells, domain of attraction,\n"
-    "centre). Without options it solves the thesis' C-SCM example (4.6.3):\n"
+    "cells; prints each periodic group (period, basin cells, kind, centre).\n"
+    "Without options it solves the thesis' C-SCM example (4.6.3):\n"
     "microchaos-pd, alpha=0.078, beta=0, P=0.007, D=0.02 on 0:500,-40:40.\n\n"
     "  --model NAME        a model of `cellmap models` (default microchaos-pd)\n"
     "  --param k=v,...     parameters (repeatable; vectors as v1:v2:...)\n"
@@ -48,9 +48,12 @@ static const char solve_help[] =
     "                      of the cluster's cells escape into the world (default 0: never)\n"
     "  --bounds LO:HI,...  extend only within this box of state space (default: anywhere)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
-    "  --threads T         OpenMP threads for the images (default: all cores)\n"
-    "  --png FILE          write the basin image (written to a temporary file, "
-    "renamed)\n" PNG_OPTIONS_HELP
+    "  --threads T         OpenMP threads for the images (default: all cores)\n";
+/* The rest of the help (one string would exceed what C compilers must take). */
+static const char solve_help_outputs[] =
+    "  --png FILE          write a figure of the basins: basin, attractors, overlays,\n"
+    "                      axes, legend and title (--layers basin,attractors: the bare\n"
+    "                      image of one pixel per cell)\n" PNG_OPTIONS_HELP
     "  --db FILE           write the cluster to a .cmdb SQLite database as it is solved,\n"
     "                      one transaction per region (replaces an older .cmdb only)\n"
     "  --resume            continue the solve saved in --db FILE (same options) after\n"
@@ -91,6 +94,7 @@ static int parse_solve(cli *c, solve_args *a)
         int64_t v;
         if (strcmp(c->opt, "--help") == 0) {
             fputs(solve_help, stdout);
+            fputs(solve_help_outputs, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
         } else if (lattice_opts_take(c, &a->lat, &err)) {
@@ -616,6 +620,7 @@ int cmd_solve(int argc, char **argv)
     solve_args a;
     memset(&a, 0, sizeof a);
     a.mo.name = "microchaos-pd";
+    a.png.default_layers = all_layers; /* --png is a figure; --layers basin the bare image */
     int rc = parse_solve(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;

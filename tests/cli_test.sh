@@ -34,6 +34,23 @@ assert d[:8] == b"\x89PNG\r\n\x1a\n"
 w, h = struct.unpack(">II", d[16:24]); assert (w, h) == (1000, 1000), (w, h)
 assert b"tEXtModel\x00microchaos-pd" in d and b"tEXtParameters" in d
 PY
+# the default PNG is a figure: axes, legend and title, on the pixels
+python3 - "$HERE" basin.png <<'PY' || fail "the default PNG is no figure"
+import sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+w, h, bpp, rows, texts = read_png(sys.argv[2])
+layers = texts["Layers"].split(",")
+assert {"basin", "attractors", "overlays", "axes", "legend", "title"} <= set(layers), layers
+px = lambda x, y: tuple(rows[y][bpp * x:bpp * x + 3])
+# the legend, right of the plot: the sink's red swatch and dark text
+legend = [px(x, y) for y in range(40, 400) for x in range(int(0.66 * w), w)]
+assert (214, 39, 40) in legend and sum(max(p) < 80 for p in legend) > 500, "no legend"
+# the axes: dark tick labels left of and below the plot
+left = [px(x, y) for y in range(40, h - 60) for x in range(0, 60)]
+below = [px(x, y) for y in range(h - 60, h) for x in range(80, int(0.6 * w))]
+assert sum(max(p) < 80 for p in left) > 100 and sum(max(p) < 80 for p in below) > 100, "no axes"
+PY
 # deterministic whatever the thread count
 "$CM" solve --threads 1 --png one.png --db one.cmdb > /dev/null || fail "solve 1 thread"
 "$CM" solve --threads 2 --png two.png > /dev/null || fail "solve 2 threads"
@@ -43,8 +60,10 @@ cmp -s one.png basin.png || fail "PNG differs between runs"
   "$(sqlite3 basin.cmdb 'SELECT group_concat(id||":"||period||":"||basin_cells) FROM groups')" ] \
   || fail "databases differ between thread counts"
 # --split: the clustered solve gives the same picture and the same groups
-"$CM" solve --split 3x2 --threads 2 --png split.png --db split.cmdb > /dev/null || fail "solve --split"
-cmp -s split.png basin.png || fail "PNG of --split 3x2 differs from the single solve"
+"$CM" solve --split 3x2 --threads 2 --png split.png --layers basin,attractors --db split.cmdb \
+  > /dev/null || fail "solve --split"
+"$CM" solve --png bare.png --layers basin,attractors > /dev/null || fail "solve --layers basin,attractors"
+cmp -s split.png bare.png || fail "PNG of --split 3x2 differs from the single solve"
 [ "$(sqlite3 split.cmdb 'SELECT group_concat(period||":"||basin_cells) FROM (SELECT * FROM groups ORDER BY basin_cells, period)')" = \
   "$(sqlite3 basin.cmdb 'SELECT group_concat(period||":"||basin_cells) FROM (SELECT * FROM groups ORDER BY basin_cells, period)')" ] \
   || fail "groups of --split 3x2 differ from the single solve"
@@ -297,7 +316,8 @@ expect_usage "--stage1 shows the regions of --split" solve --split 2x1 --stage1 
 
 # --- dry friction: sticking zones are labelled in the summary and the file --
 "$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-601.5:601.5 \
-  --cells 800x401 --max-steps 100000 --db friction.cmdb --png friction.png --json > friction.json \
+  --cells 800x401 --max-steps 100000 --db friction.cmdb --png friction.png --layers basin,attractors \
+  --json > friction.json \
   || fail "friction solve failed"
 json_sticking=$(python3 -c 'import json,sys; print(sum(g["kind"] == "sticking" for g in json.load(open(sys.argv[1]))["groups"]))' friction.json)
 db_sticking=$(sqlite3 friction.cmdb "SELECT COUNT(*) FROM groups WHERE kind = 'sticking'")
@@ -422,7 +442,53 @@ cmp -s v2-groups.csv v3-groups.csv || fail "a version 2 file reads differently"
 cmp -s v2-groups.csv v3-groups.csv && cmp -s v2-cells.csv v3-cells.csv || fail "the upgrade of a version 2 file changed its export"
 
 # --- render: figures and indexed images of a database ------------------------
-"$CM" render basin.cmdb --png rendered.png || fail "render of basin.cmdb"
+# Stable colours: the same attractors in a database of a panned region (the
+# same lattice, origin 200 cells to the right) take the same colours, cell
+# by cell; no two groups in one view share a colour (single-cell groups are
+# folded into "other")
+"$CM" solve --region 100:600,-40:40 --db panned.cmdb > /dev/null || fail "solve of a panned region"
+for f in basin panned; do
+  "$CM" render $f.cmdb --png $f-view.png --layers basin --min-basin 2 --view 130:300,-4:4 \
+    || fail "render $f.cmdb"
+  "$CM" export $f.cmdb --cells $f-view.csv --window 130:300,-4:4 --quiet || fail "export $f.cmdb"
+done
+python3 - "$HERE" basin-view panned-view <<'PY' || fail "stable colours"
+import csv, sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+def colours(name):
+    w, h, bpp, rows, texts = read_png(name + ".png")
+    cells = list(csv.DictReader(open(name + ".csv")))
+    ix0, iv0 = min(int(c["ix"]) for c in cells), min(int(c["iv"]) for c in cells)
+    assert (w, h) == (340, 100), (w, h)    # one pixel per cell
+    out = {}
+    for c in cells:
+        i, j = int(c["ix"]) - ix0, int(c["iv"]) - iv0
+        out[(round(float(c["x"]), 6), round(float(c["v"]), 6))] = (
+            int(c["grp"]), tuple(rows[h - 1 - j][bpp * i:bpp * i + 3]))
+    return out
+a, b = colours(sys.argv[2]), colours(sys.argv[3])
+assert a.keys() == b.keys()
+# cells of the same group in both files (the attractors' basins here, by
+# their periodic cells' centres, are the same sets of cells)
+for name, cells in (("basin", a), ("panned", b)):
+    by_colour = {}
+    for g, rgb in cells.values():
+        if g and rgb != (222, 210, 190):    # "other": the folded single-cell groups
+            by_colour.setdefault(rgb, set()).add(g)
+    shared = {rgb: gs for rgb, gs in by_colour.items() if len(gs) > 1}
+    assert not shared, (name, shared)
+pairs = {}
+for key in a:
+    (ga, ca), (gb, cb) = a[key], b[key]
+    if ga and gb:
+        pairs.setdefault((ga, gb), set()).add((ca, cb))
+big = [p for p, cs in pairs.items() if sum(1 for k in a if (a[k][0], b[k][0]) == p) > 100]
+assert len(big) >= 3, big
+for p in big:
+    assert len(pairs[p]) == 1 and len(set(next(iter(pairs[p])))) == 1, (p, pairs[p])
+PY
+"$CM" render basin.cmdb --png rendered.png --layers all || fail "render of basin.cmdb"
 cmp -s rendered.png basin.png || fail "render of the solve's file differs from the solve's PNG"
 "$CM" render basin.cmdb --layers all --size 1000x700 --png figure.png || fail "render --layers all"
 # switching lines SW_1..SW_3 (white) cross x' = 20 at x = (m - 20 D)/P; the

@@ -41,7 +41,7 @@ static void solve(scene *s, const char *model, const char *params, const cm_latt
     s->g = calloc(s->r.ngroups + 1, sizeof *s->g);
     cm_scm_groups(&s->r, lat, s->g, NULL);
     s->classes = calloc(s->r.ngroups + 1, 1);
-    cm_palette_classes(s->g, s->r.ngroups, lat->dim, s->classes);
+    cm_palette_classes(s->g, s->r.ngroups, lat, NULL, 0, s->classes);
 }
 
 static void scene_free(scene *s)
