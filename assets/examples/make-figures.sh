@@ -12,6 +12,9 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 pd=microchaos-pd
 
+# The README's quick start: the default solve's figure
+"$CM" solve --png quick-start.png > /dev/null
+
 # Fig. 4.13: alpha = 0.8, beta = 0.3, P = 0.9, D = 0.4; x_0*..x_2* regular,
 # x_3* virtual, switching lines SW_1..SW_5
 "$CM" solve --model $pd --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --region=-1:6.5,-2.5:2.5 \
