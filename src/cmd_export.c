@@ -13,14 +13,15 @@
 #include "src/args.h"
 #include "src/outfile.h"
 #include "src/commands.h"
+#include "src/export_arrays.h"
 #include "src/interrupt.h"
 #include "src/progress.h"
 #include "src/project.h"
 
 static const char export_help[] =
     "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
-    "                      [--flat OUT.sqlite] [--window X0:X1[,Y0:Y1...]] [--mem BYTES]\n"
-    "                      [--quiet]\n\n"
+    "                      [--flat OUT.sqlite] [--labels OUT.npy] [--steps OUT.npy]\n"
+    "                      [--window X0:X1[,Y0:Y1...]] [--mem BYTES] [--quiet]\n\n"
     "Writes only complete files: Ctrl-C stops it and leaves no partial file (exit 130).\n\n"
     "  --groups OUT.csv    one row per group: id, period, basin_cells, is_sink (group 0),\n"
     "                      centre, bounds of the periodic cells' centres, anchor cell,\n"
@@ -31,8 +32,16 @@ static const char export_help[] =
     "                      or .npy (a structured array with those fields, little-endian)\n"
     "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iv, ..., x, v, ...,\n"
     "                      grp, step, periodic), with tables groups (as --groups, kind\n"
-    "                      included) and meta\n"
-    "  --window X0:X1,...  only cells whose centre lies in this box of state space\n"
+    "                      included), meta (source file, lattice origin and widths,\n"
+    "                      state names) and indexes on cells(grp), the cells' indices\n"
+    "                      and groups(kind)\n"
+    "  --labels OUT.npy    the group of every cell as an n-D array: shape = cells per\n"
+    "                      dimension (axis k = dimension k), C order, int32 (0 the sink,\n"
+    "                      -1 not computed); OUT.json beside it holds the lattice, the\n"
+    "                      box, the model and each group (kind, period, centre, colour)\n"
+    "  --steps OUT.npy     the same array of step numbers (-1 not computed), with OUT.json\n"
+    "  --window X0:X1,...  only cells whose centre lies in this box of state space (for\n"
+    "                      --cells, --flat, --labels and --steps)\n"
     "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n"
     "  --quiet             no progress line and no count of the cells written\n";
 
@@ -51,10 +60,12 @@ typedef struct cell_out {
     uint64_t rows;
     long shape_at; /* .npy: where the row count is written at the end */
     const char *const *names; /* the state coordinates' names */
+    const char *source;       /* the .cmdb file exported */
+    int dim;
 } cell_out;
 
 typedef struct export_args {
-    const char *file, *groups, *cells, *flat, *window;
+    const char *file, *groups, *cells, *flat, *window, *labels, *steps;
     uint64_t mem;
     bool quiet;
 } export_args;
@@ -82,6 +93,12 @@ static int parse_export(cli *c, export_args *a)
                                          "on stdout)", a->cells);
         } else if (cli_is(c, "--flat", true, &err)) {
             a->flat = c->value;
+        } else if (cli_is(c, "--labels", true, &err) || cli_is(c, "--steps", true, &err)) {
+            const bool labels = strncmp(c->opt, "--labels", 8) == 0;
+            if (c->value && !ends_with(c->value, ".npy"))
+                err = cli_usage_error(c, "%s: '%s' must end in .npy (its JSON sidecar goes "
+                                         "beside it)", labels ? "--labels" : "--steps", c->value);
+            *(labels ? &a->labels : &a->steps) = c->value;
         } else if (cli_is(c, "--window", true, &err)) {
             a->window = c->value;
         } else if (cli_take_mem(c, &a->mem, &err)) {
@@ -95,10 +112,11 @@ static int parse_export(cli *c, export_args *a)
     }
     if (!err && !a->file)
         err = cli_usage_error(c, "which file? usage: cellmap export FILE.cmdb --cells OUT.csv");
-    if (!err && !a->groups && !a->cells && !a->flat)
-        err = cli_usage_error(c, "nothing to export: add --groups, --cells or --flat");
-    if (!err && a->window && !a->cells && !a->flat)
-        err = cli_usage_error(c, "--window applies to --cells and --flat");
+    if (!err && !a->groups && !a->cells && !a->flat && !a->labels && !a->steps)
+        err = cli_usage_error(c,
+                              "nothing to export: add --groups, --cells, --flat, --labels or --steps");
+    if (!err && a->window && !a->cells && !a->flat && !a->labels && !a->steps)
+        err = cli_usage_error(c, "--window applies to --cells, --flat, --labels and --steps");
     const char *const outs[3] = {a->groups, a->cells, a->flat};
     int to_stdout = 0;
     for (int k = 0; k < 3; k++)
@@ -155,6 +173,16 @@ static int npy_header(cell_out *o, int dim)
     return fwrite(magic, 1, 10, o->f) == 10 && fwrite(header, 1, (size_t)n, o->f) == (size_t)n;
 }
 
+/* "[v0,v1,...]", each number the shortest that reads back */
+static void json_numbers_text(const double *v, int n, char *out, size_t size)
+{
+    size_t used = (size_t)snprintf(out, size, "[");
+    for (int d = 0; d < n && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", d ? "," : "", CM_NUM(v[d]));
+    if (used < size)
+        snprintf(out + used, size - used, "]");
+}
+
 static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
 {
     char sql[1024];
@@ -174,10 +202,23 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
         sqlite3_exec(o->db, sql, NULL, NULL, NULL) != SQLITE_OK)
         return 0;
     sqlite3_stmt *st = NULL;
-    const char *rows[][2] = {{"model", info->model},
-                             {"params", info->params},
-                             {"command", info->command},
-                             {"source", o->path}};
+    char origin[CM_MAX_DIM * CM_NUM_TEXT + 8], width[CM_MAX_DIM * CM_NUM_TEXT + 8],
+        state[CM_MAX_DIM * 32 + 8], dims[8];
+    json_numbers_text(info->lattice.origin, dim, origin, sizeof origin);
+    json_numbers_text(info->lattice.width, dim, width, sizeof width);
+    size_t at = (size_t)snprintf(state, sizeof state, "[");
+    for (int d = 0; d < dim && at < sizeof state; d++)
+        at += (size_t)snprintf(state + at, sizeof state - at, "%s\"%s\"", d ? "," : "",
+                               o->names[d]);
+    if (at < sizeof state)
+        snprintf(state + at, sizeof state - at, "]");
+    snprintf(dims, sizeof dims, "%d", dim);
+    /* what a reader needs to place a cell without the .cmdb: the cell
+     * (i...) has centre origin + (i + 1/2) width */
+    const char *rows[][2] = {{"model", info->model},          {"params", info->params},
+                             {"command", info->command},      {"source", o->source},
+                             {"dim", dims},                   {"state", state},
+                             {"lattice_origin", origin},      {"lattice_width", width}};
     if (sqlite3_prepare_v2(o->db, "INSERT INTO meta VALUES(?, ?)", -1, &st, NULL) != SQLITE_OK)
         return 0;
     int ok = 1;
@@ -313,6 +354,22 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
 
 /* Completes the output and moves it into place (cellmap/output.h); on
  * failure removes it and, if it was the first failure (ok), says why. */
+/* Indexes for the obvious queries: the cells of a group, a cell by its
+ * indices, and groups by kind. */
+static int sqlite_indexes(cell_out *o)
+{
+    char sql[512];
+    size_t used = (size_t)snprintf(sql, sizeof sql,
+                                   "CREATE INDEX cells_grp ON cells(grp);"
+                                   "CREATE INDEX groups_kind ON groups(kind);"
+                                   "CREATE UNIQUE INDEX cells_cell ON cells(");
+    for (int d = 0; d < o->dim && used < sizeof sql; d++)
+        used += (size_t)snprintf(sql + used, sizeof sql - used, "%si%s", d ? "," : "", o->names[d]);
+    if (used < sizeof sql)
+        snprintf(sql + used, sizeof sql - used, ");");
+    return sqlite3_exec(o->db, sql, NULL, NULL, NULL) == SQLITE_OK;
+}
+
 static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 {
     const int was_ok = ok;
@@ -330,6 +387,8 @@ static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
     }
     if (o->db) {
         sqlite3_finalize(o->insert);
+        if (ok && !sqlite_indexes(o))
+            ok = 0, snprintf(msg, msg_size, "cannot index %s: %s", o->path, sqlite3_errmsg(o->db));
         if (ok && sqlite3_exec(o->db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
             ok = 0, snprintf(msg, msg_size, "cannot write %s: %s", o->path, sqlite3_errmsg(o->db));
         ok = (sqlite3_close(o->db) == SQLITE_OK) && ok;
@@ -454,7 +513,11 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     cell_out outs[2];
     int nouts = 0;
     memset(outs, 0, sizeof outs);
-    outs[0].names = outs[1].names = names;
+    for (int k = 0; k < 2; k++) {
+        outs[k].names = names;
+        outs[k].source = a->file;
+        outs[k].dim = c->lat.dim;
+    }
     if (a->cells) {
         outs[nouts].kind = ends_with(a->cells, ".npy") ? OUT_NPY : OUT_CSV;
         outs[nouts++].path = a->cells;
@@ -484,6 +547,12 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         fprintf(report_stream(a->groups, a->cells, a->flat), "exported %llu cells\n",
                 (unsigned long long)outs[0].rows);
     }
+    if (rc == EXIT_OK && (a->labels || a->steps)) {
+        const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names};
+        progress_start(&pr, "export", "cells", cm_box_cells(&window), a->quiet);
+        if (!export_arrays(c, &window, &x, &pr))
+            rc = interrupt_requested() ? EXIT_INTERRUPTED : EXIT_FAIL;
+    }
     free(g);
     return rc;
 }
@@ -491,12 +560,13 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
 int cmd_export(int argc, char **argv)
 {
     cli c = {"export", argc, argv, 0, NULL, NULL};
-    export_args a = {NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20, false};
+    export_args a = {NULL, NULL, NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20, false};
     const int rc = parse_export(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
     if (!outfile_check("export", a.groups) || !outfile_check("export", a.cells) ||
-        !outfile_check("export", a.flat))
+        !outfile_check("export", a.flat) || !outfile_check("export", a.labels) ||
+        !outfile_check("export", a.steps))
         return EXIT_FAIL;
     cm_store *s = NULL;
     cm_store_info info;

@@ -39,6 +39,12 @@ run lyapunov lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --peri
 run bifurcation bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 20 --record 5 --json
 run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json
 run simulate simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 3 --json
+"$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 \
+  || fail "export --labels --steps"
+"$CM" export basin.cmdb --cells window.csv --window 100:300,-5:5 > /dev/null || fail "export --cells"
+"$CM" solve --model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 \
+  --region=-6:6,-6:6,-6:6 --cells 6x5x4 --db cube.cmdb > /dev/null || fail "3-D solve"
+"$CM" export cube.cmdb --labels cube.npy --cells cube.csv > /dev/null || fail "3-D export --labels"
 printf 'view 0:500 -40:40\nstats --json\n' | "$CM" explore ex.cmdb --model microchaos-pd --cell-size 4,1 \
   2> /dev/null | grep '^{' > stats.json || fail "explore stats --json"
 python3 "$HERE/schema_check.py" "$SCHEMA" $(ls ./*.json | grep -v -e missing.json -e enum.json) \
@@ -79,6 +85,33 @@ assert st["box"] == [[0, 500], [-40, 40]] and st["cells"] == 125 * 80
 assert all("in_view" in g for g in st["groups"])
 PY
 
+# the arrays, read by numpy (Debian's python3-numpy): shape, dtype and every
+# value against export --cells
+for a in labels:window steps:window cube:cube; do
+  /usr/bin/python3 - ${a%%:*}.npy ${a#*:}.csv <<'PY' || fail "the array ${a%%:*}.npy"
+import csv, json, sys
+import numpy as np
+arr, side = np.load(sys.argv[1]), json.load(open(sys.argv[1][:-4] + ".json"))
+assert arr.dtype == np.dtype("<i4") and arr.flags["C_CONTIGUOUS"], arr.dtype
+rows = list(csv.DictReader(open(sys.argv[2])))
+names = side["axes"]
+lo = side["first_cell"]
+assert list(arr.shape) == side["shape"], (arr.shape, side["shape"])
+assert arr.shape == tuple(len({int(r["i" + n]) for r in rows}) for n in names), arr.shape
+field = "grp" if side["array"] == "labels" else "step"
+seen = 0
+for r in rows:
+    at = tuple(int(r["i" + n]) - lo[k] for k, n in enumerate(names))
+    assert arr[at] == int(r[field]), (at, arr[at], r[field])
+    seen += 1
+assert seen == arr.size and (arr >= 0).all(), (seen, arr.size)   # every cell computed
+ids = {g["id"] for g in side["groups"]}
+if side["array"] == "labels":
+    assert ids == set(np.unique(arr[arr > 0]).tolist()), "the sidecar lists the groups in the array"
+    assert all(g["colour"].startswith("#") and len(g["colour"]) == 7 for g in side["groups"])
+PY
+done
+
 # the CSV columns carry the JSON's names
 "$CM" sweep --model microchaos-pd-friction --vary mu=0.09:0.1:3 --cells 100x50 --csv sweep.csv > /dev/null \
   || fail "sweep --csv"
@@ -89,6 +122,17 @@ head -1 groups.csv | grep -q "^id,period,basin_cells,.*centre_x,centre_v.*,kind$
   || fail "groups CSV header: $(head -1 groups.csv)"
 "$CM" orbit --from 10,0 --steps 1 | head -1 | grep -qx "j,x,v" || fail "orbit CSV header"
 "$CM" fixed-points --range 0:0 | head -1 | grep -qx "level,band,kind,x,v" || fail "fixed-points CSV header"
+
+# a flat export says where it came from and where its cells lie, and is indexed
+"$CM" export basin.cmdb --flat flat.sqlite --window 100:300,-5:5 > /dev/null || fail "export --flat"
+[ "$(sqlite3 flat.sqlite "SELECT group_concat(key || '=' || value, ' ') FROM meta WHERE key IN
+    ('source', 'lattice_origin', 'lattice_width', 'state') ORDER BY key")" = \
+  'lattice_origin=[0,-40] lattice_width=[4.166666666666667,1] source=basin.cmdb state=["x","v"]' ] \
+  || fail "flat meta: $(sqlite3 flat.sqlite 'SELECT * FROM meta')"
+sqlite3 flat.sqlite "EXPLAIN QUERY PLAN SELECT COUNT(*) FROM cells WHERE grp = 2" | grep -q "USING.*INDEX cells_grp" \
+  || fail "no index on cells(grp)"
+sqlite3 flat.sqlite "EXPLAIN QUERY PLAN SELECT grp FROM cells WHERE ix = 30 AND iv = 18" | grep -q "INDEX cells_cell" \
+  || fail "no index on the cells' indices"
 
 [ $fails -eq 0 ] && echo "json tests passed"
 exit $fails
