@@ -1,5 +1,7 @@
 #include "render/figure.h"
 
+#include "render/figure_parts.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,10 +13,7 @@
 #include "render/palette.h"
 #include "render/text.h"
 
-enum {
-    OVERLAY_CAP = 1 << 16, /* more lines than this would paint the view over */
-    LABEL = 96
-};
+enum { OVERLAY_CAP = 1 << 16 }; /* more lines than this would paint the view over */
 
 static const cm_rgb ink = {0, 0, 0};
 static const cm_rgb paper = {255, 255, 255};
@@ -28,16 +27,6 @@ static double seconds(void)
 
 /* ---- legend --------------------------------------------------------------------- */
 
-typedef struct entry {
-    char text[LABEL];
-    cm_rgb swatch;
-    bool has_swatch;
-} entry;
-
-typedef struct legend {
-    int n;
-    entry *e;
-} legend;
 
 typedef struct group_cells {
     uint64_t cells;
@@ -133,7 +122,7 @@ static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, 
 
 /* ---- title ---------------------------------------------------------------------- */
 
-static void format_title(const cm_model *m, char *out, size_t size)
+void figure_title(const cm_model *m, char *out, size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "%s ", m->name);
     const cm_params *p = &m->values;
@@ -161,13 +150,6 @@ static void draw_fitted(const cm_font *f, const char *text, int x, int y, int ma
 
 /* ---- layout --------------------------------------------------------------------- */
 
-typedef struct layout {
-    int fs, pad, tick, line, ascent;
-    int left, right, top, bottom;
-    cm_ticks tx, ty;
-    const char *xname, *yname;
-    char yname_buf[64];
-} layout;
 
 static bool has_text(unsigned layers) { return layers & CM_LAYERS_TEXT; }
 
@@ -295,12 +277,6 @@ static void make_panels(cm_plot *p, int dim, const double lo[2], const double hi
     p->basin.h = strip;
 }
 
-typedef struct work {
-    cm_raster ras;
-    cm_overlay_list ov;
-    cm_font *font;
-    legend lg;
-} work;
 
 static void work_free(work *w)
 {
@@ -420,79 +396,89 @@ static void draw_text_layers(const cm_render_options *o, const work *w, const la
         draw_legend(&w->lg, L, p->x + p->w + 2 * L->pad, p->y, w->font, c);
     if (o->layers & CM_LAYER_TITLE) {
         char title[1024];
-        format_title(o->model, title, sizeof title);
+        figure_title(o->model, title, sizeof title);
         draw_fitted(w->font, title, L->pad, L->pad + L->ascent, c->w - 2 * L->pad, c);
     }
 }
+
+cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                       const cm_render_options *opt, figure *F, char *msg, size_t msg_size)
+{
+    memset(F, 0, sizeof *F);
+    F->o = *opt;
+    F->o.layers = F->o.layers ? F->o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
+    cm_status st = check_options(&F->o, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_slice_of(lat, r, F->o.slice, F->o.set_slice, &F->s);
+    default_view(&F->s, r->box.dim, &F->o, F->lo, F->hi);
+    st = prepare(lat, r, groups, &F->o, &F->s, F->lo, F->hi, &F->w, &F->L, msg, msg_size);
+    const layout *L = &F->L;
+    F->p = (cm_plot){&F->w.ras,
+                     groups,
+                     F->w.ov.items ? &F->w.ov : NULL,
+                     F->o.model,
+                     F->o.layers,
+                     L->left,
+                     L->top,
+                     F->o.width - L->left - L->right,
+                     F->o.height - L->top - L->bottom,
+                     {0},
+                     {0},
+                     0,
+                     F->o.gl};
+    if (st == CM_OK) {
+        const int small = F->p.w < F->p.h ? F->p.w : F->p.h;
+        F->p.line_width = small / 700 > 1 ? small / 700 : 1;
+        make_panels(&F->p, r->box.dim, F->lo, F->hi, L->line ? L->line / 2 : 4);
+    }
+    return st;
+}
+
+void figure_end(figure *F) { work_free(&F->w); }
 
 cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                            const cm_render_options *opt, uint8_t *rgba, cm_render_info *info,
                            char *msg, size_t msg_size)
 {
-    cm_render_options o = *opt;
-    o.layers = o.layers ? o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
     memset(info, 0, sizeof *info);
-    cm_status st = check_options(&o, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    cm_slice s;
-    cm_slice_of(lat, r, o.slice, o.set_slice, &s);
-    double lo[2], hi[2];
-    default_view(&s, r->box.dim, &o, lo, hi);
-    work w;
-    layout L;
-    memset(&w, 0, sizeof w);
-    memset(&L, 0, sizeof L);
+    figure F;
     double t0 = seconds();
-    st = prepare(lat, r, groups, &o, &s, lo, hi, &w, &L, msg, msg_size);
+    cm_status st = figure_begin(lat, r, groups, opt, &F, msg, msg_size);
     info->raster_s = seconds() - t0;
-    const cm_canvas c = {rgba, o.width, o.height};
-    cm_plot p = {&w.ras,
-                 groups,
-                 w.ov.items ? &w.ov : NULL,
-                 o.model,
-                 o.layers,
-                 L.left,
-                 L.top,
-                 o.width - L.left - L.right,
-                 o.height - L.top - L.bottom,
-                 {0},
-                 {0},
-                 0,
-                 o.gl};
+    const cm_render_options *o = &F.o;
+    const cm_plot *p = &F.p;
+    const cm_canvas c = {rgba, o->width, o->height};
     if (st == CM_OK) {
-        const int small = p.w < p.h ? p.w : p.h;
-        p.line_width = small / 700 > 1 ? small / 700 : 1;
-        make_panels(&p, r->box.dim, lo, hi, L.line ? L.line / 2 : 4);
         /* the margins; GL paints the plot itself */
-        cm_fill_rect(&c, 0, 0, o.width, p.y, paper);
-        cm_fill_rect(&c, 0, p.y + p.h, o.width, o.height - p.y - p.h, paper);
-        cm_fill_rect(&c, 0, p.y, p.x, p.h, paper);
-        cm_fill_rect(&c, p.x + p.w, p.y, o.width - p.x - p.w, p.h, paper);
+        cm_fill_rect(&c, 0, 0, o->width, p->y, paper);
+        cm_fill_rect(&c, 0, p->y + p->h, o->width, o->height - p->y - p->h, paper);
+        cm_fill_rect(&c, 0, p->y, p->x, p->h, paper);
+        cm_fill_rect(&c, p->x + p->w, p->y, o->width - p->x - p->w, p->h, paper);
         t0 = seconds();
-        st = cm_plot_draw(&p, rgba, o.width, &info->tiles, msg, msg_size);
+        st = cm_plot_draw(p, rgba, o->width, &info->tiles, msg, msg_size);
         info->gl_s = seconds() - t0;
     }
-    if (st == CM_OK && w.font) {
+    if (st == CM_OK && F.w.font) {
         t0 = seconds();
-        draw_text_layers(&o, &w, &L, &p, &c);
+        draw_text_layers(o, &F.w, &F.L, p, &c);
         info->text_s = seconds() - t0;
     }
     if (st == CM_OK) {
-        info->plot_x = p.x + p.basin.x;
-        info->plot_y = p.y + p.basin.y;
-        info->plot_w = p.basin.w;
-        info->plot_h = p.basin.h;
-        if (p.graph.w > 0) {
-            info->graph_x = p.x + p.graph.x;
-            info->graph_y = p.y + p.graph.y;
-            info->graph_w = p.graph.w;
-            info->graph_h = p.graph.h;
+        info->plot_x = p->x + p->basin.x;
+        info->plot_y = p->y + p->basin.y;
+        info->plot_w = p->basin.w;
+        info->plot_h = p->basin.h;
+        if (p->graph.w > 0) {
+            info->graph_x = p->x + p->graph.x;
+            info->graph_y = p->y + p->graph.y;
+            info->graph_w = p->graph.w;
+            info->graph_h = p->graph.h;
         }
-        memcpy(info->lo, lo, sizeof info->lo);
-        memcpy(info->hi, hi, sizeof info->hi);
-        info->overlays_truncated = w.ov.truncated;
+        memcpy(info->lo, F.lo, sizeof info->lo);
+        memcpy(info->hi, F.hi, sizeof info->hi);
+        info->overlays_truncated = F.w.ov.truncated;
     }
-    work_free(&w);
+    figure_end(&F);
     return st;
 }
