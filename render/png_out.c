@@ -125,3 +125,28 @@ cm_status cm_png_write_indexed(const char *path, const uint8_t *index, int width
     const png_pixels px = {index, width, height, palette, n_colours};
     return write_file(path, &px, texts, n_texts, msg, msg_size);
 }
+
+cm_status cm_png_encode(const uint8_t *rgba, int width, int height, uint8_t **out, size_t *size,
+                        char *msg, size_t msg_size)
+{
+    const png_pixels px = {rgba, width, height, NULL, 0};
+    char *buf = NULL;
+    png_job job;
+    memset(&job, 0, sizeof job);
+    job.file = open_memstream(&buf, size);
+    job.png = job.file ? png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL) : NULL;
+    job.info = job.png ? png_create_info_struct(job.png) : NULL;
+    job.row = malloc(3 * (size_t)width);
+    cm_status st = job.png && job.info && job.row ? encode(&job, &px, NULL, 0) : CM_ENOMEM;
+    png_destroy_write_struct(&job.png, &job.info);
+    free(job.row);
+    if (job.file && fclose(job.file) != 0 && st == CM_OK)
+        st = CM_ENOMEM;
+    if (st != CM_OK) {
+        free(buf);
+        return cm_fail(st, msg, msg_size, "cannot encode a %dx%d PNG: %s", width, height,
+                       cm_strerror(st));
+    }
+    *out = (uint8_t *)buf;
+    return CM_OK;
+}

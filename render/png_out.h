@@ -20,6 +20,11 @@ typedef struct cm_png_text {
 cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
                        const cm_png_text *texts, int n_texts, char *msg, size_t msg_size);
 
+/* The PNG of an RGBA image (row 0 at the top) in memory, for embedding:
+ * *out (the caller frees it) holds *size bytes. */
+cm_status cm_png_encode(const uint8_t *rgba, int width, int height, uint8_t **out, size_t *size,
+                        char *msg, size_t msg_size);
+
 /* An 8-bit palette PNG: one index per pixel (row 0 at the top), palette of
  * n_colours RGB triples. Written the same way as cm_png_write. */
 cm_status cm_png_write_indexed(const char *path, const uint8_t *index, int width, int height,

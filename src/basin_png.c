@@ -1,5 +1,7 @@
 #include "src/basin_png.h"
 
+#include "render/svg.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,6 +62,8 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 {
     if (cli_is(c, "--png", true, err)) {
         po->path = c->value;
+    } else if (cli_is(c, "--svg", true, err)) {
+        po->svg = c->value;
     } else if (cli_take_size(c, 1, 1, CM_RENDER_MAX_SIDE, &po->width, &po->height, err)) {
     } else if (cli_is(c, "--layers", true, err)) {
         char bad[64];
@@ -93,9 +97,13 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 
 int png_opts_check(const cli *c, const png_opts *po)
 {
-    if (!po->path && (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups))
+    if (!po->path && !po->svg &&
+        (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups))
         return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin and --legend "
-                                  "describe the image; add --png FILE");
+                                  "describe the image; add --png FILE (or --svg FILE)");
+    if (po->svg && po->indexed)
+        return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
+                                  "only");
     if (po->indexed && (po->width || po->layers))
         return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
                                   "classes; leave out --size and --layers");
@@ -239,7 +247,8 @@ static unsigned layers_of(const png_opts *po)
                                 : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
 }
 
-static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
+/* The renderer's options for the figure of b. */
+static void figure_options(const basin_png *b, cm_render_options *out)
 {
     const png_opts *po = b->opts;
     cm_render_options ro;
@@ -256,6 +265,14 @@ static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
     ro.model = b->model;
     ro.font_path = figure_font();
     ro.gl = b->gl;
+    *out = ro;
+}
+
+static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
+{
+    const png_opts *po = b->opts;
+    cm_render_options ro;
+    figure_options(b, &ro);
     uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
     if (!rgba)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", ro.width,
@@ -329,7 +346,7 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
         make_provenance(b, " mode indexed", 0, &p);
         p.texts[p.n++] = (cm_png_text){"Classes", "0 not computed, 1 sink, 2 periodic cell of an "
                                                   "attractor, 3 sticking-zone basin, 4 rest cell, "
-                                                  "5.. group colours"};
+                                                  "5 other (--min-basin), 6.. group colours"};
         p.texts[p.n++] = (cm_png_text){"Group classes", groups};
         st = cm_png_write_indexed(b->opts->path, rows, (int)s.nx, (int)s.ny, palette, n, p.texts,
                                   p.n, msg, msg_size);
@@ -344,7 +361,7 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
                     const cm_lattice *lat, const cm_box *box)
 {
     char msg[512];
-    if (!outfile_check(cmd, po->path))
+    if (!outfile_check(cmd, po->path) || !outfile_check(cmd, po->svg))
         return EXIT_FAIL;
     cm_status st = CM_OK;
     if (!po->indexed) {
@@ -373,14 +390,30 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
     return EXIT_OK;
 }
 
+/* The same figure as SVG (render/svg.h), written then renamed. */
+static int write_svg(const char *cmd, const basin_png *b)
+{
+    cm_render_options ro;
+    figure_options(b, &ro);
+    char msg[512];
+    outfile o;
+    if (!outfile_open(cmd, b->opts->svg, &o))
+        return EXIT_FAIL;
+    const cm_status st = cm_render_svg(b->lat, b->cells, b->groups, &ro, o.f, msg, sizeof msg);
+    if (st != CM_OK)
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return outfile_close(cmd, &o, st == CM_OK) && st == CM_OK ? EXIT_OK : EXIT_FAIL;
+}
+
 int write_basin_png(const char *cmd, const basin_png *b)
 {
     char msg[512];
-    const cm_status st =
-        b->opts->indexed ? write_indexed(b, msg, sizeof msg) : write_figure(b, msg, sizeof msg);
+    cm_status st = CM_OK;
+    if (b->opts->path)
+        st = b->opts->indexed ? write_indexed(b, msg, sizeof msg) : write_figure(b, msg, sizeof msg);
     if (st != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         return EXIT_FAIL;
     }
-    return EXIT_OK;
+    return b->opts->svg ? write_svg(cmd, b) : EXIT_OK;
 }

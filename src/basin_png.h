@@ -10,6 +10,7 @@
 
 typedef struct png_opts {
     const char *path;  /* --png FILE */
+    const char *svg;   /* --svg FILE: the same figure as SVG */
     int width, height; /* --size WxH; 0: one pixel per cell, at most 4096 a side */
     unsigned layers;   /* --layers; 0: default_layers */
     unsigned default_layers; /* the command's default (0: basin and attractors) */
@@ -34,6 +35,8 @@ extern const unsigned all_layers;
     "                      colour class; the classes of groups are in the PNG's texts)\n"          \
     "  --view X0:X1,Y0:Y1  the rectangle of state space to draw (default: all cells;\n"            \
     "                      1-D models ignore Y0:Y1)\n"                                             \
+    "  --svg FILE          the same figure as SVG: text and paths, with the basins\n"           \
+    "                      embedded as a PNG of one pixel per cell\n"                             \
     "  --min-basin N       draw groups whose basins have fewer than N cells as 'other' (one\n"   \
     "                      muted colour, one legend line); default 2 in figures with a\n"         \
     "                      legend (single-cell groups folded), else 1 (none)\n"                    \

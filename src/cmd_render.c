@@ -14,7 +14,7 @@
 #include "src/project.h"
 
 static const char render_help[] =
-    "usage: cellmap render FILE.cmdb --png OUT.png [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
+    "usage: cellmap render FILE.cmdb --png OUT.png|--svg OUT.svg [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
     "                      [--size WxH] [--layers L,...] [--png-mode rgb|indexed] [--mem BYTES]\n"
     "                      [--quiet]\n\n"
     "Draws the basins of a cluster database (made by solve --db or explore). Cells of the\n"
@@ -56,8 +56,8 @@ static int parse_render(cli *c, render_args *a)
     }
     if (!err && !a->file)
         err = cli_usage_error(c, "which file? usage: cellmap render FILE.cmdb --png OUT.png");
-    if (!err && !a->png.path)
-        err = cli_usage_error(c, "where to? add --png OUT.png");
+    if (!err && !a->png.path && !a->png.svg)
+        err = cli_usage_error(c, "where to? add --png OUT.png (or --svg OUT.svg)");
     if (!err)
         err = png_opts_check(c, &a->png);
     return err;
@@ -178,7 +178,7 @@ int cmd_render(int argc, char **argv)
     const int rc = parse_render(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
-    if (!outfile_check("render", a.png.path))
+    if (!outfile_check("render", a.png.path) || !outfile_check("render", a.png.svg))
         return EXIT_FAIL;
     cm_store *s = NULL;
     cm_store_info info;

@@ -28,8 +28,8 @@ static const char solve_help[] =
     "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
     "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
-    "                     [--png FILE [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
-    "                      [--view X0:X1,Y0:Y1]] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
+    "                     [--png FILE] [--svg FILE] [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
+    "                     [--view X0:X1,Y0:Y1] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
     "                     [--stage1]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
     "cells; prints each periodic group (period, basin cells, kind, centre).\n"
@@ -575,7 +575,8 @@ static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_latti
             return st;
     }
     if (write_basin_png("solve", &png) != EXIT_OK)
-        return cm_fail(CM_ERENDER, msg, msg_size, "%s was not written (see above)", a->png.path);
+        return cm_fail(CM_ERENDER, msg, msg_size, "%s was not written (see above)",
+                       a->png.path ? a->png.path : a->png.svg);
     return CM_OK;
 }
 
@@ -645,7 +646,7 @@ int cmd_solve(int argc, char **argv)
     }
     if ((rc = make_lattice(&c, &a, &m, &lat, &box)) != EXIT_OK ||
         (rc = make_bounds(&c, &a, &lat, &box, &bounds)) != EXIT_OK ||
-        (a.png.path && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
+        ((a.png.path || a.png.svg) && (rc = check_basin_png("solve", &a.png, &m, &lat, &box)) != EXIT_OK))
         goto done;
     progress pr;
     progress_start(&pr, "solve", "cells", cm_box_cells(&box), a.quiet);
@@ -692,7 +693,7 @@ int cmd_solve(int argc, char **argv)
         print_text(a.report, &m, &lat, &sum, &t, shown);
     if (rn.store && !a.json && !a.quiet)
         print_database(a.report, &a, &rn, &sum);
-    if (a.png.path && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)
+    if ((a.png.path || a.png.svg) && draw_png(&a, &m, &lat, &rn, &sum, &r, msg, sizeof msg) != CM_OK)
         goto fail;
     if (rn.store && finish_store(&rn, msg, sizeof msg) != CM_OK)
         goto fail;

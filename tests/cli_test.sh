@@ -51,6 +51,32 @@ left = [px(x, y) for y in range(40, h - 60) for x in range(0, 60)]
 below = [px(x, y) for y in range(h - 60, h) for x in range(80, int(0.6 * w))]
 assert sum(max(p) < 80 for p in left) > 100 and sum(max(p) < 80 for p in below) > 100, "no axes"
 PY
+# --svg: the same figure with text and paths, the basins embedded as a PNG
+# of one pixel per cell where the PNG figure draws its plot
+"$CM" solve --cells 300x200 --svg fig.svg --png fig.png > /dev/null || fail "solve --svg"
+python3 - "$HERE" fig.svg fig.png <<'PY' || fail "the SVG figure"
+import base64, re, struct, sys, xml.etree.ElementTree as ET
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+ns = "{http://www.w3.org/2000/svg}"
+root = ET.parse(sys.argv[2]).getroot()
+texts = [t.text for t in root.iter(ns + "text")]
+assert {"x", "v", "0", "500", "-40", "40"} <= set(texts), texts     # axis names and ticks
+assert any(t.startswith("microchaos-pd") for t in texts), texts     # the title
+assert "sink  91.6%" in texts or any(t.startswith("sink") for t in texts), texts  # the legend
+images = list(root.iter(ns + "image"))
+assert len(images) == 1, len(images)
+href = images[0].get("href")
+assert href.startswith("data:image/png;base64,"), href[:40]
+png = base64.b64decode(href.split(",", 1)[1])
+assert png[:8] == b"\x89PNG\r\n\x1a\n" and struct.unpack(">II", png[16:24]) == (300, 200)
+w, h, bpp, rows, pngtexts = read_png(sys.argv[3])
+x, y, pw, ph = map(int, re.search(r"plot (\d+),(\d+) (\d+)x(\d+)", pngtexts["View"]).groups())
+box = [float(images[0].get(k)) for k in ("x", "y", "width", "height")]
+assert box == [x, y, pw, ph], (box, (x, y, pw, ph))
+assert (int(root.get("width")), int(root.get("height"))) == (w, h)
+assert len(list(root.iter(ns + "circle"))) > 0      # fixed points, as vectors
+PY
 # deterministic whatever the thread count
 "$CM" solve --threads 1 --png one.png --db one.cmdb > /dev/null || fail "solve 1 thread"
 "$CM" solve --threads 2 --png two.png > /dev/null || fail "solve 2 threads"
