@@ -28,7 +28,7 @@ const char session_help[] =
     "  goto X [Y]                         centre the view on a point\n"
     "  extend auto [N]                    N times (default 1), add the tile of the view's\n"
     "                                     size where the most sequences escape (4.6.4)\n"
-    "  render FILE.png [WxH]              the view as a basin image (default: a pixel\n"
+    "  render FILE.png|FILE.svg [WxH]     the view as a basin image (default: a pixel\n"
     "                                     per cell, at most 4096)\n"
     "  stats [--json]                     groups and attractors in view, cells, memory, disk\n"
     "  export --groups|--cells|--flat ... as `cellmap export` (--window: the view)\n"
@@ -545,9 +545,11 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
 {
     png_opts po;
     memset(&po, 0, sizeof po);
-    po.path = t[1];
-    cm_status st = words(n, 2, 7, "render FILE.png [WIDTHxHEIGHT] [--layers L,...] [--png-mode M]",
-                         msg, msg_size);
+    const size_t len = n > 1 ? strlen(t[1]) : 0;
+    const bool svg = len > 4 && strcmp(t[1] + len - 4, ".svg") == 0; /* FILE.svg: as SVG */
+    *(svg ? &po.svg : &po.path) = n > 1 ? t[1] : NULL;
+    cm_status st = words(n, 2, 7, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
+                         "[--png-mode M]", msg, msg_size);
     if (st == CM_OK)
         st = render_words(t, n, &po, msg, msg_size);
     if (st == CM_OK)
@@ -559,7 +561,7 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     cm_group_info *groups = NULL;
     memset(&flat, 0, sizeof flat);
     st = shown_cells(s, &flat, &groups, msg, msg_size);
-    if (st == CM_OK && !s->gl && !po.indexed)
+    if (st == CM_OK && !s->gl && !po.indexed && !svg)
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {
         &po,  &s->model, &s->c.lat, &flat, groups, {s->lo[0], s->lo[1]}, {s->hi[0], s->hi[1]},
