@@ -78,8 +78,12 @@ static void closing_entries(const cm_raster *ras, uint64_t all, int room, legend
  * `room` lines and max_groups allow; the rest summed up in one line), the
  * groups folded into "other", and the cells not computed. */
 static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, uint32_t ngroups,
-                             int room, int max_groups, legend *lg, char *msg, size_t msg_size)
+                             int room, int max_groups, int bar_mode, legend *lg, char *msg,
+                             size_t msg_size)
 {
+    lg->bar_mode = bar_mode != CM_RASTER_BASIN && room >= BAR_LINES + 2 ? bar_mode : -1;
+    if (lg->bar_mode >= 0)
+        room -= BAR_LINES;
     const uint64_t all = ras->s.nx * ras->s.ny;
     group_cells *order = malloc(((size_t)ngroups + 1) * sizeof *order);
     lg->e = calloc((size_t)(room > 0 ? room : 1), sizeof *lg->e);
@@ -220,6 +224,33 @@ static void frame(const cm_panel *pn, int ox, int oy, const cm_canvas *c)
     cm_fill_rect(c, x - 1, y + pn->h, pn->w + 2, 1, ink);
     cm_fill_rect(c, x - 1, y - 1, 1, pn->h + 2, ink);
     cm_fill_rect(c, x + pn->w, y - 1, 1, pn->h + 2, ink);
+}
+
+uint8_t figure_bar_grey(int mode, double f)
+{
+    const int s = cm_step_shade(f, mode);
+    return (uint8_t)(mode == CM_RASTER_STEPS ? s : (255 * s) >> 8);
+}
+
+/* The step bar: light (no steps) at the top to dark (the cap) at the
+ * bottom, labelled with step numbers on the shading's log scale. */
+static void draw_step_bar(const legend *lg, const cm_raster *ras, const layout *L, int x, int y,
+                          const cm_font *f, const cm_canvas *c)
+{
+    const int box = L->ascent, top = y + L->line + L->pad, h = (BAR_LINES - 2) * L->line;
+    cm_font_draw(f, BAR_TITLE, x, y + L->ascent, ink, c->rgba, c->w, c->h);
+    cm_fill_rect(c, x, top - 1, box + 2, h + 2, ink);
+    for (int r = 0; r < h; r++) {
+        const uint8_t g = figure_bar_grey(lg->bar_mode, h > 1 ? (double)r / (h - 1) : 0);
+        cm_fill_rect(c, x + 1, top + r, box, 1, (cm_rgb){g, g, g});
+    }
+    for (int k = 0; k <= 2; k++) {
+        char label[32];
+        const uint32_t steps = cm_step_at(k / 2.0, ras->step_cap);
+        snprintf(label, sizeof label, k == 2 ? "%u or more" : "%u", steps);
+        cm_font_draw(f, label, x + box + L->pad, top + k * (h - 1) / 2 + L->ascent / 2, ink, c->rgba,
+                     c->w, c->h);
+    }
 }
 
 static void draw_legend(const legend *lg, const layout *L, int x, int y, const cm_font *f,
@@ -369,9 +400,9 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
     if (st == CM_OK && (o->layers & CM_LAYER_LEGEND)) {
         const int room = (o->height - L->top - L->bottom) / (L->line > 0 ? L->line : 1);
         st = make_legend(&w->ras, groups, r->ngroups, room,
-                         o->legend_groups > 0 ? o->legend_groups : LEGEND_GROUPS, &w->lg, msg,
-                         msg_size);
-        int widest_entry = 0;
+                         o->legend_groups > 0 ? o->legend_groups : LEGEND_GROUPS,
+                         raster_mode(o->layers), &w->lg, msg, msg_size);
+        int widest_entry = w->lg.bar_mode >= 0 ? cm_font_width(w->font, BAR_TITLE) : 0;
         for (int k = 0; k < w->lg.n; k++) {
             const int ew = cm_font_width(w->font, w->lg.e[k].text);
             widest_entry = ew > widest_entry ? ew : widest_entry;
@@ -392,8 +423,12 @@ static void draw_text_layers(const cm_render_options *o, const work *w, const la
             frame(&p->graph, p->x, p->y, c);
         y_axis(L, yp, p->x, p->y, w->font, c);
     }
-    if (o->layers & CM_LAYER_LEGEND)
+    if (o->layers & CM_LAYER_LEGEND) {
         draw_legend(&w->lg, L, p->x + p->w + 2 * L->pad, p->y, w->font, c);
+        if (w->lg.bar_mode >= 0)
+            draw_step_bar(&w->lg, &w->ras, L, p->x + p->w + 2 * L->pad,
+                          p->y + (w->lg.n + 1) * L->line, w->font, c);
+    }
     if (o->layers & CM_LAYER_TITLE) {
         char title[1024];
         figure_title(o->model, title, sizeof title);

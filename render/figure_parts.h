@@ -24,7 +24,15 @@ typedef struct entry {
 typedef struct legend {
     int n;
     entry *e;
+    int bar_mode; /* a colour bar of step numbers below the entries: the raster
+                     mode (CM_RASTER_SHADED or _STEPS), or -1 for none */
 } legend;
+
+enum { BAR_LINES = 7 }; /* lines of the legend a step bar takes */
+#define BAR_TITLE "step number"
+
+/* The grey of the step bar at fraction f (0: no steps, 1: the cap). */
+uint8_t figure_bar_grey(int mode, double f);
 
 typedef struct layout {
     int fs, pad, tick, line, ascent;

@@ -57,15 +57,21 @@ static uint32_t step_cap_of(const cm_region *r, const cm_slice *s)
     return cap;
 }
 
-/* Shade factors in 1/256 for steps 0..cap (logarithmic: transients are
- * mostly short, and the eye compares ratios). */
+uint16_t cm_step_shade(double f, int mode)
+{
+    return (uint16_t)lround(mode == CM_RASTER_STEPS ? 235.0 - 200.0 * f : 256.0 * (1.0 - 0.6 * f));
+}
+
+uint32_t cm_step_at(double f, uint32_t step_cap)
+{
+    return (uint32_t)lround(expm1(f * log1p((double)step_cap)));
+}
+
+/* Shade factors in 1/256 for steps 0..cap. */
 static void shade_table(uint32_t cap, int mode, uint16_t *table)
 {
-    for (uint32_t t = 0; t <= cap; t++) {
-        const double f = log1p((double)t) / log1p((double)cap);
-        table[t] =
-            (uint16_t)lround(mode == CM_RASTER_STEPS ? 235.0 - 200.0 * f : 256.0 * (1.0 - 0.6 * f));
-    }
+    for (uint32_t t = 0; t <= cap; t++)
+        table[t] = cm_step_shade(log1p((double)t) / log1p((double)cap), mode);
 }
 
 static void put_rgb(uint8_t *p, cm_rgb c)

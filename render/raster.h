@@ -53,6 +53,14 @@ typedef struct cm_raster {
     uint32_t colour_repeats; /* coloured groups in the slice beyond the palette's size */
 } cm_raster;
 
+/* The step shading (logarithmic: transients are mostly short, and the eye
+ * compares ratios) at fraction f in [0, 1] of log(1 + step) / log(1 +
+ * step_cap): a factor in 1/256 that darkens group colours (CM_RASTER_SHADED)
+ * or a grey level (CM_RASTER_STEPS). */
+uint16_t cm_step_shade(double f, int mode);
+/* The step number at fraction f of that scale. */
+uint32_t cm_step_at(double f, uint32_t step_cap);
+
 /* Builds the raster of r's slice; groups with basins of fewer than
  * min_basin cells are drawn as "other" (render/palette.h). Deterministic
  * whatever the thread count. */

@@ -279,6 +279,30 @@ static void axes(FILE *f, const figure *F)
     fputs("</g>\n", f);
 }
 
+/* The step bar as the PNG draws it, its shading a gradient. */
+static void step_bar(FILE *f, const figure *F, int x, int y)
+{
+    const layout *L = &F->L;
+    const int box = L->ascent, top = y + L->line + L->pad, h = (BAR_LINES - 2) * L->line;
+    text(f, x, y + L->ascent, "start", BAR_TITLE);
+    fputs("<linearGradient id=\"steps\" x1=\"0\" y1=\"0\" x2=\"0\" y2=\"1\">", f);
+    for (int k = 0; k <= 16; k++) {
+        const uint8_t g = figure_bar_grey(F->w.lg.bar_mode, k / 16.0);
+        fprintf(f, "<stop offset=\"%g\" stop-color=\"#%02x%02x%02x\"/>", k / 16.0, g, g, g);
+    }
+    fputs("</linearGradient>\n", f);
+    fprintf(f,
+            "<rect x=\"%.1f\" y=\"%.1f\" width=\"%d\" height=\"%d\" fill=\"url(#steps)\" "
+            "stroke=\"#000000\"/>\n",
+            x + 0.5, top - 0.5, box + 1, h + 1);
+    for (int k = 0; k <= 2; k++) {
+        char label[32];
+        const uint32_t steps = cm_step_at(k / 2.0, F->w.ras.step_cap);
+        snprintf(label, sizeof label, k == 2 ? "%u or more" : "%u", steps);
+        text(f, x + box + L->pad, top + k * (h - 1) / 2 + L->ascent / 2.0, "start", label);
+    }
+}
+
 static void legend_and_title(FILE *f, const figure *F)
 {
     const layout *L = &F->L;
@@ -299,6 +323,8 @@ static void legend_and_title(FILE *f, const figure *F)
             }
             text(f, x + box + L->pad, base, "start", e->text);
         }
+        if (F->w.lg.bar_mode >= 0)
+            step_bar(f, F, x, p->y + (F->w.lg.n + 1) * L->line);
         fputs("</g>\n", f);
     }
     if (F->o.layers & CM_LAYER_TITLE) {

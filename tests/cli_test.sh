@@ -77,6 +77,32 @@ assert box == [x, y, pw, ph], (box, (x, y, pw, ph))
 assert (int(root.get("width")), int(root.get("height"))) == (w, h)
 assert len(list(root.iter(ns + "circle"))) > 0      # fixed points, as vectors
 PY
+# the steps layer: cells shaded by step number, and a bar that says how
+"$CM" render basin.cmdb --png steps.png --svg steps.svg --layers all,steps --view 100:200,-10:10 \
+  --size 1000x800 || fail "render --layers all,steps"
+python3 - "$HERE" steps.png steps.svg <<'PY' || fail "the step bar"
+import sys, xml.etree.ElementTree as ET
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+w, h, bpp, rows, texts = read_png(sys.argv[2])
+def gradient(x):    # the most grey levels in one run of greys darkening down column x
+    best, levels, last = 0, set(), None
+    for y in range(h):
+        r, g, b = rows[y][bpp * x:bpp * x + 3]
+        if r == g == b and last is not None and r <= last:
+            levels.add(r)
+        else:
+            levels = {r} if r == g == b else set()
+        last = r if r == g == b else None
+        best = max(best, len(levels))
+    return best
+assert max(gradient(x) for x in range(int(0.7 * w), w)) > 50, "no step bar right of the plot"
+ns = "{http://www.w3.org/2000/svg}"
+root = ET.parse(sys.argv[3]).getroot()
+labels = [t.text for t in root.iter(ns + "text")]
+assert "step number" in labels and "0" in labels and any(t.endswith("or more") for t in labels), labels
+assert len(list(root.iter(ns + "linearGradient"))) == 1
+PY
 # deterministic whatever the thread count
 "$CM" solve --threads 1 --png one.png --db one.cmdb > /dev/null || fail "solve 1 thread"
 "$CM" solve --threads 2 --png two.png > /dev/null || fail "solve 2 threads"
