@@ -77,9 +77,23 @@ static void closing_entries(const cm_raster *ras, uint64_t all, int room, legend
 /* Entries for the sink, the groups in view with the most cells (as many as
  * `room` lines and max_groups allow; the rest summed up in one line), the
  * groups folded into "other", and the cells not computed. */
-static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, uint32_t ngroups,
-                             int room, int max_groups, int bar_mode, legend *lg, char *msg,
-                             size_t msg_size)
+/* The label given for a group, or NULL. */
+static const char *label_of(const cm_render_options *o, const cm_group_info *g, int dim)
+{
+    for (int k = 0; k < o->n_labels; k++) {
+        const cm_group_label *l = &o->labels[k];
+        bool same = l->by_anchor ? true : l->id == g->id;
+        for (int d = 0; l->by_anchor && d < dim; d++)
+            same = same && l->anchor[d] == g->anchor[d];
+        if (same)
+            return l->text;
+    }
+    return NULL;
+}
+
+static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
+                             const cm_group_info *groups, uint32_t ngroups, int dim, int room,
+                             int max_groups, int bar_mode, legend *lg, char *msg, size_t msg_size)
 {
     lg->bar_mode = bar_mode != CM_RASTER_BASIN && room >= BAR_LINES + 2 ? bar_mode : -1;
     if (lg->bar_mode >= 0)
@@ -115,9 +129,14 @@ static cm_status make_legend(const cm_raster *ras, const cm_group_info *groups, 
         }
         const uint32_t g = order[k].id;
         const cm_group_info *gi = &groups[g - 1];
-        snprintf(add_entry(lg, cm_class_colour(ras->classes[g]), true)->text, LABEL,
-                 "#%u%s p=%u  %.1f%%", gi->id, gi->kind == CM_GROUP_STICKING ? " sticking" : "",
-                 gi->period, share(order[k].cells, all));
+        const char *label = label_of(o, gi, dim);
+        entry *e = add_entry(lg, cm_class_colour(ras->palette, ras->classes[g]), true);
+        if (label)
+            snprintf(e->text, LABEL, "%s  %.1f%%", label, share(order[k].cells, all));
+        else
+            snprintf(e->text, LABEL, "#%u%s p=%u  %.1f%%", gi->id,
+                     gi->kind == CM_GROUP_STICKING ? " sticking" : "", gi->period,
+                     share(order[k].cells, all));
     }
     closing_entries(ras, all, room, lg);
     free(order);
@@ -376,8 +395,8 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
 {
     const int dim = r->box.dim;
     cm_status st =
-        cm_raster_build(lat, r, groups, s, raster_mode(o->layers), o->min_basin, &w->ras, msg,
-                        msg_size);
+        cm_raster_build(lat, r, groups, s, raster_mode(o->layers), o->min_basin, o->palette,
+                        &w->ras, msg, msg_size);
     if (st == CM_OK && o->model && o->model->overlays && (o->layers & CM_LAYER_OVERLAYS)) {
         w->ov.items = malloc(OVERLAY_CAP * sizeof *w->ov.items);
         w->ov.cap = w->ov.items ? OVERLAY_CAP : 0;
@@ -399,7 +418,7 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
     }
     if (st == CM_OK && (o->layers & CM_LAYER_LEGEND)) {
         const int room = (o->height - L->top - L->bottom) / (L->line > 0 ? L->line : 1);
-        st = make_legend(&w->ras, groups, r->ngroups, room,
+        st = make_legend(o, &w->ras, groups, r->ngroups, dim, room,
                          o->legend_groups > 0 ? o->legend_groups : LEGEND_GROUPS,
                          raster_mode(o->layers), &w->lg, msg, msg_size);
         int widest_entry = w->lg.bar_mode >= 0 ? cm_font_width(w->font, BAR_TITLE) : 0;

@@ -23,6 +23,15 @@
 
 enum { CM_RENDER_MAX_SIDE = 16384 };
 
+/* A legend's own name for a group, by id or by anchor cell (lattice
+ * indices: the same attractor in any file of the same lattice). */
+typedef struct cm_group_label {
+    bool by_anchor;
+    uint32_t id;
+    int64_t anchor[CM_MAX_DIM];
+    char text[64];
+} cm_group_label;
+
 typedef struct cm_render_options {
     int width, height;         /* pixels, 1..CM_RENDER_MAX_SIDE */
     double lo[2], hi[2];       /* view in state coordinates; all zero: the region */
@@ -35,6 +44,9 @@ typedef struct cm_render_options {
     uint64_t min_basin;        /* groups with smaller basins are drawn and listed as
                                   "other" (0, 1: none) */
     int legend_groups;         /* the most groups the legend lists (0: 12) */
+    const struct cm_palette *palette; /* group colours (render/palette.h); NULL: the default */
+    const cm_group_label *labels;     /* the legend's names of groups (n_labels of them) */
+    int n_labels;
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

@@ -9,10 +9,33 @@
 #include <stdint.h>
 
 #include "cellmap/scm.h"
+#include "cellmap/status.h"
 
 typedef struct cm_rgb {
     uint8_t r, g, b;
 } cm_rgb;
+
+enum { CM_PALETTE_MAX = 64 };
+
+/* The categorical colours of groups. */
+typedef struct cm_palette {
+    char name[64];
+    int n;
+    cm_rgb colour[CM_PALETTE_MAX];
+} cm_palette;
+
+/* Built in: "tol" (the default: 14 colours from Paul Tol's muted, light and
+ * bright schemes, which stay distinguishable with the common colour-vision
+ * deficiencies), "okabe-ito" (the six of Okabe and Ito's that are neither
+ * black nor close to the sink's red) and "tab20" (20 colours, more but not
+ * colour-blind safe). No palette holds the sink's red, black, white or the
+ * greys of sticking zones. */
+const cm_palette *cm_palette_default(void);
+/* The built-in palette `name`; CM_ENOTFOUND (msg lists the names) if none. */
+cm_status cm_palette_named(const char *name, const cm_palette **out, char *msg, size_t msg_size);
+/* A palette file: one colour per line as #rrggbb (blank lines and lines
+ * starting with "//" ignored), 1..CM_PALETTE_MAX colours. */
+cm_status cm_palette_read(const char *path, cm_palette *out, char *msg, size_t msg_size);
 
 extern const cm_rgb cm_colour_sink;            /* transient to the sink (red, as the thesis) */
 extern const cm_rgb cm_colour_not_computed;    /* cells outside every region */
@@ -32,11 +55,9 @@ enum cm_colour_class {
     CM_CLASS_OTHER,           /* groups whose basins are below --min-basin */
     CM_CLASS_FIRST_GROUP      /* then one class per categorical colour */
 };
-int cm_class_count(void);
-cm_rgb cm_class_colour(int cls);
-
-/* The number of categorical colours (classes CM_CLASS_FIRST_GROUP on). */
-int cm_palette_size(void);
+/* The classes of a palette (NULL: the default), and their colours. */
+int cm_class_count(const cm_palette *p);
+cm_rgb cm_class_colour(const cm_palette *p, int cls);
 
 /* Classes of groups 1..n (entry k for group k+1) in one view. Sticking
  * zones are grey. Groups in view (in_view[k] cells; in_view NULL: all, by
@@ -48,7 +69,8 @@ int cm_palette_size(void);
  * file and view unless a larger group of the same view hashes to it.
  * Smaller groups are CM_CLASS_OTHER. Returns how many coloured groups
  * exceed the palette (0: every colour in view is one group's). */
-uint32_t cm_palette_classes(const cm_group_info *groups, uint32_t n, const cm_lattice *lat,
-                            const uint64_t *in_view, uint64_t min_basin, uint8_t *classes);
+uint32_t cm_palette_classes(const cm_palette *p, const cm_group_info *groups, uint32_t n,
+                            const cm_lattice *lat, const uint64_t *in_view, uint64_t min_basin,
+                            uint8_t *classes);
 
 #endif

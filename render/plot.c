@@ -262,7 +262,7 @@ static void draw_cobwebs(const cm_plot *p, int lw)
         if (seen)
             continue;
         drawn[n++] = g;
-        colour(cm_class_colour(ras->classes[g]));
+        colour(cm_class_colour(ras->palette, ras->classes[g]));
         double x = ras->s.x0 + (ras->periodic[k].i + 0.5) * ras->s.dx;
         const uint32_t steps = 2 * p->groups[g - 1].period + 16;
         glBegin(GL_LINE_STRIP);

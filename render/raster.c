@@ -103,7 +103,7 @@ static void colour_cell(const cm_region *r, const cm_raster *ras, uint64_t k, in
         p[0] = p[1] = p[2] = (uint8_t)shade[t];
         return;
     }
-    const cm_rgb c = cm_class_colour(cls);
+    const cm_rgb c = cm_class_colour(ras->palette, cls);
     if (mode == CM_RASTER_BASIN) {
         put_rgb(p, c);
         return;
@@ -162,7 +162,7 @@ static void classify_groups(const cm_lattice *lat, const cm_region *r, const cm_
                             cm_raster *ras)
 {
     ras->classes[0] = CM_CLASS_SINK;
-    ras->colour_repeats = cm_palette_classes(groups, r->ngroups, lat, ras->group_cells + 1,
+    ras->colour_repeats = cm_palette_classes(ras->palette, groups, r->ngroups, lat, ras->group_cells + 1,
                                              ras->min_basin, ras->classes + 1);
     for (uint32_t g = 1; g <= r->ngroups; g++)
         if (ras->group_cells[g] && ras->classes[g] == CM_CLASS_OTHER) {
@@ -196,12 +196,13 @@ static cm_status collect_periodic(const cm_region *r, cm_raster *ras, char *msg,
 }
 
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          const cm_slice *s, int mode, uint64_t min_basin, cm_raster *ras,
-                          char *msg, size_t msg_size)
+                          const cm_slice *s, int mode, uint64_t min_basin,
+                          const cm_palette *palette, cm_raster *ras, char *msg, size_t msg_size)
 {
     memset(ras, 0, sizeof *ras);
     ras->s = *s;
     ras->min_basin = min_basin;
+    ras->palette = palette;
     const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
     if (s->nx > UINT32_MAX || s->ny > UINT32_MAX)
         return cm_fail(CM_EINVAL, msg, msg_size, "the slice is too large to draw");

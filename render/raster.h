@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "cellmap/scm.h"
+#include "render/palette.h"
 
 typedef struct cm_slice {
     uint64_t nx, ny;       /* cells in dims 0 and 1 (ny = 1 for 1-D) */
@@ -51,6 +52,7 @@ typedef struct cm_raster {
     uint32_t other_groups; /* groups in the slice drawn as "other" */
     uint64_t other_cells;  /* their cells in the slice */
     uint32_t colour_repeats; /* coloured groups in the slice beyond the palette's size */
+    const cm_palette *palette; /* the group colours (NULL: the default) */
 } cm_raster;
 
 /* The step shading (logarithmic: transients are mostly short, and the eye
@@ -65,8 +67,8 @@ uint32_t cm_step_at(double f, uint32_t step_cap);
  * min_basin cells are drawn as "other" (render/palette.h). Deterministic
  * whatever the thread count. */
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          const cm_slice *s, int mode, uint64_t min_basin, cm_raster *out,
-                          char *msg, size_t msg_size);
+                          const cm_slice *s, int mode, uint64_t min_basin,
+                          const cm_palette *palette, cm_raster *out, char *msg, size_t msg_size);
 void cm_raster_free(cm_raster *ras);
 
 #endif

@@ -221,7 +221,7 @@ static void graph(FILE *f, const figure *F)
         if (!first)
             continue;
         char colour[8];
-        hex(cm_class_colour(ras->classes[g]), colour);
+        hex(cm_class_colour(ras->palette, ras->classes[g]), colour);
         double x = ras->s.x0 + (ras->periodic[k].i + 0.5) * ras->s.dx;
         fprintf(f, "<path fill=\"none\" stroke=\"%s\" d=\"M%.2f %.2f", colour, px_x(&m, x),
                 px_y(&m, x));

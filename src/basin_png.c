@@ -2,6 +2,7 @@
 
 #include "render/svg.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,68 @@ bool parse_png_mode(const char *s, int *indexed)
     return *indexed || strcmp(s, "rgb") == 0;
 }
 
+/* "I0,I1,..." (signed integers) */
+static bool parse_counts_signed(const char *s, int64_t *v, int *n)
+{
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", s);
+    *n = 0;
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
+        if (*n == CM_MAX_DIM || !parse_int64(tok, &v[(*n)++]))
+            return false;
+    return *n > 0;
+}
+
+/* One line of a --labels file: "ID TEXT" or "I0,I1,... TEXT". */
+static bool parse_label(const char *line, cm_group_label *l)
+{
+    const size_t key = strcspn(line, " \t");
+    const char *text = line + key + strspn(line + key, " \t");
+    char head[256];
+    if (key == 0 || key >= sizeof head || !*text || strlen(text) >= sizeof l->text)
+        return false;
+    memcpy(head, line, key);
+    head[key] = 0;
+    memset(l, 0, sizeof *l);
+    snprintf(l->text, sizeof l->text, "%s", text);
+    int64_t v[CM_MAX_DIM];
+    int n = 0;
+    if (!parse_counts_signed(head, v, &n))
+        return false;
+    l->by_anchor = strchr(head, ',') != NULL;
+    if (!l->by_anchor)
+        return v[0] >= 1 && v[0] <= UINT32_MAX && (l->id = (uint32_t)v[0], true);
+    memcpy(l->anchor, v, sizeof v);
+    return true;
+}
+
+static bool read_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        snprintf(msg, msg_size, "cannot read %s: %s", path, strerror(errno));
+        return false;
+    }
+    char line[512];
+    bool ok = true;
+    for (int no = 1; ok && fgets(line, sizeof line, f); no++) {
+        line[strcspn(line, "\r\n")] = 0;
+        const char *s = line + strspn(line, " \t");
+        if (!*s || *s == '#')
+            continue;
+        if (po->n_labels == PNG_LABELS_MAX) {
+            snprintf(msg, msg_size, "%s: more than %d labels", path, PNG_LABELS_MAX);
+            ok = false;
+        } else if (!parse_label(s, &po->labels[po->n_labels++])) {
+            snprintf(msg, msg_size, "%s:%d: '%.60s' is not 'ID TEXT' or 'I0,I1 TEXT' (text up to "
+                     "63 characters)", path, no, s);
+            ok = false;
+        }
+    }
+    fclose(f);
+    return ok;
+}
+
 bool png_opts_take(cli *c, png_opts *po, int *err)
 {
     if (cli_is(c, "--png", true, err)) {
@@ -82,6 +145,22 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
                                    c->value);
         po->min_basin = (uint64_t)v;
     } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
+    } else if (cli_is(c, "--labels", true, err)) {
+        char msg[512];
+        if (c->value && !read_labels(c->value, po, msg, sizeof msg))
+            *err = cli_usage_error(c, "--labels: %s", msg);
+    } else if (cli_is(c, "--palette", true, err)) {
+        char msg[512];
+        if (c->value && cm_palette_named(c->value, &po->palette, msg, sizeof msg) != CM_OK) {
+            if (cm_palette_read(c->value, &po->file_palette, msg, sizeof msg) == CM_OK)
+                po->palette = &po->file_palette;
+            else if (strchr(c->value, '/') || strchr(c->value, '.'))
+                *err = cli_usage_error(c, "--palette: %s", msg);
+            else
+                *err = cli_usage_error(c, "--palette: no palette '%s': use tol (the default), "
+                                          "okabe-ito or tab20, or a file of #rrggbb lines",
+                                       c->value);
+        }
     } else if (cli_is(c, "--view", true, err)) {
         int n = 0;
         if (c->value && (!parse_ranges(c->value, po->lo, po->hi, &n, 2) || n != 2 ||
@@ -98,9 +177,10 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 int png_opts_check(const cli *c, const png_opts *po)
 {
     if (!po->path && !po->svg &&
-        (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups))
-        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin and --legend "
-                                  "describe the image; add --png FILE (or --svg FILE)");
+        (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups ||
+         po->palette))
+        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend and "
+                                  "--palette describe the image; add --png FILE (or --svg FILE)");
     if (po->svg && po->indexed)
         return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
                                   "only");
@@ -256,6 +336,9 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.layers = layers_of(po);
     ro.min_basin = min_basin_of(po, ro.layers);
     ro.legend_groups = po->legend_groups;
+    ro.palette = po->palette;
+    ro.labels = po->labels;
+    ro.n_labels = po->n_labels;
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -324,13 +407,13 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
                        (unsigned long long)s.nx, (unsigned long long)s.ny, CM_RENDER_MAX_SIDE);
     cm_status st =
         cm_raster_build(b->lat, b->cells, b->groups, &s, CM_RASTER_CLASSES,
-                        min_basin_of(b->opts, 0), &ras, msg, msg_size);
+                        min_basin_of(b->opts, 0), b->opts->palette, &ras, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const int n = cm_class_count();
+    const int n = cm_class_count(b->opts->palette);
     uint8_t palette[3 * 256];
     for (int k = 0; k < n; k++) {
-        const cm_rgb c = cm_class_colour(k);
+        const cm_rgb c = cm_class_colour(b->opts->palette, k);
         palette[3 * k] = c.r;
         palette[3 * k + 1] = c.g;
         palette[3 * k + 2] = c.b;

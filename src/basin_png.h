@@ -6,7 +6,11 @@
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
 #include "render/gl.h"
+#include "render/figure.h"
+#include "render/palette.h"
 #include "src/args.h"
+
+enum { PNG_LABELS_MAX = 64 };
 
 typedef struct png_opts {
     const char *path;  /* --png FILE */
@@ -19,6 +23,10 @@ typedef struct png_opts {
     double lo[2], hi[2];
     uint64_t min_basin; /* --min-basin N; 0: 2 in figures with a legend, else 1 */
     int legend_groups;  /* --legend K; 0: the renderer's default */
+    const cm_palette *palette; /* --palette NAME|FILE; NULL: the default */
+    cm_palette file_palette;   /* --palette FILE's colours */
+    cm_group_label labels[PNG_LABELS_MAX]; /* --labels FILE: the legend's names */
+    int n_labels;
 } png_opts;
 
 /* What `all` draws: every layer but steps. */
@@ -40,6 +48,11 @@ extern const unsigned all_layers;
     "  --min-basin N       draw groups whose basins have fewer than N cells as 'other' (one\n"   \
     "                      muted colour, one legend line); default 2 in figures with a\n"         \
     "                      legend (single-cell groups folded), else 1 (none)\n"                    \
+    "  --palette P         group colours: tol (default; colour-blind safe), okabe-ito,\n"     \
+    "                      tab20, or a file of #rrggbb lines\n"                                     \
+    "  --labels FILE       the legend's names of groups: lines 'ID TEXT' or, for the same\n"   \
+    "                      attractor in any file, 'ANCHOR TEXT' with the anchor cell's\n"      \
+    "                      indices as export --groups lists them (e.g. 287,500 SW2)\n"        \
     "  --legend K          list at most K groups in the legend (default 12), the rest in one\n"   \
     "                      line; colours follow each attractor's anchor cell, so the same\n"     \
     "                      attractor has the same colour in every file and view\n"

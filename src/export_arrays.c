@@ -83,7 +83,7 @@ static void write_sidecar_groups(json *j, const array_export *x, const cm_lattic
 {
     uint8_t *classes = calloc((size_t)x->ngroups + 1, 1);
     if (classes)
-        cm_palette_classes(x->groups, x->ngroups, lat, in_window + 1, 1, classes);
+        cm_palette_classes(NULL, x->groups, x->ngroups, lat, in_window + 1, 1, classes);
     json_array(j, "groups");
     for (uint32_t k = 0; k < x->ngroups; k++) {
         if (!in_window[k + 1])
@@ -100,7 +100,7 @@ static void write_sidecar_groups(json *j, const array_export *x, const cm_lattic
         json_array_end(j);
         json_uint(j, "in_view", in_window[k + 1]);
         if (classes) {
-            const cm_rgb c = cm_class_colour(classes[k]);
+            const cm_rgb c = cm_class_colour(NULL, classes[k]);
             char hex[8];
             snprintf(hex, sizeof hex, "#%02x%02x%02x", c.r, c.g, c.b);
             json_str(j, "colour", hex);

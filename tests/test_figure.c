@@ -41,7 +41,7 @@ static void solve(scene *s, const char *model, const char *params, const cm_latt
     s->g = calloc(s->r.ngroups + 1, sizeof *s->g);
     cm_scm_groups(&s->r, lat, s->g, NULL);
     s->classes = calloc(s->r.ngroups + 1, 1);
-    cm_palette_classes(s->g, s->r.ngroups, lat, NULL, 0, s->classes);
+    cm_palette_classes(NULL, s->g, s->r.ngroups, lat, NULL, 0, s->classes);
 }
 
 static void scene_free(scene *s)
@@ -92,7 +92,7 @@ static bool near(const uint8_t *rgba, int w, int h, int i, int j, int r, cm_rgb 
 static cm_rgb cell_colour(const scene *s, uint64_t k)
 {
     const uint32_t grp = s->r.group[k];
-    return grp == 0 ? cm_colour_sink : cm_class_colour(s->classes[grp - 1]);
+    return grp == 0 ? cm_colour_sink : cm_class_colour(NULL, s->classes[grp - 1]);
 }
 
 /* Every pixel whose centre is not within `margin` pixels of a cell border
@@ -311,7 +311,7 @@ static void test_indexed_png(void)
     const uint8_t index[6] = {0, 1, 2, 5, 6, 4};
     uint8_t palette[3 * 8];
     for (int k = 0; k < 8; k++) {
-        const cm_rgb c = cm_class_colour(k);
+        const cm_rgb c = cm_class_colour(NULL, k);
         memcpy(palette + 3 * k, (uint8_t[3]){c.r, c.g, c.b}, 3);
     }
     const cm_png_text texts[] = {{"Software", "cellmap test"}};

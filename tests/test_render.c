@@ -69,9 +69,9 @@ int main(void)
     cm_scm_groups(&r, &lat, g, NULL);
     cm_rgb *colours = calloc(r.ngroups, sizeof *colours);
     uint8_t *classes = calloc(r.ngroups, 1);
-    cm_palette_classes(g, r.ngroups, &lat, NULL, 0, classes);
+    cm_palette_classes(NULL, g, r.ngroups, &lat, NULL, 0, classes);
     for (uint32_t k = 0; k < r.ngroups; k++)
-        colours[k] = cm_class_colour(classes[k]);
+        colours[k] = cm_class_colour(NULL, classes[k]);
     cm_render_info ri;
 
     enum { W = 200, H = 100 };
