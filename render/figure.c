@@ -119,12 +119,12 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
         snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "sink  %.1f%%",
                  share(ras->group_cells[0], all));
     for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
-        if (slots == 1 && k + 1 < shown) { /* the rest in one line */
+        if ((slots == 1 && k + 1 < shown) || k == (uint32_t)max_groups) { /* the rest in one line */
             uint64_t rest = 0;
             for (uint32_t r = k; r < shown; r++)
                 rest += order[r].cells;
-            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more groups  %.1f%%",
-                     shown - k, share(rest, all));
+            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more group%s  %.1f%%",
+                     shown - k, shown - k == 1 ? "" : "s", share(rest, all));
             break;
         }
         const uint32_t g = order[k].id;

@@ -94,7 +94,19 @@ static bool parse_label(const char *line, cm_group_label *l)
     return true;
 }
 
-static bool read_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
+bool png_opts_palette(const char *value, png_opts *po, char *msg, size_t msg_size)
+{
+    if (cm_palette_named(value, &po->palette, msg, msg_size) == CM_OK)
+        return true;
+    const bool a_file = strchr(value, '/') || strchr(value, '.');
+    if (cm_palette_read(value, &po->file_palette, a_file ? msg : (char[64]){0},
+                        a_file ? msg_size : 64) != CM_OK)
+        return false; /* a name: the message lists the names */
+    po->palette = &po->file_palette;
+    return true;
+}
+
+bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 {
     FILE *f = fopen(path, "r");
     if (!f) {
@@ -147,20 +159,12 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
     } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
     } else if (cli_is(c, "--labels", true, err)) {
         char msg[512];
-        if (c->value && !read_labels(c->value, po, msg, sizeof msg))
+        if (c->value && !png_opts_labels(c->value, po, msg, sizeof msg))
             *err = cli_usage_error(c, "--labels: %s", msg);
     } else if (cli_is(c, "--palette", true, err)) {
         char msg[512];
-        if (c->value && cm_palette_named(c->value, &po->palette, msg, sizeof msg) != CM_OK) {
-            if (cm_palette_read(c->value, &po->file_palette, msg, sizeof msg) == CM_OK)
-                po->palette = &po->file_palette;
-            else if (strchr(c->value, '/') || strchr(c->value, '.'))
-                *err = cli_usage_error(c, "--palette: %s", msg);
-            else
-                *err = cli_usage_error(c, "--palette: no palette '%s': use tol (the default), "
-                                          "okabe-ito or tab20, or a file of #rrggbb lines",
-                                       c->value);
-        }
+        if (c->value && !png_opts_palette(c->value, po, msg, sizeof msg))
+            *err = cli_usage_error(c, "--palette: %s", msg);
     } else if (cli_is(c, "--view", true, err)) {
         int n = 0;
         if (c->value && (!parse_ranges(c->value, po->lo, po->hi, &n, 2) || n != 2 ||

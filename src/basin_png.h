@@ -57,6 +57,11 @@ extern const unsigned all_layers;
     "                      line; colours follow each attractor's anchor cell, so the same\n"     \
     "                      attractor has the same colour in every file and view\n"
 
+/* --palette NAME|FILE and --labels FILE into po; false with the problem
+ * in msg. */
+bool png_opts_palette(const char *value, png_opts *po, char *msg, size_t msg_size);
+bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size);
+
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);
 /* Checks the options together (e.g. indexed images take no --size). */

@@ -29,7 +29,9 @@ const char session_help[] =
     "  extend auto [N]                    N times (default 1), add the tile of the view's\n"
     "                                     size where the most sequences escape (4.6.4)\n"
     "  render FILE.png|FILE.svg [WxH]     the view as a basin image (default: a pixel\n"
-    "                                     per cell, at most 4096)\n"
+    "                                     per cell, at most 4096); --layers, --png-mode,\n"
+    "                                     --palette, --labels, --min-basin, --legend\n"
+    "                                     as `cellmap render` takes them\n"
     "  stats [--json]                     groups and attractors in view, cells, memory, disk\n"
     "  export --groups|--cells|--flat ... as `cellmap export` (--window: the view)\n"
     "  save                               save the view (joins are saved as they happen)\n"
@@ -523,6 +525,26 @@ static cm_status render_words(char **t, int n, png_opts *po, char *msg, size_t m
             if (!parse_png_mode(t[++k], &po->indexed))
                 return cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be rgb or indexed",
                                t[k]);
+        } else if (strcmp(t[k], "--palette") == 0 && has_value) {
+            char why[400];
+            if (!png_opts_palette(t[++k], po, why, sizeof why))
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: --palette: %s", why);
+        } else if (strcmp(t[k], "--labels") == 0 && has_value) {
+            char why[400];
+            if (!png_opts_labels(t[++k], po, why, sizeof why))
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: --labels: %s", why);
+        } else if ((strcmp(t[k], "--min-basin") == 0 || strcmp(t[k], "--legend") == 0) &&
+                   has_value) {
+            const bool legend = strcmp(t[k], "--legend") == 0;
+            int64_t v = 0;
+            if (!parse_int64(t[++k], &v) || v < 1 || (legend && v > 200))
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: %s takes %s, not '%s'",
+                               t[k - 1], legend ? "1..200" : "a whole number of cells, 1 or more",
+                               t[k]);
+            if (legend)
+                po->legend_groups = (int)v;
+            else
+                po->min_basin = (uint64_t)v;
         } else if (k == 2 && parse_counts(t[k], wh, &count, 2) && count == 2 &&
                    wh[0] <= CM_RENDER_MAX_SIDE && wh[1] <= CM_RENDER_MAX_SIDE) {
             po->width = (int)wh[0];
@@ -548,8 +570,9 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     const size_t len = n > 1 ? strlen(t[1]) : 0;
     const bool svg = len > 4 && strcmp(t[1] + len - 4, ".svg") == 0; /* FILE.svg: as SVG */
     *(svg ? &po.svg : &po.path) = n > 1 ? t[1] : NULL;
-    cm_status st = words(n, 2, 7, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
-                         "[--png-mode M]", msg, msg_size);
+    cm_status st = words(n, 2, 15, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
+                         "[--png-mode M] [--palette P] [--labels FILE] [--min-basin N] [--legend K]",
+                         msg, msg_size);
     if (st == CM_OK)
         st = render_words(t, n, &po, msg, msg_size);
     if (st == CM_OK)

@@ -148,6 +148,16 @@ check_bad "zoom 1000" "below the lattice's resolution"
 check_bad "view 5:1 0:1" "not LO:HI"
 check_bad "view 0:1" "usage: view"
 check_bad "view 0:1 0:1 at 3" "more than two dimensions"
+# render in a session takes the figure options of `cellmap render`
+printf 'view 100:200,-16:16\nrender opts.svg 800x600 --layers all --palette okabe-ito --legend 2 --min-basin 5\n' |
+  "$CM" explore opts.cmdb - $pd $lattice > /dev/null 2>&1 || fail "render with figure options"
+python3 - opts.svg <<'PY' || fail "the session's figure options"
+import sys, xml.etree.ElementTree as ET
+texts = [t.text for t in ET.parse(sys.argv[1]).getroot().iter("{http://www.w3.org/2000/svg}text")]
+groups = [t for t in texts if t.startswith("#")]
+assert len(groups) == 2 and any(t.startswith("+ ") for t in texts), texts   # --legend 2
+assert any("groups < 5 cells" in t for t in texts), texts                    # --min-basin 5
+PY
 check_bad "view 0:1,0:1,0:1" "not X0:X1,Y0:Y1"
 # the command line's box form, X0:X1,Y0:Y1, is the same view
 printf 'view 100:200,-16:16\nstats --json\n' | "$CM" explore comma.cmdb - $pd $lattice 2>/dev/null \
