@@ -422,6 +422,16 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
         }
         sqlite3_reset(st);
     }
+    const char *lib[][2] = {{"model_lib", meta->model_lib}, {"model_lib_hash", meta->model_lib_hash}};
+    for (size_t i = 0; meta->model_lib && i < 2; i++) {
+        sqlite3_bind_text(st, 1, lib[i][0], -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 2, lib[i][1] ? lib[i][1] : "", -1, SQLITE_TRANSIENT);
+        if (sqlite3_step(st) != SQLITE_DONE) {
+            sqlite3_finalize(st);
+            return store_db_error(db, "write meta", msg, msg_size);
+        }
+        sqlite3_reset(st);
+    }
     sqlite3_finalize(st);
     return CM_OK;
 }
@@ -747,6 +757,12 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
     if (st == CM_OK)
         st = meta_text(db, "tool_version", info->tool_version, sizeof info->tool_version, msg,
                        msg_size);
+    if (st == CM_OK) { /* only files of plugin models have these */
+        read_text(db, "SELECT value FROM meta WHERE key='model_lib'", info->model_lib,
+                  sizeof info->model_lib, NULL, 0);
+        read_text(db, "SELECT value FROM meta WHERE key='model_lib_hash'", info->model_lib_hash,
+                  sizeof info->model_lib_hash, NULL, 0);
+    }
     if (st == CM_OK)
         st = store_read_lattice(db, &info->lattice, msg, msg_size);
     if (st == CM_OK)

@@ -50,6 +50,8 @@ typedef struct cm_store_meta {
     const char *plan;    /* what a resumed solve must repeat, may be NULL */
     const char *tool_version;
     long long created; /* seconds since the epoch (SOURCE_DATE_EPOCH or 0) */
+    const char *model_lib;      /* the plugin the model came from (NULL: built in) */
+    const char *model_lib_hash; /* its hash, so that a changed plugin is noticed */
 } cm_store_meta;
 
 /* What a file says about itself (cm_store_read_info). */
@@ -59,6 +61,8 @@ typedef struct cm_store_info {
     char command[4096];
     char plan[1024];
     char tool_version[64];
+    char model_lib[1024];     /* the model's plugin ("": built in) */
+    char model_lib_hash[24];
     cm_lattice lattice;
     uint32_t regions;
     uint64_t cells;

@@ -1,5 +1,12 @@
+/* realpath() is XSI */
+#define _XOPEN_SOURCE 700
+
 #include "models/registry.h"
 
+#include <dlfcn.h>
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,12 +48,94 @@ size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }
 
 const cm_model_entry *cm_model_at(size_t i) { return i < cm_model_count() ? &entries[i] : NULL; }
 
-const cm_model_entry *cm_model_find(const char *name)
+const cm_model_entry *cm_model_find(const char *name) { return cm_model_set_find(NULL, name, NULL); }
+
+const cm_model_entry *cm_model_set_find(const cm_model_set *s, const char *name,
+                                        const cm_model_lib **lib)
 {
+    if (lib)
+        *lib = NULL;
     for (size_t i = 0; i < cm_model_count(); i++)
         if (strcmp(entries[i].name, name) == 0)
             return &entries[i];
+    for (int k = 0; s && k < s->n; k++)
+        for (int i = 0; i < s->lib[k].plugin->count; i++)
+            if (strcmp(s->lib[k].plugin->models[i].name, name) == 0) {
+                if (lib)
+                    *lib = &s->lib[k];
+                return &s->lib[k].plugin->models[i];
+            }
     return NULL;
+}
+
+cm_status cm_file_hash(const char *path, char out[24], char *msg, size_t msg_size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot read %s: %s", path, strerror(errno));
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    unsigned char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        for (size_t i = 0; i < n; i++)
+            h = (h ^ buf[i]) * UINT64_C(0x100000001b3);
+    const bool failed = ferror(f);
+    fclose(f);
+    if (failed)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot read %s", path);
+    snprintf(out, 24, "%016llx", (unsigned long long)h);
+    return CM_OK;
+}
+
+cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t msg_size)
+{
+    char hash[24], full[CM_MODEL_LIB_PATH + 2];
+    if (strlen(path) >= CM_MODEL_LIB_PATH)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the plugin path is too long");
+    /* dlopen searches the library path for a bare name: "./" makes it a file */
+    snprintf(full, sizeof full, "%s%s", strchr(path, '/') ? "" : "./", path);
+    cm_status st = cm_file_hash(full, hash, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    for (int k = 0; k < s->n; k++)
+        if (strcmp(s->lib[k].hash, hash) == 0)
+            return CM_OK;
+    if (s->n == CM_MODEL_LIBS_MAX)
+        return cm_fail(CM_EINVAL, msg, msg_size, "at most %d plugins", CM_MODEL_LIBS_MAX);
+    void *h = dlopen(full, RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        return cm_fail(CM_EINVAL, msg, msg_size, "cannot load plugin %s: %s", path, dlerror());
+    cm_plugin_entry entry;
+    *(void **)&entry = dlsym(h, CM_PLUGIN_ENTRY_NAME);
+    const cm_plugin *p = entry ? entry() : NULL;
+    if (!p) {
+        dlclose(h);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s is no cellmap plugin: it exports no %s() (see examples/plugin/)", path,
+                       CM_PLUGIN_ENTRY_NAME);
+    }
+    if (p->abi != CM_PLUGIN_ABI) {
+        const int abi = p->abi; /* read before the library is unmapped */
+        dlclose(h);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "plugin %s was built for plugin ABI %d, this cellmap has ABI %d: build it "
+                       "again against this cellmap's headers",
+                       path, abi, CM_PLUGIN_ABI);
+    }
+    for (int i = 0; i < p->count; i++)
+        if (!p->models[i].name || !p->models[i].params || !p->models[i].create) {
+            dlclose(h);
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "plugin %s: model %d lacks a name, params or create()", path, i + 1);
+        }
+    cm_model_lib *l = &s->lib[s->n++];
+    l->handle = h;
+    char *absolute = realpath(full, NULL); /* files record it: any directory finds it */
+    snprintf(l->path, sizeof l->path, "%s", absolute ? absolute : path);
+    free(absolute);
+    memcpy(l->hash, hash, sizeof l->hash);
+    l->plugin = p;
+    return CM_OK;
 }
 
 cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
@@ -67,11 +156,19 @@ cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params
 cm_status cm_model_create(const char *name, const char *const *texts, int n_texts, cm_model *m,
                           char *msg, size_t msg_size)
 {
+    return cm_model_set_create(NULL, name, texts, n_texts, m, msg, msg_size);
+}
+
+cm_status cm_model_set_create(const cm_model_set *s, const char *name, const char *const *texts,
+                              int n_texts, cm_model *m, char *msg, size_t msg_size)
+{
     memset(m, 0, sizeof *m);
-    const cm_model_entry *e = cm_model_find(name);
+    const cm_model_entry *e = cm_model_set_find(s, name, NULL);
     if (!e)
         return cm_fail(CM_ENOTFOUND, msg, msg_size,
-                       "unknown model '%s' (`cellmap models` lists them)", name);
+                       "unknown model '%s' (`cellmap models` lists them; a model of your own "
+                       "comes with --model-lib PLUGIN.so)",
+                       name);
     cm_params p;
     cm_status st = cm_params_defaults(e->params, &p, msg, msg_size);
     for (int i = 0; st == CM_OK && i < n_texts; i++)

@@ -3,15 +3,36 @@
 #define CM_MODELS_REGISTRY_H
 
 #include "cellmap/model.h"
+#include "cellmap/plugin.h"
 
-typedef struct cm_model_entry {
-    const char *name;
-    const char *state;   /* what the state vector holds, by its coordinates' names */
-    const char *doc;     /* one line, with the thesis equation */
-    const char *region;  /* default region LO:HI,... for the defaults, or NULL */
-    const cm_param_spec *params;
-    cm_status (*create)(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
-} cm_model_entry;
+/* A model by name: built in, or from a plugin (the same record). */
+typedef cm_plugin_model cm_model_entry;
+
+/* The plugins a command loaded (--model-lib), besides the built-in models. */
+enum { CM_MODEL_LIBS_MAX = 8, CM_MODEL_LIB_PATH = 1024 };
+typedef struct cm_model_lib {
+    void *handle;
+    char path[CM_MODEL_LIB_PATH];
+    char hash[24]; /* FNV-1a 64 of the file, hex: a changed plugin differs */
+    const cm_plugin *plugin;
+} cm_model_lib;
+typedef struct cm_model_set {
+    int n;
+    cm_model_lib lib[CM_MODEL_LIBS_MAX];
+} cm_model_set;
+
+/* Loads a plugin (its ABI checked) into s; the message names the path and
+ * the fix. Loading the same file twice adds it once. */
+cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t msg_size);
+/* The entry of `name`: built in first, then the plugins in load order (s
+ * may be NULL: built-in only); *lib (if not NULL) gets its plugin or NULL. */
+const cm_model_entry *cm_model_set_find(const cm_model_set *s, const char *name,
+                                        const cm_model_lib **lib);
+/* cm_model_create over s's models too. */
+cm_status cm_model_set_create(const cm_model_set *s, const char *name, const char *const *texts,
+                              int n_texts, cm_model *m, char *msg, size_t msg_size);
+/* The hash cm_model_lib.hash holds, of any file. */
+cm_status cm_file_hash(const char *path, char out[24], char *msg, size_t msg_size);
 
 /* Number of registered models and entry i (0-based). */
 size_t cm_model_count(void);

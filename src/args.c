@@ -226,6 +226,12 @@ bool model_opts_take(cli *c, model_opts *mo, int *error)
         mo->name = c->value;
         return true;
     }
+    if (cli_is(c, "--model-lib", true, error)) {
+        char msg[1400];
+        if (c->value && cm_model_set_load(&mo->set, c->value, msg, sizeof msg) != CM_OK)
+            *error = cli_usage_error(c, "--model-lib: %s", msg);
+        return true;
+    }
     if (cli_is(c, "--param", true, error)) {
         if (c->value && mo->n_texts == MAX_PARAM_TEXTS)
             *error = cli_usage_error(c, "too many --param options (at most %d)", MAX_PARAM_TEXTS);
@@ -239,7 +245,8 @@ bool model_opts_take(cli *c, model_opts *mo, int *error)
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m)
 {
     char msg[512];
-    if (cm_model_create(mo->name, mo->texts, mo->n_texts, m, msg, sizeof msg) != CM_OK)
+    if (cm_model_set_create(&mo->set, mo->name, mo->texts, mo->n_texts, m, msg, sizeof msg) !=
+        CM_OK)
         return cli_usage_error(c, "%s", msg);
     return EXIT_OK;
 }
@@ -282,8 +289,8 @@ bool lattice_opts_take(cli *c, lattice_opts *lo, int *error)
 int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m, cm_lattice *lat,
                        cm_box *box)
 {
-    const cm_model_entry *e = cm_model_find(m->name);
-    const char *text = lo->region_text ? lo->region_text : e->region;
+    const cm_model_entry *e = cm_model_find(m->name); /* plugins: --region given */
+    const char *text = lo->region_text ? lo->region_text : e ? e->region : NULL;
     double low[CM_MAX_DIM], high[CM_MAX_DIM];
     int n = 0;
     if (!text)

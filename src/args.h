@@ -9,6 +9,7 @@
 
 #include "cellmap/lattice.h"
 #include "cellmap/model.h"
+#include "models/registry.h"
 
 /* EXIT_INTERRUPTED: stopped by Ctrl-C (128 + SIGINT, as shells report it). */
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
@@ -63,9 +64,11 @@ typedef struct model_opts {
     const char *name;
     const char *texts[MAX_PARAM_TEXTS];
     int n_texts;
+    cm_model_set set; /* the plugins of --model-lib */
 } model_opts;
 
-/* Handles --model and --param; returns true if the current option was one. */
+/* Handles --model, --param and --model-lib (loaded at once); returns true
+ * if the current option was one. */
 bool model_opts_take(cli *c, model_opts *mo, int *error);
 /* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);

@@ -417,7 +417,7 @@ static void sweep_free(sweep_results *s, cm_model *models)
 int cmd_bifurcation(int argc, char **argv)
 {
     cli c = {"bifurcation", argc, argv, 0, NULL, NULL};
-    bif_args a = {.mo = {"friction-oscillator", {0}, 0},
+    bif_args a = {.mo = {.name = "friction-oscillator"},
                   .runs = 10,
                   .transient = 1000,
                   .record = 50,

@@ -120,7 +120,7 @@ static bool write_results(const fp_args *a, const cm_model *m, const cm_fixed_po
 int cmd_fixed_points(int argc, char **argv)
 {
     cli c = {"fixed-points", argc, argv, 0, NULL, NULL};
-    fp_args a = {{"microchaos-pd", {0}, 0}, -10, 10, NULL, false};
+    fp_args a = {.mo = {.name = "microchaos-pd"}, .m0 = -10, .m1 = 10};
     int err = parse_args(&c, &a);
     if (err)
         return err < 0 ? EXIT_OK : err;

@@ -42,6 +42,17 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     printf("file %s: cellmap database format %d, written by cellmap %s\n", path, info->version,
            info->tool_version);
     printf("model %s %s\n", info->model, info->params);
+    if (info->model_lib[0]) { /* a plugin's model: say whether it is still there and the same */
+        cm_model_set set = {0};
+        cm_model m;
+        char msg[2048];
+        if (model_of_store(info, &set, &m, msg, sizeof msg) == CM_OK) {
+            printf("plugin %s (hash %s)\n", info->model_lib, info->model_lib_hash);
+            cm_model_release(&m);
+        } else {
+            printf("plugin %s: %s\n", info->model_lib, msg);
+        }
+    }
     printf("lattice origin (");
     for (int d = 0; d < lat->dim; d++)
         printf("%s%s", d ? ", " : "", CM_NUM(lat->origin[d]));
@@ -85,7 +96,8 @@ static void print_json(const char *path, const cm_store_info *info, const cm_box
     json_str(&j, "tool_version", info->tool_version);
     cm_model m;
     char msg[512];
-    if (model_of_store(info, &m, msg, sizeof msg) == CM_OK) {
+    cm_model_set set = {0};
+    if (model_of_store(info, &set, &m, msg, sizeof msg) == CM_OK) {
         json_model(&j, &m);
         cm_model_release(&m);
     } else { /* a model this cellmap does not know: its name and parameters as written */

@@ -213,7 +213,7 @@ static void print_json(const lyap_args *a, const cm_params *base, const double *
 int cmd_lyapunov(int argc, char **argv)
 {
     cli c = {"lyapunov", argc, argv, 0, NULL, NULL};
-    lyap_args a = {.mo = {"friction-oscillator", {0}, 0},
+    lyap_args a = {.mo = {.name = "friction-oscillator"},
                    .periods = 600,
                    .d0 = 1e-8,
                    .width = 900,

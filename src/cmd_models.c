@@ -8,11 +8,13 @@
 #include "src/json.h"
 
 static const char models_help[] =
-    "usage: cellmap models [--json]\n\n"
+    "usage: cellmap models [--model-lib PLUGIN.so ...] [--json]\n\n"
     "Lists every model with its state (the coordinates' names, used for CSV, JSON\n"
     "and SQL columns) and parameters (name, default, range, meaning).\n"
     "Parameters are set with --param name=value[,name=value]; vectors as v1:v2:...\n"
-    "docs/models.md describes each model.\n";
+    "docs/models.md describes each model. --model-lib (repeatable) adds the models\n"
+    "of a plugin (examples/plugin/ shows how to write one); every command that\n"
+    "takes --model takes --model-lib too.\n";
 
 static void print_text(const cm_model_entry *e, const cm_model *m)
 {
@@ -64,12 +66,17 @@ int cmd_models(int argc, char **argv)
     cli c = {"models", argc, argv, 0, NULL, NULL};
     int err = 0;
     bool as_json = false;
+    cm_model_set set = {0};
     while (cli_next(&c) && !err) {
         if (strcmp(c.opt, "--help") == 0) {
             fputs(models_help, stdout);
             return EXIT_OK;
         } else if (cli_is(&c, "--json", false, &err)) {
             as_json = true;
+        } else if (cli_is(&c, "--model-lib", true, &err)) {
+            char msg[1400];
+            if (c.value && cm_model_set_load(&set, c.value, msg, sizeof msg) != CM_OK)
+                err = cli_usage_error(&c, "--model-lib: %s", msg);
         } else {
             err = cli_usage_error(&c, "unexpected argument '%s'", c.opt);
         }
@@ -81,11 +88,23 @@ int cmd_models(int argc, char **argv)
         json_begin(&j, stdout, "models");
         json_array(&j, "models");
     }
-    for (size_t i = 0; i < cm_model_count(); i++) {
-        const cm_model_entry *e = cm_model_at(i);
+    size_t total = cm_model_count();
+    for (int k = 0; k < set.n; k++)
+        total += (size_t)set.lib[k].plugin->count;
+    for (size_t i = 0, lib = 0, in_lib = 0; i < total; i++) {
+        const cm_model_entry *e; /* the built-in ones, then each plugin's */
+        if (i < cm_model_count()) {
+            e = cm_model_at(i);
+        } else {
+            while ((int)in_lib >= set.lib[lib].plugin->count) {
+                lib++;
+                in_lib = 0;
+            }
+            e = &set.lib[lib].plugin->models[in_lib++];
+        }
         cm_model m; /* built from its defaults, for the names of its state */
         char msg[512];
-        if (cm_model_create(e->name, NULL, 0, &m, msg, sizeof msg) != CM_OK) {
+        if (cm_model_set_create(&set, e->name, NULL, 0, &m, msg, sizeof msg) != CM_OK) {
             fprintf(stderr, "cellmap models: %s: %s\n", e->name, msg);
             return EXIT_FAIL;
         }

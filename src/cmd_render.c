@@ -138,7 +138,8 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     int rc = cells_to_draw(c, a, s, cl, lo, hi, &box);
     if (rc != EXIT_OK)
         return rc;
-    if (model_of_store(info, &m, msg, sizeof msg) != CM_OK) {
+    cm_model_set set = {0};
+    if (model_of_store(info, &set, &m, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "cellmap render: %s: %s\n", a->file, msg);
         return EXIT_FAIL;
     }

@@ -461,7 +461,7 @@ int cmd_simulate(int argc, char **argv)
 {
     cli c = {"simulate", argc, argv, 0, NULL, NULL};
     sim_args a = {
-        .mo = {"friction-oscillator", {0}, 0}, .periods = 20, .width = 900, .height = 1000};
+        .mo = {.name = "friction-oscillator"}, .periods = 20, .width = 900, .height = 1000};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;

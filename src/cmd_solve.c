@@ -487,7 +487,12 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
                             size_t msg_size)
 {
     if (!a->resume)
-        return project_create(a->db, m, lat, command, plan, &rn->store, &rn->c, msg, msg_size);
+    {
+        const cm_model_lib *lib;
+        cm_model_set_find(&a->mo.set, m->name, &lib);
+        return project_create(a->db, m, lib, lat, command, plan, &rn->store, &rn->c, msg,
+                              msg_size);
+    }
     solve_fit fit = {m, lat, plan, a->db};
     cm_store_info info;
     return project_resume("solve", a->db, same_solve, &fit, &rn->store, &info, &rn->c, msg,

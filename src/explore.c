@@ -861,10 +861,11 @@ static int open_error(const char *fmt, ...)
 }
 
 /* The file's model, rebuilt from its name and parameters. */
-static int model_of_file(session *s, const cm_store_info *info)
+static int model_of_file(session *s, const session_options *o, const cm_store_info *info)
 {
-    char msg[1024];
-    if (model_of_store(info, &s->model, msg, sizeof msg) != CM_OK)
+    char msg[2048];
+    s->models = o->mo.set; /* --model-lib's, and the file's own plugin */
+    if (model_of_store(info, &s->models, &s->model, msg, sizeof msg) != CM_OK)
         return open_error("%s: %s", s->path, msg);
     s->have_model = 1;
     return EXIT_OK;
@@ -986,7 +987,7 @@ static int check_same(const session *s, const session_options *o, const cm_store
     cm_model m;
     char msg[512], params[4096];
     if (o->mo.name) {
-        if (cm_model_create(o->mo.name, o->mo.texts, o->mo.n_texts, &m, msg, sizeof msg) != CM_OK)
+        if (cm_model_set_create(&o->mo.set, o->mo.name, o->mo.texts, o->mo.n_texts, &m, msg, sizeof msg) != CM_OK)
             return open_error("%s", msg);
         cm_params_json(&m.values, params, sizeof params);
         const int differs = strcmp(m.name, info->model) != 0 || strcmp(params, info->params) != 0;
@@ -1022,7 +1023,7 @@ static cm_status fits_session(void *user, const cm_store_info *info, const cm_mo
 {
     explore_fit *f = user;
     f->s->max_steps = plan_max_steps(info->plan);
-    f->rc = model_of_file(f->s, info);
+    f->rc = model_of_file(f->s, f->o, info);
     if (f->rc == EXIT_OK)
         f->rc = check_same(f->s, f->o, info);
     if (f->rc != EXIT_OK)
@@ -1091,7 +1092,7 @@ static int create_new(session *s, const session_options *o)
                 s->path);
         return EXIT_USAGE;
     }
-    if (cm_model_create(o->mo.name, o->mo.texts, o->mo.n_texts, &s->model, msg, sizeof msg) !=
+    if (cm_model_set_create(&o->mo.set, o->mo.name, o->mo.texts, o->mo.n_texts, &s->model, msg, sizeof msg) !=
         CM_OK) {
         fprintf(stderr, "cellmap explore: %s\n", msg);
         return EXIT_USAGE;
@@ -1105,7 +1106,9 @@ static int create_new(session *s, const session_options *o)
         return rc;
     char plan[64];
     snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
-    if (project_create(s->path, &s->model, &lat, o->command, plan, &s->store, &s->c, msg,
+    const cm_model_lib *lib;
+    cm_model_set_find(&o->mo.set, s->model.name, &lib);
+    if (project_create(s->path, &s->model, lib, &lat, o->command, plan, &s->store, &s->c, msg,
                        sizeof msg) != CM_OK)
         return open_error("%s", msg);
     return new_depth(s, o);

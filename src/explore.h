@@ -37,6 +37,7 @@ typedef struct session_options {
 typedef struct session {
     const char *path;
     cm_model model;
+    cm_model_set models; /* the plugins the model may come from */
     int have_model;
     cm_store *store;
     cm_cluster c;

@@ -155,7 +155,7 @@ bool model_with_values(const model_opts *mo, const char *const *names, const dou
         snprintf(value_text[i], sizeof value_text[i], "%s=%s", names[i], CM_NUM(values[i]));
         texts[k++] = value_text[i];
     }
-    return cm_model_create(mo->name, texts, k, m, msg, msg_size) == CM_OK;
+    return cm_model_set_create(&mo->set, mo->name, texts, k, m, msg, msg_size) == CM_OK;
 }
 
 bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,

@@ -43,12 +43,19 @@ void project_close(cm_store *s, cm_cluster *c)
     cm_store_close(s, msg, sizeof msg);
 }
 
-cm_status project_create(const char *path, const cm_model *m, const cm_lattice *lat,
-                         const char *command, const char *plan, cm_store **s, cm_cluster *c,
-                         char *msg, size_t msg_size)
+cm_status project_create(const char *path, const cm_model *m, const cm_model_lib *lib,
+                         const cm_lattice *lat, const char *command, const char *plan,
+                         cm_store **s, cm_cluster *c, char *msg, size_t msg_size)
 {
     const char *epoch = getenv("SOURCE_DATE_EPOCH"); /* reproducible files */
-    const cm_store_meta meta = {m, lat, command, plan, CELLMAP_VERSION, epoch ? atoll(epoch) : 0};
+    const cm_store_meta meta = {m,
+                                lat,
+                                command,
+                                plan,
+                                CELLMAP_VERSION,
+                                epoch ? atoll(epoch) : 0,
+                                lib ? lib->path : NULL,
+                                lib ? lib->hash : NULL};
     cm_cluster_init(c, lat);
     cm_status st = cm_store_create(path, &meta, s, msg, msg_size);
     if (st == CM_OK) {
@@ -93,7 +100,8 @@ void project_state_names(const cm_store_info *info, const char **names)
 {
     cm_model m;
     char msg[256];
-    const bool known = model_of_store(info, &m, msg, sizeof msg) == CM_OK;
+    cm_model_set set = {0};
+    const bool known = model_of_store(info, &set, &m, msg, sizeof msg) == CM_OK;
     if (!known)
         memset(&m, 0, sizeof m); /* a model this cellmap lacks: x0, x1, ... */
     for (int d = 0; d < CM_MAX_DIM; d++)
@@ -133,14 +141,45 @@ static bool params_text(const char *json, char *out, size_t size)
     return *p == '}' && used < size;
 }
 
-cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size_t msg_size)
+/* A plugin model's library: the one given (--model-lib) or the one the
+ * file records, and the same file it was made with. */
+static cm_status plugin_of_store(const cm_store_info *info, cm_model_set *set, char *msg,
+                                 size_t msg_size)
+{
+    const cm_model_lib *lib;
+    if (!cm_model_set_find(set, info->model, &lib)) {
+        if (!info->model_lib[0])
+            return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                           "its model '%s' is unknown to this cellmap (`cellmap models`)",
+                           info->model);
+        char why[1400];
+        if (cm_model_set_load(set, info->model_lib, why, sizeof why) != CM_OK ||
+            !cm_model_set_find(set, info->model, &lib))
+            return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                           "its model '%s' comes from the plugin %s, which cannot be loaded "
+                           "(%.600s): give --model-lib with where it is now",
+                           info->model, info->model_lib, why);
+    }
+    if (lib && info->model_lib_hash[0] && strcmp(lib->hash, info->model_lib_hash) != 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "its model '%s' was made with plugin %s of hash %s; %s has hash %s: the "
+                       "plugin changed since, and its results could differ (rebuild the plugin "
+                       "as it was, or solve again)",
+                       info->model, info->model_lib, info->model_lib_hash, lib->path, lib->hash);
+    return CM_OK;
+}
+
+cm_status model_of_store(const cm_store_info *info, cm_model_set *set, cm_model *m, char *msg,
+                         size_t msg_size)
 {
     char text[4096], again[4096];
     const char *texts[1] = {text};
     if (!params_text(info->params, text, sizeof text))
         return cm_fail(CM_EINVAL, msg, msg_size, "its parameters '%s' are not readable",
                        info->params);
-    cm_status st = cm_model_create(info->model, texts, 1, m, msg, msg_size);
+    cm_status st = plugin_of_store(info, set, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_model_set_create(set, info->model, texts, 1, m, msg, msg_size);
     if (st != CM_OK)
         return st;
     cm_params_json(&m->values, again, sizeof again);

@@ -10,6 +10,7 @@
 #include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/store.h"
+#include "models/registry.h"
 
 /* Opens path read-only, reads what it says about itself and restores its
  * cluster (paged out; regions are read back on demand within mem_budget
@@ -23,16 +24,17 @@ void project_close(cm_store *s, cm_cluster *c);
 
 /* The model a file was made with, rebuilt from its name and parameters
  * (which must rebuild exactly). */
-cm_status model_of_store(const cm_store_info *info, cm_model *m, char *msg, size_t msg_size);
+cm_status model_of_store(const cm_store_info *info, cm_model_set *set, cm_model *m, char *msg,
+                         size_t msg_size);
 
 /* A new file at path for model m, lattice, command line and plan (created
  * at SOURCE_DATE_EPOCH, else time 0), replacing an older cellmap database
  * there once cm_store_finish says the new cluster is complete (never
  * another file), and an empty cluster c saved into it; m
  * labels its groups' kinds and must outlive the store. */
-cm_status project_create(const char *path, const cm_model *m, const cm_lattice *lat,
-                         const char *command, const char *plan, cm_store **s, cm_cluster *c,
-                         char *msg, size_t msg_size);
+cm_status project_create(const char *path, const cm_model *m, const cm_model_lib *lib,
+                         const cm_lattice *lat, const char *command, const char *plan,
+                         cm_store **s, cm_cluster *c, char *msg, size_t msg_size);
 
 /* Says whether a file is the caller's to extend (model, parameters,
  * lattice, plan...) and gives the model to extend it with (*model, which

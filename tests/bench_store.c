@@ -104,7 +104,7 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     c.mem_budget = budget;
     cm_store *s = NULL;
     if (db) {
-        const cm_store_meta meta = {&m, &lat, "bench_store", "bench", "bench", 0};
+        const cm_store_meta meta = {&m, &lat, "bench_store", "bench", "bench", 0, NULL, NULL};
         if (cm_store_create(db, &meta, &s, msg, sizeof msg) != CM_OK)
             die("create", msg);
         cm_store_attach(s, &c);

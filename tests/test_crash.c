@@ -177,7 +177,7 @@ static void solve_until_eviction(const char *db)
     const cm_lattice lat = {2, {-13, -4}, {26.0 / 400, 8.0 / 400}};
     if (cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) != CM_OK)
         _exit(4);
-    const cm_store_meta meta = {&m, &lat, "test", "test", "test", 0};
+    const cm_store_meta meta = {&m, &lat, "test", "test", "test", 0, NULL, NULL};
     cm_store *s = NULL;
     cm_cluster c;
     cm_cluster_init(&c, &lat);

@@ -107,7 +107,7 @@ static void solve_tiles(const cm_model *m, const char *path, int budget_regions,
     c.threads = threads;
     cm_store *s = NULL;
     if (path) {
-        const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0};
+        const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0, NULL, NULL};
         CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_OK);
         cm_store_attach(s, &c);
         c.mem_budget = (uint64_t)budget_regions * 12 * cm_box_cells(&boxes[0]);
@@ -227,7 +227,7 @@ static void check_refused_untouched(const char *path, const cm_model *m, const c
     CHECK(s == NULL);
     CHECK(strstr(msg, why) != NULL);
     CHECK(cm_store_open(path, 0, &s, msg, sizeof msg) == CM_EFORMAT);
-    const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0};
+    const cm_store_meta meta = {m, &lat416, "test", "plan", "test", 0, NULL, NULL};
     CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_EFORMAT);
     CHECK(strstr(msg, "refusing") != NULL);
     char *after = slurp(path, &after_size);

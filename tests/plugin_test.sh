@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# A model of your own: cellmap installed to a temporary prefix, the Henon
+# plugin of examples/plugin/ built against it out of tree with pkg-config
+# only (plain cc and CMake), solved, and its result checked against orbits
+# this test computes itself; files remember their plugin; a plugin of
+# another ABI is refused.
+# usage: plugin_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
+set -u
+SRC=$(realpath "$2")
+BUILD=$(realpath "$3")
+HERE=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+. "$HERE/testlib.sh"
+cd "$work"
+
+cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "install: $(cat install.log)"
+CM="$work/prefix/bin/cellmap"
+export PKG_CONFIG_PATH="$work/prefix/share/pkgconfig"
+cc -Wall -Wextra -Werror -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so \
+  "$SRC/examples/plugin/henon.c" -lm || fail "cc with pkg-config"
+cmake -S "$SRC/examples/plugin" -B henon-build > cmake.log 2>&1 && cmake --build henon-build > build.log 2>&1 \
+  && [ -s henon-build/libhenon.so ] || fail "the plugin's CMake build: $(tail -5 cmake.log build.log)"
+
+"$CM" models --model-lib ./libhenon.so | grep -q "^henon$" || fail "models --model-lib lists no henon"
+henon=(--model-lib ./libhenon.so --model henon --param a=1.4,b=0.3 --region=-2.5:2.5,-2.5:2.5)
+"$CM" solve "${henon[@]}" --cells 1000x1000 --max-steps 4 --db henon.cmdb > henon.txt || fail "solve henon"
+"$CM" export henon.cmdb --cells cells.csv --quiet || fail "export henon.cmdb"
+
+# the attractor against orbits: every point of a long orbit lies in (or next
+# to) a cell of the attractor's group, and cells' labels (attractor or
+# escape) agree with the orbit from their centre
+python3 - cells.csv <<'PY' || fail "Henon against its orbits"
+import csv, random
+w, x0, y0 = 0.005, -2.5, -2.5
+grp, basin = {}, {}
+for r in csv.DictReader(open("cells.csv")):
+    c = (int(r["ix"]), int(r["iy"]))
+    grp[c] = int(r["grp"])
+    basin[grp[c]] = basin.get(grp[c], 0) + 1
+attractor = max((g for g in basin if g), key=basin.get)  # the group with the largest basin
+cell = lambda x, y: (int((x - x0) // w), int((y - y0) // w))
+def step(x, y):
+    return 1 - 1.4 * x * x + y, 0.3 * x
+x, y = 0.1, 0.1
+for _ in range(1000):
+    x, y = step(x, y)
+near = 0
+for _ in range(100000):
+    x, y = step(x, y)
+    i, j = cell(x, y)
+    near += any(grp.get((i + di, j + dj)) == attractor for di in (-1, 0, 1) for dj in (-1, 0, 1))
+assert near == 100000, near
+random.seed(1)
+agree = 0
+for _ in range(1000):
+    c = (random.randrange(1000), random.randrange(1000))
+    x, y = x0 + (c[0] + 0.5) * w, y0 + (c[1] + 0.5) * w
+    escaped = False
+    for _ in range(2000):
+        x, y = step(x, y)
+        if abs(x) > 1e6:
+            escaped = True
+            break
+    agree += (grp[c] == 0) == escaped
+assert agree >= 980, agree
+print("orbit points in the attractor's cells:", near, "labels that agree:", agree)
+PY
+
+# the file remembers its plugin: found from any directory, refused when gone or changed
+mkdir elsewhere
+(cd elsewhere && "$CM" info ../henon.cmdb > info.txt) || fail "info from another directory"
+grep -q "^model henon" elsewhere/info.txt || fail "info: $(cat elsewhere/info.txt)"
+"$CM" render henon.cmdb --png henon.png || fail "render of a plugin's file"
+grep -q "^plugin .*/libhenon.so (hash [0-9a-f]*)$" elsewhere/info.txt || fail "info names no plugin"
+mv libhenon.so moved.so
+"$CM" render henon.cmdb --png gone.png 2> gone.txt && fail "a missing plugin was not noticed"
+grep -q "comes from the plugin .*libhenon.so, which cannot be loaded" gone.txt || fail "missing: $(cat gone.txt)"
+"$CM" info henon.cmdb | grep -q "^plugin .*which cannot be loaded" || fail "info of a missing plugin"
+"$CM" explore henon.cmdb - --model-lib ./moved.so < /dev/null > /dev/null 2> moved.txt \
+  || fail "explore with the plugin where it is now: $(cat moved.txt)"
+sed 's/return fabs(y\[0\]) < 1e100/return fabs(y[0]) < 1e99/' "$SRC/examples/plugin/henon.c" > changed.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so changed.c -lm
+"$CM" render henon.cmdb --png changed.png 2> changed.txt && fail "a changed plugin was not noticed"
+grep -q "the plugin changed since" changed.txt || fail "changed: $(cat changed.txt)"
+
+# a plugin built for another ABI is refused, with both versions
+sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {CM_PLUGIN_ABI + 98,/' \
+  "$SRC/examples/plugin/henon.c" > abi.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libabi.so abi.c -lm
+expect_usage "was built for plugin ABI 99, this cellmap has ABI 1" solve --model-lib ./libabi.so --model henon
+expect_usage "is no cellmap plugin" solve --model-lib /usr/lib/x86_64-linux-gnu/libm.so.6 --model henon
+
+[ $fails -eq 0 ] && echo "plugin tests passed"
+exit $fails
