@@ -286,10 +286,11 @@ bool lattice_opts_take(cli *c, lattice_opts *lo, int *error)
     return true;
 }
 
-int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m, cm_lattice *lat,
+int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
+                       const cm_model_set *models, cm_lattice *lat,
                        cm_box *box)
 {
-    const cm_model_entry *e = cm_model_find(m->name); /* plugins: --region given */
+    const cm_model_entry *e = cm_model_set_find(models, m->name, NULL);
     const char *text = lo->region_text ? lo->region_text : e ? e->region : NULL;
     double low[CM_MAX_DIM], high[CM_MAX_DIM];
     int n = 0;

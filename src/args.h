@@ -83,10 +83,11 @@ typedef struct lattice_opts {
 
 /* Handles --region and --cells; true if the current option was one. */
 bool lattice_opts_take(cli *c, lattice_opts *lo, int *error);
-/* Builds the lattice and box for the model; prints the problem and returns
- * EXIT_USAGE on failure. */
-int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m, cm_lattice *lat,
-                       cm_box *box);
+/* Builds the lattice and box for the model (its default region from
+ * models, plugins included); prints the problem and returns EXIT_USAGE on
+ * failure. */
+int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
+                       const cm_model_set *models, cm_lattice *lat, cm_box *box);
 
 /* The lattice coordinate of the cell border at or beyond state x (below
  * it, or above it if round_up), snapped to a border within rounding of x;

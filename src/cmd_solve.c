@@ -155,7 +155,7 @@ static int parse_solve(cli *c, solve_args *a)
 static int make_lattice(const cli *c, const solve_args *a, const cm_model *m, cm_lattice *lat,
                         cm_box *box)
 {
-    const int err = lattice_opts_build(c, &a->lat, m, lat, box);
+    const int err = lattice_opts_build(c, &a->lat, m, &a->mo.set, lat, box);
     if (err)
         return err;
     if (a->n_split && a->n_split != m->dim)

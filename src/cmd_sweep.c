@@ -310,7 +310,7 @@ static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_bo
         err = cli_usage_error(c, "--near has %d range(s) but model %s has dimension %d", a->n_near,
                               m.name, m.dim);
     if (!err)
-        err = lattice_opts_build(c, &a->lat, &m, lat, box);
+        err = lattice_opts_build(c, &a->lat, &m, &a->mo.set, lat, box);
     cm_model_release(&m);
     for (int k = 0; k < a->n_values && !err; k++) {
         const char *name = a->name;

@@ -1052,7 +1052,7 @@ static int open_existing(session *s, const session_options *o)
  * or the model's example region. */
 static int new_depth(session *s, const session_options *o)
 {
-    const cm_model_entry *e = cm_model_find(s->model.name);
+    const cm_model_entry *e = cm_model_set_find(&o->mo.set, s->model.name, NULL);
     const char *text = o->depth_text;
     double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
     int n = 0;

@@ -27,6 +27,8 @@ cmake -S "$SRC/examples/plugin" -B henon-build > cmake.log 2>&1 && cmake --build
 henon=(--model-lib ./libhenon.so --model henon --param a=1.4,b=0.3 --region=-2.5:2.5,-2.5:2.5)
 "$CM" solve "${henon[@]}" --cells 1000x1000 --max-steps 4 --db henon.cmdb > henon.txt || fail "solve henon"
 "$CM" export henon.cmdb --cells cells.csv --quiet || fail "export henon.cmdb"
+"$CM" solve --model-lib ./libhenon.so --model henon --cells 60x30 --json | grep -q '"box":\[\[-1.5,1.5\],\[-0.45,0.45\]\]' \
+  || fail "the plugin's default region"
 
 # the attractor against orbits: every point of a long orbit lies in (or next
 # to) a cell of the attractor's group, and cells' labels (attractor or
