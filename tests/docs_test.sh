@@ -9,11 +9,8 @@ CM=$(realpath "$1")
 SRC=$(realpath "$2")
 BUILD=$(realpath "$3")
 HERE=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
 . "$HERE/testlib.sh"
-cd "$work"
+enter_workdir
 mkdir bin && ln -s "$CM" bin/cellmap
 export PATH="$work/bin:$PATH"
 

@@ -7,11 +7,8 @@ CM=$(realpath "$1")
 SRC=$(realpath "$2")
 HERE=$(cd "$(dirname "$0")" && pwd)
 SCHEMA=$SRC/docs/cellmap.schema.json
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
 . "$HERE/testlib.sh"
-cd "$work"
+enter_workdir
 
 # the validator itself rejects what the schema forbids
 echo '{"command":"solve","model":"m"}' > missing.json

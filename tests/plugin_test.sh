@@ -9,11 +9,8 @@ set -u
 SRC=$(realpath "$2")
 BUILD=$(realpath "$3")
 HERE=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
 . "$HERE/testlib.sh"
-cd "$work"
+enter_workdir
 
 cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "install: $(cat install.log)"
 CM="$work/prefix/bin/cellmap"
