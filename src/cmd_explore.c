@@ -13,7 +13,7 @@
 
 static const char explore_help_head[] =
     "usage: cellmap explore FILE.cmdb [SCRIPT|-] [--threads T] [--mem BYTES]\n"
-    "       cellmap explore FILE.cmdb [SCRIPT|-] --model NAME [--param k=v,...]\n"
+    "       cellmap explore FILE.cmdb [SCRIPT|-] --model NAME [--model-lib P.so] [--param k=v,...]\n"
     "                       --cell-size DX[,DY...] [--origin X,Y...] [--depth LO:HI,...]\n"
     "                       [--max-steps K] [--threads T] [--mem BYTES]\n\n"
     "Explores basins by moving a view over the state space. Each command that\n"

@@ -11,8 +11,8 @@
 #include "src/outfile.h"
 
 static const char fp_help[] =
-    "usage: cellmap fixed-points --model NAME [--param k=v[,k=v]] [--range M0:M1]\n"
-    "                            [--csv FILE|-] [--json]\n\n"
+    "usage: cellmap fixed-points --model NAME [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                            [--range M0:M1] [--csv FILE|-] [--json]\n\n"
     "Lists, for every control level m in M0..M1 (default -10:10), the candidate\n"
     "fixed point x_m* as CSV: level,band,kind and the state's coordinates (their\n"
     "names as `cellmap models` gives them), where band is the level actually\n"

@@ -10,8 +10,8 @@
 #include "src/outfile.h"
 
 static const char orbit_help[] =
-    "usage: cellmap orbit --model NAME [--param k=v[,k=v]] --from X[,Y...] --steps N\n"
-    "                     [--csv FILE|-] [--json]\n\n"
+    "usage: cellmap orbit --model NAME [--model-lib P.so] [--param k=v[,k=v]] --from X[,Y...]\n"
+    "                     --steps N [--csv FILE|-] [--json]\n\n"
     "Prints the orbit x_0 .. x_N as CSV (j and the state's coordinates, named as\n"
     "`cellmap models` gives them) with %.17g, so any implementation can be checked\n"
     "against it: to standard output, or to FILE with --csv. --json prints one JSON\n"

@@ -36,6 +36,7 @@ static const char solve_help[] =
     "Without options it solves the thesis' C-SCM example (4.6.3):\n"
     "microchaos-pd, alpha=0.078, beta=0, P=0.007, D=0.02 on 0:500,-40:40.\n\n"
     "  --model NAME        a model of `cellmap models` (default microchaos-pd)\n"
+    "  --model-lib P.so    load the models of a plugin (repeatable; examples/plugin/)\n"
     "  --param k=v,...     parameters (repeatable; vectors as v1:v2:...)\n"
     "  --region LO:HI,...  the box, one range per state dimension\n"
     "                      (default: the model's example region)\n"

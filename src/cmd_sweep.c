@@ -21,7 +21,8 @@
 #include "src/progress.h"
 
 static const char sweep_help[] =
-    "usage: cellmap sweep --model NAME [--param k=v[,k=v]] --vary NAME=V1,V2,...|NAME=LO:HI:N\n"
+    "usage: cellmap sweep --model NAME [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                     --vary NAME=V1,V2,...|NAME=LO:HI:N\n"
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
     "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE|-] [--json]\n"
     "                     [--quiet]\n\n"
