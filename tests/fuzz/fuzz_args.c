@@ -72,7 +72,7 @@ static void build_lattice(const char *text)
     cli c = {"fuzz", 0, NULL, 0, NULL, NULL};
     cm_lattice lat;
     cm_box box;
-    lattice_opts_build(&c, &lo, &m, &lat, &box);
+    lattice_opts_build(&c, &lo, &m, NULL, &lat, &box);
     cm_model_release(&m);
 }
 
@@ -85,7 +85,8 @@ static void model_from_json(const char *text)
     for (size_t k = 0; k < cm_model_count(); k++) {
         snprintf(info.model, sizeof info.model, "%s", cm_model_at(k)->name);
         cm_model m;
-        if (model_of_store(&info, &m, msg, sizeof msg) == CM_OK)
+        cm_model_set set = {0};
+        if (model_of_store(&info, &set, &m, msg, sizeof msg) == CM_OK)
             cm_model_release(&m);
     }
 }
