@@ -122,12 +122,24 @@ cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t
                        "again against this cellmap's headers",
                        path, abi, CM_PLUGIN_ABI);
     }
-    for (int i = 0; i < p->count; i++)
-        if (!p->models[i].name || !p->models[i].params || !p->models[i].create) {
-            dlclose(h);
-            return cm_fail(CM_EINVAL, msg, msg_size,
-                           "plugin %s: model %d lacks a name, params or create()", path, i + 1);
+    if (p->count < 0 || (p->count > 0 && !p->models)) {
+        dlclose(h);
+        return cm_fail(CM_EINVAL, msg, msg_size, "plugin %s lists no models", path);
+    }
+    for (int i = 0; i < p->count; i++) {
+        const char *problem = !p->models[i].name || !p->models[i].params || !p->models[i].create
+                                  ? "lacks a name, params or create()"
+                              : cm_model_set_find(s, p->models[i].name, NULL)
+                                  ? "has the name of a model cellmap knows already; rename it"
+                                  : NULL;
+        if (problem) {
+            char name[64];
+            snprintf(name, sizeof name, "%s", p->models[i].name ? p->models[i].name : "?");
+            dlclose(h); /* the names live in the library: copied first */
+            return cm_fail(CM_EINVAL, msg, msg_size, "plugin %s: model %d (%s) %s", path, i + 1,
+                           name, problem);
         }
+    }
     cm_model_lib *l = &s->lib[s->n++];
     l->handle = h;
     char *absolute = realpath(full, NULL); /* files record it: any directory finds it */
@@ -175,6 +187,12 @@ cm_status cm_model_set_create(const cm_model_set *s, const char *name, const cha
         st = cm_params_set(&p, texts[i], msg, msg_size);
     if (st == CM_OK)
         st = e->create(&p, m, msg, msg_size);
+    /* a plugin's model is checked as far as it can be before any step */
+    if (st == CM_OK && (m->dim < 1 || m->dim > CM_MAX_DIM || !m->step || !m->name))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "model %s: create() gave dimension %d%s; it must give 1..%d, a name and a "
+                     "step function",
+                     name, m->dim, m->step ? "" : " and no step function", CM_MAX_DIM);
     /* Maps of delayed values name their state after the lags: ..., x_lag1, x */
     static const char *const lag_names[CM_MAX_DIM] = {"x_lag5", "x_lag4", "x_lag3",
                                                       "x_lag2", "x_lag1", "x"};

@@ -89,6 +89,14 @@ sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin pl
   "$SRC/examples/plugin/henon.c" > abi.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libabi.so abi.c -lm
 expect_usage "was built for plugin ABI 99, this cellmap has ABI 1" solve --model-lib ./libabi.so --model henon
+# a model that cannot be one, or takes a built-in model's name, is refused
+sed 's/    m->dim = 2;/    m->dim = 9;/' "$SRC/examples/plugin/henon.c" > dim.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libdim.so dim.c -lm
+expect_usage "create() gave dimension 9; it must give 1..6" solve --model-lib ./libdim.so --model henon \
+  --region=-1:1,-1:1
+sed 's/{"henon", "x, y"/{"microchaos-pd", "x, y"/' "$SRC/examples/plugin/henon.c" > twin.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libtwin.so twin.c -lm
+expect_usage "(microchaos-pd) has the name of a model cellmap knows already" solve --model-lib ./libtwin.so
 expect_usage "is no cellmap plugin" solve --model-lib /usr/lib/x86_64-linux-gnu/libm.so.6 --model henon
 
 [ $fails -eq 0 ] && echo "plugin tests passed"
