@@ -68,6 +68,25 @@ const cm_model_entry *cm_model_set_find(const cm_model_set *s, const char *name,
     return NULL;
 }
 
+size_t cm_model_set_count(const cm_model_set *s)
+{
+    size_t n = cm_model_count();
+    for (int k = 0; s && k < s->n; k++)
+        n += (size_t)s->lib[k].plugin->count;
+    return n;
+}
+
+const cm_model_entry *cm_model_set_at(const cm_model_set *s, size_t i)
+{
+    if (i < cm_model_count())
+        return &entries[i];
+    i -= cm_model_count();
+    for (int k = 0; s && k < s->n; i -= (size_t)s->lib[k++].plugin->count)
+        if (i < (size_t)s->lib[k].plugin->count)
+            return &s->lib[k].plugin->models[i];
+    return NULL;
+}
+
 cm_status cm_file_hash(const char *path, char out[24], char *msg, size_t msg_size)
 {
     FILE *f = fopen(path, "rb");

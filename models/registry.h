@@ -28,6 +28,10 @@ cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t
  * may be NULL: built-in only); *lib (if not NULL) gets its plugin or NULL. */
 const cm_model_entry *cm_model_set_find(const cm_model_set *s, const char *name,
                                         const cm_model_lib **lib);
+/* The built-in models, then each plugin's, in load order: how many, and
+ * entry i. */
+size_t cm_model_set_count(const cm_model_set *s);
+const cm_model_entry *cm_model_set_at(const cm_model_set *s, size_t i);
 /* cm_model_create over s's models too. */
 cm_status cm_model_set_create(const cm_model_set *s, const char *name, const char *const *texts,
                               int n_texts, cm_model *m, char *msg, size_t msg_size);

@@ -82,7 +82,7 @@ static const char *label_of(const cm_render_options *o, const cm_group_info *g, 
 {
     for (int k = 0; k < o->n_labels; k++) {
         const cm_group_label *l = &o->labels[k];
-        bool same = l->by_anchor ? true : l->id == g->id;
+        bool same = l->by_anchor || l->id == g->id;
         for (int d = 0; l->by_anchor && d < dim; d++)
             same = same && l->anchor[d] == g->anchor[d];
         if (same)

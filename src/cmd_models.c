@@ -88,20 +88,8 @@ int cmd_models(int argc, char **argv)
         json_begin(&j, stdout, "models");
         json_array(&j, "models");
     }
-    size_t total = cm_model_count();
-    for (int k = 0; k < set.n; k++)
-        total += (size_t)set.lib[k].plugin->count;
-    for (size_t i = 0, lib = 0, in_lib = 0; i < total; i++) {
-        const cm_model_entry *e; /* the built-in ones, then each plugin's */
-        if (i < cm_model_count()) {
-            e = cm_model_at(i);
-        } else {
-            while ((int)in_lib >= set.lib[lib].plugin->count) {
-                lib++;
-                in_lib = 0;
-            }
-            e = &set.lib[lib].plugin->models[in_lib++];
-        }
+    for (size_t i = 0; i < cm_model_set_count(&set); i++) {
+        const cm_model_entry *e = cm_model_set_at(&set, i);
         cm_model m; /* built from its defaults, for the names of its state */
         char msg[512];
         if (cm_model_set_create(&set, e->name, NULL, 0, &m, msg, sizeof msg) != CM_OK) {

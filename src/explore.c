@@ -686,14 +686,7 @@ static void print_stats_json(const session *s, const view_counts *v, const cm_re
             continue;
         const cm_group_info *g = &groups[k - 1];
         json_object(&j, NULL);
-        json_uint(&j, "id", g->id);
-        json_str(&j, "kind", cm_group_kind_name(g->kind));
-        json_uint(&j, "period", g->period);
-        json_uint(&j, "basin_cells", g->basin_cells);
-        json_array(&j, "centre");
-        for (int d = 0; d < s->dim; d++)
-            json_num_near(&j, NULL, g->centre[d], CM_CELL_TOLERANCE * s->c.lat.width[d]);
-        json_array_end(&j);
+        json_group_fields(&j, g, &s->c.lat);
         json_uint(&j, "in_view", v->in_view[k]);
         json_object_end(&j);
     }

@@ -90,14 +90,7 @@ static void write_sidecar_groups(json *j, const array_export *x, const cm_lattic
             continue;
         const cm_group_info *g = &x->groups[k];
         json_object(j, NULL);
-        json_uint(j, "id", g->id);
-        json_str(j, "kind", cm_group_kind_name(g->kind));
-        json_uint(j, "period", g->period);
-        json_uint(j, "basin_cells", g->basin_cells);
-        json_array(j, "centre");
-        for (int d = 0; d < lat->dim; d++)
-            json_num_near(j, NULL, g->centre[d], CM_CELL_TOLERANCE * lat->width[d]);
-        json_array_end(j);
+        json_group_fields(j, g, lat);
         json_uint(j, "in_view", in_window[k + 1]);
         if (classes) {
             const cm_rgb c = cm_class_colour(NULL, classes[k]);

@@ -160,19 +160,24 @@ void json_box(json *j, const char *key, const cm_lattice *lat, const cm_box *box
     json_array_end(j);
 }
 
+void json_group_fields(json *j, const cm_group_info *g, const cm_lattice *lat)
+{
+    json_uint(j, "id", g->id);
+    json_str(j, "kind", cm_group_kind_name(g->kind));
+    json_uint(j, "period", g->period);
+    json_uint(j, "basin_cells", g->basin_cells);
+    json_array(j, "centre");
+    for (int d = 0; d < lat->dim; d++)
+        json_num_near(j, NULL, g->centre[d], CM_CELL_TOLERANCE * lat->width[d]);
+    json_array_end(j);
+}
+
 void json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat)
 {
     json_array(j, "groups");
     for (uint32_t k = 0; k < n; k++) {
         json_object(j, NULL);
-        json_uint(j, "id", g[k].id);
-        json_str(j, "kind", cm_group_kind_name(g[k].kind));
-        json_uint(j, "period", g[k].period);
-        json_uint(j, "basin_cells", g[k].basin_cells);
-        json_array(j, "centre");
-        for (int d = 0; d < lat->dim; d++)
-            json_num_near(j, NULL, g[k].centre[d], CM_CELL_TOLERANCE * lat->width[d]);
-        json_array_end(j);
+        json_group_fields(j, &g[k], lat);
         json_object_end(j);
     }
     json_array_end(j);

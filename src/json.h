@@ -61,8 +61,10 @@ void json_model(json *j, const cm_model *m);
 void json_lattice(json *j, const cm_lattice *lat);
 /* key: [[lo, hi], ...], the box's cells' extent in state units. */
 void json_box(json *j, const char *key, const cm_lattice *lat, const cm_box *box);
-/* "groups":[{id, kind, period, basin_cells, centre}, ...], centres to
- * the lattice's resolution. */
+/* A group's id, kind, period, basin_cells and centre (to the lattice's
+ * resolution), inside an object the caller opened (and may add to). */
+void json_group_fields(json *j, const cm_group_info *g, const cm_lattice *lat);
+/* "groups":[{id, kind, period, basin_cells, centre}, ...] */
 void json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat);
 
 
