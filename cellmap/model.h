@@ -70,13 +70,45 @@ enum { CM_STEP_OK = 0, CM_STEP_NO_IMAGE = 1, CM_STEP_ABORT = -1 };
 #define CM_VECTOR_LOOP
 #endif
 
+/* Integrators of a flow (cm_flow.method): GSL's explicit embedded
+ * Runge-Kutta pairs, and the classical fourth-order method with step
+ * doubling (gsl_odeiv2_step_rk8pd, _rkf45, _rkck, _rk4). */
+enum { CM_FLOW_RK8PD = 0, CM_FLOW_RKF45, CM_FLOW_RKCK, CM_FLOW_RK4 };
+
+/* A map made of an ODE flow x' = f(t, x), which cellmap integrates with
+ * GSL (gsl_odeiv2) from time t0: the stroboscopic map (the state at
+ * t0 + period) when section is NULL, else the Poincare map of the section
+ * g(t, x) = 0 (the state where g next changes sign in `direction`,
+ * located to event_tol in time). A start that leaves the world box
+ * (|x_d| > world), gives a non-finite value, makes field() fail, takes
+ * more than CM_FLOW_MAX_STEPS steps or, for a section, does not reach it
+ * before t0 + t_max has no image (the sink). Zero settings take the
+ * defaults given. */
+typedef struct cm_flow {
+    /* dxdt = f(t, x), dim entries; ctx is the model's. Returns 0, or
+     * nonzero where the field is not defined. Pure and thread-safe. */
+    int (*field)(double t, const double *x, double *dxdt, const void *ctx);
+    double t0, period;
+    double (*section)(double t, const double *x, const void *ctx); /* NULL: stroboscopic */
+    int direction;  /* +1: g from negative to >= 0; -1: the reverse; 0: either */
+    int method;     /* CM_FLOW_RK8PD ... */
+    double abs_tol; /* per step, default 1e-9 */
+    double rel_tol; /* per step, default 1e-9 */
+    double t_max;   /* a section's longest flight, default 1000 */
+    double world;   /* default 1e6 */
+    double event_tol; /* default 1e-12 */
+} cm_flow;
+#define CM_FLOW_MAX_STEPS 1000000
+
 typedef struct cm_model {
     const char *name;
     int dim;
     const cm_param_spec *params;
     cm_params values; /* the parameters the model was built from */
     void *ctx;        /* derived coefficients; owned by the model */
-    /* 0: image in y; >0: no image (the sink); <0: abort the run. */
+    /* 0: image in y; >0: no image (the sink); <0: abort the run. A model
+     * of a flow leaves step NULL and fills `flow`: cellmap gives it step
+     * and step_n. */
     int (*step)(const struct cm_model *m, const double *x, double *y);
     /* Optional: step for n points at once, in arrays by coordinate (point
      * i is x[0][i], x[1][i], ...; its image goes to y[d][i], its status to
@@ -104,6 +136,7 @@ typedef struct cm_model {
      * NULL: x0, x1, ... */
     const char *const *coord_names;
     void (*destroy)(void *ctx);
+    cm_flow flow; /* flow.field NULL: a map given by step */
 } cm_model;
 
 /* The name of state coordinate d: the model's own (coord_names, d < dim),

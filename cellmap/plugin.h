@@ -9,7 +9,7 @@
  *
  * Each model's create() fills *m from the parameter values p (defaults of
  * params overridden by --param): name, dim (1..CM_MAX_DIM), params, values
- * (*p), step and, if it needs them, ctx and destroy, coord_names (names of
+ * (*p), step (or, for an ODE, flow: cellmap integrates it) and, if it needs them, ctx and destroy, coord_names (names of
  * the state coordinates, identifiers, for CSV/JSON/SQL columns). step()
  * must be pure and thread-safe: cellmap calls it on every thread at once.
  * It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
@@ -22,7 +22,7 @@
 
 #include "cellmap/model.h"
 
-#define CM_PLUGIN_ABI 1
+#define CM_PLUGIN_ABI 2 /* 2: cm_model.flow */
 
 typedef struct cm_plugin_model {
     const char *name;   /* as --model takes it */

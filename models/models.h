@@ -21,6 +21,7 @@ extern const cm_param_spec cm_microchaos_pd_twofold_spec[];
 extern const cm_param_spec cm_microchaos_pd_friction_spec[];
 extern const cm_param_spec cm_microchaos_general_spec[];
 extern const cm_param_spec cm_friction_oscillator_spec[];
+extern const cm_param_spec cm_duffing_spec[];
 
 cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char *msg,
@@ -34,6 +35,7 @@ cm_status cm_microchaos_pd_friction_create(const cm_params *p, cm_model *m, char
 cm_status cm_microchaos_general_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_friction_oscillator_create(const cm_params *p, cm_model *m, char *msg,
                                         size_t msg_size);
+cm_status cm_duffing_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 
 /* Shared by the constructors: allocates a zeroed context of `size` bytes and
  * fills the common fields of *m. */

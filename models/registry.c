@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "models/models.h"
+#include "models/ode_flow.h"
 #include "models/params.h"
 
 /* The left region of the thesis' C-SCM example (4.6.3): it holds the chaotic
@@ -42,6 +43,9 @@ static const cm_model_entry entries[] = {
     {"friction-oscillator", "x, v (position and velocity at the section)",
      "Poincare map of the harmonically excited oscillator with dry friction (2.3), docs/models.md 9",
      CM_FO_REGION, cm_friction_oscillator_spec, cm_friction_oscillator_create},
+    {"duffing", "x, v (position and velocity at the forcing phase)",
+     "stroboscopic map of the forced Duffing oscillator x'' + delta x' - x + x^3 = gamma cos(omega t), integrated by GSL",
+     "-2.5:2.5,-2.5:2.5", cm_duffing_spec, cm_duffing_create},
 };
 
 size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }
@@ -206,6 +210,9 @@ cm_status cm_model_set_create(const cm_model_set *s, const char *name, const cha
         st = cm_params_set(&p, texts[i], msg, msg_size);
     if (st == CM_OK)
         st = e->create(&p, m, msg, msg_size);
+    /* a plugin's flow becomes a map here; built-in ones attached theirs */
+    if (st == CM_OK && m->flow.field && !m->step)
+        st = cm_flow_attach(m, msg, msg_size);
     /* a plugin's model is checked as far as it can be before any step */
     if (st == CM_OK && (m->dim < 1 || m->dim > CM_MAX_DIM || !m->step || !m->name))
         st = cm_fail(CM_EINVAL, msg, msg_size,

@@ -1,0 +1,295 @@
+/* Maps of ODE flows (models/ode_flow): stroboscopic and Poincare maps of
+ * flows with known solutions, the sink cases, step_n against step, and the
+ * forced Duffing oscillator's basins against long simulations. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/scm.h"
+#include "check.h"
+#include "models/ode_flow.h"
+#include "models/registry.h"
+
+
+#define RES 600 /* cells per side of -2.5:2.5 */
+#define TWO_PI 6.283185307179586476925286766559
+
+/* x'' + 2 zeta x' + x = 0; zeta is the context. */
+static int damped_field(double t, const double *x, double *f, const void *ctx)
+{
+    (void)t;
+    const double zeta = *(const double *)ctx;
+    f[0] = x[1];
+    f[1] = -2 * zeta * x[1] - x[0];
+    return 0;
+}
+
+static double section_x(double t, const double *x, const void *ctx)
+{
+    (void)t, (void)ctx;
+    return x[0];
+}
+
+/* x' = x^2: blows up at t = 1/x0. */
+static int blowup_field(double t, const double *x, double *f, const void *ctx)
+{
+    (void)t, (void)ctx;
+    f[0] = x[0] * x[0];
+    return 0;
+}
+
+/* Defined for x < 1 only. */
+static int partial_field(double t, const double *x, double *f, const void *ctx)
+{
+    (void)t, (void)ctx;
+    f[0] = 1;
+    return x[0] < 1 ? 0 : 1;
+}
+
+static cm_model flow_model(int dim, cm_flow f, void *ctx)
+{
+    cm_model m;
+    memset(&m, 0, sizeof m);
+    m.name = "test-flow";
+    m.dim = dim;
+    m.ctx = ctx;
+    m.flow = f;
+    char msg[256];
+    const cm_status st = cm_flow_attach(&m, msg, sizeof msg);
+    if (st != CM_OK)
+        fprintf(stderr, "%s\n", msg);
+    CHECK(st == CM_OK);
+    return m;
+}
+
+/* The undamped oscillator over a period T rotates the state by T; with
+ * damping the crossings of x = 0 upwards are 2 pi/omega_d apart and v
+ * shrinks by exp(-zeta 2 pi/omega_d) between them. */
+static void test_known_flows(void)
+{
+    double zeta = 0;
+    cm_model rot = flow_model(2, (cm_flow){.field = damped_field, .period = 1.3}, &zeta);
+    const double x[2] = {0.7, -0.2};
+    double y[2];
+    CHECK_INT(rot.step(&rot, x, y), CM_STEP_OK);
+    CHECK_NEAR(y[0], x[0] * cos(1.3) + x[1] * sin(1.3), 1e-8);
+    CHECK_NEAR(y[1], -x[0] * sin(1.3) + x[1] * cos(1.3), 1e-8);
+
+    double zeta2 = 0.1;
+    const double wd = sqrt(1 - zeta2 * zeta2), Td = TWO_PI / wd;
+    cm_model up = flow_model(
+        2, (cm_flow){.field = damped_field, .section = section_x, .direction = 1}, &zeta2);
+    const double start[2] = {0, 1};
+    double t_end;
+    long steps;
+    CHECK_INT(cm_flow_map(&up, start, y, &t_end, &steps), CM_STEP_OK);
+    CHECK_NEAR(t_end, Td, 1e-9);
+    CHECK(fabs(y[0]) < 1e-9);
+    CHECK_NEAR(y[1], exp(-zeta2 * Td), 1e-8);
+    CHECK(steps > 0);
+    cm_model down = flow_model(
+        2, (cm_flow){.field = damped_field, .section = section_x, .direction = -1}, &zeta2);
+    CHECK_INT(cm_flow_map(&down, start, y, &t_end, NULL), CM_STEP_OK);
+    CHECK_NEAR(t_end, Td / 2, 1e-9);
+    CHECK_NEAR(y[1], -exp(-zeta2 * Td / 2), 1e-8);
+    cm_model either = flow_model(
+        2, (cm_flow){.field = damped_field, .section = section_x, .direction = 0}, &zeta2);
+    CHECK_INT(cm_flow_map(&either, start, y, &t_end, NULL), CM_STEP_OK);
+    CHECK_NEAR(t_end, Td / 2, 1e-9);
+    /* a section the flow never reaches in t_max: no image */
+    const double far[2] = {0, 0};
+    CHECK_INT(cm_flow_map(&up, far, y, NULL, NULL), CM_STEP_NO_IMAGE);
+}
+
+static void test_sinks(void)
+{
+    cm_model blow = flow_model(1, (cm_flow){.field = blowup_field, .period = 2}, NULL);
+    double y[1];
+    const double slow[1] = {0.1}, fast[1] = {1.0}, nan_start[1] = {NAN};
+    CHECK_INT(blow.step(&blow, slow, y), CM_STEP_OK); /* blows up at t = 10 */
+    CHECK_NEAR(y[0], 0.1 / (1 - 0.2), 1e-8);
+    CHECK_INT(blow.step(&blow, fast, y), CM_STEP_NO_IMAGE); /* at t = 1 */
+    CHECK_INT(blow.step(&blow, nan_start, y), CM_STEP_NO_IMAGE);
+    cm_model part = flow_model(1, (cm_flow){.field = partial_field, .period = 1}, NULL);
+    const double inside[1] = {-0.5}, leaves[1] = {0.5};
+    CHECK_INT(part.step(&part, inside, y), CM_STEP_OK);
+    CHECK_NEAR(y[0], 0.5, 1e-12);
+    CHECK_INT(part.step(&part, leaves, y), CM_STEP_NO_IMAGE);
+    /* a flow with nothing to integrate is refused */
+    cm_model bad;
+    memset(&bad, 0, sizeof bad);
+    bad.name = "bad";
+    bad.dim = 1;
+    bad.flow.field = blowup_field; /* no period, no section */
+    char msg[256];
+    CHECK(cm_flow_attach(&bad, msg, sizeof msg) == CM_EINVAL);
+    CHECK(strstr(msg, "period") != NULL);
+}
+
+/* step_n gives what step gives, bit for bit. */
+static void test_step_n(const cm_model *m)
+{
+    enum { N = 64 };
+    double x0[N], x1[N], y0[N], y1[N];
+    int rc[N];
+    for (int i = 0; i < N; i++) {
+        x0[i] = -2.5 + 5.0 * i / N;
+        x1[i] = 2.0 - 4.0 * ((i * 37) % N) / N;
+    }
+    const double *xs[2] = {x0, x1};
+    double *ys[2] = {y0, y1};
+    m->step_n(m, N, xs, ys, rc);
+    int same = 0;
+    for (int i = 0; i < N; i++) {
+        const double x[2] = {x0[i], x1[i]};
+        double y[2];
+        const int r = m->step(m, x, y);
+        same += r == rc[i] && memcmp(y, (double[2]){y0[i], y1[i]}, sizeof y) == 0;
+    }
+    CHECK_INT(same, N);
+}
+
+/* ---- Duffing: SCM against simulation ---- */
+
+enum { MAX_ATTRACTORS = 32, CYCLE = 8, TRANSIENT = 300 };
+typedef struct attractor {
+    double p[CYCLE][2];
+} attractor;
+
+static double dist(const double *a, const double *b) { return hypot(a[0] - b[0], a[1] - b[1]); }
+
+/* The attractor a long simulation from x settles on, among found[0..*n)
+ * (appended when new); -1 if the orbit was lost. */
+static int settle(const cm_model *m, const double *x0, attractor *found, int *n)
+{
+    double x[2] = {x0[0], x0[1]}, y[2];
+    attractor a;
+    for (int k = 0; k < TRANSIENT + CYCLE; k++) {
+        if (m->step(m, x, y) != CM_STEP_OK)
+            return -1;
+        x[0] = y[0], x[1] = y[1];
+        if (k >= TRANSIENT)
+            memcpy(a.p[k - TRANSIENT], x, sizeof x);
+    }
+    for (int i = 0; i < *n; i++)
+        for (int j = 0; j < CYCLE; j++)
+            if (dist(found[i].p[j], x) < 1e-4)
+                return i;
+    if (*n == MAX_ATTRACTORS)
+        return -1;
+    found[*n] = a;
+    return (*n)++;
+}
+
+/* Chebyshev distance in cells from point p to the nearest periodic cell
+ * of group g. */
+static double cells_to_group(const cm_region *r, const cm_lattice *lat, uint32_t g, const double *p)
+{
+    double best = INFINITY;
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        if (!cm_is_periodic(r, i) || r->group[i] != g)
+            continue;
+        int64_t cell[2];
+        double c[2];
+        cm_box_cell(&r->box, i, cell);
+        cm_lattice_centre(lat, cell, c);
+        const double d = fmax(fabs(c[0] - p[0]) / lat->width[0], fabs(c[1] - p[1]) / lat->width[1]);
+        best = fmin(best, d);
+    }
+    return best;
+}
+
+static void test_duffing_basins(void)
+{
+    cm_model m;
+    char msg[256];
+    const char *params[1] = {"delta=0.15,gamma=0.1,omega=1"};
+    CHECK(cm_model_create("duffing", params, 1, &m, msg, sizeof msg) == CM_OK);
+    test_step_n(&m);
+    /* -2.5:2.5 squared, RES x RES cells */
+    const cm_lattice lat = {2, {-2.5, -2.5}, {5.0 / RES, 5.0 / RES}};
+    const cm_box box = {2, {0, 0}, {RES, RES}};
+    cm_region r;
+    const cm_scm_options opt = {.max_steps = 50, .threads = 2};
+    CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
+    CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
+
+    /* 1000 random starts, simulated to their attractors */
+    attractor found[MAX_ATTRACTORS];
+    int nfound = 0, lost = 0;
+    srand(12345);
+    for (int s = 0; s < 1000; s++) {
+        const double x[2] = {-2.5 + 5.0 * rand() / RAND_MAX, -2.5 + 5.0 * rand() / RAND_MAX};
+        lost += settle(&m, x, found, &nfound) < 0;
+    }
+    CHECK_INT(lost, 0);
+    CHECK_INT(nfound, 4); /* the four period-1 attractors of docs/models.md 11.2 */
+    printf("duffing: %d attractors from 1000 starts, SCM: %u groups\n", nfound, r.ngroups);
+
+    /* every simulated attractor lies on (or next to) the periodic cells of
+     * an SCM group, and every SCM group on (or next to) one of them */
+    uint32_t owner[MAX_ATTRACTORS + 1];
+    int group_attractor[64];
+    CHECK(r.ngroups < 64);
+    for (int a = 0; a < nfound; a++) {
+        owner[a] = 0;
+        for (uint32_t g = 1; g <= r.ngroups && g < 64; g++)
+            if (cells_to_group(&r, &lat, g, found[a].p[0]) <= 2)
+                owner[a] = g;
+        CHECK(owner[a] != 0);
+    }
+    for (uint32_t g = 1; g <= r.ngroups && g < 64; g++) {
+        group_attractor[g] = -1;
+        double best = INFINITY;
+        for (int a = 0; a < nfound; a++) {
+            const double d = cells_to_group(&r, &lat, g, found[a].p[0]);
+            if (d < best)
+                best = d, group_attractor[g] = a;
+        }
+        if (!(best <= 3))
+            fprintf(stderr, "SCM group %u is %.1f cells from every simulated attractor\n", g, best);
+        CHECK(best <= 3);
+    }
+
+    /* labels: the SCM group's attractor against a simulation from the
+     * centre of 1000 random cells */
+    int agree = 0;
+    for (int s = 0; s < 1000; s++) {
+        const uint64_t i = (uint64_t)rand() % r.ncells;
+        int64_t cell[2];
+        double c[2];
+        cm_box_cell(&box, i, cell);
+        cm_lattice_centre(&lat, cell, c);
+        const int sim = settle(&m, c, found, &nfound);
+        const uint32_t g = r.group[i];
+        agree += g >= 1 && g < 64 && group_attractor[g] == sim;
+    }
+    printf("duffing: SCM labels agree with simulation for %d of 1000 random cells\n", agree);
+    CHECK(agree >= 950);
+
+    /* the integrator's error: images at the default tolerances (1e-9)
+     * against 1e-12 stay far below a cell (5/400) */
+    cm_model tight;
+    const char *tight_params[2] = {params[0], "abs_tol=1e-12,rel_tol=1e-12"};
+    CHECK(cm_model_create("duffing", tight_params, 2, &tight, msg, sizeof msg) == CM_OK);
+    double worst = 0;
+    for (int s = 0; s < 200; s++) {
+        const double x[2] = {-2.5 + 5.0 * rand() / RAND_MAX, -2.5 + 5.0 * rand() / RAND_MAX};
+        double y[2], z[2];
+        CHECK(m.step(&m, x, y) == CM_STEP_OK && tight.step(&tight, x, z) == CM_STEP_OK);
+        worst = fmax(worst, dist(y, z));
+    }
+    printf("duffing: largest image difference, tolerance 1e-9 against 1e-12: %.2e\n", worst);
+    CHECK(worst < 1e-6);
+    cm_model_release(&tight);
+    cm_region_free(&r);
+    cm_model_release(&m);
+}
+
+int main(void)
+{
+    test_known_flows();
+    test_sinks();
+    test_duffing_basins();
+    CHECK_DONE();
+}
