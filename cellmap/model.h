@@ -100,6 +100,16 @@ typedef struct cm_flow {
 } cm_flow;
 #define CM_FLOW_MAX_STEPS 1000000
 
+/* The integrator settings a flow model takes as parameters, spelt the
+ * same for built-in models and plugins: put CM_FLOW_PARAM_SPECS at the end
+ * of a spec (before its terminator) and cellmap reads them. */
+#define CM_FLOW_PARAM_SPECS                                                                    \
+    {"method", "rk8pd", 0, 3, 1, "rk8pd|rkf45|rkck|rk4",                                       \
+     "integrator: GSL's Runge-Kutta Prince-Dormand 8(9), Fehlberg 4(5), Cash-Karp 4(5), RK4"},  \
+        {"abs_tol", "1e-9", 1e-15, 1e-2, 1, NULL, "absolute error per integration step"},       \
+        {"rel_tol", "1e-9", 0, 1e-2, 1, NULL, "relative error per integration step"},           \
+        {"world", "1e6", 1e-6, 1e300, 1, NULL, "|x_i| beyond this: the orbit has no image"}
+
 typedef struct cm_model {
     const char *name;
     int dim;

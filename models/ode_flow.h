@@ -5,16 +5,6 @@
 
 #include "cellmap/model.h"
 
-/* The integrator settings a flow model takes as parameters, spelt the
- * same for built-in models and plugins: put CM_FLOW_PARAM_SPECS at the end
- * of a spec (before its terminator) and cm_flow_attach reads them. */
-#define CM_FLOW_PARAM_SPECS                                                                    \
-    {"method", "rk8pd", 0, 3, 1, "rk8pd|rkf45|rkck|rk4",                                       \
-     "integrator: GSL's Runge-Kutta Prince-Dormand 8(9), Fehlberg 4(5), Cash-Karp 4(5), RK4"},  \
-        {"abs_tol", "1e-9", 1e-15, 1e-2, 1, NULL, "absolute error per integration step"},       \
-        {"rel_tol", "1e-9", 0, 1e-2, 1, NULL, "relative error per integration step"},           \
-        {"world", "1e6", 1e-6, 1e300, 1, NULL, "|x_i| beyond this: the orbit has no image"}
-
 /* Makes m, whose create() filled m->flow and left step NULL, a map:
  * checks the flow, takes the settings of CM_FLOW_PARAM_SPECS from m's
  * parameters where it has them, fills the defaults, and sets step and
