@@ -431,7 +431,7 @@ int cmd_bifurcation(int argc, char **argv)
         !chart_png_check("bifurcation", a.png))
         return EXIT_FAIL;
     cm_params base;
-    const int verr = fo_sweep_check(&c, &a.mo, &a.sweep, 1, &base);
+    const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.sweep, 1, &base);
     if (verr)
         return verr;
     const int n_values = a.sweep.n;

@@ -1,6 +1,7 @@
-/* cellmap lyapunov: the largest Lyapunov exponent of the dry friction
- * oscillator over a grid of two parameters (thesis Figs. 2.20-2.21), by
- * the renormalised two-trajectory estimator of docs/models.md 9.8. */
+/* cellmap lyapunov: the largest Lyapunov exponent over a grid of two
+ * parameters: the dry friction oscillator's (thesis Figs. 2.20-2.21) by the
+ * renormalised two-trajectory estimator of docs/models.md 9.8, any other
+ * model's by finite differences on its map (docs/models.md 11.3). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -8,6 +9,8 @@
 #include <string.h>
 
 #include "models/friction_oscillator.h"
+#include "models/map_lyapunov.h"
+#include "models/registry.h"
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
@@ -17,21 +20,28 @@
 #include "src/progress.h"
 
 static const char lyapunov_help[] =
-    "usage: cellmap lyapunov [--model friction-oscillator] [--param k=v[,k=v]]\n"
-    "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X,V]\n"
+    "usage: cellmap lyapunov [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X[,Y...]]\n"
     "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n"
     "                        [--threads T]\n\n"
-    "The largest Lyapunov exponent of the dry friction oscillator (thesis 2.5.3)\n"
-    "at the centres of an N x M grid of parameters X and Y (e.g. Omega and S at\n"
-    "fixed S0, as Figs. 2.20-2.21), by the renormalised two-trajectory\n"
-    "estimator of docs/models.md 9.8: separation D in x, samples every T/32, P\n"
-    "excitation periods. Grid points run in parallel; the results do not\n"
-    "depend on the thread count. Points with S > S0 are not computed.\n\n"
+    "The largest Lyapunov exponent at the centres of an N x M grid of parameters\n"
+    "X and Y. For the dry friction oscillator (the default model; thesis 2.5.3,\n"
+    "e.g. Omega and S at fixed S0 as Figs. 2.20-2.21) by the renormalised\n"
+    "two-trajectory estimator of docs/models.md 9.8: separation D in x, samples\n"
+    "every T/32, P excitation periods; points with S > S0 are not computed. For\n"
+    "any other model (ODE flows such as duffing, maps, plugins) by finite\n"
+    "differences on its map (docs/models.md 11.3): a second orbit D away,\n"
+    "renormalised after every iterate, P iterates after P/10 of transient; the\n"
+    "exponent is per unit of the flow's time for a flow, per iterate for a map.\n"
+    "Grid points run in parallel; the results do not depend on the thread count.\n\n"
     "  --grid X=LO:HI:N,Y=LO:HI:M  the two parameters and their ranges (N, M <= 2000);\n"
     "                      evenly spaced lists X=V1,V2,...,Y=V1,V2,... also do\n"
-    "  --periods P         excitation periods per point (default 600, the thesis')\n"
+    "  --periods P         excitation periods (friction-oscillator) or iterates of the\n"
+    "                      map per point (default 600, the thesis')\n"
     "  --d0 D              initial separation, >= 1e-9 (default 1e-8)\n"
-    "  --from X,V          start at phase 0 (default the thesis': 1 + 0.9 S0, 0)\n"
+    "  --from X[,Y...]     the start (default: friction-oscillator 1 + 0.9 S0, 0 at\n"
+    "                      phase 0, as the thesis; other models the centre of their\n"
+    "                      default region)\n"
     "  --csv FILE|-        X,Y,lambda per grid point (%.17g; nan: not computed)\n"
     "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
     "  --quiet             no progress line and no summary\n"
@@ -42,8 +52,8 @@ static const char lyapunov_help[] =
 typedef struct lyap_args {
     model_opts mo;
     param_axis ax[2];
-    int has_grid, periods, threads, width, height, has_from;
-    double d0, from[2];
+    int has_grid, periods, threads, width, height, n_from;
+    double d0, from[CM_MAX_DIM];
     const char *csv, *png;
     bool json, quiet;
 } lyap_args;
@@ -78,10 +88,8 @@ static int parse_args(cli *c, lyap_args *a)
                 err = cli_usage_error(
                     c, "--d0: '%s' must be a number in 1e-9..1e-3 (docs/models.md 9.8)", c->value);
         } else if (cli_is(c, "--from", true, &err)) {
-            int n = 0;
-            if (c->value && (!parse_doubles(c->value, a->from, &n, 2) || n != 2))
-                err = cli_usage_error(c, "--from: '%s' is not X,V", c->value);
-            a->has_from = 1;
+            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
+                err = cli_usage_error(c, "--from: '%s' is not X[,Y...] (numbers)", c->value);
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
@@ -115,10 +123,14 @@ static double point_exponent(const lyap_args *a, int i, int j, int *invalid)
         return NAN;
     }
     const cm_fo *o = cm_fo_of_model(&m);
-    const double x0 = a->has_from ? a->from[0] : 1 + 0.9 * o->S0, v0 = a->has_from ? a->from[1] : 0;
     double lambda = NAN;
-    if (!cm_fo_lyapunov(o, x0, v0, a->d0, a->periods, &lambda))
+    if (o) {
+        const double x0 = a->n_from ? a->from[0] : 1 + 0.9 * o->S0, v0 = a->n_from ? a->from[1] : 0;
+        if (!cm_fo_lyapunov(o, x0, v0, a->d0, a->periods, &lambda))
+            lambda = NAN;
+    } else if (!cm_map_lyapunov(&m, a->from, a->d0, a->periods, &lambda)) {
         lambda = NAN;
+    }
     cm_model_release(&m);
     return lambda;
 }
@@ -142,7 +154,8 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
     const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
     cm_params_format_with(p, swept, params, sizeof params);
     param_axes_format(a->ax, 2, grid, sizeof grid);
-    snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d periods", model, a->periods);
+    snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d %s", model, a->periods,
+             strcmp(model, "friction-oscillator") == 0 ? "periods" : "iterates");
     const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};
     const cm_chart chart = {a->width,
                             a->height,
@@ -158,11 +171,13 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                             0};
     char periods[32];
     snprintf(periods, sizeof periods, "%d", a->periods);
+    const bool fo = strcmp(model, "friction-oscillator") == 0;
     const cm_png_text texts[] = {{"Model", model},
                                  {"Parameters", params},
                                  {"Grid", grid},
                                  {"Periods", periods},
-                                 {"Estimator", "docs/models.md 9.8 (renormalised two trajectories)"}};
+                                 {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
+                                                  : "docs/models.md 11.3 (finite differences on the map)"}};
     return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 
@@ -210,6 +225,39 @@ static void print_json(const lyap_args *a, const cm_params *base, const double *
     json_end(&j);
 }
 
+/* The start of a model other than the friction oscillator: --from, with
+ * its dimension checked, or the centre of the model's default region. */
+static int start_of(const cli *c, lyap_args *a)
+{
+    const cm_model_entry *e = cm_model_set_find(&a->mo.set, a->mo.name, NULL);
+    cm_model m;
+    if (model_opts_build(c, &a->mo, &m) != EXIT_OK)
+        return EXIT_USAGE;
+    const int dim = m.dim;
+    cm_model_release(&m);
+    if (a->n_from && a->n_from != dim)
+        return cli_usage_error(c, "--from has %d value(s) but model %s has dimension %d",
+                               a->n_from, e->name, dim);
+    if (a->n_from)
+        return EXIT_OK;
+    if (!e->region)
+        return cli_usage_error(c, "model %s has no default region: give the start with --from",
+                               e->name);
+    const lattice_opts region = {0};
+    cm_lattice lat;
+    cm_box box;
+    if (model_opts_build(c, &a->mo, &m) != EXIT_OK)
+        return EXIT_USAGE;
+    const int err = lattice_opts_build(c, &region, &m, &a->mo.set, &lat, &box);
+    cm_model_release(&m);
+    if (err)
+        return err;
+    for (int d = 0; d < dim; d++)
+        a->from[d] = lat.origin[d] + lat.width[d] * 0.5 * (double)(box.lo[d] + box.hi[d]);
+    a->n_from = dim;
+    return EXIT_OK;
+}
+
 int cmd_lyapunov(int argc, char **argv)
 {
     cli c = {"lyapunov", argc, argv, 0, NULL, NULL};
@@ -225,9 +273,12 @@ int cmd_lyapunov(int argc, char **argv)
         return EXIT_FAIL;
     /* the parameters without the grid's; S0 >= S is checked per point */
     cm_params base;
-    const int verr = fo_sweep_check(&c, &a.mo, a.ax, 2, &base);
+    const int verr = sweep_check(&c, &a.mo, NULL, a.ax, 2, &base);
     if (verr)
         return verr;
+    const bool fo = strcmp(a.mo.name, "friction-oscillator") == 0;
+    if (!fo && start_of(&c, &a))
+        return EXIT_USAGE;
     const size_t nx = (size_t)a.ax[0].n, n = nx * (size_t)a.ax[1].n;
     double *v = malloc(n * sizeof *v);
     if (!v) {
@@ -272,7 +323,8 @@ int cmd_lyapunov(int argc, char **argv)
     bool ok = computed > 0;
     if (!ok)
         fprintf(stderr,
-                "cellmap lyapunov: no grid point could be computed (is S <= S0 anywhere?)\n");
+                "cellmap lyapunov: no grid point could be computed (%s)\n",
+                fo ? "is S <= S0 anywhere?" : "every orbit from --from left the world or had no image");
     if (ok && a.csv)
         ok = write_csv(&a, v);
     if (ok && a.png)

@@ -121,15 +121,15 @@ void param_base_json(json *j, const char *model, const cm_params *base)
     json_raw(j, "params", params);
 }
 
-int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
-                   cm_params *base)
+int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
+                int n_ax, cm_params *base)
 {
-    const cm_model_entry *e = cm_model_find(mo->name);
+    const cm_model_entry *e = cm_model_set_find(&mo->set, mo->name, NULL);
     if (!e)
         return cli_usage_error(c, "unknown model '%s' (`cellmap models` lists them)", mo->name);
-    if (strcmp(e->name, "friction-oscillator") != 0)
-        return cli_usage_error(
-            c, "model %s: this command is implemented for friction-oscillator only", e->name);
+    if (only && strcmp(e->name, only) != 0)
+        return cli_usage_error(c, "model %s: this command is implemented for %s only", e->name,
+                               only);
     char msg[256];
     cm_status st = cm_params_defaults(e->params, base, msg, sizeof msg);
     for (int k = 0; k < mo->n_texts && st == CM_OK; k++)

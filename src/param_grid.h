@@ -49,13 +49,13 @@ void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax);
 /* "model":NAME,"params":{...}: the parameters besides the axes'. */
 void param_base_json(json *j, const char *model, const cm_params *base);
 
-/* Checks the command's model options for a sweep of the friction
- * oscillator's parameters: the model is friction-oscillator, the --param
- * values are valid and each axis names a parameter. *base receives the
- * parameters without the axes' values (for the PNG texts). Prints the
- * problem and returns EXIT_USAGE, or EXIT_OK. */
-int fo_sweep_check(const cli *c, const model_opts *mo, const param_axis *ax, int n_ax,
-                   cm_params *base);
+/* Checks the command's model options for a sweep of a model's parameters:
+ * the model exists (and is `only`, unless that is NULL), the --param values
+ * are valid and each axis names a parameter. *base receives the parameters
+ * without the axes' values (for the PNG texts). Prints the problem and
+ * returns EXIT_USAGE, or EXIT_OK. */
+int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
+                int n_ax, cm_params *base);
 
 /* The model of the command's --model and --param with parameters names[k]
  * set to values[k] (n <= 2); false, with the reason in msg, where it

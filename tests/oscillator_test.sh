@@ -53,6 +53,27 @@ params = read_png(sys.argv[2])[4]["Parameters"]
 assert "S0=0.4," in params, params          # the fixed ones are named,
 assert "Omega=" not in params and "S=" not in params, params  # the grid's are in Grid only
 PY
+# --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
+# A stable focus of the map: the exponent is -delta/2 at every grid point
+# (delta varies), by finite differences; one thread or two, the same CSV.
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 1 --csv d1.csv > /dev/null || fail "lyapunov --model duffing"
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 2 --csv d2.csv > /dev/null || fail "lyapunov --model duffing, 2 threads"
+cmp -s d1.csv d2.csv || fail "duffing lyapunov differs between 1 and 2 threads"
+python3 - d1.csv <<'PY' || fail "duffing lyapunov values"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 4, rows
+for r in rows:
+    want = -float(r["delta"]) / 2
+    assert abs(float(r["lambda"]) - want) < 2e-3, (r, want)
+PY
+expect_usage "--from has 1 value(s) but model duffing has dimension 2" \
+  lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.1:0.2:2 --from 1 --csv x.csv
+"$CM" solve --model duffing --cells 60x60 --threads 2 > duf.txt \
+  || fail "solve --model duffing"
+grep -q "periodic groups" duf.txt || fail "solve --model duffing printed: $(head -3 duf.txt)"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- errors: usage (exit 2) and failures (exit 1) leave no file ------------
@@ -60,7 +81,14 @@ expect_usage "--grid: 'Omega=0.3:0.7," lyapunov --grid Omega=0.3:0.7,S=0.1:0.2:3
 expect_usage "'Q' is not a parameter" lyapunov --grid Q=0.3:0.7:3,S=0.1:0.2:3 --csv x.csv
 expect_usage "nothing to write" lyapunov --grid Omega=0.3:0.7:3,S=0.1:0.2:3
 expect_usage "--d0" lyapunov --grid Omega=0.3:0.7:3,S=0.1:0.2:3 --d0 1e-12 --csv x.csv
-expect_usage "friction-oscillator only" lyapunov --model microchaos-pd --grid P=0.1:0.2:2,D=0.1:0.2:2 --csv x.csv
+# any other map by finite differences: the 1-D micro-chaos map stretches by a
+"$CM" lyapunov --model microchaos-1d --grid a=1.5:1.7:2,b=0.9:1.1:1 --from 2.345 --periods 20000 \
+  --csv m1.csv > /dev/null || fail "lyapunov --model microchaos-1d"
+python3 - m1.csv <<'PY' || fail "microchaos-1d lyapunov is not ln a"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 2 and all(abs(float(r["lambda"]) - math.log(float(r["a"]))) < 1e-3 for r in rows), rows
+PY
 out=$("$CM" lyapunov --param S0=0.1 --grid Omega=0.3:0.7:2,S=0.2:0.3:2 --csv none.csv 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "all points invalid: $rc $out"
 out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S=0.1:0.2:2 --periods 10 --csv nodir/x.csv 2>&1); rc=$?
@@ -166,6 +194,27 @@ def frame_left(top, bottom):
 lefts = [frame_left(k * 200, k * 200 + 200) for k in range(3)]
 assert lefts[0] is not None and lefts == [lefts[0]] * 3, lefts
 PY
+# --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
+# A stable focus of the map: the exponent is -delta/2 at every grid point
+# (delta varies), by finite differences; one thread or two, the same CSV.
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 1 --csv d1.csv > /dev/null || fail "lyapunov --model duffing"
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 2 --csv d2.csv > /dev/null || fail "lyapunov --model duffing, 2 threads"
+cmp -s d1.csv d2.csv || fail "duffing lyapunov differs between 1 and 2 threads"
+python3 - d1.csv <<'PY' || fail "duffing lyapunov values"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 4, rows
+for r in rows:
+    want = -float(r["delta"]) / 2
+    assert abs(float(r["lambda"]) - want) < 2e-3, (r, want)
+PY
+expect_usage "--from has 1 value(s) but model duffing has dimension 2" \
+  lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.1:0.2:2 --from 1 --csv x.csv
+"$CM" solve --model duffing --cells 60x60 --threads 2 > duf.txt \
+  || fail "solve --model duffing"
+grep -q "periodic groups" duf.txt || fail "solve --model duffing printed: $(head -3 duf.txt)"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- simulate and bifurcation errors ----------------------------------------
@@ -183,6 +232,27 @@ out=$("$CM" bifurcation --param S0=0.1 --sweep S=0.2:0.3:2 --csv none.csv 2>&1);
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "bifurcation, all values invalid: $rc $out"
 out=$("$CM" simulate --periods 2 --png nodir/x.png 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "nodir/x.png" <<<"$out" || fail "simulate into a missing directory: $rc $out"
+# --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
+# A stable focus of the map: the exponent is -delta/2 at every grid point
+# (delta varies), by finite differences; one thread or two, the same CSV.
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 1 --csv d1.csv > /dev/null || fail "lyapunov --model duffing"
+"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
+  --periods 200 --threads 2 --csv d2.csv > /dev/null || fail "lyapunov --model duffing, 2 threads"
+cmp -s d1.csv d2.csv || fail "duffing lyapunov differs between 1 and 2 threads"
+python3 - d1.csv <<'PY' || fail "duffing lyapunov values"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 4, rows
+for r in rows:
+    want = -float(r["delta"]) / 2
+    assert abs(float(r["lambda"]) - want) < 2e-3, (r, want)
+PY
+expect_usage "--from has 1 value(s) but model duffing has dimension 2" \
+  lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.1:0.2:2 --from 1 --csv x.csv
+"$CM" solve --model duffing --cells 60x60 --threads 2 > duf.txt \
+  || fail "solve --model duffing"
+grep -q "periodic groups" duf.txt || fail "solve --model duffing printed: $(head -3 duf.txt)"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 [ $fails -eq 0 ] && echo "oscillator tests passed" || echo "$fails oscillator test(s) failed"

@@ -88,7 +88,9 @@ grep -q "the plugin changed since" changed.txt || fail "changed: $(cat changed.t
 sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {CM_PLUGIN_ABI + 98,/' \
   "$SRC/examples/plugin/henon.c" > abi.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libabi.so abi.c -lm
-expect_usage "was built for plugin ABI 99, this cellmap has ABI 1" solve --model-lib ./libabi.so --model henon
+abi=$(sed -n 's/^#define CM_PLUGIN_ABI \([0-9]*\).*/\1/p' "$SRC/cellmap/plugin.h")
+expect_usage "was built for plugin ABI $((abi + 98)), this cellmap has ABI $abi" \
+  solve --model-lib ./libabi.so --model henon
 # a model that cannot be one, or takes a built-in model's name, is refused
 sed 's/    m->dim = 2;/    m->dim = 9;/' "$SRC/examples/plugin/henon.c" > dim.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libdim.so dim.c -lm

@@ -7,6 +7,7 @@
 
 #include "cellmap/scm.h"
 #include "check.h"
+#include "models/map_lyapunov.h"
 #include "models/ode_flow.h"
 #include "models/registry.h"
 
@@ -286,8 +287,31 @@ static void test_duffing_basins(void)
     cm_model_release(&m);
 }
 
+/* Finite-difference exponents against exact ones: on a stable focus of
+ * Duffing's stroboscopic map both exponents of the flow are -delta/2 (their
+ * sum is the field's divergence, -delta); the 1-D micro-chaos map
+ * x' = a x - b Int(x) stretches by a everywhere, so its exponent is ln a. */
+static void test_lyapunov(void)
+{
+    cm_model m;
+    char msg[256];
+    CHECK(cm_model_create("duffing", NULL, 0, &m, msg, sizeof msg) == CM_OK);
+    double lambda = 0;
+    const double well[2] = {-0.9, 0.0};
+    CHECK(cm_map_lyapunov(&m, well, 1e-8, 300, &lambda));
+    CHECK_NEAR(lambda, -0.15 / 2, 1e-3);
+    cm_model_release(&m);
+    const char *params[1] = {"a=1.6,b=1"};
+    CHECK(cm_model_create("microchaos-1d", params, 1, &m, msg, sizeof msg) == CM_OK);
+    const double x0[1] = {2.345};
+    CHECK(cm_map_lyapunov(&m, x0, 1e-9, 20000, &lambda));
+    CHECK_NEAR(lambda, log(1.6), 1e-3);
+    cm_model_release(&m);
+}
+
 int main(void)
 {
+    test_lyapunov();
     test_known_flows();
     test_sinks();
     test_duffing_basins();
