@@ -84,12 +84,14 @@ enum { CM_FLOW_RK8PD = 0, CM_FLOW_RKF45, CM_FLOW_RKCK, CM_FLOW_RK4 };
  * more than CM_FLOW_MAX_STEPS steps or, for a section, does not reach it
  * before t0 + t_max has no image (the sink). Zero settings take the
  * defaults given. */
+struct cm_model;
 typedef struct cm_flow {
-    /* dxdt = f(t, x), dim entries; ctx is the model's. Returns 0, or
-     * nonzero where the field is not defined. Pure and thread-safe. */
-    int (*field)(double t, const double *x, double *dxdt, const void *ctx);
+    /* dxdt = f(t, x), dim entries, for model m (its values and ctx).
+     * Returns 0, or nonzero where the field is not defined. Pure and
+     * thread-safe, like step(). */
+    int (*field)(const struct cm_model *m, double t, const double *x, double *dxdt);
     double t0, period;
-    double (*section)(double t, const double *x, const void *ctx); /* NULL: stroboscopic */
+    double (*section)(const struct cm_model *m, double t, const double *x); /* NULL: stroboscopic */
     int direction;  /* +1: g from negative to >= 0; -1: the reverse; 0: either */
     int method;     /* CM_FLOW_RK8PD ... */
     double abs_tol; /* per step, default 1e-9 */

@@ -24,9 +24,9 @@ const cm_param_spec cm_duffing_spec[] = {
 
 static const char *const duffing_coord_names[] = {"x", "v"};
 
-static int duffing_field(double t, const double *x, double *dxdt, const void *ctx)
+static int duffing_field(const cm_model *m, double t, const double *x, double *dxdt)
 {
-    const duffing *d = ctx;
+    const duffing *d = m->ctx;
     dxdt[0] = x[1];
     dxdt[1] = -d->delta * x[1] + x[0] - x[0] * x[0] * x[0] + d->gamma * cos(d->omega * t);
     return 0;

@@ -26,7 +26,7 @@ static int field_gsl(double t, const double y[], double f[], void *params)
     const cm_model *m = params;
     /* GSL_EBADFUNC ends the integration at once (any other error would
      * make GSL retry with a smaller step) */
-    return m->flow.field(t, y, f, m->ctx) == 0 ? GSL_SUCCESS : GSL_EBADFUNC;
+    return m->flow.field(m, t, y, f) == 0 ? GSL_SUCCESS : GSL_EBADFUNC;
 }
 
 static const gsl_odeiv2_step_type *step_type(int method)
@@ -121,7 +121,7 @@ static bool locate(flow_work *w, double ta, const double *ya, double tb, const d
     double a[CM_MAX_DIM], b[CM_MAX_DIM], trial[CM_MAX_DIM];
     memcpy(a, ya, bytes);
     memcpy(b, yb, bytes);
-    double ga = m->flow.section(ta, a, m->ctx), gb = m->flow.section(tb, b, m->ctx);
+    double ga = m->flow.section(m, ta, a), gb = m->flow.section(m, tb, b);
     int kept = 0; /* which end stayed last time: -1 a, +1 b */
     for (int it = 0; it < 200 && tb - ta > m->flow.event_tol; it++) {
         double tm = gb != ga ? (ta * gb - tb * ga) / (gb - ga) : 0.5 * (ta + tb);
@@ -130,7 +130,7 @@ static bool locate(flow_work *w, double ta, const double *ya, double tb, const d
         memcpy(trial, a, bytes);
         if (!integrate(w, ta, tm, trial))
             return false;
-        const double gm = m->flow.section(tm, trial, m->ctx);
+        const double gm = m->flow.section(m, tm, trial);
         if (crossed(m->flow.direction ? m->flow.direction : (ga < 0 ? 1 : -1), ga, gm)) {
             tb = tm, gb = gm;
             memcpy(b, trial, bytes);
@@ -168,13 +168,13 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
     gsl_odeiv2_step_reset(w->step);
     const double t1 = f->t0 + f->t_max;
     double t = f->t0, h = first_step(f, f->t_max), before[CM_MAX_DIM];
-    double g = f->section(t, y, m->ctx);
+    double g = f->section(m, t, y);
     while (t < t1) {
         const double t_before = t, g_before = g;
         memcpy(before, y, (size_t)m->dim * sizeof *y);
         if (!advance(w, &t, t1, &h, y))
             return CM_STEP_NO_IMAGE;
-        g = f->section(t, y, m->ctx);
+        g = f->section(m, t, y);
         if (crossed(f->direction, g_before, g))
             return locate(w, t_before, before, t, y, y, t_end) ? CM_STEP_OK : CM_STEP_NO_IMAGE;
     }

@@ -84,6 +84,26 @@ cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so changed.c -lm
 "$CM" render henon.cmdb --png changed.png 2> changed.txt && fail "a changed plugin was not noticed"
 grep -q "the plugin changed since" changed.txt || fail "changed: $(cat changed.txt)"
 
+# an ODE in a plugin: its vector field, integrated by cellmap; unforced and
+# damped (A = 0, b = 0.5) the stroboscopic map is the linearised pendulum's
+# decay near the origin, and the solve finds the rest state
+cc -Wall -Wextra -Werror -shared -fPIC $(pkg-config --cflags cellmap) -o libpendulum.so \
+  "$SRC/examples/plugin/pendulum.c" -lm || fail "cc pendulum.c"
+"$CM" orbit --model-lib ./libpendulum.so --model pendulum --param A=0,b=0.5 --from 0.01,0 \
+  --steps 1 > pend.csv || fail "orbit of the pendulum plugin"
+python3 - pend.csv <<'PY' || fail "the pendulum plugin's map is not the linear decay"
+import csv, math, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+x1 = float(rows[2][1])
+b, T = 0.5, 2 * math.pi / 0.9     # x'' + b x' + x = 0 from (0.01, 0) over one period
+wd = math.sqrt(1 - b * b / 4)
+want = 0.01 * math.exp(-b * T / 2) * (math.cos(wd * T) + b / (2 * wd) * math.sin(wd * T))
+assert abs(x1 - want) < 1e-6 * 0.01 + 2e-7, (x1, want)   # sin(x) ~ x to 1e-6 here
+PY
+"$CM" solve --model-lib ./libpendulum.so --model pendulum --param A=0,b=0.5 --cells 41x41 \
+  --max-steps 20 --json > pend.json || fail "solve the pendulum plugin"
+grep -q '"period":1,"basin_cells":[0-9]*,"centre":\[0,0\]' pend.json || fail "pendulum: no rest state found: $(head -c 300 pend.json)"
+
 # a plugin built for another ABI is refused, with both versions
 sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {CM_PLUGIN_ABI + 98,/' \
   "$SRC/examples/plugin/henon.c" > abi.c

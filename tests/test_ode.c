@@ -16,33 +16,33 @@
 #define TWO_PI 6.283185307179586476925286766559
 
 /* x'' + 2 zeta x' + x = 0; zeta is the context. */
-static int damped_field(double t, const double *x, double *f, const void *ctx)
+static int damped_field(const cm_model *m, double t, const double *x, double *f)
 {
     (void)t;
-    const double zeta = *(const double *)ctx;
+    const double zeta = *(const double *)m->ctx;
     f[0] = x[1];
     f[1] = -2 * zeta * x[1] - x[0];
     return 0;
 }
 
-static double section_x(double t, const double *x, const void *ctx)
+static double section_x(const cm_model *m, double t, const double *x)
 {
-    (void)t, (void)ctx;
+    (void)m, (void)t;
     return x[0];
 }
 
 /* x' = x^2: blows up at t = 1/x0. */
-static int blowup_field(double t, const double *x, double *f, const void *ctx)
+static int blowup_field(const cm_model *m, double t, const double *x, double *f)
 {
-    (void)t, (void)ctx;
+    (void)m, (void)t;
     f[0] = x[0] * x[0];
     return 0;
 }
 
 /* Defined for x < 1 only. */
-static int partial_field(double t, const double *x, double *f, const void *ctx)
+static int partial_field(const cm_model *m, double t, const double *x, double *f)
 {
-    (void)t, (void)ctx;
+    (void)m, (void)t;
     f[0] = 1;
     return x[0] < 1 ? 0 : 1;
 }
