@@ -173,6 +173,13 @@ cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t
     return CM_OK;
 }
 
+void cm_model_set_close(cm_model_set *s)
+{
+    for (int k = 0; k < s->n; k++)
+        dlclose(s->lib[k].handle);
+    memset(s, 0, sizeof *s);
+}
+
 cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
                          size_t ctx_size, char *msg, size_t msg_size)
 {

@@ -24,6 +24,8 @@ typedef struct cm_model_set {
 /* Loads a plugin (its ABI checked) into s; the message names the path and
  * the fix. Loading the same file twice adds it once. */
 cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t msg_size);
+/* Unloads the plugins of s (after every model made from them is released). */
+void cm_model_set_close(cm_model_set *s);
 /* The entry of `name`: built in first, then the plugins in load order (s
  * may be NULL: built-in only); *lib (if not NULL) gets its plugin or NULL. */
 const cm_model_entry *cm_model_set_find(const cm_model_set *s, const char *name,

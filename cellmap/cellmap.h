@@ -1,0 +1,189 @@
+/* cellmap/cellmap.h - libcellmap: cell mapping of dynamical systems from C.
+ *
+ * What it does: builds a model (built in, or from a plugin), solves a box
+ * of cells of its state space by simple cell mapping (SCM; one region, or
+ * several solved concurrently and joined into one cluster, C-SCM), reads
+ * any view of a cluster database (.cmdb) that `cellmap solve --db` or
+ * `cellmap explore` wrote, and renders a result as a basin figure in PNG.
+ * Link with `pkg-config --libs cellmap` (libcellmap.so, or libcellmap.a
+ * with `--static`).
+ *
+ * The contract, for every function here:
+ * - Status. A function that can fail returns a cm_status: CM_OK (0) or a
+ *   negative code (cellmap/status.h; cm_strerror names it). When msg is not
+ *   NULL it receives a one-line reason that names the problem and its fix,
+ *   NUL-terminated within msg_size bytes (256 is always enough to be
+ *   useful). On failure no output object is made (*out is NULL) and no file
+ *   is left half-written.
+ * - Ownership. Objects are opaque. What cm_X_new / cm_X_open / cm_solve /
+ *   cm_db_read give, the caller releases with the matching cm_X_free /
+ *   cm_db_close (NULL is accepted and ignored). Arrays are the caller's:
+ *   functions fill buffers of the documented length and never keep them.
+ *   A system keeps a pointer to its model set, a result to nothing: free a
+ *   set after the systems made from it.
+ * - Threads. Different objects may be used from different threads at the
+ *   same time; one object is not to be used from two threads at once,
+ *   except cm_system_step, which is pure and may run on many threads at
+ *   once. cm_solve and cm_db_read use OpenMP threads of their own (options
+ *   say how many); their results do not depend on the thread count.
+ * - Units. States are in the model's own coordinates (`cellmap models`
+ *   names them); a grid's box is [lo, hi) per dimension cut into cells[d]
+ *   equal cells; arrays over cells run with dimension 0 fastest (C order of
+ *   an array shaped cells[dim-1] x ... x cells[0]). Times are seconds.
+ * - Labels. A cell's label is its periodic group's id 1..groups (an
+ *   attractor, or a sticking zone of a friction model), 0 for the sink (its
+ *   sequence leaves the solved cells or has no image), or CM_LABEL_NONE for
+ *   a cell of a view that no region of a database covers. Its step number
+ *   counts the map's steps to its group's periodic cells (0 on them).
+ * - Versions. CELLMAP_VERSION_* are this header's; cm_version() the
+ *   library's. The same major version keeps source and binary
+ *   compatibility (the library's SONAME is libcellmap.so.MAJOR).
+ */
+#ifndef CM_CELLMAP_H
+#define CM_CELLMAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cellmap/plugin.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CELLMAP_VERSION_MAJOR 0
+#define CELLMAP_VERSION_MINOR 2
+#define CELLMAP_VERSION_PATCH 0
+/* MAJOR * 10000 + MINOR * 100 + PATCH */
+#define CELLMAP_VERSION_NUMBER                                                                     \
+    (CELLMAP_VERSION_MAJOR * 10000 + CELLMAP_VERSION_MINOR * 100 + CELLMAP_VERSION_PATCH)
+
+/* The library's version as "MAJOR.MINOR.PATCH", and as a number. */
+const char *cm_version(void);
+int cm_version_number(void);
+
+/* The name of a status code ("out of memory", ...). */
+const char *cm_strerror(cm_status st);
+
+/* ---- models -------------------------------------------------------------- */
+
+/* The models a program can build: cellmap's own and those of the plugins
+ * it loads (cellmap/plugin.h). */
+typedef struct cm_models cm_models;
+
+cm_status cm_models_new(cm_models **out, char *msg, size_t msg_size);
+/* Loads the plugin at path (a shared object exporting cellmap_plugin());
+ * refused, with both versions named, when built for another plugin ABI. */
+cm_status cm_models_load(cm_models *set, const char *path, char *msg, size_t msg_size);
+/* How many models the set has, and the name of model i (NULL past the end). */
+size_t cm_models_count(const cm_models *set);
+const char *cm_models_name(const cm_models *set, size_t i);
+void cm_models_free(cm_models *set);
+
+/* A model built with its parameters: a dynamical system. */
+typedef struct cm_system cm_system;
+
+/* Model `name` of set (NULL: cellmap's own models only) with parameters
+ * "k=v,k=v" over its defaults (params NULL or "": the defaults). */
+cm_status cm_system_new(const cm_models *set, const char *name, const char *params,
+                        cm_system **out, char *msg, size_t msg_size);
+int cm_system_dim(const cm_system *s);
+const char *cm_system_name(const cm_system *s);
+/* The name of state coordinate d (e.g. "x", "v"). */
+const char *cm_system_coord(const cm_system *s, int d);
+/* The model's default region into lo[dim], hi[dim]; CM_ENOTFOUND if it has none. */
+cm_status cm_system_region(const cm_system *s, double *lo, double *hi);
+/* One step of the map from x into y (dim values each): CM_STEP_OK, or
+ * CM_STEP_NO_IMAGE (the sink). Pure and thread-safe. */
+int cm_system_step(const cm_system *s, const double *x, double *y);
+void cm_system_free(cm_system *s);
+
+/* ---- solving ------------------------------------------------------------- */
+
+/* A box of state space cut into cells: [lo[d], hi[d]) in cells[d] cells. */
+typedef struct cm_grid {
+    int dim;
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int64_t cells[CM_MAX_DIM];
+} cm_grid;
+
+/* Called on the calling thread with the fraction of the work done (0..1);
+ * a nonzero return cancels: the call then returns CM_ECANCELED. */
+typedef int (*cm_solve_progress_fn)(void *user, double fraction);
+
+typedef struct cm_solve_options {
+    int threads;   /* OpenMP threads; 0: all cores */
+    int max_steps; /* re-step while the image stays in its cell, up to this many steps
+                      (0 and 1: one step; useful for flows and slow maps) */
+    /* regions per dimension, solved concurrently and joined into one
+     * cluster (C-SCM); all 0: one region. The labels are the same either
+     * way, up to the numbering of the groups. */
+    int64_t split[CM_MAX_DIM];
+    cm_solve_progress_fn progress; /* optional */
+    void *user;
+} cm_solve_options;
+
+/* Labels, step numbers and groups of a grid's cells. */
+typedef struct cm_result cm_result;
+
+/* Solves grid for system s (opt NULL: the defaults). */
+cm_status cm_solve(const cm_system *s, const cm_grid *grid, const cm_solve_options *opt,
+                   cm_result **out, char *msg, size_t msg_size);
+
+#define CM_LABEL_NONE UINT32_C(0xFFFFFFFF)
+
+/* The result's grid (of a database view: the lattice's cells it covers). */
+void cm_result_grid(const cm_result *r, cm_grid *grid);
+/* Its number of cells, the product of grid.cells. */
+uint64_t cm_result_cells(const cm_result *r);
+/* Every cell's label, and step number, into arrays of cm_result_cells entries. */
+void cm_result_labels(const cm_result *r, uint32_t *labels);
+void cm_result_steps(const cm_result *r, uint32_t *steps);
+/* The number of groups: labels run 1..cm_result_groups (a database view
+ * may hold no cell of some of them). */
+uint32_t cm_result_groups(const cm_result *r);
+
+/* A periodic group, as far as the result's cells show it. */
+typedef struct cm_group_summary {
+    uint32_t id;
+    int kind;              /* 0: attractor; 1: sticking zone (rest states held by friction) */
+    uint32_t period;       /* its periodic cells among the result's */
+    uint64_t basin_cells;  /* cells labelled id, periodic ones included */
+    double centre[CM_MAX_DIM]; /* mean centre of its periodic cells */
+} cm_group_summary;
+
+/* Group id (1..cm_result_groups) into *out; CM_ENOTFOUND beyond. */
+cm_status cm_result_group(const cm_result *r, uint32_t id, cm_group_summary *out);
+/* Cells labelled 0 (the sink). */
+uint64_t cm_result_sink_cells(const cm_result *r);
+/* The basin figure (basins, attractors, axes, legend, title) as a PNG of
+ * width x height pixels (0, 0: 1000 on the longer side), written to a
+ * temporary file and renamed to path. Loads OSMesa on first use. */
+cm_status cm_result_png(const cm_result *r, const char *path, int width, int height, char *msg,
+                        size_t msg_size);
+void cm_result_free(cm_result *r);
+
+/* ---- cluster databases (.cmdb) ------------------------------------------- */
+
+typedef struct cm_db cm_db;
+
+/* Opens a database read-only; a model from a plugin is loaded from the
+ * path the file records (and refused if it changed). */
+cm_status cm_db_open(const char *path, cm_db **out, char *msg, size_t msg_size);
+/* The file's model: name, parameters as a JSON object. */
+const char *cm_db_model(const cm_db *db);
+const char *cm_db_params(const cm_db *db);
+/* The smallest grid of the lattice that holds every region. */
+void cm_db_grid(const cm_db *db, cm_grid *grid);
+/* The cells of the lattice that meet the box lo..hi (NULL, NULL: the whole
+ * cluster), resolved: labels and steps exactly as `cellmap export` gives
+ * them. Reads only the regions the box meets. */
+cm_status cm_db_read(cm_db *db, const double *lo, const double *hi, cm_result **out, char *msg,
+                     size_t msg_size);
+void cm_db_close(cm_db *db);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
