@@ -84,6 +84,39 @@ cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so changed.c -lm
 "$CM" render henon.cmdb --png changed.png 2> changed.txt && fail "a changed plugin was not noticed"
 grep -q "the plugin changed since" changed.txt || fail "changed: $(cat changed.txt)"
 
+# libcellmap from the prefix, with pkg-config only: shared (the SONAME
+# carries the major version) and static
+cat > api.c <<'C'
+#include <cellmap/cellmap.h>
+#include <stdio.h>
+int main(void)
+{
+    cm_system *s;
+    cm_result *r;
+    char msg[256];
+    const cm_grid g = {2, {-1.5, -0.45}, {1.5, 0.45}, {120, 40}};
+    if (cm_system_new(NULL, "microchaos-pd", NULL, &s, msg, sizeof msg) != CM_OK ||
+        cm_solve(s, &g, NULL, &r, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "%s\n", msg);
+        return 1;
+    }
+    printf("%s %llu %u\n", cm_version(), (unsigned long long)cm_result_cells(r), cm_result_groups(r));
+    cm_result_free(r);
+    cm_system_free(s);
+    return 0;
+}
+C
+cc -Wall -Wextra -Werror $(pkg-config --cflags cellmap) -o api-shared api.c $(pkg-config --libs cellmap) \
+  || fail "cc against libcellmap.so"
+cc $(pkg-config --cflags cellmap) -o api-static api.c -Wl,-Bstatic $(pkg-config --libs-only-L cellmap) \
+  -lcellmap -Wl,-Bdynamic $(pkg-config --static --libs-only-l cellmap | sed 's/-lcellmap//') -fopenmp \
+  || fail "cc against libcellmap.a"
+libdir=$(pkg-config --variable=libdir cellmap)
+objdump -p "$libdir/libcellmap.so" | grep -q "SONAME *libcellmap.so.0" || fail "no SONAME libcellmap.so.0"
+[ "$(LD_LIBRARY_PATH=$libdir ./api-shared | cut -d' ' -f2)" = 4800 ] || fail "api-shared: $(LD_LIBRARY_PATH=$libdir ./api-shared 2>&1)"
+[ "$(./api-static)" = "$(LD_LIBRARY_PATH=$libdir ./api-shared)" ] || fail "api-static: $(./api-static 2>&1)"
+objdump -p api-static | grep -q "NEEDED *libcellmap" && fail "api-static needs libcellmap.so"
+
 # an ODE in a plugin: its vector field, integrated by cellmap; unforced and
 # damped (A = 0, b = 0.5) the stroboscopic map is the linearised pendulum's
 # decay near the origin, and the solve finds the rest state

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The Python module (python/cellmap) over the installed libcellmap:
+# installed with pip from the source tree into a directory, it solves a
+# region and reads a database and a view; every label and step equals what
+# `cellmap solve` + `export` give; plugins, cancelling and errors.
+# usage: python_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
+set -u
+SRC=$(realpath "$2")
+BUILD=$(realpath "$3")
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+PY=/usr/bin/python3 # Debian's, with python3-numpy
+
+cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "install: $(cat install.log)"
+CM="$work/prefix/bin/cellmap"
+lib=$(ls "$work"/prefix/lib*/libcellmap.so.0 "$work"/prefix/lib/*/libcellmap.so.0 2>/dev/null | head -1)
+[ -n "$lib" ] || fail "no libcellmap.so.0 installed: $(find prefix -name 'libcellmap*')"
+export CELLMAP_LIB=$lib
+$PY -m pip install --quiet --no-deps --no-build-isolation --target "$work/site" "$SRC/python" \
+  > pip.log 2>&1 || fail "pip install: $(tail -5 pip.log)"
+export PYTHONPATH="$work/site"
+
+pd=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 400x200)
+"$CM" solve "${pd[@]}" --db pd.cmdb --quiet > /dev/null || fail "solve --db"
+"$CM" export pd.cmdb --labels labels.npy --steps steps.npy --quiet || fail "export"
+export PKG_CONFIG_PATH="$work/prefix/share/pkgconfig"
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so "$SRC/examples/plugin/henon.c" -lm \
+  || fail "cc henon"
+
+$PY - <<'PY' || fail "the Python module"
+import numpy as np
+import cellmap
+
+assert cellmap.version().count(".") == 2
+pd = cellmap.System("microchaos-pd", alpha=0.078, beta=0, P=0.007, D=0.02)
+assert pd.dim == 2 and pd.coords == ["x", "v"] and pd.region() == [(0, 500), (-40, 40)]
+labels, steps = np.load("labels.npy"), np.load("steps.npy")
+for split in (None, (2, 2)):
+    res = cellmap.solve(pd, region=[(0, 500), (-40, 40)], cells=(400, 200), threads=2, split=split)
+    assert res.labels.shape == labels.shape == (400, 200), (res.labels.shape, labels.shape)
+    assert res.labels.dtype == np.int32 and res.labels.flags["C_CONTIGUOUS"]
+    if split is None:  # one region: the same group ids as the file
+        assert (res.labels == labels).all(), "labels differ from cellmap solve + export"
+    else:              # the same partition, numbered by the joins
+        pairs = set(zip(res.labels.ravel().tolist(), labels.ravel().tolist()))
+        assert len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs})
+    assert (res.steps == steps).all(), "steps differ"
+    assert sum(g["basin_cells"] for g in res.groups) + (res.labels == 0).sum() == 400 * 200
+db = cellmap.open("pd.cmdb")
+assert db.model == "microchaos-pd" and db.cells == [400, 200]
+assert (db.read().labels == labels).all()
+view = db.read(view=[(125, 250), (-20, 20)])
+assert view.labels.shape == (100, 100) and (view.labels == labels[100:200, 50:150]).all()
+res.png("pd.png", 600, 400)
+assert open("pd.png", "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+
+# a plugin's model, and a cancelled solve
+henon = cellmap.System("henon", plugins=["./libhenon.so"], a=1.4, b=0.3)
+h = cellmap.solve(henon, cells=(300, 100))
+assert h.groups and h.groups[0]["period"] >= 1
+seen = []
+try:
+    cellmap.solve(pd, cells=(400, 200), split=(4, 4), progress=lambda f: seen.append(f) or f > 0.3)
+    raise AssertionError("not cancelled")
+except cellmap.CellmapError as e:
+    assert "cancelled" in str(e) and seen, e
+for bad in (lambda: cellmap.System("nope"), lambda: cellmap.open("missing.cmdb"),
+            lambda: cellmap.System("microchaos-pd", alpha="x")):
+    try:
+        bad()
+        raise AssertionError("no error")
+    except cellmap.CellmapError as e:
+        assert str(e), e
+print("python module: labels and steps equal cellmap solve + export")
+PY
+
+[ $fails -eq 0 ] && echo "python tests passed"
+exit $fails
