@@ -106,9 +106,10 @@ int main(void)
     return 0;
 }
 C
-cc -Wall -Wextra -Werror $(pkg-config --cflags cellmap) -o api-shared api.c $(pkg-config --libs cellmap) \
+san=${CELLMAP_SANITIZE:+-fsanitize=address,undefined} # an instrumented libcellmap
+cc -Wall -Wextra -Werror $san $(pkg-config --cflags cellmap) -o api-shared api.c $(pkg-config --libs cellmap) \
   || fail "cc against libcellmap.so"
-cc $(pkg-config --cflags cellmap) -o api-static api.c -Wl,-Bstatic $(pkg-config --libs-only-L cellmap) \
+cc $san $(pkg-config --cflags cellmap) -o api-static api.c -Wl,-Bstatic $(pkg-config --libs-only-L cellmap) \
   -lcellmap -Wl,-Bdynamic $(pkg-config --static --libs-only-l cellmap | sed 's/-lcellmap//') -fopenmp \
   || fail "cc against libcellmap.a"
 libdir=$(pkg-config --variable=libdir cellmap)

@@ -11,13 +11,17 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 . "$HERE/testlib.sh"
 enter_workdir
 PY=/usr/bin/python3 # Debian's, with python3-numpy
+if [ -n "${CELLMAP_SANITIZE:-}" ]; then # an instrumented libcellmap: its runtimes first
+  export LD_PRELOAD="$(gcc -print-file-name=libasan.so) $(gcc -print-file-name=libubsan.so)"
+  export ASAN_OPTIONS=detect_leaks=0 # Python's own allocations are no finding of ours
+fi
 
 cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "install: $(cat install.log)"
 CM="$work/prefix/bin/cellmap"
 lib=$(ls "$work"/prefix/lib*/libcellmap.so.0 "$work"/prefix/lib/*/libcellmap.so.0 2>/dev/null | head -1)
 [ -n "$lib" ] || fail "no libcellmap.so.0 installed: $(find prefix -name 'libcellmap*')"
 export CELLMAP_LIB=$lib
-$PY -m pip install --quiet --no-deps --no-build-isolation --target "$work/site" "$SRC/python" \
+LD_PRELOAD= $PY -m pip install --quiet --no-deps --no-build-isolation --target "$work/site" "$SRC/python" \
   > pip.log 2>&1 || fail "pip install: $(tail -5 pip.log)"
 export PYTHONPATH="$work/site"
 
