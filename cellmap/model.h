@@ -111,6 +111,10 @@ typedef struct cm_flow {
         {"abs_tol", "1e-9", 1e-15, 1e-2, 1, NULL, "absolute error per integration step"},       \
         {"rel_tol", "1e-9", 0, 1e-2, 1, NULL, "relative error per integration step"},           \
         {"world", "1e6", 1e-6, 1e300, 1, NULL, "|x_i| beyond this: the orbit has no image"}
+/* And, for a Poincare map, the section's settings (cm_flow.t_max, event_tol). */
+#define CM_FLOW_SECTION_PARAM_SPECS                                                            \
+    {"t_max", "1000", 1e-6, 1e12, 1, NULL, "the longest flight to the section (else no image)"}, \
+        {"event_tol", "1e-12", 1e-15, 1, 1, NULL, "the section's crossing time to this"}
 
 typedef struct cm_model {
     const char *name;

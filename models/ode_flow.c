@@ -232,8 +232,8 @@ cm_status cm_flow_attach(cm_model *m, char *msg, size_t msg_size)
     f->abs_tol = setting(m, "abs_tol", f->abs_tol > 0 ? f->abs_tol : 1e-9);
     f->rel_tol = setting(m, "rel_tol", f->rel_tol > 0 ? f->rel_tol : 1e-9);
     f->world = setting(m, "world", f->world > 0 ? f->world : 1e6);
-    f->t_max = f->t_max > 0 ? f->t_max : 1000;
-    f->event_tol = f->event_tol > 0 ? f->event_tol : 1e-12;
+    f->t_max = setting(m, "t_max", f->t_max > 0 ? f->t_max : 1000);
+    f->event_tol = setting(m, "event_tol", f->event_tol > 0 ? f->event_tol : 1e-12);
     const char *problem = !f->field                                      ? "no vector field"
                           : m->step                                      ? "both step and flow"
                           : f->method < CM_FLOW_RK8PD || f->method > CM_FLOW_RK4 ? "an unknown method"

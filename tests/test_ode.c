@@ -9,6 +9,7 @@
 #include "check.h"
 #include "models/map_lyapunov.h"
 #include "models/ode_flow.h"
+#include "models/params.h"
 #include "models/registry.h"
 
 
@@ -100,6 +101,23 @@ static void test_known_flows(void)
     /* a section the flow never reaches in t_max: no image */
     const double far[2] = {0, 0};
     CHECK_INT(cm_flow_map(&up, far, y, NULL, NULL), CM_STEP_NO_IMAGE);
+
+    /* the section's settings as parameters: t_max = 5 stops short of the
+     * crossing at 2 pi/omega_d; a coarse event_tol moves the crossing */
+    static const cm_param_spec spec[] = {CM_FLOW_PARAM_SPECS, CM_FLOW_SECTION_PARAM_SPECS,
+                                         {NULL, NULL, 0, 0, 0, NULL, NULL}};
+    char msg[256];
+    cm_model short_flight;
+    memset(&short_flight, 0, sizeof short_flight);
+    short_flight.name = "short";
+    short_flight.dim = 2;
+    short_flight.ctx = &zeta2;
+    short_flight.flow = (cm_flow){.field = damped_field, .section = section_x, .direction = 1};
+    CHECK(cm_params_defaults(spec, &short_flight.values, msg, sizeof msg) == CM_OK);
+    CHECK(cm_params_set(&short_flight.values, "t_max=5,method=rkf45", msg, sizeof msg) == CM_OK);
+    CHECK(cm_flow_attach(&short_flight, msg, sizeof msg) == CM_OK);
+    CHECK(short_flight.flow.t_max == 5 && short_flight.flow.method == CM_FLOW_RKF45);
+    CHECK_INT(cm_flow_map(&short_flight, start, y, NULL, NULL), CM_STEP_NO_IMAGE);
 }
 
 static void test_sinks(void)
