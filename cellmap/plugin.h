@@ -9,9 +9,10 @@
  *
  * Each model's create() fills *m from the parameter values p (defaults of
  * params overridden by --param): name, dim (1..CM_MAX_DIM), params, values
- * (*p), step (or, for an ODE, flow: cellmap integrates it) and, if it needs them, ctx and destroy, coord_names (names of
- * the state coordinates, identifiers, for CSV/JSON/SQL columns). step()
- * must be pure and thread-safe: cellmap calls it on every thread at once.
+ * (*p), step (or, for an ODE, flow: cellmap integrates it, see cm_flow
+ * and CM_FLOW_PARAM_SPECS in model.h) and, if it needs them, ctx and
+ * destroy, coord_names (names of the state coordinates, identifiers,
+ * for CSV/JSON/SQL columns). step() (and a flow's field) must be pure and thread-safe: cellmap calls it on every thread at once.
  * It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
  * the orbit is lost) or CM_STEP_ABORT. On failure create() returns a
  * status (CM_EINVAL ...), writes the reason into msg with snprintf and
