@@ -12,8 +12,8 @@
  * (*p), step (or, for an ODE, flow: cellmap integrates it, see cm_flow
  * and CM_FLOW_PARAM_SPECS in model.h) and, if it needs them, ctx and
  * destroy, coord_names (names of the state coordinates, identifiers,
- * for CSV/JSON/SQL columns). step() (and a flow's field) must be pure and thread-safe: cellmap calls it on every thread at once.
- * It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
+ * for CSV/JSON/SQL columns). step() (and a flow's field) must be pure
+ * and thread-safe: cellmap calls it on every thread at once. It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
  * the orbit is lost) or CM_STEP_ABORT. On failure create() returns a
  * status (CM_EINVAL ...), writes the reason into msg with snprintf and
  * leaves *m zeroed. A plugin calls no function of cellmap's: it needs these
