@@ -211,27 +211,6 @@ out=$("$CM" bifurcation --param S0=0.1 --sweep S=0.2:0.3:2 --csv none.csv 2>&1);
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "bifurcation, all values invalid: $rc $out"
 out=$("$CM" simulate --periods 2 --png nodir/x.png 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "nodir/x.png" <<<"$out" || fail "simulate into a missing directory: $rc $out"
-# --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
-# A stable focus of the map: the exponent is -delta/2 at every grid point
-# (delta varies), by finite differences; one thread or two, the same CSV.
-"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
-  --periods 200 --threads 1 --csv d1.csv > /dev/null || fail "lyapunov --model duffing"
-"$CM" lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.09:0.11:2 --from -0.9,0 \
-  --periods 200 --threads 2 --csv d2.csv > /dev/null || fail "lyapunov --model duffing, 2 threads"
-cmp -s d1.csv d2.csv || fail "duffing lyapunov differs between 1 and 2 threads"
-python3 - d1.csv <<'PY' || fail "duffing lyapunov values"
-import csv, sys
-rows = list(csv.DictReader(open(sys.argv[1])))
-assert len(rows) == 4, rows
-for r in rows:
-    want = -float(r["delta"]) / 2
-    assert abs(float(r["lambda"]) - want) < 2e-3, (r, want)
-PY
-expect_usage "--from has 1 value(s) but model duffing has dimension 2" \
-  lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.1:0.2:2 --from 1 --csv x.csv
-"$CM" solve --model duffing --cells 60x60 --threads 2 > duf.txt \
-  || fail "solve --model duffing"
-grep -q "periodic groups" duf.txt || fail "solve --model duffing printed: $(head -3 duf.txt)"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 [ $fails -eq 0 ] && echo "oscillator tests passed" || echo "$fails oscillator test(s) failed"
