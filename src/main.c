@@ -30,6 +30,8 @@ static const struct {
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
     {"bifurcation", cmd_bifurcation,
      "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
+    {"continue", cmd_continue,
+     "continuation of the friction oscillator's periodic solutions: branches and bifurcations"},
 };
 
 static void usage(FILE *out)

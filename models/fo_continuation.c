@@ -1,0 +1,604 @@
+/* Pseudo-arclength continuation of the friction oscillator's periodic
+ * solutions (docs/models.md 9.9). A branch is a curve u = (x, v, p) of
+ * G(u) = P^k(x, v; p) - (x, v) = 0. Each step predicts along the tangent
+ * (the null vector of DG = [M - I | dP^k/dp], M the exact monodromy of
+ * the k periods) and corrects by Newton on G = 0 with the arclength
+ * condition; events are test functions that change sign between two
+ * points (det(M - I) for folds, det(M + I) for period doublings, det M - 1
+ * for complex pairs) or a changed signature, located by bisection along
+ * the step. */
+#include "models/fo_continuation.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static const char *const param_names[] = {"S", "S0", "Omega", "phi"};
+
+int cm_fo_param_of(const char *name)
+{
+    for (int i = 0; i < 4; i++)
+        if (strcmp(name, param_names[i]) == 0)
+            return i;
+    return -1;
+}
+
+const char *cm_fo_param_name(int param) { return param >= 0 && param < 4 ? param_names[param] : "?"; }
+
+void cm_fo_with(const cm_fo *o, int param, double p, cm_fo *out)
+{
+    double v[4] = {o->S, o->S0, o->Omega, o->phi};
+    v[param] = p;
+    cm_fo_init(out, v[0], v[1], v[2], v[3]);
+}
+
+/* ---- one solution: P^k, its monodromy, its signature -------------------- */
+
+typedef struct sig_log {
+    char *sig;
+    size_t len;
+    double *stops;
+    int n_stops;
+} sig_log;
+
+static void add_mode(sig_log *l, int mode)
+{
+    const char c = mode == CM_FO_UP ? 'u' : mode == CM_FO_DOWN ? 'd' : 's';
+    if (l->len + 1 < CM_FO_SIGNATURE && (l->len == 0 || l->sig[l->len - 1] != c)) {
+        l->sig[l->len++] = c;
+        l->sig[l->len] = '\0';
+    }
+}
+
+static void on_fo_event(void *user, const cm_fo_event *e)
+{
+    sig_log *l = user;
+    if (e->kind == CM_FO_EV_STICK && l->n_stops < CM_FO_MAX_STOPS)
+        l->stops[l->n_stops++] = e->x;
+    add_mode(l, e->mode);
+}
+
+/* The modes as a cycle: the last one merged into the first when they
+ * agree, then the rotation that comes first alphabetically. */
+static void canonical_cycle(char *sig)
+{
+    size_t n = strlen(sig);
+    if (n > 1 && sig[n - 1] == sig[0])
+        sig[--n] = '\0';
+    char best[CM_FO_SIGNATURE], rot[CM_FO_SIGNATURE];
+    snprintf(best, sizeof best, "%s", sig);
+    for (size_t r = 1; r < n; r++) {
+        memcpy(rot, sig + r, n - r);
+        memcpy(rot + (n - r), sig, r);
+        rot[n] = '\0';
+        if (strcmp(rot, best) < 0)
+            memcpy(best, rot, n + 1);
+    }
+    memcpy(sig, best, n + 1);
+}
+
+/* 2x2 row-major: A = B A */
+static void left_mul(double A[4], const double B[4])
+{
+    const double r[4] = {B[0] * A[0] + B[1] * A[2], B[0] * A[1] + B[1] * A[3],
+                         B[2] * A[0] + B[3] * A[2], B[2] * A[1] + B[3] * A[3]};
+    memcpy(A, r, sizeof r);
+}
+
+/* P^k(z) into end and its monodromy into M (may be NULL), the solution's
+ * description into s (may be NULL). */
+static bool compose(const cm_fo *o, const double z[2], int k, double end[2], double M[4],
+                    cm_fo_solution *s)
+{
+    if (!(o->S > 0 && o->S0 >= o->S && o->Omega > 0)) /* (2.3) holds only there */
+        return false;
+    double cur[2] = {z[0], z[1]};
+    if (M) {
+        M[0] = M[3] = 1;
+        M[1] = M[2] = 0;
+    }
+    sig_log log = {s ? s->signature : NULL, 0, s ? s->stops : NULL, 0};
+    if (s) {
+        s->signature[0] = '\0';
+        s->x_max = s->x_min = z[0];
+        s->psi = 0;
+        s->n_stick = 0;
+        add_mode(&log, cm_fo_mode_of(o, 0, z[0], z[1]));
+    }
+    for (int i = 0; i < k; i++) {
+        cm_fo_tally t;
+        double next[2], J[4];
+        if (!cm_fo_poincare(o, cur, next, s ? &t : NULL, s ? on_fo_event : NULL, &log))
+            return false;
+        if (M) {
+            if (!cm_fo_monodromy(o, cur, J))
+                return false;
+            left_mul(M, J);
+        }
+        if (s) {
+            s->x_max = fmax(s->x_max, t.x_max);
+            s->x_min = fmin(s->x_min, t.x_min);
+            s->psi += t.x_zero_sum;
+            s->n_stick += t.n_stick;
+        }
+        cur[0] = next[0];
+        cur[1] = next[1];
+    }
+    if (s) {
+        s->n_stops = log.n_stops;
+        canonical_cycle(s->signature);
+    }
+    end[0] = cur[0];
+    end[1] = cur[1];
+    return isfinite(end[0]) && isfinite(end[1]);
+}
+
+static void multipliers(const double M[4], double mult[2][2])
+{
+    const double tr = M[0] + M[3], det = M[0] * M[3] - M[1] * M[2], disc = tr * tr - 4 * det;
+    if (disc >= 0) {
+        const double q = -0.5 * (tr + copysign(sqrt(disc), tr)); /* no cancellation */
+        double a = q != 0 ? det / q : 0, b = -q;                 /* the roots */
+        if (fabs(a) < fabs(b)) {
+            const double t = a;
+            a = b;
+            b = t;
+        }
+        mult[0][0] = a, mult[0][1] = 0, mult[1][0] = b, mult[1][1] = 0;
+    } else {
+        mult[0][0] = mult[1][0] = tr / 2;
+        mult[0][1] = sqrt(-disc) / 2;
+        mult[1][1] = -mult[0][1];
+    }
+}
+
+bool cm_fo_solution_at(const cm_fo *o, const double z[2], int period, cm_fo_solution *out)
+{
+    double end[2], M[4];
+    memset(out, 0, sizeof *out);
+    if (!compose(o, z, period, end, M, out))
+        return false;
+    out->z[0] = z[0];
+    out->z[1] = z[1];
+    out->phi = o->phi;
+    out->period = period;
+    multipliers(M, out->mult);
+    out->stable = hypot(out->mult[0][0], out->mult[0][1]) < 1;
+    out->symmetric = fabs(out->psi) < 1e-6;
+    return true;
+}
+
+/* Solves the 2x2 system A x = b; false if singular. */
+static bool solve2(const double A[4], const double b[2], double x[2])
+{
+    const double det = A[0] * A[3] - A[1] * A[2];
+    if (det == 0 || !isfinite(det))
+        return false;
+    x[0] = (A[3] * b[0] - A[1] * b[1]) / det;
+    x[1] = (-A[2] * b[0] + A[0] * b[1]) / det;
+    return isfinite(x[0]) && isfinite(x[1]);
+}
+
+bool cm_fo_periodic_point(const cm_fo *o, double z[2], int period)
+{
+    double end[2], M[4];
+    if (!compose(o, z, period, end, M, NULL))
+        return false;
+    double r[2] = {end[0] - z[0], end[1] - z[1]}, norm = hypot(r[0], r[1]);
+    for (int it = 0; it < 50; it++) {
+        if (norm < 1e-11)
+            return true;
+        const double A[4] = {M[0] - 1, M[1], M[2], M[3] - 1};
+        double dz[2];
+        if (!solve2(A, r, dz))
+            return false;
+        bool accepted = false; /* damped, as the corrector */
+        for (double lambda = 1; lambda > 1e-4 && !accepted; lambda /= 2) {
+            const double trial[2] = {z[0] - lambda * dz[0], z[1] - lambda * dz[1]};
+            double te[2], tM[4];
+            if (compose(o, trial, period, te, tM, NULL) &&
+                hypot(te[0] - trial[0], te[1] - trial[1]) < norm) {
+                memcpy(z, trial, sizeof trial);
+                memcpy(M, tM, sizeof tM);
+                r[0] = te[0] - z[0];
+                r[1] = te[1] - z[1];
+                norm = hypot(r[0], r[1]);
+                accepted = true;
+            }
+        }
+        if (!accepted)
+            return false;
+    }
+    return false;
+}
+
+int cm_fo_find_periodic(const cm_fo *o, double z[2], int settle, int max_period)
+{
+    double cur[2] = {z[0], z[1]};
+    for (int i = 0; i < settle; i++)
+        if (!cm_fo_poincare(o, cur, cur, NULL, NULL, NULL))
+            return 0;
+    double end[2];
+    for (int k = 1; k <= max_period; k++) {
+        if (!compose(o, cur, k, end, NULL, NULL))
+            return 0;
+        if (hypot(end[0] - cur[0], end[1] - cur[1]) < 1e-6) {
+            double p[2] = {cur[0], cur[1]};
+            if (cm_fo_periodic_point(o, p, k)) {
+                z[0] = p[0];
+                z[1] = p[1];
+                return k;
+            }
+        }
+    }
+    return 0;
+}
+
+/* ---- the branch ---------------------------------------------------------- */
+
+typedef struct branch {
+    cm_fo base; /* its section phase moves along the branch */
+    int param, period;
+} branch;
+
+/* G(u) and DG (2 x 3, row-major) at u = (x, v, p). */
+static bool residual(const branch *b, const double u[3], double G[2], double DG[6])
+{
+    cm_fo o, op, om;
+    cm_fo_with(&b->base, b->param, u[2], &o);
+    double end[2], M[4];
+    if (!compose(&o, u, b->period, end, M, NULL))
+        return false;
+    G[0] = end[0] - u[0];
+    G[1] = end[1] - u[1];
+    if (!DG)
+        return true;
+    const double h = 1e-7 * fmax(1, fabs(u[2]));
+    double ep[2], em[2];
+    cm_fo_with(&b->base, b->param, u[2] + h, &op);
+    cm_fo_with(&b->base, b->param, u[2] - h, &om);
+    if (!compose(&op, u, b->period, ep, NULL, NULL) || !compose(&om, u, b->period, em, NULL, NULL))
+        return false;
+    DG[0] = M[0] - 1, DG[1] = M[1], DG[2] = (ep[0] - em[0]) / (2 * h);
+    DG[3] = M[2], DG[4] = M[3] - 1, DG[5] = (ep[1] - em[1]) / (2 * h);
+    return true;
+}
+
+/* The unit tangent: the cross product of DG's rows, oriented along prev
+ * (or with dp of the sign of `direction` when prev is NULL). */
+static bool tangent(const double DG[6], const double *prev, double direction, double t[3])
+{
+    t[0] = DG[1] * DG[5] - DG[2] * DG[4];
+    t[1] = DG[2] * DG[3] - DG[0] * DG[5];
+    t[2] = DG[0] * DG[4] - DG[1] * DG[3];
+    const double n = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    if (!(n > 0) || !isfinite(n))
+        return false;
+    const double s = prev ? (t[0] * prev[0] + t[1] * prev[1] + t[2] * prev[2] < 0 ? -1 : 1)
+                          : (t[2] * direction < 0 ? -1 : 1);
+    for (int i = 0; i < 3; i++)
+        t[i] *= s / n;
+    return true;
+}
+
+/* Solves the 3 x 3 system A x = r by Cramer's rule; false if singular. */
+static bool solve3(const double A[9], const double r[3], double x[3])
+{
+    const double det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+                       A[2] * (A[3] * A[7] - A[4] * A[6]);
+    if (det == 0 || !isfinite(det))
+        return false;
+    for (int c = 0; c < 3; c++) {
+        double B[9];
+        memcpy(B, A, sizeof B);
+        for (int row = 0; row < 3; row++)
+            B[3 * row + c] = r[row];
+        x[c] = (B[0] * (B[4] * B[8] - B[5] * B[7]) - B[1] * (B[3] * B[8] - B[5] * B[6]) +
+                B[2] * (B[3] * B[7] - B[4] * B[6])) /
+               det;
+    }
+    return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
+}
+
+/* |G(u)| and the arclength condition's residual together. */
+static bool corrector_norm(const branch *b, const double u0[3], const double t[3], double h,
+                           const double u[3], double G[2], double DG[6], double *norm)
+{
+    if (!residual(b, u, G, DG))
+        return false;
+    const double arc = t[0] * (u[0] - u0[0]) + t[1] * (u[1] - u0[1]) + t[2] * (u[2] - u0[2]) - h;
+    *norm = hypot(hypot(G[0], G[1]), arc);
+    return isfinite(*norm);
+}
+
+/* Newton from the prediction u0 + h t onto G = 0 with t . (u - u0) = h,
+ * damped: a step is halved until the residual shrinks, since near a
+ * change of signature the map's Jacobian holds only on one side. */
+static bool correct(const branch *b, const double u0[3], const double t[3], double h, double u[3],
+                    int *iterations)
+{
+    for (int i = 0; i < 3; i++)
+        u[i] = u0[i] + h * t[i];
+    double G[2], DG[6], norm;
+    if (!corrector_norm(b, u0, t, h, u, G, DG, &norm))
+        return false;
+    for (int it = 0; it < 40; it++) {
+        if (hypot(G[0], G[1]) < 1e-11 && norm < 1e-10) {
+            *iterations = it;
+            return true;
+        }
+        const double A[9] = {DG[0], DG[1], DG[2], DG[3], DG[4], DG[5], t[0], t[1], t[2]};
+        const double r[3] = {-G[0], -G[1], -(norm * norm - G[0] * G[0] - G[1] * G[1] > 0
+                                                 ? t[0] * (u[0] - u0[0]) + t[1] * (u[1] - u0[1]) +
+                                                       t[2] * (u[2] - u0[2]) - h
+                                                 : 0)};
+        double du[3];
+        if (!solve3(A, r, du))
+            return false;
+        bool accepted = false;
+        for (double lambda = 1; lambda > 1e-4 && !accepted; lambda /= 2) {
+            double trial[3], Gt[2], DGt[6], nt;
+            for (int i = 0; i < 3; i++)
+                trial[i] = u[i] + lambda * du[i];
+            if (corrector_norm(b, u0, t, h, trial, Gt, DGt, &nt) && nt < norm) {
+                memcpy(u, trial, sizeof trial);
+                memcpy(G, Gt, sizeof Gt);
+                memcpy(DG, DGt, sizeof DGt);
+                norm = nt;
+                accepted = true;
+            }
+        }
+        if (!accepted)
+            return false;
+    }
+    return false;
+}
+
+/* A converged point: the solution and its test functions. */
+typedef struct point {
+    double u[3], t[3];
+    cm_fo_solution s;
+    double fold, pd, ns; /* det(M - I), det(M + I), det M - 1 (complex pairs; else NaN) */
+} point;
+
+static bool describe(const branch *b, const double u[3], const double *prev_t, double direction,
+                     point *pt)
+{
+    cm_fo o;
+    cm_fo_with(&b->base, b->param, u[2], &o);
+    double G[2], DG[6];
+    if (!cm_fo_solution_at(&o, u, b->period, &pt->s) || !residual(b, u, G, DG) ||
+        !tangent(DG, prev_t, direction, pt->t))
+        return false;
+    memcpy(pt->u, u, sizeof pt->u);
+    pt->s.p = u[2];
+    /* from the multipliers: (l1 - 1)(l2 - 1) and (l1 + 1)(l2 + 1) */
+    const double tr = pt->s.mult[0][0] + pt->s.mult[1][0];
+    const double det = pt->s.mult[0][0] * pt->s.mult[1][0] + pt->s.mult[0][1] * pt->s.mult[0][1];
+    pt->fold = det - tr + 1;
+    pt->pd = det + tr + 1;
+    pt->ns = pt->s.mult[0][1] != 0 ? det - 1 : NAN;
+    return true;
+}
+
+/* Moves the section of point pt to the phase, among 64 of the period,
+ * where the solution slides fastest, and pt with it (the same solution,
+ * its state at the new phase); false if the phase is the parameter or
+ * nothing better is found. */
+static bool rephase(branch *b, point *pt)
+{
+    if (b->param == CM_FO_P_PHI)
+        return false;
+    cm_fo o;
+    cm_fo_with(&b->base, b->param, pt->u[2], &o);
+    cm_fo_state st = {0, pt->u[0], pt->u[1], cm_fo_mode_of(&o, 0, pt->u[0], pt->u[1])};
+    double best_v = fabs(pt->u[1]), best_s = 0, at[2] = {0, 0};
+    for (int i = 1; i < 64; i++) {
+        const double s = o.T * i / 64;
+        if (!cm_fo_propagate(&o, &st, s, NULL, NULL, NULL))
+            return false;
+        if (fabs(st.v) > 1.5 * best_v) {
+            best_v = fabs(st.v);
+            best_s = s;
+            at[0] = st.x, at[1] = st.v;
+        }
+    }
+    if (best_s == 0)
+        return false;
+    const double phi = fmod(b->base.phi + o.Omega * best_s, 6.283185307179586476925286766559);
+    branch moved = *b;
+    cm_fo_init(&moved.base, b->base.S, b->base.S0, b->base.Omega, phi);
+    double u[3] = {at[0], at[1], pt->u[2]};
+    cm_fo_with(&moved.base, b->param, u[2], &o);
+    point q;
+    if (!cm_fo_periodic_point(&o, u, b->period) ||
+        !describe(&moved, u, NULL, pt->t[2] < 0 ? -1 : 1, &q))
+        return false;
+    *b = moved;
+    *pt = q;
+    return true;
+}
+
+/* What the sticking segments of a cyclic signature adjoin: for each 's',
+ * the modes before and after it, sorted ("du,ud"). Crossing-sliding
+ * changes this; a slip segment that appears or goes elsewhere does not. */
+static void stick_pattern(const char *sig, char *out, size_t size)
+{
+    const size_t n = strlen(sig);
+    char pairs[CM_FO_SIGNATURE][3];
+    size_t np = 0;
+    for (size_t i = 0; i < n; i++)
+        if (sig[i] == 's') {
+            pairs[np][0] = sig[(i + n - 1) % n];
+            pairs[np][1] = sig[(i + 1) % n];
+            pairs[np++][2] = '\0';
+        }
+    for (size_t i = 1; i < np; i++) /* a few pairs: insertion sort */
+        for (size_t j = i; j > 0 && strcmp(pairs[j - 1], pairs[j]) > 0; j--) {
+            char t[3];
+            memcpy(t, pairs[j], 3);
+            memcpy(pairs[j], pairs[j - 1], 3);
+            memcpy(pairs[j - 1], t, 3);
+        }
+    size_t used = 0;
+    out[0] = '\0';
+    for (size_t i = 0; i < np && used + 4 < size; i++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", i ? "," : "", pairs[i]);
+}
+
+/* The events between a and b: bit `type` set for each. */
+static unsigned events_between(const point *a, const point *b)
+{
+    unsigned set = 0;
+    if (a->fold * b->fold < 0)
+        set |= 1u << CM_FO_EVENT_SN;
+    if (a->pd * b->pd < 0)
+        set |= 1u << CM_FO_EVENT_PD;
+    if (!isnan(a->ns) && !isnan(b->ns) && a->ns * b->ns < 0)
+        set |= 1u << CM_FO_EVENT_NS;
+    if (strcmp(a->s.signature, b->s.signature) != 0) {
+        char pa[2 * CM_FO_SIGNATURE], pb[2 * CM_FO_SIGNATURE];
+        stick_pattern(a->s.signature, pa, sizeof pa);
+        stick_pattern(b->s.signature, pb, sizeof pb);
+        set |= 1u << (strcmp(pa, pb) != 0 ? CM_FO_EVENT_CS : CM_FO_EVENT_T);
+    }
+    return set;
+}
+
+static double test_value(int type, const point *p)
+{
+    switch (type) {
+    case CM_FO_EVENT_SN: return p->fold;
+    case CM_FO_EVENT_PD: return p->pd;
+    case CM_FO_EVENT_NS: return p->ns;
+    default: return 0;
+    }
+}
+
+/* Locates the event of `type` between a and b (a step h along a's
+ * tangent) by bisection of the step: test functions by sign, signatures by
+ * which side they agree with, until the corrector cannot go on (at a
+ * branch point the extended system is singular; where a sticking segment
+ * is born the map is barely differentiable). A test function's zero is
+ * interpolated between the two closest points (described by the side
+ * before: the solution that the event ends); a signature change is put at
+ * the last point of the old signature. */
+static void locate(const branch *b, const point *a, const point *bp, double h, int type,
+                   cm_fo_branch_event *e)
+{
+    double lo = 0, hi = h;
+    point near_a = *a, near_b = *bp;
+    const bool by_signature = type == CM_FO_EVENT_CS || type == CM_FO_EVENT_T;
+    for (int it = 0; it < 60 && fabs(hi - lo) > 1e-10; it++) {
+        const double mid = 0.5 * (lo + hi);
+        double u[3];
+        int iters;
+        point m;
+        if (!correct(b, a->u, a->t, mid, u, &iters) || !describe(b, u, a->t, 0, &m))
+            break;
+        const bool on_a_side = by_signature
+                                   ? strcmp(m.s.signature, a->s.signature) == 0
+                                   : test_value(type, &m) * test_value(type, a) > 0;
+        if (on_a_side) {
+            lo = mid;
+            near_a = m;
+        } else {
+            hi = mid;
+            near_b = m;
+        }
+    }
+    e->type = type;
+    e->fold = type == CM_FO_EVENT_SN && a->t[2] * bp->t[2] < 0;
+    e->at = near_a.s; /* the solution that the event ends, as it was */
+    e->other = near_b.s;
+    e->width = fabs(near_b.u[2] - near_a.u[2]);
+    if (!by_signature) { /* the zero of the test function, linearly between them */
+        const double fa = test_value(type, &near_a), fb = test_value(type, &near_b);
+        const double w = fa / (fa - fb);
+        e->at.p = near_a.u[2] + w * (near_b.u[2] - near_a.u[2]);
+        e->at.z[0] = near_a.u[0] + w * (near_b.u[0] - near_a.u[0]);
+        e->at.z[1] = near_a.u[1] + w * (near_b.u[1] - near_a.u[1]);
+    }
+    snprintf(e->before, sizeof e->before, "%s", a->s.signature);
+    snprintf(e->after, sizeof e->after, "%s", bp->s.signature);
+}
+
+int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
+                   const double z[2], int period, cm_fo_point_fn on_point,
+                   cm_fo_event_fn2 on_event, void *user, int *stop)
+{
+    branch b = {*o, opt->param, period};
+    const double h_min = opt->h_min > 0 ? opt->h_min : 1e-9;
+    const double h_max = opt->h_max > 0 ? opt->h_max : 2e-2;
+    const int max_points = opt->max_points > 0 ? opt->max_points : 5000;
+    double h = opt->h0 > 0 ? opt->h0 : 1e-3;
+    point cur;
+    const double u0[3] = {z[0], z[1], p0};
+    *stop = CM_FO_STOP_LOST;
+    if (!describe(&b, u0, NULL, opt->direction < 0 ? -1 : 1, &cur))
+        return 0;
+    rephase(&b, &cur); /* or stay where it is */
+    bool rephased = false; /* at this point already */
+    int n = 1;
+    if (on_point && on_point(user, &cur.s)) {
+        *stop = CM_FO_STOP_POINTS;
+        return n;
+    }
+    while (n < max_points) {
+        double u[3];
+        int iters = 0;
+        point next;
+        if (!correct(&b, cur.u, cur.t, h, u, &iters) || !describe(&b, u, cur.t, 0, &next)) {
+            h /= 2;
+            if (h >= h_min)
+                continue;
+            if (rephased || !rephase(&b, &cur)) {
+                *stop = CM_FO_STOP_STEP;
+                return n;
+            }
+            rephased = true;
+            h = opt->h0 > 0 ? opt->h0 : 1e-3;
+            continue;
+        }
+        rephased = false;
+        const unsigned found = on_event ? events_between(&cur, &next) : 0;
+        for (int type = 0; type <= CM_FO_EVENT_T; type++) {
+            if (!(found & (1u << type)))
+                continue;
+            cm_fo_branch_event e;
+            locate(&b, &cur, &next, h, type, &e);
+            if (on_event(user, &e)) {
+                *stop = CM_FO_STOP_POINTS;
+                return n;
+            }
+        }
+        cur = next;
+        n++;
+        if (on_point && on_point(user, &cur.s)) {
+            *stop = CM_FO_STOP_POINTS;
+            return n;
+        }
+        if (cur.u[2] < opt->lo || cur.u[2] > opt->hi) {
+            *stop = CM_FO_STOP_BOUND;
+            return n;
+        }
+        if (iters <= 3)
+            h = fmin(h * 1.5, h_max);
+    }
+    *stop = CM_FO_STOP_POINTS;
+    return n;
+}
+
+const char *cm_fo_event_name(int type)
+{
+    static const char *const names[] = {"SN", "PD", "NS", "CS", "T"};
+    return type >= 0 && type < 5 ? names[type] : "?";
+}
+
+const char *cm_fo_stop_name(int stop)
+{
+    static const char *const names[] = {"the parameter left its range", "the point limit",
+                                        "the corrector failed at the smallest step",
+                                        "the motion could not be followed"};
+    return stop >= 0 && stop < 4 ? names[stop] : "?";
+}

@@ -1,0 +1,120 @@
+/* models/fo_continuation.h - continuation of the friction oscillator's
+ * periodic solutions (thesis 2.5, docs/models.md 9.9): period-k fixed
+ * points of the Poincare map P followed in one parameter by
+ * pseudo-arclength continuation with Newton on P^k(z) - z (the exact
+ * monodromy of cm_fo_monodromy), their Floquet multipliers, and the
+ * events along a branch: folds (SN), period doublings (PD), Neimark-Sacker
+ * points (NS) and changes of the solution's signature (the order of its
+ * slip and stick segments), each located on the branch. Pure functions. */
+#ifndef CM_MODELS_FO_CONTINUATION_H
+#define CM_MODELS_FO_CONTINUATION_H
+
+#include <stdbool.h>
+
+#include "models/friction_oscillator.h"
+
+/* The parameters a branch can follow. */
+enum cm_fo_param { CM_FO_P_S = 0, CM_FO_P_S0, CM_FO_P_OMEGA, CM_FO_P_PHI };
+
+/* The parameter named "S", "S0", "Omega" or "phi", or -1. */
+int cm_fo_param_of(const char *name);
+const char *cm_fo_param_name(int param);
+
+/* The oscillator o with parameter `param` set to p. */
+void cm_fo_with(const cm_fo *o, int param, double p, cm_fo *out);
+
+enum { CM_FO_SIGNATURE = 96, CM_FO_MAX_STOPS = 16 };
+
+/* A periodic solution: z = (x, v) at the section of phase phi, a fixed
+ * point of P^period there. */
+typedef struct cm_fo_solution {
+    double p;          /* the parameter's value */
+    double phi;        /* the section's forcing phase */
+    double z[2];
+    int period;        /* excitation periods */
+    double mult[2][2]; /* Floquet multipliers (re, im), |first| >= |second| */
+    bool stable;       /* both multipliers inside the unit circle */
+    double x_max, x_min;
+    double psi;        /* asymmetry: the sum of x at the velocity zeros over the period */
+    int n_stick;       /* sticking segments per period */
+    int n_stops;
+    double stops[CM_FO_MAX_STOPS]; /* x where the block sticks, in time order */
+    bool symmetric;    /* |psi| below 1e-6 */
+    /* the modes in time order, u (up), d (down), s (stuck), as a cycle:
+     * the rotation that comes first alphabetically, so that it does not
+     * depend on the section's phase */
+    char signature[CM_FO_SIGNATURE];
+} cm_fo_solution;
+
+/* Evaluates the solution at o (parameter already set), z and period:
+ * everything but p. false where P^period cannot be followed. */
+bool cm_fo_solution_at(const cm_fo *o, const double z[2], int period, cm_fo_solution *out);
+
+/* A fixed point of P^period near z (in place) by Newton's method with the
+ * exact monodromy; false if it does not converge to 1e-11. */
+bool cm_fo_periodic_point(const cm_fo *o, double z[2], int period);
+
+/* The smallest period 1..max_period of the orbit that a simulation of
+ * `settle` periods from z settles on, and a point of it in z (in place);
+ * 0 if none (chaotic, or the motion was lost). */
+int cm_fo_find_periodic(const cm_fo *o, double z[2], int settle, int max_period);
+
+/* The kinds of events on a branch. */
+enum cm_fo_event_type {
+    CM_FO_EVENT_SN = 0, /* a real multiplier through +1 (a fold where the branch turns back,
+                           else a branch point, as the thesis' SN_2s) */
+    CM_FO_EVENT_PD,     /* a multiplier through -1 */
+    CM_FO_EVENT_NS,     /* a complex pair through the unit circle */
+    CM_FO_EVENT_CS,     /* sticking segments appear, vanish or change neighbours
+                           (crossing-sliding and the like) */
+    CM_FO_EVENT_T       /* only slip segments appear or vanish */
+};
+/* "SN", "PD", "NS", "CS", "T". */
+const char *cm_fo_event_name(int type);
+
+typedef struct cm_fo_branch_event {
+    int type;
+    bool fold;                    /* SN: the branch turns back in the parameter */
+    /* the located point, described by the solution before it: SN, PD, NS
+     * at the test function's zero (interpolated), CS and T at the last
+     * point with the signature before */
+    cm_fo_solution at;
+    cm_fo_solution other; /* the nearest point found on the other side */
+    double width;         /* |at.p - other.p|: how far the bracket closed */
+    char before[CM_FO_SIGNATURE]; /* signatures on either side (CS, T) */
+    char after[CM_FO_SIGNATURE];
+} cm_fo_branch_event;
+
+/* Why a branch ended. */
+enum cm_fo_stop {
+    CM_FO_STOP_BOUND = 0, /* the parameter left [lo, hi] */
+    CM_FO_STOP_POINTS,    /* max_points reached */
+    CM_FO_STOP_STEP,      /* the corrector failed down to the smallest step */
+    CM_FO_STOP_LOST       /* P^period cannot be followed (motion lost) */
+};
+const char *cm_fo_stop_name(int stop);
+
+typedef struct cm_fo_continue_options {
+    int param;
+    double lo, hi;    /* the parameter's range */
+    double direction; /* +1: the parameter grows first, -1: it shrinks */
+    double h0, h_min, h_max; /* arclength steps (0: 1e-3, 1e-9, 2e-2) */
+    int max_points;   /* 0: 5000 */
+} cm_fo_continue_options;
+
+/* Called for each branch point and each event, in branch order; nonzero
+ * stops the continuation (returned as CM_FO_STOP_POINTS). */
+typedef int (*cm_fo_point_fn)(void *user, const cm_fo_solution *s);
+typedef int (*cm_fo_event_fn2)(void *user, const cm_fo_branch_event *e);
+
+/* Continues the period-k solution through z at parameter value p0 (z
+ * must be a fixed point of P^period to 1e-9: cm_fo_periodic_point). The
+ * section's phase moves (unless it is the parameter) to where the solution
+ * slides fastest, at the start and wherever the corrector fails: a
+ * section inside a sticking segment makes P non-smooth there. The stop
+ * reason goes to *stop. Returns the number of points. */
+int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
+                   const double z[2], int period, cm_fo_point_fn on_point,
+                   cm_fo_event_fn2 on_event, void *user, int *stop);
+
+#endif
