@@ -247,7 +247,8 @@ static void print_json(const cont_args *a, const cm_model *m, const collected *c
         json_object(&j, NULL);
         json_str(&j, "label", label);
         json_str(&j, "kind", event_kind(e));
-        json_num(&j, a->vary, e->at.p);
+        json_num(&j, "value", e->at.p);
+        json_num(&j, "width", e->width);
         json_nums(&j, "state", e->at.z, 2);
         json_num(&j, "phi", e->at.phi);
         json_str(&j, "before", e->before);

@@ -53,6 +53,32 @@ params = read_png(sys.argv[2])[4]["Parameters"]
 assert "S0=0.4," in params, params          # the fixed ones are named,
 assert "Omega=" not in params and "S=" not in params, params  # the grid's are in Grid only
 PY
+# --- continue: branches and their events (thesis Fig. 2.17) ----------------
+expect_usage "--vary NAME=LO:HI is required" continue --csv x.csv
+expect_usage "--vary: 'Q=0:1'" continue --vary Q=0:1
+expect_usage "--vary: 'S=0.4:0.1'" continue --vary S=0.4:0.1
+expect_usage "outside --vary S=0.02:0.2" continue --param S=0.3 --vary S=0.02:0.2
+expect_usage "continue follows friction-oscillator only" continue --model microchaos-pd --vary S=0:1
+"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --csv branch.csv \
+  --events events.csv > cont.txt || fail "continue the 1a branch"
+grep -q "PD_1a  S = 0.0683" cont.txt || fail "continue: no PD_1a near S = 0.068: $(cat cont.txt)"
+python3 - branch.csv events.csv <<'PY' || fail "continue's CSV"
+import csv, sys
+pts = list(csv.DictReader(open(sys.argv[1])))
+ev = list(csv.DictReader(open(sys.argv[2])))
+assert pts[0]["S"] == "0.29999999999999999" or abs(float(pts[0]["S"]) - 0.3) < 1e-12, pts[0]
+s = [float(p["S"]) for p in pts]
+assert s == sorted(s, reverse=True), "the branch goes down in S"
+assert {p["signature"] for p in pts} == {"dsu"} and all(p["sticks"] == "1" for p in pts)
+stable = [p["stable"] == "1" for p in pts]
+assert stable[0] and not stable[-1], "stable at the start, unstable past PD"
+assert len(ev) == 1 and ev[0]["label"] == "PD_1a" and abs(float(ev[0]["mult1_re"]) + 1) < 1e-6, ev
+assert abs(float(ev[0]["S"]) - 0.068) < 1e-3
+PY
+"$CM" continue --param S=0.38 --vary S=0.3:0.4 --down --from 1.33,0.02 --period 1 --quiet \
+  --events - | grep -q "^SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
+ls | grep -q tmp- && fail "temporary files left behind"
+
 # --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
 # A stable focus of the map: the exponent is -delta/2 at every grid point
 # (delta varies), by finite differences; one thread or two, the same CSV.
