@@ -511,6 +511,10 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
     e->fold = type == CM_FO_EVENT_SN && a->t[2] * bp->t[2] < 0;
     e->at = near_a.s; /* the solution that the event ends, as it was */
     e->other = near_b.s;
+    /* near a branch point the bisection may land on the other branch: the
+     * kind of solution is the branch's, as at its last regular point */
+    e->at.symmetric = a->s.symmetric;
+    e->at.n_stick = a->s.n_stick;
     e->width = fabs(near_b.u[2] - near_a.u[2]);
     if (!by_signature) { /* the zero of the test function, linearly between them */
         const double fa = test_value(type, &near_a), fb = test_value(type, &near_b);

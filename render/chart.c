@@ -217,6 +217,27 @@ static void colour_bar(const cm_chart *c, const layout *L, const cm_font *f, dou
         cm_font_draw(f, c->heat->name, x, in->plot_y + L->ascent, ink, cv->rgba, cv->w, cv->h);
 }
 
+/* The labels, each right of and above its point, kept inside the plot. */
+static void draw_labels(const cm_chart *c, const cm_font *f, const layout *L,
+                        const cm_chart_info *in, const cm_canvas *cv)
+{
+    for (int k = 0; k < c->n_labels; k++) {
+        const cm_chart_label *l = &c->labels[k];
+        const double fx = (l->x - c->lo[0]) / (c->hi[0] - c->lo[0]);
+        const double fy = (l->y - c->lo[1]) / (c->hi[1] - c->lo[1]);
+        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) || !l->text)
+            continue;
+        const int w = cm_font_width(f, l->text);
+        int x = in->plot_x + (int)lround(fx * in->plot_w) + 4;
+        int y = in->plot_y + (int)lround((1 - fy) * in->plot_h) - 4;
+        if (x + w > in->plot_x + in->plot_w - 2) /* near the right edge: left of the point */
+            x -= w + 8;
+        if (y - L->ascent < in->plot_y + 2)
+            y = in->plot_y + 2 + L->ascent;
+        cm_font_draw(f, l->text, x, y, ink, cv->rgba, cv->w, cv->h);
+    }
+}
+
 /* Opens the chart's font and plans its layout: info gets the plot's place. */
 static cm_status measure(const cm_chart *c, cm_font **f, layout *L, cm_chart_info *info, char *msg,
                          size_t msg_size)
@@ -271,6 +292,7 @@ cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_in
     if (st == CM_OK) {
         frame(&cv, info->plot_x, info->plot_y, info->plot_w, info->plot_h);
         axes(c, &L, f, info, &cv);
+        draw_labels(c, f, &L, info, &cv);
         if (c->heat)
             colour_bar(c, &L, f, hmax, info, &cv);
         if (c->title)

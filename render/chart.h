@@ -39,6 +39,12 @@ typedef struct cm_heat {
     const char *name; /* label of the colour bar */
 } cm_heat;
 
+/* A text at a data point, drawn right of and above it (markers of events). */
+typedef struct cm_chart_label {
+    double x, y;
+    const char *text;
+} cm_chart_label;
+
 typedef struct cm_chart {
     int width, height;
     double lo[2], hi[2]; /* the data rectangle */
@@ -50,6 +56,8 @@ typedef struct cm_chart {
     int min_left; /* the plot starts at least this many pixels from the left
                      edge (stacked charts share their x axis); 0: as the
                      labels need */
+    const cm_chart_label *labels; /* may be NULL; those outside the plot are skipped */
+    int n_labels;
 } cm_chart;
 
 /* Where the plot went, so that callers and tests can map pixels. */

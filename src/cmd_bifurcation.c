@@ -343,6 +343,8 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
                                &series[k],
                                1,
                                figure_font(),
+                               0,
+                               NULL,
                                0};
     }
     snprintf(runs, sizeof runs,

@@ -13,13 +13,14 @@
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/json.h"
+#include "src/basin_png.h"
 #include "src/outfile.h"
 
 static const char continue_help[] =
     "usage: cellmap continue [--model friction-oscillator] [--param k=v[,k=v]]\n"
-    "                        --vary NAME=LO:HI [--down] [--from X,V] [--period K]\n"
-    "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--json]\n"
-    "                        [--quiet]\n\n"
+    "                        --vary NAME=LO:HI [--down|--both] [--from X,V ...] [--period K]\n"
+    "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
+    "                        [--size WxH] [--json] [--quiet]\n\n"
     "Follows a periodic solution of the dry friction oscillator in parameter NAME\n"
     "(S, S0, Omega or phi) by pseudo-arclength continuation of the fixed points of\n"
     "P^K, the K-th iterate of the stroboscopic Poincare map, with Newton's method on\n"
@@ -36,24 +37,33 @@ static const char continue_help[] =
     "signature is its cycle of modes, u (slip up), d (slip down), s (stuck).\n\n"
     "  --vary NAME=LO:HI   the parameter and its range\n"
     "  --down              the parameter decreases first (default: it increases)\n"
+    "  --both              from each start, both ways: the whole branch through it\n"
     "  --from X,V          start near (x, v) at the section (default: simulate 500\n"
-    "                      periods from the thesis' start 1 + 0.9 S0, 0)\n"
+    "                      periods from the thesis' start 1 + 0.9 S0, 0); repeat it\n"
+    "                      (up to 8) for several branches in one diagram\n"
     "  --period K          the solution's period in excitation periods (default: the\n"
     "                      smallest, 1..16, that the start settles on)\n"
     "  --max-points N      at most N branch points (default 5000)\n"
-    "  --csv FILE|-        the branch points: parameter, section phase, x, v, period,\n"
-    "                      stability, multipliers, x range, Psi, sticks, stops, signature\n"
-    "  --events FILE|-     the events: label, kind, fold, parameter, x, v, phase,\n"
+    "  --csv FILE|-        the branch points: branch, parameter, section phase, x, v,\n"
+    "                      period, stability, multipliers, x range, Psi, sticks, stops,\n"
+    "                      signature\n"
+    "  --events FILE|-     the events: branch, label, kind, fold, parameter, x, v, phase,\n"
     "                      stability, multipliers, signatures before and after\n"
+    "  --png FILE          the thesis' diagram (Figs. 2.17-2.18): maximal displacement,\n"
+    "                      stop positions and Psi against the parameter; stable points\n"
+    "                      green, unstable red, events marked and labelled\n"
+    "  --size WxH          image size (default 900x1100)\n"
     "  --json              the summary and events as JSON (docs/cellmap.schema.json)\n"
     "  --quiet             no summary\n";
+
+enum { MAX_STARTS = 8 };
 
 typedef struct cont_args {
     model_opts mo;
     char vary[16];
-    double lo, hi, from[2];
-    int has_vary, has_from, down, period, max_points;
-    const char *csv, *events;
+    double lo, hi, from[MAX_STARTS][2];
+    int has_vary, n_from, down, both, period, max_points, width, height;
+    const char *csv, *events, *png;
     bool json, quiet;
 } cont_args;
 
@@ -98,17 +108,25 @@ static int parse_args(cli *c, cont_args *a)
                 err = parse_vary(c, a);
         } else if (cli_is(c, "--down", false, &err)) {
             a->down = 1;
+        } else if (cli_is(c, "--both", false, &err)) {
+            a->both = 1;
         } else if (cli_is(c, "--from", true, &err)) {
-            if (c->value && (!parse_doubles(c->value, a->from, &n, 2) || n != 2 ||
-                             !isfinite(a->from[0]) || !isfinite(a->from[1])))
+            if (c->value && a->n_from == MAX_STARTS)
+                err = cli_usage_error(c, "--from: at most %d starts", MAX_STARTS);
+            else if (c->value &&
+                     (!parse_doubles(c->value, a->from[a->n_from], &n, 2) || n != 2 ||
+                      !isfinite(a->from[a->n_from][0]) || !isfinite(a->from[a->n_from][1])))
                 err = cli_usage_error(c, "--from: '%s' is not X,V (two finite numbers)", c->value);
-            a->has_from = 1;
+            a->n_from++;
         } else if (cli_take_int(c, "--period", 1, 64, &a->period, &err)) {
         } else if (cli_take_int(c, "--max-points", 2, 1000000, &a->max_points, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
         } else if (cli_is(c, "--events", true, &err)) {
             a->events = c->value;
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -121,18 +139,40 @@ static int parse_args(cli *c, cont_args *a)
         err = cli_usage_error(c, "--vary NAME=LO:HI is required (e.g. --vary S=0.02:0.4)");
     if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->events)))
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->events))
-        err = cli_usage_error(c, "--csv - and --events -: only one can go to standard output");
+    if (!err && (cm_output_names_stdout(a->csv) + cm_output_names_stdout(a->events) +
+                     cm_output_names_stdout(a->png) >
+                 1))
+        err = cli_usage_error(c, "--csv, --events and --png: only one can go to standard output");
+    if (!err && a->down && a->both)
+        err = cli_usage_error(c, "--down and --both: choose one");
     return err;
 }
 
-/* ---- the branch, collected ---- */
+/* ---- the branches, collected ---- */
+
+typedef struct tagged_point {
+    int branch;
+    cm_fo_solution s;
+} tagged_point;
+
+typedef struct tagged_event {
+    int branch;
+    cm_fo_branch_event e;
+} tagged_event;
+
+typedef struct branch_info {
+    cm_fo_solution start;
+    int direction, stop;
+    uint64_t points;
+} branch_info;
 
 typedef struct collected {
-    cm_fo_solution *points;
+    tagged_point *points;
     uint64_t n, cap;
-    cm_fo_branch_event *events;
+    tagged_event *events;
     uint64_t n_events, cap_events;
+    branch_info branches[2 * MAX_STARTS];
+    int n_branches;
     bool out_of_memory;
 } collected;
 
@@ -143,7 +183,7 @@ static int keep_point(void *user, const cm_fo_solution *s)
         c->out_of_memory = true;
         return 1;
     }
-    c->points[c->n++] = *s;
+    c->points[c->n++] = (tagged_point){c->n_branches, *s};
     return 0;
 }
 
@@ -154,7 +194,7 @@ static int keep_event(void *user, const cm_fo_branch_event *e)
         c->out_of_memory = true;
         return 1;
     }
-    c->events[c->n_events++] = *e;
+    c->events[c->n_events++] = (tagged_event){c->n_branches, *e};
     return 0;
 }
 
@@ -192,13 +232,13 @@ static bool write_points(const cont_args *a, const collected *c)
     outfile o;
     if (!outfile_open("continue", a->csv, &o))
         return false;
-    fprintf(o.f, "%s,phi,x,v,period,stable,mult1_re,mult1_im,mult2_re,mult2_im,x_max,x_min,psi,"
-                 "sticks,stops,signature\n",
+    fprintf(o.f, "branch,%s,phi,x,v,period,stable,mult1_re,mult1_im,mult2_re,mult2_im,x_max,x_min,"
+                 "psi,sticks,stops,signature\n",
             a->vary);
     for (uint64_t i = 0; i < c->n; i++) {
-        const cm_fo_solution *s = &c->points[i];
-        fprintf(o.f, "%.17g,%.17g,%.17g,%.17g,%d,%d", s->p, s->phi, s->z[0], s->z[1], s->period,
-                s->stable);
+        const cm_fo_solution *s = &c->points[i].s;
+        fprintf(o.f, "%d,%.17g,%.17g,%.17g,%.17g,%d,%d", c->points[i].branch + 1, s->p, s->phi,
+                s->z[0], s->z[1], s->period, s->stable);
         print_mults(o.f, s);
         fprintf(o.f, ",%.17g,%.17g,%.17g,%d,", s->x_max, s->x_min, s->psi, s->n_stick);
         for (int k = 0; k < s->n_stops; k++)
@@ -213,38 +253,49 @@ static bool write_events(const cont_args *a, const collected *c)
     outfile o;
     if (!outfile_open("continue", a->events, &o))
         return false;
-    fprintf(o.f, "label,kind,fold,%s,x,v,phi,stable,mult1_re,mult1_im,mult2_re,mult2_im,"
-                 "signature_before,signature_after\n",
+    fprintf(o.f, "branch,label,kind,fold,%s,width,x,v,phi,stable,mult1_re,mult1_im,mult2_re,"
+                 "mult2_im,signature_before,signature_after\n",
             a->vary);
     for (uint64_t i = 0; i < c->n_events; i++) {
-        const cm_fo_branch_event *e = &c->events[i];
+        const cm_fo_branch_event *e = &c->events[i].e;
         char label[32];
         event_label(e, label, sizeof label);
-        fprintf(o.f, "%s,%s,%d,%.17g,%.17g,%.17g,%.17g,%d", label, event_kind(e), e->fold,
-                e->at.p, e->at.z[0], e->at.z[1], e->at.phi, e->at.stable);
+        fprintf(o.f, "%d,%s,%s,%d,%.17g,%.3g,%.17g,%.17g,%.17g,%d", c->events[i].branch + 1, label,
+                event_kind(e), e->fold, e->at.p, e->width, e->at.z[0], e->at.z[1], e->at.phi,
+                e->at.stable);
         print_mults(o.f, &e->at);
         fprintf(o.f, ",%s,%s\n", e->before, e->after);
     }
     return outfile_close("continue", &o, true);
 }
 
-static void print_json(const cont_args *a, const cm_model *m, const collected *c, int stop)
+static void print_json(const cont_args *a, const cm_model *m, const collected *c)
 {
     json j;
     json_begin(&j, stdout, "continue");
     json_model(&j, m);
     json_str(&j, "vary", a->vary);
     json_nums(&j, "range", (const double[2]){a->lo, a->hi}, 2);
-    json_int(&j, "period", c->points[0].period);
-    json_nums(&j, "start", c->points[0].z, 2);
-    json_uint(&j, "points", c->n);
-    json_str(&j, "stop", cm_fo_stop_name(stop));
+    json_array(&j, "branches");
+    for (int b = 0; b < c->n_branches; b++) {
+        const branch_info *bi = &c->branches[b];
+        json_object(&j, NULL);
+        json_int(&j, "period", bi->start.period);
+        json_nums(&j, "start", bi->start.z, 2);
+        json_num(&j, "phi", bi->start.phi);
+        json_str(&j, "direction", bi->direction > 0 ? "up" : "down");
+        json_uint(&j, "points", bi->points);
+        json_str(&j, "stop", cm_fo_stop_name(bi->stop));
+        json_object_end(&j);
+    }
+    json_array_end(&j);
     json_array(&j, "events");
     for (uint64_t i = 0; i < c->n_events; i++) {
-        const cm_fo_branch_event *e = &c->events[i];
+        const cm_fo_branch_event *e = &c->events[i].e;
         char label[32];
         event_label(e, label, sizeof label);
         json_object(&j, NULL);
+        json_int(&j, "branch", c->events[i].branch + 1);
         json_str(&j, "label", label);
         json_str(&j, "kind", event_kind(e));
         json_num(&j, "value", e->at.p);
@@ -259,29 +310,151 @@ static void print_json(const cont_args *a, const cm_model *m, const collected *c
     json_end(&j);
 }
 
-static void print_text(const cont_args *a, const collected *c, int stop)
+static void print_text(const cont_args *a, const collected *c)
 {
-    FILE *out = report_stream(a->csv, a->events, NULL);
-    const cm_fo_solution *s0 = &c->points[0];
-    fprintf(out, "period-%d solution at %s = %s, (x, v) = (%s, %s) at phase %s, signature %s\n",
-            s0->period, a->vary, CM_NUM(s0->p), CM_NUM(s0->z[0]), CM_NUM(s0->z[1]),
-            CM_NUM(s0->phi), s0->signature);
-    for (uint64_t i = 0; i < c->n_events; i++) {
-        const cm_fo_branch_event *e = &c->events[i];
-        char label[32];
-        event_label(e, label, sizeof label);
-        fprintf(out, "  %-6s %s = %.9g  (%s; %s -> %s)\n", label, a->vary, e->at.p, event_kind(e),
-                e->before, e->after);
+    FILE *out = report_stream(a->csv, a->events, a->png);
+    for (int b = 0; b < c->n_branches; b++) {
+        const branch_info *bi = &c->branches[b];
+        fprintf(out,
+                "branch %d: period-%d solution at %s = %s, (x, v) = (%s, %s) at phase %s, "
+                "signature %s; %s %s\n",
+                b + 1, bi->start.period, a->vary, CM_NUM(bi->start.p), CM_NUM(bi->start.z[0]),
+                CM_NUM(bi->start.z[1]), CM_NUM(bi->start.phi), bi->start.signature, a->vary,
+                bi->direction > 0 ? "up" : "down");
+        for (uint64_t i = 0; i < c->n_events; i++) {
+            if (c->events[i].branch != b)
+                continue;
+            const cm_fo_branch_event *e = &c->events[i].e;
+            char label[32];
+            event_label(e, label, sizeof label);
+            fprintf(out, "  %-6s %s = %.9g  (%s; %s -> %s)\n", label, a->vary, e->at.p,
+                    event_kind(e), e->before, e->after);
+        }
+        fprintf(out, "  %llu points; stopped: %s\n", (unsigned long long)bi->points,
+                cm_fo_stop_name(bi->stop));
     }
-    fprintf(out, "%llu branch points; stopped: %s\n", (unsigned long long)c->n,
-            cm_fo_stop_name(stop));
 }
 
-/* The start: a fixed point of P^K at the model's parameters. */
-static bool find_start(const cont_args *a, const cm_fo *o, double z[2], int *period)
+/* ---- the diagram ---- */
+
+typedef struct cloud {
+    double *x, *y;
+    uint64_t n, cap;
+} cloud;
+
+static bool cloud_add(cloud *c, double x, double y)
 {
-    z[0] = a->has_from ? a->from[0] : 1 + 0.9 * o->S0;
-    z[1] = a->has_from ? a->from[1] : 0;
+    if (c->n == c->cap) {
+        const uint64_t cap = c->cap ? 2 * c->cap : 256;
+        double *nx = realloc(c->x, cap * sizeof *nx);
+        if (nx)
+            c->x = nx;
+        double *ny = nx ? realloc(c->y, cap * sizeof *ny) : NULL;
+        if (!ny)
+            return false;
+        c->y = ny;
+        c->cap = cap;
+    }
+    c->x[c->n] = x;
+    c->y[c->n++] = y;
+    return true;
+}
+
+static void cloud_range(const cloud *c, double *lo, double *hi)
+{
+    for (uint64_t i = 0; i < c->n; i++) {
+        *lo = fmin(*lo, c->y[i]);
+        *hi = fmax(*hi, c->y[i]);
+    }
+}
+
+/* Three panels as Figs. 2.17-2.18: the maximal displacement, the stops
+ * and Psi against the parameter; stable green, unstable red, events black
+ * with their labels on the top panel. */
+static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
+{
+    enum { PANELS = 3 };
+    cloud stable[PANELS] = {{0}}, unstable[PANELS] = {{0}}, marks[PANELS] = {{0}};
+    bool ok = true;
+    for (uint64_t i = 0; i < c->n && ok; i++) {
+        const cm_fo_solution *s = &c->points[i].s;
+        cloud *into = s->stable ? stable : unstable;
+        ok = cloud_add(&into[0], s->p, s->x_max) && cloud_add(&into[2], s->p, s->psi);
+        for (int k = 0; k < s->n_stops && ok; k++)
+            ok = cloud_add(&into[1], s->p, s->stops[k]);
+    }
+    cm_chart_label *labels = calloc(c->n_events + 1, sizeof *labels);
+    char(*texts)[32] = calloc(c->n_events + 1, sizeof *texts);
+    ok = ok && labels && texts;
+    for (uint64_t i = 0; i < c->n_events && ok; i++) {
+        const cm_fo_branch_event *e = &c->events[i].e;
+        event_label(e, texts[i], sizeof texts[i]);
+        labels[i] = (cm_chart_label){e->at.p, e->at.x_max, texts[i]};
+        ok = cloud_add(&marks[0], e->at.p, e->at.x_max) && cloud_add(&marks[2], e->at.p, e->at.psi);
+        for (int k = 0; k < e->at.n_stops && ok; k++)
+            ok = cloud_add(&marks[1], e->at.p, e->at.stops[k]);
+    }
+    if (!ok)
+        fprintf(stderr, "cellmap continue: out of memory for the diagram\n");
+    static const char *const y_names[PANELS] = {"x_max", "stops", "Psi"};
+    char title[512], params[400];
+    const char *const varied[] = {a->vary, NULL};
+    cm_params_format_with(&m->values, varied, params, sizeof params);
+    snprintf(title, sizeof title, "continuation in %s, %s; stable green, unstable red", a->vary,
+             params);
+    const char *titles[PANELS] = {title, "stop positions", "asymmetry Psi"};
+    const cm_rgb green = {26, 152, 80}, red = {215, 48, 39}, black = {0, 0, 0};
+    cm_series series[PANELS][3];
+    cm_chart charts[PANELS];
+    const int h = a->height / PANELS;
+    for (int k = 0; k < PANELS && ok; k++) {
+        double lo = INFINITY, hi = -INFINITY;
+        cloud_range(&stable[k], &lo, &hi);
+        cloud_range(&unstable[k], &lo, &hi);
+        if (!(lo <= hi))
+            lo = -1, hi = 1;
+        const double pad = hi > lo ? 0.06 * (hi - lo) : 0.5;
+        series[k][0] = (cm_series){CM_SERIES_POINTS, unstable[k].x, unstable[k].y, unstable[k].n,
+                                   red, 3};
+        series[k][1] = (cm_series){CM_SERIES_POINTS, stable[k].x, stable[k].y, stable[k].n,
+                                   green, 3};
+        series[k][2] = (cm_series){CM_SERIES_POINTS, marks[k].x, marks[k].y, marks[k].n, black, 7};
+        charts[k] = (cm_chart){a->width,
+                               k < PANELS - 1 ? h : a->height - (PANELS - 1) * h,
+                               {a->lo, lo - pad},
+                               {a->hi, hi + pad},
+                               a->vary,
+                               y_names[k],
+                               titles[k],
+                               NULL,
+                               series[k],
+                               3,
+                               figure_font(),
+                               0,
+                               k == 0 ? labels : NULL,
+                               k == 0 ? (int)c->n_events : 0};
+    }
+    char range[96];
+    snprintf(range, sizeof range, "%s=%s:%s", a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
+    const cm_png_text png_texts[] = {{"Model", m->name}, {"Parameters", params}, {"Vary", range}};
+    if (ok)
+        ok = write_chart_png("continue", a->png, charts, PANELS, png_texts, 3);
+    for (int k = 0; k < PANELS; k++) {
+        free(stable[k].x), free(stable[k].y);
+        free(unstable[k].x), free(unstable[k].y);
+        free(marks[k].x), free(marks[k].y);
+    }
+    free(labels);
+    free(texts);
+    return ok;
+}
+
+/* The start from (x, v): a fixed point of P^K at the model's parameters. */
+static bool find_start(const cont_args *a, const cm_fo *o, const double *from, double z[2],
+                       int *period)
+{
+    z[0] = from ? from[0] : 1 + 0.9 * o->S0;
+    z[1] = from ? from[1] : 0;
     if (a->period) {
         *period = a->period;
         if (cm_fo_periodic_point(o, z, a->period))
@@ -290,20 +463,62 @@ static bool find_start(const cont_args *a, const cm_fo *o, double z[2], int *per
         *period = cm_fo_find_periodic(o, z, 500, 64);
         return *period == a->period;
     }
-    *period = cm_fo_find_periodic(o, z, a->has_from ? 0 : 500, 16);
-    if (*period == 0 && a->has_from)
+    *period = cm_fo_find_periodic(o, z, from ? 0 : 500, 16);
+    if (*period == 0 && from)
         *period = cm_fo_find_periodic(o, z, 500, 16);
     return *period > 0;
+}
+
+/* Every branch: from each start, one way or both. */
+static int follow(const cont_args *a, const cm_fo *o, int param, double p0, collected *col)
+{
+    const int starts = a->n_from ? a->n_from : 1;
+    for (int k = 0; k < starts && !col->out_of_memory; k++) {
+        double z[2];
+        int period = 0;
+        const double *from = a->n_from ? a->from[k] : NULL;
+        if (!find_start(a, o, from, z, &period)) {
+            fprintf(stderr,
+                    "cellmap continue: no periodic solution%s found from (%s, %s) at %s = %s "
+                    "(chaotic there, or a longer period: give --from near one, and --period)\n",
+                    a->period ? " of that period" : " of period 1..16", CM_NUM(z[0]),
+                    CM_NUM(z[1]), a->vary, CM_NUM(p0));
+            return EXIT_FAIL;
+        }
+        for (int way = 0; way < (a->both ? 2 : 1) && !col->out_of_memory; way++) {
+            const int direction = a->both ? (way == 0 ? 1 : -1) : a->down ? -1 : 1;
+            const cm_fo_continue_options opt = {param, a->lo, a->hi, direction,
+                                                0,     0,     0,     a->max_points};
+            branch_info *bi = &col->branches[col->n_branches];
+            const uint64_t before = col->n;
+            cm_fo_continue(o, &opt, p0, z, period, keep_point, keep_event, col, &bi->stop);
+            bi->points = col->n - before;
+            bi->direction = direction;
+            if (bi->points == 0) {
+                fprintf(stderr, "cellmap continue: the solution at (%s, %s) cannot be followed\n",
+                        CM_NUM(z[0]), CM_NUM(z[1]));
+                return EXIT_FAIL;
+            }
+            bi->start = col->points[before].s;
+            col->n_branches++;
+        }
+    }
+    if (col->out_of_memory) {
+        fprintf(stderr, "cellmap continue: out of memory for the branch\n");
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
 }
 
 int cmd_continue(int argc, char **argv)
 {
     cli c = {"continue", argc, argv, 0, NULL, NULL};
-    cont_args a = {.mo = {.name = "friction-oscillator"}};
+    cont_args a = {.mo = {.name = "friction-oscillator"}, .width = 900, .height = 1100};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("continue", a.csv) || !outfile_check("continue", a.events))
+    if (!outfile_check("continue", a.csv) || !outfile_check("continue", a.events) ||
+        !chart_png_check("continue", a.png))
         return EXIT_FAIL;
     cm_model m;
     const int merr = model_opts_build(&c, &a.mo, &m);
@@ -321,39 +536,22 @@ int cmd_continue(int argc, char **argv)
                               "%s = %s (from --param or the default) is outside --vary %s=%s:%s; "
                               "start inside the range",
                               a.vary, CM_NUM(p0), a.vary, CM_NUM(a.lo), CM_NUM(a.hi));
-    double z[2];
-    int period = 0;
-    if (!err && !find_start(&a, o, z, &period)) {
-        fprintf(stderr,
-                "cellmap continue: no periodic solution%s found from (%s, %s) at %s = %s "
-                "(chaotic there, or a longer period: give --from near one, and --period)\n",
-                a.period ? " of that period" : " of period 1..16", CM_NUM(z[0]), CM_NUM(z[1]),
-                a.vary, CM_NUM(p0));
-        err = EXIT_FAIL;
-    }
-    if (err) {
-        cm_model_release(&m);
-        return err;
-    }
-    const cm_fo_continue_options opt = {param, a.lo, a.hi, a.down ? -1 : 1, 0, 0, 0, a.max_points};
     collected col = {0};
-    int stop = 0;
-    cm_fo_continue(o, &opt, p0, z, period, keep_point, keep_event, &col, &stop);
-    bool ok = !col.out_of_memory && col.n > 0;
-    if (col.out_of_memory)
-        fprintf(stderr, "cellmap continue: out of memory for the branch\n");
-    else if (col.n == 0)
-        fprintf(stderr, "cellmap continue: the solution at the start cannot be followed\n");
+    if (!err)
+        err = follow(&a, o, param, p0, &col);
+    bool ok = !err;
     if (ok && a.json)
-        print_json(&a, &m, &col, stop);
+        print_json(&a, &m, &col);
     else if (ok && !a.quiet)
-        print_text(&a, &col, stop);
+        print_text(&a, &col);
     if (ok && a.csv)
         ok = write_points(&a, &col);
     if (ok && a.events)
         ok = write_events(&a, &col);
+    if (ok && a.png)
+        ok = write_png(&a, &m, &col);
     free(col.points);
     free(col.events);
     cm_model_release(&m);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    return ok ? EXIT_OK : err ? err : EXIT_FAIL;
 }

@@ -168,6 +168,8 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                             NULL,
                             0,
                             figure_font(),
+                            0,
+                            NULL,
                             0};
     char periods[32];
     snprintf(periods, sizeof periods, "%d", a->periods);

@@ -385,6 +385,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          top,
          5,
          figure_font(),
+         0,
+         NULL,
          0},
         {a->width,
          a->height - h_top,
@@ -397,6 +399,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          bottom,
          4,
          figure_font(),
+         0,
+         NULL,
          0},
     };
     snprintf(start, sizeof start, "t0=%s,x=%s,v=%s", CM_NUM(a->t0), CM_NUM(a->from[0]),

@@ -76,7 +76,7 @@ assert len(ev) == 1 and ev[0]["label"] == "PD_1a" and abs(float(ev[0]["mult1_re"
 assert abs(float(ev[0]["S"]) - 0.068) < 1e-3
 PY
 "$CM" continue --param S=0.38 --vary S=0.3:0.4 --down --from 1.33,0.02 --period 1 --quiet \
-  --events - | grep -q "^SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
+  --events - | grep -q "^1,SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------

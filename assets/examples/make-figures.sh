@@ -76,3 +76,12 @@ fo="$fo --max-steps 200"
 # 10 random starts per value, 1000 periods of transients, 50 recorded
 "$CM" bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.02:0.4:190 --png fig-2.22-bifurcation.png \
   > /dev/null
+
+# Figs. 2.17 and 2.18 by continuation: branches of periodic solutions with
+# their bifurcations located and labelled. 2.17: S varied at Omega = 0.5,
+# S0 = 0.4, through the 1a pair and the (unstable there) 2s solution at
+# S = 0.3; 2.18: Omega varied at S = 0.32, S0 = 0.4.
+"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --both --from 1.461,0.044 \
+  --from 1.34,0 --period 1 --png fig-2.17-continue.png --quiet
+"$CM" continue --param S=0.32,S0=0.4,Omega=0.5 --vary Omega=0.45:0.6 --both \
+  --png fig-2.18-continue.png --quiet
