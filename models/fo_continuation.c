@@ -593,6 +593,44 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
     return n;
 }
 
+bool cm_fo_period_doubled(const cm_fo *o, int param, const cm_fo_branch_event *e, double z[2],
+                          double *p)
+{
+    if (e->type != CM_FO_EVENT_PD)
+        return false;
+    const int k = e->at.period;
+    cm_fo at;
+    cm_fo_with(o, param, e->at.p, &at);
+    cm_fo_init(&at, at.S, at.S0, at.Omega, param == CM_FO_P_PHI ? e->at.p : e->at.phi);
+    double end[2], M[4];
+    if (!compose(&at, e->at.z, k, end, M, NULL))
+        return false;
+    /* the null vector of M + I, from its larger row */
+    double v[2] = {-M[1], M[0] + 1};
+    if (hypot(M[2], M[3] + 1) > hypot(M[0] + 1, M[1]))
+        v[0] = M[3] + 1, v[1] = -M[2];
+    const double n = hypot(v[0], v[1]);
+    if (!(n > 0))
+        return false;
+    const double scale = fmax(1e-3, fabs(e->at.p));
+    for (int side = -1; side <= 1; side += 2)
+        for (double eps = 3e-2; eps > 1e-3; eps /= 3) {
+            cm_fo past;
+            const double q = e->at.p + side * 1e-3 * scale;
+            cm_fo_with(&at, param, q, &past);
+            double guess[2] = {e->at.z[0] + eps * v[0] / n, e->at.z[1] + eps * v[1] / n};
+            if (!cm_fo_periodic_point(&past, guess, 2 * k) ||
+                !compose(&past, guess, k, end, NULL, NULL) ||
+                hypot(end[0] - guess[0], end[1] - guess[1]) < 1e-6) /* the period-k one */
+                continue;
+            z[0] = guess[0];
+            z[1] = guess[1];
+            *p = q;
+            return true;
+        }
+    return false;
+}
+
 const char *cm_fo_event_name(int type)
 {
     static const char *const names[] = {"SN", "PD", "NS", "CS", "T"};

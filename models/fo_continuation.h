@@ -107,6 +107,14 @@ typedef struct cm_fo_continue_options {
 typedef int (*cm_fo_point_fn)(void *user, const cm_fo_solution *s);
 typedef int (*cm_fo_event_fn2)(void *user, const cm_fo_branch_event *e);
 
+/* Branch switching at a period doubling e (of a period-k branch in
+ * `param`): a period-2k solution near it, off the period-k one along the
+ * eigenvector of the multiplier -1, at a parameter value just past the
+ * event on whichever side has one. Its state goes to z, its parameter value
+ * to *p; false if none is found. */
+bool cm_fo_period_doubled(const cm_fo *o, int param, const cm_fo_branch_event *e, double z[2],
+                          double *p);
+
 /* Continues the period-k solution through z at parameter value p0 (z
  * must be a fixed point of P^period to 1e-9: cm_fo_periodic_point). The
  * section's phase moves (unless it is the parameter) to where the solution

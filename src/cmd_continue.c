@@ -19,6 +19,7 @@
 static const char continue_help[] =
     "usage: cellmap continue [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                        --vary NAME=LO:HI [--down|--both] [--from X,V ...] [--period K]\n"
+    "                        [--switch]\n"
     "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
     "                        [--size WxH] [--json] [--quiet]\n\n"
     "Follows a periodic solution of the dry friction oscillator in parameter NAME\n"
@@ -38,6 +39,8 @@ static const char continue_help[] =
     "  --vary NAME=LO:HI   the parameter and its range\n"
     "  --down              the parameter decreases first (default: it increases)\n"
     "  --both              from each start, both ways: the whole branch through it\n"
+    "  --switch            at each period doubling, switch to the doubled branch and\n"
+    "                      follow it both ways too\n"
     "  --from X,V          start near (x, v) at the section (default: simulate 500\n"
     "                      periods from the thesis' start 1 + 0.9 S0, 0); repeat it\n"
     "                      (up to 8) for several branches in one diagram\n"
@@ -56,13 +59,13 @@ static const char continue_help[] =
     "  --json              the summary and events as JSON (docs/cellmap.schema.json)\n"
     "  --quiet             no summary\n";
 
-enum { MAX_STARTS = 8 };
+enum { MAX_STARTS = 8, MAX_BRANCHES = 64 };
 
 typedef struct cont_args {
     model_opts mo;
     char vary[16];
     double lo, hi, from[MAX_STARTS][2];
-    int has_vary, n_from, down, both, period, max_points, width, height;
+    int has_vary, n_from, down, both, switch_pd, period, max_points, width, height;
     const char *csv, *events, *png;
     bool json, quiet;
 } cont_args;
@@ -110,6 +113,8 @@ static int parse_args(cli *c, cont_args *a)
             a->down = 1;
         } else if (cli_is(c, "--both", false, &err)) {
             a->both = 1;
+        } else if (cli_is(c, "--switch", false, &err)) {
+            a->switch_pd = 1;
         } else if (cli_is(c, "--from", true, &err)) {
             if (c->value && a->n_from == MAX_STARTS)
                 err = cli_usage_error(c, "--from: at most %d starts", MAX_STARTS);
@@ -171,7 +176,7 @@ typedef struct collected {
     uint64_t n, cap;
     tagged_event *events;
     uint64_t n_events, cap_events;
-    branch_info branches[2 * MAX_STARTS];
+    branch_info branches[MAX_BRANCHES];
     int n_branches;
     bool out_of_memory;
 } collected;
@@ -469,11 +474,57 @@ static bool find_start(const cont_args *a, const cm_fo *o, const double *from, d
     return *period > 0;
 }
 
-/* Every branch: from each start, one way or both. */
+/* The branch through the period-k solution z at p0 of o: one way or both. */
+static int follow_ways(const cont_args *a, const cm_fo *o, int param, double p0, const double z[2],
+                       int period, bool both, collected *col)
+{
+    for (int way = 0; way < (both ? 2 : 1) && !col->out_of_memory; way++) {
+        if (col->n_branches == MAX_BRANCHES)
+            return EXIT_OK; /* said in the summary: no room for more */
+        const int direction = both ? (way == 0 ? 1 : -1) : a->down ? -1 : 1;
+        const cm_fo_continue_options opt = {param, a->lo, a->hi, direction,
+                                            0,     0,     0,     a->max_points};
+        branch_info *bi = &col->branches[col->n_branches];
+        const uint64_t before = col->n;
+        cm_fo_continue(o, &opt, p0, z, period, keep_point, keep_event, col, &bi->stop);
+        bi->points = col->n - before;
+        bi->direction = direction;
+        if (bi->points == 0) {
+            fprintf(stderr, "cellmap continue: the solution at (%s, %s) cannot be followed\n",
+                    CM_NUM(z[0]), CM_NUM(z[1]));
+            return EXIT_FAIL;
+        }
+        bi->start = col->points[before].s;
+        col->n_branches++;
+    }
+    return EXIT_OK;
+}
+
+/* --switch: from each period doubling on the branches so far, the
+ * period-doubled branch, both ways. */
+static int switch_branches(const cont_args *a, const cm_fo *o, int param, collected *col)
+{
+    const uint64_t events = col->n_events;
+    int err = EXIT_OK;
+    for (uint64_t i = 0; i < events && !err && !col->out_of_memory; i++) {
+        const cm_fo_branch_event e = col->events[i].e;
+        double z[2], q;
+        if (!cm_fo_period_doubled(o, param, &e, z, &q))
+            continue;
+        cm_fo from;
+        cm_fo_with(o, param, q, &from);
+        cm_fo_init(&from, from.S, from.S0, from.Omega, param == CM_FO_P_PHI ? q : e.at.phi);
+        err = follow_ways(a, &from, param, q, z, 2 * e.at.period, true, col);
+    }
+    return err;
+}
+
+/* Every branch: from each start, one way or both; then --switch. */
 static int follow(const cont_args *a, const cm_fo *o, int param, double p0, collected *col)
 {
     const int starts = a->n_from ? a->n_from : 1;
-    for (int k = 0; k < starts && !col->out_of_memory; k++) {
+    int err = EXIT_OK;
+    for (int k = 0; k < starts && !err && !col->out_of_memory; k++) {
         double z[2];
         int period = 0;
         const double *from = a->n_from ? a->from[k] : NULL;
@@ -485,29 +536,15 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
                     CM_NUM(z[1]), a->vary, CM_NUM(p0));
             return EXIT_FAIL;
         }
-        for (int way = 0; way < (a->both ? 2 : 1) && !col->out_of_memory; way++) {
-            const int direction = a->both ? (way == 0 ? 1 : -1) : a->down ? -1 : 1;
-            const cm_fo_continue_options opt = {param, a->lo, a->hi, direction,
-                                                0,     0,     0,     a->max_points};
-            branch_info *bi = &col->branches[col->n_branches];
-            const uint64_t before = col->n;
-            cm_fo_continue(o, &opt, p0, z, period, keep_point, keep_event, col, &bi->stop);
-            bi->points = col->n - before;
-            bi->direction = direction;
-            if (bi->points == 0) {
-                fprintf(stderr, "cellmap continue: the solution at (%s, %s) cannot be followed\n",
-                        CM_NUM(z[0]), CM_NUM(z[1]));
-                return EXIT_FAIL;
-            }
-            bi->start = col->points[before].s;
-            col->n_branches++;
-        }
+        err = follow_ways(a, o, param, p0, z, period, a->both, col);
     }
-    if (col->out_of_memory) {
+    if (!err && a->switch_pd)
+        err = switch_branches(a, o, param, col);
+    if (!err && col->out_of_memory) {
         fprintf(stderr, "cellmap continue: out of memory for the branch\n");
-        return EXIT_FAIL;
+        err = EXIT_FAIL;
     }
-    return EXIT_OK;
+    return err;
 }
 
 int cmd_continue(int argc, char **argv)

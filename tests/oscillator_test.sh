@@ -77,6 +77,18 @@ assert abs(float(ev[0]["S"]) - 0.068) < 1e-3
 PY
 "$CM" continue --param S=0.38 --vary S=0.3:0.4 --down --from 1.33,0.02 --period 1 --quiet \
   --events - | grep -q "^1,SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
+# --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
+# fixed point, not P's) stable just below the doubling
+"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --switch --csv pd.csv \
+  --quiet || fail "continue --switch"
+python3 - pd.csv <<'PY' || fail "continue --switch: the doubled branch"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+two = [r for r in rows if r["branch"] in ("2", "3")]
+assert two and all(r["period"] == "2" for r in two), set(r["period"] for r in two)
+near = [r for r in two if 0.06 < float(r["S"]) < 0.0683]
+assert near and all(r["stable"] == "1" for r in near), near[:2]
+PY
 ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------
