@@ -631,6 +631,74 @@ bool cm_fo_period_doubled(const cm_fo *o, int param, const cm_fo_branch_event *e
     return false;
 }
 
+double cm_fo_turn_hmax(double Omega)
+{
+    const double w = Omega, a = 3.14159265358979323846 / w, sa = sin(a), ca = cos(a);
+    double best = 1 / (w * w); /* the limit at t -> 0 (2.30) */
+    enum { SAMPLES = 4000 };
+    for (int i = 0; i < SAMPLES; i++) {
+        const double t = (i + 0.5) * a / SAMPLES;
+        const double den = w * sin(w * t) * (1 + ca);
+        if (den == 0)
+            continue;
+        const double H = (sin(t) + sa * cos(w * t) + sin(t - a)) / den;
+        if (isfinite(H) && H > best)
+            best = H;
+    }
+    return best;
+}
+
+/* The symmetric non-sticking solution at o: from its turnaround (x0, 0) at
+ * phase `phase`, a quarter period on (off the turnaround, where P is
+ * smooth), refined by Newton; its multipliers if its cycle never sticks. */
+static bool symmetric_solution(const cm_fo *o, double x0, double phase, cm_fo_solution *s)
+{
+    cm_fo at_turn, quarter;
+    cm_fo_init(&at_turn, o->S, o->S0, o->Omega, phase);
+    cm_fo_state st = {0, x0, 0, cm_fo_mode_of(&at_turn, 0, x0, 0)};
+    if (!cm_fo_propagate(&at_turn, &st, at_turn.T / 4, NULL, NULL, NULL))
+        return false;
+    cm_fo_init(&quarter, o->S, o->S0, o->Omega, fmod(phase + 1.5707963267948966, 6.283185307179586));
+    double z[2] = {st.x, st.v};
+    return cm_fo_periodic_point(&quarter, z, 1) && cm_fo_solution_at(&quarter, z, 1, s) &&
+           strchr(s->signature, 's') == NULL && fabs(s->x_max - x0) < 1e-6 * fmax(1, x0);
+}
+
+void cm_fo_amplitude_at(const cm_fo *o, int periods, int record, cm_fo_amplitude *out)
+{
+    double x0 = NAN, phase = 0;
+    if (!cm_fo_symmetric_amplitude(o->S, o->Omega, &x0, &phase))
+        x0 = NAN;
+    out->x0 = x0;
+    out->slip_limit = o->S0 / (o->Omega * o->Omega);
+    out->turn_limit = o->S * cm_fo_turn_hmax(o->Omega);
+    out->valid = x0 >= out->slip_limit && x0 >= out->turn_limit;
+    out->mult_max = NAN;
+    out->stable = false;
+    cm_fo_solution s;
+    if (out->valid && symmetric_solution(o, x0, phase, &s)) {
+        out->mult_max = hypot(s.mult[0][0], s.mult[0][1]);
+        out->stable = s.stable;
+    }
+    /* the simulation */
+    cm_fo start;
+    cm_fo_init(&start, o->S, o->S0, o->Omega, 0);
+    double z[2] = {1 + 0.9 * o->S0, 0}, lo = INFINITY, hi = -INFINITY;
+    int sticks = 0;
+    bool lost = false;
+    for (int k = 0; k < periods && !lost; k++) {
+        cm_fo_tally t;
+        lost = !cm_fo_poincare(&start, z, z, k >= periods - record ? &t : NULL, NULL, NULL);
+        if (!lost && k >= periods - record) {
+            lo = fmin(lo, t.x_min);
+            hi = fmax(hi, t.x_max);
+            sticks += t.n_stick;
+        }
+    }
+    out->sim_amplitude = lost ? NAN : (hi - lo) / 2;
+    out->sim_sticks = lost ? NAN : (double)sticks / record;
+}
+
 const char *cm_fo_event_name(int type)
 {
     static const char *const names[] = {"SN", "PD", "NS", "CS", "T"};

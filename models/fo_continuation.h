@@ -107,6 +107,29 @@ typedef struct cm_fo_continue_options {
 typedef int (*cm_fo_point_fn)(void *user, const cm_fo_solution *s);
 typedef int (*cm_fo_event_fn2)(void *user, const cm_fo_branch_event *e);
 
+/* The amplitude-frequency analysis of thesis 2.2 (Figs. 2.4, 2.6, 2.7,
+ * 2.12-2.14) at one frequency, for the oscillator o (its Omega): */
+typedef struct cm_fo_amplitude {
+    double x0;         /* (2.25); NaN where it is imaginary */
+    double slip_limit; /* S0/Omega^2: (2.27) wants x0 at least this */
+    double turn_limit; /* S H_max (2.29): two turnarounds want x0 at least this */
+    bool valid;        /* x0 real and both conditions hold */
+    /* where valid: the symmetric non-sticking solution's multipliers by
+     * the exact monodromy, and whether it is stable; else NaN, false */
+    double mult_max;   /* the largest modulus */
+    bool stable;
+    /* a simulation from the thesis' start (1 + 0.9 S0, 0): the half range
+     * of x and the sticking segments per period over the last `record` of
+     * `periods` periods (NaN if the motion was lost) */
+    double sim_amplitude, sim_sticks;
+} cm_fo_amplitude;
+
+/* H_max of (2.29): max over t in (0, pi/Omega) of H(t, Omega), 1/Omega^2 at
+ * t -> 0 included; sampled finely enough for the figures (4000 points). */
+double cm_fo_turn_hmax(double Omega);
+
+void cm_fo_amplitude_at(const cm_fo *o, int periods, int record, cm_fo_amplitude *out);
+
 /* Branch switching at a period doubling e (of a period-k branch in
  * `param`): a period-2k solution near it, off the period-k one along the
  * eigenvector of the multiplier -1, at a parameter value just past the

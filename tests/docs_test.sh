@@ -57,7 +57,7 @@ spell orbit --from 10,0 --steps 3 --csv -
 spell fixed-points --range 0:2 --csv -
 spell export basin.cmdb --groups - --quiet
 spell render basin.cmdb --png - --view 100:200,-10:10
-for c in solve sweep explore render info export models orbit fixed-points lyapunov simulate bifurcation continue; do
+for c in solve sweep explore render info export models orbit fixed-points lyapunov simulate bifurcation continue amplitude; do
   spell help $c
   spell $c -h
 done
@@ -74,7 +74,7 @@ import re, subprocess, sys
 man = open(sys.argv[1]).read()
 unescape = lambda s: re.sub(r"^\\&", "", s, flags=re.M).replace("\\e", "\\")
 commands = re.findall(r"^  ([a-z][a-z-]*) ", subprocess.run([sys.argv[2], "--help"], capture_output=True, text=True).stdout, re.M)
-assert len(commands) == 13, commands
+assert len(commands) == 14, commands
 for c in commands:
     section = re.search(r"^\.SS " + re.escape(c) + r"\n\.nf\n(.*?)^\.fi$", man, re.S | re.M)
     assert section, c

@@ -36,6 +36,7 @@ run lyapunov lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --peri
 run bifurcation bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 20 --record 5 --json
 run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json
 run simulate simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 3 --json
+run amplitude amplitude --param S=0.5,S0=0.5 --omega 0.2:2:10 --json
 run continue continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --json
 "$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 \
   || fail "export --labels --steps"

@@ -89,6 +89,38 @@ assert two and all(r["period"] == "2" for r in two), set(r["period"] for r in tw
 near = [r for r in two if 0.06 < float(r["S"]) < 0.0683]
 assert near and all(r["stable"] == "1" for r in near), near[:2]
 PY
+# --- amplitude: the symmetric non-sticking solution (thesis 2.2) -----------
+"$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --csv amp5.csv --quiet \
+  || fail "amplitude at S = S0 = 0.5"
+"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --periods 2000 --threads 1 --csv amp05.csv \
+  --quiet || fail "amplitude at S = S0 = 0.05"
+"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --periods 2000 --threads 2 --csv amp05b.csv \
+  --quiet || fail "amplitude, 2 threads"
+cmp -s amp05.csv amp05b.csv || fail "amplitude differs between 1 and 2 threads"
+python3 - amp5.csv amp05.csv <<'PY' || fail "amplitude against the thesis"
+import csv, math, sys
+for path, S in ((sys.argv[1], 0.5), (sys.argv[2], 0.05)):
+    rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(path))]
+    for r in rows:
+        w = r["Omega"]
+        if w >= 0.5:  # (2.34): H_max = 1/Omega^2 there
+            assert abs(r["turn_limit"] - S / w**2) < 1e-12 * max(1, S / w**2), r
+        # where (2.25) holds and the solution attracts fast, the simulation finds it
+        if r["valid"] and r["stable"] and r["mult_max"] < 0.9:
+            assert abs(r["sim_amplitude"] - r["x0"]) < 1e-6 * max(1, r["x0"]), r
+            assert r["sim_sticks"] == 0, r
+        # where the slipping condition (2.27) fails, the motion sticks
+        if not math.isnan(r["x0"]) and r["x0"] < r["slip_limit"] * 0.99:
+            assert r["sim_sticks"] > 0, r
+    if S == 0.5:  # S0 > 1/3: no non-sticking symmetric solution below Omega = 0.5
+        assert not any(r["valid"] for r in rows if r["Omega"] < 0.5)
+        assert all(r["valid"] and r["stable"] for r in rows if r["Omega"] > 0.6)
+PY
+# x0 = (1 - 1/(4 n^2))^-1 at Omega = 1/(2n), whatever S: 4/3 at Omega = 0.5
+for S in 0.05 0.3; do
+  "$CM" amplitude --param S=$S,S0=$S --omega 0.499:0.501:1 --csv - --quiet | tail -1 \
+    | awk -F, '{ if ($2 < 1.3333 || $2 > 1.33337) exit 1 }' || fail "x0(0.5, $S) is not 4/3"
+done
 ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- ODE flows: Duffing's stroboscopic map (docs/models.md 11) -------------

@@ -85,3 +85,7 @@ fo="$fo --max-steps 200"
   --from 1.34,0 --period 1 --png fig-2.17-continue.png --quiet
 "$CM" continue --param S=0.32,S0=0.4,Omega=0.5 --vary Omega=0.45:0.6 --both \
   --png fig-2.18-continue.png --quiet
+
+# Figs. 2.4 and 2.7: amplitude-frequency diagrams, (2.25) against simulation
+"$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --png fig-2.4-amplitude.png --quiet
+"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --png fig-2.7-amplitude.png --quiet

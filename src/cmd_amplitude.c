@@ -1,0 +1,268 @@
+/* cellmap amplitude: the friction oscillator's amplitude-frequency diagram
+ * (thesis 2.2, Figs. 2.4, 2.6, 2.7, 2.12-2.14): the symmetric non-sticking
+ * solution's amplitude (2.25) with its conditions of validity (2.27),
+ * (2.29) and its stability, against simulation. */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models/fo_continuation.h"
+#include "models/params.h"
+#include "src/args.h"
+#include "src/basin_png.h"
+#include "src/commands.h"
+#include "src/json.h"
+#include "src/outfile.h"
+#include "src/param_grid.h"
+
+static const char amplitude_help[] =
+    "usage: cellmap amplitude [--model friction-oscillator] [--param k=v[,k=v]]\n"
+    "                         --omega LO:HI:N [--periods P] [--csv FILE|-] [--png FILE]\n"
+    "                         [--ymax Y] [--size WxH] [--json] [--quiet] [--threads T]\n\n"
+    "The amplitude-frequency diagram of the dry friction oscillator (thesis 2.2)\n"
+    "at N excitation frequencies Omega (centres of N cells of LO:HI): the amplitude\n"
+    "x0 of the symmetric non-sticking solution by (2.25), the slipping condition\n"
+    "x0 >= S0/Omega^2 (2.27) and the condition of two turnarounds x0 >= S H_max\n"
+    "(2.29); where both hold, the solution's stability by its exact monodromy; and\n"
+    "a simulation from the thesis' start (1 + 0.9 S0, 0) over P periods (default\n"
+    "400), whose half range of x and sticking segments per period over the last\n"
+    "40 periods are the numerical amplitude and N of Figs. 2.4, 2.12-2.14.\n"
+    "Frequencies run in parallel; the results do not depend on the thread count.\n\n"
+    "  --omega LO:HI:N     the frequencies (N <= 100000)\n"
+    "  --periods P         simulated periods, 50..100000 (default 400)\n"
+    "  --csv FILE|-        Omega,x0,slip_limit,turn_limit,valid,mult_max,stable,\n"
+    "                      sim_amplitude,sim_sticks per frequency (nan: none)\n"
+    "  --png FILE          the diagram: x0 (green stable, red unstable, grey where\n"
+    "                      (2.27) or (2.29) fails), S0/Omega^2 (blue), S H_max\n"
+    "                      (purple), simulated amplitudes (black) and sticking\n"
+    "                      segments per period / 10 (orange columns)\n"
+    "  --ymax Y            the diagram's top (default 5; the resonance at Omega = 1\n"
+    "                      is unbounded)\n"
+    "  --size WxH          image size (default 1000x700)\n"
+    "  --json              the summary as JSON on standard output\n"
+    "  --quiet             no summary\n"
+    "  --threads T         OpenMP threads (default: all cores)\n";
+
+enum { RECORD = 40 };
+
+typedef struct amp_args {
+    model_opts mo;
+    param_axis omega;
+    int has_omega, periods, threads, width, height;
+    double ymax;
+    const char *csv, *png;
+    bool json, quiet;
+} amp_args;
+
+static int parse_args(cli *c, amp_args *a)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(amplitude_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (cli_is(c, "--omega", true, &err)) {
+            char text[160];
+            snprintf(text, sizeof text, "Omega=%s", c->value ? c->value : "");
+            if (c->value && (!param_axis_parse(text, strlen(text), &a->omega) || a->omega.lo <= 0 ||
+                             a->omega.n > 100000 || !param_axis_even(&a->omega)))
+                err = cli_usage_error(c,
+                                      "--omega: '%s' is not LO:HI:N with 0 < LO < HI and "
+                                      "1 <= N <= 100000 (e.g. 0.1:3:300)",
+                                      c->value);
+            a->has_omega = 1;
+        } else if (cli_take_int(c, "--periods", 50, 100000, &a->periods, &err)) {
+        } else if (cli_is(c, "--ymax", true, &err)) {
+            if (c->value && (!parse_double(c->value, &a->ymax) || !(a->ymax > 0 && a->ymax < 1e6)))
+                err = cli_usage_error(c, "--ymax: '%s' must be a number in (0, 1e6)", c->value);
+        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            a->json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            a->quiet = true;
+        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else {
+            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+        }
+    }
+    if (!err && !a->has_omega)
+        err = cli_usage_error(c, "--omega LO:HI:N is required (e.g. --omega 0.1:3:300)");
+    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
+        err = cli_usage_error(c, "--json and an output to standard output: choose one");
+    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
+        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    return err;
+}
+
+static bool write_csv(const amp_args *a, const cm_fo_amplitude *v)
+{
+    outfile o;
+    if (!outfile_open("amplitude", a->csv, &o))
+        return false;
+    fprintf(o.f, "Omega,x0,slip_limit,turn_limit,valid,mult_max,stable,sim_amplitude,sim_sticks\n");
+    for (int i = 0; i < a->omega.n; i++) {
+        const cm_fo_amplitude *p = &v[i];
+        fprintf(o.f, "%.17g,%.17g,%.17g,%.17g,%d,%.17g,%d,%.17g,%.17g\n",
+                param_axis_value(&a->omega, i), p->x0, p->slip_limit, p->turn_limit, p->valid,
+                p->mult_max, p->stable, p->sim_amplitude, p->sim_sticks);
+    }
+    return outfile_close("amplitude", &o, true);
+}
+
+/* Series of the diagram: a line per kind of x0 (NaN breaks it where the
+ * kind changes), the limits, the simulation and the columns. */
+typedef struct diagram {
+    double *omega, *x0[3], *slip, *turn, *sim, *cols_x, *cols_y;
+} diagram;
+
+static bool write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v)
+{
+    const int n = a->omega.n;
+    diagram d;
+    double *all = malloc((size_t)n * 11 * sizeof *all);
+    if (!all) {
+        fprintf(stderr, "cellmap amplitude: out of memory for the diagram\n");
+        return false;
+    }
+    d.omega = all, d.x0[0] = all + n, d.x0[1] = all + 2 * n, d.x0[2] = all + 3 * n;
+    d.slip = all + 4 * n, d.turn = all + 5 * n, d.sim = all + 6 * n;
+    d.cols_x = all + 7 * n, d.cols_y = all + 9 * n;
+    double top = 1; /* without --ymax: what the simulation and the columns reach */
+    for (int i = 0; i < n; i++) {
+        const cm_fo_amplitude *q = &v[i];
+        const double w = param_axis_value(&a->omega, i);
+        const int kind = !q->valid ? 2 : q->stable ? 0 : 1;
+        d.omega[i] = w;
+        for (int k = 0; k < 3; k++)
+            d.x0[k][i] = k == kind ? q->x0 : NAN;
+        d.slip[i] = q->slip_limit;
+        d.turn[i] = q->turn_limit;
+        d.sim[i] = q->sim_amplitude;
+        d.cols_x[2 * i] = d.cols_x[2 * i + 1] = w;
+        d.cols_y[2 * i] = 0;
+        d.cols_y[2 * i + 1] = isnan(q->sim_sticks) ? 0 : q->sim_sticks / 10;
+        top = fmax(top, isnan(q->sim_amplitude) ? 0 : q->sim_amplitude);
+        top = fmax(top, d.cols_y[2 * i + 1]);
+    }
+    const cm_rgb green = {26, 152, 80}, red = {215, 48, 39}, grey = {170, 170, 170},
+                 blue = {69, 117, 180}, purple = {118, 42, 131}, black = {0, 0, 0},
+                 orange = {253, 174, 97};
+    const cm_series series[] = {
+        {CM_SERIES_SEGMENTS, d.cols_x, d.cols_y, (size_t)(2 * n), orange, 3},
+        {CM_SERIES_LINE, d.omega, d.slip, (size_t)n, blue, 1},
+        {CM_SERIES_LINE, d.omega, d.turn, (size_t)n, purple, 1},
+        {CM_SERIES_POINTS, d.omega, d.sim, (size_t)n, black, 5}, /* under the line, as diamonds */
+        {CM_SERIES_LINE, d.omega, d.x0[2], (size_t)n, grey, 2},
+        {CM_SERIES_LINE, d.omega, d.x0[1], (size_t)n, red, 2},
+        {CM_SERIES_LINE, d.omega, d.x0[0], (size_t)n, green, 2},
+    };
+    char params[400], title[640];
+    const char *const skip[] = {"Omega", NULL};
+    cm_params_format_with(p, skip, params, sizeof params);
+    snprintf(title, sizeof title,
+             "x0 (2.25) stable/unstable/invalid; S0/Omega^2, S H_max; simulation, N/10; %s",
+             params);
+    const cm_chart chart = {a->width,
+                            a->height,
+                            {a->omega.lo, 0},
+                            {a->omega.hi, a->ymax > 0 ? a->ymax : 1.15 * top},
+                            "Omega",
+                            "x",
+                            title,
+                            NULL,
+                            series,
+                            (int)(sizeof series / sizeof series[0]),
+                            figure_font(),
+                            0,
+                            NULL,
+                            0};
+    char range[96];
+    snprintf(range, sizeof range, "Omega=%s:%s:%d", CM_NUM(a->omega.lo), CM_NUM(a->omega.hi),
+             a->omega.n);
+    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Omega", range}};
+    const bool ok = write_chart_png("amplitude", a->png, &chart, 1, texts, 3);
+    free(all);
+    return ok;
+}
+
+typedef struct counts {
+    int valid, stable, lost;
+} counts;
+
+static void summarise(const amp_args *a, const cm_fo_amplitude *v, counts *c)
+{
+    *c = (counts){0, 0, 0};
+    for (int i = 0; i < a->omega.n; i++) {
+        c->valid += v[i].valid;
+        c->stable += v[i].stable;
+        c->lost += isnan(v[i].sim_amplitude);
+    }
+}
+
+int cmd_amplitude(int argc, char **argv)
+{
+    cli c = {"amplitude", argc, argv, 0, NULL, NULL};
+    amp_args a = {.mo = {.name = "friction-oscillator"}, .periods = 400, .width = 1000,
+                  .height = 700, .ymax = 5};
+    const int perr = parse_args(&c, &a);
+    if (perr)
+        return perr < 0 ? EXIT_OK : perr;
+    if (!outfile_check("amplitude", a.csv) || !chart_png_check("amplitude", a.png))
+        return EXIT_FAIL;
+    cm_params base;
+    const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);
+    if (verr)
+        return verr;
+    const int n = a.omega.n;
+    cm_fo_amplitude *v = calloc((size_t)n, sizeof *v);
+    if (!v) {
+        fprintf(stderr, "cellmap amplitude: out of memory for %d frequencies\n", n);
+        return EXIT_FAIL;
+    }
+    int invalid = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(a.threads ? a.threads : omp_get_max_threads()) reduction(| : invalid)
+    for (int i = 0; i < n; i++) {
+        const int idx[1] = {i};
+        cm_model m;
+        if (!model_at_point(&a.mo, &a.omega, idx, 1, &m)) {
+            invalid = 1;
+            v[i] = (cm_fo_amplitude){NAN, NAN, NAN, false, NAN, false, NAN, NAN};
+            continue;
+        }
+        cm_fo_amplitude_at(cm_fo_of_model(&m), a.periods, RECORD, &v[i]);
+        cm_model_release(&m);
+    }
+    counts cnt;
+    summarise(&a, v, &cnt);
+    if (a.json) {
+        json j;
+        json_begin(&j, stdout, "amplitude");
+        param_base_json(&j, a.mo.name, &base);
+        param_axes_json(&j, "omega", &a.omega, 1);
+        json_int(&j, "periods", a.periods);
+        json_int(&j, "valid", cnt.valid);
+        json_int(&j, "stable", cnt.stable);
+        json_int(&j, "lost", cnt.lost);
+        json_end(&j);
+    } else if (!a.quiet) {
+        fprintf(report_stream(a.csv, a.png, NULL),
+                "%d frequencies: (2.25) valid at %d, the symmetric non-sticking solution "
+                "stable at %d; %d simulations lost%s\n",
+                n, cnt.valid, cnt.stable, cnt.lost,
+                invalid ? "; some frequencies could not be built (S > S0)" : "");
+    }
+    bool ok = true;
+    if (a.csv)
+        ok = write_csv(&a, v);
+    if (ok && a.png)
+        ok = write_png(&a, &base, v);
+    free(v);
+    return ok ? EXIT_OK : EXIT_FAIL;
+}
