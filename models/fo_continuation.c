@@ -699,6 +699,199 @@ void cm_fo_amplitude_at(const cm_fo *o, int periods, int record, cm_fo_amplitude
     out->sim_sticks = lost ? NAN : (double)sticks / record;
 }
 
+/* ---- two-parameter curves -------------------------------------------- */
+
+typedef struct curve {
+    cm_fo base; /* phase of the event */
+    int param, param2, period;
+    double sign; /* -1: det(M - I) (SN); +1: det(M + I) (PD) */
+} curve;
+
+/* F(u) at u = (x, v, p, p2): P^k(z) - z and det(M + sign I). */
+static bool curve_f(const curve *c, const double u[4], double F[3])
+{
+    cm_fo a, o;
+    cm_fo_with(&c->base, c->param, u[2], &a);
+    cm_fo_with(&a, c->param2, u[3], &o);
+    double end[2], M[4];
+    if (!compose(&o, u, c->period, end, M, NULL))
+        return false;
+    F[0] = end[0] - u[0];
+    F[1] = end[1] - u[1];
+    F[2] = (M[0] + c->sign) * (M[3] + c->sign) - M[1] * M[2];
+    return isfinite(F[2]);
+}
+
+/* DF (3 x 4, row-major) by central differences. */
+static bool curve_jacobian(const curve *c, const double u[4], double J[12])
+{
+    for (int col = 0; col < 4; col++) {
+        const double h = 1e-7 * fmax(1, fabs(u[col]));
+        double up[4], um[4], Fp[3], Fm[3];
+        memcpy(up, u, sizeof up);
+        memcpy(um, u, sizeof um);
+        up[col] += h;
+        um[col] -= h;
+        if (!curve_f(c, up, Fp) || !curve_f(c, um, Fm))
+            return false;
+        for (int row = 0; row < 3; row++)
+            J[4 * row + col] = (Fp[row] - Fm[row]) / (2 * h);
+    }
+    return true;
+}
+
+static double det3(const double *a, const double *b, const double *c)
+{
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+/* The unit null vector of the 3 x 4 matrix J (signed cofactors), oriented
+ * along prev (or with the sign of `direction` in component 3). */
+static bool curve_tangent(const double J[12], const double *prev, int direction, double t[4])
+{
+    double n2 = 0;
+    for (int k = 0; k < 4; k++) {
+        double r[3][3];
+        for (int row = 0; row < 3; row++)
+            for (int col = 0, m = 0; col < 4; col++)
+                if (col != k)
+                    r[row][m++] = J[4 * row + col];
+        t[k] = (k % 2 ? -1 : 1) * det3(r[0], r[1], r[2]);
+        n2 += t[k] * t[k];
+    }
+    if (!(n2 > 0) || !isfinite(n2))
+        return false;
+    double dot = 0;
+    for (int k = 0; k < 4; k++)
+        dot += prev ? t[k] * prev[k] : 0;
+    const double s = (prev ? dot : t[3] * direction) < 0 ? -1 : 1;
+    for (int k = 0; k < 4; k++)
+        t[k] *= s / sqrt(n2);
+    return true;
+}
+
+/* Solves the 4 x 4 system A x = b by Gaussian elimination with pivoting. */
+static bool solve4(double A[16], double b[4], double x[4])
+{
+    for (int c = 0; c < 4; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(A[4 * r + c]) > fabs(A[4 * piv + c]))
+                piv = r;
+        if (A[4 * piv + c] == 0)
+            return false;
+        for (int k = 0; k < 4; k++) {
+            const double t = A[4 * c + k];
+            A[4 * c + k] = A[4 * piv + k];
+            A[4 * piv + k] = t;
+        }
+        const double tb = b[c];
+        b[c] = b[piv];
+        b[piv] = tb;
+        for (int r = c + 1; r < 4; r++) {
+            const double f = A[4 * r + c] / A[4 * c + c];
+            for (int k = c; k < 4; k++)
+                A[4 * r + k] -= f * A[4 * c + k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int r = 3; r >= 0; r--) {
+        double s = b[r];
+        for (int k = r + 1; k < 4; k++)
+            s -= A[4 * r + k] * x[k];
+        x[r] = s / A[4 * r + r];
+    }
+    return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(x[3]);
+}
+
+/* Newton onto F = 0 with t . (u - u0) = h, damped as the branch corrector. */
+static bool curve_correct(const curve *c, const double u0[4], const double t[4], double h,
+                          double u[4], int *iterations)
+{
+    for (int k = 0; k < 4; k++)
+        u[k] = u0[k] + h * t[k];
+    for (int it = 0; it < 30; it++) {
+        double F[3], J[12];
+        if (!curve_f(c, u, F) || !curve_jacobian(c, u, J))
+            return false;
+        double arc = -h;
+        for (int k = 0; k < 4; k++)
+            arc += t[k] * (u[k] - u0[k]);
+        const double norm = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2] + arc * arc);
+        if (hypot(F[0], F[1]) < 1e-11 && fabs(F[2]) < 1e-9 && fabs(arc) < 1e-10) {
+            *iterations = it;
+            return true;
+        }
+        double A[16], b[4] = {-F[0], -F[1], -F[2], -arc}, du[4];
+        memcpy(A, J, sizeof J);
+        memcpy(A + 12, t, 4 * sizeof *t);
+        if (!solve4(A, b, du))
+            return false;
+        bool accepted = false;
+        for (double lambda = 1; lambda > 1e-4 && !accepted; lambda /= 2) {
+            double trial[4], Ft[3], at = -h;
+            for (int k = 0; k < 4; k++) {
+                trial[k] = u[k] + lambda * du[k];
+                at += t[k] * (trial[k] - u0[k]);
+            }
+            if (curve_f(c, trial, Ft) &&
+                sqrt(Ft[0] * Ft[0] + Ft[1] * Ft[1] + Ft[2] * Ft[2] + at * at) < norm) {
+                memcpy(u, trial, sizeof trial);
+                accepted = true;
+            }
+        }
+        if (!accepted)
+            return false;
+    }
+    return false;
+}
+
+int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param, int param2,
+                         const double lo[2], const double hi[2], int direction, int max_points,
+                         cm_fo_curve_fn on_point, void *user)
+{
+    if ((e->type != CM_FO_EVENT_SN && e->type != CM_FO_EVENT_PD) || param == param2 ||
+        param == CM_FO_P_PHI || param2 == CM_FO_P_PHI)
+        return 0;
+    curve c = {*o, param, param2, e->at.period, e->type == CM_FO_EVENT_SN ? -1.0 : 1.0};
+    cm_fo_init(&c.base, o->S, o->S0, o->Omega, e->at.phi);
+    const double p2 = (double[4]){o->S, o->S0, o->Omega, o->phi}[param2];
+    double u[4] = {e->at.z[0], e->at.z[1], e->at.p, p2}, J[12], t[4], prev[4];
+    int iters;
+    /* the located point is interpolated: onto the curve first, at fixed p2 */
+    const double fix[4] = {0, 0, 0, 1};
+    if (!curve_correct(&c, u, fix, 0, u, &iters) || !curve_jacobian(&c, u, J) ||
+        !curve_tangent(J, NULL, direction, t))
+        return 0;
+    int n = 0;
+    if (on_point && on_point(user, u[2], u[3], u))
+        return 1;
+    n++;
+    double h = 1e-3;
+    while (n < max_points) {
+        double next[4];
+        if (!curve_correct(&c, u, t, h, next, &iters)) {
+            h /= 2;
+            if (h < 1e-8)
+                break;
+            continue;
+        }
+        memcpy(prev, t, sizeof prev);
+        if (!curve_jacobian(&c, next, J) || !curve_tangent(J, prev, direction, t))
+            break;
+        memcpy(u, next, sizeof next);
+        n++;
+        if (on_point && on_point(user, u[2], u[3], u))
+            break;
+        if (u[2] < lo[0] || u[2] > hi[0] || u[3] < lo[1] || u[3] > hi[1])
+            break;
+        if (iters <= 3)
+            h = fmin(2 * h, 2e-2);
+    }
+    return n;
+}
+
 const char *cm_fo_event_name(int type)
 {
     static const char *const names[] = {"SN", "PD", "NS", "CS", "T"};

@@ -19,7 +19,7 @@
 static const char continue_help[] =
     "usage: cellmap continue [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                        --vary NAME=LO:HI [--down|--both] [--from X,V ...] [--period K]\n"
-    "                        [--switch]\n"
+    "                        [--switch] [--curve NAME2=LO:HI --curves FILE|-]\n"
     "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
     "                        [--size WxH] [--json] [--quiet]\n\n"
     "Follows a periodic solution of the dry friction oscillator in parameter NAME\n"
@@ -41,6 +41,11 @@ static const char continue_help[] =
     "  --both              from each start, both ways: the whole branch through it\n"
     "  --switch            at each period doubling, switch to the doubled branch and\n"
     "                      follow it both ways too\n"
+    "  --curve NAME2=LO:HI from each SN and PD event, the curve in the plane of NAME and\n"
+    "                      NAME2 (S, S0 or Omega) on which the multiplier stays +1 or -1,\n"
+    "                      both ways (two-parameter continuation)\n"
+    "  --curves FILE|-     those curves as CSV: curve, label, NAME, NAME2, x, v (lyapunov\n"
+    "                      --curves draws them over its heat map)\n"
     "  --from X,V          start near (x, v) at the section (default: simulate 500\n"
     "                      periods from the thesis' start 1 + 0.9 S0, 0); repeat it\n"
     "                      (up to 8) for several branches in one diagram\n"
@@ -63,36 +68,40 @@ enum { MAX_STARTS = 8, MAX_BRANCHES = 64 };
 
 typedef struct cont_args {
     model_opts mo;
-    char vary[16];
-    double lo, hi, from[MAX_STARTS][2];
+    char vary[16], vary2[16];
+    double lo, hi, lo2, hi2, from[MAX_STARTS][2];
     int has_vary, n_from, down, both, switch_pd, period, max_points, width, height;
-    const char *csv, *events, *png;
+    const char *csv, *events, *png, *curves;
     bool json, quiet;
 } cont_args;
 
-static int parse_vary(cli *c, cont_args *a)
+/* NAME=LO:HI into name (size 16), lo, hi; false if it is not one. */
+static bool parse_range(const char *text, char *name, double *lo, double *hi)
 {
-    const char *eq = strchr(c->value, '=');
+    const char *eq = strchr(text, '=');
     char range[128];
     int n = 0;
     double v[2];
-    if (!eq || (size_t)(eq - c->value) >= sizeof a->vary ||
-        snprintf(range, sizeof range, "%s", eq + 1) >= (int)sizeof range) {
-        n = -1;
-    } else {
-        memcpy(a->vary, c->value, (size_t)(eq - c->value));
-        a->vary[eq - c->value] = '\0';
-        for (char *p = range; *p; p++)
-            *p = *p == ':' ? ',' : *p;
-    }
-    if (n < 0 || !parse_doubles(range, v, &n, 2) || n != 2 || !(v[0] < v[1]) ||
-        cm_fo_param_of(a->vary) < 0)
+    if (!eq || eq - text >= 16 || snprintf(range, sizeof range, "%s", eq + 1) >= (int)sizeof range)
+        return false;
+    memcpy(name, text, (size_t)(eq - text));
+    name[eq - text] = '\0';
+    for (char *p = range; *p; p++)
+        *p = *p == ':' ? ',' : *p;
+    if (!parse_doubles(range, v, &n, 2) || n != 2 || !(v[0] < v[1]) || cm_fo_param_of(name) < 0)
+        return false;
+    *lo = v[0];
+    *hi = v[1];
+    return true;
+}
+
+static int parse_vary(cli *c, cont_args *a)
+{
+    if (!parse_range(c->value, a->vary, &a->lo, &a->hi))
         return cli_usage_error(c,
                                "--vary: '%s' is not NAME=LO:HI with NAME one of S, S0, Omega, "
                                "phi and LO < HI (e.g. S=0.02:0.4)",
                                c->value);
-    a->lo = v[0];
-    a->hi = v[1];
     a->has_vary = 1;
     return 0;
 }
@@ -115,6 +124,14 @@ static int parse_args(cli *c, cont_args *a)
             a->both = 1;
         } else if (cli_is(c, "--switch", false, &err)) {
             a->switch_pd = 1;
+        } else if (cli_is(c, "--curve", true, &err)) {
+            if (c->value && !parse_range(c->value, a->vary2, &a->lo2, &a->hi2))
+                err = cli_usage_error(c,
+                                      "--curve: '%s' is not NAME2=LO:HI with NAME2 one of S, S0, "
+                                      "Omega and LO < HI (e.g. Omega=0.2:0.8)",
+                                      c->value);
+        } else if (cli_is(c, "--curves", true, &err)) {
+            a->curves = c->value;
         } else if (cli_is(c, "--from", true, &err)) {
             if (c->value && a->n_from == MAX_STARTS)
                 err = cli_usage_error(c, "--from: at most %d starts", MAX_STARTS);
@@ -150,6 +167,17 @@ static int parse_args(cli *c, cont_args *a)
         err = cli_usage_error(c, "--csv, --events and --png: only one can go to standard output");
     if (!err && a->down && a->both)
         err = cli_usage_error(c, "--down and --both: choose one");
+    if (!err && (a->vary2[0] != '\0') != (a->curves != NULL))
+        err = cli_usage_error(c, "--curve NAME2=LO:HI and --curves FILE go together");
+    if (!err && a->vary2[0] &&
+        (strcmp(a->vary2, a->vary) == 0 || strcmp(a->vary2, "phi") == 0 ||
+         strcmp(a->vary, "phi") == 0))
+        err = cli_usage_error(c, "--curve: the second parameter must differ from --vary's, and "
+                                 "neither may be phi");
+    if (!err && cm_output_names_stdout(a->curves) &&
+        (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->events) ||
+         cm_output_names_stdout(a->png) || a->json))
+        err = cli_usage_error(c, "--curves - and another output to standard output: choose one");
     return err;
 }
 
@@ -338,6 +366,48 @@ static void print_text(const cont_args *a, const collected *c)
         fprintf(out, "  %llu points; stopped: %s\n", (unsigned long long)bi->points,
                 cm_fo_stop_name(bi->stop));
     }
+}
+
+/* ---- two-parameter curves ---- */
+
+typedef struct curve_out {
+    FILE *f;
+    int id;
+    const char *label;
+} curve_out;
+
+static int write_curve_point(void *user, double p, double p2, const double z[2])
+{
+    const curve_out *c = user;
+    fprintf(c->f, "%d,%s,%.17g,%.17g,%.17g,%.17g\n", c->id, c->label, p, p2, z[0], z[1]);
+    return 0;
+}
+
+/* From every SN and PD event, its curve in (vary, vary2), both ways; each
+ * way is one curve. */
+static bool write_curves(const cont_args *a, const cm_fo *o, const collected *c, int *n_curves)
+{
+    outfile out;
+    if (!outfile_open("continue", a->curves, &out))
+        return false;
+    fprintf(out.f, "curve,label,%s,%s,x,v\n", a->vary, a->vary2);
+    const int param = cm_fo_param_of(a->vary), param2 = cm_fo_param_of(a->vary2);
+    const double lo[2] = {a->lo, a->lo2}, hi[2] = {a->hi, a->hi2};
+    *n_curves = 0;
+    for (uint64_t i = 0; i < c->n_events; i++) {
+        const cm_fo_branch_event *e = &c->events[i].e;
+        if (e->type != CM_FO_EVENT_SN && e->type != CM_FO_EVENT_PD)
+            continue;
+        char label[32];
+        event_label(e, label, sizeof label);
+        for (int way = 1; way >= -1; way -= 2) {
+            curve_out co = {out.f, *n_curves + 1, label};
+            if (cm_fo_continue_curve(o, e, param, param2, lo, hi, way, 5000, write_curve_point,
+                                     &co) > 0)
+                (*n_curves)++;
+        }
+    }
+    return outfile_close("continue", &out, true);
 }
 
 /* ---- the diagram ---- */
@@ -587,6 +657,12 @@ int cmd_continue(int argc, char **argv)
         ok = write_events(&a, &col);
     if (ok && a.png)
         ok = write_png(&a, &m, &col);
+    int n_curves = 0;
+    if (ok && a.curves)
+        ok = write_curves(&a, o, &col, &n_curves);
+    if (ok && a.curves && !a.quiet && !a.json)
+        fprintf(report_stream(a.csv, a.events, a.png), "%d curves in (%s, %s) to %s\n", n_curves,
+                a.vary, a.vary2, cm_output_names_stdout(a.curves) ? "standard output" : a.curves);
     free(col.points);
     free(col.events);
     cm_model_release(&m);

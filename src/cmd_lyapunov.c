@@ -2,6 +2,7 @@
  * parameters: the dry friction oscillator's (thesis Figs. 2.20-2.21) by the
  * renormalised two-trajectory estimator of docs/models.md 9.8, any other
  * model's by finite differences on its map (docs/models.md 11.3). */
+#include <errno.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -46,6 +47,8 @@ static const char lyapunov_help[] =
     "  --json              the summary as JSON on standard output (docs/cellmap.schema.json)\n"
     "  --quiet             no progress line and no summary\n"
     "  --png FILE          heat map; only positive exponents are coloured\n"
+    "  --curves FILE       draw the curves of `cellmap continue --curves` (bifurcation\n"
+    "                      curves in the grid's two parameters) over the heat map\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
 
@@ -54,7 +57,7 @@ typedef struct lyap_args {
     param_axis ax[2];
     int has_grid, periods, threads, width, height, n_from;
     double d0, from[CM_MAX_DIM];
-    const char *csv, *png;
+    const char *csv, *png, *curves;
     bool json, quiet;
 } lyap_args;
 
@@ -94,6 +97,8 @@ static int parse_args(cli *c, lyap_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
+        } else if (cli_is(c, "--curves", true, &err)) {
+            a->curves = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -105,6 +110,8 @@ static int parse_args(cli *c, lyap_args *a)
     }
     if (!err && !a->has_grid)
         err = cli_usage_error(c, "--grid X=LO:HI:N,Y=LO:HI:M is required");
+    if (!err && a->curves && !a->png)
+        err = cli_usage_error(c, "--curves draws over the heat map: give --png FILE too");
     if (!err && !a->csv && !a->png && !a->json)
         err = cli_usage_error(c, "nothing to write: give --csv FILE, --png FILE and/or --json");
     if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
@@ -148,8 +155,89 @@ static bool write_csv(const lyap_args *a, const double *v)
     return outfile_close("lyapunov", &o, true);
 }
 
+/* The curves of `continue --curves` (curve,label,P,P2,x,v) in the grid's
+ * axes, as one polyline broken by NaN between curves, and a label at each
+ * curve's start; false, with the problem said, if the file does not fit. */
+typedef struct overlay {
+    double *x, *y;
+    size_t n;
+    cm_chart_label labels[64];
+    char texts[64][32];
+    int n_labels;
+} overlay;
+
+static bool read_curves(const lyap_args *a, overlay *ov)
+{
+    FILE *f = fopen(a->curves, "r");
+    char line[512], n1[64] = "", n2[64] = "";
+    memset(ov, 0, sizeof *ov);
+    if (!f || !fgets(line, sizeof line, f) ||
+        sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
+        fprintf(stderr, "cellmap lyapunov: --curves %s: %s (make it with cellmap continue "
+                        "--curves)\n",
+                a->curves, f ? "not a file of curve,label,P,P2,x,v lines" : strerror(errno));
+        if (f)
+            fclose(f);
+        return false;
+    }
+    const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
+    const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
+    if (!same && !swapped) {
+        fprintf(stderr, "cellmap lyapunov: --curves %s is in (%s, %s), the grid in (%s, %s)\n",
+                a->curves, n1, n2, a->ax[0].name, a->ax[1].name);
+        fclose(f);
+        return false;
+    }
+    size_t cap = 0;
+    int last = -1;
+    bool ok = true;
+    while (ok && fgets(line, sizeof line, f)) {
+        int id;
+        char label[32];
+        double p1, p2;
+        if (sscanf(line, "%d,%31[^,],%lf,%lf", &id, label, &p1, &p2) != 4)
+            continue;
+        if (ov->n + 2 > cap) {
+            cap = cap ? 2 * cap : 1024;
+            double *nx = realloc(ov->x, cap * sizeof *nx), *ny = nx ? realloc(ov->y, cap * sizeof *ny) : NULL;
+            if (nx)
+                ov->x = nx;
+            ok = ny != NULL;
+            if (ny)
+                ov->y = ny;
+        }
+        if (!ok)
+            break;
+        if (id != last && ov->n > 0) { /* a break between curves */
+            ov->x[ov->n] = ov->y[ov->n] = NAN;
+            ov->n++;
+        }
+        ov->x[ov->n] = same ? p1 : p2;
+        ov->y[ov->n] = same ? p2 : p1;
+        if (id != last && ov->n_labels < 64 && (id % 2 == 1)) { /* both ways share a label */
+            snprintf(ov->texts[ov->n_labels], sizeof ov->texts[0], "%s", label);
+            ov->labels[ov->n_labels] = (cm_chart_label){ov->x[ov->n], ov->y[ov->n],
+                                                        ov->texts[ov->n_labels]};
+            ov->n_labels++;
+        }
+        ov->n++;
+        last = id;
+    }
+    fclose(f);
+    if (!ok)
+        fprintf(stderr, "cellmap lyapunov: out of memory for the curves\n");
+    return ok;
+}
+
 static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v)
 {
+    overlay ov = {0};
+    if (a->curves && !read_curves(a, &ov)) {
+        free(ov.x);
+        free(ov.y);
+        return false;
+    }
+    const cm_series curves = {CM_SERIES_LINE, ov.x, ov.y, ov.n, (cm_rgb){0, 0, 0}, 2};
     char title[512], params[400], grid[200];
     const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
     cm_params_format_with(p, swept, params, sizeof params);
@@ -165,12 +253,12 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                             a->ax[1].name,
                             title,
                             &heat,
-                            NULL,
-                            0,
+                            &curves,
+                            ov.n > 0,
                             figure_font(),
                             0,
-                            NULL,
-                            0};
+                            ov.labels,
+                            ov.n_labels};
     char periods[32];
     snprintf(periods, sizeof periods, "%d", a->periods);
     const bool fo = strcmp(model, "friction-oscillator") == 0;
@@ -180,7 +268,10 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                                  {"Periods", periods},
                                  {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
                                                   : "docs/models.md 11.3 (finite differences on the map)"}};
-    return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
+    const bool ok = write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
+    free(ov.x);
+    free(ov.y);
+    return ok;
 }
 
 typedef struct summary {

@@ -89,6 +89,27 @@ assert two and all(r["period"] == "2" for r in two), set(r["period"] for r in tw
 near = [r for r in two if 0.06 < float(r["S"]) < 0.0683]
 assert near and all(r["stable"] == "1" for r in near), near[:2]
 PY
+# --curve: the PD_1a curve in (S, Omega), drawn over a Lyapunov heat map
+"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --curve Omega=0.2:0.8 \
+  --curves curves.csv --quiet || fail "continue --curve"
+python3 - curves.csv <<'PY' || fail "continue --curves CSV"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert rows and {r["label"] for r in rows} == {"PD_1a"}, rows[:2]
+assert abs(float(rows[0]["S"]) - 0.06838) < 1e-4 and float(rows[0]["Omega"]) == 0.5
+assert len({r["curve"] for r in rows}) == 2 and max(abs(float(r["Omega"]) - 0.5) for r in rows) > 0.02
+PY
+"$CM" lyapunov --param S0=0.4 --grid Omega=0.3:0.7:8,S=0.02:0.4:8 --periods 20 --png lle.png \
+  --curves curves.csv --quiet || fail "lyapunov --curves"
+python3 "$HERE/pngcheck.py" lle.png > /dev/null 2>&1 || [ -s lle.png ] || fail "lyapunov --curves: no PNG"
+expect_usage "--curves draws over the heat map" lyapunov --grid Omega=0.3:0.7:8,S=0.02:0.4:8 \
+  --curves curves.csv --csv x.csv
+out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S0=0.4:0.5:2 --periods 5 --png l2.png --curves curves.csv 2>&1)
+[ $? -eq 1 ] && grep -q "is in (S, Omega), the grid in (Omega, S0)" <<<"$out" && [ ! -e l2.png ] \
+  || fail "lyapunov --curves of other parameters: $out"
+expect_usage "--curve NAME2=LO:HI and --curves FILE go together" continue --vary S=0.02:0.4 \
+  --curve Omega=0.2:0.8
+
 # --- amplitude: the symmetric non-sticking solution (thesis 2.2) -----------
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --csv amp5.csv --quiet \
   || fail "amplitude at S = S0 = 0.5"

@@ -217,8 +217,57 @@ static void test_fig_2_18(void)
     }
 }
 
+/* The PD_1a curve in (S, Omega): at points along it, Newton from the
+ * curve's state at its (S, Omega) and phase converges nearby, and the
+ * multiplier by finite differences of P is -1. */
+typedef struct curve_points {
+    double p[64][2], z[64][2];
+    int n;
+} curve_points;
+
+static int keep_curve(void *user, double p, double p2, const double z[2])
+{
+    curve_points *c = user;
+    if (c->n < 64) {
+        c->p[c->n][0] = p, c->p[c->n][1] = p2;
+        c->z[c->n][0] = z[0], c->z[c->n][1] = z[1];
+        c->n++;
+    }
+    return 0;
+}
+
+static void test_pd_curve(void)
+{
+    cm_fo base;
+    cm_fo_init(&base, 0.3, 0.4, 0.5, 0);
+    found f;
+    int period;
+    branch_events(0.3, 0.4, 0.5, CM_FO_P_S, 0.02, 0.4, -1, &f, &period);
+    const cm_fo_branch_event *pd = first(&f, CM_FO_EVENT_PD, 0, 0);
+    CHECK(pd != NULL);
+    if (!pd)
+        return;
+    const double lo[2] = {0.02, 0.2}, hi[2] = {0.4, 0.8};
+    for (int way = -1; way <= 1; way += 2) {
+        curve_points c = {.n = 0};
+        CHECK(cm_fo_continue_curve(&base, pd, CM_FO_P_S, CM_FO_P_OMEGA, lo, hi, way, 64,
+                                   keep_curve, &c) >= 10);
+        CHECK(fabs(c.p[0][0] - pd->at.p) < 1e-6 && c.p[0][1] == 0.5);
+        CHECK(fabs(c.p[c.n - 1][1] - 0.5) > 0.02); /* it goes somewhere in Omega */
+        for (int i = 0; i < c.n; i += 4) {
+            cm_fo_branch_event e = *pd; /* the point as an event at (S, Omega) */
+            cm_fo at;
+            cm_fo_init(&at, c.p[i][0], 0.4, c.p[i][1], 0);
+            e.at.p = c.p[i][0];
+            e.at.z[0] = c.z[i][0], e.at.z[1] = c.z[i][1];
+            check_point(&e, CM_FO_P_S, &at, -1, 5e-3);
+        }
+    }
+}
+
 int main(void)
 {
+    test_pd_curve();
     test_fig_2_17();
     test_fig_2_18();
     CHECK_DONE();
