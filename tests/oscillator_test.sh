@@ -111,11 +111,11 @@ expect_usage "--curve NAME2=LO:HI and --curves FILE go together" continue --vary
   --curve Omega=0.2:0.8
 
 # --- amplitude: the symmetric non-sticking solution (thesis 2.2) -----------
-"$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --csv amp5.csv --quiet \
+"$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:116 --csv amp5.csv --quiet \
   || fail "amplitude at S = S0 = 0.5"
-"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --periods 2000 --threads 1 --csv amp05.csv \
+"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:116 --periods 600 --threads 1 --csv amp05.csv \
   --quiet || fail "amplitude at S = S0 = 0.05"
-"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --periods 2000 --threads 2 --csv amp05b.csv \
+"$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:116 --periods 600 --threads 2 --csv amp05b.csv \
   --quiet || fail "amplitude, 2 threads"
 cmp -s amp05.csv amp05b.csv || fail "amplitude differs between 1 and 2 threads"
 python3 - amp5.csv amp05.csv <<'PY' || fail "amplitude against the thesis"
