@@ -1,5 +1,6 @@
 #include "cellmap/model.h"
 
+#include <stdio.h>
 #include <string.h>
 
 const char *cm_model_coord_name(const cm_model *m, int d)
@@ -8,6 +9,22 @@ const char *cm_model_coord_name(const cm_model *m, int d)
     if (d < 0 || d >= CM_MAX_DIM)
         return "?";
     return m->coord_names && d < m->dim ? m->coord_names[d] : generic[d];
+}
+
+void cm_param_choice_name(const char *choices, int k, char *buf, size_t size)
+{
+    const char *c = choices;
+    for (int i = 0; i < k && c; i++) {
+        c = strchr(c, '|');
+        if (c)
+            c++;
+    }
+    if (!c) {
+        snprintf(buf, size, "%d", k);
+        return;
+    }
+    const char *end = strchr(c, '|');
+    snprintf(buf, size, "%.*s", (int)(end ? (size_t)(end - c) : strlen(c)), c);
 }
 
 void cm_model_release(cm_model *m)

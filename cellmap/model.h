@@ -160,6 +160,10 @@ typedef struct cm_model {
  * arrays and SQL columns. */
 const char *cm_model_coord_name(const cm_model *m, int d);
 
+/* Word k of a parameter's '|'-separated choices into buf (k itself, as a
+ * number, past the last word). */
+void cm_param_choice_name(const char *choices, int k, char *buf, size_t size);
+
 /* Releases the model's context; NULL-safe; leaves the struct zeroed. */
 void cm_model_release(cm_model *m);
 

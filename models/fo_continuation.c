@@ -108,10 +108,13 @@ static bool compose(const cm_fo *o, const double z[2], int k, double end[2], dou
     for (int i = 0; i < k; i++) {
         cm_fo_tally t;
         double next[2], J[4];
-        if (!cm_fo_poincare(o, cur, next, s ? &t : NULL, s ? on_fo_event : NULL, &log))
+        /* the monodromy's propagation gives the image too; a description
+         * needs the tally and the events of one of its own */
+        if ((s || !M) &&
+            !cm_fo_poincare(o, cur, next, s ? &t : NULL, s ? on_fo_event : NULL, &log))
             return false;
         if (M) {
-            if (!cm_fo_monodromy(o, cur, J))
+            if (!cm_fo_monodromy(o, cur, J, s ? NULL : next))
                 return false;
             left_mul(M, J);
         }
@@ -300,14 +303,15 @@ static bool solve3(const double A[9], const double r[3], double x[3])
     return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
 }
 
-/* |G(u)| and the arclength condition's residual together. */
+/* G(u), the arclength condition's residual *arc, and both together in *norm. */
 static bool corrector_norm(const branch *b, const double u0[3], const double t[3], double h,
-                           const double u[3], double G[2], double DG[6], double *norm)
+                           const double u[3], double G[2], double DG[6], double *arc,
+                           double *norm)
 {
     if (!residual(b, u, G, DG))
         return false;
-    const double arc = t[0] * (u[0] - u0[0]) + t[1] * (u[1] - u0[1]) + t[2] * (u[2] - u0[2]) - h;
-    *norm = hypot(hypot(G[0], G[1]), arc);
+    *arc = t[0] * (u[0] - u0[0]) + t[1] * (u[1] - u0[1]) + t[2] * (u[2] - u0[2]) - h;
+    *norm = hypot(hypot(G[0], G[1]), *arc);
     return isfinite(*norm);
 }
 
@@ -319,8 +323,8 @@ static bool correct(const branch *b, const double u0[3], const double t[3], doub
 {
     for (int i = 0; i < 3; i++)
         u[i] = u0[i] + h * t[i];
-    double G[2], DG[6], norm;
-    if (!corrector_norm(b, u0, t, h, u, G, DG, &norm))
+    double G[2], DG[6], arc, norm;
+    if (!corrector_norm(b, u0, t, h, u, G, DG, &arc, &norm))
         return false;
     for (int it = 0; it < 40; it++) {
         if (hypot(G[0], G[1]) < 1e-11 && norm < 1e-10) {
@@ -328,22 +332,20 @@ static bool correct(const branch *b, const double u0[3], const double t[3], doub
             return true;
         }
         const double A[9] = {DG[0], DG[1], DG[2], DG[3], DG[4], DG[5], t[0], t[1], t[2]};
-        const double r[3] = {-G[0], -G[1], -(norm * norm - G[0] * G[0] - G[1] * G[1] > 0
-                                                 ? t[0] * (u[0] - u0[0]) + t[1] * (u[1] - u0[1]) +
-                                                       t[2] * (u[2] - u0[2]) - h
-                                                 : 0)};
+        const double r[3] = {-G[0], -G[1], -arc};
         double du[3];
         if (!solve3(A, r, du))
             return false;
         bool accepted = false;
         for (double lambda = 1; lambda > 1e-4 && !accepted; lambda /= 2) {
-            double trial[3], Gt[2], DGt[6], nt;
+            double trial[3], Gt[2], DGt[6], at, nt;
             for (int i = 0; i < 3; i++)
                 trial[i] = u[i] + lambda * du[i];
-            if (corrector_norm(b, u0, t, h, trial, Gt, DGt, &nt) && nt < norm) {
+            if (corrector_norm(b, u0, t, h, trial, Gt, DGt, &at, &nt) && nt < norm) {
                 memcpy(u, trial, sizeof trial);
                 memcpy(G, Gt, sizeof Gt);
                 memcpy(DG, DGt, sizeof DGt);
+                arc = at;
                 norm = nt;
                 accepted = true;
             }

@@ -510,12 +510,14 @@ static void free_flight(double J[4], double tau)
     left_multiply(J, R);
 }
 
-bool cm_fo_monodromy(const cm_fo *o, const double z[2], double J[4])
+bool cm_fo_monodromy(const cm_fo *o, const double z[2], double J[4], double image[2])
 {
     event_log log = {.n = 0};
     double end[2];
     if (!cm_fo_poincare(o, z, end, NULL, log_event, &log) || log.lost)
         return false;
+    if (image)
+        memcpy(image, end, sizeof end);
     int mode = cm_fo_mode_of(o, 0, z[0], z[1]);
     const double I[4] = {1, 0, 0, mode == CM_FO_STICK ? 0 : 1};
     memcpy(J, I, sizeof I);

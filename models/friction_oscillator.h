@@ -97,8 +97,10 @@ bool cm_fo_run_period(const cm_fo *o, cm_fo_run *r, cm_fo_tally *tally, cm_fo_ev
 
 /* The Jacobian of P_phi at z (row-major) from the events of one period:
  * the free-flight rotations and the saltation matrices of turns, sticks and
- * breakaways (docs/models.md 9.7). Returns false where P_phi is not followed. */
-bool cm_fo_monodromy(const cm_fo *o, const double z[2], double J[4]);
+ * breakaways (docs/models.md 9.7), and P_phi(z) itself into image (may be
+ * NULL): the same propagation gives both. Returns false where P_phi is not
+ * followed. */
+bool cm_fo_monodromy(const cm_fo *o, const double z[2], double J[4], double image[2]);
 
 /* A fixed point of P_phi by Newton's method from z (in place), with
  * central-difference Jacobians (step 1e-7) as docs/models.md 9.6 prescribes.

@@ -126,23 +126,6 @@ cm_status cm_params_set(cm_params *p, const char *text, char *msg, size_t msg_si
     return CM_OK;
 }
 
-/* Name of choice k of a '|'-separated list, copied into buf. */
-static void choice_name(const char *choices, int k, char *buf, size_t size)
-{
-    const char *c = choices;
-    for (int i = 0; i < k && c; i++) {
-        c = strchr(c, '|');
-        if (c)
-            c++;
-    }
-    if (!c) {
-        snprintf(buf, size, "%d", k);
-        return;
-    }
-    const char *end = strchr(c, '|');
-    snprintf(buf, size, "%.*s", (int)(end ? (size_t)(end - c) : strlen(c)), c);
-}
-
 static bool listed(const char *name, const char *const *names)
 {
     for (; names && *names; names++)
@@ -163,7 +146,8 @@ void cm_params_format_with(const cm_params *p, const char *const *skip, char *bu
         for (int k = 0; k < p->value[i].count && used < size; k++) {
             if (p->spec[i].choices) {
                 char word[64];
-                choice_name(p->spec[i].choices, (int)p->value[i].v[k], word, sizeof word);
+                cm_param_choice_name(p->spec[i].choices, (int)p->value[i].v[k], word,
+                                     sizeof word);
                 used += (size_t)snprintf(buf + used, size - used, "%s", word);
             } else {
                 char text[CM_NUM_TEXT];

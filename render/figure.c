@@ -145,16 +145,6 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
 
 /* ---- title ---------------------------------------------------------------------- */
 
-/* Word k of a '|'-separated list of choices, into out. */
-static void choice_word(const char *choices, int k, char *out, size_t size)
-{
-    const char *w = choices;
-    for (int i = 0; i < k && w; i++)
-        w = strchr(w, '|') ? strchr(w, '|') + 1 : NULL;
-    const size_t len = w ? strcspn(w, "|") : 0;
-    snprintf(out, size, "%.*s", (int)len, w ? w : "");
-}
-
 void figure_title(const cm_model *m, char *out, size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "%s ", m->name);
@@ -162,7 +152,8 @@ void figure_title(const cm_model *m, char *out, size_t size)
     for (int k = 0; k < p->count && p->spec && p->spec[k].name && used < size; k++) {
         used += (size_t)snprintf(out + used, size - used, " %s=", p->spec[k].name);
         if (p->spec[k].choices && used < size) { /* the word, as --param takes it */
-            choice_word(p->spec[k].choices, (int)p->value[k].v[0], out + used, size - used);
+            cm_param_choice_name(p->spec[k].choices, (int)p->value[k].v[0], out + used,
+                                 size - used);
             used += strlen(out + used);
             continue;
         }

@@ -16,6 +16,7 @@
 #include "models/registry.h"
 #include "render/figure.h"
 #include "render/png_out.h"
+#include "src/args.h"
 #include "src/project.h"
 
 
@@ -115,28 +116,11 @@ const char *cm_system_coord(const cm_system *s, int d)
     return d >= 0 && d < s->model.dim ? cm_model_coord_name(&s->model, d) : NULL;
 }
 
-/* "LO:HI,LO:HI,..." into lo, hi (dim pairs). */
-static bool parse_region(const char *text, int dim, double *lo, double *hi)
-{
-    const char *p = text;
-    for (int d = 0; d < dim; d++) {
-        char *end;
-        lo[d] = strtod(p, &end);
-        if (end == p || *end != ':')
-            return false;
-        p = end + 1;
-        hi[d] = strtod(p, &end);
-        if (end == p || (d + 1 < dim ? *end != ',' : *end != '\0'))
-            return false;
-        p = end + 1;
-    }
-    return true;
-}
-
 cm_status cm_system_region(const cm_system *s, double *lo, double *hi)
 {
-    if (!s->entry || !s->entry->region ||
-        !parse_region(s->entry->region, s->model.dim, lo, hi))
+    int n = 0;
+    if (!s->entry || !s->entry->region || !parse_ranges(s->entry->region, lo, hi, &n, CM_MAX_DIM) ||
+        n != s->model.dim)
         return CM_ENOTFOUND;
     return CM_OK;
 }

@@ -79,20 +79,12 @@ typedef struct cont_args {
 static bool parse_range(const char *text, char *name, double *lo, double *hi)
 {
     const char *eq = strchr(text, '=');
-    char range[128];
     int n = 0;
-    double v[2];
-    if (!eq || eq - text >= 16 || snprintf(range, sizeof range, "%s", eq + 1) >= (int)sizeof range)
+    if (!eq || eq - text >= 16)
         return false;
     memcpy(name, text, (size_t)(eq - text));
     name[eq - text] = '\0';
-    for (char *p = range; *p; p++)
-        *p = *p == ':' ? ',' : *p;
-    if (!parse_doubles(range, v, &n, 2) || n != 2 || !(v[0] < v[1]) || cm_fo_param_of(name) < 0)
-        return false;
-    *lo = v[0];
-    *hi = v[1];
-    return true;
+    return cm_fo_param_of(name) >= 0 && parse_ranges(eq + 1, lo, hi, &n, 1);
 }
 
 static int parse_vary(cli *c, cont_args *a)

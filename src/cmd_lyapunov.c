@@ -333,20 +333,13 @@ static int start_of(const cli *c, lyap_args *a)
                                a->n_from, e->name, dim);
     if (a->n_from)
         return EXIT_OK;
-    if (!e->region)
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    if (!e->region || !parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != dim)
         return cli_usage_error(c, "model %s has no default region: give the start with --from",
                                e->name);
-    const lattice_opts region = {0};
-    cm_lattice lat;
-    cm_box box;
-    if (model_opts_build(c, &a->mo, &m) != EXIT_OK)
-        return EXIT_USAGE;
-    const int err = lattice_opts_build(c, &region, &m, &a->mo.set, &lat, &box);
-    cm_model_release(&m);
-    if (err)
-        return err;
     for (int d = 0; d < dim; d++)
-        a->from[d] = lat.origin[d] + lat.width[d] * 0.5 * (double)(box.lo[d] + box.hi[d]);
+        a->from[d] = 0.5 * (lo[d] + hi[d]);
     a->n_from = dim;
     return EXIT_OK;
 }

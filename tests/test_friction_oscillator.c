@@ -220,7 +220,7 @@ static void test_symmetric_amplitude(void)
         cm_fo_init(&later, S, S, W, fmod(o.phi + 0.3 * W, TWO_PI));
         const double zl[2] = {st.x, st.v};
         double J[4], F[4];
-        CHECK(cm_fo_monodromy(&later, zl, J));
+        CHECK(cm_fo_monodromy(&later, zl, J, NULL));
         CHECK(central_jacobian(&later, zl, F));
         CHECK_NEAR(J[0] + J[3], trC, 1e-9);
         CHECK_NEAR(J[0] * J[3] - J[1] * J[2], detC, 1e-9);
@@ -342,7 +342,7 @@ static void steady_orbit(const cm_fo *o, double x0, double v0, orbit *r)
     double p[2], J[4];
     CHECK(cm_fo_poincare(o, r->z, p, &r->t, NULL, NULL));
     r->psi = fabs((r->t.x_max + r->t.x_min) / (r->t.x_max - r->t.x_min));
-    CHECK(cm_fo_monodromy(o, r->z, J));
+    CHECK(cm_fo_monodromy(o, r->z, J, NULL));
     r->floquet = log(spectral_radius(J)) / o->T;
     CHECK(cm_fo_lyapunov(o, r->z[0], r->z[1], 1e-8, 3000, &r->lambda));
 }
@@ -365,7 +365,7 @@ static void test_2s_and_1a(void)
     CHECK(s2.floquet < 0);
     CHECK_NEAR(s2.lambda, s2.floquet, 0.01 * fabs(s2.floquet));
     double J[4], F[4];
-    CHECK(cm_fo_monodromy(&o, s2.z, J) && central_jacobian(&o, s2.z, F));
+    CHECK(cm_fo_monodromy(&o, s2.z, J, NULL) && central_jacobian(&o, s2.z, F));
     CHECK_NEAR(spectral_radius(J), spectral_radius(F), 1e-6);
     printf("2s (S = 0.4): z = (%.12f, %.12f), %d sticks, Psi %.1e, LLE %.6f, ln|mult|/T %.6f\n",
            s2.z[0], s2.z[1], s2.t.n_stick, s2.psi, s2.lambda, s2.floquet);
@@ -387,7 +387,7 @@ static void test_2s_and_1a(void)
                a[k].z[0], a[k].z[1], a[k].t.n_stick, a[k].psi, a[k].lambda, a[k].floquet);
     }
     const int sliding = a[0].z[1] != 0 ? 0 : 1; /* the other one is stuck at the section */
-    CHECK(cm_fo_monodromy(&o, a[sliding].z, J) && central_jacobian(&o, a[sliding].z, F));
+    CHECK(cm_fo_monodromy(&o, a[sliding].z, J, NULL) && central_jacobian(&o, a[sliding].z, F));
     CHECK_NEAR(spectral_radius(J), spectral_radius(F), 1e-6);
 }
 
