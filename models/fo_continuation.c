@@ -215,6 +215,19 @@ bool cm_fo_periodic_point(const cm_fo *o, double z[2], int period)
     return false;
 }
 
+int cm_fo_minimal_period(const cm_fo *o, const double z[2], int k)
+{
+    double end[2];
+    for (int d = 1; d < k; d++)
+        if (k % d == 0) {
+            if (!compose(o, z, d, end, NULL, NULL))
+                return 0;
+            if (hypot(end[0] - z[0], end[1] - z[1]) < 1e-9 * fmax(1, hypot(z[0], z[1])))
+                return d;
+        }
+    return k;
+}
+
 int cm_fo_find_periodic(const cm_fo *o, double z[2], int settle, int max_period)
 {
     double cur[2] = {z[0], z[1]};

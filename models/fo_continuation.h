@@ -54,6 +54,10 @@ bool cm_fo_solution_at(const cm_fo *o, const double z[2], int period, cm_fo_solu
  * exact monodromy; false if it does not converge to 1e-11. */
 bool cm_fo_periodic_point(const cm_fo *o, double z[2], int period);
 
+/* The smallest d dividing k for which the fixed point z of P^k is a fixed
+ * point of P^d (to 1e-9): its true period; 0 where P cannot be followed. */
+int cm_fo_minimal_period(const cm_fo *o, const double z[2], int k);
+
 /* The smallest period 1..max_period of the orbit that a simulation of
  * `settle` periods from z settles on, and a point of it in z (in place);
  * 0 if none (chaotic, or the motion was lost). */

@@ -598,6 +598,16 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
                     CM_NUM(z[1]), a->vary, CM_NUM(p0));
             return EXIT_FAIL;
         }
+        const int true_period = cm_fo_minimal_period(o, z, period);
+        if (true_period != period) {
+            fprintf(stderr,
+                    "cellmap continue: the solution found near (%s, %s) repeats after %d "
+                    "period(s), not %d: give --period %d, or --from near a solution of period "
+                    "%d\n",
+                    CM_NUM(from ? from[0] : z[0]), CM_NUM(from ? from[1] : z[1]), true_period,
+                    period, true_period, period);
+            return EXIT_FAIL;
+        }
         err = follow_ways(a, o, param, p0, z, period, a->both, col);
     }
     if (!err && a->switch_pd)

@@ -77,6 +77,10 @@ assert abs(float(ev[0]["S"]) - 0.068) < 1e-3
 PY
 "$CM" continue --param S=0.38 --vary S=0.3:0.4 --down --from 1.33,0.02 --period 1 --quiet \
   --events - | grep -q "^1,SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
+out=$("$CM" continue --vary S=0.02:0.4 --from 1.46,0.04 --period 3 --csv p3.csv 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "repeats after 1 period(s), not 3: give --period 1" <<<"$out" && [ ! -e p3.csv ] \
+  || fail "continue --period 3 on a period-1 solution: $rc $out"
+
 # --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
 # fixed point, not P's) stable just below the doubling
 "$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --switch --csv pd.csv \
