@@ -328,14 +328,15 @@ static bool corrector_norm(const branch *b, const double u0[3], const double t[3
     return isfinite(*norm);
 }
 
-/* Newton from the prediction u0 + h t onto G = 0 with t . (u - u0) = h,
- * damped: a step is halved until the residual shrinks, since near a
- * change of signature the map's Jacobian holds only on one side. */
-static bool correct(const branch *b, const double u0[3], const double t[3], double h, double u[3],
-                    int *iterations)
+/* Newton from the prediction u0 + h t (or from `guess`, if not NULL) onto
+ * G = 0 with t . (u - u0) = h, damped: a step is halved until the residual
+ * shrinks, since near a change of signature the map's Jacobian holds only
+ * on one side. */
+static bool correct_from(const branch *b, const double u0[3], const double t[3], double h,
+                         const double *guess, double u[3], int *iterations)
 {
     for (int i = 0; i < 3; i++)
-        u[i] = u0[i] + h * t[i];
+        u[i] = guess ? guess[i] : u0[i] + h * t[i];
     double G[2], DG[6], arc, norm;
     if (!corrector_norm(b, u0, t, h, u, G, DG, &arc, &norm))
         return false;
@@ -367,6 +368,29 @@ static bool correct(const branch *b, const double u0[3], const double t[3], doub
             return false;
     }
     return false;
+}
+
+static bool correct(const branch *b, const double u0[3], const double t[3], double h, double u[3],
+                    int *iterations)
+{
+    return correct_from(b, u0, t, h, NULL, u, iterations);
+}
+
+/* Bisection of a step's arclength from a point at lo to one at hi, both
+ * on the hyperplanes t . (u - u0) = lo, hi: the point at mid, from the
+ * chord between them (which lies on its hyperplane), else from the
+ * tangent's prediction. The chord stays on the branch's side near a
+ * corner, where the tangent's prediction does not. */
+static bool correct_between(const branch *b, const double u0[3], const double t[3], double lo,
+                            const double ulo[3], double hi, const double uhi[3], double mid,
+                            double u[3])
+{
+    double guess[3];
+    const double w = (mid - lo) / (hi - lo);
+    for (int i = 0; i < 3; i++)
+        guess[i] = ulo[i] + w * (uhi[i] - ulo[i]);
+    int iters;
+    return correct_from(b, u0, t, mid, guess, u, &iters) || correct(b, u0, t, mid, u, &iters);
 }
 
 /* A converged point: the solution and its test functions. */
@@ -461,12 +485,31 @@ static void stick_pattern(const char *sig, char *out, size_t size)
         used += (size_t)snprintf(out + used, size - used, "%s%s", i ? "," : "", pairs[i]);
 }
 
+/* Besides the reported types: a turning point of the branch in the
+ * parameter where the multiplier only touches +1 (the side branch of a
+ * symmetry-breaking branch point), located by the tangent's parameter
+ * component and reported as a fold. */
+enum { EVENT_TURN = CM_FO_EVENT_SS + 1 };
+
+/* The pauses in a stick pattern: sticks between two slips the same way
+ * ("dd", "uu"), after which the block goes on as it went. */
+static int pauses(const char *pattern)
+{
+    int n = 0;
+    for (const char *c = pattern; c[0] && c[1]; c++)
+        if ((c == pattern || c[-1] == ',') && c[0] == c[1])
+            n++;
+    return n;
+}
+
 /* The events between a and b: bit `type` set for each. */
 static unsigned events_between(const point *a, const point *b)
 {
     unsigned set = 0;
     if (a->fold * b->fold < 0)
         set |= 1u << CM_FO_EVENT_SN;
+    else if (a->t[2] * b->t[2] < 0)
+        set |= 1u << EVENT_TURN;
     if (a->pd * b->pd < 0)
         set |= 1u << CM_FO_EVENT_PD;
     if (!isnan(a->ns) && !isnan(b->ns) && a->ns * b->ns < 0)
@@ -475,7 +518,9 @@ static unsigned events_between(const point *a, const point *b)
         char pa[2 * CM_FO_SIGNATURE], pb[2 * CM_FO_SIGNATURE];
         stick_pattern(a->s.signature, pa, sizeof pa);
         stick_pattern(b->s.signature, pb, sizeof pb);
-        set |= 1u << (strcmp(pa, pb) != 0 ? CM_FO_EVENT_CS : CM_FO_EVENT_T);
+        set |= 1u << (strcmp(pa, pb) == 0                            ? CM_FO_EVENT_T
+                      : pauses(pa) != pauses(pb) ? CM_FO_EVENT_SS
+                                                 : CM_FO_EVENT_CS);
     }
     return set;
 }
@@ -486,6 +531,7 @@ static double test_value(int type, const point *p)
     case CM_FO_EVENT_SN: return p->fold;
     case CM_FO_EVENT_PD: return p->pd;
     case CM_FO_EVENT_NS: return p->ns;
+    case EVENT_TURN: return p->t[2];
     default: return 0;
     }
 }
@@ -503,13 +549,14 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
 {
     double lo = 0, hi = h;
     point near_a = *a, near_b = *bp;
-    const bool by_signature = type == CM_FO_EVENT_CS || type == CM_FO_EVENT_T;
+    const bool by_signature =
+        type == CM_FO_EVENT_CS || type == CM_FO_EVENT_T || type == CM_FO_EVENT_SS;
     for (int it = 0; it < 60 && fabs(hi - lo) > 1e-10; it++) {
         const double mid = 0.5 * (lo + hi);
         double u[3];
-        int iters;
         point m;
-        if (!correct(b, a->u, a->t, mid, u, &iters) || !describe(b, u, a->t, 0, &m))
+        if (!correct_between(b, a->u, a->t, lo, near_a.u, hi, near_b.u, mid, u) ||
+            !describe(b, u, a->t, 0, &m))
             break;
         const bool on_a_side = by_signature
                                    ? strcmp(m.s.signature, a->s.signature) == 0
@@ -522,8 +569,9 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
             near_b = m;
         }
     }
-    e->type = type;
-    e->fold = type == CM_FO_EVENT_SN && a->t[2] * bp->t[2] < 0;
+    memset(e, 0, sizeof *e);
+    e->type = type == EVENT_TURN ? CM_FO_EVENT_SN : type;
+    e->fold = (type == CM_FO_EVENT_SN || type == EVENT_TURN) && a->t[2] * bp->t[2] < 0;
     e->at = near_a.s; /* the solution that the event ends, as it was */
     e->other = near_b.s;
     /* near a branch point the bisection may land on the other branch: the
@@ -540,6 +588,168 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
     }
     snprintf(e->before, sizeof e->before, "%s", a->s.signature);
     snprintf(e->after, sizeof e->after, "%s", bp->s.signature);
+}
+
+/* Steps this short are taken only at corners of a branch. */
+#define H_CORNER 1e-6
+
+/* A corrected step from a to b of length h is kept only if the branch
+ * stayed near the prediction and turned little: otherwise the corrector
+ * may have landed on a neighbouring branch (they lie close where sticking
+ * segments appear), and a smaller step is tried, or the corner is crossed
+ * (cross_corner). Steps shorter than H_CORNER may turn, as a branch does
+ * at a corner at every scale, but must still end near the prediction. */
+static bool step_acceptable(const point *a, const point *b, double h)
+{
+    double dist2 = 0, cos_turn = 0;
+    for (int i = 0; i < 3; i++) {
+        const double d = b->u[i] - (a->u[i] + h * a->t[i]);
+        dist2 += d * d;
+        cos_turn += a->t[i] * b->t[i];
+    }
+    const double dist = sqrt(dist2);
+    return (dist <= 0.3 * h && cos_turn >= 0.95) || (h <= H_CORNER && dist <= 2 * h);
+}
+
+/* Whether parameter value p lies at the edge of the oscillator's domain
+ * (S0 >= S > 0, Omega > 0), where the branch must end. */
+static bool at_model_limit(const branch *b, double p)
+{
+    const double near = 1e-5;
+    switch (b->param) {
+    case CM_FO_P_S: return fabs(p - b->base.S0) < near || p < near;
+    case CM_FO_P_S0: return fabs(p - b->base.S) < near;
+    case CM_FO_P_OMEGA: return p < near;
+    default: return false;
+    }
+}
+
+/* How far G(u) moves from a to the point d ahead along its tangent, and
+ * the motion from there to ahead (may be NULL); NaN if it is lost. */
+static double motion_ahead(const branch *b, const point *a, double d, cm_fo_solution *ahead)
+{
+    double u[3], G[2], Gu[2];
+    for (int i = 0; i < 3; i++)
+        u[i] = a->u[i] + d * a->t[i];
+    cm_fo o;
+    cm_fo_with(&b->base, b->param, u[2], &o);
+    if (!residual(b, a->u, G, NULL) || !residual(b, u, Gu, NULL) ||
+        (ahead && !cm_fo_solution_at(&o, u, b->period, ahead)))
+        return NAN;
+    return hypot(Gu[0] - G[0], Gu[1] - G[1]);
+}
+
+/* Where the corrector fails even at the smallest step: whether the
+ * motion from the last point a changes just ahead along the branch, so
+ * that the solution past it, if any, is no smooth continuation: its
+ * signature changes (a segment meets a boundary), or P^period jumps (a
+ * slip segment grazes v = 0 inside the stick band: on one side the block
+ * sticks there, on the other it slides on). If so, the change as an event
+ * at a, to e. */
+static bool signature_breaks(const branch *b, const point *a, cm_fo_branch_event *e)
+{
+    for (int k = 8; k >= 5; k--) {
+        const double d = pow(10, -k);
+        cm_fo_solution ahead;
+        const double moved = motion_ahead(b, a, d, &ahead);
+        if (isnan(moved))
+            continue;
+        /* G moves by O(d) on a smooth map and by O(sqrt d) where a segment
+         * is born tangentially: ten times d moves it 3 to 10 times as far,
+         * unless it jumps in between */
+        const bool jump = moved > 1e-6 && moved > 100 * motion_ahead(b, a, d / 10, NULL);
+        if (!jump && strcmp(ahead.signature, a->s.signature) == 0)
+            continue;
+        point next = *a;
+        next.s = ahead;
+        memset(e, 0, sizeof *e);
+        e->jump = jump;
+        const unsigned found = events_between(a, &next);
+        e->type = found & (1u << CM_FO_EVENT_SS)   ? CM_FO_EVENT_SS
+                  : found & (1u << CM_FO_EVENT_CS) ? CM_FO_EVENT_CS
+                                                   : CM_FO_EVENT_T;
+        e->at = a->s;
+        e->other = a->s; /* no solution was found past it */
+        snprintf(e->before, sizeof e->before, "%s", a->s.signature);
+        snprintf(e->after, sizeof e->after, "%s", ahead.signature);
+        return true;
+    }
+    return false;
+}
+
+/* Whether a turning point e found with a step h is a fold of its own, not
+ * a corner where a segment appears (steps that short turn at corners) or
+ * the period doubling that a branch of period 2k comes from: there it
+ * meets the period-k solution, whose multiplier is -1, and turns back onto
+ * its other half. */
+static bool smooth_turn(const branch *b, const cm_fo_branch_event *e, double h)
+{
+    if (h <= H_CORNER)
+        return false;
+    if (b->period % 2)
+        return true;
+    cm_fo o;
+    cm_fo_solution half;
+    cm_fo_with(&b->base, b->param, e->at.p, &o);
+    if (!cm_fo_solution_at(&o, e->at.z, b->period / 2, &half))
+        return true;
+    double end[2];
+    const bool near_half = compose(&o, e->at.z, b->period / 2, end, NULL, NULL) &&
+                           hypot(end[0] - e->at.z[0], end[1] - e->at.z[1]) < 1e-3;
+    const bool flips = half.mult[0][1] == 0 &&
+                       (fabs(half.mult[0][0] + 1) < 1e-2 || fabs(half.mult[1][0] + 1) < 1e-2);
+    return !(near_half && flips);
+}
+
+/* A step of length h from a that is not smooth and changes the signature
+ * crosses a corner of the branch, where a segment appears or vanishes:
+ * the step is bisected to the corner, and the first point past it, in
+ * *out, goes on along its own side's tangent, oriented away from a. False
+ * where the corner cannot be closed in on (the corrector fails: the
+ * branch ends there, or the new signature lies on another branch). */
+/* A step of length h from a that is not smooth and changes the signature
+ * may cross a corner of the branch, where a segment appears or vanishes:
+ * the step is bisected to where the signature changes (as far as the
+ * corrector converges), and if the points on either side are as close as
+ * the bracket (the branch is continuous there, not a jump onto another
+ * one), the first point past it, in *out, goes on
+ * along its own side's tangent, oriented away from a; the step's length
+ * to it goes to *h. False where there
+ * is no such corner (or the corrector fails: the branch ends there). */
+static bool cross_corner(const branch *b, const point *a, double *h, point *out)
+{
+    double lo = 0, hi = *h;
+    point before = *a, after;
+    bool found = false;
+    while (hi - lo > 1e-13 * fmax(1, *h)) {
+        const double mid = 0.5 * (lo + hi);
+        double u[3];
+        point m;
+        if (!correct_between(b, a->u, a->t, lo, before.u, hi, found ? after.u : a->u, mid, u) ||
+            !describe(b, u, a->t, 0, &m))
+            break; /* the map is barely differentiable at the corner */
+        if (strcmp(m.s.signature, a->s.signature) == 0) {
+            lo = mid;
+            before = m;
+        } else {
+            hi = mid;
+            after = m;
+            found = true;
+        }
+    }
+    double gap2 = 0, away = 0;
+    for (int i = 0; i < 3 && found; i++) {
+        gap2 += (after.u[i] - before.u[i]) * (after.u[i] - before.u[i]);
+        away += after.t[i] * (after.u[i] - a->u[i]);
+    }
+    if (!found || sqrt(gap2) > 1e-6 + 10 * (hi - lo))
+        return false;
+    *out = after;
+    *h = hi;
+    if (away < 0)
+        for (int i = 0; i < 3; i++)
+            out->t[i] = -out->t[i];
+    return true;
 }
 
 int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
@@ -567,12 +777,30 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
         double u[3];
         int iters = 0;
         point next;
-        if (!correct(&b, cur.u, cur.t, h, u, &iters) || !describe(&b, u, cur.t, 0, &next)) {
+        bool ok = correct(&b, cur.u, cur.t, h, u, &iters) && describe(&b, u, cur.t, 0, &next);
+        double step = h;
+        if (ok && !step_acceptable(&cur, &next, h)) {
+            ok = strcmp(cur.s.signature, next.s.signature) != 0 &&
+                 cross_corner(&b, &cur, &step, &next);
+            if (ok) {
+                h = fmin(h, 1e-4); /* the new side, from a short step */
+                iters = 4;
+            }
+        }
+        if (!ok) {
             h /= 2;
             if (h >= h_min)
                 continue;
             if (rephased || !rephase(&b, &cur)) {
+                cm_fo_branch_event e;
                 *stop = CM_FO_STOP_STEP;
+                if (at_model_limit(&b, cur.u[2]))
+                    *stop = CM_FO_STOP_BOUND;
+                else if (signature_breaks(&b, &cur, &e)) {
+                    *stop = CM_FO_STOP_SIGNATURE;
+                    if (on_event)
+                        on_event(user, &e);
+                }
                 return n;
             }
             rephased = true;
@@ -581,11 +809,18 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
         }
         rephased = false;
         const unsigned found = on_event ? events_between(&cur, &next) : 0;
-        for (int type = 0; type <= CM_FO_EVENT_T; type++) {
+        for (int type = 0; type <= EVENT_TURN; type++) {
             if (!(found & (1u << type)))
                 continue;
             cm_fo_branch_event e;
-            locate(&b, &cur, &next, h, type, &e);
+            locate(&b, &cur, &next, step, type, &e);
+            if (type == EVENT_TURN && !smooth_turn(&b, &e, step))
+                continue;
+            /* a test function that changes sign only where the signature
+             * does jumps at the corner: no event of its own */
+            if (type <= CM_FO_EVENT_NS || type == EVENT_TURN)
+                if (strcmp(e.at.signature, e.other.signature) != 0)
+                    continue;
             if (on_event(user, &e)) {
                 *stop = CM_FO_STOP_POINTS;
                 return n;
@@ -909,14 +1144,15 @@ int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param,
 
 const char *cm_fo_event_name(int type)
 {
-    static const char *const names[] = {"SN", "PD", "NS", "CS", "T"};
-    return type >= 0 && type < 5 ? names[type] : "?";
+    static const char *const names[] = {"SN", "PD", "NS", "CS", "T", "SS"};
+    return type >= 0 && type < 6 ? names[type] : "?";
 }
 
 const char *cm_fo_stop_name(int stop)
 {
     static const char *const names[] = {"the parameter left its range", "the point limit",
                                         "the corrector failed at the smallest step",
-                                        "the motion could not be followed"};
-    return stop >= 0 && stop < 4 ? names[stop] : "?";
+                                        "the motion could not be followed",
+                                        "a change of signature or a jump of the map it cannot follow"};
+    return stop >= 0 && stop < 5 ? names[stop] : "?";
 }

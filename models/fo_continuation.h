@@ -71,19 +71,26 @@ enum cm_fo_event_type {
     CM_FO_EVENT_NS,     /* a complex pair through the unit circle */
     CM_FO_EVENT_CS,     /* sticking segments appear, vanish or change neighbours
                            (crossing-sliding and the like) */
-    CM_FO_EVENT_T       /* only slip segments appear or vanish */
+    CM_FO_EVENT_T,      /* only slip segments appear or vanish, or (at a branch's
+                           end, jump set) a slip segment grazes v = 0 */
+    CM_FO_EVENT_SS      /* a pause appears or vanishes: a stick between two slips
+                           the same way (switching sliding, the thesis' SS_a) */
 };
-/* "SN", "PD", "NS", "CS", "T". */
+/* "SN", "PD", "NS", "CS", "T", "SS". */
 const char *cm_fo_event_name(int type);
 
 typedef struct cm_fo_branch_event {
     int type;
     bool fold;                    /* SN: the branch turns back in the parameter */
+    bool jump;                    /* CS, T at a branch's end: P^period jumps just past
+                                     it (a slip segment grazes v = 0 in the stick band) */
     /* the located point, described by the solution before it: SN, PD, NS
      * at the test function's zero (interpolated), CS and T at the last
      * point with the signature before */
     cm_fo_solution at;
-    cm_fo_solution other; /* the nearest point found on the other side */
+    cm_fo_solution other; /* the nearest point found on the other side; at a
+                             branch's end (CM_FO_STOP_SIGNATURE) none was
+                             found, and other is at */
     double width;         /* |at.p - other.p|: how far the bracket closed */
     char before[CM_FO_SIGNATURE]; /* signatures on either side (CS, T) */
     char after[CM_FO_SIGNATURE];
@@ -94,7 +101,11 @@ enum cm_fo_stop {
     CM_FO_STOP_BOUND = 0, /* the parameter left [lo, hi] */
     CM_FO_STOP_POINTS,    /* max_points reached */
     CM_FO_STOP_STEP,      /* the corrector failed down to the smallest step */
-    CM_FO_STOP_LOST       /* P^period cannot be followed (motion lost) */
+    CM_FO_STOP_LOST,      /* P^period cannot be followed (motion lost) */
+    CM_FO_STOP_SIGNATURE  /* the corrector fails where the signature changes
+                             or the map jumps just ahead: a segment grazes a
+                             boundary and no smooth continuation exists
+                             (reported as an event at the last point) */
 };
 const char *cm_fo_stop_name(int stop);
 

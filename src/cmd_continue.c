@@ -18,7 +18,7 @@
 
 static const char continue_help[] =
     "usage: cellmap continue [--model friction-oscillator] [--param k=v[,k=v]]\n"
-    "                        --vary NAME=LO:HI [--down|--both] [--from X,V ...] [--period K]\n"
+    "                        --vary NAME=LO:HI [--down|--both] [--from X,V[,P] ...] [--period K]\n"
     "                        [--switch] [--curve NAME2=LO:HI --curves FILE|-]\n"
     "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
     "                        [--size WxH] [--json] [--quiet]\n\n"
@@ -46,7 +46,8 @@ static const char continue_help[] =
     "                      both ways (two-parameter continuation)\n"
     "  --curves FILE|-     those curves as CSV: curve, label, NAME, NAME2, x, v (lyapunov\n"
     "                      --curves draws them over its heat map)\n"
-    "  --from X,V          start near (x, v) at the section (default: simulate 500\n"
+    "  --from X,V[,P]      start near (x, v) at the section, at NAME = P (default: the\n"
+    "                      value --param gives NAME; without --from: simulate 500\n"
     "                      periods from the thesis' start 1 + 0.9 S0, 0); repeat it\n"
     "                      (up to 8) for several branches in one diagram\n"
     "  --period K          the solution's period in excitation periods (default: the\n"
@@ -69,7 +70,8 @@ enum { MAX_STARTS = 8, MAX_BRANCHES = 64 };
 typedef struct cont_args {
     model_opts mo;
     char vary[16], vary2[16];
-    double lo, hi, lo2, hi2, from[MAX_STARTS][2];
+    double lo, hi, lo2, hi2;
+    double from[MAX_STARTS][3]; /* x, v and the parameter's value (NaN: --param's) */
     int has_vary, n_from, down, both, switch_pd, period, max_points, width, height;
     const char *csv, *events, *png, *curves;
     bool json, quiet;
@@ -127,11 +129,15 @@ static int parse_args(cli *c, cont_args *a)
         } else if (cli_is(c, "--from", true, &err)) {
             if (c->value && a->n_from == MAX_STARTS)
                 err = cli_usage_error(c, "--from: at most %d starts", MAX_STARTS);
-            else if (c->value &&
-                     (!parse_doubles(c->value, a->from[a->n_from], &n, 2) || n != 2 ||
-                      !isfinite(a->from[a->n_from][0]) || !isfinite(a->from[a->n_from][1])))
-                err = cli_usage_error(c, "--from: '%s' is not X,V (two finite numbers)", c->value);
-            a->n_from++;
+            else if (c->value) {
+                double *f = a->from[a->n_from++];
+                if (!parse_doubles(c->value, f, &n, 3) || n < 2 || !isfinite(f[0]) ||
+                    !isfinite(f[1]) || (n == 3 && !isfinite(f[2])))
+                    err = cli_usage_error(
+                        c, "--from: '%s' is not X,V or X,V,P (finite numbers)", c->value);
+                if (n == 2)
+                    f[2] = NAN;
+            }
         } else if (cli_take_int(c, "--period", 1, 64, &a->period, &err)) {
         } else if (cli_take_int(c, "--max-points", 2, 1000000, &a->max_points, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
@@ -229,10 +235,10 @@ static void event_label(const cm_fo_branch_event *e, char *out, size_t size)
 {
     const char *name = cm_fo_event_name(e->type);
     const char sym = e->at.symmetric ? 's' : 'a';
-    if (e->type == CM_FO_EVENT_CS || e->type == CM_FO_EVENT_T)
+    if (e->type >= CM_FO_EVENT_CS)
         snprintf(out, size, "%s_%c", name, sym);
     else
-        snprintf(out, size, "%s_%d%c", name, e->at.n_stick / e->at.period, sym);
+        snprintf(out, size, "%s_%d%c", name, e->at.n_stick, sym);
 }
 
 static const char *event_kind(const cm_fo_branch_event *e)
@@ -241,8 +247,11 @@ static const char *event_kind(const cm_fo_branch_event *e)
     case CM_FO_EVENT_SN: return e->fold ? "fold" : "branch point";
     case CM_FO_EVENT_PD: return "period doubling";
     case CM_FO_EVENT_NS: return "Neimark-Sacker";
-    case CM_FO_EVENT_CS: return "sticking segments change";
-    default: return "slip segments change";
+    case CM_FO_EVENT_CS: return e->jump ? "sticking segments change and the map jumps"
+                                        : "sticking segments change";
+    case CM_FO_EVENT_SS: return e->jump ? "a pause appears or vanishes and the map jumps"
+                                        : "a pause appears or vanishes";
+    default: return e->jump ? "grazing: the map jumps" : "slip segments change";
     }
 }
 
@@ -590,15 +599,25 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
         double z[2];
         int period = 0;
         const double *from = a->n_from ? a->from[k] : NULL;
-        if (!find_start(a, o, from, z, &period)) {
+        const double p = from && !isnan(from[2]) ? from[2] : p0;
+        cm_fo at;
+        cm_fo_with(o, param, p, &at);
+        if (!(p >= a->lo && p <= a->hi) || !(at.S > 0 && at.S0 >= at.S && at.Omega > 0)) {
+            fprintf(stderr,
+                    "cellmap continue: --from's %s = %s is outside --vary %s=%s:%s or the "
+                    "model's domain (S0 >= S > 0, Omega > 0); start inside both\n",
+                    a->vary, CM_NUM(p), a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
+            return EXIT_USAGE;
+        }
+        if (!find_start(a, &at, from, z, &period)) {
             fprintf(stderr,
                     "cellmap continue: no periodic solution%s found from (%s, %s) at %s = %s "
                     "(chaotic there, or a longer period: give --from near one, and --period)\n",
                     a->period ? " of that period" : " of period 1..16", CM_NUM(z[0]),
-                    CM_NUM(z[1]), a->vary, CM_NUM(p0));
+                    CM_NUM(z[1]), a->vary, CM_NUM(p));
             return EXIT_FAIL;
         }
-        const int true_period = cm_fo_minimal_period(o, z, period);
+        const int true_period = cm_fo_minimal_period(&at, z, period);
         if (true_period != period) {
             fprintf(stderr,
                     "cellmap continue: the solution found near (%s, %s) repeats after %d "
@@ -608,7 +627,7 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
                     period, true_period, period);
             return EXIT_FAIL;
         }
-        err = follow_ways(a, o, param, p0, z, period, a->both, col);
+        err = follow_ways(a, &at, param, p, z, period, a->both, col);
     }
     if (!err && a->switch_pd)
         err = switch_branches(a, o, param, col);

@@ -5,6 +5,8 @@
  * the Poincare map, stability on either side by simulation, and signatures
  * on either side of the sliding bifurcations. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
@@ -174,9 +176,160 @@ static void test_fig_2_17(void)
     }
 }
 
+/* How far P^k moves the state of e with the parameter d off e's. */
+static double moved_by(const cm_fo_branch_event *e, int param, const cm_fo *base, double d)
+{
+    cm_fo at;
+    cm_fo_with(base, param, e->at.p + d, &at);
+    cm_fo_init(&at, at.S, at.S0, at.Omega, e->at.phi);
+    double w[2] = {e->at.z[0], e->at.z[1]};
+    for (int k = 0; k < e->at.period; k++)
+        if (!cm_fo_poincare(&at, w, w, NULL, NULL, NULL))
+            return NAN;
+    return hypot(w[0] - e->at.z[0], w[1] - e->at.z[1]);
+}
+
+/* Whether P^k from the state of e jumps as the parameter crosses e (by
+ * simulation): on one side it moves the state by as much at 1e-7 off as
+ * at 1e-6 off, and by 50 times more than on the other side, where it moves
+ * it in proportion. */
+static bool jumps_at(const cm_fo_branch_event *e, int param, const cm_fo *base)
+{
+    for (int side = -1; side <= 1; side += 2) {
+        const double near = moved_by(e, param, base, side * 1e-7);
+        const double far = moved_by(e, param, base, side * 1e-6);
+        const double other = moved_by(e, param, base, -side * 1e-7);
+        if (far < 2 * near && near > 50 * other)
+            return true;
+    }
+    return false;
+}
+
+/* The stable points of several branches, and the events of the last. */
+typedef struct stable_points {
+    double p[8192];
+    int n;
+    found events;
+} stable_points;
+
+static int keep_stable(void *user, const cm_fo_solution *s)
+{
+    stable_points *sp = user;
+    if (s->stable && sp->n < 8192)
+        sp->p[sp->n++] = s->p;
+    return 0;
+}
+
+static int keep_event_of(void *user, const cm_fo_branch_event *e)
+{
+    return keep(&((stable_points *)user)->events, e);
+}
+
+/* Both ways along the period-k solution z of o at p0 in S over 0.02:0.4:
+ * stable points to sp, events to sp->events (both ways), stop reasons to
+ * stop[2]. */
+static void follow_s(const cm_fo *o, double p0, const double z[2], int period, stable_points *sp,
+                     int stop[2])
+{
+    sp->events.n = 0;
+    for (int way = 0; way < 2; way++) {
+        const cm_fo_continue_options opt = {CM_FO_P_S, 0.02, 0.4, way ? -1 : 1, 0, 0, 0, 3000};
+        CHECK(cm_fo_continue(o, &opt, p0, z, period, keep_stable, keep_event_of, sp, &stop[way]) >
+              3);
+    }
+}
+
+/* Fig. 2.17 below PD_1a (S0 = 0.4, Omega = 0.5): the doubled solution 2a
+ * is stable from PD_1a down to T (S ~ 0.055787), where the map jumps and the
+ * branch ends; 1a,9seg is stable from SS_a (S ~ 0.043479) down to its fold,
+ * the thesis' N (S ~ 0.035620); none of the branches (1a, 2s, 2a, 1a,9seg)
+ * is stable in between, and simulation finds no periodic attractor there. */
+static void test_fig_2_17_window(void)
+{
+    stable_points *sp = calloc(1, sizeof *sp);
+    if (!sp)
+        return;
+    int stop[2], period;
+    cm_fo o;
+    /* 1a and 2s: the branches through the simulated solutions at S = 0.3, 0.38 */
+    const double starts[2] = {0.3, 0.38};
+    cm_fo_branch_event pd = {.type = -1};
+    for (int k = 0; k < 2; k++) {
+        cm_fo_init(&o, starts[k], 0.4, 0.5, 0);
+        double z[2] = {1.36, 0};
+        CHECK((period = cm_fo_find_periodic(&o, z, 500, 16)) == 1);
+        follow_s(&o, starts[k], z, 1, sp, stop);
+        const cm_fo_branch_event *e = first(&sp->events, CM_FO_EVENT_PD, 0.068, 1e-3);
+        if (e)
+            pd = *e;
+    }
+    CHECK(pd.type == CM_FO_EVENT_PD);
+    /* 2a: switched onto at PD_1a; both of its halves end at T */
+    cm_fo_init(&o, 0.3, 0.4, 0.5, 0);
+    double z[2], q;
+    CHECK(cm_fo_period_doubled(&o, CM_FO_P_S, &pd, z, &q));
+    cm_fo from;
+    cm_fo_with(&o, CM_FO_P_S, q, &from);
+    cm_fo_init(&from, from.S, from.S0, from.Omega, pd.at.phi);
+    follow_s(&from, q, z, 2, sp, stop);
+    CHECK_INT(stop[0], CM_FO_STOP_SIGNATURE);
+    CHECK_INT(stop[1], CM_FO_STOP_SIGNATURE);
+    const cm_fo_branch_event *t = first(&sp->events, CM_FO_EVENT_T, 0.055787, 1e-3);
+    CHECK(t != NULL);
+    if (t) {
+        CHECK(t->jump && t->at.stable && t->at.period == 2 && t->at.n_stick == 2);
+        CHECK(jumps_at(t, CM_FO_P_S, &o)); /* independently, by simulation */
+        /* and just above T simulation settles on the period-2 solution */
+        cm_fo above;
+        cm_fo_init(&above, t->at.p + 1e-3, 0.4, 0.5, t->at.phi);
+        double w[2] = {t->at.z[0], t->at.z[1]};
+        CHECK_INT(cm_fo_find_periodic(&above, w, 2000, 16), 2);
+        double image[2] = {t->at.z[0], t->at.z[1]}; /* the orbit's other point */
+        CHECK(cm_fo_poincare(&above, image, image, NULL, NULL, NULL));
+        CHECK(hypot(w[0] - t->at.z[0], w[1] - t->at.z[1]) < 0.05 ||
+              hypot(w[0] - image[0], w[1] - image[1]) < 0.05);
+    }
+    /* 1a,9seg: through the solution simulation settles on at S = 0.04 */
+    cm_fo_init(&o, 0.04, 0.4, 0.5, 0);
+    z[0] = 1.36, z[1] = 0;
+    CHECK((period = cm_fo_find_periodic(&o, z, 500, 16)) == 1);
+    CHECK(stays(&o, CM_FO_P_S, 0.04, z, 0, 1));
+    follow_s(&o, 0.04, z, 1, sp, stop);
+    const cm_fo_branch_event *ss = first(&sp->events, CM_FO_EVENT_SS, 0.043479, 1e-3);
+    const cm_fo_branch_event *n = first(&sp->events, CM_FO_EVENT_SN, 0.035620, 1e-4);
+    CHECK(ss != NULL && n != NULL);
+    if (ss)
+        CHECK(ss->at.stable && ss->at.n_stick == 1 && !ss->at.symmetric);
+    if (n) {
+        CHECK(n->fold);
+        check_point(n, CM_FO_P_S, &o, 1, 2e-3);
+    }
+    /* the window: nothing stable inside, stable points at both ends */
+    double below = 0, above = 1;
+    for (int i = 0; i < sp->n; i++) {
+        if (sp->p[i] <= 0.05)
+            below = fmax(below, sp->p[i]);
+        else
+            above = fmin(above, sp->p[i]);
+    }
+    if (fabs(below - 0.043479) >= 1e-3 || fabs(above - 0.055787) >= 1e-3)
+        fprintf(stderr, "no stable solution in (%.9g, %.9g), not (0.043479, 0.055787)\n", below,
+                above);
+    CHECK(fabs(below - 0.043479) < 1e-3 && fabs(above - 0.055787) < 1e-3);
+    for (double S = 0.045; S < 0.055; S += 0.0025) {
+        cm_fo_init(&o, S, 0.4, 0.5, 0);
+        double w[2] = {1.36, 0};
+        CHECK_INT(cm_fo_find_periodic(&o, w, 2000, 16), 0);
+    }
+    free(sp);
+}
+
 /* Fig. 2.18, S = 0.32, S0 = 0.4, Omega varied: 1a is stable between CS_a
  * (0.49182) and SN_1a (0.54191); the symmetric solution's CS_s at 0.53529,
- * where 2s begins, and 2s loses stability at SN_2s, 0.48874. */
+ * where 2s begins, and 2s loses stability at SN_2s, 0.48874. Each from the
+ * branch that a simulation at Omega settles on: 1a at 0.5, the symmetric
+ * non-sticking 0s at 0.58, 2s at 0.47 (several branches meet at CS_s, and a
+ * branch through it may go on along any of them). */
 static void test_fig_2_18(void)
 {
     cm_fo base;
@@ -191,29 +344,38 @@ static void test_fig_2_18(void)
         CHECK(fabs(sn->at.p - 0.54191) < 2e-4);
         check_point(sn, CM_FO_P_OMEGA, &base, 1, 2e-3);
     }
-    const cm_fo_branch_event *cs = NULL; /* the symmetric one: CS_s */
-    for (int i = 0; i < f.n && !cs; i++)
-        if (f.e[i].type == CM_FO_EVENT_CS && f.e[i].at.symmetric &&
-            fabs(f.e[i].at.p - 0.53529) < 2e-4)
-            cs = &f.e[i];
+    /* CS_s, from 0s: its sticking segments are born there */
+    CHECK(branch_events(0.32, 0.4, 0.58, CM_FO_P_OMEGA, 0.45, 0.6, -1, &f, &period) > 10);
+    const cm_fo_branch_event *cs = first(&f, CM_FO_EVENT_CS, 0, 0);
     CHECK(cs != NULL);
     if (cs) {
-        CHECK(cs->at.symmetric && cs->other.symmetric && cs->at.n_stick == 0);
-        CHECK(check_sides(cs, CM_FO_P_OMEGA, &base) < 2e-4);
+        CHECK(fabs(cs->at.p - 0.53529) < 2e-4);
+        CHECK(cs->at.symmetric && cs->at.n_stick == 0 && cs->other.n_stick > 0);
+        CHECK(check_sides(cs, CM_FO_P_OMEGA, &base) < 1e-6);
     }
+    /* SN_2s, from 2s */
+    CHECK(branch_events(0.32, 0.4, 0.47, CM_FO_P_OMEGA, 0.45, 0.6, 1, &f, &period) > 10);
     const cm_fo_branch_event *sn2 = first(&f, CM_FO_EVENT_SN, 0.48874, 2e-4);
     CHECK(sn2 != NULL);
     if (sn2) {
-        CHECK(sn2->at.n_stick == 2);
+        CHECK(sn2->at.symmetric && sn2->at.n_stick == 2);
         check_point(sn2, CM_FO_P_OMEGA, &base, 1, 2e-3);
     }
+    /* CS_a, from 1a down: the map jumps there, and 1a ends; below it
+     * simulation settles on 2a, with two sticking segments */
     CHECK(branch_events(0.32, 0.4, 0.5, CM_FO_P_OMEGA, 0.45, 0.6, -1, &f, &period) > 3);
     cs = first(&f, CM_FO_EVENT_CS, 0, 0);
     CHECK(cs != NULL);
     if (cs) {
-        CHECK(!cs->at.symmetric && cs->at.n_stick == 1 && cs->other.n_stick == 2);
+        CHECK(!cs->at.symmetric && cs->at.n_stick == 1 && cs->jump);
         CHECK(fabs(cs->at.p - 0.49182) < 2e-4);
-        CHECK(check_sides(cs, CM_FO_P_OMEGA, &base) < 2e-4);
+        CHECK(jumps_at(cs, CM_FO_P_OMEGA, &base));
+        cm_fo below;
+        cm_fo_init(&below, 0.32, 0.4, cs->at.p - 1e-3, cs->at.phi);
+        double w[2] = {cs->at.z[0], cs->at.z[1]};
+        cm_fo_solution s;
+        CHECK_INT(cm_fo_find_periodic(&below, w, 2000, 16), 1);
+        CHECK(cm_fo_solution_at(&below, w, 1, &s) && s.stable && s.n_stick == 2);
     }
 }
 
@@ -269,6 +431,7 @@ int main(void)
 {
     test_pd_curve();
     test_fig_2_17();
+    test_fig_2_17_window();
     test_fig_2_18();
     CHECK_DONE();
 }
