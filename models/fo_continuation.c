@@ -168,6 +168,7 @@ bool cm_fo_solution_at(const cm_fo *o, const double z[2], int period, cm_fo_solu
     multipliers(M, out->mult);
     out->stable = hypot(out->mult[0][0], out->mult[0][1]) < 1;
     out->symmetric = fabs(out->psi) < 1e-6;
+    out->asymmetry = fabs((out->x_max + out->x_min) / (out->x_max - out->x_min));
     return true;
 }
 
@@ -590,8 +591,12 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
     snprintf(e->after, sizeof e->after, "%s", bp->s.signature);
 }
 
-/* Steps this short are taken only at corners of a branch. */
+/* Steps this short are taken only at corners of a branch; where a branch
+ * takes MAX_CREEP of them in a row, the map is nearly singular (a segment
+ * nearly grazes a boundary: Newton converges only from within about 1e-7),
+ * and the branch is given up. */
 #define H_CORNER 1e-6
+enum { MAX_CREEP = 200 };
 
 /* A corrected step from a to b of length h is kept only if the branch
  * stayed near the prediction and turned little: otherwise the corrector
@@ -624,13 +629,14 @@ static bool at_model_limit(const branch *b, double p)
     }
 }
 
-/* How far G(u) moves from a to the point d ahead along its tangent, and
- * the motion from there to ahead (may be NULL); NaN if it is lost. */
-static double motion_ahead(const branch *b, const point *a, double d, cm_fo_solution *ahead)
+/* How far G(u) moves from a to the point d ahead along direction dir,
+ * and the motion from there to ahead (may be NULL); NaN if it is lost. */
+static double motion_ahead(const branch *b, const point *a, const double dir[3], double d,
+                           cm_fo_solution *ahead)
 {
     double u[3], G[2], Gu[2];
     for (int i = 0; i < 3; i++)
-        u[i] = a->u[i] + d * a->t[i];
+        u[i] = a->u[i] + d * dir[i];
     cm_fo o;
     cm_fo_with(&b->base, b->param, u[2], &o);
     if (!residual(b, a->u, G, NULL) || !residual(b, u, Gu, NULL) ||
@@ -648,16 +654,21 @@ static double motion_ahead(const branch *b, const point *a, double d, cm_fo_solu
  * at a, to e. */
 static bool signature_breaks(const branch *b, const point *a, cm_fo_branch_event *e)
 {
-    for (int k = 8; k >= 5; k--) {
-        const double d = pow(10, -k);
+    /* ahead along the tangent, and in the parameter alone (where the
+     * branch is steep, the tangent hardly moves it) */
+    const double in_p[3] = {0, 0, a->t[2] < 0 ? -1 : 1};
+    const double *const dirs[2] = {a->t, in_p};
+    for (int k = 24; k >= 10; k--) {
+        const double *dir = dirs[k % 2];
+        const double d = pow(10, -k / 2);
         cm_fo_solution ahead;
-        const double moved = motion_ahead(b, a, d, &ahead);
+        const double moved = motion_ahead(b, a, dir, d, &ahead);
         if (isnan(moved))
             continue;
         /* G moves by O(d) on a smooth map and by O(sqrt d) where a segment
          * is born tangentially: ten times d moves it 3 to 10 times as far,
          * unless it jumps in between */
-        const bool jump = moved > 1e-6 && moved > 100 * motion_ahead(b, a, d / 10, NULL);
+        const bool jump = moved > 1e-6 && moved > 100 * motion_ahead(b, a, dir, d / 10, NULL);
         if (!jump && strcmp(ahead.signature, a->s.signature) == 0)
             continue;
         point next = *a;
@@ -752,6 +763,26 @@ static bool cross_corner(const branch *b, const point *a, double *h, point *out)
     return true;
 }
 
+/* Whether the branch, going from a to b, passes through the solution s
+ * (it has closed into a loop): s lies on the segment from a to b, to 5% of
+ * its length, in the solution's parameter and range of x, which do not
+ * depend on the section's phase. */
+static bool passes_by(const cm_fo_solution *s, const cm_fo_solution *a, const cm_fo_solution *b)
+{
+    const double d[3] = {b->p - a->p, b->x_max - a->x_max, b->x_min - a->x_min};
+    const double r[3] = {s->p - a->p, s->x_max - a->x_max, s->x_min - a->x_min};
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (!(dd > 0))
+        return false;
+    const double w = (r[0] * d[0] + r[1] * d[1] + r[2] * d[2]) / dd;
+    if (w < 0 || w > 1)
+        return false;
+    double off2 = 0;
+    for (int i = 0; i < 3; i++)
+        off2 += (r[i] - w * d[i]) * (r[i] - w * d[i]);
+    return off2 <= 0.0025 * dd + 1e-18;
+}
+
 int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
                    const double z[2], int period, cm_fo_point_fn on_point,
                    cm_fo_event_fn2 on_event, void *user, int *stop)
@@ -767,6 +798,8 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
     if (!describe(&b, u0, NULL, opt->direction < 0 ? -1 : 1, &cur))
         return 0;
     rephase(&b, &cur); /* or stay where it is */
+    const cm_fo_solution start = cur.s;
+    int creep = 0; /* steps in a row no longer than H_CORNER */
     bool rephased = false; /* at this point already */
     int n = 1;
     if (on_point && on_point(user, &cur.s)) {
@@ -814,8 +847,9 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
                 continue;
             cm_fo_branch_event e;
             locate(&b, &cur, &next, step, type, &e);
-            if (type == EVENT_TURN && !smooth_turn(&b, &e, step))
-                continue;
+            if (type == EVENT_TURN &&
+                (strcmp(cur.s.signature, next.s.signature) != 0 || !smooth_turn(&b, &e, step)))
+                continue; /* a corner turns the branch: the CS event says so */
             /* a test function that changes sign only where the signature
              * does jumps at the corner: no event of its own */
             if (type <= CM_FO_EVENT_NS || type == EVENT_TURN)
@@ -826,17 +860,29 @@ int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
                 return n;
             }
         }
+        const bool closes = n > 3 && passes_by(&start, &cur.s, &next.s);
+        creep = step <= H_CORNER ? creep + 1 : 0;
         cur = next;
         n++;
         if (on_point && on_point(user, &cur.s)) {
             *stop = CM_FO_STOP_POINTS;
             return n;
         }
+        if (closes) {
+            *stop = CM_FO_STOP_LOOP;
+            return n;
+        }
+        if (creep == MAX_CREEP) {
+            *stop = CM_FO_STOP_STEP;
+            return n;
+        }
         if (cur.u[2] < opt->lo || cur.u[2] > opt->hi) {
             *stop = CM_FO_STOP_BOUND;
             return n;
         }
-        if (iters <= 3)
+        /* a short step grows whatever Newton needed: near a corner it needs
+         * many iterations, and would creep up to it */
+        if (iters <= 3 || h <= H_CORNER)
             h = fmin(h * 1.5, h_max);
     }
     *stop = CM_FO_STOP_POINTS;
@@ -1151,8 +1197,12 @@ const char *cm_fo_event_name(int type)
 const char *cm_fo_stop_name(int stop)
 {
     static const char *const names[] = {"the parameter left its range", "the point limit",
-                                        "the corrector failed at the smallest step",
+                                        "the corrector failed at the smallest step, or crept "
+                                        "below 1e-6 for 200 points (the map is nearly singular "
+                                        "there)",
                                         "the motion could not be followed",
-                                        "a change of signature or a jump of the map it cannot follow"};
-    return stop >= 0 && stop < 5 ? names[stop] : "?";
+                                        "a change of signature or a jump of the map it cannot follow",
+                                        "the branch came back to its start (a loop, or from a "
+                                        "period doubling the orbit's other point)"};
+    return stop >= 0 && stop < 6 ? names[stop] : "?";
 }

@@ -35,7 +35,9 @@ typedef struct cm_fo_solution {
     double mult[2][2]; /* Floquet multipliers (re, im), |first| >= |second| */
     bool stable;       /* both multipliers inside the unit circle */
     double x_max, x_min;
-    double psi;        /* asymmetry: the sum of x at the velocity zeros over the period */
+    double psi;        /* the sum of x at the velocity zeros over the period (thesis 2.6.1;
+                          signed: mirror images have opposite signs) */
+    double asymmetry;  /* the thesis' Psi (2.90): |(x_max + x_min) / (x_max - x_min)| */
     int n_stick;       /* sticking segments per period */
     int n_stops;
     double stops[CM_FO_MAX_STOPS]; /* x where the block sticks, in time order */
@@ -100,12 +102,17 @@ typedef struct cm_fo_branch_event {
 enum cm_fo_stop {
     CM_FO_STOP_BOUND = 0, /* the parameter left [lo, hi] */
     CM_FO_STOP_POINTS,    /* max_points reached */
-    CM_FO_STOP_STEP,      /* the corrector failed down to the smallest step */
+    CM_FO_STOP_STEP,      /* the corrector failed down to the smallest step, or
+                             took 200 steps in a row no longer than 1e-6 */
     CM_FO_STOP_LOST,      /* P^period cannot be followed (motion lost) */
-    CM_FO_STOP_SIGNATURE  /* the corrector fails where the signature changes
+    CM_FO_STOP_SIGNATURE, /* the corrector fails where the signature changes
                              or the map jumps just ahead: a segment grazes a
                              boundary and no smooth continuation exists
                              (reported as an event at the last point) */
+    CM_FO_STOP_LOOP       /* the branch came back to its start, in the parameter
+                             and x range: a closed loop (an isola), all of it
+                             followed; or, on a branch from a period doubling,
+                             the other point of the same orbit */
 };
 const char *cm_fo_stop_name(int stop);
 

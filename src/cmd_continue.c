@@ -18,10 +18,11 @@
 
 static const char continue_help[] =
     "usage: cellmap continue [--model friction-oscillator] [--param k=v[,k=v]]\n"
-    "                        --vary NAME=LO:HI [--down|--both] [--from X,V[,P] ...] [--period K]\n"
+    "                        --vary NAME=LO:HI [--down|--both] [--from X,V[,P] ...]\n"
+    "                        [--start P ...] [--period K]\n"
     "                        [--switch] [--curve NAME2=LO:HI --curves FILE|-]\n"
     "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
-    "                        [--size WxH] [--json] [--quiet]\n\n"
+    "                        [--panels LIST] [--size WxH] [--json] [--quiet]\n\n"
     "Follows a periodic solution of the dry friction oscillator in parameter NAME\n"
     "(S, S0, Omega or phi) by pseudo-arclength continuation of the fixed points of\n"
     "P^K, the K-th iterate of the stroboscopic Poincare map, with Newton's method on\n"
@@ -50,32 +51,66 @@ static const char continue_help[] =
     "                      value --param gives NAME; without --from: simulate 500\n"
     "                      periods from the thesis' start 1 + 0.9 S0, 0); repeat it\n"
     "                      (up to 8) for several branches in one diagram\n"
+    "  --start P           start where a simulation of 500 periods from the thesis'\n"
+    "                      start settles at NAME = P; repeatable, with --from too\n"
     "  --period K          the solution's period in excitation periods (default: the\n"
     "                      smallest, 1..16, that the start settles on)\n"
     "  --max-points N      at most N branch points (default 5000)\n"
     "  --csv FILE|-        the branch points: branch, parameter, section phase, x, v,\n"
-    "                      period, stability, multipliers, x range, Psi, sticks, stops,\n"
-    "                      signature\n"
+    "                      period, stability, multipliers, x range, psi (the signed sum\n"
+    "                      of x at the velocity zeros), asymmetry (the thesis' Psi,\n"
+    "                      (2.90)), sticks, stops, signature\n"
     "  --events FILE|-     the events: branch, label, kind, fold, parameter, x, v, phase,\n"
     "                      stability, multipliers, signatures before and after\n"
-    "  --png FILE          the thesis' diagram (Figs. 2.17-2.18): maximal displacement,\n"
-    "                      stop positions and Psi against the parameter; stable points\n"
-    "                      green, unstable red, events marked and labelled\n"
-    "  --size WxH          image size (default 900x1100)\n"
+    "  --png FILE          the thesis' diagram (Figs. 2.17-2.19): maximal displacement,\n"
+    "                      stop positions and the asymmetry Psi (2.90) against the\n"
+    "                      parameter; stable points green, unstable red, events marked\n"
+    "                      and labelled\n"
+    "  --panels LIST       the diagram's panels, in order: x_max, stops, psi (default\n"
+    "                      all three; e.g. psi for Fig. 2.19, stops for Fig. 2.22's\n"
+    "                      bottom panel)\n"
+    "  --size WxH          image size (default 900x1100; 900x380 per panel when\n"
+    "                      --panels picks fewer)\n"
     "  --json              the summary and events as JSON (docs/cellmap.schema.json)\n"
     "  --quiet             no summary\n";
 
 enum { MAX_STARTS = 8, MAX_BRANCHES = 64 };
 
+/* The diagram's panels. */
+enum { PANEL_X_MAX = 0, PANEL_STOPS, PANEL_PSI, PANELS };
+static const char *const panel_names[PANELS] = {"x_max", "stops", "psi"};
+
 typedef struct cont_args {
     model_opts mo;
     char vary[16], vary2[16];
     double lo, hi, lo2, hi2;
-    double from[MAX_STARTS][3]; /* x, v and the parameter's value (NaN: --param's) */
+    /* the starts: x, v (NaN: simulate) and the parameter's value (NaN: --param's) */
+    double from[MAX_STARTS][3];
     int has_vary, n_from, down, both, switch_pd, period, max_points, width, height;
+    int panels[PANELS], n_panels;
     const char *csv, *events, *png, *curves;
     bool json, quiet;
 } cont_args;
+
+/* "x_max,stops,psi" (any of them, in any order, each once) into a->panels. */
+static bool parse_panels(const char *text, cont_args *a)
+{
+    a->n_panels = 0;
+    bool seen[PANELS] = {false};
+    for (const char *p = text;;) {
+        const size_t len = strcspn(p, ",");
+        int k = 0;
+        while (k < PANELS && !(strlen(panel_names[k]) == len && strncmp(p, panel_names[k], len) == 0))
+            k++;
+        if (k == PANELS || seen[k])
+            return false;
+        seen[k] = true;
+        a->panels[a->n_panels++] = k;
+        if (p[len] == '\0')
+            return true;
+        p += len + 1;
+    }
+}
 
 /* NAME=LO:HI into name (size 16), lo, hi; false if it is not one. */
 static bool parse_range(const char *text, char *name, double *lo, double *hi)
@@ -128,7 +163,7 @@ static int parse_args(cli *c, cont_args *a)
             a->curves = c->value;
         } else if (cli_is(c, "--from", true, &err)) {
             if (c->value && a->n_from == MAX_STARTS)
-                err = cli_usage_error(c, "--from: at most %d starts", MAX_STARTS);
+                err = cli_usage_error(c, "--from and --start: at most %d starts", MAX_STARTS);
             else if (c->value) {
                 double *f = a->from[a->n_from++];
                 if (!parse_doubles(c->value, f, &n, 3) || n < 2 || !isfinite(f[0]) ||
@@ -138,6 +173,14 @@ static int parse_args(cli *c, cont_args *a)
                 if (n == 2)
                     f[2] = NAN;
             }
+        } else if (cli_is(c, "--start", true, &err)) {
+            double p;
+            if (c->value && a->n_from == MAX_STARTS)
+                err = cli_usage_error(c, "--from and --start: at most %d starts", MAX_STARTS);
+            else if (c->value && !parse_double(c->value, &p))
+                err = cli_usage_error(c, "--start: '%s' is not a number", c->value);
+            else if (c->value)
+                memcpy(a->from[a->n_from++], (double[3]){NAN, NAN, p}, sizeof a->from[0]);
         } else if (cli_take_int(c, "--period", 1, 64, &a->period, &err)) {
         } else if (cli_take_int(c, "--max-points", 2, 1000000, &a->max_points, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
@@ -146,7 +189,13 @@ static int parse_args(cli *c, cont_args *a)
             a->events = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
-        } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
+        } else if (cli_is(c, "--panels", true, &err)) {
+            if (c->value && !parse_panels(c->value, a))
+                err = cli_usage_error(c,
+                                      "--panels: '%s' is not a list of x_max, stops and psi, "
+                                      "each at most once (e.g. psi or x_max,stops)",
+                                      c->value);
+        } else if (cli_take_size(c, 300, 300, 4096, &a->width, &a->height, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -157,6 +206,16 @@ static int parse_args(cli *c, cont_args *a)
     }
     if (!err && !a->has_vary)
         err = cli_usage_error(c, "--vary NAME=LO:HI is required (e.g. --vary S=0.02:0.4)");
+    if (!err && a->n_panels == 0)
+        for (int k = 0; k < PANELS; k++)
+            a->panels[a->n_panels++] = k;
+    if (!err && a->height == 0) {
+        a->width = 900;
+        a->height = a->n_panels == PANELS ? 1100 : 450 * a->n_panels;
+    }
+    if (!err && a->height < 150 * a->n_panels)
+        err = cli_usage_error(c, "--size: %d panels want at least %d pixels of height",
+                              a->n_panels, 150 * a->n_panels);
     if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->events)))
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && (cm_output_names_stdout(a->csv) + cm_output_names_stdout(a->events) +
@@ -267,14 +326,15 @@ static bool write_points(const cont_args *a, const collected *c)
     if (!outfile_open("continue", a->csv, &o))
         return false;
     fprintf(o.f, "branch,%s,phi,x,v,period,stable,mult1_re,mult1_im,mult2_re,mult2_im,x_max,x_min,"
-                 "psi,sticks,stops,signature\n",
+                 "psi,asymmetry,sticks,stops,signature\n",
             a->vary);
     for (uint64_t i = 0; i < c->n; i++) {
         const cm_fo_solution *s = &c->points[i].s;
         fprintf(o.f, "%d,%.17g,%.17g,%.17g,%.17g,%d,%d", c->points[i].branch + 1, s->p, s->phi,
                 s->z[0], s->z[1], s->period, s->stable);
         print_mults(o.f, s);
-        fprintf(o.f, ",%.17g,%.17g,%.17g,%d,", s->x_max, s->x_min, s->psi, s->n_stick);
+        fprintf(o.f, ",%.17g,%.17g,%.17g,%.17g,%d,", s->x_max, s->x_min, s->psi, s->asymmetry,
+                s->n_stick);
         for (int k = 0; k < s->n_stops; k++)
             fprintf(o.f, "%s%.9g", k ? ";" : "", s->stops[k]);
         fprintf(o.f, ",%s\n", s->signature);
@@ -444,20 +504,34 @@ static void cloud_range(const cloud *c, double *lo, double *hi)
     }
 }
 
-/* Three panels as Figs. 2.17-2.18: the maximal displacement, the stops
- * and Psi against the parameter; stable green, unstable red, events black
- * with their labels on the top panel. */
+/* Branches through the same point each report its events: a label that
+ * repeats an earlier one within 1% of the parameter's range (and 0.02 in
+ * y) is left out, so that it is drawn once. */
+static void drop_repeated_labels(cm_chart_label *labels, uint64_t n, double range)
+{
+    for (uint64_t i = 0; i < n; i++)
+        for (uint64_t j = 0; j < i && labels[i].text; j++)
+            if (labels[j].text && strcmp(labels[i].text, labels[j].text) == 0 &&
+                fabs(labels[i].x - labels[j].x) < 0.01 * range &&
+                fabs(labels[i].y - labels[j].y) < 0.02)
+                labels[i].text = NULL;
+}
+
+/* Up to three panels as Figs. 2.17-2.19: the maximal displacement, the
+ * stops and Psi (2.90) against the parameter, those --panels picks in its
+ * order; stable green, unstable red, events black with their labels on the
+ * top panel. */
 static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
 {
-    enum { PANELS = 3 };
     cloud stable[PANELS] = {{0}}, unstable[PANELS] = {{0}}, marks[PANELS] = {{0}};
     bool ok = true;
     for (uint64_t i = 0; i < c->n && ok; i++) {
         const cm_fo_solution *s = &c->points[i].s;
         cloud *into = s->stable ? stable : unstable;
-        ok = cloud_add(&into[0], s->p, s->x_max) && cloud_add(&into[2], s->p, s->psi);
+        ok = cloud_add(&into[PANEL_X_MAX], s->p, s->x_max) &&
+             cloud_add(&into[PANEL_PSI], s->p, s->asymmetry);
         for (int k = 0; k < s->n_stops && ok; k++)
-            ok = cloud_add(&into[1], s->p, s->stops[k]);
+            ok = cloud_add(&into[PANEL_STOPS], s->p, s->stops[k]);
     }
     cm_chart_label *labels = calloc(c->n_events + 1, sizeof *labels);
     char(*texts)[32] = calloc(c->n_events + 1, sizeof *texts);
@@ -465,25 +539,34 @@ static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
     for (uint64_t i = 0; i < c->n_events && ok; i++) {
         const cm_fo_branch_event *e = &c->events[i].e;
         event_label(e, texts[i], sizeof texts[i]);
-        labels[i] = (cm_chart_label){e->at.p, e->at.x_max, texts[i]};
-        ok = cloud_add(&marks[0], e->at.p, e->at.x_max) && cloud_add(&marks[2], e->at.p, e->at.psi);
+        const double y[PANELS] = {e->at.x_max, e->at.n_stops ? e->at.stops[0] : NAN,
+                                  e->at.asymmetry};
+        labels[i] = (cm_chart_label){e->at.p, y[a->panels[0]], texts[i]};
+        ok = cloud_add(&marks[PANEL_X_MAX], e->at.p, e->at.x_max) &&
+             cloud_add(&marks[PANEL_PSI], e->at.p, e->at.asymmetry);
         for (int k = 0; k < e->at.n_stops && ok; k++)
-            ok = cloud_add(&marks[1], e->at.p, e->at.stops[k]);
+            ok = cloud_add(&marks[PANEL_STOPS], e->at.p, e->at.stops[k]);
     }
     if (!ok)
         fprintf(stderr, "cellmap continue: out of memory for the diagram\n");
+    drop_repeated_labels(labels, c->n_events, a->hi - a->lo);
     static const char *const y_names[PANELS] = {"x_max", "stops", "Psi"};
+    static const char *const panel_titles[PANELS] = {"maximal displacement", "stop positions",
+                                                     "asymmetry Psi (2.90)"};
     char title[512], params[400];
     const char *const varied[] = {a->vary, NULL};
     cm_params_format_with(&m->values, varied, params, sizeof params);
     snprintf(title, sizeof title, "continuation in %s, %s; stable green, unstable red", a->vary,
              params);
-    const char *titles[PANELS] = {title, "stop positions", "asymmetry Psi"};
+
     const cm_rgb green = {26, 152, 80}, red = {215, 48, 39}, black = {0, 0, 0};
     cm_series series[PANELS][3];
     cm_chart charts[PANELS];
-    const int h = a->height / PANELS;
-    for (int k = 0; k < PANELS && ok; k++) {
+    const int n = a->n_panels, h = a->height / n;
+    char first_title[600];
+    snprintf(first_title, sizeof first_title, "%s: %s", panel_titles[a->panels[0]], title);
+    for (int i = 0; i < n && ok; i++) {
+        const int k = a->panels[i];
         double lo = INFINITY, hi = -INFINITY;
         cloud_range(&stable[k], &lo, &hi);
         cloud_range(&unstable[k], &lo, &hi);
@@ -495,26 +578,26 @@ static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
         series[k][1] = (cm_series){CM_SERIES_POINTS, stable[k].x, stable[k].y, stable[k].n,
                                    green, 3};
         series[k][2] = (cm_series){CM_SERIES_POINTS, marks[k].x, marks[k].y, marks[k].n, black, 7};
-        charts[k] = (cm_chart){a->width,
-                               k < PANELS - 1 ? h : a->height - (PANELS - 1) * h,
+        charts[i] = (cm_chart){a->width,
+                               i < n - 1 ? h : a->height - (n - 1) * h,
                                {a->lo, lo - pad},
                                {a->hi, hi + pad},
                                a->vary,
                                y_names[k],
-                               titles[k],
+                               i == 0 ? first_title : panel_titles[k],
                                NULL,
                                series[k],
                                3,
                                figure_font(),
                                0,
-                               k == 0 ? labels : NULL,
-                               k == 0 ? (int)c->n_events : 0};
+                               i == 0 ? labels : NULL,
+                               i == 0 ? (int)c->n_events : 0};
     }
     char range[96];
     snprintf(range, sizeof range, "%s=%s:%s", a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
     const cm_png_text png_texts[] = {{"Model", m->name}, {"Parameters", params}, {"Vary", range}};
     if (ok)
-        ok = write_chart_png("continue", a->png, charts, PANELS, png_texts, 3);
+        ok = write_chart_png("continue", a->png, charts, n, png_texts, 3);
     for (int k = 0; k < PANELS; k++) {
         free(stable[k].x), free(stable[k].y);
         free(unstable[k].x), free(unstable[k].y);
@@ -598,13 +681,14 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
     for (int k = 0; k < starts && !err && !col->out_of_memory; k++) {
         double z[2];
         int period = 0;
-        const double *from = a->n_from ? a->from[k] : NULL;
-        const double p = from && !isnan(from[2]) ? from[2] : p0;
+        const double *given = a->n_from ? a->from[k] : NULL;
+        const double p = given && !isnan(given[2]) ? given[2] : p0;
+        const double *from = given && !isnan(given[0]) ? given : NULL;
         cm_fo at;
         cm_fo_with(o, param, p, &at);
         if (!(p >= a->lo && p <= a->hi) || !(at.S > 0 && at.S0 >= at.S && at.Omega > 0)) {
             fprintf(stderr,
-                    "cellmap continue: --from's %s = %s is outside --vary %s=%s:%s or the "
+                    "cellmap continue: the start's %s = %s is outside --vary %s=%s:%s or the "
                     "model's domain (S0 >= S > 0, Omega > 0); start inside both\n",
                     a->vary, CM_NUM(p), a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
             return EXIT_USAGE;
@@ -641,7 +725,7 @@ static int follow(const cont_args *a, const cm_fo *o, int param, double p0, coll
 int cmd_continue(int argc, char **argv)
 {
     cli c = {"continue", argc, argv, 0, NULL, NULL};
-    cont_args a = {.mo = {.name = "friction-oscillator"}, .width = 900, .height = 1100};
+    cont_args a = {.mo = {.name = "friction-oscillator"}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;

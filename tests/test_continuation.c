@@ -272,8 +272,10 @@ static void test_fig_2_17_window(void)
     cm_fo_with(&o, CM_FO_P_S, q, &from);
     cm_fo_init(&from, from.S, from.S0, from.Omega, pd.at.phi);
     follow_s(&from, q, z, 2, sp, stop);
-    CHECK_INT(stop[0], CM_FO_STOP_SIGNATURE);
-    CHECK_INT(stop[1], CM_FO_STOP_SIGNATURE);
+    /* one way ends at T; the other either at T too or where it comes back
+     * to the orbit it started on, through PD_1a */
+    CHECK(stop[0] == CM_FO_STOP_SIGNATURE || stop[1] == CM_FO_STOP_SIGNATURE);
+    CHECK(stop[0] != CM_FO_STOP_STEP && stop[1] != CM_FO_STOP_STEP);
     const cm_fo_branch_event *t = first(&sp->events, CM_FO_EVENT_T, 0.055787, 1e-3);
     CHECK(t != NULL);
     if (t) {
