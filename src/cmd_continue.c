@@ -504,17 +504,25 @@ static void cloud_range(const cloud *c, double *lo, double *hi)
     }
 }
 
-/* Branches through the same point each report its events: a label that
- * repeats an earlier one within 1% of the parameter's range (and 0.02 in
- * y) is left out, so that it is drawn once. */
-static void drop_repeated_labels(cm_chart_label *labels, uint64_t n, double range)
+enum { LABEL_SIZE = 64 };
+
+/* Branches through the same point each report its events, and several
+ * events fall on one point: a label within 1% of the parameter's range
+ * (and 0.02 in y) of an earlier one joins it ("SN_2a, SN_2s"), unless it
+ * says the same, so that each point is labelled once, legibly. */
+static void merge_near_labels(cm_chart_label *labels, char (*texts)[LABEL_SIZE], uint64_t n,
+                              double range)
 {
     for (uint64_t i = 0; i < n; i++)
-        for (uint64_t j = 0; j < i && labels[i].text; j++)
-            if (labels[j].text && strcmp(labels[i].text, labels[j].text) == 0 &&
-                fabs(labels[i].x - labels[j].x) < 0.01 * range &&
-                fabs(labels[i].y - labels[j].y) < 0.02)
-                labels[i].text = NULL;
+        for (uint64_t j = 0; j < i && labels[i].text; j++) {
+            if (!labels[j].text || fabs(labels[i].x - labels[j].x) >= 0.01 * range ||
+                !(fabs(labels[i].y - labels[j].y) < 0.02))
+                continue;
+            const size_t used = strlen(texts[j]), more = strlen(texts[i]);
+            if (!strstr(texts[j], texts[i]) && used + 2 + more < LABEL_SIZE)
+                snprintf(texts[j] + used, LABEL_SIZE - used, ", %s", texts[i]);
+            labels[i].text = NULL;
+        }
 }
 
 /* Up to three panels as Figs. 2.17-2.19: the maximal displacement, the
@@ -534,7 +542,7 @@ static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
             ok = cloud_add(&into[PANEL_STOPS], s->p, s->stops[k]);
     }
     cm_chart_label *labels = calloc(c->n_events + 1, sizeof *labels);
-    char(*texts)[32] = calloc(c->n_events + 1, sizeof *texts);
+    char(*texts)[LABEL_SIZE] = calloc(c->n_events + 1, sizeof *texts);
     ok = ok && labels && texts;
     for (uint64_t i = 0; i < c->n_events && ok; i++) {
         const cm_fo_branch_event *e = &c->events[i].e;
@@ -549,7 +557,7 @@ static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
     }
     if (!ok)
         fprintf(stderr, "cellmap continue: out of memory for the diagram\n");
-    drop_repeated_labels(labels, c->n_events, a->hi - a->lo);
+    merge_near_labels(labels, texts, c->n_events, a->hi - a->lo);
     static const char *const y_names[PANELS] = {"x_max", "stops", "Psi"};
     static const char *const panel_titles[PANELS] = {"maximal displacement", "stop positions",
                                                      "asymmetry Psi (2.90)"};

@@ -272,10 +272,10 @@ static void test_fig_2_17_window(void)
     cm_fo_with(&o, CM_FO_P_S, q, &from);
     cm_fo_init(&from, from.S, from.S0, from.Omega, pd.at.phi);
     follow_s(&from, q, z, 2, sp, stop);
-    /* one way ends at T; the other either at T too or where it comes back
-     * to the orbit it started on, through PD_1a */
-    CHECK(stop[0] == CM_FO_STOP_SIGNATURE || stop[1] == CM_FO_STOP_SIGNATURE);
-    CHECK(stop[0] != CM_FO_STOP_STEP && stop[1] != CM_FO_STOP_STEP);
+    /* up, through PD_1a, it comes back to the orbit it started on (at the
+     * orbit's other point); down it ends at T */
+    CHECK_INT(stop[0], CM_FO_STOP_LOOP);
+    CHECK_INT(stop[1], CM_FO_STOP_SIGNATURE);
     const cm_fo_branch_event *t = first(&sp->events, CM_FO_EVENT_T, 0.055787, 1e-3);
     CHECK(t != NULL);
     if (t) {
@@ -381,6 +381,45 @@ static void test_fig_2_18(void)
     }
 }
 
+/* The branch through the solution simulation settles on at Omega = start
+ * (S = 0.22, S0), followed in Omega one way: its first event of `type`. */
+static bool end_event(double S0, double start, int direction, int type, cm_fo_branch_event *e)
+{
+    found f;
+    int period;
+    branch_events(0.22, S0, start, CM_FO_P_OMEGA, 0.3, 0.7, direction, &f, &period);
+    const cm_fo_branch_event *first_of = first(&f, type, 0, 0);
+    if (first_of)
+        *e = *first_of;
+    return first_of != NULL && period == 1;
+}
+
+/* Fig. 2.19, S = 0.22: the asymmetric solutions 2a (from Omega = 0.4) and
+ * 1a (from 0.5) no longer connect. At S0 = 0.4, 2a ends where the map
+ * jumps (0.41699) and 1a at CS_a (0.45458); at S0 = 0.3 the domains are
+ * separated further: 2a ends at 0.41824, 1a is a loop whose lower fold is
+ * at 0.47804. Between them simulation settles on no period-1 solution
+ * (multi-periodic or chaotic, as the thesis reports). */
+static void test_fig_2_19(void)
+{
+    const double S0[2] = {0.4, 0.3};
+    for (int k = 0; k < 2; k++) {
+        cm_fo_branch_event end_2a = {.type = -1}, end_1a = {.type = -1};
+        CHECK(end_event(S0[k], 0.4, 1, CM_FO_EVENT_CS, &end_2a));
+        CHECK(end_2a.jump && end_2a.at.n_stick == 2 && !end_2a.at.symmetric);
+        CHECK(end_event(S0[k], 0.5, -1, k == 0 ? CM_FO_EVENT_CS : CM_FO_EVENT_SN, &end_1a));
+        CHECK(end_1a.at.n_stick == 1 && !end_1a.at.symmetric);
+        CHECK(k == 0 ? end_1a.jump : end_1a.fold);
+        CHECK(end_1a.at.p - end_2a.at.p > (k == 0 ? 0.03 : 0.05));
+        for (double Omega = end_2a.at.p + 2e-3; Omega < end_1a.at.p - 2e-3; Omega += 4e-3) {
+            cm_fo o;
+            cm_fo_init(&o, 0.22, S0[k], Omega, 0);
+            double z[2] = {1 + 0.9 * S0[k], 0};
+            CHECK(cm_fo_find_periodic(&o, z, 2000, 16) != 1);
+        }
+    }
+}
+
 /* The PD_1a curve in (S, Omega): at points along it, Newton from the
  * curve's state at its (S, Omega) and phase converges nearby, and the
  * multiplier by finite differences of P is -1. */
@@ -435,5 +474,6 @@ int main(void)
     test_fig_2_17();
     test_fig_2_17_window();
     test_fig_2_18();
+    test_fig_2_19();
     CHECK_DONE();
 }

@@ -77,14 +77,27 @@ fo="$fo --max-steps 200"
 "$CM" bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.02:0.4:190 --png fig-2.22-bifurcation.png \
   > /dev/null
 
-# Figs. 2.17 and 2.18 by continuation: branches of periodic solutions with
-# their bifurcations located and labelled. 2.17: S varied at Omega = 0.5,
-# S0 = 0.4, through the 1a pair and the (unstable there) 2s solution at
-# S = 0.3; 2.18: Omega varied at S = 0.32, S0 = 0.4.
-"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --both --from 1.461,0.044 \
-  --from 1.34,0 --period 1 --png fig-2.17-continue.png --quiet
-"$CM" continue --param S=0.32,S0=0.4,Omega=0.5 --vary Omega=0.45:0.6 --both \
-  --png fig-2.18-continue.png --quiet
+# Figs. 2.17-2.19 and 2.22 (bottom) by continuation: branches of periodic
+# solutions with their bifurcations located and labelled, from the solutions
+# that simulations settle on at the --start values. 2.17: S varied at
+# Omega = 0.5, S0 = 0.4, from 1a (S = 0.3), 2s (0.38) and 1a,9seg (0.04),
+# with the period-doubled 2a switched onto at PD_1a; 2.22 (bottom): the same
+# branches' stop positions; 2.18: Omega varied at S = 0.32, S0 = 0.4, from
+# 1a (0.5), 0s (0.58), 2s (0.47) and 2a (0.49); 2.19: the asymmetry Psi
+# against Omega at S = 0.22, S0 = 0.4 (left) and 0.3 (right).
+fig217="--param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --both --start 0.3 --start 0.38
+  --start 0.04 --switch"
+# shellcheck disable=SC2086
+"$CM" continue $fig217 --png fig-2.17-continue.png --quiet
+# shellcheck disable=SC2086
+"$CM" continue $fig217 --panels stops --size 900x450 --png fig-2.22-continue.png --quiet
+"$CM" continue --param S=0.32,S0=0.4,Omega=0.5 --vary Omega=0.45:0.6 --both --start 0.5 \
+  --start 0.58 --start 0.47 --start 0.49 --png fig-2.18-continue.png --quiet
+for s0 in 0.4 0.3; do
+  "$CM" continue --param S=0.22,S0=$s0,Omega=0.5 --vary Omega=0.3:0.7 --both --start 0.35 \
+    --start 0.4 --start 0.45 --start 0.5 --start 0.6 --panels psi --size 900x450 \
+    --png fig-2.19-continue-S0-$s0.png --quiet
+done
 
 # Figs. 2.4 and 2.7: amplitude-frequency diagrams, (2.25) against simulation
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --png fig-2.4-amplitude.png --quiet
