@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <stdlib.h>
 
 static const char *const param_names[] = {"S", "S0", "Omega", "phi"};
 
@@ -446,13 +447,26 @@ static bool rephase(branch *b, point *pt)
     if (best_s == 0)
         return false;
     const double phi = fmod(b->base.phi + o.Omega * best_s, 6.283185307179586476925286766559);
+    /* the tangent's direction at the new phase: the parameter's sign where
+     * the branch moves in it clearly; where it is steep, a point a little
+     * along the tangent carried there as the point itself was (where the
+     * old phase was a bad one, its tangent's state part is unreliable) */
+    const double eps = 1e-6;
+    cm_fo oe;
+    cm_fo_with(&b->base, b->param, pt->u[2] + eps * pt->t[2], &oe);
+    const double ze[2] = {pt->u[0] + eps * pt->t[0], pt->u[1] + eps * pt->t[1]};
+    cm_fo_state se = {0, ze[0], ze[1], cm_fo_mode_of(&oe, 0, ze[0], ze[1])};
+    if (!cm_fo_propagate(&oe, &se, best_s, NULL, NULL, NULL))
+        return false;
+    const double along[3] = {se.x - at[0], se.v - at[1], eps * pt->t[2]};
     branch moved = *b;
     cm_fo_init(&moved.base, b->base.S, b->base.S0, b->base.Omega, phi);
     double u[3] = {at[0], at[1], pt->u[2]};
     cm_fo_with(&moved.base, b->param, u[2], &o);
     point q;
+    const bool steep = fabs(pt->t[2]) < 0.05;
     if (!cm_fo_periodic_point(&o, u, b->period) ||
-        !describe(&moved, u, NULL, pt->t[2] < 0 ? -1 : 1, &q))
+        !describe(&moved, u, steep ? along : NULL, pt->t[2] < 0 ? -1 : 1, &q))
         return false;
     *b = moved;
     *pt = q;
@@ -1143,12 +1157,194 @@ static bool curve_correct(const curve *c, const double u0[4], const double t[4],
     return false;
 }
 
+/* Whether the segment from a to b (4 coordinates) passes through s, to 5%
+ * of its length. */
+static bool segment_passes(const double a[4], const double b[4], const double s[4])
+{
+    double dd = 0, rd = 0;
+    for (int i = 0; i < 4; i++) {
+        dd += (b[i] - a[i]) * (b[i] - a[i]);
+        rd += (s[i] - a[i]) * (b[i] - a[i]);
+    }
+    const double w = dd > 0 ? rd / dd : -1;
+    if (w < 0 || w > 1)
+        return false;
+    double off2 = 0;
+    for (int i = 0; i < 4; i++) {
+        const double d = s[i] - a[i] - w * (b[i] - a[i]);
+        off2 += d * d;
+    }
+    return off2 <= 0.0025 * dd + 1e-18;
+}
+
+/* ---- signature boundaries in two parameters ---------------------------- */
+
+/* The state at phase phi of the periodic motion through z at phase o->phi
+ * (in place): z propagated over the phase difference. */
+static bool to_phase(const cm_fo *o, double phi, double z[2])
+{
+    const double two_pi = 6.283185307179586476925286766559;
+    const double dphi = fmod(fmod(phi - o->phi, two_pi) + two_pi, two_pi);
+    cm_fo_state st = {0, z[0], z[1], cm_fo_mode_of(o, 0, z[0], z[1])};
+    if (dphi > 0 && !cm_fo_propagate(o, &st, dphi / o->Omega, NULL, NULL, NULL))
+        return false;
+    z[0] = st.x;
+    z[1] = st.v;
+    return true;
+}
+
+/* The old side of a signature boundary, as it moves: the solution with
+ * signature `before`, last seen at (p, p2) in state z at phase phi. */
+typedef struct boundary {
+    cm_fo base; /* the other parameters */
+    int param, param2, period;
+    const char *before;
+    double toward; /* the sign of the step in param from the old side to the boundary */
+    double p, p2, phi, z[2];
+} boundary;
+
+/* The solution of signature `before` at (p, p2), followed from the last
+ * state (at its phase) by Newton in small steps: first away from the
+ * boundary in p, then in p2; its state into z. */
+static bool old_side_at(const boundary *w, double p, double p2, double z[2])
+{
+    enum { SUBSTEPS = 8 };
+    z[0] = w->z[0], z[1] = w->z[1];
+    for (int k = 1; k <= 2 * SUBSTEPS; k++) {
+        const double f = k <= SUBSTEPS ? (double)k / SUBSTEPS : 1;
+        const double g = k <= SUBSTEPS ? 0 : (double)(k - SUBSTEPS) / SUBSTEPS;
+        cm_fo a, o;
+        cm_fo_with(&w->base, w->param, w->p + f * (p - w->p), &a);
+        cm_fo_with(&a, w->param2, w->p2 + g * (p2 - w->p2), &o);
+        cm_fo_init(&o, o.S, o.S0, o.Omega, w->phi);
+        cm_fo_solution s;
+        if (!cm_fo_periodic_point(&o, z, w->period) || !cm_fo_solution_at(&o, z, w->period, &s) ||
+            strcmp(s.signature, w->before) != 0)
+            return false;
+    }
+    return true;
+}
+
+typedef struct catch_change {
+    const char *before;
+    bool found;
+    cm_fo_branch_event e;
+} catch_change;
+
+static int catch_signature_change(void *user, const cm_fo_branch_event *e)
+{
+    catch_change *c = user;
+    if (e->type >= CM_FO_EVENT_CS && strcmp(e->before, c->before) == 0) {
+        c->e = *e;
+        c->found = true;
+        return 1;
+    }
+    return 0;
+}
+
+/* The boundary at p2: from the old side, a little before where it was,
+ * the branch in param is followed towards it until the signature changes;
+ * w moves there. */
+static bool relocate(boundary *w, double p2, double lo, double hi)
+{
+    for (double back = 1e-4; back < 0.05; back *= 10) {
+        const double p = w->p - w->toward * back;
+        double z[2];
+        if (p < lo || p > hi || !old_side_at(w, p, p2, z)) {
+            if (getenv("DBGC")) fprintf(stderr, "  no old side at p=%.8f back %g\n", p, back);
+            continue; }
+        cm_fo a, o;
+        cm_fo_with(&w->base, w->param, p, &a);
+        cm_fo_with(&a, w->param2, p2, &o);
+        cm_fo_init(&o, o.S, o.S0, o.Omega, w->phi);
+        /* the boundary moved by about as much as the last step moved it */
+        const cm_fo_continue_options opt = {w->param, fmax(lo, p - 10 * back),
+                                            fmin(hi, p + 10 * back), w->toward, back / 10, 0,
+                                            back, 100};
+        catch_change c = {w->before, false, {0}};
+        int stop;
+        cm_fo_continue(&o, &opt, p, z, w->period, NULL, catch_signature_change, &c, &stop);
+        if (!c.found) {
+            if (getenv("DBGC")) fprintf(stderr, "  not found from p=%.8f back %g stop %d\n", p, back, stop);
+            continue; }
+        w->p = c.e.at.p;
+        w->p2 = p2;
+        w->phi = c.e.at.phi;
+        w->z[0] = c.e.at.z[0], w->z[1] = c.e.at.z[1];
+        return true;
+    }
+    return false;
+}
+
+/* Hands the boundary's point to on_point, its state at phase phi, and
+ * counts it; false when the curve is to end (on_point says so, or the
+ * state cannot be moved to phi). */
+static bool emit_boundary(const boundary *w, double phi, cm_fo_curve_fn on_point, void *user,
+                          int *n)
+{
+    double z[2] = {w->z[0], w->z[1]};
+    cm_fo a, at;
+    cm_fo_with(&w->base, w->param, w->p, &a);
+    cm_fo_with(&a, w->param2, w->p2, &at);
+    cm_fo_init(&at, at.S, at.S0, at.Omega, w->phi);
+    if (!to_phase(&at, phi, z))
+        return false;
+    (*n)++;
+    return !(on_point && on_point(user, w->p, w->p2, z));
+}
+
+/* A CS, SS or T event e continued in two parameters by relocation: p2
+ * moves in steps, and at each the event is located again on the branch in
+ * param (the one-parameter machinery, which crosses the corners and finds
+ * where the map jumps). Ends where p2 leaves its range, or where the
+ * event cannot be found again (the boundary turns back in p2, or ends). */
+static int boundary_curve(const cm_fo *o, const cm_fo_branch_event *e, int param, int param2,
+                          const double lo[2], const double hi[2], int direction, int max_points,
+                          cm_fo_curve_fn on_point, void *user)
+{
+    boundary w = {*o, param, param2, e->at.period, e->before, 0, e->at.p,
+                  (double[4]){o->S, o->S0, o->Omega, o->phi}[param2], e->at.phi,
+                  {e->at.z[0], e->at.z[1]}};
+    /* the old side: where the solution has the signature before the event */
+    for (double d = 1e-6; d < 2e-3 && w.toward == 0; d *= 10)
+        for (int side = -1; side <= 1 && w.toward == 0; side += 2) {
+            double z[2];
+            if (old_side_at(&w, e->at.p + side * d, w.p2, z))
+                w.toward = -side;
+        }
+    if (w.toward == 0)
+        return 0;
+    const double span = hi[1] - lo[1];
+    double step = span / 200;
+    int n = 0;
+    if (!emit_boundary(&w, e->at.phi, on_point, user, &n))
+        return n;
+    while (n < max_points) {
+        const double p2 = w.p2 + direction * step;
+        if (p2 < lo[1] || p2 > hi[1])
+            break;
+        if (getenv("DBGC")) fprintf(stderr, "relocate p=%.8f p2=%.6f -> %.6f step %g toward %g\n", w.p, w.p2, p2, step, w.toward);
+        if (!relocate(&w, p2, lo[0], hi[0])) {
+            if ((step /= 4) < 1e-4 * span)
+                break;
+            continue;
+        }
+        step = fmin(1.5 * step, span / 50);
+        if (!emit_boundary(&w, e->at.phi, on_point, user, &n))
+            break;
+    }
+    return n;
+}
+
 int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param, int param2,
                          const double lo[2], const double hi[2], int direction, int max_points,
                          cm_fo_curve_fn on_point, void *user)
 {
-    if ((e->type != CM_FO_EVENT_SN && e->type != CM_FO_EVENT_PD) || param == param2 ||
-        param == CM_FO_P_PHI || param2 == CM_FO_P_PHI)
+    if (param == param2 || param == CM_FO_P_PHI || param2 == CM_FO_P_PHI)
+        return 0;
+    if (e->type >= CM_FO_EVENT_CS)
+        return boundary_curve(o, e, param, param2, lo, hi, direction, max_points, on_point, user);
+    if (e->type == CM_FO_EVENT_NS)
         return 0;
     curve c = {*o, param, param2, e->at.period, e->type == CM_FO_EVENT_SN ? -1.0 : 1.0};
     cm_fo_init(&c.base, o->S, o->S0, o->Omega, e->at.phi);
@@ -1164,7 +1360,9 @@ int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param,
     if (on_point && on_point(user, u[2], u[3], u))
         return 1;
     n++;
-    double h = 1e-3;
+    double h = 1e-3, start[4];
+    memcpy(start, u, sizeof start);
+    int creep = 0;
     while (n < max_points) {
         double next[4];
         if (!curve_correct(&c, u, t, h, next, &iters)) {
@@ -1176,13 +1374,19 @@ int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param,
         memcpy(prev, t, sizeof prev);
         if (!curve_jacobian(&c, next, J) || !curve_tangent(J, prev, direction, t))
             break;
+        /* back at the start (a closed curve, or one that retraces itself
+         * through a singular point), or creeping: done */
+        const bool closes = n > 3 && segment_passes(u, next, start);
+        creep = h <= H_CORNER ? creep + 1 : 0;
         memcpy(u, next, sizeof next);
         n++;
         if (on_point && on_point(user, u[2], u[3], u))
             break;
+        if (closes || creep == MAX_CREEP)
+            break;
         if (u[2] < lo[0] || u[2] > hi[0] || u[3] < lo[1] || u[3] > hi[1])
             break;
-        if (iters <= 3)
+        if (iters <= 3 || h <= H_CORNER)
             h = fmin(2 * h, 2e-2);
     }
     return n;

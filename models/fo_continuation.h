@@ -152,14 +152,17 @@ double cm_fo_turn_hmax(double Omega);
 
 void cm_fo_amplitude_at(const cm_fo *o, int periods, int record, cm_fo_amplitude *out);
 
-/* Two-parameter continuation of an SN or PD event e (located on a branch
- * in `param`): the curve in the plane of `param` and `param2` on which the
- * period-k solution keeps a multiplier +1 (SN) or -1 (PD). Unknowns x, v,
- * p, p2; equations P^k(z) - z = 0 and det(M -+ I) = 0; pseudo-arclength
- * with a Jacobian by central differences, from e both ways (direction
- * +1: param2 grows first) until either parameter leaves its range or
- * max_points are made. on_point gets (p, p2, z) in order; returns the
- * number of points. */
+/* Two-parameter continuation of an SN, PD, CS or SS event e (located on
+ * a branch in `param`): the curve in the plane of `param` and `param2` on
+ * which the period-k solution keeps a multiplier +1 (SN) or -1 (PD), or
+ * keeps a velocity zero on the stick-slip boundary |cos - x| = S0 (CS, SS:
+ * where a stick is born or dies; an event that is a grazing of v = 0
+ * instead gives no curve). Unknowns x, v, p, p2; equations P^k(z) - z = 0
+ * and det(M -+ I) = 0 or the boundary's gap = 0; pseudo-arclength with a
+ * Jacobian by central differences, from e both ways (direction +1: param2
+ * grows first) until either parameter leaves its range or max_points are
+ * made. on_point gets (p, p2, z) in order; returns the number of points
+ * (0 where e gives no curve). */
 typedef int (*cm_fo_curve_fn)(void *user, double p, double p2, const double z[2]);
 int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param, int param2,
                          const double lo[2], const double hi[2], int direction, int max_points,

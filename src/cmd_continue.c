@@ -35,16 +35,26 @@ static const char continue_help[] =
     "asymmetric solution): SN (a multiplier through +1: a fold, or a branch point\n"
     "where the branch goes on), PD (through -1), NS (a complex pair through the\n"
     "unit circle), CS (sticking segments appear, vanish or change neighbours:\n"
-    "crossing-sliding and its kin) and T (only slip segments change). A solution's\n"
-    "signature is its cycle of modes, u (slip up), d (slip down), s (stuck).\n\n"
+    "crossing-sliding and its kin), SS (a pause, a stick between two slips the same\n"
+    "way, appears or vanishes) and T (only slip segments change, or one grazes v = 0\n"
+    "and the map jumps). A solution's signature is its cycle of modes, u (slip up),\n"
+    "d (slip down), s (stuck). A branch ends where the map jumps or the signature\n"
+    "changes past what it can follow, where it comes back to its start (a loop),\n"
+    "or where the map is nearly singular; the summary says which.\n\n"
+    ;
+
+/* Split from continue_help: C11 wants no string over 4095 characters. */
+static const char continue_options[] =
     "  --vary NAME=LO:HI   the parameter and its range\n"
     "  --down              the parameter decreases first (default: it increases)\n"
     "  --both              from each start, both ways: the whole branch through it\n"
     "  --switch            at each period doubling, switch to the doubled branch and\n"
     "                      follow it both ways too\n"
-    "  --curve NAME2=LO:HI from each SN and PD event, the curve in the plane of NAME and\n"
-    "                      NAME2 (S, S0 or Omega) on which the multiplier stays +1 or -1,\n"
-    "                      both ways (two-parameter continuation)\n"
+    "  --curve NAME2=LO:HI from each fold, PD, CS, SS and T event, its curve in the\n"
+    "                      plane of NAME and NAME2 (S, S0 or Omega), both ways: where a\n"
+    "                      multiplier stays +1 or -1 (two-parameter continuation), or\n"
+    "                      where the signature changes (the event located again on the\n"
+    "                      branch in NAME as NAME2 moves in steps)\n"
     "  --curves FILE|-     those curves as CSV: curve, label, NAME, NAME2, x, v (lyapunov\n"
     "                      --curves draws them over its heat map)\n"
     "  --from X,V[,P]      start near (x, v) at the section, at NAME = P (default: the\n"
@@ -142,6 +152,7 @@ static int parse_args(cli *c, cont_args *a)
         int n = 0;
         if (strcmp(c->opt, "--help") == 0) {
             fputs(continue_help, stdout);
+            fputs(continue_options, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
         } else if (cli_is(c, "--vary", true, &err)) {
@@ -446,6 +457,22 @@ static int write_curve_point(void *user, double p, double p2, const double z[2])
 
 /* From every SN and PD event, its curve in (vary, vary2), both ways; each
  * way is one curve. */
+/* Whether an earlier event is the same (another branch through the same
+ * point reports it too): its curves are the same. A mirror image's event
+ * has other signatures and is kept: its curves coincide in the parameter
+ * plane, but are computed from another state, and may reach further. */
+static bool already_curved(const collected *c, uint64_t i)
+{
+    const cm_fo_branch_event *e = &c->events[i].e;
+    for (uint64_t j = 0; j < i; j++) {
+        const cm_fo_branch_event *f = &c->events[j].e;
+        if (f->type == e->type && strcmp(f->before, e->before) == 0 &&
+            strcmp(f->after, e->after) == 0 && fabs(f->at.p - e->at.p) < 1e-6)
+            return true;
+    }
+    return false;
+}
+
 static bool write_curves(const cont_args *a, const cm_fo *o, const collected *c, int *n_curves)
 {
     outfile out;
@@ -457,7 +484,11 @@ static bool write_curves(const cont_args *a, const cm_fo *o, const collected *c,
     *n_curves = 0;
     for (uint64_t i = 0; i < c->n_events; i++) {
         const cm_fo_branch_event *e = &c->events[i].e;
-        if (e->type != CM_FO_EVENT_SN && e->type != CM_FO_EVENT_PD)
+        /* NS has no curve yet; at a branch point the fold's extended
+         * system is singular (the symmetric branch's own tangent is in
+         * the kernel), and its curve is not followed */
+        if (e->type == CM_FO_EVENT_NS || (e->type == CM_FO_EVENT_SN && !e->fold) ||
+            already_curved(c, i))
             continue;
         char label[32];
         event_label(e, label, sizeof label);

@@ -468,6 +468,59 @@ static void test_pd_curve(void)
     }
 }
 
+/* The CS_a boundary of Fig. 2.18 (where 1a ends, S = 0.32) in (Omega, S):
+ * down in S it passes through Fig. 2.19's CS_a (S = 0.22, located there by
+ * its own branch), and each of its points is where the 1a branch in Omega
+ * through the solution simulation settles on at Omega = 0.5 ends (down to
+ * S = 0.15); up in S
+ * it ends near S = 0.38, where the thesis finds the domain of asymmetric
+ * solutions disappearing. */
+static void test_cs_curve(void)
+{
+    cm_fo base;
+    cm_fo_init(&base, 0.32, 0.4, 0.5, 0);
+    found f;
+    int period;
+    branch_events(0.32, 0.4, 0.5, CM_FO_P_OMEGA, 0.45, 0.6, -1, &f, &period);
+    const cm_fo_branch_event *cs = first(&f, CM_FO_EVENT_CS, 0.49182, 2e-4);
+    CHECK(cs != NULL);
+    if (!cs)
+        return;
+    const double lo[2] = {0.45, 0.05}, hi[2] = {0.6, 0.4};
+    curve_points down = {.n = 0}, up = {.n = 0};
+    CHECK(cm_fo_continue_curve(&base, cs, CM_FO_P_OMEGA, CM_FO_P_S, lo, hi, -1, 64, keep_curve,
+                               &down) >= 10);
+    CHECK(cm_fo_continue_curve(&base, cs, CM_FO_P_OMEGA, CM_FO_P_S, lo, hi, 1, 64, keep_curve,
+                               &up) >= 10);
+    double top = 0;
+    for (int i = 0; i < up.n; i++)
+        top = fmax(top, up.p[i][1]);
+    CHECK(top > 0.37 && top < 0.40);
+    /* S = 0.22 on the curve, linearly between its neighbours there */
+    cm_fo_branch_event end_1a = {.type = -1};
+    CHECK(end_event(0.4, 0.5, -1, CM_FO_EVENT_CS, &end_1a));
+    bool crossed = false;
+    for (int i = 1; i < down.n; i++)
+        if (down.p[i - 1][1] >= 0.22 && down.p[i][1] < 0.22) {
+            const double w = (0.22 - down.p[i - 1][1]) / (down.p[i][1] - down.p[i - 1][1]);
+            const double Omega = down.p[i - 1][0] + w * (down.p[i][0] - down.p[i - 1][0]);
+            CHECK(fabs(Omega - end_1a.at.p) < 2e-4);
+            crossed = true;
+        }
+    CHECK(crossed);
+    /* (below S = 0.15 the branch from Omega = 0.5 ends before, where its
+     * map becomes nearly singular) */
+    for (int i = 3; i < down.n && down.p[i][1] > 0.15; i += 6) {
+        found g;
+        branch_events(down.p[i][1], 0.4, 0.5, CM_FO_P_OMEGA, 0.45, 0.6, -1, &g, &period);
+        const cm_fo_branch_event *e = first(&g, CM_FO_EVENT_CS, down.p[i][0], 1e-5);
+        if (!e)
+            fprintf(stderr, "CS_a curve at S = %.9g: Omega %.9g not found again\n", down.p[i][1],
+                    down.p[i][0]);
+        CHECK(e != NULL);
+    }
+}
+
 int main(void)
 {
     test_pd_curve();
@@ -475,5 +528,6 @@ int main(void)
     test_fig_2_17_window();
     test_fig_2_18();
     test_fig_2_19();
+    test_cs_curve();
     CHECK_DONE();
 }
