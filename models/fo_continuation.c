@@ -12,7 +12,6 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include <stdlib.h>
 
 static const char *const param_names[] = {"S", "S0", "Omega", "phi"};
 
@@ -259,6 +258,18 @@ typedef struct branch {
     int param, period;
 } branch;
 
+/* The derivative in p from values at p - h, p, p + h: central where the
+ * one-sided differences agree, else the smaller one. Where the map jumps
+ * within h of p (at a grazing), the central difference straddles the jump
+ * and is meaningless; the side without the jump is the solution's own. */
+static double p_derivative(double minus, double at, double plus, double h)
+{
+    const double back = (at - minus) / h, ahead = (plus - at) / h;
+    if (fabs(ahead - back) <= 0.5 * (fabs(ahead) + fabs(back)) + 1e-6)
+        return 0.5 * (ahead + back);
+    return fabs(ahead) < fabs(back) ? ahead : back;
+}
+
 /* G(u) and DG (2 x 3, row-major) at u = (x, v, p). */
 static bool residual(const branch *b, const double u[3], double G[2], double DG[6])
 {
@@ -277,8 +288,8 @@ static bool residual(const branch *b, const double u[3], double G[2], double DG[
     cm_fo_with(&b->base, b->param, u[2] - h, &om);
     if (!compose(&op, u, b->period, ep, NULL, NULL) || !compose(&om, u, b->period, em, NULL, NULL))
         return false;
-    DG[0] = M[0] - 1, DG[1] = M[1], DG[2] = (ep[0] - em[0]) / (2 * h);
-    DG[3] = M[2], DG[4] = M[3] - 1, DG[5] = (ep[1] - em[1]) / (2 * h);
+    DG[0] = M[0] - 1, DG[1] = M[1], DG[2] = p_derivative(em[0], end[0], ep[0], h);
+    DG[3] = M[2], DG[4] = M[3] - 1, DG[5] = p_derivative(em[1], end[1], ep[1], h);
     return true;
 }
 
@@ -354,19 +365,18 @@ static bool correct_from(const branch *b, const double u0[3], const double t[3],
             return false;
         bool accepted = false;
         for (double lambda = 1; lambda > 1e-4 && !accepted; lambda /= 2) {
-            double trial[3], Gt[2], DGt[6], at, nt;
+            /* trials by G alone (a third of the work); DG where one is kept */
+            double trial[3], Gt[2], at, nt;
             for (int i = 0; i < 3; i++)
                 trial[i] = u[i] + lambda * du[i];
-            if (corrector_norm(b, u0, t, h, trial, Gt, DGt, &at, &nt) && nt < norm) {
+            if (corrector_norm(b, u0, t, h, trial, Gt, NULL, &at, &nt) && nt < norm) {
                 memcpy(u, trial, sizeof trial);
-                memcpy(G, Gt, sizeof Gt);
-                memcpy(DG, DGt, sizeof DGt);
                 arc = at;
                 norm = nt;
                 accepted = true;
             }
         }
-        if (!accepted)
+        if (!accepted || !corrector_norm(b, u0, t, h, u, G, DG, &arc, &norm))
             return false;
     }
     return false;
@@ -587,6 +597,7 @@ static void locate(const branch *b, const point *a, const point *bp, double h, i
     memset(e, 0, sizeof *e);
     e->type = type == EVENT_TURN ? CM_FO_EVENT_SN : type;
     e->fold = (type == CM_FO_EVENT_SN || type == EVENT_TURN) && a->t[2] * bp->t[2] < 0;
+    e->touch = type == EVENT_TURN;
     e->at = near_a.s; /* the solution that the event ends, as it was */
     e->other = near_b.s;
     /* near a branch point the bisection may land on the other branch: the
@@ -1203,20 +1214,37 @@ typedef struct boundary {
     double p, p2, phi, z[2];
 } boundary;
 
-/* The solution of signature `before` at (p, p2), followed from the last
- * state (at its phase) by Newton in small steps: first away from the
- * boundary in p, then in p2; its state into z. */
-static bool old_side_at(const boundary *w, double p, double p2, double z[2])
+static int keep_last(void *user, const cm_fo_solution *s)
+{
+    *(cm_fo_solution *)user = *s;
+    return 0;
+}
+
+/* The solution of signature `before` at (p, p2), into z at phase *phi:
+ * from the boundary's last point, first along the branch in param away
+ * from it (Newton from the boundary's state at fixed parameters may jump
+ * across it, where the map does), then by Newton in small steps of p2. */
+static bool old_side_at(const boundary *w, double p, double p2, double z[2], double *phi)
 {
     enum { SUBSTEPS = 8 };
-    z[0] = w->z[0], z[1] = w->z[1];
-    for (int k = 1; k <= 2 * SUBSTEPS; k++) {
-        const double f = k <= SUBSTEPS ? (double)k / SUBSTEPS : 1;
-        const double g = k <= SUBSTEPS ? 0 : (double)(k - SUBSTEPS) / SUBSTEPS;
-        cm_fo a, o;
-        cm_fo_with(&w->base, w->param, w->p + f * (p - w->p), &a);
-        cm_fo_with(&a, w->param2, w->p2 + g * (p2 - w->p2), &o);
-        cm_fo_init(&o, o.S, o.S0, o.Omega, w->phi);
+    cm_fo a, o;
+    cm_fo_with(&w->base, w->param, w->p, &a);
+    cm_fo_with(&a, w->param2, w->p2, &o);
+    cm_fo_init(&o, o.S, o.S0, o.Omega, w->phi);
+    const double away = fabs(p - w->p);
+    const cm_fo_continue_options opt = {w->param, fmin(w->p, p), fmax(w->p, p), p > w->p ? 1 : -1,
+                                        away / 10, 0, away / 2, 100};
+    cm_fo_solution last = {.p = NAN};
+    int stop;
+    cm_fo_continue(&o, &opt, w->p, w->z, w->period, keep_last, NULL, &last, &stop);
+    if (stop != CM_FO_STOP_BOUND || strcmp(last.signature, w->before) != 0)
+        return false;
+    z[0] = last.z[0], z[1] = last.z[1];
+    *phi = last.phi;
+    for (int k = 0; k <= SUBSTEPS; k++) { /* k = 0: onto p itself */
+        cm_fo_with(&w->base, w->param, p, &a);
+        cm_fo_with(&a, w->param2, w->p2 + (double)k / SUBSTEPS * (p2 - w->p2), &o);
+        cm_fo_init(&o, o.S, o.S0, o.Omega, *phi);
         cm_fo_solution s;
         if (!cm_fo_periodic_point(&o, z, w->period) || !cm_fo_solution_at(&o, z, w->period, &s) ||
             strcmp(s.signature, w->before) != 0)
@@ -1249,24 +1277,22 @@ static bool relocate(boundary *w, double p2, double lo, double hi)
 {
     for (double back = 1e-4; back < 0.05; back *= 10) {
         const double p = w->p - w->toward * back;
-        double z[2];
-        if (p < lo || p > hi || !old_side_at(w, p, p2, z)) {
-            if (getenv("DBGC")) fprintf(stderr, "  no old side at p=%.8f back %g\n", p, back);
-            continue; }
+        double z[2], phi;
+        if (p < lo || p > hi || !old_side_at(w, p, p2, z, &phi))
+            continue;
         cm_fo a, o;
         cm_fo_with(&w->base, w->param, p, &a);
         cm_fo_with(&a, w->param2, p2, &o);
-        cm_fo_init(&o, o.S, o.S0, o.Omega, w->phi);
+        cm_fo_init(&o, o.S, o.S0, o.Omega, phi);
         /* the boundary moved by about as much as the last step moved it */
         const cm_fo_continue_options opt = {w->param, fmax(lo, p - 10 * back),
-                                            fmin(hi, p + 10 * back), w->toward, back / 10, 0,
+                                            fmin(hi, p + 10 * back), w->toward, back / 10, 1e-8,
                                             back, 100};
         catch_change c = {w->before, false, {0}};
         int stop;
         cm_fo_continue(&o, &opt, p, z, w->period, NULL, catch_signature_change, &c, &stop);
-        if (!c.found) {
-            if (getenv("DBGC")) fprintf(stderr, "  not found from p=%.8f back %g stop %d\n", p, back, stop);
-            continue; }
+        if (!c.found)
+            continue;
         w->p = c.e.at.p;
         w->p2 = p2;
         w->phi = c.e.at.phi;
@@ -1308,8 +1334,8 @@ static int boundary_curve(const cm_fo *o, const cm_fo_branch_event *e, int param
     /* the old side: where the solution has the signature before the event */
     for (double d = 1e-6; d < 2e-3 && w.toward == 0; d *= 10)
         for (int side = -1; side <= 1 && w.toward == 0; side += 2) {
-            double z[2];
-            if (old_side_at(&w, e->at.p + side * d, w.p2, z))
+            double z[2], phi;
+            if (old_side_at(&w, e->at.p + side * d, w.p2, z, &phi))
                 w.toward = -side;
         }
     if (w.toward == 0)
@@ -1323,7 +1349,6 @@ static int boundary_curve(const cm_fo *o, const cm_fo_branch_event *e, int param
         const double p2 = w.p2 + direction * step;
         if (p2 < lo[1] || p2 > hi[1])
             break;
-        if (getenv("DBGC")) fprintf(stderr, "relocate p=%.8f p2=%.6f -> %.6f step %g toward %g\n", w.p, w.p2, p2, step, w.toward);
         if (!relocate(&w, p2, lo[0], hi[0])) {
             if ((step /= 4) < 1e-4 * span)
                 break;

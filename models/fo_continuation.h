@@ -84,6 +84,8 @@ const char *cm_fo_event_name(int type);
 typedef struct cm_fo_branch_event {
     int type;
     bool fold;                    /* SN: the branch turns back in the parameter */
+    bool touch;                   /* SN: the multiplier only touches +1 there (the side
+                                     branch of a branch point, which turns back at it) */
     bool jump;                    /* CS, T at a branch's end: P^period jumps just past
                                      it (a slip segment grazes v = 0 in the stick band) */
     /* the located point, described by the solution before it: SN, PD, NS

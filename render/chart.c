@@ -217,6 +217,22 @@ static void colour_bar(const cm_chart *c, const layout *L, const cm_font *f, dou
         cm_font_draw(f, c->heat->name, x, in->plot_y + L->ascent, ink, cv->rgba, cv->w, cv->h);
 }
 
+void cm_chart_join_labels(cm_chart_label *labels, int n, char *texts, size_t text_size, double dx,
+                          double dy)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < i && labels[i].text; j++) {
+            if (!labels[j].text || !(fabs(labels[i].x - labels[j].x) < dx) ||
+                !(fabs(labels[i].y - labels[j].y) < dy))
+                continue;
+            char *into = texts + (size_t)j * text_size;
+            const size_t used = strlen(into), more = strlen(labels[i].text);
+            if (!strstr(into, labels[i].text) && used + 2 + more < text_size)
+                snprintf(into + used, text_size - used, ", %s", labels[i].text);
+            labels[i].text = NULL;
+        }
+}
+
 /* The labels, each right of and above its point, kept inside the plot. */
 static void draw_labels(const cm_chart *c, const cm_font *f, const layout *L,
                         const cm_chart_info *in, const cm_canvas *cv)

@@ -66,6 +66,14 @@ typedef struct cm_chart_info {
     double heat_max;
 } cm_chart_info;
 
+/* Labels that fall on one place: each label within dx and dy of an
+ * earlier one is left out (text NULL), its text joined to the earlier's
+ * ("SN_2a, SN_2s") unless it says the same or there is no room. texts
+ * holds n buffers of text_size bytes, labels[i].text pointing at the i-th
+ * (or NULL). */
+void cm_chart_join_labels(cm_chart_label *labels, int n, char *texts, size_t text_size, double dx,
+                          double dy);
+
 /* The colour of a heat value on the scale 0..max. */
 cm_rgb cm_heat_colour(double v, double max);
 

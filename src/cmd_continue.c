@@ -457,17 +457,21 @@ static int write_curve_point(void *user, double p, double p2, const double z[2])
 
 /* From every SN and PD event, its curve in (vary, vary2), both ways; each
  * way is one curve. */
-/* Whether an earlier event is the same (another branch through the same
- * point reports it too): its curves are the same. A mirror image's event
- * has other signatures and is kept: its curves coincide in the parameter
- * plane, but are computed from another state, and may reach further. */
-static bool already_curved(const collected *c, uint64_t i)
+/* Whether an earlier event gives the same curves: the same event (another
+ * branch through the same point reports it too), or its mirror image (the
+ * same kind at the same value) if that gave curves of 20 points or more.
+ * The mirror's curves coincide in the parameter plane, but are computed
+ * from another state, and where one stops early the other may go on. */
+static bool already_curved(const collected *c, uint64_t i, const int *points)
 {
     const cm_fo_branch_event *e = &c->events[i].e;
     for (uint64_t j = 0; j < i; j++) {
         const cm_fo_branch_event *f = &c->events[j].e;
-        if (f->type == e->type && strcmp(f->before, e->before) == 0 &&
-            strcmp(f->after, e->after) == 0 && fabs(f->at.p - e->at.p) < 1e-6)
+        if (f->type != e->type || f->at.period != e->at.period || f->at.n_stick != e->at.n_stick ||
+            fabs(f->at.p - e->at.p) >= 1e-6)
+            continue;
+        if ((strcmp(f->before, e->before) == 0 && strcmp(f->after, e->after) == 0) ||
+            points[j] >= 20)
             return true;
     }
     return false;
@@ -481,24 +485,33 @@ static bool write_curves(const cont_args *a, const cm_fo *o, const collected *c,
     fprintf(out.f, "curve,label,%s,%s,x,v\n", a->vary, a->vary2);
     const int param = cm_fo_param_of(a->vary), param2 = cm_fo_param_of(a->vary2);
     const double lo[2] = {a->lo, a->lo2}, hi[2] = {a->hi, a->hi2};
+    int *points = calloc(c->n_events + 1, sizeof *points); /* per event, both ways */
+    if (!points) {
+        fprintf(stderr, "cellmap continue: out of memory for the curves\n");
+        outfile_close("continue", &out, false);
+        return false;
+    }
     *n_curves = 0;
     for (uint64_t i = 0; i < c->n_events; i++) {
         const cm_fo_branch_event *e = &c->events[i].e;
-        /* NS has no curve yet; at a branch point the fold's extended
-         * system is singular (the symmetric branch's own tangent is in
-         * the kernel), and its curve is not followed */
-        if (e->type == CM_FO_EVENT_NS || (e->type == CM_FO_EVENT_SN && !e->fold) ||
-            already_curved(c, i))
+        /* NS has no curve yet; at a branch point, and where a side branch
+         * turns back at one, the fold's extended system is singular (the
+         * symmetric branch's own tangent is in the kernel): no curve */
+        if (e->type == CM_FO_EVENT_NS ||
+            (e->type == CM_FO_EVENT_SN && (!e->fold || e->touch)) ||
+            already_curved(c, i, points))
             continue;
         char label[32];
         event_label(e, label, sizeof label);
         for (int way = 1; way >= -1; way -= 2) {
             curve_out co = {out.f, *n_curves + 1, label};
-            if (cm_fo_continue_curve(o, e, param, param2, lo, hi, way, 5000, write_curve_point,
-                                     &co) > 0)
-                (*n_curves)++;
+            const int n = cm_fo_continue_curve(o, e, param, param2, lo, hi, way, 5000,
+                                               write_curve_point, &co);
+            points[i] += n;
+            *n_curves += n > 0;
         }
     }
+    free(points);
     return outfile_close("continue", &out, true);
 }
 
@@ -537,25 +550,6 @@ static void cloud_range(const cloud *c, double *lo, double *hi)
 
 enum { LABEL_SIZE = 64 };
 
-/* Branches through the same point each report its events, and several
- * events fall on one point: a label within 1% of the parameter's range
- * (and 0.02 in y) of an earlier one joins it ("SN_2a, SN_2s"), unless it
- * says the same, so that each point is labelled once, legibly. */
-static void merge_near_labels(cm_chart_label *labels, char (*texts)[LABEL_SIZE], uint64_t n,
-                              double range)
-{
-    for (uint64_t i = 0; i < n; i++)
-        for (uint64_t j = 0; j < i && labels[i].text; j++) {
-            if (!labels[j].text || fabs(labels[i].x - labels[j].x) >= 0.01 * range ||
-                !(fabs(labels[i].y - labels[j].y) < 0.02))
-                continue;
-            const size_t used = strlen(texts[j]), more = strlen(texts[i]);
-            if (!strstr(texts[j], texts[i]) && used + 2 + more < LABEL_SIZE)
-                snprintf(texts[j] + used, LABEL_SIZE - used, ", %s", texts[i]);
-            labels[i].text = NULL;
-        }
-}
-
 /* Up to three panels as Figs. 2.17-2.19: the maximal displacement, the
  * stops and Psi (2.90) against the parameter, those --panels picks in its
  * order; stable green, unstable red, events black with their labels on the
@@ -588,7 +582,11 @@ static bool write_png(const cont_args *a, const cm_model *m, const collected *c)
     }
     if (!ok)
         fprintf(stderr, "cellmap continue: out of memory for the diagram\n");
-    merge_near_labels(labels, texts, c->n_events, a->hi - a->lo);
+    /* branches through one point each report its events, and several
+     * events fall on one point: each point is labelled once, legibly */
+    if (ok)
+        cm_chart_join_labels(labels, (int)c->n_events, texts[0], LABEL_SIZE,
+                             0.01 * (a->hi - a->lo), 0.02);
     static const char *const y_names[PANELS] = {"x_max", "stops", "Psi"};
     static const char *const panel_titles[PANELS] = {"maximal displacement", "stop positions",
                                                      "asymmetry Psi (2.90)"};

@@ -48,16 +48,20 @@ static const char lyapunov_help[] =
     "  --quiet             no progress line and no summary\n"
     "  --png FILE          heat map; only positive exponents are coloured\n"
     "  --curves FILE       draw the curves of `cellmap continue --curves` (bifurcation\n"
-    "                      curves in the grid's two parameters) over the heat map\n"
+    "                      curves in the grid's two parameters) over the heat map;\n"
+    "                      repeat it (up to 8) for the curves of several runs\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
+
+enum { MAX_CURVE_FILES = 8 };
 
 typedef struct lyap_args {
     model_opts mo;
     param_axis ax[2];
     int has_grid, periods, threads, width, height, n_from;
     double d0, from[CM_MAX_DIM];
-    const char *csv, *png, *curves;
+    const char *csv, *png, *curves[MAX_CURVE_FILES];
+    int n_curves;
     bool json, quiet;
 } lyap_args;
 
@@ -98,7 +102,10 @@ static int parse_args(cli *c, lyap_args *a)
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
         } else if (cli_is(c, "--curves", true, &err)) {
-            a->curves = c->value;
+            if (c->value && a->n_curves == MAX_CURVE_FILES)
+                err = cli_usage_error(c, "--curves: at most %d files", MAX_CURVE_FILES);
+            else if (c->value)
+                a->curves[a->n_curves++] = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -110,7 +117,7 @@ static int parse_args(cli *c, lyap_args *a)
     }
     if (!err && !a->has_grid)
         err = cli_usage_error(c, "--grid X=LO:HI:N,Y=LO:HI:M is required");
-    if (!err && a->curves && !a->png)
+    if (!err && a->n_curves && !a->png)
         err = cli_usage_error(c, "--curves draws over the heat map: give --png FILE too");
     if (!err && !a->csv && !a->png && !a->json)
         err = cli_usage_error(c, "nothing to write: give --csv FILE, --png FILE and/or --json");
@@ -166,16 +173,17 @@ typedef struct overlay {
     int n_labels;
 } overlay;
 
-static bool read_curves(const lyap_args *a, overlay *ov)
+/* Appends the curves of one file to ov; false, with the problem said, if
+ * the file does not fit. */
+static bool read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap)
 {
-    FILE *f = fopen(a->curves, "r");
+    FILE *f = fopen(path, "r");
     char line[512], n1[64] = "", n2[64] = "";
-    memset(ov, 0, sizeof *ov);
     if (!f || !fgets(line, sizeof line, f) ||
         sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
         fprintf(stderr, "cellmap lyapunov: --curves %s: %s (make it with cellmap continue "
                         "--curves)\n",
-                a->curves, f ? "not a file of curve,label,P,P2,x,v lines" : strerror(errno));
+                path, f ? "not a file of curve,label,P,P2,x,v lines" : strerror(errno));
         if (f)
             fclose(f);
         return false;
@@ -184,11 +192,10 @@ static bool read_curves(const lyap_args *a, overlay *ov)
     const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
     if (!same && !swapped) {
         fprintf(stderr, "cellmap lyapunov: --curves %s is in (%s, %s), the grid in (%s, %s)\n",
-                a->curves, n1, n2, a->ax[0].name, a->ax[1].name);
+                path, n1, n2, a->ax[0].name, a->ax[1].name);
         fclose(f);
         return false;
     }
-    size_t cap = 0;
     int last = -1;
     bool ok = true;
     while (ok && fgets(line, sizeof line, f)) {
@@ -197,9 +204,9 @@ static bool read_curves(const lyap_args *a, overlay *ov)
         double p1, p2;
         if (sscanf(line, "%d,%31[^,],%lf,%lf", &id, label, &p1, &p2) != 4)
             continue;
-        if (ov->n + 2 > cap) {
-            cap = cap ? 2 * cap : 1024;
-            double *nx = realloc(ov->x, cap * sizeof *nx), *ny = nx ? realloc(ov->y, cap * sizeof *ny) : NULL;
+        if (ov->n + 2 > *cap) {
+            *cap = *cap ? 2 * *cap : 1024;
+            double *nx = realloc(ov->x, *cap * sizeof *nx), *ny = nx ? realloc(ov->y, *cap * sizeof *ny) : NULL;
             if (nx)
                 ov->x = nx;
             ok = ny != NULL;
@@ -214,7 +221,7 @@ static bool read_curves(const lyap_args *a, overlay *ov)
         }
         ov->x[ov->n] = same ? p1 : p2;
         ov->y[ov->n] = same ? p2 : p1;
-        if (id != last && ov->n_labels < 64 && (id % 2 == 1)) { /* both ways share a label */
+        if (id != last && ov->n_labels < 64) { /* each curve's start */
             snprintf(ov->texts[ov->n_labels], sizeof ov->texts[0], "%s", label);
             ov->labels[ov->n_labels] = (cm_chart_label){ov->x[ov->n], ov->y[ov->n],
                                                         ov->texts[ov->n_labels]};
@@ -229,14 +236,27 @@ static bool read_curves(const lyap_args *a, overlay *ov)
     return ok;
 }
 
+static bool read_curves(const lyap_args *a, overlay *ov)
+{
+    size_t cap = 0;
+    memset(ov, 0, sizeof *ov);
+    for (int k = 0; k < a->n_curves; k++)
+        if (!read_curve_file(a, a->curves[k], ov, &cap))
+            return false;
+    return true;
+}
+
 static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v)
 {
     overlay ov = {0};
-    if (a->curves && !read_curves(a, &ov)) {
+    if (a->n_curves && !read_curves(a, &ov)) {
         free(ov.x);
         free(ov.y);
         return false;
     }
+    /* both ways of a curve, and curves of one point, start at one place */
+    cm_chart_join_labels(ov.labels, ov.n_labels, ov.texts[0], sizeof ov.texts[0],
+                         0.05 * (a->ax[0].hi - a->ax[0].lo), 0.03 * (a->ax[1].hi - a->ax[1].lo));
     const cm_series curves = {CM_SERIES_LINE, ov.x, ov.y, ov.n, (cm_rgb){0, 0, 0}, 2};
     char title[512], params[400], grid[200];
     const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */

@@ -60,9 +60,16 @@ fo="$fo --max-steps 200"
 "$CM" solve $fo --param S=0.32,S0=0.4,Omega=0.5,phi=3.141592653589793 --png fig-2-1a-phipi.png \
   --layers all --size 800x700 > /dev/null
 
-# Fig. 2.20 (right): largest Lyapunov exponent over Omega and S at S0 = 0.4
+# Fig. 2.20 (right): largest Lyapunov exponent over Omega and S at S0 = 0.4,
+# with the bifurcation curves of two continuations: in Omega at S = 0.32
+# (SN_1a, CS_a, CS_s) and in S at Omega = 0.5 (PD_1a, T, SS_a, the fold N)
+"$CM" continue --param S=0.32,S0=0.4,Omega=0.5 --vary Omega=0.2:0.7 --both --start 0.5 \
+  --start 0.58 --start 0.47 --curve S=0.005:0.4 --curves "$tmp/curves-omega.csv" --quiet
+"$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.005:0.4 --both --start 0.3 \
+  --start 0.38 --start 0.04 --switch --curve Omega=0.2:0.7 --curves "$tmp/curves-s.csv" --quiet
 "$CM" lyapunov --param S0=0.4 --grid Omega=0.2:0.7:60,S=0.005:0.4:48 --periods 600 \
-  --png fig-2.20-lyapunov.png --size 900x700 > /dev/null
+  --curves "$tmp/curves-omega.csv" --curves "$tmp/curves-s.csv" --png fig-2.20-lyapunov.png \
+  --size 900x700 > /dev/null
 
 # Figs. 2.3 (upper panel) and 2.16: trajectories over the sticking region
 # |x - cos(Omega t)| < S0; slips red, sticks green. 2.16 starts from rest
