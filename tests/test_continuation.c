@@ -300,8 +300,10 @@ static void test_fig_2_17_window(void)
     const cm_fo_branch_event *ss = first(&sp->events, CM_FO_EVENT_SS, 0.043479, 1e-3);
     const cm_fo_branch_event *n = first(&sp->events, CM_FO_EVENT_SN, 0.035620, 1e-4);
     CHECK(ss != NULL && n != NULL);
-    if (ss)
-        CHECK(ss->at.stable && ss->at.n_stick == 1 && !ss->at.symmetric);
+    if (ss) {
+        CHECK(ss->at.stable && ss->at.n_stick == 1 && !ss->at.symmetric && ss->jump);
+        CHECK(jumps_at(ss, CM_FO_P_S, &o)); /* independently, by simulation */
+    }
     if (n) {
         CHECK(n->fold);
         check_point(n, CM_FO_P_S, &o, 1, 2e-3);
