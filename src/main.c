@@ -30,6 +30,8 @@ static const struct {
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
     {"bifurcation", cmd_bifurcation,
      "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
+    {"escape", cmd_escape,
+     "transient chaos of the 1-D friction micro-chaos map: repeller, escape rate, mean escape number"},
     {"amplitude", cmd_amplitude,
      "amplitude-frequency diagram of the friction oscillator: (2.25), validity, stability"},
     {"continue", cmd_continue,

@@ -239,6 +239,15 @@ done
 
 # --- every bad argument: exit 2 and a message naming it -----------------------
 expect_usage "unknown command" frobnicate
+expect_usage "thesis 4.3 takes one positive fixed point" escape --param a=3
+expect_usage "--sweep: 'x=1:2:3' is not NAME=LO:HI:N" escape --sweep x=1:2:3
+expect_usage "--I0: '-1' must be a number" escape --I0 -1
+expect_usage "implemented for microchaos-1d-friction only" escape --model microchaos-pd
+for t in 1 2; do
+  "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:8 --cells 2000 --ensemble 2000 --threads $t \
+    --csv escape-$t.csv --quiet || fail "escape --threads $t"
+done
+cmp -s escape-1.csv escape-2.csv || fail "escape's CSV differs between 1 and 2 threads"
 expect_usage "unknown option '--frob'" solve --frob
 expect_usage "unknown model" solve --model nope
 expect_usage "unknown parameter 'gamma'" solve --param gamma=1

@@ -106,6 +106,13 @@ for s0 in 0.4 0.3; do
     --png fig-2.19-continue-S0-$s0.png --quiet
 done
 
+# Figs. 4.5 and 4.7: transient chaos of the 1-D friction map at b = 1.3,
+# |I0| = 0.25: the escape numbers across the domain at a = 1.5, and the mean
+# escape number against a, four ways
+"$CM" escape --param a=1.5,b=1.3 --I0 0.25 --cells 0 --ensemble 0 --png fig-4.5-escape.png --quiet
+"$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:64 --ensemble 200000 \
+  --png fig-4.7-escape.png --quiet
+
 # Figs. 2.4 and 2.7: amplitude-frequency diagrams, (2.25) against simulation
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --png fig-2.4-amplitude.png --quiet
 "$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --png fig-2.7-amplitude.png --quiet
