@@ -402,6 +402,26 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     return images_of_rows(model, lat, max_steps, threads, opt, r, msg, msg_size);
 }
 
+void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM])
+{
+    const cm_box *box = &r->box;
+    const int dim = box->dim;
+    uint64_t moved = 0, same[CM_MAX_DIM] = {0};
+    int64_t from[CM_MAX_DIM], to[CM_MAX_DIM];
+    for (uint64_t i = 0; i < r->ncells; i++) {
+        const uint32_t j = r->image[i];
+        if (j >= r->ncells || j == i) /* the sink, an exit, or a fixed cell */
+            continue;
+        cm_box_cell(box, i, from);
+        cm_box_cell(box, j, to);
+        moved++;
+        for (int d = 0; d < dim; d++)
+            same[d] += from[d] == to[d];
+    }
+    for (int d = 0; d < CM_MAX_DIM; d++)
+        share[d] = d < dim && moved ? (double)same[d] / (double)moved : NAN;
+}
+
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
 {
     return cm_classify((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups,

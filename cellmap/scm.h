@@ -131,6 +131,15 @@ uint64_t cm_region_bytes(const cm_region *r);
 cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
                         cm_region *r, char *msg, size_t msg_size);
 
+/* Slow directions: for each dimension d, the share of the cells whose image
+ * is another cell of the box in the same slab of d (equal coordinate d),
+ * into share[d]; NaN where no cell's image is another cell of the box. A
+ * large share means the map moves less than a cell per step in d there:
+ * restarting each step from a cell's centre then undoes the motion in d,
+ * and a coordinate that decays slowly never decays (docs/engine.md, "Slow
+ * directions"). Finer cells in d are the cure. */
+void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM]);
+
 /* Classifies the functional graph in image[] into group[] and step[]. */
 cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size);
 

@@ -1425,13 +1425,15 @@ const char *cm_fo_event_name(int type)
 
 const char *cm_fo_stop_name(int stop)
 {
-    static const char *const names[] = {"the parameter left its range", "the point limit",
-                                        "the corrector failed at the smallest step, or crept "
-                                        "below 1e-6 for 200 points (the map is nearly singular "
-                                        "there)",
-                                        "the motion could not be followed",
-                                        "a change of signature or a jump of the map it cannot follow",
-                                        "the branch came back to its start (a loop, or from a "
-                                        "period doubling the orbit's other point)"};
+    /* (parentheses: the split literals are meant) */
+    static const char *const names[] = {
+        "the parameter left its range",
+        "the point limit",
+        ("the corrector failed at the smallest step, or crept below 1e-6 for 200 points (the "
+         "map is nearly singular there)"),
+        "the motion could not be followed",
+        "a change of signature or a jump of the map it cannot follow",
+        ("the branch came back to its start (a loop, or from a period doubling the orbit's "
+         "other point)")};
     return stop >= 0 && stop < 6 ? names[stop] : "?";
 }

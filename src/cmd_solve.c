@@ -236,6 +236,7 @@ typedef struct summary {
     uint64_t sink;  /* cells of the sink's domain */
     uint32_t ngroups;
     cm_group_info *groups; /* in id order */
+    double slow[CM_MAX_DIM]; /* cm_scm_slow_share of a single region; NaN: unknown */
 } summary;
 
 /* Groups of one fixed cell without a basin of its own: in micro-chaos maps
@@ -248,6 +249,9 @@ static uint32_t single_cells(const cm_group_info *g, uint32_t n)
         count += g[k].period == 1 && g[k].basin_cells == 1;
     return count;
 }
+
+/* A share of slow cells (cm_scm_slow_share) above which the summary says so. */
+#define SLOW_SHARE 0.25
 
 static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, const summary *sum,
                        const timing *t, const extend_log *log)
@@ -289,6 +293,14 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
                      "basin: usually cells the map moves by less than a cell, not attractors "
                      "(--max-steps removes them)\n",
                 singles, ngroups);
+    for (int d = 0; d < lat->dim && lat->dim > 1; d++)
+        if (sum->slow[d] > SLOW_SHARE)
+            fprintf(out, "note: %.0f%% of the cells that move stay in their own %s slab: the "
+                         "map moves less than a cell per step in %s, which cell mapping cannot "
+                         "follow (a slowly decaying %s never decays); finer cells in %s give "
+                         "the true picture (docs/engine.md, \"Slow directions\")\n",
+                    100 * sum->slow[d], cm_model_coord_name(m, d), cm_model_coord_name(m, d),
+                    cm_model_coord_name(m, d), cm_model_coord_name(m, d));
     free(sorted);
 }
 
@@ -642,6 +654,8 @@ int cmd_solve(int argc, char **argv)
     char msg[1024], command[4096];
     memset(&r, 0, sizeof r);
     memset(&sum, 0, sizeof sum);
+    for (int d = 0; d < CM_MAX_DIM; d++)
+        sum.slow[d] = NAN; /* known for a single region only */
     memset(&rn, 0, sizeof rn);
     join_argv(argc + 1, argv - 1, command, sizeof command);
     extend_log *log = calloc(1, sizeof *log);
@@ -689,6 +703,7 @@ int cmd_solve(int argc, char **argv)
         sum.box = r.box;
         sum.cells = r.ncells;
         sum.ngroups = r.ngroups;
+        cm_scm_slow_share(&r, sum.slow);
         if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }

@@ -20,10 +20,16 @@ pd=microchaos-pd
 "$CM" solve --model $pd --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --region=-1:6.5,-2.5:2.5 \
   --cells 750x500 --png fig-4.13.png --layers all --size 1200x800 > /dev/null
 
-# Fig. 4.21: twelve tiny attractors at the switching lines (real device)
+# Fig. 4.21: twelve tiny attractors at the switching lines (real device),
+# coloured as the thesis colours it, by the steps to reach an attractor, with
+# the sink red. v changes by less than 1.5 per step, so the cells are 0.375
+# tall in v: on 3-unit rows cell mapping cannot follow v's decay and sends 80 %
+# of the box to the sink (docs/engine.md, "Slow directions"); the basins'
+# hundreds of fragments are one colour
 "$CM" solve --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
-  --region=-125000:125000,-600:600 --cells 1000x400 --max-steps 100000 \
-  --png fig-4.21-figure.png --layers all --size 1400x600 > /dev/null
+  --region=-125000:125000,-600:600 --cells 4000x3200 --max-steps 100000 \
+  --png fig-4.21-figure.png --layers basin,steps,attractors,overlays,axes,legend,title \
+  --min-basin 100000000 --size 1400x600 > /dev/null
 
 # Figs. 4.26-4.28 (thesis 4.6.3): the two regions solved apart, after Stage 1
 # of their join, and the cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
