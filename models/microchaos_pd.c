@@ -84,6 +84,27 @@ double cm_pd_D_at_P_max(double alpha, double beta)
            (1 - 2 * c * e - 3 * e * e) * beta / den;
 }
 
+void cm_pd_eigen_curves_at(double alpha, double beta, double P, cm_pd_eigen_curves *out)
+{
+    const double a2 = alpha * alpha;
+    const double g = sqrt(a2 + beta * beta);
+    const double s = sinh(g), c = cosh(g), e = exp(beta);
+    out->D_1 = (2 * c * g * a2 + (e * g - c * g - beta * s) * P) / (a2 * s);
+    out->D_0 = (g * a2 + (c * e * g - g - beta * e * s) * P) / (a2 * e * s);
+    const double mid = (g * (P - 2 * a2) * (e - c) - P * beta * s) / (a2 * s);
+    const double r = (a2 - P) * (1 + e * e - 2 * e * c); /* >= 0 for P >= alpha^2 */
+    const double half = r >= 0 ? 2 * g * sqrt(r) / (alpha * s) : NAN;
+    out->D_c_minus = mid - half;
+    out->D_c_plus = mid + half;
+}
+
+double cm_pd_P_quick(double alpha, double beta)
+{
+    const double g = sqrt(alpha * alpha + beta * beta);
+    const double c = cosh(g), e = exp(beta);
+    return alpha * alpha * (1 - 2 * c * e) / (1 - 2 * c * e + e * e);
+}
+
 int64_t cm_pd_m_fix_max(double alpha, double P)
 {
     const double a2 = alpha * alpha;

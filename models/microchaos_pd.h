@@ -40,6 +40,18 @@ void cm_pd_stability_at(double alpha, double beta, double P, double D, cm_pd_sta
 double cm_pd_P_max(double alpha, double beta);
 double cm_pd_D_at_P_max(double alpha, double beta);
 
+/* The eigen-structure of S inside the stability domain (C.52)-(C.56), as
+ * curves D(P): trace S = 0 (D_1), det S = 0 (D_0), and the double
+ * eigenvalue D_c- <= D_c+ (NaN for P < alpha^2, where they are complex). */
+typedef struct cm_pd_eigen_curves {
+    double D_1, D_0, D_c_minus, D_c_plus;
+} cm_pd_eigen_curves;
+
+void cm_pd_eigen_curves_at(double alpha, double beta, double P, cm_pd_eigen_curves *out);
+
+/* P_quick: where D_0 = D_1 and both eigenvalues of S vanish (deadbeat). */
+double cm_pd_P_quick(double alpha, double beta);
+
 /* (4.75) m_fix,max = Int(alpha^2/(P - alpha^2)), with the border rule of
  * docs/models.md 6.4 (a colliding fixed point is virtual); (4.76) m_max =
  * m_fix,max + 1. Return -1 when P <= alpha^2 (unbounded). */

@@ -30,6 +30,8 @@ static const struct {
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
     {"bifurcation", cmd_bifurcation,
      "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
+    {"stability", cmd_stability,
+     "analytic charts of the PD micro-chaos map: stability domain, fixed points, control error"},
     {"escape", cmd_escape,
      "transient chaos of the 1-D friction micro-chaos map: repeller, escape rate, mean escape number"},
     {"amplitude", cmd_amplitude,

@@ -243,6 +243,8 @@ expect_usage "thesis 4.3 takes one positive fixed point" escape --param a=3
 expect_usage "--sweep: 'x=1:2:3' is not NAME=LO:HI:N" escape --sweep x=1:2:3
 expect_usage "--I0: '-1' must be a number" escape --I0 -1
 expect_usage "implemented for microchaos-1d-friction only" escape --model microchaos-pd
+expect_usage "--P: '1:0:5' is not LO:HI:N" stability --P 1:0:5
+expect_usage "implemented for microchaos-pd only" stability --model microchaos-1d
 for t in 1 2; do
   "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:8 --cells 2000 --ensemble 2000 --threads $t \
     --csv escape-$t.csv --quiet || fail "escape --threads $t"

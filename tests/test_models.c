@@ -164,6 +164,32 @@ static void stability_domain(void)
     cm_pd_stability_at(alpha, beta, Pmax, 0, &at);
     CHECK_NEAR(at.D_b0, at.D_b1, 1e-12);
     CHECK_NEAR(at.D_b0, cm_pd_D_at_P_max(alpha, beta), 1e-12);
+    /* the eigen-structure curves (C.52)-(C.56) against S itself: trace 0 on
+     * D_1, det 0 on D_0, a double eigenvalue on D_c+-, and at P_quick both
+     * eigenvalues 0 where D_0 and D_1 meet */
+    for (double P = alpha * alpha * 1.01; P < Pmax; P += 0.05) {
+        cm_pd_eigen_curves ec;
+        cm_pd_eigen_curves_at(alpha, beta, P, &ec);
+        const double Ds[4] = {ec.D_1, ec.D_0, ec.D_c_minus, ec.D_c_plus};
+        for (int k = 0; k < 4; k++) {
+            cm_pd_coef c;
+            cm_pd_coefficients(alpha, beta, P, Ds[k], &c);
+            const double tr = c.S[0] + c.S[3], det = c.S[0] * c.S[3] - c.S[1] * c.S[2];
+            const double want[4] = {tr, det, tr * tr - 4 * det, tr * tr - 4 * det};
+            CHECK(fabs(want[k]) < 1e-10);
+        }
+        CHECK(ec.D_c_minus <= ec.D_c_plus);
+    }
+    cm_pd_eigen_curves below;
+    cm_pd_eigen_curves_at(alpha, beta, alpha * alpha * 0.9, &below);
+    CHECK(isnan(below.D_c_plus)); /* complex below P = alpha^2 */
+    const double Pq = cm_pd_P_quick(alpha, beta);
+    cm_pd_eigen_curves q;
+    cm_pd_eigen_curves_at(alpha, beta, Pq, &q);
+    CHECK_NEAR(q.D_0, q.D_1, 1e-12);
+    cm_pd_coef cq;
+    cm_pd_coefficients(alpha, beta, Pq, q.D_0, &cq);
+    CHECK(fabs(cq.S[0] + cq.S[3]) < 1e-12 && fabs(cq.S[0] * cq.S[3] - cq.S[1] * cq.S[2]) < 1e-12);
 }
 
 /* ---- orbits against independent evaluations of the formulas ---------- */

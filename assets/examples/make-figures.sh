@@ -112,6 +112,14 @@ for s0 in 0.4 0.3; do
     --png fig-2.19-continue-S0-$s0.png --quiet
 done
 
+# Figs. 4.12, C.4 and 4.14: the PD map's stability domain without quantisation
+# with its eigen-structure curves, the regular fixed points against P, the
+# fewest against alpha; at alpha = 0.8, beta = 0.3 (with Fig. 4.13's gains)
+# and at alpha = 1.8, beta = 0.3 (Fig. 4.14, left)
+"$CM" stability --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --png fig-4.12-stability.png --quiet
+"$CM" stability --param alpha=1.8,beta=0.3,P=3.5,D=1 --P 3.3:6:540 --png fig-4.14-stability.png \
+  --quiet
+
 # Figs. 4.5 and 4.7: transient chaos of the 1-D friction map at b = 1.3,
 # |I0| = 0.25: the escape numbers across the domain at a = 1.5, and the mean
 # escape number against a, four ways
