@@ -105,6 +105,100 @@ double cm_pd_P_quick(double alpha, double beta)
     return alpha * alpha * (1 - 2 * c * e) / (1 - 2 * c * e + e * e);
 }
 
+/* x - origin in the eigenbasis of A: x - origin = a e_u + b e_s. */
+static void eigen_coordinates(const cm_pd_coef *k, const double origin[2], const double x[2],
+                              double *a, double *b)
+{
+    const double dx = x[0] - origin[0], dv = x[1] - origin[1];
+    const double det = k->e_s[1] - k->e_u[1]; /* e_u = (1, u), e_s = (1, s): det [e_u e_s] */
+    *a = (dx * k->e_s[1] - dv) / det;
+    *b = (dv - dx * k->e_u[1]) / det;
+}
+
+/* f restricted to level q: A x + b q. */
+static void restricted(const cm_pd_coef *k, double q, const double x[2], double y[2])
+{
+    y[0] = k->A[0] * x[0] + k->A[1] * x[1] + k->b[0] * q;
+    y[1] = k->A[2] * x[0] + k->A[3] * x[1] + k->b[1] * q;
+}
+
+void cm_pd_horseshoe_at(double alpha, double beta, double P, double D, int64_t m,
+                        cm_pd_horseshoe *h)
+{
+    cm_pd_coef k;
+    cm_pd_coefficients(alpha, beta, P, D, &k);
+    const double a2 = alpha * alpha, g = k.gamma, md = (double)m, gb = g - beta;
+    h->m = m;
+    h->x_l[0] = (md - 1) / a2, h->x_l[1] = 0;
+    h->x_r[0] = md / a2, h->x_r[1] = 0;
+    h->RULS[0] = (-beta + (2 * md - 1) * g) / (2 * a2 * g), h->RULS[1] = -1 / (2 * g);
+    h->LURS[0] = (beta + (2 * md - 1) * g) / (2 * a2 * g), h->LURS[1] = 1 / (2 * g);
+    const double den = a2 * (P + D * gb);
+    h->RUSW[0] = (a2 + D * gb) * md / den, h->RUSW[1] = gb * md * (a2 - P) / den;
+    h->LUSW[0] = (D * gb * (md - 1) + a2 * md) / den;
+    h->LUSW[1] = gb * (a2 * md - P * (md - 1)) / den;
+    const double *corner[2] = {h->LUSW, h->RUSW};
+    for (int i = 0; i < 2; i++) {
+        double y[2], a, b;
+        restricted(&k, md - 1, corner[i], y); /* f_l: right of W_R^S */
+        eigen_coordinates(&k, h->x_r, y, &a, &b);
+        h->escape[i] = a > 0;
+        restricted(&k, md, corner[i], y); /* f_r: left of W_L^S */
+        eigen_coordinates(&k, h->x_l, y, &a, &b);
+        h->escape[2 + i] = a < 0;
+    }
+    h->stretches = h->escape[0] || h->escape[1] || h->escape[2] || h->escape[3];
+    h->full_shift = h->escape[0] && h->escape[1] && h->escape[2] && h->escape[3];
+}
+
+uint64_t cm_pd_horseshoe_periodic(double alpha, double beta, double P, double D, int64_t m, int n)
+{
+    if (n < 1 || n > 24)
+        return 0;
+    cm_pd_coef k;
+    cm_pd_coefficients(alpha, beta, P, D, &k);
+    cm_pd_horseshoe h;
+    cm_pd_horseshoe_at(alpha, beta, P, D, m, &h);
+    double a_r, b_r; /* Q_m: 0 <= a <= a_r, b between 0 and b_r, from x_l* */
+    eigen_coordinates(&k, h.x_l, h.x_r, &a_r, &b_r);
+    /* A^n and the powers for the fixed point of the composition */
+    uint64_t count = 0;
+    for (uint64_t word = 0; word < (UINT64_C(1) << n); word++) {
+        /* x = F(x), F = f_{s_n} o ... o f_{s_1}: x = M x + c with M = A^n */
+        double M[4] = {1, 0, 0, 1}, c[2] = {0, 0};
+        for (int j = 0; j < n; j++) {
+            const double q = (double)(m - 1) + (double)((word >> j) & 1);
+            const double M2[4] = {k.A[0] * M[0] + k.A[1] * M[2], k.A[0] * M[1] + k.A[1] * M[3],
+                                  k.A[2] * M[0] + k.A[3] * M[2], k.A[2] * M[1] + k.A[3] * M[3]};
+            const double c2[2] = {k.A[0] * c[0] + k.A[1] * c[1] + k.b[0] * q,
+                                  k.A[2] * c[0] + k.A[3] * c[1] + k.b[1] * q};
+            memcpy(M, M2, sizeof M);
+            memcpy(c, c2, sizeof c);
+        }
+        const double I_M[4] = {1 - M[0], -M[1], -M[2], 1 - M[3]};
+        const double det = I_M[0] * I_M[3] - I_M[1] * I_M[2];
+        double x[2] = {(I_M[3] * c[0] - I_M[1] * c[1]) / det, (I_M[0] * c[1] - I_M[2] * c[0]) / det};
+        bool follows = isfinite(x[0]) && isfinite(x[1]);
+        /* a point of the invariant set may lie on Q_m's edge or on SW_m (the
+         * fixed points are corners), and the solve and the orbit lose a few
+         * digits to the expansion lambda_u^n: 10^-7 of the cell's size */
+        const double tol = 1e-7;
+        for (int j = 0; j < n && follows; j++) {
+            const double q = (double)(m - 1) + (double)((word >> j) & 1);
+            double a, b;
+            eigen_coordinates(&k, h.x_l, x, &a, &b);
+            const double u = P * x[0] + D * x[1]; /* in band q: q <= u < q + 1 (m >= 1) */
+            follows = a >= -tol * a_r && a <= a_r * (1 + tol) && b * b_r >= -tol * b_r * b_r &&
+                      fabs(b) <= fabs(b_r) * (1 + tol) && u >= q - tol && u < q + 1 + tol;
+            double y[2];
+            restricted(&k, q, x, y);
+            x[0] = y[0], x[1] = y[1];
+        }
+        count += follows;
+    }
+    return count;
+}
+
 int64_t cm_pd_m_fix_max(double alpha, double P)
 {
     const double a2 = alpha * alpha;

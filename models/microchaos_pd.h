@@ -52,6 +52,30 @@ void cm_pd_eigen_curves_at(double alpha, double beta, double P, cm_pd_eigen_curv
 /* P_quick: where D_0 = D_1 and both eigenvalues of S vanish (deadbeat). */
 double cm_pd_P_quick(double alpha, double beta);
 
+/* The horseshoe at switching line SW_m, m >= 1 (thesis 4.5.3, Fig. 4.15):
+ * the parallelogram Q_m between the fixed points x_l* (l = m - 1) and x_r*
+ * (r = m) bounded by their stable and unstable manifolds, cut by SW_m into
+ * the trapezoids L = (x_l*, RULS, RUSW, LUSW) and R = (LUSW, RUSW, x_r*,
+ * LURS); f_l and f_r are the map restricted to level l or r. */
+typedef struct cm_pd_horseshoe {
+    int64_t m;
+    double x_l[2], x_r[2];
+    double RULS[2], LURS[2], RUSW[2], LUSW[2]; /* docs/models.md 6.6 */
+    /* the four escape conditions: f_l(LUSW), f_l(RUSW) right of W_R^S and
+     * f_r(LUSW), f_r(RUSW) left of W_L^S */
+    bool escape[4];
+    bool stretches;  /* any of them: an image leaves Q_m, a repeller */
+    bool full_shift; /* all four: conjugate to a full binary shift */
+} cm_pd_horseshoe;
+
+void cm_pd_horseshoe_at(double alpha, double beta, double P, double D, int64_t m,
+                        cm_pd_horseshoe *h);
+
+/* The points of Q_m of period n under the two restricted maps: itineraries
+ * over {l, r} whose affine fixed point follows them, each iterate in Q_m
+ * and in the band of its symbol. 2^n on a full horseshoe. */
+uint64_t cm_pd_horseshoe_periodic(double alpha, double beta, double P, double D, int64_t m, int n);
+
 /* (4.75) m_fix,max = Int(alpha^2/(P - alpha^2)), with the border rule of
  * docs/models.md 6.4 (a colliding fixed point is virtual); (4.76) m_max =
  * m_fix,max + 1. Return -1 when P <= alpha^2 (unbounded). */

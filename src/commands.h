@@ -17,6 +17,7 @@ int cmd_continue(int argc, char **argv);
 int cmd_amplitude(int argc, char **argv);
 int cmd_escape(int argc, char **argv);
 int cmd_stability(int argc, char **argv);
+int cmd_horseshoe(int argc, char **argv);
 int cmd_bifurcation(int argc, char **argv);
 int cmd_sweep(int argc, char **argv);
 

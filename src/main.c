@@ -30,6 +30,8 @@ static const struct {
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
     {"bifurcation", cmd_bifurcation,
      "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
+    {"horseshoe", cmd_horseshoe,
+     "horseshoes of the PD micro-chaos map: escape conditions, binary shift, entropy"},
     {"stability", cmd_stability,
      "analytic charts of the PD micro-chaos map: stability domain, fixed points, control error"},
     {"escape", cmd_escape,

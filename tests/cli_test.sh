@@ -245,6 +245,8 @@ expect_usage "--I0: '-1' must be a number" escape --I0 -1
 expect_usage "implemented for microchaos-1d-friction only" escape --model microchaos-pd
 expect_usage "--P: '1:0:5' is not LO:HI:N" stability --P 1:0:5
 expect_usage "implemented for microchaos-pd only" stability --model microchaos-1d
+expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
+expect_usage "--sweep: 'D=1:2:3' is not P=LO:HI:K" horseshoe --sweep D=1:2:3
 for t in 1 2; do
   "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:8 --cells 2000 --ensemble 2000 --threads $t \
     --csv escape-$t.csv --quiet || fail "escape --threads $t"

@@ -192,6 +192,61 @@ static void stability_domain(void)
     CHECK(fabs(cq.S[0] + cq.S[3]) < 1e-12 && fabs(cq.S[0] * cq.S[3] - cq.S[1] * cq.S[2]) < 1e-12);
 }
 
+/* ---- horseshoes (thesis 4.5.3) ----------------------------------------- */
+
+/* Whether y - x is parallel to the direction (1, slope), to tol. */
+static bool along(const double x[2], const double y[2], double slope, double tol)
+{
+    return fabs((y[1] - x[1]) - slope * (y[0] - x[0])) < tol;
+}
+
+static void horseshoes(void)
+{
+    /* the corners where the thesis' lines meet, checked on the lines
+     * themselves: W^U along e_u = (1, gamma - beta), W^S along e_s = (1,
+     * -gamma - beta) through the fixed points, SW_m: P x + D x' = m */
+    const double alpha = 0.8, beta = 0.3, P = 0.7, D = 0.6;
+    const double g = sqrt(alpha * alpha + beta * beta), u = g - beta, st = -g - beta;
+    for (int m = 1; m <= 8; m++) {
+        cm_pd_horseshoe h;
+        cm_pd_horseshoe_at(alpha, beta, P, D, m, &h);
+        CHECK(along(h.x_r, h.RULS, u, 1e-12) && along(h.x_l, h.RULS, st, 1e-12));
+        CHECK(along(h.x_l, h.LURS, u, 1e-12) && along(h.x_r, h.LURS, st, 1e-12));
+        CHECK(along(h.x_r, h.RUSW, u, 1e-12) && fabs(P * h.RUSW[0] + D * h.RUSW[1] - m) < 1e-12);
+        CHECK(along(h.x_l, h.LUSW, u, 1e-12) && fabs(P * h.LUSW[0] + D * h.LUSW[1] - m) < 1e-12);
+        /* and the thesis' own printed forms of P^RUSW and P^LUSW */
+        const double a2 = alpha * alpha, den = -beta * D + D * g + P;
+        CHECK(fabs(h.RUSW[0] - (a2 + D * (-beta + g)) * m / (a2 * den)) < 1e-12);
+        CHECK(fabs(h.RUSW[1] + (beta - g) * m * (a2 - P) / (a2 * den)) < 1e-12);
+        const double den2 = a2 * (beta * D - D * g - P);
+        CHECK(fabs(h.LUSW[0] - (D * (beta - g) * (m - 1) - a2 * m) / den2) < 1e-12);
+        CHECK(fabs(h.LUSW[1] - (beta - g) * (a2 * m + P - m * P) / den2) < 1e-12);
+    }
+    /* Fig. 4.16: repellers at SW_4 and SW_7, attractors at SW_5 and SW_6 */
+    for (int m = 4; m <= 7; m++) {
+        cm_pd_horseshoe h;
+        cm_pd_horseshoe_at(alpha, beta, P, D, m, &h);
+        CHECK(h.stretches == (m == 4 || m == 7));
+        CHECK(!h.full_shift);
+    }
+    /* Fig. 4.18 at SW_3 (alpha = 0.77, beta = 0.02, D = 0.83): a full binary
+     * shift at P = 0.71, with 2^n points of period n (entropy log 2); at
+     * 0.655 and 0.67 not, and fewer */
+    const double Ps[3] = {0.655, 0.67, 0.71};
+    for (int k = 0; k < 3; k++) {
+        cm_pd_horseshoe h;
+        cm_pd_horseshoe_at(0.77, 0.02, Ps[k], 0.83, 3, &h);
+        CHECK(h.full_shift == (k == 2));
+        for (int n = 1; n <= 12; n++) {
+            const uint64_t N = cm_pd_horseshoe_periodic(0.77, 0.02, Ps[k], 0.83, 3, n);
+            if (k == 2)
+                CHECK(N == UINT64_C(1) << n);
+            else if (n >= 4)
+                CHECK(N < UINT64_C(1) << n);
+        }
+    }
+}
+
 /* ---- orbits against independent evaluations of the formulas ---------- */
 
 static double Int(double z) { return trunc(z); }
@@ -370,6 +425,7 @@ int main(void)
     border_collision();
     pd_coefficients();
     stability_domain();
+    horseshoes();
     orbits();
     general_equals_specific();
     friction_and_delay_fixed_points();

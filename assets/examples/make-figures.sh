@@ -120,6 +120,13 @@ done
 "$CM" stability --param alpha=1.8,beta=0.3,P=3.5,D=1 --P 3.3:6:540 --png fig-4.14-stability.png \
   --quiet
 
+# Figs. 4.16 and 4.17: the horseshoes at SW_4..7 (alpha = 0.8, beta = 0.3,
+# P = 0.7, D = 0.6; repellers at 4 and 7) and the entropy estimate against P
+# at SW_2..5 (alpha = 0.77, beta = 0.02, D = 0.83)
+"$CM" horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --png fig-4.16-horseshoe.png --quiet
+"$CM" horseshoe --param alpha=0.77,beta=0.02,D=0.83 --m 2:5 --sweep P=0.6:0.75:150 \
+  --png fig-4.17-entropy.png --quiet
+
 # Figs. 4.5 and 4.7: transient chaos of the 1-D friction map at b = 1.3,
 # |I0| = 0.25: the escape numbers across the domain at a = 1.5, and the mean
 # escape number against a, four ways
