@@ -18,6 +18,7 @@ int cmd_amplitude(int argc, char **argv);
 int cmd_escape(int argc, char **argv);
 int cmd_stability(int argc, char **argv);
 int cmd_horseshoe(int argc, char **argv);
+int cmd_partition(int argc, char **argv);
 int cmd_bifurcation(int argc, char **argv);
 int cmd_sweep(int argc, char **argv);
 

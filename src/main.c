@@ -30,6 +30,8 @@ static const struct {
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},
     {"bifurcation", cmd_bifurcation,
      "Monte Carlo bifurcation diagram of the friction oscillator, with Psi"},
+    {"partition", cmd_partition,
+     "the delay micro-chaos map's proof of chaos: partition, transition matrix, primitivity"},
     {"horseshoe", cmd_horseshoe,
      "horseshoes of the PD micro-chaos map: escape conditions, binary shift, entropy"},
     {"stability", cmd_stability,

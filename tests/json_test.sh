@@ -38,6 +38,7 @@ run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --t
 run simulate simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 3 --json
 run amplitude amplitude --param S=0.5,S0=0.5 --omega 0.2:2:10 --json
 run continue continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --json
+run partition partition --param a=1.3,b=0.66 --json
 run horseshoe horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --json
 run stability stability --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --json
 run escape escape --param a=1.5,b=1.3 --I0 0.25 --cells 100000 --ensemble 100000 --json
@@ -88,6 +89,8 @@ assert st["box"] == [[0, 500], [-40, 40]] and st["cells"] == 125 * 80
 assert all("in_view" in g for g in st["groups"])
 sb = load("stability")
 assert sb["stable"] and sb["n_fixed"] == 5 and sb["m_max"] == 3 and abs(sb["P_min"] - 0.64) < 1e-15, sb
+pt = load("partition")
+assert [r["row"] for r in pt["regions"]][3] == "000011000" and pt["primitive_index"] == 65, pt
 hs = load("horseshoe")["lines"]
 assert [l["kind"] for l in hs] == ["repeller", "attractor", "attractor", "repeller"], hs
 es = load("escape")["points"][0]

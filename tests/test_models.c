@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "models/delay_partition.h"
 #include "models/microchaos_pd.h"
 #include "models/params.h"
 #include "models/registry.h"
@@ -247,6 +248,50 @@ static void horseshoes(void)
     }
 }
 
+/* ---- the delay map's partition (thesis 4.4.2, App. C.3) ---------------- */
+
+static void delay_partition(void)
+{
+    /* Fig. 4.11 (a = 1.3, b = 0.66): nine regions and the matrix (4.53),
+     * irreducible and primitive with index N = 65 <= r^2 - r = 72 */
+    static const char *const thesis[9] = {"010000000", "001000000", "000100000",
+                                          "000011000", "000001000", "000000100",
+                                          "000000010", "000000001", "100000000"};
+    cm_delay_partition p;
+    char why[200];
+    CHECK(cm_delay_partition_01(1.3, 0.66, &p, why, sizeof why));
+    CHECK_INT(p.r, 9);
+    for (int i = 0; i < 9 && p.r == 9; i++)
+        for (int j = 0; j < 9; j++)
+            CHECK_INT(p.P[i][j], thesis[i][j] - '0');
+    CHECK(p.irreducible);
+    CHECK_INT(p.primitive_index, 65);
+    CHECK(fabs(p.x_l - 0.172) < 1e-12 && fabs(p.x_r - 1.69) < 1e-12);
+    /* the regions tile the two branches; each transition P_ij = 1 checked on
+     * the map itself: 1000 points of I_j all have a pre-image in I_i */
+    for (int i = 0; i < p.r; i++)
+        for (int j = 0; j < p.r; j++) {
+            if (!p.P[i][j])
+                continue;
+            for (int k = 0; k <= 1000; k++) {
+                const double s = p.lo[j] + (p.hi[j] - p.lo[j]) * k / 1000.0;
+                /* f takes (t, a t - b branch_i) to branch Int(t) at a t - b branch_i */
+                const double t = (s + 0.66 * p.branch[i]) / 1.3;
+                CHECK(t >= p.lo[i] - 1e-12 && t <= p.hi[i] + 1e-12);
+                CHECK((t >= 1) == (p.branch[j] == 1) || fabs(t - 1) < 1e-12);
+            }
+        }
+    /* App. C.3.2: primitive partitions for c_m^u = 0.5953 <= b <= c_s^l =
+     * 0.6766 at a = 1.3; below, this construction is not irreducible */
+    for (double b = 0.6; b <= 0.675; b += 0.0125) {
+        CHECK(cm_delay_partition_01(1.3, b, &p, why, sizeof why));
+        CHECK(p.irreducible && p.primitive_index > 0 &&
+              p.primitive_index <= p.r * p.r - p.r);
+    }
+    CHECK(cm_delay_partition_01(1.3, 0.58, &p, why, sizeof why) && !p.irreducible);
+    CHECK(!cm_delay_partition_01(1.5, 0.6, &p, why, sizeof why)); /* Fig. 4.9: m_min = 2 */
+}
+
 /* ---- orbits against independent evaluations of the formulas ---------- */
 
 static double Int(double z) { return trunc(z); }
@@ -426,6 +471,7 @@ int main(void)
     pd_coefficients();
     stability_domain();
     horseshoes();
+    delay_partition();
     orbits();
     general_equals_specific();
     friction_and_delay_fixed_points();

@@ -120,6 +120,9 @@ done
 "$CM" stability --param alpha=1.8,beta=0.3,P=3.5,D=1 --P 3.3:6:540 --png fig-4.14-stability.png \
   --quiet
 
+# Fig. 4.11: the delay map's attractor partitioned (a = 1.3, b = 0.66)
+"$CM" partition --param a=1.3,b=0.66 --png fig-4.11-partition.png --quiet
+
 # Figs. 4.16 and 4.17: the horseshoes at SW_4..7 (alpha = 0.8, beta = 0.3,
 # P = 0.7, D = 0.6; repellers at 4 and 7) and the entropy estimate against P
 # at SW_2..5 (alpha = 0.77, beta = 0.02, D = 0.83)
