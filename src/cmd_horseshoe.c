@@ -20,8 +20,8 @@
 
 static const char horseshoe_help[] =
     "usage: cellmap horseshoe [--model microchaos-pd] [--param k=v[,k=v]] [--m M0:M1]\n"
-    "                         [--periods N] [--sweep P=LO:HI:K] [--csv FILE|-] [--png FILE]\n"
-    "                         [--size WxH] [--json] [--quiet]\n\n"
+    "                         [--periods N] [--sweep P=LO:HI:K [--crisis]] [--csv FILE|-]\n"
+    "                         [--png FILE] [--size WxH] [--json] [--quiet]\n\n"
     "The horseshoes of the PD micro-chaos map (thesis 4.5.3, docs/models.md 6.6): at\n"
     "each switching line SW_m the parallelogram Q_m between the fixed points x_(m-1)*\n"
     "and x_m*, bounded by their stable and unstable manifolds and cut by SW_m into\n"
@@ -34,6 +34,10 @@ static const char horseshoe_help[] =
     "  --m M0:M1           the switching lines, 1 <= M0 <= M1 (default 1 to m_max, 4.76)\n"
     "  --periods N         the period of the estimate, 1..20 (default 12)\n"
     "  --sweep P=LO:HI:K   the entropy estimate against P (Fig. 4.17), at each m\n"
+    "  --crisis            with --sweep: the PNG is the crisis chart of Fig. 4.20 instead:\n"
+    "                      at each P and SW_m, an attractor (green), or a repeller whose\n"
+    "                      orbits escape away from the origin (Out: red), towards it (In:\n"
+    "                      blue) or both (purple); beyond m_max (4.76) nothing (grey)\n"
     "  --csv FILE|-        per m (and P): the corners, the escape conditions, attractor\n"
     "                      or repeller, full shift, N_n and the entropy estimate\n"
     "  --png FILE          one point: L and R (red, blue), their images f_l(L), f_r(R)\n"
@@ -46,7 +50,7 @@ static const char horseshoe_help[] =
 typedef struct hs_args {
     model_opts mo;
     int64_t m0, m1;
-    int has_m, periods, has_sweep, width, height;
+    int has_m, periods, has_sweep, crisis, width, height;
     param_axis sweep;
     const char *csv, *png;
     bool json, quiet;
@@ -71,6 +75,8 @@ static int parse_args(cli *c, hs_args *a)
                 a->m0 = lo, a->m1 = hi;
             a->has_m = 1;
         } else if (cli_take_int(c, "--periods", 1, 20, &a->periods, &err)) {
+        } else if (cli_is(c, "--crisis", false, &err)) {
+            a->crisis = 1;
         } else if (cli_is(c, "--sweep", true, &err)) {
             if (c->value && (!param_axis_parse(c->value, strlen(c->value), &a->sweep) ||
                              strcmp(a->sweep.name, "P") != 0 || a->sweep.n > 10000 ||
@@ -96,6 +102,8 @@ static int parse_args(cli *c, hs_args *a)
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
         err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err && a->crisis && !a->has_sweep)
+        err = cli_usage_error(c, "--crisis charts a sweep: give --sweep P=LO:HI:K too");
     return err;
 }
 
@@ -217,6 +225,65 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
     const bool ok = write_chart_png("horseshoe", a->png, &chart, 1, texts, 2);
     free(v);
+    return ok;
+}
+
+/* Fig. 4.20: at each P and m, attractor or repeller (which way its orbits
+ * escape), as coloured marks; nothing beyond m_max. */
+static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double alpha,
+                       const char *params)
+{
+    const int np = a->sweep.n;
+    const size_t n = (size_t)np * (size_t)nm;
+    double *v = malloc(n * 2 * sizeof *v);
+    size_t *counts = calloc(5, sizeof *counts);
+    if (!v || !counts) {
+        free(v);
+        free(counts);
+        fprintf(stderr, "cellmap horseshoe: out of memory for the figure\n");
+        return false;
+    }
+    /* kinds: 0 attractor, 1 out, 2 in, 3 both, 4 beyond m_max; the marks
+     * sorted by kind, a series each */
+    size_t at[5] = {0}, fill[5] = {0};
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i < n; i++) {
+            const hs_item *it = &items[i];
+            const cm_pd_horseshoe *h = &it->h;
+            const bool out = h->escape[0] || h->escape[1], in = h->escape[2] || h->escape[3];
+            const int kind = h->m > cm_pd_m_max(alpha, it->P) ? 4 : out && in ? 3 : out ? 1 : in ? 2 : 0;
+            if (pass == 0) {
+                counts[kind]++;
+            } else {
+                const size_t k = at[kind] + fill[kind]++;
+                v[k] = it->P;
+                v[n + k] = (double)h->m;
+            }
+        }
+        for (int k = 1; pass == 0 && k < 5; k++)
+            at[k] = at[k - 1] + counts[k - 1];
+    }
+    const cm_rgb colours[5] = {{26, 152, 80}, {215, 48, 39}, {69, 117, 180}, {118, 42, 131},
+                               {200, 200, 200}};
+    cm_series series[5];
+    for (int k = 0; k < 5; k++)
+        series[k] = (cm_series){CM_SERIES_POINTS, v + at[k], v + n + at[k], counts[k], colours[k], 6};
+    char title[600];
+    snprintf(title, sizeof title,
+             "crisis chart: attractor (green), repeller escaping out (red), in (blue), both "
+             "(purple), beyond m_max (grey); %s",
+             params);
+    const cm_chart chart = {a->width,     a->height, {a->sweep.lo, (double)a->m0 - 0.5},
+                            {a->sweep.hi, (double)a->m1 + 0.5},
+                            "P",          "m",       title,  NULL,
+                            series,       5,         figure_font(), 0,
+                            NULL,         0};
+    char range[120];
+    param_axes_format(&a->sweep, 1, range, sizeof range);
+    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
+    const bool ok = write_chart_png("horseshoe", a->png, &chart, 1, texts, 3);
+    free(v);
+    free(counts);
     return ok;
 }
 
@@ -350,8 +417,9 @@ int cmd_horseshoe(int argc, char **argv)
     if (a.csv)
         ok = write_csv(&a, items, count);
     if (ok && a.png)
-        ok = a.has_sweep ? png_sweep(&a, items, nm, params)
-                         : png_point(&a, items, count, alpha, beta, P, D, params);
+        ok = a.crisis      ? png_crisis(&a, items, nm, alpha, params)
+             : a.has_sweep ? png_sweep(&a, items, nm, params)
+                           : png_point(&a, items, count, alpha, beta, P, D, params);
     free(items);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -247,6 +247,7 @@ expect_usage "--P: '1:0:5' is not LO:HI:N" stability --P 1:0:5
 expect_usage "implemented for microchaos-pd only" stability --model microchaos-1d
 expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
 expect_usage "domain '01'" partition --param a=1.5,b=0.6
+expect_usage "--crisis charts a sweep" horseshoe --crisis
 expect_usage "--sweep: 'D=1:2:3' is not P=LO:HI:K" horseshoe --sweep D=1:2:3
 for t in 1 2; do
   "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:8 --cells 2000 --ensemble 2000 --threads $t \

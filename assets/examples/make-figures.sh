@@ -129,6 +129,9 @@ done
 "$CM" horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --png fig-4.16-horseshoe.png --quiet
 "$CM" horseshoe --param alpha=0.77,beta=0.02,D=0.83 --m 2:5 --sweep P=0.6:0.75:150 \
   --png fig-4.17-entropy.png --quiet
+# Fig. 4.20: the crisis chart at alpha = 0.8, beta = 0.3, D = 0.6
+"$CM" horseshoe --param alpha=0.8,beta=0.3,D=0.6 --m 1:10 --sweep P=0.65:1.45:160 --periods 1 \
+  --crisis --png fig-4.20-crisis.png --quiet
 
 # Figs. 4.5 and 4.7: transient chaos of the 1-D friction map at b = 1.3,
 # |I0| = 0.25: the escape numbers across the domain at a = 1.5, and the mean
