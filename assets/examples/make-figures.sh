@@ -50,8 +50,9 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
   --cells 800x201 --max-steps 100000 --png fig-4.30-figure.png --layers all --size 1400x600 \
   > /dev/null
 
-# Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip
-"$CM" solve --model microchaos-1d --param a=3.5,b=2.8 --region=-4:4 --cells 800 \
+# Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip, out
+# to x_8* = 8.96 (regular) and x_9* = 10.08 (virtual: beyond 10)
+"$CM" solve --model microchaos-1d --param a=3.5,b=2.8 --region=-11:11 --cells 2200 \
   --png fig-4.2.png --layers all --size 800x800 > /dev/null
 
 # Ch. 2: the dry friction oscillator's Poincare map at S = 0.32, S0 = 0.4,
