@@ -65,6 +65,44 @@ static int fixed_points_delay(const cm_model *m, int64_t m0, int64_t m1, cm_fixe
     return 0;
 }
 
+/* The overlays of the view (thesis Fig. 4.9): the band borders x_{j-1} = m
+ * (switching lines: Int(x_{j-1}) changes there), the lines U_m, x_j = a
+ * x_{j-1} - b m, onto which band m maps in one step (the unstable
+ * manifolds of y_m*, the attractor's branches lie on them), and the fixed
+ * points y_m* (regular or virtual). */
+static void overlays_delay(const cm_model *m, const double lo[2], const double hi[2],
+                           cm_overlay_list *out)
+{
+    const delay_map *c = m->ctx;
+    const double k0 = floor(lo[0]), k1 = ceil(hi[0]);
+    if (!(k1 - k0 <= 2000)) /* too many lines to draw: none */
+        return;
+    const double up[2] = {0, 1}, along[2] = {1, c->a};
+    for (double k = k0; k <= k1; k++) {
+        const double border[2] = {k, 0}, on_u[2] = {0, -c->b * k};
+        if (k != 0)
+            cm_overlay_add_line(out, CM_OVERLAY_SWITCHING_LINE, border, up, lo, hi, NULL, 0, 0);
+        cm_overlay_add_line(out, CM_OVERLAY_UNSTABLE_MANIFOLD, on_u, along, lo, hi, NULL, 0, 0);
+    }
+    if (c->a == 1.0)
+        return;
+    /* fixed points whose x = m b/(a - 1) lies in the view */
+    const double per = c->b / (c->a - 1.0);
+    if (per == 0 || !isfinite(per))
+        return;
+    double m0 = ceil(fmin(lo[0] / per, hi[0] / per)), m1 = floor(fmax(lo[0] / per, hi[0] / per));
+    if (m1 - m0 > 2000)
+        return;
+    for (double k = m0; k <= m1; k++) {
+        const double x = k * per, p[2] = {x, x};
+        double band;
+        const bool regular = cm_int_part(x, &band) && band == k;
+        if (cm_overlay_in_view(p, lo, hi))
+            cm_overlay_add(out, regular ? CM_OVERLAY_FIXED_REGULAR : CM_OVERLAY_FIXED_VIRTUAL, p,
+                           p);
+    }
+}
+
 cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
 {
     cm_status st = cm_model_setup(m, "microchaos-delay", 2, p, sizeof(delay_map), msg, msg_size);
@@ -76,5 +114,6 @@ cm_status cm_microchaos_delay_create(const cm_params *p, cm_model *m, char *msg,
     m->step = step_delay;
     m->step_n = step_n_delay;
     m->fixed_points = fixed_points_delay;
+    m->overlays = overlays_delay;
     return CM_OK;
 }

@@ -433,6 +433,32 @@ static void friction_and_delay_fixed_points(void)
         CHECK_NEAR(fp[i].x[0], 1.2 * (double)fp[i].level, 1e-14);
         CHECK_INT(fp[i].regular, fp[i].level <= 4);
     }
+    /* its overlays on [0, 6]^2 (Fig. 4.9): the band borders x = 1..6, the
+     * lines U_0..U_6 where they cross the view, each on x_j = a x - b m,
+     * and the fixed points y_0*..y_5* (y_5* = (6, 6) lies on the corner) */
+    cm_overlay items[64];
+    cm_overlay_list ov = {items, 64, 0, false};
+    md.overlays(&md, (const double[2]){0, 0}, (const double[2]){6, 6}, &ov);
+    CHECK(!ov.truncated);
+    int borders = 0, lines = 0, points = 0;
+    for (size_t i = 0; i < ov.count; i++) {
+        const cm_overlay *o = &items[i];
+        if (o->kind == CM_OVERLAY_SWITCHING_LINE) {
+            borders++;
+            CHECK(o->a[0] == o->b[0] && o->a[0] == round(o->a[0]));
+        } else if (o->kind == CM_OVERLAY_UNSTABLE_MANIFOLD) {
+            lines++;
+            const double m = (1.5 * o->a[0] - o->a[1]) / 0.6; /* x_j = a x - b m at both ends */
+            CHECK(fabs(m - round(m)) < 1e-12 && fabs(1.5 * o->b[0] - 0.6 * round(m) - o->b[1]) < 1e-12);
+        } else {
+            points++;
+            CHECK(o->a[0] == o->a[1]);
+            CHECK_INT(o->kind == CM_OVERLAY_FIXED_REGULAR, round(o->a[0] / 1.2) <= 4);
+        }
+    }
+    CHECK_INT(borders, 6);
+    CHECK(lines >= 6);
+    CHECK_INT(points, 6);
     cm_model_release(&md);
 }
 

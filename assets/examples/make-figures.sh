@@ -121,6 +121,11 @@ done
 "$CM" stability --param alpha=1.8,beta=0.3,P=3.5,D=1 --P 3.3:6:540 --png fig-4.14-stability.png \
   --quiet
 
+# Fig. 4.9: the delay map's basins at a = 1.5, b = 0.6, with its band borders,
+# the lines U_m its attractor's branches lie on, and the fixed points
+"$CM" solve --model microchaos-delay --param a=1.5,b=0.6 --region=0:6,0:6 --cells 600x600 \
+  --png fig-4.9.png --layers all --size 800x700 > /dev/null
+
 # Fig. 4.11: the delay map's attractor partitioned (a = 1.3, b = 0.66)
 "$CM" partition --param a=1.3,b=0.66 --png fig-4.11-partition.png --quiet
 
