@@ -39,8 +39,8 @@ static void transitions(cm_delay_partition *p)
 static void primitivity(cm_delay_partition *p)
 {
     const int r = p->r;
-    unsigned char Q[CM_DELAY_MAX_REGIONS][CM_DELAY_MAX_REGIONS], R[CM_DELAY_MAX_REGIONS][CM_DELAY_MAX_REGIONS];
-    unsigned char reach[CM_DELAY_MAX_REGIONS][CM_DELAY_MAX_REGIONS];
+    typedef unsigned char matrix[CM_DELAY_MAX_REGIONS][CM_DELAY_MAX_REGIONS];
+    matrix Q, R, reach;
     memcpy(Q, p->P, sizeof Q);
     memcpy(reach, p->P, sizeof reach);
     p->primitive_index = 0;

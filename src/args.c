@@ -203,6 +203,30 @@ bool parse_counts(const char *s, int64_t *v, int *count, int max)
     return n > 0;
 }
 
+bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *error)
+{
+    if (cli_is(c, "--csv", true, error))
+        o->csv = c->value;
+    else if (cli_is(c, "--png", true, error))
+        o->png = c->value;
+    else if (cli_is(c, "--json", false, error))
+        o->json = true;
+    else if (cli_is(c, "--quiet", false, error))
+        o->quiet = true;
+    else
+        return cli_take_size(c, min_w, min_h, 4096, &o->width, &o->height, error);
+    return true;
+}
+
+int chart_outputs_check(const cli *c, const chart_outputs *o)
+{
+    if (o->json && (cm_output_names_stdout(o->csv) || cm_output_names_stdout(o->png)))
+        return cli_usage_error(c, "--json and an output to standard output: choose one");
+    if (cm_output_names_stdout(o->csv) && cm_output_names_stdout(o->png))
+        return cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    return 0;
+}
+
 bool parse_doubles(const char *s, double *v, int *count, int max)
 {
     const int n = parse_pieces(s, ',', max, v, parse_one_double);

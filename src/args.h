@@ -47,6 +47,21 @@ bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error
 /* Handles --size WxH with W in min_w..max_side and H in min_h..max_side;
  * true if the current option was it. */
 bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error);
+
+/* The outputs of the analysis commands (escape, stability, horseshoe,
+ * partition): --csv FILE|-, --png FILE|-, --json, --quiet, --size WxH. */
+typedef struct chart_outputs {
+    const char *csv, *png;
+    bool json, quiet;
+    int width, height;
+} chart_outputs;
+
+/* Takes the current option if it is one of those (--size at least min_w x
+ * min_h); true if it was. */
+bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *error);
+/* After the options: --json and a table or image on standard output, or
+ * both on it, are usage errors. Returns 0 or the error's status. */
+int chart_outputs_check(const cli *c, const chart_outputs *o);
 /* The limits of --max-steps and --threads, which several commands take. */
 enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
 /* "LO:HI,LO:HI,..." -> lo[], hi[], count. */

@@ -61,11 +61,10 @@ enum { SEED = 20260412, MAX_PARTITION = 1000000 };
 typedef struct esc_args {
     model_opts mo;
     param_axis sweep;
-    int has_sweep, has_I0, threads, width, height;
+    int has_sweep, has_I0, threads;
     double I0;
     long cells, ensemble;
-    const char *csv, *png;
-    bool json, quiet;
+    chart_outputs out;
 } esc_args;
 
 /* Everything at one parameter point. */
@@ -115,25 +114,15 @@ static int parse_args(cli *c, esc_args *a)
             else if (c->value)
                 a->ensemble = (long)v;
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
     if (!err && a->has_sweep && strcmp(a->sweep.name, "I0") == 0 && a->has_I0)
         err = cli_usage_error(c, "--sweep I0=... and --I0: choose one");
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
-        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     return err;
 }
 
@@ -187,7 +176,8 @@ static bool point_model(const esc_args *a, int i, cm_model *m, char *why, size_t
     if (!has_I0)
         return true;
     /* c from |I0| at this point's a and b */
-    const double c = cm_te_c_of_I0(cm_params_get(&m->values, "a"), cm_params_get(&m->values, "b"), I0);
+    const double c =
+        cm_te_c_of_I0(cm_params_get(&m->values, "a"), cm_params_get(&m->values, "b"), I0);
     names[n] = "c";
     values[n++] = c;
     cm_model_release(m);
@@ -222,7 +212,7 @@ static int points_of(const esc_args *a)
 static bool write_csv(const esc_args *a, const esc_point *pts)
 {
     outfile o;
-    if (!outfile_open("escape", a->csv, &o))
+    if (!outfile_open("escape", a->out.csv, &o))
         return false;
     fprintf(o.f, "a,b,c,I0,valid,x0,rep_len,F,a_crit,border,D0_C1,D0_C2,kappa_C1,kappa_C2,"
                  "n_esc_C1,n_esc_C2,exact_mean,partition,ensemble_kappa,ensemble_mean,"
@@ -249,7 +239,7 @@ static bool write_csv(const esc_args *a, const esc_point *pts)
 static bool png_structure(const esc_args *a, const esc_point *p, const char *params)
 {
     const cm_te *t = &p->t;
-    const int n = 4 * a->width;
+    const int n = 4 * a->out.width;
     const double hi = 1.05 * t->rep_hi;
     double *x = malloc((size_t)n * 2 * sizeof *x);
     if (!x) {
@@ -278,10 +268,10 @@ static bool png_structure(const esc_args *a, const esc_point *p, const char *par
     snprintf(title, sizeof title,
              "escape numbers (steps to fall below x0*); I0 and x = 1 blue, I_rep red; %s",
              params);
-    const cm_chart chart = {a->width, a->height, {0, 0},  {hi, top + 1}, "x", "escape number",
+    const cm_chart chart = {a->out.width, a->out.height, {0, 0},  {hi, top + 1}, "x", "escape number",
                             title,    NULL,      series, 4,            figure_font(), 0, NULL, 0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    const bool ok = write_chart_png("escape", a->png, &chart, 1, texts, 2);
+    const bool ok = write_chart_png("escape", a->out.png, &chart, 1, texts, 2);
     free(x);
     return ok;
 }
@@ -312,8 +302,10 @@ static bool png_sweep(const esc_args *a, const esc_point *pts, const char *param
     const cm_rgb blue = {69, 117, 180}, purple = {118, 42, 131}, black = {0, 0, 0},
                  green = {26, 152, 80}, orange = {244, 109, 67};
     const cm_series series[] = {
-        {CM_SERIES_LINE, xs, hi, (size_t)n, blue, 2},   {CM_SERIES_LINE, xs, lo, (size_t)n, purple, 2},
-        {CM_SERIES_LINE, xs, exact, (size_t)n, black, 2}, {CM_SERIES_POINTS, xs, ens, (size_t)n, green, 5},
+        {CM_SERIES_LINE, xs, hi, (size_t)n, blue, 2},
+        {CM_SERIES_LINE, xs, lo, (size_t)n, purple, 2},
+        {CM_SERIES_LINE, xs, exact, (size_t)n, black, 2},
+        {CM_SERIES_POINTS, xs, ens, (size_t)n, green, 5},
         {CM_SERIES_POINTS, xs, scm, (size_t)n, orange, 3},
     };
     char title[600];
@@ -321,8 +313,8 @@ static bool png_sweep(const esc_args *a, const esc_point *pts, const char *param
              "mean escape number: (4.3) from kappa of D0 with C1 (blue), C2 (purple) and of an "
              "ensemble (green); exact (black); cell mapping (orange); %s",
              params);
-    const cm_chart chart = {a->width,
-                            a->height,
+    const cm_chart chart = {a->out.width,
+                            a->out.height,
                             {a->sweep.lo, 0},
                             {a->sweep.hi, 1.1 * top},
                             a->sweep.name,
@@ -338,7 +330,7 @@ static bool png_sweep(const esc_args *a, const esc_point *pts, const char *param
     char range[120];
     param_axes_format(&a->sweep, 1, range, sizeof range);
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
-    const bool ok = write_chart_png("escape", a->png, &chart, 1, texts, 3);
+    const bool ok = write_chart_png("escape", a->out.png, &chart, 1, texts, 3);
     free(v);
     return ok;
 }
@@ -406,11 +398,11 @@ int cmd_escape(int argc, char **argv)
 {
     cli c = {"escape", argc, argv, 0, NULL, NULL};
     esc_args a = {.mo = {.name = "microchaos-1d-friction"}, .cells = 100000,
-                  .ensemble = 1000000, .width = 1000, .height = 600};
+                  .ensemble = 1000000, .out = {.width = 1000, .height = 600}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("escape", a.csv) || !chart_png_check("escape", a.png))
+    if (!outfile_check("escape", a.out.csv) || !chart_png_check("escape", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     param_axis none = {0};
@@ -443,7 +435,7 @@ int cmd_escape(int argc, char **argv)
         const size_t used = strlen(params);
         snprintf(params + used, sizeof params - used, "%s|I0|=%s", used ? "," : "", CM_NUM(a.I0));
     }
-    if (a.json) {
+    if (a.out.json) {
         json j;
         json_begin(&j, stdout, "escape");
         param_base_json(&j, a.mo.name, &base);
@@ -458,8 +450,8 @@ int cmd_escape(int argc, char **argv)
             json_point(&j, &pts[i]);
         json_array_end(&j);
         json_end(&j);
-    } else if (!a.quiet) {
-        FILE *f = report_stream(a.csv, a.png, NULL);
+    } else if (!a.out.quiet) {
+        FILE *f = report_stream(a.out.csv, a.out.png, NULL);
         if (a.has_sweep)
             fprintf(f, "%d points, %d in the case of 4.3 (one positive fixed point in I_rep)\n", n,
                     valid);
@@ -467,9 +459,9 @@ int cmd_escape(int argc, char **argv)
             print_point(f, &a, &pts[0]);
     }
     bool ok = true;
-    if (a.csv)
+    if (a.out.csv)
         ok = write_csv(&a, pts);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = a.has_sweep ? png_sweep(&a, pts, params) : png_structure(&a, &pts[0], params);
     free(pts);
     return ok ? EXIT_OK : EXIT_FAIL;

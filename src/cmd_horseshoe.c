@@ -50,10 +50,9 @@ static const char horseshoe_help[] =
 typedef struct hs_args {
     model_opts mo;
     int64_t m0, m1;
-    int has_m, periods, has_sweep, crisis, width, height;
+    int has_m, periods, has_sweep, crisis;
     param_axis sweep;
-    const char *csv, *png;
-    bool json, quiet;
+    chart_outputs out;
 } hs_args;
 
 static int parse_args(cli *c, hs_args *a)
@@ -85,23 +84,13 @@ static int parse_args(cli *c, hs_args *a)
                                          "1 <= K <= 10000",
                                       c->value);
             a->has_sweep = 1;
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
-        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     if (!err && a->crisis && !a->has_sweep)
         err = cli_usage_error(c, "--crisis charts a sweep: give --sweep P=LO:HI:K too");
     return err;
@@ -126,7 +115,7 @@ static void item_at(double alpha, double beta, double P, double D, int64_t m, in
 static bool write_csv(const hs_args *a, const hs_item *items, int count)
 {
     outfile o;
-    if (!outfile_open("horseshoe", a->csv, &o))
+    if (!outfile_open("horseshoe", a->out.csv, &o))
         return false;
     fprintf(o.f, "P,m,RULS_x,RULS_v,LURS_x,LURS_v,RUSW_x,RUSW_v,LUSW_x,LUSW_v,"
                  "escape_l_LUSW,escape_l_RUSW,escape_r_LUSW,escape_r_RUSW,kind,full_shift,"
@@ -208,8 +197,8 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
     snprintf(title, sizeof title,
              "horseshoes: L (red), R (blue), f_l(L) and f_r(R) (light) at SW_%lld..%lld; %s",
              (long long)items[0].h.m, (long long)items[count - 1].h.m, params);
-    const cm_chart chart = {a->width,
-                            a->height,
+    const cm_chart chart = {a->out.width,
+                            a->out.height,
                             {lo[0] - pad[0], lo[1] - pad[1]},
                             {hi[0] + pad[0], hi[1] + pad[1]},
                             "x",
@@ -223,7 +212,7 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
                             NULL,
                             0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    const bool ok = write_chart_png("horseshoe", a->png, &chart, 1, texts, 2);
+    const bool ok = write_chart_png("horseshoe", a->out.png, &chart, 1, texts, 2);
     free(v);
     return ok;
 }
@@ -251,7 +240,11 @@ static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double al
             const hs_item *it = &items[i];
             const cm_pd_horseshoe *h = &it->h;
             const bool out = h->escape[0] || h->escape[1], in = h->escape[2] || h->escape[3];
-            const int kind = h->m > cm_pd_m_max(alpha, it->P) ? 4 : out && in ? 3 : out ? 1 : in ? 2 : 0;
+            const int kind = h->m > cm_pd_m_max(alpha, it->P) ? 4
+                             : out && in                        ? 3
+                             : out                              ? 1
+                             : in                               ? 2
+                                                                : 0;
             if (pass == 0) {
                 counts[kind]++;
             } else {
@@ -273,7 +266,7 @@ static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double al
              "crisis chart: attractor (green), repeller escaping out (red), in (blue), both "
              "(purple), beyond m_max (grey); %s",
              params);
-    const cm_chart chart = {a->width,     a->height, {a->sweep.lo, (double)a->m0 - 0.5},
+    const cm_chart chart = {a->out.width,     a->out.height, {a->sweep.lo, (double)a->m0 - 0.5},
                             {a->sweep.hi, (double)a->m1 + 0.5},
                             "P",          "m",       title,  NULL,
                             series,       5,         figure_font(), 0,
@@ -281,7 +274,7 @@ static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double al
     char range[120];
     param_axes_format(&a->sweep, 1, range, sizeof range);
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
-    const bool ok = write_chart_png("horseshoe", a->png, &chart, 1, texts, 3);
+    const bool ok = write_chart_png("horseshoe", a->out.png, &chart, 1, texts, 3);
     free(v);
     free(counts);
     return ok;
@@ -314,14 +307,14 @@ static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char
              "topological entropy, lower estimate log(N_%d)/%d, at SW_%lld..%lld (colours in "
              "order: red, blue, green, purple, orange, black); %s",
              a->periods, a->periods, (long long)a->m0, (long long)a->m1, params);
-    const cm_chart chart = {a->width,     a->height, {a->sweep.lo, 0}, {a->sweep.hi, 0.8},
+    const cm_chart chart = {a->out.width,     a->out.height, {a->sweep.lo, 0}, {a->sweep.hi, 0.8},
                             "P",          "h",       title,            NULL,
                             series,       shown,     figure_font(),    0,
                             NULL,         0};
     char range[120];
     param_axes_format(&a->sweep, 1, range, sizeof range);
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
-    const bool ok = write_chart_png("horseshoe", a->png, &chart, 1, texts, 3);
+    const bool ok = write_chart_png("horseshoe", a->out.png, &chart, 1, texts, 3);
     free(v);
     return ok;
 }
@@ -339,11 +332,13 @@ static void print_item(FILE *f, const hs_args *a, const hs_item *it)
 int cmd_horseshoe(int argc, char **argv)
 {
     cli c = {"horseshoe", argc, argv, 0, NULL, NULL};
-    hs_args a = {.mo = {.name = "microchaos-pd"}, .periods = 12, .width = 1000, .height = 600};
+    hs_args a = {.mo = {.name = "microchaos-pd"},
+                 .periods = 12,
+                 .out = {.width = 1000, .height = 600}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("horseshoe", a.csv) || !chart_png_check("horseshoe", a.png))
+    if (!outfile_check("horseshoe", a.out.csv) || !chart_png_check("horseshoe", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr =
@@ -376,7 +371,7 @@ int cmd_horseshoe(int argc, char **argv)
     char params[400];
     const char *const skip[] = {a.has_sweep ? "P" : "", NULL};
     cm_params_format_with(&base, skip, params, sizeof params);
-    if (a.json) {
+    if (a.out.json) {
         json j;
         json_begin(&j, stdout, "horseshoe");
         param_base_json(&j, a.mo.name, &base);
@@ -405,8 +400,8 @@ int cmd_horseshoe(int argc, char **argv)
         }
         json_array_end(&j);
         json_end(&j);
-    } else if (!a.quiet) {
-        FILE *f = report_stream(a.csv, a.png, NULL);
+    } else if (!a.out.quiet) {
+        FILE *f = report_stream(a.out.csv, a.out.png, NULL);
         if (a.has_sweep)
             fprintf(f, "%d values of P at SW_%lld..%lld\n", np, (long long)a.m0, (long long)a.m1);
         else
@@ -414,9 +409,9 @@ int cmd_horseshoe(int argc, char **argv)
                 print_item(f, &a, &items[i]);
     }
     bool ok = true;
-    if (a.csv)
+    if (a.out.csv)
         ok = write_csv(&a, items, count);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = a.crisis      ? png_crisis(&a, items, nm, alpha, params)
              : a.has_sweep ? png_sweep(&a, items, nm, params)
                            : png_point(&a, items, count, alpha, beta, P, D, params);

@@ -35,8 +35,7 @@ static const char partition_help[] =
 typedef struct part_args {
     model_opts mo;
     int width, height;
-    const char *csv, *png;
-    bool json, quiet;
+    chart_outputs out;
 } part_args;
 
 static int parse_args(cli *c, part_args *a)
@@ -47,23 +46,13 @@ static int parse_args(cli *c, part_args *a)
             fputs(partition_help, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
-        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     return err;
 }
 
@@ -77,7 +66,7 @@ static void row_text(const cm_delay_partition *p, int i, char *out)
 static bool write_csv(const part_args *a, const cm_delay_partition *p)
 {
     outfile o;
-    if (!outfile_open("partition", a->csv, &o))
+    if (!outfile_open("partition", a->out.csv, &o))
         return false;
     fprintf(o.f, "region,branch,lo,hi,row\n");
     char row[CM_DELAY_MAX_REGIONS + 1];
@@ -115,8 +104,8 @@ static bool write_png(const part_args *a, const cm_delay_partition *p, const cha
     snprintf(title, sizeof title,
              "partition I_1..I_%d (alternating colours), x_(j-1) = 1 grey; %s",
              p->r, params);
-    const cm_chart chart = {a->width,
-                            a->height,
+    const cm_chart chart = {a->out.width,
+                            a->out.height,
                             {p->x_l - 0.1, bottom - 0.1},
                             {p->x_r + 0.1, top + 0.1},
                             "x_(j-1)",
@@ -130,17 +119,17 @@ static bool write_png(const part_args *a, const cm_delay_partition *p, const cha
                             NULL,
                             0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    return write_chart_png("partition", a->png, &chart, 1, texts, 2);
+    return write_chart_png("partition", a->out.png, &chart, 1, texts, 2);
 }
 
 int cmd_partition(int argc, char **argv)
 {
     cli c = {"partition", argc, argv, 0, NULL, NULL};
-    part_args a = {.mo = {.name = "microchaos-delay"}, .width = 900, .height = 700};
+    part_args a = {.mo = {.name = "microchaos-delay"}, .out = {.width = 900, .height = 700}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("partition", a.csv) || !chart_png_check("partition", a.png))
+    if (!outfile_check("partition", a.out.csv) || !chart_png_check("partition", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-delay", NULL, 0, &base);
@@ -155,7 +144,7 @@ int cmd_partition(int argc, char **argv)
     }
     char params[400], row[CM_DELAY_MAX_REGIONS + 1];
     cm_params_format(&base, params, sizeof params);
-    if (a.json) {
+    if (a.out.json) {
         json j;
         json_begin(&j, stdout, "partition");
         param_base_json(&j, a.mo.name, &base);
@@ -173,8 +162,8 @@ int cmd_partition(int argc, char **argv)
         json_bool(&j, "irreducible", p.irreducible);
         json_int(&j, "primitive_index", p.primitive_index);
         json_end(&j);
-    } else if (!a.quiet) {
-        FILE *f = report_stream(a.csv, a.png, NULL);
+    } else if (!a.out.quiet) {
+        FILE *f = report_stream(a.out.csv, a.out.png, NULL);
         fprintf(f, "%d regions on the branches x_j = a x_(j-1) (upper) and a x_(j-1) - b "
                    "(lower), x_(j-1) in (%.9g, %.9g):\n",
                 p.r, p.x_l, p.x_r);
@@ -191,9 +180,9 @@ int cmd_partition(int argc, char **argv)
             fprintf(f, "%s, not primitive\n", p.irreducible ? "irreducible" : "not irreducible");
     }
     bool ok = true;
-    if (a.csv)
+    if (a.out.csv)
         ok = write_csv(&a, &p);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = write_png(&a, &p, params);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -48,9 +48,8 @@ static const char stability_help[] =
 typedef struct stab_args {
     model_opts mo;
     param_axis P, alpha;
-    int has_P, has_alpha, width, height;
-    const char *csv, *png;
-    bool json, quiet;
+    int has_P, has_alpha;
+    chart_outputs out;
 } stab_args;
 
 static int take_axis(cli *c, const char *opt, const char *name, param_axis *ax, int *has,
@@ -80,23 +79,13 @@ static int parse_args(cli *c, stab_args *a)
         } else if (take_axis(c, "--alpha", "alpha", &a->alpha, &a->has_alpha, &err)) {
             if (!err && a->alpha.lo <= 0)
                 err = cli_usage_error(c, "--alpha: alpha must be positive");
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 450, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
-        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     return err;
 }
 
@@ -128,7 +117,7 @@ static double n_fixed(const stab_row *r)
 static bool write_csv(const stab_args *a, const stab_row *rows)
 {
     outfile o;
-    if (!outfile_open("stability", a->csv, &o))
+    if (!outfile_open("stability", a->out.csv, &o))
         return false;
     fprintf(o.f, "P,D_b1,D_b0,D_1,D_0,D_c_minus,D_c_plus,m_fix_max,n_fixed,m_max,x_max_sw,x_max\n");
     for (int i = 0; i < a->P.n; i++) {
@@ -147,8 +136,8 @@ static cm_chart chart_of(const stab_args *a, int k, double xlo, double xhi, doub
                          double yhi, const char *x_name, const char *y_name, const char *title,
                          const cm_series *series, int n_series)
 {
-    const int h = a->height / CHARTS;
-    return (cm_chart){a->width,  k < CHARTS - 1 ? h : a->height - (CHARTS - 1) * h,
+    const int h = a->out.height / CHARTS;
+    return (cm_chart){a->out.width,  k < CHARTS - 1 ? h : a->out.height - (CHARTS - 1) * h,
                       {xlo, ylo}, {xhi, yhi},
                       x_name,    y_name,
                       title,     NULL,
@@ -252,7 +241,7 @@ static bool write_png(const stab_args *a, const cm_params *p, const stab_row *ro
                  fewest, 1),
     };
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    const bool ok = write_chart_png("stability", a->png, charts, CHARTS, texts, 2);
+    const bool ok = write_chart_png("stability", a->out.png, charts, CHARTS, texts, 2);
     free(v);
     return ok;
 }
@@ -314,11 +303,11 @@ static void print_json(const stab_args *a, const cm_params *p, double alpha, dou
 int cmd_stability(int argc, char **argv)
 {
     cli c = {"stability", argc, argv, 0, NULL, NULL};
-    stab_args a = {.mo = {.name = "microchaos-pd"}, .width = 900, .height = 1200};
+    stab_args a = {.mo = {.name = "microchaos-pd"}, .out = {.width = 900, .height = 1200}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("stability", a.csv) || !chart_png_check("stability", a.png))
+    if (!outfile_check("stability", a.out.csv) || !chart_png_check("stability", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-pd", NULL, 0, &base);
@@ -342,14 +331,14 @@ int cmd_stability(int argc, char **argv)
     }
     for (int i = 0; i < a.P.n; i++)
         row_at(alpha, beta, param_axis_value(&a.P, i), D, &rows[i]);
-    if (a.json)
+    if (a.out.json)
         print_json(&a, &base, alpha, beta, P, D);
-    else if (!a.quiet)
-        print_summary(report_stream(a.csv, a.png, NULL), alpha, beta, P, D);
+    else if (!a.out.quiet)
+        print_summary(report_stream(a.out.csv, a.out.png, NULL), alpha, beta, P, D);
     bool ok = true;
-    if (a.csv)
+    if (a.out.csv)
         ok = write_csv(&a, rows);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = write_png(&a, &base, rows, alpha, beta, P, D);
     free(rows);
     return ok ? EXIT_OK : EXIT_FAIL;
