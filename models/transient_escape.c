@@ -1,5 +1,5 @@
 /* models/transient_escape.c - the transient chaos of the 1-D micro-chaos
- * map with Coulomb friction (thesis 4.3). docs/models.md 4.3. */
+ * map with Coulomb friction (thesis 4.3). docs/models.md 4.1. */
 #include "models/transient_escape.h"
 
 #include <math.h>

@@ -1,5 +1,5 @@
 /* models/transient_escape.h - the transient chaos of the 1-D micro-chaos
- * map with Coulomb friction (thesis 4.3, docs/models.md 4.3):
+ * map with Coulomb friction (thesis 4.3, docs/models.md 4.1):
  *
  *     f(x) = a x - b Int(x) - c  (x > c/a),  0 on the dead zone,  (4.23)
  *

@@ -24,7 +24,7 @@ static const char escape_help[] =
     "                      [--sweep NAME=LO:HI:N] [--cells N] [--ensemble M] [--csv FILE|-]\n"
     "                      [--png FILE] [--size WxH] [--json] [--quiet] [--threads T]\n\n"
     "The transient chaos of the 1-D micro-chaos map with Coulomb friction (4.23)\n"
-    "(thesis 4.3, docs/models.md 4.3), where it has one positive fixed point x0* in\n"
+    "(thesis 4.3, docs/models.md 4.1), where it has one positive fixed point x0* in\n"
     "its repeller's interval I_rep = [x0*, a - c]. A point escapes when an iterate\n"
     "falls below x0*; its escape number is the steps that takes. The mean escape\n"
     "number over I_rep, four ways:\n"
