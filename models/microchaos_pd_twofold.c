@@ -62,6 +62,57 @@ static int fixed_points_twofold(const cm_model *m, int64_t m0, int64_t m1, cm_fi
     return 0;
 }
 
+/* The control level of the input tile (i, k): x in [i rho, (i+1) rho), x'
+ * in [k rho, (k+1) rho) (Int rounds towards zero, so the tiles are
+ * numbered by Int of the tile's centre). */
+static bool tile_level(const twofold_map *c, double i, double k, double *u)
+{
+    const double centre[2] = {(i + 0.5) * c->rho, (k + 0.5) * c->rho};
+    return twofold_control(c, centre, u);
+}
+
+/* The overlays of the view (thesis Figs. 4.33-4.36): the stair-shaped
+ * switching lines, the edges of the input tiles (rho x rho) across which
+ * the control level changes, and the fixed points with the PD map's
+ * manifolds. Tiles finer than the view can show (more than 400 across)
+ * give no stairs. */
+static void overlays_twofold(const cm_model *m, const double lo[2], const double hi[2],
+                             cm_overlay_list *out)
+{
+    const twofold_map *c = m->ctx;
+    const double i0 = floor(lo[0] / c->rho) - 1, i1 = ceil(hi[0] / c->rho),
+                 k0 = floor(lo[1] / c->rho) - 1, k1 = ceil(hi[1] / c->rho);
+    if (i1 - i0 <= 400 && k1 - k0 <= 400) {
+        for (double i = i0; i <= i1; i++)
+            for (double k = k0; k <= k1; k++) {
+                double u, right, above;
+                if (!tile_level(c, i, k, &u))
+                    continue;
+                /* the tile's right and upper edges, where the neighbour differs */
+                const double x = (i + 1) * c->rho, v = (k + 1) * c->rho;
+                const double edges[2][4] = {{x, k * c->rho, x, v}, {i * c->rho, v, x, v}};
+                const bool differs[2] = {tile_level(c, i + 1, k, &right) && right != u,
+                                         tile_level(c, i, k + 1, &above) && above != u};
+                for (int e = 0; e < 2; e++) {
+                    const double a[2] = {edges[e][0], edges[e][1]}, b[2] = {edges[e][2], edges[e][3]};
+                    if (differs[e] && (cm_overlay_in_view(a, lo, hi) || cm_overlay_in_view(b, lo, hi)))
+                        cm_overlay_add(out, CM_OVERLAY_SWITCHING_LINE, a, b);
+                }
+            }
+    }
+    /* the fixed points x* = [u/alpha^2, 0], regular where the control law
+     * there gives u */
+    const double u0 = ceil(lo[0] * c->alpha2), u1 = floor(hi[0] * c->alpha2);
+    if (lo[1] > 0 || hi[1] < 0 || u1 - u0 > 2000)
+        return;
+    for (double k = u0; k <= u1; k++) {
+        const double p[2] = {k / c->alpha2, 0};
+        double u;
+        const bool regular = twofold_control(c, p, &u) && u == k;
+        cm_overlay_add(out, regular ? CM_OVERLAY_FIXED_REGULAR : CM_OVERLAY_FIXED_VIRTUAL, p, p);
+    }
+}
+
 cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char *msg,
                                           size_t msg_size)
 {
@@ -78,5 +129,7 @@ cm_status cm_microchaos_pd_twofold_create(const cm_params *p, cm_model *m, char 
         k.alpha * k.alpha};
     m->step = step_twofold;
     m->fixed_points = fixed_points_twofold;
+    m->overlays = overlays_twofold;
+    m->coord_names = cm_pd_coord_names; /* the pendulum's x, v, as docs/models.md lists them */
     return CM_OK;
 }

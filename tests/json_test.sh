@@ -77,6 +77,7 @@ assert len(e["extension"]["steps"]) == 2 and e["box"] == [[-500, 1000], [-40, 40
 assert any(g["kind"] == "sticking" for g in load("solve-friction")["groups"])
 m = {x["name"]: x for x in load("models")["models"]}
 assert m["microchaos-delay"]["state"] == ["x_lag1", "x"] and m["friction-oscillator"]["state"] == ["x", "v"]
+assert m["microchaos-pd-twofold"]["state"] == ["x", "v"], m["microchaos-pd-twofold"]
 sw = load("sweep")
 assert [p["value"] for p in sw["points"]] == sorted(p["value"] for p in sw["points"])
 o = load("orbit")

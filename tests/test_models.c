@@ -460,6 +460,40 @@ static void friction_and_delay_fixed_points(void)
     CHECK(lines >= 6);
     CHECK_INT(points, 6);
     cm_model_release(&md);
+    /* twofold quantisation (Figs. 4.33-4.36): each stair of the switching
+     * lines is an edge of the rho x rho input tiles, and the control level
+     * (read off one step of the map) differs on its two sides */
+    const double rho = 0.7;
+    cm_model mt = make("microchaos-pd-twofold", "alpha=0.8,beta=0.3,P=0.9,D=0.4,rho=0.7");
+    CHECK(strcmp(cm_model_coord_name(&mt, 1), "v") == 0);
+    cm_pd_coef k;
+    cm_pd_coefficients(0.8, 0.3, 0.9, 0.4, &k);
+    cm_overlay stairs[4096];
+    cm_overlay_list st = {stairs, 4096, 0, false};
+    mt.overlays(&mt, (const double[2]){-6, -3}, (const double[2]){6, 3}, &st);
+    CHECK(!st.truncated);
+    int edges = 0;
+    for (size_t i = 0; i < st.count; i++) {
+        const cm_overlay *o = &stairs[i];
+        if (o->kind != CM_OVERLAY_SWITCHING_LINE)
+            continue;
+        edges++;
+        const bool vertical = o->a[0] == o->b[0];
+        CHECK(vertical || o->a[1] == o->b[1]);
+        CHECK(fabs(fabs(o->b[0] - o->a[0]) + fabs(o->b[1] - o->a[1]) - rho) < 1e-12);
+        const double mid[2] = {0.5 * (o->a[0] + o->b[0]), 0.5 * (o->a[1] + o->b[1])};
+        double level[2];
+        for (int side = 0; side < 2; side++) {
+            const double e = side ? 1e-6 : -1e-6;
+            const double x[2] = {mid[0] + (vertical ? e : 0), mid[1] + (vertical ? 0 : e)};
+            double y[2];
+            CHECK_INT(mt.step(&mt, x, y), 0);
+            level[side] = (y[1] - k.A[2] * x[0] - k.A[3] * x[1]) / k.b[1];
+        }
+        CHECK(fabs(level[0] - level[1]) > 0.5);
+    }
+    CHECK(edges > 20);
+    cm_model_release(&mt);
 }
 
 static void parameter_errors(void)

@@ -126,6 +126,12 @@ done
 "$CM" solve --model microchaos-delay --param a=1.5,b=0.6 --region=0:6,0:6 --cells 600x600 \
   --png fig-4.9.png --layers all --size 800x700 > /dev/null
 
+# Fig. 4.33 (right): twofold quantisation, the stair-shaped switching lines of
+# the rho x rho input tiles over the basins (Fig. 4.13's gains, rho = 0.7)
+"$CM" solve --model microchaos-pd-twofold --param alpha=0.8,beta=0.3,P=0.9,D=0.4,rho=0.7 \
+  --region=-6:6,-3:3 --cells 600x300 --png fig-4.33-twofold.png --layers all --size 1000x560 \
+  > /dev/null
+
 # Fig. 4.11: the delay map's attractor partitioned (a = 1.3, b = 0.66)
 "$CM" partition --param a=1.3,b=0.66 --png fig-4.11-partition.png --quiet
 
