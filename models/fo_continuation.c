@@ -432,6 +432,25 @@ static bool describe(const branch *b, const double u[3], const double *prev_t, d
     return true;
 }
 
+/* The direction, at the state `at` a time s later, of the tangent of
+ * point pt: a point a little along the tangent carried there as pt itself
+ * was; false if it is lost. */
+static bool carried_along(const branch *b, const point *pt, double s, const double at[2],
+                          double along[3])
+{
+    const double eps = 1e-6;
+    cm_fo oe;
+    cm_fo_with(&b->base, b->param, pt->u[2] + eps * pt->t[2], &oe);
+    const double ze[2] = {pt->u[0] + eps * pt->t[0], pt->u[1] + eps * pt->t[1]};
+    cm_fo_state se = {0, ze[0], ze[1], cm_fo_mode_of(&oe, 0, ze[0], ze[1])};
+    if (!cm_fo_propagate(&oe, &se, s, NULL, NULL, NULL))
+        return false;
+    along[0] = se.x - at[0];
+    along[1] = se.v - at[1];
+    along[2] = eps * pt->t[2];
+    return true;
+}
+
 /* Moves the section of point pt to the phase, among 64 of the period,
  * where the solution slides fastest, and pt with it (the same solution,
  * its state at the new phase); false if the phase is the parameter or
@@ -461,20 +480,15 @@ static bool rephase(branch *b, point *pt)
      * the branch moves in it clearly; where it is steep, a point a little
      * along the tangent carried there as the point itself was (where the
      * old phase was a bad one, its tangent's state part is unreliable) */
-    const double eps = 1e-6;
-    cm_fo oe;
-    cm_fo_with(&b->base, b->param, pt->u[2] + eps * pt->t[2], &oe);
-    const double ze[2] = {pt->u[0] + eps * pt->t[0], pt->u[1] + eps * pt->t[1]};
-    cm_fo_state se = {0, ze[0], ze[1], cm_fo_mode_of(&oe, 0, ze[0], ze[1])};
-    if (!cm_fo_propagate(&oe, &se, best_s, NULL, NULL, NULL))
+    const bool steep = fabs(pt->t[2]) < 0.05;
+    double along[3];
+    if (steep && !carried_along(b, pt, best_s, at, along))
         return false;
-    const double along[3] = {se.x - at[0], se.v - at[1], eps * pt->t[2]};
     branch moved = *b;
     cm_fo_init(&moved.base, b->base.S, b->base.S0, b->base.Omega, phi);
     double u[3] = {at[0], at[1], pt->u[2]};
     cm_fo_with(&moved.base, b->param, u[2], &o);
     point q;
-    const bool steep = fabs(pt->t[2]) < 0.05;
     if (!cm_fo_periodic_point(&o, u, b->period) ||
         !describe(&moved, u, steep ? along : NULL, pt->t[2] < 0 ? -1 : 1, &q))
         return false;
@@ -654,20 +668,20 @@ static bool at_model_limit(const branch *b, double p)
     }
 }
 
-/* How far G(u) moves from a to the point d ahead along direction dir,
- * and the motion from there to ahead (may be NULL); NaN if it is lost. */
-static double motion_ahead(const branch *b, const point *a, const double dir[3], double d,
-                           cm_fo_solution *ahead)
+/* How far G(u) moves from G(a) = Ga to the point d ahead of a along
+ * direction dir, and the motion from there to ahead (may be NULL); NaN if
+ * it is lost. */
+static double motion_ahead(const branch *b, const point *a, const double Ga[2],
+                           const double dir[3], double d, cm_fo_solution *ahead)
 {
-    double u[3], G[2], Gu[2];
+    double u[3], Gu[2];
     for (int i = 0; i < 3; i++)
         u[i] = a->u[i] + d * dir[i];
     cm_fo o;
     cm_fo_with(&b->base, b->param, u[2], &o);
-    if (!residual(b, a->u, G, NULL) || !residual(b, u, Gu, NULL) ||
-        (ahead && !cm_fo_solution_at(&o, u, b->period, ahead)))
+    if (!residual(b, u, Gu, NULL) || (ahead && !cm_fo_solution_at(&o, u, b->period, ahead)))
         return NAN;
-    return hypot(Gu[0] - G[0], Gu[1] - G[1]);
+    return hypot(Gu[0] - Ga[0], Gu[1] - Ga[1]);
 }
 
 /* Where the corrector fails even at the smallest step: whether the
@@ -683,17 +697,20 @@ static bool signature_breaks(const branch *b, const point *a, cm_fo_branch_event
      * branch is steep, the tangent hardly moves it) */
     const double in_p[3] = {0, 0, a->t[2] < 0 ? -1 : 1};
     const double *const dirs[2] = {a->t, in_p};
+    double Ga[2];
+    if (!residual(b, a->u, Ga, NULL))
+        return false;
     for (int k = 24; k >= 10; k--) {
         const double *dir = dirs[k % 2];
         const double d = pow(10, -k / 2);
         cm_fo_solution ahead;
-        const double moved = motion_ahead(b, a, dir, d, &ahead);
+        const double moved = motion_ahead(b, a, Ga, dir, d, &ahead);
         if (isnan(moved))
             continue;
         /* G moves by O(d) on a smooth map and by O(sqrt d) where a segment
          * is born tangentially: ten times d moves it 3 to 10 times as far,
          * unless it jumps in between */
-        const bool jump = moved > 1e-6 && moved > 100 * motion_ahead(b, a, dir, d / 10, NULL);
+        const bool jump = moved > 1e-6 && moved > 100 * motion_ahead(b, a, Ga, dir, d / 10, NULL);
         if (!jump && strcmp(ahead.signature, a->s.signature) == 0)
             continue;
         point next = *a;
@@ -788,24 +805,35 @@ static bool cross_corner(const branch *b, const point *a, double *h, point *out)
     return true;
 }
 
-/* Whether the branch, going from a to b, passes through the solution s
- * (it has closed into a loop): s lies on the segment from a to b, to 5% of
- * its length, in the solution's parameter and range of x, which do not
- * depend on the section's phase. */
-static bool passes_by(const cm_fo_solution *s, const cm_fo_solution *a, const cm_fo_solution *b)
+/* Whether the segment from a to b (n coordinates) passes through s, to 5%
+ * of its length. */
+static bool segment_passes(int n, const double *a, const double *b, const double *s)
 {
-    const double d[3] = {b->p - a->p, b->x_max - a->x_max, b->x_min - a->x_min};
-    const double r[3] = {s->p - a->p, s->x_max - a->x_max, s->x_min - a->x_min};
-    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    if (!(dd > 0))
-        return false;
-    const double w = (r[0] * d[0] + r[1] * d[1] + r[2] * d[2]) / dd;
+    double dd = 0, rd = 0;
+    for (int i = 0; i < n; i++) {
+        dd += (b[i] - a[i]) * (b[i] - a[i]);
+        rd += (s[i] - a[i]) * (b[i] - a[i]);
+    }
+    const double w = dd > 0 ? rd / dd : -1;
     if (w < 0 || w > 1)
         return false;
     double off2 = 0;
-    for (int i = 0; i < 3; i++)
-        off2 += (r[i] - w * d[i]) * (r[i] - w * d[i]);
+    for (int i = 0; i < n; i++) {
+        const double d = s[i] - a[i] - w * (b[i] - a[i]);
+        off2 += d * d;
+    }
     return off2 <= 0.0025 * dd + 1e-18;
+}
+
+/* Whether the branch, going from a to b, passes through the solution s
+ * (it has closed into a loop), in the solution's parameter and range of
+ * x, which do not depend on the section's phase. */
+static bool passes_by(const cm_fo_solution *s, const cm_fo_solution *a, const cm_fo_solution *b)
+{
+    const double sa[3] = {s->p, s->x_max, s->x_min};
+    const double aa[3] = {a->p, a->x_max, a->x_min};
+    const double ba[3] = {b->p, b->x_max, b->x_min};
+    return segment_passes(3, aa, ba, sa);
 }
 
 int cm_fo_continue(const cm_fo *o, const cm_fo_continue_options *opt, double p0,
@@ -1168,26 +1196,6 @@ static bool curve_correct(const curve *c, const double u0[4], const double t[4],
     return false;
 }
 
-/* Whether the segment from a to b (4 coordinates) passes through s, to 5%
- * of its length. */
-static bool segment_passes(const double a[4], const double b[4], const double s[4])
-{
-    double dd = 0, rd = 0;
-    for (int i = 0; i < 4; i++) {
-        dd += (b[i] - a[i]) * (b[i] - a[i]);
-        rd += (s[i] - a[i]) * (b[i] - a[i]);
-    }
-    const double w = dd > 0 ? rd / dd : -1;
-    if (w < 0 || w > 1)
-        return false;
-    double off2 = 0;
-    for (int i = 0; i < 4; i++) {
-        const double d = s[i] - a[i] - w * (b[i] - a[i]);
-        off2 += d * d;
-    }
-    return off2 <= 0.0025 * dd + 1e-18;
-}
-
 /* ---- signature boundaries in two parameters ---------------------------- */
 
 /* The state at phase phi of the periodic motion through z at phase o->phi
@@ -1401,7 +1409,7 @@ int cm_fo_continue_curve(const cm_fo *o, const cm_fo_branch_event *e, int param,
             break;
         /* back at the start (a closed curve, or one that retraces itself
          * through a singular point), or creeping: done */
-        const bool closes = n > 3 && segment_passes(u, next, start);
+        const bool closes = n > 3 && segment_passes(4, u, next, start);
         creep = h <= H_CORNER ? creep + 1 : 0;
         memcpy(u, next, sizeof next);
         n++;

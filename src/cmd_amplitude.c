@@ -50,10 +50,9 @@ enum { RECORD = 40 };
 typedef struct amp_args {
     model_opts mo;
     param_axis omega;
-    int has_omega, periods, threads, width, height;
+    int has_omega, periods, threads;
     double ymax;
-    const char *csv, *png;
-    bool json, quiet;
+    chart_outputs out;
 } amp_args;
 
 static int parse_args(cli *c, amp_args *a)
@@ -79,32 +78,22 @@ static int parse_args(cli *c, amp_args *a)
             if (c->value && (!parse_double(c->value, &a->ymax) || !(a->ymax > 0 && a->ymax < 1e6)))
                 err = cli_usage_error(c, "--ymax: '%s' must be a number in (0, 1e6)", c->value);
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
     if (!err && !a->has_omega)
         err = cli_usage_error(c, "--omega LO:HI:N is required (e.g. --omega 0.1:3:300)");
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
-    if (!err && cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
-        err = cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     return err;
 }
 
 static bool write_csv(const amp_args *a, const cm_fo_amplitude *v)
 {
     outfile o;
-    if (!outfile_open("amplitude", a->csv, &o))
+    if (!outfile_open("amplitude", a->out.csv, &o))
         return false;
     fprintf(o.f, "Omega,x0,slip_limit,turn_limit,valid,mult_max,stable,sim_amplitude,sim_sticks\n");
     for (int i = 0; i < a->omega.n; i++) {
@@ -169,8 +158,8 @@ static bool write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitu
     snprintf(title, sizeof title,
              "x0 (2.25) stable/unstable/invalid; S0/Omega^2, S H_max; simulation, N/10; %s",
              params);
-    const cm_chart chart = {a->width,
-                            a->height,
+    const cm_chart chart = {a->out.width,
+                            a->out.height,
                             {a->omega.lo, 0},
                             {a->omega.hi, a->ymax > 0 ? a->ymax : 1.15 * top},
                             "Omega",
@@ -187,7 +176,7 @@ static bool write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitu
     snprintf(range, sizeof range, "Omega=%s:%s:%d", CM_NUM(a->omega.lo), CM_NUM(a->omega.hi),
              a->omega.n);
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Omega", range}};
-    const bool ok = write_chart_png("amplitude", a->png, &chart, 1, texts, 3);
+    const bool ok = write_chart_png("amplitude", a->out.png, &chart, 1, texts, 3);
     free(all);
     return ok;
 }
@@ -209,12 +198,12 @@ static void summarise(const amp_args *a, const cm_fo_amplitude *v, counts *c)
 int cmd_amplitude(int argc, char **argv)
 {
     cli c = {"amplitude", argc, argv, 0, NULL, NULL};
-    amp_args a = {.mo = {.name = "friction-oscillator"}, .periods = 400, .width = 1000,
-                  .height = 700, .ymax = 5};
+    amp_args a = {.mo = {.name = "friction-oscillator"}, .periods = 400, .ymax = 5,
+                  .out = {.width = 1000, .height = 700}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("amplitude", a.csv) || !chart_png_check("amplitude", a.png))
+    if (!outfile_check("amplitude", a.out.csv) || !chart_png_check("amplitude", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);
@@ -241,7 +230,7 @@ int cmd_amplitude(int argc, char **argv)
     }
     counts cnt;
     summarise(&a, v, &cnt);
-    if (a.json) {
+    if (a.out.json) {
         json j;
         json_begin(&j, stdout, "amplitude");
         param_base_json(&j, a.mo.name, &base);
@@ -251,17 +240,17 @@ int cmd_amplitude(int argc, char **argv)
         json_int(&j, "stable", cnt.stable);
         json_int(&j, "lost", cnt.lost);
         json_end(&j);
-    } else if (!a.quiet) {
-        fprintf(report_stream(a.csv, a.png, NULL),
+    } else if (!a.out.quiet) {
+        fprintf(report_stream(a.out.csv, a.out.png, NULL),
                 "%d frequencies: (2.25) valid at %d, the symmetric non-sticking solution "
                 "stable at %d; %d simulations lost%s\n",
                 n, cnt.valid, cnt.stable, cnt.lost,
                 invalid ? "; some frequencies could not be built (S > S0)" : "");
     }
     bool ok = true;
-    if (a.csv)
+    if (a.out.csv)
         ok = write_csv(&a, v);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = write_png(&a, &base, v);
     free(v);
     return ok ? EXIT_OK : EXIT_FAIL;

@@ -217,6 +217,15 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
     return ok;
 }
 
+/* Writes a chart over the swept P with the PNG's text chunks. */
+static bool write_sweep_chart(const hs_args *a, const cm_chart *chart, const char *params)
+{
+    char range[120];
+    param_axes_format(&a->sweep, 1, range, sizeof range);
+    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
+    return write_chart_png("horseshoe", a->out.png, chart, 1, texts, 3);
+}
+
 /* Fig. 4.20: at each P and m, attractor or repeller (which way its orbits
  * escape), as coloured marks; nothing beyond m_max. */
 static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double alpha,
@@ -271,10 +280,7 @@ static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double al
                             "P",          "m",       title,  NULL,
                             series,       5,         figure_font(), 0,
                             NULL,         0};
-    char range[120];
-    param_axes_format(&a->sweep, 1, range, sizeof range);
-    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
-    const bool ok = write_chart_png("horseshoe", a->out.png, &chart, 1, texts, 3);
+    const bool ok = write_sweep_chart(a, &chart, params);
     free(v);
     free(counts);
     return ok;
@@ -311,10 +317,7 @@ static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char
                             "P",          "h",       title,            NULL,
                             series,       shown,     figure_font(),    0,
                             NULL,         0};
-    char range[120];
-    param_axes_format(&a->sweep, 1, range, sizeof range);
-    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Sweep", range}};
-    const bool ok = write_chart_png("horseshoe", a->out.png, &chart, 1, texts, 3);
+    const bool ok = write_sweep_chart(a, &chart, params);
     free(v);
     return ok;
 }

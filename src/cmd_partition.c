@@ -34,7 +34,6 @@ static const char partition_help[] =
 
 typedef struct part_args {
     model_opts mo;
-    int width, height;
     chart_outputs out;
 } part_args;
 

@@ -703,7 +703,8 @@ int cmd_solve(int argc, char **argv)
         sum.box = r.box;
         sum.cells = r.ncells;
         sum.ngroups = r.ngroups;
-        cm_scm_slow_share(&r, sum.slow);
+        if (!a.json && !a.quiet) /* only the text summary shows it */
+            cm_scm_slow_share(&r, sum.slow);
         if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }
