@@ -113,6 +113,20 @@ out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S0=0.4:0.5:2 --periods 5 --png l2.pn
   || fail "lyapunov --curves of other parameters: $out"
 expect_usage "--curve NAME2=LO:HI and --curves FILE go together" continue --vary S=0.02:0.4 \
   --curve Omega=0.2:0.8
+# bad starts and panels: a usage error each, and no file written
+expect_usage "--start: 'abc' is not a number" continue --vary S=0.02:0.4 --start abc --csv bad.csv
+expect_usage "--from: '1,2,3,4' is not X,V or X,V,P" continue --vary S=0.02:0.4 --from 1,2,3,4 \
+  --csv bad.csv
+expect_usage "--panels: 'bogus' is not a list of x_max, stops and psi" continue \
+  --vary S=0.02:0.4 --panels bogus --png bad.png
+expect_usage "--panels: 'psi,psi' is not a list" continue --vary S=0.02:0.4 --panels psi,psi \
+  --png bad.png
+expect_usage "--curve: 'Q=1:2' is not NAME2=LO:HI" continue --vary S=0.02:0.4 \
+  --curve Q=1:2 --curves bad.csv
+out=$("$CM" continue --vary S=0.02:0.4 --start 0.5 --csv bad.csv 2>&1); rc=$?
+[ "$rc" -eq 2 ] && grep -qF "the start's S = 0.5 is outside --vary S=0.02:0.4" <<<"$out" \
+  || fail "continue --start outside the range: exit $rc, $out"
+[ ! -e bad.csv ] && [ ! -e bad.png ] || fail "a rejected continue left a file behind"
 
 # --- amplitude: the symmetric non-sticking solution (thesis 2.2) -----------
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:116 --csv amp5.csv --quiet \
