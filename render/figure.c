@@ -106,18 +106,32 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
         free(order);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
     }
+    /* Sticking zones share one grey: unlabelled ones take one line between
+     * them (a friction map has hundreds), unless there is only one. */
+    uint32_t sticking = 0;
+    uint64_t sticking_cells = 0;
+    for (uint32_t g = 1; g <= ngroups; g++)
+        if (ras->group_cells[g] && ras->classes[g] == CM_CLASS_STICKING &&
+            !label_of(o, &groups[g - 1], dim))
+            sticking++, sticking_cells += ras->group_cells[g];
+    const bool one_sticking_line = sticking > 1;
     uint32_t shown = 0;
     for (uint32_t g = 1; g <= ngroups; g++)
-        if (ras->group_cells[g] && ras->classes[g] != CM_CLASS_OTHER)
+        if (ras->group_cells[g] && ras->classes[g] != CM_CLASS_OTHER &&
+            !(one_sticking_line && ras->classes[g] == CM_CLASS_STICKING &&
+              !label_of(o, &groups[g - 1], dim)))
             order[shown++] = (group_cells){ras->group_cells[g], g};
     qsort(order, shown, sizeof *order, more_cells_first);
     const int closing = (ras->other_groups ? 1 : 0) + (ras->colour_repeats ? 1 : 0) +
                         (ras->computed < all ? 1 : 0);
-    int slots = room - (ras->group_cells[0] ? 1 : 0) - closing;
+    int slots = room - (ras->group_cells[0] ? 1 : 0) - (one_sticking_line ? 1 : 0) - closing;
     slots = slots < max_groups + 1 ? slots : max_groups + 1;
     if (ras->group_cells[0] && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "sink  %.1f%%",
                  share(ras->group_cells[0], all));
+    if (one_sticking_line && lg->n < room)
+        snprintf(add_entry(lg, cm_colour_sticking, true)->text, LABEL,
+                 "%u sticking zones  %.1f%%", sticking, share(sticking_cells, all));
     for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
         if ((slots == 1 && k + 1 < shown) || k == (uint32_t)max_groups) { /* the rest in one line */
             uint64_t rest = 0;

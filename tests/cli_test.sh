@@ -441,6 +441,10 @@ json.dump({"view": [-1e5, 1e5, -601.5, 601.5], "size": [800, 401], "colour_at": 
            "black_near": black}, open(sys.argv[1], "w"))
 PY
 python3 "$HERE/pngcheck.py" friction.png friction.check.json || fail "friction.png pixels"
+# the zones share one grey, so the legend counts them in one line
+"$CM" render friction.cmdb --svg friction.svg --layers all > /dev/null || fail "friction svg"
+grep -q ">$json_sticking sticking zones " friction.svg \
+  && [ "$(grep -c " sticking p=" friction.svg)" = 0 ] || fail "one legend line for the sticking zones"
 "$CM" info friction.cmdb > /dev/null || fail "info on a friction file"
 "$CM" export friction.cmdb --flat friction.sqlite || fail "flat export of a friction file"
 [ "$(sqlite3 friction.sqlite "SELECT COUNT(*) FROM groups WHERE kind = 'sticking'")" = "$db_sticking" ] \

@@ -13,15 +13,15 @@ typedef struct solved {
     cm_group_info *g;
 } solved;
 
-static solved run(const char *params, double x0, double x1, double v0, double v1, int64_t nx,
-                  int64_t nv, int max_steps)
+static solved run_model(const char *model, const char *params, double x0, double x1, double v0,
+                        double v1, int64_t nx, int64_t nv, int max_steps)
 {
     cm_model m;
     char msg[256];
     const char *texts[1] = {params};
     solved s;
     memset(&s, 0, sizeof s);
-    if (cm_model_create("microchaos-pd", texts, 1, &m, msg, sizeof msg) != CM_OK) {
+    if (cm_model_create(model, texts, 1, &m, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "%s\n", msg);
         exit(1);
     }
@@ -30,10 +30,15 @@ static solved run(const char *params, double x0, double x1, double v0, double v1
     const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
     CHECK(cm_region_alloc(&s.r, &box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(&m, &lat, &opt, &s.r, msg, sizeof msg) == CM_OK);
-    s.g = calloc(s.r.ngroups + 1, sizeof *s.g);
-    cm_scm_groups(&s.r, &lat, s.g, NULL);
+    CHECK(cm_scm_describe(&m, &lat, &s.r, &s.g, NULL, msg, sizeof msg) == CM_OK);
     cm_model_release(&m);
     return s;
+}
+
+static solved run(const char *params, double x0, double x1, double v0, double v1, int64_t nx,
+                  int64_t nv, int max_steps)
+{
+    return run_model("microchaos-pd", params, x0, x1, v0, v1, nx, nv, max_steps);
 }
 
 static void release(solved *s)
@@ -204,11 +209,127 @@ static void fig_4_21_fine(void)
     release(&s);
 }
 
+/* Where the true orbit of the hybrid map from (x, v) goes: 0 if it leaves
+ * the box within `steps` steps; 1000 + m if it comes to rest in the sticking
+ * zone about x_m* = m/alpha^2; else the switching line m (x near m/P) it ends
+ * near. */
+static int friction_fate(const cm_model *m, double P, double a2, const double s0[2],
+                         const double box[4], int steps)
+{
+    double s[2] = {s0[0], s0[1]}, y[2];
+    for (int k = 0; k < steps; k++) {
+        if (m->step(m, s, y) != 0 || y[0] < box[0] || y[0] >= box[1] || y[1] < box[2] ||
+            y[1] >= box[3])
+            return 0;
+        if (y[0] == s[0] && y[1] == s[1] && y[1] == 0)
+            return 1000 + (int)lround(y[0] * a2);
+        s[0] = y[0], s[1] = y[1];
+    }
+    return (int)lround(s[0] * P);
+}
+
+static int friction_cell_fate(const solved *s, uint64_t i, double P, double a2)
+{
+    const uint32_t g = s->r.group[i];
+    if (g == 0)
+        return 0;
+    const cm_group_info *gi = &s->g[g - 1];
+    return gi->kind == CM_GROUP_STICKING ? 1000 + (int)lround(gi->centre[0] * a2)
+                                         : (int)lround(gi->centre[0] * P);
+}
+
+/* Fig. 4.30 (alpha = 6.53e-3, beta = 0, P = 5.5e-5, D = 2.5e-3, mu = 0.095)
+ * has Fig. 4.21's slow v: on the 3-unit rows of an 800 x 201 lattice over
+ * -301.5:301.5 in v, 83 % of the moving cells stay in their row and 59 % of
+ * the box goes to the sink. On 3200 x 1609 cells (0.375 tall, a row on the
+ * rest states v = 0) the sink is the two corners where x and v have one
+ * sign (and the outermost rows), and 1000 random cells go where their true orbits go: into the sink
+ * or not to 99 %; to the same switching line or sticking zone to 85 %
+ * (orbits next to the outer sticking zones come to rest there late, which
+ * the cells' cycles at the switching line do not show). */
+static void fig_4_30_fine(void)
+{
+    const char *params = "alpha=6.53e-3,beta=0,P=5.5e-5,D=2.5e-3,mu=0.095";
+    const double P = 5.5e-5, a2 = 6.53e-3 * 6.53e-3, box[4] = {-100000, 100000, -301.5, 301.5};
+    double share[CM_MAX_DIM];
+    solved coarse = run_model("microchaos-pd-friction", params, box[0], box[1], box[2], box[3],
+                              800, 201, 100000);
+    cm_scm_slow_share(&coarse.r, share);
+    CHECK(share[1] > 0.8);
+    release(&coarse);
+    const int64_t nx = 3200, nv = 1609;
+    const double wx = (box[1] - box[0]) / (double)nx, wv = (box[3] - box[2]) / (double)nv;
+    solved s = run_model("microchaos-pd-friction", params, box[0], box[1], box[2], box[3], nx, nv,
+                         100000);
+    cm_scm_slow_share(&s.r, share);
+    CHECK(share[1] < 0.25);
+    uint64_t sink = 0, corners = 0;
+    for (uint64_t i = 0; i < s.r.ncells; i++) {
+        if (s.r.group[i] != 0)
+            continue;
+        const double x = box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
+                     v = box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv;
+        sink++;
+        corners += x * v > 0 || fabs(v) > 300; /* or the top and bottom rows */
+    }
+    CHECK((double)sink <= 0.1 * (double)s.r.ncells);
+    CHECK(corners == sink);
+    cm_model m;
+    char msg[256];
+    const char *texts[1] = {params};
+    CHECK(cm_model_create("microchaos-pd-friction", texts, 1, &m, msg, sizeof msg) == CM_OK);
+    int agree = 0, sink_agree = 0;
+    uint64_t seed = 12345;
+    for (int k = 0; k < 1000; k++) {
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        const uint64_t i = (seed >> 33) % s.r.ncells;
+        const double at[2] = {box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
+                              box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv};
+        const int cell = friction_cell_fate(&s, i, P, a2),
+                  orbit = friction_fate(&m, P, a2, at, box, 20000);
+        agree += cell == orbit;
+        sink_agree += (cell == 0) == (orbit == 0);
+    }
+    fprintf(stderr, "Fig 4.30 on 3200 x 1609 cells: sink %.1f %%, %d of 1000 cells as their "
+                    "orbits (%d sink or not), %.0f %% of moving cells in their v row\n",
+            100.0 * (double)sink / (double)s.r.ncells, agree, sink_agree, 100 * share[1]);
+    CHECK(sink_agree >= 990);
+    CHECK(agree >= 850);
+    cm_model_release(&m);
+    release(&s);
+}
+
+/* With the printed parameters of Fig. 4.30 the sticking zone of level 3
+ * absorbs the attractor at SW_4 (x = 4/P = 72727) near mu = alpha^2 m_max / P
+ * - (m_max - 1) = 0.10116, not at the printed 0.095: the true orbit from
+ * (73062.5, -7.5) still moves near SW_4 after 300000 steps at mu = 0.095 and
+ * 0.101, and comes to rest in the zone about x_3* at 0.1012. */
+static void fig_4_30_absorption(void)
+{
+    const double P = 5.5e-5, a2 = 6.53e-3 * 6.53e-3, box[4] = {-1e6, 1e6, -1e6, 1e6};
+    const char *params[3] = {"alpha=6.53e-3,beta=0,P=5.5e-5,D=2.5e-3,mu=0.095",
+                             "alpha=6.53e-3,beta=0,P=5.5e-5,D=2.5e-3,mu=0.101",
+                             "alpha=6.53e-3,beta=0,P=5.5e-5,D=2.5e-3,mu=0.1012"};
+    const int fate[3] = {4, 4, 1003};
+    CHECK(fabs(a2 * 4 / P - 3 - 0.10116) < 1e-5);
+    for (int k = 0; k < 3; k++) {
+        cm_model m;
+        char msg[256];
+        CHECK(cm_model_create("microchaos-pd-friction", &params[k], 1, &m, msg, sizeof msg) ==
+              CM_OK);
+        const double at[2] = {73062.5, -7.5};
+        CHECK_INT(friction_fate(&m, P, a2, at, box, 300000), fate[k]);
+        cm_model_release(&m);
+    }
+}
+
 int main(void)
 {
     cscm_example();
     fig_4_16();
     fig_4_21();
     fig_4_21_fine();
+    fig_4_30_fine();
+    fig_4_30_absorption();
     CHECK_DONE();
 }

@@ -45,10 +45,18 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 "$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --stage1 \
   --png fig-4.27.png --layers all --size 1400x700 > /dev/null
 
-# Fig. 4.30: the hybrid map with dry friction, mu = 0.095 (sticking zones grey)
-"$CM" solve --model microchaos-pd-friction --param mu=0.095 --region=-100000:100000,-301.5:301.5 \
-  --cells 800x201 --max-steps 100000 --png fig-4.30-figure.png --layers all --size 1400x600 \
-  > /dev/null
+# Fig. 4.30: the hybrid map with dry friction at mu = 0 and 0.095 (the thesis'
+# two panels) and 0.105, where the outermost attractors are absorbed with the
+# printed parameters; sticking zones grey, coloured by the steps to reach an
+# attractor with the sink red, as Fig. 4.21. v changes by less than 1.5 per
+# step: cells 0.375 tall in v (3 units tall, cell mapping sent 59 % of the box
+# to the sink), a row of them on v = 0 for the rest states
+for mu in 0 0.095 0.105; do
+  "$CM" solve --model microchaos-pd-friction --param mu=$mu --region=-100000:100000,-301.5:301.5 \
+    --cells 3200x1609 --max-steps 100000 --png fig-4.30-mu$mu.png \
+    --layers basin,steps,attractors,overlays,axes,legend,title --min-basin 100000000 \
+    --size 1000x500 > /dev/null
+done
 
 # Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip, out
 # to x_8* = 8.96 (regular) and x_9* = 10.08 (virtual: beyond 10)
