@@ -19,6 +19,8 @@ enum cm_overlay_kind {
     CM_OVERLAY_STICKING_ZONE,      /* segment a-b: a set of rest states */
     CM_OVERLAY_FIXED_REGULAR,      /* point a: a fixed point inside its own band */
     CM_OVERLAY_FIXED_VIRTUAL,      /* point a: a fixed point outside its band */
+    CM_OVERLAY_REPELLER,           /* segment a-b: holds a chaotic repeller (transient chaos) */
+    CM_OVERLAY_ESCAPE,             /* segment a-b: orbits that reach it end their transient */
     CM_OVERLAY_KINDS
 };
 

@@ -2,8 +2,10 @@
 #include <math.h>
 #include <string.h>
 
+#include "cellmap/overlay.h"
 #include "models/models.h"
 #include "models/params.h"
+#include "models/transient_escape.h"
 
 const cm_param_spec cm_microchaos_1d_friction_spec[] = {
     {"a", "1.5", 1.0000001, 1e6, 1, NULL, "a = exp(g N tau/M) > 1 (4.24)"},
@@ -67,6 +69,54 @@ static int fixed_points_friction(const cm_model *m, int64_t m0, int64_t m1, cm_f
     return 0;
 }
 
+/* A segment of the graph plane's diagonal: the states lo..hi. */
+static void diagonal_segment(cm_overlay_list *out, int kind, double lo, double hi,
+                             const double view_lo[2], const double view_hi[2])
+{
+    const double a = lo > view_lo[0] ? lo : view_lo[0], b = hi < view_hi[0] ? hi : view_hi[0];
+    if (a < b) {
+        const double p[2] = {a, a}, q[2] = {b, b};
+        cm_overlay_add(out, kind, p, q);
+    }
+}
+
+/* On the diagonal of the graph plane: the fixed points in view, and, in the
+ * case of thesis 4.3 (one positive fixed point x0* below 1), the interval
+ * I_rep = [x0*, a - c] that holds the chaotic repeller and the escape
+ * interval I0 = [a - b - c, x0*) next to it, with their mirror images (the
+ * map is odd). */
+static void overlays_friction(const cm_model *m, const double lo[2], const double hi[2],
+                              cm_overlay_list *out)
+{
+    const friction1d *f = m->ctx;
+    cm_te t;
+    char why[160];
+    if (cm_te_setup(f->a, f->b, f->c, &t, why, sizeof why))
+        for (int s = 1; s >= -1; s -= 2) {
+            diagonal_segment(out, CM_OVERLAY_ESCAPE, s > 0 ? f->a - f->b - f->c : -t.x0,
+                             s > 0 ? t.x0 : -(f->a - f->b - f->c), lo, hi);
+            diagonal_segment(out, CM_OVERLAY_REPELLER, s > 0 ? t.x0 : -t.rep_hi,
+                             s > 0 ? t.rep_hi : -t.x0, lo, hi);
+        }
+    /* levels whose fixed points can lie in view: |x (a - 1) - b m| <= c */
+    const double k0 = f->b > 0 ? floor(((f->a - 1) * lo[0] - f->c) / f->b) : 0,
+                 k1 = f->b > 0 ? ceil(((f->a - 1) * hi[0] + f->c) / f->b) : 0;
+    if (!(k0 >= -1e6 && k1 <= 1e6)) /* more points than a picture can show */
+        return;
+    for (int64_t k = (int64_t)k0; k <= (int64_t)k1 && !out->truncated; k++) {
+        cm_fixed_point fp[3];
+        size_t n = 0;
+        fixed_points_friction(m, k, k, fp, 3, &n, NULL, 0);
+        for (size_t i = 0; i < n; i++) {
+            const double p[2] = {fp[i].x[0], fp[i].x[0]};
+            if (cm_overlay_in_view(p, lo, hi))
+                cm_overlay_add(out,
+                               fp[i].regular ? CM_OVERLAY_FIXED_REGULAR : CM_OVERLAY_FIXED_VIRTUAL,
+                               p, NULL);
+        }
+    }
+}
+
 cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char *msg,
                                            size_t msg_size)
 {
@@ -81,5 +131,6 @@ cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char
     f->dead = f->c / f->a;
     m->step = step_friction;
     m->fixed_points = fixed_points_friction;
+    m->overlays = overlays_friction;
     return CM_OK;
 }

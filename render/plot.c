@@ -15,6 +15,8 @@ static const cm_rgb manifold_colour = {0, 0, 0};
 static const cm_rgb zone_colour = {40, 40, 40};
 static const cm_rgb diagonal_colour = {150, 150, 150};
 static const cm_rgb graph_colour = {0, 0, 0};
+static const cm_rgb repeller_colour = {230, 159, 0}; /* Okabe-Ito orange and blue */
+static const cm_rgb escape_colour = {0, 114, 178};
 
 static void colour(cm_rgb c) { glColor3ub(c.r, c.g, c.b); }
 
@@ -213,6 +215,8 @@ static void draw_fixed_points(const cm_overlay_list *ov, double px, double py, i
 
 static void draw_overlay_lines(const cm_overlay_list *ov, int lw)
 {
+    draw_segments(ov, CM_OVERLAY_REPELLER, repeller_colour, (float)(3 * lw), 0, 1);
+    draw_segments(ov, CM_OVERLAY_ESCAPE, escape_colour, (float)(3 * lw), 0, 1);
     draw_segments(ov, CM_OVERLAY_STICKING_ZONE, zone_colour, (float)(2 * lw + 1), 0, 1);
     draw_segments(ov, CM_OVERLAY_SWITCHING_LINE, switching_colour, (float)lw, 0, 1);
     draw_segments(ov, CM_OVERLAY_UNSTABLE_MANIFOLD, manifold_colour, (float)lw, 0x00FF, 2 * lw);

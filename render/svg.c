@@ -169,6 +169,10 @@ static void overlays(FILE *f, const figure *F, const cm_panel *pn)
     const int lw = F->p.line_width;
     char style[160];
     fputs("<g fill=\"none\" clip-path=\"url(#panel)\">\n", f);
+    snprintf(style, sizeof style, "stroke=\"#e69f00\" stroke-width=\"%d\"", 3 * lw);
+    segments(f, ov, &m, CM_OVERLAY_REPELLER, style);
+    snprintf(style, sizeof style, "stroke=\"#0072b2\" stroke-width=\"%d\"", 3 * lw);
+    segments(f, ov, &m, CM_OVERLAY_ESCAPE, style);
     snprintf(style, sizeof style, "stroke=\"#282828\" stroke-width=\"%d\"", 2 * lw + 1);
     segments(f, ov, &m, CM_OVERLAY_STICKING_ZONE, style);
     snprintf(style, sizeof style, "stroke=\"#ffffff\" stroke-width=\"%d\"", lw);

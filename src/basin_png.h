@@ -37,7 +37,8 @@ extern const unsigned all_layers;
     "                      1000 on the longer side for figures with text)\n"                       \
     "  --layers L,...      what to draw: basin, steps (shading by transient length; alone:\n"      \
     "                      step numbers only), attractors, overlays (switching lines, fixed\n"     \
-    "                      points, manifolds, sticking zones), axes, legend, title; or all\n"      \
+    "                      points, manifolds, sticking zones, repellers orange and escape\n"      \
+    "                      intervals blue), axes, legend, title; or all\n"                          \
     "                      (default: basin,attractors)\n"                                          \
     "  --png-mode MODE     rgb (a figure) or indexed (one pixel per cell, its value the\n"         \
     "                      colour class; the classes of groups are in the PNG's texts)\n"          \

@@ -411,6 +411,61 @@ static void general_equals_specific(void)
     }
 }
 
+/* The 1-D friction map's overlays at Fig. 4.5's a = 1.5, b = 1.3, |I0| =
+ * 0.25 (c = 0.15), on the diagonal of the graph plane: I0 = [a - b - c, x0*]
+ * and I_rep = [x0*, a - c] with their mirror images, and the fixed points.
+ * Checked on the map: I_rep goes into I0 and I_rep, and I0 to rest at 0
+ * without coming back above x0*. */
+static void friction_1d_overlays(void)
+{
+    cm_model mf = make("microchaos-1d-friction", "a=1.5,b=1.3,c=0.15");
+    cm_overlay items[64];
+    cm_overlay_list ov = {items, 64, 0, false};
+    mf.overlays(&mf, (const double[2]){-2, -2}, (const double[2]){2, 2}, &ov);
+    CHECK(!ov.truncated);
+    const double x0 = 0.15 / 0.5, lo = 1.5 - 1.3 - 0.15, hi = 1.5 - 0.15;
+    int escape = 0, repeller = 0, points = 0;
+    for (size_t i = 0; i < ov.count; i++) {
+        const cm_overlay *o = &items[i];
+        if (o->kind == CM_OVERLAY_FIXED_REGULAR || o->kind == CM_OVERLAY_FIXED_VIRTUAL) {
+            points++;
+            CHECK(o->a[0] == o->a[1]);
+            continue;
+        }
+        CHECK(o->a[0] == o->a[1] && o->b[0] == o->b[1]); /* on the diagonal */
+        const double s = o->a[0] + o->b[0] > 0 ? 1 : -1, a = s * fmin(s * o->a[0], s * o->b[0]),
+                     b = s * fmax(s * o->a[0], s * o->b[0]); /* a: the end nearer 0 */
+        if (o->kind == CM_OVERLAY_ESCAPE) {
+            escape++;
+            CHECK_NEAR(a, s * lo, 1e-15);
+            CHECK_NEAR(b, s * x0, 1e-15);
+        } else {
+            CHECK_INT(o->kind, CM_OVERLAY_REPELLER);
+            repeller++;
+            CHECK_NEAR(a, s * x0, 1e-15);
+            CHECK_NEAR(b, s * hi, 1e-15);
+        }
+        for (int k = 1; k < 100; k++) {
+            double x = a + (b - a) * k / 100.0, y;
+            CHECK_INT(mf.step(&mf, &x, &y), CM_STEP_OK);
+            if (o->kind == CM_OVERLAY_REPELLER) {
+                CHECK(s * y >= lo - 1e-12 && s * y <= hi + 1e-12);
+                continue;
+            }
+            for (int t = 0; t < 100 && x != 0; t++) {
+                CHECK(s * x < x0);
+                mf.step(&mf, &x, &y);
+                x = y;
+            }
+            CHECK(x == 0);
+        }
+    }
+    CHECK_INT(escape, 2);
+    CHECK_INT(repeller, 2);
+    CHECK(points >= 3); /* the origin and +-x0* */
+    cm_model_release(&mf);
+}
+
 static void friction_and_delay_fixed_points(void)
 {
     cm_model mf = make("microchaos-1d-friction", NULL); /* Fig. 4.4 defaults */
@@ -427,6 +482,7 @@ static void friction_and_delay_fixed_points(void)
     CHECK_NEAR(fp[3].x[0], (b + c) / (a - 1), 1e-14); /* 2.67: band 2, virtual */
     CHECK(!fp[3].regular);
     cm_model_release(&mf);
+    friction_1d_overlays();
     cm_model md = make("microchaos-delay", "a=1.5,b=0.6");
     const size_t nd = fixed(&md, 0, 6, fp);
     for (size_t i = 0; i < nd; i++) {

@@ -157,6 +157,9 @@ done
 # |I0| = 0.25: the escape numbers across the domain at a = 1.5, and the mean
 # escape number against a, four ways
 "$CM" escape --param a=1.5,b=1.3 --I0 0.25 --cells 0 --ensemble 0 --png fig-4.5-escape.png --quiet
+# the map's graph there (c = 0.15) with I_rep (orange) and I0 (blue) on the diagonal
+"$CM" solve --model microchaos-1d-friction --param a=1.5,b=1.3,c=0.15 --region=-1.6:1.6 \
+  --cells 3200 --png fig-4.5-graph.png --layers all --size 700x700 > /dev/null
 "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:64 --ensemble 200000 \
   --png fig-4.7-escape.png --quiet
 
