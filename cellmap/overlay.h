@@ -21,6 +21,8 @@ enum cm_overlay_kind {
     CM_OVERLAY_FIXED_VIRTUAL,      /* point a: a fixed point outside its band */
     CM_OVERLAY_REPELLER,           /* segment a-b: holds a chaotic repeller (transient chaos) */
     CM_OVERLAY_ESCAPE,             /* segment a-b: orbits that reach it end their transient */
+    CM_OVERLAY_COLLISION,          /* point a: two neighbouring switching lines touch */
+    CM_OVERLAY_COLLISION_HIGHER,   /* point a: SW_m and SW_m+n touch, n >= 2 */
     CM_OVERLAY_KINDS
 };
 

@@ -1,7 +1,10 @@
 /* Twofold quantisation of the PD map (4.84): u = Int(rho (P Int(x/rho) +
  * D Int(x'/rho))), [x, x'] -> A [x, x'] + b u. docs/models.md 7. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "models/microchaos_pd_twofold.h"
 
 #include "models/microchaos_pd.h"
 #include "models/models.h"
@@ -71,35 +74,62 @@ static bool tile_level(const twofold_map *c, double i, double k, double *u)
     return twofold_control(c, centre, u);
 }
 
+/* The order of the switching line collision at a corner of four tiles
+ * (levels a, b below it, c, d above it; a, d and b, c diagonal), 0 if none:
+ * the levels of one diagonal lie one below and one above those of the
+ * other, so the lines around the lower tile and around the upper one touch
+ * at the corner (SW_m and SW_m+n, n = 1 + the other diagonal's spread), and
+ * the bands between are pinched there. */
+int cm_twofold_collision_order(double a, double b, double c, double d)
+{
+    if (isnan(a) || isnan(b) || isnan(c) || isnan(d)) /* a tile without a level */
+        return 0;
+    const double diag[2][2] = {{a, d}, {b, c}};
+    for (int k = 0; k < 2; k++) {
+        const double *p = diag[k], *q = diag[1 - k];
+        const double qlo = fmin(q[0], q[1]), qhi = fmax(q[0], q[1]);
+        if (fmin(p[0], p[1]) < qlo && fmax(p[0], p[1]) > qhi)
+            return (int)(qhi - qlo) + 1;
+    }
+    return 0;
+}
+
 /* The overlays of the view (thesis Figs. 4.33-4.36): the stair-shaped
  * switching lines, the edges of the input tiles (rho x rho) across which
- * the control level changes, and the fixed points with the PD map's
- * manifolds. Tiles finer than the view can show (more than 400 across)
- * give no stairs. */
+ * the control level changes; the tile corners where two switching lines
+ * collide (first order, and higher); and the fixed points. Tiles finer
+ * than the view can show (more than 400 across) give no stairs. */
 static void overlays_twofold(const cm_model *m, const double lo[2], const double hi[2],
                              cm_overlay_list *out)
 {
     const twofold_map *c = m->ctx;
     const double i0 = floor(lo[0] / c->rho) - 1, i1 = ceil(hi[0] / c->rho),
                  k0 = floor(lo[1] / c->rho) - 1, k1 = ceil(hi[1] / c->rho);
-    if (i1 - i0 <= 400 && k1 - k0 <= 400) {
-        for (double i = i0; i <= i1; i++)
-            for (double k = k0; k <= k1; k++) {
-                double u, right, above;
-                if (!tile_level(c, i, k, &u))
-                    continue;
-                /* the tile's right and upper edges, where the neighbour differs */
-                const double x = (i + 1) * c->rho, v = (k + 1) * c->rho;
-                const double edges[2][4] = {{x, k * c->rho, x, v}, {i * c->rho, v, x, v}};
-                const bool differs[2] = {tile_level(c, i + 1, k, &right) && right != u,
-                                         tile_level(c, i, k + 1, &above) && above != u};
-                for (int e = 0; e < 2; e++) {
-                    const double a[2] = {edges[e][0], edges[e][1]}, b[2] = {edges[e][2], edges[e][3]};
-                    if (differs[e] && (cm_overlay_in_view(a, lo, hi) || cm_overlay_in_view(b, lo, hi)))
-                        cm_overlay_add(out, CM_OVERLAY_SWITCHING_LINE, a, b);
-                }
+    const size_t ni = (size_t)(i1 - i0 + 2), nk = (size_t)(k1 - k0 + 2);
+    double *level = i1 - i0 <= 400 && k1 - k0 <= 400 ? malloc(ni * nk * sizeof *level) : NULL;
+    for (size_t t = 0; level && t < ni * nk; t++) /* tiles i0..i1+1 by k0..k1+1; NaN: none */
+        if (!tile_level(c, i0 + (double)(t % ni), k0 + (double)(t / ni), &level[t]))
+            level[t] = NAN;
+    for (size_t kk = 0; level && kk + 1 < nk; kk++)
+        for (size_t ii = 0; ii + 1 < ni; ii++) {
+            const double *at = &level[kk * ni + ii], u = at[0], right = at[1], above = at[ni];
+            /* the tile's right and upper edges, where the neighbour differs */
+            const double x = (i0 + (double)ii + 1) * c->rho, v = (k0 + (double)kk + 1) * c->rho;
+            const double edges[2][4] = {{x, v - c->rho, x, v}, {x - c->rho, v, x, v}};
+            const bool differs[2] = {right != u, above != u}; /* NaN differs from all */
+            for (int e = 0; e < 2; e++) {
+                const double a[2] = {edges[e][0], edges[e][1]}, b[2] = {edges[e][2], edges[e][3]};
+                if (differs[e] && !isnan(u) && !isnan(e ? above : right) &&
+                    (cm_overlay_in_view(a, lo, hi) || cm_overlay_in_view(b, lo, hi)))
+                    cm_overlay_add(out, CM_OVERLAY_SWITCHING_LINE, a, b);
             }
-    }
+            const double corner[2] = {x, v};
+            const int order = cm_twofold_collision_order(u, right, above, at[ni + 1]);
+            if (order && cm_overlay_in_view(corner, lo, hi))
+                cm_overlay_add(out, order == 1 ? CM_OVERLAY_COLLISION : CM_OVERLAY_COLLISION_HIGHER,
+                               corner, NULL);
+        }
+    free(level);
     /* the fixed points x* = [u/alpha^2, 0], regular where the control law
      * there gives u */
     const double u0 = ceil(lo[0] * c->alpha2), u1 = floor(hi[0] * c->alpha2);

@@ -17,6 +17,8 @@ static const cm_rgb diagonal_colour = {150, 150, 150};
 static const cm_rgb graph_colour = {0, 0, 0};
 static const cm_rgb repeller_colour = {230, 159, 0}; /* Okabe-Ito orange and blue */
 static const cm_rgb escape_colour = {0, 114, 178};
+static const cm_rgb collision_colour = {220, 30, 30}; /* the thesis' red and orange */
+static const cm_rgb higher_collision_colour = {255, 150, 0};
 
 static void colour(cm_rgb c) { glColor3ub(c.r, c.g, c.b); }
 
@@ -195,17 +197,30 @@ static void draw_circle(double x, double y, double rx, double ry, bool filled, f
     glLineWidth(1.0f);
 }
 
-/* Regular fixed points as white discs ringed black, virtual ones as black
- * rings (Figs. 4.13, 4.26). */
-static void draw_fixed_points(const cm_overlay_list *ov, double px, double py, int lw)
+/* The discs of point overlays, ringed black: regular fixed points white,
+ * virtual ones only the ring (Figs. 4.13, 4.26); switching line collisions
+ * red, higher-order ones orange (Figs. 4.34, 4.35). False: not a point. */
+static bool point_style(int kind, bool *filled, cm_rgb *fill)
+{
+    *filled = kind != CM_OVERLAY_FIXED_VIRTUAL;
+    *fill = kind == CM_OVERLAY_FIXED_REGULAR ? switching_colour
+            : kind == CM_OVERLAY_COLLISION   ? collision_colour
+                                             : higher_collision_colour;
+    return kind == CM_OVERLAY_FIXED_REGULAR || kind == CM_OVERLAY_FIXED_VIRTUAL ||
+           kind == CM_OVERLAY_COLLISION || kind == CM_OVERLAY_COLLISION_HIGHER;
+}
+
+static void draw_points(const cm_overlay_list *ov, double px, double py, int lw)
 {
     const double r = 2.0 + 1.5 * lw;
     for (size_t k = 0; k < ov->count; k++) {
         const cm_overlay *o = &ov->items[k];
-        if (o->kind != CM_OVERLAY_FIXED_REGULAR && o->kind != CM_OVERLAY_FIXED_VIRTUAL)
+        bool filled;
+        cm_rgb fill;
+        if (!point_style(o->kind, &filled, &fill))
             continue;
-        if (o->kind == CM_OVERLAY_FIXED_REGULAR) {
-            colour(switching_colour);
+        if (filled) {
+            colour(fill);
             draw_circle(o->a[0], o->a[1], r * px, r * py, true, 0);
         }
         colour(manifold_colour);
@@ -213,12 +228,15 @@ static void draw_fixed_points(const cm_overlay_list *ov, double px, double py, i
     }
 }
 
-static void draw_overlay_lines(const cm_overlay_list *ov, int lw)
+/* Switching lines are white over basins (as the thesis draws them) and
+ * black on paper (Fig. 4.34). */
+static void draw_overlay_lines(const cm_overlay_list *ov, int lw, bool on_paper)
 {
     draw_segments(ov, CM_OVERLAY_REPELLER, repeller_colour, (float)(3 * lw), 0, 1);
     draw_segments(ov, CM_OVERLAY_ESCAPE, escape_colour, (float)(3 * lw), 0, 1);
     draw_segments(ov, CM_OVERLAY_STICKING_ZONE, zone_colour, (float)(2 * lw + 1), 0, 1);
-    draw_segments(ov, CM_OVERLAY_SWITCHING_LINE, switching_colour, (float)lw, 0, 1);
+    draw_segments(ov, CM_OVERLAY_SWITCHING_LINE, on_paper ? manifold_colour : switching_colour,
+                  (float)lw, 0, 1);
     draw_segments(ov, CM_OVERLAY_UNSTABLE_MANIFOLD, manifold_colour, (float)lw, 0x00FF, 2 * lw);
     draw_segments(ov, CM_OVERLAY_STABLE_MANIFOLD, manifold_colour, (float)lw, 0x3333, 2 * lw);
 }
@@ -295,13 +313,14 @@ static void draw_basin_panel(const cm_plot *p, const tile *t)
         draw_raster(p->ras, p->basin.lo, p->basin.hi);
     const bool graph = p->graph.w > 0;
     if (p->overlays && !graph && (p->layers & CM_LAYER_OVERLAYS))
-        draw_overlay_lines(p->overlays, p->line_width);
+        draw_overlay_lines(p->overlays, p->line_width,
+                           !(p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS)));
     if (p->layers & CM_LAYER_ATTRACTORS) { /* attractors last: they stay black */
         draw_markers(p, &p->basin, CM_GROUP_STICKING, px, py);
         draw_markers(p, &p->basin, CM_GROUP_ATTRACTOR, px, py);
     }
     if (p->overlays && !graph && (p->layers & CM_LAYER_OVERLAYS))
-        draw_fixed_points(p->overlays, px, py, p->line_width);
+        draw_points(p->overlays, px, py, p->line_width);
 }
 
 static void draw_graph_panel(const cm_plot *p, const tile *t)
@@ -313,8 +332,8 @@ static void draw_graph_panel(const cm_plot *p, const tile *t)
     if (p->layers & CM_LAYER_ATTRACTORS)
         draw_cobwebs(p, p->line_width);
     if (p->overlays && (p->layers & CM_LAYER_OVERLAYS)) {
-        draw_overlay_lines(p->overlays, p->line_width);
-        draw_fixed_points(p->overlays, px, py, p->line_width);
+        draw_overlay_lines(p->overlays, p->line_width, true);
+        draw_points(p->overlays, px, py, p->line_width);
     }
 }
 

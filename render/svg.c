@@ -175,7 +175,9 @@ static void overlays(FILE *f, const figure *F, const cm_panel *pn)
     segments(f, ov, &m, CM_OVERLAY_ESCAPE, style);
     snprintf(style, sizeof style, "stroke=\"#282828\" stroke-width=\"%d\"", 2 * lw + 1);
     segments(f, ov, &m, CM_OVERLAY_STICKING_ZONE, style);
-    snprintf(style, sizeof style, "stroke=\"#ffffff\" stroke-width=\"%d\"", lw);
+    const bool on_paper = pn == &F->p.graph || !(F->p.layers & (CM_LAYER_BASIN | CM_LAYER_STEPS));
+    snprintf(style, sizeof style, "stroke=\"%s\" stroke-width=\"%d\"",
+             on_paper ? "#000000" : "#ffffff", lw); /* white over basins, black on paper */
     segments(f, ov, &m, CM_OVERLAY_SWITCHING_LINE, style);
     snprintf(style, sizeof style, "stroke=\"#000000\" stroke-width=\"%d\" stroke-dasharray=\"%d %d\"",
              lw, 16 * lw, 16 * lw);
@@ -186,12 +188,16 @@ static void overlays(FILE *f, const figure *F, const cm_panel *pn)
     const double r = 2.0 + 1.5 * lw;
     for (size_t k = 0; k < ov->count; k++) {
         const cm_overlay *o = &ov->items[k];
-        if (o->kind == CM_OVERLAY_FIXED_REGULAR || o->kind == CM_OVERLAY_FIXED_VIRTUAL)
+        const char *fill = o->kind == CM_OVERLAY_FIXED_REGULAR       ? "#ffffff"
+                           : o->kind == CM_OVERLAY_FIXED_VIRTUAL     ? "none"
+                           : o->kind == CM_OVERLAY_COLLISION         ? "#dc1e1e"
+                           : o->kind == CM_OVERLAY_COLLISION_HIGHER ? "#ff9600"
+                                                                     : NULL;
+        if (fill)
             fprintf(f,
                     "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\" stroke=\"#000000\" "
                     "stroke-width=\"%d\"/>\n",
-                    px_x(&m, o->a[0]), px_y(&m, o->a[1]), r,
-                    o->kind == CM_OVERLAY_FIXED_REGULAR ? "#ffffff" : "none", lw);
+                    px_x(&m, o->a[0]), px_y(&m, o->a[1]), r, fill, lw);
     }
     fputs("</g>\n", f);
 }

@@ -552,6 +552,111 @@ static void friction_and_delay_fixed_points(void)
     cm_model_release(&mt);
 }
 
+/* The control level of twofold quantisation at x, read off one step. */
+static double twofold_level(const cm_model *m, const cm_pd_coef *k, double x, double v)
+{
+    const double s[2] = {x, v};
+    double y[2];
+    CHECK_INT(m->step(m, s, y), 0);
+    return round((y[1] - k->A[2] * x - k->A[3] * v) / k->b[1]);
+}
+
+typedef struct slc_count {
+    int first, higher; /* collision points of order 1 and >= 2 */
+    int ties;          /* vertical (horizontal) edges where the level before output
+                          rounding is an integer in exact arithmetic */
+    int jumps;         /* other such edges across which the level jumps by n */
+} slc_count;
+
+/* Switching line collisions of Figs. 4.34-4.35 (P = 2/5, D = 2/9) over
+ * tiles 2..60 in x and x' (off the double deadzone at 0), each checked on
+ * the map: the four tiles' levels, one diagonal below and above the other. */
+static slc_count twofold_slc(double rho, int n_jump, bool vertical)
+{
+    char text[160];
+    snprintf(text, sizeof text, "alpha=0.5,beta=0.1,P=0.4,D=%.17g,rho=%.17g", 2.0 / 9, rho);
+    cm_model m = make("microchaos-pd-twofold", text);
+    cm_pd_coef k;
+    cm_pd_coefficients(0.5, 0.1, 0.4, 2.0 / 9, &k);
+    static cm_overlay items[1 << 15];
+    cm_overlay_list ov = {items, 1 << 15, 0, false};
+    const double lo[2] = {2 * rho + 1e-9 * rho, 2 * rho + 1e-9 * rho}, hi[2] = {60 * rho, 60 * rho};
+    m.overlays(&m, lo, hi, &ov);
+    CHECK(!ov.truncated);
+    slc_count n = {0, 0, 0, 0};
+    int switching = 0, differing = 0; /* edges inside: overlays, and by the map */
+    for (size_t i = 0; i < ov.count; i++) {
+        const cm_overlay *o = &items[i];
+        if (o->kind == CM_OVERLAY_SWITCHING_LINE) {
+            switching += o->a[0] > lo[0] && o->b[0] < hi[0] && o->a[1] > lo[1] && o->b[1] < hi[1];
+            continue;
+        }
+        if (o->kind != CM_OVERLAY_COLLISION && o->kind != CM_OVERLAY_COLLISION_HIGHER)
+            continue;
+        const double h = rho / 2, x = o->a[0], v = o->a[1];
+        const double a = twofold_level(&m, &k, x - h, v - h), b = twofold_level(&m, &k, x + h, v - h),
+                     c = twofold_level(&m, &k, x - h, v + h), d = twofold_level(&m, &k, x + h, v + h);
+        /* with P, D > 0 the levels grow to the upper right: a, d around b, c */
+        CHECK(a < fmin(b, c) && d > fmax(b, c));
+        const int order = (int)fabs(b - c) + 1;
+        CHECK_INT(o->kind == CM_OVERLAY_COLLISION, order == 1);
+        if (order == 1)
+            n.first++;
+        else
+            n.higher++;
+    }
+    /* tiles i, k: [i rho, (i + 1) rho) x [k rho, (k + 1) rho) */
+    for (int i = 3; i < 60; i++)
+        for (int j = 3; j < 59; j++)
+            for (int e = 0; e < 2; e++) { /* e = 0: the edge x = i rho; 1: x' = i rho */
+                const int ti = e ? j : i, tk = e ? i : j; /* the tile above or right */
+                const double upper = twofold_level(&m, &k, (ti + 0.5) * rho, (tk + 0.5) * rho),
+                             lower = twofold_level(&m, &k, (ti - !e + 0.5) * rho,
+                                                   (tk - e + 0.5) * rho);
+                differing += upper != lower;
+                if (e != vertical) {
+                    const double z = rho * (0.4 * (ti - !e) + 2.0 / 9 * (tk - e));
+                    const bool tie = fabs(z - round(z)) < 1e-9;
+                    n.ties += tie;
+                    n.jumps += !tie && upper - lower == n_jump;
+                }
+            }
+    CHECK_INT(switching, differing); /* the stairs are where the map's level changes */
+    cm_model_release(&m);
+    return n;
+}
+
+/* Thesis (4.87)-(4.92) at P = 2/5, D = 2/9: first-order collisions exist
+ * only for 1/(P + D) < rho < 1/(P - D) (the lowest and highest ratios), and
+ * from there higher orders take their place; at rho = n/P the level jumps
+ * by exactly n across every vertical tile edge (so each switching line
+ * meets its n-th neighbour at every x = i rho), at n/D across every
+ * horizontal one. Edges where the level before output rounding is an
+ * integer in exact arithmetic are ties that floating point may round
+ * either way; they are left out. */
+static void twofold_collision_ratios(void)
+{
+    const double P = 0.4, D = 2.0 / 9;
+    const int edges = 57 * 56; /* vertical (or horizontal) tile edges counted */
+    CHECK_INT(twofold_slc(0.99 / (P + D), 1, true).first, 0);
+    CHECK(twofold_slc(1.01 / (P + D), 1, true).first > 0);
+    CHECK(twofold_slc(0.99 / (P - D), 1, true).first > 0);
+    const slc_count above = twofold_slc(1.01 / (P - D), 1, true);
+    CHECK(above.first == 0 && above.higher > 0);
+    const slc_count left = twofold_slc(1.0, 1, true), right = twofold_slc(1.65, 1, true);
+    CHECK(left.first + left.higher == 0 && right.first > 0); /* Fig. 4.34 */
+    CHECK(twofold_slc(2 / P, 2, true).higher > 0);           /* Fig. 4.35 (right) */
+    for (int n = 1; n <= 2; n++)
+        for (int vertical = 1; vertical >= 0; vertical--) {
+            const double rho = n / (vertical ? P : D);
+            const slc_count at = twofold_slc(rho, n, vertical);
+            CHECK(at.ties < edges / 4);
+            CHECK_INT(at.jumps + at.ties, edges);
+            const slc_count below = twofold_slc(0.97 * rho, n, vertical);
+            CHECK(below.jumps + below.ties < edges); /* some edges jump by n - 1 */
+        }
+}
+
 static void parameter_errors(void)
 {
     const struct {
@@ -592,5 +697,6 @@ int main(void)
     general_equals_specific();
     friction_and_delay_fixed_points();
     parameter_errors();
+    twofold_collision_ratios();
     CHECK_DONE();
 }

@@ -140,6 +140,16 @@ done
   --region=-6:6,-3:3 --cells 600x300 --png fig-4.33-twofold.png --layers all --size 1000x560 \
   > /dev/null
 
+# Figs. 4.34 and 4.35: switching line collisions at P = 2/5, D = 2/9 (the
+# lines on paper, black; first-order collisions red, higher orange):
+# rho = 1.0 and 1.65 (just above 1/(P + D) = 1.61), 1/P = 2.5 and 2/P = 5
+for f in 4.34:1.0:12:8 4.34:1.65:12:8 4.35:2.5:25:16 4.35:5:25:16; do
+  IFS=: read -r fig rho wx wv <<< "$f"
+  "$CM" solve --model microchaos-pd-twofold --param alpha=0.5,beta=0.1,P=0.4,D=0.2222222222222222,rho=$rho \
+    --region=-$wx:$wx,-$wv:$wv --cells 120x80 --png fig-$fig-rho$rho.png \
+    --layers overlays,axes,title --size 720x480 > /dev/null
+done
+
 # Fig. 4.11: the delay map's attractor partitioned (a = 1.3, b = 0.66)
 "$CM" partition --param a=1.3,b=0.66 --png fig-4.11-partition.png --quiet
 
