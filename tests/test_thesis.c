@@ -102,7 +102,31 @@ static void fig_4_16(void)
     CHECK(sw7 < total / 20);
     /* the mirror image on the negative side */
     CHECK_INT(basin_between(&s, -5 * xs, -4 * xs, 1), sw5);
+    /* At SW_7 cell mapping finds cycles on the repeller (a period-25 group
+     * on these cells) whose cells' true orbits leave for SW_6; their basins
+     * shrink with the cells: 2.9 % here, 0.1 % on cells half as large. */
+    CHECK(sw7 > total / 50);
+    cm_model m;
+    char msg[256];
+    const char *texts[1] = {"alpha=0.8,beta=0.3,P=0.7,D=0.6"};
+    CHECK(cm_model_create("microchaos-pd", texts, 1, &m, msg, sizeof msg) == CM_OK);
+    for (uint32_t k = 0; k < s.r.ngroups; k++) {
+        if (!(s.g[k].lo[0] > 6 * xs && s.g[k].hi[0] < 7 * xs && s.g[k].basin_cells > total / 100))
+            continue;
+        double x[2] = {s.g[k].centre[0], s.g[k].centre[1]}, y[2];
+        for (int t = 0; t < 5000; t++) {
+            CHECK_INT(m.step(&m, x, y), CM_STEP_OK);
+            x[0] = y[0], x[1] = y[1];
+        }
+        CHECK(x[0] > 5 * xs && x[0] < 6 * xs); /* at SW_6 */
+    }
+    cm_model_release(&m);
     release(&s);
+    solved fine = run("alpha=0.8,beta=0.3,P=0.7,D=0.6", -13, 13, -4, 4, 2600, 800, 1);
+    const uint64_t sw7_fine = basin_between(&fine, 6 * xs, 7 * xs, 1);
+    fprintf(stderr, "Fig 4.16 on cells of 0.01: SW7 %.4f\n", (double)sw7_fine / fine.r.ncells);
+    CHECK(sw7_fine < fine.r.ncells / 500);
+    release(&fine);
 }
 
 /* Fig. 4.21 (alpha = 6.8511e-3, beta = 0, P = 5.4997e-5, D = 2.5665e-3):
