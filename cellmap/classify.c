@@ -18,7 +18,18 @@
  * fully known, the result equals the sequential algorithm's: group ids are
  * finally renumbered in order of the lowest local index in each domain,
  * which is exactly the order in which a sequential scan discovers them.
- * Everything runs on one thread, so it is deterministic.
+ * With threads, the cells are cut into one block of indices per thread
+ * (cm_classify_threads): each thread walks its block as above, and a path
+ * that runs into another block stops at the block's edge, pending, its cells
+ * keeping the last cell before the edge (the block's *exit*) and their
+ * distance to it. One thread then follows the exits from block to block:
+ * to a classified cell (each exit takes that cell's group and step), or
+ * back to an exit of the same chain (a cycle through several blocks, whose
+ * cells it marks periodic). Each thread finally settles its pending cells
+ * from their exits; those whose exit lies on such a cycle are walked again,
+ * since their step counts to where they meet the cycle. Groups are
+ * renumbered as above, so the result is the sequential one, whatever the
+ * number of threads.
  */
 #include "cellmap/classify.h"
 
@@ -26,6 +37,9 @@
 
 #include <stdbool.h>
 #include <stdlib.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* step[] holds each cell's state (classify.h); while a cell is on a walk's
  * path, group[] holds LANE_MARK + the walk's lane, above every group id. */
@@ -37,30 +51,56 @@
  * image[] from the last remembered cell. */
 #define LANE_BUFFER 4096
 #define NO_LANE (-1)
+/* With blocks, a cell whose path left its block is pending: step[] holds
+ * PENDING | its distance to the block's exit plus one, group[] the exit.
+ * Blocks are used only below 2^30 cells, so final steps stay below it. */
+#define PENDING UINT32_C(0x40000000)
+#define BLOCKS_MAX_CELLS (UINT32_C(1) << 30)
 
 typedef struct lane {
     bool busy;
     uint32_t start; /* first cell of the path */
     uint32_t len;   /* cells on the path */
     uint32_t next;  /* cell the walk enters next: image of the last path cell */
+    uint32_t last;  /* the last path cell */
     uint32_t *path; /* LANE_BUFFER entries */
 } lane;
 
 typedef struct classifier {
     uint32_t n;
+    uint32_t lo, hi; /* the block of cells walked; images outside it leave it */
     const uint32_t *image;
     uint32_t *group, *step;
-    uint32_t cursor;  /* every cell below it has been started or visited */
+    uint32_t cursor;  /* every cell of the block below it has been started or visited */
     uint32_t ngroups; /* provisional groups found so far */
+    uint32_t max_groups; /* the largest provisional id the block may give */
+    uint32_t *exits;     /* the block's exits, in the order found (with blocks) */
+    size_t nexits, exits_cap;
+    cm_status status; /* of the block's last walk */
     int node_refs;    /* paths into recorded exits take CM_NODE_REF | exit */
     lane lanes[LANES];
 } classifier;
 
 typedef enum { WALK_ON, WALK_WAIT, WALK_DONE } walk_result;
 
+static bool grow(void **items, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return true;
+    const size_t cap2 = need > 2 * *cap ? need : 2 * *cap;
+    void *p = realloc(*items, cap2 * size);
+    if (!p)
+        return false;
+    *items = p;
+    *cap = cap2;
+    return true;
+}
+
+static bool in_block(const classifier *c, uint32_t cell) { return cell - c->lo < c->hi - c->lo; }
+
 static void prefetch_cell(const classifier *c, uint32_t cell)
 {
-    if (cell < c->n) {
+    if (in_block(c, cell)) {
         __builtin_prefetch(&c->step[cell], 1);
         __builtin_prefetch(&c->group[cell], 1);
         __builtin_prefetch(&c->image[cell], 0);
@@ -71,7 +111,7 @@ static void prefetch_cell(const classifier *c, uint32_t cell)
  * classified or outside the region. */
 static int lane_of(const classifier *c, uint32_t cell)
 {
-    if (cell >= c->n)
+    if (!in_block(c, cell))
         return NO_LANE;
     const uint32_t s = c->step[cell];
     if (s == CM_STEP_UNVISITED || !(s & CM_STEP_ON_PATH))
@@ -101,22 +141,24 @@ static void append(classifier *c, int k, uint32_t cell)
         l->path[l->len] = cell;
     c->step[cell] = CM_STEP_ON_PATH | l->len++;
     c->group[cell] = LANE_MARK + (uint32_t)k;
+    l->last = cell;
     l->next = c->image[cell];
     prefetch_cell(c, l->next);
 }
 
 /* Labels the lane's path: the cells from position cycle_at on are periodic
  * (cycle_at == UINT32_MAX: none), the others count their steps to the cycle
- * or to the cell the path ran into, whose step is tail_step. */
+ * or to the cell the path ran into, whose step is tail_step; `pending`
+ * (0 or PENDING) marks steps counted to the block's exit. */
 static void label(classifier *c, const lane *l, uint32_t group, uint32_t cycle_at,
-                  uint32_t tail_step)
+                  uint32_t tail_step, uint32_t pending)
 {
     uint32_t cell = l->start;
     for (uint32_t pos = 0; pos < l->len; pos++) {
         cell = pos < LANE_BUFFER ? l->path[pos] : c->image[cell];
         c->group[cell] = group;
         if (cycle_at == UINT32_MAX)
-            c->step[cell] = tail_step + (l->len - pos);
+            c->step[cell] = pending | (tail_step + (l->len - pos));
         else
             c->step[cell] = pos >= cycle_at ? 0 : cycle_at - pos;
     }
@@ -125,10 +167,10 @@ static void label(classifier *c, const lane *l, uint32_t group, uint32_t cycle_a
 /* Starts the lane on the next unvisited cell; false when none is left. */
 static bool start_walk(classifier *c, int k)
 {
-    while (c->cursor < c->n && c->step[c->cursor] != CM_STEP_UNVISITED)
+    while (c->cursor < c->hi && c->step[c->cursor] != CM_STEP_UNVISITED)
         c->cursor++;
     lane *l = &c->lanes[k];
-    l->busy = c->cursor < c->n;
+    l->busy = c->cursor < c->hi;
     if (!l->busy)
         return false;
     l->start = c->cursor;
@@ -144,7 +186,16 @@ static walk_result advance(classifier *c, int k, cm_status *st)
     const uint32_t cell = l->next;
     if (cell >= c->n) { /* the sink's domain, through the node on the path's end */
         const int64_t exit = c->node_refs ? cm_image_exit_index(cell) : -1;
-        label(c, l, exit >= 0 ? CM_NODE_REF | (uint32_t)exit : 0, UINT32_MAX, 0);
+        label(c, l, exit >= 0 ? CM_NODE_REF | (uint32_t)exit : 0, UINT32_MAX, 0, 0);
+        return WALK_DONE;
+    }
+    if (!in_block(c, cell)) { /* another block's cell: pending at this block's exit */
+        if (!grow((void **)&c->exits, &c->exits_cap, c->nexits + 1, sizeof *c->exits)) {
+            *st = CM_ENOMEM;
+            return WALK_DONE;
+        }
+        c->exits[c->nexits++] = l->last;
+        label(c, l, l->last, UINT32_MAX, 0, PENDING);
         return WALK_DONE;
     }
     const uint32_t s = c->step[cell];
@@ -152,17 +203,17 @@ static walk_result advance(classifier *c, int k, cm_status *st)
         append(c, k, cell);
         return WALK_ON;
     }
-    if (!(s & CM_STEP_ON_PATH)) { /* a classified cell */
-        label(c, l, c->group[cell], UINT32_MAX, s);
+    if (!(s & CM_STEP_ON_PATH)) { /* a classified cell, or a pending one */
+        label(c, l, c->group[cell], UINT32_MAX, s & ~PENDING, s & PENDING);
         return WALK_DONE;
     }
     const int owner = (int)(c->group[cell] - LANE_MARK);
     if (owner == k) { /* the path closes a new cycle */
-        if (c->ngroups == CM_MAX_GROUPS) {
+        if (c->ngroups == c->max_groups) {
             *st = CM_ETOOBIG;
             return WALK_DONE;
         }
-        label(c, l, ++c->ngroups, s & ~CM_STEP_ON_PATH, 0);
+        label(c, l, ++c->ngroups, s & ~CM_STEP_ON_PATH, 0, 0);
         return WALK_DONE;
     }
     if (!waits_on(c, owner, k))
@@ -180,56 +231,379 @@ static walk_result advance(classifier *c, int k, cm_status *st)
     return WALK_ON;
 }
 
-/* Renumbers groups in order of the lowest local index of their domain. */
-static cm_status renumber(classifier *c, char *msg, size_t msg_size)
+/* Walks every unvisited cell of the classifier's block. */
+static cm_status walk_block(classifier *c, uint32_t *buffers)
 {
-    uint32_t *final_id = malloc(((size_t)c->ngroups + 1) * sizeof *final_id);
+    c->cursor = c->lo;
+    int busy = 0;
+    for (int k = 0; k < LANES; k++) {
+        c->lanes[k].path = buffers + (size_t)k * LANE_BUFFER;
+        busy += start_walk(c, k);
+    }
+    cm_status st = CM_OK;
+    while (busy > 0 && st == CM_OK) {
+        for (int k = 0; k < LANES; k++) {
+            if (!c->lanes[k].busy || advance(c, k, &st) != WALK_DONE)
+                continue;
+            c->lanes[k].busy = false;
+            busy--;
+            busy += st == CM_OK && start_walk(c, k);
+        }
+    }
+    return st;
+}
+
+/* Where block b of `threads` starts (b = threads: n). */
+static uint32_t block_end(uint32_t n, int b, int threads)
+{
+    return (uint32_t)((uint64_t)n * (uint64_t)b / (uint64_t)threads);
+}
+
+/* Provisional group ids: block b numbers its groups b * 2^shift + 1 .. and
+ * the cycles through several blocks take the next range; compact[] says
+ * where each range starts in one dense numbering. */
+typedef struct id_ranges {
+    int shift;
+    uint32_t compact[65]; /* per range: dense index of its id 0 */
+    uint32_t count;       /* dense indices in use, the sink's 0 included */
+} id_ranges;
+
+static uint32_t dense_id(const id_ranges *r, uint32_t g)
+{
+    return r->compact[g >> r->shift] + (g & ((UINT32_C(1) << r->shift) - 1));
+}
+
+/* Renumbers groups in order of the lowest local index of their domain. */
+static cm_status renumber(uint32_t n, uint32_t *group, const id_ranges *ids, uint32_t *ngroups,
+                          char *msg, size_t msg_size)
+{
+    uint32_t *final_id = malloc((size_t)ids->count * sizeof *final_id);
     if (!final_id)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory renumbering groups");
     final_id[0] = 0;
-    for (uint32_t g = 1; g <= c->ngroups; g++)
+    for (uint32_t g = 1; g < ids->count; g++)
         final_id[g] = UINT32_MAX;
     uint32_t next_id = 1;
-    for (uint32_t i = 0; i < c->n; i++) {
-        uint32_t *g = &c->group[i];
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t *g = &group[i];
         if (*g & CM_NODE_REF)
             continue;
-        if (final_id[*g] == UINT32_MAX)
-            final_id[*g] = next_id++;
-        *g = final_id[*g];
+        uint32_t *id = &final_id[dense_id(ids, *g)];
+        if (*id == UINT32_MAX)
+            *id = next_id++;
+        *g = *id;
     }
     free(final_id);
+    *ngroups = next_id - 1;
     return CM_OK;
 }
 
-cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
-                      uint32_t *ngroups, int node_refs, char *msg, size_t msg_size)
+/* ---- several blocks ------------------------------------------------------------ */
+
+static bool is_final(uint32_t s) { return !(s & (PENDING | CM_STEP_ON_PATH)); }
+
+/* An exit on the chain the resolver follows, and the distance plus one from
+ * its image to the image's own exit (when that image is pending). */
+typedef struct chain_link {
+    uint32_t exit, target_local;
+} chain_link;
+
+typedef struct resolver {
+    const uint32_t *image;
+    uint32_t *group, *step;
+    chain_link *chain; /* the exits followed so far; step[] of each: ON_PATH | position */
+    size_t len, cap;
+    uint32_t *path; /* cells of a tree walked to a cycle */
+    size_t path_cap;
+    uint32_t next_group, max_group; /* ids of cycles through several blocks */
+} resolver;
+
+/* The step of pending cell t whose exit lies on a cycle: the walk from t to
+ * the first classified cell (a cell of the cycle, or of a tree labelled
+ * before), whose cells it labels. */
+static cm_status walk_to_cycle(resolver *r, uint32_t t, uint32_t *step_of_t)
 {
-    classifier c = {n, image, group, step, 0, 0, node_refs, {{0}}};
+    size_t len = 0;
+    uint32_t cell = t;
+    for (; !is_final(r->step[cell]); cell = r->image[cell]) {
+        if (!grow((void **)&r->path, &r->path_cap, len + 1, sizeof *r->path))
+            return CM_ENOMEM;
+        r->path[len++] = cell;
+    }
+    const uint32_t g = r->group[cell];
+    uint32_t s = r->step[cell];
+    while (len > 0) {
+        const uint32_t c = r->path[--len];
+        r->group[c] = g;
+        r->step[c] = ++s;
+    }
+    *step_of_t = r->step[t];
+    return CM_OK;
+}
+
+/* Settles the exits chain[0..top]: the top one's image has group g and
+ * step t; each lower exit's image is pending at the exit above it. */
+static void settle_chain(resolver *r, size_t top, uint32_t g, uint32_t t)
+{
+    for (size_t j = top;; j--) {
+        const uint32_t e = r->chain[j].exit;
+        r->group[e] = g;
+        r->step[e] = 1 + t;
+        if (j == 0)
+            return;
+        t = r->chain[j - 1].target_local - 1 + r->step[e];
+    }
+}
+
+/* The exits chain[a..top] close a cycle: every cell from each exit's image
+ * to the next exit (chain[a] after the top) is periodic. */
+static void mark_cycle(resolver *r, size_t a, uint32_t g)
+{
+    const size_t top = r->len - 1;
+    for (size_t j = a; j <= top; j++) {
+        const uint32_t end = r->chain[j == top ? a : j + 1].exit;
+        for (uint32_t cell = r->image[r->chain[j].exit];; cell = r->image[cell]) {
+            r->group[cell] = g;
+            r->step[cell] = 0;
+            if (cell == end)
+                break;
+        }
+    }
+}
+
+/* Follows pending exit e from block to block until a classified cell or a
+ * cycle, and settles every exit on the way. */
+static cm_status resolve_exit(resolver *r, uint32_t e)
+{
+    r->len = 0;
+    for (uint32_t cur = e;;) {
+        if (!grow((void **)&r->chain, &r->cap, r->len + 1, sizeof *r->chain))
+            return CM_ENOMEM;
+        r->chain[r->len] = (chain_link){cur, 0};
+        r->step[cur] = CM_STEP_ON_PATH | (uint32_t)r->len++;
+        const uint32_t t = r->image[cur], s = r->step[t];
+        if (is_final(s)) { /* a classified cell: the chain ends */
+            settle_chain(r, r->len - 1, r->group[t], s);
+            return CM_OK;
+        }
+        const bool t_on_chain = s & CM_STEP_ON_PATH;
+        const uint32_t next = t_on_chain ? t : r->group[t], s2 = r->step[next];
+        r->chain[r->len - 1].target_local = t_on_chain ? 1 : s & ~PENDING;
+        if (s2 & CM_STEP_ON_PATH) { /* back on this chain: a cycle */
+            if (r->next_group == r->max_group)
+                return CM_ETOOBIG;
+            const uint32_t g = ++r->next_group;
+            const size_t a = s2 & ~CM_STEP_ON_PATH;
+            mark_cycle(r, a, g);
+            if (a == 0)
+                return CM_OK;
+            const uint32_t below = r->image[r->chain[a - 1].exit];
+            uint32_t t_below = r->step[below];
+            if (!is_final(t_below)) {
+                const cm_status st = walk_to_cycle(r, below, &t_below);
+                if (st != CM_OK)
+                    return st;
+            }
+            settle_chain(r, a - 1, g, t_below);
+            return CM_OK;
+        }
+        if (is_final(s2)) { /* an exit settled before */
+            uint32_t t_step = s2 == 0 ? 0 : r->chain[r->len - 1].target_local - 1 + s2;
+            if (s2 == 0) { /* on a cycle: t hangs on a tree into it */
+                const cm_status st = walk_to_cycle(r, t, &t_step);
+                if (st != CM_OK)
+                    return st;
+            }
+            settle_chain(r, r->len - 1, r->group[next], t_step);
+            return CM_OK;
+        }
+        cur = next;
+    }
+}
+
+/* Settles the pending cells of [lo, hi) from their exits; those whose exit
+ * lies on a cycle become unvisited, to be walked again. */
+static void settle_block(uint32_t lo, uint32_t hi, uint32_t *group, uint32_t *step)
+{
+    for (uint32_t i = lo; i < hi; i++) {
+        const uint32_t s = step[i];
+        if (!(s & PENDING))
+            continue;
+        const uint32_t e = group[i], se = step[e];
+        if (se == 0) {
+            step[i] = CM_STEP_UNVISITED;
+        } else {
+            group[i] = group[e];
+            step[i] = (s & ~PENDING) - 1 + se;
+        }
+    }
+}
+
+/* Renumbers groups as renumber() does, on one thread per block: each lists
+ * its groups in the order they first appear in it, the lists are merged in
+ * block order, and each block relabels its cells. */
+static cm_status renumber_blocks(uint32_t n, uint32_t *group, const id_ranges *ids, int threads,
+                                 uint32_t *ngroups)
+{
+    uint32_t *final_id = malloc((size_t)ids->count * sizeof *final_id);
+    uint8_t *seen = calloc((size_t)threads * ids->count, 1);
+    uint32_t **order = calloc((size_t)threads, sizeof *order);
+    uint32_t *listed = calloc((size_t)threads, sizeof *listed);
+    bool ok = final_id && seen && order && listed;
+    for (int b = 0; ok && b < threads; b++)
+        ok = (order[b] = malloc((size_t)ids->count * sizeof **order)) != NULL;
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (ok)
+    for (int b = 0; b < threads; b++) {
+        if (!ok)
+            continue;
+        uint8_t *mine = seen + (size_t)b * ids->count;
+        const uint32_t hi = block_end(n, b + 1, threads);
+        for (uint32_t i = block_end(n, b, threads); i < hi; i++) {
+            if (group[i] & CM_NODE_REF)
+                continue;
+            const uint32_t d = dense_id(ids, group[i]);
+            if (!mine[d]) {
+                mine[d] = 1;
+                order[b][listed[b]++] = d;
+            }
+        }
+    }
+    uint32_t next_id = 1;
+    if (ok) {
+        final_id[0] = 0;
+        for (uint32_t d = 1; d < ids->count; d++)
+            final_id[d] = UINT32_MAX;
+        for (int b = 0; b < threads; b++)
+            for (uint32_t k = 0; k < listed[b]; k++)
+                if (final_id[order[b][k]] == UINT32_MAX)
+                    final_id[order[b][k]] = next_id++;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (ok)
+    for (int b = 0; b < threads; b++) {
+        const uint32_t hi = block_end(n, b + 1, threads);
+        for (uint32_t i = block_end(n, b, threads); ok && i < hi; i++)
+            if (!(group[i] & CM_NODE_REF))
+                group[i] = final_id[dense_id(ids, group[i])];
+    }
+    for (int b = 0; order && b < threads; b++)
+        free(order[b]);
+    free(order);
+    free(listed);
+    free(seen);
+    free(final_id);
+    *ngroups = next_id - 1;
+    return ok ? CM_OK : CM_ENOMEM;
+}
+
+static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *group,
+                                 uint32_t *step, uint32_t *ngroups, int node_refs, int threads,
+                                 char *msg, size_t msg_size)
+{
+    int shift = 31; /* threads + 1 ranges of ids, 2^shift each */
+    while ((UINT32_C(1) << (31 - shift)) < (uint32_t)threads + 1)
+        shift--;
+    const uint32_t range = UINT32_C(1) << shift;
+    uint32_t *buffers = malloc((size_t)threads * LANES * LANE_BUFFER * sizeof *buffers);
+    classifier *blocks = calloc((size_t)threads, sizeof *blocks);
+    resolver r = {image, group, step, NULL, 0, 0, NULL, 0, (uint32_t)threads * range,
+                  (uint32_t)threads * range + range - 1};
+    cm_status st = buffers && blocks ? CM_OK : CM_ENOMEM;
+    for (int b = 0; st == CM_OK && b < threads; b++)
+        blocks[b] = (classifier){.n = n,
+                                 .lo = block_end(n, b, threads),
+                                 .hi = block_end(n, b + 1, threads),
+                                 .image = image,
+                                 .group = group,
+                                 .step = step,
+                                 .ngroups = (uint32_t)b * range,
+                                 .max_groups = (uint32_t)b * range + range - 1,
+                                 .node_refs = node_refs};
+    /* 1. each block alone; paths into other blocks stop pending at its exits */
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (st == CM_OK)
+    for (int b = 0; b < threads; b++) {
+        classifier *c = &blocks[b];
+        if (st != CM_OK)
+            continue;
+        for (uint32_t i = c->lo; i < c->hi; i++)
+            step[i] = CM_STEP_UNVISITED;
+        c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
+    }
+    /* 2. the exits, followed from block to block */
+    for (int b = 0; st == CM_OK && b < threads; b++)
+        st = blocks[b].status;
+    for (int b = 0; b < threads && st == CM_OK; b++)
+        for (size_t k = 0; k < blocks[b].nexits && st == CM_OK; k++)
+            if (step[blocks[b].exits[k]] & PENDING)
+                st = resolve_exit(&r, blocks[b].exits[k]);
+    /* 3. the pending cells, from their exits */
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (st == CM_OK)
+    for (int b = 0; b < threads; b++) {
+        classifier *c = &blocks[b];
+        if (st != CM_OK)
+            continue;
+        settle_block(c->lo, c->hi, group, step);
+        const uint32_t found = c->ngroups;
+        const size_t exits = c->nexits;
+        c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
+        /* every cycle and exit is known by now */
+        if (c->status == CM_OK && (c->ngroups != found || c->nexits != exits))
+            c->status = CM_EINVAL;
+    }
+    for (int b = 0; st == CM_OK && b < threads; b++)
+        st = blocks[b].status;
+    id_ranges ids = {shift, {0}, 1};
+    for (int b = 0; st == CM_OK && b <= threads; b++) {
+        ids.compact[b] = ids.count - 1;
+        ids.count += b < threads ? blocks[b].ngroups - (uint32_t)b * range
+                                 : r.next_group - (uint32_t)threads * range;
+    }
+    for (int b = 0; blocks && b < threads; b++)
+        free(blocks[b].exits);
+    free(blocks);
+    free(buffers);
+    free(r.chain);
+    free(r.path);
+    if (st == CM_ETOOBIG) /* a block, or the cycles through blocks, ran out of ids */
+        return cm_classify_threads(n, image, group, step, ngroups, node_refs, 1, msg, msg_size);
+    if (st == CM_OK)
+        st = renumber_blocks(n, group, &ids, threads, ngroups);
+    if (st != CM_OK)
+        return cm_fail(st, msg, msg_size, st == CM_ENOMEM ? "out of memory classifying cells"
+                                                          : "classification in blocks failed");
+    return CM_OK;
+}
+
+cm_status cm_classify_threads(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
+                              uint32_t *ngroups, int node_refs, int threads, char *msg,
+                              size_t msg_size)
+{
+    if (threads > 64)
+        threads = 64;
+    if (threads > 1 && n < BLOCKS_MAX_CELLS && n >= (uint32_t)threads)
+        return classify_blocks(n, image, group, step, ngroups, node_refs, threads, msg, msg_size);
+    classifier c = {.n = n,
+                    .hi = n,
+                    .image = image,
+                    .group = group,
+                    .step = step,
+                    .max_groups = CM_MAX_GROUPS,
+                    .node_refs = node_refs};
     uint32_t *buffers = malloc((size_t)LANES * LANE_BUFFER * sizeof *buffers);
     if (!buffers)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffers");
     for (uint32_t i = 0; i < n; i++)
         step[i] = CM_STEP_UNVISITED;
-    int busy = 0;
-    for (int k = 0; k < LANES; k++) {
-        c.lanes[k].path = buffers + (size_t)k * LANE_BUFFER;
-        busy += start_walk(&c, k);
-    }
-    cm_status st = CM_OK;
-    while (busy > 0 && st == CM_OK) {
-        for (int k = 0; k < LANES; k++) {
-            if (!c.lanes[k].busy || advance(&c, k, &st) != WALK_DONE)
-                continue;
-            c.lanes[k].busy = false;
-            busy--;
-            busy += st == CM_OK && start_walk(&c, k);
-        }
-    }
+    const cm_status st = walk_block(&c, buffers);
     free(buffers);
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "more than %lu periodic groups in one region",
                        (unsigned long)CM_MAX_GROUPS);
-    *ngroups = c.ngroups;
-    return renumber(&c, msg, msg_size);
+    const id_ranges ids = {31, {0}, c.ngroups + 1};
+    return renumber(n, group, &ids, ngroups, msg, msg_size);
+}
+
+cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
+                      uint32_t *ngroups, int node_refs, char *msg, size_t msg_size)
+{
+    return cm_classify_threads(n, image, group, step, ngroups, node_refs, 1, msg, msg_size);
 }

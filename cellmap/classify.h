@@ -40,4 +40,10 @@ static inline int cm_is_node_ref(uint32_t group)
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
                       uint32_t *ngroups, int node_refs, char *msg, size_t msg_size);
 
+/* The same on `threads` threads (one block of cells each; below 2^30 cells),
+ * with the same result. */
+cm_status cm_classify_threads(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
+                              uint32_t *ngroups, int node_refs, int threads, char *msg,
+                              size_t msg_size);
+
 #endif

@@ -422,10 +422,19 @@ void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM])
         share[d] = d < dim && moved ? (double)same[d] / (double)moved : NAN;
 }
 
-cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size)
+/* Regions below this many cells are classified on one thread. */
+#define PARALLEL_CLASSIFY_CELLS 65536
+
+cm_status cm_scm_classify(cm_region *r, int threads, char *msg, size_t msg_size)
 {
-    return cm_classify((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups,
-                       r->exits_recorded, msg, msg_size);
+#ifdef _OPENMP
+    if (threads <= 0)
+        threads = omp_get_max_threads();
+#endif
+    if (threads < 1 || r->ncells < PARALLEL_CLASSIFY_CELLS)
+        threads = 1;
+    return cm_classify_threads((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups,
+                               r->exits_recorded, threads, msg, msg_size);
 }
 
 cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
@@ -437,7 +446,7 @@ cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_sc
     if (st == CM_OK && opt && opt->progress && opt->progress(opt->user, "classification", 0) != 0)
         st = cm_fail(CM_ECANCELED, msg, msg_size, "cancelled");
     if (st == CM_OK)
-        st = cm_scm_classify(r, msg, msg_size);
+        st = cm_scm_classify(r, opt ? opt->threads : 0, msg, msg_size);
     return st;
 }
 

@@ -140,8 +140,10 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
  * directions"). Finer cells in d are the cure. */
 void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM]);
 
-/* Classifies the functional graph in image[] into group[] and step[]. */
-cm_status cm_scm_classify(cm_region *r, char *msg, size_t msg_size);
+/* Classifies the functional graph in image[] into group[] and step[], on
+ * `threads` threads (0: every core; regions below 65536 cells on one). The
+ * result does not depend on the number of threads. */
+cm_status cm_scm_classify(cm_region *r, int threads, char *msg, size_t msg_size);
 
 /* Images then classification. */
 cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,

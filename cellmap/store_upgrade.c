@@ -70,7 +70,7 @@ static cm_status join_again(cm_store *s, const cm_cluster *saved, cm_cluster *c,
         st = store_page_in(s, k, &r, msg, msg_size);
         r.exits_recorded = 1;
         if (st == CM_OK)
-            st = cm_scm_classify(&r, msg, msg_size);
+            st = cm_scm_classify(&r, 0, msg, msg_size);
         if (st == CM_OK)
             st = cm_cluster_join(c, &r, NULL, msg, msg_size);
         cm_region_free(&r);

@@ -387,7 +387,7 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
     if (st == CM_OK && interrupt_requested()) /* classification cannot stop half-way */
         st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     if (st == CM_OK)
-        st = cm_scm_classify(r, msg, msg_size);
+        st = cm_scm_classify(r, a->threads, msg, msg_size);
     t->t1 = t1 - t0;
     t->t2 = progress_now() - t1;
     return st;

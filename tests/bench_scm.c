@@ -66,7 +66,7 @@ static void run_config(const config *c, double million, int repeats)
             if (cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK)
                 die(msg);
             const double t1 = now();
-            if (cm_scm_classify(&r, msg, sizeof msg) != CM_OK)
+            if (cm_scm_classify(&r, threads, msg, sizeof msg) != CM_OK)
                 die(msg);
             const double t2 = now();
             if (k < 0)

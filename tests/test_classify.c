@@ -1,20 +1,24 @@
-/* Classification of functional graphs: cm_classify against the plain
+/* Classification of functional graphs: cm_classify_threads against the plain
  * sequential algorithm written here (one walk at a time), on graphs chosen
  * to make interleaved walks meet: random maps, random permutations (long
  * cycles shared by many walks), one cycle through every cell, chains longer
- * than the path buffers, and graphs that leave the region. Results must be
- * equal cell by cell, group ids included. */
+ * than the path buffers, graphs that leave the region and graphs into
+ * recorded exits, on 1 to 5 threads (cells cut into as many blocks, so
+ * cycles and chains run through several blocks). Results must be equal cell
+ * by cell, group ids included. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cellmap/classify.h"
+#include "cellmap/scm.h"
 #include "check.h"
 
 #define OUTSIDE UINT32_C(0xFFFFFFFE)
 
 /* The textbook algorithm: walk from each unvisited cell, label the path. */
-static uint32_t reference(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step)
+static uint32_t reference(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
+                          int node_refs)
 {
     enum { UNSEEN = 0, ON_PATH = 1, DONE = 2 };
     uint8_t *state = calloc(n, 1);
@@ -36,6 +40,8 @@ static uint32_t reference(uint32_t n, const uint32_t *image, uint32_t *group, ui
         } else if (i < n) {
             g = group[i];
             tail = step[i];
+        } else if (node_refs && cm_image_exit_index(i) >= 0) {
+            g = CM_NODE_REF | (uint32_t)cm_image_exit_index(i);
         }
         for (uint32_t p = 0; p < len; p++) {
             group[path[p]] = g;
@@ -59,30 +65,39 @@ static uint32_t rnd(uint32_t bound)
     return (uint32_t)(rng_state % bound);
 }
 
-/* Runs both classifiers on image[] and compares; returns the group count. */
-static uint32_t compare(const char *what, uint32_t n, const uint32_t *image)
+/* Runs cm_classify on 1 to 5 threads (cells cut into as many blocks) and
+ * the reference on image[] and compares; returns the group count. */
+static uint32_t compare_refs(const char *what, uint32_t n, const uint32_t *image, int node_refs)
 {
     uint32_t *g1 = malloc((size_t)n * 4), *s1 = malloc((size_t)n * 4);
     uint32_t *g2 = malloc((size_t)n * 4), *s2 = malloc((size_t)n * 4);
-    uint32_t ng1 = 0;
-    char msg[128];
-    CHECK(cm_classify(n, image, g1, s1, &ng1, 0, msg, sizeof msg) == CM_OK);
-    const uint32_t ng2 = reference(n, image, g2, s2);
-    CHECK_INT(ng1, ng2);
-    uint32_t bad = 0;
-    for (uint32_t i = 0; i < n && bad < 5; i++) {
-        if (g1[i] != g2[i] || s1[i] != s2[i]) {
-            fprintf(stderr, "%s: cell %u: group %u step %u, reference %u %u\n", what, i, g1[i],
-                    s1[i], g2[i], s2[i]);
-            bad++;
+    const uint32_t ng2 = reference(n, image, g2, s2, node_refs);
+    for (int threads = 1; threads <= 5; threads++) {
+        uint32_t ng1 = 0;
+        char msg[128];
+        CHECK(cm_classify_threads(n, image, g1, s1, &ng1, node_refs, threads, msg, sizeof msg) ==
+              CM_OK);
+        CHECK_INT(ng1, ng2);
+        uint32_t bad = 0;
+        for (uint32_t i = 0; i < n && bad < 5; i++) {
+            if (g1[i] != g2[i] || s1[i] != s2[i]) {
+                fprintf(stderr, "%s, %d threads: cell %u: group %u step %u, reference %u %u\n",
+                        what, threads, i, g1[i], s1[i], g2[i], s2[i]);
+                bad++;
+            }
         }
+        CHECK_INT(bad, 0);
     }
-    CHECK_INT(bad, 0);
     free(g1);
     free(s1);
     free(g2);
     free(s2);
     return ng2;
+}
+
+static uint32_t compare(const char *what, uint32_t n, const uint32_t *image)
+{
+    return compare_refs(what, n, image, 0);
 }
 
 static void test_random_maps(void)
@@ -160,6 +175,23 @@ static void test_long_chains(void)
     free(image);
 }
 
+/* Chains into recorded exits (images CM_IMAGE_EXIT_BASE + k) take
+ * CM_NODE_REF | k, through any number of blocks. */
+static void test_node_refs(void)
+{
+    for (uint32_t n = 2; n <= 200000; n = n * 5 + 3) {
+        uint32_t *image = malloc((size_t)n * 4);
+        for (int trial = 0; trial < 4; trial++) {
+            for (uint32_t i = 0; i < n; i++)
+                image[i] = rnd(8) == 0 ? CM_IMAGE_EXIT_BASE + rnd(1000)
+                           : rnd(8) == 0 ? OUTSIDE
+                                          : rnd(n);
+            compare_refs("exits", n, image, 1);
+        }
+        free(image);
+    }
+}
+
 int main(void)
 {
     test_random_maps();
@@ -167,5 +199,6 @@ int main(void)
     test_permutations();
     test_one_cycle();
     test_long_chains();
+    test_node_refs();
     CHECK_DONE();
 }
