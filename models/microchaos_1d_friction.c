@@ -69,14 +69,16 @@ static int fixed_points_friction(const cm_model *m, int64_t m0, int64_t m1, cm_f
     return 0;
 }
 
-/* A segment of the graph plane's diagonal: the states lo..hi. */
-static void diagonal_segment(cm_overlay_list *out, int kind, double lo, double hi,
-                             const double view_lo[2], const double view_hi[2])
+/* The states x0..x1 and their mirror images -x1..-x0 as segments of the
+ * graph plane's diagonal, cut to the view. */
+static void diagonal_interval(cm_overlay_list *out, int kind, double x0, double x1,
+                              const double view_lo[2], const double view_hi[2])
 {
-    const double a = lo > view_lo[0] ? lo : view_lo[0], b = hi < view_hi[0] ? hi : view_hi[0];
-    if (a < b) {
-        const double p[2] = {a, a}, q[2] = {b, b};
-        cm_overlay_add(out, kind, p, q);
+    for (int mirror = 0; mirror < 2; mirror++) {
+        const double from = mirror ? -x1 : x0, to = mirror ? -x0 : x1;
+        const double a = fmax(from, view_lo[0]), b = fmin(to, view_hi[0]);
+        if (a < b)
+            cm_overlay_add(out, kind, (const double[2]){a, a}, (const double[2]){b, b});
     }
 }
 
@@ -91,13 +93,10 @@ static void overlays_friction(const cm_model *m, const double lo[2], const doubl
     const friction1d *f = m->ctx;
     cm_te t;
     char why[160];
-    if (cm_te_setup(f->a, f->b, f->c, &t, why, sizeof why))
-        for (int s = 1; s >= -1; s -= 2) {
-            diagonal_segment(out, CM_OVERLAY_ESCAPE, s > 0 ? f->a - f->b - f->c : -t.x0,
-                             s > 0 ? t.x0 : -(f->a - f->b - f->c), lo, hi);
-            diagonal_segment(out, CM_OVERLAY_REPELLER, s > 0 ? t.x0 : -t.rep_hi,
-                             s > 0 ? t.rep_hi : -t.x0, lo, hi);
-        }
+    if (cm_te_setup(f->a, f->b, f->c, &t, why, sizeof why)) {
+        diagonal_interval(out, CM_OVERLAY_ESCAPE, f->a - f->b - f->c, t.x0, lo, hi);
+        diagonal_interval(out, CM_OVERLAY_REPELLER, t.x0, t.rep_hi, lo, hi);
+    }
     /* levels whose fixed points can lie in view: |x (a - 1) - b m| <= c */
     const double k0 = f->b > 0 ? floor(((f->a - 1) * lo[0] - f->c) / f->b) : 0,
                  k1 = f->b > 0 ? ceil(((f->a - 1) * hi[0] + f->c) / f->b) : 0;
