@@ -57,6 +57,18 @@ static uint64_t basin_between(const solved *s, double lo, double hi, uint64_t mi
     return cells;
 }
 
+/* The next of a fixed sequence of random cells of an nx x nv lattice over
+ * box: its index, and its centre in at. */
+static uint64_t random_cell(uint64_t *seed, const double box[4], int64_t nx, int64_t nv,
+                            double at[2])
+{
+    *seed = *seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    const uint64_t i = (*seed >> 33) % (uint64_t)(nx * nv);
+    at[0] = box[0] + ((double)(i % (uint64_t)nx) + 0.5) * (box[1] - box[0]) / (double)nx;
+    at[1] = box[2] + ((double)(i / (uint64_t)nx) + 0.5) * (box[3] - box[2]) / (double)nv;
+    return i;
+}
+
 /* Sec. 4.6.3 (alpha = 0.078, beta = 0, P = 0.007, D = 0.02), the left region
  * of the C-SCM example: the small chaotic attractors at the crossings of
  * SW_1, SW_2, SW_3 with the x-axis (x = m/P), and nothing else of size. */
@@ -217,10 +229,8 @@ static void fig_4_21_fine(void)
     int agree = 0;
     uint64_t seed = 12345;
     for (int k = 0; k < 1000; k++) {
-        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-        const uint64_t i = (seed >> 33) % s.r.ncells;
-        const double at[2] = {box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
-                              box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv};
+        double at[2];
+        const uint64_t i = random_cell(&seed, box, nx, nv, at);
         const uint32_t g = s.r.group[i];
         const int cell_fate = g == 0 ? 0 : (int)lround(s.g[g - 1].centre[0] * P);
         agree += cell_fate == orbit_fate(&m, P, at, box, 20000);
@@ -267,10 +277,11 @@ static int friction_cell_fate(const solved *s, uint64_t i, double P, double a2)
  * -301.5:301.5 in v, 83 % of the moving cells stay in their row and 59 % of
  * the box goes to the sink. On 3200 x 1609 cells (0.375 tall, a row on the
  * rest states v = 0) the sink is the two corners where x and v have one
- * sign (and the outermost rows), and 1000 random cells go where their true orbits go: into the sink
- * or not to 99 %; to the same switching line or sticking zone to 85 %
- * (orbits next to the outer sticking zones come to rest there late, which
- * the cells' cycles at the switching line do not show). */
+ * sign (and the outermost rows), and 1000 random cells go where their true
+ * orbits go: into the sink or not to 99 %; to the same switching line or
+ * sticking zone to 85 % (orbits next to the outer sticking zones come to
+ * rest there late, which the cells' cycles at the switching line do not
+ * show). */
 static void fig_4_30_fine(void)
 {
     const char *params = "alpha=6.53e-3,beta=0,P=5.5e-5,D=2.5e-3,mu=0.095";
@@ -305,10 +316,8 @@ static void fig_4_30_fine(void)
     int agree = 0, sink_agree = 0;
     uint64_t seed = 12345;
     for (int k = 0; k < 1000; k++) {
-        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-        const uint64_t i = (seed >> 33) % s.r.ncells;
-        const double at[2] = {box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
-                              box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv};
+        double at[2];
+        const uint64_t i = random_cell(&seed, box, nx, nv, at);
         const int cell = friction_cell_fate(&s, i, P, a2),
                   orbit = friction_fate(&m, P, a2, at, box, 20000);
         agree += cell == orbit;
