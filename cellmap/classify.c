@@ -421,78 +421,67 @@ static cm_status resolve_exit(resolver *r, uint32_t e)
     }
 }
 
-/* Settles the pending cells of [lo, hi) from their exits; those whose exit
- * lies on a cycle become unvisited, to be walked again. */
-static void settle_block(uint32_t lo, uint32_t hi, uint32_t *group, uint32_t *step)
+/* A block's groups in the order they first appear in it (dense ids). */
+typedef struct first_seen {
+    uint8_t *seen; /* per dense id */
+    uint32_t *order;
+    uint32_t listed;
+} first_seen;
+
+static void note_group(first_seen *f, const id_ranges *ids, uint32_t g)
 {
-    for (uint32_t i = lo; i < hi; i++) {
-        const uint32_t s = step[i];
-        if (!(s & PENDING))
-            continue;
-        const uint32_t e = group[i], se = step[e];
-        if (se == 0) {
-            step[i] = CM_STEP_UNVISITED;
-        } else {
-            group[i] = group[e];
-            step[i] = (s & ~PENDING) - 1 + se;
-        }
+    if (g & CM_NODE_REF)
+        return;
+    const uint32_t d = dense_id(ids, g);
+    if (!f->seen[d]) {
+        f->seen[d] = 1;
+        f->order[f->listed++] = d;
     }
 }
 
-/* Renumbers groups as renumber() does, on one thread per block: each lists
- * its groups in the order they first appear in it, the lists are merged in
- * block order, and each block relabels its cells. */
+/* Settles the pending cells of [lo, hi) from their exits; those whose exit
+ * lies on a cycle become unvisited, to be walked again (into the exit's
+ * group). Lists the block's groups as they first appear. */
+static void settle_block(uint32_t lo, uint32_t hi, uint32_t *group, uint32_t *step,
+                         const id_ranges *ids, first_seen *f)
+{
+    for (uint32_t i = lo; i < hi; i++) {
+        const uint32_t s = step[i];
+        if (s & PENDING) {
+            const uint32_t e = group[i], se = step[e];
+            group[i] = group[e];
+            step[i] = se == 0 ? CM_STEP_UNVISITED : (s & ~PENDING) - 1 + se;
+        }
+        note_group(f, ids, group[i]);
+    }
+}
+
+/* Renumbers groups as renumber() does from the blocks' lists: merged in
+ * block order, then each block relabels its cells. */
 static cm_status renumber_blocks(uint32_t n, uint32_t *group, const id_ranges *ids, int threads,
-                                 uint32_t *ngroups)
+                                 const first_seen *f, uint32_t *ngroups)
 {
     uint32_t *final_id = malloc((size_t)ids->count * sizeof *final_id);
-    uint8_t *seen = calloc((size_t)threads * ids->count, 1);
-    uint32_t **order = calloc((size_t)threads, sizeof *order);
-    uint32_t *listed = calloc((size_t)threads, sizeof *listed);
-    bool ok = final_id && seen && order && listed;
-    for (int b = 0; ok && b < threads; b++)
-        ok = (order[b] = malloc((size_t)ids->count * sizeof **order)) != NULL;
-#pragma omp parallel for num_threads(threads) schedule(static, 1) if (ok)
-    for (int b = 0; b < threads; b++) {
-        if (!ok)
-            continue;
-        uint8_t *mine = seen + (size_t)b * ids->count;
-        const uint32_t hi = block_end(n, b + 1, threads);
-        for (uint32_t i = block_end(n, b, threads); i < hi; i++) {
-            if (group[i] & CM_NODE_REF)
-                continue;
-            const uint32_t d = dense_id(ids, group[i]);
-            if (!mine[d]) {
-                mine[d] = 1;
-                order[b][listed[b]++] = d;
-            }
-        }
-    }
+    if (!final_id)
+        return CM_ENOMEM;
+    final_id[0] = 0;
+    for (uint32_t d = 1; d < ids->count; d++)
+        final_id[d] = UINT32_MAX;
     uint32_t next_id = 1;
-    if (ok) {
-        final_id[0] = 0;
-        for (uint32_t d = 1; d < ids->count; d++)
-            final_id[d] = UINT32_MAX;
-        for (int b = 0; b < threads; b++)
-            for (uint32_t k = 0; k < listed[b]; k++)
-                if (final_id[order[b][k]] == UINT32_MAX)
-                    final_id[order[b][k]] = next_id++;
-    }
-#pragma omp parallel for num_threads(threads) schedule(static, 1) if (ok)
+    for (int b = 0; b < threads; b++)
+        for (uint32_t k = 0; k < f[b].listed; k++)
+            if (final_id[f[b].order[k]] == UINT32_MAX)
+                final_id[f[b].order[k]] = next_id++;
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
     for (int b = 0; b < threads; b++) {
         const uint32_t hi = block_end(n, b + 1, threads);
-        for (uint32_t i = block_end(n, b, threads); ok && i < hi; i++)
+        for (uint32_t i = block_end(n, b, threads); i < hi; i++)
             if (!(group[i] & CM_NODE_REF))
                 group[i] = final_id[dense_id(ids, group[i])];
     }
-    for (int b = 0; order && b < threads; b++)
-        free(order[b]);
-    free(order);
-    free(listed);
-    free(seen);
     free(final_id);
     *ngroups = next_id - 1;
-    return ok ? CM_OK : CM_ENOMEM;
+    return CM_OK;
 }
 
 static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *group,
@@ -535,13 +524,28 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
         for (size_t k = 0; k < blocks[b].nexits && st == CM_OK; k++)
             if (step[blocks[b].exits[k]] & PENDING)
                 st = resolve_exit(&r, blocks[b].exits[k]);
-    /* 3. the pending cells, from their exits */
+    id_ranges ids = {shift, {0}, 1};
+    for (int b = 0; st == CM_OK && b <= threads; b++) {
+        ids.compact[b] = ids.count - 1;
+        ids.count += b < threads ? blocks[b].ngroups - (uint32_t)b * range
+                                 : r.next_group - (uint32_t)threads * range;
+    }
+    first_seen *firsts = calloc((size_t)threads, sizeof *firsts);
+    if (st == CM_OK && !firsts)
+        st = CM_ENOMEM;
+    for (int b = 0; st == CM_OK && b < threads; b++) {
+        firsts[b].seen = calloc(ids.count, 1);
+        firsts[b].order = malloc((size_t)ids.count * sizeof *firsts[b].order);
+        if (!firsts[b].seen || !firsts[b].order)
+            st = CM_ENOMEM;
+    }
+    /* 3. the pending cells, from their exits; each block lists its groups */
 #pragma omp parallel for num_threads(threads) schedule(static, 1) if (st == CM_OK)
     for (int b = 0; b < threads; b++) {
         classifier *c = &blocks[b];
         if (st != CM_OK)
             continue;
-        settle_block(c->lo, c->hi, group, step);
+        settle_block(c->lo, c->hi, group, step, &ids, &firsts[b]);
         const uint32_t found = c->ngroups;
         const size_t exits = c->nexits;
         c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
@@ -551,12 +555,13 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
     }
     for (int b = 0; st == CM_OK && b < threads; b++)
         st = blocks[b].status;
-    id_ranges ids = {shift, {0}, 1};
-    for (int b = 0; st == CM_OK && b <= threads; b++) {
-        ids.compact[b] = ids.count - 1;
-        ids.count += b < threads ? blocks[b].ngroups - (uint32_t)b * range
-                                 : r.next_group - (uint32_t)threads * range;
+    if (st == CM_OK) /* 4. groups numbered as one thread would */
+        st = renumber_blocks(n, group, &ids, threads, firsts, ngroups);
+    for (int b = 0; firsts && b < threads; b++) {
+        free(firsts[b].seen);
+        free(firsts[b].order);
     }
+    free(firsts);
     for (int b = 0; blocks && b < threads; b++)
         free(blocks[b].exits);
     free(blocks);
@@ -565,8 +570,6 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
     free(r.path);
     if (st == CM_ETOOBIG) /* a block, or the cycles through blocks, ran out of ids */
         return cm_classify_threads(n, image, group, step, ngroups, node_refs, 1, msg, msg_size);
-    if (st == CM_OK)
-        st = renumber_blocks(n, group, &ids, threads, ngroups);
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, st == CM_ENOMEM ? "out of memory classifying cells"
                                                           : "classification in blocks failed");
