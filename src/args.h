@@ -49,7 +49,8 @@ bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error
 bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error);
 
 /* The outputs of the analysis commands (escape, stability, horseshoe,
- * partition, amplitude): --csv FILE|-, --png FILE|-, --json, --quiet, --size WxH. */
+ * partition, amplitude, simulate, bifurcation): --csv FILE|-, --png FILE|-,
+ * --json, --quiet, --size WxH. */
 typedef struct chart_outputs {
     const char *csv, *png;
     bool json, quiet;

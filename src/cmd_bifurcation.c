@@ -57,10 +57,10 @@ enum { LAST_STOPS = 10 };
 typedef struct bif_args {
     model_opts mo;
     param_axis sweep;
-    int has_sweep, runs, transient, record, threads, width, height;
+    int has_sweep, runs, transient, record, threads;
     long long seed;
-    const char *csv, *runs_csv, *png;
-    bool json, quiet;
+    const char *runs_csv;
+    chart_outputs out;
 } bif_args;
 
 static int parse_args(cli *c, bif_args *a)
@@ -88,30 +88,23 @@ static int parse_args(cli *c, bif_args *a)
             if (c->value && (!parse_int64(c->value, &v) || v < 0))
                 err = cli_usage_error(c, "--seed: '%s' must be a non-negative integer", c->value);
             a->seed = v;
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
         } else if (cli_is(c, "--runs-csv", true, &err)) {
             a->runs_csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 450, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 450, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
     if (!err && !a->has_sweep)
         err = cli_usage_error(c, "--sweep NAME=LO:HI:N is required (e.g. --sweep S=0.02:0.4:190)");
-    if (!err && !a->csv && !a->runs_csv && !a->png && !a->json)
+    if (!err && !a->out.csv && !a->runs_csv && !a->out.png && !a->out.json)
         err = cli_usage_error(c,
                               "nothing to write: give --csv, --runs-csv and/or --png FILE, or --json");
-    if (!err && a->json &&
-        (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->runs_csv) ||
-         cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
+    if (!err && cm_output_names_stdout(a->runs_csv) &&
+        (a->out.json || cm_output_names_stdout(a->out.csv) || cm_output_names_stdout(a->out.png)))
+        err = cli_usage_error(c, "--runs-csv - and another output to standard output: choose one");
     if (!err && (double)a->sweep.n * a->runs * a->record > 1e7)
         err = cli_usage_error(c,
                               "%d values x %d runs x %d recorded periods is more than 1e7 "
@@ -241,7 +234,7 @@ static void print_point(void *user, int kind, double p, int run, double x, doubl
 static bool write_points_csv(const bif_args *a, const sweep_results *s)
 {
     outfile o;
-    if (!outfile_open("bifurcation", a->csv, &o))
+    if (!outfile_open("bifurcation", a->out.csv, &o))
         return false;
     fprintf(o.f, "%s,run,kind,x,v\n", a->sweep.name);
     visit_points(a, s, print_point, o.f);
@@ -325,15 +318,15 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
     snprintf(titles[2], sizeof titles[2], "asymmetry Psi per period (thesis 2.6.1)");
     cm_series series[3];
     cm_chart charts[3];
-    const int h = a->height / 3;
+    const int h = a->out.height / 3;
     for (int k = 0; k < 3; k++) {
         double lo = c[k].n ? c[k].lo : -1, hi = c[k].n ? c[k].hi : 1;
         const double pad = hi > lo ? 0.05 * (hi - lo) : 0.5;
         if (k == 2)
             lo = 0; /* Psi >= 0: its zero is the point of the panel */
         series[k] = (cm_series){CM_SERIES_POINTS, c[k].x, c[k].y, c[k].n, colours[k], sizes[k]};
-        charts[k] = (cm_chart){a->width,
-                               k < 2 ? h : a->height - 2 * h,
+        charts[k] = (cm_chart){a->out.width,
+                               k < 2 ? h : a->out.height - 2 * h,
                                {a->sweep.lo, lo - pad},
                                {a->sweep.hi, hi + pad},
                                a->sweep.name,
@@ -353,7 +346,7 @@ static bool write_png(const bif_args *a, const cm_params *base, const sweep_resu
     const cm_png_text texts[] = {
         {"Model", a->mo.name}, {"Parameters", params}, {"Sweep", sweep}, {"Runs", runs}};
     if (ok)
-        ok = write_chart_png("bifurcation", a->png, charts, 3, texts, 4);
+        ok = write_chart_png("bifurcation", a->out.png, charts, 3, texts, 4);
     for (int k = 0; k < 3; k++) {
         free(c[k].x);
         free(c[k].y);
@@ -376,7 +369,7 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
                 psi_hi = fmax(psi_hi, res->psi / s->record);
             }
         }
-    if (a->json) {
+    if (a->out.json) {
         json j;
         json_begin(&j, stdout, "bifurcation");
         param_base_json(&j, a->mo.name, base);
@@ -394,7 +387,7 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
         json_end(&j);
         return;
     }
-    FILE *out = report_stream(a->csv, a->runs_csv, a->png);
+    FILE *out = report_stream(a->out.csv, a->runs_csv, a->out.png);
     fprintf(out, "%d values of %s x %d runs in %.2f s: %d runs followed, %d lost", s->n_values,
            a->sweep.name, s->runs, secs, valid - lost, lost);
     if (psi_lo <= psi_hi)
@@ -424,13 +417,12 @@ int cmd_bifurcation(int argc, char **argv)
                   .transient = 1000,
                   .record = 50,
                   .seed = 1,
-                  .width = 900,
-                  .height = 1200};
+                  .out = {.width = 900, .height = 1200}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("bifurcation", a.csv) || !outfile_check("bifurcation", a.runs_csv) ||
-        !chart_png_check("bifurcation", a.png))
+    if (!outfile_check("bifurcation", a.out.csv) || !outfile_check("bifurcation", a.runs_csv) ||
+        !chart_png_check("bifurcation", a.out.png))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.sweep, 1, &base);
@@ -458,7 +450,7 @@ int cmd_bifurcation(int argc, char **argv)
     }
     const double t0 = omp_get_wtime();
     progress pr;
-    progress_start(&pr, "bifurcation", "runs", n_runs, a.quiet);
+    progress_start(&pr, "bifurcation", "runs", n_runs, a.out.quiet);
     interrupt_catch();
     uint64_t done = 0;
 #pragma omp parallel for schedule(dynamic, 1)                                                      \
@@ -475,7 +467,7 @@ int cmd_bifurcation(int argc, char **argv)
         sweep_free(&s, models);
         return interrupt_stopped("bifurcation", done, n_runs, "runs");
     }
-    if (!a.quiet || a.json)
+    if (!a.out.quiet || a.out.json)
         print_summary(&a, &base, &s, omp_get_wtime() - t0);
     bool ok = n_valid > 0;
     if (!ok)
@@ -483,11 +475,11 @@ int cmd_bifurcation(int argc, char **argv)
                 "cellmap bifurcation: no value of %s admits the model (is S <= S0 "
                 "anywhere?)\n",
                 a.sweep.name);
-    if (ok && a.csv)
+    if (ok && a.out.csv)
         ok = write_points_csv(&a, &s);
     if (ok && a.runs_csv)
         ok = write_runs_csv(&a, &s);
-    if (ok && a.png)
+    if (ok && a.out.png)
         ok = write_png(&a, &base, &s);
     sweep_free(&s, models);
     return ok ? EXIT_OK : EXIT_FAIL;

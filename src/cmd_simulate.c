@@ -40,9 +40,8 @@ static const char simulate_help[] =
 typedef struct sim_args {
     model_opts mo;
     double from[2], t0;
-    int has_t0, periods, skip, width, height;
-    const char *csv, *png;
-    bool json, quiet;
+    int has_t0, periods, skip;
+    chart_outputs out;
 } sim_args;
 
 static int parse_args(cli *c, sim_args *a)
@@ -64,21 +63,13 @@ static int parse_args(cli *c, sim_args *a)
             a->has_t0 = 1;
         } else if (cli_take_int(c, "--periods", 1, 100000, &a->periods, &err)) {
         } else if (cli_take_int(c, "--skip", 0, 100000, &a->skip, &err)) {
-        } else if (cli_is(c, "--csv", true, &err)) {
-            a->csv = c->value;
-        } else if (cli_is(c, "--png", true, &err)) {
-            a->png = c->value;
-        } else if (cli_is(c, "--json", false, &err)) {
-            a->json = true;
-        } else if (cli_is(c, "--quiet", false, &err)) {
-            a->quiet = true;
-        } else if (cli_take_size(c, 300, 400, 4096, &a->width, &a->height, &err)) {
+        } else if (chart_outputs_take(c, &a->out, 300, 400, &err)) {
         } else {
             err = cli_usage_error(c, "unknown option '%s'", c->opt);
         }
     }
-    if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
-        err = cli_usage_error(c, "--json and an output to standard output: choose one");
+    if (!err)
+        err = chart_outputs_check(c, &a->out);
     if (!err && a->skip >= a->periods)
         err = cli_usage_error(c, "--skip %d leaves nothing of %d periods to show", a->skip,
                               a->periods);
@@ -372,9 +363,9 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
     char params[400], title_top[512], start[160], periods[64];
     cm_params_format(&m->values, params, sizeof params);
     snprintf(title_top, sizeof title_top, "x(t), %s %s", m->name, params);
-    const int h_top = a->height / 2;
+    const int h_top = a->out.height / 2;
     const cm_chart charts[2] = {
-        {a->width,
+        {a->out.width,
          h_top,
          {lo_t[0], lo_t[1]},
          {hi_t[0], hi_t[1]},
@@ -388,8 +379,8 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
          0,
          NULL,
          0},
-        {a->width,
-         a->height - h_top,
+        {a->out.width,
+         a->out.height - h_top,
          {lo_p[0], lo_p[1]},
          {hi_p[0], hi_p[1]},
          "x",
@@ -408,7 +399,7 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
     snprintf(periods, sizeof periods, "%d (the first %d not shown)", a->periods, a->skip);
     const cm_png_text texts[] = {
         {"Model", m->name}, {"Parameters", params}, {"Start", start}, {"Periods", periods}};
-    ok = write_chart_png("simulate", a->png, charts, 2, texts, 4);
+    ok = write_chart_png("simulate", a->out.png, charts, 2, texts, 4);
     figure_data_free(&d);
     return ok;
 }
@@ -441,13 +432,13 @@ static void print_json(const sim_args *a, const cm_model *m, const cm_fo_run *r,
 static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run *r,
                           const cm_fo_tally *last, const double z_prev[2], double psi)
 {
-    if (a->json) {
+    if (a->out.json) {
         print_json(a, m, r, last, z_prev, psi);
         return;
     }
-    if (a->quiet)
+    if (a->out.quiet)
         return;
-    FILE *out = report_stream(a->csv, a->png, NULL);
+    FILE *out = report_stream(a->out.csv, a->out.png, NULL);
     fprintf(out, "followed %d periods from (x, v) = (%s, %s) at t = %s to t = %s\n", a->periods,
             CM_NUM(a->from[0]), CM_NUM(a->from[1]), CM_NUM(a->t0), CM_NUM(r->t_section));
     fprintf(out, "last period: %d sticks, %d turns, %d breakaways; x in [%.9g, %.9g]\n", last->n_stick,
@@ -465,11 +456,11 @@ int cmd_simulate(int argc, char **argv)
 {
     cli c = {"simulate", argc, argv, 0, NULL, NULL};
     sim_args a = {
-        .mo = {.name = "friction-oscillator"}, .periods = 20, .width = 900, .height = 1000};
+        .mo = {.name = "friction-oscillator"}, .periods = 20, .out = {.width = 900, .height = 1000}};
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("simulate", a.csv) || !chart_png_check("simulate", a.png))
+    if (!outfile_check("simulate", a.out.csv) || !chart_png_check("simulate", a.out.png))
         return EXIT_FAIL;
     cm_model m;
     const int merr = model_opts_build(&c, &a.mo, &m);
@@ -498,9 +489,9 @@ int cmd_simulate(int argc, char **argv)
                 CM_NUM(r.t_section + r.st.s), CM_FO_MAX_EVENTS);
     if (ok) {
         print_summary(&a, &m, &r, &last, z_prev, fabs(tr.psi_sum));
-        if (a.csv)
-            ok = write_csv(a.csv, &tr);
-        if (ok && a.png)
+        if (a.out.csv)
+            ok = write_csv(a.out.csv, &tr);
+        if (ok && a.out.png)
             ok = write_png(&a, &m, o, &tr);
     }
     free(tr.rows);

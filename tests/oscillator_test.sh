@@ -316,6 +316,12 @@ expect_usage "'Q' is not a parameter" bifurcation --sweep Q=0.1:0.4:3 --csv x.cs
 expect_usage "nothing to write" bifurcation --sweep S=0.1:0.4:3
 expect_usage "more than 1e7" bifurcation --sweep S=0.1:0.4:2000 --runs 1000 --record 10 --csv x.csv
 expect_usage "friction-oscillator only" bifurcation --model microchaos-pd --sweep P=0.1:0.2:2 --csv x.csv
+# the two commands' outputs: at most one on standard output, and not with --json
+expect_usage "--json and an output to standard output" simulate --json --csv -
+expect_usage "--csv - and --png -: only one" simulate --csv - --png -
+expect_usage "--json and an output to standard output" bifurcation --sweep S=0.1:0.4:3 --json --png -
+expect_usage "--runs-csv - and another output" bifurcation --sweep S=0.1:0.4:3 --runs-csv - --csv -
+expect_usage "--runs-csv - and another output" bifurcation --sweep S=0.1:0.4:3 --runs-csv - --json
 out=$("$CM" bifurcation --param S0=0.1 --sweep S=0.2:0.3:2 --csv none.csv 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "bifurcation, all values invalid: $rc $out"
 out=$("$CM" simulate --periods 2 --png nodir/x.png 2>&1); rc=$?
