@@ -1,4 +1,3 @@
-#define _DEFAULT_SOURCE /* madvise */
 #include "cellmap/scm.h"
 
 #include "cellmap/classify.h"
@@ -7,30 +6,9 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-/* A cell array. Large ones sit on 2 MiB pages where the system gives them
- * (Linux's transparent huge pages): classification reads cells at random,
- * and with 4 KiB pages nearly every read also misses the TLB; the first
- * touch of a fresh array also faults 512 times less often. free() releases
- * it either way. */
-static void *cell_array(uint64_t bytes)
-{
-    enum { HUGE_PAGE = 2 << 20 };
-#ifdef MADV_HUGEPAGE
-    if (bytes >= 2 * HUGE_PAGE) {
-        void *p = NULL;
-        if (posix_memalign(&p, HUGE_PAGE, bytes) != 0)
-            return NULL;
-        madvise(p, bytes, MADV_HUGEPAGE); /* a hint: without it, 4 KiB pages */
-        return p;
-    }
-#endif
-    return malloc(bytes);
-}
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size)
 {
@@ -45,9 +23,9 @@ cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg
                        (unsigned long long)CM_REGION_MAX_CELLS, (unsigned long long)n);
     r->box = *box;
     r->ncells = n;
-    r->image = cell_array(n * sizeof *r->image);
-    r->group = cell_array(n * sizeof *r->group);
-    r->step = cell_array(n * sizeof *r->step);
+    r->image = malloc(n * sizeof *r->image);
+    r->group = malloc(n * sizeof *r->group);
+    r->step = malloc(n * sizeof *r->step);
     if (!r->image || !r->group || !r->step) {
         cm_region_free(r);
         return cm_fail(CM_ENOMEM, msg, msg_size, "cannot allocate %llu cells (%llu bytes)",
