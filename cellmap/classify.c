@@ -18,6 +18,7 @@
  * fully known, the result equals the sequential algorithm's: group ids are
  * finally renumbered in order of the lowest local index in each domain,
  * which is exactly the order in which a sequential scan discovers them.
+ *
  * With threads, the cells are cut into one block of indices per thread
  * (cm_classify_threads): each thread walks its block as above, and a path
  * that runs into another block stops at the block's edge, pending, its cells
@@ -253,6 +254,33 @@ static cm_status walk_block(classifier *c, uint32_t *buffers)
     return st;
 }
 
+/* Renumbers groups 1..found in order of the lowest local index of their
+ * domain. */
+static cm_status renumber(uint32_t n, uint32_t *group, uint32_t found, uint32_t *ngroups,
+                          char *msg, size_t msg_size)
+{
+    uint32_t *final_id = malloc(((size_t)found + 1) * sizeof *final_id);
+    if (!final_id)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory renumbering groups");
+    final_id[0] = 0;
+    for (uint32_t g = 1; g <= found; g++)
+        final_id[g] = UINT32_MAX;
+    uint32_t next_id = 1;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t *g = &group[i];
+        if (*g & CM_NODE_REF)
+            continue;
+        if (final_id[*g] == UINT32_MAX)
+            final_id[*g] = next_id++;
+        *g = final_id[*g];
+    }
+    free(final_id);
+    *ngroups = next_id - 1;
+    return CM_OK;
+}
+
+/* ---- several blocks ------------------------------------------------------------ */
+
 /* Where block b of `threads` starts (b = threads: n). */
 static uint32_t block_end(uint32_t n, int b, int threads)
 {
@@ -272,33 +300,6 @@ static uint32_t dense_id(const id_ranges *r, uint32_t g)
 {
     return r->compact[g >> r->shift] + (g & ((UINT32_C(1) << r->shift) - 1));
 }
-
-/* Renumbers groups in order of the lowest local index of their domain. */
-static cm_status renumber(uint32_t n, uint32_t *group, const id_ranges *ids, uint32_t *ngroups,
-                          char *msg, size_t msg_size)
-{
-    uint32_t *final_id = malloc((size_t)ids->count * sizeof *final_id);
-    if (!final_id)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory renumbering groups");
-    final_id[0] = 0;
-    for (uint32_t g = 1; g < ids->count; g++)
-        final_id[g] = UINT32_MAX;
-    uint32_t next_id = 1;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t *g = &group[i];
-        if (*g & CM_NODE_REF)
-            continue;
-        uint32_t *id = &final_id[dense_id(ids, *g)];
-        if (*id == UINT32_MAX)
-            *id = next_id++;
-        *g = *id;
-    }
-    free(final_id);
-    *ngroups = next_id - 1;
-    return CM_OK;
-}
-
-/* ---- several blocks ------------------------------------------------------------ */
 
 static bool is_final(uint32_t s) { return !(s & (PENDING | CM_STEP_ON_PATH)); }
 
@@ -456,7 +457,7 @@ static void settle_block(uint32_t lo, uint32_t hi, uint32_t *group, uint32_t *st
     }
 }
 
-/* Renumbers groups as renumber() does from the blocks' lists: merged in
+/* Renumbers groups as renumber() does, from the blocks' lists: merged in
  * block order, then each block relabels its cells. */
 static cm_status renumber_blocks(uint32_t n, uint32_t *group, const id_ranges *ids, int threads,
                                  const first_seen *f, uint32_t *ngroups)
@@ -601,8 +602,7 @@ cm_status cm_classify_threads(uint32_t n, const uint32_t *image, uint32_t *group
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "more than %lu periodic groups in one region",
                        (unsigned long)CM_MAX_GROUPS);
-    const id_ranges ids = {31, {0}, c.ngroups + 1};
-    return renumber(n, group, &ids, ngroups, msg, msg_size);
+    return renumber(n, group, c.ngroups, ngroups, msg, msg_size);
 }
 
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,

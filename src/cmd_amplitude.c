@@ -203,7 +203,7 @@ int cmd_amplitude(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("amplitude", a.out.csv) || !chart_png_check("amplitude", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);

@@ -421,8 +421,7 @@ int cmd_bifurcation(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("bifurcation", a.out.csv) || !outfile_check("bifurcation", a.runs_csv) ||
-        !chart_png_check("bifurcation", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out) || !outfile_check("bifurcation", a.runs_csv))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.sweep, 1, &base);

@@ -402,7 +402,7 @@ int cmd_escape(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("escape", a.out.csv) || !chart_png_check("escape", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_params base;
     param_axis none = {0};

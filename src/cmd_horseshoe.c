@@ -341,7 +341,7 @@ int cmd_horseshoe(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("horseshoe", a.out.csv) || !chart_png_check("horseshoe", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_params base;
     const int verr =

@@ -128,7 +128,7 @@ int cmd_partition(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("partition", a.out.csv) || !chart_png_check("partition", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-delay", NULL, 0, &base);

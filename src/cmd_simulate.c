@@ -460,7 +460,7 @@ int cmd_simulate(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("simulate", a.out.csv) || !chart_png_check("simulate", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_model m;
     const int merr = model_opts_build(&c, &a.mo, &m);

@@ -307,7 +307,7 @@ int cmd_stability(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("stability", a.out.csv) || !chart_png_check("stability", a.out.png))
+    if (!chart_outputs_writable(&c, &a.out))
         return EXIT_FAIL;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-pd", NULL, 0, &base);

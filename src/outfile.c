@@ -32,6 +32,11 @@ bool chart_png_check(const char *cmd, const char *path)
     return true;
 }
 
+bool chart_outputs_writable(const cli *c, const chart_outputs *o)
+{
+    return outfile_check(c->cmd, o->csv) && chart_png_check(c->cmd, o->png);
+}
+
 bool outfile_open(const char *cmd, const char *path, outfile *o)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];

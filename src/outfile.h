@@ -11,6 +11,7 @@
 #include "cellmap/output.h"
 #include "render/chart.h"
 #include "render/png_out.h"
+#include "src/args.h"
 
 typedef struct outfile {
     cm_output out;
@@ -25,6 +26,8 @@ bool outfile_check(const char *cmd, const char *path);
  * (render/gl_loader.h), so that a missing library stops the command
  * before its work. */
 bool chart_png_check(const char *cmd, const char *path);
+/* Both, for the --csv and --png of a command's chart outputs. */
+bool chart_outputs_writable(const cli *c, const chart_outputs *o);
 /* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
 bool outfile_open(const char *cmd, const char *path, outfile *o);
 /* Closes and renames it when ok (and every write succeeded), else removes

@@ -69,6 +69,25 @@ static uint64_t random_cell(uint64_t *seed, const double box[4], int64_t nx, int
     return i;
 }
 
+/* The sink cells of an nx x nv lattice over box (into *sink), and how many
+ * of them lie in the corners where x and v have one sign or in the top and
+ * bottom rows (|v| > 300), where Figs. 4.21 and 4.30 put the sink. */
+static uint64_t sink_in_corners(const solved *s, const double box[4], int64_t nx, int64_t nv,
+                                uint64_t *sink)
+{
+    const double wx = (box[1] - box[0]) / (double)nx, wv = (box[3] - box[2]) / (double)nv;
+    uint64_t corners = 0;
+    for (uint64_t i = 0; i < s->r.ncells; i++) {
+        if (s->r.group[i] != 0)
+            continue;
+        const double x = box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
+                     v = box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv;
+        ++*sink;
+        corners += x * v > 0 || fabs(v) > 300;
+    }
+    return corners;
+}
+
 /* Sec. 4.6.3 (alpha = 0.078, beta = 0, P = 0.007, D = 0.02), the left region
  * of the C-SCM example: the small chaotic attractors at the crossings of
  * SW_1, SW_2, SW_3 with the x-axis (x = m/P), and nothing else of size. */
@@ -201,19 +220,11 @@ static void fig_4_21_fine(void)
     CHECK(share[1] > 0.8);
     release(&coarse);
     const int64_t nx = 4000, nv = 3200;
-    const double wx = (box[1] - box[0]) / (double)nx, wv = (box[3] - box[2]) / (double)nv;
     solved s = run(params, box[0], box[1], box[2], box[3], nx, nv, 100000);
     cm_scm_slow_share(&s.r, share);
     CHECK(share[1] < 0.25);
-    uint64_t sink = 0, corners = 0;
-    for (uint64_t i = 0; i < s.r.ncells; i++) {
-        if (s.r.group[i] != 0)
-            continue;
-        const double x = box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
-                     v = box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv;
-        sink++;
-        corners += x * v > 0 || fabs(v) > 300;
-    }
+    uint64_t sink = 0;
+    const uint64_t corners = sink_in_corners(&s, box, nx, nv, &sink);
     CHECK((double)sink <= 0.35 * (double)s.r.ncells);
     CHECK(corners == sink);
     int lines = 0;
@@ -293,20 +304,12 @@ static void fig_4_30_fine(void)
     CHECK(share[1] > 0.8);
     release(&coarse);
     const int64_t nx = 3200, nv = 1609;
-    const double wx = (box[1] - box[0]) / (double)nx, wv = (box[3] - box[2]) / (double)nv;
     solved s = run_model("microchaos-pd-friction", params, box[0], box[1], box[2], box[3], nx, nv,
                          100000);
     cm_scm_slow_share(&s.r, share);
     CHECK(share[1] < 0.25);
-    uint64_t sink = 0, corners = 0;
-    for (uint64_t i = 0; i < s.r.ncells; i++) {
-        if (s.r.group[i] != 0)
-            continue;
-        const double x = box[0] + ((double)(i % (uint64_t)nx) + 0.5) * wx,
-                     v = box[2] + ((double)(i / (uint64_t)nx) + 0.5) * wv;
-        sink++;
-        corners += x * v > 0 || fabs(v) > 300; /* or the top and bottom rows */
-    }
+    uint64_t sink = 0;
+    const uint64_t corners = sink_in_corners(&s, box, nx, nv, &sink);
     CHECK((double)sink <= 0.1 * (double)s.r.ncells);
     CHECK(corners == sink);
     cm_model m;
