@@ -404,19 +404,30 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
 
 void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM])
 {
-    const cm_box *box = &r->box;
-    const int dim = box->dim;
+    /* Called on every solve's summary, so no cm_box_cell per cell: the
+     * cell's own position is counted up as i goes, and its image's found
+     * with one 32-bit division per dimension but the last (local indices
+     * stay below 2^32). */
+    const int dim = r->box.dim;
+    uint32_t side[CM_MAX_DIM], at[CM_MAX_DIM] = {0}, to[CM_MAX_DIM];
+    for (int d = 0; d < dim; d++)
+        side[d] = (uint32_t)(r->box.hi[d] - r->box.lo[d]);
     uint64_t moved = 0, same[CM_MAX_DIM] = {0};
-    int64_t from[CM_MAX_DIM], to[CM_MAX_DIM];
     for (uint64_t i = 0; i < r->ncells; i++) {
         const uint32_t j = r->image[i];
-        if (j >= r->ncells || j == i) /* the sink, an exit, or a fixed cell */
-            continue;
-        cm_box_cell(box, i, from);
-        cm_box_cell(box, j, to);
-        moved++;
-        for (int d = 0; d < dim; d++)
-            same[d] += from[d] == to[d];
+        if (j < r->ncells && j != i) { /* not the sink, an exit or a fixed cell */
+            uint32_t rest = j;
+            for (int d = 0; d < dim - 1; d++) {
+                to[d] = rest % side[d];
+                rest /= side[d];
+            }
+            to[dim - 1] = rest;
+            moved++;
+            for (int d = 0; d < dim; d++)
+                same[d] += at[d] == to[d];
+        }
+        for (int d = 0; d < dim && ++at[d] == side[d]; d++)
+            at[d] = 0;
     }
     for (int d = 0; d < CM_MAX_DIM; d++)
         share[d] = d < dim && moved ? (double)same[d] / (double)moved : NAN;

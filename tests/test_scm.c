@@ -316,6 +316,44 @@ static void test_random_maps(void)
     CHECK(sink_cells > 100);
 }
 
+/* cm_scm_slow_share against its definition, by cm_box_cell, on random
+ * images (some to the sink, some fixed) in boxes of unequal sides off the
+ * origin. */
+static void test_slow_share(void)
+{
+    const cm_box boxes[] = {{1, {-3}, {17}}, {2, {-2, 5}, {5, 9}}, {3, {-2, 5, 1}, {5, 9, 4}}};
+    uint64_t x = 12345;
+    for (size_t b = 0; b < sizeof boxes / sizeof *boxes; b++) {
+        const cm_box *box = &boxes[b];
+        cm_region r;
+        char msg[256];
+        CHECK(cm_region_alloc(&r, box, msg, sizeof msg) == CM_OK);
+        for (uint32_t i = 0; i < r.ncells; i++) {
+            x = x * 6364136223846793005u + 1442695040888963407u;
+            const uint32_t pick = (uint32_t)(x >> 33);
+            r.image[i] = pick % 7 == 0 ? CM_IMAGE_SINK : pick % 7 == 1 ? i : pick % (uint32_t)r.ncells;
+        }
+        uint64_t moved = 0, same[CM_MAX_DIM] = {0};
+        for (uint32_t i = 0; i < r.ncells; i++) {
+            if (r.image[i] >= r.ncells || r.image[i] == i)
+                continue;
+            int64_t from[CM_MAX_DIM], to[CM_MAX_DIM];
+            cm_box_cell(box, i, from);
+            cm_box_cell(box, r.image[i], to);
+            moved++;
+            for (int d = 0; d < box->dim; d++)
+                same[d] += from[d] == to[d];
+        }
+        double share[CM_MAX_DIM];
+        cm_scm_slow_share(&r, share);
+        for (int d = 0; d < box->dim; d++)
+            CHECK_NEAR(share[d], (double)same[d] / (double)moved, 0);
+        for (int d = 0; d < box->dim && box->dim > 1; d++) /* both outcomes, in 2-D and 3-D */
+            CHECK(same[d] > 0 && same[d] < moved);
+        cm_region_free(&r);
+    }
+}
+
 static void test_threads_identical(void)
 {
     cm_model m;
@@ -507,6 +545,7 @@ int main(void)
     test_no_image();
     test_max_steps();
     test_random_maps();
+    test_slow_share();
     test_threads_identical();
     CHECK_DONE();
 }
