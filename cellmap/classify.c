@@ -532,8 +532,10 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
         classifier *c = &blocks[b];
         if (st != CM_OK)
             continue;
-        for (uint32_t i = c->lo; i < c->hi; i++)
+        for (uint32_t i = c->lo; i < c->hi; i++) { /* group[] too: see cm_classify_threads */
             step[i] = CM_STEP_UNVISITED;
+            group[i] = 0;
+        }
         c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
     }
     /* 2. the exits, followed from block to block */
@@ -613,8 +615,13 @@ cm_status cm_classify_threads(uint32_t n, const uint32_t *image, uint32_t *group
     uint32_t *buffers = malloc((size_t)LANES * LANE_BUFFER * sizeof *buffers);
     if (!buffers)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffers");
-    for (uint32_t i = 0; i < n; i++)
+    /* group[] is written here too although every walk sets it: a fresh
+     * array's pages are then mapped in one sequential pass, not one fault
+     * at a time in the middle of the walks' cache misses */
+    for (uint32_t i = 0; i < n; i++) {
         step[i] = CM_STEP_UNVISITED;
+        group[i] = 0;
+    }
     const cm_status st = walk_block(&c, buffers);
     free(buffers);
     if (st != CM_OK)
