@@ -1,6 +1,5 @@
 #include "cellmap/cover.h"
 
-#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,35 +104,37 @@ static int compare_int64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-typedef struct z_entry {
-    uint64_t key;
+/* A box's place in the grid: its rank in each dimension, slowest first. */
+typedef struct scan_entry {
+    uint32_t place[CM_MAX_DIM];
     uint32_t at;
-} z_entry;
+} scan_entry;
 
-static int compare_z(const void *a, const void *b)
+static int compare_places(const void *a, const void *b)
 {
-    const z_entry *x = a, *y = b;
-    if (x->key != y->key)
-        return x->key < y->key ? -1 : 1;
+    const scan_entry *x = a, *y = b;
+    for (int d = 0; d < CM_MAX_DIM; d++)
+        if (x->place[d] != y->place[d])
+            return x->place[d] < y->place[d] ? -1 : 1;
     return (x->at > y->at) - (x->at < y->at);
 }
 
-cm_status cm_boxes_z_order(cm_box *boxes, uint32_t n)
+cm_status cm_boxes_scan_order(cm_box *boxes, uint32_t n)
 {
     if (n < 2)
         return CM_OK;
-    const int dim = boxes[0].dim, bits = 64 / dim;
+    const int dim = boxes[0].dim;
     int64_t *lo = malloc((size_t)n * (size_t)dim * sizeof *lo);
-    uint32_t distinct[CM_MAX_DIM];
-    z_entry *z = malloc(n * sizeof *z);
+    scan_entry *e = calloc(n, sizeof *e);
     cm_box *sorted = malloc(n * sizeof *sorted);
-    if (!lo || !z || !sorted) {
+    if (!lo || !e || !sorted) {
         free(lo);
-        free(z);
+        free(e);
         free(sorted);
         return CM_ENOMEM;
     }
     /* each dimension's distinct lower bounds, sorted: a box's place is its rank */
+    uint32_t distinct[CM_MAX_DIM];
     for (int d = 0; d < dim; d++) {
         int64_t *v = lo + (size_t)d * n;
         for (uint32_t k = 0; k < n; k++)
@@ -144,26 +145,32 @@ cm_status cm_boxes_z_order(cm_box *boxes, uint32_t n)
             if (distinct[d] == 0 || v[k] != v[distinct[d] - 1])
                 v[distinct[d]++] = v[k];
     }
-    bool fits = true;
+    /* the dimensions from slowest to fastest: most places first; on a tie
+     * the higher dimension, so that a square grid keeps its row order */
+    int slow[CM_MAX_DIM];
     for (int d = 0; d < dim; d++)
-        fits = fits && (bits >= 32 || distinct[d] <= (UINT32_C(1) << bits));
-    for (uint32_t k = 0; k < n && fits; k++) {
-        uint64_t key = 0;
-        for (int d = 0; d < dim; d++) {
-            const uint64_t r = rank_of(lo + (size_t)d * n, distinct[d], boxes[k].lo[d]);
-            for (int b = 0; b < bits; b++)
-                key |= ((r >> b) & 1) << (b * dim + d);
+        slow[d] = d;
+    for (int i = 1; i < dim; i++)
+        for (int j = i; j > 0 && (distinct[slow[j]] > distinct[slow[j - 1]] ||
+                                  (distinct[slow[j]] == distinct[slow[j - 1]] &&
+                                   slow[j] > slow[j - 1]));
+             j--) {
+            const int t = slow[j];
+            slow[j] = slow[j - 1];
+            slow[j - 1] = t;
         }
-        z[k] = (z_entry){key, k};
+    for (uint32_t k = 0; k < n; k++) {
+        e[k].at = k;
+        for (int i = 0; i < dim; i++)
+            e[k].place[i] = (uint32_t)rank_of(lo + (size_t)slow[i] * n, distinct[slow[i]],
+                                              boxes[k].lo[slow[i]]);
     }
-    if (fits) {
-        qsort(z, n, sizeof *z, compare_z);
-        for (uint32_t k = 0; k < n; k++)
-            sorted[k] = boxes[z[k].at];
-        memcpy(boxes, sorted, n * sizeof *boxes);
-    }
+    qsort(e, n, sizeof *e, compare_places);
+    for (uint32_t k = 0; k < n; k++)
+        sorted[k] = boxes[e[k].at];
+    memcpy(boxes, sorted, n * sizeof *boxes);
     free(lo);
-    free(z);
+    free(e);
     free(sorted);
     return CM_OK;
 }

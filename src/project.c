@@ -211,8 +211,9 @@ void project_plan_text(const project_plan *p, const cm_box *box, char *out, size
                  p->bounds_text ? p->bounds_text : "-");
 }
 
-/* Splits into more boxes than this are joined in Z order. */
-#define Z_ORDER_FROM 64
+/* Splits into more boxes than this are joined in scan order along their
+ * short side (cm_boxes_scan_order). */
+#define SCAN_ORDER_FROM 64
 
 uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes)
 {
@@ -233,10 +234,11 @@ uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes)
             boxes[k].hi[d] = box->lo[d] + size * (i + 1) / parts[d];
         }
     }
-    /* many regions go in Z order, so that neighbours join close together
-     * (paging keeps them); fewer keep the row order earlier files have */
-    if (boxes && n > Z_ORDER_FROM)
-        cm_boxes_z_order(boxes, n); /* unsorted if out of memory */
+    /* many regions are scanned along the grid's short side, so that the
+     * regions a join reads are few and recent (paging keeps them); fewer
+     * keep the row order earlier files have */
+    if (boxes && n > SCAN_ORDER_FROM)
+        cm_boxes_scan_order(boxes, n); /* unsorted if out of memory */
     return n;
 }
 

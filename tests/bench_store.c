@@ -2,7 +2,8 @@
  * region of the PD micro-chaos map (alpha = 6.8511e-3, beta = 0,
  * P = 5.4997e-5, D = 2.5665e-3; x in [-125000, 125000], x' in [-600, 600],
  * re-stepping up to 100000 times as in the figure) cut into TX x TY regions
- * of SIDE x SIDE cells, solved two at a time and joined in row order.
+ * of SIDE x SIDE cells, solved two at a time and joined as solve --split
+ * joins more than 64 regions (scanned along the short side of the grid).
  *
  * Four runs (RUNS, a comma-separated choice of them), each in its own
  * process so each has its own peak RSS:
@@ -97,7 +98,7 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
     for (uint32_t k = 0; k < n; k++)
         boxes[k] = box_of(cf, k);
     if (n > 64)
-        cm_boxes_z_order(boxes, n); /* as solve --split orders more than 64 regions */
+        cm_boxes_scan_order(boxes, n); /* as solve --split orders more than 64 regions */
     cm_cluster c;
     cm_cluster_init(&c, &lat);
     c.threads = 2;

@@ -238,49 +238,57 @@ static void test_many_regions(void)
     cm_model_release(&m);
 }
 
-/* Z order: a 4 x 4 grid goes in Morton order (dimension 0 fastest); a
- * 3 x 5 grid keeps every box once, each 2 x 2 block of the grid together;
- * and the 16 x 16 grid of test_many_regions joined in Z order still equals
- * the whole box. */
-static void test_z_order(void)
+/* The join order of large splits: a square grid keeps its row order; a
+ * grid wider than high is scanned along its columns, a 3-D grid with its
+ * dimension of most places slowest and of fewest fastest; every box once;
+ * and a 16 x 8 grid joined in that order still equals the whole box. */
+static void test_scan_order(void)
 {
-    const cm_box whole = {2, {0, 0}, {300, 240}};
+    const cm_box whole = {2, {0, 0}, {320, 240}};
     static cm_box boxes[256];
     uint32_t n = grid(&whole, 4, boxes);
-    CHECK(cm_boxes_z_order(boxes, n) == CM_OK);
-    static const int expect[16][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, {3, 0}, {2, 1},
-                                      {3, 1}, {0, 2}, {1, 2}, {0, 3}, {1, 3}, {2, 2}, {3, 2},
-                                      {2, 3}, {3, 3}};
+    CHECK(cm_boxes_scan_order(boxes, n) == CM_OK);
     for (uint32_t k = 0; k < n; k++) {
-        CHECK_INT(boxes[k].lo[0], expect[k][0] * 75);
-        CHECK_INT(boxes[k].lo[1], expect[k][1] * 60);
+        CHECK_INT(boxes[k].lo[0], (int64_t)(k % 4) * 80);
+        CHECK_INT(boxes[k].lo[1], (int64_t)(k / 4) * 60);
     }
-    cm_box odd[15];
-    for (int j = 0; j < 5; j++)
-        for (int i = 0; i < 3; i++)
-            odd[j * 3 + i] = (cm_box){2, {i * 10, j * 7}, {i * 10 + 10, j * 7 + 7}};
-    CHECK(cm_boxes_z_order(odd, 15) == CM_OK);
+    n = 0;
+    for (int j = 0; j < 8; j++) /* row order, as project_split makes it */
+        for (int i = 0; i < 16; i++)
+            boxes[n++] = (cm_box){2, {i * 20, j * 30}, {i * 20 + 20, j * 30 + 30}};
+    CHECK(cm_boxes_scan_order(boxes, n) == CM_OK);
+    for (uint32_t k = 0; k < n; k++) { /* columns of 8, left to right */
+        CHECK_INT(boxes[k].lo[0], (int64_t)(k / 8) * 20);
+        CHECK_INT(boxes[k].lo[1], (int64_t)(k % 8) * 30);
+    }
+    cm_box cube[24];
+    uint32_t m3 = 0;
+    for (int z = 0; z < 3; z++)
+        for (int y = 0; y < 4; y++)
+            for (int x = 0; x < 2; x++)
+                cube[m3++] = (cm_box){3, {x, y, z}, {x + 1, y + 1, z + 1}};
+    CHECK(cm_boxes_scan_order(cube, m3) == CM_OK);
     uint32_t seen = 0;
-    for (int k = 0; k < 15; k++)
-        seen |= 1u << (odd[k].lo[1] / 7 * 3 + odd[k].lo[0] / 10);
-    CHECK_INT(seen, 0x7FFF);
-    for (int k = 0; k < 4; k++) /* the first 2 x 2 block first */
-        CHECK(odd[k].lo[0] < 20 && odd[k].lo[1] < 14);
+    for (uint32_t k = 0; k < m3; k++) { /* y slowest (4 places), then z (3), x fastest (2) */
+        CHECK_INT(cube[k].lo[0], (int64_t)(k % 2));
+        CHECK_INT(cube[k].lo[2], (int64_t)(k / 2 % 3));
+        CHECK_INT(cube[k].lo[1], (int64_t)(k / 6));
+        seen |= 1u << (cube[k].lo[2] * 8 + cube[k].lo[1] * 2 + cube[k].lo[0]);
+    }
+    CHECK_INT(seen, 0xFFFFFF);
 
     cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
-    const cm_lattice lat = {2, {0, -40}, {500.0 / 300, 80.0 / 240}};
+    const cm_lattice lat = {2, {0, -40}, {500.0 / 320, 80.0 / 240}};
     cm_region whole_r, flat;
     char msg[256];
     solve_whole(&m, &lat, &whole, 1, &whole_r);
-    n = grid(&whole, 16, boxes);
-    CHECK(cm_boxes_z_order(boxes, n) == CM_OK);
     cm_cluster c;
     cm_cluster_init(&c, &lat);
     const cm_scm_options opt = {1, 2, NULL, NULL, 1};
     CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) ==
           CM_OK);
     CHECK(cm_cluster_flatten(&c, &whole, &flat, msg, sizeof msg) == CM_OK);
-    CHECK_INT(compare_regions("256 regions in Z order", &whole_r, &flat), 0);
+    CHECK_INT(compare_regions("16 x 8 regions in scan order", &whole_r, &flat), 0);
     cm_cluster_free(&c);
     cm_region_free(&flat);
     cm_region_free(&whole_r);
@@ -712,7 +720,7 @@ int main(void)
     test_delay_and_3d();
     test_many_regions();
     test_solve_boxes_equals_joins();
-    test_z_order();
+    test_scan_order();
     test_pan_sequence();
     test_ids_stable();
     test_threads_identical();
