@@ -212,9 +212,11 @@ static void step_batch(const cm_model *model, const cm_lattice *lat, const cm_bo
         xs[d] = b->x[d];
         ys[d] = b->y[d];
     }
-    /* centres as cm_lattice_centre computes them: (double)cell is exact */
+    /* centres as cm_lattice_centre computes them: (double)cell is exact;
+     * an int counter, which SSE2 converts to doubles in vectors (a size_t
+     * kept this loop scalar) */
     const double first = (double)from[0];
-    for (size_t i = 0; i < n; i++)
+    for (int i = 0; i < (int)n; i++)
         b->x[0][i] = lat->origin[0] + ((first + (double)i) + 0.5) * lat->width[0];
     for (int d = 1; d < dim; d++)
         for (size_t i = 0; i < n; i++)
@@ -233,6 +235,24 @@ static void step_batch(const cm_model *model, const cm_lattice *lat, const cm_bo
                          d == 0 ? 1.0 : 0.0, (int)n, b->in_box, b->stays, b->local);
 }
 
+/* The images the batch's first steps give (the sink, a local index or an
+ * exit), and which cells need more: a model error, a re-step (the image is
+ * the cell itself and restep is set), or an exit whose target is kept
+ * (keep_exits). Vectorised, hence flags rather than branches, and a local
+ * index converted as an int32 (it is below 2^31). */
+CM_VECTOR_LOOP
+static void first_images(const batch *restrict b, int n, int restep, int keep_exits,
+                         uint32_t *restrict image, unsigned char *restrict special)
+{
+    for (int i = 0; i < n; i++) {
+        const int world = b->world[i] != 0.0, in_box = b->in_box[i] != 0.0;
+        const int32_t local = (int32_t)(in_box ? b->local[i] : 0.0);
+        image[i] = !world ? CM_IMAGE_SINK : in_box ? (uint32_t)local : CM_IMAGE_EXIT;
+        special[i] = (unsigned char)((b->rc[i] < 0) | (world & (b->stays[i] != 0.0) & restep) |
+                                     (world & !in_box & keep_exits));
+    }
+}
+
 /* Images of one row with the model's step_n: as images_of_row gives them,
  * cell for cell. A cell whose image stays in it takes the scalar path
  * (image_of_cell re-steps it). */
@@ -247,7 +267,11 @@ static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, c
     for (uint64_t i0 = 0; i0 < nx; i0 += BATCH) {
         const size_t n = nx - i0 < BATCH ? (size_t)(nx - i0) : BATCH;
         step_batch(model, lat, box, from, n, b);
-        for (size_t i = 0; i < n; i++) {
+        unsigned char special[BATCH];
+        first_images(b, (int)n, max_steps > 1, eb != NULL, image + i0, special);
+        for (size_t i = 0; i < n; i++) { /* in index order: exits are numbered so */
+            if (!special[i])
+                continue;
             if (b->rc[i] < 0)
                 return b->rc[i];
             if (b->world[i] != 0.0 && b->stays[i] != 0.0 && max_steps > 1) {
@@ -257,17 +281,10 @@ static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, c
                 const int rc = image_of_cell(model, lat, box, max_steps, here, eb, &image[i0 + i]);
                 if (rc < 0)
                     return rc;
-            } else if (b->world[i] == 0.0) {
-                image[i0 + i] = CM_IMAGE_SINK;
-            } else if (b->in_box[i] != 0.0) {
-                image[i0 + i] = (uint32_t)b->local[i];
-            } else {
-                image[i0 + i] = CM_IMAGE_EXIT;
-                if (eb) {
-                    for (int d = 0; d < box->dim; d++)
-                        cell[d] = (int64_t)b->at[d][i];
-                    keep_exit(eb, cell, box->dim);
-                }
+            } else { /* an exit, its target kept */
+                for (int d = 0; d < box->dim; d++)
+                    cell[d] = (int64_t)b->at[d][i];
+                keep_exit(eb, cell, box->dim);
             }
         }
         from[0] += (int64_t)n;
