@@ -1,5 +1,6 @@
 #include "cellmap/cover.h"
 
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -119,6 +120,13 @@ static int compare_places(const void *a, const void *b)
     return (x->at > y->at) - (x->at < y->at);
 }
 
+/* Whether dimension a is scanned slower than b: it has more places, or as
+ * many and comes later (a square grid keeps its row order). */
+static bool slower(const uint32_t *places, int a, int b)
+{
+    return places[a] > places[b] || (places[a] == places[b] && a > b);
+}
+
 cm_status cm_boxes_scan_order(cm_box *boxes, uint32_t n)
 {
     if (n < 2)
@@ -145,16 +153,11 @@ cm_status cm_boxes_scan_order(cm_box *boxes, uint32_t n)
             if (distinct[d] == 0 || v[k] != v[distinct[d] - 1])
                 v[distinct[d]++] = v[k];
     }
-    /* the dimensions from slowest to fastest: most places first; on a tie
-     * the higher dimension, so that a square grid keeps its row order */
-    int slow[CM_MAX_DIM];
+    int slow[CM_MAX_DIM]; /* the dimensions from slowest to fastest */
     for (int d = 0; d < dim; d++)
         slow[d] = d;
     for (int i = 1; i < dim; i++)
-        for (int j = i; j > 0 && (distinct[slow[j]] > distinct[slow[j - 1]] ||
-                                  (distinct[slow[j]] == distinct[slow[j - 1]] &&
-                                   slow[j] > slow[j - 1]));
-             j--) {
+        for (int j = i; j > 0 && slower(distinct, slow[j], slow[j - 1]); j--) {
             const int t = slow[j];
             slow[j] = slow[j - 1];
             slow[j - 1] = t;
