@@ -34,6 +34,7 @@
  */
 #include "cellmap/classify.h"
 
+#include "cellmap/grow.h"
 #include "cellmap/scm.h"
 
 #include <stdbool.h>
@@ -78,26 +79,13 @@ typedef struct classifier {
     uint32_t ngroups; /* provisional groups found so far */
     uint32_t max_groups; /* the largest provisional id the block may give */
     uint32_t *exits;     /* the block's exits, in the order found (with blocks) */
-    size_t nexits, exits_cap;
+    uint64_t nexits, exits_cap;
     cm_status status; /* of the block's last walk */
     int node_refs;    /* paths into recorded exits take CM_NODE_REF | exit */
     lane lanes[LANES];
 } classifier;
 
 typedef enum { WALK_ON, WALK_WAIT, WALK_TOOK_OVER, WALK_DONE } walk_result;
-
-static bool grow(void **items, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap)
-        return true;
-    const size_t cap2 = need > 2 * *cap ? need : 2 * *cap;
-    void *p = realloc(*items, cap2 * size);
-    if (!p)
-        return false;
-    *items = p;
-    *cap = cap2;
-    return true;
-}
 
 static bool in_block(const classifier *c, uint32_t cell) { return cell - c->lo < c->hi - c->lo; }
 
@@ -193,7 +181,7 @@ static walk_result advance(classifier *c, int k, cm_status *st)
         return WALK_DONE;
     }
     if (!in_block(c, cell)) { /* another block's cell: pending at this block's exit */
-        if (!grow((void **)&c->exits, &c->exits_cap, c->nexits + 1, sizeof *c->exits)) {
+        if (cm_grow((void **)&c->exits, &c->exits_cap, c->nexits + 1, sizeof *c->exits) != CM_OK) {
             *st = CM_ENOMEM;
             return WALK_DONE;
         }
@@ -249,6 +237,7 @@ static cm_status walk_block(classifier *c, uint32_t *buffers)
         busy += start_walk(c, k);
     }
     cm_status st = CM_OK;
+    int parked = 0;
     while (busy > 0 && st == CM_OK) {
         for (int k = 0; k < LANES; k++) {
             if (!c->lanes[k].busy || c->lanes[k].parked)
@@ -258,10 +247,12 @@ static cm_status walk_block(classifier *c, uint32_t *buffers)
                 continue;
             if (w == WALK_WAIT) {
                 c->lanes[k].parked = true;
+                parked++;
                 continue;
             }
-            for (int m = 0; m < LANES; m++)
+            for (int m = 0; parked > 0 && m < LANES; m++)
                 c->lanes[m].parked = false;
+            parked = 0;
             if (w == WALK_DONE) {
                 c->lanes[k].busy = false;
                 busy--;
@@ -331,9 +322,10 @@ typedef struct resolver {
     const uint32_t *image;
     uint32_t *group, *step;
     chain_link *chain; /* the exits followed so far; step[] of each: ON_PATH | position */
-    size_t len, cap;
+    size_t len;
+    uint64_t cap;
     uint32_t *path; /* cells of a tree walked to a cycle */
-    size_t path_cap;
+    uint64_t path_cap;
     uint32_t next_group, max_group; /* ids of cycles through several blocks */
 } resolver;
 
@@ -345,7 +337,7 @@ static cm_status walk_to_cycle(resolver *r, uint32_t t, uint32_t *step_of_t)
     size_t len = 0;
     uint32_t cell = t;
     for (; !is_final(r->step[cell]); cell = r->image[cell]) {
-        if (!grow((void **)&r->path, &r->path_cap, len + 1, sizeof *r->path))
+        if (cm_grow((void **)&r->path, &r->path_cap, len + 1, sizeof *r->path) != CM_OK)
             return CM_ENOMEM;
         r->path[len++] = cell;
     }
@@ -396,7 +388,7 @@ static cm_status resolve_exit(resolver *r, uint32_t e)
 {
     r->len = 0;
     for (uint32_t cur = e;;) {
-        if (!grow((void **)&r->chain, &r->cap, r->len + 1, sizeof *r->chain))
+        if (cm_grow((void **)&r->chain, &r->cap, r->len + 1, sizeof *r->chain) != CM_OK)
             return CM_ENOMEM;
         r->chain[r->len] = (chain_link){cur, 0};
         r->step[cur] = CM_STEP_ON_PATH | (uint32_t)r->len++;
@@ -542,7 +534,7 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
     for (int b = 0; st == CM_OK && b < threads; b++)
         st = blocks[b].status;
     for (int b = 0; b < threads && st == CM_OK; b++)
-        for (size_t k = 0; k < blocks[b].nexits && st == CM_OK; k++)
+        for (uint64_t k = 0; k < blocks[b].nexits && st == CM_OK; k++)
             if (step[blocks[b].exits[k]] & PENDING)
                 st = resolve_exit(&r, blocks[b].exits[k]);
     id_ranges ids = {shift, {0}, 1};
@@ -568,7 +560,7 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
             continue;
         settle_block(c->lo, c->hi, group, step, &ids, &firsts[b]);
         const uint32_t found = c->ngroups;
-        const size_t exits = c->nexits;
+        const uint64_t exits = c->nexits;
         c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
         /* every cycle and exit is known by now */
         if (c->status == CM_OK && (c->ngroups != found || c->nexits != exits))

@@ -13,6 +13,10 @@ const cm_rgb cm_colour_marker = {0, 0, 0};
 const cm_rgb cm_colour_sticking = {180, 180, 180};
 const cm_rgb cm_colour_sticking_marker = {96, 96, 96};
 const cm_rgb cm_colour_other = {236, 226, 208}; /* pale beige: present, not one group */
+const cm_rgb cm_colour_repeller = {230, 159, 0};
+const cm_rgb cm_colour_escape = {0, 114, 178};
+const cm_rgb cm_colour_collision = {220, 30, 30};
+const cm_rgb cm_colour_collision_higher = {255, 150, 0};
 
 /* No red (the sink), black (markers), white (not computed) or grey
  * (sticking zones) in any palette. */

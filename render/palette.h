@@ -43,6 +43,13 @@ extern const cm_rgb cm_colour_marker;          /* periodic cells (black dots) */
 extern const cm_rgb cm_colour_sticking;        /* basins of sticking zones (grey, Fig. 4.30) */
 extern const cm_rgb cm_colour_sticking_marker; /* the sticking zones' rest cells */
 extern const cm_rgb cm_colour_other;           /* basins folded into "other" (--min-basin) */
+/* overlays: intervals holding a chaotic repeller, and escape intervals
+ * (Okabe-Ito orange and blue); switching line collisions of the first and
+ * of higher orders (red and orange, as the thesis draws them) */
+extern const cm_rgb cm_colour_repeller;
+extern const cm_rgb cm_colour_escape;
+extern const cm_rgb cm_colour_collision;
+extern const cm_rgb cm_colour_collision_higher;
 
 /* Colour classes: the figure's colours, numbered. An indexed PNG stores
  * the class of each cell; its palette is cm_class_colour of each class. */

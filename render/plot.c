@@ -15,10 +15,6 @@ static const cm_rgb manifold_colour = {0, 0, 0};
 static const cm_rgb zone_colour = {40, 40, 40};
 static const cm_rgb diagonal_colour = {150, 150, 150};
 static const cm_rgb graph_colour = {0, 0, 0};
-static const cm_rgb repeller_colour = {230, 159, 0}; /* Okabe-Ito orange and blue */
-static const cm_rgb escape_colour = {0, 114, 178};
-static const cm_rgb collision_colour = {220, 30, 30}; /* the thesis' red and orange */
-static const cm_rgb higher_collision_colour = {255, 150, 0};
 
 static void colour(cm_rgb c) { glColor3ub(c.r, c.g, c.b); }
 
@@ -204,8 +200,8 @@ static bool point_style(int kind, bool *filled, cm_rgb *fill)
 {
     *filled = kind != CM_OVERLAY_FIXED_VIRTUAL;
     *fill = kind == CM_OVERLAY_FIXED_REGULAR ? switching_colour
-            : kind == CM_OVERLAY_COLLISION   ? collision_colour
-                                             : higher_collision_colour;
+            : kind == CM_OVERLAY_COLLISION   ? cm_colour_collision
+                                             : cm_colour_collision_higher;
     return kind == CM_OVERLAY_FIXED_REGULAR || kind == CM_OVERLAY_FIXED_VIRTUAL ||
            kind == CM_OVERLAY_COLLISION || kind == CM_OVERLAY_COLLISION_HIGHER;
 }
@@ -228,12 +224,11 @@ static void draw_points(const cm_overlay_list *ov, double px, double py, int lw)
     }
 }
 
-/* Switching lines are white over basins (as the thesis draws them) and
- * black on paper (Fig. 4.34). */
+/* on_paper: see cm_layers_on_paper */
 static void draw_overlay_lines(const cm_overlay_list *ov, int lw, bool on_paper)
 {
-    draw_segments(ov, CM_OVERLAY_REPELLER, repeller_colour, (float)(3 * lw), 0, 1);
-    draw_segments(ov, CM_OVERLAY_ESCAPE, escape_colour, (float)(3 * lw), 0, 1);
+    draw_segments(ov, CM_OVERLAY_REPELLER, cm_colour_repeller, (float)(3 * lw), 0, 1);
+    draw_segments(ov, CM_OVERLAY_ESCAPE, cm_colour_escape, (float)(3 * lw), 0, 1);
     draw_segments(ov, CM_OVERLAY_STICKING_ZONE, zone_colour, (float)(2 * lw + 1), 0, 1);
     draw_segments(ov, CM_OVERLAY_SWITCHING_LINE, on_paper ? manifold_colour : switching_colour,
                   (float)lw, 0, 1);
@@ -313,8 +308,7 @@ static void draw_basin_panel(const cm_plot *p, const tile *t)
         draw_raster(p->ras, p->basin.lo, p->basin.hi);
     const bool graph = p->graph.w > 0;
     if (p->overlays && !graph && (p->layers & CM_LAYER_OVERLAYS))
-        draw_overlay_lines(p->overlays, p->line_width,
-                           !(p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS)));
+        draw_overlay_lines(p->overlays, p->line_width, cm_layers_on_paper(p->layers));
     if (p->layers & CM_LAYER_ATTRACTORS) { /* attractors last: they stay black */
         draw_markers(p, &p->basin, CM_GROUP_STICKING, px, py);
         draw_markers(p, &p->basin, CM_GROUP_ATTRACTOR, px, py);

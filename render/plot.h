@@ -11,6 +11,7 @@
 #ifndef CM_RENDER_PLOT_H
 #define CM_RENDER_PLOT_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "cellmap/model.h"
@@ -29,6 +30,13 @@ enum cm_layer {
     CM_LAYER_LEGEND = 1 << 5,
     CM_LAYER_TITLE = 1 << 6
 };
+/* Switching lines are white over basins and step shading, and black on
+ * paper: where neither is drawn (Fig. 4.34), and on a map's graph. */
+static inline bool cm_layers_on_paper(unsigned layers)
+{
+    return !(layers & (CM_LAYER_BASIN | CM_LAYER_STEPS));
+}
+
 /* The layers drawn with text, which need a font and margins. */
 #define CM_LAYERS_TEXT (CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE)
 

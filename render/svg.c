@@ -167,15 +167,17 @@ static void overlays(FILE *f, const figure *F, const cm_panel *pn)
     const cm_overlay_list *ov = F->p.overlays;
     const frame_map m = map_of(&F->p, pn);
     const int lw = F->p.line_width;
-    char style[160];
+    char style[160], colour[8];
     fputs("<g fill=\"none\" clip-path=\"url(#panel)\">\n", f);
-    snprintf(style, sizeof style, "stroke=\"#e69f00\" stroke-width=\"%d\"", 3 * lw);
+    hex(cm_colour_repeller, colour);
+    snprintf(style, sizeof style, "stroke=\"%s\" stroke-width=\"%d\"", colour, 3 * lw);
     segments(f, ov, &m, CM_OVERLAY_REPELLER, style);
-    snprintf(style, sizeof style, "stroke=\"#0072b2\" stroke-width=\"%d\"", 3 * lw);
+    hex(cm_colour_escape, colour);
+    snprintf(style, sizeof style, "stroke=\"%s\" stroke-width=\"%d\"", colour, 3 * lw);
     segments(f, ov, &m, CM_OVERLAY_ESCAPE, style);
     snprintf(style, sizeof style, "stroke=\"#282828\" stroke-width=\"%d\"", 2 * lw + 1);
     segments(f, ov, &m, CM_OVERLAY_STICKING_ZONE, style);
-    const bool on_paper = pn == &F->p.graph || !(F->p.layers & (CM_LAYER_BASIN | CM_LAYER_STEPS));
+    const bool on_paper = pn == &F->p.graph || cm_layers_on_paper(F->p.layers);
     snprintf(style, sizeof style, "stroke=\"%s\" stroke-width=\"%d\"",
              on_paper ? "#000000" : "#ffffff", lw); /* white over basins, black on paper */
     segments(f, ov, &m, CM_OVERLAY_SWITCHING_LINE, style);
@@ -188,11 +190,14 @@ static void overlays(FILE *f, const figure *F, const cm_panel *pn)
     const double r = 2.0 + 1.5 * lw;
     for (size_t k = 0; k < ov->count; k++) {
         const cm_overlay *o = &ov->items[k];
-        const char *fill = o->kind == CM_OVERLAY_FIXED_REGULAR       ? "#ffffff"
-                           : o->kind == CM_OVERLAY_FIXED_VIRTUAL     ? "none"
-                           : o->kind == CM_OVERLAY_COLLISION         ? "#dc1e1e"
-                           : o->kind == CM_OVERLAY_COLLISION_HIGHER ? "#ff9600"
-                                                                     : NULL;
+        const char *fill = o->kind == CM_OVERLAY_FIXED_REGULAR   ? "#ffffff"
+                           : o->kind == CM_OVERLAY_FIXED_VIRTUAL ? "none"
+                                                                 : NULL;
+        if (o->kind == CM_OVERLAY_COLLISION || o->kind == CM_OVERLAY_COLLISION_HIGHER) {
+            hex(o->kind == CM_OVERLAY_COLLISION ? cm_colour_collision : cm_colour_collision_higher,
+                colour);
+            fill = colour;
+        }
         if (fill)
             fprintf(f,
                     "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\" stroke=\"#000000\" "
