@@ -10,18 +10,6 @@
 
 size_t cm_codec_bound(size_t bytes) { return ZSTD_compressBound(bytes) + 32; /* + checksum */ }
 
-static uint64_t load_value(const void *v, size_t i, int width)
-{
-    if (width == 4) {
-        uint32_t x;
-        memcpy(&x, (const unsigned char *)v + 4 * i, 4);
-        return x;
-    }
-    uint64_t x;
-    memcpy(&x, (const unsigned char *)v + 8 * i, 8);
-    return x;
-}
-
 static void store_value(void *v, size_t i, int width, uint64_t x)
 {
     if (width == 4) {
@@ -32,8 +20,10 @@ static void store_value(void *v, size_t i, int width, uint64_t x)
     }
 }
 
-/* Step 1 and 2 for uint32 arrays: the hot path of every page written. */
-static void planes_u32(const uint32_t *v, size_t n, int64_t first_index, unsigned char *planes)
+/* Step 1 and 2 for uint32 arrays: the hot path of every page written.
+ * restrict: planes may not alias v, so the loop vectorises. */
+static void planes_u32(const uint32_t *restrict v, size_t n, int64_t first_index,
+                       unsigned char *restrict planes)
 {
     const uint32_t base = first_index >= 0 ? (uint32_t)first_index : 0;
     const uint32_t relative = first_index >= 0;
@@ -43,6 +33,19 @@ static void planes_u32(const uint32_t *v, size_t n, int64_t first_index, unsigne
         planes[n + i] = (unsigned char)(x >> 8);
         planes[2 * n + i] = (unsigned char)(x >> 16);
         planes[3 * n + i] = (unsigned char)(x >> 24);
+    }
+}
+
+/* Step 2 for 64-bit values (exit tables, open nodes): one pass writing
+ * the eight planes, which vectorises; a loop over the bytes of each value
+ * stored them one at a time. */
+static void planes_u64(const unsigned char *restrict v, size_t n, unsigned char *restrict planes)
+{
+    for (size_t i = 0; i < n; i++) {
+        uint64_t x;
+        memcpy(&x, v + 8 * i, 8);
+        for (size_t b = 0; b < 8; b++)
+            planes[b * n + i] = (unsigned char)(x >> (8 * b));
     }
 }
 
@@ -91,15 +94,10 @@ cm_status cm_codec_encode_with(cm_codec_ctx *ctx, const void *v, size_t n, int w
                                size_t *len)
 {
     unsigned char *planes = scratch;
-    if (width == 4) {
+    if (width == 4)
         planes_u32(v, n, first_index, planes);
-    } else {
-        for (size_t i = 0; i < n; i++) {
-            const uint64_t x = load_value(v, i, width);
-            for (int b = 0; b < width; b++)
-                planes[(size_t)b * n + i] = (unsigned char)(x >> (8 * b));
-        }
-    }
+    else
+        planes_u64(v, n, planes);
     const size_t r = ZSTD_compress2(ctx->zstd, out, out_cap, planes, n * (size_t)width);
     if (ZSTD_isError(r))
         return CM_ENOMEM;
