@@ -253,9 +253,70 @@ static void first_images(const batch *restrict b, int n, int restep, int keep_ex
     }
 }
 
+/* The cells of a batch whose first image stays in them (with max_steps >
+ * 1), stepped on from that image through step_n as image_cell steps them
+ * one at a time: until the image leaves the cell, has none, or max_steps
+ * steps are done. Their images go into image[]; an exit's target cell into
+ * b->at, where the in-order pass keeps it as it keeps the others'; a
+ * model's error into b->rc. b->x and b->y are reused: the batch's first
+ * steps are done. */
+static void restep_batch(const cm_model *model, const cm_lattice *lat, const cm_box *box,
+                         int max_steps, const int64_t *from, size_t n, batch *b,
+                         const unsigned char *special, uint32_t *image)
+{
+    const int dim = lat->dim;
+    const double *xs[CM_MAX_DIM];
+    double *ys[CM_MAX_DIM];
+    int pos[BATCH], rc[BATCH];
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!special[i] || b->world[i] == 0.0 || b->stays[i] == 0.0)
+            continue;
+        for (int d = 0; d < dim; d++)
+            b->x[d][m] = b->y[d][i];
+        pos[m++] = (int)i;
+    }
+    for (int d = 0; d < dim; d++) {
+        xs[d] = b->x[d];
+        ys[d] = b->y[d];
+    }
+    for (int k = 2; m > 0; k++) { /* k: the step being done */
+        model->step_n(model, m, xs, ys, rc);
+        size_t going_on = 0;
+        for (size_t j = 0; j < m; j++) {
+            const int i = pos[j];
+            if (rc[j] < 0) {
+                b->rc[i] = rc[j];
+                continue;
+            }
+            double y[CM_MAX_DIM];
+            int64_t cell[CM_MAX_DIM];
+            for (int d = 0; d < dim; d++)
+                y[d] = b->y[d][j];
+            const bool in_world = rc[j] == 0 && cm_lattice_cell(lat, y, cell);
+            bool same = in_world;
+            for (int d = 0; d < dim; d++)
+                same = same && cell[d] == from[d] + (d == 0 ? i : 0);
+            if (same && k < max_steps) {
+                for (int d = 0; d < dim; d++)
+                    b->x[d][going_on] = y[d];
+                pos[going_on++] = i;
+            } else if (!in_world) {
+                image[i] = CM_IMAGE_SINK;
+            } else if (cm_box_contains(box, cell)) {
+                image[i] = (uint32_t)cm_box_index(box, cell);
+            } else {
+                image[i] = CM_IMAGE_EXIT;
+                for (int d = 0; d < dim; d++)
+                    b->at[d][i] = (double)cell[d];
+            }
+        }
+        m = going_on;
+    }
+}
+
 /* Images of one row with the model's step_n: as images_of_row gives them,
- * cell for cell. A cell whose image stays in it takes the scalar path
- * (image_of_cell re-steps it). */
+ * cell for cell (re-steps too, through restep_batch). */
 static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, const cm_region *r,
                                  int max_steps, uint64_t row, exit_buf *eb, batch *b)
 {
@@ -269,19 +330,14 @@ static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, c
         step_batch(model, lat, box, from, n, b);
         unsigned char special[BATCH];
         first_images(b, (int)n, max_steps > 1, eb != NULL, image + i0, special);
+        if (max_steps > 1)
+            restep_batch(model, lat, box, max_steps, from, n, b, special, image + i0);
         for (size_t i = 0; i < n; i++) { /* in index order: exits are numbered so */
             if (!special[i])
                 continue;
             if (b->rc[i] < 0)
                 return b->rc[i];
-            if (b->world[i] != 0.0 && b->stays[i] != 0.0 && max_steps > 1) {
-                int64_t here[CM_MAX_DIM];
-                memcpy(here, from, sizeof here);
-                here[0] += (int64_t)i;
-                const int rc = image_of_cell(model, lat, box, max_steps, here, eb, &image[i0 + i]);
-                if (rc < 0)
-                    return rc;
-            } else { /* an exit, its target kept */
+            if (image[i0 + i] == CM_IMAGE_EXIT && eb) { /* its target kept */
                 for (int d = 0; d < box->dim; d++)
                     cell[d] = (int64_t)b->at[d][i];
                 keep_exit(eb, cell, box->dim);
