@@ -1,4 +1,5 @@
-/* cellmap/grow.h - growable arrays: the one place that doubles a buffer. */
+/* cellmap/grow.h - growable arrays (the one place that doubles a buffer)
+ * and arrays of per-thread records. */
 #ifndef CM_GROW_H
 #define CM_GROW_H
 
@@ -40,6 +41,24 @@ static inline cm_status cm_grow_zeroed(void **items, uint64_t *cap, uint64_t *le
     memset((char *)*items + *len * item_size, 0, (need - *len) * item_size);
     *len = need;
     return CM_OK;
+}
+
+/* A cache line. Records that threads update at every step of a loop start
+ * on their own line (_Alignas(CM_CACHE_LINE) on their first member):
+ * records of different threads sharing a line make each thread's writes
+ * evict the line from the other's cache (false sharing). */
+#define CM_CACHE_LINE 64
+
+/* n zeroed records of `size` bytes (a multiple of CM_CACHE_LINE), the
+ * first on a line of its own; free() frees them. NULL: out of memory. */
+static inline void *cm_thread_records(size_t n, size_t size)
+{
+    if (n == 0 || size > SIZE_MAX / n)
+        return NULL;
+    void *p = aligned_alloc(CM_CACHE_LINE, n * size);
+    if (p)
+        memset(p, 0, n * size);
+    return p;
 }
 
 #endif

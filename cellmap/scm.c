@@ -76,7 +76,7 @@ static int image_cell(const cm_model *model, const cm_lattice *lat, const int64_
 
 /* Exit targets one thread found, rows in the order it did them. */
 typedef struct exit_buf {
-    int64_t *cells; /* dim coordinates per exit */
+    _Alignas(CM_CACHE_LINE) int64_t *cells; /* dim coordinates per exit (a line per thread) */
     uint64_t n, cap;
     int failed; /* out of memory */
 } exit_buf;
@@ -400,7 +400,7 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
     const bool record_exits = opt && opt->record_exits;
     const cm_progress_fn progress = opt ? opt->progress : NULL;
     const uint64_t nrows = r->ncells / (uint64_t)(r->box.hi[0] - r->box.lo[0]);
-    exit_buf *bufs = record_exits ? calloc((size_t)threads, sizeof *bufs) : NULL;
+    exit_buf *bufs = record_exits ? cm_thread_records((size_t)threads, sizeof *bufs) : NULL;
     row_exits rows = {NULL, NULL};
     if (record_exits) {
         rows.thread = malloc(nrows * sizeof *rows.thread);
