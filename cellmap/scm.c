@@ -3,6 +3,7 @@
 #include "cellmap/classify.h"
 #include "cellmap/grow.h"
 
+#include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -390,6 +391,9 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
 /* Regions below this many cells compute their images on one thread. */
 #define PARALLEL_CELLS 1024
 
+/* Cells of the rows a thread takes at a time. */
+#define ROW_CHUNK_CELLS 4096
+
 /* Rows between two calls of the progress callback (on the calling thread). */
 #define PROGRESS_ROWS 64
 
@@ -399,7 +403,7 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
 {
     const bool record_exits = opt && opt->record_exits;
     const cm_progress_fn progress = opt ? opt->progress : NULL;
-    const uint64_t nrows = r->ncells / (uint64_t)(r->box.hi[0] - r->box.lo[0]);
+    const uint64_t nx = (uint64_t)(r->box.hi[0] - r->box.lo[0]), nrows = r->ncells / nx;
     exit_buf *bufs = record_exits ? cm_thread_records((size_t)threads, sizeof *bufs) : NULL;
     row_exits rows = {NULL, NULL};
     if (record_exits) {
@@ -410,6 +414,11 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
     if (record_exits && (!bufs || !rows.thread || !rows.first))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
     atomic_int stop = 0; /* 1: the model aborted; 2: the progress callback cancelled */
+    /* Rows are handed out a few thousand cells at a time, as threads ask:
+     * rows cost more where cells re-step or leave, and a thread of a
+     * shared machine may lose its core for a while; equal shares fixed in
+     * advance left one thread waiting for the other. */
+    const int chunk = nx >= ROW_CHUNK_CELLS ? 1 : (int)(ROW_CHUNK_CELLS / nx);
     if (st == CM_OK) {
     /* a few cells are quicker on one thread than waking others */
 #pragma omp parallel num_threads(threads) if (r->ncells >= PARALLEL_CELLS)
@@ -422,7 +431,7 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
         exit_buf *eb = bufs ? &bufs[t] : NULL;
         batch *b = model->step_n ? malloc(sizeof *b) : NULL; /* NULL: the scalar path */
         uint64_t mine = 0; /* rows this thread did */
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, chunk)
         for (int64_t row = 0; row < (int64_t)nrows; row++) {
             if (eb) {
                 rows.thread[row] = (uint32_t)t;
@@ -435,10 +444,11 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
                              : images_of_row(model, lat, r, max_steps, (uint64_t)row, eb);
             if (rc < 0)
                 atomic_store(&stop, 1);
-            /* the calling thread reports, for the rows of a static share */
+            /* the calling thread reports, from the rows it did: about a
+             * team's share of them */
             if (t == 0 && progress && ++mine % PROGRESS_ROWS == 0 &&
                 progress(opt->user, "images",
-                         (double)mine * (double)team / (double)(nrows + 1)) != 0)
+                         fmin(1.0, (double)mine * (double)team / (double)(nrows + 1))) != 0)
                 atomic_store(&stop, 2);
         }
         free(b);
