@@ -266,6 +266,19 @@ static cm_status walk_block(classifier *c, uint32_t *buffers)
     return st;
 }
 
+/* Writes one element of group[lo, hi) per page. Every walk labels each
+ * cell's group, so the array needs no other start; but a fresh array's
+ * pages are then mapped in one sequential pass (with step[]'s), not one
+ * fault at a time in the middle of the walks' cache misses. */
+static void map_pages(uint32_t *group, uint32_t lo, uint32_t hi)
+{
+    const uint32_t per_page = 4096 / sizeof *group;
+    for (uint32_t i = lo; i < hi; i += per_page)
+        group[i] = 0;
+    if (hi > lo)
+        group[hi - 1] = 0;
+}
+
 /* Renumbers groups 1..found in order of the lowest local index of their
  * domain. */
 static cm_status renumber(uint32_t n, uint32_t *group, uint32_t found, uint32_t *ngroups,
@@ -527,10 +540,9 @@ static cm_status classify_blocks(uint32_t n, const uint32_t *image, uint32_t *gr
         classifier *c = &blocks[b];
         if (st != CM_OK)
             continue;
-        for (uint32_t i = c->lo; i < c->hi; i++) { /* group[] too: see cm_classify_threads */
+        for (uint32_t i = c->lo; i < c->hi; i++)
             step[i] = CM_STEP_UNVISITED;
-            group[i] = 0;
-        }
+        map_pages(group, c->lo, c->hi);
         c->status = walk_block(c, buffers + (size_t)b * LANES * LANE_BUFFER);
     }
     /* 2. the exits, followed from block to block */
@@ -610,13 +622,9 @@ cm_status cm_classify_threads(uint32_t n, const uint32_t *image, uint32_t *group
     uint32_t *buffers = malloc((size_t)LANES * LANE_BUFFER * sizeof *buffers);
     if (!buffers)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the path buffers");
-    /* group[] is written here too although every walk sets it: a fresh
-     * array's pages are then mapped in one sequential pass, not one fault
-     * at a time in the middle of the walks' cache misses */
-    for (uint32_t i = 0; i < n; i++) {
+    for (uint32_t i = 0; i < n; i++)
         step[i] = CM_STEP_UNVISITED;
-        group[i] = 0;
-    }
+    map_pages(group, 0, n);
     const cm_status st = walk_block(&c, buffers);
     free(buffers);
     if (st != CM_OK)
