@@ -485,39 +485,61 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     return images_of_rows(model, lat, max_steps, threads, opt, r, msg, msg_size);
 }
 
-void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM])
+/* Regions below this many cells are classified, and summarised, on one
+ * thread. */
+#define PARALLEL_CLASSIFY_CELLS 65536
+
+void cm_scm_slow_share(const cm_region *r, int threads, double share[CM_MAX_DIM])
 {
-    /* Called on every solve's summary, so no cm_box_cell per cell: the
-     * cell's own position is counted up as i goes, and its image's found
-     * with one 32-bit division per dimension but the last (local indices
-     * stay below 2^32). */
+    /* Called on every solve's summary, so no cm_box_cell per cell: each
+     * thread counts its cells' positions up from the first of its share,
+     * and finds an image's with one 32-bit division per dimension but the
+     * last (local indices stay below 2^32). The counts are integers: the
+     * same whatever the thread count. */
     const int dim = r->box.dim;
-    uint32_t side[CM_MAX_DIM], at[CM_MAX_DIM] = {0}, to[CM_MAX_DIM];
+    uint32_t side[CM_MAX_DIM];
     for (int d = 0; d < dim; d++)
         side[d] = (uint32_t)(r->box.hi[d] - r->box.lo[d]);
     uint64_t moved = 0, same[CM_MAX_DIM] = {0};
-    for (uint64_t i = 0; i < r->ncells; i++) {
-        const uint32_t j = r->image[i];
-        if (j < r->ncells && j != i) { /* not the sink, an exit or a fixed cell */
-            uint32_t rest = j;
-            for (int d = 0; d < dim - 1; d++) {
-                to[d] = rest % side[d];
-                rest /= side[d];
+#ifdef _OPENMP
+    if (threads <= 0)
+        threads = omp_get_max_threads();
+#endif
+#pragma omp parallel num_threads(threads > 0 ? threads : 1) if (r->ncells >= PARALLEL_CLASSIFY_CELLS) \
+    reduction(+ : moved, same[:CM_MAX_DIM])
+    {
+        int t = 0, team = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        team = omp_get_num_threads();
+#endif
+        const uint64_t lo = r->ncells * (uint64_t)t / (uint64_t)team,
+                       hi = r->ncells * (uint64_t)(t + 1) / (uint64_t)team;
+        int64_t first[CM_MAX_DIM];
+        uint32_t at[CM_MAX_DIM] = {0}, to[CM_MAX_DIM];
+        cm_box_cell(&r->box, lo, first);
+        for (int d = 0; d < dim; d++)
+            at[d] = (uint32_t)(first[d] - r->box.lo[d]);
+        for (uint64_t i = lo; i < hi; i++) {
+            const uint32_t j = r->image[i];
+            if (j < r->ncells && j != i) { /* not the sink, an exit or a fixed cell */
+                uint32_t rest = j;
+                for (int d = 0; d < dim - 1; d++) {
+                    to[d] = rest % side[d];
+                    rest /= side[d];
+                }
+                to[dim - 1] = rest;
+                moved++;
+                for (int d = 0; d < dim; d++)
+                    same[d] += at[d] == to[d];
             }
-            to[dim - 1] = rest;
-            moved++;
-            for (int d = 0; d < dim; d++)
-                same[d] += at[d] == to[d];
+            for (int d = 0; d < dim && ++at[d] == side[d]; d++)
+                at[d] = 0;
         }
-        for (int d = 0; d < dim && ++at[d] == side[d]; d++)
-            at[d] = 0;
     }
     for (int d = 0; d < CM_MAX_DIM; d++)
         share[d] = d < dim && moved ? (double)same[d] / (double)moved : NAN;
 }
-
-/* Regions below this many cells are classified on one thread. */
-#define PARALLEL_CLASSIFY_CELLS 65536
 
 cm_status cm_scm_classify(cm_region *r, int threads, char *msg, size_t msg_size)
 {

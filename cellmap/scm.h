@@ -137,8 +137,9 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
  * large share means the map moves less than a cell per step in d there:
  * restarting each step from a cell's centre then undoes the motion in d,
  * and a coordinate that decays slowly never decays (docs/engine.md, "Slow
- * directions"). Finer cells in d are the cure. */
-void cm_scm_slow_share(const cm_region *r, double share[CM_MAX_DIM]);
+ * directions"). Finer cells in d are the cure. On `threads` threads (0:
+ * the OpenMP default; the shares do not depend on their number). */
+void cm_scm_slow_share(const cm_region *r, int threads, double share[CM_MAX_DIM]);
 
 /* Classifies the functional graph in image[] into group[] and step[], on
  * `threads` threads (0: every core; regions below 65536 cells on one). The

@@ -704,7 +704,7 @@ int cmd_solve(int argc, char **argv)
         sum.cells = r.ncells;
         sum.ngroups = r.ngroups;
         if (!a.json && !a.quiet) /* only the text summary shows it */
-            cm_scm_slow_share(&r, sum.slow);
+            cm_scm_slow_share(&r, a.threads, sum.slow);
         if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }

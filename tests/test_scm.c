@@ -318,10 +318,14 @@ static void test_random_maps(void)
 
 /* cm_scm_slow_share against its definition, by cm_box_cell, on random
  * images (some to the sink, some fixed) in boxes of unequal sides off the
- * origin. */
+ * origin, on 1 to 3 threads (the last box is big enough to be shared out,
+ * with shares that start mid-row). */
 static void test_slow_share(void)
 {
-    const cm_box boxes[] = {{1, {-3}, {17}}, {2, {-2, 5}, {5, 9}}, {3, {-2, 5, 1}, {5, 9, 4}}};
+    const cm_box boxes[] = {{1, {-3}, {17}},
+                            {2, {-2, 5}, {5, 9}},
+                            {3, {-2, 5, 1}, {5, 9, 4}},
+                            {3, {-7, 2, -1}, {60, 53, 40}}};
     uint64_t x = 12345;
     for (size_t b = 0; b < sizeof boxes / sizeof *boxes; b++) {
         const cm_box *box = &boxes[b];
@@ -344,10 +348,12 @@ static void test_slow_share(void)
             for (int d = 0; d < box->dim; d++)
                 same[d] += from[d] == to[d];
         }
-        double share[CM_MAX_DIM];
-        cm_scm_slow_share(&r, share);
-        for (int d = 0; d < box->dim; d++)
-            CHECK_NEAR(share[d], (double)same[d] / (double)moved, 0);
+        for (int threads = 1; threads <= 3; threads++) {
+            double share[CM_MAX_DIM];
+            cm_scm_slow_share(&r, threads, share);
+            for (int d = 0; d < box->dim; d++)
+                CHECK_NEAR(share[d], (double)same[d] / (double)moved, 0);
+        }
         for (int d = 0; d < box->dim && box->dim > 1; d++) /* both outcomes, in 2-D and 3-D */
             CHECK(same[d] > 0 && same[d] < moved);
         cm_region_free(&r);

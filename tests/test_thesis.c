@@ -212,11 +212,11 @@ static solved slow_rows_then_fine(const char *model, const char *params, const d
     double share[CM_MAX_DIM];
     solved c = run_model(model, params, box[0], box[1], box[2], box[3], coarse[0], coarse[1],
                          100000);
-    cm_scm_slow_share(&c.r, share);
+    cm_scm_slow_share(&c.r, 0, share);
     CHECK(share[1] > 0.8);
     release(&c);
     solved s = run_model(model, params, box[0], box[1], box[2], box[3], fine[0], fine[1], 100000);
-    cm_scm_slow_share(&s.r, share);
+    cm_scm_slow_share(&s.r, 0, share);
     CHECK(share[1] < 0.25);
     *fine_share = share[1];
     return s;
