@@ -100,6 +100,15 @@ static void keep_exit(exit_buf *eb, const int64_t *cell, int dim)
     eb->n++;
 }
 
+/* The image a step gives: the sink (outside the world), the local index of
+ * the cell it lands in, or an exit (outside the box). */
+static uint32_t image_value(const cm_box *box, bool in_world, const int64_t *cell)
+{
+    if (!in_world)
+        return CM_IMAGE_SINK;
+    return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
+}
+
 /* The image of cell `from` of the box into *image, by single steps; with
  * eb, the target of an image that leaves the box is appended to it.
  * Returns the model's status. */
@@ -113,15 +122,9 @@ static int image_of_cell(const cm_model *model, const cm_lattice *lat, const cm_
     const int rc = image_cell(model, lat, from, max_steps, x, cell, &in_world);
     if (rc < 0)
         return rc;
-    if (!in_world) {
-        *image = CM_IMAGE_SINK;
-    } else if (cm_box_contains(box, cell)) {
-        *image = (uint32_t)cm_box_index(box, cell);
-    } else {
-        *image = CM_IMAGE_EXIT;
-        if (eb)
-            keep_exit(eb, cell, box->dim);
-    }
+    *image = image_value(box, in_world, cell);
+    if (*image == CM_IMAGE_EXIT && eb)
+        keep_exit(eb, cell, box->dim);
     return 0;
 }
 
@@ -302,15 +305,12 @@ static void restep_batch(const cm_model *model, const cm_lattice *lat, const cm_
                 for (int d = 0; d < dim; d++)
                     b->x[d][going_on] = y[d];
                 pos[going_on++] = i;
-            } else if (!in_world) {
-                image[i] = CM_IMAGE_SINK;
-            } else if (cm_box_contains(box, cell)) {
-                image[i] = (uint32_t)cm_box_index(box, cell);
-            } else {
-                image[i] = CM_IMAGE_EXIT;
+                continue;
+            }
+            image[i] = image_value(box, in_world, cell);
+            if (image[i] == CM_IMAGE_EXIT) /* its target, for the in-order pass */
                 for (int d = 0; d < dim; d++)
                     b->at[d][i] = (double)cell[d];
-            }
         }
         m = going_on;
     }
@@ -388,6 +388,16 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
 
 /* The image loop: rows are independent and every image depends on its cell
  * alone, so the result is the same whatever the schedule or thread count. */
+/* The threads to use: `threads`, or the OpenMP default for 0 or less. */
+static int threads_or_default(int threads)
+{
+#ifdef _OPENMP
+    if (threads <= 0)
+        threads = omp_get_max_threads();
+#endif
+    return threads > 0 ? threads : 1;
+}
+
 /* Regions below this many cells compute their images on one thread. */
 #define PARALLEL_CELLS 1024
 
@@ -474,10 +484,7 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
     if (!model || !model->step || model->dim != lat->dim || r->box.dim != lat->dim)
         return cm_fail(CM_EINVAL, msg, msg_size, "model, lattice and region dimensions differ");
     const int max_steps = opt && opt->max_steps > 1 ? opt->max_steps : 1;
-    int threads = 1;
-#ifdef _OPENMP
-    threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
-#endif
+    const int threads = threads_or_default(opt ? opt->threads : 0);
     free(r->exit_target);
     r->exit_target = NULL;
     r->nexits = 0;
@@ -501,11 +508,8 @@ void cm_scm_slow_share(const cm_region *r, int threads, double share[CM_MAX_DIM]
     for (int d = 0; d < dim; d++)
         side[d] = (uint32_t)(r->box.hi[d] - r->box.lo[d]);
     uint64_t moved = 0, same[CM_MAX_DIM] = {0};
-#ifdef _OPENMP
-    if (threads <= 0)
-        threads = omp_get_max_threads();
-#endif
-#pragma omp parallel num_threads(threads > 0 ? threads : 1) if (r->ncells >= PARALLEL_CLASSIFY_CELLS) \
+#pragma omp parallel num_threads(threads_or_default(threads)) \
+    if (r->ncells >= PARALLEL_CLASSIFY_CELLS) \
     reduction(+ : moved, same[:CM_MAX_DIM])
     {
         int t = 0, team = 1;
@@ -543,12 +547,7 @@ void cm_scm_slow_share(const cm_region *r, int threads, double share[CM_MAX_DIM]
 
 cm_status cm_scm_classify(cm_region *r, int threads, char *msg, size_t msg_size)
 {
-#ifdef _OPENMP
-    if (threads <= 0)
-        threads = omp_get_max_threads();
-#endif
-    if (threads < 1 || r->ncells < PARALLEL_CLASSIFY_CELLS)
-        threads = 1;
+    threads = r->ncells < PARALLEL_CLASSIFY_CELLS ? 1 : threads_or_default(threads);
     return cm_classify_threads((uint32_t)r->ncells, r->image, r->group, r->step, &r->ngroups,
                                r->exits_recorded, threads, msg, msg_size);
 }
