@@ -129,7 +129,7 @@ static bool waits_on(const classifier *c, int from, int self)
     return false;
 }
 
-static void append(classifier *c, int k, uint32_t cell)
+static inline void append(classifier *c, int k, uint32_t cell)
 {
     lane *l = &c->lanes[k];
     if (l->len < LANE_BUFFER)
