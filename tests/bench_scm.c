@@ -7,13 +7,19 @@
  * 4.21's. Each runs once untimed (pages faulted in, threads woken), then
  * `repeats` times with 1 and 2 threads in turns; the program prints the
  * medians: image time, classification time, total, images and total in ns
- * per cell, and bytes per cell (the region's per-cell arrays).
+ * per cell, and bytes per cell (the region's per-cell arrays). A last line
+ * gives the machine's own limits to read them by (machine_reference).
  *
  * usage: bench_scm [repeats (default 5)] [million cells (default 8)] */
+#define _DEFAULT_SOURCE /* MAP_ANONYMOUS */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+
+#include <omp.h>
 
 #include "cellmap/scm.h"
 #include "bench_util.h"
@@ -88,6 +94,69 @@ static void run_config(const config *c, double million, int repeats)
     cm_model_release(&m);
 }
 
+/* The machine's limits for arrays the size of the region's (12 bytes per
+ * cell), medians of 3: a random read, as the classification's walks make
+ * them (32 independent chains per thread through one cycle over every
+ * entry, 2 threads; ns per read of both threads together), and the first
+ * touch of fresh memory (the page faults a command pays on its region and
+ * this benchmark, which reuses its region, does not; ns per cell). */
+static void machine_reference(double million)
+{
+    enum { CHAINS = 32, THREADS = 2, RUNS = 3 };
+    const size_t n = (size_t)(3 * million * 1e6), cells = (size_t)(million * 1e6);
+    uint32_t *next = malloc(n * sizeof *next);
+    if (!next)
+        die("out of memory for the machine reference");
+    for (size_t i = 0; i < n; i++)
+        next[i] = (uint32_t)i;
+    uint64_t x = UINT64_C(88172645463325252);
+    for (size_t i = n - 1; i > 0; i--) { /* Sattolo's shuffle: a single cycle */
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        const size_t j = (size_t)(x % i);
+        const uint32_t t = next[i];
+        next[i] = next[j];
+        next[j] = t;
+    }
+    const size_t steps = (size_t)1 << 18; /* per chain */
+    double t_read[RUNS], t_touch[RUNS];
+    uint64_t sink = 0;
+    for (int r = 0; r < RUNS; r++) {
+        const double t0 = now();
+#pragma omp parallel num_threads(THREADS) reduction(+ : sink)
+        {
+            const size_t spacing = n / (THREADS * CHAINS);
+            uint32_t at[CHAINS];
+            for (int c = 0; c < CHAINS; c++)
+                at[c] = (uint32_t)((size_t)(omp_get_thread_num() * CHAINS + c) * spacing);
+            for (size_t s = 0; s < steps; s++)
+                for (int c = 0; c < CHAINS; c++)
+                    at[c] = next[at[c]];
+            for (int c = 0; c < CHAINS; c++)
+                sink += at[c];
+        }
+        t_read[r] = (now() - t0) / ((double)steps * CHAINS * THREADS);
+        const size_t bytes = n * sizeof *next;
+        char *fresh = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (fresh == MAP_FAILED)
+            die("out of memory for the machine reference");
+        const double t1 = now();
+#pragma omp parallel for num_threads(THREADS) schedule(static)
+        for (size_t page = 0; page < bytes / 4096; page++)
+            fresh[page * 4096] = 1;
+        t_touch[r] = (now() - t1) / (double)cells;
+        munmap(fresh, bytes);
+    }
+    free(next);
+    const volatile uint64_t keep = sink; /* the chains' ends: the reads are not optimised away */
+    (void)keep;
+    printf("machine: a random read in %.0f MiB %.2f ns (%d threads x %d chains); first touch of "
+           "fresh memory %.2f ns/cell\n",
+           (double)(n * sizeof *next) / 1048576.0, 1e9 * median(t_read, RUNS), THREADS, CHAINS,
+           1e9 * median(t_touch, RUNS));
+}
+
 int main(int argc, char **argv)
 {
     const int repeats = argc > 1 ? atoi(argv[1]) : 5;
@@ -101,5 +170,6 @@ int main(int argc, char **argv)
            "groups");
     for (size_t c = 0; c < sizeof configs / sizeof configs[0]; c++)
         run_config(&configs[c], million, repeats);
+    machine_reference(million);
     return 0;
 }
