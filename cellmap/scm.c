@@ -52,6 +52,14 @@ uint64_t cm_region_bytes(const cm_region *r)
            r->nexits * (uint64_t)r->box.dim * sizeof *r->exit_target;
 }
 
+static bool same_cell(int dim, const int64_t *a, const int64_t *b)
+{
+    for (int d = 0; d < dim; d++)
+        if (a[d] != b[d])
+            return false;
+    return true;
+}
+
 /* Image cell of the point x that starts in cell `from`, re-stepping while
  * the image stays in `from` (at most max_steps steps in all). Returns the
  * model's status; *in_world is false when there is no image cell. */
@@ -63,13 +71,8 @@ static int image_cell(const cm_model *model, const cm_lattice *lat, const int64_
     for (int k = 1;; k++) {
         const int rc = model->step(model, x, y);
         *in_world = rc == 0 && cm_lattice_cell(lat, y, cell);
-        if (rc < 0 || !*in_world || k >= max_steps)
+        if (rc < 0 || !*in_world || k >= max_steps || !same_cell(dim, cell, from))
             return rc < 0 ? rc : 0;
-        bool same = true;
-        for (int d = 0; d < dim; d++)
-            same = same && cell[d] == from[d];
-        if (!same)
-            return 0;
         for (int d = 0; d < dim; d++)
             x[d] = y[d];
     }
@@ -272,6 +275,8 @@ static void restep_batch(const cm_model *model, const cm_lattice *lat, const cm_
     const double *xs[CM_MAX_DIM];
     double *ys[CM_MAX_DIM];
     int pos[BATCH], rc[BATCH];
+    int64_t here[CM_MAX_DIM]; /* the cell being re-stepped */
+    memcpy(here, from, sizeof here);
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         if (!special[i] || b->world[i] == 0.0 || b->stays[i] == 0.0)
@@ -298,10 +303,8 @@ static void restep_batch(const cm_model *model, const cm_lattice *lat, const cm_
             for (int d = 0; d < dim; d++)
                 y[d] = b->y[d][j];
             const bool in_world = rc[j] == 0 && cm_lattice_cell(lat, y, cell);
-            bool same = in_world;
-            for (int d = 0; d < dim; d++)
-                same = same && cell[d] == from[d] + (d == 0 ? i : 0);
-            if (same && k < max_steps) {
+            here[0] = from[0] + i;
+            if (in_world && k < max_steps && same_cell(dim, cell, here)) {
                 for (int d = 0; d < dim; d++)
                     b->x[d][going_on] = y[d];
                 pos[going_on++] = i;
@@ -386,8 +389,6 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
     return CM_OK;
 }
 
-/* The image loop: rows are independent and every image depends on its cell
- * alone, so the result is the same whatever the schedule or thread count. */
 /* The threads to use: `threads`, or the OpenMP default for 0 or less. */
 static int threads_or_default(int threads)
 {
@@ -407,6 +408,8 @@ static int threads_or_default(int threads)
 /* Rows between two calls of the progress callback (on the calling thread). */
 #define PROGRESS_ROWS 64
 
+/* The image loop: rows are independent and every image depends on its cell
+ * alone, so the result is the same whatever the schedule or thread count. */
 static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, int max_steps,
                                 int threads, const cm_scm_options *opt, cm_region *r, char *msg,
                                 size_t msg_size)
