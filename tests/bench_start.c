@@ -4,7 +4,8 @@
  * command RUNS times, in turns, and prints its median wall time and
  * median peak RSS: `solve --cells 10x10` (no PNG), `info` of a small
  * database, `models`, `orbit`, `export --groups`, and for comparison a
- * `solve --cells 10x10 --png` that loads OSMesa.
+ * `solve --cells 10x10 --png` that loads OSMesa; and the machine's own
+ * floor, an empty process (/bin/true), run in the same turns.
  * usage: bench_start PATH/TO/cellmap [DIR] [RUNS]   (DIR default /tmp, RUNS 20) */
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,7 +17,7 @@
 #define CM_BENCH_RUN_COMMAND
 #include "bench_util.h"
 
-enum { COMMANDS = 6, MAX_RUNS = 200 };
+enum { COMMANDS = 7, MAX_RUNS = 200 };
 
 int main(int argc, char **argv)
 {
@@ -47,10 +48,11 @@ int main(int argc, char **argv)
         {cm, "orbit", "--from", "100,0", "--steps", "10", NULL},
         {cm, "export", db, "--groups", csv, NULL},
         {cm, "solve", "--cells", "10x10", "--png", png, NULL},
+        {"/bin/true", NULL},
     };
     const char *const names[COMMANDS] = {"solve --cells 10x10", "info FILE", "models",
                                          "orbit --steps 10", "export --groups",
-                                         "solve 10x10 --png"};
+                                         "solve 10x10 --png", "/bin/true (machine)"};
     static double walls[COMMANDS][MAX_RUNS], rsss[COMMANDS][MAX_RUNS];
     for (int r = 0; r < runs; r++)
         for (int c = 0; c < COMMANDS; c++)
