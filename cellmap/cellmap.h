@@ -107,8 +107,9 @@ typedef struct cm_grid {
     int64_t cells[CM_MAX_DIM];
 } cm_grid;
 
-/* Called on the calling thread with the fraction of the work done (0..1);
- * a nonzero return cancels: the call then returns CM_ECANCELED. */
+/* Called on the calling thread with the fraction of the work done (0..1),
+ * at least once, last with 1 when the work is done; a nonzero return
+ * cancels: the call then returns CM_ECANCELED. */
 typedef int (*cm_solve_progress_fn)(void *user, double fraction);
 
 typedef struct cm_solve_options {

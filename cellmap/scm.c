@@ -451,6 +451,7 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
     if (record_exits && (!bufs || !rows.thread || !rows.first))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
     atomic_int stop = 0; /* 1: the model aborted; 2: the progress callback cancelled */
+    atomic_uint_fast64_t rows_done = 0; /* by every thread: what the calling thread reports */
     /* Rows are handed out a few thousand cells at a time, as threads ask:
      * rows cost more where cells re-step or leave, and a thread of a
      * shared machine may lose its core for a while; equal shares fixed in
@@ -460,10 +461,9 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
     /* a few cells are quicker on one thread than waking others */
 #pragma omp parallel num_threads(threads) if (r->ncells >= PARALLEL_CELLS)
     {
-        int t = 0, team = 1;
+        int t = 0;
 #ifdef _OPENMP
         t = omp_get_thread_num();
-        team = omp_get_num_threads();
 #endif
         exit_buf *eb = bufs ? &bufs[t] : NULL;
         batch *b = model->step_n ? malloc(sizeof *b) : NULL; /* NULL: the scalar path */
@@ -481,16 +481,20 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
                              : images_of_row(model, lat, r, max_steps, (uint64_t)row, eb);
             if (rc < 0)
                 atomic_store(&stop, 1);
-            /* the calling thread reports, from the rows it did: about a
-             * team's share of them */
+            const uint64_t done =
+                atomic_fetch_add_explicit(&rows_done, 1, memory_order_relaxed) + 1;
             if (t == 0 && progress && ++mine % PROGRESS_ROWS == 0 &&
-                progress(opt->user, "images",
-                         fmin(1.0, (double)mine * (double)team / (double)(nrows + 1))) != 0)
+                progress(opt->user, "images", (double)done / (double)nrows) != 0)
                 atomic_store(&stop, 2);
         }
         free(b);
     }
     }
+    /* The images are done: said on the calling thread whatever share of
+     * the rows it did (on a busy machine the other threads may have done
+     * them all), and a last chance to cancel before classification. */
+    if (st == CM_OK && stop == 0 && progress && progress(opt->user, "images", 1.0) != 0)
+        stop = 2;
     if (st == CM_OK && stop == 1)
         st = cm_fail(CM_EMODEL, msg, msg_size, "model %s aborted the computation", model->name);
     if (st == CM_OK && stop == 2)

@@ -74,8 +74,9 @@ static inline const int64_t *cm_region_exit(const cm_region *r, uint64_t k)
 }
 
 /* Progress callback, called on the calling thread: phase "images" with the
- * fraction of them done in [0, 1], then (cm_scm_solve) "classification"
- * with 0 as it starts. Nonzero cancels: the call returns CM_ECANCELED. */
+ * fraction of them done in [0, 1], always last with 1 when they are done,
+ * then (cm_scm_solve) "classification" with 0 as it starts. Nonzero
+ * cancels: the call returns CM_ECANCELED. */
 typedef int (*cm_progress_fn)(void *user, const char *phase, double fraction);
 
 typedef struct cm_scm_options {

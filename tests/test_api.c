@@ -38,6 +38,13 @@ static int cancel_at_half(void *user, double fraction)
     return fraction >= 0.5;
 }
 
+static int record_largest(void *user, double fraction)
+{
+    double *largest = user;
+    *largest = fraction > *largest ? fraction : *largest;
+    return 0;
+}
+
 static void test_versions_and_errors(void)
 {
     CHECK_INT(cm_version_number(), CELLMAP_VERSION_NUMBER);
@@ -121,6 +128,16 @@ static void test_solve(cm_system *s, uint32_t *labels, uint32_t *steps)
     CHECK(calls >= 1 && strstr(msg, "cancelled") != NULL);
     cancel.split[0] = cancel.split[1] = 0;
     CHECK(cm_solve(s, &pd_grid, &cancel, &r, msg, sizeof msg) == CM_ECANCELED && r == NULL);
+    /* progress ends at 1, said on the calling thread even where the other
+     * threads did every row (a busy machine): the cancel above cannot miss */
+    for (int split = 0; split <= 4; split += 4) {
+        double largest = -1;
+        const cm_solve_options watch = {.progress = record_largest, .user = &largest,
+                                        .split = {split, split}};
+        CHECK(cm_solve(s, &pd_grid, &watch, &r, msg, sizeof msg) == CM_OK);
+        CHECK(largest == 1.0);
+        cm_result_free(r);
+    }
 
     /* the figure */
     CHECK(cm_result_png(whole, "api.png", 600, 400, msg, sizeof msg) == CM_OK);
