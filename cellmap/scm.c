@@ -17,11 +17,11 @@
  * They are a command's largest memory and are first touched by the solve
  * itself, so their page faults are part of its time: on the virtual
  * machines we measure on, first touch of 12 bytes per cell in 4 KiB pages
- * cost 2-27 ns/cell, in 2 MiB transparent huge pages 3.5 ns/cell where 4 KiB
- * cost 24 (bench_scm's machine line). Arrays of 2 MiB or more are therefore
- * asked for in huge pages: the whole 2 MiB of them, so that they take no
- * more memory than their bytes (the rest in 4 KiB pages; rounding the array
- * up to whole huge pages instead measured no faster from the command line). */
+ * cost 2-27 ns/cell; on one where it cost 17-27, in 2 MiB transparent huge
+ * pages it cost 0.9-3.5 (bench_scm's machine line). The whole 2 MiB of an
+ * array are therefore asked for in huge pages, and the rest stays in 4 KiB
+ * ones, so that an array takes no more memory than its bytes (rounding it
+ * up to whole huge pages measured no faster from the command line). */
 static void *cells_array(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
