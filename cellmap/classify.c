@@ -321,9 +321,10 @@ static cm_status walk_block(classifier *c, uint32_t *buffers)
 }
 
 /* Writes one element of group[lo, hi) per page. Every cell's group is
- * labelled (by a walk, or by the scan), so the array needs no other start; but a fresh array's
- * pages are then mapped in one sequential pass (with step[]'s), not one
- * fault at a time in the middle of the walks' cache misses. */
+ * labelled (by a walk, or by the scan), so the array needs no other start;
+ * but a fresh array's pages are then mapped in one sequential pass (with
+ * step[]'s), not one fault at a time in the middle of the walks' cache
+ * misses. */
 static void map_pages(uint32_t *group, uint32_t lo, uint32_t hi)
 {
     const uint32_t per_page = 4096 / sizeof *group;

@@ -483,7 +483,7 @@ static cm_status images_of_rows(const cm_model *model, const cm_lattice *lat, in
             if (rc < 0)
                 atomic_store(&stop, 1);
             const uint64_t done =
-                atomic_fetch_add_explicit(&rows_done, 1, memory_order_relaxed) + 1;
+                progress ? atomic_fetch_add_explicit(&rows_done, 1, memory_order_relaxed) + 1 : 0;
             if (t == 0 && progress && ++mine % PROGRESS_ROWS == 0 &&
                 progress(opt->user, "images", (double)done / (double)nrows) != 0)
                 atomic_store(&stop, 2);

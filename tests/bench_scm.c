@@ -117,8 +117,9 @@ static double first_touch(size_t bytes, bool huge, int threads)
  * cell), medians of 3: a random read, as the classification's walks make
  * them (32 independent chains per thread through one cycle over every
  * entry, 2 threads; ns per read of both threads together), and the first
- * touch of fresh memory (the page faults a command pays on its region and
- * this benchmark, which reuses its region, does not; ns per cell). */
+ * touch of fresh memory in 4 KiB and in huge pages (the page faults a
+ * command pays on its region and this benchmark, which reuses its region,
+ * does not; ns per cell). */
 static void machine_reference(double million)
 {
     enum { CHAINS = 32, THREADS = 2, RUNS = 3 };
