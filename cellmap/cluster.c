@@ -884,13 +884,8 @@ void cm_cluster_bounds(const cm_cluster *c, cm_box *box)
         return;
     }
     *box = c->regions[0].r.box;
-    for (uint32_t k = 1; k < c->nregions; k++) {
-        const cm_box *b = &c->regions[k].r.box;
-        for (int d = 0; d < box->dim; d++) {
-            box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
-            box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
-        }
-    }
+    for (uint32_t k = 1; k < c->nregions; k++)
+        cm_box_grow(box, &c->regions[k].r.box);
 }
 
 /* ---- adding regions -------------------------------------------------------- */

@@ -113,6 +113,14 @@ bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out)
     return true;
 }
 
+void cm_box_grow(cm_box *box, const cm_box *b)
+{
+    for (int d = 0; d < box->dim; d++) {
+        box->lo[d] = b->lo[d] < box->lo[d] ? b->lo[d] : box->lo[d];
+        box->hi[d] = b->hi[d] > box->hi[d] ? b->hi[d] : box->hi[d];
+    }
+}
+
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell)
 {
     uint64_t index = 0;

@@ -61,6 +61,9 @@ bool cm_box_contains(const cm_box *box, const int64_t *cell);
  * *out untouched, when they share none. */
 bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out);
 
+/* Grows box to the smallest box holding both it and b. */
+void cm_box_grow(cm_box *box, const cm_box *b);
+
 /* Local row-major index of a cell inside the box (caller checked contains). */
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 

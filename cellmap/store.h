@@ -135,6 +135,12 @@ void cm_store_get_stats(const cm_store *s, cm_store_stats *stats);
 /* Makes the store the pager of c (c->page_in, c->page_out, c->pager). */
 void cm_store_attach(cm_store *s, cm_cluster *c);
 
+/* The records of the file's n regions (n from cm_store_read_info), in
+ * order: box and counts, no cells (every array NULL). For what a reader
+ * needs to know of the regions without loading the cluster. */
+cm_status cm_store_regions(cm_store *s, cm_region *regions, uint32_t n, char *msg,
+                           size_t msg_size);
+
 /* Rebuilds the saved cluster into c (initialised on the file's lattice):
  * every region restored paged out, the store attached as pager. */
 cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);

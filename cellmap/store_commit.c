@@ -253,21 +253,25 @@ cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64
 {
     cm_lattice lat;
     cm_status status = store_read_lattice(s->db, &lat, msg, msg_size);
+    /* From version 4 on, the groups view's rows of the attractors straight
+       from its tables: its ORDER BY over a UNION ALL sorts every row. */
+    const char *const sql =
+        s->version >= 4
+            ? "SELECT a.id, a.period, IFNULL((SELECT cells FROM basins WHERE grp = a.id), 0),"
+              " a.centre, a.lo, a.hi, a.anchor, a.kind FROM attractors a ORDER BY a.id"
+            : "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
+              "WHERE id > 0 ORDER BY id";
+    const int64_t sink = status == CM_OK ? store_sink_cells(s) : 0;
+    if (status == CM_OK && sink < 0)
+        status = cm_fail(CM_EFORMAT, msg, msg_size,
+                         "%s is damaged: its basins hold more cells than its regions", s->path);
+    *sink_cells = (uint64_t)(sink > 0 ? sink : 0);
     sqlite3_stmt *st = NULL;
-    if (status == CM_OK &&
-        sqlite3_prepare_v2(
-            s->db,
-            "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
-            "ORDER BY id",
-            -1, &st, NULL))
+    if (status == CM_OK && sqlite3_prepare_v2(s->db, sql, -1, &st, NULL))
         status = store_db_error(s->db, "read groups", msg, msg_size);
     uint32_t seen = 0;
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
         const int64_t id = sqlite3_column_int64(st, 0);
-        if (id == 0) {
-            *sink_cells = (uint64_t)sqlite3_column_int64(st, 2);
-            continue;
-        }
         double anchor[CM_MAX_DIM];
         cm_group_info *g = &groups[seen];
         memset(g, 0, sizeof *g);

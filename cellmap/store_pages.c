@@ -366,6 +366,35 @@ static cm_status region_record(const cm_store *s, sqlite3_stmt *st, uint32_t k, 
     return CM_OK;
 }
 
+static const char regions_sql[] =
+    "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id";
+
+cm_status cm_store_regions(cm_store *s, cm_region *regions, uint32_t n, char *msg,
+                           size_t msg_size)
+{
+    cm_lattice lat;
+    cm_status status = store_read_lattice(s->db, &lat, msg, msg_size);
+    sqlite3_stmt *st = NULL;
+    if (status == CM_OK && sqlite3_prepare_v2(s->db, regions_sql, -1, &st, NULL))
+        status = store_db_error(s->db, "read regions", msg, msg_size);
+    uint32_t k = 0;
+    int rc = SQLITE_DONE;
+    while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (k == n) {
+            status = cm_fail(CM_EFORMAT, msg, msg_size, "it holds more than %u regions", n);
+            break;
+        }
+        status = region_record(s, st, k, lat.dim, &regions[k], msg, msg_size);
+        k++;
+    }
+    if (status == CM_OK && rc != SQLITE_DONE)
+        status = store_db_error(s->db, "read regions", msg, msg_size);
+    else if (status == CM_OK && k != n)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "it holds %u regions, not %u", k, n);
+    sqlite3_finalize(st);
+    return store_damaged(s, status, msg, msg_size);
+}
+
 /* The regions' rows. Files of version 5 keep their node tables in the file
  * (read back on use); older ones give every node table and exit table
  * (into *exits), for cm_cluster_restored. */
@@ -375,9 +404,7 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
     sqlite3_stmt *st = NULL;
     uint64_t cap = 0;
     const bool tables = s->version < 5;
-    if (sqlite3_prepare_v2(s->db,
-                           "SELECT id, lo, hi, cells, exits, own_groups FROM regions ORDER BY id",
-                           -1, &st, NULL))
+    if (sqlite3_prepare_v2(s->db, regions_sql, -1, &st, NULL))
         return store_db_error(s->db, "read regions", msg, msg_size);
     cm_status status = CM_OK;
     int rc;

@@ -140,25 +140,36 @@ int cmd_info(int argc, char **argv)
         return cli_usage_error(&c, "which file? usage: cellmap info FILE.cmdb");
     cm_store *s = NULL;
     cm_store_info info;
-    cm_cluster cl;
-    if (project_open_read("info", path, 0, &s, &info, &cl) != EXIT_OK)
-        return EXIT_FAIL;
-    cm_group_info *g = calloc((size_t)info.groups + 1, sizeof *g);
+    cm_region *regions = NULL;
+    cm_group_info *g = NULL;
     uint64_t sink = 0;
     char msg[1024];
-    int rc = EXIT_FAIL;
-    if (!g)
-        snprintf(msg, sizeof msg, "out of memory for %u groups", info.groups);
-    else if (cm_store_snapshot_begin(s, msg, sizeof msg) == CM_OK &&
-             cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK)
-        rc = EXIT_OK;
+    /* the file's records only: info loads no cluster */
+    cm_status st = cm_store_open(path, 0, &s, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_snapshot_begin(s, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_read_info(s, &info, msg, sizeof msg);
+    if (st == CM_OK && info.regions == 0)
+        st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
+    if (st == CM_OK) {
+        regions = calloc(info.regions, sizeof *regions);
+        g = calloc((size_t)info.groups + 1, sizeof *g);
+        if (!regions || !g)
+            st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u regions and %u groups",
+                         info.regions, info.groups);
+    }
+    if (st == CM_OK)
+        st = cm_store_regions(s, regions, info.regions, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg);
     cm_store_snapshot_end(s);
-    if (rc == EXIT_OK) {
-        cm_box bounds;
-        cm_cluster_bounds(&cl, &bounds);
+    if (st == CM_OK) {
+        cm_box bounds = regions[0].box;
         uint64_t largest = 0;
-        for (uint32_t k = 0; k < cl.nregions; k++) {
-            const uint64_t bytes = cm_region_bytes(&cl.regions[k].r);
+        for (uint32_t k = 0; k < info.regions; k++) {
+            cm_box_grow(&bounds, &regions[k].box);
+            const uint64_t bytes = cm_region_bytes(&regions[k]);
             largest = bytes > largest ? bytes : largest;
         }
         if (json) {
@@ -170,7 +181,8 @@ int cmd_info(int argc, char **argv)
     } else {
         fprintf(stderr, "cellmap info: %s\n", msg);
     }
+    free(regions);
     free(g);
-    project_close(s, &cl);
-    return rc;
+    cm_store_close(s, msg, sizeof msg);
+    return st == CM_OK ? EXIT_OK : EXIT_FAIL;
 }

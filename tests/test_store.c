@@ -201,6 +201,23 @@ static void test_budgets(const char *dir, const cm_model *m)
     CHECK_INT(sink, ref_sink);
     for (uint32_t k = 0; k < info.groups; k++)
         CHECK(memcmp(&g[k], &ref[k], sizeof g[k]) == 0);
+    /* the regions' records without the cluster: the loaded regions' */
+    cm_region *rec = calloc(info.regions + 1, sizeof *rec);
+    CHECK(cm_store_regions(s, rec, info.regions, msg, sizeof msg) == CM_OK);
+    for (uint32_t k = 0; k < info.regions; k++) {
+        const cm_region *r = &c.regions[k].r;
+        CHECK(memcmp(&rec[k].box, &r->box, sizeof r->box) == 0);
+        CHECK_INT(rec[k].ncells, r->ncells);
+        CHECK_INT(rec[k].nexits, r->nexits);
+        CHECK_INT(rec[k].ngroups, r->ngroups);
+        CHECK(rec[k].image == NULL && rec[k].exit_target == NULL);
+        CHECK_INT(cm_region_bytes(&rec[k]), cm_region_bytes(r));
+    }
+    CHECK(cm_store_regions(s, rec, info.regions - 1, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "damaged") && strstr(msg, "more than"));
+    CHECK(cm_store_regions(s, rec, info.regions + 1, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "damaged") && strstr(msg, "regions, not"));
+    free(rec);
     free(g);
     free(ref);
     cm_region_free(&back);
@@ -260,6 +277,27 @@ static void test_refused(const char *dir, const char *good, const cm_model *m)
     fwrite(whole, 1, (size_t)size / 2, f);
     fclose(f);
     check_refused_untouched(path, m, "damaged");
+    unlink(path);
+
+    /* basins of more cells than the regions hold: the sink would be negative */
+    snprintf(path, sizeof path, "%s/oversized-basin.cmdb", dir);
+    f = fopen(path, "wb");
+    fwrite(whole, 1, (size_t)size, f);
+    fclose(f);
+    sql_exec(path, "UPDATE basins SET cells = cells + (SELECT SUM(cells) FROM regions) + 1 "
+                   "WHERE grp = 1");
+    char msg[512];
+    cm_store *s = NULL;
+    CHECK(cm_store_open(path, 0, &s, msg, sizeof msg) == CM_OK);
+    cm_store_info info;
+    CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "basins hold more cells than its regions") != NULL);
+    cm_group_info *g = calloc(info.groups + 1, sizeof *g);
+    uint64_t sink = 0;
+    CHECK(cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_EFORMAT);
+    CHECK(strstr(msg, "basins hold more cells than its regions") != NULL);
+    free(g);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
     unlink(path);
 
     snprintf(path, sizeof path, "%s/newer.cmdb", dir);
