@@ -145,16 +145,16 @@ static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor
 /* Tables a file of this version (or of versions 2 to 4) must have; their
  * absence means corruption. */
 #define CHECK_V4_SQL                                                                               \
-    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"                          \
-    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"                            \
-    " (SELECT COUNT(*) FROM nodes), (SELECT COUNT(*) FROM basins),"                                \
-    " (SELECT COUNT(*) FROM pages WHERE region = 1)"
-static const char *const check_sql = CHECK_V4_SQL ", (SELECT COUNT(*) FROM open_nodes)";
+    "SELECT EXISTS(SELECT 1 FROM meta), EXISTS(SELECT 1 FROM regions),"                          \
+    " EXISTS(SELECT 1 FROM exits), EXISTS(SELECT 1 FROM attractors),"                            \
+    " EXISTS(SELECT 1 FROM nodes), EXISTS(SELECT 1 FROM basins),"                                \
+    " EXISTS(SELECT 1 FROM pages WHERE region = 1)"
+static const char *const check_sql = CHECK_V4_SQL ", EXISTS(SELECT 1 FROM open_nodes)";
 static const char *const check_v4_sql = CHECK_V4_SQL;
 static const char *const check_v3_sql =
-    "SELECT (SELECT COUNT(*) FROM meta), (SELECT COUNT(*) FROM regions),"
-    " (SELECT COUNT(*) FROM exits), (SELECT COUNT(*) FROM attractors),"
-    " (SELECT COUNT(*) FROM region_groups), (SELECT COUNT(*) FROM pages WHERE region = 1)";
+    "SELECT EXISTS(SELECT 1 FROM meta), EXISTS(SELECT 1 FROM regions),"
+    " EXISTS(SELECT 1 FROM exits), EXISTS(SELECT 1 FROM attractors),"
+    " EXISTS(SELECT 1 FROM region_groups), EXISTS(SELECT 1 FROM pages WHERE region = 1)";
 
 
 double store_seconds_now(void)
@@ -409,6 +409,7 @@ static cm_status write_meta(sqlite3 *db, const cm_store_meta *meta, char *msg, s
         {"codec", "zstd-planes-1"},
         {"page_cells", page},
         {"groups", "0"},
+        {"page_bytes", "0"}, /* the pages' blobs, kept by store_write_pages */
     };
     sqlite3_stmt *st = NULL;
     if (sqlite3_prepare_v2(db, "INSERT INTO meta(key, value) VALUES(?, ?)", -1, &st, NULL))
@@ -743,6 +744,19 @@ int64_t store_query_int(sqlite3 *db, const char *sql)
     return v;
 }
 
+int64_t store_page_bytes(sqlite3 *db)
+{
+    /* files written before the meta value existed are read page by page:
+       a row per page, so a page of the file per row */
+    char text[32], *end = NULL;
+    if (read_text(db, "SELECT value FROM meta WHERE key='page_bytes'", text, sizeof text, NULL,
+                  0) != CM_OK)
+        return store_query_int(db, "SELECT IFNULL(SUM(LENGTH(image) + LENGTH(grp) + "
+                                   "LENGTH(step)), 0) FROM pages");
+    const long long bytes = strtoll(text, &end, 10);
+    return end == text || *end || bytes < 0 ? -1 : bytes;
+}
+
 static cm_status shortest_params(char *params, size_t size, char *msg, size_t msg_size)
 {
     char out[sizeof ((cm_store_info *)0)->params];
@@ -784,8 +798,7 @@ cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t
     const int64_t regions = store_query_int(db, "SELECT COUNT(*) FROM regions");
     const int64_t cells = store_query_int(db, "SELECT IFNULL(SUM(cells), 0) FROM regions");
     const int64_t groups = store_query_int(db, "SELECT COUNT(*) FROM attractors");
-    const int64_t pages = store_query_int(db, "SELECT IFNULL(SUM(LENGTH(image) + LENGTH(grp) + "
-                                        "LENGTH(step)), 0) FROM pages");
+    const int64_t pages = store_page_bytes(db);
     if (regions < 0 || cells < 0 || groups < 0 || pages < 0 || groups > CM_MAX_GROUPS)
         return cm_fail(CM_EFORMAT, msg, msg_size, "%s is a damaged cellmap database (%s)", s->path,
                        sqlite3_errmsg(db));

@@ -168,6 +168,12 @@ void cm_store_set_model(cm_store *s, const cm_model *model);
 cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
                           char *msg, size_t msg_size);
 
+/* The k groups of most cells (k at most the info's groups), largest first,
+ * ties by id, into a caller array; and the sink's cell count. Reads k rows,
+ * not every group's. */
+cm_status cm_store_largest_groups(cm_store *s, cm_group_info *groups, uint32_t k,
+                                  uint64_t *sink_cells, char *msg, size_t msg_size);
+
 /* Application notes kept with the cluster (e.g. an explore session's
  * view), under keys that begin with "note.": set (in its own transaction,
  * or in the open one) and get; CM_ENOTFOUND when the key is not there. */

@@ -248,19 +248,40 @@ cm_status cm_store_commit_join(void *store, cm_cluster *c, uint32_t box, const c
     return cm_store_commit(store, c, msg, msg_size); /* the next join makes room */
 }
 
-cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
-                          char *msg, size_t msg_size)
+/* Group row `st` (id, period, basin_cells, centre, lo, hi, anchor, kind)
+ * into g. */
+static cm_status group_row(const cm_store *s, sqlite3_stmt *st, const cm_lattice *lat,
+                           cm_group_info *g, char *msg, size_t msg_size)
+{
+    const int64_t id = sqlite3_column_int64(st, 0);
+    double anchor[CM_MAX_DIM];
+    memset(g, 0, sizeof *g);
+    g->id = (uint32_t)id;
+    g->period = (uint32_t)sqlite3_column_int64(st, 1);
+    g->basin_cells = (uint64_t)sqlite3_column_int64(st, 2);
+    for (int col = 3; col <= 6; col++) {
+        double *const out[] = {g->centre, g->lo, g->hi, anchor};
+        if (store_parse_json_numbers((const char *)sqlite3_column_text(st, col), out[col - 3],
+                                     CM_MAX_DIM) != lat->dim)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
+                           (long long)id);
+    }
+    for (int d = 0; d < lat->dim; d++)
+        g->anchor[d] = (int64_t)anchor[d];
+    const unsigned char *kind = sqlite3_column_text(st, 7);
+    g->kind = kind && strcmp((const char *)kind, cm_group_kind_name(CM_GROUP_STICKING)) == 0
+                  ? CM_GROUP_STICKING
+                  : CM_GROUP_ATTRACTOR;
+    return CM_OK;
+}
+
+/* The n group rows `sql` gives (its ?1, if it has one: n) into groups, and
+ * the sink's cells; in_id_order: the rows must be groups 1..n. */
+static cm_status read_groups(cm_store *s, const char *sql, bool in_id_order, cm_group_info *groups,
+                             uint32_t n, uint64_t *sink_cells, char *msg, size_t msg_size)
 {
     cm_lattice lat;
     cm_status status = store_read_lattice(s->db, &lat, msg, msg_size);
-    /* From version 4 on, the groups view's rows of the attractors straight
-       from its tables: its ORDER BY over a UNION ALL sorts every row. */
-    const char *const sql =
-        s->version >= 4
-            ? "SELECT a.id, a.period, IFNULL((SELECT cells FROM basins WHERE grp = a.id), 0),"
-              " a.centre, a.lo, a.hi, a.anchor, a.kind FROM attractors a ORDER BY a.id"
-            : "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
-              "WHERE id > 0 ORDER BY id";
     const int64_t sink = status == CM_OK ? store_sink_cells(s) : 0;
     if (status == CM_OK && sink < 0)
         status = cm_fail(CM_EFORMAT, msg, msg_size,
@@ -269,38 +290,47 @@ cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64
     sqlite3_stmt *st = NULL;
     if (status == CM_OK && sqlite3_prepare_v2(s->db, sql, -1, &st, NULL))
         status = store_db_error(s->db, "read groups", msg, msg_size);
+    if (st && sqlite3_bind_parameter_count(st) > 0)
+        sqlite3_bind_int64(st, 1, n);
     uint32_t seen = 0;
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
         const int64_t id = sqlite3_column_int64(st, 0);
-        double anchor[CM_MAX_DIM];
-        cm_group_info *g = &groups[seen];
-        memset(g, 0, sizeof *g);
-        g->id = (uint32_t)id;
-        g->period = (uint32_t)sqlite3_column_int64(st, 1);
-        g->basin_cells = (uint64_t)sqlite3_column_int64(st, 2);
-        if (id != (int64_t)seen + 1 || seen >= n ||
-            store_parse_json_numbers((const char *)sqlite3_column_text(st, 3), g->centre, CM_MAX_DIM) !=
-                lat.dim ||
-            store_parse_json_numbers((const char *)sqlite3_column_text(st, 4), g->lo, CM_MAX_DIM) !=
-                lat.dim ||
-            store_parse_json_numbers((const char *)sqlite3_column_text(st, 5), g->hi, CM_MAX_DIM) !=
-                lat.dim ||
-            store_parse_json_numbers((const char *)sqlite3_column_text(st, 6), anchor, CM_MAX_DIM) !=
-                lat.dim) {
+        if (seen == n || id < 1 || (in_id_order && id != (int64_t)seen + 1)) {
             status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: group %lld", s->path,
                              (long long)id);
             break;
         }
-        for (int d = 0; d < lat.dim; d++)
-            g->anchor[d] = (int64_t)anchor[d];
-        const unsigned char *kind = sqlite3_column_text(st, 7);
-        g->kind = kind && strcmp((const char *)kind, cm_group_kind_name(CM_GROUP_STICKING)) == 0
-                      ? CM_GROUP_STICKING
-                      : CM_GROUP_ATTRACTOR;
-        seen++;
+        status = group_row(s, st, &lat, &groups[seen++], msg, msg_size);
     }
     sqlite3_finalize(st);
     if (status == CM_OK && seen != n)
         status = cm_fail(CM_EFORMAT, msg, msg_size, "%s holds %u groups, not %u", s->path, seen, n);
     return status;
+}
+
+/* From version 4 on, the groups view's rows of the attractors are read
+ * straight from its tables: its ORDER BY over a UNION ALL sorts every row. */
+cm_status cm_store_groups(cm_store *s, cm_group_info *groups, uint32_t n, uint64_t *sink_cells,
+                          char *msg, size_t msg_size)
+{
+    const char *const sql =
+        s->version >= 4
+            ? "SELECT a.id, a.period, IFNULL((SELECT cells FROM basins WHERE grp = a.id), 0),"
+              " a.centre, a.lo, a.hi, a.anchor, a.kind FROM attractors a ORDER BY a.id"
+            : "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
+              "WHERE id > 0 ORDER BY id";
+    return read_groups(s, sql, true, groups, n, sink_cells, msg, msg_size);
+}
+
+cm_status cm_store_largest_groups(cm_store *s, cm_group_info *groups, uint32_t k,
+                                  uint64_t *sink_cells, char *msg, size_t msg_size)
+{
+    const char *const sql =
+        s->version >= 4
+            ? "SELECT a.id, a.period, IFNULL(b.cells, 0) AS basin, a.centre, a.lo, a.hi,"
+              " a.anchor, a.kind FROM attractors a LEFT JOIN basins b ON b.grp = a.id"
+              " ORDER BY basin DESC, a.id LIMIT ?1"
+            : "SELECT id, period, basin_cells, centre, lo, hi, anchor, kind FROM groups "
+              "WHERE id > 0 ORDER BY basin_cells DESC, id LIMIT ?1";
+    return read_groups(s, sql, false, groups, k, sink_cells, msg, msg_size);
 }

@@ -72,6 +72,9 @@ cm_status store_damaged(const cm_store *s, cm_status st, char *msg, size_t msg_s
 /* Checks the groups: attractors numbered 1..N with periods, N what the
  * meta table says, basins of those groups only and within the cells. */
 cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size);
+/* Bytes of the pages' blobs: the meta value 'page_bytes', or, in files
+ * without it, their sum; -1 if damaged or on a database error. */
+int64_t store_page_bytes(sqlite3 *db);
 /* Cells in the sink's basin (group 0); -1 on a database error. */
 int64_t store_sink_cells(const cm_store *s);
 

@@ -637,6 +637,23 @@ static cm_status encode_batch(cm_store *s, const cm_region *r, uint64_t first, i
     return failed ? CM_ENOMEM : CM_OK;
 }
 
+/* Adds a region's page bytes to the meta value 'page_bytes', in the
+ * transaction that writes the pages. Files made before the value existed
+ * have none and get none: a sum of only the later pages would be wrong. */
+static cm_status add_page_bytes(cm_store *s, uint64_t bytes, char *msg, size_t msg_size)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(s->db,
+                           "UPDATE meta SET value = CAST(value AS INTEGER) + ? "
+                           "WHERE key = 'page_bytes'",
+                           -1, &st, NULL))
+        return store_db_error(s->db, "prepare page bytes", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)bytes);
+    const cm_status status = store_step_done(s->db, st, "write page bytes", msg, msg_size);
+    sqlite3_finalize(st);
+    return status;
+}
+
 /* Writes all of region k's pages, once: a region never changes. Pages are
  * encoded in parallel a batch at a time and written in order. */
 cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *msg,
@@ -652,6 +669,7 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
                            NULL))
         return store_db_error(s->db, "prepare pages", msg, msg_size);
     cm_status status = CM_OK;
+    uint64_t bytes = 0;
     for (uint64_t b = 0; status == CM_OK && b < pages; b += WRITE_BATCH) {
         const int batch = (int)(pages - b < WRITE_BATCH ? pages - b : WRITE_BATCH);
         if (encode_batch(s, r, b, batch, part, lens) != CM_OK)
@@ -667,13 +685,14 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
                                   SQLITE_STATIC);
                 s->stats.bytes_written += lens[t];
                 s->stats.page_bytes_written += lens[t];
+                bytes += lens[t];
             }
             status = store_step_done(s->db, st, "write page", msg, msg_size);
             s->stats.pages_written++;
         }
     }
     sqlite3_finalize(st);
-    return status;
+    return status == CM_OK ? add_page_bytes(s, bytes, msg, msg_size) : status;
 }
 
 /* Region k's node records that changed: each chunk of CM_NODE_CHUNK nodes

@@ -110,7 +110,9 @@ static cm_status rewrite(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
     if (store_exec(s->db, "DROP VIEW IF EXISTS temp.groups; DROP VIEW main.groups;"
                           " DROP TABLE region_groups; DROP TABLE pages; DROP TABLE exits;"
                           " DROP TABLE attractors; DROP TABLE regions;") != SQLITE_OK ||
-        store_exec(s->db, store_tables_sql) != SQLITE_OK)
+        store_exec(s->db, store_tables_sql) != SQLITE_OK ||
+        store_exec(s->db, "INSERT OR REPLACE INTO meta(key, value) VALUES('page_bytes', '0')") !=
+            SQLITE_OK)
         return store_db_error(s->db, "replace the tables", msg, msg_size);
     for (uint32_t k = 0; k < c->nregions; k++)
         c->regions[k].written = 0; /* all regions, nodes, counts and groups are unsaved */

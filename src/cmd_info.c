@@ -18,14 +18,6 @@ static const char info_help[] =
 
 enum { SHOWN_GROUPS = 10 };
 
-static int larger_basin_first(const void *a, const void *b)
-{
-    const cm_group_info *x = a, *y = b;
-    if (x->basin_cells != y->basin_cells)
-        return x->basin_cells > y->basin_cells ? -1 : 1;
-    return x->id < y->id ? -1 : (x->id > y->id);
-}
-
 static void print_cells(const cm_lattice *lat, const int64_t *cell)
 {
     double x[CM_MAX_DIM];
@@ -152,9 +144,11 @@ int cmd_info(int argc, char **argv)
         st = cm_store_read_info(s, &info, msg, sizeof msg);
     if (st == CM_OK && info.regions == 0)
         st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
+    uint32_t shown = 0; /* the text lists the largest groups only: it reads only those */
     if (st == CM_OK) {
+        shown = json || info.groups < SHOWN_GROUPS ? info.groups : SHOWN_GROUPS;
         regions = calloc(info.regions, sizeof *regions);
-        g = calloc((size_t)info.groups + 1, sizeof *g);
+        g = calloc((size_t)shown + 1, sizeof *g);
         if (!regions || !g)
             st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u regions and %u groups",
                          info.regions, info.groups);
@@ -162,7 +156,8 @@ int cmd_info(int argc, char **argv)
     if (st == CM_OK)
         st = cm_store_regions(s, regions, info.regions, msg, sizeof msg);
     if (st == CM_OK)
-        st = cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg);
+        st = json ? cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg)
+                  : cm_store_largest_groups(s, g, shown, &sink, msg, sizeof msg);
     cm_store_snapshot_end(s);
     if (st == CM_OK) {
         cm_box bounds = regions[0].box;
@@ -172,12 +167,10 @@ int cmd_info(int argc, char **argv)
             const uint64_t bytes = cm_region_bytes(&regions[k]);
             largest = bytes > largest ? bytes : largest;
         }
-        if (json) {
+        if (json)
             print_json(path, &info, &bounds, g, sink);
-        } else {
-            qsort(g, info.groups, sizeof *g, larger_basin_first);
+        else
             print_text(path, &info, &bounds, g, sink, largest);
-        }
     } else {
         fprintf(stderr, "cellmap info: %s\n", msg);
     }

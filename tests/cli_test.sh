@@ -175,6 +175,7 @@ strip() { sed 's/"time_s":{[^}]*}//' "$1"; }
 [ "$(strip paged.json)" = "$(strip plain.json)" ] || fail "summary under --mem 1M differs"
 "$CM" solve $small --db paged.cmdb --mem 1M --resume > resumed.txt || fail "--resume of a finished file"
 grep -q "^database paged.cmdb: 6 regions" resumed.txt || fail "resume summary: $(tail -1 resumed.txt)"
+check_page_bytes paged.cmdb
 "$CM" solve --cells 300x300 --split 3x2 --db paged.cmdb --resume > /dev/null 2> err.txt
 [ $? -eq 1 ] && grep -q "made by another solve" err.txt || fail "resume with other options"
 "$CM" info paged.cmdb > info.txt || fail "info"
@@ -514,6 +515,7 @@ cp v3.cmdb v3-explore.cmdb
 "$CM" solve "${V3_SOLVE[@]}" --db v3.cmdb --resume > /dev/null 2> v3.err || fail "resume of a version 3 file: $(cat v3.err)"
 grep -q "upgraded v3.cmdb from format version 3 to 5" v3.err || fail "upgrade message: $(cat v3.err)"
 [ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 5 ] || fail "the resumed version 3 file was not upgraded"
+check_page_bytes v3.cmdb
 "$CM" export v3.cmdb --groups up-groups.csv --cells up-cells.csv 2> /dev/null || fail "export of an upgraded file"
 cmp -s up-groups.csv v3-groups.csv && cmp -s up-cells.csv v3-cells.csv || fail "the upgrade changed the export"
 "$CM" render v3.cmdb --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"

@@ -115,6 +115,8 @@ done
 "$CM" explore killed.cmdb long.explore $pd $lattice > replay.out ||
   fail "the replay after kills failed"
 "$CM" export killed.cmdb --cells killed.csv --groups killed-groups.csv || fail "export killed"
+check_page_bytes killed.cmdb
+check_page_bytes ref.cmdb
 cmp -s ref.csv killed.csv || fail "cells after kills and replay differ from an uninterrupted session"
 cmp -s ref-groups.csv killed-groups.csv || fail "groups after kills and replay differ"
 # a finished session replayed computes nothing

@@ -27,6 +27,14 @@ static char *slurp(const char *path, long *size)
     return buf;
 }
 
+static int larger_basin_first(const void *a, const void *b)
+{
+    const cm_group_info *x = a, *y = b;
+    if (x->basin_cells != y->basin_cells)
+        return x->basin_cells > y->basin_cells ? -1 : 1;
+    return x->id < y->id ? -1 : (x->id > y->id);
+}
+
 static int64_t sql_int(const char *path, const char *sql)
 {
     sqlite3 *db = NULL;
@@ -164,6 +172,13 @@ static void test_budgets(const char *dir, const cm_model *m)
     const uint64_t h = cmdb_content_hash(path[0]);
     for (int k = 1; k < 4; k++)
         CHECK(cmdb_content_hash(path[k]) == h);
+    /* the bytes of the pages, kept in meta at every commit, are their sum */
+    for (int k = 0; k < 4; k++) {
+        const int64_t kept = sql_int(path[k], "SELECT value FROM meta WHERE key = 'page_bytes'");
+        CHECK(kept > 0);
+        CHECK_INT(kept, sql_int(path[k], "SELECT SUM(LENGTH(image) + LENGTH(grp) + "
+                                         "LENGTH(step)) FROM pages"));
+    }
     /* the groups view: every cell counted once; periodic cells are dim int64 each */
     CHECK_INT(sql_int(path[0], "SELECT SUM(basin_cells) FROM groups"), NX * NY);
     CHECK_INT(sql_int(path[0], "SELECT COUNT(*) FROM groups WHERE is_sink = 0"), flat[4].ngroups);
@@ -201,6 +216,18 @@ static void test_budgets(const char *dir, const cm_model *m)
     CHECK_INT(sink, ref_sink);
     for (uint32_t k = 0; k < info.groups; k++)
         CHECK(memcmp(&g[k], &ref[k], sizeof g[k]) == 0);
+    /* the largest groups: the first k of all of them sorted by cells, then id */
+    qsort(g, info.groups, sizeof *g, larger_basin_first);
+    cm_group_info *top = calloc(info.groups + 1, sizeof *top);
+    const uint32_t ks[] = {1, 3, info.groups};
+    for (int t = 0; t < 3; t++) {
+        uint64_t top_sink = 0;
+        CHECK(cm_store_largest_groups(s, top, ks[t], &top_sink, msg, sizeof msg) == CM_OK);
+        CHECK_INT(top_sink, ref_sink);
+        CHECK(memcmp(top, g, ks[t] * sizeof *g) == 0);
+    }
+    CHECK(info.groups > 3 && g[0].basin_cells > g[info.groups - 1].basin_cells);
+    free(top);
     /* the regions' records without the cluster: the loaded regions' */
     cm_region *rec = calloc(info.regions + 1, sizeof *rec);
     CHECK(cm_store_regions(s, rec, info.regions, msg, sizeof msg) == CM_OK);

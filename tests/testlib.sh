@@ -19,3 +19,12 @@ expect_usage() {
   [ "$rc" -eq 2 ] || fail "cellmap $* exited $rc, expected 2"
   grep -qF -- "$needle" <<<"$out" || fail "cellmap $*: message '$out' lacks '$needle'"
 }
+
+# check_page_bytes FILE.cmdb: the meta value 'page_bytes' (kept at every
+# commit, read by info) is the sum of the file's page blobs
+check_page_bytes() {
+  local kept sum
+  kept=$(sqlite3 "$1" "SELECT value FROM meta WHERE key = 'page_bytes'")
+  sum=$(sqlite3 "$1" 'SELECT SUM(LENGTH(image) + LENGTH(grp) + LENGTH(step)) FROM pages')
+  [ -n "$kept" ] && [ "$kept" = "$sum" ] || fail "$1: meta page_bytes '$kept', its pages $sum bytes"
+}
