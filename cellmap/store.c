@@ -145,9 +145,9 @@ static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor
 /* Tables a file of this version (or of versions 2 to 4) must have; their
  * absence means corruption. */
 #define CHECK_V4_SQL                                                                               \
-    "SELECT EXISTS(SELECT 1 FROM meta), EXISTS(SELECT 1 FROM regions),"                          \
-    " EXISTS(SELECT 1 FROM exits), EXISTS(SELECT 1 FROM attractors),"                            \
-    " EXISTS(SELECT 1 FROM nodes), EXISTS(SELECT 1 FROM basins),"                                \
+    "SELECT EXISTS(SELECT 1 FROM meta), EXISTS(SELECT 1 FROM regions),"                            \
+    " EXISTS(SELECT 1 FROM exits), EXISTS(SELECT 1 FROM attractors),"                              \
+    " EXISTS(SELECT 1 FROM nodes), EXISTS(SELECT 1 FROM basins),"                                  \
     " EXISTS(SELECT 1 FROM pages WHERE region = 1)"
 static const char *const check_sql = CHECK_V4_SQL ", EXISTS(SELECT 1 FROM open_nodes)";
 static const char *const check_v4_sql = CHECK_V4_SQL;
@@ -690,8 +690,10 @@ cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size)
                             "(SELECT COUNT(*) FROM attractors) OR cells < 0") != 0)
         return cm_fail(CM_EFORMAT, msg, msg_size, "its basins name groups it does not have");
     /* with no basin below 0 (version 4 on), only the sink can be */
-    if (s->version >= 4 ? store_sink_cells(s) < 0
-                        : store_query_int(db, "SELECT COUNT(*) FROM groups WHERE basin_cells < 0") != 0)
+    const bool negative =
+        s->version >= 4 ? store_sink_cells(s) < 0
+                        : store_query_int(db, "SELECT COUNT(*) FROM groups WHERE basin_cells < 0");
+    if (negative)
         return cm_fail(CM_EFORMAT, msg, msg_size, "its basins hold more cells than its regions");
     return CM_OK;
 }
