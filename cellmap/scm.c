@@ -13,16 +13,16 @@
 #include <omp.h>
 #endif
 
-/* One of the region's per-cell arrays, of `bytes` bytes; free() frees it.
- * They are a command's largest memory and are first touched by the solve
- * itself, so their page faults are part of its time: on the virtual
+/* The per-cell arrays are a command's largest memory and are first touched
+ * by the solve itself (or by the store paging a region in), so their page
+ * faults are part of its time: on the virtual
  * machines we measure on, first touch of 12 bytes per cell in 4 KiB pages
  * cost 2-27 ns/cell; on one where it cost 17-27, in 2 MiB transparent huge
  * pages it cost 0.9-3.5 (bench_scm's machine line). The whole 2 MiB of an
  * array are therefore asked for in huge pages, and the rest stays in 4 KiB
  * ones, so that an array takes no more memory than its bytes (rounding it
  * up to whole huge pages measured no faster from the command line). */
-static void *cells_array(size_t bytes)
+void *cm_cells_array(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
     if (bytes < huge)
@@ -49,9 +49,9 @@ cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg
                        (unsigned long long)CM_REGION_MAX_CELLS, (unsigned long long)n);
     r->box = *box;
     r->ncells = n;
-    r->image = cells_array(n * sizeof *r->image);
-    r->group = cells_array(n * sizeof *r->group);
-    r->step = cells_array(n * sizeof *r->step);
+    r->image = cm_cells_array(n * sizeof *r->image);
+    r->group = cm_cells_array(n * sizeof *r->group);
+    r->step = cm_cells_array(n * sizeof *r->step);
     if (!r->image || !r->group || !r->step) {
         cm_region_free(r);
         return cm_fail(CM_ENOMEM, msg, msg_size, "cannot allocate %llu cells (%llu bytes)",

@@ -106,8 +106,9 @@ static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, si
         status = CM_EFORMAT;
     /* the arrays only once the rows are known to hold the region's cells */
     const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
-    if (status == CM_OK && (!(r->image = malloc(bytes + 4)) || !(r->group = malloc(bytes + 4)) ||
-                            !(r->step = malloc(bytes + 4))))
+    if (status == CM_OK &&
+        (!(r->image = cm_cells_array(bytes)) || !(r->group = cm_cells_array(bytes)) ||
+         !(r->step = cm_cells_array(bytes))))
         status = CM_ENOMEM;
     if (status == CM_OK)
         status = decode_columns(s, r, refs, nrefs);

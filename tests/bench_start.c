@@ -4,9 +4,10 @@
  * command RUNS times, in turns, and prints its median wall time and
  * median peak RSS: `solve --cells 10x10` (no PNG), `info` of a small
  * database and of one of 1 M cells in 4 regions (info reads the file's
- * records, so it should not grow with the file), `models`, `orbit`, `export --groups`, and for comparison a
- * `solve --cells 10x10 --png` that loads OSMesa; and the machine's own
- * floor, an empty process (/bin/true), run in the same turns.
+ * records, so it should not grow with the file), `models`, `orbit`,
+ * `export --groups`, and for comparison a `solve --cells 10x10 --png` that
+ * loads OSMesa; and the machine's own floor, an empty process (/bin/true),
+ * run in the same turns.
  * usage: bench_start PATH/TO/cellmap [DIR] [RUNS]   (DIR default /tmp, RUNS 20) */
 #include <stdio.h>
 #include <stdlib.h>
