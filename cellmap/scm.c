@@ -15,13 +15,13 @@
 
 /* The per-cell arrays are a command's largest memory and are first touched
  * by the solve itself (or by the store paging a region in), so their page
- * faults are part of its time: on the virtual
- * machines we measure on, first touch of 12 bytes per cell in 4 KiB pages
- * cost 2-27 ns/cell; on one where it cost 17-27, in 2 MiB transparent huge
- * pages it cost 0.9-3.5 (bench_scm's machine line). The whole 2 MiB of an
- * array are therefore asked for in huge pages, and the rest stays in 4 KiB
- * ones, so that an array takes no more memory than its bytes (rounding it
- * up to whole huge pages measured no faster from the command line). */
+ * faults are part of its time: on the virtual machines we measure on, first
+ * touch of 12 bytes per cell in 4 KiB pages cost 2-27 ns/cell; on one where
+ * it cost 17-27, in 2 MiB transparent huge pages it cost 0.9-3.5
+ * (bench_scm's machine line). The whole 2 MiB of an array are therefore
+ * asked for in huge pages, and the rest stays in 4 KiB ones, so that an
+ * array takes no more memory than its bytes (rounding it up to whole huge
+ * pages measured no faster from the command line). */
 void *cm_cells_array(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
