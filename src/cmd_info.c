@@ -14,7 +14,9 @@ static const char info_help[] =
     "usage: cellmap info FILE.cmdb [--json]\n\n"
     "Prints the model, parameters, lattice, the command that made the file, its\n"
     "regions and groups (largest basins first), and its size on disk and in memory.\n"
-    "The file is opened read-only.\n";
+    "The file is opened read-only. info reads its records, not its cells (export\n"
+    "and render read those, and report a damaged page), so it takes milliseconds\n"
+    "on files of millions of cells.\n";
 
 enum { SHOWN_GROUPS = 10 };
 
