@@ -557,6 +557,42 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     return rc;
 }
 
+/* export --groups alone: the groups are records, so the cluster (its node
+ * tables, open nodes) is not loaded, as for info. */
+static int export_groups_only(const export_args *a)
+{
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_group_info *g = NULL;
+    uint64_t sink = 0;
+    char msg[1024];
+    cm_status st = cm_store_open(a->file, 0, &s, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_snapshot_begin(s, msg, sizeof msg);
+    if (st == CM_OK)
+        st = cm_store_read_info(s, &info, msg, sizeof msg);
+    if (st == CM_OK && info.regions == 0)
+        st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", a->file);
+    if (st == CM_OK && !(g = calloc((size_t)info.groups + 1, sizeof *g)))
+        st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u groups", info.groups);
+    if (st == CM_OK)
+        st = cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg);
+    cm_store_snapshot_end(s);
+    int rc = st == CM_OK ? EXIT_OK : EXIT_FAIL;
+    if (st == CM_OK) {
+        const char *names[CM_MAX_DIM];
+        project_state_names(&info, names);
+        if (!export_groups(a->groups, names, &info.lattice, g, info.groups, sink, msg,
+                           sizeof msg))
+            rc = EXIT_FAIL;
+    }
+    if (rc != EXIT_OK)
+        fprintf(stderr, "cellmap export: %s\n", msg);
+    free(g);
+    cm_store_close(s, msg, sizeof msg);
+    return rc;
+}
+
 int cmd_export(int argc, char **argv)
 {
     cli c = {"export", argc, argv, 0, NULL, NULL};
@@ -568,6 +604,8 @@ int cmd_export(int argc, char **argv)
         !outfile_check("export", a.flat) || !outfile_check("export", a.labels) ||
         !outfile_check("export", a.steps))
         return EXIT_FAIL;
+    if (a.groups && !a.cells && !a.flat && !a.labels && !a.steps && !a.window)
+        return export_groups_only(&a);
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;

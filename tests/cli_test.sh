@@ -184,6 +184,9 @@ grep -q "^disk: .* bytes/cell" info.txt || fail "info disk"
 "$CM" export paged.cmdb --groups g.csv --cells c.csv --flat flat.sqlite --window 0:250,-40:0 \
   2> export.txt || fail "export"
 head -1 c.csv | grep -qx "ix,iv,x,v,grp,step,periodic" || fail "cells CSV header"  # the model's names
+# --groups alone reads no cluster, and writes the same file
+"$CM" export paged.cmdb --groups g-only.csv 2> /dev/null && cmp -s g.csv g-only.csv ||
+  fail "export --groups alone differs from --groups with --cells"
 [ "$(($(wc -l < c.csv) - 1))" = "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" ] \
   || fail "CSV and flat table differ"
 [ "$(sqlite3 flat.sqlite 'SELECT COUNT(*) FROM cells')" = 15000 ] || fail "window 150x100 cells"
