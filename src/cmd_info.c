@@ -139,13 +139,7 @@ int cmd_info(int argc, char **argv)
     uint64_t sink = 0;
     char msg[1024];
     /* the file's records only: info loads no cluster */
-    cm_status st = cm_store_open(path, 0, &s, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_store_snapshot_begin(s, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_store_read_info(s, &info, msg, sizeof msg);
-    if (st == CM_OK && info.regions == 0)
-        st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
+    cm_status st = project_open_records(path, &s, &info, msg, sizeof msg);
     uint32_t shown = 0; /* the text lists the largest groups only: it reads only those */
     if (st == CM_OK) {
         shown = json || info.groups < SHOWN_GROUPS ? info.groups : SHOWN_GROUPS;

@@ -11,21 +11,28 @@
 #include "models/registry.h"
 #include "src/args.h"
 
+cm_status project_open_records(const char *path, cm_store **s, cm_store_info *info, char *msg,
+                               size_t msg_size)
+{
+    cm_status st = cm_store_open(path, 0, s, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_snapshot_begin(*s, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_read_info(*s, info, msg, msg_size);
+    if (st == CM_OK && info->regions == 0)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "%s holds no region yet", path);
+    return st;
+}
+
 int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
                       cm_store_info *info, cm_cluster *c)
 {
     char msg[1024];
     cm_cluster_init(c, &(cm_lattice){1, {0}, {1}});
-    cm_status st = cm_store_open(path, 0, s, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_store_snapshot_begin(*s, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_store_read_info(*s, info, msg, sizeof msg);
+    cm_status st = project_open_records(path, s, info, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_store_load_cluster(*s, c, msg, sizeof msg);
     cm_store_snapshot_end(*s);
-    if (st == CM_OK && c->nregions == 0)
-        st = cm_fail(CM_EINVAL, msg, sizeof msg, "%s holds no region yet", path);
     if (st != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         project_close(*s, c);
