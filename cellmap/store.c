@@ -544,6 +544,16 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
     return store_new(path, db, writable, out, msg, msg_size);
 }
 
+void cm_store_map_reads(cm_store *s)
+{
+    /* A read copies a page into a slot of SQLite's cache, a fresh page of
+       memory each (a page fault, dear on virtual machines); through a map,
+       one fault maps 16 of the file's pages. Measured on `info` of a file
+       of 8 M cells and 1188 groups: 7.6 -> 6.7 ms. A hint: no map, reads. */
+    if (!s->writable)
+        store_exec(s->db, "PRAGMA mmap_size=67108864");
+}
+
 cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size)
 {
     if (s->writable || s->in_transaction)

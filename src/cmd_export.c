@@ -566,7 +566,7 @@ static int export_groups_only(const export_args *a)
     cm_group_info *g = NULL;
     uint64_t sink = 0;
     char msg[1024];
-    cm_status st = project_open_records(a->file, &s, &info, msg, sizeof msg);
+    cm_status st = project_open_records(a->file, true, &s, &info, msg, sizeof msg);
     if (st == CM_OK && !(g = calloc((size_t)info.groups + 1, sizeof *g)))
         st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u groups", info.groups);
     if (st == CM_OK)

@@ -139,7 +139,7 @@ int cmd_info(int argc, char **argv)
     uint64_t sink = 0;
     char msg[1024];
     /* the file's records only: info loads no cluster */
-    cm_status st = project_open_records(path, &s, &info, msg, sizeof msg);
+    cm_status st = project_open_records(path, true, &s, &info, msg, sizeof msg);
     uint32_t shown = 0; /* the text lists the largest groups only: it reads only those */
     if (st == CM_OK) {
         shown = json || info.groups < SHOWN_GROUPS ? info.groups : SHOWN_GROUPS;

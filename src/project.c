@@ -11,10 +11,12 @@
 #include "models/registry.h"
 #include "src/args.h"
 
-cm_status project_open_records(const char *path, cm_store **s, cm_store_info *info, char *msg,
-                               size_t msg_size)
+cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
+                               cm_store_info *info, char *msg, size_t msg_size)
 {
     cm_status st = cm_store_open(path, 0, s, msg, msg_size);
+    if (st == CM_OK && map_reads)
+        cm_store_map_reads(*s);
     if (st == CM_OK)
         st = cm_store_snapshot_begin(*s, msg, msg_size);
     if (st == CM_OK)
@@ -29,7 +31,7 @@ int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm
 {
     char msg[1024];
     cm_cluster_init(c, &(cm_lattice){1, {0}, {1}});
-    cm_status st = project_open_records(path, s, info, msg, sizeof msg);
+    cm_status st = project_open_records(path, false, s, info, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_store_load_cluster(*s, c, msg, sizeof msg);
     cm_store_snapshot_end(*s);

@@ -12,12 +12,13 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 
-/* Opens path read-only in a snapshot and reads what it says about itself,
- * for commands that read its records only (info, export --groups); a file
- * with no region yet is refused. The caller ends the snapshot and closes
- * *s, whatever the status (*s may be NULL). */
-cm_status project_open_records(const char *path, cm_store **s, cm_store_info *info, char *msg,
-                               size_t msg_size);
+/* Opens path read-only in a snapshot and reads what it says about itself;
+ * a file with no region yet is refused. map_reads: reads through a memory
+ * map (cm_store_map_reads), for commands that read its records only (info,
+ * export --groups). The caller ends the snapshot and closes *s, whatever
+ * the status (*s may be NULL). */
+cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
+                               cm_store_info *info, char *msg, size_t msg_size);
 
 /* Opens path read-only, reads what it says about itself and restores its
  * cluster (paged out; regions are read back on demand within mem_budget
