@@ -106,16 +106,16 @@ cm_status cm_store_open(const char *path, int writable, cm_store **out, char *ms
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size);
 
-/* A read-only store reads one snapshot from cm_store_snapshot_begin to
- * cm_store_snapshot_end: its statements share one lock of the file, where
- * each would otherwise take and drop it and look for a journal. Keep
- * snapshots short: in rollback mode they hold a writer off. */
 /* Makes a read-only store read the first 64 MiB of its file through a
  * memory map: for readers of scattered records (info, export --groups),
  * not for readers of every cell, whose resident memory the mapped pages
  * would join. Does nothing on a writable store. */
 void cm_store_map_reads(cm_store *s);
 
+/* A read-only store reads one snapshot from cm_store_snapshot_begin to
+ * cm_store_snapshot_end: its statements share one lock of the file, where
+ * each would otherwise take and drop it and look for a journal. Keep
+ * snapshots short: in rollback mode they hold a writer off. */
 cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size);
 void cm_store_snapshot_end(cm_store *s);
 
