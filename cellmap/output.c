@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -176,6 +177,111 @@ void cm_output_abandon(cm_output *o)
         unlink(o->tmp);
         o->tmp[0] = '\0';
     }
+}
+
+/* Where a file of a command lives: its device and inode when it exists,
+ * else its canonical path (the directory resolved, the name kept). */
+typedef struct file_key {
+    bool compared; /* false: stdout, a device, a FIFO or a socket */
+    bool exists;
+    dev_t dev;
+    ino_t ino;
+    char name[CM_OUTPUT_PATH_MAX];
+} file_key;
+
+static void file_key_of(const char *path, file_key *k)
+{
+    memset(k, 0, sizeof *k);
+    if (cm_output_names_stdout(path))
+        return;
+    char dest[CM_OUTPUT_PATH_MAX], ignored[8];
+    if (follow_links(path, dest, ignored, sizeof ignored) != CM_OK)
+        snprintf(dest, sizeof dest, "%s", path);
+    struct stat sb;
+    if (stat(dest, &sb) == 0) {
+        if (!S_ISREG(sb.st_mode))
+            return;
+        k->exists = true;
+        k->dev = sb.st_dev;
+        k->ino = sb.st_ino;
+    }
+    k->compared = true;
+    char resolved[PATH_MAX];
+    if (realpath(dest, resolved)) {
+        snprintf(k->name, sizeof k->name, "%s", resolved);
+        return;
+    }
+    const char *slash = strrchr(dest, '/');
+    char dir[CM_OUTPUT_PATH_MAX];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - dest) : 1, slash ? dest : ".");
+    if (slash == dest)
+        snprintf(dir, sizeof dir, "/");
+    if (realpath(dir, resolved))
+        snprintf(k->name, sizeof k->name, "%.4096s/%.100s", resolved, slash ? slash + 1 : dest);
+    else
+        snprintf(k->name, sizeof k->name, "%s", dest);
+}
+
+static bool same_file(const file_key *a, const file_key *b)
+{
+    if (!a->compared || !b->compared)
+        return false;
+    if (a->exists && b->exists)
+        return a->dev == b->dev && a->ino == b->ino;
+    return strcmp(a->name, b->name) == 0;
+}
+
+/* Which part of entry `in` the output key out is: 0 none, 1 the file
+ * itself, 2.. its SQLite companion suffixes[part - 2]. */
+static const char *const companions[] = {"-wal", "-shm", "-journal"};
+
+static int part_of(const file_key *out, const cm_file_use *in)
+{
+    file_key k;
+    file_key_of(in->path, &k);
+    if (same_file(out, &k))
+        return 1;
+    for (int c = 0; in->database && c < 3; c++) {
+        char name[CM_OUTPUT_PATH_MAX];
+        snprintf(name, sizeof name, "%.4150s%s", in->path, companions[c]);
+        file_key_of(name, &k);
+        if (same_file(out, &k))
+            return 2 + c;
+    }
+    return 0;
+}
+
+cm_status cm_files_apart(const cm_file_use *files, size_t n, char *msg, size_t msg_size)
+{
+    for (size_t i = 0; i < n; i++) {
+        const cm_file_use *o = &files[i];
+        if (!o->path || !o->written)
+            continue;
+        file_key out;
+        file_key_of(o->path, &out);
+        for (size_t j = 0; j < n; j++) {
+            const cm_file_use *e = &files[j];
+            if (j == i || !e->path || (e->written && !e->database && j < i))
+                continue; /* a pair of plain outputs is reported once */
+            const int part = part_of(&out, e);
+            if (part == 0)
+                continue;
+            if (e->written && !e->database)
+                return cm_fail(CM_EINVAL, msg, msg_size,
+                               "%s %s and %s %s are the same file: give each output its own "
+                               "name",
+                               e->what, e->path, o->what, o->path);
+            char part_name[64] = "";
+            if (part > 1)
+                snprintf(part_name, sizeof part_name, "the %s file of ", companions[part - 2]);
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s %s is %s%s %s: writing it would destroy what the command %s; "
+                           "give %s another file name",
+                           o->what, o->path, part_name, e->what, e->path,
+                           e->written ? "writes" : "reads", o->what);
+        }
+    }
+    return CM_OK;
 }
 
 cm_status cm_stdout_check(char *msg, size_t msg_size)

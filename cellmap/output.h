@@ -54,6 +54,24 @@ cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size);
 /* Removes the temporary file (after a failure; NULL-safe). */
 void cm_output_abandon(cm_output *o);
 
+/* One file a command reads or writes, for cm_files_apart. */
+typedef struct cm_file_use {
+    const char *path; /* NULL: an unused slot */
+    const char *what; /* how the user gave it, for messages: "--png", "the database" */
+    bool written;     /* the command writes it (else it only reads it) */
+    bool database;    /* an SQLite file: its -wal, -shm and -journal files are its too */
+} cm_file_use;
+
+/* Refuses (CM_EINVAL, naming both) an output that is, or resolves to, a
+ * file of another entry: the same file by device and inode (symlinks and
+ * hard links included), or for names that do not exist yet the same
+ * canonical path; a database's -wal, -shm and -journal count as the
+ * database. Two outputs may not be one file either. Standard output and
+ * devices, FIFOs and sockets are never replaced, so they are not compared
+ * (two outputs on stdout are the commands' own rule). Call it before any
+ * work: nothing is opened or created. */
+cm_status cm_files_apart(const cm_file_use *files, size_t n, char *msg, size_t msg_size);
+
 /* Flushes stdout; CM_EIO with the reason if anything written to it was
  * lost (a full device, a closed pipe). */
 cm_status cm_stdout_check(char *msg, size_t msg_size);

@@ -103,6 +103,7 @@ bool png_opts_palette(const char *value, png_opts *po, char *msg, size_t msg_siz
                         a_file ? msg_size : 64) != CM_OK)
         return false; /* a name: the message lists the names */
     po->palette = &po->file_palette;
+    po->palette_file = value;
     return true;
 }
 
@@ -113,6 +114,7 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
         snprintf(msg, msg_size, "cannot read %s: %s", path, strerror(errno));
         return false;
     }
+    po->labels_file = path;
     char line[512];
     bool ok = true;
     for (int no = 1; ok && fgets(line, sizeof line, f); no++) {
@@ -192,6 +194,17 @@ int png_opts_check(const cli *c, const png_opts *po)
         return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
                                   "classes; leave out --size and --layers");
     return EXIT_OK;
+}
+
+bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *msg,
+                    size_t msg_size)
+{
+    const cm_file_use files[] = {
+        {db, "the database", db_written, true},     {po->path, "--png", true, false},
+        {po->svg, "--svg", true, false},             {po->palette_file, "--palette", false, false},
+        {po->labels_file, "--labels", false, false},
+    };
+    return cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size) == CM_OK;
 }
 
 void view_cells(const cm_lattice *lat, const double lo[2], const double hi[2], const cm_box *within,

@@ -27,6 +27,7 @@ typedef struct png_opts {
     cm_palette file_palette;   /* --palette FILE's colours */
     cm_group_label labels[PNG_LABELS_MAX]; /* --labels FILE: the legend's names */
     int n_labels;
+    const char *palette_file, *labels_file; /* the files read, if any */
 } png_opts;
 
 /* What `all` draws: every layer but steps. */
@@ -67,6 +68,13 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 bool png_opts_take(cli *c, png_opts *po, int *error);
 /* Checks the options together (e.g. indexed images take no --size). */
 int png_opts_check(const cli *c, const png_opts *po);
+
+/* Refuses (false, the reason in msg) a --png or --svg that would replace
+ * the database db (NULL: none; db_written: the command writes it), a
+ * --palette or --labels file it read, or the other image
+ * (cm_files_apart). */
+bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *msg,
+                    size_t msg_size);
 
 /* "basin,steps,..." or "all" -> enum cm_layer bits. On a bad word, false
  * with the word in bad. */

@@ -76,6 +76,28 @@ static int ends_with(const char *s, const char *suffix)
     return n >= m && strcmp(s + n - m, suffix) == 0;
 }
 
+/* No output may replace the file exported (or its -wal, -shm), another
+ * output, or an array's JSON sidecar. */
+static int outputs_apart(const cli *c, const export_args *a)
+{
+    char labels_json[CM_OUTPUT_PATH_MAX], steps_json[CM_OUTPUT_PATH_MAX], why[2048];
+    array_sidecar_path(a->labels ? a->labels : "", labels_json, sizeof labels_json);
+    array_sidecar_path(a->steps ? a->steps : "", steps_json, sizeof steps_json);
+    const cm_file_use files[] = {
+        {a->file, "the database", false, true},
+        {a->groups, "--groups", true, false},
+        {a->cells, "--cells", true, false},
+        {a->flat, "--flat", true, true},
+        {a->labels, "--labels", true, false},
+        {a->labels ? labels_json : NULL, "--labels' JSON", true, false},
+        {a->steps, "--steps", true, false},
+        {a->steps ? steps_json : NULL, "--steps' JSON", true, false},
+    };
+    if (cm_files_apart(files, sizeof files / sizeof *files, why, sizeof why) != CM_OK)
+        return cli_usage_error(c, "%s", why);
+    return EXIT_OK;
+}
+
 static int parse_export(cli *c, export_args *a)
 {
     int err = 0;
@@ -123,7 +145,7 @@ static int parse_export(cli *c, export_args *a)
         to_stdout += outs[k] && cm_output_names_stdout(outs[k]);
     if (!err && to_stdout > 1)
         err = cli_usage_error(c, "only one of --groups, --cells and --flat can go to stdout");
-    return err;
+    return err ? err : outputs_apart(c, a);
 }
 
 /* The cells whose centres lie in the window, within the cluster's bounds. */

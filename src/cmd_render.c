@@ -60,6 +60,9 @@ static int parse_render(cli *c, render_args *a)
         err = cli_usage_error(c, "where to? add --png OUT.png (or --svg OUT.svg)");
     if (!err)
         err = png_opts_check(c, &a->png);
+    char why[2048];
+    if (!err && !png_opts_apart(&a->png, a->file, false, why, sizeof why))
+        err = cli_usage_error(c, "%s", why);
     return err;
 }
 

@@ -136,6 +136,9 @@ static int parse_solve(cli *c, solve_args *a)
     }
     if (!err)
         err = png_opts_check(c, &a->png);
+    char why[2048];
+    if (!err && !png_opts_apart(&a->png, a->db, true, why, sizeof why))
+        err = cli_usage_error(c, "%s", why);
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
         err = cli_usage_error(c, "--bounds and --escape-below apply to --extend; add --extend N");
     if (!err && a->stage1 && (!a->n_split || a->extend || a->db || a->png.has_view))

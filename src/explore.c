@@ -10,6 +10,7 @@
 
 #include "cellmap/cover.h"
 #include "cellmap/extend.h"
+#include "cellmap/output.h"
 #include "models/registry.h"
 #include "render/figure.h"
 #include "src/basin_png.h"
@@ -575,6 +576,12 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
                          msg, msg_size);
     if (st == CM_OK)
         st = render_words(t, n, &po, msg, msg_size);
+    const cm_file_use files[] = {{s->path, "the session's database", true, true},
+                                 {n > 1 ? t[1] : NULL, "render", true, false},
+                                 {po.palette_file, "--palette", false, false},
+                                 {po.labels_file, "--labels", false, false}};
+    if (st == CM_OK)
+        st = cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size);
     if (st == CM_OK)
         st = need_view(s, "render", msg, msg_size);
     if (st != CM_OK)
