@@ -194,7 +194,7 @@ static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
         st = store_db_error(s->db, "add the open nodes", msg, msg_size);
     for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++) {
         st = store_write_nodes(s, &c, k, msg, msg_size);
-        if (st == CM_OK && c.regions[k].nopen > 0)
+        if (st == CM_OK) /* a row for every region, as a solve writes them */
             st = store_write_open_nodes(s, &c, k, msg, msg_size);
     }
     char pragma[64];

@@ -150,6 +150,21 @@ check_bad "zoom 1000" "below the lattice's resolution"
 check_bad "view 5:1 0:1" "not LO:HI"
 check_bad "view 0:1" "usage: view"
 check_bad "view 0:1 0:1 at 3" "more than two dimensions"
+# `at` on a model of three dimensions: the depth -2:2 is the cells [-2, 2)
+# of dimension 3 (width 0.5); the centre of its last cell and its lower
+# bound are slices of it, its upper bound and anything below it are not
+d3=(--model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 --cell-size 0.5,0.5,0.5
+    --depth=-2:2)
+for z in 1.75 -2 2 -2.01; do
+  rm -f d3.cmdb
+  out=$(printf 'view -2:2 -2:2 at %s\n' "$z" | "$CM" explore d3.cmdb - "${d3[@]}" 2>&1); rc=$?
+  case $z in # a slice is shown at its cell's centre
+    1.75|-2) [ $rc -eq 0 ] && grep -qF "view -2:2 -2:2 at ${z/#-2/-1.75}; computed 512 cells" <<<"$out" \
+      || fail "at $z inside the depth: rc $rc, '$out'" ;;
+    *) [ $rc -eq 1 ] && grep -qF "stdin:1: view: x = $z is outside the session's depth (--depth)" <<<"$out" \
+      || fail "at $z outside the depth: rc $rc, '$out'" ;;
+  esac
+done
 # render in a session takes the figure options of `cellmap render`
 printf 'view 100:200,-16:16\nrender opts.svg 800x600 --layers all --palette okabe-ito --legend 2 --min-basin 5\n' |
   "$CM" explore opts.cmdb - $pd $lattice > /dev/null 2>&1 || fail "render with figure options"

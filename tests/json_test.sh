@@ -46,6 +46,9 @@ run escape-sweep escape --param b=1.3 --I0 0.25 --sweep a=1.15:1.55:4 --cells 10
 "$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 \
   || fail "export --labels --steps"
 "$CM" export basin.cmdb --cells window.csv --window 100:300,-5:5 > /dev/null || fail "export --cells"
+# a window whose v bounds are cell centres (v = -4.5 and 4.5: both in)
+"$CM" export basin.cmdb --labels edge.npy --steps edge-steps.npy --cells edge.csv \
+  --window 100:300,-4.5:4.5 > /dev/null || fail "export of a window on cell centres"
 "$CM" solve --model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 \
   --region=-6:6,-6:6,-6:6 --cells 6x5x4 --db cube.cmdb > /dev/null || fail "3-D solve"
 "$CM" export cube.cmdb --labels cube.npy --cells cube.csv > /dev/null || fail "3-D export --labels"
@@ -127,6 +130,34 @@ if side["array"] == "labels":
     assert all(g["colour"].startswith("#") and len(g["colour"]) == 7 for g in side["groups"])
 PY
 done
+
+# the windows' cells against the window computed here, by brute force over
+# basin.cmdb's lattice (0:500 x -40:40 in 120 x 80 cells): the cells whose
+# centres lie in the window, bounds included
+/usr/bin/python3 - <<'PY' || fail "export --window: shape, first and last cell"
+import csv, json
+import numpy as np
+width = (500 / 120, 80 / 80)
+origin = (0, -40)
+def inside(k, lo, hi):
+    return [i for i in range((120, 80)[k]) if lo <= origin[k] + (i + 0.5) * width[k] <= hi]
+for stem, csv_name, window in (("labels", "window", ((100, 300), (-5, 5))),
+                               ("steps", "window", ((100, 300), (-5, 5))),
+                               ("edge", "edge", ((100, 300), (-4.5, 4.5))),
+                               ("edge-steps", "edge", ((100, 300), (-4.5, 4.5)))):
+    cells = [inside(k, *window[k]) for k in range(2)]
+    first, last = [c[0] for c in cells], [c[-1] for c in cells]
+    shape = [len(c) for c in cells]
+    side = json.load(open(stem + ".json"))
+    assert side["first_cell"] == first, (stem, side["first_cell"], first)
+    assert side["shape"] == shape and list(np.load(stem + ".npy").shape) == shape, (stem, side["shape"], shape)
+    assert [a + n - 1 for a, n in zip(side["first_cell"], side["shape"])] == last, (stem, last)
+    rows = list(csv.DictReader(open(csv_name + ".csv")))
+    got = sorted((int(r["ix"]), int(r["iv"])) for r in rows)
+    assert got == sorted((i, j) for i in cells[0] for j in cells[1]), (csv_name, got[:3], got[-3:])
+    assert got[0] == tuple(first) and got[-1] == tuple(last), (got[0], got[-1])
+assert inside(1, -4.5, 4.5) == list(range(35, 45)), inside(1, -4.5, 4.5)   # both centres in
+PY
 
 # the CSV columns carry the JSON's names
 "$CM" sweep --model microchaos-pd-friction --vary mu=0.09:0.1:3 --cells 100x50 --csv sweep.csv > /dev/null \

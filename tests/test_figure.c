@@ -16,6 +16,7 @@
 #include "render/figure.h"
 #include "render/palette.h"
 #include "render/png_out.h"
+#include "render/svg.h"
 
 static const cm_rgb white = {255, 255, 255};
 
@@ -342,9 +343,191 @@ static void test_indexed_png(void)
     CHECK(rmdir(dir) == 0);
 }
 
+/* The SVG's one <image>: its rectangle into box[4] and its PNG, decoded
+ * from base64, into *png (malloc'd) and *n. */
+static bool svg_image(const char *svg, double box[4], uint8_t **png, size_t *n)
+{
+    const char *img = strstr(svg, "<image ");
+    if (!img || strstr(img + 1, "<image ") ||
+        sscanf(img, "<image x=\"%lf\" y=\"%lf\" width=\"%lf\" height=\"%lf\"", &box[0], &box[1],
+               &box[2], &box[3]) != 4)
+        return false;
+    const char *b64 = strstr(img, "base64,"), *end = b64 ? strchr(b64, '"') : NULL;
+    if (!end)
+        return false;
+    b64 += 7;
+    static const char digits[] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    *png = malloc((size_t)(end - b64));
+    *n = 0;
+    uint32_t acc = 0;
+    int bits = 0;
+    for (const char *p = b64; p < end && *p != '='; p++) {
+        const char *d = strchr(digits, *p);
+        if (!d || !*p)
+            return false;
+        acc = acc << 6 | (uint32_t)(d - digits);
+        if ((bits += 6) >= 8)
+            (*png)[(*n)++] = (uint8_t)(acc >> (bits -= 8));
+    }
+    return true;
+}
+
+/* The SVG's embedded raster is the PNG figure's plot, pixel for pixel:
+ * the <image> sits on the PNG's plot rectangle, holds one pixel per cell
+ * in its cell's colour (row 0 the highest cells), and every pixel of the
+ * PNG's plot shows the raster pixel of its cell. */
+static void test_svg_raster(void)
+{
+    scene s;
+    const cm_lattice lat = {2, {-8, -4}, {0.04, 0.04}};
+    const cm_box box = {2, {0, 0}, {400, 200}};
+    solve(&s, "microchaos-pd", "alpha=0.8,beta=0.3,P=0.9,D=0.4", &lat, &box);
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.width = 1000;
+    ro.height = 620;
+    ro.layers = CM_LAYER_BASIN | CM_LAYER_AXES | CM_LAYER_LEGEND | CM_LAYER_TITLE;
+    uint8_t *fig = NULL;
+    cm_render_info fi;
+    CHECK(draw(&s, &ro, &fig, &fi) == CM_OK);
+    char *svg = NULL, msg[256];
+    size_t svg_size = 0;
+    FILE *f = open_memstream(&svg, &svg_size);
+    CHECK(cm_render_svg(&s.lat, &s.r, s.g, &ro, f, msg, sizeof msg) == CM_OK);
+    fclose(f);
+    double rect[4];
+    uint8_t *png = NULL;
+    size_t n = 0;
+    const bool found = svg_image(svg, rect, &png, &n);
+    CHECK(found);
+    CHECK_NEAR(rect[0], fi.plot_x, 1e-9);
+    CHECK_NEAR(rect[1], fi.plot_y, 1e-9);
+    CHECK_NEAR(rect[2], fi.plot_w, 1e-9);
+    CHECK_NEAR(rect[3], fi.plot_h, 1e-9);
+    png_image im;
+    memset(&im, 0, sizeof im);
+    im.version = PNG_IMAGE_VERSION;
+    uint8_t *ras = NULL;
+    if (found && png_image_begin_read_from_memory(&im, png, n)) {
+        im.format = PNG_FORMAT_RGBA;
+        ras = malloc(PNG_IMAGE_SIZE(im));
+        CHECK(png_image_finish_read(&im, NULL, ras, 0, NULL) != 0);
+    }
+    CHECK(ras != NULL);
+    CHECK_INT(im.width, 400);
+    CHECK_INT(im.height, 200);
+    int wrong_cells = 0, wrong_plot = 0, compared = 0;
+    for (int j = 0; ras && im.width == 400 && im.height == 200 && j < 200; j++)
+        for (int i = 0; i < 400; i++)
+            wrong_cells += !is(at(ras, 400, i, j), cell_colour(&s, (uint64_t)(199 - j) * 400 + (uint64_t)i));
+    for (int y = fi.plot_y; ras && wrong_cells == 0 && y < fi.plot_y + fi.plot_h; y++) {
+        const double cy = (y - fi.plot_y + 0.5) * 200.0 / fi.plot_h; /* raster rows, from the top */
+        if (fabs(cy - round(cy)) * fi.plot_h / 200.0 < 0.5)
+            continue; /* within half a pixel of a cell border */
+        for (int x = fi.plot_x; x < fi.plot_x + fi.plot_w; x++) {
+            const double cx = (x - fi.plot_x + 0.5) * 400.0 / fi.plot_w;
+            if (fabs(cx - round(cx)) * fi.plot_w / 400.0 < 0.5)
+                continue;
+            compared++;
+            wrong_plot += memcmp(at(fig, ro.width, x, y), at(ras, 400, (int)cx, (int)cy), 3) != 0;
+        }
+    }
+    CHECK_INT(wrong_cells, 0);
+    CHECK_INT(wrong_plot, 0);
+    CHECK(compared > fi.plot_w * fi.plot_h / 4);
+    free(ras);
+    free(png);
+    free(svg);
+    free(fig);
+    scene_free(&s);
+}
+
+/* A region of 5 x 3 cells whose groups 1, 2, 3 have n - 1, n and n + 1
+ * cells (n = 5; each group's first cell periodic), and its group infos. */
+static void boundary_scene(scene *s)
+{
+    char msg[256];
+    memset(s, 0, sizeof *s);
+    s->lat = (cm_lattice){2, {0, 0}, {1, 1}};
+    const cm_box box = {2, {0, 0}, {5, 3}};
+    CHECK(cm_region_alloc(&s->r, &box, msg, sizeof msg) == CM_OK);
+    s->r.ngroups = 3;
+    s->g = calloc(4, sizeof *s->g);
+    const uint32_t first[4] = {0, 4, 9, 15}; /* group k's cells: first[k-1] .. first[k]-1 */
+    for (uint32_t k = 1; k <= 3; k++) {
+        s->g[k - 1] = (cm_group_info){.id = k, .period = 1, .basin_cells = first[k] - first[k - 1]};
+        s->g[k - 1].anchor[0] = first[k - 1] % 5;
+        s->g[k - 1].anchor[1] = first[k - 1] / 5;
+        for (uint32_t i = first[k - 1]; i < first[k]; i++) {
+            s->r.group[i] = k;
+            s->r.step[i] = i != first[k - 1];
+            s->r.image[i] = first[k - 1];
+        }
+    }
+}
+
+/* The text of the SVG legend's "other" line of a figure with min_basin. */
+static bool svg_has_text(const scene *s, uint64_t min_basin, const char *text)
+{
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.width = 900;
+    ro.height = 500;
+    ro.layers = CM_LAYER_BASIN | CM_LAYER_LEGEND;
+    ro.min_basin = min_basin;
+    ro.font_path = CELLMAP_FONT_PATH;
+    char *svg = NULL, msg[256];
+    size_t n = 0;
+    FILE *f = open_memstream(&svg, &n);
+    const cm_status st = cm_render_svg(&s->lat, &s->r, s->g, &ro, f, msg, sizeof msg);
+    fclose(f);
+    if (st != CM_OK)
+        fprintf(stderr, "cm_render_svg: %s\n", msg);
+    CHECK(st == CM_OK);
+    const bool found = st == CM_OK && strstr(svg, text) != NULL;
+    free(svg);
+    return found;
+}
+
+/* --min-basin N folds groups of fewer than N cells, and only those, into
+ * "other": groups of N - 1, N and N + 1 cells; the raster's count and the
+ * legend's line say how many were folded. */
+static void test_min_basin_boundary(void)
+{
+    scene s;
+    boundary_scene(&s);
+    cm_slice sl;
+    cm_slice_of(&s.lat, &s.r, NULL, 0, &sl);
+    const uint64_t rules[3] = {5, 6, 7}; /* N: groups 1; 1, 2; 1, 2, 3 folded */
+    const uint64_t folded_cells[3] = {4, 9, 15};
+    for (int t = 0; t < 3; t++) {
+        cm_raster ras;
+        char msg[256];
+        CHECK(cm_raster_build(&s.lat, &s.r, s.g, &sl, CM_RASTER_BASIN, rules[t], NULL, &ras, msg,
+                              sizeof msg) == CM_OK);
+        CHECK_INT(ras.other_groups, t + 1);
+        CHECK_INT(ras.other_cells, folded_cells[t]);
+        for (uint32_t k = 1; k <= 3; k++)
+            CHECK_INT(ras.classes[k] == CM_CLASS_OTHER, (int)k <= t + 1);
+        int wrong = 0;
+        for (uint64_t i = 0; i < 15; i++)
+            wrong += !is(ras.pixels + 3 * i, cm_colour_other) != (s.r.group[i] > (uint32_t)t + 1);
+        CHECK_INT(wrong, 0);
+        cm_raster_free(&ras);
+    }
+    CHECK(svg_has_text(&s, 5, ">1 groups &lt; 5 cells  26.7%<"));
+    CHECK(svg_has_text(&s, 6, ">2 groups &lt; 6 cells  60.0%<"));
+    CHECK(!svg_has_text(&s, 4, "groups &lt;"));
+    cm_region_free(&s.r);
+    free(s.g);
+}
+
 int main(void)
 {
     test_pd_figure();
+    test_min_basin_boundary();
+    test_svg_raster();
     test_1d_graph();
     test_indexed_png();
     CHECK_DONE();

@@ -28,3 +28,14 @@ check_page_bytes() {
   sum=$(sqlite3 "$1" 'SELECT SUM(LENGTH(image) + LENGTH(grp) + LENGTH(step)) FROM pages')
   [ -n "$kept" ] && [ "$kept" = "$sum" ] || fail "$1: meta page_bytes '$kept', its pages $sum bytes"
 }
+
+# same_rows A.cmdb B.cmdb QUERY: QUERY runs in both files and gives the
+# same rows, at least one (two failed queries print nothing, and nothing
+# equals nothing)
+same_rows() {
+  local a b
+  a=$(sqlite3 "$1" "$3") || { echo "same_rows: sqlite3 $1 failed: $3" >&2; return 1; }
+  b=$(sqlite3 "$2" "$3") || { echo "same_rows: sqlite3 $2 failed: $3" >&2; return 1; }
+  [ -n "$a" ] || { echo "same_rows: no rows in $1: $3" >&2; return 1; }
+  [ "$a" = "$b" ]
+}
