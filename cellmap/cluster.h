@@ -243,6 +243,12 @@ cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_
 /* The region holding the cell and the cell's local index, or -1. O(1). */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
 
+/* The cell's resolved group (0: the sink) into *group, CM_GROUP_NONE when
+ * no region holds it; reads its region (and node tables) back if paged
+ * out. A cm_cell_group_fn (cellmap/attractors.h) with user the cluster. */
+cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
+                                size_t msg_size);
+
 /* Indexes open node id, whose exit leads to `cell` outside the cluster, by
  * that cell (and in its region's open list, at its end: add a region's in
  * node order), with weight w. */

@@ -20,6 +20,7 @@
 #include "src/progress.h"
 #include "src/project.h"
 #include "src/args.h"
+#include "src/attractor_report.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
 
@@ -32,7 +33,10 @@ static const char solve_help[] =
     "                     [--view X0:X1,Y0:Y1] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
     "                     [--stage1]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
-    "cells; prints each periodic group (period, basin cells, kind, centre).\n"
+    "cells, then the system's attractors: each periodic cell group is checked by\n"
+    "the true map from its anchor cell (true period, or aperiodic with the cells\n"
+    "its orbit visits), and groups whose true orbits end on one attractor are one\n"
+    "(docs/engine.md, \"Attractors\"). Prints the attractors, then the groups.\n"
     "Without options it solves the thesis' C-SCM example (4.6.3):\n"
     "microchaos-pd, alpha=0.078, beta=0, P=0.007, D=0.02 on 0:500,-40:40.\n\n"
     "  --model NAME        a model of `cellmap models` (default microchaos-pd)\n"
@@ -49,7 +53,8 @@ static const char solve_help[] =
     "                      of the cluster's cells escape into the world (default 0: never)\n"
     "  --bounds LO:HI,...  extend only within this box of state space (default: anywhere)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
-    "  --threads T         OpenMP threads for the images (default: all cores)\n";
+    "  --threads T         OpenMP threads for the images (default: all cores)\n"
+    ATTRACTOR_OPTIONS_HELP;
 /* The rest of the help (one string would exceed what C compilers must take). */
 static const char solve_help_outputs[] =
     "  --png FILE          write a figure of the basins: basin, attractors, overlays,\n"
@@ -86,6 +91,7 @@ typedef struct solve_args {
     const char *db;
     int resume;
     uint64_t mem;
+    cm_attractor_options att;
 } solve_args;
 
 static int parse_solve(cli *c, solve_args *a)
@@ -98,6 +104,7 @@ static int parse_solve(cli *c, solve_args *a)
             fputs(solve_help_outputs, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (attractor_options_take(c, &a->att, &err)) {
         } else if (lattice_opts_take(c, &a->lat, &err)) {
         } else if (cli_is(c, "--split", true, &err)) {
             if (c->value && !parse_counts(c->value, a->split, &a->n_split, CM_MAX_DIM))
@@ -137,6 +144,13 @@ static int parse_solve(cli *c, solve_args *a)
     if (!err)
         err = png_opts_check(c, &a->png);
     char why[2048];
+    cm_attractor_options att;
+    cm_attractor_defaults(NULL, &a->att, &att);
+    if (!err && (a->att.max_steps || a->att.transient || a->att.record) &&
+        cm_attractor_check(&att, why, sizeof why) != CM_OK)
+        err = cli_usage_error(c, "--attractor-steps: %s", why);
+    else if (!err && cm_attractor_check(&att, why, sizeof why) != CM_OK)
+        err = cli_usage_error(c, "--attractor-tol: %s", why);
     if (!err && !png_opts_apart(&a->png, a->db, true, why, sizeof why))
         err = cli_usage_error(c, "%s", why);
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
@@ -240,18 +254,10 @@ typedef struct summary {
     uint32_t ngroups;
     cm_group_info *groups; /* in id order */
     double slow[CM_MAX_DIM]; /* cm_scm_slow_share of a single region; NaN: unknown */
+    cm_attractor_set att;    /* the attractors the groups' true orbits give */
+    cell_fates fates;
+    double att_seconds;
 } summary;
-
-/* Groups of one fixed cell without a basin of its own: in micro-chaos maps
- * mostly spurious fixed cells of the centre-point method (the README's
- * glossary), not attractors. */
-static uint32_t single_cells(const cm_group_info *g, uint32_t n)
-{
-    uint32_t count = 0;
-    for (uint32_t k = 0; k < n; k++)
-        count += g[k].period == 1 && g[k].basin_cells == 1;
-    return count;
-}
 
 /* A share of slow cells (cm_scm_slow_share) above which the summary says so. */
 #define SLOW_SHARE 0.25
@@ -271,31 +277,35 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     if (cells != box_cells)
         fprintf(out, " (of %llu in the bounding box; the others not computed)",
                (unsigned long long)box_cells);
-    fprintf(out, ", periodic groups %u, sink basin %llu cells (%.1f%%)\n", ngroups,
-           (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
-    fprintf(out, "time: %s %.3f s, %s %.3f s (%.1f ns/cell)\n", t->first, t->t1, t->second, t->t2,
-           1e9 * (t->t1 + t->t2) / (double)cells);
+    fprintf(out, "\n");
+    fprintf(out, "time: %s %.3f s, %s %.3f s (%.1f ns/cell), attractors %.3f s (%llu steps)\n",
+            t->first, t->t1, t->second, t->t2, 1e9 * (t->t1 + t->t2) / (double)cells,
+            sum->att_seconds, (unsigned long long)sum->att.steps);
+    attractor_text(out, lat, &sum->att, &sum->fates, cells, TEXT_GROUPS);
+    fprintf(out, "cell groups %u (simple cell mapping's periodic groups; the sink %llu cells, "
+                 "%.1f%%):\n",
+            ngroups, (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
     cm_group_info *sorted = malloc((ngroups + 1) * sizeof *sorted);
     if (!sorted)
         return;
     memcpy(sorted, g, ngroups * sizeof *sorted);
     qsort(sorted, ngroups, sizeof *sorted, larger_basin_first);
-    fprintf(out, "%6s %8s %12s  %-9s  %s\n", "group", "period", "basin", "kind", "centre");
+    fprintf(out, "%6s %8s %12s  %-9s %6s  %s\n", "group", "period", "basin", "kind", "attr.",
+            "centre");
     for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
-        char centre[CM_MAX_DIM * CM_NUM_TEXT];
+        char centre[CM_MAX_DIM * CM_NUM_TEXT], attractor[16];
         format_point(lat, sorted[k].centre, ", ", centre, sizeof centre);
-        fprintf(out, "%6u %8u %12llu  %-9s  (%s)\n", sorted[k].id, sorted[k].period,
+        const uint32_t at = sum->att.of_group[sorted[k].id];
+        snprintf(attractor, sizeof attractor, at == CM_FATE_DIVERGED     ? "div."
+                                              : at == CM_FATE_UNRESOLVED ? "?"
+                                                                         : "%u",
+                 at);
+        fprintf(out, "%6u %8u %12llu  %-9s %6s  (%s)\n", sorted[k].id, sorted[k].period,
                 (unsigned long long)sorted[k].basin_cells, cm_group_kind_name(sorted[k].kind),
-                centre);
+                attractor, centre);
     }
     if (ngroups > TEXT_GROUPS)
         fprintf(out, "... and %u smaller groups (--json lists all)\n", ngroups - TEXT_GROUPS);
-    const uint32_t singles = single_cells(g, ngroups);
-    if (singles)
-        fprintf(out, "%u of the %u groups are single fixed cells with no other cell in their "
-                     "basin: usually cells the map moves by less than a cell, not attractors "
-                     "(--max-steps removes them)\n",
-                singles, ngroups);
     for (int d = 0; d < lat->dim && lat->dim > 1; d++)
         if (sum->slow[d] > SLOW_SHARE)
             fprintf(out, "note: %.0f%% of the cells that move stay in their own %s slab: the "
@@ -343,10 +353,12 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     json_object(&j, "time_s");
     json_seconds(&j, t->first, t->t1);
     json_seconds(&j, t->second, t->t2);
+    json_seconds(&j, "attractors", sum->att_seconds);
     json_object_end(&j);
     if (log)
         print_json_extension(&j, lat, log);
-    json_groups(&j, sum->groups, sum->ngroups, lat);
+    attractor_json(&j, lat, &sum->att, &sum->fates);
+    attractor_json_groups(&j, sum->groups, sum->ngroups, lat, &sum->att);
     json_end(&j);
 }
 
@@ -711,6 +723,17 @@ int cmd_solve(int argc, char **argv)
         if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }
+    const double ta = progress_now();
+    a.att.threads = a.threads;
+    /* the cells' groups: the region's, or the cluster's (resolved on the way) */
+    const bool whole = r.group != NULL;
+    if (cm_attractors_find(&m, &lat, sum.groups, sum.ngroups,
+                           whole ? cm_region_cell_group : cm_cluster_cell_group,
+                           whole ? (void *)&r : (void *)&rn.c, &a.att, &sum.att, msg,
+                           sizeof msg) != CM_OK)
+        goto fail;
+    sum.att_seconds = progress_now() - ta;
+    attractor_fates(&sum.att, sum.groups, sum.ngroups, sum.sink, &sum.fates);
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
         print_json(a.report, &m, &lat, &sum, &t, shown);
@@ -731,6 +754,7 @@ done:
     cm_cluster_free(&rn.c);
     free(log);
     free(sum.groups);
+    cm_attractors_free(&sum.att);
     cm_region_free(&r);
     cm_model_release(&m);
     return rc;

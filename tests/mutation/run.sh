@@ -16,7 +16,7 @@ cmake -S "$tree" -B "$tree/build" -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build "$tree/build" -j "$(nproc)" > /dev/null || { echo "the unmutated tree does not build"; exit 1; }
 killed=0 survived=0 total=0
 trim() { sed 's/^ *//; s/ *$//' <<<"$1"; }
-while IFS= read -r line; do
+while IFS= read -r line <&3; do
   case $line in '' | '#'*) continue ;; esac
   # FILE | SCRIPT | WHAT: split at the first and the last " | " (scripts may hold "||")
   file=$(trim "${line%% | *}")
@@ -43,6 +43,6 @@ while IFS= read -r line; do
   fi
   mv "$tree/$file.orig" "$tree/$file"
   touch "$tree/$file"
-done < "$list"
+done 3< "$list"
 cmake --build "$tree/build" -j "$(nproc)" > /dev/null 2>&1
 echo "mutation score: $killed of $total killed ($(( total ? 100 * killed / total : 0 )) %)"

@@ -1,0 +1,132 @@
+/* cellmap/attractors.h - the system's attractors over a solve's cell groups.
+ *
+ * Simple cell mapping's periodic groups belong to the lattice as much as to
+ * the system: a period-1 attractor can show as a cell cycle of period 3, one
+ * attractor as several groups, a cell the map moves by less than a cell as a
+ * fixed "group" of its own. This layer checks every group by the true map in
+ * full precision: from the centre of its anchor cell (its smallest periodic
+ * cell, cm_group_info.anchor) the orbit is followed for a transient, then
+ * recorded, and the recording decides
+ *   - periodic: the orbit recurs in state space, |x_n - x_{n-p}| <= tol
+ *     cell widths in every coordinate over its last two cycles, at the
+ *     smallest such p (the true period);
+ *   - aperiodic (chaotic or quasi-periodic): the second half of the record
+ *     visits almost no cell that the first half did not (at most 2 % new
+ *     cells); the cells visited are the attractor's footprint;
+ *   - diverged: the map gives no image, or the orbit leaves the world;
+ *   - unresolved: none of these within the step budget (the record doubles,
+ *     the old record becoming transient, until the budget is spent).
+ * Groups whose true orbits end on one attractor are that attractor: two
+ * periodic results are one when their periods agree and their cycles lie
+ * within match cell widths of each other, two aperiodic ones when their
+ * footprints share at least a quarter of the smaller one's cells. A
+ * sticking zone of a friction model (CM_GROUP_STICKING) is kept as it is,
+ * an attractor of kind CM_ATTRACTOR_STICKING of its own.
+ *
+ * Attractors are numbered 1..n in the box order (cm_cell_less) of their
+ * anchors (the smallest cell of their footprints), and every result here
+ * depends only on the groups' anchors, never on their ids or on the thread
+ * count: a split, extended or resumed solve gives the attractors of the
+ * single-box solve of the same cells. Cost: per group, not per cell (at
+ * most max_steps steps of the map each); the groups are followed on
+ * `threads` OpenMP threads.
+ */
+#ifndef CM_ATTRACTORS_H
+#define CM_ATTRACTORS_H
+
+#include <stdint.h>
+
+#include "cellmap/model.h"
+#include "cellmap/scm.h"
+
+/* The budget and tolerances of the check; 0 in a field: its default. */
+typedef struct cm_attractor_options {
+    uint32_t transient; /* steps of the probe before its window; default 64 */
+    uint32_t record;    /* steps of the first record; default 500 */
+    uint32_t max_steps; /* every group's budget, transient and records; default
+                           65536 for maps, 8192 for flows (an image costs an
+                           integration over a period) */
+    double tol;         /* recurrence tolerance, in cell widths; default 1e-4 */
+    double match;       /* two cycles are one within this, in cell widths; default 1e-2 */
+    int threads;        /* OpenMP threads; 0: the OpenMP default */
+} cm_attractor_options;
+
+#define CM_ATTRACTOR_TRANSIENT 64
+#define CM_ATTRACTOR_RECORD 500
+#define CM_ATTRACTOR_MAX_STEPS 65536
+#define CM_ATTRACTOR_MAX_STEPS_FLOW 8192
+#define CM_ATTRACTOR_TOL 1e-4
+#define CM_ATTRACTOR_MATCH 1e-2
+
+enum cm_attractor_kind {
+    CM_ATTRACTOR_PERIODIC = 0,
+    CM_ATTRACTOR_APERIODIC = 1,
+    CM_ATTRACTOR_STICKING = 2 /* a sticking zone of rest states, as SCM gives it */
+};
+
+/* "periodic", "aperiodic" or "sticking". */
+const char *cm_attractor_kind_name(int kind);
+
+/* What became of a group (cm_attractor_set.of_group) besides an attractor
+ * id: its true orbit diverges, or is undecided within the budget. */
+#define CM_FATE_DIVERGED UINT32_C(0)
+#define CM_FATE_UNRESOLVED UINT32_C(0xFFFFFFFE)
+
+typedef struct cm_attractor {
+    uint32_t id;                  /* 1..n */
+    int kind;                     /* enum cm_attractor_kind */
+    uint32_t period;              /* true period; 0 when aperiodic */
+    double centre[CM_MAX_DIM];    /* mean of the cycle's points, or of the recorded orbit */
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* bounds of those points */
+    int64_t anchor[CM_MAX_DIM];   /* the smallest cell of its footprint: its identity */
+    uint32_t groups;              /* the cell groups that are this attractor */
+    uint64_t basin_cells;         /* their basins' cells */
+    uint64_t footprint_cells;     /* distinct cells of its footprint */
+} cm_attractor;
+
+typedef struct cm_attractor_set {
+    uint32_t n;          /* attractors */
+    cm_attractor *a;     /* n entries; a[k].id = k + 1 */
+    uint32_t ngroups;
+    uint32_t *of_group;  /* ngroups + 1 entries: group g's attractor id, CM_FATE_DIVERGED or
+                            CM_FATE_UNRESOLVED; [0] (the sink) CM_FATE_DIVERGED */
+    int64_t *footprint;  /* the attractors' footprint cells, dim coordinates each, attractor
+                            by attractor in box order */
+    uint64_t *footprint_at; /* n + 1 offsets (in cells) into footprint */
+    uint32_t merged;     /* groups that are another group's attractor (groups - n) */
+    uint32_t diverged_groups, unresolved_groups;
+    uint64_t unresolved_cells; /* the basins of unresolved groups */
+    uint64_t steps;      /* map steps taken */
+} cm_attractor_set;
+
+/* The options with every 0 replaced by its default for model m. */
+void cm_attractor_defaults(const cm_model *m, const cm_attractor_options *in,
+                           cm_attractor_options *out);
+
+/* Checks the options (tolerances > 0 and finite, match >= tol, a budget
+ * that holds the transient and one record): CM_EINVAL naming the bad one. */
+cm_status cm_attractor_check(const cm_attractor_options *o, char *msg, size_t msg_size);
+
+/* The group of a cell (its id; 0: the sink; CM_GROUP_NONE: no cell
+ * computed there) into *group. Called on the calling thread only. */
+typedef cm_status (*cm_cell_group_fn)(void *user, const int64_t *cell, uint32_t *group,
+                                      char *msg, size_t msg_size);
+
+/* A cm_cell_group_fn over one resolved region (user: the cm_region). */
+cm_status cm_region_cell_group(void *region, const int64_t *cell, uint32_t *group, char *msg,
+                               size_t msg_size);
+
+/* The attractors of groups[0..ngroups) (entry k: group k + 1, as
+ * cm_scm_groups and cm_store_groups give them) into *out, which the caller
+ * releases with cm_attractors_free (also on failure). label (may be NULL:
+ * every group is checked on its own) gives the cells' groups. opt NULL:
+ * defaults. */
+cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
+                             const cm_group_info *groups, uint32_t ngroups,
+                             cm_cell_group_fn label, void *label_user,
+                             const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
+                             size_t msg_size);
+
+void cm_attractors_free(cm_attractor_set *s);
+
+#endif

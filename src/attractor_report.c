@@ -1,0 +1,151 @@
+#include "src/attractor_report.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "src/basin_png.h"
+
+bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
+{
+    if (cli_is(c, "--attractor-steps", true, error)) {
+        double v[3] = {0, 0, 0};
+        int n = 0;
+        bool ok = c->value && parse_doubles(c->value, v, &n, 3) && n >= 2;
+        for (int k = 0; ok && k < n; k++)
+            ok = v[k] >= (k == 1 ? 8 : k == 2 ? 1 : 0) && v[k] <= UINT32_MAX && v[k] == floor(v[k]);
+        if (c->value && !ok)
+            *error = cli_usage_error(c, "--attractor-steps: '%s' must be T,R or T,R,MAX (whole "
+                                        "numbers of steps, R at least 8)", c->value);
+        o->transient = (uint32_t)v[0];
+        o->record = (uint32_t)v[1];
+        o->max_steps = (uint32_t)v[2];
+    } else if (cli_is(c, "--attractor-tol", true, error)) {
+        double v[2] = {0, 0};
+        int n = 0;
+        if (c->value && (!parse_doubles(c->value, v, &n, 2) || !(v[0] > 0) ||
+                         (n == 2 && !(v[1] > 0))))
+            *error = cli_usage_error(c, "--attractor-tol: '%s' must be TOL or TOL,MATCH, each "
+                                        "above 0 (cell widths)", c->value);
+        o->tol = v[0];
+        o->match = n == 2 ? v[1] : 0;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+void attractor_fates(const cm_attractor_set *s, const cm_group_info *groups, uint32_t ngroups,
+                     uint64_t sink_cells, cell_fates *out)
+{
+    memset(out, 0, sizeof *out);
+    out->left = sink_cells;
+    for (uint32_t k = 0; k < ngroups; k++) {
+        const uint32_t a = s->of_group[groups[k].id];
+        out->diverged += a == CM_FATE_DIVERGED ? groups[k].basin_cells : 0;
+        out->undecided += a == CM_FATE_UNRESOLVED ? groups[k].basin_cells : 0;
+    }
+}
+
+static int larger_basin(const void *a, const void *b)
+{
+    const cm_attractor *x = a, *y = b;
+    if (x->basin_cells != y->basin_cells)
+        return x->basin_cells > y->basin_cells ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+static double percent(uint64_t part, uint64_t all) { return all ? 100.0 * part / all : 0; }
+
+void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
+                    const cell_fates *fates, uint64_t cells, int rows)
+{
+    fprintf(out, "attractors %u, by true orbits from %u cell groups: %u merged into another "
+                 "group's attractor, %u artefacts (%u diverge, %u undecided)\n",
+            s->n, s->ngroups, s->merged, s->diverged_groups + s->unresolved_groups,
+            s->diverged_groups, s->unresolved_groups);
+    cm_attractor *sorted = malloc(((size_t)s->n + 1) * sizeof *sorted);
+    if (sorted && s->n) {
+        memcpy(sorted, s->a, s->n * sizeof *sorted);
+        qsort(sorted, s->n, sizeof *sorted, larger_basin);
+        fprintf(out, "%6s  %-9s %6s %12s %7s %6s  %s\n", "attr.", "kind", "period", "basin",
+                "share", "groups", "centre [in its footprint's bounds]");
+        for (uint32_t k = 0; k < s->n && (int)k < rows; k++) {
+            const cm_attractor *a = &sorted[k];
+            char centre[CM_MAX_DIM * CM_NUM_TEXT], period[16], bounds[2 * CM_MAX_DIM * CM_NUM_TEXT + 16] = "";
+            format_point(lat, a->centre, ", ", centre, sizeof centre);
+            snprintf(period, sizeof period, a->kind == CM_ATTRACTOR_APERIODIC ? "-" : "%u",
+                     a->period);
+            if (a->kind == CM_ATTRACTOR_APERIODIC) {
+                char lo[CM_MAX_DIM * CM_NUM_TEXT], hi[CM_MAX_DIM * CM_NUM_TEXT];
+                format_point(lat, a->lo, ", ", lo, sizeof lo);
+                format_point(lat, a->hi, ", ", hi, sizeof hi);
+                snprintf(bounds, sizeof bounds, " in (%s)..(%s)", lo, hi);
+            }
+            fprintf(out, "%6u  %-9s %6s %12llu %6.1f%% %6u  (%s)%s\n", a->id,
+                    cm_attractor_kind_name(a->kind), period, (unsigned long long)a->basin_cells,
+                    percent(a->basin_cells, cells), a->groups, centre, bounds);
+        }
+        if (s->n > (uint32_t)rows)
+            fprintf(out, "... and %u attractors with smaller basins (--json lists all)\n",
+                    s->n - (uint32_t)rows);
+    }
+    free(sorted);
+    fprintf(out, "diverged %llu cells (%.1f%%), undecided %llu (%.1f%%), left the computed "
+                 "cells (fate unknown) %llu (%.1f%%)\n",
+            (unsigned long long)fates->diverged, percent(fates->diverged, cells),
+            (unsigned long long)fates->undecided, percent(fates->undecided, cells),
+            (unsigned long long)fates->left, percent(fates->left, cells));
+}
+
+void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
+                    const cell_fates *fates)
+{
+    json_array(j, "attractors");
+    for (uint32_t k = 0; k < s->n; k++) {
+        const cm_attractor *a = &s->a[k];
+        json_object(j, NULL);
+        json_uint(j, "id", a->id);
+        json_str(j, "kind", cm_attractor_kind_name(a->kind));
+        if (a->kind == CM_ATTRACTOR_APERIODIC)
+            json_raw(j, "period", "null");
+        else
+            json_uint(j, "period", a->period);
+        json_uint(j, "basin_cells", a->basin_cells);
+        json_array(j, "groups");
+        for (uint32_t g = 1; g <= s->ngroups; g++)
+            if (s->of_group[g] == a->id)
+                json_uint(j, NULL, g);
+        json_array_end(j);
+        json_nums(j, "centre", a->centre, lat->dim);
+        json_nums(j, "lo", a->lo, lat->dim);
+        json_nums(j, "hi", a->hi, lat->dim);
+        json_array(j, "anchor");
+        for (int d = 0; d < lat->dim; d++)
+            json_int(j, NULL, a->anchor[d]);
+        json_array_end(j);
+        json_uint(j, "footprint_cells", a->footprint_cells);
+        json_object_end(j);
+    }
+    json_array_end(j);
+    json_uint(j, "diverged_cells", fates->diverged);
+    json_uint(j, "undecided_cells", fates->undecided);
+    json_uint(j, "outside_cells", fates->left);
+}
+
+void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat,
+                           const cm_attractor_set *s)
+{
+    json_array(j, "groups");
+    for (uint32_t k = 0; k < n; k++) {
+        json_object(j, NULL);
+        json_group_fields(j, &g[k], lat);
+        const uint32_t a = s->of_group[g[k].id];
+        if (a == CM_FATE_DIVERGED || a == CM_FATE_UNRESOLVED)
+            json_raw(j, "attractor", "null");
+        else
+            json_uint(j, "attractor", a);
+        json_object_end(j);
+    }
+    json_array_end(j);
+}

@@ -1,0 +1,50 @@
+/* src/attractor_report.h - the attractors of a solve (cellmap/attractors.h)
+ * as the commands report them: the options that set the check, the text
+ * summary's table and the JSON's "attractors", and what each group's
+ * cells became. */
+#ifndef CM_SRC_ATTRACTOR_REPORT_H
+#define CM_SRC_ATTRACTOR_REPORT_H
+
+#include <stdio.h>
+
+#include "cellmap/attractors.h"
+#include "src/args.h"
+#include "src/json.h"
+
+#define ATTRACTOR_OPTIONS_HELP                                                                     \
+    "  --attractor-steps T,R[,MAX]  the true-orbit check of each cell group: T steps of\n"         \
+    "                      transient, a record of R steps (doubled while undecided), at most\n"    \
+    "                      MAX steps a group (default 500,500,65536; 8192 for ODE flows)\n"         \
+    "  --attractor-tol TOL[,MATCH]  recurrence within TOL cell widths is periodic; cycles\n"      \
+    "                      within MATCH cell widths are one attractor (default 1e-4,1e-2)\n"
+
+/* Handles --attractor-steps and --attractor-tol; true if the current option
+ * was one of them (a bad value is reported and *error set). */
+bool attractor_options_take(cli *c, cm_attractor_options *o, int *error);
+
+/* Cells of the solve by what the true orbits say: on attractors' basins,
+ * diverged (their group's orbit diverges), undecided (their group's orbit
+ * was still undecided) and left (the sink of cell mapping: the sequence
+ * left the computed cells, fate unknown). */
+typedef struct cell_fates {
+    uint64_t diverged, undecided, left;
+} cell_fates;
+
+void attractor_fates(const cm_attractor_set *s, const cm_group_info *groups, uint32_t ngroups,
+                     uint64_t sink_cells, cell_fates *out);
+
+/* The text summary's attractor lines (the largest basins first, at most
+ * `rows`), and the line on the cell groups behind them. */
+void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
+                    const cell_fates *fates, uint64_t cells, int rows);
+
+/* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells". */
+void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
+                    const cell_fates *fates);
+
+/* The groups as json_groups writes them, each with "attractor" (its id, or
+ * null when its orbit diverges or is undecided). */
+void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat,
+                           const cm_attractor_set *s);
+
+#endif
