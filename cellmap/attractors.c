@@ -1,6 +1,7 @@
 #include "cellmap/attractors.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,11 +65,8 @@ enum {
 /* The cells whose groups a probe counts, after its transient. */
 #define LABEL_WINDOW 16
 
-/* A loose recurrence (half a cell) over two cycles, left when the budget
- * ends, is a cycle that converges slowly: still periodic. */
-#define LOOSE_TOL 0.5
 /* The share of new cells in a record's second half below which it has settled. */
-#define SETTLED_NEW 0.02
+#define SETTLED_NEW 0.05
 
 /* A cell with its unused coordinates 0, so that comparisons need no
  * dimension (qsort has no user pointer). */
@@ -89,7 +87,7 @@ typedef struct follow_ctx {
     const cm_model *m;
     const cm_lattice *lat;
     const cm_attractor_options *o;
-    double tol_abs[CM_MAX_DIM], loose_abs[CM_MAX_DIM];
+    double tol_abs[CM_MAX_DIM];
 } follow_ctx;
 
 static int cell_compare_dim(const int64_t *a, const int64_t *b, int dim)
@@ -145,7 +143,12 @@ static uint32_t recurrence(const double *s, uint64_t n, int dim, const double *t
         uint64_t i = n - 2 * p;
         while (i < n - 1 && close_states(s + i * dim, s + (i - p) * dim, dim, tol))
             i++;
-        if (i == n - 1)
+        /* converged, not creeping: every earlier cycle of the record is
+         * within tol of the last one too */
+        uint64_t j = p;
+        while (i == n - 1 && j + p < n && close_states(last, last - (j + p) * dim, dim, tol))
+            j += p;
+        if (i == n - 1 && j + p >= n)
             return (uint32_t)p;
     }
     return 0;
@@ -153,13 +156,13 @@ static uint32_t recurrence(const double *s, uint64_t n, int dim, const double *t
 
 /* One step of the true map; false when the orbit diverges (no image, a
  * state that is not finite or beyond the world). */
-static bool true_step(const follow_ctx *f, double *x)
+static bool true_step(const follow_ctx *f, double *x, cell_key *k)
 {
     double y[CM_MAX_DIM];
-    int64_t cell[CM_MAX_DIM];
-    if (f->m->step(f->m, x, y) != CM_STEP_OK || !cm_lattice_cell(f->lat, y, cell))
+    if (f->m->step(f->m, x, y) != CM_STEP_OK || !cm_lattice_cell(f->lat, y, k->c))
         return false;
-    memcpy(x, y, (size_t)f->lat->dim * sizeof *x);
+    for (int d = 0; d < f->lat->dim; d++)
+        x[d] = y[d];
     return true;
 }
 
@@ -185,28 +188,45 @@ typedef struct cell_owner {
     cell_key *cells;
     uint32_t *owner; /* UINT32_MAX: an empty slot */
     uint64_t mask, used;
+    int dim;
 } cell_owner;
 
-static uint64_t cell_hash(const cell_key *k)
+static uint64_t cell_hash(const cell_key *k, int dim)
 {
     uint64_t h = 0x9E3779B97F4A7C15u;
-    for (int d = 0; d < CM_MAX_DIM; d++) {
+    for (int d = 0; d < dim; d++) {
         h ^= (uint64_t)k->c[d] + 0x9E3779B97F4A7C15u + (h << 6) + (h >> 2);
         h *= 0xBF58476D1CE4E5B9u;
     }
     return h ^ (h >> 31);
 }
 
-static uint64_t owner_slot(const cell_owner *t, const cell_key *k)
+static bool same_cell(const cell_key *a, const cell_key *b, int dim)
 {
-    uint64_t i = cell_hash(k) & t->mask;
-    while (t->owner[i] != UINT32_MAX && key_compare(&t->cells[i], k) != 0)
+    for (int d = 0; d < dim; d++)
+        if (a->c[d] != b->c[d])
+            return false;
+    return true;
+}
+
+/* The slot of cell k (hash h = cell_hash(k)): its own, or the empty one
+ * it would take. */
+static uint64_t owner_slot_hashed(const cell_owner *t, const cell_key *k, uint64_t h)
+{
+    uint64_t i = h & t->mask;
+    while (t->owner[i] != UINT32_MAX && !same_cell(&t->cells[i], k, t->dim))
         i = (i + 1) & t->mask;
     return i;
 }
 
-static cm_status owner_init(cell_owner *t, uint64_t cells)
+static uint64_t owner_slot(const cell_owner *t, const cell_key *k)
 {
+    return owner_slot_hashed(t, k, cell_hash(k, t->dim));
+}
+
+static cm_status owner_init(cell_owner *t, uint64_t cells, int dim)
+{
+    t->dim = dim;
     uint64_t cap = 16;
     while (cap < 2 * cells + 2)
         cap *= 2;
@@ -228,11 +248,12 @@ static void owner_free(cell_owner *t)
 
 /* Gives cell k to owner o unless it has one; returns its owner before
  * (UINT32_MAX: none). Grows the table at half load. */
-static cm_status owner_claim(cell_owner *t, const cell_key *k, uint32_t o, uint32_t *before)
+static cm_status owner_claim_hashed(cell_owner *t, const cell_key *k, uint64_t h, uint32_t o,
+                                    uint32_t *before)
 {
     if (2 * (t->used + 1) > t->mask + 1) {
         cell_owner bigger;
-        if (owner_init(&bigger, t->mask + 1) != CM_OK) {
+        if (owner_init(&bigger, t->mask + 1, t->dim) != CM_OK) {
             owner_free(&bigger);
             return CM_ENOMEM;
         }
@@ -246,7 +267,7 @@ static cm_status owner_claim(cell_owner *t, const cell_key *k, uint32_t o, uint3
         owner_free(t);
         *t = bigger;
     }
-    const uint64_t i = owner_slot(t, k);
+    const uint64_t i = owner_slot_hashed(t, k, h);
     *before = t->owner[i];
     if (*before == UINT32_MAX) {
         t->cells[i] = *k;
@@ -256,116 +277,197 @@ static cm_status owner_claim(cell_owner *t, const cell_key *k, uint32_t o, uint3
     return CM_OK;
 }
 
-/* Whether the record's second half (cells c[n/2..n)) visits almost no
- * cell that its first half did not (at most 1 + 2 %); if so its footprint
- * (both halves' cells, distinct, in box order) is left in c[0..*k). */
-static cm_status settled(cell_key *c, uint64_t n, bool *yes, uint64_t *k)
+static cm_status owner_claim(cell_owner *t, const cell_key *k, uint32_t o, uint32_t *before)
 {
-    enum { FIRST, SEEN_AGAIN, FRESH };
-    const uint64_t h = n / 2;
+    return owner_claim_hashed(t, k, cell_hash(k, t->dim), o, before);
+}
+
+/* Consecutive moves from cell to cell inside the footprint of one
+ * attractor found before after which an orbit is taken to be on it (moves,
+ * not steps: a map that moves less than a cell a step stays in a cell for
+ * many steps wherever it is). */
+#define KNOWN_RUN 8
+
+/* The states a record keeps, its last ones: periods up to a third of them
+ * are found (RING / 3 = 1024); longer cycles are aperiodic here. */
+#define RING 3072
+
+/* One record of len steps from x: the last states in ring (the state of
+ * step i at i % RING), and the cells in t (of the first half FIRST, of the
+ * second half seen in the first SEEN_AGAIN, else FRESH). Stops early when
+ * the orbit diverges (*done < len) or makes KNOWN_RUN moves on one known
+ * footprint (*owner). */
+enum { FIRST, SEEN_AGAIN, FRESH };
+
+typedef struct record {
+    double *ring;       /* min(len, RING) states */
+    uint64_t ring_cap;  /* states it holds */
     cell_owner t;
-    cm_status st = owner_init(&t, n);
-    uint64_t again = 0, fresh = 0;
-    for (uint64_t i = 0; st == CM_OK && i < h; i++) {
-        uint32_t before;
-        st = owner_claim(&t, &c[i], FIRST, &before);
+    uint64_t done, again, fresh;
+    uint32_t owner, run; /* the known footprint the last `run` moves stayed on */
+    cell_key cell;       /* the cell of the last move */
+    double origin[CM_MAX_DIM]; /* the state before the record: sums are taken from it */
+    double sum[2][CM_MAX_DIM], squares[CM_MAX_DIM]; /* of each half, and of both */
+} record;
+
+static cm_status take_record(const follow_ctx *f, double *x, uint64_t len, const cell_owner *known,
+                             record *rec)
+{
+    const int dim = f->lat->dim;
+    cm_status st = owner_init(&rec->t, 32, dim);
+    const uint64_t need = len < RING ? len : RING;
+    if (st == CM_OK && rec->ring_cap < need) {
+        double *ring = realloc(rec->ring, (size_t)need * dim * sizeof *ring);
+        if (!ring)
+            return CM_ENOMEM;
+        rec->ring = ring;
+        rec->ring_cap = need;
     }
-    for (uint64_t i = h; st == CM_OK && i < n; i++) {
-        const uint64_t slot = owner_slot(&t, &c[i]);
-        if (t.owner[slot] == FIRST) {
-            t.owner[slot] = SEEN_AGAIN;
-            again++;
-        } else if (t.owner[slot] == UINT32_MAX) {
-            uint32_t before;
-            st = owner_claim(&t, &c[i], FRESH, &before);
-            fresh++;
+    rec->done = rec->again = rec->fresh = 0;
+    memcpy(rec->origin, x, (size_t)dim * sizeof *x);
+    memset(rec->sum, 0, sizeof rec->sum);
+    memset(rec->squares, 0, sizeof rec->squares);
+    cell_key k;
+    memset(&k, 0, sizeof k);
+    for (uint64_t i = 0; st == CM_OK && i < len && rec->run < KNOWN_RUN; i++) {
+        if (!true_step(f, x, &k))
+            return CM_OK;
+        rec->done++;
+        double *kept = rec->ring + (i % RING) * dim;
+        for (int d = 0; d < dim; d++) {
+            kept[d] = x[d];
+            const double u = x[d] - rec->origin[d];
+            rec->sum[i >= len / 2][d] += u;
+            rec->squares[d] += u * u;
+        }
+        const uint64_t h = cell_hash(&k, dim);
+        uint64_t slot = owner_slot_hashed(&rec->t, &k, h);
+        uint32_t before;
+        if (i < len / 2) {
+            if (rec->t.owner[slot] == UINT32_MAX)
+                st = owner_claim_hashed(&rec->t, &k, h, FIRST, &before);
+        } else if (rec->t.owner[slot] == FIRST) {
+            rec->t.owner[slot] = SEEN_AGAIN;
+            rec->again++;
+        } else if (rec->t.owner[slot] == UINT32_MAX) {
+            st = owner_claim_hashed(&rec->t, &k, h, FRESH, &before);
+            rec->fresh++;
+        }
+        if (known && !same_cell(&k, &rec->cell, dim)) { /* a move to another cell */
+            const uint32_t j = known->owner[owner_slot_hashed(known, &k, h)];
+            rec->run = j != UINT32_MAX && j == rec->owner ? rec->run + 1 : j != UINT32_MAX;
+            rec->owner = j;
+            rec->cell = k;
         }
     }
-    *yes = st == CM_OK && (double)fresh <= 1 + SETTLED_NEW * (double)(again + fresh);
-    *k = 0;
-    for (uint64_t i = 0; *yes && i <= t.mask; i++)
-        if (t.owner[i] != UINT32_MAX)
-            c[(*k)++] = t.cells[i];
-    if (*yes)
-        *k = unique_cells(c, *k);
-    owner_free(&t);
     return st;
 }
 
-/* Consecutive steps in the footprint of one attractor found before after
- * which an orbit is taken to be on it. */
-#define KNOWN_RUN 32
+/* Whether the record is stationary, not creeping: in every coordinate the
+ * means of its halves differ by less than half the record's spread (a
+ * steady drift differs by about 1.7 times its spread; an orbit on an
+ * attractor by ever less as the record grows). */
+static bool stationary(const record *rec, uint64_t len, int dim)
+{
+    const double h1 = (double)(len / 2), h2 = (double)(len - len / 2), n = (double)len;
+    for (int d = 0; d < dim; d++) {
+        const double m1 = rec->sum[0][d] / h1, m2 = rec->sum[1][d] / h2;
+        const double mean = (rec->sum[0][d] + rec->sum[1][d]) / n;
+        const double var = fmax(rec->squares[d] / n - mean * mean, 0);
+        if (fabs(m2 - m1) > 0.5 * sqrt(var))
+            return false;
+    }
+    return true;
+}
+
+/* The record's last min(len, RING) states in order into s. */
+static uint64_t ring_states(const record *rec, uint64_t len, int dim, double *s)
+{
+    const uint64_t n = len < RING ? len : RING;
+    for (uint64_t i = 0; i < n; i++)
+        memcpy(s + i * dim, rec->ring + ((len - n + i) % RING) * dim, (size_t)dim * sizeof *s);
+    return n;
+}
+
+/* The record's cells, distinct and in box order, as r's footprint. */
+static cm_status footprint_of(const record *rec, orbit *r)
+{
+    r->cells = malloc((size_t)(rec->t.used + 1) * sizeof *r->cells);
+    if (!r->cells)
+        return CM_ENOMEM;
+    r->ncells = 0;
+    for (uint64_t i = 0; i <= rec->t.mask; i++)
+        if (rec->t.owner[i] != UINT32_MAX)
+            r->cells[r->ncells++] = rec->t.cells[i];
+    r->ncells = unique_cells(r->cells, r->ncells);
+    return CM_OK;
+}
 
 /* Follows the true orbit on from x (steps taken so far in r->steps):
- * records that double until the orbit recurs, settles or diverges, or the
- * budget is spent, or (known not NULL) it stays KNOWN_RUN steps in the
- * footprint of one earlier orbit (r->fate ORBIT_INHERITS, *from its
- * owner). */
+ * records that double until the orbit recurs, settles (the record is
+ * stationary, and its second half visits almost no cell that its first
+ * half did not: at most SETTLED_NEW of them) or diverges, or the budget is spent, or (known not
+ * NULL) it makes KNOWN_RUN moves in the footprint of one earlier orbit
+ * (r->fate ORBIT_INHERITS, *from its owner). */
 static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known, orbit *r,
                         uint32_t *from)
 {
     const int dim = f->lat->dim;
     const cm_attractor_options *o = f->o;
     uint64_t len = o->record;
+    record *rec = calloc(1, sizeof *rec);
     double *s = NULL;
-    cell_key *c = NULL;
-    cm_status st = CM_OK;
-    uint32_t owner = UINT32_MAX, run = 0;
+    uint64_t s_cap = 0;
+    cm_status st = rec ? CM_OK : CM_ENOMEM;
+    if (rec)
+        rec->owner = UINT32_MAX;
     r->fate = ORBIT_UNRESOLVED;
     while (st == CM_OK && r->fate == ORBIT_UNRESOLVED) {
         const bool last = r->steps + 2 * len > o->max_steps;
         if (r->steps + len > o->max_steps)
             len = o->max_steps - r->steps;
-        double *ns = realloc(s, (size_t)len * dim * sizeof *s);
-        cell_key *nc = ns ? realloc(c, (size_t)len * sizeof *c) : NULL;
-        s = ns ? ns : s;
-        c = nc ? nc : c;
-        if (!ns || !nc) {
-            st = CM_ENOMEM;
-            break;
-        }
-        uint64_t i = 0;
-        for (; i < len && run < KNOWN_RUN && true_step(f, x); i++) {
-            memcpy(s + i * dim, x, (size_t)dim * sizeof *x);
-            c[i] = key_of(f->lat, x);
-            if (known) {
-                const uint32_t j = known->owner[owner_slot(known, &c[i])];
-                run = j != UINT32_MAX && j == owner ? run + 1 : j != UINT32_MAX;
-                owner = j;
-            }
-        }
-        r->steps += i;
-        if (run >= KNOWN_RUN) {
-            r->fate = ORBIT_INHERITS;
-            *from = owner;
-            break;
-        }
-        if (i < len) {
-            r->fate = ORBIT_DIVERGED;
-            break;
-        }
-        uint32_t p = recurrence(s, len, dim, f->tol_abs);
-        if (!p && last)
-            p = recurrence(s, len, dim, f->loose_abs); /* a slowly converging cycle */
-        bool calm = false;
-        if (!p && !recurrence(s, len, dim, f->loose_abs))
-            st = settled(c, len, &calm, &r->ncells);
+        st = take_record(f, x, len, known, rec);
+        r->steps += rec->done;
         if (st != CM_OK)
             break;
-        if (p) {
-            st = cycle_result(r, s, len, p, dim, f->lat);
-        } else if (calm) {
-            r->fate = ORBIT_APERIODIC;
-            r->cells = c;
-            c = NULL;
-        } else if (last || len < 8) {
-            break; /* unresolved */
+        if (rec->run >= KNOWN_RUN) {
+            r->fate = ORBIT_INHERITS;
+            *from = rec->owner;
+        } else if (rec->done < len) {
+            r->fate = ORBIT_DIVERGED;
         } else {
-            len *= 2; /* this record becomes transient */
+            if (s_cap < rec->ring_cap) {
+                double *grown = realloc(s, (size_t)rec->ring_cap * dim * sizeof *s);
+                if (!grown) {
+                    st = CM_ENOMEM;
+                    break;
+                }
+                s = grown;
+                s_cap = rec->ring_cap;
+            }
+            const uint64_t n = ring_states(rec, len, dim, s);
+            const uint32_t p = recurrence(s, n, dim, f->tol_abs);
+            const bool calm = !p && stationary(rec, len, dim) &&
+                              (double)rec->fresh <= SETTLED_NEW * (double)(rec->again + rec->fresh);
+            if (p)
+                st = cycle_result(r, s, n, p, dim, f->lat);
+            else if (calm) {
+                r->fate = ORBIT_APERIODIC;
+                st = footprint_of(rec, r);
+            } else if (last || len < 8)
+                break; /* unresolved */
+            else
+                len *= 2; /* this record becomes transient */
         }
+        owner_free(&rec->t);
+        memset(&rec->t, 0, sizeof rec->t);
     }
+    if (rec) {
+        owner_free(&rec->t);
+        free(rec->ring);
+    }
+    free(rec);
     free(s);
-    free(c);
     return st;
 }
 
@@ -449,28 +551,32 @@ static cm_status match_cycles(const orbit *r, uint32_t n, int dim, const double 
     return CM_OK;
 }
 
-/* Unites aperiodic orbits whose footprints share at least a quarter of
- * the smaller one's cells. Orbits come in anchor order; each counts its
- * cells that an earlier one claimed first, by that one. */
+/* Unites orbits whose footprints (a cycle's cells, or the cells an
+ * aperiodic orbit visits) share at least a quarter of the smaller one's
+ * cells: at the lattice's resolution they are one attractor. Orbits come
+ * in anchor order; each counts its cells that an earlier one claimed
+ * first, by that one. */
+static bool has_footprint(int fate) { return fate == ORBIT_APERIODIC || fate == ORBIT_PERIODIC; }
+
 static cm_status match_footprints(const orbit *r, uint32_t n, uint32_t *parent)
 {
     uint64_t all = 0;
-    uint32_t aperiodic = 0;
+    uint32_t with = 0;
     for (uint32_t k = 0; k < n; k++)
-        if (r[k].fate == ORBIT_APERIODIC) {
+        if (has_footprint(r[k].fate)) {
             all += r[k].ncells;
-            aperiodic++;
+            with++;
         }
-    if (aperiodic < 2)
+    if (with < 2)
         return CM_OK;
     cell_owner t;
     uint64_t *shared = calloc(n, sizeof *shared);
     uint32_t *hit = malloc((size_t)n * sizeof *hit);
-    cm_status st = owner_init(&t, all);
+    cm_status st = owner_init(&t, all, CM_MAX_DIM);
     if (!shared || !hit)
         st = CM_ENOMEM;
     for (uint32_t k = 0; st == CM_OK && k < n; k++) {
-        if (r[k].fate != ORBIT_APERIODIC)
+        if (!has_footprint(r[k].fate))
             continue;
         uint32_t nhit = 0;
         for (uint64_t i = 0; i < r[k].ncells; i++) {
@@ -591,9 +697,14 @@ static uint64_t describe(const cm_lattice *lat, const cm_group_info *groups,
                          uint32_t count, cm_attractor *at, cell_key *fp)
 {
     const int dim = lat->dim;
-    const orbit *first = &r[members[0]];
-    for (uint32_t i = 0; i < count && first->fate == ORBIT_INHERITS; i++)
-        first = &r[members[i]]; /* the first representative speaks for the class */
+    /* a converged cycle speaks for the class, else its first representative */
+    const orbit *first = NULL;
+    for (uint32_t i = 0; i < count && !first; i++)
+        if (r[members[i]].fate == ORBIT_PERIODIC)
+            first = &r[members[i]];
+    for (uint32_t i = 0; i < count && !first; i++)
+        if (r[members[i]].fate != ORBIT_INHERITS)
+            first = &r[members[i]];
     at->kind = first->fate == ORBIT_PERIODIC   ? CM_ATTRACTOR_PERIODIC
                : first->fate == ORBIT_STICKING ? CM_ATTRACTOR_STICKING
                                                : CM_ATTRACTOR_APERIODIC;
@@ -710,13 +821,14 @@ static void run_probe(const follow_ctx *f, const int64_t *anchor, probe *p, int6
     const int dim = f->lat->dim;
     cm_lattice_centre(f->lat, anchor, p->x);
     p->diverged = false;
+    cell_key k;
     for (uint32_t i = 0; i < f->o->transient + LABEL_WINDOW; i++, ++*steps) {
-        if (!true_step(f, p->x)) {
+        if (!true_step(f, p->x, &k)) {
             p->diverged = true;
             return;
         }
         if (i >= f->o->transient)
-            cm_lattice_cell(f->lat, p->x, window + (size_t)(i - f->o->transient) * dim);
+            memcpy(window + (size_t)(i - f->o->transient) * dim, k.c, (size_t)dim * sizeof *k.c);
     }
 }
 
@@ -794,10 +906,13 @@ static void cycles_of(const uint32_t *next, uint32_t n, uint32_t *parent, bool *
     free(mark);
 }
 
-/* Representatives checked at once, each against the footprints of those
- * checked before: a fixed number, so that what is known when a group is
- * checked never depends on the thread count. */
+/* Representatives are checked in batches, each against the footprints of
+ * the batches before: the first of CHECK_BATCH, then twice as many each
+ * time up to CHECK_BATCH_MAX (once the largest basins' attractors are
+ * known, most orbits end on them at once). Fixed sizes, so that what is
+ * known when a group is checked never depends on the thread count. */
 #define CHECK_BATCH 8
+#define CHECK_BATCH_MAX 256
 
 /* A representative's place in the checking order: the largest basins
  * first (the likely attractors, whose footprints then catch the orbits of
@@ -827,7 +942,7 @@ static cm_status check_representatives(const follow_ctx *f, const cm_group_info 
     ranked_rep *todo = malloc(((size_t)n + 1) * sizeof *todo);
     uint32_t *from = malloc(((size_t)n + 1) * sizeof *from);
     cell_owner known;
-    cm_status st = owner_init(&known, 64);
+    cm_status st = owner_init(&known, 64, f->lat->dim);
     uint32_t m = 0;
     for (uint32_t k = 0; todo && k < n; k++)
         if (r[k].fate == ORBIT_UNRESOLVED)
@@ -836,8 +951,10 @@ static cm_status check_representatives(const follow_ctx *f, const cm_group_info 
         st = CM_ENOMEM;
     if (st == CM_OK)
         qsort(todo, m, sizeof *todo, larger_first);
-    for (uint32_t b = 0; st == CM_OK && b < m; b += CHECK_BATCH) {
-        const uint32_t end = b + CHECK_BATCH < m ? b + CHECK_BATCH : m;
+    uint32_t size = CHECK_BATCH;
+    for (uint32_t b = 0, end; st == CM_OK && b < m; b = end) {
+        end = b + size < m ? b + size : m;
+        size = 2 * size < CHECK_BATCH_MAX ? 2 * size : CHECK_BATCH_MAX;
         int failed = 0;
         uint64_t steps = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(| : failed) \
@@ -847,6 +964,8 @@ static cm_status check_representatives(const follow_ctx *f, const cm_group_info 
             const uint64_t before = r[k].steps;
             failed |= follow(f, p[k].x, known.used ? &known : NULL, &r[k], &from[k]) != CM_OK;
             steps += r[k].steps - before;
+            if (getenv("CM_ATT_DEBUG"))
+                fprintf(stderr, "rep %u basin %llu fate %d steps %llu cells %llu\n", groups[order[k].index].id, (unsigned long long)todo[i].basin, r[k].fate, (unsigned long long)(r[k].steps - before), (unsigned long long)r[k].ncells);
         }
         *taken += steps;
         if (failed)
@@ -952,11 +1071,10 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
     if (st != CM_OK)
         return st;
     const int dim = lat->dim;
-    follow_ctx f = {m, lat, &o, {0}, {0}};
+    follow_ctx f = {m, lat, &o, {0}};
     double match[CM_MAX_DIM];
     for (int d = 0; d < dim; d++) {
         f.tol_abs[d] = o.tol * lat->width[d];
-        f.loose_abs[d] = LOOSE_TOL * lat->width[d];
         match[d] = o.match * lat->width[d];
     }
     out->ngroups = ngroups;

@@ -41,19 +41,19 @@
 
 /* The budget and tolerances of the check; 0 in a field: its default. */
 typedef struct cm_attractor_options {
-    uint32_t transient; /* steps of the probe before its window; default 64 */
+    uint32_t transient; /* steps of the probe before its window; default 16 */
     uint32_t record;    /* steps of the first record; default 500 */
     uint32_t max_steps; /* every group's budget, transient and records; default
-                           65536 for maps, 8192 for flows (an image costs an
+                           2^20 for maps, 8192 for flows (an image costs an
                            integration over a period) */
     double tol;         /* recurrence tolerance, in cell widths; default 1e-4 */
     double match;       /* two cycles are one within this, in cell widths; default 1e-2 */
     int threads;        /* OpenMP threads; 0: the OpenMP default */
 } cm_attractor_options;
 
-#define CM_ATTRACTOR_TRANSIENT 64
+#define CM_ATTRACTOR_TRANSIENT 16
 #define CM_ATTRACTOR_RECORD 500
-#define CM_ATTRACTOR_MAX_STEPS 65536
+#define CM_ATTRACTOR_MAX_STEPS 1048576
 #define CM_ATTRACTOR_MAX_STEPS_FLOW 8192
 #define CM_ATTRACTOR_TOL 1e-4
 #define CM_ATTRACTOR_MATCH 1e-2
