@@ -127,8 +127,8 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
     int slots = room - (ras->group_cells[0] ? 1 : 0) - (one_sticking_line ? 1 : 0) - closing;
     slots = slots < max_groups + 1 ? slots : max_groups + 1;
     if (ras->group_cells[0] && lg->n < room)
-        snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "sink  %.1f%%",
-                 share(ras->group_cells[0], all));
+        snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "%s  %.1f%%",
+                 o->sink_label ? o->sink_label : "sink", share(ras->group_cells[0], all));
     if (one_sticking_line && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sticking, true)->text, LABEL,
                  "%u sticking zones  %.1f%%", sticking, share(sticking_cells, all));

@@ -47,6 +47,7 @@ typedef struct cm_render_options {
     const struct cm_palette *palette; /* group colours (render/palette.h); NULL: the default */
     const cm_group_label *labels;     /* the legend's names of groups (n_labels of them) */
     int n_labels;
+    const char *sink_label;           /* the legend's name of label 0; NULL: "sink" */
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

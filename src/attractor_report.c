@@ -149,3 +149,75 @@ void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm
     }
     json_array_end(j);
 }
+
+bool by_option_take(cli *c, int *by, int *error)
+{
+    if (!cli_is(c, "--by", true, error))
+        return false;
+    if (c->value && strcmp(c->value, "groups") == 0)
+        *by = BY_GROUPS;
+    else if (c->value && strcmp(c->value, "attractors") == 0)
+        *by = BY_ATTRACTORS;
+    else if (c->value)
+        *error = cli_usage_error(c, "--by: '%s' must be attractors (the system's, by true "
+                                    "orbits) or groups (cell mapping's)", c->value);
+    return true;
+}
+
+cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
+                             uint32_t ngroups, const cm_attractor_options *o,
+                             cm_attractor_set *out, char *msg, size_t msg_size)
+{
+    return cm_attractors_find(m, &c->lat, groups, ngroups, cm_cluster_cell_group, c, o, out, msg,
+                              msg_size);
+}
+
+uint32_t attractor_label(const cm_attractor_set *s, uint32_t g)
+{
+    if (g == CM_GROUP_NONE)
+        return g;
+    const uint32_t a = g <= s->ngroups ? s->of_group[g] : CM_FATE_DIVERGED;
+    return a == CM_FATE_UNRESOLVED ? 0 : a;
+}
+
+cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_info **groups,
+                         uint32_t *n, char *msg, size_t msg_size)
+{
+    cm_group_info *g = calloc((size_t)s->n + 1, sizeof *g);
+    if (!g)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u attractors", s->n);
+    for (uint64_t i = 0; i < flat->ncells; i++) {
+        const uint32_t was = flat->group[i];
+        if (was != CM_GROUP_NONE && was != 0 && flat->step[i] == 0)
+            flat->step[i] = 1; /* a cell cycle's cell: the footprints are the markers */
+        flat->group[i] = attractor_label(s, was);
+    }
+    const int dim = flat->box.dim;
+    for (uint32_t a = 0; a < s->n; a++) {
+        const cm_attractor *at = &s->a[a];
+        g[a] = (cm_group_info){.id = at->id,
+                               .period = at->period,
+                               .basin_cells = at->basin_cells,
+                               .kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
+                                                                         : CM_GROUP_ATTRACTOR};
+        memcpy(g[a].centre, at->centre, sizeof at->centre);
+        memcpy(g[a].lo, at->lo, sizeof at->lo);
+        memcpy(g[a].hi, at->hi, sizeof at->hi);
+        memcpy(g[a].anchor, at->anchor, sizeof at->anchor);
+        for (uint64_t c = s->footprint_at[a]; c < s->footprint_at[a + 1]; c++) {
+            const int64_t *cell = s->footprint + c * dim;
+            if (!cm_box_contains(&flat->box, cell))
+                continue;
+            const uint64_t i = cm_box_index(&flat->box, cell);
+            if (flat->group[i] == CM_GROUP_NONE)
+                continue; /* not computed: nothing to mark */
+            flat->group[i] = at->id; /* visited by its orbit: on it */
+            flat->step[i] = 0;
+        }
+    }
+    free(*groups);
+    *groups = g;
+    *n = s->n;
+    flat->ngroups = s->n;
+    return CM_OK;
+}

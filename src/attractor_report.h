@@ -8,6 +8,7 @@
 #include <stdio.h>
 
 #include "cellmap/attractors.h"
+#include "cellmap/cluster.h"
 #include "src/args.h"
 #include "src/json.h"
 
@@ -17,6 +18,11 @@
     "                      MAX steps a group (default 500,500,65536; 8192 for ODE flows)\n"         \
     "  --attractor-tol TOL[,MATCH]  recurrence within TOL cell widths is periodic; cycles\n"      \
     "                      within MATCH cell widths are one attractor (default 1e-4,1e-2)\n"
+
+#define BY_OPTION_HELP                                                                             \
+    "  --by attractors|groups  figures and labels by the system's attractors (default;\n"      \
+    "                      their footprints marked) or by cell mapping's groups (the\n"          \
+    "                      thesis' figures are drawn by groups)\n"
 
 /* Handles --attractor-steps and --attractor-tol; true if the current option
  * was one of them (a bad value is reported and *error set). */
@@ -41,6 +47,29 @@ void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
 /* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells". */
 void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
                     const cell_fates *fates);
+
+/* --by groups|attractors: what figures and labels show (default: attractors). */
+enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
+bool by_option_take(cli *c, int *by, int *error);
+
+/* The attractors of a cluster's groups (groups[k]: group k + 1), the
+ * cells' groups read from the cluster. */
+cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
+                             uint32_t ngroups, const cm_attractor_options *o,
+                             cm_attractor_set *out, char *msg, size_t msg_size);
+
+/* Group g's label by attractors: its attractor's id, or 0 when its orbit
+ * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */
+uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);
+
+/* A flat region relabelled by attractors, in place: each cell's group id
+ * becomes its attractor's (attractor_label), the attractors' footprint
+ * cells in it take their attractor with step 0 (and no other cell has
+ * step 0: the markers are the footprints); *groups (freed) becomes the
+ * attractors' summaries, as groups, for the figure's colours and legend
+ * (*n of them). */
+cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_info **groups,
+                         uint32_t *n, char *msg, size_t msg_size);
 
 /* The groups as json_groups writes them, each with "attractor" (its id, or
  * null when its orbit diverges or is undecided). */

@@ -13,6 +13,7 @@
 #include "render/palette.h"
 #include "render/png_out.h"
 #include "render/raster.h"
+#include "src/attractor_report.h"
 #include "src/outfile.h"
 
 enum { MAX_DEFAULT_SIDE = 4096, FIGURE_SIDE = 1000 };
@@ -137,7 +138,8 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 
 bool png_opts_take(cli *c, png_opts *po, int *err)
 {
-    if (cli_is(c, "--png", true, err)) {
+    if (by_option_take(c, &po->by, err)) {
+    } else if (cli_is(c, "--png", true, err)) {
         po->path = c->value;
     } else if (cli_is(c, "--svg", true, err)) {
         po->svg = c->value;
@@ -356,6 +358,7 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.palette = po->palette;
     ro.labels = po->labels;
     ro.n_labels = po->n_labels;
+    ro.sink_label = po->sink_label;
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -505,8 +508,68 @@ static int write_svg(const char *cmd, const basin_png *b)
     return outfile_close(cmd, &o, st == CM_OK) && st == CM_OK ? EXIT_OK : EXIT_FAIL;
 }
 
+/* The legend's name of each attractor the user did not name ("A3 p=1",
+ * "A5 aperiodic"), after the user's labels. */
+static void attractor_names(const cm_attractor_set *s, png_opts *po)
+{
+    for (uint32_t a = 0; a < s->n && po->n_labels < PNG_LABELS_MAX; a++) {
+        bool named = false;
+        for (int k = 0; k < po->n_labels; k++)
+            named |= !po->labels[k].by_anchor && po->labels[k].id == s->a[a].id;
+        if (named)
+            continue;
+        cm_group_label *l = &po->labels[po->n_labels++];
+        memset(l, 0, sizeof *l);
+        l->id = s->a[a].id;
+        if (s->a[a].kind == CM_ATTRACTOR_PERIODIC)
+            snprintf(l->text, sizeof l->text, "A%u p=%u", s->a[a].id, s->a[a].period);
+        else
+            snprintf(l->text, sizeof l->text, "A%u %s", s->a[a].id,
+                     cm_attractor_kind_name(s->a[a].kind));
+    }
+}
+
+/* b's figure drawn by attractors: its cells relabelled in a copy. */
+static int write_by_attractors(const char *cmd, const basin_png *b)
+{
+    char msg[512];
+    cm_region view;
+    cm_status st = cm_region_alloc(&view, &b->cells->box, msg, sizeof msg);
+    cm_group_info *groups = NULL;
+    uint32_t n = 0;
+    png_opts *po = malloc(sizeof *po);
+    if (st == CM_OK && !po)
+        st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the figure");
+    if (st == CM_OK) {
+        memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
+        memcpy(view.step, b->cells->step, view.ncells * sizeof *view.step);
+        memcpy(view.image, b->cells->image, view.ncells * sizeof *view.image);
+        st = attractor_view(b->attractors, &view, &groups, &n, msg, sizeof msg);
+    }
+    int rc = EXIT_FAIL;
+    if (st == CM_OK) {
+        *po = *b->opts;
+        attractor_names(b->attractors, po);
+        po->sink_label = "no attractor";
+        basin_png by = *b;
+        by.opts = po;
+        by.cells = &view;
+        by.groups = groups;
+        by.attractors = NULL;
+        rc = write_basin_png(cmd, &by);
+    } else {
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    }
+    cm_region_free(&view);
+    free(groups);
+    free(po);
+    return rc;
+}
+
 int write_basin_png(const char *cmd, const basin_png *b)
 {
+    if (b->attractors)
+        return write_by_attractors(cmd, b);
     char msg[512];
     cm_status st = CM_OK;
     if (b->opts->path)

@@ -28,6 +28,8 @@ typedef struct png_opts {
     cm_group_label labels[PNG_LABELS_MAX]; /* --labels FILE: the legend's names */
     int n_labels;
     const char *palette_file, *labels_file; /* the files read, if any */
+    int by; /* --by: BY_ATTRACTORS (the default) or BY_GROUPS (src/attractor_report.h) */
+    const char *sink_label; /* the legend's name of label 0 (NULL: "sink") */
 } png_opts;
 
 /* What `all` draws: every layer but steps. */
@@ -95,6 +97,9 @@ typedef struct basin_png {
     const cm_group_info *groups; /* the groups' summaries, for the colours */
     double lo[2], hi[2];         /* the view; all 0: the cells' box */
     cm_gl *gl;                   /* a kept OSMesa context, or NULL */
+    const struct cm_attractor_set *attractors; /* not NULL: drawn by attractors (the cells'
+                                                  groups' attractors, the footprints marked;
+                                                  src/attractor_report.h), else by groups */
 } basin_png;
 
 /* Checks before anything is computed that the PNG of these options can be

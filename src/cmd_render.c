@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "src/args.h"
+#include "src/attractor_report.h"
 #include "src/outfile.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
@@ -24,12 +25,14 @@ static const char render_help[] =
     "                      the cluster's bounding box)\n"
     "  --slice Z,...       models of more than two dimensions: the point of dimensions\n"
     "                      3.. the 2-D slice passes through (default: the cluster's middle)\n"
+    BY_OPTION_HELP ATTRACTOR_OPTIONS_HELP
     "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n"
     "  --quiet             no progress line while the view's cells are read\n";
 
 typedef struct render_args {
     const char *file;
     png_opts png;
+    cm_attractor_options att; /* --attractor-steps, --attractor-tol */
     const char *slice_text;
     uint64_t mem;
     bool quiet;
@@ -43,6 +46,7 @@ static int parse_render(cli *c, render_args *a)
             fputs(render_help, stdout);
             return -1;
         } else if (png_opts_take(c, &a->png, &err)) {
+        } else if (attractor_options_take(c, &a->att, &err)) {
         } else if (cli_is(c, "--slice", true, &err)) {
             a->slice_text = c->value;
         } else if (cli_take_mem(c, &a->mem, &err)) {
@@ -152,6 +156,10 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     progress pr;
     progress_start(&pr, "render", "cells", cm_box_cells(&box), a->quiet);
     interrupt_catch();
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
+        st = cluster_attractors(&m, cl, groups, cl->ngroups, &a->att, &att, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_cluster_flatten_progress(cl, &box, &flat, reading, &pr, msg, sizeof msg);
     progress_end(&pr);
@@ -163,11 +171,12 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     } else if (st != CM_OK) {
         fprintf(stderr, "cellmap render: %s\n", msg);
     } else {
-        const basin_png png = {&a->png,        &m,  &cl->lat, &flat, groups, {lo[0], lo[1]},
-                               {hi[0], hi[1]}, NULL};
+        const basin_png png = {&a->png, &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
+                               {hi[0], hi[1]}, NULL, a->png.by == BY_ATTRACTORS ? &att : NULL};
         rc = write_basin_png("render", &png);
     }
     cm_region_free(&flat);
+    cm_attractors_free(&att);
     free(groups);
     cm_model_release(&m);
     return rc;

@@ -54,7 +54,7 @@ static const char solve_help[] =
     "  --bounds LO:HI,...  extend only within this box of state space (default: anywhere)\n"
     "  --max-steps K       re-step while the image stays in its own cell (default 1)\n"
     "  --threads T         OpenMP threads for the images (default: all cores)\n"
-    ATTRACTOR_OPTIONS_HELP;
+    ATTRACTOR_OPTIONS_HELP BY_OPTION_HELP;
 /* The rest of the help (one string would exceed what C compilers must take). */
 static const char solve_help_outputs[] =
     "  --png FILE          write a figure of the basins: basin, attractors, overlays,\n"
@@ -592,7 +592,8 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, summary *sum,
 static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_lattice *lat, run *rn,
                           const summary *sum, cm_region *r, char *msg, size_t msg_size)
 {
-    basin_png png = {&a->png, m, lat, r, sum->groups, {0, 0}, {0, 0}, NULL};
+    basin_png png = {&a->png, m,   lat, r, sum->groups, {0, 0}, {0, 0}, NULL,
+                     a->png.by == BY_ATTRACTORS ? &sum->att : NULL};
     if (a->png.has_view) {
         cm_box box;
         view_cells(lat, a->png.lo, a->png.hi, &sum->box, &box);

@@ -13,6 +13,7 @@
 #include "cellmap/output.h"
 #include "models/registry.h"
 #include "render/figure.h"
+#include "src/attractor_report.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
 #include "src/project.h"
@@ -526,6 +527,12 @@ static cm_status render_words(char **t, int n, png_opts *po, char *msg, size_t m
             if (!parse_png_mode(t[++k], &po->indexed))
                 return cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be rgb or indexed",
                                t[k]);
+        } else if (strcmp(t[k], "--by") == 0 && has_value) {
+            const char *by = t[++k];
+            if (strcmp(by, "groups") != 0 && strcmp(by, "attractors") != 0)
+                return cm_fail(CM_EINVAL, msg, msg_size,
+                               "render: --by '%s' must be attractors or groups", by);
+            po->by = strcmp(by, "groups") == 0 ? BY_GROUPS : BY_ATTRACTORS;
         } else if (strcmp(t[k], "--palette") == 0 && has_value) {
             char why[400];
             if (!png_opts_palette(t[++k], po, why, sizeof why))
@@ -571,8 +578,9 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     const size_t len = n > 1 ? strlen(t[1]) : 0;
     const bool svg = len > 4 && strcmp(t[1] + len - 4, ".svg") == 0; /* FILE.svg: as SVG */
     *(svg ? &po.svg : &po.path) = n > 1 ? t[1] : NULL;
-    cm_status st = words(n, 2, 15, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
-                         "[--png-mode M] [--palette P] [--labels FILE] [--min-basin N] [--legend K]",
+    cm_status st = words(n, 2, 17, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
+                         "[--png-mode M] [--palette P] [--labels FILE] [--min-basin N] [--legend K] "
+                         "[--by attractors|groups]",
                          msg, msg_size);
     if (st == CM_OK)
         st = render_words(t, n, &po, msg, msg_size);
@@ -591,11 +599,22 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     cm_group_info *groups = NULL;
     memset(&flat, 0, sizeof flat);
     st = shown_cells(s, &flat, &groups, msg, msg_size);
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    if (st == CM_OK && po.by == BY_ATTRACTORS)
+        st = cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, &att, msg,
+                                msg_size);
     if (st == CM_OK && !s->gl && !po.indexed && !svg)
         st = cm_gl_open(&s->gl, msg, msg_size);
-    const basin_png png = {
-        &po,  &s->model, &s->c.lat, &flat, groups, {s->lo[0], s->lo[1]}, {s->hi[0], s->hi[1]},
-        s->gl};
+    const basin_png png = {&po,
+                           &s->model,
+                           &s->c.lat,
+                           &flat,
+                           groups,
+                           {s->lo[0], s->lo[1]},
+                           {s->hi[0], s->hi[1]},
+                           s->gl,
+                           po.by == BY_ATTRACTORS ? &att : NULL};
     if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
         st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
     if (st == CM_OK && s->out) {
@@ -603,6 +622,7 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
         fflush(s->out);
     }
     cm_region_free(&flat);
+    cm_attractors_free(&att);
     free(groups);
     return st;
 }

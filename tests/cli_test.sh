@@ -53,7 +53,7 @@ assert sum(max(p) < 80 for p in left) > 100 and sum(max(p) < 80 for p in below) 
 PY
 # --svg: the same figure with text and paths, the basins embedded as a PNG
 # of one pixel per cell where the PNG figure draws its plot
-"$CM" solve --cells 300x200 --svg fig.svg --png fig.png > /dev/null || fail "solve --svg"
+"$CM" solve --cells 300x200 --svg fig.svg --png fig.png --by groups > /dev/null || fail "solve --svg"
 python3 - "$HERE" fig.svg fig.png <<'PY' || fail "the SVG figure"
 import base64, re, struct, sys, xml.etree.ElementTree as ET
 sys.path.insert(0, sys.argv[1])
@@ -113,8 +113,9 @@ printf '#e69f00\n// two colours only\n#56b4e9\n' > two.pal
 for run in "m1:--min-basin 1" "m100:--min-basin 100" "oi:--palette okabe-ito" "two:--palette two.pal" \
            "named:--labels names.txt"; do
   "$CM" render basin.cmdb --png ${run%%:*}.png --svg ${run%%:*}.svg --layers all --size 900x700 \
-    ${run#*:} || fail "render ${run#*:}"
-  "$CM" render basin.cmdb --png ${run%%:*}-bare.png --layers basin ${run#*:} || fail "render ${run#*:} bare"
+    --by groups ${run#*:} || fail "render ${run#*:}"
+  "$CM" render basin.cmdb --png ${run%%:*}-bare.png --layers basin --by groups ${run#*:} \
+    || fail "render ${run#*:} bare"
 done
 python3 - "$HERE" <<'PY' || fail "--min-basin, --palette, --labels"
 import sys, xml.etree.ElementTree as ET
@@ -333,7 +334,8 @@ rm -f big.png
   --region=-6:6,-6:6,-6:6 --cells 24x24x24 --db s3.cmdb > /dev/null || fail "3-D solve"
 "$CM" export s3.cmdb --cells s3.csv 2> /dev/null || fail "3-D export"
 for z in 0.25 -3.25; do
-  "$CM" render s3.cmdb --png "s3$z.png" --png-mode indexed --slice "$z" || fail "render --slice $z"
+  "$CM" render s3.cmdb --png "s3$z.png" --png-mode indexed --slice "$z" --by groups \
+    || fail "render --slice $z"
 done
 python3 - "$HERE" s3.csv s3-3.25.png s30.25.png <<'PY' || fail "3-D slices"
 import csv, struct, sys, zlib
@@ -374,7 +376,7 @@ assert images[0] != images[1]    # the slices differ: --slice is obeyed
 PY
 expect_usage "--slice" render s3.cmdb --png x.png --slice 1,2
 # --- 2-D indexed PNGs: row 0 is the top (high y), column 0 the left (low x) --
-"$CM" solve --cells 40x30 --split 2x1 --db o2.cmdb --png o2.png --png-mode indexed > /dev/null \
+"$CM" solve --cells 40x30 --split 2x1 --db o2.cmdb --png o2.png --png-mode indexed --by groups > /dev/null \
   || fail "2-D indexed solve"
 "$CM" export o2.cmdb --cells o2.csv 2> /dev/null || fail "2-D export"
 python3 - "$HERE" o2.csv o2.png <<'PY' || fail "2-D PNG orientation"
@@ -447,7 +449,7 @@ json.dump({"view": [-1e5, 1e5, -601.5, 601.5], "size": [800, 401], "colour_at": 
 PY
 python3 "$HERE/pngcheck.py" friction.png friction.check.json || fail "friction.png pixels"
 # the zones share one grey, so the legend counts them in one line
-"$CM" render friction.cmdb --svg friction.svg --layers all > /dev/null || fail "friction svg"
+"$CM" render friction.cmdb --svg friction.svg --layers all --by groups > /dev/null || fail "friction svg"
 grep -q ">$json_sticking sticking zones " friction.svg \
   && [ "$(grep -c " sticking p=" friction.svg)" = 0 ] || fail "one legend line for the sticking zones"
 "$CM" info friction.cmdb > /dev/null || fail "info on a friction file"
@@ -565,7 +567,7 @@ cmp -s v2-groups.csv v3-groups.csv && cmp -s v2-cells.csv v3-cells.csv || fail "
 "$CM" solve --region 100:600,-40:40 --db panned.cmdb > /dev/null || fail "solve of a panned region"
 for f in basin panned; do
   "$CM" render $f.cmdb --png $f-view.png --layers basin --min-basin 2 --view 130:300,-4:4 \
-    || fail "render $f.cmdb"
+    --by groups || fail "render $f.cmdb"
   "$CM" export $f.cmdb --cells $f-view.csv --window 130:300,-4:4 --quiet || fail "export $f.cmdb"
 done
 python3 - "$HERE" basin-view panned-view <<'PY' || fail "stable colours"
@@ -709,7 +711,9 @@ grep -q "lyapunov: [0-9]* of 576 grid points, .* grid points/s" tty.txt \
 script -qfec "$CM ${LYAP[*]} --csv l.csv --quiet" /dev/null > quiet.txt
 [ -s quiet.txt ] && fail "lyapunov --quiet printed: $(head -c 300 quiet.txt)"
 rm -f l.csv
-"$CM" "${LYAP[@]}" --csv l.csv > /dev/null 2> int.txt &
+# ten times the periods, so that the run outlasts the second before Ctrl-C
+# on a quiet machine too (the short run takes about 1 s on 2 cores)
+"$CM" "${LYAP[@]}" --periods 4000 --csv l.csv > /dev/null 2> int.txt &
 job=$!
 sleep 1
 kill -INT $job 2> /dev/null || fail "lyapunov ended before Ctrl-C"

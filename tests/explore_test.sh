@@ -166,7 +166,7 @@ for z in 1.75 -2 2 -2.01; do
   esac
 done
 # render in a session takes the figure options of `cellmap render`
-printf 'view 100:200,-16:16\nrender opts.svg 800x600 --layers all --palette okabe-ito --legend 2 --min-basin 5\n' |
+printf 'view 100:200,-16:16\nrender opts.svg 800x600 --layers all --palette okabe-ito --legend 2 --min-basin 5 --by groups\n' |
   "$CM" explore opts.cmdb - $pd $lattice > /dev/null 2>&1 || fail "render with figure options"
 python3 - opts.svg <<'PY' || fail "the session's figure options"
 import sys, xml.etree.ElementTree as ET

@@ -12,12 +12,13 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 pd=microchaos-pd
 
-# The README's quick start: the default solve's figure
+# The README's quick start: the default solve's figure, by attractors. The thesis'
+# figures below are drawn by cell groups (--by groups), as the thesis draws them.
 "$CM" solve --png quick-start.png > /dev/null
 
 # Fig. 4.13: alpha = 0.8, beta = 0.3, P = 0.9, D = 0.4; x_0*..x_2* regular,
 # x_3* virtual, switching lines SW_1..SW_5
-"$CM" solve --model $pd --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --region=-1:6.5,-2.5:2.5 \
+"$CM" solve --by groups --model $pd --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --region=-1:6.5,-2.5:2.5 \
   --cells 750x500 --png fig-4.13.png --layers all --size 1200x800 > /dev/null
 
 # Fig. 4.21: twelve tiny attractors at the switching lines (real device),
@@ -26,7 +27,7 @@ pd=microchaos-pd
 # tall in v: on 3-unit rows cell mapping cannot follow v's decay and sends 80 %
 # of the box to the sink (docs/engine.md, "Slow directions"); the basins'
 # hundreds of fragments are one colour
-"$CM" solve --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
+"$CM" solve --by groups --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
   --region=-125000:125000,-600:600 --cells 4000x3200 --max-steps 100000 \
   --png fig-4.21-figure.png --layers basin,steps,attractors,overlays,axes,legend,title \
   --min-basin 100000000 --size 1400x600 > /dev/null
@@ -34,15 +35,15 @@ pd=microchaos-pd
 # Figs. 4.26-4.28 (thesis 4.6.3): the two regions solved apart, after Stage 1
 # of their join, and the cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
 ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
-"$CM" solve $ex --region 0:500,-40:40 --cells 1000x1000 --png fig-4.26-left.png \
+"$CM" solve --by groups $ex --region 0:500,-40:40 --cells 1000x1000 --png fig-4.26-left.png \
   --layers all --size 700x700 > /dev/null
-"$CM" solve $ex --region 500:1000,-40:40 --cells 1000x1000 --png fig-4.26-right.png \
+"$CM" solve --by groups $ex --region 500:1000,-40:40 --cells 1000x1000 --png fig-4.26-right.png \
   --layers all --size 700x700 > /dev/null
-"$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --db "$tmp/c.cmdb" \
+"$CM" solve --by groups $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --db "$tmp/c.cmdb" \
   > /dev/null
-"$CM" render "$tmp/c.cmdb" --png fig-4.28.png --layers all --size 1400x700
+"$CM" render --by groups "$tmp/c.cmdb" --png fig-4.28.png --layers all --size 1400x700
 # Fig. 4.27: the same two regions after Stage 1 of the join only
-"$CM" solve $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --stage1 \
+"$CM" solve --by groups $ex --region 0:1000,-40:40 --cells 2000x1000 --split 2x1 --stage1 \
   --png fig-4.27.png --layers all --size 1400x700 > /dev/null
 
 # Fig. 4.30: the hybrid map with dry friction at mu = 0 and 0.095 (the thesis'
@@ -52,7 +53,7 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 # step: cells 0.375 tall in v (3 units tall, cell mapping sent 59 % of the box
 # to the sink), a row of them on v = 0 for the rest states
 for mu in 0 0.095 0.105; do
-  "$CM" solve --model microchaos-pd-friction --param mu=$mu --region=-100000:100000,-301.5:301.5 \
+  "$CM" solve --by groups --model microchaos-pd-friction --param mu=$mu --region=-100000:100000,-301.5:301.5 \
     --cells 3200x1609 --max-steps 100000 --png fig-4.30-mu$mu.png \
     --layers basin,steps,attractors,overlays,axes,legend,title --min-basin 100000000 \
     --size 1000x500 > /dev/null
@@ -60,7 +61,7 @@ done
 
 # Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip, out
 # to x_8* = 8.96 (regular) and x_9* = 10.08 (virtual: beyond 10)
-"$CM" solve --model microchaos-1d --param a=3.5,b=2.8 --region=-11:11 --cells 2200 \
+"$CM" solve --by groups --model microchaos-1d --param a=3.5,b=2.8 --region=-11:11 --cells 2200 \
   --png fig-4.2.png --layers all --size 800x800 > /dev/null
 
 # Ch. 2: the dry friction oscillator's Poincare map at S = 0.32, S0 = 0.4,
@@ -70,9 +71,9 @@ done
 # about the origin (cell 0 centred on it).
 fo="--model friction-oscillator --region=-3.00375:3.00375,-3.00375:3.00375 --cells 801x801"
 fo="$fo --max-steps 200"
-"$CM" solve $fo --param S=0.32,S0=0.4,Omega=0.5,phi=0 --png fig-2-1a-phi0.png --layers all \
+"$CM" solve --by groups $fo --param S=0.32,S0=0.4,Omega=0.5,phi=0 --png fig-2-1a-phi0.png --layers all \
   --size 800x700 > /dev/null
-"$CM" solve $fo --param S=0.32,S0=0.4,Omega=0.5,phi=3.141592653589793 --png fig-2-1a-phipi.png \
+"$CM" solve --by groups $fo --param S=0.32,S0=0.4,Omega=0.5,phi=3.141592653589793 --png fig-2-1a-phipi.png \
   --layers all --size 800x700 > /dev/null
 
 # Fig. 2.20 (right): largest Lyapunov exponent over Omega and S at S0 = 0.4,
@@ -131,12 +132,12 @@ done
 
 # Fig. 4.9: the delay map's basins at a = 1.5, b = 0.6, with its band borders,
 # the lines U_m its attractor's branches lie on, and the fixed points
-"$CM" solve --model microchaos-delay --param a=1.5,b=0.6 --region=0:6,0:6 --cells 600x600 \
+"$CM" solve --by groups --model microchaos-delay --param a=1.5,b=0.6 --region=0:6,0:6 --cells 600x600 \
   --png fig-4.9.png --layers all --size 800x700 > /dev/null
 
 # Fig. 4.33 (right): twofold quantisation, the stair-shaped switching lines of
 # the rho x rho input tiles over the basins (Fig. 4.13's gains, rho = 0.7)
-"$CM" solve --model microchaos-pd-twofold --param alpha=0.8,beta=0.3,P=0.9,D=0.4,rho=0.7 \
+"$CM" solve --by groups --model microchaos-pd-twofold --param alpha=0.8,beta=0.3,P=0.9,D=0.4,rho=0.7 \
   --region=-6:6,-3:3 --cells 600x300 --png fig-4.33-twofold.png --layers all --size 1000x560 \
   > /dev/null
 
@@ -145,7 +146,7 @@ done
 # rho = 1.0 and 1.65 (just above 1/(P + D) = 1.61), 1/P = 2.5 and 2/P = 5
 for f in 4.34:1.0:12:8 4.34:1.65:12:8 4.35:2.5:25:16 4.35:5:25:16; do
   IFS=: read -r fig rho wx wv <<< "$f"
-  "$CM" solve --model microchaos-pd-twofold --param alpha=0.5,beta=0.1,P=0.4,D=0.2222222222222222,rho=$rho \
+  "$CM" solve --by groups --model microchaos-pd-twofold --param alpha=0.5,beta=0.1,P=0.4,D=0.2222222222222222,rho=$rho \
     --region=-$wx:$wx,-$wv:$wv --cells 120x80 --png fig-$fig-rho$rho.png \
     --layers overlays,axes,title --size 720x480 > /dev/null
 done
@@ -168,7 +169,7 @@ done
 # escape number against a, four ways
 "$CM" escape --param a=1.5,b=1.3 --I0 0.25 --cells 0 --ensemble 0 --png fig-4.5-escape.png --quiet
 # the map's graph there (c = 0.15) with I_rep (orange) and I0 (blue) on the diagonal
-"$CM" solve --model microchaos-1d-friction --param a=1.5,b=1.3,c=0.15 --region=-1.6:1.6 \
+"$CM" solve --by groups --model microchaos-1d-friction --param a=1.5,b=1.3,c=0.15 --region=-1.6:1.6 \
   --cells 3200 --png fig-4.5-graph.png --layers all --size 700x700 > /dev/null
 "$CM" escape --param b=1.3 --I0 0.25 --sweep a=1.2:2.25:64 --ensemble 200000 \
   --png fig-4.7-escape.png --quiet
