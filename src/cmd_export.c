@@ -13,6 +13,7 @@
 #include "src/args.h"
 #include "src/outfile.h"
 #include "src/commands.h"
+#include "src/attractor_report.h"
 #include "src/export_arrays.h"
 #include "src/interrupt.h"
 #include "src/progress.h"
@@ -35,10 +36,15 @@ static const char export_help[] =
     "                      included), meta (source file, lattice origin and widths,\n"
     "                      state names) and indexes on cells(grp), the cells' indices\n"
     "                      and groups(kind)\n"
-    "  --labels OUT.npy    the group of every cell as an n-D array: shape = cells per\n"
-    "                      dimension (axis k = dimension k), C order, int32 (0 the sink,\n"
-    "                      -1 not computed); OUT.json beside it holds the lattice, the\n"
-    "                      box, the model and each group (kind, period, centre, colour)\n"
+    "  --labels OUT.npy    the attractor of every cell as an n-D array: shape = cells per\n"
+    "                      dimension (axis k = dimension k), C order, int32 (attractor ids\n"
+    "                      from 1; 0 diverged; -2 outside: the sequence left the computed\n"
+    "                      cells, or its group's true orbit was undecided; -1 not\n"
+    "                      computed); OUT.json beside it holds the lattice, the box, the\n"
+    "                      model and each attractor (kind, period, centre)\n"
+    "  --by groups         --labels gives cell mapping's groups instead (0 the sink), and\n"
+    "                      OUT.json each group (kind, period, centre, colour)\n"
+    ATTRACTOR_OPTIONS_HELP
     "  --steps OUT.npy     the same array of step numbers (-1 not computed), with OUT.json\n"
     "  --window X0:X1,...  only cells whose centre lies in this box of state space (for\n"
     "                      --cells, --flat, --labels and --steps)\n"
@@ -68,6 +74,8 @@ typedef struct export_args {
     const char *file, *groups, *cells, *flat, *window, *labels, *steps;
     uint64_t mem;
     bool quiet;
+    int by;                   /* --by: --labels by attractors (default) or groups */
+    cm_attractor_options att; /* --attractor-steps, --attractor-tol */
 } export_args;
 
 static int ends_with(const char *s, const char *suffix)
@@ -123,6 +131,8 @@ static int parse_export(cli *c, export_args *a)
             *(labels ? &a->labels : &a->steps) = c->value;
         } else if (cli_is(c, "--window", true, &err)) {
             a->window = c->value;
+        } else if (by_option_take(c, &a->by, &err)) {
+        } else if (attractor_options_take(c, &a->att, &err)) {
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--quiet", false, &err)) {
             a->quiet = true;
@@ -322,7 +332,7 @@ static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, u
     return ok;
 }
 
-static int json_array(char *buf, size_t size, const double *v, int n)
+static int numbers_json(char *buf, size_t size, const double *v, int n)
 {
     size_t used = (size_t)snprintf(buf, size, "[");
     for (int d = 0; d < n && used < size; d++)
@@ -353,10 +363,10 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             double a[CM_MAX_DIM];
             for (int d = 0; d < lat->dim; d++)
                 a[d] = (double)gi->anchor[d];
-            json_array(centre, sizeof centre, gi->centre, lat->dim);
-            json_array(lo, sizeof lo, gi->lo, lat->dim);
-            json_array(hi, sizeof hi, gi->hi, lat->dim);
-            json_array(anchor, sizeof anchor, a, lat->dim);
+            numbers_json(centre, sizeof centre, gi->centre, lat->dim);
+            numbers_json(lo, sizeof lo, gi->lo, lat->dim);
+            numbers_json(hi, sizeof hi, gi->hi, lat->dim);
+            numbers_json(anchor, sizeof anchor, a, lat->dim);
             sqlite3_bind_int64(st, 1, gi->id);
             sqlite3_bind_int64(st, 2, gi->period);
             sqlite3_bind_int64(st, 3, (sqlite3_int64)gi->basin_cells);
@@ -507,6 +517,24 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
     return CM_OK;
 }
 
+/* The attractors of the file's groups, for --labels: the model's true
+ * map from the file (its plugin loaded from where the file says). */
+static cm_status labels_attractors(const export_args *a, const cm_store_info *info, cm_cluster *c,
+                                   const cm_group_info *g, cm_attractor_set *att)
+{
+    char msg[1024];
+    cm_model_set set = {0};
+    cm_model m;
+    cm_status st = model_of_store(info, &set, &m, msg, sizeof msg);
+    if (st == CM_OK) {
+        st = cluster_attractors(&m, c, g, info->groups, &a->att, att, msg, sizeof msg);
+        cm_model_release(&m);
+    }
+    if (st != CM_OK)
+        fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
+    return st;
+}
+
 static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm_store_info *info,
                       cm_cluster *c)
 {
@@ -569,12 +597,19 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         fprintf(report_stream(a->groups, a->cells, a->flat), "exported %llu cells\n",
                 (unsigned long long)outs[0].rows);
     }
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    const bool by_attractors = a->labels && a->by == BY_ATTRACTORS;
+    if (rc == EXIT_OK && by_attractors && labels_attractors(a, info, c, g, &att) != CM_OK)
+        rc = EXIT_FAIL;
     if (rc == EXIT_OK && (a->labels || a->steps)) {
-        const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names};
+        const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names,
+                                by_attractors ? &att : NULL};
         progress_start(&pr, "export", "cells", cm_box_cells(&window), a->quiet);
         if (!export_arrays(c, &window, &x, &pr))
             rc = interrupt_requested() ? EXIT_INTERRUPTED : EXIT_FAIL;
     }
+    cm_attractors_free(&att);
     free(g);
     return rc;
 }
@@ -612,7 +647,9 @@ static int export_groups_only(const export_args *a)
 int cmd_export(int argc, char **argv)
 {
     cli c = {"export", argc, argv, 0, NULL, NULL};
-    export_args a = {NULL, NULL, NULL, NULL, NULL, NULL, NULL, UINT64_C(256) << 20, false};
+    export_args a;
+    memset(&a, 0, sizeof a);
+    a.mem = UINT64_C(256) << 20;
     const int rc = parse_export(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;

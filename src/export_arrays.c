@@ -8,6 +8,7 @@
 
 #include "render/palette.h"
 #include "src/interrupt.h"
+#include "cellmap/attractors.h"
 #include "src/json.h"
 #include "src/outfile.h"
 
@@ -45,8 +46,26 @@ static void put_i32(unsigned char *p, int32_t v)
         p[b] = (unsigned char)(u >> (8 * b));
 }
 
-/* The slab's cells in C order (dimension 0 slowest): one int32 each. */
-static bool write_slab(const cm_region *flat, FILE *labels, FILE *steps, uint64_t *in_window)
+/* A cell's label: its group (by groups), or its group's attractor: the
+ * attractor's id, 0 diverged, -2 outside (left the cells, undecided); -1
+ * not computed. */
+static int32_t label_of(const cm_attractor_set *s, uint32_t g)
+{
+    if (g == CM_GROUP_NONE)
+        return -1;
+    if (!s)
+        return (int32_t)g;
+    if (g == 0)
+        return -2;
+    const uint32_t a = s->of_group[g];
+    return a == CM_FATE_UNRESOLVED ? -2 : (int32_t)a;
+}
+
+/* The slab's cells in C order (dimension 0 slowest): one int32 each;
+ * in_window counts the cells of each group, by_label those of each label
+ * (at label + 2: -2 and -1 first). */
+static bool write_slab(const cm_region *flat, const cm_attractor_set *s, FILE *labels,
+                       FILE *steps, uint64_t *in_window, uint64_t *by_label)
 {
     const cm_box *b = &flat->box;
     const int dim = b->dim;
@@ -63,9 +82,11 @@ static bool write_slab(const cm_region *flat, FILE *labels, FILE *steps, uint64_
         }
         const uint32_t g = flat->group[index];
         unsigned char v[4];
+        const int32_t label = label_of(s, g);
         if (g != CM_GROUP_NONE)
             in_window[g]++;
-        put_i32(v, g == CM_GROUP_NONE ? -1 : (int32_t)g);
+        by_label[label + 2]++;
+        put_i32(v, label);
         ok = !labels || fwrite(v, 1, 4, labels) == 4;
         put_i32(v, g == CM_GROUP_NONE ? -1 : (int32_t)flat->step[index]);
         ok = ok && (!steps || fwrite(v, 1, 4, steps) == 4);
@@ -104,9 +125,37 @@ static void write_sidecar_groups(json *j, const array_export *x, const cm_lattic
     free(classes);
 }
 
-static bool write_sidecar(const char *npy, const char *kind, const array_export *x,
-                          const cm_lattice *lat, const cm_box *w, const uint64_t *in_window)
+/* The attractors with cells in the window, as solve --json lists them,
+ * with their cells in it. */
+static void write_sidecar_attractors(json *j, const array_export *x, const cm_lattice *lat,
+                                     const uint64_t *in_window)
 {
+    const cm_attractor_set *s = x->attractors;
+    json_array(j, "attractors");
+    for (uint32_t k = 0; k < s->n; k++) {
+        if (!in_window[s->a[k].id + 2])
+            continue;
+        const cm_attractor *a = &s->a[k];
+        json_object(j, NULL);
+        json_uint(j, "id", a->id);
+        json_str(j, "kind", cm_attractor_kind_name(a->kind));
+        if (a->kind == CM_ATTRACTOR_APERIODIC)
+            json_raw(j, "period", "null");
+        else
+            json_uint(j, "period", a->period);
+        json_uint(j, "basin_cells", a->basin_cells);
+        json_nums(j, "centre", a->centre, lat->dim);
+        json_uint(j, "in_view", in_window[a->id + 2]);
+        json_object_end(j);
+    }
+    json_array_end(j);
+}
+
+static bool write_sidecar(const char *npy, const char *kind, const array_export *x,
+                          const cm_lattice *lat, const cm_box *w, const uint64_t *in_window,
+                          const uint64_t *by_label)
+{
+    const bool by_attractors = x->attractors && strcmp(kind, "labels") == 0;
     char path[CM_OUTPUT_PATH_MAX];
     array_sidecar_path(npy, path, sizeof path);
     outfile o;
@@ -135,16 +184,25 @@ static bool write_sidecar(const char *npy, const char *kind, const array_export 
     json_lattice(&j, lat);
     json_str(&j, "model", x->info->model);
     json_raw(&j, "params", x->info->params);
+    json_str(&j, "by", by_attractors ? "attractors" : "groups");
     json_object(&j, "values");
     json_str(&j, "-1", "not computed");
-    if (strcmp(kind, "labels") == 0) {
+    if (by_attractors) {
+        json_str(&j, "-2", "outside: the sequence left the computed cells, or its group's true "
+                           "orbit was undecided");
+        json_str(&j, "0", "diverged: its group's true orbit diverges");
+        json_str(&j, "k", "attractor k");
+    } else if (strcmp(kind, "labels") == 0) {
         json_str(&j, "0", "the sink (the sequence leaves the cluster)");
         json_str(&j, "k", "group k");
     } else {
         json_str(&j, "k", "steps to the group's periodic cells");
     }
     json_object_end(&j);
-    write_sidecar_groups(&j, x, lat, in_window);
+    if (by_attractors)
+        write_sidecar_attractors(&j, x, lat, by_label);
+    else
+        write_sidecar_groups(&j, x, lat, in_window);
     json_end(&j);
     return outfile_close("export", &o, true);
 }
@@ -153,8 +211,11 @@ bool export_arrays(cm_cluster *c, const cm_box *window, const array_export *x, p
 {
     outfile labels, steps;
     const bool has_labels = x->labels != NULL, has_steps = x->steps != NULL;
+    const uint32_t labels_n = x->attractors ? x->attractors->n : x->ngroups;
     uint64_t *in_window = calloc((size_t)x->ngroups + 2, sizeof *in_window);
-    if (!in_window) {
+    uint64_t *by_label = calloc((size_t)labels_n + 3, sizeof *by_label);
+    if (!in_window || !by_label) {
+        free(by_label);
         fprintf(stderr, "cellmap export: out of memory for %u groups\n", x->ngroups);
         return false;
     }
@@ -183,7 +244,8 @@ bool export_arrays(cm_cluster *c, const cm_box *window, const array_export *x, p
             ok = false;
             break;
         }
-        ok = write_slab(&flat, has_labels ? labels.f : NULL, has_steps ? steps.f : NULL, in_window);
+        ok = write_slab(&flat, x->attractors, has_labels ? labels.f : NULL,
+                        has_steps ? steps.f : NULL, in_window, by_label);
         if (!ok)
             snprintf(msg, sizeof msg, "cannot write the arrays");
         done += flat.ncells;
@@ -202,9 +264,10 @@ bool export_arrays(cm_cluster *c, const cm_box *window, const array_export *x, p
     if (has_steps)
         ok = outfile_close("export", &steps, ok) && ok;
     if (ok && has_labels)
-        ok = write_sidecar(x->labels, "labels", x, &c->lat, window, in_window);
+        ok = write_sidecar(x->labels, "labels", x, &c->lat, window, in_window, by_label);
     if (ok && has_steps)
-        ok = write_sidecar(x->steps, "steps", x, &c->lat, window, in_window);
+        ok = write_sidecar(x->steps, "steps", x, &c->lat, window, in_window, by_label);
     free(in_window);
+    free(by_label);
     return ok;
 }

@@ -2,8 +2,11 @@
  * cells of a window as an n-D array for numpy, Julia (NPZ.jl) or MATLAB.
  *
  * FILE.npy holds one little-endian int32 per cell, shape (n_0, ..., n_d-1)
- * (cells per state dimension, axis k = dimension k), C order: the group id
- * (0 the sink, -1 not computed) or the step number (-1 not computed).
+ * (cells per state dimension, axis k = dimension k), C order: the
+ * attractor id (0 diverged, -2 outside: the sequence left the computed
+ * cells, or its group's true orbit was undecided; -1 not computed), or
+ * with --by groups the group id (0 the sink, -1 not computed), or the step
+ * number (-1 not computed).
  * FILE.json beside it (docs/cellmap.schema.json, "export") says where the
  * array lies on the lattice and in state space, the model, and each group
  * in it with its kind, period, centre and figure colour. */
@@ -21,6 +24,7 @@ typedef struct array_export {
     const cm_group_info *groups; /* groups 1..ngroups */
     uint32_t ngroups;
     const char *const *names; /* the state coordinates' names */
+    const struct cm_attractor_set *attractors; /* not NULL: labels by attractors */
 } array_export;
 
 /* The sidecar's path: FILE.npy -> FILE.json. */

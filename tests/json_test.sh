@@ -43,15 +43,18 @@ run horseshoe horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --json
 run stability stability --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --json
 run escape escape --param a=1.5,b=1.3 --I0 0.25 --cells 100000 --ensemble 100000 --json
 run escape-sweep escape --param b=1.3 --I0 0.25 --sweep a=1.15:1.55:4 --cells 1000 --ensemble 10000 --json
-"$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 \
+"$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 --by groups \
   || fail "export --labels --steps"
 "$CM" export basin.cmdb --cells window.csv --window 100:300,-5:5 > /dev/null || fail "export --cells"
 # a window whose v bounds are cell centres (v = -4.5 and 4.5: both in)
-"$CM" export basin.cmdb --labels edge.npy --steps edge-steps.npy --cells edge.csv \
+"$CM" export basin.cmdb --labels edge.npy --steps edge-steps.npy --cells edge.csv --by groups \
   --window 100:300,-4.5:4.5 > /dev/null || fail "export of a window on cell centres"
 "$CM" solve --model microchaos-general --param n=1,d=2,A=1.5,B=-1,K=0.6:0.2:0.1 \
   --region=-6:6,-6:6,-6:6 --cells 6x5x4 --db cube.cmdb > /dev/null || fail "3-D solve"
-"$CM" export cube.cmdb --labels cube.npy --cells cube.csv > /dev/null || fail "3-D export --labels"
+"$CM" export cube.cmdb --labels cube.npy --cells cube.csv --by groups > /dev/null \
+  || fail "3-D export --labels"
+# by attractors (the default): each cell's label is its group's attractor
+"$CM" export basin.cmdb --labels att.npy --cells att.csv > /dev/null || fail "export --labels by attractors"
 printf 'view 0:500 -40:40\nstats --json\n' | "$CM" explore ex.cmdb --model microchaos-pd --cell-size 4,1 \
   2> /dev/null | grep '^{' > stats.json || fail "explore stats --json"
 python3 "$HERE/schema_check.py" "$SCHEMA" $(ls ./*.json | grep -v -e missing.json -e enum.json) \
@@ -157,6 +160,27 @@ for stem, csv_name, window in (("labels", "window", ((100, 300), (-5, 5))),
     assert got == sorted((i, j) for i in cells[0] for j in cells[1]), (csv_name, got[:3], got[-3:])
     assert got[0] == tuple(first) and got[-1] == tuple(last), (got[0], got[-1])
 assert inside(1, -4.5, 4.5) == list(range(35, 45)), inside(1, -4.5, 4.5)   # both centres in
+PY
+
+# the attractor labels against the groups' attractors of solve --json, cell
+# by cell: the sink -2 (outside), a group whose orbit diverges 0 or whose
+# orbit is undecided -2 (its attractor null), else its attractor's id
+/usr/bin/python3 - <<'PY' || fail "export --labels by attractors"
+import csv, json
+import numpy as np
+arr, side, solve = np.load("att.npy"), json.load(open("att.json")), json.load(open("solve.json"))
+assert side["by"] == "attractors" and "attractors" in side and "groups" not in side, side.keys()
+of = {g["id"]: g["attractor"] for g in solve["groups"]}
+ids = {a["id"] for a in solve["attractors"]}
+bad = 0
+for r in csv.DictReader(open("att.csv")):
+    g, got = int(r["grp"]), int(arr[int(r["ix"]), int(r["iv"])])
+    want = {-2} if g == 0 else ({0, -2} if of[g] is None else {of[g]})
+    bad += got not in want
+assert bad == 0, bad
+assert {a["id"] for a in side["attractors"]} == set(np.unique(arr[arr > 0]).tolist()) <= ids
+for a in side["attractors"]:
+    assert a["in_view"] == int((arr == a["id"]).sum()), a
 PY
 
 # the CSV columns carry the JSON's names

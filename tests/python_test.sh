@@ -27,7 +27,7 @@ export PYTHONPATH="$work/site"
 
 pd=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 400x200)
 "$CM" solve "${pd[@]}" --db pd.cmdb --quiet > /dev/null || fail "solve --db"
-"$CM" export pd.cmdb --labels labels.npy --steps steps.npy --quiet || fail "export"
+"$CM" export pd.cmdb --labels labels.npy --steps steps.npy --by groups --quiet || fail "export"
 export PKG_CONFIG_PATH="$work/prefix/share/pkgconfig"
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so "$SRC/examples/plugin/henon.c" -lm \
   || fail "cc henon"
