@@ -795,6 +795,7 @@ static cm_status build_set(const cm_lattice *lat, const cm_group_info *groups,
             out->diverged_groups += fate == ORBIT_DIVERGED;
             out->unresolved_groups += fate == ORBIT_UNRESOLVED;
             out->unresolved_cells += fate == ORBIT_UNRESOLVED ? g->basin_cells : 0;
+            out->diverged_cells += fate == ORBIT_DIVERGED ? g->basin_cells : 0;
         }
     }
     free(fp);

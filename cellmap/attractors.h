@@ -96,6 +96,7 @@ typedef struct cm_attractor_set {
     uint32_t merged;     /* groups that are another group's attractor (groups - n) */
     uint32_t diverged_groups, unresolved_groups;
     uint64_t unresolved_cells; /* the basins of unresolved groups */
+    uint64_t diverged_cells;   /* the basins of groups whose orbits diverge (not the sink) */
     uint64_t steps;      /* map steps taken */
 } cm_attractor_set;
 

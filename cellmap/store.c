@@ -135,7 +135,7 @@ const char *const store_tables_sql =
     " centre TEXT NOT NULL, lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"
     " periodic_cells BLOB NOT NULL,"
     " kind TEXT NOT NULL DEFAULT 'attractor' CHECK(kind IN ('attractor', "
-    "'sticking')));" GROUPS_VIEW_SQL("", "a.kind");
+    "'sticking')));" GROUPS_VIEW_SQL("", "a.kind") SYSTEM_ATTRACTORS_SQL;
 
 /* Version 2 had no kinds: every group of such a file is an attractor (no
  * model with rest states existed); read-only, a temporary view shadows the
@@ -149,7 +149,10 @@ static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor
     " EXISTS(SELECT 1 FROM exits), EXISTS(SELECT 1 FROM attractors),"                              \
     " EXISTS(SELECT 1 FROM nodes), EXISTS(SELECT 1 FROM basins),"                                  \
     " EXISTS(SELECT 1 FROM pages WHERE region = 1)"
-static const char *const check_sql = CHECK_V4_SQL ", EXISTS(SELECT 1 FROM open_nodes)";
+#define CHECK_V5_SQL CHECK_V4_SQL ", EXISTS(SELECT 1 FROM open_nodes)"
+static const char *const check_sql =
+    CHECK_V5_SQL ", EXISTS(SELECT 1 FROM system_attractors), EXISTS(SELECT 1 FROM group_fates)";
+static const char *const check_v5_sql = CHECK_V5_SQL;
 static const char *const check_v4_sql = CHECK_V4_SQL;
 static const char *const check_v3_sql =
     "SELECT EXISTS(SELECT 1 FROM meta), EXISTS(SELECT 1 FROM regions),"
@@ -217,7 +220,10 @@ static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, 
     if (ids != CM_OK)
         return ids;
     sqlite3_stmt *st = NULL;
-    const char *sql = version >= 5 ? check_sql : version == 4 ? check_v4_sql : check_v3_sql;
+    const char *sql = version >= 6   ? check_sql
+                      : version == 5 ? check_v5_sql
+                      : version == 4 ? check_v4_sql
+                                     : check_v3_sql;
     int rc = sqlite3_prepare_v2(db, sql, -1, &st, NULL);
     if (rc == SQLITE_OK)
         rc = sqlite3_step(st) == SQLITE_ROW ? SQLITE_OK : SQLITE_CORRUPT;

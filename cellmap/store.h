@@ -5,16 +5,18 @@
  * lattice, tool version, command line, solve plan), the regions in join
  * order, their cell arrays as compressed pages of CM_STORE_PAGE_CELLS cells
  * (cellmap/codec.h), their exit tables, node tables and open nodes, the
- * cell count per group, and the attractors (periodic groups). The view
- * `groups` adds basin sizes and the sink. Layout: README, "The .cmdb
- * format".
+ * cell count per group, the periodic groups (table `attractors`, a name
+ * kept from version 2), and (version 6) the system's attractors that the
+ * groups' true orbits give (cellmap/attractors.h) with each group's. The
+ * view `groups` adds basin sizes and the sink. Layout: docs/format.md.
  *
  * The file carries application_id CM_STORE_APP_ID and user_version
  * CM_STORE_VERSION; files that are not SQLite, not cellmap's, of another
  * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
  * versions 2 and 3 (regions stored resolved, no node tables; version 2
- * without group kinds) and 4 (no table of open nodes: every node table is
- * read at open) are read as they are; writing needs cm_store_upgrade.
+ * without group kinds), 4 (no table of open nodes: every node table is
+ * read at open) and 5 (no system attractors) are read as they are; writing
+ * needs cm_store_upgrade.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
  * cm_store_commit writes everything a join changed in one transaction, so
@@ -33,12 +35,13 @@
 
 #include <stdbool.h>
 
+#include "cellmap/attractors.h"
 #include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 5
+#define CM_STORE_VERSION 6
 #define CM_STORE_PAGE_CELLS 65536
 
 typedef struct cm_store cm_store;
@@ -187,6 +190,19 @@ cm_status cm_store_set_note(cm_store *s, const char *key, const char *value, cha
                             size_t msg_size);
 cm_status cm_store_get_note(cm_store *s, const char *key, char *out, size_t size, char *msg,
                             size_t msg_size);
+
+/* The system's attractors of the file's groups (dim: the lattice's) with
+ * the options they were found with: replaced (in its own transaction, or
+ * in the open one). */
+cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
+                                  const cm_attractor_options *o, int dim, char *msg,
+                                  size_t msg_size);
+/* Reads them back into *a (released with cm_attractors_free) for the
+ * file's ngroups groups, and their options into *o (may be NULL);
+ * CM_ENOTFOUND when the file holds none (version 5 or older, or a solve
+ * stopped before them), CM_EFORMAT when damaged. Reads no cell. */
+cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
+                                  cm_attractor_options *o, char *msg, size_t msg_size);
 
 /* Parameters as a JSON object text, e.g. {"alpha":0.078,"mode":"output"}. */
 void cm_params_json(const cm_params *p, char *buf, size_t size);

@@ -4,7 +4,8 @@
  *   store_pages.c   region rows, cell pages, exit and node tables; the
  *                   pager; loading a saved cluster
  *   store_commit.c  groups, basins and commits
- *   store_upgrade.c files of versions 2, 3 and 4 to version 5
+ *   store_upgrade.c files of versions 2 to 5 to version 6
+ *   store_attractors.c the system's attractors (version 6)
  */
 #ifndef CM_STORE_DB_H
 #define CM_STORE_DB_H
@@ -51,6 +52,14 @@ extern const char *const store_tables_sql;
 #define OPEN_NODES_TABLE_SQL                                                                       \
     "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"                   \
     " count INTEGER NOT NULL, data BLOB NOT NULL);"
+/* Version 6's tables of the system's attractors (store_attractors.c). */
+#define SYSTEM_ATTRACTORS_SQL                                                                      \
+    "CREATE TABLE system_attractors(id INTEGER PRIMARY KEY,"                                       \
+    " kind TEXT NOT NULL CHECK(kind IN ('periodic', 'aperiodic', 'sticking')), period INTEGER,"   \
+    " basin_cells INTEGER NOT NULL, groups INTEGER NOT NULL, centre TEXT NOT NULL,"               \
+    " lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"                                   \
+    " footprint_cells INTEGER NOT NULL, footprint BLOB NOT NULL);"                                 \
+    "CREATE TABLE group_fates(grp INTEGER PRIMARY KEY, attractor INTEGER NOT NULL);"
 
 double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);

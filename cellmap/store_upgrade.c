@@ -189,8 +189,8 @@ static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
     cm_status st = cm_store_load_cluster(s, &c, msg, msg_size);
     if (st == CM_OK)
         st = list_linked_in(&c, msg, msg_size);
-    if (st == CM_OK &&
-        store_exec(s->db, "DROP TABLE nodes;" NODES_TABLE_SQL OPEN_NODES_TABLE_SQL) != SQLITE_OK)
+    if (st == CM_OK && store_exec(s->db, "DROP TABLE nodes;" NODES_TABLE_SQL OPEN_NODES_TABLE_SQL
+                                             SYSTEM_ATTRACTORS_SQL) != SQLITE_OK)
         st = store_db_error(s->db, "add the open nodes", msg, msg_size);
     for (uint32_t k = 0; st == CM_OK && k < c.nregions; k++) {
         st = store_write_nodes(s, &c, k, msg, msg_size);
@@ -203,6 +203,18 @@ static cm_status add_open_nodes(cm_store *s, char *msg, size_t msg_size)
         st = store_db_error(s->db, "write the version", msg, msg_size);
     cm_cluster_free(&c);
     return st;
+}
+
+/* Version 5 had everything but the system's attractors: their tables come
+ * empty, and the solve or session that upgraded the file fills them. */
+static cm_status add_system_attractors(cm_store *s, char *msg, size_t msg_size)
+{
+    char sql[1024];
+    snprintf(sql, sizeof sql, "%s PRAGMA user_version=%d;", SYSTEM_ATTRACTORS_SQL,
+             CM_STORE_VERSION);
+    return store_exec(s->db, sql) == SQLITE_OK
+               ? CM_OK
+               : store_db_error(s->db, "add the attractors' tables", msg, msg_size);
 }
 
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
@@ -228,7 +240,9 @@ cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgrade
         st = store_db_error(s->db, "begin", why, sizeof why);
     s->in_transaction = st == CM_OK;
     if (st == CM_OK)
-        st = from == 4 ? add_open_nodes(s, why, sizeof why) : upgrade(s, why, sizeof why);
+        st = from == 5   ? add_system_attractors(s, why, sizeof why)
+             : from == 4 ? add_open_nodes(s, why, sizeof why)
+                         : upgrade(s, why, sizeof why);
     if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)
         st = store_db_error(s->db, "commit", why, sizeof why);
     if (st != CM_OK) {

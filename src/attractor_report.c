@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "src/basin_png.h"
+#include "src/project.h"
 
 bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
 {
@@ -35,16 +36,11 @@ bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
     return true;
 }
 
-void attractor_fates(const cm_attractor_set *s, const cm_group_info *groups, uint32_t ngroups,
-                     uint64_t sink_cells, cell_fates *out)
+void attractor_fates(const cm_attractor_set *s, uint64_t sink_cells, cell_fates *out)
 {
-    memset(out, 0, sizeof *out);
     out->left = sink_cells;
-    for (uint32_t k = 0; k < ngroups; k++) {
-        const uint32_t a = s->of_group[groups[k].id];
-        out->diverged += a == CM_FATE_DIVERGED ? groups[k].basin_cells : 0;
-        out->undecided += a == CM_FATE_UNRESOLVED ? groups[k].basin_cells : 0;
-    }
+    out->diverged = s->diverged_cells;
+    out->undecided = s->unresolved_cells;
 }
 
 static int larger_basin(const void *a, const void *b)
@@ -170,6 +166,30 @@ cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_in
 {
     return cm_attractors_find(m, &c->lat, groups, ngroups, cm_cluster_cell_group, c, o, out, msg,
                               msg_size);
+}
+
+cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
+                          cm_cluster *c, const cm_group_info *groups, uint32_t ngroups,
+                          const cm_attractor_options *o, cm_attractor_set *out, char *msg,
+                          size_t msg_size)
+{
+    const bool asked = o && (o->transient || o->record || o->max_steps || o->tol || o->match);
+    if (!asked) {
+        const cm_status st =
+            cm_store_get_attractors(s, c->lat.dim, ngroups, out, NULL, msg, msg_size);
+        if (st != CM_ENOTFOUND)
+            return st;
+    }
+    if (m)
+        return cluster_attractors(m, c, groups, ngroups, o, out, msg, msg_size);
+    cm_model_set set = {0};
+    cm_model own;
+    cm_status st = model_of_store(info, &set, &own, msg, msg_size);
+    if (st == CM_OK) {
+        st = cluster_attractors(&own, c, groups, ngroups, o, out, msg, msg_size);
+        cm_model_release(&own);
+    }
+    return st;
 }
 
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g)

@@ -9,6 +9,7 @@
 
 #include "cellmap/attractors.h"
 #include "cellmap/cluster.h"
+#include "cellmap/store.h"
 #include "src/args.h"
 #include "src/json.h"
 
@@ -36,8 +37,7 @@ typedef struct cell_fates {
     uint64_t diverged, undecided, left;
 } cell_fates;
 
-void attractor_fates(const cm_attractor_set *s, const cm_group_info *groups, uint32_t ngroups,
-                     uint64_t sink_cells, cell_fates *out);
+void attractor_fates(const cm_attractor_set *s, uint64_t sink_cells, cell_fates *out);
 
 /* The text summary's attractor lines (the largest basins first, at most
  * `rows`), and the line on the cell groups behind them. */
@@ -57,6 +57,15 @@ bool by_option_take(cli *c, int *by, int *error);
 cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
                              uint32_t ngroups, const cm_attractor_options *o,
                              cm_attractor_set *out, char *msg, size_t msg_size);
+
+/* The attractors of a file's cluster: those it stores, unless o asks for
+ * others (a field set) or it stores none; then found with the true map of
+ * model m (NULL: the file's, rebuilt from info) and the cluster's cells
+ * (cluster_attractors). */
+cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
+                          cm_cluster *c, const cm_group_info *groups, uint32_t ngroups,
+                          const cm_attractor_options *o, cm_attractor_set *out, char *msg,
+                          size_t msg_size);
 
 /* Group g's label by attractors: its attractor's id, or 0 when its orbit
  * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */

@@ -517,24 +517,6 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
     return CM_OK;
 }
 
-/* The attractors of the file's groups, for --labels: the model's true
- * map from the file (its plugin loaded from where the file says). */
-static cm_status labels_attractors(const export_args *a, const cm_store_info *info, cm_cluster *c,
-                                   const cm_group_info *g, cm_attractor_set *att)
-{
-    char msg[1024];
-    cm_model_set set = {0};
-    cm_model m;
-    cm_status st = model_of_store(info, &set, &m, msg, sizeof msg);
-    if (st == CM_OK) {
-        st = cluster_attractors(&m, c, g, info->groups, &a->att, att, msg, sizeof msg);
-        cm_model_release(&m);
-    }
-    if (st != CM_OK)
-        fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
-    return st;
-}
-
 static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm_store_info *info,
                       cm_cluster *c)
 {
@@ -600,8 +582,12 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
     const bool by_attractors = a->labels && a->by == BY_ATTRACTORS;
-    if (rc == EXIT_OK && by_attractors && labels_attractors(a, info, c, g, &att) != CM_OK)
+    if (rc == EXIT_OK && by_attractors &&
+        file_attractors(s, info, NULL, c, g, info->groups, &a->att, &att, msg, sizeof msg) !=
+            CM_OK) {
+        fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
         rc = EXIT_FAIL;
+    }
     if (rc == EXIT_OK && (a->labels || a->steps)) {
         const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names,
                                 by_attractors ? &att : NULL};

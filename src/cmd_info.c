@@ -7,6 +7,7 @@
 #include "src/args.h"
 #include "src/basin_png.h"
 #include "src/commands.h"
+#include "src/attractor_report.h"
 #include "src/json.h"
 #include "src/project.h"
 
@@ -30,7 +31,8 @@ static void print_cells(const cm_lattice *lat, const int64_t *cell)
 }
 
 static void print_text(const char *path, const cm_store_info *info, const cm_box *bounds,
-                       const cm_group_info *g, uint64_t sink, uint64_t largest_region)
+                       const cm_group_info *g, uint64_t sink, uint64_t largest_region,
+                       const cm_attractor_set *att)
 {
     const cm_lattice *lat = &info->lattice;
     printf("file %s: cellmap database format %d, written by cellmap %s\n", path, info->version,
@@ -58,7 +60,15 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     format_box(lat, bounds, box, sizeof box);
     printf("regions %u, cells %llu, bounding box %s (%llu cells)\n", info->regions,
            (unsigned long long)info->cells, box, (unsigned long long)cm_box_cells(bounds));
-    printf("groups %u periodic, sink basin %llu cells (%.1f%%)\n", info->groups,
+    if (att) {
+        cell_fates fates;
+        attractor_fates(att, sink, &fates);
+        attractor_text(stdout, lat, att, &fates, info->cells, SHOWN_GROUPS);
+    } else {
+        printf("attractors: not in this file (written before format 6, or by a solve stopped "
+               "before its end): solve --resume with the same options, or explore, adds them\n");
+    }
+    printf("cell groups %u periodic, sink basin %llu cells (%.1f%%)\n", info->groups,
            (unsigned long long)sink, 100.0 * (double)sink / (double)info->cells);
     printf("%6s %8s %12s  %s\n", "group", "period", "basin", "centre");
     for (uint32_t k = 0; k < info->groups && k < SHOWN_GROUPS; k++) {
@@ -81,7 +91,7 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
 }
 
 static void print_json(const char *path, const cm_store_info *info, const cm_box *bounds,
-                       const cm_group_info *g, uint64_t sink)
+                       const cm_group_info *g, uint64_t sink, const cm_attractor_set *att)
 {
     json j;
     json_begin(&j, stdout, "info");
@@ -107,7 +117,14 @@ static void print_json(const char *path, const cm_store_info *info, const cm_box
     json_uint(&j, "sink_cells", sink);
     json_uint(&j, "file_bytes", info->file_bytes);
     json_uint(&j, "page_bytes", info->page_bytes);
-    json_groups(&j, g, info->groups, &info->lattice);
+    if (att) {
+        cell_fates fates;
+        attractor_fates(att, sink, &fates);
+        attractor_json(&j, &info->lattice, att, &fates);
+        attractor_json_groups(&j, g, info->groups, &info->lattice, att);
+    } else {
+        json_groups(&j, g, info->groups, &info->lattice);
+    }
     json_end(&j);
 }
 
@@ -154,6 +171,15 @@ int cmd_info(int argc, char **argv)
     if (st == CM_OK)
         st = json ? cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg)
                   : cm_store_largest_groups(s, g, shown, &sink, msg, sizeof msg);
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    bool has_att = false;
+    if (st == CM_OK) {
+        const cm_status a = cm_store_get_attractors(s, info.lattice.dim, info.groups, &att, NULL,
+                                                    msg, sizeof msg);
+        has_att = a == CM_OK;
+        st = a == CM_ENOTFOUND ? CM_OK : a;
+    }
     cm_store_snapshot_end(s);
     if (st == CM_OK) {
         cm_box bounds = regions[0].box;
@@ -164,14 +190,15 @@ int cmd_info(int argc, char **argv)
             largest = bytes > largest ? bytes : largest;
         }
         if (json)
-            print_json(path, &info, &bounds, g, sink);
+            print_json(path, &info, &bounds, g, sink, has_att ? &att : NULL);
         else
-            print_text(path, &info, &bounds, g, sink, largest);
+            print_text(path, &info, &bounds, g, sink, largest, has_att ? &att : NULL);
     } else {
         fprintf(stderr, "cellmap info: %s\n", msg);
     }
     free(regions);
     free(g);
+    cm_attractors_free(&att);
     cm_store_close(s, msg, sizeof msg);
     return st == CM_OK ? EXIT_OK : EXIT_FAIL;
 }

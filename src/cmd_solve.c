@@ -734,7 +734,13 @@ int cmd_solve(int argc, char **argv)
                            sizeof msg) != CM_OK)
         goto fail;
     sum.att_seconds = progress_now() - ta;
-    attractor_fates(&sum.att, sum.groups, sum.ngroups, sum.sink, &sum.fates);
+    cm_attractor_options used;
+    cm_attractor_defaults(&m, &a.att, &used);
+    used.threads = 0;
+    if (rn.store && cm_store_put_attractors(rn.store, &sum.att, &used, lat.dim, msg, sizeof msg) !=
+                        CM_OK)
+        goto fail;
+    attractor_fates(&sum.att, sum.sink, &sum.fates);
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
         print_json(a.report, &m, &lat, &sum, &t, shown);

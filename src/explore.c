@@ -137,6 +137,7 @@ static cm_status compute_boxes(session *s, const cm_box *boxes, uint32_t n, comp
     cm_status st = cm_cluster_solve_boxes(&s->c, &s->model, boxes, n, &opt, cm_store_commit_join,
                                           s->store, &stats, msg, msg_size);
     done->seconds += now_seconds() - t0;
+    s->grew |= n > 0;
     if (st != CM_OK)
         return st;
     done->cells += cm_boxes_cells(boxes, n);
@@ -1150,9 +1151,42 @@ int session_open(session *s, const session_options *o)
     return EXIT_OK;
 }
 
+/* The system's attractors of the cluster into the file, when it grew (or
+ * holds none: a file of an older format, a killed session). */
+static cm_status save_attractors(session *s, char *msg, size_t msg_size)
+{
+    cm_attractor_set att;
+    const int dim = s->c.lat.dim;
+    if (s->damaged || s->c.nregions == 0)
+        return CM_OK;
+    if (!s->grew &&
+        cm_store_get_attractors(s->store, dim, s->c.ngroups, &att, NULL, msg, msg_size) == CM_OK) {
+        cm_attractors_free(&att); /* written, and current */
+        return CM_OK;
+    }
+    cm_group_info *groups = calloc((size_t)s->c.ngroups + 1, sizeof *groups);
+    uint64_t sink = 0;
+    cm_status st = groups ? cm_store_groups(s->store, groups, s->c.ngroups, &sink, msg, msg_size)
+                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups");
+    memset(&att, 0, sizeof att);
+    cm_attractor_options used;
+    cm_attractor_defaults(&s->model, NULL, &used);
+    if (st == CM_OK)
+        st = cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, &att, msg,
+                                msg_size);
+    if (st == CM_OK)
+        st = cm_store_put_attractors(s->store, &att, &used, dim, msg, msg_size);
+    s->grew = st != CM_OK;
+    cm_attractors_free(&att);
+    free(groups);
+    return st;
+}
+
 cm_status session_close(session *s, char *msg, size_t msg_size)
 {
-    cm_status st = s->store ? save_view(s, msg, msg_size) : CM_OK;
+    cm_status st = s->store ? save_attractors(s, msg, msg_size) : CM_OK;
+    if (st == CM_OK && s->store)
+        st = save_view(s, msg, msg_size);
     const cm_status closed = cm_store_close(s->store, msg, msg_size);
     s->store = NULL;
     cm_cluster_free(&s->c);

@@ -46,6 +46,7 @@ typedef struct session {
     int have_view;
     int view_unsaved; /* the view changed since it was written to the file */
     int damaged;      /* a command found the file damaged: it is not written again */
+    int grew;         /* regions were added since the attractors were written */
     double lo[2], hi[2];          /* the view in state coordinates */
     int64_t depth_lo[CM_MAX_DIM]; /* dimensions >= 2: the cells computed */
     int64_t depth_hi[CM_MAX_DIM];

@@ -501,7 +501,11 @@ cmp -s v3-cells.csv v4-cells.csv || fail "a version 3 file's cells read differen
 "$CM" render v3.cmdb --png v3.png 2> /dev/null || fail "render of a version 3 file"
 "$CM" render v4.cmdb --png v4.png 2> /dev/null
 cmp -s v3.png v4.png || fail "a version 3 file renders differently"
-"$CM" info v3.cmdb | grep -v '^disk:\|^file ' > v3-info.txt || fail "info of a version 3 file"
+# info's lines on the groups and regions (the attractors' block aside: an
+# old file holds none, the upgraded one those its resume found)
+info_groups() { "$CM" info "$1" | grep -v '^disk:\|^file ' | sed '/^attractors/,/^cell groups/{/^cell groups/!d}'; }
+info_groups v3.cmdb > v3-info.txt || fail "info of a version 3 file"
+grep -q "^attractors: not in this file" <("$CM" info v3.cmdb) || fail "info of a version 3 file: attractors"
 "$CM" export v3.cmdb --flat flat.npz 2> /dev/null && mv flat.npz v3-flat.npz || fail "export --flat of a version 3 file"
 # a resume with other options is refused before anything is upgraded
 "$CM" solve --param alpha=0.077,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 120x72 \
@@ -512,24 +516,25 @@ cp v3.cmdb v3-bad.cmdb
 sqlite3 v3-bad.cmdb "UPDATE attractors SET centre = '[1,2]' WHERE id = 7"
 sum_bad=$(sha256sum v3-bad.cmdb)
 "$CM" solve "${V3_SOLVE[@]}" --db v3-bad.cmdb --resume > /dev/null 2> v3.err && fail "upgraded a file whose groups differ"
-grep -q "could not be upgraded to version 5 (its groups would change); the file is unchanged" v3.err ||
+grep -q "could not be upgraded to version 6 (its groups would change); the file is unchanged" v3.err ||
     fail "refused upgrade message: $(cat v3.err)"
 [ "$(sha256sum v3-bad.cmdb)" = "$sum_bad" ] || fail "a refused upgrade changed the file"
 [ "$(sha256sum v3.cmdb)" = "$sum_v3" ] || fail "reading or refusing a version 3 file changed it"
 # --resume upgrades it in one transaction; every output stays what it was
 cp v3.cmdb v3-explore.cmdb
 "$CM" solve "${V3_SOLVE[@]}" --db v3.cmdb --resume > /dev/null 2> v3.err || fail "resume of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3.cmdb from format version 3 to 5" v3.err || fail "upgrade message: $(cat v3.err)"
-[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 5 ] || fail "the resumed version 3 file was not upgraded"
+grep -q "upgraded v3.cmdb from format version 3 to 6" v3.err || fail "upgrade message: $(cat v3.err)"
+[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 6 ] || fail "the resumed version 3 file was not upgraded"
 check_page_bytes v3.cmdb
 "$CM" export v3.cmdb --groups up-groups.csv --cells up-cells.csv 2> /dev/null || fail "export of an upgraded file"
 cmp -s up-groups.csv v3-groups.csv && cmp -s up-cells.csv v3-cells.csv || fail "the upgrade changed the export"
 "$CM" render v3.cmdb --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"
-"$CM" info v3.cmdb | grep -v '^disk:\|^file ' | diff - v3-info.txt || fail "the upgrade changed info"
+info_groups v3.cmdb | diff - v3-info.txt || fail "the upgrade changed info"
+"$CM" info v3.cmdb | grep -q "^attractors [0-9]*, by true orbits" || fail "the upgraded file has no attractors"
 "$CM" export v3.cmdb --flat flat.npz 2> /dev/null && cmp -s flat.npz v3-flat.npz || fail "the upgrade changed export --flat"
 # explore upgrades too, and goes on
 "$CM" explore v3-explore.cmdb - <<< "stats" > v3-stats.txt 2> v3.err || fail "explore of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3-explore.cmdb from format version 3 to 5" v3.err || fail "explore upgrade message: $(cat v3.err)"
+grep -q "upgraded v3-explore.cmdb from format version 3 to 6" v3.err || fail "explore upgrade message: $(cat v3.err)"
 # tests/data/v4-split.cmdb: the same solve by cellmap with format version 4
 # (node tables, no table of open nodes); read as it is, upgraded on --resume
 cp "$HERE/data/v4-split.cmdb" v4old.cmdb
@@ -539,11 +544,43 @@ cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || 
 "$CM" render v4old.cmdb --png v4old.png 2> /dev/null && cmp -s v4old.png v3.png || fail "a version 4 file renders differently"
 [ "$(sha256sum v4old.cmdb)" = "$sum_v4" ] || fail "reading a version 4 file changed it"
 "$CM" solve "${V3_SOLVE[@]}" --db v4old.cmdb --resume > /dev/null 2> v4.err || fail "resume of a version 4 file: $(cat v4.err)"
-grep -q "upgraded v4old.cmdb from format version 4 to 5" v4.err || fail "v4 upgrade message: $(cat v4.err)"
+grep -q "upgraded v4old.cmdb from format version 4 to 6" v4.err || fail "v4 upgrade message: $(cat v4.err)"
 "$CM" export v4old.cmdb --groups v4old-groups.csv --cells v4old-cells.csv 2> /dev/null || fail "export of an upgraded version 4 file"
 cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || fail "the upgrade of a version 4 file changed its export"
 same_rows v4old.cmdb v4.cmdb 'SELECT region, count, hex(data) FROM open_nodes ORDER BY region' ||
     fail "an upgraded version 4 file has other open nodes than a fresh solve"
+# the system's attractors: a resumed upgrade writes those of a fresh solve
+for q in 'SELECT * FROM system_attractors ORDER BY id' 'SELECT * FROM group_fates ORDER BY grp' \
+         "SELECT value FROM meta WHERE key = 'attractor_options'"; do
+  same_rows v4old.cmdb v4.cmdb "$q" || fail "an upgraded version 4 file's attractors differ: $q"
+done
+# version 5 had no system attractors: read as it is (they are found on the
+# way, the same), upgraded by --resume, which writes them
+cp v4.cmdb v5.cmdb
+sqlite3 v5.cmdb "DROP TABLE system_attractors; DROP TABLE group_fates;
+  DELETE FROM meta WHERE key = 'attractor_options'; PRAGMA user_version = 5;"
+sum_v5=$(sha256sum v5.cmdb)
+"$CM" export v5.cmdb --labels v5.npy 2> /dev/null && "$CM" export v4.cmdb --labels v6.npy 2> /dev/null \
+  && cmp -s v5.npy v6.npy || fail "a version 5 file's attractor labels differ"
+"$CM" render v5.cmdb --png v5.png 2> /dev/null && "$CM" render v4.cmdb --png v6.png 2> /dev/null \
+  && cmp -s v5.png v6.png || fail "a version 5 file renders differently"
+[ "$(sha256sum v5.cmdb)" = "$sum_v5" ] || fail "reading a version 5 file changed it"
+"$CM" solve "${V3_SOLVE[@]}" --db v5.cmdb --resume > /dev/null 2> v5.err || fail "resume of a version 5 file: $(cat v5.err)"
+grep -q "upgraded v5.cmdb from format version 5 to 6" v5.err || fail "v5 upgrade message: $(cat v5.err)"
+same_rows v5.cmdb v4.cmdb 'SELECT * FROM system_attractors ORDER BY id' \
+  || fail "an upgraded version 5 file's attractors differ from a fresh solve's"
+# the stored attractors are those found again; a damaged row is refused
+"$CM" solve --cells 200x200 --db att.cmdb > /dev/null || fail "solve --db att.cmdb"
+"$CM" export att.cmdb --labels stored.npy > /dev/null 2>&1 \
+  && "$CM" export att.cmdb --labels found.npy --attractor-tol 1e-4 > /dev/null 2>&1 \
+  && cmp -s stored.npy found.npy || fail "the stored attractors differ from those found again"
+for bad in "UPDATE group_fates SET attractor = 99 WHERE grp = 1" "DELETE FROM group_fates WHERE grp = 2" \
+           "UPDATE system_attractors SET footprint = x'00' WHERE id = 1"; do
+  cp att.cmdb attbad.cmdb
+  sqlite3 attbad.cmdb "$bad"
+  out=$("$CM" info attbad.cmdb 2>&1 >/dev/null); rc=$?
+  [ $rc -eq 1 ] && grep -q "attbad.cmdb is damaged" <<<"$out" || fail "info after '$bad': rc $rc, $out"
+done
 # version 2 had no kinds: every group is an attractor
 cp "$HERE/data/v3-split.cmdb" v2.cmdb
 sqlite3 v2.cmdb "DROP VIEW groups; ALTER TABLE attractors DROP COLUMN kind;

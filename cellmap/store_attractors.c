@@ -1,0 +1,247 @@
+/* The system's attractors in a .cmdb file (format version 6): tables
+ * system_attractors (one row each, the footprint as a BLOB of little-endian
+ * int64 cells, dim coordinates each, in box order) and group_fates (each
+ * group's attractor id, 0 when its true orbit diverges, -1 undecided), and
+ * the options they were found with (meta 'attractor_options'). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/store_db.h"
+
+#define OPTIONS_KEY "attractor_options"
+
+static void options_text(const cm_attractor_options *o, uint64_t steps, char *out, size_t size)
+{
+    snprintf(out, size, "%u,%u,%u,%.17g,%.17g,%llu", o->transient, o->record, o->max_steps,
+             o->tol, o->match, (unsigned long long)steps);
+}
+
+static cm_status write_rows(cm_store *s, const cm_attractor_set *a, int dim, char *msg,
+                            size_t msg_size)
+{
+    sqlite3_stmt *ins = NULL, *fate = NULL;
+    cm_status st = CM_OK;
+    if (store_exec(s->db, "DELETE FROM system_attractors; DELETE FROM group_fates;") != SQLITE_OK ||
+        sqlite3_prepare_v2(s->db,
+                           "INSERT INTO system_attractors VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                           -1, &ins, NULL) != SQLITE_OK ||
+        sqlite3_prepare_v2(s->db, "INSERT INTO group_fates VALUES(?, ?)", -1, &fate, NULL) !=
+            SQLITE_OK)
+        st = store_db_error(s->db, "prepare the attractors", msg, msg_size);
+    for (uint32_t k = 0; st == CM_OK && k < a->n; k++) {
+        const cm_attractor *at = &a->a[k];
+        char centre[CM_MAX_DIM * 32], lo[CM_MAX_DIM * 32], hi[CM_MAX_DIM * 32], anchor[CM_MAX_DIM * 24];
+        store_json_doubles(centre, sizeof centre, at->centre, dim);
+        store_json_doubles(lo, sizeof lo, at->lo, dim);
+        store_json_doubles(hi, sizeof hi, at->hi, dim);
+        store_json_ints(anchor, sizeof anchor, at->anchor, dim);
+        const uint64_t from = a->footprint_at[k], cells = a->footprint_at[k + 1] - from;
+        sqlite3_bind_int64(ins, 1, at->id);
+        sqlite3_bind_text(ins, 2, cm_attractor_kind_name(at->kind), -1, SQLITE_STATIC);
+        if (at->kind == CM_ATTRACTOR_APERIODIC)
+            sqlite3_bind_null(ins, 3);
+        else
+            sqlite3_bind_int64(ins, 3, at->period);
+        sqlite3_bind_int64(ins, 4, (sqlite3_int64)at->basin_cells);
+        sqlite3_bind_int64(ins, 5, at->groups);
+        sqlite3_bind_text(ins, 6, centre, -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(ins, 7, lo, -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(ins, 8, hi, -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(ins, 9, anchor, -1, SQLITE_TRANSIENT);
+        sqlite3_bind_int64(ins, 10, (sqlite3_int64)cells);
+        sqlite3_bind_blob64(ins, 11, a->footprint + from * dim, cells * dim * sizeof *a->footprint,
+                            SQLITE_STATIC); /* x86-64 and arm64: little-endian in memory */
+        st = store_step_done(s->db, ins, "write an attractor", msg, msg_size);
+    }
+    for (uint32_t g = 1; st == CM_OK && g <= a->ngroups; g++) {
+        const uint32_t f = a->of_group[g];
+        sqlite3_bind_int64(fate, 1, g);
+        sqlite3_bind_int64(fate, 2, f == CM_FATE_UNRESOLVED ? -1 : (sqlite3_int64)f);
+        st = store_step_done(s->db, fate, "write a group's attractor", msg, msg_size);
+    }
+    sqlite3_finalize(ins);
+    sqlite3_finalize(fate);
+    return st;
+}
+
+cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
+                                  const cm_attractor_options *o, int dim, char *msg,
+                                  size_t msg_size)
+{
+    const int own = !s->in_transaction;
+    cm_status st = store_begin(s, msg, msg_size);
+    if (st == CM_OK)
+        st = write_rows(s, a, dim, msg, msg_size);
+    char text[256];
+    options_text(o, a->steps, text, sizeof text);
+    sqlite3_stmt *meta = NULL;
+    if (st == CM_OK && sqlite3_prepare_v2(s->db,
+                                          "INSERT OR REPLACE INTO meta(key, value) VALUES('" OPTIONS_KEY
+                                          "', ?)",
+                                          -1, &meta, NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "prepare the attractor options", msg, msg_size);
+    if (st == CM_OK) {
+        sqlite3_bind_text(meta, 1, text, -1, SQLITE_STATIC);
+        st = store_step_done(s->db, meta, "write the attractor options", msg, msg_size);
+    }
+    sqlite3_finalize(meta);
+    if (st == CM_OK && own && store_exec(s->db, "COMMIT") != SQLITE_OK)
+        st = store_db_error(s->db, "commit the attractors", msg, msg_size);
+    if (st == CM_OK && own)
+        s->in_transaction = 0;
+    return st == CM_OK ? st : store_abandon(s, st);
+}
+
+/* The options of the stored attractors; CM_ENOTFOUND if none are stored
+ * (a file of version 5 or older, or a solve interrupted before them). */
+static cm_status stored_options(cm_store *s, cm_attractor_options *o, uint64_t *steps)
+{
+    if (s->version < 6)
+        return CM_ENOTFOUND;
+    sqlite3_stmt *q = NULL;
+    cm_status st = CM_ENOTFOUND;
+    if (sqlite3_prepare_v2(s->db, "SELECT value FROM meta WHERE key = '" OPTIONS_KEY "'", -1, &q,
+                           NULL) == SQLITE_OK &&
+        sqlite3_step(q) == SQLITE_ROW && sqlite3_column_text(q, 0)) {
+        unsigned long long n = 0;
+        memset(o, 0, sizeof *o);
+        st = sscanf((const char *)sqlite3_column_text(q, 0), "%u,%u,%u,%lg,%lg,%llu",
+                    &o->transient, &o->record, &o->max_steps, &o->tol, &o->match, &n) == 6
+                 ? CM_OK
+                 : CM_EFORMAT;
+        *steps = n;
+    }
+    sqlite3_finalize(q);
+    return st;
+}
+
+static cm_status read_attractors(cm_store *s, int dim, cm_attractor_set *a, char *msg,
+                                 size_t msg_size)
+{
+    const int64_t n = store_query_int(s->db, "SELECT COUNT(*) FROM system_attractors");
+    const int64_t cells = store_query_int(s->db, "SELECT IFNULL(SUM(footprint_cells), 0) FROM "
+                                                 "system_attractors");
+    if (n < 0 || cells < 0 || n > UINT32_MAX)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "its attractors cannot be read");
+    a->n = (uint32_t)n;
+    a->a = calloc((size_t)n + 1, sizeof *a->a);
+    a->footprint_at = calloc((size_t)n + 2, sizeof *a->footprint_at);
+    a->footprint = malloc(((size_t)cells + 1) * dim * sizeof *a->footprint);
+    if (!a->a || !a->footprint_at || !a->footprint)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %lld attractors",
+                       (long long)n);
+    sqlite3_stmt *q = NULL;
+    cm_status st = CM_OK;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT id, kind, period, basin_cells, groups, centre, lo, hi, anchor,"
+                           " footprint_cells, footprint FROM system_attractors ORDER BY id",
+                           -1, &q, NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "read the attractors", msg, msg_size);
+    uint32_t k = 0;
+    for (; st == CM_OK && sqlite3_step(q) == SQLITE_ROW; k++) {
+        cm_attractor *at = &a->a[k];
+        const char *kind = (const char *)sqlite3_column_text(q, 1);
+        double v[3][CM_MAX_DIM], anchor[CM_MAX_DIM];
+        const uint64_t fp = (uint64_t)sqlite3_column_int64(q, 9);
+        const int bytes = sqlite3_column_bytes(q, 10);
+        at->id = (uint32_t)sqlite3_column_int64(q, 0);
+        at->kind = kind && strcmp(kind, "aperiodic") == 0  ? CM_ATTRACTOR_APERIODIC
+                   : kind && strcmp(kind, "sticking") == 0 ? CM_ATTRACTOR_STICKING
+                                                           : CM_ATTRACTOR_PERIODIC;
+        at->period = (uint32_t)sqlite3_column_int64(q, 2);
+        at->basin_cells = (uint64_t)sqlite3_column_int64(q, 3);
+        at->groups = (uint32_t)sqlite3_column_int64(q, 4);
+        at->footprint_cells = fp;
+        bool ok = at->id == k + 1 && kind && fp >= 1 &&
+                  a->footprint_at[k] + fp <= (uint64_t)cells &&
+                  (uint64_t)bytes == fp * (uint64_t)dim * sizeof *a->footprint;
+        for (int c = 0; c < 3 && ok; c++)
+            ok = store_parse_json_numbers((const char *)sqlite3_column_text(q, 5 + c), v[c],
+                                          CM_MAX_DIM) == dim;
+        ok = ok && store_parse_json_numbers((const char *)sqlite3_column_text(q, 8), anchor,
+                                            CM_MAX_DIM) == dim;
+        if (!ok) {
+            st = cm_fail(CM_EFORMAT, msg, msg_size, "its attractor %u is damaged", k + 1);
+            break;
+        }
+        for (int d = 0; d < dim; d++) {
+            at->centre[d] = v[0][d];
+            at->lo[d] = v[1][d];
+            at->hi[d] = v[2][d];
+            at->anchor[d] = (int64_t)anchor[d];
+        }
+        memcpy(a->footprint + a->footprint_at[k] * dim, sqlite3_column_blob(q, 10),
+               (size_t)bytes);
+        a->footprint_at[k + 1] = a->footprint_at[k] + fp;
+        a->merged += at->groups > 0 ? at->groups - 1 : 0;
+    }
+    sqlite3_finalize(q);
+    if (st == CM_OK && k != a->n)
+        st = cm_fail(CM_EFORMAT, msg, msg_size, "its attractors cannot be read");
+    return st;
+}
+
+static cm_status read_fates(cm_store *s, cm_attractor_set *a, char *msg, size_t msg_size)
+{
+    sqlite3_stmt *q = NULL;
+    cm_status st = CM_OK;
+    for (uint32_t g = 0; g <= a->ngroups; g++)
+        a->of_group[g] = CM_FATE_UNRESOLVED;
+    a->of_group[0] = CM_FATE_DIVERGED;
+    if (sqlite3_prepare_v2(s->db,
+                           "SELECT f.grp, f.attractor, IFNULL(b.cells, 0) FROM group_fates f"
+                           " LEFT JOIN basins b ON b.grp = f.grp",
+                           -1, &q, NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "read the groups' attractors", msg, msg_size);
+    uint32_t rows = 0;
+    while (st == CM_OK && sqlite3_step(q) == SQLITE_ROW) {
+        const int64_t g = sqlite3_column_int64(q, 0), f = sqlite3_column_int64(q, 1);
+        const int64_t cells = sqlite3_column_int64(q, 2);
+        if (g < 1 || g > a->ngroups || f < -1 || f > a->n || cells < 0) {
+            st = cm_fail(CM_EFORMAT, msg, msg_size, "the attractor of its group %lld is damaged",
+                         (long long)g);
+            break;
+        }
+        a->of_group[g] = f < 0 ? CM_FATE_UNRESOLVED : (uint32_t)f;
+        a->diverged_groups += f == 0;
+        a->unresolved_groups += f < 0;
+        a->diverged_cells += f == 0 ? (uint64_t)cells : 0;
+        a->unresolved_cells += f < 0 ? (uint64_t)cells : 0;
+        rows++;
+    }
+    sqlite3_finalize(q);
+    if (st == CM_OK && rows != a->ngroups)
+        st = cm_fail(CM_EFORMAT, msg, msg_size,
+                     "it holds the attractors of %u groups, not of its %u", rows, a->ngroups);
+    return st;
+}
+
+cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
+                                  cm_attractor_options *o, char *msg, size_t msg_size)
+{
+    memset(a, 0, sizeof *a);
+    cm_attractor_options stored;
+    uint64_t steps = 0;
+    cm_status st = stored_options(s, &stored, &steps);
+    if (st == CM_ENOTFOUND)
+        return st;
+    if (st != CM_OK)
+        return store_damaged(s, cm_fail(CM_EFORMAT, msg, msg_size,
+                                        "its attractor options are damaged"),
+                             msg, msg_size);
+    a->ngroups = ngroups;
+    a->steps = steps;
+    a->of_group = calloc((size_t)ngroups + 1, sizeof *a->of_group);
+    st = a->of_group ? read_attractors(s, dim, a, msg, msg_size)
+                     : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", ngroups);
+    if (st == CM_OK)
+        st = read_fates(s, a, msg, msg_size);
+    if (st != CM_OK) {
+        cm_attractors_free(a);
+        return store_damaged(s, st, msg, msg_size);
+    }
+    if (o)
+        *o = stored;
+    return CM_OK;
+}
