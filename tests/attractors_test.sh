@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# The system's attractors of a cluster are those of the single-box solve of
+# its cells, cell by cell (export --labels by attractors) and attractor by
+# attractor (solve --json): a 4x4 split, 1 and 2 threads, a budget that
+# pages regions out, a 50-pan explore session over the same box, and a
+# solve killed (kill -9) and resumed. Then the bad input the attractor
+# options refuse.
+# usage: attractors_test.sh PATH/TO/cellmap
+set -u
+CM=$1
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+
+pd=(--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02)
+box=(--region 0:500,-40:40 --cells 1000x400)
+"$CM" solve "${pd[@]}" "${box[@]}" --db whole.cmdb --json > whole-solve.json || fail "single-box solve"
+"$CM" export whole.cmdb --labels whole.npy > /dev/null || fail "export whole"
+
+# attractors JSON without times and group ids (a split numbers groups its own way)
+attractors() {
+  /usr/bin/python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+for a in d["attractors"]:
+    print(a["kind"], a["period"], a["basin_cells"], a["anchor"], a["centre"], a["lo"], a["hi"],
+          a["footprint_cells"], len(a["groups"]))
+print(d["diverged_cells"], d["undecided_cells"], d["outside_cells"])' "$1"
+}
+want=$(attractors whole-solve.json) && [ -n "$want" ] || fail "no attractors in whole-solve.json"
+
+# same_labels NAME: NAME.cmdb's attractor labels equal whole.npy's, cell by cell
+same_labels() {
+  "$CM" export "$1.cmdb" --labels "$1.npy" > /dev/null || { fail "export $1"; return; }
+  cmp -s "$1.npy" whole.npy || fail "$1: attractor labels differ from the single-box solve's"
+}
+
+for run in "split:--split 4x4" "one-thread:--threads 1" "paged:--split 4x4 --mem 1M"; do
+  name=${run%%:*}
+  "$CM" solve "${pd[@]}" "${box[@]}" ${run#*:} --db $name.cmdb --json > $name-solve.json \
+    || fail "solve $name"
+  [ "$(attractors $name-solve.json)" = "$want" ] || fail "$name: attractors differ"
+  same_labels $name
+done
+
+# explore: 50 pans right over a lattice of the same cells, from a view of
+# 10 cells' width at the box's left edge to its right edge
+{
+  echo "view 0:5 -40:40"
+  for _ in $(seq 49); do echo "pan right 100%"; done
+  echo "view 0:500 -40:40"
+  echo "render pans.png 200x80"
+} > pans.explore
+"$CM" explore pans.cmdb pans.explore "${pd[@]}" --cell-size 0.5,0.2 --origin 0,-40 > /dev/null \
+  || fail "explore of 50 pans"
+same_labels pans
+"$CM" info pans.cmdb --json > pans-info.json || fail "info pans"
+[ "$(attractors pans-info.json)" = "$want" ] || fail "pans: attractors differ"
+
+# kill -9 in the middle of a split solve (after some of its 64 joins were
+# committed), then --resume: the single-box solve's labels
+big=(--region 0:500,-40:40 --cells 2000x1600)
+"$CM" solve "${pd[@]}" "${big[@]}" --db whole-big.cmdb > /dev/null || fail "single-box solve (big)"
+"$CM" export whole-big.cmdb --labels whole-big.npy > /dev/null || fail "export whole-big"
+"$CM" solve "${pd[@]}" "${big[@]}" --split 8x8 --threads 1 --db killed.cmdb > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 400); do
+  [ "$(sqlite3 killed.cmdb 'SELECT COUNT(*) FROM regions' 2> /dev/null)" -ge 8 ] 2> /dev/null && break
+  sleep 0.01
+done
+kill -9 "$pid" 2> /dev/null || fail "the split solve ended before kill -9"
+wait "$pid" 2> /dev/null
+joined=$(sqlite3 killed.cmdb 'SELECT COUNT(*) FROM regions' 2> /dev/null)
+[ -n "$joined" ] && [ "$joined" -lt 64 ] || fail "kill -9 left $joined regions, expected some of 64"
+"$CM" solve "${pd[@]}" "${big[@]}" --split 8x8 --threads 1 --db killed.cmdb --resume > /dev/null \
+  || fail "resume after kill -9"
+"$CM" export killed.cmdb --labels killed.npy > /dev/null || fail "export killed"
+cmp -s killed.npy whole-big.npy || fail "killed and resumed: attractor labels differ from the single-box solve's"
+
+# bad input: a clear message, exit 2, nothing written
+expect_usage "--attractor-tol: '0' must be TOL or TOL,MATCH, each above 0" solve --cells 10x10 \
+  --attractor-tol 0 --db bad1.cmdb
+expect_usage "matching tolerance" solve --cells 10x10 --attractor-tol 1e-3,1e-5
+expect_usage "--attractor-tol" solve --cells 10x10 --attractor-tol -1
+expect_usage "--attractor-steps" solve --cells 10x10 --attractor-steps 10
+expect_usage "budget" solve --cells 10x10 --attractor-steps 100,50,60 --db bad2.cmdb
+expect_usage "--by" render whole.cmdb --png x.png --by cells
+[ ! -e bad1.cmdb ] && [ ! -e bad2.cmdb ] && [ ! -e x.png ] || fail "a refused command wrote a file"
+
+[ "$fails" -eq 0 ] && echo "attractors_test: ok"
+exit $((fails > 0))
