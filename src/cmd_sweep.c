@@ -13,6 +13,7 @@
 
 #include "cellmap/scm.h"
 #include "src/args.h"
+#include "src/attractor_report.h"
 #include "src/commands.h"
 #include "src/json.h"
 #include "src/interrupt.h"
@@ -28,9 +29,10 @@ static const char sweep_help[] =
     "                     [--quiet]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
-    "the attractors and the sticking groups (rest cells: a sticking zone is\n"
-    "one group per rest cell) whose periodic cells' centre lies in the --near\n"
-    "window (default: anywhere), and their basin cells. Where the number of\n"
+    "the system's attractors (as solve finds them from the groups' true orbits)\n"
+    "and the sticking groups (rest cells: a sticking zone is one group per rest\n"
+    "cell) whose centre lies in the --near window (default: anywhere), and their\n"
+    "basin cells; --by groups counts cell mapping's groups instead. Where the number of\n"
     "attractors differs between neighbouring values, --refine K bisects the\n"
     "interval K times and reports where it changes: e.g. where a sticking\n"
     "zone absorbs an attractor.\n\n"
@@ -44,7 +46,8 @@ static const char sweep_help[] =
     "  --json              the values solved and the changes found as one JSON\n"
     "                      document on standard output (docs/cellmap.schema.json)\n"
     "  --quiet             no progress line and no report\n"
-    "  --max-steps, --threads, --region, --cells: as for solve\n";
+    "  --max-steps, --threads, --region, --cells, --by, --attractor-steps,\n"
+    "  --attractor-tol: as for solve\n";
 
 enum { MAX_VALUES = 200, MAX_REFINE = 40 };
 
@@ -57,6 +60,8 @@ typedef struct sweep_args {
     double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
     const char *csv;
     bool json, quiet;
+    int by;                   /* --by: count attractors (default) or groups */
+    cm_attractor_options att; /* --attractor-steps, --attractor-tol */
 } sweep_args;
 
 /* "NAME=V1,V2,..." (increasing) or "NAME=LO:HI:N", 2..MAX_VALUES values */
@@ -101,6 +106,8 @@ static int parse_args(cli *c, sweep_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (by_option_take(c, &a->by, &err)) {
+        } else if (attractor_options_take(c, &a->att, &err)) {
         } else if (cli_is(c, "--quiet", false, &err)) {
             a->quiet = true;
         } else {
@@ -129,6 +136,29 @@ static bool in_window(const sweep_args *a, const cm_group_info *g)
         if (!(g->centre[d] >= a->near_lo[d] && g->centre[d] <= a->near_hi[d]))
             return false;
     return true;
+}
+
+/* The system's attractors (cellmap/attractors.h) in the window: sticking
+ * zones are kept as cell mapping gives them. */
+static void count_attractors(const sweep_args *a, const cm_attractor_set *s, uint32_t ngroups,
+                             sweep_point *pt)
+{
+    pt->groups = ngroups;
+    for (uint32_t k = 0; k < s->n; k++) {
+        const cm_attractor *at = &s->a[k];
+        cm_group_info as_group = {.kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
+                                                                          : CM_GROUP_ATTRACTOR};
+        memcpy(as_group.centre, at->centre, sizeof at->centre);
+        if (!in_window(a, &as_group))
+            continue;
+        if (at->kind == CM_ATTRACTOR_STICKING) {
+            pt->sticking++;
+            pt->sticking_cells += at->basin_cells;
+        } else {
+            pt->attractors++;
+            pt->attractor_cells += at->basin_cells;
+        }
+    }
 }
 
 static void count_groups(const sweep_args *a, const cm_group_info *groups, uint32_t n,
@@ -167,8 +197,19 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
         st = cm_scm_solve(&m, lat, &opt, &r, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
-    if (st == CM_OK)
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    if (st == CM_OK && a->by == BY_ATTRACTORS) {
+        cm_attractor_options o = a->att;
+        o.threads = a->threads;
+        st = cm_attractors_find(&m, lat, groups, r.ngroups, cm_region_cell_group, &r, &o, &att,
+                                msg, msg_size);
+        if (st == CM_OK)
+            count_attractors(a, &att, r.ngroups, pt);
+    } else if (st == CM_OK) {
         count_groups(a, groups, r.ngroups, pt);
+    }
+    cm_attractors_free(&att);
     free(groups);
     cm_region_free(&r);
     cm_model_release(&m);

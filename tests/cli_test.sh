@@ -462,7 +462,7 @@ grep -q ">$json_sticking sticking zones " friction.svg \
 # (x = 4/P = 72727) on the figure's lattice: the one-cell attractor centred at
 # x = 72625 comes to rest at mu = 72625 alpha^2 - 3 = 0.09680 (docs/gallery.md)
 "$CM" sweep --model microchaos-pd-friction --vary mu=0.095,0.1 --region=-100000:100000,-601.5:601.5 \
-  --cells 800x401 --max-steps 100000 --near 71818:73636 --refine 8 --csv sweep.csv > sweep.out \
+  --cells 800x401 --max-steps 100000 --near 71818:73636 --refine 8 --by groups --csv sweep.csv > sweep.out \
   || fail "sweep failed"
 python3 - sweep.csv sweep.out friction.json <<'PY' || fail "sweep results"
 import csv, json, re, sys
