@@ -30,11 +30,14 @@
  *   names them); a grid's box is [lo, hi) per dimension cut into cells[d]
  *   equal cells; arrays over cells run with dimension 0 fastest (C order of
  *   an array shaped cells[dim-1] x ... x cells[0]). Times are seconds.
- * - Labels. A cell's label is its periodic group's id 1..groups (an
- *   attractor, or a sticking zone of a friction model), 0 for the sink (its
- *   sequence leaves the solved cells or has no image), or CM_LABEL_NONE for
- *   a cell of a view that no region of a database covers. Its step number
- *   counts the map's steps to its group's periodic cells (0 on them).
+ * - Labels. A cell's label is its periodic group's id 1..groups (a cell
+ *   cycle of cell mapping, or a sticking zone of a friction model), 0 for
+ *   the sink (its sequence leaves the solved cells or has no image), or
+ *   CM_LABEL_NONE for a cell of a view that no region of a database covers.
+ *   Its step number counts the map's steps to its group's periodic cells
+ *   (0 on them). Its attractor label is the system's attractor its group's
+ *   true orbit reaches (cm_result_attractor_labels; docs/engine.md,
+ *   "Attractors").
  * - Versions. CELLMAP_VERSION_* are this header's; cm_version() the
  *   library's. The same major version keeps source and binary
  *   compatibility (the library's SONAME is libcellmap.so.MAJOR).
@@ -52,7 +55,7 @@ extern "C" {
 #endif
 
 #define CELLMAP_VERSION_MAJOR 0
-#define CELLMAP_VERSION_MINOR 2
+#define CELLMAP_VERSION_MINOR 3
 #define CELLMAP_VERSION_PATCH 0
 /* MAJOR * 10000 + MINOR * 100 + PATCH */
 #define CELLMAP_VERSION_NUMBER                                                                     \
@@ -157,6 +160,33 @@ typedef struct cm_group_summary {
 cm_status cm_result_group(const cm_result *r, uint32_t id, cm_group_summary *out);
 /* Cells labelled 0 (the sink). */
 uint64_t cm_result_sink_cells(const cm_result *r);
+/* The system's attractors behind the groups (found by their true orbits,
+ * as `cellmap solve` finds them, with its default options; a database's
+ * are those it stores, else found from its cells): periodic, aperiodic
+ * (chaotic or quasi-periodic: its footprint is the cells its orbit visits)
+ * or a sticking zone. */
+typedef struct cm_attractor_summary {
+    uint32_t id;
+    int kind;        /* 0: periodic; 1: aperiodic; 2: sticking zone */
+    uint32_t period; /* its true period; 0 when aperiodic */
+    uint64_t basin_cells; /* the basins of its groups (the whole cluster's, for a database) */
+    uint32_t groups;      /* cell groups that are this attractor */
+    double centre[CM_MAX_DIM], lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* mean and bounds of its
+                                  cycle's states, or of its footprint's cell centres */
+    int64_t anchor[CM_MAX_DIM]; /* the smallest cell of its footprint: its identity */
+    uint64_t footprint_cells;
+} cm_attractor_summary;
+
+/* How many attractors: ids run 1..cm_result_attractors. */
+uint32_t cm_result_attractors(const cm_result *r);
+/* Attractor id into *out; CM_ENOTFOUND beyond. */
+cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summary *out);
+/* Every cell's attractor label into an array of cm_result_cells entries:
+ * the attractor's id, 0 when its group's true orbit diverges, -2 outside
+ * (its sequence leaves the solved cells, or its group's orbit was
+ * undecided), -1 for a cell no region covers. */
+void cm_result_attractor_labels(const cm_result *r, int32_t *labels);
+
 /* The basin figure (basins, attractors, axes, legend, title) as a PNG of
  * width x height pixels (0, 0: 1000 on the longer side), written to a
  * temporary file and renamed to path. Loads OSMesa on first use. */

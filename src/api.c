@@ -2,6 +2,7 @@
  * the .cmdb store and the renderer: the one module of the library that
  * sees all of them, as the command does. */
 #include "cellmap/cellmap.h"
+#include "cellmap/attractors.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -35,6 +36,7 @@ struct cm_result {
     cm_group_info *groups; /* entry k: group k + 1 */
     uint64_t sink;
     const cm_model *model; /* the system's or database's, for figures */
+    cm_attractor_set att;  /* the system's attractors of the groups */
 };
 
 struct cm_db {
@@ -166,8 +168,32 @@ static cm_status grid_lattice(const cm_grid *g, int dim, cm_lattice *lat, cm_box
 }
 
 /* A result over r's cells (taken), with its groups summarised. */
+/* make_result's attractors: a database's (stored, else found from its
+ * cluster), or those of a solve's cells. */
+typedef struct result_attractors {
+    cm_store *store;     /* NULL: a solve */
+    cm_cluster *cluster; /* a database's */
+} result_attractors;
+
+/* A database's attractors found from its cluster (a file without them). */
+static cm_status db_attractors(const cm_model *m, const result_attractors *from,
+                               cm_attractor_set *out, char *msg, size_t msg_size)
+{
+    cm_cluster *c = from->cluster;
+    cm_group_info *g = calloc((size_t)c->ngroups + 1, sizeof *g);
+    uint64_t sink;
+    cm_status st = g ? cm_store_groups(from->store, g, c->ngroups, &sink, msg, msg_size)
+                     : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups");
+    if (st == CM_OK)
+        st = cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, out, msg,
+                                msg_size);
+    free(g);
+    return st;
+}
+
 static cm_status make_result(const cm_model *m, const cm_lattice *lat, cm_region *r,
-                             cm_result **out, char *msg, size_t msg_size)
+                             const result_attractors *from, cm_result **out, char *msg,
+                             size_t msg_size)
 {
     cm_result *res = calloc(1, sizeof *res);
     if (!res) {
@@ -178,8 +204,16 @@ static cm_status make_result(const cm_model *m, const cm_lattice *lat, cm_region
     res->cells = *r;
     res->model = m;
     memset(r, 0, sizeof *r);
-    const cm_status st =
-        cm_scm_describe(m, lat, &res->cells, &res->groups, &res->sink, msg, msg_size);
+    cm_status st = cm_scm_describe(m, lat, &res->cells, &res->groups, &res->sink, msg, msg_size);
+    if (st == CM_OK && !from->store)
+        st = cm_attractors_find(m, lat, res->groups, res->cells.ngroups, cm_region_cell_group,
+                                &res->cells, NULL, &res->att, msg, msg_size);
+    if (st == CM_OK && from->store) {
+        st = cm_store_get_attractors(from->store, lat->dim, from->cluster->ngroups, &res->att, NULL,
+                                     msg, msg_size);
+        if (st == CM_ENOTFOUND)
+            st = db_attractors(m, from, &res->att, msg, msg_size);
+    }
     if (st != CM_OK) {
         cm_result_free(res);
         return st;
@@ -270,7 +304,8 @@ cm_status cm_solve(const cm_system *s, const cm_grid *grid, const cm_solve_optio
         cm_region_free(&r);
         return st;
     }
-    return make_result(&s->model, &lat, &r, out, msg, msg_size);
+    const result_attractors solved = {NULL, NULL};
+    return make_result(&s->model, &lat, &r, &solved, out, msg, msg_size);
 }
 
 void cm_result_grid(const cm_result *r, cm_grid *g)
@@ -355,7 +390,40 @@ void cm_result_free(cm_result *r)
         return;
     cm_region_free(&r->cells);
     free(r->groups);
+    cm_attractors_free(&r->att);
     free(r);
+}
+
+uint32_t cm_result_attractors(const cm_result *r) { return r->att.n; }
+
+cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summary *out)
+{
+    if (id < 1 || id > r->att.n)
+        return CM_ENOTFOUND;
+    const cm_attractor *a = &r->att.a[id - 1];
+    memset(out, 0, sizeof *out);
+    out->id = a->id;
+    out->kind = a->kind;
+    out->period = a->period;
+    out->basin_cells = a->basin_cells;
+    out->groups = a->groups;
+    memcpy(out->centre, a->centre, sizeof out->centre);
+    memcpy(out->lo, a->lo, sizeof out->lo);
+    memcpy(out->hi, a->hi, sizeof out->hi);
+    memcpy(out->anchor, a->anchor, sizeof out->anchor);
+    out->footprint_cells = a->footprint_cells;
+    return CM_OK;
+}
+
+void cm_result_attractor_labels(const cm_result *r, int32_t *labels)
+{
+    for (uint64_t i = 0; i < r->cells.ncells; i++) {
+        const uint32_t g = r->cells.group[i];
+        const uint32_t a = g == CM_GROUP_NONE || g == 0 || g > r->att.ngroups ? 0 : r->att.of_group[g];
+        labels[i] = g == CM_GROUP_NONE ? -1
+                    : g == 0 || a == CM_FATE_UNRESOLVED ? -2
+                                                        : (int32_t)a;
+    }
 }
 
 /* ---- databases ----------------------------------------------------------- */
@@ -453,7 +521,8 @@ cm_status cm_db_read(cm_db *db, const double *lo, const double *hi, cm_result **
         st = cm_cluster_flatten(&db->cluster, &box, &r, msg, msg_size);
     if (st != CM_OK)
         return st;
-    return make_result(&db->model, &db->cluster.lat, &r, out, msg, msg_size);
+    const result_attractors stored = {db->store, &db->cluster};
+    return make_result(&db->model, &db->cluster.lat, &r, &stored, out, msg, msg_size);
 }
 
 void cm_db_close(cm_db *db)

@@ -28,6 +28,7 @@ export PYTHONPATH="$work/site"
 pd=(--param alpha=0.078,beta=0,P=0.007,D=0.02 --region 0:500,-40:40 --cells 400x200)
 "$CM" solve "${pd[@]}" --db pd.cmdb --quiet > /dev/null || fail "solve --db"
 "$CM" export pd.cmdb --labels labels.npy --steps steps.npy --by groups --quiet || fail "export"
+"$CM" export pd.cmdb --labels attractors.npy --quiet || fail "export by attractors"
 export PKG_CONFIG_PATH="$work/prefix/share/pkgconfig"
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libhenon.so "$SRC/examples/plugin/henon.c" -lm \
   || fail "cc henon"
@@ -40,6 +41,7 @@ assert cellmap.version().count(".") == 2
 pd = cellmap.System("microchaos-pd", alpha=0.078, beta=0, P=0.007, D=0.02)
 assert pd.dim == 2 and pd.coords == ["x", "v"] and pd.region() == [(0, 500), (-40, 40)]
 labels, steps = np.load("labels.npy"), np.load("steps.npy")
+attractors = np.load("attractors.npy")
 for split in (None, (2, 2)):
     res = cellmap.solve(pd, region=[(0, 500), (-40, 40)], cells=(400, 200), threads=2, split=split)
     assert res.labels.shape == labels.shape == (400, 200), (res.labels.shape, labels.shape)
@@ -50,10 +52,16 @@ for split in (None, (2, 2)):
         pairs = set(zip(res.labels.ravel().tolist(), labels.ravel().tolist()))
         assert len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs})
     assert (res.steps == steps).all(), "steps differ"
+    # the system's attractors: the same labels as export --labels, in any split
+    assert (res.attractor_labels == attractors).all(), "attractor labels differ from export"
+    assert len(res.attractors) == len(set(attractors[attractors > 0].ravel().tolist()))
+    assert all(a["kind"] in ("periodic", "aperiodic") and a["footprint_cells"] > 0
+               for a in res.attractors), res.attractors
     assert sum(g["basin_cells"] for g in res.groups) + (res.labels == 0).sum() == 400 * 200
 db = cellmap.open("pd.cmdb")
 assert db.model == "microchaos-pd" and db.cells == [400, 200]
 assert (db.read().labels == labels).all()
+assert (db.read().attractor_labels == attractors).all()
 view = db.read(view=[(125, 250), (-20, 20)])
 assert view.labels.shape == (100, 100) and (view.labels == labels[100:200, 50:150]).all()
 res.png("pd.png", 600, 400)

@@ -76,6 +76,38 @@ static void test_versions_and_errors(void)
 
 /* One region, 2x2 and 4x2 split regions and 1 or 2 threads give the same
  * labels (up to numbering) and the same steps. */
+/* The system's attractors of a result: each group's cells share one
+ * label, every attractor has cells, and a summary per id. */
+static void check_attractors(const cm_result *r)
+{
+    const uint64_t n = cm_result_cells(r);
+    const uint32_t na = cm_result_attractors(r), ng = cm_result_groups(r);
+    uint32_t *g = malloc(n * sizeof *g);
+    int32_t *a = malloc(n * sizeof *a), *of = calloc(ng + 1, sizeof *of);
+    cm_result_labels(r, g);
+    cm_result_attractor_labels(r, a);
+    int mixed = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        if (g[i] == 0) {
+            mixed += a[i] != -2; /* the sink: outside */
+            continue;
+        }
+        mixed += of[g[i]] && of[g[i]] != a[i] + 1000;
+        of[g[i]] = a[i] + 1000;
+        mixed += a[i] < -2 || a[i] > (int32_t)na;
+    }
+    CHECK_INT(mixed, 0);
+    cm_attractor_summary s;
+    CHECK(na > 0);
+    for (uint32_t id = 1; id <= na; id++)
+        CHECK(cm_result_attractor(r, id, &s) == CM_OK && s.id == id && s.basin_cells > 0 &&
+              s.footprint_cells > 0 && (s.kind != 0 || s.period > 0));
+    CHECK(cm_result_attractor(r, na + 1, &s) == CM_ENOTFOUND);
+    free(g);
+    free(a);
+    free(of);
+}
+
 static void test_solve(cm_system *s, uint32_t *labels, uint32_t *steps)
 {
     char msg[256];
@@ -87,6 +119,7 @@ static void test_solve(cm_system *s, uint32_t *labels, uint32_t *steps)
     cm_result_steps(whole, steps);
     const uint32_t groups = cm_result_groups(whole);
     CHECK(groups > 10);
+    check_attractors(whole);
     uint64_t sink = 0, basins = 0;
     for (uint64_t i = 0; i < n; i++)
         sink += labels[i] == 0;
@@ -155,6 +188,33 @@ static void test_solve(cm_system *s, uint32_t *labels, uint32_t *steps)
 /* A database of the same grid, solved as 3x2 regions by the command: every
  * label (up to numbering) and step as cm_solve gives them; a view reads
  * the cells that meet it. */
+/* Whether labels equal those `cellmap export FILE --labels` writes (the
+ * .npy's int32 cells after its header, in C order: x slowest; labels have
+ * x fastest, 400 x 200 cells). */
+static bool same_attractor_labels(const int32_t *labels, uint64_t n, const char *file,
+                                  const char *cellmap)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "'%s' export '%s' --labels api-att.npy --quiet > /dev/null", cellmap,
+             file);
+    if (system(cmd) != 0)
+        return false;
+    FILE *f = fopen("api-att.npy", "rb");
+    unsigned char head[10];
+    bool same = f && fread(head, 1, 10, f) == 10 &&
+                fseek(f, 10 + head[8] + 256 * head[9], SEEK_SET) == 0;
+    for (uint64_t x = 0; same && x < 400; x++)
+        for (uint64_t y = 0; same && y < 200; y++) {
+            int32_t v;
+            same = fread(&v, 4, 1, f) == 1 && y * 400 + x < n && v == labels[y * 400 + x];
+        }
+    if (f)
+        fclose(f);
+    remove("api-att.npy");
+    remove("api-att.json");
+    return same;
+}
+
 static void test_db(const char *cellmap, const uint32_t *labels, const uint32_t *steps)
 {
     char cmd[1024], msg[256];
@@ -183,6 +243,12 @@ static void test_db(const char *cellmap, const uint32_t *labels, const uint32_t 
     cm_result_steps(r, st);
     CHECK(same_partition(labels, l, n, cm_result_groups(r)));
     CHECK(memcmp(steps, st, n * sizeof *st) == 0);
+    /* the attractors the file stores are those of the same cells solved
+     * here, label for label, and `export --labels` writes the same */
+    int32_t *att = malloc(n * sizeof *att);
+    cm_result_attractor_labels(r, att);
+    CHECK(same_attractor_labels(att, n, "api.cmdb", cellmap));
+    free(att);
     cm_result_free(r);
     /* cells 100..199 x 50..149 (x 125:250, v -20:20) */
     const double lo[2] = {125, -20}, hi[2] = {250, 20};

@@ -5,12 +5,17 @@ needed. Arrays come back as numpy int32 arrays shaped like the lattice, as
 `cellmap export --labels/--steps` writes them: for cells (nx, ny),
 labels[i, j] is the cell i along the first coordinate and j along the
 second; a label is 0 for the sink, k for group k, -1 for a cell that no
-region of a database computed.
+region of a database computed. attractor_labels are the system's
+attractors behind the groups (found by their true orbits, as `cellmap
+solve` does): k for attractor k, 0 diverged, -2 outside (the sequence left
+the cells, or its group's orbit was undecided), -1 not computed, as
+`cellmap export --labels` writes them.
 
     import cellmap
     pd = cellmap.System("microchaos-pd", alpha=0.078, beta=0, P=0.007, D=0.02)
     res = cellmap.solve(pd, region=[(0, 500), (-40, 40)], cells=(800, 400))
-    print(res.groups[0], (res.labels == 0).mean())   # an attractor; the sink's share
+    print(res.groups[0], (res.labels == 0).mean())   # a group; the sink's share
+    print(res.attractors[0], (res.attractor_labels == 1).mean())
     view = cellmap.open("file.cmdb").read(view=[(100, 200), (-10, 10)])
 
 The library is found through $CELLMAP_LIB, then next to an installed
@@ -86,6 +91,14 @@ class _Group(ctypes.Structure):
                 ("basin_cells", ctypes.c_uint64), ("centre", ctypes.c_double * _MAX_DIM)]
 
 
+class _Attractor(ctypes.Structure):
+    _fields_ = [("id", ctypes.c_uint32), ("kind", ctypes.c_int), ("period", ctypes.c_uint32),
+                ("basin_cells", ctypes.c_uint64), ("groups", ctypes.c_uint32),
+                ("centre", ctypes.c_double * _MAX_DIM), ("lo", ctypes.c_double * _MAX_DIM),
+                ("hi", ctypes.c_double * _MAX_DIM), ("anchor", ctypes.c_int64 * _MAX_DIM),
+                ("footprint_cells", ctypes.c_uint64)]
+
+
 _lib = _load()
 _P = ctypes.c_void_p
 
@@ -119,6 +132,9 @@ _sig("cm_result_labels", None, _P, ctypes.POINTER(ctypes.c_uint32))
 _sig("cm_result_steps", None, _P, ctypes.POINTER(ctypes.c_uint32))
 _sig("cm_result_groups", ctypes.c_uint32, _P)
 _sig("cm_result_group", ctypes.c_int, _P, ctypes.c_uint32, ctypes.POINTER(_Group))
+_sig("cm_result_attractors", ctypes.c_uint32, _P)
+_sig("cm_result_attractor", ctypes.c_int, _P, ctypes.c_uint32, ctypes.POINTER(_Attractor))
+_sig("cm_result_attractor_labels", None, _P, ctypes.POINTER(ctypes.c_int32))
 _sig("cm_result_png", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_int, ctypes.c_int,
      ctypes.c_char_p, ctypes.c_size_t)
 _sig("cm_result_free", None, _P)
@@ -218,7 +234,11 @@ class Result:
     labels: numpy int32 array shaped like the lattice (see the module's
     help): 0 the sink, 1.. a group, LABEL_NONE (-1) a cell no region covers.
     steps: steps to the group's periodic cells. groups: list of dicts (id,
-    kind, period, basin_cells, centre). lo, hi, cells: the grid."""
+    kind, period, basin_cells, centre). attractor_labels: the same array by
+    the system's attractors (k attractor k, 0 diverged, -2 outside, -1 not
+    computed); attractors: list of dicts (id, kind periodic|aperiodic|
+    sticking, period (None when aperiodic), basin_cells, groups, centre,
+    lo, hi, anchor, footprint_cells). lo, hi, cells: the grid."""
 
     def __init__(self, handle, owner):
         self._h, self._owner = handle, owner  # owner: the system or database it needs
@@ -238,11 +258,25 @@ class Result:
             self.groups.append({"id": s.id, "kind": "sticking" if s.kind else "attractor",
                                 "period": s.period, "basin_cells": s.basin_cells,
                                 "centre": [s.centre[d] for d in range(g.dim)]})
+        self.attractor_labels = self._array(_lib.cm_result_attractor_labels, n,
+                                            ctypes.c_int32, np.int32)
+        self.attractors = []
+        for aid in range(1, _lib.cm_result_attractors(handle) + 1):
+            a = _Attractor()
+            _lib.cm_result_attractor(handle, aid, ctypes.byref(a))
+            kind = ("periodic", "aperiodic", "sticking")[a.kind]
+            self.attractors.append({
+                "id": a.id, "kind": kind, "period": None if a.kind == 1 else a.period,
+                "basin_cells": a.basin_cells, "groups": a.groups,
+                "centre": [a.centre[d] for d in range(g.dim)],
+                "lo": [a.lo[d] for d in range(g.dim)], "hi": [a.hi[d] for d in range(g.dim)],
+                "anchor": [a.anchor[d] for d in range(g.dim)],
+                "footprint_cells": a.footprint_cells})
 
-    def _array(self, fill, n):
+    def _array(self, fill, n, ctype=ctypes.c_uint32, dtype=np.uint32):
         """What fill writes (dimension 0 fastest), indexed [i0, i1, ...]."""
-        flat = np.empty(n, dtype=np.uint32)
-        fill(self._h, flat.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)))
+        flat = np.empty(n, dtype=dtype)
+        fill(self._h, flat.ctypes.data_as(ctypes.POINTER(ctype)))
         return np.ascontiguousarray(flat.view(np.int32).reshape(tuple(reversed(self.cells))).T)
 
     def png(self, path, width=0, height=0):
