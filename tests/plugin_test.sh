@@ -21,6 +21,19 @@ cmake -S "$SRC/examples/plugin" -B henon-build > cmake.log 2>&1 && cmake --build
   && [ -s henon-build/libhenon.so ] || fail "the plugin's CMake build: $(tail -5 cmake.log build.log)"
 
 "$CM" models --model-lib ./libhenon.so | grep -q "^henon$" || fail "models --model-lib lists no henon"
+# Newton's method for z^3 - 1: the three roots, each of period 1
+cc -Wall -Wextra -Werror -shared -fPIC $(pkg-config --cflags cellmap) -o libnewton.so \
+  "$SRC/examples/plugin/newton.c" -lm || fail "cc newton.c"
+[ -s henon-build/libnewton.so ] || fail "the CMake build has no libnewton.so"
+"$CM" solve --model-lib ./libnewton.so --model newton --cells 300x300 --json > newton.json \
+  || fail "solve newton"
+python3 - newton.json <<'PY' || fail "Newton's attractors"
+import json, sys
+a = json.load(open(sys.argv[1]))["attractors"]
+roots = [(1, 0), (-0.5, 0.8660254037844386), (-0.5, -0.8660254037844386)]
+assert len(a) == 3 and all(x["kind"] == "periodic" and x["period"] == 1 for x in a), a
+assert sorted(min(abs(x["centre"][0] - r[0]) + abs(x["centre"][1] - r[1]) for r in roots) for x in a)[-1] < 1e-12, a
+PY
 henon=(--model-lib ./libhenon.so --model henon --param a=1.4,b=0.3 --region=-2.5:2.5,-2.5:2.5)
 "$CM" solve "${henon[@]}" --cells 1000x1000 --max-steps 4 --db henon.cmdb > henon.txt || fail "solve henon"
 "$CM" export henon.cmdb --cells cells.csv --quiet || fail "export henon.cmdb"
