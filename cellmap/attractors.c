@@ -408,13 +408,51 @@ static cm_status footprint_of(const record *rec, orbit *r)
  * stationary, and its second half visits almost no cell that its first
  * half did not: at most SETTLED_NEW of them) or diverges, or the budget is spent, or (known not
  * NULL) it makes KNOWN_RUN moves in the footprint of one earlier orbit
- * (r->fate ORBIT_INHERITS, *from its owner). */
+ * (r->fate ORBIT_INHERITS, *from its owner), which it first looks for
+ * alone for a record's length. */
+/* Before any record: up to `steps` steps that only look for KNOWN_RUN
+ * moves on one known footprint (most orbits of a cluster end on the
+ * attractors its largest basins hold). 1: on footprint *owner; -1: the
+ * orbit diverged; 0: neither. */
+static int onto_known(const follow_ctx *f, double *x, uint64_t steps, const cell_owner *known,
+                      uint32_t *owner, uint64_t *done)
+{
+    cell_key k, at;
+    memset(&k, 0, sizeof k);
+    memset(&at, 0, sizeof at);
+    uint32_t run = 0, last = UINT32_MAX;
+    for (uint64_t i = 0; i < steps; i++) {
+        if (!true_step(f, x, &k))
+            return -1;
+        ++*done;
+        if (same_cell(&k, &at, f->lat->dim))
+            continue;
+        at = k;
+        const uint32_t j = known->owner[owner_slot(known, &k)];
+        run = j != UINT32_MAX && j == last ? run + 1 : j != UINT32_MAX;
+        last = j;
+        if (run >= KNOWN_RUN) {
+            *owner = j;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known, orbit *r,
                         uint32_t *from)
 {
     const int dim = f->lat->dim;
     const cm_attractor_options *o = f->o;
     uint64_t len = o->record;
+    if (known) {
+        const uint64_t room = r->steps < o->max_steps ? o->max_steps - r->steps : 0;
+        const int on = onto_known(f, x, len < room ? len : room, known, from, &r->steps);
+        if (on) {
+            r->fate = on > 0 ? ORBIT_INHERITS : ORBIT_DIVERGED;
+            return CM_OK;
+        }
+    }
     record *rec = calloc(1, sizeof *rec);
     double *s = NULL;
     uint64_t s_cap = 0;
@@ -714,7 +752,8 @@ static uint64_t describe(const cm_lattice *lat, const cm_group_info *groups,
     for (uint32_t i = 0; i < count; i++) {
         const orbit *o = &r[members[i]];
         at->basin_cells += groups[order[members[i]].index].basin_cells;
-        memcpy(fp + used, o->cells, (size_t)o->ncells * sizeof *fp);
+        if (o->ncells) /* those that inherit have no footprint of their own */
+            memcpy(fp + used, o->cells, (size_t)o->ncells * sizeof *fp);
         used += o->ncells;
     }
     used = unique_cells(fp, used);

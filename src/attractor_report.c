@@ -94,6 +94,18 @@ void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
             (unsigned long long)fates->left, percent(fates->left, cells));
 }
 
+void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat)
+{
+    json_uint(j, "id", a->id);
+    json_str(j, "kind", cm_attractor_kind_name(a->kind));
+    if (a->kind == CM_ATTRACTOR_APERIODIC)
+        json_raw(j, "period", "null");
+    else
+        json_uint(j, "period", a->period);
+    json_uint(j, "basin_cells", a->basin_cells);
+    json_nums(j, "centre", a->centre, lat->dim);
+}
+
 void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
                     const cell_fates *fates)
 {
@@ -101,19 +113,12 @@ void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
     for (uint32_t k = 0; k < s->n; k++) {
         const cm_attractor *a = &s->a[k];
         json_object(j, NULL);
-        json_uint(j, "id", a->id);
-        json_str(j, "kind", cm_attractor_kind_name(a->kind));
-        if (a->kind == CM_ATTRACTOR_APERIODIC)
-            json_raw(j, "period", "null");
-        else
-            json_uint(j, "period", a->period);
-        json_uint(j, "basin_cells", a->basin_cells);
+        json_attractor_fields(j, a, lat);
         json_array(j, "groups");
         for (uint32_t g = 1; g <= s->ngroups; g++)
             if (s->of_group[g] == a->id)
                 json_uint(j, NULL, g);
         json_array_end(j);
-        json_nums(j, "centre", a->centre, lat->dim);
         json_nums(j, "lo", a->lo, lat->dim);
         json_nums(j, "hi", a->hi, lat->dim);
         json_array(j, "anchor");

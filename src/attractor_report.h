@@ -44,6 +44,10 @@ void attractor_fates(const cm_attractor_set *s, uint64_t sink_cells, cell_fates 
 void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
                     const cell_fates *fates, uint64_t cells, int rows);
 
+/* An attractor's id, kind, period (null when aperiodic), basin_cells and
+ * centre, the fields every JSON that lists attractors has. */
+void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat);
+
 /* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells". */
 void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
                     const cell_fates *fates);

@@ -8,7 +8,7 @@
 
 #include "render/palette.h"
 #include "src/interrupt.h"
-#include "cellmap/attractors.h"
+#include "src/attractor_report.h"
 #include "src/json.h"
 #include "src/outfile.h"
 
@@ -137,14 +137,7 @@ static void write_sidecar_attractors(json *j, const array_export *x, const cm_la
             continue;
         const cm_attractor *a = &s->a[k];
         json_object(j, NULL);
-        json_uint(j, "id", a->id);
-        json_str(j, "kind", cm_attractor_kind_name(a->kind));
-        if (a->kind == CM_ATTRACTOR_APERIODIC)
-            json_raw(j, "period", "null");
-        else
-            json_uint(j, "period", a->period);
-        json_uint(j, "basin_cells", a->basin_cells);
-        json_nums(j, "centre", a->centre, lat->dim);
+        json_attractor_fields(j, a, lat);
         json_uint(j, "in_view", in_window[a->id + 2]);
         json_object_end(j);
     }
