@@ -119,10 +119,13 @@ static cm_status stored_options(cm_store *s, cm_attractor_options *o, uint64_t *
 static cm_status read_attractors(cm_store *s, int dim, cm_attractor_set *a, char *msg,
                                  size_t msg_size)
 {
+    /* sized by the bytes the footprints hold, not by what the rows say (a
+     * damaged count must not ask for memory the file does not have) */
     const int64_t n = store_query_int(s->db, "SELECT COUNT(*) FROM system_attractors");
-    const int64_t cells = store_query_int(s->db, "SELECT IFNULL(SUM(footprint_cells), 0) FROM "
+    const int64_t bytes = store_query_int(s->db, "SELECT IFNULL(SUM(LENGTH(footprint)), 0) FROM "
                                                  "system_attractors");
-    if (n < 0 || cells < 0 || n > UINT32_MAX)
+    const int64_t cells = bytes / (int64_t)(dim * sizeof *a->footprint);
+    if (n < 0 || bytes < 0 || n > UINT32_MAX)
         return cm_fail(CM_EFORMAT, msg, msg_size, "its attractors cannot be read");
     a->n = (uint32_t)n;
     a->a = calloc((size_t)n + 1, sizeof *a->a);

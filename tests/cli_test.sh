@@ -575,7 +575,8 @@ same_rows v5.cmdb v4.cmdb 'SELECT * FROM system_attractors ORDER BY id' \
   && "$CM" export att.cmdb --labels found.npy --attractor-tol 1e-4 > /dev/null 2>&1 \
   && cmp -s stored.npy found.npy || fail "the stored attractors differ from those found again"
 for bad in "UPDATE group_fates SET attractor = 99 WHERE grp = 1" "DELETE FROM group_fates WHERE grp = 2" \
-           "UPDATE system_attractors SET footprint = x'00' WHERE id = 1"; do
+           "UPDATE system_attractors SET footprint = x'00' WHERE id = 1" \
+           "UPDATE system_attractors SET footprint_cells = 2147483648 WHERE id = 1"; do
   cp att.cmdb attbad.cmdb
   sqlite3 attbad.cmdb "$bad"
   out=$("$CM" info attbad.cmdb 2>&1 >/dev/null); rc=$?
