@@ -26,7 +26,8 @@ static const char export_help[] =
     "Writes only complete files: Ctrl-C stops it and leaves no partial file (exit 130).\n\n"
     "  --groups OUT.csv    one row per group: id, period, basin_cells, is_sink (group 0),\n"
     "                      centre, bounds of the periodic cells' centres, anchor cell,\n"
-    "                      kind (attractor, sticking zone or the sink)\n"
+    "                      kind (attractor, sticking zone or the sink), and the system's\n"
+    "                      attractor its true orbit reaches (0: it diverges, -1: undecided)\n"
     "  --cells OUT         one row per computed cell: lattice indices ix, iv, ..., cell\n"
     "                      centre x, v, ... (i and the model's state names, as `cellmap\n"
     "                      models` lists them), grp, step, periodic; CSV with a header,\n"
@@ -226,7 +227,8 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     snprintf(sql + used, sizeof sql - used,
              "grp INTEGER, step INTEGER, periodic INTEGER);"
              "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
-             " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT, kind TEXT);"
+             " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT, kind TEXT,"
+             " attractor INTEGER);"
              "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT);");
     if (sqlite3_open(o->out.tmp, &o->db) != SQLITE_OK ||
         sqlite3_exec(o->db, "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF; BEGIN", NULL, NULL,
@@ -340,12 +342,20 @@ static int numbers_json(char *buf, size_t size, const double *v, int n)
     return snprintf(buf + used, used < size ? size - used : 0, "]") > 0;
 }
 
+/* A group's attractor as the file's group_fates has it: its id, 0 when its
+ * true orbit diverges, -1 undecided. */
+static int64_t group_attractor(const cm_attractor_set *att, uint32_t id)
+{
+    const uint32_t a = att->of_group[id];
+    return a == CM_FATE_UNRESOLVED ? -1 : (int64_t)a;
+}
+
 static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info *g, uint32_t n,
-                         uint64_t sink)
+                         uint64_t sink, const cm_attractor_set *att)
 {
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(o->db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?)", -1, &st,
-                           NULL) != SQLITE_OK)
+    if (sqlite3_prepare_v2(o->db, "INSERT INTO groups VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", -1,
+                           &st, NULL) != SQLITE_OK)
         return 0;
     int ok = 1;
     for (uint32_t k = 0; k <= n && ok; k++) {
@@ -358,6 +368,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             for (int c = 5; c <= 8; c++)
                 sqlite3_bind_null(st, c);
             sqlite3_bind_text(st, 9, "sink", -1, SQLITE_STATIC);
+            sqlite3_bind_null(st, 10);
         } else {
             const cm_group_info *gi = &g[k - 1];
             double a[CM_MAX_DIM];
@@ -376,6 +387,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             sqlite3_bind_text(st, 7, hi, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 8, anchor, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 9, cm_group_kind_name(gi->kind), -1, SQLITE_STATIC);
+            sqlite3_bind_int64(st, 10, group_attractor(att, gi->id));
         }
         ok = sqlite3_step(st) == SQLITE_DONE;
         sqlite3_reset(st);
@@ -437,8 +449,8 @@ static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 /* ---- what is exported ------------------------------------------------- */
 
 static int export_groups(const char *path, const char *const *names, const cm_lattice *lat,
-                         const cm_group_info *g, uint32_t n, uint64_t sink, char *msg,
-                         size_t msg_size)
+                         const cm_group_info *g, uint32_t n, uint64_t sink,
+                         const cm_attractor_set *att, char *msg, size_t msg_size)
 {
     cell_out o;
     memset(&o, 0, sizeof o);
@@ -456,10 +468,10 @@ static int export_groups(const char *path, const char *const *names, const cm_la
     for (int p = 0; p < 4; p++)
         for (int d = 0; d < lat->dim; d++)
             fprintf(o.f, ",%s%s", parts[p], names[d]);
-    fprintf(o.f, ",kind\n0,1,%llu,1", (unsigned long long)sink);
+    fprintf(o.f, ",kind,attractor\n0,1,%llu,1", (unsigned long long)sink);
     for (int k = 0; k < 4 * lat->dim; k++)
         fprintf(o.f, ",");
-    fprintf(o.f, ",sink\n");
+    fprintf(o.f, ",sink,\n");
     for (uint32_t k = 0; k < n; k++) {
         fprintf(o.f, "%u,%u,%llu,0", g[k].id, g[k].period, (unsigned long long)g[k].basin_cells);
         const double *v[3] = {g[k].centre, g[k].lo, g[k].hi};
@@ -468,7 +480,8 @@ static int export_groups(const char *path, const char *const *names, const cm_la
                 fprintf(o.f, ",%.17g", v[p][d]);
         for (int d = 0; d < lat->dim; d++)
             fprintf(o.f, ",%lld", (long long)g[k].anchor[d]);
-        fprintf(o.f, ",%s\n", cm_group_kind_name(g[k].kind));
+        fprintf(o.f, ",%s,%lld\n", cm_group_kind_name(g[k].kind),
+                (long long)group_attractor(att, g[k].id));
     }
     return out_end(&o, 1, msg, msg_size);
 }
@@ -538,7 +551,15 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     const char *names[CM_MAX_DIM];
     project_state_names(info, names);
     int rc = EXIT_OK;
-    if (a->groups && !export_groups(a->groups, names, &c->lat, g, info->groups, sink, msg, sizeof msg)) {
+    cm_attractor_set att; /* the groups' attractors: stored, else found */
+    memset(&att, 0, sizeof att);
+    if (file_attractors(s, info, NULL, c, g, info->groups, &a->att, &att, msg, sizeof msg) !=
+        CM_OK) {
+        fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK && a->groups &&
+        !export_groups(a->groups, names, &c->lat, g, info->groups, sink, &att, msg, sizeof msg)) {
         fprintf(stderr, "cellmap export: %s\n", msg);
         rc = EXIT_FAIL;
     }
@@ -561,7 +582,7 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     int ok = 1;
     for (int k = 0; k < nouts && ok; k++)
         ok = out_begin(&outs[k], c->lat.dim, info, msg, sizeof msg);
-    if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink))
+    if (ok && a->flat && !sqlite_groups(&outs[nouts - 1], &c->lat, g, info->groups, sink, &att))
         ok = 0, snprintf(msg, sizeof msg, "cannot write %.900s", a->flat);
     progress pr;
     progress_start(&pr, "export", "cells", cm_box_cells(&window), a->quiet);
@@ -579,15 +600,7 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
         fprintf(report_stream(a->groups, a->cells, a->flat), "exported %llu cells\n",
                 (unsigned long long)outs[0].rows);
     }
-    cm_attractor_set att;
-    memset(&att, 0, sizeof att);
     const bool by_attractors = a->labels && a->by == BY_ATTRACTORS;
-    if (rc == EXIT_OK && by_attractors &&
-        file_attractors(s, info, NULL, c, g, info->groups, &a->att, &att, msg, sizeof msg) !=
-            CM_OK) {
-        fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
-        rc = EXIT_FAIL;
-    }
     if (rc == EXIT_OK && (a->labels || a->steps)) {
         const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names,
                                 by_attractors ? &att : NULL};
@@ -602,29 +615,44 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
 
 /* export --groups alone: the groups are records, so the cluster (its node
  * tables, open nodes) is not loaded, as for info. */
+/* The records-only path cannot find attractors a file does not store. */
+enum { NEEDS_CLUSTER = -2 };
+
 static int export_groups_only(const export_args *a)
 {
     cm_store *s = NULL;
     cm_store_info info;
     cm_group_info *g = NULL;
+    cm_attractor_set att;
     uint64_t sink = 0;
     char msg[1024];
+    memset(&att, 0, sizeof att);
     cm_status st = project_open_records(a->file, true, &s, &info, msg, sizeof msg);
     if (st == CM_OK && !(g = calloc((size_t)info.groups + 1, sizeof *g)))
         st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u groups", info.groups);
     if (st == CM_OK)
         st = cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg);
+    const bool asked = a->att.transient || a->att.record || a->att.max_steps || a->att.tol ||
+                       a->att.match;
+    cm_status got = CM_ENOTFOUND;
+    if (st == CM_OK && !asked)
+        got = cm_store_get_attractors(s, info.lattice.dim, info.groups, &att, NULL, msg,
+                                      sizeof msg);
+    st = got == CM_ENOTFOUND ? st : got;
     cm_store_snapshot_end(s);
     int rc = st == CM_OK ? EXIT_OK : EXIT_FAIL;
-    if (st == CM_OK) {
+    if (st == CM_OK && got == CM_ENOTFOUND)
+        rc = NEEDS_CLUSTER; /* found from the cells: the full path */
+    if (rc == EXIT_OK) {
         const char *names[CM_MAX_DIM];
         project_state_names(&info, names);
-        if (!export_groups(a->groups, names, &info.lattice, g, info.groups, sink, msg,
+        if (!export_groups(a->groups, names, &info.lattice, g, info.groups, sink, &att, msg,
                            sizeof msg))
             rc = EXIT_FAIL;
     }
-    if (rc != EXIT_OK)
+    if (rc == EXIT_FAIL)
         fprintf(stderr, "cellmap export: %s\n", msg);
+    cm_attractors_free(&att);
     free(g);
     cm_store_close(s, msg, sizeof msg);
     return rc;
@@ -643,8 +671,11 @@ int cmd_export(int argc, char **argv)
         !outfile_check("export", a.flat) || !outfile_check("export", a.labels) ||
         !outfile_check("export", a.steps))
         return EXIT_FAIL;
-    if (a.groups && !a.cells && !a.flat && !a.labels && !a.steps && !a.window)
-        return export_groups_only(&a);
+    if (a.groups && !a.cells && !a.flat && !a.labels && !a.steps && !a.window) {
+        const int only = export_groups_only(&a);
+        if (only != NEEDS_CLUSTER)
+            return only;
+    }
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;

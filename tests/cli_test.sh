@@ -107,7 +107,7 @@ PY
 # muted colour and one legend line, every group colour from the palette, the
 # legend's names by id or by anchor cell
 "$CM" export basin.cmdb --groups named.csv --quiet || fail "export --groups"
-anchor=$(awk -F, 'NR > 1 && $1 == 5 {print $(NF-2) "," $(NF-1)}' named.csv)
+anchor=$(awk -F, 'NR > 1 && $1 == 5 {print $(NF-3) "," $(NF-2)}' named.csv)
 printf '# names\n2 chaotic at SW1\n%s chaotic at SW3\n' "$anchor" > names.txt
 printf '#e69f00\n// two colours only\n#56b4e9\n' > two.pal
 for run in "m1:--min-basin 1" "m100:--min-basin 100" "oi:--palette okabe-ito" "two:--palette two.pal" \

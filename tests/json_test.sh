@@ -189,7 +189,7 @@ PY
 head -1 sweep.csv | grep -qx "mu,attractors,sticking,attractor_cells,sticking_cells,groups,sink_cells,seconds" \
   || fail "sweep CSV header: $(head -1 sweep.csv)"
 "$CM" export basin.cmdb --groups groups.csv 2> /dev/null || fail "export --groups"
-head -1 groups.csv | grep -q "^id,period,basin_cells,.*centre_x,centre_v.*,kind$" \
+head -1 groups.csv | grep -q "^id,period,basin_cells,.*centre_x,centre_v.*,kind,attractor$" \
   || fail "groups CSV header: $(head -1 groups.csv)"
 "$CM" orbit --from 10,0 --steps 1 | head -1 | grep -qx "j,x,v" || fail "orbit CSV header"
 "$CM" fixed-points --range 0:0 | head -1 | grep -qx "level,band,kind,x,v" || fail "fixed-points CSV header"
