@@ -554,9 +554,11 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     cm_attractor_set att; /* the groups' attractors: stored, else found */
     memset(&att, 0, sizeof att);
     if (file_attractors(s, info, NULL, c, g, info->groups, &a->att, &att, msg, sizeof msg) !=
-        CM_OK) {
+        CM_OK) { /* nothing is written without them */
         fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
-        rc = EXIT_FAIL;
+        cm_attractors_free(&att);
+        free(g);
+        return EXIT_FAIL;
     }
     if (rc == EXIT_OK && a->groups &&
         !export_groups(a->groups, names, &c->lat, g, info->groups, sink, &att, msg, sizeof msg)) {
