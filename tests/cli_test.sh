@@ -581,6 +581,10 @@ for bad in "UPDATE group_fates SET attractor = 99 WHERE grp = 1" "DELETE FROM gr
   sqlite3 attbad.cmdb "$bad"
   out=$("$CM" info attbad.cmdb 2>&1 >/dev/null); rc=$?
   [ $rc -eq 1 ] && grep -q "attbad.cmdb is damaged" <<<"$out" || fail "info after '$bad': rc $rc, $out"
+  sum=$(sha256sum < attbad.cmdb)
+  echo stats | "$CM" explore attbad.cmdb - > /dev/null 2>&1; rc=$?
+  [ $rc -eq 1 ] && [ "$(sha256sum < attbad.cmdb)" = "$sum" ] \
+    || fail "explore after '$bad': rc $rc, or the damaged file was written"
   for o in "--flat attbad.sqlite" "--groups attbad.csv" "--cells attbad-cells.csv --mem 1M"; do
     "$CM" export attbad.cmdb $o > /dev/null 2>&1; rc=$?
     [ $rc -eq 1 ] && [ ! -e attbad.sqlite ] && [ ! -e attbad.csv ] && [ ! -e attbad-cells.csv ] \
