@@ -1159,16 +1159,16 @@ static cm_status save_attractors(session *s, char *msg, size_t msg_size)
     const int dim = s->c.lat.dim;
     if (s->damaged || s->c.nregions == 0)
         return CM_OK;
-    const cm_status stored = cm_store_get_attractors(s->store, dim, s->c.ngroups, &att, NULL, msg,
-                                                     msg_size);
-    if (stored == CM_OK)
-        cm_attractors_free(&att);
-    if (stored == CM_EFORMAT) { /* damaged: not written again */
-        s->damaged = 1;
-        return stored;
+    if (!s->grew) { /* the file's own groups: what it stores is current, or damaged */
+        const cm_status stored =
+            cm_store_get_attractors(s->store, dim, s->c.ngroups, &att, NULL, msg, msg_size);
+        if (stored == CM_OK)
+            cm_attractors_free(&att);
+        if (stored == CM_EFORMAT)
+            s->damaged = 1; /* not written again */
+        if (stored != CM_ENOTFOUND)
+            return stored;
     }
-    if (!s->grew && stored == CM_OK)
-        return CM_OK; /* written, and current */
     cm_group_info *groups = calloc((size_t)s->c.ngroups + 1, sizeof *groups);
     uint64_t sink = 0;
     cm_status st = groups ? cm_store_groups(s->store, groups, s->c.ngroups, &sink, msg, msg_size)
