@@ -90,17 +90,11 @@ typedef struct follow_ctx {
     double tol_abs[CM_MAX_DIM];
 } follow_ctx;
 
-static int cell_compare_dim(const int64_t *a, const int64_t *b, int dim)
-{
-    for (int d = dim - 1; d >= 0; d--) /* box order: the last coordinate first */
-        if (a[d] != b[d])
-            return a[d] < b[d] ? -1 : 1;
-    return 0;
-}
-
+/* Box order (cm_cell_less), for qsort. */
 static int key_compare(const void *a, const void *b)
 {
-    return cell_compare_dim(((const cell_key *)a)->c, ((const cell_key *)b)->c, CM_MAX_DIM);
+    const int64_t *x = ((const cell_key *)a)->c, *y = ((const cell_key *)b)->c;
+    return cm_cell_less(x, y, CM_MAX_DIM) ? -1 : cm_cell_less(y, x, CM_MAX_DIM);
 }
 
 /* Sorts n cells into box order and drops repeats; returns how many remain. */
@@ -288,6 +282,26 @@ static cm_status owner_claim(cell_owner *t, const cell_key *k, uint32_t o, uint3
  * many steps wherever it is). */
 #define KNOWN_RUN 8
 
+/* The known footprint the last `run` moves of a walk stayed on. */
+typedef struct known_walk {
+    cell_key at; /* the cell of the last move */
+    uint32_t owner, run;
+} known_walk;
+
+/* Notes the walk's cell k (hash h): true once KNOWN_RUN moves from cell to
+ * cell stayed on one footprint of known (walk->owner). */
+static bool known_move(const cell_owner *known, known_walk *w, const cell_key *k, uint64_t h,
+                       int dim)
+{
+    if (same_cell(k, &w->at, dim))
+        return false;
+    w->at = *k;
+    const uint32_t j = known->owner[owner_slot_hashed(known, k, h)];
+    w->run = j != UINT32_MAX && j == w->owner ? w->run + 1 : j != UINT32_MAX;
+    w->owner = j;
+    return w->run >= KNOWN_RUN;
+}
+
 /* The states a record keeps, its last ones: periods up to a third of them
  * are found (RING / 3 = 1024); longer cycles are aperiodic here. */
 #define RING 3072
@@ -304,8 +318,7 @@ typedef struct record {
     uint64_t ring_cap;  /* states it holds */
     cell_owner t;
     uint64_t done, again, fresh;
-    uint32_t owner, run; /* the known footprint the last `run` moves stayed on */
-    cell_key cell;       /* the cell of the last move */
+    known_walk walk; /* on the known footprints */
     double origin[CM_MAX_DIM]; /* the state before the record: sums are taken from it */
     double sum[2][CM_MAX_DIM], squares[CM_MAX_DIM]; /* of each half, and of both */
 } record;
@@ -329,7 +342,8 @@ static cm_status take_record(const follow_ctx *f, double *x, uint64_t len, const
     memset(rec->squares, 0, sizeof rec->squares);
     cell_key k;
     memset(&k, 0, sizeof k);
-    for (uint64_t i = 0; st == CM_OK && i < len && rec->run < KNOWN_RUN; i++) {
+    bool on_known = false;
+    for (uint64_t i = 0; st == CM_OK && i < len && !on_known; i++) {
         if (!true_step(f, x, &k))
             return CM_OK;
         rec->done++;
@@ -353,12 +367,7 @@ static cm_status take_record(const follow_ctx *f, double *x, uint64_t len, const
             st = owner_claim_hashed(&rec->t, &k, h, FRESH, &before);
             rec->fresh++;
         }
-        if (known && !same_cell(&k, &rec->cell, dim)) { /* a move to another cell */
-            const uint32_t j = known->owner[owner_slot_hashed(known, &k, h)];
-            rec->run = j != UINT32_MAX && j == rec->owner ? rec->run + 1 : j != UINT32_MAX;
-            rec->owner = j;
-            rec->cell = k;
-        }
+        on_known = known && known_move(known, &rec->walk, &k, h, dim);
     }
     return st;
 }
@@ -403,13 +412,6 @@ static cm_status footprint_of(const record *rec, orbit *r)
     return CM_OK;
 }
 
-/* Follows the true orbit on from x (steps taken so far in r->steps):
- * records that double until the orbit recurs, settles (the record is
- * stationary, and its second half visits almost no cell that its first
- * half did not: at most SETTLED_NEW of them) or diverges, or the budget is spent, or (known not
- * NULL) it makes KNOWN_RUN moves in the footprint of one earlier orbit
- * (r->fate ORBIT_INHERITS, *from its owner), which it first looks for
- * alone for a record's length. */
 /* Before any record: up to `steps` steps that only look for KNOWN_RUN
  * moves on one known footprint (most orbits of a cluster end on the
  * attractors its largest basins hold). 1: on footprint *owner; -1: the
@@ -417,28 +419,30 @@ static cm_status footprint_of(const record *rec, orbit *r)
 static int onto_known(const follow_ctx *f, double *x, uint64_t steps, const cell_owner *known,
                       uint32_t *owner, uint64_t *done)
 {
-    cell_key k, at;
+    cell_key k;
+    known_walk w;
     memset(&k, 0, sizeof k);
-    memset(&at, 0, sizeof at);
-    uint32_t run = 0, last = UINT32_MAX;
+    memset(&w, 0, sizeof w);
+    w.owner = UINT32_MAX;
     for (uint64_t i = 0; i < steps; i++) {
         if (!true_step(f, x, &k))
             return -1;
         ++*done;
-        if (same_cell(&k, &at, f->lat->dim))
-            continue;
-        at = k;
-        const uint32_t j = known->owner[owner_slot(known, &k)];
-        run = j != UINT32_MAX && j == last ? run + 1 : j != UINT32_MAX;
-        last = j;
-        if (run >= KNOWN_RUN) {
-            *owner = j;
+        if (known_move(known, &w, &k, cell_hash(&k, f->lat->dim), f->lat->dim)) {
+            *owner = w.owner;
             return 1;
         }
     }
     return 0;
 }
 
+/* Follows the true orbit on from x (steps taken so far in r->steps):
+ * records that double until the orbit recurs, settles (the record is
+ * stationary, and its second half visits almost no cell that its first
+ * half did not: at most SETTLED_NEW of them) or diverges, or the budget is spent, or (known not
+ * NULL) it makes KNOWN_RUN moves in the footprint of one earlier orbit
+ * (r->fate ORBIT_INHERITS, *from its owner), which it first looks for
+ * alone for a record's length. */
 static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known, orbit *r,
                         uint32_t *from)
 {
@@ -458,7 +462,7 @@ static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known,
     uint64_t s_cap = 0;
     cm_status st = rec ? CM_OK : CM_ENOMEM;
     if (rec)
-        rec->owner = UINT32_MAX;
+        rec->walk.owner = UINT32_MAX;
     r->fate = ORBIT_UNRESOLVED;
     while (st == CM_OK && r->fate == ORBIT_UNRESOLVED) {
         const bool last = r->steps + 2 * len > o->max_steps;
@@ -468,9 +472,9 @@ static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known,
         r->steps += rec->done;
         if (st != CM_OK)
             break;
-        if (rec->run >= KNOWN_RUN) {
+        if (rec->walk.run >= KNOWN_RUN) {
             r->fate = ORBIT_INHERITS;
-            *from = rec->owner;
+            *from = rec->walk.owner;
         } else if (rec->done < len) {
             r->fate = ORBIT_DIVERGED;
         } else {
@@ -1156,6 +1160,20 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
     free(order);
     free(parent);
     return st;
+}
+
+int32_t cm_attractor_label(const cm_attractor_set *s, uint32_t g)
+{
+    if (g == CM_GROUP_NONE)
+        return -1;
+    const uint32_t a = g == 0 || g > s->ngroups ? CM_FATE_UNRESOLVED : s->of_group[g];
+    return a == CM_FATE_UNRESOLVED ? -2 : (int32_t)a;
+}
+
+int64_t cm_attractor_fate(const cm_attractor_set *s, uint32_t g)
+{
+    const uint32_t a = s->of_group[g];
+    return a == CM_FATE_UNRESOLVED ? -1 : (int64_t)a;
 }
 
 void cm_attractors_free(cm_attractor_set *s)

@@ -128,6 +128,14 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
                              const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
                              size_t msg_size);
 
+/* Group g's label by attractors, as `export --labels` writes it: its
+ * attractor's id, 0 when its true orbit diverges, -2 outside (the sink,
+ * g = 0, or an undecided orbit), -1 for CM_GROUP_NONE (no cell computed). */
+int32_t cm_attractor_label(const cm_attractor_set *s, uint32_t g);
+/* Group g's fate as a file stores it (group_fates): its attractor's id, 0
+ * when its orbit diverges, -1 undecided. g in 1..s->ngroups. */
+int64_t cm_attractor_fate(const cm_attractor_set *s, uint32_t g);
+
 void cm_attractors_free(cm_attractor_set *s);
 
 #endif

@@ -55,9 +55,8 @@ static cm_status write_rows(cm_store *s, const cm_attractor_set *a, int dim, cha
         st = store_step_done(s->db, ins, "write an attractor", msg, msg_size);
     }
     for (uint32_t g = 1; st == CM_OK && g <= a->ngroups; g++) {
-        const uint32_t f = a->of_group[g];
         sqlite3_bind_int64(fate, 1, g);
-        sqlite3_bind_int64(fate, 2, f == CM_FATE_UNRESOLVED ? -1 : (sqlite3_int64)f);
+        sqlite3_bind_int64(fate, 2, cm_attractor_fate(a, g));
         st = store_step_done(s->db, fate, "write a group's attractor", msg, msg_size);
     }
     sqlite3_finalize(ins);

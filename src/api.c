@@ -417,13 +417,8 @@ cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summ
 
 void cm_result_attractor_labels(const cm_result *r, int32_t *labels)
 {
-    for (uint64_t i = 0; i < r->cells.ncells; i++) {
-        const uint32_t g = r->cells.group[i];
-        const uint32_t a = g == CM_GROUP_NONE || g == 0 || g > r->att.ngroups ? 0 : r->att.of_group[g];
-        labels[i] = g == CM_GROUP_NONE ? -1
-                    : g == 0 || a == CM_FATE_UNRESOLVED ? -2
-                                                        : (int32_t)a;
-    }
+    for (uint64_t i = 0; i < r->cells.ncells; i++)
+        labels[i] = cm_attractor_label(&r->att, r->cells.group[i]);
 }
 
 /* ---- databases ----------------------------------------------------------- */

@@ -33,14 +33,14 @@ bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
     } else {
         return false;
     }
+    /* the options together, for every command that takes them: a bad
+     * budget or tolerance is the user's, before any work */
+    cm_attractor_options all;
+    char why[256];
+    cm_attractor_defaults(NULL, o, &all);
+    if (!*error && cm_attractor_check(&all, why, sizeof why) != CM_OK)
+        *error = cli_usage_error(c, "%s: %s", c->opt, why);
     return true;
-}
-
-void attractor_fates(const cm_attractor_set *s, uint64_t sink_cells, cell_fates *out)
-{
-    out->left = sink_cells;
-    out->diverged = s->diverged_cells;
-    out->undecided = s->unresolved_cells;
 }
 
 static int larger_basin(const void *a, const void *b)
@@ -54,7 +54,7 @@ static int larger_basin(const void *a, const void *b)
 static double percent(uint64_t part, uint64_t all) { return all ? 100.0 * part / all : 0; }
 
 void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
-                    const cell_fates *fates, uint64_t cells, int rows)
+                    uint64_t sink_cells, uint64_t cells, int rows)
 {
     fprintf(out, "attractors %u, by true orbits from %u cell groups: %u merged into another "
                  "group's attractor, %u artefacts (%u diverge, %u undecided)\n",
@@ -89,9 +89,9 @@ void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
     free(sorted);
     fprintf(out, "diverged %llu cells (%.1f%%), undecided %llu (%.1f%%), left the computed "
                  "cells (fate unknown) %llu (%.1f%%)\n",
-            (unsigned long long)fates->diverged, percent(fates->diverged, cells),
-            (unsigned long long)fates->undecided, percent(fates->undecided, cells),
-            (unsigned long long)fates->left, percent(fates->left, cells));
+            (unsigned long long)s->diverged_cells, percent(s->diverged_cells, cells),
+            (unsigned long long)s->unresolved_cells, percent(s->unresolved_cells, cells),
+            (unsigned long long)sink_cells, percent(sink_cells, cells));
 }
 
 void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat)
@@ -107,7 +107,7 @@ void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat
 }
 
 void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
-                    const cell_fates *fates)
+                    uint64_t sink_cells)
 {
     json_array(j, "attractors");
     for (uint32_t k = 0; k < s->n; k++) {
@@ -129,9 +129,9 @@ void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
         json_object_end(j);
     }
     json_array_end(j);
-    json_uint(j, "diverged_cells", fates->diverged);
-    json_uint(j, "undecided_cells", fates->undecided);
-    json_uint(j, "outside_cells", fates->left);
+    json_uint(j, "diverged_cells", s->diverged_cells);
+    json_uint(j, "undecided_cells", s->unresolved_cells);
+    json_uint(j, "outside_cells", sink_cells);
 }
 
 void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat,
@@ -149,6 +149,11 @@ void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm
         json_object_end(j);
     }
     json_array_end(j);
+}
+
+bool attractor_options_given(const cm_attractor_options *o)
+{
+    return o->transient || o->record || o->max_steps || o->tol || o->match;
 }
 
 bool by_option_take(cli *c, int *by, int *error)
@@ -178,8 +183,7 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
                           const cm_attractor_options *o, cm_attractor_set *out, char *msg,
                           size_t msg_size)
 {
-    const bool asked = o && (o->transient || o->record || o->max_steps || o->tol || o->match);
-    if (!asked) {
+    if (!o || !attractor_options_given(o)) {
         const cm_status st =
             cm_store_get_attractors(s, c->lat.dim, ngroups, out, NULL, msg, msg_size);
         if (st != CM_ENOTFOUND)
@@ -199,10 +203,8 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
 
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g)
 {
-    if (g == CM_GROUP_NONE)
-        return g;
-    const uint32_t a = g <= s->ngroups ? s->of_group[g] : CM_FATE_DIVERGED;
-    return a == CM_FATE_UNRESOLVED ? 0 : a;
+    const int32_t label = cm_attractor_label(s, g);
+    return g == CM_GROUP_NONE ? g : label > 0 ? (uint32_t)label : 0;
 }
 
 cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_info **groups,

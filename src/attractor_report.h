@@ -29,28 +29,25 @@
  * was one of them (a bad value is reported and *error set). */
 bool attractor_options_take(cli *c, cm_attractor_options *o, int *error);
 
-/* Cells of the solve by what the true orbits say: on attractors' basins,
- * diverged (their group's orbit diverges), undecided (their group's orbit
- * was still undecided) and left (the sink of cell mapping: the sequence
- * left the computed cells, fate unknown). */
-typedef struct cell_fates {
-    uint64_t diverged, undecided, left;
-} cell_fates;
-
-void attractor_fates(const cm_attractor_set *s, uint64_t sink_cells, cell_fates *out);
-
 /* The text summary's attractor lines (the largest basins first, at most
- * `rows`), and the line on the cell groups behind them. */
+ * `rows`), and the cells that reach none: those of groups whose orbits
+ * diverge or were undecided, and the sink's (sink_cells: the sequence left
+ * the computed cells, fate unknown). */
 void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
-                    const cell_fates *fates, uint64_t cells, int rows);
+                    uint64_t sink_cells, uint64_t cells, int rows);
 
 /* An attractor's id, kind, period (null when aperiodic), basin_cells and
  * centre, the fields every JSON that lists attractors has. */
 void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat);
 
-/* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells". */
+/* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells"
+ * (the sink's sink_cells). */
 void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
-                    const cell_fates *fates);
+                    uint64_t sink_cells);
+
+/* Whether any --attractor-* option was given (then a file's stored
+ * attractors are not the ones asked for). */
+bool attractor_options_given(const cm_attractor_options *o);
 
 /* --by groups|attractors: what figures and labels show (default: attractors). */
 enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };

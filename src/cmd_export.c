@@ -342,14 +342,6 @@ static int numbers_json(char *buf, size_t size, const double *v, int n)
     return snprintf(buf + used, used < size ? size - used : 0, "]") > 0;
 }
 
-/* A group's attractor as the file's group_fates has it: its id, 0 when its
- * true orbit diverges, -1 undecided. */
-static int64_t group_attractor(const cm_attractor_set *att, uint32_t id)
-{
-    const uint32_t a = att->of_group[id];
-    return a == CM_FATE_UNRESOLVED ? -1 : (int64_t)a;
-}
-
 static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info *g, uint32_t n,
                          uint64_t sink, const cm_attractor_set *att)
 {
@@ -387,7 +379,7 @@ static int sqlite_groups(cell_out *o, const cm_lattice *lat, const cm_group_info
             sqlite3_bind_text(st, 7, hi, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 8, anchor, -1, SQLITE_TRANSIENT);
             sqlite3_bind_text(st, 9, cm_group_kind_name(gi->kind), -1, SQLITE_STATIC);
-            sqlite3_bind_int64(st, 10, group_attractor(att, gi->id));
+            sqlite3_bind_int64(st, 10, cm_attractor_fate(att, gi->id));
         }
         ok = sqlite3_step(st) == SQLITE_DONE;
         sqlite3_reset(st);
@@ -481,7 +473,7 @@ static int export_groups(const char *path, const char *const *names, const cm_la
         for (int d = 0; d < lat->dim; d++)
             fprintf(o.f, ",%lld", (long long)g[k].anchor[d]);
         fprintf(o.f, ",%s,%lld\n", cm_group_kind_name(g[k].kind),
-                (long long)group_attractor(att, g[k].id));
+                (long long)cm_attractor_fate(att, g[k].id));
     }
     return out_end(&o, 1, msg, msg_size);
 }
@@ -634,10 +626,8 @@ static int export_groups_only(const export_args *a)
         st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for %u groups", info.groups);
     if (st == CM_OK)
         st = cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg);
-    const bool asked = a->att.transient || a->att.record || a->att.max_steps || a->att.tol ||
-                       a->att.match;
     cm_status got = CM_ENOTFOUND;
-    if (st == CM_OK && !asked)
+    if (st == CM_OK && !attractor_options_given(&a->att))
         got = cm_store_get_attractors(s, info.lattice.dim, info.groups, &att, NULL, msg,
                                       sizeof msg);
     st = got == CM_ENOTFOUND ? st : got;

@@ -144,13 +144,6 @@ static int parse_solve(cli *c, solve_args *a)
     if (!err)
         err = png_opts_check(c, &a->png);
     char why[2048];
-    cm_attractor_options att;
-    cm_attractor_defaults(NULL, &a->att, &att);
-    if (!err && (a->att.max_steps || a->att.transient || a->att.record) &&
-        cm_attractor_check(&att, why, sizeof why) != CM_OK)
-        err = cli_usage_error(c, "--attractor-steps: %s", why);
-    else if (!err && cm_attractor_check(&att, why, sizeof why) != CM_OK)
-        err = cli_usage_error(c, "--attractor-tol: %s", why);
     if (!err && !png_opts_apart(&a->png, a->db, true, why, sizeof why))
         err = cli_usage_error(c, "%s", why);
     if (!err && !a->extend && (a->bounds_text || a->escape_below > 0))
@@ -255,7 +248,6 @@ typedef struct summary {
     cm_group_info *groups; /* in id order */
     double slow[CM_MAX_DIM]; /* cm_scm_slow_share of a single region; NaN: unknown */
     cm_attractor_set att;    /* the attractors the groups' true orbits give */
-    cell_fates fates;
     double att_seconds;
 } summary;
 
@@ -281,7 +273,7 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     fprintf(out, "time: %s %.3f s, %s %.3f s (%.1f ns/cell), attractors %.3f s (%llu steps)\n",
             t->first, t->t1, t->second, t->t2, 1e9 * (t->t1 + t->t2) / (double)cells,
             sum->att_seconds, (unsigned long long)sum->att.steps);
-    attractor_text(out, lat, &sum->att, &sum->fates, cells, TEXT_GROUPS);
+    attractor_text(out, lat, &sum->att, sink, cells, TEXT_GROUPS);
     fprintf(out, "cell groups %u (simple cell mapping's periodic groups; the sink %llu cells, "
                  "%.1f%%):\n",
             ngroups, (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
@@ -357,7 +349,7 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     json_object_end(&j);
     if (log)
         print_json_extension(&j, lat, log);
-    attractor_json(&j, lat, &sum->att, &sum->fates);
+    attractor_json(&j, lat, &sum->att, sum->sink);
     attractor_json_groups(&j, sum->groups, sum->ngroups, lat, &sum->att);
     json_end(&j);
 }
@@ -740,7 +732,6 @@ int cmd_solve(int argc, char **argv)
     if (rn.store && cm_store_put_attractors(rn.store, &sum.att, &used, lat.dim, msg, sizeof msg) !=
                         CM_OK)
         goto fail;
-    attractor_fates(&sum.att, sum.sink, &sum.fates);
     const extend_log *shown = a.extend ? log : NULL;
     if (a.json)
         print_json(a.report, &m, &lat, &sum, &t, shown);

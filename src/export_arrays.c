@@ -46,19 +46,13 @@ static void put_i32(unsigned char *p, int32_t v)
         p[b] = (unsigned char)(u >> (8 * b));
 }
 
-/* A cell's label: its group (by groups), or its group's attractor: the
- * attractor's id, 0 diverged, -2 outside (left the cells, undecided); -1
- * not computed. */
+/* A cell's label: its group (by groups; -1 not computed), or its group's
+ * attractor (cm_attractor_label). */
 static int32_t label_of(const cm_attractor_set *s, uint32_t g)
 {
-    if (g == CM_GROUP_NONE)
-        return -1;
-    if (!s)
-        return (int32_t)g;
-    if (g == 0)
-        return -2;
-    const uint32_t a = s->of_group[g];
-    return a == CM_FATE_UNRESOLVED ? -2 : (int32_t)a;
+    if (s)
+        return cm_attractor_label(s, g);
+    return g == CM_GROUP_NONE ? -1 : (int32_t)g;
 }
 
 /* The slab's cells in C order (dimension 0 slowest): one int32 each;
