@@ -28,6 +28,8 @@ void cm_attractor_defaults(const cm_model *m, const cm_attractor_options *in,
         out->tol = CM_ATTRACTOR_TOL;
     if (out->match == 0)
         out->match = CM_ATTRACTOR_MATCH;
+    if (!out->outside)
+        out->outside = CM_OUTSIDE_STEPS;
 }
 
 cm_status cm_attractor_check(const cm_attractor_options *o, char *msg, size_t msg_size)
@@ -46,6 +48,10 @@ cm_status cm_attractor_check(const cm_attractor_options *o, char *msg, size_t ms
                        "the attractor budget of %u steps must hold the transient (%u) and a "
                        "record of at least 8 steps (%u)",
                        o->max_steps, o->transient, o->record);
+    if (o->outside > CM_OUTSIDE_MAX_STEPS && o->outside != CM_OUTSIDE_OFF)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "orbits that leave the computed cells are followed at most %u steps, "
+                       "not %u", CM_OUTSIDE_MAX_STEPS, o->outside);
     return CM_OK;
 }
 
@@ -1008,8 +1014,6 @@ static cm_status check_representatives(const follow_ctx *f, const cm_group_info 
             const uint64_t before = r[k].steps;
             failed |= follow(f, p[k].x, known.used ? &known : NULL, &r[k], &from[k]) != CM_OK;
             steps += r[k].steps - before;
-            if (getenv("CM_ATT_DEBUG"))
-                fprintf(stderr, "rep %u basin %llu fate %d steps %llu cells %llu\n", groups[order[k].index].id, (unsigned long long)todo[i].basin, r[k].fate, (unsigned long long)(r[k].steps - before), (unsigned long long)r[k].ncells);
         }
         *taken += steps;
         if (failed)
@@ -1165,9 +1169,15 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
 int32_t cm_attractor_label(const cm_attractor_set *s, uint32_t g)
 {
     if (g == CM_GROUP_NONE)
-        return -1;
+        return CM_LABEL_UNCOMPUTED;
     const uint32_t a = g == 0 || g > s->ngroups ? CM_FATE_UNRESOLVED : s->of_group[g];
-    return a == CM_FATE_UNRESOLVED ? -2 : (int32_t)a;
+    return a == CM_FATE_UNRESOLVED ? CM_LABEL_OUTSIDE : (int32_t)a;
+}
+
+int32_t cm_attractor_exit_label(const cm_attractor_set *s, int dim, const int64_t *cell)
+{
+    const uint64_t k = cm_cell_search(s->exit_cell, s->nexits, dim, cell);
+    return k == UINT64_MAX ? CM_LABEL_OUTSIDE : s->exit_label[k];
 }
 
 int64_t cm_attractor_fate(const cm_attractor_set *s, uint32_t g)
@@ -1184,5 +1194,7 @@ void cm_attractors_free(cm_attractor_set *s)
     free(s->of_group);
     free(s->footprint);
     free(s->footprint_at);
+    free(s->exit_cell);
+    free(s->exit_label);
     memset(s, 0, sizeof *s);
 }

@@ -48,8 +48,16 @@ typedef struct cm_attractor_options {
                            integration over a period) */
     double tol;         /* recurrence tolerance, in cell widths; default 1e-4 */
     double match;       /* two cycles are one within this, in cell widths; default 1e-2 */
+    uint32_t outside;   /* steps an orbit that leaves the computed cells is followed
+                           (cellmap/outside.h); default 100; CM_OUTSIDE_OFF: not followed */
     int threads;        /* OpenMP threads; 0: the OpenMP default */
 } cm_attractor_options;
+
+/* Newton's method for z^3 - 1 needs about 30 steps back into -2:2^2 from
+ * the cells next to the origin at 1000^2 cells: 100 leaves room. */
+#define CM_OUTSIDE_STEPS 100
+#define CM_OUTSIDE_OFF UINT32_MAX
+#define CM_OUTSIDE_MAX_STEPS 1048576 /* the largest budget other than CM_OUTSIDE_OFF */
 
 #define CM_ATTRACTOR_TRANSIENT 16
 #define CM_ATTRACTOR_RECORD 500
@@ -98,7 +106,23 @@ typedef struct cm_attractor_set {
     uint64_t unresolved_cells; /* the basins of unresolved groups */
     uint64_t diverged_cells;   /* the basins of groups whose orbits diverge (not the sink) */
     uint64_t steps;      /* map steps taken */
+    /* orbits that left the computed cells (cellmap/outside.h) */
+    uint32_t outside_steps;       /* the budget they were followed with; 0: not followed */
+    uint64_t nexits;              /* exit cells */
+    int64_t *exit_cell;           /* nexits cells, dim coordinates each, in box order */
+    int32_t *exit_label;          /* each one's fate: an attractor id, 0 diverged, -2 outside */
+    uint64_t sink_diverged_cells; /* sink cells that diverge: no image, beyond the world, or
+                                     an orbit that does */
+    uint64_t outside_cells;       /* sink cells whose orbits stay outside (or keep leaving) */
+    uint64_t returned_cells;      /* sink cells whose orbits return to an attractor's basin
+                                     (counted in its basin_cells) */
+    uint64_t outside_steps_taken; /* map steps taken following them */
 } cm_attractor_set;
+
+/* Labels by attractors: an attractor's id (1..n), or one of these. */
+#define CM_LABEL_DIVERGED 0
+#define CM_LABEL_UNCOMPUTED (-1) /* no cell computed there */
+#define CM_LABEL_OUTSIDE (-2) /* left the computed cells and did not come back; undecided */
 
 /* The options with every 0 replaced by its default for model m. */
 void cm_attractor_defaults(const cm_model *m, const cm_attractor_options *in,
@@ -130,8 +154,12 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
 
 /* Group g's label by attractors, as `export --labels` writes it: its
  * attractor's id, 0 when its true orbit diverges, -2 outside (the sink,
- * g = 0, or an undecided orbit), -1 for CM_GROUP_NONE (no cell computed). */
+ * g = 0, or an undecided orbit), -1 for CM_GROUP_NONE (no cell computed).
+ * The sink's cells have labels of their own: cm_attractor_cell_labels. */
 int32_t cm_attractor_label(const cm_attractor_set *s, uint32_t g);
+/* The fate of exit cell `cell` (cellmap/outside.h): an attractor id, 0
+ * diverged, -2 outside (also for a cell that is not one of s's exits). */
+int32_t cm_attractor_exit_label(const cm_attractor_set *s, int dim, const int64_t *cell);
 /* Group g's fate as a file stores it (group_fates): its attractor's id, 0
  * when its orbit diverges, -1 undecided. g in 1..s->ngroups. */
 int64_t cm_attractor_fate(const cm_attractor_set *s, uint32_t g);

@@ -36,8 +36,10 @@
  *   CM_LABEL_NONE for a cell of a view that no region of a database covers.
  *   Its step number counts the map's steps to its group's periodic cells
  *   (0 on them). Its attractor label is the system's attractor its group's
- *   true orbit reaches (cm_result_attractor_labels; docs/engine.md,
- *   "Attractors").
+ *   true orbit reaches, and for a sink cell the attractor the true orbit
+ *   from the cell its sequence leaves into comes back to
+ *   (cm_result_attractor_labels; docs/engine.md, "Attractors" and "Orbits
+ *   that leave the computed cells").
  * - Versions. CELLMAP_VERSION_* are this header's; cm_version() the
  *   library's. The same major version keeps source and binary
  *   compatibility (the library's SONAME is libcellmap.so.MAJOR).
@@ -182,9 +184,11 @@ uint32_t cm_result_attractors(const cm_result *r);
 /* Attractor id into *out; CM_ENOTFOUND beyond. */
 cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summary *out);
 /* Every cell's attractor label into an array of cm_result_cells entries:
- * the attractor's id, 0 when its group's true orbit diverges, -2 outside
- * (its sequence leaves the solved cells, or its group's orbit was
- * undecided), -1 for a cell no region covers. */
+ * the attractor's id; 0 when it diverges (its group's true orbit does, or
+ * its sequence has no image, or leaves the solved cells on an orbit that
+ * leaves the world); -2 outside (it leaves the solved cells and its orbit
+ * does not come back within the budget, 100 steps, or its group's orbit
+ * was undecided); -1 for a cell no region covers. */
 void cm_result_attractor_labels(const cm_result *r, int32_t *labels);
 
 /* The basin figure (basins, attractors, axes, legend, title) as a PNG of

@@ -137,6 +137,9 @@ typedef struct cm_cluster {
      * without a database) sets 0: a joined region then drops its exit
      * table (16 bytes per exit in 2-D) and open lists are not kept. */
     int keep_exits;
+    /* read-only: the regions hold resolved cells (a file of version 2 or
+     * 3): a sink cell does not say which exit its sequence leaves by */
+    int resolved_cells;
     uint64_t nnodes;                  /* read-only: nodes of all regions */
     uint64_t cells;                   /* read-only: cells of all regions */
     uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */

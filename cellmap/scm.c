@@ -103,6 +103,14 @@ static int image_cell(const cm_model *model, const cm_lattice *lat, const int64_
     }
 }
 
+int cm_scm_image_cell(const cm_model *model, const cm_lattice *lat, const int64_t *from,
+                      int max_steps, int64_t *cell, bool *in_world)
+{
+    double x[CM_MAX_DIM];
+    cm_lattice_centre(lat, from, x);
+    return image_cell(model, lat, from, max_steps, x, cell, in_world);
+}
+
 /* Exit targets one thread found, rows in the order it did them. */
 typedef struct exit_buf {
     _Alignas(CM_CACHE_LINE) int64_t *cells; /* dim coordinates per exit (a line per thread) */
@@ -603,6 +611,19 @@ bool cm_cell_less(const int64_t *a, const int64_t *b, int dim)
         if (a[d] != b[d])
             return a[d] < b[d];
     return false;
+}
+
+uint64_t cm_cell_search(const int64_t *cells, uint64_t n, int dim, const int64_t *cell)
+{
+    uint64_t lo = 0, hi = n;
+    while (lo < hi) { /* the first cell not before `cell` */
+        const uint64_t mid = lo + (hi - lo) / 2;
+        if (cm_cell_less(cells + mid * (uint64_t)dim, cell, dim))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && !cm_cell_less(cell, cells + lo * (uint64_t)dim, dim) ? lo : UINT64_MAX;
 }
 
 void cm_group_add_periodic(cm_group_info *gi, const cm_lattice *lat, const int64_t *cell)

@@ -138,6 +138,13 @@ uint64_t cm_region_bytes(const cm_region *r);
 cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_scm_options *opt,
                         cm_region *r, char *msg, size_t msg_size);
 
+/* The image cell of cell `from` by the rule cm_scm_images uses (the
+ * centre's image, re-stepped while it stays in `from`, max_steps steps in
+ * all) into cell; *in_world false when there is none (no image, or beyond
+ * the world). Returns the model's status (< 0: it aborted). */
+int cm_scm_image_cell(const cm_model *model, const cm_lattice *lat, const int64_t *from,
+                      int max_steps, int64_t *cell, bool *in_world);
+
 /* Slow directions: for each dimension d, the share of the cells whose image
  * is another cell of the box in the same slab of d (equal coordinate d),
  * into share[d]; NaN where no cell's image is another cell of the box. A
@@ -159,6 +166,9 @@ cm_status cm_scm_solve(const cm_model *model, const cm_lattice *lat, const cm_sc
 
 /* Box order of cells: the last coordinate first (true if a comes before b). */
 bool cm_cell_less(const int64_t *a, const int64_t *b, int dim);
+/* The index of `cell` among n distinct cells in box order (dim coordinates
+ * each), or UINT64_MAX when it is not one of them. O(log n). */
+uint64_t cm_cell_search(const int64_t *cells, uint64_t n, int dim, const int64_t *cell);
 
 /* Adds a periodic cell to a group's summary (period, anchor, bounds, the
  * centre's running sum); cells must come in box order (cm_cell_less) for

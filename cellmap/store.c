@@ -150,8 +150,10 @@ static const char *const shadow_v2_sql = GROUPS_VIEW_V3_SQL("TEMP ", "'attractor
     " EXISTS(SELECT 1 FROM nodes), EXISTS(SELECT 1 FROM basins),"                                  \
     " EXISTS(SELECT 1 FROM pages WHERE region = 1)"
 #define CHECK_V5_SQL CHECK_V4_SQL ", EXISTS(SELECT 1 FROM open_nodes)"
-static const char *const check_sql =
-    CHECK_V5_SQL ", EXISTS(SELECT 1 FROM system_attractors), EXISTS(SELECT 1 FROM group_fates)";
+#define CHECK_V6_SQL                                                                               \
+    CHECK_V5_SQL ", EXISTS(SELECT 1 FROM system_attractors), EXISTS(SELECT 1 FROM group_fates)"
+static const char *const check_sql = CHECK_V6_SQL ", EXISTS(SELECT 1 FROM exit_fates)";
+static const char *const check_v6_sql = CHECK_V6_SQL;
 static const char *const check_v5_sql = CHECK_V5_SQL;
 static const char *const check_v4_sql = CHECK_V4_SQL;
 static const char *const check_v3_sql =
@@ -220,7 +222,8 @@ static cm_status check_file(sqlite3 *db, const char *path, int full, char *msg, 
     if (ids != CM_OK)
         return ids;
     sqlite3_stmt *st = NULL;
-    const char *sql = version >= 6   ? check_sql
+    const char *sql = version >= 7   ? check_sql
+                      : version == 6 ? check_v6_sql
                       : version == 5 ? check_v5_sql
                       : version == 4 ? check_v4_sql
                                      : check_v3_sql;

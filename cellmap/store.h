@@ -7,7 +7,9 @@
  * (cellmap/codec.h), their exit tables, node tables and open nodes, the
  * cell count per group, the periodic groups (table `attractors`, a name
  * kept from version 2), and (version 6) the system's attractors that the
- * groups' true orbits give (cellmap/attractors.h) with each group's. The
+ * groups' true orbits give (cellmap/attractors.h) with each group's, and
+ * (version 7) the fates of the orbits that leave the computed cells
+ * (cellmap/outside.h). The
  * view `groups` adds basin sizes and the sink. Layout: docs/format.md.
  *
  * The file carries application_id CM_STORE_APP_ID and user_version
@@ -15,7 +17,8 @@
  * version or corrupt are refused (CM_EFORMAT) and never modified. Files of
  * versions 2 and 3 (regions stored resolved, no node tables; version 2
  * without group kinds), 4 (no table of open nodes: every node table is
- * read at open) and 5 (no system attractors) are read as they are; writing
+ * read at open), 5 (no system attractors) and 6 (attractors found without
+ * following orbits out of the cells: read as none) are read as they are; writing
  * needs cm_store_upgrade.
  *
  * Crash safety: the file is in WAL mode while open for writing, and
@@ -41,7 +44,7 @@
 #include "cellmap/scm.h"
 
 #define CM_STORE_APP_ID 0x434D4442 /* "CMDB" */
-#define CM_STORE_VERSION 6
+#define CM_STORE_VERSION 7
 #define CM_STORE_PAGE_CELLS 65536
 
 typedef struct cm_store cm_store;

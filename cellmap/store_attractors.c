@@ -1,8 +1,11 @@
-/* The system's attractors in a .cmdb file (format version 6): tables
+/* The system's attractors in a .cmdb file (format version 7): tables
  * system_attractors (one row each, the footprint as a BLOB of little-endian
- * int64 cells, dim coordinates each, in box order) and group_fates (each
- * group's attractor id, 0 when its true orbit diverges, -1 undecided), and
- * the options they were found with (meta 'attractor_options'). */
+ * int64 cells, dim coordinates each, in box order), group_fates (each
+ * group's attractor id, 0 when its true orbit diverges, -1 undecided) and
+ * exit_fates (one row per fate of the exits, cellmap/outside.h: an
+ * attractor id, 0 diverged, -2 outside, with its exit cells as a BLOB like
+ * the footprints), and the options they were found with and the sink's
+ * counts (meta 'attractor_options'). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,10 +14,44 @@
 
 #define OPTIONS_KEY "attractor_options"
 
-static void options_text(const cm_attractor_options *o, uint64_t steps, char *out, size_t size)
+static void options_text(const cm_attractor_options *o, const cm_attractor_set *a, char *out,
+                         size_t size)
 {
-    snprintf(out, size, "%u,%u,%u,%.17g,%.17g,%llu", o->transient, o->record, o->max_steps,
-             o->tol, o->match, (unsigned long long)steps);
+    snprintf(out, size, "%u,%u,%u,%.17g,%.17g,%llu,%u,%llu,%llu,%llu,%llu", o->transient,
+             o->record, o->max_steps, o->tol, o->match, (unsigned long long)a->steps,
+             a->outside_steps, (unsigned long long)a->outside_steps_taken,
+             (unsigned long long)a->sink_diverged_cells, (unsigned long long)a->outside_cells,
+             (unsigned long long)a->returned_cells);
+}
+
+/* Exit cells of s in box order, label by label: exit_fates' rows. */
+static cm_status write_exit_fates(cm_store *s, const cm_attractor_set *a, int dim, char *msg,
+                                  size_t msg_size)
+{
+    sqlite3_stmt *ins = NULL;
+    int64_t *cells = malloc(((size_t)a->nexits + 1) * (size_t)dim * sizeof *cells);
+    cm_status st = cells ? CM_OK
+                         : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                                   (unsigned long long)a->nexits);
+    if (st == CM_OK && (store_exec(s->db, "DELETE FROM exit_fates") != SQLITE_OK ||
+                        sqlite3_prepare_v2(s->db, "INSERT INTO exit_fates VALUES(?, ?, ?)", -1,
+                                           &ins, NULL) != SQLITE_OK))
+        st = store_db_error(s->db, "prepare the exits' fates", msg, msg_size);
+    for (int64_t label = CM_LABEL_OUTSIDE; st == CM_OK && label <= (int64_t)a->n; label++) {
+        uint64_t n = 0;
+        for (uint64_t e = 0; e < a->nexits; e++)
+            if (a->exit_label[e] == label)
+                memcpy(cells + n++ * dim, a->exit_cell + e * dim, (size_t)dim * sizeof *cells);
+        if (n == 0)
+            continue;
+        sqlite3_bind_int64(ins, 1, label);
+        sqlite3_bind_int64(ins, 2, (sqlite3_int64)n);
+        sqlite3_bind_blob64(ins, 3, cells, n * dim * sizeof *cells, SQLITE_STATIC);
+        st = store_step_done(s->db, ins, "write the exits' fates", msg, msg_size);
+    }
+    sqlite3_finalize(ins);
+    free(cells);
+    return st;
 }
 
 static cm_status write_rows(cm_store *s, const cm_attractor_set *a, int dim, char *msg,
@@ -72,8 +109,10 @@ cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
     cm_status st = store_begin(s, msg, msg_size);
     if (st == CM_OK)
         st = write_rows(s, a, dim, msg, msg_size);
-    char text[256];
-    options_text(o, a->steps, text, sizeof text);
+    if (st == CM_OK)
+        st = write_exit_fates(s, a, dim, msg, msg_size);
+    char text[512];
+    options_text(o, a, text, sizeof text);
     sqlite3_stmt *meta = NULL;
     if (st == CM_OK && sqlite3_prepare_v2(s->db,
                                           "INSERT OR REPLACE INTO meta(key, value) VALUES('" OPTIONS_KEY
@@ -92,24 +131,32 @@ cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
     return st == CM_OK ? st : store_abandon(s, st);
 }
 
-/* The options of the stored attractors; CM_ENOTFOUND if none are stored
- * (a file of version 5 or older, or a solve interrupted before them). */
-static cm_status stored_options(cm_store *s, cm_attractor_options *o, uint64_t *steps)
+/* The options of the stored attractors and the sink's counts into a;
+ * CM_ENOTFOUND if none are stored (a file of version 6 or older, or a
+ * solve interrupted before them). */
+static cm_status stored_options(cm_store *s, cm_attractor_options *o, cm_attractor_set *a)
 {
-    if (s->version < 6)
+    if (s->version < 7)
         return CM_ENOTFOUND;
     sqlite3_stmt *q = NULL;
     cm_status st = CM_ENOTFOUND;
     if (sqlite3_prepare_v2(s->db, "SELECT value FROM meta WHERE key = '" OPTIONS_KEY "'", -1, &q,
                            NULL) == SQLITE_OK &&
         sqlite3_step(q) == SQLITE_ROW && sqlite3_column_text(q, 0)) {
-        unsigned long long n = 0;
+        unsigned long long n[5] = {0};
         memset(o, 0, sizeof *o);
-        st = sscanf((const char *)sqlite3_column_text(q, 0), "%u,%u,%u,%lg,%lg,%llu",
-                    &o->transient, &o->record, &o->max_steps, &o->tol, &o->match, &n) == 6
+        st = sscanf((const char *)sqlite3_column_text(q, 0),
+                    "%u,%u,%u,%lg,%lg,%llu,%u,%llu,%llu,%llu,%llu", &o->transient, &o->record,
+                    &o->max_steps, &o->tol, &o->match, &n[0], &a->outside_steps, &n[1], &n[2],
+                    &n[3], &n[4]) == 11
                  ? CM_OK
                  : CM_EFORMAT;
-        *steps = n;
+        o->outside = a->outside_steps ? a->outside_steps : CM_OUTSIDE_OFF;
+        a->steps = n[0];
+        a->outside_steps_taken = n[1];
+        a->sink_diverged_cells = n[2];
+        a->outside_cells = n[3];
+        a->returned_cells = n[4];
     }
     sqlite3_finalize(q);
     return st;
@@ -219,13 +266,79 @@ static cm_status read_fates(cm_store *s, cm_attractor_set *a, char *msg, size_t 
     return st;
 }
 
+typedef struct exit_row {
+    int64_t c[CM_MAX_DIM];
+    int32_t label;
+} exit_row;
+
+static int exit_row_less(const void *a, const void *b)
+{
+    const int64_t *x = ((const exit_row *)a)->c, *y = ((const exit_row *)b)->c;
+    return cm_cell_less(x, y, CM_MAX_DIM) ? -1 : cm_cell_less(y, x, CM_MAX_DIM);
+}
+
+/* The exits' fates into a (a->n attractors read), sorted into box order. */
+static cm_status read_exit_fates(cm_store *s, int dim, cm_attractor_set *a, char *msg,
+                                 size_t msg_size)
+{
+    const int64_t bytes = store_query_int(s->db, "SELECT IFNULL(SUM(LENGTH(cells)), 0) FROM "
+                                                 "exit_fates");
+    const uint64_t cells = bytes > 0 ? (uint64_t)bytes / (dim * sizeof(int64_t)) : 0;
+    exit_row *rows = calloc((size_t)cells + 1, sizeof *rows);
+    a->exit_cell = malloc(((size_t)cells + 1) * dim * sizeof *a->exit_cell);
+    a->exit_label = malloc(((size_t)cells + 1) * sizeof *a->exit_label);
+    if (bytes < 0 || !rows || !a->exit_cell || !a->exit_label) {
+        free(rows);
+        return bytes < 0 ? cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates cannot be read")
+                         : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                                   (unsigned long long)cells);
+    }
+    sqlite3_stmt *q = NULL;
+    cm_status st = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "SELECT attractor, exits, cells FROM exit_fates", -1, &q,
+                           NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "read the exits' fates", msg, msg_size);
+    uint64_t n = 0;
+    while (st == CM_OK && sqlite3_step(q) == SQLITE_ROW) {
+        const int64_t label = sqlite3_column_int64(q, 0), count = sqlite3_column_int64(q, 1);
+        const int64_t *blob = sqlite3_column_blob(q, 2);
+        const uint64_t size = (uint64_t)sqlite3_column_bytes(q, 2);
+        if (label < CM_LABEL_OUTSIDE || label == CM_LABEL_UNCOMPUTED || label > a->n ||
+            count < 1 || n + (uint64_t)count > cells ||
+            size != (uint64_t)count * dim * sizeof *blob) {
+            st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
+            break;
+        }
+        for (int64_t k = 0; k < count; k++, n++) {
+            memcpy(rows[n].c, blob + k * dim, (size_t)dim * sizeof *blob);
+            rows[n].label = (int32_t)label;
+        }
+    }
+    sqlite3_finalize(q);
+    if (st == CM_OK && n != cells)
+        st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
+    if (st == CM_OK) {
+        qsort(rows, n, sizeof *rows, exit_row_less);
+        for (uint64_t e = 0; e < n; e++) {
+            if (e && exit_row_less(&rows[e - 1], &rows[e]) == 0) {
+                st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
+                break;
+            }
+            memcpy(a->exit_cell + e * dim, rows[e].c, (size_t)dim * sizeof *a->exit_cell);
+            a->exit_label[e] = rows[e].label;
+        }
+        a->nexits = n;
+    }
+    free(rows);
+    return st;
+}
+
 cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
                                   cm_attractor_options *o, char *msg, size_t msg_size)
 {
     memset(a, 0, sizeof *a);
     cm_attractor_options stored;
-    uint64_t steps = 0;
-    cm_status st = stored_options(s, &stored, &steps);
+    cm_status st = stored_options(s, &stored, a);
     if (st == CM_ENOTFOUND)
         return st;
     if (st != CM_OK)
@@ -233,12 +346,13 @@ cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_att
                                         "its attractor options are damaged"),
                              msg, msg_size);
     a->ngroups = ngroups;
-    a->steps = steps;
     a->of_group = calloc((size_t)ngroups + 1, sizeof *a->of_group);
     st = a->of_group ? read_attractors(s, dim, a, msg, msg_size)
                      : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", ngroups);
     if (st == CM_OK)
         st = read_fates(s, a, msg, msg_size);
+    if (st == CM_OK)
+        st = read_exit_fates(s, dim, a, msg, msg_size);
     if (st != CM_OK) {
         cm_attractors_free(a);
         return store_damaged(s, st, msg, msg_size);

@@ -52,14 +52,19 @@ extern const char *const store_tables_sql;
 #define OPEN_NODES_TABLE_SQL                                                                       \
     "CREATE TABLE open_nodes(region INTEGER PRIMARY KEY REFERENCES regions(id),"                   \
     " count INTEGER NOT NULL, data BLOB NOT NULL);"
-/* Version 6's tables of the system's attractors (store_attractors.c). */
+/* Version 6's tables of the system's attractors (store_attractors.c), and 7's. */
 #define SYSTEM_ATTRACTORS_SQL                                                                      \
     "CREATE TABLE system_attractors(id INTEGER PRIMARY KEY,"                                       \
     " kind TEXT NOT NULL CHECK(kind IN ('periodic', 'aperiodic', 'sticking')), period INTEGER,"   \
     " basin_cells INTEGER NOT NULL, groups INTEGER NOT NULL, centre TEXT NOT NULL,"               \
     " lo TEXT NOT NULL, hi TEXT NOT NULL, anchor TEXT NOT NULL,"                                   \
     " footprint_cells INTEGER NOT NULL, footprint BLOB NOT NULL);"                                 \
-    "CREATE TABLE group_fates(grp INTEGER PRIMARY KEY, attractor INTEGER NOT NULL);"
+    "CREATE TABLE group_fates(grp INTEGER PRIMARY KEY, attractor INTEGER NOT NULL);"           \
+    EXIT_FATES_SQL
+/* Version 7's: where the orbits that leave the computed cells go. */
+#define EXIT_FATES_SQL                                                                             \
+    "CREATE TABLE exit_fates(attractor INTEGER PRIMARY KEY, exits INTEGER NOT NULL,"               \
+    " cells BLOB NOT NULL);"
 
 double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);

@@ -537,6 +537,7 @@ cm_status cm_store_load_cluster(cm_store *s, cm_cluster *c, char *msg, size_t ms
     if (status != CM_OK)
         return status;
     cm_cluster_init(c, &lat);
+    c->resolved_cells = s->version < 4;
     cm_store_attach(s, c);
     status = store_check_groups(s, msg, msg_size);
     if (status != CM_OK)

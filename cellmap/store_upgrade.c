@@ -217,6 +217,21 @@ static cm_status add_system_attractors(cm_store *s, char *msg, size_t msg_size)
                : store_db_error(s->db, "add the attractors' tables", msg, msg_size);
 }
 
+/* Version 6's attractors were found without following the orbits that
+ * leave the computed cells: they go (the solve or session that upgraded
+ * the file finds them again), and the table of exits' fates comes. */
+static cm_status add_exit_fates(cm_store *s, char *msg, size_t msg_size)
+{
+    char sql[1024];
+    snprintf(sql, sizeof sql,
+             "DELETE FROM system_attractors; DELETE FROM group_fates;"
+             " DELETE FROM meta WHERE key = 'attractor_options'; %s PRAGMA user_version=%d;",
+             EXIT_FATES_SQL, CM_STORE_VERSION);
+    return store_exec(s->db, sql) == SQLITE_OK
+               ? CM_OK
+               : store_db_error(s->db, "add the exits' fates", msg, msg_size);
+}
+
 cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgraded, char *msg,
                            size_t msg_size)
 {
@@ -240,7 +255,8 @@ cm_status cm_store_upgrade(const char *path, const cm_model *model, int *upgrade
         st = store_db_error(s->db, "begin", why, sizeof why);
     s->in_transaction = st == CM_OK;
     if (st == CM_OK)
-        st = from == 5   ? add_system_attractors(s, why, sizeof why)
+        st = from == 6   ? add_exit_fates(s, why, sizeof why)
+             : from == 5 ? add_system_attractors(s, why, sizeof why)
              : from == 4 ? add_open_nodes(s, why, sizeof why)
                          : upgrade(s, why, sizeof why);
     if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)

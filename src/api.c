@@ -11,6 +11,7 @@
 
 #include "cellmap/cluster.h"
 #include "cellmap/join.h"
+#include "cellmap/outside.h"
 #include "cellmap/scm.h"
 #include "cellmap/store.h"
 #include "models/params.h"
@@ -37,6 +38,7 @@ struct cm_result {
     uint64_t sink;
     const cm_model *model; /* the system's or database's, for figures */
     cm_attractor_set att;  /* the system's attractors of the groups */
+    int32_t *att_labels;   /* every cell's attractor (cm_attractor_cell_labels) */
 };
 
 struct cm_db {
@@ -167,32 +169,76 @@ static cm_status grid_lattice(const cm_grid *g, int dim, cm_lattice *lat, cm_box
     return st;
 }
 
-/* A result over r's cells (taken), with its groups summarised. */
-/* make_result's attractors: a database's (stored, else found from its
- * cluster), or those of a solve's cells. */
-typedef struct result_attractors {
-    cm_store *store;     /* NULL: a solve */
-    cm_cluster *cluster; /* a database's */
-} result_attractors;
+/* Where a result's cells come from, for their attractors: a database
+ * (its stored attractors, else found from its cluster), a split solve's
+ * cluster, or a single region with its exits (cm_region_settle_exits). */
+typedef struct result_source {
+    cm_store *store;       /* a database's, or NULL */
+    cm_cluster *cluster;   /* the database's or the split's cluster, or NULL */
+    const cm_exits *exits; /* a single region's */
+    int max_steps;         /* the solve's, for a single region */
+} result_source;
 
-/* A database's attractors found from its cluster (a file without them). */
-static cm_status db_attractors(const cm_model *m, const result_attractors *from,
-                               cm_attractor_set *out, char *msg, size_t msg_size)
+/* The attractors of the cluster's groups (read from the store when it
+ * has them). */
+static cm_status cluster_attractors_of(const cm_model *m, const result_source *from,
+                                       cm_attractor_set *out, char *msg, size_t msg_size)
 {
     cm_cluster *c = from->cluster;
+    if (from->store) {
+        const cm_status st =
+            cm_store_get_attractors(from->store, c->lat.dim, c->ngroups, out, NULL, msg, msg_size);
+        if (st != CM_ENOTFOUND)
+            return st;
+    }
     cm_group_info *g = calloc((size_t)c->ngroups + 1, sizeof *g);
     uint64_t sink;
-    cm_status st = g ? cm_store_groups(from->store, g, c->ngroups, &sink, msg, msg_size)
-                     : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups");
+    cm_status st = !g ? cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups")
+                   : from->store ? cm_store_groups(from->store, g, c->ngroups, &sink, msg, msg_size)
+                                 : cm_cluster_describe_new(c, m, g, msg, msg_size);
     if (st == CM_OK)
-        st = cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, out, msg,
-                                msg_size);
+        st = cm_cluster_attractors(m, c, g, NULL, out, msg, msg_size);
     free(g);
     return st;
 }
 
+/* The result's attractors and every cell's label by them. */
+static cm_status result_attractors_of(cm_result *res, const result_source *from, char *msg,
+                                      size_t msg_size)
+{
+    const cm_model *m = res->model;
+    cm_status st = from->cluster ? cluster_attractors_of(m, from, &res->att, msg, msg_size)
+                                 : cm_region_attractors(m, &res->lat, &res->cells, from->max_steps,
+                                                        from->exits, res->groups, NULL, &res->att,
+                                                        msg, msg_size);
+    res->att_labels = st == CM_OK ? malloc((res->cells.ncells + 1) * sizeof *res->att_labels)
+                                  : NULL;
+    if (st == CM_OK && !res->att_labels)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
+    if (st != CM_OK)
+        return st;
+    if (!from->cluster) {
+        cm_region_cells rc = {&res->cells, m, &res->lat, from->max_steps};
+        const cm_computed cells = cm_region_computed(&rc);
+        return cm_attractor_cell_labels(&res->att, &res->cells, &cells, res->att_labels, msg,
+                                        msg_size);
+    }
+    cm_exits x;
+    st = cm_cluster_exits(from->cluster, &x, msg, msg_size);
+    if (st == CM_OK) {
+        cm_cluster_cells cc = {from->cluster, &x};
+        const cm_computed cells = cm_cluster_computed(&cc);
+        st = cm_attractor_cell_labels(&res->att, &res->cells, &cells, res->att_labels, msg,
+                                      msg_size);
+        cm_exits_free(&x);
+    }
+    return st;
+}
+
+/* A result over r's cells (taken), with its groups summarised and their
+ * attractors found. */
 static cm_status make_result(const cm_model *m, const cm_lattice *lat, cm_region *r,
-                             const result_attractors *from, cm_result **out, char *msg,
+                             const result_source *from, cm_result **out, char *msg,
                              size_t msg_size)
 {
     cm_result *res = calloc(1, sizeof *res);
@@ -205,15 +251,8 @@ static cm_status make_result(const cm_model *m, const cm_lattice *lat, cm_region
     res->model = m;
     memset(r, 0, sizeof *r);
     cm_status st = cm_scm_describe(m, lat, &res->cells, &res->groups, &res->sink, msg, msg_size);
-    if (st == CM_OK && !from->store)
-        st = cm_attractors_find(m, lat, res->groups, res->cells.ngroups, cm_region_cell_group,
-                                &res->cells, NULL, &res->att, msg, msg_size);
-    if (st == CM_OK && from->store) {
-        st = cm_store_get_attractors(from->store, lat->dim, from->cluster->ngroups, &res->att, NULL,
-                                     msg, msg_size);
-        if (st == CM_ENOTFOUND)
-            st = db_attractors(m, from, &res->att, msg, msg_size);
-    }
+    if (st == CM_OK)
+        st = result_attractors_of(res, from, msg, msg_size);
     if (st != CM_OK) {
         cm_result_free(res);
         return st;
@@ -243,11 +282,11 @@ static cm_status region_joined(void *user, cm_cluster *c, uint32_t box,
     return CM_OK;
 }
 
-/* The box as a cluster of the split's regions, solved and joined, then
- * flattened into r. */
+/* The box as a cluster c (initialised here, freed by the caller) of the
+ * split's regions, solved and joined, then flattened into r. */
 static cm_status solve_split(const cm_model *m, const cm_lattice *lat, const cm_box *box,
-                             const cm_solve_options *opt, const cm_scm_options *scm, cm_region *r,
-                             char *msg, size_t msg_size)
+                             const cm_solve_options *opt, const cm_scm_options *scm, cm_cluster *c,
+                             cm_region *r, char *msg, size_t msg_size)
 {
     project_plan plan = {.nsplit = box->dim, .opt = *scm};
     for (int d = 0; d < box->dim; d++)
@@ -257,16 +296,14 @@ static cm_status solve_split(const cm_model *m, const cm_lattice *lat, const cm_
     if (!boxes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u regions", n);
     project_split(&plan, box, boxes);
-    cm_cluster c;
-    cm_cluster_init(&c, lat);
-    c.keep_exits = 0; /* nothing saves the cluster or reads its images */
-    c.threads = opt->threads;
+    cm_cluster_init(c, lat);
+    c->keep_exits = 0; /* nothing saves the cluster or reads its images */
+    c->threads = opt->threads;
     solve_progress sp = {opt, n};
-    cm_status st = cm_cluster_solve_boxes(&c, m, boxes, n, scm, region_joined, &sp, NULL, msg,
+    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, scm, region_joined, &sp, NULL, msg,
                                           msg_size);
     if (st == CM_OK)
-        st = cm_cluster_flatten(&c, box, r, msg, msg_size);
-    cm_cluster_free(&c);
+        st = cm_cluster_flatten(c, box, r, msg, msg_size);
     free(boxes);
     return st;
 }
@@ -287,25 +324,34 @@ cm_status cm_solve(const cm_system *s, const cm_grid *grid, const cm_solve_optio
     for (int d = 0; d < box.dim; d++)
         split |= opt->split[d] > 1;
     solve_progress sp = {opt, 1};
+    /* a single region records its exits: their orbits are followed */
     cm_scm_options scm = {opt->max_steps, opt->threads, opt->progress ? images_progress : NULL,
-                          &sp, 0};
+                          &sp, !split};
     cm_region r;
+    cm_cluster c;
+    cm_exits exits;
     memset(&r, 0, sizeof r);
+    memset(&c, 0, sizeof c);
+    memset(&exits, 0, sizeof exits);
     if (split) {
-        st = solve_split(&s->model, &lat, &box, opt, &scm, &r, msg, msg_size);
+        st = solve_split(&s->model, &lat, &box, opt, &scm, &c, &r, msg, msg_size);
     } else {
         st = cm_region_alloc(&r, &box, msg, msg_size);
         if (st == CM_OK)
             st = cm_scm_solve(&s->model, &lat, &scm, &r, msg, msg_size);
         if (st == CM_ECANCELED)
             cm_fail(st, msg, msg_size, "cancelled by the progress callback");
+        if (st == CM_OK)
+            st = cm_region_settle_exits(&r, opt->threads, &exits, msg, msg_size);
     }
-    if (st != CM_OK) {
-        cm_region_free(&r);
-        return st;
-    }
-    const result_attractors solved = {NULL, NULL};
-    return make_result(&s->model, &lat, &r, &solved, out, msg, msg_size);
+    const result_source solved = {NULL, split ? &c : NULL, &exits, opt->max_steps};
+    if (st == CM_OK)
+        st = make_result(&s->model, &lat, &r, &solved, out, msg, msg_size);
+    cm_region_free(&r);
+    cm_exits_free(&exits);
+    if (split)
+        cm_cluster_free(&c);
+    return st;
 }
 
 void cm_result_grid(const cm_result *r, cm_grid *g)
@@ -391,6 +437,7 @@ void cm_result_free(cm_result *r)
     cm_region_free(&r->cells);
     free(r->groups);
     cm_attractors_free(&r->att);
+    free(r->att_labels);
     free(r);
 }
 
@@ -417,8 +464,7 @@ cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summ
 
 void cm_result_attractor_labels(const cm_result *r, int32_t *labels)
 {
-    for (uint64_t i = 0; i < r->cells.ncells; i++)
-        labels[i] = cm_attractor_label(&r->att, r->cells.group[i]);
+    memcpy(labels, r->att_labels, r->cells.ncells * sizeof *labels);
 }
 
 /* ---- databases ----------------------------------------------------------- */
@@ -516,7 +562,7 @@ cm_status cm_db_read(cm_db *db, const double *lo, const double *hi, cm_result **
         st = cm_cluster_flatten(&db->cluster, &box, &r, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const result_attractors stored = {db->store, &db->cluster};
+    const result_source stored = {db->store, &db->cluster, NULL, 0};
     return make_result(&db->model, &db->cluster.lat, &r, &stored, out, msg, msg_size);
 }
 

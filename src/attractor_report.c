@@ -30,6 +30,15 @@ bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
                                         "above 0 (cell widths)", c->value);
         o->tol = v[0];
         o->match = n == 2 ? v[1] : 0;
+    } else if (cli_is(c, "--outside-steps", true, error)) {
+        double v = 0;
+        int n = 0;
+        if (c->value && (!parse_doubles(c->value, &v, &n, 1) || n != 1 || !(v >= 0) ||
+                         v > CM_OUTSIDE_MAX_STEPS || v != floor(v)))
+            *error = cli_usage_error(c, "--outside-steps: '%s' must be a whole number of steps "
+                                        "from 0 (not followed) to %u", c->value,
+                                     CM_OUTSIDE_MAX_STEPS);
+        o->outside = v == 0 ? CM_OUTSIDE_OFF : (uint32_t)v;
     } else {
         return false;
     }
@@ -53,8 +62,8 @@ static int larger_basin(const void *a, const void *b)
 
 static double percent(uint64_t part, uint64_t all) { return all ? 100.0 * part / all : 0; }
 
-void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
-                    uint64_t sink_cells, uint64_t cells, int rows)
+void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s, uint64_t cells,
+                    int rows)
 {
     fprintf(out, "attractors %u, by true orbits from %u cell groups: %u merged into another "
                  "group's attractor, %u artefacts (%u diverge, %u undecided)\n",
@@ -87,11 +96,20 @@ void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
                     s->n - (uint32_t)rows);
     }
     free(sorted);
-    fprintf(out, "diverged %llu cells (%.1f%%), undecided %llu (%.1f%%), left the computed "
-                 "cells (fate unknown) %llu (%.1f%%)\n",
-            (unsigned long long)s->diverged_cells, percent(s->diverged_cells, cells),
-            (unsigned long long)s->unresolved_cells, percent(s->unresolved_cells, cells),
-            (unsigned long long)sink_cells, percent(sink_cells, cells));
+    const uint64_t diverged = s->diverged_cells + s->sink_diverged_cells;
+    fprintf(out, "diverged %llu cells (%.1f%%), outside %llu (%.1f%%", (unsigned long long)diverged,
+            percent(diverged, cells), (unsigned long long)s->outside_cells,
+            percent(s->outside_cells, cells));
+    if (s->outside_steps)
+        fprintf(out, ": left the computed cells, not back within %u steps", s->outside_steps);
+    else
+        fprintf(out, ": left the computed cells, not followed");
+    fprintf(out, "), undecided %llu (%.1f%%)\n", (unsigned long long)s->unresolved_cells,
+            percent(s->unresolved_cells, cells));
+    if (s->returned_cells)
+        fprintf(out, "%llu cells (%.1f%%) left the computed cells and came back (in the basins "
+                     "above)\n",
+                (unsigned long long)s->returned_cells, percent(s->returned_cells, cells));
 }
 
 void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat)
@@ -106,8 +124,7 @@ void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat
     json_nums(j, "centre", a->centre, lat->dim);
 }
 
-void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
-                    uint64_t sink_cells)
+void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s)
 {
     json_array(j, "attractors");
     for (uint32_t k = 0; k < s->n; k++) {
@@ -129,9 +146,11 @@ void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
         json_object_end(j);
     }
     json_array_end(j);
-    json_uint(j, "diverged_cells", s->diverged_cells);
+    json_uint(j, "diverged_cells", s->diverged_cells + s->sink_diverged_cells);
+    json_uint(j, "outside_cells", s->outside_cells);
     json_uint(j, "undecided_cells", s->unresolved_cells);
-    json_uint(j, "outside_cells", sink_cells);
+    json_uint(j, "returned_cells", s->returned_cells);
+    json_uint(j, "outside_steps", s->outside_steps);
 }
 
 void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm_lattice *lat,
@@ -153,7 +172,7 @@ void attractor_json_groups(json *j, const cm_group_info *g, uint32_t n, const cm
 
 bool attractor_options_given(const cm_attractor_options *o)
 {
-    return o->transient || o->record || o->max_steps || o->tol || o->match;
+    return o->transient || o->record || o->max_steps || o->tol || o->match || o->outside;
 }
 
 bool by_option_take(cli *c, int *by, int *error)
@@ -174,9 +193,18 @@ cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_in
                              uint32_t ngroups, const cm_attractor_options *o,
                              cm_attractor_set *out, char *msg, size_t msg_size)
 {
-    return cm_attractors_find(m, &c->lat, groups, ngroups, cm_cluster_cell_group, c, o, out, msg,
-                              msg_size);
+    (void)ngroups; /* the cluster's */
+    return cm_cluster_attractors(m, c, groups, o, out, msg, msg_size);
 }
+
+cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size)
+{
+    e->cc = (cm_cluster_cells){c, &e->exits};
+    e->computed = cm_cluster_computed(&e->cc);
+    return cm_cluster_exits(c, &e->exits, msg, msg_size);
+}
+
+void cluster_ends_close(cluster_ends *e) { cm_exits_free(&e->exits); }
 
 cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
                           cm_cluster *c, const cm_group_info *groups, uint32_t ngroups,
@@ -207,30 +235,26 @@ uint32_t attractor_label(const cm_attractor_set *s, uint32_t g)
     return g == CM_GROUP_NONE ? g : label > 0 ? (uint32_t)label : 0;
 }
 
-cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_info **groups,
-                         uint32_t *n, char *msg, size_t msg_size)
+/* The summary of attractor a, as a group for the figure's colours. */
+static cm_group_info attractor_group(const cm_attractor *at)
 {
-    cm_group_info *g = calloc((size_t)s->n + 1, sizeof *g);
-    if (!g)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u attractors", s->n);
-    for (uint64_t i = 0; i < flat->ncells; i++) {
-        const uint32_t was = flat->group[i];
-        if (was != CM_GROUP_NONE && was != 0 && flat->step[i] == 0)
-            flat->step[i] = 1; /* a cell cycle's cell: the footprints are the markers */
-        flat->group[i] = attractor_label(s, was);
-    }
+    cm_group_info g = {.id = at->id,
+                       .period = at->period,
+                       .basin_cells = at->basin_cells,
+                       .kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
+                                                                 : CM_GROUP_ATTRACTOR};
+    memcpy(g.centre, at->centre, sizeof at->centre);
+    memcpy(g.lo, at->lo, sizeof at->lo);
+    memcpy(g.hi, at->hi, sizeof at->hi);
+    memcpy(g.anchor, at->anchor, sizeof at->anchor);
+    return g;
+}
+
+/* Marks the attractors' footprint cells in flat (step 0: the markers). */
+static void mark_footprints(const cm_attractor_set *s, cm_region *flat)
+{
     const int dim = flat->box.dim;
-    for (uint32_t a = 0; a < s->n; a++) {
-        const cm_attractor *at = &s->a[a];
-        g[a] = (cm_group_info){.id = at->id,
-                               .period = at->period,
-                               .basin_cells = at->basin_cells,
-                               .kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
-                                                                         : CM_GROUP_ATTRACTOR};
-        memcpy(g[a].centre, at->centre, sizeof at->centre);
-        memcpy(g[a].lo, at->lo, sizeof at->lo);
-        memcpy(g[a].hi, at->hi, sizeof at->hi);
-        memcpy(g[a].anchor, at->anchor, sizeof at->anchor);
+    for (uint32_t a = 0; a < s->n; a++)
         for (uint64_t c = s->footprint_at[a]; c < s->footprint_at[a + 1]; c++) {
             const int64_t *cell = s->footprint + c * dim;
             if (!cm_box_contains(&flat->box, cell))
@@ -238,13 +262,49 @@ cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_in
             const uint64_t i = cm_box_index(&flat->box, cell);
             if (flat->group[i] == CM_GROUP_NONE)
                 continue; /* not computed: nothing to mark */
-            flat->group[i] = at->id; /* visited by its orbit: on it */
+            flat->group[i] = s->a[a].id; /* visited by its orbit: on it */
             flat->step[i] = 0;
         }
+}
+
+cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const cm_computed *cells,
+                         cm_group_info **groups, uint32_t *n, char *msg, size_t msg_size)
+{
+    cm_group_info *g = calloc((size_t)s->n + 2, sizeof *g);
+    int32_t *label = malloc((flat->ncells + 1) * sizeof *label);
+    cm_status st = g && label ? cm_attractor_cell_labels(s, flat, cells, label, msg, msg_size)
+                              : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
+    if (st != CM_OK) {
+        free(g);
+        free(label);
+        return st;
+    }
+    const uint32_t outside = s->n + 1; /* the figure's group of cells that reach no attractor known */
+    bool any_outside = false;
+    for (uint64_t i = 0; i < flat->ncells; i++) {
+        const uint32_t was = flat->group[i];
+        if (was != CM_GROUP_NONE && was != 0 && flat->step[i] == 0)
+            flat->step[i] = 1; /* a cell cycle's cell: the footprints are the markers */
+        const int32_t l = label[i];
+        flat->group[i] = l > 0                   ? (uint32_t)l
+                         : l == CM_LABEL_OUTSIDE ? outside
+                         : l == CM_LABEL_UNCOMPUTED ? CM_GROUP_NONE
+                                                    : 0;
+        any_outside |= l == CM_LABEL_OUTSIDE;
+    }
+    free(label);
+    for (uint32_t a = 0; a < s->n; a++)
+        g[a] = attractor_group(&s->a[a]);
+    mark_footprints(s, flat);
+    *n = s->n;
+    if (any_outside) { /* grey, as "fate unknown" reads */
+        g[s->n] = (cm_group_info){.id = outside, .period = 1, .kind = CM_GROUP_STICKING};
+        g[s->n].basin_cells = s->outside_cells + s->unresolved_cells;
+        g[s->n].anchor[0] = INT64_MAX;
+        *n = outside;
     }
     free(*groups);
     *groups = g;
-    *n = s->n;
-    flat->ngroups = s->n;
+    flat->ngroups = *n;
     return CM_OK;
 }

@@ -9,6 +9,7 @@
 
 #include "cellmap/attractors.h"
 #include "cellmap/cluster.h"
+#include "cellmap/outside.h"
 #include "cellmap/store.h"
 #include "src/args.h"
 #include "src/json.h"
@@ -16,34 +17,39 @@
 #define ATTRACTOR_OPTIONS_HELP                                                                     \
     "  --attractor-steps T,R[,MAX]  the true-orbit check of each cell group: T steps of\n"         \
     "                      transient, a record of R steps (doubled while undecided), at most\n"    \
-    "                      MAX steps a group (default 500,500,65536; 8192 for ODE flows)\n"         \
+    "                      MAX steps a group (default 16,500,1048576; MAX 8192 for ODE flows)\n"         \
     "  --attractor-tol TOL[,MATCH]  recurrence within TOL cell widths is periodic; cycles\n"      \
-    "                      within MATCH cell widths are one attractor (default 1e-4,1e-2)\n"
+    "                      within MATCH cell widths are one attractor (default 1e-4,1e-2)\n"  \
+    "  --outside-steps N   follow an orbit that leaves the computed cells N steps on the\n"      \
+    "                      true map: back in, it goes where the cell it lands in goes;\n"        \
+    "                      beyond the world, it diverges; else it is outside (default 100;\n"   \
+    "                      0: not followed, every such cell outside)\n"
 
 #define BY_OPTION_HELP                                                                             \
     "  --by attractors|groups  figures and labels by the system's attractors (default;\n"      \
     "                      their footprints marked) or by cell mapping's groups (the\n"          \
     "                      thesis' figures are drawn by groups)\n"
 
-/* Handles --attractor-steps and --attractor-tol; true if the current option
+/* Handles --attractor-steps, --attractor-tol and --outside-steps; true if the current option
  * was one of them (a bad value is reported and *error set). */
 bool attractor_options_take(cli *c, cm_attractor_options *o, int *error);
 
 /* The text summary's attractor lines (the largest basins first, at most
- * `rows`), and the cells that reach none: those of groups whose orbits
- * diverge or were undecided, and the sink's (sink_cells: the sequence left
- * the computed cells, fate unknown). */
-void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
-                    uint64_t sink_cells, uint64_t cells, int rows);
+ * `rows`), and the cells that reach none: diverged (groups whose orbits
+ * diverge, and the sink's cells with no image, beyond the world or whose
+ * orbits diverge outside), outside (left the computed cells and did not
+ * come back) and undecided; then the cells that left and came back. */
+void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s, uint64_t cells,
+                    int rows);
 
 /* An attractor's id, kind, period (null when aperiodic), basin_cells and
  * centre, the fields every JSON that lists attractors has. */
 void json_attractor_fields(json *j, const cm_attractor *a, const cm_lattice *lat);
 
-/* "attractors": [...], "diverged_cells", "undecided_cells", "outside_cells"
- * (the sink's sink_cells). */
-void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s,
-                    uint64_t sink_cells);
+/* "attractors": [...], "diverged_cells", "outside_cells",
+ * "undecided_cells", "returned_cells" and "outside_steps" (the budget
+ * orbits that left were followed with; 0: not followed). */
+void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s);
 
 /* Whether any --attractor-* option was given (then a file's stored
  * attractors are not the ones asked for). */
@@ -54,7 +60,8 @@ enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
 bool by_option_take(cli *c, int *by, int *error);
 
 /* The attractors of a cluster's groups (groups[k]: group k + 1), the
- * cells' groups read from the cluster. */
+ * cells' groups read from the cluster, its exits followed
+ * (cm_cluster_attractors). */
 cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
                              uint32_t ngroups, const cm_attractor_options *o,
                              cm_attractor_set *out, char *msg, size_t msg_size);
@@ -73,13 +80,27 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);
 
 /* A flat region relabelled by attractors, in place: each cell's group id
- * becomes its attractor's (attractor_label), the attractors' footprint
- * cells in it take their attractor with step 0 (and no other cell has
- * step 0: the markers are the footprints); *groups (freed) becomes the
- * attractors' summaries, as groups, for the figure's colours and legend
- * (*n of them). */
-cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, cm_group_info **groups,
-                         uint32_t *n, char *msg, size_t msg_size);
+ * becomes its attractor's (cm_attractor_cell_labels: a sink cell's is the
+ * fate of the exit its sequence leaves by, asked of `cells` where it
+ * leaves flat's box; cells NULL: not followed), 0 where it diverges, and
+ * n + 1, a grey group of its own, where it stays outside or is undecided;
+ * the attractors' footprint cells in it take their attractor with step 0
+ * (and no other cell has step 0: the markers are the footprints); *groups
+ * (freed) becomes the attractors' summaries, as groups, for the figure's
+ * colours and legend (*n of them, the grey one last when there is one). */
+cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const cm_computed *cells,
+                         cm_group_info **groups, uint32_t *n, char *msg, size_t msg_size);
+
+/* Where the sink cells of a cluster's views go (cellmap/outside.h): its
+ * exits and the adapter over them; `computed` points into the struct, which
+ * must stay where it is until cluster_ends_close. */
+typedef struct cluster_ends {
+    cm_exits exits;
+    cm_cluster_cells cc;
+    cm_computed computed;
+} cluster_ends;
+cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size);
+void cluster_ends_close(cluster_ends *e);
 
 /* The groups as json_groups writes them, each with "attractor" (its id, or
  * null when its orbit diverges or is undecided). */

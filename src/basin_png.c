@@ -544,13 +544,19 @@ static int write_by_attractors(const char *cmd, const basin_png *b)
         memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
         memcpy(view.step, b->cells->step, view.ncells * sizeof *view.step);
         memcpy(view.image, b->cells->image, view.ncells * sizeof *view.image);
-        st = attractor_view(b->attractors, &view, &groups, &n, msg, sizeof msg);
+        st = attractor_view(b->attractors, &view, b->computed, &groups, &n, msg, sizeof msg);
     }
     int rc = EXIT_FAIL;
     if (st == CM_OK) {
         *po = *b->opts;
         attractor_names(b->attractors, po);
-        po->sink_label = "no attractor";
+        if (n > b->attractors->n && po->n_labels < PNG_LABELS_MAX) {
+            cm_group_label *l = &po->labels[po->n_labels++];
+            memset(l, 0, sizeof *l);
+            l->id = n;
+            snprintf(l->text, sizeof l->text, "outside or undecided");
+        }
+        po->sink_label = "diverged";
         basin_png by = *b;
         by.opts = po;
         by.cells = &view;

@@ -100,6 +100,8 @@ typedef struct basin_png {
     const struct cm_attractor_set *attractors; /* not NULL: drawn by attractors (the cells'
                                                   groups' attractors, the footprints marked;
                                                   src/attractor_report.h), else by groups */
+    const struct cm_computed *computed; /* by attractors: where the sink cells' sequences go
+                                           beyond the cells (NULL: not followed) */
 } basin_png;
 
 /* Checks before anything is computed that the PNG of these options can be

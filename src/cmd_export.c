@@ -595,13 +595,20 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
                 (unsigned long long)outs[0].rows);
     }
     const bool by_attractors = a->labels && a->by == BY_ATTRACTORS;
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
+    if (rc == EXIT_OK && by_attractors && cluster_ends_open(&ends, c, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap export: %s\n", msg);
+        rc = EXIT_FAIL;
+    }
     if (rc == EXIT_OK && (a->labels || a->steps)) {
         const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names,
-                                by_attractors ? &att : NULL};
+                                by_attractors ? &att : NULL, &ends.computed};
         progress_start(&pr, "export", "cells", cm_box_cells(&window), a->quiet);
         if (!export_arrays(c, &window, &x, &pr))
             rc = interrupt_requested() ? EXIT_INTERRUPTED : EXIT_FAIL;
     }
+    cluster_ends_close(&ends);
     cm_attractors_free(&att);
     free(g);
     return rc;

@@ -61,9 +61,9 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     printf("regions %u, cells %llu, bounding box %s (%llu cells)\n", info->regions,
            (unsigned long long)info->cells, box, (unsigned long long)cm_box_cells(bounds));
     if (att) {
-        attractor_text(stdout, lat, att, sink, info->cells, SHOWN_GROUPS);
+        attractor_text(stdout, lat, att, info->cells, SHOWN_GROUPS);
     } else {
-        printf("attractors: not in this file (written before format 6, or by a solve stopped "
+        printf("attractors: not in this file (written before format 7, or by a solve stopped "
                "before its end): solve --resume with the same options, or explore, adds them\n");
     }
     printf("cell groups %u periodic, sink basin %llu cells (%.1f%%)\n", info->groups,
@@ -116,7 +116,7 @@ static void print_json(const char *path, const cm_store_info *info, const cm_box
     json_uint(&j, "file_bytes", info->file_bytes);
     json_uint(&j, "page_bytes", info->page_bytes);
     if (att) {
-        attractor_json(&j, &info->lattice, att, sink);
+        attractor_json(&j, &info->lattice, att);
         attractor_json_groups(&j, g, info->groups, &info->lattice, att);
     } else {
         json_groups(&j, g, info->groups, &info->lattice);

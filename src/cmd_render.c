@@ -161,6 +161,10 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     if (st == CM_OK && a->png.by == BY_ATTRACTORS)
         st = file_attractors(s, info, &m, cl, groups, cl->ngroups, &a->att, &att, msg,
                              sizeof msg);
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
+    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
+        st = cluster_ends_open(&ends, cl, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_cluster_flatten_progress(cl, &box, &flat, reading, &pr, msg, sizeof msg);
     progress_end(&pr);
@@ -173,10 +177,12 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
         fprintf(stderr, "cellmap render: %s\n", msg);
     } else {
         const basin_png png = {&a->png, &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
-                               {hi[0], hi[1]}, NULL, a->png.by == BY_ATTRACTORS ? &att : NULL};
+                               {hi[0], hi[1]}, NULL, a->png.by == BY_ATTRACTORS ? &att : NULL,
+                               &ends.computed};
         rc = write_basin_png("render", &png);
     }
     cm_region_free(&flat);
+    cluster_ends_close(&ends);
     cm_attractors_free(&att);
     free(groups);
     cm_model_release(&m);

@@ -249,6 +249,7 @@ typedef struct summary {
     double slow[CM_MAX_DIM]; /* cm_scm_slow_share of a single region; NaN: unknown */
     cm_attractor_set att;    /* the attractors the groups' true orbits give */
     double att_seconds;
+    cm_exits exits;          /* a single region's (cm_region_settle_exits) */
 } summary;
 
 /* A share of slow cells (cm_scm_slow_share) above which the summary says so. */
@@ -273,7 +274,7 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     fprintf(out, "time: %s %.3f s, %s %.3f s (%.1f ns/cell), attractors %.3f s (%llu steps)\n",
             t->first, t->t1, t->second, t->t2, 1e9 * (t->t1 + t->t2) / (double)cells,
             sum->att_seconds, (unsigned long long)sum->att.steps);
-    attractor_text(out, lat, &sum->att, sink, cells, TEXT_GROUPS);
+    attractor_text(out, lat, &sum->att, cells, TEXT_GROUPS);
     fprintf(out, "cell groups %u (simple cell mapping's periodic groups; the sink %llu cells, "
                  "%.1f%%):\n",
             ngroups, (unsigned long long)sink, 100.0 * (double)sink / (double)cells);
@@ -349,7 +350,7 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat, cons
     json_object_end(&j);
     if (log)
         print_json_extension(&j, lat, log);
-    attractor_json(&j, lat, &sum->att, sum->sink);
+    attractor_json(&j, lat, &sum->att);
     attractor_json_groups(&j, sum->groups, sum->ngroups, lat, &sum->att);
     json_end(&j);
 }
@@ -384,7 +385,8 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
                              const cm_box *box, cm_region *r, timing *t, progress *p, char *msg,
                              size_t msg_size)
 {
-    const cm_scm_options opt = {a->max_steps, a->threads, whole_progress, p, 0};
+    /* exits recorded: their orbits are followed (cm_region_settle_exits) */
+    const cm_scm_options opt = {a->max_steps, a->threads, whole_progress, p, 1};
     *t = (timing){"images", "classification", 0, 0};
     cm_status st = cm_region_alloc(r, box, msg, msg_size);
     const double t0 = progress_now();
@@ -579,19 +581,17 @@ static cm_status summarise_cluster(run *rn, const cm_model *m, summary *sum,
     return cm_cluster_describe_new(c, m, sum->groups, msg, msg_size);
 }
 
-/* The PNG of the solved cells, or of --view (cells outside the cluster are
- * drawn as not computed). */
-static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_lattice *lat, run *rn,
-                          const summary *sum, cm_region *r, char *msg, size_t msg_size)
+/* The figure of the cells drawn: the solved ones, or those of --view. */
+static cm_status draw_cells(const solve_args *a, const cm_lattice *lat, run *rn,
+                            const summary *sum, cm_region *r, basin_png *png, char *msg,
+                            size_t msg_size)
 {
-    basin_png png = {&a->png, m,   lat, r, sum->groups, {0, 0}, {0, 0}, NULL,
-                     a->png.by == BY_ATTRACTORS ? &sum->att : NULL};
     if (a->png.has_view) {
         cm_box box;
         view_cells(lat, a->png.lo, a->png.hi, &sum->box, &box);
         cm_region_free(r);
-        memcpy(png.lo, a->png.lo, sizeof png.lo);
-        memcpy(png.hi, a->png.hi, sizeof png.hi);
+        memcpy(png->lo, a->png.lo, sizeof png->lo);
+        memcpy(png->hi, a->png.hi, sizeof png->hi);
         cm_status st = cm_cluster_flatten(&rn->c, &box, r, msg, msg_size);
         if (st != CM_OK)
             return st;
@@ -600,11 +600,32 @@ static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_latti
         if (st != CM_OK)
             return st;
     }
-    if (write_basin_png("solve", &png) != EXIT_OK)
+    if (write_basin_png("solve", png) != EXIT_OK)
         return cm_fail(CM_ERENDER, msg, msg_size, "%s was not written (see above)",
                        a->png.path ? a->png.path : a->png.svg);
     return CM_OK;
 }
+
+/* The PNG of the solved cells, or of --view (cells outside the cluster are
+ * drawn as not computed). */
+static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_lattice *lat, run *rn,
+                          const summary *sum, cm_region *r, char *msg, size_t msg_size)
+{
+    basin_png png = {&a->png, m,   lat, r, sum->groups, {0, 0}, {0, 0}, NULL,
+                     a->png.by == BY_ATTRACTORS ? &sum->att : NULL, NULL};
+    /* where the sink cells' sequences leave the cells drawn */
+    cm_region_cells whole = {r, m, lat, a->max_steps};
+    const cm_computed region = cm_region_computed(&whole);
+    cluster_ends joined;
+    memset(&joined, 0, sizeof joined);
+    cm_status st = r->group ? CM_OK : cluster_ends_open(&joined, &rn->c, msg, msg_size);
+    png.computed = r->group ? &region : &joined.computed;
+    if (st == CM_OK)
+        st = draw_cells(a, lat, rn, sum, r, &png, msg, msg_size);
+    cluster_ends_close(&joined);
+    return st;
+}
+
 
 static void print_database(FILE *out, const solve_args *a, const run *rn, const summary *sum)
 {
@@ -708,6 +729,8 @@ int cmd_solve(int argc, char **argv)
         }
         if (st != CM_OK)
             goto fail;
+        if (!a.stage1 && cm_region_settle_exits(&r, a.threads, &sum.exits, msg, sizeof msg) != CM_OK)
+            goto fail;
         sum.box = r.box;
         sum.cells = r.ncells;
         sum.ngroups = r.ngroups;
@@ -719,12 +742,15 @@ int cmd_solve(int argc, char **argv)
     const double ta = progress_now();
     a.att.threads = a.threads;
     /* the cells' groups: the region's, or the cluster's (resolved on the way) */
-    const bool whole = r.group != NULL;
-    if (cm_attractors_find(&m, &lat, sum.groups, sum.ngroups,
-                           whole ? cm_region_cell_group : cm_cluster_cell_group,
-                           whole ? (void *)&r : (void *)&rn.c, &a.att, &sum.att, msg,
-                           sizeof msg) != CM_OK)
+    if ((r.group ? cm_region_attractors(&m, &lat, &r, a.max_steps, &sum.exits, sum.groups, &a.att,
+                                        &sum.att, msg, sizeof msg)
+                 : cm_cluster_attractors(&m, &rn.c, sum.groups, &a.att, &sum.att, msg,
+                                         sizeof msg)) != CM_OK)
         goto fail;
+    if (a.stage1) { /* its sink is Stage 1's: pending, not followed */
+        sum.att.outside_steps = 0;
+        sum.att.outside_cells = sum.sink;
+    }
     sum.att_seconds = progress_now() - ta;
     cm_attractor_options used;
     cm_attractor_defaults(&m, &a.att, &used);
@@ -753,6 +779,7 @@ done:
     free(log);
     free(sum.groups);
     cm_attractors_free(&sum.att);
+    cm_exits_free(&sum.exits);
     cm_region_free(&r);
     cm_model_release(&m);
     return rc;

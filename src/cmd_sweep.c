@@ -188,13 +188,16 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     const char *name = a->name;
     if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
         return CM_EINVAL;
-    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 0};
+    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1}; /* exits followed */
     cm_region r;
     memset(&r, 0, sizeof r);
     cm_group_info *groups = NULL;
+    cm_exits exits = {0};
     cm_status st = cm_region_alloc(&r, box, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_solve(&m, lat, &opt, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_region_settle_exits(&r, a->threads, &exits, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
     cm_attractor_set att;
@@ -202,14 +205,15 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     if (st == CM_OK && a->by == BY_ATTRACTORS) {
         cm_attractor_options o = a->att;
         o.threads = a->threads;
-        st = cm_attractors_find(&m, lat, groups, r.ngroups, cm_region_cell_group, &r, &o, &att,
-                                msg, msg_size);
+        st = cm_region_attractors(&m, lat, &r, a->max_steps, &exits, groups, &o, &att, msg,
+                                  msg_size);
         if (st == CM_OK)
             count_attractors(a, &att, r.ngroups, pt);
     } else if (st == CM_OK) {
         count_groups(a, groups, r.ngroups, pt);
     }
     cm_attractors_free(&att);
+    cm_exits_free(&exits);
     free(groups);
     cm_region_free(&r);
     cm_model_release(&m);

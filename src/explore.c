@@ -602,9 +602,13 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     st = shown_cells(s, &flat, &groups, msg, msg_size);
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
     if (st == CM_OK && po.by == BY_ATTRACTORS)
         st = cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, &att, msg,
                                 msg_size);
+    if (st == CM_OK && po.by == BY_ATTRACTORS)
+        st = cluster_ends_open(&ends, &s->c, msg, msg_size);
     if (st == CM_OK && !s->gl && !po.indexed && !svg)
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {&po,
@@ -615,7 +619,8 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
                            {s->lo[0], s->lo[1]},
                            {s->hi[0], s->hi[1]},
                            s->gl,
-                           po.by == BY_ATTRACTORS ? &att : NULL};
+                           po.by == BY_ATTRACTORS ? &att : NULL,
+                           &ends.computed};
     if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
         st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
     if (st == CM_OK && s->out) {
@@ -623,6 +628,7 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
         fflush(s->out);
     }
     cm_region_free(&flat);
+    cluster_ends_close(&ends);
     cm_attractors_free(&att);
     free(groups);
     return st;

@@ -46,20 +46,12 @@ static void put_i32(unsigned char *p, int32_t v)
         p[b] = (unsigned char)(u >> (8 * b));
 }
 
-/* A cell's label: its group (by groups; -1 not computed), or its group's
- * attractor (cm_attractor_label). */
-static int32_t label_of(const cm_attractor_set *s, uint32_t g)
-{
-    if (s)
-        return cm_attractor_label(s, g);
-    return g == CM_GROUP_NONE ? -1 : (int32_t)g;
-}
-
-/* The slab's cells in C order (dimension 0 slowest): one int32 each;
- * in_window counts the cells of each group, by_label those of each label
- * (at label + 2: -2 and -1 first). */
-static bool write_slab(const cm_region *flat, const cm_attractor_set *s, FILE *labels,
-                       FILE *steps, uint64_t *in_window, uint64_t *by_label)
+/* The slab's cells in C order (dimension 0 slowest): one int32 each, the
+ * label of each cell (label[index] by attractors, else its group; -1 not
+ * computed); in_window counts the cells of each group, by_label those of
+ * each label (at label + 2: -2 and -1 first). */
+static bool write_slab(const cm_region *flat, const int32_t *label, FILE *labels, FILE *steps,
+                       uint64_t *in_window, uint64_t *by_label)
 {
     const cm_box *b = &flat->box;
     const int dim = b->dim;
@@ -76,11 +68,13 @@ static bool write_slab(const cm_region *flat, const cm_attractor_set *s, FILE *l
         }
         const uint32_t g = flat->group[index];
         unsigned char v[4];
-        const int32_t label = label_of(s, g);
+        const int32_t l = label                ? label[index]
+                          : g == CM_GROUP_NONE ? -1
+                                               : (int32_t)g;
         if (g != CM_GROUP_NONE)
             in_window[g]++;
-        by_label[label + 2]++;
-        put_i32(v, label);
+        by_label[l + 2]++;
+        put_i32(v, l);
         ok = !labels || fwrite(v, 1, 4, labels) == 4;
         put_i32(v, g == CM_GROUP_NONE ? -1 : (int32_t)flat->step[index]);
         ok = ok && (!steps || fwrite(v, 1, 4, steps) == 4);
@@ -231,10 +225,19 @@ bool export_arrays(cm_cluster *c, const cm_box *window, const array_export *x, p
             ok = false;
             break;
         }
-        ok = write_slab(&flat, x->attractors, has_labels ? labels.f : NULL,
-                        has_steps ? steps.f : NULL, in_window, by_label);
-        if (!ok)
-            snprintf(msg, sizeof msg, "cannot write the arrays");
+        int32_t *label = x->attractors ? malloc((flat.ncells + 1) * sizeof *label) : NULL;
+        if (x->attractors && (!label || cm_attractor_cell_labels(x->attractors, &flat, x->computed,
+                                                                  label, msg, sizeof msg) != CM_OK)) {
+            if (!label)
+                snprintf(msg, sizeof msg, "out of memory for the labels");
+            ok = false;
+        } else {
+            ok = write_slab(&flat, label, has_labels ? labels.f : NULL,
+                            has_steps ? steps.f : NULL, in_window, by_label);
+            if (!ok)
+                snprintf(msg, sizeof msg, "cannot write the arrays");
+        }
+        free(label);
         done += flat.ncells;
         cm_region_free(&flat);
         if (ok && interrupt_requested()) {

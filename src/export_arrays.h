@@ -3,8 +3,9 @@
  *
  * FILE.npy holds one little-endian int32 per cell, shape (n_0, ..., n_d-1)
  * (cells per state dimension, axis k = dimension k), C order: the
- * attractor id (0 diverged, -2 outside: the sequence left the computed
- * cells, or its group's true orbit was undecided; -1 not computed), or
+ * attractor id (0 diverged; -2 outside: the sequence left the computed
+ * cells and its orbit did not come back, or its group's true orbit was
+ * undecided; -1 not computed: cm_attractor_cell_labels), or
  * with --by groups the group id (0 the sink, -1 not computed), or the step
  * number (-1 not computed).
  * FILE.json beside it (docs/cellmap.schema.json, "export") says where the
@@ -25,6 +26,8 @@ typedef struct array_export {
     uint32_t ngroups;
     const char *const *names; /* the state coordinates' names */
     const struct cm_attractor_set *attractors; /* not NULL: labels by attractors */
+    const struct cm_computed *computed;        /* where sink cells' sequences go beyond a
+                                                  slab (by attractors) */
 } array_export;
 
 /* The sidecar's path: FILE.npy -> FILE.json. */

@@ -43,9 +43,10 @@ w, h, bpp, rows, texts = read_png(sys.argv[2])
 layers = texts["Layers"].split(",")
 assert {"basin", "attractors", "overlays", "axes", "legend", "title"} <= set(layers), layers
 px = lambda x, y: tuple(rows[y][bpp * x:bpp * x + 3])
-# the legend, right of the plot: the sink's red swatch and dark text
+# the legend, right of the plot: the grey swatch of the cells whose orbits
+# leave the box and stay outside (91.5 %), and dark text
 legend = [px(x, y) for y in range(40, 400) for x in range(int(0.66 * w), w)]
-assert (214, 39, 40) in legend and sum(max(p) < 80 for p in legend) > 500, "no legend"
+assert (180, 180, 180) in legend and sum(max(p) < 80 for p in legend) > 500, "no legend"
 # the axes: dark tick labels left of and below the plot
 left = [px(x, y) for y in range(40, h - 60) for x in range(0, 60)]
 below = [px(x, y) for y in range(h - 60, h) for x in range(80, int(0.6 * w))]
@@ -212,7 +213,7 @@ ls | grep -q tmp- && fail "temporary files left behind"
 head -c 4096 mem.cmdb > truncated.cmdb
 head -c 5000 /dev/urandom > random.cmdb
 sqlite3 foreign.cmdb "CREATE TABLE t(x)"
-cp mem.cmdb newer.cmdb && sqlite3 newer.cmdb "PRAGMA user_version = 7"
+cp mem.cmdb newer.cmdb && sqlite3 newer.cmdb "PRAGMA user_version = 8"
 for f in truncated random foreign newer notes; do
   [ -f $f.cmdb ] || cp notes.txt $f.cmdb
   sum=$(md5sum < $f.cmdb)
@@ -498,9 +499,14 @@ sum_v3=$(sha256sum v3.cmdb)
 "$CM" export v4.cmdb --groups v4-groups.csv --cells v4-cells.csv 2> /dev/null
 cmp -s v3-groups.csv v4-groups.csv || fail "a version 3 file's groups read differently"
 cmp -s v3-cells.csv v4-cells.csv || fail "a version 3 file's cells read differently"
-"$CM" render v3.cmdb --png v3.png 2> /dev/null || fail "render of a version 3 file"
-"$CM" render v4.cmdb --png v4.png 2> /dev/null
+# by groups: a version 3 file's sink cells do not say where they leave the
+# cells, so by attractors they are all outside (docs/format.md)
+"$CM" render v3.cmdb --by groups --png v3.png 2> /dev/null || fail "render of a version 3 file"
+"$CM" render v4.cmdb --by groups --png v4.png 2> /dev/null
 cmp -s v3.png v4.png || fail "a version 3 file renders differently"
+"$CM" render v3.cmdb --png v3-att.png 2> /dev/null || fail "render of a version 3 file by attractors"
+"$CM" render v4.cmdb --png v4-att.png 2> /dev/null
+"$CM" info v3.cmdb > /dev/null || fail "info of a version 3 file"
 # info's lines on the groups and regions (the attractors' block aside: an
 # old file holds none, the upgraded one those its resume found)
 info_groups() { "$CM" info "$1" | grep -v '^disk:\|^file ' | sed '/^attractors/,/^cell groups/{/^cell groups/!d}'; }
@@ -516,48 +522,52 @@ cp v3.cmdb v3-bad.cmdb
 sqlite3 v3-bad.cmdb "UPDATE attractors SET centre = '[1,2]' WHERE id = 7"
 sum_bad=$(sha256sum v3-bad.cmdb)
 "$CM" solve "${V3_SOLVE[@]}" --db v3-bad.cmdb --resume > /dev/null 2> v3.err && fail "upgraded a file whose groups differ"
-grep -q "could not be upgraded to version 6 (its groups would change); the file is unchanged" v3.err ||
+grep -q "could not be upgraded to version 7 (its groups would change); the file is unchanged" v3.err ||
     fail "refused upgrade message: $(cat v3.err)"
 [ "$(sha256sum v3-bad.cmdb)" = "$sum_bad" ] || fail "a refused upgrade changed the file"
 [ "$(sha256sum v3.cmdb)" = "$sum_v3" ] || fail "reading or refusing a version 3 file changed it"
 # --resume upgrades it in one transaction; every output stays what it was
 cp v3.cmdb v3-explore.cmdb
 "$CM" solve "${V3_SOLVE[@]}" --db v3.cmdb --resume > /dev/null 2> v3.err || fail "resume of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3.cmdb from format version 3 to 6" v3.err || fail "upgrade message: $(cat v3.err)"
-[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 6 ] || fail "the resumed version 3 file was not upgraded"
+grep -q "upgraded v3.cmdb from format version 3 to 7" v3.err || fail "upgrade message: $(cat v3.err)"
+[ "$(sqlite3 v3.cmdb 'PRAGMA user_version')" = 7 ] || fail "the resumed version 3 file was not upgraded"
 check_page_bytes v3.cmdb
 "$CM" export v3.cmdb --groups up-groups.csv --cells up-cells.csv 2> /dev/null || fail "export of an upgraded file"
 cmp -s up-groups.csv v3-groups.csv && cmp -s up-cells.csv v3-cells.csv || fail "the upgrade changed the export"
-"$CM" render v3.cmdb --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"
+"$CM" render v3.cmdb --by groups --png up.png 2> /dev/null && cmp -s up.png v3.png || fail "the upgrade changed the render"
+"$CM" render v3.cmdb --png up-att.png 2> /dev/null && cmp -s up-att.png v4-att.png \
+  || fail "the upgraded file renders by attractors unlike a fresh solve"
 info_groups v3.cmdb | diff - v3-info.txt || fail "the upgrade changed info"
 "$CM" info v3.cmdb | grep -q "^attractors [0-9]*, by true orbits" || fail "the upgraded file has no attractors"
 "$CM" export v3.cmdb --flat flat.npz 2> /dev/null && cmp -s flat.npz v3-flat.npz || fail "the upgrade changed export --flat"
 # explore upgrades too, and goes on
 "$CM" explore v3-explore.cmdb - <<< "stats" > v3-stats.txt 2> v3.err || fail "explore of a version 3 file: $(cat v3.err)"
-grep -q "upgraded v3-explore.cmdb from format version 3 to 6" v3.err || fail "explore upgrade message: $(cat v3.err)"
+grep -q "upgraded v3-explore.cmdb from format version 3 to 7" v3.err || fail "explore upgrade message: $(cat v3.err)"
 # tests/data/v4-split.cmdb: the same solve by cellmap with format version 4
 # (node tables, no table of open nodes); read as it is, upgraded on --resume
 cp "$HERE/data/v4-split.cmdb" v4old.cmdb
 sum_v4=$(sha256sum v4old.cmdb)
 "$CM" export v4old.cmdb --groups v4old-groups.csv --cells v4old-cells.csv 2> /dev/null || fail "export of a version 4 file"
 cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || fail "a version 4 file reads differently"
-"$CM" render v4old.cmdb --png v4old.png 2> /dev/null && cmp -s v4old.png v3.png || fail "a version 4 file renders differently"
+"$CM" render v4old.cmdb --by groups --png v4old.png 2> /dev/null && cmp -s v4old.png v3.png || fail "a version 4 file renders differently"
+"$CM" render v4old.cmdb --png v4old-att.png 2> /dev/null && cmp -s v4old-att.png v4-att.png \
+  || fail "a version 4 file renders by attractors unlike a fresh solve"
 [ "$(sha256sum v4old.cmdb)" = "$sum_v4" ] || fail "reading a version 4 file changed it"
 "$CM" solve "${V3_SOLVE[@]}" --db v4old.cmdb --resume > /dev/null 2> v4.err || fail "resume of a version 4 file: $(cat v4.err)"
-grep -q "upgraded v4old.cmdb from format version 4 to 6" v4.err || fail "v4 upgrade message: $(cat v4.err)"
+grep -q "upgraded v4old.cmdb from format version 4 to 7" v4.err || fail "v4 upgrade message: $(cat v4.err)"
 "$CM" export v4old.cmdb --groups v4old-groups.csv --cells v4old-cells.csv 2> /dev/null || fail "export of an upgraded version 4 file"
 cmp -s v4old-groups.csv v3-groups.csv && cmp -s v4old-cells.csv v3-cells.csv || fail "the upgrade of a version 4 file changed its export"
 same_rows v4old.cmdb v4.cmdb 'SELECT region, count, hex(data) FROM open_nodes ORDER BY region' ||
     fail "an upgraded version 4 file has other open nodes than a fresh solve"
 # the system's attractors: a resumed upgrade writes those of a fresh solve
 for q in 'SELECT * FROM system_attractors ORDER BY id' 'SELECT * FROM group_fates ORDER BY grp' \
-         "SELECT value FROM meta WHERE key = 'attractor_options'"; do
+         'SELECT * FROM exit_fates ORDER BY attractor' "SELECT value FROM meta WHERE key = 'attractor_options'"; do
   same_rows v4old.cmdb v4.cmdb "$q" || fail "an upgraded version 4 file's attractors differ: $q"
 done
 # version 5 had no system attractors: read as it is (they are found on the
 # way, the same), upgraded by --resume, which writes them
 cp v4.cmdb v5.cmdb
-sqlite3 v5.cmdb "DROP TABLE system_attractors; DROP TABLE group_fates;
+sqlite3 v5.cmdb "DROP TABLE system_attractors; DROP TABLE group_fates; DROP TABLE exit_fates;
   DELETE FROM meta WHERE key = 'attractor_options'; PRAGMA user_version = 5;"
 sum_v5=$(sha256sum v5.cmdb)
 "$CM" export v5.cmdb --labels v5.npy 2> /dev/null && "$CM" export v4.cmdb --labels v6.npy 2> /dev/null \
@@ -566,9 +576,24 @@ sum_v5=$(sha256sum v5.cmdb)
   && cmp -s v5.png v6.png || fail "a version 5 file renders differently"
 [ "$(sha256sum v5.cmdb)" = "$sum_v5" ] || fail "reading a version 5 file changed it"
 "$CM" solve "${V3_SOLVE[@]}" --db v5.cmdb --resume > /dev/null 2> v5.err || fail "resume of a version 5 file: $(cat v5.err)"
-grep -q "upgraded v5.cmdb from format version 5 to 6" v5.err || fail "v5 upgrade message: $(cat v5.err)"
+grep -q "upgraded v5.cmdb from format version 5 to 7" v5.err || fail "v5 upgrade message: $(cat v5.err)"
 same_rows v5.cmdb v4.cmdb 'SELECT * FROM system_attractors ORDER BY id' \
   || fail "an upgraded version 5 file's attractors differ from a fresh solve's"
+# version 6's attractors were found without following the orbits that
+# leave the cells: read as none (found again, the same), and a resume
+# upgrades the file and writes them with the exits' fates
+cp v4.cmdb v6.cmdb
+sqlite3 v6.cmdb "DROP TABLE exit_fates; PRAGMA user_version = 6;"
+sum_v6=$(sha256sum v6.cmdb)
+"$CM" export v6.cmdb --labels v6-labels.npy 2> /dev/null && "$CM" export v4.cmdb --labels v7.npy 2> /dev/null \
+  && cmp -s v6-labels.npy v7.npy || fail "a version 6 file's attractor labels differ"
+[ "$(sha256sum v6.cmdb)" = "$sum_v6" ] || fail "reading a version 6 file changed it"
+"$CM" solve "${V3_SOLVE[@]}" --db v6.cmdb --resume > /dev/null 2> v6.err || fail "resume of a version 6 file: $(cat v6.err)"
+grep -q "upgraded v6.cmdb from format version 6 to 7" v6.err || fail "v6 upgrade message: $(cat v6.err)"
+for q in 'SELECT * FROM system_attractors ORDER BY id' 'SELECT * FROM exit_fates ORDER BY attractor' \
+         "SELECT value FROM meta WHERE key = 'attractor_options'"; do
+  same_rows v6.cmdb v4.cmdb "$q" || fail "an upgraded version 6 file's attractors differ: $q"
+done
 # the stored attractors are those found again; a damaged row is refused
 "$CM" solve --cells 200x200 --db att.cmdb > /dev/null || fail "solve --db att.cmdb"
 "$CM" export att.cmdb --labels stored.npy > /dev/null 2>&1 \

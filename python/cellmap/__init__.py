@@ -7,9 +7,10 @@ labels[i, j] is the cell i along the first coordinate and j along the
 second; a label is 0 for the sink, k for group k, -1 for a cell that no
 region of a database computed. attractor_labels are the system's
 attractors behind the groups (found by their true orbits, as `cellmap
-solve` does): k for attractor k, 0 diverged, -2 outside (the sequence left
-the cells, or its group's orbit was undecided), -1 not computed, as
-`cellmap export --labels` writes them.
+solve` does, sink cells by the true orbits from where their sequences
+leave the cells): k for attractor k, 0 diverged, -2 outside (left the
+cells and did not come back, or its group's orbit was undecided), -1 not
+computed, as `cellmap export --labels` writes them.
 
     import cellmap
     pd = cellmap.System("microchaos-pd", alpha=0.078, beta=0, P=0.007, D=0.02)

@@ -1,0 +1,737 @@
+/* Orbits that leave the computed cells (cellmap/outside.h). */
+#include "cellmap/outside.h"
+
+#include "cellmap/grow.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cm_exits_free(cm_exits *x)
+{
+    if (!x)
+        return;
+    free(x->cell);
+    free(x->weight);
+    free(x->node);
+    free(x->node_exit);
+    memset(x, 0, sizeof *x);
+}
+
+/* Radix sorting: digits of this many bits, as many passes as the keys'
+ * spread needs (a cluster's cells span few bits; 2^40 at most). */
+#define DIGIT_BITS 11
+#define DIGITS (1u << DIGIT_BITS)
+
+/* Reorders order[0..n) stably by key(order[i]) = keys[order[i] * stride],
+ * tmp: n entries of scratch. */
+static void radix_pass_all(uint32_t *order, uint32_t *tmp, uint64_t n, const int64_t *keys,
+                           size_t stride)
+{
+    if (n < 2)
+        return;
+    int64_t lo = keys[(size_t)order[0] * stride], hi = lo;
+    for (uint64_t i = 1; i < n; i++) {
+        const int64_t k = keys[(size_t)order[i] * stride];
+        lo = k < lo ? k : lo;
+        hi = k > hi ? k : hi;
+    }
+    const uint64_t spread = (uint64_t)hi - (uint64_t)lo;
+    for (int shift = 0; shift < 64 && (shift == 0 || (spread >> shift) != 0); shift += DIGIT_BITS) {
+        uint64_t count[DIGITS + 1] = {0};
+        for (uint64_t i = 0; i < n; i++)
+            count[((((uint64_t)keys[(size_t)order[i] * stride] - (uint64_t)lo) >> shift) &
+                   (DIGITS - 1)) + 1]++;
+        for (uint32_t d = 1; d <= DIGITS; d++)
+            count[d] += count[d - 1];
+        for (uint64_t i = 0; i < n; i++) {
+            const uint64_t d =
+                (((uint64_t)keys[(size_t)order[i] * stride] - (uint64_t)lo) >> shift) & (DIGITS - 1);
+            tmp[count[d]++] = order[i];
+        }
+        memcpy(order, tmp, (size_t)n * sizeof *order);
+    }
+}
+
+/* The order of n cells (dim coordinates each) in box order: the first
+ * coordinate sorted first, the last (the most significant) last. */
+static cm_status box_order(const int64_t *cells, uint64_t n, int dim, uint32_t **out)
+{
+    uint32_t *order = malloc(((size_t)n + 1) * sizeof *order);
+    uint32_t *tmp = malloc(((size_t)n + 1) * sizeof *tmp);
+    if (!order || !tmp) {
+        free(order);
+        free(tmp);
+        return CM_ENOMEM;
+    }
+    for (uint64_t i = 0; i < n; i++)
+        order[i] = (uint32_t)i;
+    for (int d = 0; d < dim; d++)
+        radix_pass_all(order, tmp, n, cells + d, (size_t)dim);
+    free(tmp);
+    *out = order;
+    return CM_OK;
+}
+
+static bool same_cell(const int64_t *a, const int64_t *b, int dim)
+{
+    for (int d = 0; d < dim; d++)
+        if (a[d] != b[d])
+            return false;
+    return true;
+}
+
+/* The distinct cells of targets[0..n) (dim coordinates each) in box order
+ * into x->cell, their weights summed into x->weight; exit_of[i] (may be
+ * NULL) receives the exit of target i. */
+static cm_status exits_of_targets(const int64_t *targets, const uint64_t *weight, uint64_t n,
+                                  int dim, cm_exits *x, uint64_t *exit_of)
+{
+    if (n >= UINT32_MAX)
+        return CM_ETOOBIG;
+    uint32_t *order = NULL;
+    cm_status st = box_order(targets, n, dim, &order);
+    x->cell = malloc(((size_t)n + 1) * (size_t)dim * sizeof *x->cell);
+    x->weight = malloc(((size_t)n + 1) * sizeof *x->weight);
+    if (st != CM_OK || !x->cell || !x->weight) {
+        free(order);
+        return CM_ENOMEM;
+    }
+    x->n = 0;
+    for (uint64_t k = 0; k < n; k++) {
+        const int64_t *t = targets + (size_t)order[k] * (size_t)dim;
+        if (!x->n || !same_cell(t, x->cell + (x->n - 1) * (uint64_t)dim, dim)) {
+            memcpy(x->cell + x->n * (uint64_t)dim, t, (size_t)dim * sizeof *t);
+            x->weight[x->n++] = 0;
+        }
+        x->weight[x->n - 1] += weight[order[k]];
+        if (exit_of)
+            exit_of[order[k]] = x->n - 1;
+    }
+    free(order);
+    return CM_OK;
+}
+
+/* Whether the image of a sink cell leaves the region's cells: an exit, or
+ * a cell of the box that was not computed. */
+static bool leaves(const cm_region *r, uint32_t image)
+{
+    return image >= CM_IMAGE_EXIT_BASE ? image != CM_IMAGE_SINK
+                                       : image < r->ncells && r->group[image] == CM_GROUP_NONE;
+}
+
+/* Whether a sink cell's sequence ends at cell j: its image is the sink, or
+ * leaves the region's cells. */
+static bool ends_here(const cm_region *r, uint64_t j)
+{
+    return r->image[j] == CM_IMAGE_SINK || leaves(r, r->image[j]);
+}
+
+/* The exit cell a leaving cell's image lands in: the recorded exit's
+ * target, the uncomputed cell of the box it points to, or (an image
+ * CM_IMAGE_EXIT, not recorded) found again by the image rule. Returns the
+ * model's status; 1 when the model now gives no image. */
+static int exit_of(const cm_region_cells *rc, uint64_t local, int64_t *exit)
+{
+    const cm_region *r = rc->r;
+    const uint32_t image = r->image[local];
+    const int64_t k = cm_image_exit_index(image);
+    if (k >= 0 && r->exit_target) {
+        memcpy(exit, cm_region_exit(r, (uint64_t)k), (size_t)r->box.dim * sizeof *exit);
+        return 0;
+    }
+    if (image < r->ncells) {
+        cm_box_cell(&r->box, image, exit);
+        return 0;
+    }
+    int64_t from[CM_MAX_DIM];
+    bool in_world;
+    cm_box_cell(&r->box, local, from);
+    const int st = cm_scm_image_cell(rc->m, rc->lat, from, rc->max_steps, exit, &in_world);
+    return st < 0 ? st : in_world ? 0 : 1;
+}
+
+static int threads_of(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+cm_status cm_region_settle_exits(cm_region *r, int threads, cm_exits *out, char *msg,
+                                 size_t msg_size)
+{
+    memset(out, 0, sizeof *out);
+    if (!r->exits_recorded)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the region's exits were not recorded");
+    const int dim = r->box.dim;
+    uint64_t *weight = calloc((size_t)r->nexits + 1, sizeof *weight);
+    if (!weight)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                       (unsigned long long)r->nexits);
+    uint64_t world = 0;
+#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : world)
+    {
+        uint64_t *mine = calloc((size_t)r->nexits + 1, sizeof *mine); /* NULL: atomics */
+#pragma omp for schedule(static)
+        for (uint64_t i = 0; i < r->ncells; i++) {
+            const uint32_t g = r->group[i];
+            if (g == 0) {
+                world++;
+            } else if (cm_is_node_ref(g)) {
+                r->group[i] = 0; /* the sink, as a resolved region has it */
+                if (mine) {
+                    mine[g & ~CM_NODE_REF]++;
+                } else {
+#pragma omp atomic
+                    weight[g & ~CM_NODE_REF]++;
+                }
+            }
+        }
+        for (uint64_t k = 0; mine && k < r->nexits; k++) {
+            if (mine[k]) {
+#pragma omp atomic
+                weight[k] += mine[k];
+            }
+        }
+        free(mine);
+    }
+    out->world_cells = world;
+    const cm_status st = exits_of_targets(r->exit_target, weight, r->nexits, dim, out, NULL);
+    free(weight);
+    if (st != CM_OK) {
+        cm_exits_free(out);
+        return cm_fail(st, msg, msg_size, "out of memory for %llu exits",
+                       (unsigned long long)r->nexits);
+    }
+    return CM_OK;
+}
+
+typedef struct escape_list {
+    int dim;
+    int64_t *cell;
+    uint32_t *node;
+    uint64_t n, cap, cap_node;
+    int failed;
+} escape_list;
+
+static void add_escape(void *user, uint32_t node, const int64_t *cell)
+{
+    escape_list *l = user;
+    if (l->failed ||
+        cm_grow((void **)&l->cell, &l->cap, (l->n + 1) * (uint64_t)l->dim, sizeof *l->cell) != CM_OK ||
+        cm_grow((void **)&l->node, &l->cap_node, l->n + 1, sizeof *l->node) != CM_OK) {
+        l->failed = 1;
+        return;
+    }
+    memcpy(l->cell + l->n * (uint64_t)l->dim, cell, (size_t)l->dim * sizeof *cell);
+    l->node[l->n++] = node;
+}
+
+/* Each open node's exit (exit_of[i] for node l->node[i]), by node id. */
+static cm_status index_nodes(const escape_list *l, const uint64_t *exit_of, cm_exits *x)
+{
+    uint32_t *order = malloc(((size_t)l->n + 1) * sizeof *order);
+    uint32_t *tmp = malloc(((size_t)l->n + 1) * sizeof *tmp);
+    int64_t *ids = calloc((size_t)l->n + 1, sizeof *ids);
+    x->node = malloc(((size_t)l->n + 1) * sizeof *x->node);
+    x->node_exit = malloc(((size_t)l->n + 1) * sizeof *x->node_exit);
+    cm_status st = order && tmp && ids && x->node && x->node_exit ? CM_OK : CM_ENOMEM;
+    for (uint64_t i = 0; st == CM_OK && i < l->n; i++) {
+        order[i] = (uint32_t)i;
+        ids[i] = l->node[i];
+    }
+    if (st == CM_OK)
+        radix_pass_all(order, tmp, l->n, ids, 1);
+    for (uint64_t i = 0; st == CM_OK && i < l->n; i++) {
+        x->node[i] = l->node[order[i]];
+        x->node_exit[i] = exit_of[order[i]];
+    }
+    x->nnodes = st == CM_OK ? l->n : 0;
+    free(order);
+    free(tmp);
+    free(ids);
+    return st;
+}
+
+cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size)
+{
+    memset(out, 0, sizeof *out);
+    if (c->resolved_cells) { /* where sink cells leave is not known: all outside */
+        out->unknown_cells = cm_cluster_sink_cells(c);
+        return CM_OK;
+    }
+    escape_list l = {c->lat.dim, NULL, NULL, 0, 0, 0, 0};
+    cm_cluster_each_escape(c, add_escape, &l);
+    cm_status st = l.failed ? CM_ENOMEM : CM_OK;
+    uint64_t *weight = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *weight) : NULL;
+    uint64_t *exit_of = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *exit_of) : NULL;
+    if (st == CM_OK && (!weight || !exit_of))
+        st = CM_ENOMEM;
+    uint64_t open = 0;
+    for (uint64_t i = 0; st == CM_OK && i < l.n; i++) {
+        weight[i] = cm_cluster_open_weight(c, l.node[i]);
+        open += weight[i];
+    }
+    if (st == CM_OK)
+        st = exits_of_targets(l.cell, weight, l.n, l.dim, out, exit_of);
+    if (st == CM_OK)
+        st = index_nodes(&l, exit_of, out);
+    const uint64_t sink = cm_cluster_sink_cells(c);
+    out->world_cells = sink > open ? sink - open : 0;
+    free(l.cell);
+    free(l.node);
+    free(weight);
+    free(exit_of);
+    if (st != CM_OK) {
+        cm_exits_free(out);
+        return cm_fail(st, msg, msg_size, "out of memory for the cluster's exits");
+    }
+    return CM_OK;
+}
+
+/* The region adapter: a computed cell is a cell of the box with a group. */
+static bool region_holds(const void *user, const int64_t *cell)
+{
+    const cm_region *r = ((const cm_region_cells *)user)->r;
+    return cm_box_contains(&r->box, cell) && r->group[cm_box_index(&r->box, cell)] != CM_GROUP_NONE;
+}
+
+static cm_status region_end(void *user, const int64_t *cell, uint32_t *group, bool *out_leaves,
+                            int64_t *exit, char *msg, size_t msg_size)
+{
+    const cm_region_cells *rc = user;
+    const cm_region *r = rc->r;
+    *out_leaves = false;
+    *group = region_holds(rc, cell) ? r->group[cm_box_index(&r->box, cell)] : CM_GROUP_NONE;
+    if (*group != 0)
+        return CM_OK;
+    uint64_t j = cm_box_index(&r->box, cell);
+    while (r->image[j] != CM_IMAGE_SINK && !leaves(r, r->image[j]))
+        j = r->image[j]; /* a sink chain: it ends */
+    if (r->image[j] == CM_IMAGE_SINK)
+        return CM_OK;
+    const int st = exit_of(rc, j, exit);
+    *out_leaves = st == 0;
+    return st < 0 ? cm_fail(CM_EMODEL, msg, msg_size, "the model aborted finding an exit's cell")
+                  : CM_OK;
+}
+
+cm_computed cm_region_computed(cm_region_cells *rc)
+{
+    return (cm_computed){region_holds, region_end, rc, rc->r->box};
+}
+
+static bool cluster_holds(const void *user, const int64_t *cell)
+{
+    uint64_t local;
+    return cm_cluster_locate(((const cm_cluster_cells *)user)->c, cell, &local) >= 0;
+}
+
+/* The exit open node id leads to (cm_cluster_exits' node index). */
+static const int64_t *node_exit(const cm_exits *x, int dim, uint32_t id)
+{
+    uint64_t lo = 0, hi = x->nnodes;
+    while (lo < hi) {
+        const uint64_t mid = lo + (hi - lo) / 2;
+        if (x->node[mid] < id)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < x->nnodes && x->node[lo] == id && x->node_exit[lo] < x->n
+               ? x->cell + x->node_exit[lo] * (uint64_t)dim
+               : NULL;
+}
+
+static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, bool *out_leaves,
+                             int64_t *exit, char *msg, size_t msg_size)
+{
+    const cm_cluster_cells *cc = user;
+    cm_cluster *c = cc->c;
+    const int dim = c->lat.dim;
+    uint64_t local;
+    const int64_t k = cm_cluster_locate(c, cell, &local);
+    *group = CM_GROUP_NONE;
+    *out_leaves = false;
+    if (k < 0)
+        return CM_OK;
+    cm_status st = cm_cluster_acquire(c, (uint32_t)k, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const uint32_t g = c->regions[k].r.group[local];
+    if (!cm_is_node_ref(g)) {
+        *group = g;
+        /* resolved cells: the exit is not known, and no exit is that cell */
+        *out_leaves = g == 0 && c->resolved_cells;
+        memcpy(exit, cell, (size_t)dim * sizeof *exit);
+        return CM_OK;
+    }
+    uint32_t step, open;
+    st = cm_cluster_resolve(c, c->regions[k].node_base + (g & ~CM_NODE_REF), group, &step, &open,
+                            msg, msg_size);
+    if (st != CM_OK || *group != 0 || open == CM_NODE_OPEN)
+        return st;
+    const int64_t *e = node_exit(cc->exits, dim, open);
+    if (!e)
+        return cm_fail(CM_EINVAL, msg, msg_size, "open node %u is not among the cluster's exits",
+                       open);
+    memcpy(exit, e, (size_t)dim * sizeof *exit);
+    *out_leaves = true;
+    return CM_OK;
+}
+
+cm_computed cm_cluster_computed(cm_cluster_cells *cc)
+{
+    cm_computed out = {cluster_holds, cluster_end, cc, {0}};
+    cm_cluster_bounds(cc->c, &out.bounds);
+    return out;
+}
+
+/* What following one exit found. */
+enum { FOLLOW_DIVERGED = 0, FOLLOW_OUTSIDE, FOLLOW_RETURNED, FOLLOW_ABORTED };
+typedef struct followed {
+    int how;
+    int64_t cell[CM_MAX_DIM]; /* FOLLOW_RETURNED: the computed cell it lands in */
+} followed;
+
+/* Exits followed together, through the model's step_n where it has one. */
+#define FOLLOW_BATCH 256
+
+/* One batch's points: states, images, their cells (as doubles), and per
+ * point whether the image is in the world and within the computed
+ * cells' bounds. */
+typedef struct follow_buf {
+    double x[CM_MAX_DIM][FOLLOW_BATCH], y[CM_MAX_DIM][FOLLOW_BATCH];
+    double at[CM_MAX_DIM][FOLLOW_BATCH];
+    double world[FOLLOW_BATCH], near[FOLLOW_BATCH];
+    int rc[FOLLOW_BATCH], who[FOLLOW_BATCH];
+} follow_buf;
+
+/* The batch's images one step on (n points). */
+static void step_points(const cm_model *m, int dim, int n, follow_buf *b)
+{
+    if (m->step_n) {
+        const double *xs[CM_MAX_DIM];
+        double *ys[CM_MAX_DIM];
+        for (int d = 0; d < dim; d++) {
+            xs[d] = b->x[d];
+            ys[d] = b->y[d];
+        }
+        m->step_n(m, (size_t)n, xs, ys, b->rc);
+        return;
+    }
+    for (int i = 0; i < n; i++) {
+        double p[CM_MAX_DIM], q[CM_MAX_DIM];
+        for (int d = 0; d < dim; d++)
+            p[d] = b->x[d][i];
+        b->rc[i] = m->step(m, p, q);
+        for (int d = 0; d < dim; d++)
+            b->y[d][i] = q[d];
+    }
+}
+
+/* floor(u) for |u| < 2^51, as cm_lattice_cell gives it (no libm call). */
+static inline double floor_exact(double u)
+{
+    const double magic = 0x1.8p52;
+    const double t = (u + magic) - magic;
+    return t - (t > u ? 1.0 : 0.0);
+}
+
+/* The cells of the images (as cm_lattice_cell finds them), whether they
+ * are in the world, and whether within bounds: loops the compiler
+ * vectorises. */
+CM_VECTOR_LOOP
+static void place_points(const cm_lattice *lat, const cm_box *bounds, int n, follow_buf *b)
+{
+    const double limit = (double)CM_WORLD_LIMIT;
+    for (int i = 0; i < n; i++) {
+        b->world[i] = b->rc[i] == CM_STEP_OK ? 1.0 : 0.0;
+        b->near[i] = 1.0;
+    }
+    for (int d = 0; d < lat->dim; d++) {
+        const double origin = lat->origin[d], width = lat->width[d];
+        const double lo = (double)bounds->lo[d], hi = (double)bounds->hi[d];
+        for (int i = 0; i < n; i++) {
+            const double u = (b->y[d][i] - origin) / width;
+            const double inside = ((u >= -limit) & (u < limit)) ? 1.0 : 0.0; /* 0 for NaN */
+            const double at = floor_exact(inside != 0.0 ? u : 0.0);
+            b->at[d][i] = at;
+            b->world[i] *= inside;
+            b->near[i] *= ((at >= lo) & (at < hi)) ? 1.0 : 0.0;
+        }
+    }
+}
+
+/* The true orbits from the centres of exits first..first+n-1 (n at most
+ * FOLLOW_BATCH), at most `steps` steps each, until each lands in a
+ * computed cell, diverges or runs out of steps (outside). Returns the
+ * steps taken. */
+static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
+                             const cm_exits *x, uint64_t first, int n, uint32_t steps,
+                             follow_buf *b, followed *out)
+{
+    const int dim = lat->dim;
+    for (int i = 0; i < n; i++) {
+        double c[CM_MAX_DIM];
+        cm_lattice_centre(lat, x->cell + (first + (uint64_t)i) * (uint64_t)dim, c);
+        for (int d = 0; d < dim; d++)
+            b->x[d][i] = c[d];
+        b->who[i] = i;
+        out[i].how = FOLLOW_OUTSIDE;
+    }
+    uint64_t taken = 0;
+    for (uint32_t k = 1; k <= steps && n > 0; k++) {
+        step_points(m, dim, n, b);
+        place_points(lat, &cells->bounds, n, b);
+        taken += (uint64_t)n;
+        int kept = 0;
+        for (int i = 0; i < n; i++) {
+            followed *f = &out[b->who[i]];
+            if (b->world[i] == 0.0) {
+                f->how = b->rc[i] < 0 ? FOLLOW_ABORTED : FOLLOW_DIVERGED;
+                continue;
+            }
+            for (int d = 0; d < dim; d++)
+                f->cell[d] = (int64_t)b->at[d][i];
+            if (b->near[i] != 0.0 && cells->holds(cells->user, f->cell)) {
+                f->how = FOLLOW_RETURNED;
+                continue;
+            }
+            for (int d = 0; d < dim; d++) /* still outside: on to the next step */
+                b->x[d][kept] = b->y[d][i];
+            b->who[kept++] = b->who[i];
+        }
+        n = kept;
+    }
+    return taken;
+}
+
+/* Chains of exits: an exit whose orbit returns into the sink's domain goes
+ * where the exit of that cell's sequence goes. */
+#define NEXT_LABEL UINT64_MAX       /* label[e] is final */
+#define LABEL_PENDING INT32_MIN     /* not known yet */
+#define LABEL_WALKING (INT32_MIN + 1) /* on the walk under way */
+
+/* Settles label[] along next[]: a chain that ends at a final label takes
+ * it; a chain that comes back on itself is outside. */
+static void settle_chains(uint64_t n, const uint64_t *next, int32_t *label)
+{
+    for (uint64_t e = 0; e < n; e++) {
+        if (label[e] != LABEL_PENDING)
+            continue;
+        uint64_t j = e;
+        while (label[j] == LABEL_PENDING) {
+            label[j] = LABEL_WALKING;
+            j = next[j];
+        }
+        const int32_t v = label[j] == LABEL_WALKING ? CM_LABEL_OUTSIDE : label[j];
+        for (uint64_t i = e; label[i] == LABEL_WALKING; i = next[i])
+            label[i] = v;
+    }
+}
+
+/* The fate of the cell an orbit returned to. */
+static cm_status returned_to(const cm_computed *cells, const cm_exits *x, int dim,
+                             const cm_attractor_set *s, const int64_t *cell, int32_t *label,
+                             uint64_t *next, char *msg, size_t msg_size)
+{
+    uint32_t g;
+    bool out;
+    int64_t exit[CM_MAX_DIM];
+    const cm_status st = cells->end(cells->user, cell, &g, &out, exit, msg, msg_size);
+    *next = NEXT_LABEL;
+    if (st != CM_OK)
+        return st;
+    if (g != 0) {
+        *label = cm_attractor_label(s, g);
+        return CM_OK;
+    }
+    if (!out) {
+        *label = CM_LABEL_DIVERGED;
+        return CM_OK;
+    }
+    *next = cm_cell_search(x->cell, x->n, dim, exit);
+    *label = *next == UINT64_MAX ? CM_LABEL_OUTSIDE : LABEL_PENDING;
+    if (*next == UINT64_MAX)
+        *next = NEXT_LABEL;
+    return CM_OK;
+}
+
+/* The counts of s from its exits' fates and weights. */
+static void count_fates(const cm_exits *x, cm_attractor_set *s)
+{
+    s->sink_diverged_cells = x->world_cells;
+    s->outside_cells = x->unknown_cells;
+    s->returned_cells = 0;
+    for (uint64_t e = 0; e < x->n; e++) {
+        const int32_t v = s->exit_label[e];
+        if (v > 0 && (uint32_t)v <= s->n) {
+            s->a[v - 1].basin_cells += x->weight[e];
+            s->returned_cells += x->weight[e];
+        } else if (v == CM_LABEL_DIVERGED)
+            s->sink_diverged_cells += x->weight[e];
+        else
+            s->outside_cells += x->weight[e];
+    }
+}
+
+cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
+                                const cm_computed *cells, uint32_t steps, int threads,
+                                cm_attractor_set *s, char *msg, size_t msg_size)
+{
+    const int dim = lat->dim;
+    free(s->exit_cell);
+    free(s->exit_label);
+    s->nexits = x->n;
+    s->outside_steps = steps;
+    s->outside_steps_taken = 0;
+    s->exit_cell = malloc(((size_t)x->n + 1) * (size_t)dim * sizeof *s->exit_cell);
+    s->exit_label = malloc(((size_t)x->n + 1) * sizeof *s->exit_label);
+    followed *f = malloc(((size_t)x->n + 1) * sizeof *f);
+    uint64_t *next = malloc(((size_t)x->n + 1) * sizeof *next);
+    cm_status st = s->exit_cell && s->exit_label && f && next
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                                 (unsigned long long)x->n);
+    uint64_t taken = 0;
+    int aborted = 0;
+    if (st == CM_OK) {
+        memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
+        const int64_t batches = (int64_t)((x->n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
+#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : taken) reduction(| : aborted)
+        {
+            follow_buf *buf = malloc(sizeof *buf);
+            aborted |= !buf;
+#pragma omp for schedule(dynamic, 1)
+            for (int64_t b = 0; b < batches; b++) {
+                const uint64_t first = (uint64_t)b * FOLLOW_BATCH;
+                const int n = (int)(x->n - first < FOLLOW_BATCH ? x->n - first : FOLLOW_BATCH);
+                if (buf)
+                    taken += follow_batch(m, lat, cells, x, first, n, steps, buf, f + first);
+            }
+            free(buf);
+        }
+        if (aborted)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following the exits");
+        for (uint64_t e = 0; st == CM_OK && e < x->n; e++)
+            if (f[e].how == FOLLOW_ABORTED)
+                st = cm_fail(CM_EMODEL, msg, msg_size,
+                             "the model aborted following an exit's orbit");
+    }
+    for (uint64_t e = 0; st == CM_OK && e < x->n; e++) {
+        next[e] = NEXT_LABEL;
+        s->exit_label[e] = f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+        if (f[e].how == FOLLOW_RETURNED)
+            st = returned_to(cells, x, dim, s, f[e].cell, &s->exit_label[e], &next[e], msg,
+                             msg_size);
+    }
+    if (st == CM_OK) {
+        settle_chains(x->n, next, s->exit_label);
+        s->outside_steps_taken = taken;
+        count_fates(x, s);
+    }
+    free(f);
+    free(next);
+    return st;
+}
+
+/* The label of a sink cell whose sequence leaves the flat region at cell j
+ * (local index): into an uncomputed cell of the box, or out of the box,
+ * where `cells` knows where it goes. */
+static cm_status leaving_label(const cm_attractor_set *s, const cm_region *flat, uint64_t j,
+                               const cm_computed *cells, int32_t *v, char *msg, size_t msg_size)
+{
+    const int dim = flat->box.dim;
+    int64_t at[CM_MAX_DIM], exit[CM_MAX_DIM];
+    const uint32_t image = flat->image[j];
+    if (image < flat->ncells) { /* an uncomputed cell of the box: an exit itself */
+        cm_box_cell(&flat->box, image, exit);
+        *v = cm_attractor_exit_label(s, dim, exit);
+        return CM_OK;
+    }
+    uint32_t g;
+    bool out;
+    if (!cells) { /* orbits not followed */
+        *v = CM_LABEL_OUTSIDE;
+        return CM_OK;
+    }
+    cm_box_cell(&flat->box, j, at);
+    const cm_status st = cells->end(cells->user, at, &g, &out, exit, msg, msg_size);
+    *v = g != 0 ? cm_attractor_label(s, g)
+         : out  ? cm_attractor_exit_label(s, dim, exit)
+                : CM_LABEL_DIVERGED;
+    return st;
+}
+
+cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *flat,
+                                   const cm_computed *cells, int32_t *labels, char *msg,
+                                   size_t msg_size)
+{
+    const int32_t unknown = LABEL_PENDING;
+    for (uint64_t i = 0; i < flat->ncells; i++)
+        labels[i] = flat->group[i] == 0 ? unknown : cm_attractor_label(s, flat->group[i]);
+    for (uint64_t i = 0; i < flat->ncells; i++) {
+        if (labels[i] != unknown)
+            continue;
+        uint64_t j = i;
+        int32_t v = unknown;
+        while (v == unknown) { /* a sink chain: it ends */
+            const uint32_t image = flat->image[j];
+            if (image == CM_IMAGE_SINK)
+                v = CM_LABEL_DIVERGED;
+            else if (leaves(flat, image)) {
+                const cm_status st = leaving_label(s, flat, j, cells, &v, msg, msg_size);
+                if (st != CM_OK)
+                    return st;
+            } else if (labels[image] != unknown)
+                v = labels[image];
+            else
+                j = image;
+        }
+        for (j = i; labels[j] == unknown; j = flat->image[j]) {
+            labels[j] = v;
+            if (ends_here(flat, j))
+                break;
+        }
+    }
+    return CM_OK;
+}
+
+/* The budget opt asks (0 when not followed). */
+static uint32_t outside_budget(const cm_model *m, const cm_attractor_options *opt)
+{
+    cm_attractor_options o;
+    cm_attractor_defaults(m, opt, &o);
+    return o.outside == CM_OUTSIDE_OFF ? 0 : o.outside;
+}
+
+cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const cm_region *r,
+                               int max_steps, const cm_exits *x, const cm_group_info *groups,
+                               const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
+                               size_t msg_size)
+{
+    cm_status st = cm_attractors_find(m, lat, groups, r->ngroups, cm_region_cell_group,
+                                      (void *)r, opt, out, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_region_cells rc = {r, m, lat, max_steps};
+    const cm_computed cells = cm_region_computed(&rc);
+    return cm_attractors_outside(m, lat, x, &cells, outside_budget(m, opt), opt ? opt->threads : 0,
+                                 out, msg, msg_size);
+}
+
+cm_status cm_cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
+                                const cm_attractor_options *opt, cm_attractor_set *out,
+                                char *msg, size_t msg_size)
+{
+    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c,
+                                      opt, out, msg, msg_size);
+    cm_exits x;
+    if (st == CM_OK)
+        st = cm_cluster_exits(c, &x, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_cluster_cells cc = {c, &x};
+    const cm_computed cells = cm_cluster_computed(&cc);
+    st = cm_attractors_outside(m, &c->lat, &x, &cells, outside_budget(m, opt),
+                               opt ? opt->threads : 0, out, msg, msg_size);
+    cm_exits_free(&x);
+    return st;
+}

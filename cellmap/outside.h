@@ -1,0 +1,141 @@
+/* cellmap/outside.h - orbits that leave the computed cells.
+ *
+ * Simple cell mapping sends every cell whose image leaves the computed
+ * cells to the sink, so "sink" means "left the box once", not "diverged":
+ * Newton's method leaves -2:2^2 from near the origin and comes back to a
+ * root. This layer follows each such image on the true orbit.
+ *
+ * The cells an image leaves into (the *exits*: distinct cells outside the
+ * computed ones, in the world) are followed from their centres by the
+ * true map for at most `steps` steps:
+ *   - the orbit lands in a computed cell u: the exit's fate is u's, the
+ *     attractor label of u's group (cm_attractor_label), or, when u's
+ *     sequence leaves the computed cells in turn, the fate of the exit it
+ *     leaves into (an orbit that keeps leaving and returning through a
+ *     chain of exits back to one of them is *outside*: its attractor lies
+ *     partly outside the computed cells);
+ *   - the map gives no image or the orbit leaves the world: *diverged*;
+ *   - it is still outside after `steps` steps: *outside* (fate unknown).
+ * Every cell of the sink's domain takes the fate of the exit its sequence
+ * leaves into, or diverges when the sequence ends in the world's sink (no
+ * image, or an image beyond the world).
+ *
+ * The fate of an exit depends on the exit cell, the model and which cells
+ * are computed, never on how they were solved: a cluster of any split,
+ * extension, pans or resume gives its exits the fates the single-box solve
+ * of the same cells gives them (the exits are the targets of its open
+ * nodes, which are the targets of the single box's exits). Fates are found
+ * again whenever the computed cells change (a join or a pan changes what
+ * an orbit returns to). Following is per exit cell, not per cell, on
+ * `threads` OpenMP threads, and gives the same fates for any number.
+ */
+#ifndef CM_OUTSIDE_H
+#define CM_OUTSIDE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cellmap/attractors.h"
+#include "cellmap/cluster.h"
+#include "cellmap/model.h"
+#include "cellmap/scm.h"
+
+
+/* The exits of a set of computed cells. */
+typedef struct cm_exits {
+    uint64_t n;          /* distinct exit cells */
+    int64_t *cell;       /* n cells, dim coordinates each, in box order (cm_cell_less) */
+    uint64_t *weight;    /* cells whose sequences leave into each */
+    uint64_t world_cells; /* cells of the sink's domain whose sequences end in the world's sink */
+    uint64_t unknown_cells; /* cells of the sink's domain whose exits are not known (a cluster
+                               of resolved cells, cm_cluster.resolved_cells): outside */
+    /* a cluster's open nodes (ascending ids) and the exit each leads to;
+     * none for a region */
+    uint64_t nnodes;
+    uint32_t *node;
+    uint64_t *node_exit;
+} cm_exits;
+
+/* The exits of a region solved with its exits recorded (record_exits),
+ * whose sink cells hold node references (cellmap/classify.h): their
+ * weights counted, the references turned into 0 (the sink), so that r
+ * becomes a resolved region whose images still name its exits. O(cells),
+ * on `threads` threads. */
+cm_status cm_region_settle_exits(cm_region *r, int threads, cm_exits *out, char *msg,
+                                 size_t msg_size);
+
+/* The exits of a cluster: the targets of its open nodes, with their
+ * weights (no cell is read). */
+cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size);
+
+void cm_exits_free(cm_exits *x);
+
+/* Where a computed cell's sequence ends: its group (1..G; 0: the sink's
+ * domain; CM_GROUP_NONE: not a computed cell) and, in the sink's domain,
+ * whether the sequence leaves the computed cells (*leaves; into the exit
+ * cell `exit`, dim coordinates) or ends in the world's sink. Called on the
+ * calling thread only. */
+typedef cm_status (*cm_cell_end_fn)(void *user, const int64_t *cell, uint32_t *group,
+                                    bool *leaves, int64_t *exit, char *msg, size_t msg_size);
+/* Whether a cell is computed. Pure and thread-safe: the followers call it
+ * from every thread. */
+typedef bool (*cm_cell_holds_fn)(const void *user, const int64_t *cell);
+
+/* The computed cells as following orbits reads them. */
+typedef struct cm_computed {
+    cm_cell_holds_fn holds;
+    cm_cell_end_fn end;
+    void *user;
+    cm_box bounds; /* every computed cell is in it */
+} cm_computed;
+
+/* The adapters for a resolved region (its exits recorded, else found
+ * again from the model with max_steps) and for a cluster (cm_cluster_exits'
+ * exits); cm_computed.user points at the struct given. */
+typedef struct cm_region_cells {
+    const cm_region *r;
+    const cm_model *m;
+    const cm_lattice *lat;
+    int max_steps;
+} cm_region_cells;
+typedef struct cm_cluster_cells {
+    cm_cluster *c;
+    const cm_exits *exits;
+} cm_cluster_cells;
+cm_computed cm_region_computed(cm_region_cells *rc);
+cm_computed cm_cluster_computed(cm_cluster_cells *cc);
+
+/* Follows the exits x of the cells `cells` (the groups' attractors s found
+ * on them) for at most `steps` steps each (0: none is followed, every exit
+ * is outside) and records their fates in s: exit_label, and the counts
+ * sink_diverged_cells, outside_cells, returned_cells and the attractors'
+ * basin_cells (their basins gain the cells whose orbits return to them).
+ * CM_EMODEL when the model aborts. */
+cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
+                                const cm_computed *cells, uint32_t steps, int threads,
+                                cm_attractor_set *s, char *msg, size_t msg_size);
+
+/* The label of every cell of a flat region (a single-box solve, or a
+ * flattened cluster or part of it) by attractors into labels[ncells]: the
+ * attractor of its group; for the sink's domain, the fate of the exit its
+ * sequence leaves into (followed along the region's images; a sequence
+ * that leaves the region's box is asked of `cells`), 0 (diverged) when it
+ * ends in the world's sink; -1 where no cell is computed. */
+cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *flat,
+                                   const cm_computed *cells, int32_t *labels, char *msg,
+                                   size_t msg_size);
+
+/* The attractors of the groups (entry k: group k + 1) with the exits
+ * followed: cm_attractors_find, then the exits (a region's x, from
+ * cm_region_settle_exits, or the cluster's) followed opt->outside steps
+ * (cm_attractors_outside). *out is the caller's to release
+ * (cm_attractors_free), also on failure. */
+cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const cm_region *r,
+                               int max_steps, const cm_exits *x, const cm_group_info *groups,
+                               const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
+                               size_t msg_size);
+cm_status cm_cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
+                                const cm_attractor_options *opt, cm_attractor_set *out,
+                                char *msg, size_t msg_size);
+
+#endif
