@@ -593,7 +593,8 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
     uint64_t taken = 0;
     int aborted = 0;
     if (st == CM_OK) {
-        memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
+        if (x->n)
+            memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
         const int64_t batches = (int64_t)((x->n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
 #pragma omp parallel num_threads(threads_of(threads)) reduction(+ : taken) reduction(| : aborted)
         {

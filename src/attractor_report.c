@@ -299,8 +299,7 @@ cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const cm_co
     *n = s->n;
     if (any_outside) { /* grey, as "fate unknown" reads */
         g[s->n] = (cm_group_info){.id = outside, .period = 1, .kind = CM_GROUP_STICKING};
-        g[s->n].basin_cells = s->outside_cells + s->unresolved_cells;
-        g[s->n].anchor[0] = INT64_MAX;
+        g[s->n].basin_cells = s->outside_cells + s->unresolved_cells; /* grey: no hash needed */
         *n = outside;
     }
     free(*groups);

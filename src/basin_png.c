@@ -447,9 +447,16 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
             memcpy(rows + (s.ny - 1 - j) * s.nx, ras.pixels + j * s.nx, s.nx);
         provenance p;
         make_provenance(b, " mode indexed", 0, &p);
-        p.texts[p.n++] = (cm_png_text){"Classes", "0 not computed, 1 sink, 2 periodic cell of an "
-                                                  "attractor, 3 sticking-zone basin, 4 rest cell, "
-                                                  "5 other (--min-basin), 6.. group colours"};
+        /* by attractors (the sink's label set) the sink is what diverges,
+         * and the grey of sticking zones also marks the cells outside */
+        p.texts[p.n++] = (cm_png_text){
+            "Classes", b->opts->sink_label
+                           ? "0 not computed, 1 diverged, 2 footprint cell of an attractor, 3 "
+                             "sticking-zone basin or outside/undecided, 4 rest cell, 5 other "
+                             "(--min-basin), 6.. attractor colours"
+                           : "0 not computed, 1 sink, 2 periodic cell of an attractor, 3 "
+                             "sticking-zone basin, 4 rest cell, 5 other (--min-basin), 6.. group "
+                             "colours"};
         p.texts[p.n++] = (cm_png_text){"Group classes", groups};
         st = cm_png_write_indexed(b->opts->path, rows, (int)s.nx, (int)s.ny, palette, n, p.texts,
                                   p.n, msg, msg_size);

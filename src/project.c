@@ -133,6 +133,8 @@ static bool params_text(const char *json, char *out, size_t size)
 {
     size_t used = 0;
     const char *p = json;
+    if (size)
+        out[0] = 0; /* a model without parameters: "{}" */
     if (*p++ != '{')
         return false;
     while (*p && *p != '}') {

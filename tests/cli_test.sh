@@ -700,7 +700,7 @@ python3 "$HERE/pngcheck.py" figure.png figure.check.json || fail "figure.png pix
 python3 - indexed.check.json <<'PY'
 import json, sys
 json.dump({"view": [100, 400, -20, 20], "size": [600, 500], "black_near": [[m / 0.007, 0, 4] for m in (1, 2)],
-           "texts": {"Group classes": "", "Classes": "0 not computed, 1 sink"}}, open(sys.argv[1], "w"))
+           "texts": {"Group classes": "", "Classes": "0 not computed, 1 diverged"}}, open(sys.argv[1], "w"))
 PY
 python3 "$HERE/pngcheck.py" indexed.png indexed.check.json || fail "indexed.png pixels and texts"
 "$CM" explore basin.cmdb - <<< "render session.png 600x400 --layers all" > /dev/null \
