@@ -124,29 +124,34 @@ static cell_key key_of(const cm_lattice *lat, const double *x)
     return k;
 }
 
-static bool close_states(const double *a, const double *b, int dim, const double *tol)
+/* Whether a and b are within tol in every coordinate (the shortest way
+ * round a periodic one: period[d] > 0). */
+static bool close_states(const double *a, const double *b, int dim, const double *tol,
+                         const double *period)
 {
     for (int d = 0; d < dim; d++)
-        if (!(fabs(a[d] - b[d]) <= tol[d]))
+        if (!(fabs(cm_period_diff(period, d, a[d], b[d])) <= tol[d]))
             return false;
     return true;
 }
 
 /* The smallest p with s[i] within tol of s[i - p] for the last 2p states
  * (n >= 3p), or 0. */
-static uint32_t recurrence(const double *s, uint64_t n, int dim, const double *tol)
+static uint32_t recurrence(const double *s, uint64_t n, int dim, const double *tol,
+                           const double *period)
 {
     const double *last = s + (n - 1) * dim;
     for (uint64_t p = 1; 3 * p <= n; p++) {
-        if (!close_states(last, last - p * dim, dim, tol))
+        if (!close_states(last, last - p * dim, dim, tol, period))
             continue;
         uint64_t i = n - 2 * p;
-        while (i < n - 1 && close_states(s + i * dim, s + (i - p) * dim, dim, tol))
+        while (i < n - 1 && close_states(s + i * dim, s + (i - p) * dim, dim, tol, period))
             i++;
         /* converged, not creeping: every earlier cycle of the record is
          * within tol of the last one too */
         uint64_t j = p;
-        while (i == n - 1 && j + p < n && close_states(last, last - (j + p) * dim, dim, tol))
+        while (i == n - 1 && j + p < n &&
+               close_states(last, last - (j + p) * dim, dim, tol, period))
             j += p;
         if (i == n - 1 && j + p >= n)
             return (uint32_t)p;
@@ -356,7 +361,7 @@ static cm_status take_record(const follow_ctx *f, double *x, uint64_t len, const
         double *kept = rec->ring + (i % RING) * dim;
         for (int d = 0; d < dim; d++) {
             kept[d] = x[d];
-            const double u = x[d] - rec->origin[d];
+            const double u = cm_model_diff(f->m, d, x[d], rec->origin[d]);
             rec->sum[i >= len / 2][d] += u;
             rec->squares[d] += u * u;
         }
@@ -494,7 +499,7 @@ static cm_status follow(const follow_ctx *f, double *x, const cell_owner *known,
                 s_cap = rec->ring_cap;
             }
             const uint64_t n = ring_states(rec, len, dim, s);
-            const uint32_t p = recurrence(s, n, dim, f->tol_abs);
+            const uint32_t p = recurrence(s, n, dim, f->tol_abs, f->m->period);
             const bool calm = !p && stationary(rec, len, dim) &&
                               (double)rec->fresh <= SETTLED_NEW * (double)(rec->again + rec->fresh);
             if (p)
@@ -563,7 +568,7 @@ static int by_x0(const void *a, const void *b)
 /* Unites periodic orbits whose cycles are one: equal periods, and the first
  * state of one within match of a state of the other. */
 static cm_status match_cycles(const orbit *r, uint32_t n, int dim, const double *match,
-                              uint32_t *parent)
+                              const double *period, uint32_t *parent)
 {
     uint64_t points = 0;
     for (uint32_t k = 0; k < n; k++)
@@ -591,7 +596,7 @@ static cm_status match_cycles(const orbit *r, uint32_t n, int dim, const double 
         for (uint64_t j = lo; j < m && pt[j].x0 <= a[0] + match[0]; j++) {
             const orbit *b = &r[pt[j].group];
             if (pt[j].group != k && b->period == r[k].period &&
-                close_states(a, b->cycle + (size_t)pt[j].i * dim, dim, match))
+                close_states(a, b->cycle + (size_t)pt[j].i * dim, dim, match, period))
                 unite(parent, k, pt[j].group);
         }
     }
@@ -740,7 +745,7 @@ static void classes_free(classes *c)
  * smallest anchor), its footprint (the members' cells, distinct, into fp
  * from fp[0]; returns how many), basin, centre and bounds (the first
  * member's cycle, else the footprint cells' centres). */
-static uint64_t describe(const cm_lattice *lat, const cm_group_info *groups,
+static uint64_t describe(const cm_model *m, const cm_lattice *lat, const cm_group_info *groups,
                          const anchored *order, const orbit *r, const uint32_t *members,
                          uint32_t count, cm_attractor *at, cell_key *fp)
 {
@@ -775,26 +780,30 @@ static uint64_t describe(const cm_lattice *lat, const cm_group_info *groups,
         at->hi[d] = -INFINITY;
     }
     const uint64_t points = first->cycle ? first->period : used;
+    double ref[CM_MAX_DIM]; /* periodic coordinates are taken the shortest way from here */
     for (uint64_t i = 0; i < points; i++) {
         double x[CM_MAX_DIM];
         if (first->cycle)
             memcpy(x, first->cycle + i * dim, (size_t)dim * sizeof *x);
         else
             cm_lattice_centre(lat, fp[i].c, x);
+        if (i == 0)
+            memcpy(ref, x, (size_t)dim * sizeof *x);
         for (int d = 0; d < dim; d++) {
+            x[d] = ref[d] + cm_model_diff(m, d, x[d], ref[d]);
             sum[d] += x[d];
             at->lo[d] = fmin(at->lo[d], x[d]);
             at->hi[d] = fmax(at->hi[d], x[d]);
         }
     }
     for (int d = 0; d < dim; d++)
-        at->centre[d] = sum[d] / (double)points;
+        at->centre[d] = cm_model_wrap(m, d, sum[d] / (double)points);
     return used;
 }
 
 /* The classes as attractors numbered 1..n in the box order of their
  * anchors (the smallest cells of their footprints), and the groups' fates. */
-static cm_status build_set(const cm_lattice *lat, const cm_group_info *groups,
+static cm_status build_set(const cm_model *m, const cm_lattice *lat, const cm_group_info *groups,
                            const anchored *order, const orbit *r, uint32_t n, const classes *c,
                            cm_attractor_set *out)
 {
@@ -816,7 +825,7 @@ static cm_status build_set(const cm_lattice *lat, const cm_group_info *groups,
                        : CM_ENOMEM;
     for (uint32_t k = 0; st == CM_OK && k < c->n; k++) {
         const uint32_t from = c->at[k], count = c->at[k + 1] - from;
-        fp_at[k + 1] = fp_at[k] + describe(lat, groups, order, r, c->members + from, count,
+        fp_at[k + 1] = fp_at[k] + describe(m, lat, groups, order, r, c->members + from, count,
                                            &a[k], fp + fp_at[k]);
         rank[k] = (anchored){fp[fp_at[k]], k};
     }
@@ -1147,13 +1156,13 @@ cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
     }
     cm_status mem = CM_OK;
     if (st == CM_OK)
-        mem = match_cycles(r, ngroups, dim, match, parent);
+        mem = match_cycles(r, ngroups, dim, match, m->period, parent);
     if (st == CM_OK && mem == CM_OK)
         mem = match_footprints(r, ngroups, parent);
     if (st == CM_OK && mem == CM_OK)
         mem = make_classes(r, ngroups, parent, &c);
     if (st == CM_OK && mem == CM_OK)
-        mem = build_set(lat, groups, order, r, ngroups, &c, out);
+        mem = build_set(m, lat, groups, order, r, ngroups, &c, out);
     if (st == CM_OK && mem != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors of %u groups",
                      ngroups);

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "cellmap/lattice.h"
+#include "cellmap/status.h"
 #include "cellmap/numtext.h" /* models print their parameters with it */
 #include "cellmap/overlay.h"
 
@@ -155,7 +156,51 @@ typedef struct cm_model {
     const char *const *coord_names;
     void (*destroy)(void *ctx);
     cm_flow flow; /* flow.field NULL: a map given by step */
+    /* Optional: angles and phases. period[d] > 0 makes coordinate d
+     * periodic: cellmap takes every state step() gives modulo period[d]
+     * into [period_lo[d], period_lo[d] + period[d]) (a pendulum's angle:
+     * 2 pi from -pi), so cells, regions and their joins, attractors,
+     * figures and exports see one period, and a rotation is no exit.
+     * 0: not periodic. Boxes must lie within that period. */
+    double period[CM_MAX_DIM];
+    double period_lo[CM_MAX_DIM];
+    /* private: the model's own step functions, which cm_model_wrap_periods
+     * wraps */
+    int (*own_step)(const struct cm_model *m, const double *x, double *y);
+    void (*own_step_n)(const struct cm_model *m, size_t n, const double *const *x,
+                       double *const *y, int *rc);
 } cm_model;
+
+/* Whether coordinate d of m is periodic (cm_model.period). */
+static inline bool cm_model_periodic(const cm_model *m, int d) { return m->period[d] > 0; }
+
+/* Checks a model's periods (each 0, or above 0 and finite with a finite
+ * period_lo) and, when one is set, makes step and step_n take their states
+ * into the periods. CM_EINVAL naming the coordinate. Called once, when the
+ * model is made (cm_model_set_create). */
+cm_status cm_model_wrap_periods(cm_model *m, char *msg, size_t msg_size);
+
+/* x (coordinate d) taken into the model's period, or as it is. */
+double cm_model_wrap(const cm_model *m, int d, double x);
+
+/* a - b in coordinate d, for a periodic one the shortest way round (in
+ * [-period/2, period/2)). */
+double cm_model_diff(const cm_model *m, int d, double a, double b);
+
+/* The same for a bare array of periods (period[d] 0: not periodic). */
+double cm_period_diff(const double *period, int d, double a, double b);
+
+/* Whether box (cells of lat) lies within every periodic coordinate's
+ * period (at most one period wide): CM_EINVAL naming the coordinate and
+ * the period otherwise. */
+cm_status cm_model_check_box(const cm_model *m, const cm_lattice *lat, const cm_box *box,
+                             char *msg, size_t msg_size);
+
+/* Whether lat's cells tile every periodic coordinate's period (a whole
+ * number of cells from period_lo to its end), as views that pan across
+ * the seam need: CM_EINVAL naming the coordinate otherwise. */
+cm_status cm_model_check_lattice(const cm_model *m, const cm_lattice *lat, char *msg,
+                                 size_t msg_size);
 
 /* The name of state coordinate d: the model's own (coord_names, d < dim),
  * else x0, x1, ... (d < CM_MAX_DIM). The same names head CSV columns, JSON

@@ -12,7 +12,9 @@
  * (*p), step (or, for an ODE, flow: cellmap integrates it, see cm_flow
  * and CM_FLOW_PARAM_SPECS in model.h) and, if it needs them, ctx and
  * destroy, coord_names (names of the state coordinates, identifiers,
- * for CSV/JSON/SQL columns). step() (and a flow's field) must be pure
+ * for CSV/JSON/SQL columns), and period/period_lo for a coordinate that is
+ * an angle or a phase (cellmap takes every image into that period; boxes
+ * hold at most one). step() (and a flow's field) must be pure
  * and thread-safe: cellmap calls it on every thread at once. It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
  * the orbit is lost) or CM_STEP_ABORT. On failure create() returns a
  * status (CM_EINVAL ...), writes the reason into msg with snprintf and
@@ -23,7 +25,7 @@
 
 #include "cellmap/model.h"
 
-#define CM_PLUGIN_ABI 2 /* 2: cm_model.flow */
+#define CM_PLUGIN_ABI 3 /* 2: cm_model.flow; 3: cm_model.period (angles) */
 
 typedef struct cm_plugin_model {
     const char *name;   /* as --model takes it */

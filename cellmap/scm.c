@@ -523,6 +523,9 @@ cm_status cm_scm_images(const cm_model *model, const cm_lattice *lat, const cm_s
 {
     if (!model || !model->step || model->dim != lat->dim || r->box.dim != lat->dim)
         return cm_fail(CM_EINVAL, msg, msg_size, "model, lattice and region dimensions differ");
+    const cm_status within = cm_model_check_box(model, lat, &r->box, msg, msg_size);
+    if (within != CM_OK) /* a cell beyond an angle's period would never be an image */
+        return within;
     const int max_steps = opt && opt->max_steps > 1 ? opt->max_steps : 1;
     const int threads = threads_or_default(opt ? opt->threads : 0);
     free(r->exit_target);

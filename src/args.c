@@ -343,8 +343,9 @@ int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
     if (total > (double)CM_REGION_MAX_CELLS)
         return cli_usage_error(c, "--cells asks for %.0f cells; one region holds at most %llu",
                                total, (unsigned long long)CM_REGION_MAX_CELLS);
-    char msg[256];
-    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK)
+    char msg[512];
+    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK ||
+        cm_model_check_box(m, lat, box, msg, sizeof msg) != CM_OK)
         return cli_usage_error(c, "%s", msg);
     return EXIT_OK;
 }

@@ -199,11 +199,39 @@ static void report(const session *s, const char *what, const computed *done)
     fflush(s->out);
 }
 
-/* Moves the view to lo..hi and computes what it uncovers. */
-static cm_status move_view(session *s, const double *lo, const double *hi, const char *what,
-                           char *msg, size_t msg_size)
+/* A view kept within the periods of periodic coordinates: one wider than
+ * a period is refused, one across the seam moved back inside (a pan stops
+ * there: one period is the whole circle). */
+static cm_status within_periods(const session *s, double *lo, double *hi, const char *verb,
+                                char *msg, size_t msg_size)
 {
-    cm_status st = check_view(s, lo, hi, what, msg, msg_size);
+    const cm_model *m = &s->model;
+    for (int d = 0; d < s->view_dims; d++) {
+        if (!cm_model_periodic(m, d))
+            continue;
+        const double from = m->period_lo[d], to = from + m->period[d];
+        if (hi[d] - lo[d] > m->period[d] * (1 + 1e-12))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s: the view would be %.9g wide in %s, more than its period %.9g "
+                           "(%s is periodic, %.9g:%.9g): view at most one period",
+                           verb, hi[d] - lo[d], cm_model_coord_name(m, d), m->period[d],
+                           cm_model_coord_name(m, d), from, to);
+        const double shift = lo[d] < from ? from - lo[d] : hi[d] > to ? to - hi[d] : 0;
+        lo[d] += shift;
+        hi[d] += shift;
+    }
+    return CM_OK;
+}
+
+/* Moves the view to lo..hi and computes what it uncovers. */
+static cm_status move_view(session *s, const double *given_lo, const double *given_hi,
+                           const char *what, char *msg, size_t msg_size)
+{
+    double lo[2] = {given_lo[0], s->view_dims > 1 ? given_lo[1] : 0};
+    double hi[2] = {given_hi[0], s->view_dims > 1 ? given_hi[1] : 0};
+    cm_status st = within_periods(s, lo, hi, what, msg, msg_size);
+    if (st == CM_OK)
+        st = check_view(s, lo, hi, what, msg, msg_size);
     cm_box box;
     computed done = {0};
     if (st != CM_OK)
@@ -1131,6 +1159,10 @@ static int create_new(session *s, const session_options *o)
     int rc = options_lattice(o, s->dim, &lat);
     if (rc != EXIT_OK)
         return rc;
+    if (cm_model_check_lattice(&s->model, &lat, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap explore: --cell-size/--origin: %s\n", msg);
+        return EXIT_USAGE;
+    }
     char plan[64];
     snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
     const cm_model_lib *lib;

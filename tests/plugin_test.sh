@@ -159,6 +159,44 @@ cc -shared -fPIC $(pkg-config --cflags cellmap) -o libabi.so abi.c -lm
 abi=$(sed -n 's/^#define CM_PLUGIN_ABI \([0-9]*\).*/\1/p' "$SRC/cellmap/plugin.h")
 expect_usage "was built for plugin ABI $((abi + 98)), this cellmap has ABI $abi" \
   solve --model-lib ./libabi.so --model henon
+# a plugin of the ABI before periodic coordinates (cm_model.period) is refused
+sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {CM_PLUGIN_ABI - 1,/' \
+  "$SRC/examples/plugin/henon.c" > old.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libold.so old.c -lm
+expect_usage "was built for plugin ABI $((abi - 1)), this cellmap has ABI $abi: build it again" \
+  solve --model-lib ./libold.so --model henon
+
+# the pendulum's angle is periodic (-pi:pi): a rotation goes round instead
+# of leaving the box, so nothing is left outside or diverges
+"$CM" solve --model-lib ./libpendulum.so --model pendulum --cells 100x100 --json > rot.json \
+  || fail "solve the forced pendulum"
+python3 - rot.json <<'PY' || fail "the pendulum's rotations leave the box: $(head -c 300 rot.json)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert abs(d["box"][0][0] + 3.141592653589793) < 1e-9 and abs(d["box"][0][1] - 3.141592653589793) < 1e-9, d["box"]
+assert d["diverged_cells"] == d["outside_cells"] == 0 and len(d["attractors"]) >= 1, d
+PY
+# a box wider than the period, or beyond it: a clear message, exit 2, nothing written
+expect_usage "more than its period" solve --model-lib ./libpendulum.so --model pendulum \
+  --region=-4:4,-4:4 --cells 10x10 --db wide.cmdb
+expect_usage "beyond its period" solve --model-lib ./libpendulum.so --model pendulum \
+  --region=0:4,-4:4 --cells 10x10 --db beyond.cmdb
+expect_usage "its cells must tile the period" explore tile.cmdb - --model-lib ./libpendulum.so \
+  --model pendulum --cell-size 0.05,0.1
+[ ! -e wide.cmdb ] && [ ! -e beyond.cmdb ] && [ ! -e tile.cmdb ] || fail "a refused command wrote a file"
+# a pan across the seam stops there: every region stays within -pi:pi
+w=$(python3 -c 'import math; print(repr(2 * math.pi / 100))')
+printf 'view 2.5:3.1 -1:1\npan right 50%%\npan right 50%%\nview -3.14:-2.5 -1:1\npan left 50%%\n' |
+  "$CM" explore seam.cmdb - --model-lib ./libpendulum.so --model pendulum --cell-size "$w",0.1 \
+  --origin=-3.141592653589793,0 > seam.out || fail "explore across the angle's seam"
+sqlite3 seam.cmdb "SELECT lo, hi FROM regions" | python3 -c '
+import json, math, sys
+w = 2 * math.pi / 100
+for line in sys.stdin:
+    lo, hi = (json.loads(v) for v in line.strip().split("|"))
+    assert -math.pi - 1e-9 <= -math.pi + lo[0] * w and -math.pi + hi[0] * w <= math.pi + 1e-9, line
+' || fail "a region of the explore session crosses the angle's seam"
+
 # a model that cannot be one, or takes a built-in model's name, is refused
 sed 's/    m->dim = 2;/    m->dim = 9;/' "$SRC/examples/plugin/henon.c" > dim.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libdim.so dim.c -lm

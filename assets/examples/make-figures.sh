@@ -179,13 +179,17 @@ done
 "$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --png fig-2.7-amplitude.png --quiet
 
 # The example plugins' attractors (examples/plugin/): Newton's method for
-# z^3 - 1 (three roots) and the Henon map (one aperiodic attractor, its
-# footprint black), drawn by attractors
+# z^3 - 1 (three roots), the Henon map (one aperiodic attractor, its
+# footprint black) and the pendulum, drawn by attractors
 src=$(cd "$(dirname "$0")/../.." && pwd)
-for p in newton henon; do
+for p in newton henon pendulum; do
   cc -shared -fPIC -I"$src" -o "$tmp/lib$p.so" "$src/examples/plugin/$p.c" -lm
 done
 "$CM" solve --model-lib "$tmp/libnewton.so" --model newton --cells 1000x1000 \
   --png plugin-newton.png --size 900x760 > /dev/null
 "$CM" solve --model-lib "$tmp/libhenon.so" --model henon --cells 2000x600 \
   --png plugin-henon.png --size 1000x420 > /dev/null
+# the forced damped pendulum, its angle periodic (-pi:pi): the rotating
+# period-1 attractor's basin is the whole cylinder
+"$CM" solve --model-lib "$tmp/libpendulum.so" --model pendulum --cells 400x400 \
+  --png plugin-pendulum.png --size 900x700 > /dev/null

@@ -2,7 +2,9 @@
  * pendulum  theta'' + b theta' + sin(theta) = A cos(omega t),  given by its
  * vector field; cellmap integrates it (GSL) into the stroboscopic map over
  * one forcing period. The integrator's settings (method, abs_tol, rel_tol,
- * world) come with CM_FLOW_PARAM_SPECS.
+ * world) come with CM_FLOW_PARAM_SPECS. The angle is periodic (period 2 pi
+ * from -pi): cellmap takes every image's theta into -pi:pi, so a rotation
+ * goes round the cylinder instead of leaving the box.
  * Build: cc -shared -fPIC $(pkg-config --cflags cellmap) -o libpendulum.so pendulum.c -lm
  * Run:   cellmap solve --model-lib ./libpendulum.so --model pendulum --png pendulum.png */
 #include <cellmap/plugin.h>
@@ -39,12 +41,14 @@ static cm_status pendulum_create(const cm_params *p, cm_model *m, char *msg, siz
     m->coord_names = pendulum_state;
     m->flow.field = pendulum_field;
     m->flow.period = 6.283185307179586 / p->value[2].v[0];
+    m->period[0] = 6.283185307179586; /* theta, from -pi */
+    m->period_lo[0] = -3.141592653589793;
     return CM_OK;
 }
 
 static const cm_plugin_model models[] = {
     {"pendulum", "theta, v at the forcing phase", "the forced damped pendulum's stroboscopic map",
-     "-3.2:3.2,-3:3", pendulum_params, pendulum_create},
+     "-3.141592653589793:3.141592653589793,-4:4", pendulum_params, pendulum_create},
 };
 static const cm_plugin plugin = {CM_PLUGIN_ABI, 1, models};
 
