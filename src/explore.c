@@ -707,7 +707,67 @@ static void print_groups(const session *s, uint32_t ngroups, const cm_group_info
 typedef struct view_counts {
     uint64_t cells, missing, groups_in_view, cluster_cells, file_bytes;
     const uint64_t *in_view; /* cells per group id; [0]: the sink's domain */
+    const cm_attractor_set *att; /* the system's attractors */
+    const uint64_t *by_label;    /* cells per attractor label, at label + 2 (-2 and -1 first) */
 } view_counts;
+
+/* The view's cells by attractor label (cm_attractor_cell_labels), the
+ * attractors found first (as render finds them). */
+static cm_status count_by_attractors(session *s, const cm_region *flat, const cm_group_info *groups,
+                                     cm_attractor_set *att, uint64_t **by_label, char *msg,
+                                     size_t msg_size)
+{
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
+    int32_t *label = malloc((flat->ncells + 1) * sizeof *label);
+    cm_status st = label ? cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, att,
+                                              msg, msg_size)
+                         : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
+    if (st == CM_OK)
+        st = cluster_ends_open(&ends, &s->c, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_attractor_cell_labels(att, flat, &ends.computed, label, msg, msg_size);
+    *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
+    if (st == CM_OK && !*by_label)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors in view");
+    for (uint64_t i = 0; st == CM_OK && i < flat->ncells; i++)
+        (*by_label)[label[i] + 2]++;
+    cluster_ends_close(&ends);
+    free(label);
+    return st;
+}
+
+/* The attractors with cells in view, the most first, and the cells that
+ * diverge or stay outside. */
+static void print_attractors(const session *s, const view_counts *v)
+{
+    const cm_attractor_set *att = v->att;
+    group_count *ids = malloc(((size_t)att->n + 1) * sizeof *ids);
+    uint32_t n = 0;
+    if (!ids)
+        return;
+    for (uint32_t a = 1; a <= att->n; a++)
+        if (v->by_label[a + 2])
+            ids[n++] = (group_count){v->by_label[a + 2], a};
+    qsort(ids, n, sizeof *ids, more_in_view);
+    fprintf(s->out, "attractors in view %u; diverged %llu cells, outside or undecided %llu\n", n,
+            (unsigned long long)v->by_label[CM_LABEL_DIVERGED + 2],
+            (unsigned long long)v->by_label[CM_LABEL_OUTSIDE + 2]);
+    fprintf(s->out, "%6s  %-9s %6s %12s %12s  %s\n", "attr.", "kind", "period", "in view",
+            "basin", "centre");
+    for (uint32_t k = 0; k < n && k < STATS_GROUPS; k++) {
+        const cm_attractor *a = &att->a[ids[k].id - 1];
+        char centre[CM_MAX_DIM * CM_NUM_TEXT], period[16];
+        format_point(&s->c.lat, a->centre, ", ", centre, sizeof centre);
+        snprintf(period, sizeof period, a->kind == CM_ATTRACTOR_APERIODIC ? "-" : "%u", a->period);
+        fprintf(s->out, "%6u  %-9s %6s %12llu %12llu  (%s)\n", a->id,
+                cm_attractor_kind_name(a->kind), period, (unsigned long long)ids[k].cells,
+                (unsigned long long)a->basin_cells, centre);
+    }
+    if (n > STATS_GROUPS)
+        fprintf(s->out, "... and %u attractors with fewer cells in view\n", n - STATS_GROUPS);
+    free(ids);
+}
 
 static void print_stats_text(const session *s, const view_counts *v, const cm_region *flat,
                              const cm_group_info *groups)
@@ -719,6 +779,7 @@ static void print_stats_text(const session *s, const view_counts *v, const cm_re
             view, (unsigned long long)v->cells, (unsigned long long)v->missing,
             (unsigned long long)v->in_view[0], (unsigned long long)v->groups_in_view);
     print_groups(s, flat->ngroups, groups, v->in_view);
+    print_attractors(s, v);
     fprintf(s->out,
             "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays "
             "resident %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
@@ -753,6 +814,19 @@ static void print_stats_json(const session *s, const view_counts *v, const cm_re
         json_object_end(&j);
     }
     json_array_end(&j);
+    json_array(&j, "attractors");
+    for (uint32_t k = 0; k < v->att->n; k++) {
+        const cm_attractor *a = &v->att->a[k];
+        if (!v->by_label[a->id + 2])
+            continue;
+        json_object(&j, NULL);
+        json_attractor_fields(&j, a, &s->c.lat);
+        json_uint(&j, "in_view", v->by_label[a->id + 2]);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_uint(&j, "diverged_cells", v->by_label[CM_LABEL_DIVERGED + 2]);
+    json_uint(&j, "outside_cells", v->by_label[CM_LABEL_OUTSIDE + 2]);
     json_object(&j, "cluster");
     json_uint(&j, "regions", s->c.nregions);
     json_uint(&j, "cells", v->cluster_cells);
@@ -780,8 +854,13 @@ static cm_status cmd_stats(session *s, char **t, int n, char *msg, size_t msg_si
     uint64_t *in_view = st == CM_OK ? calloc((size_t)flat.ngroups + 2, sizeof *in_view) : NULL;
     if (st == CM_OK && !in_view)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups in view");
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    uint64_t *by_label = NULL;
+    if (st == CM_OK && s->out)
+        st = count_by_attractors(s, &flat, groups, &att, &by_label, msg, msg_size);
     if (st == CM_OK && s->out) {
-        view_counts v = {flat.ncells, 0, 0, 0, 0, in_view};
+        view_counts v = {flat.ncells, 0, 0, 0, 0, in_view, &att, by_label};
         for (uint64_t i = 0; i < flat.ncells; i++) {
             if (flat.group[i] == CM_GROUP_NONE)
                 v.missing++;
@@ -800,6 +879,8 @@ static cm_status cmd_stats(session *s, char **t, int n, char *msg, size_t msg_si
         fflush(s->out);
     }
     free(in_view);
+    free(by_label);
+    cm_attractors_free(&att);
     cm_region_free(&flat);
     free(groups);
     return st;

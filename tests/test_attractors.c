@@ -423,6 +423,30 @@ static void test_micro_chaos(void)
     const double lo[2] = {-125000, -600}, hi[2] = {125000, 600};
     micro_chaos("Fig. 4.21, 1000x400", f421, 5.4997e-5, lo, hi, 1000, 400, 100000, 12, 6, 0, 0);
     micro_chaos("Fig. 4.21, 4000x3200", f421, 5.4997e-5, lo, hi, 4000, 3200, 100000, 12, 6, 0, 0);
+    /* Fig. 4.16: the horseshoes at SW_5 and SW_6 (and their mirror images)
+     * are attractors, those at SW_4 and SW_7 repellers whose cell cycles
+     * go: 4 attractors, each footprint around +-5/P or +-6/P, none around
+     * 4/P or 7/P; the cells whose sequences leave -13:13 come back */
+    solved v;
+    const double P = 0.7;
+    solve_named(&v, "microchaos-pd", "alpha=0.8,beta=0.3,P=0.7,D=0.6", (double[2]){-13, -4},
+                (double[2]){13, 4}, 2600, 800, 1);
+    CHECK_INT(v.s.n, 4);
+    int at[8] = {0};
+    for (uint32_t a = 0; a < v.s.n; a++)
+        for (int m = 4; m <= 7; m++)
+            for (int sign = -1; sign <= 1; sign += 2) {
+                const double x = sign * m / P;
+                at[2 * (m - 4) + (sign > 0)] += v.s.a[a].lo[0] <= x && x <= v.s.a[a].hi[0];
+            }
+    fprintf(stderr, "Fig. 4.16: %u groups, %u attractors; around SW_4..7 (-, +): %d %d, %d %d, "
+                    "%d %d, %d %d; %llu sink cells came back\n",
+            v.r.ngroups, v.s.n, at[0], at[1], at[2], at[3], at[4], at[5], at[6], at[7],
+            (unsigned long long)v.s.returned_cells);
+    CHECK(at[0] == 0 && at[1] == 0 && at[6] == 0 && at[7] == 0);
+    CHECK(at[2] == 1 && at[3] == 1 && at[4] == 1 && at[5] == 1);
+    CHECK(v.s.returned_cells > 0 && v.s.outside_cells + v.s.sink_diverged_cells == 0);
+    release(&v, true);
 }
 
 /* The same attractors, anchors, footprints and group fates on 1 and 2
