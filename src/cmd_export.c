@@ -30,18 +30,21 @@ static const char export_help[] =
     "                      attractor its true orbit reaches (0: it diverges, -1: undecided)\n"
     "  --cells OUT         one row per computed cell: lattice indices ix, iv, ..., cell\n"
     "                      centre x, v, ... (i and the model's state names, as `cellmap\n"
-    "                      models` lists them), grp, step, periodic; CSV with a header,\n"
-    "                      or .npy (a structured array with those fields, little-endian)\n"
+    "                      models` lists them), grp, step, periodic, and the cell's\n"
+    "                      attractor (as --labels gives it); CSV with a header, or .npy\n"
+    "                      (a structured array with those fields, little-endian)\n"
     "  --flat OUT.sqlite   the same rows as a plain table cells(ix, iv, ..., x, v, ...,\n"
-    "                      grp, step, periodic), with tables groups (as --groups, kind\n"
+    "                      grp, step, periodic, attractor), with tables groups (as\n"
+    "                      --groups, kind\n"
     "                      included), meta (source file, lattice origin and widths,\n"
     "                      state names) and indexes on cells(grp), the cells' indices\n"
     "                      and groups(kind)\n"
     "  --labels OUT.npy    the attractor of every cell as an n-D array: shape = cells per\n"
     "                      dimension (axis k = dimension k), C order, int32 (attractor ids\n"
     "                      from 1; 0 diverged; -2 outside: the sequence left the computed\n"
-    "                      cells, or its group's true orbit was undecided; -1 not\n"
-    "                      computed); OUT.json beside it holds the lattice, the box, the\n"
+    "                      cells and its orbit did not come back (--outside-steps), or its\n"
+    "                      group's true orbit was undecided; -1 not computed); OUT.json\n"
+    "                      beside it holds the lattice, the box, the\n"
     "                      model and each attractor (kind, period, centre)\n"
     "  --by groups         --labels gives cell mapping's groups instead (0 the sink), and\n"
     "                      OUT.json each group (kind, period, centre, colour)\n"
@@ -192,7 +195,7 @@ static int npy_header(cell_out *o, int dim)
         used +=
             (size_t)snprintf(descr + used, sizeof descr - used, "('%s', '<f8'), ", o->names[d]);
     snprintf(descr + used, sizeof descr - used,
-             "('grp', '<u4'), ('step', '<u4'), ('periodic', '|u1')");
+             "('grp', '<u4'), ('step', '<u4'), ('periodic', '|u1'), ('attractor', '<i4')");
     char header[1024];
     int n = snprintf(header, sizeof header, "{'descr': [%s], 'fortran_order': False, 'shape': (",
                      descr);
@@ -225,7 +228,7 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     for (int d = 0; d < dim; d++)
         used += (size_t)snprintf(sql + used, sizeof sql - used, "%s REAL, ", o->names[d]);
     snprintf(sql + used, sizeof sql - used,
-             "grp INTEGER, step INTEGER, periodic INTEGER);"
+             "grp INTEGER, step INTEGER, periodic INTEGER, attractor INTEGER);"
              "CREATE TABLE groups(id INTEGER PRIMARY KEY, period INTEGER, basin_cells INTEGER,"
              " is_sink INTEGER, centre TEXT, lo TEXT, hi TEXT, anchor TEXT, kind TEXT,"
              " attractor INTEGER);"
@@ -264,7 +267,7 @@ static int sqlite_begin(cell_out *o, int dim, const cm_store_info *info)
     }
     sqlite3_finalize(st);
     used = (size_t)snprintf(sql, sizeof sql, "INSERT INTO cells VALUES(");
-    for (int k = 0; k < 2 * dim + 3; k++)
+    for (int k = 0; k < 2 * dim + 4; k++)
         used += (size_t)snprintf(sql + used, sizeof sql - used, "%s?", k ? "," : "");
     snprintf(sql + used, sizeof sql - used, ")");
     return ok && sqlite3_prepare_v2(o->db, sql, -1, &o->insert, NULL) == SQLITE_OK;
@@ -288,11 +291,11 @@ static int out_begin(cell_out *o, int dim, const cm_store_info *info, char *msg,
         fprintf(o->f, "i%s,", o->names[d]);
     for (int d = 0; d < dim; d++)
         fprintf(o->f, "%s,", o->names[d]);
-    return fprintf(o->f, "grp,step,periodic\n") > 0;
+    return fprintf(o->f, "grp,step,periodic,attractor\n") > 0;
 }
 
 static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, uint32_t grp,
-                   uint32_t step, int periodic)
+                   uint32_t step, int periodic, int32_t attractor)
 {
     o->rows++;
     if (o->kind == OUT_CSV) {
@@ -300,10 +303,10 @@ static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, u
             fprintf(o->f, "%lld,", (long long)cell[d]);
         for (int d = 0; d < dim; d++)
             fprintf(o->f, "%.17g,", x[d]);
-        return fprintf(o->f, "%u,%u,%d\n", grp, step, periodic) > 0;
+        return fprintf(o->f, "%u,%u,%d,%d\n", grp, step, periodic, (int)attractor) > 0;
     }
     if (o->kind == OUT_NPY) {
-        unsigned char row[CM_MAX_DIM * 16 + 9];
+        unsigned char row[CM_MAX_DIM * 16 + 13];
         size_t n = 0;
         for (int d = 0; d < dim; d++, n += 8)
             for (int b = 0; b < 8; b++)
@@ -319,6 +322,8 @@ static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, u
             for (int b = 0; b < 4; b++)
                 row[n + (size_t)b] = (unsigned char)(u[k] >> (8 * b));
         row[n++] = (unsigned char)periodic;
+        for (int b = 0; b < 4; b++)
+            row[n++] = (unsigned char)((uint32_t)attractor >> (8 * b));
         return fwrite(row, 1, n, o->f) == n;
     }
     int col = 1;
@@ -328,7 +333,8 @@ static int out_row(cell_out *o, int dim, const int64_t *cell, const double *x, u
         sqlite3_bind_double(o->insert, col++, x[d]);
     sqlite3_bind_int64(o->insert, col++, grp);
     sqlite3_bind_int64(o->insert, col++, step);
-    sqlite3_bind_int(o->insert, col, periodic);
+    sqlite3_bind_int(o->insert, col++, periodic);
+    sqlite3_bind_int(o->insert, col, attractor);
     const int ok = sqlite3_step(o->insert) == SQLITE_DONE;
     sqlite3_reset(o->insert);
     return ok;
@@ -480,7 +486,8 @@ static int export_groups(const char *path, const char *const *names, const cm_la
 
 /* Walks the window in slabs along the last dimension, reading regions
  * back as needed, and writes every computed cell to each output. */
-static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *outs, int nouts,
+static cm_status export_slabs(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
+                              const cm_computed *computed, cell_out *outs, int nouts,
                               progress *pr, char *msg, size_t msg_size)
 {
     uint64_t done = 0;
@@ -497,6 +504,9 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
         cm_status st = cm_cluster_flatten(c, &slab, &flat, msg, msg_size);
         if (st != CM_OK)
             return st;
+        int32_t *label = malloc((flat.ncells + 1) * sizeof *label);
+        st = label ? cm_attractor_cell_labels(att, &flat, computed, label, msg, msg_size)
+                   : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
         for (uint64_t i = 0; i < flat.ncells && st == CM_OK; i++) {
             if (flat.group[i] == CM_GROUP_NONE)
                 continue;
@@ -506,11 +516,12 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
             cm_lattice_centre(&c->lat, cell, x);
             for (int k = 0; k < nouts && st == CM_OK; k++)
                 if (!out_row(&outs[k], dim, cell, x, flat.group[i], flat.step[i],
-                             cm_is_periodic(&flat, i)))
+                             cm_is_periodic(&flat, i), label[i]))
                     st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s: %s", outs[k].path,
                                  outs[k].db ? sqlite3_errmsg(outs[k].db) : strerror(errno));
         }
         done += flat.ncells;
+        free(label);
         cm_region_free(&flat);
         if (st == CM_OK && interrupt_requested())
             st = cm_fail(CM_ECANCELED, msg, msg_size,
@@ -520,6 +531,20 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, cell_out *out
         progress_say(pr, done, NULL);
     }
     return CM_OK;
+}
+
+/* The rows of the window's cells, a slab at a time, each with its
+ * attractor (cm_attractor_cell_labels over att and the cluster's exits). */
+static cm_status export_cells(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
+                              cell_out *outs, int nouts, progress *pr, char *msg,
+                              size_t msg_size)
+{
+    cluster_ends ends;
+    cm_status st = cluster_ends_open(&ends, c, msg, msg_size);
+    if (st == CM_OK)
+        st = export_slabs(c, window, att, &ends.computed, outs, nouts, pr, msg, msg_size);
+    cluster_ends_close(&ends);
+    return st;
 }
 
 static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm_store_info *info,
@@ -583,7 +608,7 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     interrupt_catch();
     cm_status st = CM_OK;
     if (ok && nouts)
-        ok = (st = export_cells(c, &window, outs, nouts, &pr, msg, sizeof msg)) == CM_OK;
+        ok = (st = export_cells(c, &window, &att, outs, nouts, &pr, msg, sizeof msg)) == CM_OK;
     progress_end(&pr);
     for (int k = 0; k < nouts; k++)
         ok = out_end(&outs[k], ok, msg, sizeof msg) && ok;

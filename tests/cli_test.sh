@@ -186,7 +186,7 @@ grep -q "^regions 6, cells 60000" info.txt || fail "info regions: $(cat info.txt
 grep -q "^disk: .* bytes/cell" info.txt || fail "info disk"
 "$CM" export paged.cmdb --groups g.csv --cells c.csv --flat flat.sqlite --window 0:250,-40:0 \
   2> export.txt || fail "export"
-head -1 c.csv | grep -qx "ix,iv,x,v,grp,step,periodic" || fail "cells CSV header"  # the model's names
+head -1 c.csv | grep -qx "ix,iv,x,v,grp,step,periodic,attractor" || fail "cells CSV header"  # the model's names
 # --groups alone reads no cluster, and writes the same file
 "$CM" export paged.cmdb --groups g-only.csv 2> /dev/null && cmp -s g.csv g-only.csv ||
   fail "export --groups alone differs from --groups with --cells"
@@ -205,8 +205,24 @@ assert d[:8] == b"\x93NUMPY\x01\x00"
 n = struct.unpack("<H", d[8:10])[0]
 h = ast.literal_eval(d[10:10 + n].decode())
 assert h["shape"] == (60000,), h
-size = 8 * 4 + 4 + 4 + 1
+size = 8 * 4 + 4 + 4 + 1 + 4
 assert len(d) == 10 + n + 60000 * size and (10 + n) % 64 == 0
+assert "('attractor', '<i4')" in d[10:10 + n].decode()
+PY
+# each cell's attractor in the flat table is the one --labels gives it
+"$CM" export paged.cmdb --labels w.npy --window 0:250,-40:0 2> /dev/null || fail "export --labels --window"
+sqlite3 flat.sqlite "SELECT ix, iv, attractor FROM cells" > flat-att.txt
+python3 - w.npy flat-att.txt <<'PY' || fail "the flat table's attractors differ from --labels"
+import ast, struct, sys
+d = open(sys.argv[1], "rb").read()
+n = struct.unpack("<H", d[8:10])[0]
+h = ast.literal_eval(d[10:10 + n].decode())
+nx, ny = h["shape"]
+a = struct.unpack("<%di" % (nx * ny), d[10 + n:])
+rows = [tuple(map(int, l.split("|"))) for l in open(sys.argv[2])]
+assert len(rows) == nx * ny
+assert all(a[ix * ny + iv] == att for ix, iv, att in rows)
+assert len({att for _, _, att in rows}) > 1
 PY
 ls | grep -q tmp- && fail "temporary files left behind"
 # refused files: exit 1, a message, the file unchanged
