@@ -191,9 +191,11 @@ cm_status cm_result_attractor(const cm_result *r, uint32_t id, cm_attractor_summ
  * was undecided); -1 for a cell no region covers. */
 void cm_result_attractor_labels(const cm_result *r, int32_t *labels);
 
-/* The basin figure (basins, attractors, axes, legend, title) as a PNG of
- * width x height pixels (0, 0: 1000 on the longer side), written to a
- * temporary file and renamed to path. Loads OSMesa on first use. */
+/* The basin figure (basins by the system's attractors, their footprints,
+ * axes, legend, title; diverged cells red, outside or undecided ones
+ * grey) as a PNG of width x height pixels (0, 0: 1000 on the longer
+ * side), written to a temporary file and renamed to path. Loads OSMesa on
+ * first use. */
 cm_status cm_result_png(const cm_result *r, const char *path, int width, int height, char *msg,
                         size_t msg_size);
 void cm_result_free(cm_result *r);

@@ -19,6 +19,7 @@
 #include "render/figure.h"
 #include "render/png_out.h"
 #include "src/args.h"
+#include "src/attractor_view.h"
 #include "src/project.h"
 
 
@@ -406,7 +407,9 @@ cm_status cm_result_png(const cm_result *r, const char *path, int width, int hei
         return cm_fail(CM_EINVAL, msg, msg_size, "image size %dx%d: each side must be 1..%d",
                        width, height, CM_RENDER_MAX_SIDE);
     const char *font = getenv("CELLMAP_FONT");
-    const cm_render_options o = {
+    /* by the system's attractors, as `cellmap solve --png` draws it */
+    cm_group_label names[64];
+    cm_render_options o = {
         .width = width,
         .height = height,
         .layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS | CM_LAYER_AXES |
@@ -414,14 +417,30 @@ cm_status cm_result_png(const cm_result *r, const char *path, int width, int hei
         .model = r->model,
         .font_path = font && font[0] ? font : CELLMAP_FONT_PATH,
         .min_basin = 2,
+        .labels = names,
+        .sink_label = "diverged",
     };
     uint8_t *rgba = malloc((size_t)width * (size_t)height * 4);
     if (!rgba)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", width, height);
     cm_render_info info;
+    cm_region view;
+    cm_group_info *groups = NULL;
+    uint32_t n = 0;
     cm_status st = cm_render_check(&o, r->lat.dim, msg, msg_size);
     if (st == CM_OK)
-        st = cm_render_figure(&r->lat, &r->cells, r->groups, &o, rgba, &info, msg, msg_size);
+        st = cm_region_alloc(&view, &r->cells.box, msg, msg_size);
+    if (st == CM_OK) {
+        memcpy(view.group, r->cells.group, view.ncells * sizeof *view.group);
+        memcpy(view.step, r->cells.step, view.ncells * sizeof *view.step);
+        memcpy(view.image, r->cells.image, view.ncells * sizeof *view.image);
+        st = attractor_view(&r->att, &view, r->att_labels, &groups, &n, msg, msg_size);
+        o.n_labels = attractor_legend(&r->att, n, names, 0, 64);
+        if (st == CM_OK)
+            st = cm_render_figure(&r->lat, &view, groups, &o, rgba, &info, msg, msg_size);
+        cm_region_free(&view);
+        free(groups);
+    }
     const cm_png_text texts[] = {{"Software", "libcellmap " CELLMAP_VERSION},
                                  {"Model", r->model->name}};
     if (st == CM_OK)

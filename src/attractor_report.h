@@ -11,6 +11,7 @@
 #include "cellmap/cluster.h"
 #include "cellmap/outside.h"
 #include "cellmap/store.h"
+#include "src/attractor_view.h"
 #include "src/args.h"
 #include "src/json.h"
 
@@ -78,18 +79,6 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
 /* Group g's label by attractors: its attractor's id, or 0 when its orbit
  * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);
-
-/* A flat region relabelled by attractors, in place: each cell's group id
- * becomes its attractor's (cm_attractor_cell_labels: a sink cell's is the
- * fate of the exit its sequence leaves by, asked of `cells` where it
- * leaves flat's box; cells NULL: not followed), 0 where it diverges, and
- * n + 1, a grey group of its own, where it stays outside or is undecided;
- * the attractors' footprint cells in it take their attractor with step 0
- * (and no other cell has step 0: the markers are the footprints); *groups
- * (freed) becomes the attractors' summaries, as groups, for the figure's
- * colours and legend (*n of them, the grey one last when there is one). */
-cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const cm_computed *cells,
-                         cm_group_info **groups, uint32_t *n, char *msg, size_t msg_size);
 
 /* Where the sink cells of a cluster's views go (cellmap/outside.h): its
  * exits and the adapter over them; `computed` points into the struct, which

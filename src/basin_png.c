@@ -515,27 +515,6 @@ static int write_svg(const char *cmd, const basin_png *b)
     return outfile_close(cmd, &o, st == CM_OK) && st == CM_OK ? EXIT_OK : EXIT_FAIL;
 }
 
-/* The legend's name of each attractor the user did not name ("A3 p=1",
- * "A5 aperiodic"), after the user's labels. */
-static void attractor_names(const cm_attractor_set *s, png_opts *po)
-{
-    for (uint32_t a = 0; a < s->n && po->n_labels < PNG_LABELS_MAX; a++) {
-        bool named = false;
-        for (int k = 0; k < po->n_labels; k++)
-            named |= !po->labels[k].by_anchor && po->labels[k].id == s->a[a].id;
-        if (named)
-            continue;
-        cm_group_label *l = &po->labels[po->n_labels++];
-        memset(l, 0, sizeof *l);
-        l->id = s->a[a].id;
-        if (s->a[a].kind == CM_ATTRACTOR_PERIODIC)
-            snprintf(l->text, sizeof l->text, "A%u p=%u", s->a[a].id, s->a[a].period);
-        else
-            snprintf(l->text, sizeof l->text, "A%u %s", s->a[a].id,
-                     cm_attractor_kind_name(s->a[a].kind));
-    }
-}
-
 /* b's figure drawn by attractors: its cells relabelled in a copy. */
 static int write_by_attractors(const char *cmd, const basin_png *b)
 {
@@ -547,22 +526,24 @@ static int write_by_attractors(const char *cmd, const basin_png *b)
     png_opts *po = malloc(sizeof *po);
     if (st == CM_OK && !po)
         st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the figure");
+    int32_t *label = st == CM_OK ? malloc((view.ncells + 1) * sizeof *label) : NULL;
+    if (st == CM_OK && !label)
+        st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the figure");
+    if (st == CM_OK)
+        st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, label, msg,
+                                      sizeof msg);
     if (st == CM_OK) {
         memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
         memcpy(view.step, b->cells->step, view.ncells * sizeof *view.step);
         memcpy(view.image, b->cells->image, view.ncells * sizeof *view.image);
-        st = attractor_view(b->attractors, &view, b->computed, &groups, &n, msg, sizeof msg);
+        st = attractor_view(b->attractors, &view, label, &groups, &n, msg, sizeof msg);
     }
+    free(label);
     int rc = EXIT_FAIL;
     if (st == CM_OK) {
         *po = *b->opts;
-        attractor_names(b->attractors, po);
-        if (n > b->attractors->n && po->n_labels < PNG_LABELS_MAX) {
-            cm_group_label *l = &po->labels[po->n_labels++];
-            memset(l, 0, sizeof *l);
-            l->id = n;
-            snprintf(l->text, sizeof l->text, "outside or undecided");
-        }
+        po->n_labels = attractor_legend(b->attractors, n, po->labels, po->n_labels,
+                                        PNG_LABELS_MAX);
         po->sink_label = "diverged";
         basin_png by = *b;
         by.opts = po;
