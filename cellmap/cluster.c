@@ -1345,26 +1345,33 @@ static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group
     return st;
 }
 
-cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
-                                size_t msg_size)
+cm_status cm_cluster_cell_end(cm_cluster *c, const int64_t *cell, uint32_t *group,
+                              uint32_t *open, char *msg, size_t msg_size)
 {
-    cm_cluster *c = cluster;
     uint64_t local;
     const int64_t k = cm_cluster_locate(c, cell, &local);
     *group = CM_GROUP_NONE;
+    *open = CM_NODE_OPEN;
     if (k < 0)
         return CM_OK;
     cm_status st = cm_cluster_acquire(c, (uint32_t)k, msg, msg_size);
     if (st != CM_OK)
         return st;
     const uint32_t g = c->regions[k].r.group[local];
-    uint32_t step;
     if (!cm_is_node_ref(g)) {
         *group = g;
         return CM_OK;
     }
-    return cm_cluster_resolve(c, c->regions[k].node_base + (g & ~CM_NODE_REF), group, &step, NULL,
+    uint32_t step;
+    return cm_cluster_resolve(c, c->regions[k].node_base + (g & ~CM_NODE_REF), group, &step, open,
                               msg, msg_size);
+}
+
+cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
+                                size_t msg_size)
+{
+    uint32_t open;
+    return cm_cluster_cell_end(cluster, cell, group, &open, msg, msg_size);
 }
 
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,

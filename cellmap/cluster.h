@@ -252,6 +252,11 @@ int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *lo
 cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
                                 size_t msg_size);
 
+/* The same, and the open node the cell's sequence leaves the cluster
+ * through (CM_NODE_OPEN if it does not: a group, or the world's sink). */
+cm_status cm_cluster_cell_end(cm_cluster *c, const int64_t *cell, uint32_t *group,
+                              uint32_t *open, char *msg, size_t msg_size);
+
 /* Indexes open node id, whose exit leads to `cell` outside the cluster, by
  * that cell (and in its region's open list, at its end: add a region's in
  * node order), with weight w. */

@@ -343,30 +343,19 @@ static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, b
                              int64_t *exit, char *msg, size_t msg_size)
 {
     const cm_cluster_cells *cc = user;
-    cm_cluster *c = cc->c;
-    const int dim = c->lat.dim;
-    uint64_t local;
-    const int64_t k = cm_cluster_locate(c, cell, &local);
-    *group = CM_GROUP_NONE;
+    const int dim = cc->c->lat.dim;
+    uint32_t open;
     *out_leaves = false;
-    if (k < 0)
-        return CM_OK;
-    cm_status st = cm_cluster_acquire(c, (uint32_t)k, msg, msg_size);
-    if (st != CM_OK)
+    const cm_status st = cm_cluster_cell_end(cc->c, cell, group, &open, msg, msg_size);
+    if (st != CM_OK || *group != 0)
         return st;
-    const uint32_t g = c->regions[k].r.group[local];
-    if (!cm_is_node_ref(g)) {
-        *group = g;
-        /* resolved cells: the exit is not known, and no exit is that cell */
-        *out_leaves = g == 0 && c->resolved_cells;
+    if (cc->c->resolved_cells) { /* the exit is not known, and no exit is that cell */
+        *out_leaves = true;
         memcpy(exit, cell, (size_t)dim * sizeof *exit);
         return CM_OK;
     }
-    uint32_t step, open;
-    st = cm_cluster_resolve(c, c->regions[k].node_base + (g & ~CM_NODE_REF), group, &step, &open,
-                            msg, msg_size);
-    if (st != CM_OK || *group != 0 || open == CM_NODE_OPEN)
-        return st;
+    if (open == CM_NODE_OPEN) /* the world's sink */
+        return CM_OK;
     const int64_t *e = node_exit(cc->exits, dim, open);
     if (!e)
         return cm_fail(CM_EINVAL, msg, msg_size, "open node %u is not among the cluster's exits",

@@ -24,22 +24,8 @@
 #include "cellmap/outside.h"
 #include "cellmap/scm.h"
 #include "models/registry.h"
+#include "newton_map.h"
 
-/* Newton's method for z^3 - 1 (examples/plugin/newton.c's map). */
-static int newton_step(const cm_model *m, const double *z, double *out)
-{
-    (void)m;
-    const double x = z[0], y = z[1];
-    const double x2 = x * x - y * y, y2 = 2 * x * y;
-    const double x3 = x2 * x - y2 * y, y3 = x2 * y + y2 * x;
-    const double nx = 2 * x3 + 1, ny = 2 * y3, dx = 3 * x2, dy = 3 * y2;
-    const double d = dx * dx + dy * dy;
-    if (!(d > 1e-300))
-        return CM_STEP_NO_IMAGE;
-    out[0] = (nx * dx + ny * dy) / d;
-    out[1] = (ny * dx - nx * dy) / d;
-    return isfinite(out[0]) && isfinite(out[1]) ? CM_STEP_OK : CM_STEP_NO_IMAGE;
-}
 
 typedef struct config {
     const char *name, *model, *params; /* model NULL: Newton's method */

@@ -6,15 +6,21 @@
  *   fixed point their simulated orbits converge to for at least 98 %;
  * - Newton's method for z^3 - 1 on 999 and 1000 squared cells over -2:2
  *   (the root z = 1 on a cell corner at 1000): exactly 3 attractors of
- *   period 1 at the roots; random cells outside the sink go to the root
- *   their iteration converges to (at least 99.5 %);
+ *   period 1 at the roots; the sink's cells (13.7 %) followed out of the
+ *   box and back, at most 0.1 % left diverged or outside; random cells go
+ *   to the root their iteration converges to (99.1 %: 99.9 % outside the
+ *   sink, 94 % of the sink's, along the Julia set);
  * - the Henon map (a = 1.4, b = 0.3) over -1.5:1.5 x -0.45:0.45: one
  *   aperiodic attractor; every point of a 10^5-step orbit (after 1000
  *   steps) lies within 2 cells of its footprint, and the orbit visits at
- *   least 90 % of the footprint's cells;
+ *   least 90 % of the footprint's cells; every other cell diverges;
  * - the quick start and Fig. 4.21 (both lattices): their micro-chaos
  *   attractors, one per switching line (6; 12), the cells of their basins
  *   going where simulated orbits go;
+ * - Fig. 4.16: attractors at +-SW_5 and +-SW_6 only;
+ * - the pendulum plugin, its angle periodic (with --pendulum PLUGIN.so):
+ *   the attractors simulation finds, nothing outside, 98 % of 10 000
+ *   random cells where simulation goes;
  * - the result is the same on 1 and 2 threads, bit for bit. */
 #include <math.h>
 #include <omp.h>
@@ -26,6 +32,7 @@
 #include "cellmap/scm.h"
 #include "check.h"
 #include "models/registry.h"
+#include "newton_map.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -208,22 +215,6 @@ static void test_duffing(void)
     cm_model_release(&m);
 }
 
-/* ---- Newton's method for z^3 - 1 -------------------------------------- */
-
-static int newton_step(const cm_model *m, const double *z, double *out)
-{
-    (void)m;
-    const double x = z[0], y = z[1];
-    const double x2 = x * x - y * y, y2 = 2 * x * y;
-    const double x3 = x2 * x - y2 * y, y3 = x2 * y + y2 * x;
-    const double nx = 2 * x3 + 1, ny = 2 * y3, dx = 3 * x2, dy = 3 * y2;
-    const double d = dx * dx + dy * dy;
-    if (!(d > 1e-300))
-        return CM_STEP_NO_IMAGE;
-    out[0] = (nx * dx + ny * dy) / d;
-    out[1] = (ny * dx - nx * dy) / d;
-    return isfinite(out[0]) && isfinite(out[1]) ? CM_STEP_OK : CM_STEP_NO_IMAGE;
-}
 
 static void test_newton(void)
 {
@@ -270,9 +261,9 @@ static void test_newton(void)
                 (unsigned long long)v.s.returned_cells, (unsigned long long)v.s.sink_diverged_cells,
                 (unsigned long long)v.s.outside_cells, (unsigned long long)v.s.nexits,
                 (unsigned long long)v.s.outside_steps_taken, agree, tried, sink_agree, sink_tried);
-        /* outside the sink cell mapping's basins agree for 99.7 %; the sink's
-         * cells are the preimages of the origin's neighbourhood, the Julia
-         * set's, where a cell's chain and its centre's orbit part (89 %
+        /* outside the sink cell mapping's basins agree for 99.9 %; the sink's
+         * cells are the preimages of the origin's neighbourhood, along the
+         * Julia set, where a cell's chain and its centre's orbit part (94 %
          * agree): 99.1 % in all, not the 99.5 % the issue asks */
         CHECK(tried > 9900 && agree >= 0.99 * tried);
         CHECK(tried - sink_tried - (agree - sink_agree) <= 0.004 * (tried - sink_tried));
