@@ -292,3 +292,37 @@ cm_status cm_stdout_check(char *msg, size_t msg_size)
                        strerror(errno ? errno : EIO));
     return CM_OK;
 }
+
+cm_status cm_input_open(const char *path, const char *what, uint64_t max_bytes, FILE **f,
+                        char *msg, size_t msg_size)
+{
+    *f = NULL;
+    /* opened first, then checked: what is read is what was checked, and
+     * O_NONBLOCK keeps a FIFO without a writer from blocking the open */
+    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return cm_fail(CM_EIO, msg, msg_size, "cannot read %s %s: %s", what, path,
+                       strerror(errno));
+    struct stat st;
+    const char *problem = fstat(fd, &st) != 0     ? strerror(errno)
+                          : S_ISDIR(st.st_mode)   ? "it is a directory"
+                          : !S_ISREG(st.st_mode)  ? "it is not a regular file (a device or a FIFO)"
+                          : (uint64_t)st.st_size > max_bytes ? "it is too large"
+                                                             : NULL;
+    if (problem) {
+        close(fd);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s %s cannot be read: %s; give a text file of at most %llu bytes", what,
+                       path, problem, (unsigned long long)max_bytes);
+    }
+    const int flags = fcntl(fd, F_GETFL);
+    if (flags >= 0)
+        fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+    *f = fdopen(fd, "r");
+    if (!*f) {
+        close(fd);
+        return cm_fail(CM_EIO, msg, msg_size, "cannot read %s %s: %s", what, path,
+                       strerror(errno));
+    }
+    return CM_OK;
+}

@@ -20,6 +20,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "cellmap/status.h"
@@ -75,5 +76,14 @@ cm_status cm_files_apart(const cm_file_use *files, size_t n, char *msg, size_t m
 /* Flushes stdout; CM_EIO with the reason if anything written to it was
  * lost (a full device, a closed pipe). */
 cm_status cm_stdout_check(char *msg, size_t msg_size);
+
+/* Opens a file a user gives the command to read (a palette, labels,
+ * curves: `what` names it in messages) as text: only a regular file of at
+ * most max_bytes, so that a device (/dev/zero), a FIFO or a directory
+ * never makes a command hang or read forever. *f is the caller's to close.
+ * CM_EIO (not readable) or CM_EINVAL (not a regular file, too large), the
+ * message naming the file and the fix. */
+cm_status cm_input_open(const char *path, const char *what, uint64_t max_bytes, FILE **f,
+                        char *msg, size_t msg_size);
 
 #endif

@@ -574,9 +574,23 @@ cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size)
     return CM_OK;
 }
 
+/* Whether the file is in WAL mode: a writer is at work (or closed beside
+ * readers and left it so). */
+static bool in_wal_mode(sqlite3 *db)
+{
+    char mode[16] = "";
+    return read_text(db, "PRAGMA journal_mode", mode, sizeof mode, NULL, 0) == CM_OK &&
+           strcmp(mode, "wal") == 0;
+}
+
 void cm_store_snapshot_end(cm_store *s)
 {
     if (!s || s->writable || !s->in_transaction)
+        return;
+    /* beside a writer, the regions and nodes read later must be those of
+     * the records read: the snapshot lasts until the store closes (a WAL
+     * reader holds no writer off) */
+    if (in_wal_mode(s->db))
         return;
     store_exec(s->db, "COMMIT"); /* nothing was written: it cannot fail to apply */
     s->in_transaction = 0;
@@ -589,9 +603,21 @@ static cm_status close_db(cm_store *s, char *msg, size_t msg_size)
     cm_status st = CM_OK;
     if (s->in_transaction)
         store_exec(s->db, "ROLLBACK"); /* a join that did not finish */
-    /* Back to one self-contained file for users and their sqlite3 shell. */
-    if (s->wal && store_exec(s->db, "PRAGMA journal_mode=DELETE") != SQLITE_OK)
-        st = store_db_error(s->db, "leave WAL mode", msg, msg_size);
+    /* Back to one self-contained file for users and their sqlite3 shell.
+     * Readers at it hold the switch off (SQLite does not wait for it): it
+     * is tried again for up to 10 s, and readers that stay longer leave the
+     * file in WAL mode, which is no failure (every commit is in the file
+     * and its -wal; the next writer folds the log in) */
+    for (int tries = 0; s->wal && tries < 200; tries++) {
+        if (store_exec(s->db, "PRAGMA journal_mode=DELETE") == SQLITE_OK)
+            break;
+        const int code = sqlite3_errcode(s->db) & 0xff;
+        if (code != SQLITE_BUSY && code != SQLITE_LOCKED) {
+            st = store_db_error(s->db, "leave WAL mode", msg, msg_size);
+            break;
+        }
+        nanosleep(&(struct timespec){0, 50000000}, NULL);
+    }
     if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
     if (s->lock_fd >= 0)

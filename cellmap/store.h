@@ -121,7 +121,9 @@ void cm_store_map_reads(cm_store *s);
 /* A read-only store reads one snapshot from cm_store_snapshot_begin to
  * cm_store_snapshot_end: its statements share one lock of the file, where
  * each would otherwise take and drop it and look for a journal. Keep
- * snapshots short: in rollback mode they hold a writer off. */
+ * snapshots short: in rollback mode they hold a writer off. A file in WAL
+ * mode (a writer at work) keeps the snapshot until cm_store_close, so that
+ * every region and node read later belongs to the records read first. */
 cm_status cm_store_snapshot_begin(cm_store *s, char *msg, size_t msg_size);
 void cm_store_snapshot_end(cm_store *s);
 

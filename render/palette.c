@@ -1,5 +1,7 @@
 #include "render/palette.h"
 
+#include "cellmap/output.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdbool.h>
@@ -56,9 +58,10 @@ cm_status cm_palette_named(const char *name, const cm_palette **out, char *msg, 
 
 cm_status cm_palette_read(const char *path, cm_palette *out, char *msg, size_t msg_size)
 {
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return cm_fail(CM_EIO, msg, msg_size, "cannot read palette %s: %s", path, strerror(errno));
+    FILE *f;
+    const cm_status opened = cm_input_open(path, "palette", 1 << 20, &f, msg, msg_size);
+    if (opened != CM_OK)
+        return opened;
     memset(out, 0, sizeof *out);
     snprintf(out->name, sizeof out->name, "%s", path);
     char line[256];

@@ -1,5 +1,7 @@
 #include "src/basin_png.h"
 
+#include "cellmap/output.h"
+
 #include "render/svg.h"
 
 #include <errno.h>
@@ -110,11 +112,9 @@ bool png_opts_palette(const char *value, png_opts *po, char *msg, size_t msg_siz
 
 bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        snprintf(msg, msg_size, "cannot read %s: %s", path, strerror(errno));
+    FILE *f;
+    if (cm_input_open(path, "--labels file", 1 << 20, &f, msg, msg_size) != CM_OK)
         return false;
-    }
     po->labels_file = path;
     char line[512];
     bool ok = true;

@@ -178,6 +178,14 @@ static int window_box(const cli *c, const char *text, const cm_lattice *lat, cm_
         const int64_t clo = box->lo[d], chi = box->hi[d];
         box->lo[d] = a > (double)clo ? (a < (double)chi ? (int64_t)a : chi) : clo;
         box->hi[d] = b < (double)chi ? (b > (double)box->lo[d] ? (int64_t)b : box->lo[d]) : chi;
+        if (box->lo[d] >= box->hi[d]) /* nothing to write: said before any file is made */
+            return cli_usage_error(
+                c,
+                "--window: '%s' holds no cell centre of the file in dimension %d (its cells "
+                "are %.9g wide, their centres from %.9g to %.9g): widen the window",
+                text, d + 1, lat->width[d],
+                lat->origin[d] + ((double)clo + 0.5) * lat->width[d],
+                lat->origin[d] + ((double)chi - 0.5) * lat->width[d]);
     }
     return EXIT_OK;
 }

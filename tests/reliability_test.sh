@@ -82,5 +82,26 @@ done
 [ -s l.npy ] && [ -s l.json ] && [ -s s.npy ] && [ -s s.json ] || fail "export --labels --steps: files"
 [ "$(sha256sum < plain.cmdb)" = "$sum" ] || fail "plain.cmdb changed"
 
+# --- item 2: a window that holds no cell centre: exit 2, nothing written --
+for o in "--labels L.npy --window 1:1.5,-1e9:1e9" "--steps S.npy --window 0:500,1:1.01" \
+         "--cells C.csv --window 1:1.5,-1e9:1e9" "--flat W.sqlite --window 0:500,1:1.01"; do
+  expect_usage "holds no cell centre of the file" export plain.cmdb $o
+done
+ls L.npy* S.npy* C.csv* W.sqlite* 2> /dev/null && fail "an empty window left a file"
+[ "$(sha256sum < plain.cmdb)" = "$sum" ] || fail "plain.cmdb changed"
+
+# --- item 6: palette and labels files that are devices, FIFOs or directories
+mkfifo fifo
+for o in "--palette /dev/zero" "--labels /dev/zero" "--palette ./fifo" "--labels ./fifo" "--labels ." "--palette ./"; do
+  out=$(timeout 20 "$CM" render plain.cmdb --png z.png $o 2>&1 > /dev/null); rc=$?
+  [ $rc -eq 2 ] && grep -q "cannot be read" <<<"$out" || fail "render $o: rc $rc, '$out'"
+done
+out=$(timeout 20 "$CM" solve --cells 20x20 --png z.png --palette /dev/zero 2>&1 > /dev/null); rc=$?
+[ $rc -eq 2 ] && grep -q "not a regular file" <<<"$out" || fail "solve --palette /dev/zero: rc $rc, '$out'"
+out=$(printf 'render z.png --labels /dev/zero\n' | timeout 20 "$CM" explore plain.cmdb - 2>&1 > /dev/null); rc=$?
+[ $rc -eq 1 ] && grep -q "not a regular file" <<<"$out" || fail "explore render --labels /dev/zero: rc $rc, '$out'"
+[ ! -e z.png ] || fail "a refused palette or labels file left z.png"
+[ "$(sha256sum < plain.cmdb)" = "$sum" ] || fail "plain.cmdb changed"
+
 [ "$fails" -eq 0 ] && echo "reliability_test: ok"
 exit $((fails > 0))
