@@ -18,9 +18,11 @@ bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
         if (c->value && !ok)
             *error = cli_usage_error(c, "--attractor-steps: '%s' must be T,R or T,R,MAX (whole "
                                         "numbers of steps, R at least 8)", c->value);
-        o->transient = (uint32_t)v[0];
-        o->record = (uint32_t)v[1];
-        o->max_steps = (uint32_t)v[2];
+        if (ok) { /* converted only when in range: a negative count is no uint32_t */
+            o->transient = (uint32_t)v[0];
+            o->record = (uint32_t)v[1];
+            o->max_steps = (uint32_t)v[2];
+        }
     } else if (cli_is(c, "--attractor-tol", true, error)) {
         double v[2] = {0, 0};
         int n = 0;
@@ -33,12 +35,14 @@ bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
     } else if (cli_is(c, "--outside-steps", true, error)) {
         double v = 0;
         int n = 0;
-        if (c->value && (!parse_doubles(c->value, &v, &n, 1) || n != 1 || !(v >= 0) ||
-                         v > CM_OUTSIDE_MAX_STEPS || v != floor(v)))
+        const bool ok = c->value && parse_doubles(c->value, &v, &n, 1) && n == 1 && v >= 0 &&
+                        v <= CM_OUTSIDE_MAX_STEPS && v == floor(v);
+        if (c->value && !ok)
             *error = cli_usage_error(c, "--outside-steps: '%s' must be a whole number of steps "
                                         "from 0 (not followed) to %u", c->value,
                                      CM_OUTSIDE_MAX_STEPS);
-        o->outside = v == 0 ? CM_OUTSIDE_OFF : (uint32_t)v;
+        if (ok)
+            o->outside = v == 0 ? CM_OUTSIDE_OFF : (uint32_t)v;
     } else {
         return false;
     }

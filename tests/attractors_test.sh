@@ -168,6 +168,8 @@ expect_usage "--attractor-tol: '0' must be TOL or TOL,MATCH, each above 0" solve
 expect_usage "matching tolerance" solve --cells 10x10 --attractor-tol 1e-3,1e-5
 expect_usage "--attractor-tol" solve --cells 10x10 --attractor-tol -1
 expect_usage "--attractor-steps" solve --cells 10x10 --attractor-steps 10
+expect_usage "--attractor-steps" solve --cells 10x10 --attractor-steps -1,500
+expect_usage "--outside-steps" solve --cells 10x10 --outside-steps nan
 expect_usage "budget" solve --cells 10x10 --attractor-steps 100,50,60 --db bad2.cmdb
 expect_usage "--by" render whole.cmdb --png x.png --by cells
 [ ! -e bad1.cmdb ] && [ ! -e bad2.cmdb ] && [ ! -e bad3.cmdb ] && [ ! -e x.png ] || fail "a refused command wrote a file"
