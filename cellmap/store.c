@@ -605,19 +605,23 @@ static cm_status close_db(cm_store *s, char *msg, size_t msg_size)
         store_exec(s->db, "ROLLBACK"); /* a join that did not finish */
     /* Back to one self-contained file for users and their sqlite3 shell.
      * Readers at it hold the switch off (SQLite does not wait for it): it
-     * is tried again for up to 10 s, and readers that stay longer leave the
-     * file in WAL mode, which is no failure (every commit is in the file
-     * and its -wal; the next writer folds the log in) */
-    for (int tries = 0; s->wal && tries < 200; tries++) {
-        if (store_exec(s->db, "PRAGMA journal_mode=DELETE") == SQLITE_OK)
-            break;
+     * is tried again for up to 10 s; readers that stay longer leave the
+     * file in WAL mode, which is no failure, once every commit is copied
+     * into the file itself (a full checkpoint waits for the readers of
+     * older snapshots): the .cmdb alone holds the whole cluster */
+    bool switched = !s->wal;
+    for (int tries = 0; !switched && st == CM_OK && tries < 200; tries++) {
+        switched = store_exec(s->db, "PRAGMA journal_mode=DELETE") == SQLITE_OK;
         const int code = sqlite3_errcode(s->db) & 0xff;
-        if (code != SQLITE_BUSY && code != SQLITE_LOCKED) {
+        if (!switched && code != SQLITE_BUSY && code != SQLITE_LOCKED)
             st = store_db_error(s->db, "leave WAL mode", msg, msg_size);
-            break;
-        }
-        nanosleep(&(struct timespec){0, 50000000}, NULL);
+        else if (!switched)
+            nanosleep(&(struct timespec){0, 50000000}, NULL);
     }
+    if (!switched && st == CM_OK &&
+        sqlite3_wal_checkpoint_v2(s->db, NULL, SQLITE_CHECKPOINT_FULL, NULL, NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "copy the log into the file beside its readers", msg,
+                            msg_size);
     if (sqlite3_close(s->db) != SQLITE_OK && st == CM_OK)
         st = cm_fail(CM_EDB, msg, msg_size, "closing %s failed", s->path);
     if (s->lock_fd >= 0)
