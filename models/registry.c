@@ -215,8 +215,13 @@ cm_status cm_model_set_create(const cm_model_set *s, const char *name, const cha
     cm_status st = cm_params_defaults(e->params, &p, msg, msg_size);
     for (int i = 0; st == CM_OK && i < n_texts; i++)
         st = cm_params_set(&p, texts[i], msg, msg_size);
+    if (st == CM_OK && msg && msg_size)
+        msg[0] = 0;
     if (st == CM_OK)
         st = e->create(&p, m, msg, msg_size);
+    if (st != CM_OK && msg && msg_size && !msg[0]) /* a plugin that said nothing */
+        snprintf(msg, msg_size, "model %s: create() failed (status %d) and gave no reason", name,
+                 (int)st);
     /* a plugin's flow becomes a map here; built-in ones attached theirs */
     if (st == CM_OK && m->flow.field && !m->step)
         st = cm_flow_attach(m, msg, msg_size);

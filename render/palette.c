@@ -107,8 +107,10 @@ static uint64_t anchor_hash(const int64_t *anchor, const cm_lattice *lat)
     uint64_t h = UINT64_C(0x9e3779b97f4a7c15);
     for (int d = 0; d < lat->dim; d++) {
         const double shift = round(lat->origin[d] / lat->width[d]);
-        const int64_t from_zero = fabs(shift) < 0x1p52 ? anchor[d] + (int64_t)shift : anchor[d];
-        h = mix(h ^ (uint64_t)from_zero);
+        /* unsigned: a damaged file's anchor must not overflow */
+        const uint64_t from_zero = fabs(shift) < 0x1p52 ? (uint64_t)anchor[d] + (uint64_t)(int64_t)shift
+                                                        : (uint64_t)anchor[d];
+        h = mix(h ^ from_zero);
     }
     return h;
 }

@@ -2,6 +2,7 @@
  * database, from a script, from stdin, or at a prompt with line editing
  * (libedit) when stdin is a terminal. */
 #include <editline/readline.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -115,19 +116,12 @@ static int run_prompt(session *s)
     return EXIT_OK;
 }
 
-static int run_input(session *s, const char *script)
+/* The session's input: the script file (opened before the session, so
+ * that a missing one makes no file), standard input or the prompt. */
+static int run_input(session *s, const char *script, FILE *f)
 {
-    if (script && strcmp(script, "-") != 0) {
-        FILE *f = fopen(script, "r");
-        if (!f) {
-            fprintf(stderr, "cellmap explore: cannot open the script %s (check the path)\n",
-                    script);
-            return EXIT_FAIL;
-        }
-        const int rc = run_script(s, f, script);
-        fclose(f);
-        return rc;
-    }
+    if (f)
+        return run_script(s, f, script);
     if (!script && isatty(STDIN_FILENO))
         return run_prompt(s);
     return run_script(s, stdin, "stdin");
@@ -145,10 +139,18 @@ int cmd_explore(int argc, char **argv)
     join_argv(argc + 1, argv - 1, command, sizeof command);
     a.o.command = command;
     a.o.out = stdout;
+    FILE *f = NULL;
+    if (a.script && strcmp(a.script, "-") != 0 && !(f = fopen(a.script, "r"))) {
+        fprintf(stderr, "cellmap explore: cannot open the script %s: %s (check the path)\n",
+                a.script, strerror(errno));
+        return EXIT_USAGE;
+    }
     session s;
     rc = session_open(&s, &a.o);
     if (rc == EXIT_OK)
-        rc = run_input(&s, a.script);
+        rc = run_input(&s, a.script, f);
+    if (f)
+        fclose(f);
     /* what the session did is saved in any case */
     if (session_close(&s, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "cellmap explore: %s\n", msg);

@@ -211,7 +211,7 @@ out=$("$CM" explore union1.cmdb first.explore --model microchaos-1d 2>&1); rc=$?
 out=$("$CM" explore x.cmdb --model microchaos-pd 2>&1); rc=$?
 [ "$rc" -eq 2 ] && grep -qF -- "--cell-size needs 2" <<<"$out" || fail "no --cell-size: rc $rc, '$out'"
 out=$("$CM" explore x.cmdb missing.explore $pd $lattice 2>&1); rc=$?
-[ "$rc" -eq 1 ] && grep -qF "cannot open the script missing.explore" <<<"$out" ||
+[ "$rc" -eq 2 ] && grep -qF "cannot open the script missing.explore" <<<"$out" && [ ! -e x.cmdb ] ||
   fail "missing script: rc $rc, '$out'"
 
 # --- stdin, a file made by solve, and export in a session ----------------

@@ -197,6 +197,12 @@ for line in sys.stdin:
     assert -math.pi - 1e-9 <= -math.pi + lo[0] * w and -math.pi + hi[0] * w <= math.pi + 1e-9, line
 ' || fail "a region of the explore session crosses the angle's seam"
 
+# a plugin whose create() fails without a message: the failure is said
+sed 's/    memset(m, 0, sizeof \*m);/    memset(m, 0, sizeof *m);\n    return CM_EINVAL;/' \
+  "$SRC/examples/plugin/henon.c" > mute.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libmute.so mute.c -lm 2> /dev/null
+expect_usage "create() failed (status" solve --model-lib ./libmute.so --model henon --region=-1:1,-1:1
+
 # a model that cannot be one, or takes a built-in model's name, is refused
 sed 's/    m->dim = 2;/    m->dim = 9;/' "$SRC/examples/plugin/henon.c" > dim.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libdim.so dim.c -lm

@@ -82,6 +82,15 @@ done
 [ -s l.npy ] && [ -s l.json ] && [ -s s.npy ] && [ -s s.json ] || fail "export --labels --steps: files"
 [ "$(sha256sum < plain.cmdb)" = "$sum" ] || fail "plain.cmdb changed"
 
+# --- item 7: a damaged anchor far out: no overflow in the colour hash ----
+cp plain.cmdb anchor.cmdb
+sqlite3 anchor.cmdb "UPDATE attractors SET anchor = '[9223372036854775807,-9223372036854775808]' WHERE id = 1"
+out=$("$CM" render anchor.cmdb --by groups --png anchor.png 2>&1 > /dev/null); rc=$?
+[ $rc -le 1 ] && ! grep -q "runtime error" <<<"$out" || fail "render of a damaged anchor: rc $rc, '$out'"
+# a missing explore script: exit 2 before the session makes its file
+out=$("$CM" explore new.cmdb missing.explore --model microchaos-pd --cell-size 1,1 2>&1); rc=$?
+[ $rc -eq 2 ] && [ ! -e new.cmdb ] || fail "explore with a missing script: rc $rc, '$out'"
+
 # --- item 2: a window that holds no cell centre: exit 2, nothing written --
 for o in "--labels L.npy --window 1:1.5,-1e9:1e9" "--steps S.npy --window 0:500,1:1.01" \
          "--cells C.csv --window 1:1.5,-1e9:1e9" "--flat W.sqlite --window 0:500,1:1.01"; do
