@@ -6,6 +6,7 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
+#include <math.h>
 #include <string.h>
 
 #include "models/params.h"
@@ -73,21 +74,62 @@ static bool in_world(const cm_model *m, const double *y)
 }
 
 /* The first step GSL tries: a fraction of the period (or of a time unit
- * for an autonomous section); its error control adapts it from there. */
-static double first_step(const cm_flow *f, double span)
+ * for an autonomous section), and at most a hundredth of the time the
+ * field takes to change the state by its own size (|y| + 1), so that a
+ * long period (omega = 0.001: 98 time units) does not start with a step
+ * over which the state overflows; the error control adapts it from there. */
+static double first_step(const cm_model *m, double t, const double *y, double span)
 {
-    const double h = (f->period > 0 ? f->period : 1.0) / 64;
+    const cm_flow *f = &m->flow;
+    double h = (f->period > 0 ? f->period : 1.0) / 64;
+    double dydt[CM_MAX_DIM], scale = 0, rate = 0;
+    if (f->field(m, t, y, dydt) == 0)
+        for (int d = 0; d < m->dim; d++) {
+            scale = fmax(scale, fabs(y[d]) + 1);
+            rate = fmax(rate, fabs(dydt[d]));
+        }
+    if (rate > 0 && isfinite(rate))
+        h = fmin(h, 0.01 * scale / rate);
     return h < span ? h : span;
 }
 
+static bool finite_state(int dim, const double *y)
+{
+    for (int d = 0; d < dim; d++)
+        if (!isfinite(y[d]))
+            return false;
+    return true;
+}
+
 /* One accepted step towards t1 from (*t, y); false when the orbit has no
- * image (the field failed, the world was left, too many steps). */
+ * image (the field failed, the world was left, too many steps). A step
+ * GSL accepts with a non-finite state (its error estimate NaN, which its
+ * control takes as small) is taken back and tried again ten times
+ * shorter: only a state beyond the world, or non-finite at steps below
+ * 1e-12 of the period, is a blow-up. */
 static bool advance(flow_work *w, double *t, double t1, double *h, double *y)
 {
-    if (gsl_odeiv2_evolve_apply(w->evolve, w->control, w->step, &w->sys, t, t1, h, y) !=
-        GSL_SUCCESS)
-        return false;
-    return ++w->steps <= CM_FLOW_MAX_STEPS && in_world(w->m, y);
+    const int dim = w->m->dim;
+    const double t0 = *t, shortest = 1e-12 * (w->m->flow.period > 0 ? w->m->flow.period : 1.0);
+    double y0[CM_MAX_DIM];
+    memcpy(y0, y, (size_t)dim * sizeof *y);
+    for (;;) {
+        if (gsl_odeiv2_evolve_apply(w->evolve, w->control, w->step, &w->sys, t, t1, h, y) !=
+            GSL_SUCCESS)
+            return false;
+        if (++w->steps > CM_FLOW_MAX_STEPS)
+            return false;
+        if (finite_state(dim, y))
+            return in_world(w->m, y);
+        const double tried = *t - t0;
+        if (!(tried > shortest))
+            return false;
+        *t = t0;
+        *h = 0.1 * tried;
+        memcpy(y, y0, (size_t)dim * sizeof *y);
+        gsl_odeiv2_evolve_reset(w->evolve);
+        gsl_odeiv2_step_reset(w->step);
+    }
 }
 
 /* y from time t to time t1 (> t). */
@@ -95,7 +137,7 @@ static bool integrate(flow_work *w, double t, double t1, double *y)
 {
     gsl_odeiv2_evolve_reset(w->evolve);
     gsl_odeiv2_step_reset(w->step);
-    double h = first_step(&w->m->flow, t1 - t);
+    double h = first_step(w->m, t, y, t1 - t);
     while (t < t1)
         if (!advance(w, &t, t1, &h, y))
             return false;
@@ -167,7 +209,7 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
     gsl_odeiv2_evolve_reset(w->evolve);
     gsl_odeiv2_step_reset(w->step);
     const double t1 = f->t0 + f->t_max;
-    double t = f->t0, h = first_step(f, f->t_max), before[CM_MAX_DIM];
+    double t = f->t0, h = first_step(m, f->t0, y, f->t_max), before[CM_MAX_DIM];
     double g = f->section(m, t, y);
     while (t < t1) {
         const double t_before = t, g_before = g;

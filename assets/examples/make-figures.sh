@@ -6,6 +6,7 @@
 # manifolds (dashed), axes, legend and title.
 set -euo pipefail
 CM=$(realpath "$1")
+src=$(cd "$(dirname "$0")/../.." && pwd) # before the cd below: $0 may be relative
 OUT=${2:-$(cd "$(dirname "$0")" && pwd)}
 cd "$OUT"
 tmp=$(mktemp -d)
@@ -181,7 +182,6 @@ done
 # The example plugins' attractors (examples/plugin/): Newton's method for
 # z^3 - 1 (three roots), the Henon map (one aperiodic attractor, its
 # footprint black) and the pendulum, drawn by attractors
-src=$(cd "$(dirname "$0")/../.." && pwd)
 for p in newton henon pendulum; do
   cc -shared -fPIC -I"$src" -o "$tmp/lib$p.so" "$src/examples/plugin/$p.c" -lm
 done
