@@ -84,6 +84,15 @@ for bad in (lambda: cellmap.System("nope"), lambda: cellmap.open("missing.cmdb")
         raise AssertionError("no error")
     except cellmap.CellmapError as e:
         assert str(e), e
+# short or long states and views are refused, not padded or read past
+for bad in (lambda: pd.step([1.0]), lambda: pd.step([1.0, 2.0, 3.0]), lambda: db.read([(0, 100)]),
+            lambda: db.read([]), lambda: db.read([(0, 100)] * 7), lambda: db.read([(0,), (1,)])):
+    try:
+        bad()
+        raise AssertionError("accepted")
+    except ValueError as e:
+        assert "dimension" in str(e) or "(lo, hi)" in str(e), e
+assert len(pd.step([1.0, 0.5])) == 2
 print("python module: labels and steps equal cellmap solve + export")
 PY
 

@@ -218,7 +218,11 @@ class System:
         return list(zip(lo, hi))
 
     def step(self, x):
-        """The image of state x, or None (the sink)."""
+        """The image of state x (dim numbers), or None (the sink)."""
+        x = [float(v) for v in x]
+        if len(x) != self.dim:
+            raise ValueError("model %s has dimension %d: step() needs %d numbers, not %d"
+                             % (self.name, self.dim, self.dim, len(x)))
         xs = (ctypes.c_double * self.dim)(*x)
         ys = (ctypes.c_double * self.dim)()
         return list(ys) if _lib.cm_system_step(self._h, xs, ys) == 0 else None
@@ -343,6 +347,12 @@ class Database:
         if view is None:
             _call(_lib.cm_db_read, self._h, None, None, ctypes.byref(h))
         else:
+            view = list(view)
+            if len(view) != len(self.lo):
+                raise ValueError("the database has dimension %d: read() needs %d (lo, hi) "
+                                 "ranges, not %d" % (len(self.lo), len(self.lo), len(view)))
+            if any(len(r) != 2 for r in view):
+                raise ValueError("read(): each range of the view is (lo, hi)")
             lo = (ctypes.c_double * len(view))(*[float(a) for a, _ in view])
             hi = (ctypes.c_double * len(view))(*[float(b) for _, b in view])
             _call(_lib.cm_db_read, self._h, lo, hi, ctypes.byref(h))
