@@ -72,9 +72,17 @@ double cm_model_diff(const cm_model *m, int d, double a, double b)
     return cm_period_diff(m->period, d, a, b);
 }
 
+/* A step's status as the engine takes it: a code that is none of
+ * CM_STEP_OK, CM_STEP_NO_IMAGE and CM_STEP_ABORT (a plugin's mistake)
+ * stops the run rather than passing for the sink. */
+static int known_status(int rc)
+{
+    return rc == CM_STEP_OK || rc == CM_STEP_NO_IMAGE ? rc : CM_STEP_ABORT;
+}
+
 static int wrapped_step(const cm_model *m, const double *x, double *y)
 {
-    const int rc = m->own_step(m, x, y);
+    const int rc = known_status(m->own_step(m, x, y));
     for (int d = 0; rc == CM_STEP_OK && d < m->dim; d++)
         y[d] = cm_model_wrap(m, d, y[d]);
     return rc;
@@ -84,6 +92,8 @@ static void wrapped_step_n(const cm_model *m, size_t n, const double *const *x, 
                            int *rc)
 {
     m->own_step_n(m, n, x, y, rc);
+    for (size_t i = 0; i < n; i++)
+        rc[i] = known_status(rc[i]);
     for (int d = 0; d < m->dim; d++)
         if (cm_model_periodic(m, d))
             for (size_t i = 0; i < n; i++)
@@ -91,9 +101,9 @@ static void wrapped_step_n(const cm_model *m, size_t n, const double *const *x, 
                                               : y[d][i];
 }
 
-cm_status cm_model_wrap_periods(cm_model *m, char *msg, size_t msg_size)
+cm_status cm_model_wrap_periods(cm_model *m, bool check_status, char *msg, size_t msg_size)
 {
-    bool any = false;
+    bool any = check_status;
     for (int d = 0; d < m->dim && d < CM_MAX_DIM; d++) {
         const double p = m->period[d], lo = m->period_lo[d];
         if (p == 0 && lo == 0)

@@ -175,10 +175,13 @@ typedef struct cm_model {
 static inline bool cm_model_periodic(const cm_model *m, int d) { return m->period[d] > 0; }
 
 /* Checks a model's periods (each 0, or above 0 and finite with a finite
- * period_lo) and, when one is set, makes step and step_n take their states
- * into the periods. CM_EINVAL naming the coordinate. Called once, when the
- * model is made (cm_model_set_create). */
-cm_status cm_model_wrap_periods(cm_model *m, char *msg, size_t msg_size);
+ * period_lo) and, when one is set (or check_status: a plugin's model),
+ * wraps step and step_n: states taken into the periods, and a status
+ * other than CM_STEP_OK, CM_STEP_NO_IMAGE and CM_STEP_ABORT made
+ * CM_STEP_ABORT (it stops the run instead of passing for the sink).
+ * CM_EINVAL naming the coordinate. Called once, when the model is made
+ * (cm_model_set_create). */
+cm_status cm_model_wrap_periods(cm_model *m, bool check_status, char *msg, size_t msg_size);
 
 /* x (coordinate d) taken into the model's period, or as it is. */
 double cm_model_wrap(const cm_model *m, int d, double x);

@@ -16,7 +16,8 @@
  * an angle or a phase (cellmap takes every image into that period; boxes
  * hold at most one). step() (and a flow's field) must be pure
  * and thread-safe: cellmap calls it on every thread at once. It returns CM_STEP_OK with the image in y, CM_STEP_NO_IMAGE (the sink:
- * the orbit is lost) or CM_STEP_ABORT. On failure create() returns a
+ * the orbit is lost) or CM_STEP_ABORT; any other code stops the run as
+ * CM_STEP_ABORT does. On failure create() returns a
  * status (CM_EINVAL ...), writes the reason into msg with snprintf and
  * leaves *m zeroed. A plugin calls no function of cellmap's: it needs these
  * headers (their inline functions included) and nothing to link. */

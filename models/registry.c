@@ -231,8 +231,10 @@ cm_status cm_model_set_create(const cm_model_set *s, const char *name, const cha
                      "model %s: create() gave dimension %d%s; it must give 1..%d, a name and a "
                      "step function",
                      name, m->dim, m->step ? "" : " and no step function", CM_MAX_DIM);
-    if (st == CM_OK)
-        st = cm_model_wrap_periods(m, msg, msg_size);
+    const cm_model_lib *lib = NULL;
+    cm_model_set_find(s, name, &lib);
+    if (st == CM_OK) /* a plugin's step is guarded: its status codes are checked */
+        st = cm_model_wrap_periods(m, lib != NULL, msg, msg_size);
     /* Maps of delayed values name their state after the lags: ..., x_lag1, x */
     static const char *const lag_names[CM_MAX_DIM] = {"x_lag5", "x_lag4", "x_lag3",
                                                       "x_lag2", "x_lag1", "x"};

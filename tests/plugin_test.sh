@@ -203,6 +203,15 @@ sed 's/    memset(m, 0, sizeof \*m);/    memset(m, 0, sizeof *m);\n    return CM
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libmute.so mute.c -lm 2> /dev/null
 expect_usage "create() failed (status" solve --model-lib ./libmute.so --model henon --region=-1:1,-1:1
 
+# a step that returns a status that is no CM_STEP_* code stops the run
+# (exit 1, the model named) instead of passing for the sink
+sed 's/    return fabs(y\[0\]) < 1e100/    return x[0] > 1.5 ? 7 : fabs(y[0]) < 1e100/' \
+  "$SRC/examples/plugin/henon.c" > code.c
+grep -q "? 7 :" code.c || fail "the undefined-status plugin was not made"
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o libcode.so code.c -lm
+out=$("$CM" solve --model-lib ./libcode.so --model henon --region=-2:2,-2:2 --cells 50x50 2>&1 > /dev/null); rc=$?
+[ $rc -eq 1 ] && grep -q "model henon aborted" <<<"$out" || fail "an undefined step status: rc $rc, '$out'"
+
 # a model that cannot be one, or takes a built-in model's name, is refused
 sed 's/    m->dim = 2;/    m->dim = 9;/' "$SRC/examples/plugin/henon.c" > dim.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libdim.so dim.c -lm

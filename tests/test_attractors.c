@@ -565,7 +565,7 @@ static void test_pendulum(const char *plugin)
     cm_model bad = m;
     bad.period[1] = -1;
     bad.own_step = NULL;
-    CHECK(cm_model_wrap_periods(&bad, msg, sizeof msg) == CM_EINVAL && strstr(msg, "period"));
+    CHECK(cm_model_wrap_periods(&bad, false, msg, sizeof msg) == CM_EINVAL && strstr(msg, "period"));
     /* a box wider than a period, or beyond it, is refused */
     const cm_lattice lat = {2, {-4, -4}, {0.01, 0.01}};
     const cm_box wide = {2, {0, 0}, {700, 10}}, beyond = {2, {300, 0}, {800, 10}};
