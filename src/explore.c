@@ -158,9 +158,11 @@ static cm_status cover_box(session *s, const cm_box *box, const char *verb, comp
     const uint64_t cells = cm_boxes_cells(boxes, n);
     if (st == CM_OK && cells > s->max_new_cells)
         st = cm_fail(CM_ETOOBIG, msg, msg_size,
-                     "%s would compute %llu new cells, more than %llu at once; zoom out or pan "
-                     "in smaller steps",
-                     verb, (unsigned long long)cells, (unsigned long long)s->max_new_cells);
+                     "%s would compute %llu new cells, more than %llu at once%s; zoom or pan in "
+                     "smaller steps%s",
+                     verb, (unsigned long long)cells, (unsigned long long)s->max_new_cells,
+                     s->mem_given ? " (what --mem holds, 12 bytes a cell)" : "",
+                     s->mem_given ? ", or give a larger --mem" : "");
     if (st == CM_OK && n > 0)
         st = compute_boxes(s, boxes, n, done, msg, msg_size);
     free(boxes);
@@ -1262,6 +1264,11 @@ int session_open(session *s, const session_options *o)
     s->out = o->out;
     s->threads = o->threads;
     s->max_new_cells = o->max_new_cells ? o->max_new_cells : MAX_NEW_CELLS;
+    /* under --mem, one step computes no more than its cell arrays (12 bytes
+     * a cell) hold: a region being solved is resident whole */
+    if (o->mem && o->mem / 12 < s->max_new_cells)
+        s->max_new_cells = o->mem / 12 > 4096 ? o->mem / 12 : 4096;
+    s->mem_given = o->mem != 0;
     const int rc = stat(o->path, &sb) == 0 ? open_existing(s, o) : create_new(s, o);
     if (rc != EXIT_OK)
         return rc;

@@ -52,7 +52,8 @@ typedef struct session {
     int64_t depth_hi[CM_MAX_DIM];
     int64_t slice[CM_MAX_DIM]; /* dimensions >= 2: the cell shown */
     int quit;
-    uint64_t max_new_cells;
+    uint64_t max_new_cells; /* most cells one step computes (bounded by --mem) */
+    int mem_given;          /* --mem was given */
     FILE *out;
     cm_gl *gl; /* kept between renders (made by the first); NULL until then */
 } session;

@@ -91,6 +91,13 @@ out=$("$CM" render anchor.cmdb --by groups --png anchor.png 2>&1 > /dev/null); r
 out=$("$CM" explore new.cmdb missing.explore --model microchaos-pd --cell-size 1,1 2>&1); rc=$?
 [ $rc -eq 2 ] && [ ! -e new.cmdb ] || fail "explore with a missing script: rc $rc, '$out'"
 
+# one explore step computes no more than --mem holds (12 bytes a cell)
+out=$(printf 'view 0:20 -40:40\nview 0:500 -40:40\n' |
+  "$CM" explore mem.cmdb - --model microchaos-pd --cell-size 0.5,0.08 --mem 1M 2>&1 > /dev/null); rc=$?
+[ $rc -eq 1 ] && grep -q "more than 87381 at once (what --mem holds" <<<"$out" \
+  || fail "explore beyond --mem: rc $rc, '$out'"
+[ "$(sqlite3 mem.cmdb 'SELECT SUM(cells) FROM regions')" = 40000 ] || fail "explore beyond --mem computed cells"
+
 # --- item 2: a window that holds no cell centre: exit 2, nothing written --
 for o in "--labels L.npy --window 1:1.5,-1e9:1e9" "--steps S.npy --window 0:500,1:1.01" \
          "--cells C.csv --window 1:1.5,-1e9:1e9" "--flat W.sqlite --window 0:500,1:1.01"; do
