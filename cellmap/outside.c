@@ -73,14 +73,6 @@ static cm_status box_order(const int64_t *cells, uint64_t n, int dim, uint32_t *
     return CM_OK;
 }
 
-static bool same_cell(const int64_t *a, const int64_t *b, int dim)
-{
-    for (int d = 0; d < dim; d++)
-        if (a[d] != b[d])
-            return false;
-    return true;
-}
-
 /* The distinct cells of targets[0..n) (dim coordinates each) in box order
  * into x->cell, their weights summed into x->weight; exit_of[i] (may be
  * NULL) receives the exit of target i. */
@@ -100,7 +92,7 @@ static cm_status exits_of_targets(const int64_t *targets, const uint64_t *weight
     x->n = 0;
     for (uint64_t k = 0; k < n; k++) {
         const int64_t *t = targets + (size_t)order[k] * (size_t)dim;
-        if (!x->n || !same_cell(t, x->cell + (x->n - 1) * (uint64_t)dim, dim)) {
+        if (!x->n || memcmp(t, x->cell + (x->n - 1) * (uint64_t)dim, (size_t)dim * sizeof *t)) {
             memcpy(x->cell + x->n * (uint64_t)dim, t, (size_t)dim * sizeof *t);
             x->weight[x->n++] = 0;
         }
@@ -415,14 +407,6 @@ static void step_points(const cm_model *m, int dim, int n, follow_buf *b)
     }
 }
 
-/* floor(u) for |u| < 2^51, as cm_lattice_cell gives it (no libm call). */
-static inline double floor_exact(double u)
-{
-    const double magic = 0x1.8p52;
-    const double t = (u + magic) - magic;
-    return t - (t > u ? 1.0 : 0.0);
-}
-
 /* The cells of the images (as cm_lattice_cell finds them), whether they
  * are in the world, and whether within bounds: loops the compiler
  * vectorises. */
@@ -440,7 +424,7 @@ static void place_points(const cm_lattice *lat, const cm_box *bounds, int n, fol
         for (int i = 0; i < n; i++) {
             const double u = (b->y[d][i] - origin) / width;
             const double inside = ((u >= -limit) & (u < limit)) ? 1.0 : 0.0; /* 0 for NaN */
-            const double at = floor_exact(inside != 0.0 ? u : 0.0);
+            const double at = cm_floor_exact(inside != 0.0 ? u : 0.0);
             b->at[d][i] = at;
             b->world[i] *= inside;
             b->near[i] *= ((at >= lo) & (at < hi)) ? 1.0 : 0.0;
@@ -580,15 +564,16 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                  (unsigned long long)x->n);
     uint64_t taken = 0;
-    int aborted = 0;
+    int no_memory = 0;
     if (st == CM_OK) {
         if (x->n)
             memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
         const int64_t batches = (int64_t)((x->n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
-#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : taken) reduction(| : aborted)
+#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : taken) \
+    reduction(| : no_memory)
         {
             follow_buf *buf = malloc(sizeof *buf);
-            aborted |= !buf;
+            no_memory |= !buf;
 #pragma omp for schedule(dynamic, 1)
             for (int64_t b = 0; b < batches; b++) {
                 const uint64_t first = (uint64_t)b * FOLLOW_BATCH;
@@ -598,7 +583,7 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
             }
             free(buf);
         }
-        if (aborted)
+        if (no_memory)
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following the exits");
         for (uint64_t e = 0; st == CM_OK && e < x->n; e++)
             if (f[e].how == FOLLOW_ABORTED)
@@ -707,21 +692,16 @@ cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const c
                                  out, msg, msg_size);
 }
 
-cm_status cm_cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
-                                const cm_attractor_options *opt, cm_attractor_set *out,
-                                char *msg, size_t msg_size)
+cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
+                                const cm_group_info *groups, const cm_attractor_options *opt,
+                                cm_attractor_set *out, char *msg, size_t msg_size)
 {
+    cm_cluster *c = cc->c;
     cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c,
                                       opt, out, msg, msg_size);
-    cm_exits x;
-    if (st == CM_OK)
-        st = cm_cluster_exits(c, &x, msg, msg_size);
     if (st != CM_OK)
         return st;
-    cm_cluster_cells cc = {c, &x};
-    const cm_computed cells = cm_cluster_computed(&cc);
-    st = cm_attractors_outside(m, &c->lat, &x, &cells, outside_budget(m, opt),
-                               opt ? opt->threads : 0, out, msg, msg_size);
-    cm_exits_free(&x);
-    return st;
+    const cm_computed cells = cm_cluster_computed(cc);
+    return cm_attractors_outside(m, &c->lat, cc->exits, &cells, outside_budget(m, opt),
+                                 opt ? opt->threads : 0, out, msg, msg_size);
 }

@@ -127,15 +127,17 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
 
 /* The attractors of the groups (entry k: group k + 1) with the exits
  * followed: cm_attractors_find, then the exits (a region's x, from
- * cm_region_settle_exits, or the cluster's) followed opt->outside steps
+ * cm_region_settle_exits, or the cluster's, cc->exits from
+ * cm_cluster_exits, which callers keep for the cells' labels) followed
+ * opt->outside steps
  * (cm_attractors_outside). *out is the caller's to release
  * (cm_attractors_free), also on failure. */
 cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const cm_region *r,
                                int max_steps, const cm_exits *x, const cm_group_info *groups,
                                const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
                                size_t msg_size);
-cm_status cm_cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
-                                const cm_attractor_options *opt, cm_attractor_set *out,
-                                char *msg, size_t msg_size);
+cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
+                                const cm_group_info *groups, const cm_attractor_options *opt,
+                                cm_attractor_set *out, char *msg, size_t msg_size);
 
 #endif

@@ -184,16 +184,6 @@ static int images_of_row(const cm_model *model, const cm_lattice *lat, const cm_
 /* Cells a batch of images takes (models with step_n). */
 #define BATCH 256
 
-/* floor(u) for |u| < 2^51 in double arithmetic (vectorisable): adding and
- * taking away 1.5 * 2^52 rounds to an integer, and stepping down where that
- * went up gives the floor, as cm_lattice_cell's truncation does. */
-static inline double floor_exact(double u)
-{
-    const double magic = 0x1.8p52;
-    const double t = (u + magic) - magic;
-    return t - (t > u ? 1.0 : 0.0);
-}
-
 /* Whether coordinate d of the images (at) lies in the box (lo..hi) and
  * equals the cell's own (here, plus i along the row: step 1 in dimension
  * 0), and the local index so far (dimensions from the last down). */
@@ -234,7 +224,7 @@ static void floor_coordinates(const double *restrict y, double origin, double wi
     for (size_t i = 0; i < n; i++) {
         const double u = (y[i] - origin) / width;
         const double inside = ((u >= -limit) & (u < limit)) ? 1.0 : 0.0; /* 0 for NaN */
-        at[i] = floor_exact(inside != 0.0 ? u : 0.0);
+        at[i] = cm_floor_exact(inside != 0.0 ? u : 0.0);
         world[i] *= inside;
     }
 }

@@ -181,11 +181,12 @@ typedef struct result_source {
 } result_source;
 
 /* The attractors of the cluster's groups (read from the store when it
- * has them). */
+ * has them), cc: the cluster and its exits. */
 static cm_status cluster_attractors_of(const cm_model *m, const result_source *from,
-                                       cm_attractor_set *out, char *msg, size_t msg_size)
+                                       cm_cluster_cells *cc, cm_attractor_set *out, char *msg,
+                                       size_t msg_size)
 {
-    cm_cluster *c = from->cluster;
+    cm_cluster *c = cc->c;
     if (from->store) {
         const cm_status st =
             cm_store_get_attractors(from->store, c->lat.dim, c->ngroups, out, NULL, msg, msg_size);
@@ -198,7 +199,7 @@ static cm_status cluster_attractors_of(const cm_model *m, const result_source *f
                    : from->store ? cm_store_groups(from->store, g, c->ngroups, &sink, msg, msg_size)
                                  : cm_cluster_describe_new(c, m, g, msg, msg_size);
     if (st == CM_OK)
-        st = cm_cluster_attractors(m, c, g, NULL, out, msg, msg_size);
+        st = cm_cluster_attractors(m, cc, g, NULL, out, msg, msg_size);
     free(g);
     return st;
 }
@@ -208,31 +209,24 @@ static cm_status result_attractors_of(cm_result *res, const result_source *from,
                                       size_t msg_size)
 {
     const cm_model *m = res->model;
-    cm_status st = from->cluster ? cluster_attractors_of(m, from, &res->att, msg, msg_size)
-                                 : cm_region_attractors(m, &res->lat, &res->cells, from->max_steps,
-                                                        from->exits, res->groups, NULL, &res->att,
-                                                        msg, msg_size);
+    cm_exits x = {0}; /* a cluster's */
+    cm_cluster_cells cc = {from->cluster, &x};
+    cm_region_cells rc = {&res->cells, m, &res->lat, from->max_steps};
+    const cm_computed cells = from->cluster ? cm_cluster_computed(&cc) : cm_region_computed(&rc);
+    cm_status st = from->cluster ? cm_cluster_exits(from->cluster, &x, msg, msg_size) : CM_OK;
+    if (st == CM_OK)
+        st = from->cluster ? cluster_attractors_of(m, from, &cc, &res->att, msg, msg_size)
+                           : cm_region_attractors(m, &res->lat, &res->cells, from->max_steps,
+                                                  from->exits, res->groups, NULL, &res->att, msg,
+                                                  msg_size);
     res->att_labels = st == CM_OK ? malloc((res->cells.ncells + 1) * sizeof *res->att_labels)
                                   : NULL;
     if (st == CM_OK && !res->att_labels)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
-    if (st != CM_OK)
-        return st;
-    if (!from->cluster) {
-        cm_region_cells rc = {&res->cells, m, &res->lat, from->max_steps};
-        const cm_computed cells = cm_region_computed(&rc);
-        return cm_attractor_cell_labels(&res->att, &res->cells, &cells, res->att_labels, msg,
-                                        msg_size);
-    }
-    cm_exits x;
-    st = cm_cluster_exits(from->cluster, &x, msg, msg_size);
-    if (st == CM_OK) {
-        cm_cluster_cells cc = {from->cluster, &x};
-        const cm_computed cells = cm_cluster_computed(&cc);
+    if (st == CM_OK)
         st = cm_attractor_cell_labels(&res->att, &res->cells, &cells, res->att_labels, msg,
                                       msg_size);
-        cm_exits_free(&x);
-    }
+    cm_exits_free(&x);
     return st;
 }
 

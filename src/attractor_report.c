@@ -193,13 +193,6 @@ bool by_option_take(cli *c, int *by, int *error)
     return true;
 }
 
-cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
-                             uint32_t ngroups, const cm_attractor_options *o,
-                             cm_attractor_set *out, char *msg, size_t msg_size)
-{
-    (void)ngroups; /* the cluster's */
-    return cm_cluster_attractors(m, c, groups, o, out, msg, msg_size);
-}
 
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size)
 {
@@ -211,23 +204,24 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
 void cluster_ends_close(cluster_ends *e) { cm_exits_free(&e->exits); }
 
 cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
-                          cm_cluster *c, const cm_group_info *groups, uint32_t ngroups,
+                          cluster_ends *ends, const cm_group_info *groups,
                           const cm_attractor_options *o, cm_attractor_set *out, char *msg,
                           size_t msg_size)
 {
+    const cm_cluster *c = ends->cc.c;
     if (!o || !attractor_options_given(o)) {
         const cm_status st =
-            cm_store_get_attractors(s, c->lat.dim, ngroups, out, NULL, msg, msg_size);
+            cm_store_get_attractors(s, c->lat.dim, c->ngroups, out, NULL, msg, msg_size);
         if (st != CM_ENOTFOUND)
             return st;
     }
     if (m)
-        return cluster_attractors(m, c, groups, ngroups, o, out, msg, msg_size);
+        return cm_cluster_attractors(m, &ends->cc, groups, o, out, msg, msg_size);
     cm_model_set set = {0};
     cm_model own;
     cm_status st = model_of_store(info, &set, &own, msg, msg_size);
     if (st == CM_OK) {
-        st = cluster_attractors(&own, c, groups, ngroups, o, out, msg, msg_size);
+        st = cm_cluster_attractors(&own, &ends->cc, groups, o, out, msg, msg_size);
         cm_model_release(&own);
     }
     return st;

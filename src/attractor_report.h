@@ -60,26 +60,6 @@ bool attractor_options_given(const cm_attractor_options *o);
 enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
 bool by_option_take(cli *c, int *by, int *error);
 
-/* The attractors of a cluster's groups (groups[k]: group k + 1), the
- * cells' groups read from the cluster, its exits followed
- * (cm_cluster_attractors). */
-cm_status cluster_attractors(const cm_model *m, cm_cluster *c, const cm_group_info *groups,
-                             uint32_t ngroups, const cm_attractor_options *o,
-                             cm_attractor_set *out, char *msg, size_t msg_size);
-
-/* The attractors of a file's cluster: those it stores, unless o asks for
- * others (a field set) or it stores none; then found with the true map of
- * model m (NULL: the file's, rebuilt from info) and the cluster's cells
- * (cluster_attractors). */
-cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
-                          cm_cluster *c, const cm_group_info *groups, uint32_t ngroups,
-                          const cm_attractor_options *o, cm_attractor_set *out, char *msg,
-                          size_t msg_size);
-
-/* Group g's label by attractors: its attractor's id, or 0 when its orbit
- * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */
-uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);
-
 /* Where the sink cells of a cluster's views go (cellmap/outside.h): its
  * exits and the adapter over them; `computed` points into the struct, which
  * must stay where it is until cluster_ends_close. */
@@ -90,6 +70,21 @@ typedef struct cluster_ends {
 } cluster_ends;
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size);
 void cluster_ends_close(cluster_ends *e);
+
+/* The attractors of a file's cluster (ends: its exits, cluster_ends_open):
+ * those it stores, unless o asks for others (a field set) or it stores
+ * none; then found with the true map of model m (NULL: the file's, rebuilt
+ * from info), the cluster's cells and its exits (cm_cluster_attractors).
+ * groups[k]: group k + 1. */
+cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
+                          cluster_ends *ends, const cm_group_info *groups,
+                          const cm_attractor_options *o, cm_attractor_set *out, char *msg,
+                          size_t msg_size);
+
+/* Group g's label by attractors: its attractor's id, or 0 when its orbit
+ * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */
+uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);
+
 
 /* The groups as json_groups writes them, each with "attractor" (its id, or
  * null when its orbit diverges or is undecided). */

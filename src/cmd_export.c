@@ -494,7 +494,9 @@ static int export_groups(const char *path, const char *const *names, const cm_la
 
 /* Walks the window in slabs along the last dimension, reading regions
  * back as needed, and writes every computed cell to each output. */
-static cm_status export_slabs(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
+/* The rows of the window's cells, a slab at a time, each with its
+ * attractor (cm_attractor_cell_labels over att and the cluster's exits). */
+static cm_status export_cells(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
                               const cm_computed *computed, cell_out *outs, int nouts,
                               progress *pr, char *msg, size_t msg_size)
 {
@@ -541,20 +543,6 @@ static cm_status export_slabs(cm_cluster *c, const cm_box *window, const cm_attr
     return CM_OK;
 }
 
-/* The rows of the window's cells, a slab at a time, each with its
- * attractor (cm_attractor_cell_labels over att and the cluster's exits). */
-static cm_status export_cells(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
-                              cell_out *outs, int nouts, progress *pr, char *msg,
-                              size_t msg_size)
-{
-    cluster_ends ends;
-    cm_status st = cluster_ends_open(&ends, c, msg, msg_size);
-    if (st == CM_OK)
-        st = export_slabs(c, window, att, &ends.computed, outs, nouts, pr, msg, msg_size);
-    cluster_ends_close(&ends);
-    return st;
-}
-
 static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm_store_info *info,
                       cm_cluster *c)
 {
@@ -578,9 +566,12 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     int rc = EXIT_OK;
     cm_attractor_set att; /* the groups' attractors: stored, else found */
     memset(&att, 0, sizeof att);
-    if (file_attractors(s, info, NULL, c, g, info->groups, &a->att, &att, msg, sizeof msg) !=
-        CM_OK) { /* nothing is written without them */
+    cluster_ends ends; /* the cluster's exits, for the attractors and the cells' labels */
+    if (cluster_ends_open(&ends, c, msg, sizeof msg) != CM_OK ||
+        file_attractors(s, info, NULL, &ends, g, &a->att, &att, msg, sizeof msg) !=
+            CM_OK) { /* nothing is written without them */
         fprintf(stderr, "cellmap export: %s: %s\n", a->file, msg);
+        cluster_ends_close(&ends);
         cm_attractors_free(&att);
         free(g);
         return EXIT_FAIL;
@@ -616,7 +607,8 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
     interrupt_catch();
     cm_status st = CM_OK;
     if (ok && nouts)
-        ok = (st = export_cells(c, &window, &att, outs, nouts, &pr, msg, sizeof msg)) == CM_OK;
+        ok = (st = export_cells(c, &window, &att, &ends.computed, outs, nouts, &pr, msg,
+                                sizeof msg)) == CM_OK;
     progress_end(&pr);
     for (int k = 0; k < nouts; k++)
         ok = out_end(&outs[k], ok, msg, sizeof msg) && ok;
@@ -628,12 +620,6 @@ static int run_export(const cli *cl, const export_args *a, cm_store *s, const cm
                 (unsigned long long)outs[0].rows);
     }
     const bool by_attractors = a->labels && a->by == BY_ATTRACTORS;
-    cluster_ends ends;
-    memset(&ends, 0, sizeof ends);
-    if (rc == EXIT_OK && by_attractors && cluster_ends_open(&ends, c, msg, sizeof msg) != CM_OK) {
-        fprintf(stderr, "cellmap export: %s\n", msg);
-        rc = EXIT_FAIL;
-    }
     if (rc == EXIT_OK && (a->labels || a->steps)) {
         const array_export x = {a->labels, a->steps, a->file, info, g, info->groups, names,
                                 by_attractors ? &att : NULL, &ends.computed};

@@ -158,13 +158,12 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     interrupt_catch();
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
-    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
-        st = file_attractors(s, info, &m, cl, groups, cl->ngroups, &a->att, &att, msg,
-                             sizeof msg);
     cluster_ends ends;
     memset(&ends, 0, sizeof ends);
     if (st == CM_OK && a->png.by == BY_ATTRACTORS)
         st = cluster_ends_open(&ends, cl, msg, sizeof msg);
+    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
+        st = file_attractors(s, info, &m, &ends, groups, &a->att, &att, msg, sizeof msg);
     if (st == CM_OK)
         st = cm_cluster_flatten_progress(cl, &box, &flat, reading, &pr, msg, sizeof msg);
     progress_end(&pr);

@@ -250,6 +250,7 @@ typedef struct summary {
     cm_attractor_set att;    /* the attractors the groups' true orbits give */
     double att_seconds;
     cm_exits exits;          /* a single region's (cm_region_settle_exits) */
+    cluster_ends joined;     /* a cluster's exits, for its attractors and figure */
 } summary;
 
 /* A share of slow cells (cm_scm_slow_share) above which the summary says so. */
@@ -616,14 +617,8 @@ static cm_status draw_png(const solve_args *a, const cm_model *m, const cm_latti
     /* where the sink cells' sequences leave the cells drawn */
     cm_region_cells whole = {r, m, lat, a->max_steps};
     const cm_computed region = cm_region_computed(&whole);
-    cluster_ends joined;
-    memset(&joined, 0, sizeof joined);
-    cm_status st = r->group ? CM_OK : cluster_ends_open(&joined, &rn->c, msg, msg_size);
-    png.computed = r->group ? &region : &joined.computed;
-    if (st == CM_OK)
-        st = draw_cells(a, lat, rn, sum, r, &png, msg, msg_size);
-    cluster_ends_close(&joined);
-    return st;
+    png.computed = r->group ? &region : &sum->joined.computed;
+    return draw_cells(a, lat, rn, sum, r, &png, msg, msg_size);
 }
 
 
@@ -742,10 +737,13 @@ int cmd_solve(int argc, char **argv)
     const double ta = progress_now();
     a.att.threads = a.threads;
     /* the cells' groups: the region's, or the cluster's (resolved on the way) */
-    if ((r.group ? cm_region_attractors(&m, &lat, &r, a.max_steps, &sum.exits, sum.groups, &a.att,
-                                        &sum.att, msg, sizeof msg)
-                 : cm_cluster_attractors(&m, &rn.c, sum.groups, &a.att, &sum.att, msg,
-                                         sizeof msg)) != CM_OK)
+    cm_status found = r.group ? cm_region_attractors(&m, &lat, &r, a.max_steps, &sum.exits,
+                                                     sum.groups, &a.att, &sum.att, msg, sizeof msg)
+                              : cluster_ends_open(&sum.joined, &rn.c, msg, sizeof msg);
+    if (found == CM_OK && !r.group)
+        found = cm_cluster_attractors(&m, &sum.joined.cc, sum.groups, &a.att, &sum.att, msg,
+                                      sizeof msg);
+    if (found != CM_OK)
         goto fail;
     if (a.stage1) { /* its sink is Stage 1's: pending, not followed */
         sum.att.outside_steps = 0;
@@ -780,6 +778,7 @@ done:
     free(sum.groups);
     cm_attractors_free(&sum.att);
     cm_exits_free(&sum.exits);
+    cluster_ends_close(&sum.joined);
     cm_region_free(&r);
     cm_model_release(&m);
     return rc;

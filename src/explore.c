@@ -635,10 +635,9 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     cluster_ends ends;
     memset(&ends, 0, sizeof ends);
     if (st == CM_OK && po.by == BY_ATTRACTORS)
-        st = cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, &att, msg,
-                                msg_size);
-    if (st == CM_OK && po.by == BY_ATTRACTORS)
         st = cluster_ends_open(&ends, &s->c, msg, msg_size);
+    if (st == CM_OK && po.by == BY_ATTRACTORS)
+        st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, &att, msg, msg_size);
     if (st == CM_OK && !s->gl && !po.indexed && !svg)
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {&po,
@@ -722,11 +721,10 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
     cluster_ends ends;
     memset(&ends, 0, sizeof ends);
     int32_t *label = malloc((flat->ncells + 1) * sizeof *label);
-    cm_status st = label ? cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, att,
-                                              msg, msg_size)
+    cm_status st = label ? cluster_ends_open(&ends, &s->c, msg, msg_size)
                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
     if (st == CM_OK)
-        st = cluster_ends_open(&ends, &s->c, msg, msg_size);
+        st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, att, msg, msg_size);
     if (st == CM_OK)
         st = cm_attractor_cell_labels(att, flat, &ends.computed, label, msg, msg_size);
     *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
@@ -1302,12 +1300,16 @@ static cm_status save_attractors(session *s, char *msg, size_t msg_size)
     memset(&att, 0, sizeof att);
     cm_attractor_options used;
     cm_attractor_defaults(&s->model, NULL, &used);
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
     if (st == CM_OK)
-        st = cluster_attractors(&s->model, &s->c, groups, s->c.ngroups, NULL, &att, msg,
-                                msg_size);
+        st = cluster_ends_open(&ends, &s->c, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, &att, msg, msg_size);
     if (st == CM_OK)
         st = cm_store_put_attractors(s->store, &att, &used, dim, msg, msg_size);
     s->grew = st != CM_OK;
+    cluster_ends_close(&ends);
     cm_attractors_free(&att);
     free(groups);
     return st;
