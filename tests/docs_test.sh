@@ -11,35 +11,92 @@ BUILD=$(realpath "$3")
 HERE=$(cd "$(dirname "$0")" && pwd)
 . "$HERE/testlib.sh"
 enter_workdir
-mkdir bin && ln -s "$CM" bin/cellmap
-export PATH="$work/bin:$PATH"
 
-# --- the newcomer's path: the README's quick start and glossary -------------
-# Each ```sh block of "Quick start" and "Glossary" runs as written; the
-# ```text block after the first is what it must print, times aside.
-python3 - "$SRC/README.md" <<'PY' || fail "the README's quick start"
+# --- the newcomer's path: the README's two commands, quick start, glossary ---
+# The README's first command runs as written (copied from the README now),
+# in a fresh copy of the source tree (the files git tracks or would track,
+# no build), with a scratch HOME and PATH reset to the system's default.
+# Its install goes to a staging root (DESTDIR, cmake's own mechanism) so
+# that the test leaves the machine as it was; PATH is the default with
+# that root's /usr/local/bin in front, so `cellmap` is found exactly where
+# the install put it and nowhere in the build tree.
+newcomer=$(python3 - "$SRC/README.md" "$SRC/.ci/run" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+head = text[text.index("## A fresh machine in two commands"):]
+head = head[:head.index("\n## ", 1)]
+sh = [b for lang, b in re.findall(r"```(\w+)\n(.*?)```", head, re.S) if lang == "sh"]
+assert len(sh) == 2 and all(b.count("\n") == 1 for b in sh), "the README opens with two one-line commands: %r" % sh
+ci = [l.strip() for l in open(sys.argv[2]) if l.strip() and not l.lstrip().startswith(("#", "set ", "cd "))]
+assert ci == [sh[1].strip()], ".ci/run calls %r, the README's second command is %r" % (ci, sh[1].strip())
+print(sh[0].strip())
+PY
+) || fail "the README's two commands"
+mkdir fresh home stage
+python3 - "$SRC" fresh <<'PY' || fail "copy of the source tree"
+import os, shutil, subprocess, sys
+src, dst = sys.argv[1], sys.argv[2]
+try:
+    names = subprocess.run(["git", "-C", src, "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+                           capture_output=True, check=True).stdout.decode().split("\0")
+except (OSError, subprocess.CalledProcessError):   # not a git checkout: the tree without builds
+    names = [os.path.relpath(os.path.join(d, f), src) for d, ds, fs in os.walk(src)
+             for f in fs if not os.path.relpath(d, src).startswith(("build", ".git"))]
+for n in filter(None, names):
+    s = os.path.join(src, n)
+    if os.path.lexists(s):
+        os.makedirs(os.path.join(dst, os.path.dirname(n)), exist_ok=True)
+        shutil.copy2(s, os.path.join(dst, n), follow_symlinks=False)
+PY
+[ "$(id -u)" -eq 0 ] && key=ENV_SUPATH || key=ENV_PATH
+syspath=$(sed -n "s/^$key[[:space:]]*PATH=//p" /etc/login.defs 2>/dev/null)
+[ -n "$syspath" ] || syspath=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
+newpath="$work/stage/usr/local/bin:$syspath"
+( cd fresh && env -i HOME="$work/home" PATH="$newpath" DESTDIR="$work/stage" \
+    bash -c "$newcomer" > ../first.out 2> ../first.err ) || fail "the README's first command failed: $(tail -5 first.err)"
+[ -x stage/usr/local/bin/cellmap ] || fail "the README's first command installed no /usr/local/bin/cellmap"
+# the README shows basin.png as assets/examples/quick-start.png, which the
+# gallery script makes with the same solve
+cmp -s fresh/basin.png "$SRC/assets/examples/quick-start.png" \
+  || fail "the README's first command made no basin.png, or not the figure the README shows"
+[ "$(sqlite3 fresh/basin.cmdb 'SELECT SUM(cells) FROM regions' 2>&1)" = 1000000 ] \
+  || fail "the README's first command made no basin.cmdb of 1000000 cells"
+# What it printed after the build's lines is the README's block, times
+# aside; then the quick start's and the glossary's commands run in the
+# same tree with the same PATH.
+( cd fresh && env -i HOME="$work/home" PATH="$newpath" python3 - "$SRC/README.md" ../first.out <<'PY' ) || fail "the README's quick start"
 import re, subprocess, sys
 text = open(sys.argv[1]).read()
-quick = text[text.index("## Quick start"):text.index("## One vocabulary")]
-blocks = re.findall(r"```(\w+)\n(.*?)```", quick, re.S)
-assert [b[0] for b in blocks[:3]] == ["sh", "text", "sh"], [b[0] for b in blocks]
-def run(cmd):
-    return subprocess.run(cmd, shell=True, capture_output=True, text=True, check=True).stdout
+head = text[text.index("## A fresh machine in two commands"):]
+head = head[:head.index("\n## ", 1)]
+promised = re.findall(r"```text\n(.*?)```", head, re.S)[0]
 times = lambda s: re.sub(r"\d+\.\d+ (s|ns/cell)", "T", s)
-got, promised = run(blocks[0][1]), blocks[1][1]
-if times(got) != times(promised):
-    for a, b in zip(times(got).splitlines(), times(promised).splitlines()):
+lines = open(sys.argv[2]).read().splitlines()
+tail = "\n".join(lines[-len(promised.splitlines()):]) + "\n"
+if times(tail) != times(promised):
+    for a, b in zip(times(tail).splitlines(), times(promised).splitlines()):
         if a != b:
             print("printed:  " + a + "\npromised: " + b)
     sys.exit(1)
-for lang, cmd in blocks[2:]:          # the render and glossary commands
+first = re.findall(r"```sh\n(.*?)```", head, re.S)[0]
+quick = text[text.index("## Quick start"):text.index("## One vocabulary")]
+blocks = re.findall(r"```(\w+)\n(.*?)```", quick, re.S)
+assert blocks[0][0] == "sh" and first.strip().endswith("&& " + blocks[0][1].strip()), \
+    "the quick start's command %r is not the first command's last step" % blocks[0][1]
+def run(cmd):
+    return subprocess.run(cmd, shell=True, capture_output=True, text=True, check=True).stdout
+for lang, cmd in blocks[1:]:          # the render and glossary commands
     if lang == "sh":
         run(cmd)
 m = re.search(r"```sh\n\s*(sqlite3 basin\.cmdb .*?)\n\s*```\s*\n\s*prints `(\d+)`", text)
 assert m, "the glossary's count of single-cell groups"
 assert run(m.group(1)).strip() == m.group(2), run(m.group(1))
 PY
-[ -s basin.png ] && [ -s fig.png ] || fail "the quick start made no basin.png or fig.png"
+[ -s fresh/fig.png ] || fail "the quick start made no fig.png"
+cp fresh/basin.cmdb . 2> /dev/null || "$CM" solve --db basin.cmdb --quiet   # (for what follows)
+# from here on, the cellmap under test (the completion asks it too)
+mkdir bin && ln -s "$CM" bin/cellmap
+export PATH="$work/bin:$PATH"
 
 # --- every documented spelling of the vocabulary works ------------------------
 spell() { "$CM" "$@" > /dev/null 2>&1 || fail "documented spelling: cellmap $*"; }
