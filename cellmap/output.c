@@ -1,12 +1,15 @@
-#define _DEFAULT_SOURCE /* readlink, mkstemp */
+#define _DEFAULT_SOURCE /* readlink, mkstemp, flock */
 #include "cellmap/output.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -47,6 +50,119 @@ static cm_status follow_links(const char *path, char *out, char *msg, size_t msg
     return cm_fail(CM_EINVAL, msg, msg_size, "%s: too many levels of symlinks", path);
 }
 
+cm_status cm_output_fail(const char *path, int err, char *msg, size_t msg_size)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[CM_OUTPUT_PATH_MAX];
+    if (!slash)
+        snprintf(dir, sizeof dir, "the current directory");
+    else
+        snprintf(dir, sizeof dir, "the directory %.*s", slash == path ? 1 : (int)(slash - path),
+                 path);
+    switch (err) {
+    case ENOENT:
+    case ENOTDIR:
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "cannot write %s: %s does not exist (%s); create it or give a path in an "
+                       "existing directory",
+                       path, dir, strerror(err));
+    case EACCES:
+    case EPERM:
+    case EROFS:
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "cannot write %s: %s is not writable (%s); give a path in a writable "
+                       "directory",
+                       path, dir, strerror(err));
+    case ENOSPC:
+    case EDQUOT:
+    case EFBIG:
+        return cm_fail(CM_EIO, msg, msg_size,
+                       "cannot write %s: %s; free space on its disk (or raise the quota) or give "
+                       "a path on another disk",
+                       path, strerror(err));
+    default:
+        return cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", path,
+                       strerror(err ? err : EIO));
+    }
+}
+
+/* Whether process pid may still be running on this machine. */
+static bool process_runs(long pid)
+{
+    return pid > 0 && pid <= INT_MAX && (kill((pid_t)pid, 0) == 0 || errno == EPERM);
+}
+
+/* Whether the file name in dir may be removed as a killed run's: it does
+ * not exist, or it is a regular file of ours that no process holds locked. */
+static bool stale_file(int dir, const char *name)
+{
+    struct stat sb;
+    if (fstatat(dir, name, &sb, AT_SYMLINK_NOFOLLOW) != 0)
+        return errno == ENOENT; /* nothing to keep */
+    if (!S_ISREG(sb.st_mode) || sb.st_uid != geteuid())
+        return false;
+    const int fd = openat(dir, name, O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0)
+        return false;
+    const bool unlocked = flock(fd, LOCK_EX | LOCK_NB) == 0;
+    close(fd);
+    return unlocked;
+}
+
+/* Removes the temporary files base.tmp-N[-wal|-shm|-journal] in dir of
+ * killed runs: N no longer runs here and nobody holds base.tmp-N's lock. */
+static void remove_stale_temps(const char *dest)
+{
+    const char *slash = strrchr(dest, '/');
+    char dirname[CM_OUTPUT_PATH_MAX], prefix[CM_OUTPUT_PATH_MAX];
+    snprintf(dirname, sizeof dirname, "%.*s", slash ? (int)(slash - dest) + (slash == dest) : 1,
+             slash ? dest : ".");
+    snprintf(prefix, sizeof prefix, "%s.tmp-", slash ? slash + 1 : dest);
+    const size_t np = strlen(prefix);
+    DIR *d = opendir(dirname);
+    if (!d)
+        return;
+    const struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (strncmp(e->d_name, prefix, np) != 0)
+            continue;
+        char *end;
+        errno = 0;
+        const long pid = strtol(e->d_name + np, &end, 10);
+        if (end == e->d_name + np || errno || pid == (long)getpid() || process_runs(pid))
+            continue;
+        if (*end && strcmp(end, "-wal") != 0 && strcmp(end, "-shm") != 0 &&
+            strcmp(end, "-journal") != 0)
+            continue;
+        char main_file[CM_OUTPUT_PATH_MAX];
+        snprintf(main_file, sizeof main_file, "%.*s", (int)(end - e->d_name), e->d_name);
+        if (stale_file(dirfd(d), main_file) && stale_file(dirfd(d), e->d_name))
+            unlinkat(dirfd(d), e->d_name, 0);
+    }
+    closedir(d);
+}
+
+/* Creates o->tmp beside the destination, empty and locked. */
+static cm_status create_locked_temp(cm_output *o, char *msg, size_t msg_size)
+{
+    remove_stale_temps(o->dest);
+    unlink(o->tmp); /* left by a killed run of a process with our id */
+    const int fd = open(o->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        const int e = errno;
+        o->tmp[0] = '\0';
+        return cm_output_fail(o->path, e, msg, msg_size);
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) { /* a new file: only a file system without locks */
+        close(fd);
+        o->lock_fd = -1;
+        return CM_OK;
+    }
+    o->lock_fd = fd;
+    o->locked = true;
+    return CM_OK;
+}
+
 /* A temporary file in $TMPDIR (or /tmp) for an output copied in place. */
 static cm_status make_temp(cm_output *o, char *msg, size_t msg_size)
 {
@@ -70,6 +186,7 @@ cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, ch
 {
     memset(o, 0, sizeof *o);
     o->path = path;
+    o->lock_fd = -1;
     if (!path || !*path)
         return cm_fail(CM_EINVAL, msg, msg_size, "an output file name is empty");
     if (strlen(path) + 32 >= CM_OUTPUT_PATH_MAX)
@@ -105,8 +222,7 @@ cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, ch
     if (strlen(o->dest) + 32 >= sizeof o->tmp)
         return cm_fail(CM_EINVAL, msg, msg_size, "the output path of %.64s... is too long", path);
     snprintf(o->tmp, sizeof o->tmp, "%.4150s.tmp-%ld", o->dest, (long)getpid());
-    unlink(o->tmp); /* left by a killed run of a process with our id */
-    return CM_OK;
+    return create_locked_temp(o, msg, msg_size);
 }
 
 /* Copies the temporary file into the open destination f. */
@@ -127,7 +243,7 @@ static cm_status copy_into(const cm_output *o, FILE *f, char *msg, size_t msg_si
     if (!error && fflush(f) != 0)
         error = errno ? errno : EIO;
     if (error)
-        return cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->dest, strerror(error));
+        return cm_output_fail(o->to_stdout ? "standard output" : o->path, error, msg, msg_size);
     return CM_OK;
 }
 
@@ -137,8 +253,7 @@ cm_status cm_output_close_stream(const cm_output *o, FILE *f, char *msg, size_t 
     int error = fflush(f) != 0 || ferror(f) ? (errno ? errno : EIO) : 0;
     if (fclose(f) != 0 && !error)
         error = errno ? errno : EIO;
-    return error ? cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->path, strerror(error))
-                 : CM_OK;
+    return error ? cm_output_fail(o->path, error, msg, msg_size) : CM_OK;
 }
 
 cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size)
@@ -146,8 +261,7 @@ cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size)
     cm_status st = CM_OK;
     if (!o->in_place) {
         if (rename(o->tmp, o->dest) != 0)
-            st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s: %s", o->tmp, o->dest,
-                         strerror(errno));
+            st = cm_output_fail(o->path, errno, msg, msg_size);
     } else if (o->to_stdout) {
         errno = 0;
         st = copy_into(o, stdout, msg, msg_size);
@@ -156,15 +270,14 @@ cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size)
         const int fd = open(o->dest, O_WRONLY | O_TRUNC);
         FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
         if (!f) {
-            st = cm_fail(CM_EIO, msg, msg_size, "cannot open %s: %s", o->dest, strerror(errno));
+            st = cm_output_fail(o->path, errno, msg, msg_size);
             if (fd >= 0)
                 close(fd);
         } else {
             errno = 0;
             st = copy_into(o, f, msg, msg_size);
             if (fclose(f) != 0 && st == CM_OK)
-                st = cm_fail(CM_EIO, msg, msg_size, "cannot write %s: %s", o->dest,
-                             strerror(errno));
+                st = cm_output_fail(o->path, errno, msg, msg_size);
         }
     }
     cm_output_abandon(o);
@@ -177,6 +290,18 @@ void cm_output_abandon(cm_output *o)
         unlink(o->tmp);
         o->tmp[0] = '\0';
     }
+    const int fd = o ? cm_output_release(o) : -1;
+    if (fd >= 0)
+        close(fd);
+}
+
+int cm_output_release(cm_output *o)
+{
+    const int fd = o->locked ? o->lock_fd : -1;
+    o->locked = false;
+    o->lock_fd = -1;
+    o->tmp[0] = '\0';
+    return fd;
 }
 
 /* Where a file of a command lives: its device and inode when it exists,

@@ -14,7 +14,14 @@
  *   - a directory: refused.
  * Writers write cm_output.tmp however they like (stdio, libpng, SQLite).
  * Failed writes (a full disk, a full device, a closed pipe) are reported
- * with their reason. */
+ * with the user's path, their reason and the fix.
+ *
+ * Killed runs: PATH.tmp-PID is created by cm_output_begin and locked
+ * (flock) for as long as it is written. cm_output_begin removes the
+ * PATH.tmp-N files of earlier runs (and their SQLite -wal, -shm and
+ * -journal files) that are stale: owned by this user, of a process N that
+ * no longer runs on this machine, and not locked by any process (a writer
+ * on another machine of a network file system keeps its lock). */
 #ifndef CM_OUTPUT_H
 #define CM_OUTPUT_H
 
@@ -33,17 +40,29 @@ typedef struct cm_output {
     char tmp[CM_OUTPUT_PATH_MAX];  /* the file the writer writes */
     bool in_place;                 /* copied into dest (stdout, device, FIFO, socket) */
     bool to_stdout;
+    bool locked;                   /* lock_fd holds tmp's lock */
+    int lock_fd;
 } cm_output;
 
 /* Whether path (NULL: none) names standard output: "-", /dev/stdout, /dev/fd/1 or
  * /proc/self/fd/1 (commands then print their reports to stderr). */
 bool cm_output_names_stdout(const char *path);
 
-/* Checks path and prepares o (no file is created yet: the writer creates
- * o->tmp). needs_regular: the output must be a regular file (e.g. an
- * SQLite database), so stdout and devices are refused. */
+/* Checks path and prepares o: o->tmp is created empty (the writer opens
+ * it again, truncating it, or lets SQLite take the empty file), so a
+ * missing or read-only directory is found here, before any work.
+ * needs_regular: the output must be a regular file (e.g. an SQLite
+ * database), so stdout and devices are refused. CM_EINVAL for what the
+ * user can fix in the path (the message says how), CM_EIO otherwise. On
+ * failure nothing is left to abandon. */
 cm_status cm_output_begin(cm_output *o, const char *path, bool needs_regular, char *msg,
                           size_t msg_size);
+
+/* Why `path` (as the user gave it) cannot be written, errno err: the
+ * reason and the fix (a missing or read-only directory, a full disk).
+ * Returns CM_EINVAL when the path is the problem (missing directory, no
+ * permission, read-only file system), CM_EIO otherwise. */
+cm_status cm_output_fail(const char *path, int err, char *msg, size_t msg_size);
 
 /* Flushes and closes f, the writer's stream on o->tmp: CM_EIO naming
  * o->path and the reason if a write failed (a full disk, a full device). */
@@ -54,6 +73,12 @@ cm_status cm_output_commit(cm_output *o, char *msg, size_t msg_size);
 
 /* Removes the temporary file (after a failure; NULL-safe). */
 void cm_output_abandon(cm_output *o);
+
+/* For a writer that moves or keeps o->tmp itself (a database being
+ * replaced keeps it until it is complete): o forgets the file without
+ * removing it; returns the descriptor holding its lock (-1: none), the
+ * caller's to close when the file is in place or removed. */
+int cm_output_release(cm_output *o);
 
 /* One file a command reads or writes, for cm_files_apart. */
 typedef struct cm_file_use {

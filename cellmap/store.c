@@ -79,6 +79,18 @@ void cm_params_json(const cm_params *p, char *buf, size_t size)
 
 cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_size)
 {
+    const int code = db ? sqlite3_errcode(db) & 0xff : SQLITE_OK;
+    if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY ||
+        code == SQLITE_CANTOPEN) {
+        /* the file system's reason, with the file and the fix */
+        int err = sqlite3_system_errno(db);
+        if (!err)
+            err = code == SQLITE_FULL ? ENOSPC : code == SQLITE_READONLY ? EROFS : EIO;
+        const char *file = sqlite3_db_filename(db, "main");
+        char why[CM_OUTPUT_PATH_MAX + 256];
+        cm_output_fail(file && *file ? file : "the database", err, why, sizeof why);
+        return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, why);
+    }
     return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, db ? sqlite3_errmsg(db) : "no database");
 }
 
@@ -266,7 +278,9 @@ static cm_status check_header(const char *path, char *msg, size_t msg_size)
     unsigned char h[100];
     FILE *f = fopen(path, "rb");
     if (!f)
-        return cm_fail(CM_EIO, msg, msg_size, "%s does not exist or cannot be read", path);
+        return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                       "%s does not exist or cannot be read (%s); give the path of a .cmdb file",
+                       path, strerror(errno));
     const size_t n = fread(h, 1, sizeof h, f);
     fclose(f);
     if (n < sizeof h || memcmp(h, "SQLite format 3", 16) != 0)
@@ -316,6 +330,15 @@ cm_status store_open_checked(const char *path, int full, int writable, int old, 
     }
     *out = db;
     return CM_OK;
+}
+
+cm_status cm_store_probe(const char *path, char *msg, size_t msg_size)
+{
+    struct stat sb;
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                       "%s is a directory; give the path of a .cmdb file", path);
+    return check_header(path, msg, msg_size);
 }
 
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size)
@@ -463,7 +486,7 @@ static void remove_side_files(const char *path)
 {
     char side[CM_OUTPUT_PATH_MAX + 16];
     const char *suffixes[] = {"-wal", "-shm", "-journal"};
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3 && path[0]; k++) {
         snprintf(side, sizeof side, "%s%s", path, suffixes[k]);
         unlink(side);
     }
@@ -473,8 +496,7 @@ static void remove_side_files(const char *path)
 static cm_status write_empty(const char *path, const cm_store_meta *meta, char *msg,
                              size_t msg_size)
 {
-    sqlite3 *db = NULL;
-    unlink(path);
+    sqlite3 *db = NULL; /* path is cm_output's new empty (and locked) file */
     cm_status st = open_db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, &db, msg, msg_size);
     if (st != CM_OK)
         return st;
@@ -516,15 +538,23 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         st = write_empty(o.tmp, meta, msg, msg_size);
     }
     if (st == CM_OK && !replacing && rename(o.tmp, o.dest) != 0)
-        st = cm_fail(CM_EIO, msg, msg_size, "cannot rename %s to %s: %s", o.tmp, o.dest,
-                     strerror(errno));
+        st = cm_output_fail(path, errno, msg, msg_size);
+    /* the store's own lock (cm_store_open) marks the file as being written
+     * from here on; o's is let go, as both cannot be held */
+    char tmp[CM_OUTPUT_PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", o.tmp);
+    if (st == CM_OK) {
+        const int fd = cm_output_release(&o);
+        if (fd >= 0)
+            close(fd);
+    }
     if (st == CM_OK)
-        st = cm_store_open(replacing ? o.tmp : o.dest, 1, out, msg, msg_size);
+        st = cm_store_open(replacing ? tmp : o.dest, 1, out, msg, msg_size);
     if (st == CM_OK && replacing) {
         (*out)->replaces_lock_fd = old_lock;
         old_lock = -1;
         (*out)->replaces = strdup(o.dest);
-        (*out)->tmp_path = strdup(o.tmp);
+        (*out)->tmp_path = strdup(tmp);
         free((*out)->path);
         (*out)->path = strdup(path);
         if (!(*out)->replaces || !(*out)->tmp_path || !(*out)->path)
@@ -533,8 +563,10 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
     if (st != CM_OK) {
         cm_store_close(*out, NULL, 0);
         *out = NULL;
-        cm_output_abandon(&o);
-        remove_side_files(o.tmp);
+        cm_output_abandon(&o); /* o's file, if o still has it */
+        if (replacing && tmp[0])
+            unlink(tmp);
+        remove_side_files(tmp);
     }
     if (old_lock >= 0)
         close(old_lock);

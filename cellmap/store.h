@@ -142,6 +142,13 @@ bool cm_store_replacing(const cm_store *s);
 /* Checks that path is a cellmap database this version can read. */
 cm_status cm_store_check(const char *path, char *msg, size_t msg_size);
 
+/* The quick check of a file the user names as a database, before any
+ * work: by its header alone (nothing is opened through SQLite), whether
+ * it exists and is readable (else CM_ENOTFOUND, with the reason) and is a
+ * cellmap database of a version this cellmap reads (else CM_EFORMAT). Its
+ * contents (damage) are checked when it is opened. */
+cm_status cm_store_probe(const char *path, char *msg, size_t msg_size);
+
 cm_status cm_store_read_info(cm_store *s, cm_store_info *info, char *msg, size_t msg_size);
 
 void cm_store_get_stats(const cm_store *s, cm_store_stats *stats);

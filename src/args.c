@@ -22,6 +22,13 @@ int cli_usage_error(const cli *c, const char *fmt, ...)
     return EXIT_USAGE;
 }
 
+int cli_stray(const cli *c)
+{
+    if (c->opt[0] == '-' && c->opt[1])
+        return cli_usage_error(c, "unknown option '%s'", c->opt);
+    return cli_usage_error(c, "unexpected argument '%s'", c->opt);
+}
+
 bool cli_next(cli *c)
 {
     c->i++;

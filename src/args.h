@@ -27,6 +27,10 @@ typedef struct cli {
 
 /* Prints the usage error and returns EXIT_USAGE. */
 int cli_usage_error(const cli *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The one wording for an argument no rule of the command takes: "unknown
+ * option '--x'" for what starts with '-', "unexpected argument 'x'" for
+ * anything else (a second file name, a stray word). Returns EXIT_USAGE. */
+int cli_stray(const cli *c);
 
 /* Advances to the next argument. Returns false at the end. */
 bool cli_next(cli *c);

@@ -471,8 +471,10 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
                     const cm_lattice *lat, const cm_box *box)
 {
     char msg[512];
-    if (!outfile_check(cmd, po->path) || !outfile_check(cmd, po->svg))
-        return EXIT_FAIL;
+    const char *const outs[] = {po->path, po->svg};
+    const int rc = outfiles_check(cmd, outs, 2);
+    if (rc != EXIT_OK)
+        return rc;
     cm_status st = CM_OK;
     if (!po->indexed) {
         cm_render_options ro;

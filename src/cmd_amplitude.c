@@ -80,7 +80,7 @@ static int parse_args(cli *c, amp_args *a)
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->has_omega)
@@ -203,8 +203,9 @@ int cmd_amplitude(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);
     if (verr)

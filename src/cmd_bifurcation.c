@@ -92,7 +92,7 @@ static int parse_args(cli *c, bif_args *a)
             a->runs_csv = c->value;
         } else if (chart_outputs_take(c, &a->out, 300, 450, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->has_sweep)
@@ -421,8 +421,11 @@ int cmd_bifurcation(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out) || !outfile_check("bifurcation", a.runs_csv))
-        return EXIT_FAIL;
+    int werr = chart_outputs_writable(&c, &a.out);
+    if (werr == EXIT_OK)
+        werr = outfile_check("bifurcation", a.runs_csv, false);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.sweep, 1, &base);
     if (verr)

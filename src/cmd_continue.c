@@ -212,7 +212,7 @@ static int parse_args(cli *c, cont_args *a)
         } else if (cli_is(c, "--quiet", false, &err)) {
             a->quiet = true;
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->has_vary)
@@ -766,9 +766,12 @@ int cmd_continue(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("continue", a.csv) || !outfile_check("continue", a.events) ||
-        !chart_png_check("continue", a.png))
-        return EXIT_FAIL;
+    const char *const outs[] = {a.csv, a.events};
+    int werr = outfiles_check("continue", outs, 2);
+    if (werr == EXIT_OK)
+        werr = chart_png_check("continue", a.png);
+    if (werr != EXIT_OK)
+        return werr;
     cm_model m;
     const int merr = model_opts_build(&c, &a.mo, &m);
     if (merr)

@@ -116,7 +116,7 @@ static int parse_args(cli *c, esc_args *a)
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && a->has_sweep && strcmp(a->sweep.name, "I0") == 0 && a->has_I0)
@@ -402,8 +402,9 @@ int cmd_escape(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     param_axis none = {0};
     const bool sweeps_param = a.has_sweep && strcmp(a.sweep.name, "I0") != 0;

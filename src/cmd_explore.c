@@ -6,11 +6,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/explore.h"
+#include "models/registry.h"
 
 static const char explore_help_head[] =
     "usage: cellmap explore FILE.cmdb [SCRIPT|-] [--threads T] [--mem BYTES]\n"
@@ -26,7 +28,11 @@ static const char explore_help_head[] =
     "with its model, lattice and last view. Commands come from SCRIPT, from\n"
     "stdin (- or no SCRIPT), or from a prompt when stdin is a terminal. In a\n"
     "script, a bad line stops the session with exit status 1 after saving all\n"
-    "done so far; at the prompt the session goes on.\n\n"
+    "done so far; at the prompt the session goes on. A script file's run is\n"
+    "journaled in FILE: the same script run again after a kill (or a failed\n"
+    "line) resumes that run, so its `extend auto` steps are not repeated and the\n"
+    "file ends as one run would have left it; after the script's end, a run of\n"
+    "it is a new run.\n\n"
     "  --depth LO:HI,...  models of more than two dimensions: the ranges of\n"
     "                     dimensions 3.. that every view computes (default: the\n"
     "                     model's example region)\n"
@@ -67,7 +73,7 @@ static int parse_explore(cli *c, explore_args *a)
         } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !a->script) {
             a->script = c->opt;
         } else {
-            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !o->path)
@@ -82,6 +88,7 @@ static int run_script(session *s, FILE *f, const char *name)
 {
     char line[8192], msg[1024];
     for (long lineno = 1; !s->quit && fgets(line, sizeof line, f); lineno++) {
+        s->line = lineno;
         if (!strchr(line, '\n') && !feof(f)) {
             fprintf(stderr, "%s:%ld: the line is longer than %zu characters\n", name, lineno,
                     sizeof line - 2);
@@ -117,12 +124,37 @@ static int run_prompt(session *s)
     return EXIT_OK;
 }
 
+/* A script file's run, journaled in the file (session_journal_begin): a
+ * run of the same script that was killed is resumed without repeating
+ * its extensions. A pipe is not journaled (it cannot be read twice). */
+static int run_journaled(session *s, const char *script, FILE *f)
+{
+    char hash[24], msg[1024];
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode))
+        return run_script(s, f, script);
+    cm_status st = cm_file_hash(script, hash, msg, sizeof msg);
+    const uint64_t h = strtoull(hash, NULL, 16);
+    if (st == CM_OK)
+        st = session_journal_begin(s, h ? h : 1, msg, sizeof msg);
+    if (st != CM_OK) {
+        fprintf(stderr, "cellmap explore: %s\n", msg);
+        return EXIT_FAIL;
+    }
+    int rc = run_script(s, f, script);
+    if (rc == EXIT_OK && session_journal_end(s, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap explore: %s\n", msg);
+        rc = EXIT_FAIL;
+    }
+    return rc;
+}
+
 /* The session's input: the script file (opened before the session, so
  * that a missing one makes no file), standard input or the prompt. */
 static int run_input(session *s, const char *script, FILE *f)
 {
     if (f)
-        return run_script(s, f, script);
+        return run_journaled(s, script, f);
     if (!script && isatty(STDIN_FILENO))
         return run_prompt(s);
     return run_script(s, stdin, "stdin");
@@ -144,6 +176,16 @@ int cmd_explore(int argc, char **argv)
     if (a.script && strcmp(a.script, "-") != 0 && !(f = fopen(a.script, "r"))) {
         fprintf(stderr, "cellmap explore: cannot open the script %s: %s (check the path)\n",
                 a.script, strerror(errno));
+        return EXIT_USAGE;
+    }
+    /* a script is a file or a pipe (as <(...) gives); not a directory or a device */
+    struct stat sb;
+    if (f && fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode) && !S_ISFIFO(sb.st_mode) &&
+        !S_ISSOCK(sb.st_mode)) {
+        fprintf(stderr, "cellmap explore: the script %s is %s; give a file of explore commands "
+                        "(or - for standard input)\n",
+                a.script, S_ISDIR(sb.st_mode) ? "a directory" : "a device");
+        fclose(f);
         return EXIT_USAGE;
     }
     session s;

@@ -143,7 +143,7 @@ static int parse_export(cli *c, export_args *a)
         } else if (c->opt[0] != '-' && !a->file) {
             a->file = c->opt;
         } else {
-            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->file)
@@ -420,6 +420,20 @@ static int sqlite_indexes(cell_out *o)
     return sqlite3_exec(o->db, sql, NULL, NULL, NULL) == SQLITE_OK;
 }
 
+/* Why a write to o failed (err: errno of a stream's write): the file
+ * system's reason, which SQLite keeps too (but for a full disk, which it
+ * reports as SQLITE_FULL alone), with the fix, else SQLite's message. */
+static void out_failed(const cell_out *o, int err, char *msg, size_t msg_size)
+{
+    const int sys = !o->db                                         ? err
+                    : (sqlite3_errcode(o->db) & 0xff) == SQLITE_FULL ? ENOSPC
+                                                                   : sqlite3_system_errno(o->db);
+    if (sys || !o->db)
+        cm_output_fail(o->path, sys ? sys : EIO, msg, msg_size);
+    else
+        snprintf(msg, msg_size, "cannot write %s: %s", o->path, sqlite3_errmsg(o->db));
+}
+
 static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
 {
     const int was_ok = ok;
@@ -440,7 +454,7 @@ static int out_end(cell_out *o, int ok, char *msg, size_t msg_size)
         if (ok && !sqlite_indexes(o))
             ok = 0, snprintf(msg, msg_size, "cannot index %s: %s", o->path, sqlite3_errmsg(o->db));
         if (ok && sqlite3_exec(o->db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
-            ok = 0, snprintf(msg, msg_size, "cannot write %s: %s", o->path, sqlite3_errmsg(o->db));
+            ok = 0, out_failed(o, 0, msg, msg_size);
         ok = (sqlite3_close(o->db) == SQLITE_OK) && ok;
         o->db = NULL;
     }
@@ -526,9 +540,10 @@ static cm_status export_cells(cm_cluster *c, const cm_box *window, const cm_attr
             cm_lattice_centre(&c->lat, cell, x);
             for (int k = 0; k < nouts && st == CM_OK; k++)
                 if (!out_row(&outs[k], dim, cell, x, flat.group[i], flat.step[i],
-                             cm_is_periodic(&flat, i), label[i]))
-                    st = cm_fail(CM_EIO, msg, msg_size, "cannot write %.900s: %s", outs[k].path,
-                                 outs[k].db ? sqlite3_errmsg(outs[k].db) : strerror(errno));
+                             cm_is_periodic(&flat, i), label[i])) {
+                    out_failed(&outs[k], errno, msg, msg_size);
+                    st = CM_EIO;
+                }
         }
         done += flat.ncells;
         free(label);
@@ -685,10 +700,12 @@ int cmd_export(int argc, char **argv)
     const int rc = parse_export(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
-    if (!outfile_check("export", a.groups) || !outfile_check("export", a.cells) ||
-        !outfile_check("export", a.flat) || !outfile_check("export", a.labels) ||
-        !outfile_check("export", a.steps))
-        return EXIT_FAIL;
+    const char *const outs[] = {a.groups, a.cells, a.flat, a.labels, a.steps};
+    int werr = project_input_check("export", a.file);
+    if (werr == EXIT_OK)
+        werr = outfiles_check("export", outs, 5);
+    if (werr != EXIT_OK)
+        return werr;
     if (a.groups && !a.cells && !a.flat && !a.labels && !a.steps && !a.window) {
         const int only = export_groups_only(&a);
         if (only != NEEDS_CLUSTER)

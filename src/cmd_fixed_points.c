@@ -58,7 +58,7 @@ static int parse_args(cli *c, fp_args *a)
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && a->json && a->csv)
@@ -124,8 +124,9 @@ int cmd_fixed_points(int argc, char **argv)
     int err = parse_args(&c, &a);
     if (err)
         return err < 0 ? EXIT_OK : err;
-    if (!outfile_check("fixed-points", a.csv))
-        return EXIT_FAIL;
+    const int werr = outfile_check("fixed-points", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
     cm_model m;
     if ((err = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
         return err;

@@ -86,7 +86,7 @@ static int parse_args(cli *c, hs_args *a)
             a->has_sweep = 1;
         } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err)
@@ -341,8 +341,9 @@ int cmd_horseshoe(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     const int verr =
         sweep_check(&c, &a.mo, "microchaos-pd", a.has_sweep ? &a.sweep : NULL, a.has_sweep, &base);

@@ -138,13 +138,15 @@ int cmd_info(int argc, char **argv)
         } else if (c.opt[0] != '-' && !path) {
             path = c.opt;
         } else {
-            err = cli_usage_error(&c, "unexpected argument '%s'", c.opt);
+            err = cli_stray(&c);
         }
     }
     if (err)
         return err;
     if (!path)
         return cli_usage_error(&c, "which file? usage: cellmap info FILE.cmdb");
+    if ((err = project_input_check("info", path)) != EXIT_OK)
+        return err;
     cm_store *s = NULL;
     cm_store_info info;
     cm_region *regions = NULL;

@@ -112,7 +112,7 @@ static int parse_args(cli *c, lyap_args *a)
             a->quiet = true;
         } else if (cli_take_size(c, 200, 150, 4096, &a->width, &a->height, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->has_grid)
@@ -173,20 +173,24 @@ typedef struct overlay {
     int n_labels;
 } overlay;
 
-/* Appends the curves of one file to ov; false, with the problem said, if
- * the file does not fit. */
-static bool read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap)
+/* Appends the curves of one file to ov: EXIT_OK, or the problem said and
+ * EXIT_USAGE (the file is not one of curves in the grid's parameters) or
+ * EXIT_FAIL (out of memory). */
+static int read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap)
 {
-    FILE *f = fopen(path, "r");
-    char line[512], n1[64] = "", n2[64] = "";
-    if (!f || !fgets(line, sizeof line, f) ||
+    FILE *f = NULL;
+    char line[512], n1[64] = "", n2[64] = "", msg[CM_OUTPUT_PATH_MAX + 256];
+    if (cm_input_open(path, "--curves file", UINT64_C(64) << 20, &f, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap lyapunov: %s (make it with cellmap continue --curves)\n", msg);
+        return EXIT_USAGE;
+    }
+    if (!fgets(line, sizeof line, f) ||
         sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
-        fprintf(stderr, "cellmap lyapunov: --curves %s: %s (make it with cellmap continue "
-                        "--curves)\n",
-                path, f ? "not a file of curve,label,P,P2,x,v lines" : strerror(errno));
-        if (f)
-            fclose(f);
-        return false;
+        fprintf(stderr, "cellmap lyapunov: --curves %s: not a file of curve,label,P,P2,x,v lines "
+                        "(make it with cellmap continue --curves)\n",
+                path);
+        fclose(f);
+        return EXIT_USAGE;
     }
     const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
     const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
@@ -194,7 +198,7 @@ static bool read_curve_file(const lyap_args *a, const char *path, overlay *ov, s
         fprintf(stderr, "cellmap lyapunov: --curves %s is in (%s, %s), the grid in (%s, %s)\n",
                 path, n1, n2, a->ax[0].name, a->ax[1].name);
         fclose(f);
-        return false;
+        return EXIT_USAGE;
     }
     int last = -1;
     bool ok = true;
@@ -233,31 +237,33 @@ static bool read_curve_file(const lyap_args *a, const char *path, overlay *ov, s
     fclose(f);
     if (!ok)
         fprintf(stderr, "cellmap lyapunov: out of memory for the curves\n");
-    return ok;
+    return ok ? EXIT_OK : EXIT_FAIL;
 }
 
-static bool read_curves(const lyap_args *a, overlay *ov)
+/* Every --curves file, read before the grid is computed (ov is the
+ * caller's to free with overlay_free, whatever the result). */
+static int read_curves(const lyap_args *a, overlay *ov)
 {
     size_t cap = 0;
-    memset(ov, 0, sizeof *ov);
-    for (int k = 0; k < a->n_curves; k++)
-        if (!read_curve_file(a, a->curves[k], ov, &cap))
-            return false;
-    return true;
+    int rc = EXIT_OK;
+    for (int k = 0; k < a->n_curves && rc == EXIT_OK; k++)
+        rc = read_curve_file(a, a->curves[k], ov, &cap);
+    return rc;
 }
 
-static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v)
+static void overlay_free(overlay *ov)
 {
-    overlay ov = {0};
-    if (a->n_curves && !read_curves(a, &ov)) {
-        free(ov.x);
-        free(ov.y);
-        return false;
-    }
+    free(ov->x);
+    free(ov->y);
+}
+
+static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
+                      overlay *ov)
+{
     /* both ways of a curve, and curves of one point, start at one place */
-    cm_chart_join_labels(ov.labels, ov.n_labels, ov.texts[0], sizeof ov.texts[0],
+    cm_chart_join_labels(ov->labels, ov->n_labels, ov->texts[0], sizeof ov->texts[0],
                          0.05 * (a->ax[0].hi - a->ax[0].lo), 0.03 * (a->ax[1].hi - a->ax[1].lo));
-    const cm_series curves = {CM_SERIES_LINE, ov.x, ov.y, ov.n, (cm_rgb){0, 0, 0}, 2};
+    const cm_series curves = {CM_SERIES_LINE, ov->x, ov->y, ov->n, (cm_rgb){0, 0, 0}, 2};
     char title[512], params[400], grid[200];
     const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
     cm_params_format_with(p, swept, params, sizeof params);
@@ -274,11 +280,11 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                             title,
                             &heat,
                             &curves,
-                            ov.n > 0,
+                            ov->n > 0,
                             figure_font(),
                             0,
-                            ov.labels,
-                            ov.n_labels};
+                            ov->labels,
+                            ov->n_labels};
     char periods[32];
     snprintf(periods, sizeof periods, "%d", a->periods);
     const bool fo = strcmp(model, "friction-oscillator") == 0;
@@ -288,10 +294,7 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
                                  {"Periods", periods},
                                  {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
                                                   : "docs/models.md 11.3 (finite differences on the map)"}};
-    const bool ok = write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
-    free(ov.x);
-    free(ov.y);
-    return ok;
+    return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 
 typedef struct summary {
@@ -375,8 +378,11 @@ int cmd_lyapunov(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!outfile_check("lyapunov", a.csv) || !chart_png_check("lyapunov", a.png))
-        return EXIT_FAIL;
+    int werr = outfile_check("lyapunov", a.csv, false);
+    if (werr == EXIT_OK)
+        werr = chart_png_check("lyapunov", a.png);
+    if (werr != EXIT_OK)
+        return werr;
     /* the parameters without the grid's; S0 >= S is checked per point */
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, NULL, a.ax, 2, &base);
@@ -385,9 +391,15 @@ int cmd_lyapunov(int argc, char **argv)
     const bool fo = strcmp(a.mo.name, "friction-oscillator") == 0;
     if (!fo && start_of(&c, &a))
         return EXIT_USAGE;
+    overlay ov;
+    memset(&ov, 0, sizeof ov);
+    const int cerr = read_curves(&a, &ov);
     const size_t nx = (size_t)a.ax[0].n, n = nx * (size_t)a.ax[1].n;
-    double *v = malloc(n * sizeof *v);
+    double *v = cerr == EXIT_OK ? malloc(n * sizeof *v) : NULL;
     if (!v) {
+        overlay_free(&ov);
+        if (cerr != EXIT_OK)
+            return cerr;
         fprintf(stderr, "cellmap lyapunov: out of memory for %zu grid points\n", n);
         return EXIT_FAIL;
     }
@@ -411,6 +423,7 @@ int cmd_lyapunov(int argc, char **argv)
     progress_end(&pr);
     if (interrupt_requested()) {
         free(v);
+        overlay_free(&ov);
         return interrupt_stopped("lyapunov", done, n, "grid points");
     }
     const double secs = omp_get_wtime() - t0;
@@ -434,7 +447,8 @@ int cmd_lyapunov(int argc, char **argv)
     if (ok && a.csv)
         ok = write_csv(&a, v);
     if (ok && a.png)
-        ok = write_png(&a, a.mo.name, &base, v);
+        ok = write_png(&a, a.mo.name, &base, v, &ov);
     free(v);
+    overlay_free(&ov);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -78,7 +78,7 @@ int cmd_models(int argc, char **argv)
             if (c.value && cm_model_set_load(&set, c.value, msg, sizeof msg) != CM_OK)
                 err = cli_usage_error(&c, "--model-lib: %s", msg);
         } else {
-            err = cli_usage_error(&c, "unexpected argument '%s'", c.opt);
+            err = cli_stray(&c);
         }
     }
     if (err)

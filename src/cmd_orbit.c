@@ -50,7 +50,7 @@ static int parse_args(cli *c, orbit_args *a)
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && (a->n_from == 0 || a->steps < 0))
@@ -117,8 +117,9 @@ int cmd_orbit(int argc, char **argv)
     int err = parse_args(&c, &a);
     if (err)
         return err < 0 ? EXIT_OK : err;
-    if (!outfile_check("orbit", a.csv))
-        return EXIT_FAIL;
+    const int werr = outfile_check("orbit", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
     cm_model m;
     if ((err = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
         return err;

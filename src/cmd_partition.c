@@ -47,7 +47,7 @@ static int parse_args(cli *c, part_args *a)
         } else if (model_opts_take(c, &a->mo, &err)) {
         } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err)
@@ -128,8 +128,9 @@ int cmd_partition(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-delay", NULL, 0, &base);
     if (verr)

@@ -55,7 +55,7 @@ static int parse_render(cli *c, render_args *a)
         } else if (c->opt[0] != '-' && !a->file) {
             a->file = c->opt;
         } else {
-            err = cli_usage_error(c, "unexpected argument '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && !a->file)
@@ -197,8 +197,12 @@ int cmd_render(int argc, char **argv)
     const int rc = parse_render(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
-    if (!outfile_check("render", a.png.path) || !outfile_check("render", a.png.svg))
-        return EXIT_FAIL;
+    const char *const outs[] = {a.png.path, a.png.svg};
+    int werr = project_input_check("render", a.file);
+    if (werr == EXIT_OK)
+        werr = outfiles_check("render", outs, 2);
+    if (werr != EXIT_OK)
+        return werr;
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;

@@ -65,7 +65,7 @@ static int parse_args(cli *c, sim_args *a)
         } else if (cli_take_int(c, "--skip", 0, 100000, &a->skip, &err)) {
         } else if (chart_outputs_take(c, &a->out, 300, 400, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err)
@@ -460,8 +460,9 @@ int cmd_simulate(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_model m;
     const int merr = model_opts_build(&c, &a.mo, &m);
     if (merr)

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -17,6 +18,7 @@
 #include "models/registry.h"
 #include "src/interrupt.h"
 #include "src/json.h"
+#include "src/outfile.h"
 #include "src/progress.h"
 #include "src/project.h"
 #include "src/args.h"
@@ -138,7 +140,7 @@ static int parse_solve(cli *c, solve_args *a)
         } else if (cli_is(c, "--stage1", false, &err)) {
             a->stage1 = 1;
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err)
@@ -503,6 +505,25 @@ static cm_status same_solve(void *user, const cm_store_info *info, const cm_mode
     return CM_OK;
 }
 
+/* --db before any work: a file to resume, or where a new one can be
+ * written (an existing file there must be a cellmap database, which the
+ * new one replaces once complete). */
+static int check_db_arg(const solve_args *a)
+{
+    char why[1024];
+    struct stat sb;
+    if (!a->db)
+        return EXIT_OK;
+    if (a->resume)
+        return project_input_check("solve", a->db);
+    if (stat(a->db, &sb) == 0 && S_ISREG(sb.st_mode) && cm_store_probe(a->db, why, sizeof why) != CM_OK) {
+        fprintf(stderr, "cellmap solve: refusing to overwrite %s: %s; choose another --db file\n",
+                a->db, why);
+        return EXIT_USAGE;
+    }
+    return outfile_check("solve", a->db, true);
+}
+
 /* The database of --db: a new one, or (--resume) the saved cluster, which
  * must come from the same model, parameters, lattice and plan. */
 static cm_status open_store(const solve_args *a, const char *command, const cm_model *m,
@@ -641,19 +662,26 @@ static cm_status finish_store(run *rn, char *msg, size_t msg_size)
     return st;
 }
 
-/* After Ctrl-C: what is kept and how to go on. */
-static int say_interrupted(const solve_args *a, const char *command, const run *rn)
+/* After Ctrl-C or a failure (why: "interrupted", or the failure's
+ * message): what --db keeps and how to go on. */
+static void say_kept(const solve_args *a, const char *command, const run *rn, const char *why)
 {
     if (rn->store && cm_store_replacing(rn->store))
-        fprintf(stderr, "cellmap solve: interrupted; %s is unchanged (the new cluster is "
-                        "discarded)\n",
+        fprintf(stderr, "cellmap solve: %s; %s is unchanged (the new cluster is discarded)\n", why,
                 a->db);
     else if (rn->store)
-        fprintf(stderr, "cellmap solve: interrupted; %s keeps the %u regions joined so far. "
-                        "To finish it: %s%s\n",
-                a->db, rn->c.nregions, command, a->resume ? "" : " --resume");
+        fprintf(stderr, "cellmap solve: %s; %s keeps the %u region%s joined so far. To finish "
+                        "it%s: %s%s\n",
+                why, a->db, rn->c.nregions, rn->c.nregions == 1 ? "" : "s",
+                strcmp(why, "interrupted") ? " once that is fixed" : "", command,
+                a->resume ? "" : " --resume");
     else
-        fprintf(stderr, "cellmap solve: interrupted\n");
+        fprintf(stderr, "cellmap solve: %s\n", why);
+}
+
+static int say_interrupted(const solve_args *a, const char *command, const run *rn)
+{
+    say_kept(a, command, rn, "interrupted");
     return EXIT_INTERRUPTED;
 }
 
@@ -667,6 +695,8 @@ int cmd_solve(int argc, char **argv)
     int rc = parse_solve(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
+    if ((rc = check_db_arg(&a)) != EXIT_OK)
+        return rc;
     cm_model m;
     if ((rc = model_opts_build(&c, &a.mo, &m)) != EXIT_OK)
         return rc;
@@ -770,7 +800,7 @@ int cmd_solve(int argc, char **argv)
     rc = EXIT_OK;
     goto done;
 fail:
-    fprintf(stderr, "cellmap solve: %s\n", msg);
+    say_kept(&a, command, &rn, msg);
 done:
     cm_store_close(rn.store, msg, sizeof msg);
     cm_cluster_free(&rn.c);

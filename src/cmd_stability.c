@@ -81,7 +81,7 @@ static int parse_args(cli *c, stab_args *a)
                 err = cli_usage_error(c, "--alpha: alpha must be positive");
         } else if (chart_outputs_take(c, &a->out, 300, 450, &err)) {
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err)
@@ -307,8 +307,9 @@ int cmd_stability(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    if (!chart_outputs_writable(&c, &a.out))
-        return EXIT_FAIL;
+    const int werr = chart_outputs_writable(&c, &a.out);
+    if (werr != EXIT_OK)
+        return werr;
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, "microchaos-pd", NULL, 0, &base);
     if (verr)

@@ -111,7 +111,7 @@ static int parse_args(cli *c, sweep_args *a)
         } else if (cli_is(c, "--quiet", false, &err)) {
             a->quiet = true;
         } else {
-            err = cli_usage_error(c, "unknown option '%s'", c->opt);
+            err = cli_stray(c);
         }
     }
     if (!err && a->json && a->csv && cm_output_names_stdout(a->csv))
@@ -378,8 +378,9 @@ int cmd_sweep(int argc, char **argv)
     int rc = parse_args(&c, &a);
     if (rc)
         return rc < 0 ? EXIT_OK : rc;
-    if (!outfile_check("sweep", a.csv))
-        return EXIT_FAIL;
+    const int werr = outfile_check("sweep", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
     cm_lattice lat;
     cm_box box;
     if ((rc = check_setup(&c, &a, &lat, &box)))

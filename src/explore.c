@@ -469,28 +469,116 @@ static cm_status cmd_goto(session *s, char **t, int n, char *msg, size_t msg_siz
     return st == CM_OK ? move_view(s, lo, hi, "goto", msg, msg_size) : st;
 }
 
-/* ---- extend auto ----------------------------------------------------------- */
+/* ---- extend auto, and the journal of a script's run ------------------------ */
 
-static cm_status extend_step(session *s, const cm_box *tile, int step, char *msg, size_t msg_size)
+#define JOURNAL_NOTE "note.explore.journal"
+
+/* Writes the journal's state: "script H line K step J tile LO:HI,..." (a
+ * step's tile, before it is computed), "script H line K done" or "script
+ * H complete". Nothing without a journal. */
+static cm_status journal_write(session *s, const char *state, char *msg, size_t msg_size)
+{
+    char text[96 + CM_MAX_DIM * 48];
+    if (!s->script_hash || s->damaged)
+        return CM_OK;
+    snprintf(text, sizeof text, "script %016llx %s", (unsigned long long)s->script_hash, state);
+    return cm_store_set_note(s->store, JOURNAL_NOTE, text, msg, msg_size);
+}
+
+static cm_status journal_step(session *s, int step, const cm_box *tile, char *msg, size_t msg_size)
+{
+    char state[48 + CM_MAX_DIM * 48];
+    size_t used = (size_t)snprintf(state, sizeof state, "line %ld step %d tile ", s->line, step);
+    for (int d = 0; d < tile->dim && used < sizeof state; d++)
+        used += (size_t)snprintf(state + used, sizeof state - used, "%s%lld:%lld", d ? "," : "",
+                                 (long long)tile->lo[d], (long long)tile->hi[d]);
+    return journal_write(s, state, msg, msg_size);
+}
+
+cm_status session_journal_begin(session *s, uint64_t script_hash, char *msg, size_t msg_size)
+{
+    char text[512], ignored[64];
+    s->script_hash = script_hash;
+    s->resume_line = 0;
+    s->resume_step = 0;
+    if (cm_store_get_note(s->store, JOURNAL_NOTE, text, sizeof text, ignored, sizeof ignored) !=
+        CM_OK)
+        return CM_OK; /* no run journaled yet */
+    unsigned long long hash;
+    long line;
+    int step, at = 0;
+    if (sscanf(text, "script %llx line %ld %n", &hash, &line, &at) != 2 || hash != script_hash ||
+        line < 1)
+        return CM_OK; /* another script, or this one's run went to its end */
+    const char *rest = text + at;
+    s->resume_line = line;
+    if (sscanf(rest, "step %d tile %n", &step, &at) == 1 && step >= 1) {
+        cm_box *b = &s->resume_tile;
+        b->dim = s->c.lat.dim;
+        const char *p = rest + at;
+        for (int d = 0; d < b->dim; d++) {
+            long long lo, hi;
+            int used = 0;
+            if (sscanf(p, "%lld:%lld%n", &lo, &hi, &used) != 2 || lo >= hi)
+                return cm_fail(CM_EFORMAT, msg, msg_size,
+                               "%s is damaged: its journal of explore runs says '%s'", s->path,
+                               text);
+            b->lo[d] = lo;
+            b->hi[d] = hi;
+            p += used + (p[used] == ',');
+        }
+        s->resume_step = step;
+    }
+    if (s->out) {
+        if (s->resume_step)
+            fprintf(s->out, "resuming this script's run that stopped in line %ld (extend auto, "
+                            "step %d): extensions done before are not repeated\n",
+                    s->resume_line, s->resume_step);
+        else
+            fprintf(s->out, "resuming this script's run that stopped after line %ld: "
+                            "extensions done before are not repeated\n",
+                    s->resume_line);
+    }
+    return CM_OK;
+}
+
+cm_status session_journal_end(session *s, char *msg, size_t msg_size)
+{
+    return journal_write(s, "complete", msg, msg_size);
+}
+
+/* One step: the tile the cluster's escaping sequences lead to most
+ * (given: a resumed step's recorded tile), journaled, then computed. */
+static cm_status extend_step(session *s, const cm_box *tile, int step, const cm_box *given,
+                             char *msg, size_t msg_size)
 {
     cm_extend_choice choice;
+    memset(&choice, 0, sizeof choice);
     computed done = {0};
     const double t0 = now_seconds();
-    cm_status st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
+    cm_status st = CM_OK;
+    if (given)
+        choice.box = *given;
+    else
+        st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
+    if (st == CM_OK)
+        st = journal_step(s, step, &choice.box, msg, msg_size);
     if (st == CM_OK)
         st = cover_box(s, &choice.box, "extend auto", &done, msg, msg_size);
     if (st != CM_OK)
         return st;
     if (s->out) {
-        char box[CM_MAX_DIM * 64];
+        char box[CM_MAX_DIM * 64], where[128] = "recorded before the interruption";
         format_box(&s->c.lat, &choice.box, box, sizeof box);
+        if (!given)
+            snprintf(where, sizeof where, "where %llu of the %llu escaping sequences go",
+                     (unsigned long long)choice.escaping, (unsigned long long)choice.all_escaping);
         fprintf(s->out,
-                "extend auto %d: tile %s, where %llu of the %llu escaping sequences go; computed "
-                "%llu cells in %u new region%s, %u new group%s (%u across borders); %.1f ms\n",
-                step, box, (unsigned long long)choice.escaping,
-                (unsigned long long)choice.all_escaping, (unsigned long long)done.cells,
-                done.regions, done.regions == 1 ? "" : "s", done.new_groups,
-                done.new_groups == 1 ? "" : "s", done.straddling, 1e3 * (now_seconds() - t0));
+                "extend auto %d: tile %s, %s; computed %llu cells in %u new region%s, %u new "
+                "group%s (%u across borders); %.1f ms\n",
+                step, box, where, (unsigned long long)done.cells, done.regions,
+                done.regions == 1 ? "" : "s", done.new_groups, done.new_groups == 1 ? "" : "s",
+                done.straddling, 1e3 * (now_seconds() - t0));
         fflush(s->out);
     }
     return CM_OK;
@@ -507,16 +595,39 @@ static cm_status cmd_extend(session *s, char **t, int n, char *msg, size_t msg_s
                      t[2]);
     if (st == CM_OK)
         st = need_view(s, "extend", msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    /* a resumed run: the extend lines before the one that stopped are done,
+     * and that one goes on from its recorded step */
+    int first = 1;
+    const bool resumed_here = s->script_hash && s->line == s->resume_line && s->resume_step;
+    if (s->script_hash && (s->line < s->resume_line || (s->line == s->resume_line && !s->resume_step))) {
+        if (s->out)
+            fprintf(s->out, "extend auto: done in the run that stopped; not repeated\n");
+        return CM_OK;
+    }
     cm_box tile;
-    if (st == CM_OK)
-        view_box(s, s->lo, s->hi, &tile);
-    for (int64_t k = 0; k < steps && st == CM_OK; k++) {
-        st = extend_step(s, &tile, (int)k + 1, msg, msg_size);
+    view_box(s, s->lo, s->hi, &tile);
+    if (resumed_here) {
+        first = s->resume_step;
+        s->resume_step = 0; /* resumed once */
+        if (first <= steps)
+            st = extend_step(s, &tile, first, &s->resume_tile, msg, msg_size);
+        first++;
+    }
+    for (int64_t k = first; k <= steps && st == CM_OK; k++) {
+        st = extend_step(s, &tile, (int)k, NULL, msg, msg_size);
         if (st == CM_ENOTFOUND) { /* nothing escapes next to the cluster: done, not an error */
             if (s->out)
                 fprintf(s->out, "extend auto: stopped, %s\n", msg);
-            return CM_OK;
+            st = CM_OK;
+            break;
         }
+    }
+    if (st == CM_OK) {
+        char state[48];
+        snprintf(state, sizeof state, "line %ld done", s->line);
+        st = journal_write(s, state, msg, msg_size);
     }
     return st;
 }

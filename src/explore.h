@@ -56,6 +56,13 @@ typedef struct session {
     int mem_given;          /* --mem was given */
     FILE *out;
     cm_gl *gl; /* kept between renders (made by the first); NULL until then */
+    /* the journal of a script's run (session_journal_begin): which line
+     * runs, and where a killed run of the same script stopped */
+    uint64_t script_hash; /* 0: no journal (stdin, the prompt) */
+    long line;            /* the script's line that runs */
+    long resume_line;     /* 0: nothing to resume; else its extensions up to here are done */
+    int resume_step;      /* > 0: resume_line's extend stopped in this step, on resume_tile */
+    cm_box resume_tile;
 } session;
 
 /* Opens path (creating it from the model options if it does not exist).
@@ -66,6 +73,21 @@ int session_open(session *s, const session_options *o);
 /* Runs one line (comments and blank lines do nothing). On failure msg says
  * why and the session is as before the line (what it computed is kept). */
 cm_status session_exec(session *s, const char *line, char *msg, size_t msg_size);
+
+/* A script file's run is journaled in the file (note.explore.journal):
+ * each `extend auto` step's tile before it is computed, each extend line
+ * when done, the script's end. script_hash identifies the script (its
+ * bytes). If the journal shows that a run of this same script stopped
+ * before its end (killed, or a failed line), this run resumes it: its
+ * lines run again (views, pans, renders and exports compute and write
+ * the same), but the extension steps done before are not repeated (the
+ * interrupted step's recorded tile is completed), so that the file ends
+ * as one run would have left it. Prints what it resumes. */
+cm_status session_journal_begin(session *s, uint64_t script_hash, char *msg, size_t msg_size);
+
+/* The journal's end: the script ran to its end (a later run of it is a
+ * new run). */
+cm_status session_journal_end(session *s, char *msg, size_t msg_size);
 
 /* Saves the view and closes the database. Returns the close status. */
 cm_status session_close(session *s, char *msg, size_t msg_size);

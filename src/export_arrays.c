@@ -2,6 +2,7 @@
  * (src/export_arrays.h). */
 #include "src/export_arrays.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -232,10 +233,12 @@ bool export_arrays(cm_cluster *c, const cm_box *window, const array_export *x, p
                 snprintf(msg, sizeof msg, "out of memory for the labels");
             ok = false;
         } else {
+            errno = 0;
             ok = write_slab(&flat, label, has_labels ? labels.f : NULL,
                             has_steps ? steps.f : NULL, in_window, by_label);
-            if (!ok)
-                snprintf(msg, sizeof msg, "cannot write the arrays");
+            if (!ok) /* the file a write failed on, and why */
+                cm_output_fail(has_labels && ferror(labels.f) ? x->labels : x->steps,
+                               errno ? errno : EIO, msg, sizeof msg);
         }
         free(label);
         done += flat.ncells;

@@ -27,6 +27,8 @@ void interrupt_catch(void)
 
 bool interrupt_requested(void) { return requested != 0; }
 
+void interrupt_clear(void) { requested = 0; }
+
 int interrupt_stopped(const char *cmd, uint64_t done, uint64_t total, const char *unit)
 {
     fprintf(stderr, "cellmap %s: interrupted (Ctrl-C) after %llu of %llu %s; nothing written\n",

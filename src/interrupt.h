@@ -14,6 +14,10 @@ void interrupt_catch(void);
 /* Whether SIGINT came since interrupt_catch. */
 bool interrupt_requested(void);
 
+/* Forgets a request, for a process that runs commands one after another
+ * (the fuzz harness of whole commands); the commands never call it. */
+void interrupt_clear(void);
+
 /* Says that CMD stopped after `done` of `total` UNITs and wrote nothing;
  * returns EXIT_INTERRUPTED. */
 int interrupt_stopped(const char *cmd, uint64_t done, uint64_t total, const char *unit);

@@ -7,34 +7,47 @@
 
 #include "render/gl_loader.h"
 
-bool outfile_check(const char *cmd, const char *path)
+int outfile_check(const char *cmd, const char *path, bool needs_regular)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];
     cm_output o;
     if (!path)
-        return true;
-    const cm_status st = cm_output_begin(&o, path, false, msg, sizeof msg);
+        return EXIT_OK;
+    const cm_status st = cm_output_begin(&o, path, needs_regular, msg, sizeof msg);
     cm_output_abandon(&o);
-    if (st != CM_OK)
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-    return st == CM_OK;
+    if (st == CM_OK)
+        return EXIT_OK;
+    fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return st == CM_EINVAL ? EXIT_USAGE : EXIT_FAIL;
 }
 
-bool chart_png_check(const char *cmd, const char *path)
+int outfiles_check(const char *cmd, const char *const *paths, int n)
+{
+    for (int k = 0; k < n; k++) {
+        const int rc = outfile_check(cmd, paths[k], false);
+        if (rc != EXIT_OK)
+            return rc;
+    }
+    return EXIT_OK;
+}
+
+int chart_png_check(const char *cmd, const char *path)
 {
     char msg[1024];
-    if (!outfile_check(cmd, path))
-        return false;
+    const int rc = outfile_check(cmd, path, false);
+    if (rc != EXIT_OK)
+        return rc;
     if (path && cm_gl_load(msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-        return false;
+        return EXIT_FAIL;
     }
-    return true;
+    return EXIT_OK;
 }
 
-bool chart_outputs_writable(const cli *c, const chart_outputs *o)
+int chart_outputs_writable(const cli *c, const chart_outputs *o)
 {
-    return outfile_check(c->cmd, o->csv) && chart_png_check(c->cmd, o->png);
+    const int rc = outfile_check(c->cmd, o->csv, false);
+    return rc != EXIT_OK ? rc : chart_png_check(c->cmd, o->png);
 }
 
 bool outfile_open(const char *cmd, const char *path, outfile *o)
@@ -47,8 +60,8 @@ bool outfile_open(const char *cmd, const char *path, outfile *o)
     }
     o->f = fopen(o->out.tmp, "w");
     if (!o->f) {
-        fprintf(stderr, "cellmap %s: cannot write %s: %s (does the directory exist?)\n", cmd,
-                path, strerror(errno));
+        cm_output_fail(path, errno, msg, sizeof msg);
+        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         cm_output_abandon(&o->out);
     }
     return o->f != NULL;

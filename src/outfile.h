@@ -19,15 +19,19 @@ typedef struct outfile {
 } outfile;
 
 /* Checks an output path before the work that fills it (NULL: none): a
- * directory, or a device where a database must go, is refused at once.
- * Prints "cellmap CMD: ..." and returns false then. */
-bool outfile_check(const char *cmd, const char *path);
+ * directory, a missing or read-only directory, or a device where a
+ * database must go (needs_regular), is refused at once. Prints "cellmap
+ * CMD: ..." and returns EXIT_USAGE then (EXIT_FAIL for a failure of the
+ * system, e.g. no file descriptor), else EXIT_OK. */
+int outfile_check(const char *cmd, const char *path, bool needs_regular);
+/* outfile_check of each of n paths (NULL entries skipped): the first failure. */
+int outfiles_check(const char *cmd, const char *const *paths, int n);
 /* The same for a chart PNG, which also needs OSMesa: loaded now
  * (render/gl_loader.h), so that a missing library stops the command
- * before its work. */
-bool chart_png_check(const char *cmd, const char *path);
+ * before its work (EXIT_FAIL). */
+int chart_png_check(const char *cmd, const char *path);
 /* Both, for the --csv and --png of a command's chart outputs. */
-bool chart_outputs_writable(const cli *c, const chart_outputs *o);
+int chart_outputs_writable(const cli *c, const chart_outputs *o);
 /* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
 bool outfile_open(const char *cmd, const char *path, outfile *o);
 /* Closes and renames it when ok (and every write succeeded), else removes

@@ -26,6 +26,15 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
     return st;
 }
 
+int project_input_check(const char *cmd, const char *path)
+{
+    char msg[1024];
+    if (cm_store_probe(path, msg, sizeof msg) == CM_OK)
+        return EXIT_OK;
+    fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return EXIT_USAGE;
+}
+
 int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
                       cm_store_info *info, cm_cluster *c)
 {

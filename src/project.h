@@ -12,6 +12,12 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 
+/* The database a command is given to read or resume, checked before any
+ * work (cm_store_probe: it exists, is readable and is a cellmap database
+ * this version reads). Prints "cellmap CMD: problem" and returns
+ * EXIT_USAGE if not; EXIT_OK. Damage inside is found when it is opened. */
+int project_input_check(const char *cmd, const char *path);
+
 /* Opens path read-only in a snapshot and reads what it says about itself;
  * a file with no region yet is refused. map_reads: reads through a memory
  * map (cm_store_map_reads), for commands that read its records only (info,

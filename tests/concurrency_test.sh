@@ -16,7 +16,8 @@ enter_workdir
 # reader_loop FILE PID K: reads FILE in turns until PID ends (the cells of
 # a window: regions, their pages and node tables; a render; info); prints
 # its runs and the failures: a false "damaged", or a crash (before the
-# first commit the file may not be there or hold no region: status 1)
+# first commit the file may not be there, status 2 "does not exist", or
+# hold no region, status 1)
 reader_loop() {
   local file=$1 pid=$2 k=$3 runs=0 rc out
   while kill -0 "$pid" 2> /dev/null; do
@@ -27,7 +28,8 @@ reader_loop() {
     esac
     rc=$?
     runs=$((runs + 1))
-    if [ $rc -gt 1 ] || grep -q "damaged" <<<"$out"; then
+    if { [ $rc -gt 1 ] && ! { [ $rc -eq 2 ] && grep -q "does not exist" <<<"$out"; }; } ||
+      grep -q "damaged" <<<"$out"; then
       echo "failure (rc $rc): $out"
     fi
   done

@@ -129,6 +129,35 @@ printf 'view 100:150 -4:4\nextend auto 2\n' > extend.explore
 [ "$(grep -c '^extend auto [12]: tile .*computed 10000 cells' extend.out)" -eq 2 ] ||
   fail "extend auto: $(cat extend.out)"
 
+# a session killed inside `extend auto N` and replayed ends as one run
+# would have left it: the journal in the file records each step's tile
+# before it is computed, so the replay completes the interrupted step and
+# does not repeat the steps done (a replay used to extend N times more)
+fine="--cell-size 0.05,0.008"
+printf 'view 100:150 -4:4\nextend auto 3\npan right 10%%\nextend auto 9\nview 100:150 -4:4\n' > ext.explore
+"$CM" explore ext-ref.cmdb ext.explore $pd $fine > /dev/null || fail "the reference extend session"
+journal() { sqlite3 -readonly "$1" "SELECT value FROM meta WHERE key = 'note.explore.journal'" 2> /dev/null; }
+journal ext-ref.cmdb | grep -q " complete$" || fail "the finished run's journal: $(journal ext-ref.cmdb)"
+for stop in "line 2 step 2" "line 4 step 3" "line 4 step 7"; do
+  "$CM" explore ext-kill.cmdb ext.explore $pd $fine > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1500); do journal ext-kill.cmdb | grep -q "$stop" && break; sleep 0.01; done
+  kill -9 $pid 2> /dev/null || fail "the extend session ended before '$stop'"
+  wait $pid 2> /dev/null
+done
+journal ext-kill.cmdb | grep -q "line 4 step" || fail "not killed inside the second extend: $(journal ext-kill.cmdb)"
+"$CM" explore ext-kill.cmdb ext.explore $pd $fine > ext-replay.out || fail "the replay after kills in extend auto"
+grep -q "^resuming this script's run that stopped in line 4 (extend auto, step [0-9]*)" ext-replay.out \
+  || fail "the replay did not say it resumes: $(head -3 ext-replay.out)"
+same_rows ext-kill.cmdb ext-ref.cmdb "SELECT lo || ' ' || hi FROM regions ORDER BY lo, hi" ||
+  fail "the regions after kills in extend auto differ from one run's"
+"$CM" export ext-ref.cmdb --labels ext-ref.npy --quiet && "$CM" export ext-kill.cmdb --labels ext-kill.npy --quiet &&
+  cmp -s ext-ref.npy ext-kill.npy || fail "the cells after kills in extend auto differ from one run's"
+# a run of another script, or of this one after its end, is a new run
+"$CM" explore ext-ref.cmdb ext.explore $pd $fine > ext-again.out || fail "the finished script run again"
+grep -q "resuming" ext-again.out && fail "a finished run was resumed"
+[ "$(grep -c '^extend auto [0-9]*: tile' ext-again.out)" -eq 12 ] || fail "a new run of the script did not extend 12 times"
+
 # --- malformed commands: line number, message, exit 1, work kept ---------
 check_bad() { # check_bad 'line' 'needle'
   rm -f bad.cmdb

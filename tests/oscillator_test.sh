@@ -109,7 +109,7 @@ python3 "$HERE/pngcheck.py" lle.png > /dev/null 2>&1 || [ -s lle.png ] || fail "
 expect_usage "--curves draws over the heat map" lyapunov --grid Omega=0.3:0.7:8,S=0.02:0.4:8 \
   --curves curves.csv --csv x.csv
 out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S0=0.4:0.5:2 --periods 5 --png l2.png --curves curves.csv 2>&1)
-[ $? -eq 1 ] && grep -q "is in (S, Omega), the grid in (Omega, S0)" <<<"$out" && [ ! -e l2.png ] \
+[ $? -eq 2 ] && grep -q "is in (S, Omega), the grid in (Omega, S0)" <<<"$out" && [ ! -e l2.png ] \
   || fail "lyapunov --curves of other parameters: $out"
 expect_usage "--curve NAME2=LO:HI and --curves FILE go together" continue --vary S=0.02:0.4 \
   --curve Omega=0.2:0.8
@@ -201,7 +201,7 @@ PY
 out=$("$CM" lyapunov --param S0=0.1 --grid Omega=0.3:0.7:2,S=0.2:0.3:2 --csv none.csv 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "all points invalid: $rc $out"
 out=$("$CM" lyapunov --grid Omega=0.3:0.7:2,S=0.1:0.2:2 --periods 10 --csv nodir/x.csv 2>&1); rc=$?
-[ $rc -eq 1 ] && grep -q "nodir/x.csv" <<<"$out" || fail "lyapunov into a missing directory: $rc $out"
+[ $rc -eq 2 ] && grep -q "nodir/x.csv" <<<"$out" || fail "lyapunov into a missing directory: $rc $out"
 
 # --- simulate: the 1a orbit (S = 0.32) from its fixed point stuck at the section
 "$CM" simulate --param S=0.32 --from 1.242560606171,0 --periods 5 --csv a1.csv --png a1.png \
@@ -325,7 +325,7 @@ expect_usage "--runs-csv - and another output" bifurcation --sweep S=0.1:0.4:3 -
 out=$("$CM" bifurcation --param S0=0.1 --sweep S=0.2:0.3:2 --csv none.csv 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q "S <= S0" <<<"$out" && [ ! -e none.csv ] || fail "bifurcation, all values invalid: $rc $out"
 out=$("$CM" simulate --periods 2 --png nodir/x.png 2>&1); rc=$?
-[ $rc -eq 1 ] && grep -q "nodir/x.png" <<<"$out" || fail "simulate into a missing directory: $rc $out"
+[ $rc -eq 2 ] && grep -q "nodir/x.png" <<<"$out" || fail "simulate into a missing directory: $rc $out"
 ls | grep -q tmp- && fail "temporary files left behind"
 
 [ $fails -eq 0 ] && echo "oscillator tests passed" || echo "$fails oscillator test(s) failed"

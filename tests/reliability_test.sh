@@ -119,5 +119,108 @@ out=$(printf 'render z.png --labels /dev/zero\n' | timeout 20 "$CM" explore plai
 [ ! -e z.png ] || fail "a refused palette or labels file left z.png"
 [ "$(sha256sum < plain.cmdb)" = "$sum" ] || fail "plain.cmdb changed"
 
+# --- item 7: temporary outputs of killed runs --------------------------------
+# OUT.tmp-N of a process N that no longer runs, ours and not locked, goes
+# (with its SQLite companions) when OUT is written again; one whose process
+# runs, one locked by a live writer (as another machine's writer on a
+# network file system is), a symlink and another user's are kept
+for s in "" -journal -wal; do echo stale > "s.png.tmp-999999$s"; done
+echo live > "s.png.tmp-$$"
+echo locked > s.png.tmp-999998
+exec 9< s.png.tmp-999998 && flock -n 9 || fail "flock s.png.tmp-999998"   # held by this shell
+ln -s plain.cmdb s.png.tmp-999997
+if [ "$(id -u)" = 0 ]; then echo theirs > s.png.tmp-999996; chown 65534 s.png.tmp-999996; fi
+"$CM" render plain.cmdb --png s.png --quiet || fail "render over stale temporary files"
+for s in "" -journal -wal; do [ ! -e "s.png.tmp-999999$s" ] || fail "stale s.png.tmp-999999$s kept"; done
+[ -e "s.png.tmp-$$" ] || fail "the temporary file of a running process was removed"
+[ -e s.png.tmp-999998 ] || fail "a temporary file locked by a live writer was removed"
+[ -L s.png.tmp-999997 ] || fail "a symlink named like a temporary file was removed"
+[ "$(id -u)" != 0 ] || [ -e s.png.tmp-999996 ] || fail "another user's temporary file was removed"
+exec 9<&-
+rm -f s.png.tmp-*
+# a killed export leaves its locked temporary file; the next export removes it
+"$CM" solve --cells 1500x1500 --db big.cmdb --quiet || fail "solve big.cmdb"
+"$CM" export big.cmdb --cells big.csv --quiet & exporter=$!
+for _ in $(seq 200); do compgen -G "big.csv.tmp-*" > /dev/null && break; sleep 0.02; done
+sleep 0.2
+kill -9 $exporter 2> /dev/null || fail "the export ended before it could be killed"
+wait $exporter 2> /dev/null
+compgen -G "big.csv.tmp-*" > /dev/null || fail "the killed export left no temporary file (nothing tested)"
+"$CM" export plain.cmdb --cells big.csv --quiet || fail "export after a killed one"
+! compgen -G "big.csv.tmp-*" > /dev/null || fail "the killed export's temporary file stayed: $(ls big.csv.tmp-*)"
+
+# --- item 8: one exit-code rule, messages that name the user's path ---------
+# 2: the user's arguments or files, found before any work
+expect_usage "missing.cmdb does not exist" info missing.cmdb
+expect_usage "missing.cmdb does not exist" render missing.cmdb --png x.png
+expect_usage "missing.cmdb does not exist" export missing.cmdb --groups x.csv
+expect_usage "missing.cmdb does not exist" solve --cells 20x20 --db missing.cmdb --resume
+expect_usage "cannot read --curves file missing.csv" lyapunov --grid Omega=0.3:0.7:2,S=0.02:0.4:2 --periods 2 --png x.png --curves missing.csv
+expect_usage "an output file name is empty" sweep --vary P=0.006,0.007 --cells 40x20 --csv ""
+expect_usage "an output file name is empty" export plain.cmdb --groups ""
+expect_usage "the directory nodir does not exist" render plain.cmdb --png nodir/x.png
+expect_usage "the directory nodir does not exist" solve --cells 20x20 --db nodir/x.cmdb
+expect_usage "the directory nodir does not exist" export plain.cmdb --flat nodir/x.sqlite
+expect_usage "the directory nodir does not exist" export plain.cmdb --labels nodir/x.npy
+expect_usage "the directory nodir does not exist" orbit --from 10,0 --steps 3 --csv nodir/x.csv
+mkdir adir
+expect_usage "the script adir is a directory" explore plain.cmdb adir
+# one wording for a stray argument, in every command
+for cmd in solve sweep render info export models orbit fixed-points lyapunov simulate bifurcation \
+           continue amplitude escape stability horseshoe partition; do
+  file=; case $cmd in render|info|export) file=plain.cmdb ;; esac
+  expect_usage "unexpected argument 'stray'" $cmd $file stray
+  expect_usage "unknown option '--stray'" $cmd $file --stray
+done
+[ ! -e x.png ] && [ ! -e x.csv ] && [ ! -e x.cmdb ] || fail "a refused command wrote an output"
+! compgen -G "*.tmp-*" > /dev/null || fail "refused commands left temporary files: $(ls ./*.tmp-*)"
+
+# A full disk and a read-only directory (a small tmpfs in a private mount
+# namespace: root, or an unprivileged user namespace). On a full disk: exit
+# 1, the user's path, the reason and the fix, no file left; a solve --db
+# keeps what it committed and says how to resume, and the resumed file is
+# the solve's without a full disk, cell by cell.
+if [ "$(id -u)" = 0 ]; then ns=(unshare -m); else ns=(unshare -rm); fi
+if "${ns[@]}" true 2> /dev/null; then
+  "$CM" solve --cells 600x600 --split 4x4 --db whole.cmdb --quiet || fail "solve whole.cmdb"
+  cat > disk.sh <<'SH'
+set -u
+CM=$1; mkdir -p small ro
+mount -t tmpfs -o size=64k tmpfs small && mount -t tmpfs -o ro,size=64k tmpfs ro || exit 99
+check() { # check RC NEEDLE args...: exit RC, a message with NEEDLE, no file left in small
+  local want=$1 needle=$2; shift 2
+  out=$("$CM" "$@" 2>&1 > /dev/null); rc=$?
+  [ $rc -eq "$want" ] && grep -qF -- "$needle" <<<"$out" || echo "FAIL: cellmap $*: rc $rc, '$out'"
+  [ -z "$(ls small | grep -v filler)" ] || echo "FAIL: cellmap $* left $(ls small)"
+}
+head -c 65536 /dev/zero > small/filler 2> /dev/null
+full="No space left on device; free space"
+check 1 "cannot write small/a.png: $full" render plain.cmdb --png small/a.png
+check 1 "cannot write small/a.svg: $full" render plain.cmdb --svg small/a.svg
+check 1 "cannot write small/L.npy: $full" export plain.cmdb --labels small/L.npy
+check 1 "cannot write small/f.sqlite: $full" export plain.cmdb --flat small/f.sqlite
+check 1 "cannot write small/c.csv: $full" export plain.cmdb --cells small/c.csv
+check 1 "cannot write small/g.csv: $full" export plain.cmdb --groups small/g.csv
+check 1 "cannot write small/x.csv: $full" orbit --from 10,0 --steps 3 --csv small/x.csv
+check 2 "cannot write ro/a.png: the directory ro is not writable" render plain.cmdb --png ro/a.png
+check 2 "cannot write ro/s.cmdb: the directory ro is not writable" solve --cells 20x20 --db ro/s.cmdb
+check 2 "cannot write ro/f.sqlite: the directory ro is not writable" export plain.cmdb --flat ro/f.sqlite
+rm small/filler
+mount -o remount,size=400k small
+out=$("$CM" solve --cells 600x600 --split 4x4 --db small/s.cmdb --quiet 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q "s.cmdb: No space left on device" <<<"$out" && grep -q "small/s.cmdb keeps the [0-9]* regions* joined so far.*--resume" <<<"$out" \
+  || echo "FAIL: solve onto a full disk: rc $rc, '$out'"
+mount -o remount,size=64m small
+"$CM" solve --cells 600x600 --split 4x4 --db small/s.cmdb --resume --quiet || echo "FAIL: the resume after a full disk"
+"$CM" export small/s.cmdb --labels a.npy --steps as.npy --quiet && "$CM" export whole.cmdb --labels b.npy --steps bs.npy --quiet \
+  && cmp -s a.npy b.npy && cmp -s as.npy bs.npy || echo "FAIL: the resumed file differs from a solve without a full disk"
+SH
+  "${ns[@]}" bash disk.sh "$CM" > disk.out 2>&1; rc=$?
+  [ $rc -ne 99 ] || fail "no tmpfs could be mounted: $(cat disk.out)"
+  while read -r line; do fail "${line#FAIL: }"; done < <(grep '^FAIL' disk.out)
+else
+  echo "reliability_test: no private mount namespace here; the full-disk checks did not run" >&2
+fi
+
 [ "$fails" -eq 0 ] && echo "reliability_test: ok"
 exit $((fails > 0))

@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-25}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_args fuzz_session fuzz_cmdb_bytes fuzz_cmdb_rows)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_args fuzz_session fuzz_cmdb_bytes fuzz_cmdb_rows fuzz_commands fuzz_files fuzz_api)
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLMAP_FUZZ=ON > /dev/null
 cmake --build build-fuzz -j "$(nproc)" > /dev/null
 work=$(mktemp -d)

@@ -154,7 +154,7 @@ int main(void)
     png_destroy_read_struct(&png, &info, NULL);
     fclose(f);
     /* writing into a missing directory fails cleanly */
-    CHECK(cm_png_write("/nonexistent-dir/x.png", a, W, H, texts, 2, msg, sizeof msg) == CM_EIO);
+    CHECK(cm_png_write("/nonexistent-dir/x.png", a, W, H, texts, 2, msg, sizeof msg) == CM_EINVAL);
     unlink(path);
     CHECK(rmdir(dir) == 0); /* empty: no temporary file left behind */
 
