@@ -23,7 +23,7 @@ ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print
 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" --repeat until-pass:2
 # an attacker's campaign of damaged files against every command (sanitizer build)
-python3 tests/campaign.py build-sanitize/cellmap 100
+python3 tests/campaign.py build-sanitize/cellmap 600
 # libFuzzer targets (clang), each for a fixed budget
 tests/run_fuzz.sh 25
 echo "all tests passed (release and sanitizer builds, fuzz targets)"
