@@ -36,7 +36,6 @@
 #include "cellmap/classify.h"
 
 #include "cellmap/grow.h"
-#include "cellmap/scm.h"
 
 #include <stdbool.h>
 #include <stdlib.h>

@@ -30,13 +30,28 @@
  * knows; a cluster resolves them through its node table. */
 #define CM_NODE_REF UINT32_C(0x80000000)
 
+/* Image values beyond a region's local indices (cellmap/scm.h makes
+ * them): the sink (no image, or outside the world), a cell outside the
+ * region not recorded, and recorded exit k as CM_IMAGE_EXIT_BASE + k. */
+#define CM_IMAGE_SINK UINT32_C(0xFFFFFFFF)
+#define CM_IMAGE_EXIT UINT32_C(0xFFFFFFFE)
+#define CM_IMAGE_EXIT_BASE UINT32_C(0x80000000)
+
+/* Index into the exit table of an image value, or -1 if it is not a recorded exit. */
+static inline int64_t cm_image_exit_index(uint32_t image)
+{
+    return image >= CM_IMAGE_EXIT_BASE && image < CM_IMAGE_EXIT
+               ? (int64_t)(image - CM_IMAGE_EXIT_BASE)
+               : -1;
+}
+
 static inline int cm_is_node_ref(uint32_t group)
 {
     return (group & CM_NODE_REF) && group != UINT32_C(0xFFFFFFFF);
 }
 
 /* node_refs: cells whose chains end in a recorded exit get CM_NODE_REF | k
- * instead of group 0 (image values CM_IMAGE_EXIT_BASE + k, cellmap/scm.h). */
+ * instead of group 0 (image values CM_IMAGE_EXIT_BASE + k). */
 cm_status cm_classify(uint32_t n, const uint32_t *image, uint32_t *group, uint32_t *step,
                       uint32_t *ngroups, int node_refs, char *msg, size_t msg_size);
 

@@ -1,7 +1,10 @@
 #include "cellmap/lattice.h"
 
+#include "cellmap/numtext.h"
+
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 
 cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
 {
@@ -148,4 +151,30 @@ bool cm_index_next(int dim, const int64_t *lo, const int64_t *hi, int64_t *index
         index[d] = lo[d];
     }
     return false;
+}
+
+void cm_box_text(const cm_lattice *lat, const cm_box *box, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 0; d < box->dim && used < size; d++) {
+        const double tol = CM_CELL_TOLERANCE * lat->width[d];
+        used += (size_t)snprintf(
+            out + used, size - used, "%s%s:%s", d ? "," : "",
+            cm_num_text_near(lat->origin[d] + (double)box->lo[d] * lat->width[d], tol,
+                             (char[CM_NUM_TEXT]){0}),
+            cm_num_text_near(lat->origin[d] + (double)box->hi[d] * lat->width[d], tol,
+                             (char[CM_NUM_TEXT]){0}));
+    }
+}
+
+void cm_point_text(const cm_lattice *lat, const double *x, const char *sep, char *out,
+                  size_t size)
+{
+    size_t used = 0;
+    out[0] = 0;
+    for (int d = 0; d < lat->dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", d ? sep : "",
+                                 cm_num_text_near(x[d], CM_CELL_TOLERANCE * lat->width[d],
+                                                  (char[CM_NUM_TEXT]){0}));
 }

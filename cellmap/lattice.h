@@ -85,4 +85,11 @@ static inline double cm_floor_exact(double u)
     return t - (t > u ? 1.0 : 0.0);
 }
 
+/* The box in state coordinates, "x0:x1,y0:y1,...", each edge the shortest
+ * number within a billionth of a cell (0:500, not 0:500.00000000000006). */
+void cm_box_text(const cm_lattice *lat, const cm_box *box, char *out, size_t size);
+/* A point in state coordinates to the same resolution, joined by sep. */
+void cm_point_text(const cm_lattice *lat, const double *x, const char *sep, char *out,
+                   size_t size);
+
 #endif

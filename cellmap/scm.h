@@ -25,24 +25,15 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "cellmap/classify.h"
 #include "cellmap/lattice.h"
 #include "cellmap/model.h"
 #include "cellmap/status.h"
 
-#define CM_IMAGE_SINK UINT32_C(0xFFFFFFFF)
-#define CM_IMAGE_EXIT UINT32_C(0xFFFFFFFE)
-#define CM_IMAGE_EXIT_BASE UINT32_C(0x80000000)
 /* group[] of a cell that was not computed (outside every region of a
  * flattened cluster); cm_scm_groups and the renderer skip it. */
 #define CM_GROUP_NONE UINT32_C(0xFFFFFFFF)
 
-/* Index into the exit table of an image value, or -1 if it is not a recorded exit. */
-static inline int64_t cm_image_exit_index(uint32_t image)
-{
-    return image >= CM_IMAGE_EXIT_BASE && image < CM_IMAGE_EXIT
-               ? (int64_t)(image - CM_IMAGE_EXIT_BASE)
-               : -1;
-}
 /* Largest number of cells in one region: local indices stay below the
  * image marks, and step numbers below 2^31 (classification keeps a flag in
  * the top bit). */

@@ -8,14 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
-                           size_t msg_size)
-{
-    const int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    return rc == SQLITE_DONE ? CM_OK : store_db_error(db, what, msg, msg_size);
-}
-
 /* The cell counts of the groups whose counts changed. */
 static cm_status write_basins(cm_store *s, const cm_cluster *c, char *msg, size_t msg_size)
 {
@@ -143,68 +135,13 @@ cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *m
 }
 
 /* A region never saved: its row, exit table and pages. */
-static cm_status write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
-                              size_t msg_size)
-{
-    const cm_region *r = &c->regions[k].r;
-    if (!r->group)
-        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
-    cm_status st = store_insert_region(s, k, r, msg, msg_size);
-    if (st == CM_OK)
-        st = store_write_pages(s, k, r, msg, msg_size);
-    s->stats.regions_written++;
-    return st;
-}
-
-cm_status store_begin(cm_store *s, char *msg, size_t msg_size)
-{
-    if (!s->writable)
-        return cm_fail(CM_EINVAL, msg, msg_size, "%s is open read-only", s->path);
-    if (s->failed)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "an earlier write to %s failed; reopen it (solve --resume) to go on",
-                       s->path);
-    if (!s->in_transaction) {
-        const cm_status st = store_use_wal(s, msg, msg_size);
-        if (st != CM_OK)
-            return st;
-        if (store_exec(s->db, "BEGIN IMMEDIATE") != SQLITE_OK)
-            return store_db_error(s->db, "begin", msg, msg_size);
-    }
-    s->in_transaction = 1;
-    return CM_OK;
-}
-
-/* Undoes the open transaction after a failed write. */
-cm_status store_abandon(cm_store *s, cm_status st)
-{
-    if (s->in_transaction)
-        store_exec(s->db, "ROLLBACK");
-    s->in_transaction = 0;
-    s->failed = 1;
-    return st;
-}
-
-/* The pager's other half: saves a dirty region about to be evicted, in the
- * transaction the next commit ends (a kill before it undoes the write). */
-cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
-{
-    cm_store *s = user;
-    const double t0 = store_seconds_now();
-    cm_status st = store_begin(s, msg, msg_size);
-    if (st == CM_OK)
-        st = write_region(s, c, k, msg, msg_size);
-    s->stats.regions_evicted++;
-    s->stats.evict_seconds += store_seconds_now() - t0;
-    return st == CM_OK ? CM_OK : store_abandon(s, st);
-}
 
 cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
     cm_status st = CM_OK;
     for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
         if (!c->regions[k].written)
-            st = write_region(s, c, k, msg, msg_size);
+            st = store_write_region(s, c, k, msg, msg_size);
     for (uint32_t k = 0; st == CM_OK && k < c->nregions; k++)
         if (c->regions[k].nodes_dirty)
             st = store_write_nodes(s, c, k, msg, msg_size);
@@ -334,3 +271,4 @@ cm_status cm_store_largest_groups(cm_store *s, cm_group_info *groups, uint32_t k
               "WHERE id > 0 ORDER BY basin_cells DESC, id LIMIT ?1";
     return read_groups(s, sql, false, groups, k, sink_cells, msg, msg_size);
 }
+

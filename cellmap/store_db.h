@@ -66,9 +66,18 @@ extern const char *const store_tables_sql;
     "CREATE TABLE exit_fates(attractor INTEGER PRIMARY KEY, exits INTEGER NOT NULL,"               \
     " cells BLOB NOT NULL);"
 
+/* ---- store_sql.c: the lowest helpers, which call no other store file ---- */
 double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);
 int64_t store_query_int(sqlite3 *db, const char *sql);
+/* The text of the first column of the first row of sql into out. */
+cm_status store_read_text(sqlite3 *db, const char *sql, char *out, size_t size, char *msg,
+                          size_t msg_size);
+/* The meta table's value of key into out; CM_EFORMAT if it has none. */
+cm_status store_meta_text(sqlite3 *db, const char *key, char *out, size_t size, char *msg,
+                          size_t msg_size);
+/* SQLite's error, or for a full disk, a read-only or missing file the
+ * file system's reason with the file and the fix, after "what: ". */
 cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_size);
 /* Steps a statement that returns no row, and resets it. */
 cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char *msg,
@@ -76,13 +85,16 @@ cm_status store_step_done(sqlite3 *db, sqlite3_stmt *st, const char *what, char 
 void store_json_doubles(char *buf, size_t size, const double *v, int n);
 void store_json_ints(char *buf, size_t size, const int64_t *v, int n);
 /* Numbers of a JSON array text into out (at most cap); how many, or -1. */
-/* A CM_EFORMAT message prefixed "PATH is damaged: " unless it names the
- * file already; other statuses as they are. */
+int store_parse_json_numbers(const char *text, double *out, int cap);
+cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size);
 /* Puts the file in WAL mode for writing (once: the first store_begin). */
 cm_status store_use_wal(cm_store *s, char *msg, size_t msg_size);
-
+/* Transactions: begin one unless open; abandon rolls back after a failed write. */
+cm_status store_begin(cm_store *s, char *msg, size_t msg_size);
+cm_status store_abandon(cm_store *s, cm_status st);
+/* A CM_EFORMAT message prefixed "PATH is damaged: " unless it names the
+ * file already; other statuses as they are. */
 cm_status store_damaged(const cm_store *s, cm_status st, char *msg, size_t msg_size);
-
 /* Checks the groups: attractors numbered 1..N with periods, N what the
  * meta table says, basins of those groups only and within the cells. */
 cm_status store_check_groups(const cm_store *s, char *msg, size_t msg_size);
@@ -92,9 +104,7 @@ int64_t store_page_bytes(sqlite3 *db);
 /* Cells in the sink's basin (group 0); -1 on a database error. */
 int64_t store_sink_cells(const cm_store *s);
 
-int store_parse_json_numbers(const char *text, double *out, int cap);
-cm_status store_read_lattice(sqlite3 *db, cm_lattice *lat, char *msg, size_t msg_size);
-
+/* ---- store.c: files ---- */
 /* Opens and checks an existing file (full: every page too); old: a file of
  * version 2 or 3 may be opened for writing (to upgrade it). */
 cm_status store_open_checked(const char *path, int full, int writable, int old, sqlite3 **out,
@@ -102,10 +112,7 @@ cm_status store_open_checked(const char *path, int full, int writable, int old, 
 cm_status store_new(const char *path, sqlite3 *db, int writable, cm_store **out, char *msg,
                     size_t msg_size);
 
-/* Transactions: begin one unless open; abandon rolls back after a failed write. */
-cm_status store_begin(cm_store *s, char *msg, size_t msg_size);
-cm_status store_abandon(cm_store *s, cm_status st);
-
+/* ---- store_pages.c: regions, their pages and node tables ---- */
 /* Region k's row and exit table; its pages (each once). */
 cm_status store_insert_region(cm_store *s, uint32_t k, const cm_region *r, char *msg,
                               size_t msg_size);
@@ -114,13 +121,23 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
 /* Region k's node records (replacing the saved ones). */
 cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                             size_t msg_size);
-/* Region k's open nodes (replacing the saved ones). */
-cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *msg,
-                                 size_t msg_size);
-/* The pager (cm_page_in_fn and cm_page_out_fn with the store as user). */
+/* The node table's reader (cm_nodes_in_fn with the store as user). */
+cm_status store_nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
+                         size_t msg_size);
+/* The pager (cm_page_in_fn and cm_page_out_fn with the store as user):
+ * the page out saves a dirty region about to be evicted. */
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size);
 cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg,
                          size_t msg_size);
+/* Region k's row, exit table and pages, whole. */
+cm_status store_write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                             size_t msg_size);
+
+/* ---- store_commit.c: commits ---- */
+/* Region k's open nodes (replacing the saved ones). */
+cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *msg,
+                                 size_t msg_size);
+
 /* Everything the cluster changed since it was last saved, in the open
  * transaction (cm_store_commit without BEGIN and COMMIT). */
 cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_size);

@@ -194,8 +194,7 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
     return st;
 }
 
-static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
-                          size_t msg_size);
+
 
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
@@ -203,7 +202,7 @@ void cm_store_attach(cm_store *s, cm_cluster *c)
     s->cluster = c;
     c->page_in = store_page_in;
     c->page_out = s->writable ? store_page_out : NULL;
-    c->nodes_in = nodes_in;
+    c->nodes_in = store_nodes_in;
     c->pager = s;
 }
 
@@ -298,7 +297,7 @@ static cm_status read_nodes(cm_store *s, uint32_t k, uint64_t n, cm_node *nodes,
 }
 
 /* The pager of node tables (cm_nodes_in_fn). */
-static cm_status nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
+cm_status store_nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, char *msg,
                           size_t msg_size)
 {
     cm_store *s = user;
@@ -751,4 +750,32 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
     free(scratch);
     free(blob);
     return status;
+}
+
+/* Region k's row, exits and pages (a region saved whole). */
+cm_status store_write_region(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
+                             size_t msg_size)
+{
+    const cm_region *r = &c->regions[k].r;
+    if (!r->group)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
+    cm_status st = store_insert_region(s, k, r, msg, msg_size);
+    if (st == CM_OK)
+        st = store_write_pages(s, k, r, msg, msg_size);
+    s->stats.regions_written++;
+    return st;
+}
+
+/* The pager's other half: saves a dirty region about to be evicted, in the
+ * transaction the next commit ends (a kill before it undoes the write). */
+cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = store_seconds_now();
+    cm_status st = store_begin(s, msg, msg_size);
+    if (st == CM_OK)
+        st = store_write_region(s, c, k, msg, msg_size);
+    s->stats.regions_evicted++;
+    s->stats.evict_seconds += store_seconds_now() - t0;
+    return st == CM_OK ? CM_OK : store_abandon(s, st);
 }

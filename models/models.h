@@ -9,6 +9,7 @@
 #define CM_MODELS_MODELS_H
 
 #include "cellmap/model.h"
+#include "models/params.h" /* cm_model_setup */
 
 typedef cm_status (*cm_model_create_fn)(const cm_params *p, cm_model *m, char *msg,
                                         size_t msg_size);
@@ -37,9 +38,5 @@ cm_status cm_friction_oscillator_create(const cm_params *p, cm_model *m, char *m
                                         size_t msg_size);
 cm_status cm_duffing_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 
-/* Shared by the constructors: allocates a zeroed context of `size` bytes and
- * fills the common fields of *m. */
-cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
-                         size_t ctx_size, char *msg, size_t msg_size);
 
 #endif

@@ -162,3 +162,18 @@ void cm_params_format(const cm_params *p, char *buf, size_t size)
 {
     cm_params_format_with(p, NULL, buf, size);
 }
+
+cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
+                         size_t ctx_size, char *msg, size_t msg_size)
+{
+    memset(m, 0, sizeof *m);
+    m->ctx = calloc(1, ctx_size);
+    if (!m->ctx)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory building model %s", name);
+    m->name = name;
+    m->dim = dim;
+    m->params = p->spec;
+    m->values = *p;
+    m->destroy = free;
+    return CM_OK;
+}

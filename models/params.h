@@ -30,4 +30,9 @@ void cm_params_format(const cm_params *p, char *buf, size_t size);
  * list (the swept ones; skip itself may be NULL). */
 void cm_params_format_with(const cm_params *p, const char *const *skip, char *buf, size_t size);
 
+/* Shared by the constructors: allocates a zeroed context of `size` bytes and
+ * fills the common fields of *m. */
+cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
+                         size_t ctx_size, char *msg, size_t msg_size);
+
 #endif

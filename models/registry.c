@@ -180,21 +180,6 @@ void cm_model_set_close(cm_model_set *s)
     memset(s, 0, sizeof *s);
 }
 
-cm_status cm_model_setup(cm_model *m, const char *name, int dim, const cm_params *p,
-                         size_t ctx_size, char *msg, size_t msg_size)
-{
-    memset(m, 0, sizeof *m);
-    m->ctx = calloc(1, ctx_size);
-    if (!m->ctx)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory building model %s", name);
-    m->name = name;
-    m->dim = dim;
-    m->params = p->spec;
-    m->values = *p;
-    m->destroy = free;
-    return CM_OK;
-}
-
 cm_status cm_model_create(const char *name, const char *const *texts, int n_texts, cm_model *m,
                           char *msg, size_t msg_size)
 {

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "src/basin_png.h"
 #include "src/project.h"
 
 bool attractor_options_take(cli *c, cm_attractor_options *o, int *error)
@@ -82,13 +81,13 @@ void attractor_text(FILE *out, const cm_lattice *lat, const cm_attractor_set *s,
         for (uint32_t k = 0; k < s->n && (int)k < rows; k++) {
             const cm_attractor *a = &sorted[k];
             char centre[CM_MAX_DIM * CM_NUM_TEXT], period[16], bounds[2 * CM_MAX_DIM * CM_NUM_TEXT + 16] = "";
-            format_point(lat, a->centre, ", ", centre, sizeof centre);
+            cm_point_text(lat, a->centre, ", ", centre, sizeof centre);
             snprintf(period, sizeof period, a->kind == CM_ATTRACTOR_APERIODIC ? "-" : "%u",
                      a->period);
             if (a->kind == CM_ATTRACTOR_APERIODIC) {
                 char lo[CM_MAX_DIM * CM_NUM_TEXT], hi[CM_MAX_DIM * CM_NUM_TEXT];
-                format_point(lat, a->lo, ", ", lo, sizeof lo);
-                format_point(lat, a->hi, ", ", hi, sizeof hi);
+                cm_point_text(lat, a->lo, ", ", lo, sizeof lo);
+                cm_point_text(lat, a->hi, ", ", hi, sizeof hi);
                 snprintf(bounds, sizeof bounds, " in (%s)..(%s)", lo, hi);
             }
             fprintf(out, "%6u  %-9s %6s %12llu %6.1f%% %6u  (%s)%s\n", a->id,

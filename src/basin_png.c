@@ -251,32 +251,6 @@ static void figure_size(const cm_lattice *lat, const cm_box *box, unsigned layer
     *h = *h < 200 ? 200 : *h;
 }
 
-void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size)
-{
-    size_t used = 0;
-    out[0] = 0;
-    for (int d = 0; d < box->dim && used < size; d++) {
-        const double tol = CM_CELL_TOLERANCE * lat->width[d];
-        used += (size_t)snprintf(
-            out + used, size - used, "%s%s:%s", d ? "," : "",
-            cm_num_text_near(lat->origin[d] + (double)box->lo[d] * lat->width[d], tol,
-                             (char[CM_NUM_TEXT]){0}),
-            cm_num_text_near(lat->origin[d] + (double)box->hi[d] * lat->width[d], tol,
-                             (char[CM_NUM_TEXT]){0}));
-    }
-}
-
-void format_point(const cm_lattice *lat, const double *x, const char *sep, char *out,
-                  size_t size)
-{
-    size_t used = 0;
-    out[0] = 0;
-    for (int d = 0; d < lat->dim && used < size; d++)
-        used += (size_t)snprintf(out + used, size - used, "%s%s", d ? sep : "",
-                                 cm_num_text_near(x[d], CM_CELL_TOLERANCE * lat->width[d],
-                                                  (char[CM_NUM_TEXT]){0}));
-}
-
 const char *figure_font(void)
 {
     const char *env = getenv("CELLMAP_FONT");
@@ -318,7 +292,7 @@ static void make_provenance(const basin_png *b, const char *view, unsigned layer
     }
     cm_params_json(&b->model->values, p->params, sizeof p->params);
     snprintf(p->lattice, sizeof p->lattice, "origin %s width %s", origin, width);
-    format_box(lat, box, state, sizeof state);
+    cm_box_text(lat, box, state, sizeof state);
     snprintf(p->view, sizeof p->view, "box %s cells %s%s", state, counts, view);
     layers_text(layers, p->layers, sizeof p->layers);
     const cm_png_text texts[] = {{"Software", "cellmap " CELLMAP_VERSION},

@@ -119,12 +119,6 @@ int write_basin_png(const char *cmd, const basin_png *b);
  * down so that neither side exceeds 4096. */
 void default_image_size(const cm_lattice *lat, const cm_box *box, int *width, int *height);
 
-/* The box in state coordinates, "x0:x1,y0:y1,...", each edge the shortest
- * number within a billionth of a cell (0:500, not 0:500.00000000000006). */
-void format_box(const cm_lattice *lat, const cm_box *box, char *out, size_t size);
-/* A point in state coordinates to the same resolution, joined by sep. */
-void format_point(const cm_lattice *lat, const double *x, const char *sep, char *out,
-                  size_t size);
 
 /* The font for figure text: $CELLMAP_FONT, else the build's default. */
 const char *figure_font(void);

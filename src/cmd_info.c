@@ -26,7 +26,7 @@ static void print_cells(const cm_lattice *lat, const int64_t *cell)
     double x[CM_MAX_DIM];
     char text[CM_MAX_DIM * CM_NUM_TEXT];
     cm_lattice_centre(lat, cell, x);
-    format_point(lat, x, ", ", text, sizeof text);
+    cm_point_text(lat, x, ", ", text, sizeof text);
     fputs(text, stdout);
 }
 
@@ -57,7 +57,7 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
         printf("%s%s", d ? ", " : "", CM_NUM(lat->width[d]));
     printf(")\nmade by: %s\n", info->command);
     char box[CM_MAX_DIM * 2 * CM_NUM_TEXT];
-    format_box(lat, bounds, box, sizeof box);
+    cm_box_text(lat, bounds, box, sizeof box);
     printf("regions %u, cells %llu, bounding box %s (%llu cells)\n", info->regions,
            (unsigned long long)info->cells, box, (unsigned long long)cm_box_cells(bounds));
     if (att) {
@@ -71,7 +71,7 @@ static void print_text(const char *path, const cm_store_info *info, const cm_box
     printf("%6s %8s %12s  %s\n", "group", "period", "basin", "centre");
     for (uint32_t k = 0; k < info->groups && k < SHOWN_GROUPS; k++) {
         char centre[CM_MAX_DIM * CM_NUM_TEXT];
-        format_point(lat, g[k].centre, ", ", centre, sizeof centre);
+        cm_point_text(lat, g[k].centre, ", ", centre, sizeof centre);
         printf("%6u %8u %12llu  (%s)  anchor cell centre (", g[k].id, g[k].period,
                (unsigned long long)g[k].basin_cells, centre);
         print_cells(lat, g[k].anchor);

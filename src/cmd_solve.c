@@ -290,7 +290,7 @@ static void print_text(FILE *out, const cm_model *m, const cm_lattice *lat, cons
             "centre");
     for (uint32_t k = 0; k < ngroups && k < TEXT_GROUPS; k++) {
         char centre[CM_MAX_DIM * CM_NUM_TEXT], attractor[16];
-        format_point(lat, sorted[k].centre, ", ", centre, sizeof centre);
+        cm_point_text(lat, sorted[k].centre, ", ", centre, sizeof centre);
         const uint32_t at = sum->att.of_group[sorted[k].id];
         snprintf(attractor, sizeof attractor, at == CM_FATE_DIVERGED     ? "div."
                                               : at == CM_FATE_UNRESOLVED ? "?"
@@ -468,7 +468,7 @@ static void report_step(void *user, const project_step *s, int k)
     if (rep->a->json)
         return;
     char box[CM_MAX_DIM * 64];
-    format_box(rep->lat, &s->box, box, sizeof box);
+    cm_box_text(rep->lat, &s->box, box, sizeof box);
     fprintf(rep->a->report,
             "extend %d: box %s (%llu cells): %llu of the %llu escaping sequences of %llu cells "
             "led there; %u new groups (%u across borders); %.3f s\n",

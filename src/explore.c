@@ -569,7 +569,7 @@ static cm_status extend_step(session *s, const cm_box *tile, int step, const cm_
         return st;
     if (s->out) {
         char box[CM_MAX_DIM * 64], where[128] = "recorded before the interruption";
-        format_box(&s->c.lat, &choice.box, box, sizeof box);
+        cm_box_text(&s->c.lat, &choice.box, box, sizeof box);
         if (!given)
             snprintf(where, sizeof where, "where %llu of the %llu escaping sequences go",
                      (unsigned long long)choice.escaping, (unsigned long long)choice.all_escaping);
@@ -806,7 +806,7 @@ static void print_groups(const session *s, uint32_t ngroups, const cm_group_info
     for (uint32_t k = 0; k < n && k < STATS_GROUPS; k++) {
         const cm_group_info *gi = &g[ids[k].id - 1];
         char centre[CM_MAX_DIM * CM_NUM_TEXT];
-        format_point(&s->c.lat, gi->centre, ", ", centre, sizeof centre);
+        cm_point_text(&s->c.lat, gi->centre, ", ", centre, sizeof centre);
         fprintf(s->out, "%6u %8u %12llu %12llu  (%s)\n", gi->id, gi->period,
                 (unsigned long long)ids[k].cells, (unsigned long long)gi->basin_cells, centre);
     }
@@ -869,7 +869,7 @@ static void print_attractors(const session *s, const view_counts *v)
     for (uint32_t k = 0; k < n && k < STATS_GROUPS; k++) {
         const cm_attractor *a = &att->a[ids[k].id - 1];
         char centre[CM_MAX_DIM * CM_NUM_TEXT], period[16];
-        format_point(&s->c.lat, a->centre, ", ", centre, sizeof centre);
+        cm_point_text(&s->c.lat, a->centre, ", ", centre, sizeof centre);
         snprintf(period, sizeof period, a->kind == CM_ATTRACTOR_APERIODIC ? "-" : "%u", a->period);
         fprintf(s->out, "%6u  %-9s %6s %12llu %12llu  (%s)\n", a->id,
                 cm_attractor_kind_name(a->kind), period, (unsigned long long)ids[k].cells,
@@ -1013,7 +1013,7 @@ static cm_status cmd_export_view(session *s, char **t, int n, char *msg, size_t 
     if (has_cells && !has_window && s->have_view) {
         cm_box box;
         view_box(s, s->lo, s->hi, &box);
-        format_box(&s->c.lat, &box, window, sizeof window);
+        cm_box_text(&s->c.lat, &box, window, sizeof window);
         argv[argc++] = "--window";
         argv[argc++] = window;
     }

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Readers beside a writer (issue 45, item 3): `info`, `export --cells` and
-# `render` in a loop while `solve --split` writes a file, while an explore
+# Readers beside a writer (issue 45, item 3): `info`, `export --cells`,
+# `render` and the Python module's read() in a loop while `solve --split` writes a file, while an explore
 # session pans over one, and while a killed solve is resumed. No reader may
 # call the file damaged (a reader of a file in WAL mode keeps one snapshot
 # for its whole read), every writer exits 0 (readers that hold the switch
 # back to rollback mode off are waited for), and the final file reads as
 # the same solve without readers, cell by cell.
-# usage: concurrency_test.sh PATH/TO/cellmap
+# usage: concurrency_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
 set -u
 CM=$1
+SRC=$(realpath "$2")
+BUILD=$(realpath "$3")
 HERE=$(cd "$(dirname "$0")" && pwd)
 . "$HERE/testlib.sh"
 enter_workdir
@@ -21,10 +23,11 @@ enter_workdir
 reader_loop() {
   local file=$1 pid=$2 k=$3 runs=0 rc out
   while kill -0 "$pid" 2> /dev/null; do
-    case $(((runs + k) % 3)) in
+    case $(((runs + k) % 4)) in
       0) out=$("$CM" export "$file" --cells cells$k.csv --window 0:60,-40:-31 --quiet 2>&1 > /dev/null) ;;
       1) out=$("$CM" render "$file" --png view$k.png --view 0:60,-40:-31 --quiet 2>&1 > /dev/null) ;;
       2) out=$("$CM" info "$file" 2>&1 > /dev/null) ;;
+      3) out=$(python_read "$file" 2>&1 > /dev/null) ;;
     esac
     rc=$?
     runs=$((runs + 1))
@@ -35,6 +38,20 @@ reader_loop() {
   done
   echo "runs $runs"
 }
+
+# python_read FILE: the Python module (from the source tree, over the
+# build's libcellmap) reads a window as arrays; its exceptions name the
+# problem ("damaged" for damage), status 1
+python_read() {
+  env PYTHONPATH="$SRC/python" CELLMAP_LIB="$lib" LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0 \
+    /usr/bin/python3 -c 'import sys, cellmap
+r = cellmap.open(sys.argv[1]).read(view=[(0, 60), (-40, -31)])
+assert r.labels.size > 0' "$1"
+}
+lib=$(ls "$BUILD"/libcellmap.so.0 2> /dev/null | head -1)
+[ -n "$lib" ] || { echo "concurrency_test: no libcellmap.so.0 in $BUILD" >&2; exit 1; }
+preload=
+[ -n "${CELLMAP_SANITIZE:-}" ] && preload="$(gcc -print-file-name=libasan.so) $(gcc -print-file-name=libubsan.so)"
 
 # readers FILE PID: two reader loops beside the writer PID; their runs in
 # $n, each failure counted (not in a subshell: fail counts here)
