@@ -320,8 +320,11 @@ cm_status cm_solve(const cm_system *s, const cm_grid *grid, const cm_solve_optio
         split |= opt->split[d] > 1;
     solve_progress sp = {opt, 1};
     /* a single region records its exits: their orbits are followed */
-    cm_scm_options scm = {opt->max_steps, opt->threads, opt->progress ? images_progress : NULL,
-                          &sp, !split};
+    cm_scm_options scm = {.max_steps = opt->max_steps,
+                          .threads = opt->threads,
+                          .progress = opt->progress ? images_progress : NULL,
+                          .user = &sp,
+                          .record_exits = !split};
     cm_region r;
     cm_cluster c;
     cm_exits exits;

@@ -136,7 +136,7 @@ static void cell_mapping(const cm_model *m, const cm_te *t, long cells, esc_poin
         return;
     const cm_lattice lat = {1, {t->x0}, {t->rep_len / (double)cells}};
     const cm_box box = {1, {0}, {cells}};
-    const cm_scm_options opt = {1, 1, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1};
     cm_region r;
     char msg[256];
     memset(&r, 0, sizeof r);

@@ -389,7 +389,11 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
                              size_t msg_size)
 {
     /* exits recorded: their orbits are followed (cm_region_settle_exits) */
-    const cm_scm_options opt = {a->max_steps, a->threads, whole_progress, p, 1};
+    const cm_scm_options opt = {.max_steps = a->max_steps,
+                                .threads = a->threads,
+                                .progress = whole_progress,
+                                .user = p,
+                                .record_exits = 1};
     *t = (timing){"images", "classification", 0, 0};
     cm_status st = cm_region_alloc(r, box, msg, msg_size);
     const double t0 = progress_now();

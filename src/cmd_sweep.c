@@ -188,7 +188,9 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     const char *name = a->name;
     if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
         return CM_EINVAL;
-    const cm_scm_options opt = {a->max_steps, a->threads, NULL, NULL, 1}; /* exits followed */
+    const cm_scm_options opt = {.max_steps = a->max_steps,
+                                .threads = a->threads,
+                                .record_exits = 1}; /* exits followed */
     cm_region r;
     memset(&r, 0, sizeof r);
     cm_group_info *groups = NULL;

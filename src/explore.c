@@ -131,7 +131,9 @@ typedef struct computed {
 static cm_status compute_boxes(session *s, const cm_box *boxes, uint32_t n, computed *done,
                                char *msg, size_t msg_size)
 {
-    const cm_scm_options opt = {s->max_steps, s->threads, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = s->max_steps,
+                                .threads = s->threads,
+                                .record_exits = 1};
     cm_join_stats stats;
     const double t0 = now_seconds();
     cm_status st = cm_cluster_solve_boxes(&s->c, &s->model, boxes, n, &opt, cm_store_commit_join,

@@ -80,7 +80,7 @@ static void run_config(const config *c, int repeats)
         cm_group_info *g = NULL;
         cm_exits x;
         uint64_t sink;
-        const cm_scm_options opt = {c->max_steps, 2, NULL, NULL, 1};
+        const cm_scm_options opt = {.max_steps = c->max_steps, .threads = 2, .record_exits = 1};
         const double t0 = now();
         if (cm_region_alloc(&r, &box, msg, sizeof msg) != CM_OK ||
             cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK ||

@@ -47,8 +47,8 @@ int main(int argc, char **argv)
         uint32_t groups = 0;
         double bytes = 0;
         for (int k = -1; k < repeats; k++) {
-            const cm_scm_options opt = {1, 2, NULL, NULL, 1};
-            const cm_scm_options plain = {1, 2, NULL, NULL, 0};
+            const cm_scm_options opt = {.max_steps = 1, .threads = 2, .record_exits = 1};
+            const cm_scm_options plain = {.max_steps = 1, .threads = 2};
             /* one region, then the join of the second (each solved with 2 threads) */
             cm_cluster c;
             cm_region r[2];

@@ -75,7 +75,7 @@ int main(int argc, char **argv)
         count_events(window, t % 2 ? 0.095 : 0);
         for (int threads = 1; threads <= 2; threads++) {
             double rate[100];
-            const cm_scm_options opt = {1, threads, NULL, NULL, 0};
+            const cm_scm_options opt = {.max_steps = 1, .threads = threads};
             cm_scm_images(&m, window, &opt, &r, msg, sizeof msg); /* warm-up */
             for (int k = 0; k < repeats; k++) {
                 const double t0 = now();

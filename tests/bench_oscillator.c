@@ -91,7 +91,7 @@ int main(int argc, char **argv)
         for (int threads = 1; threads <= 2; threads++) {
             double orbit_rate[100], cell_rate[100];
             long events = 0;
-            const cm_scm_options opt = {1, threads, NULL, NULL, 0};
+            const cm_scm_options opt = {.max_steps = 1, .threads = threads};
             for (int k = 0; k < repeats; k++) {
                 orbit_rate[k] = (double)ORBITS * PERIODS / run_orbits(&o, starts, threads, &events);
                 const double t0 = now();

@@ -43,7 +43,7 @@ static void make_cells(const cm_model *m, const cm_lattice *lat, cm_region *flat
     cm_cluster c;
     cm_cluster_init(&c, lat);
     c.threads = 2;
-    const cm_scm_options opt = {1, 0, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = 1};
     const double t0 = now();
     if (cm_cluster_solve_boxes(&c, m, boxes, 4, &opt, NULL, NULL, NULL, msg, sizeof msg) != CM_OK ||
         cm_cluster_flatten(&c, &whole, flat, msg, sizeof msg) != CM_OK)

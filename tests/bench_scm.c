@@ -67,7 +67,7 @@ static void run_config(const config *c, double million, int repeats)
     double t_img[2][100], t_cls[2][100], t_tot[2][100];
     for (int k = -1; k < repeats; k++)
         for (int threads = 1; threads <= 2; threads++) {
-            const cm_scm_options opt = {c->max_steps, threads, NULL, NULL, 0};
+            const cm_scm_options opt = {.max_steps = c->max_steps, .threads = threads};
             const double t0 = now();
             if (cm_scm_images(&m, &lat, &opt, &r, msg, sizeof msg) != CM_OK)
                 die(msg);

@@ -110,7 +110,7 @@ static void run(const config *cf, const char *name, const char *db, uint64_t bud
             die("create", msg);
         cm_store_attach(s, &c);
     }
-    const cm_scm_options opt = {100000, 2, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 100000, .threads = 2, .record_exits = 1};
     const double t0 = now();
     if (cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, s ? cm_store_commit_join : NULL, s, NULL, msg,
                                sizeof msg) != CM_OK)
@@ -150,7 +150,7 @@ static void run_scm(const config *cf)
     setup(cf, &m, &lat);
     const int64_t nx = cf->tx * cf->side, ny = cf->ty * cf->side;
     const int64_t n = cf->tx * cf->ty;
-    const cm_scm_options opt = {100000, 1, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 100000, .threads = 1, .record_exits = 1};
     int failed = 0;
     const double t0 = now();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(2) reduction(| : failed)

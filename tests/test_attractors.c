@@ -55,7 +55,7 @@ static void solve_model(solved *v, const cm_model *m, const double lo[2], const 
     v->g = NULL;
     v->lat = (cm_lattice){2, {lo[0], lo[1]}, {(hi[0] - lo[0]) / nx, (hi[1] - lo[1]) / ny}};
     const cm_box box = {2, {0, 0}, {nx, ny}};
-    const cm_scm_options opt = {max_steps, threads, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = max_steps, .threads = threads, .record_exits = 1};
     uint64_t sink;
     CHECK(cm_region_alloc(&v->r, &box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(m, &v->lat, &opt, &v->r, msg, sizeof msg) == CM_OK);

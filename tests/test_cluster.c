@@ -91,7 +91,7 @@ static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *
                         cm_region *r)
 {
     char msg[256];
-    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = max_steps};
     CHECK(cm_region_alloc(r, box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(m, lat, &opt, r, msg, sizeof msg) == CM_OK);
 }
@@ -104,7 +104,7 @@ static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_b
     char msg[256];
     cm_cluster c;
     cm_cluster_init(&c, lat);
-    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = max_steps, .record_exits = 1};
     *straddling = 0;
     for (uint32_t k = 0; k < n; k++) {
         cm_region r;
@@ -284,7 +284,7 @@ static void test_scan_order(void)
     solve_whole(&m, &lat, &whole, 1, &whole_r);
     cm_cluster c;
     cm_cluster_init(&c, &lat);
-    const cm_scm_options opt = {1, 2, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 2, .record_exits = 1};
     CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) ==
           CM_OK);
     CHECK(cm_cluster_flatten(&c, &whole, &flat, msg, sizeof msg) == CM_OK);
@@ -315,7 +315,7 @@ static void test_solve_boxes_equals_joins(void)
     cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
     const cm_lattice lat = {2, {0, -40}, {500.0 / 300, 80.0 / 240}};
     const cm_box whole = {2, {0, 0}, {300, 240}};
-    const cm_scm_options opt = {1, 2, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 2, .record_exits = 1};
     cm_region whole_r;
     solve_whole(&m, &lat, &whole, 1, &whole_r);
     static cm_box boxes[256], ordered[256];
@@ -507,7 +507,7 @@ static void test_ids_stable(void)
     cm_model m = registry_model("microchaos-pd", "alpha=0.078,beta=0,P=0.007,D=0.02");
     const cm_lattice lat = {2, {0, -40}, {1, 0.25}};
     const cm_box left = {2, {0, 0}, {250, 320}}, right = {2, {250, 0}, {500, 320}};
-    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .record_exits = 1};
     char msg[256];
     cm_cluster c;
     cm_region r;
@@ -558,7 +558,7 @@ static void test_threads_identical(void)
         cm_cluster c;
         cm_cluster_init(&c, &lat);
         c.threads = t + 1;
-        const cm_scm_options opt = {1, t + 1, NULL, NULL, 1};
+        const cm_scm_options opt = {.max_steps = 1, .threads = t + 1, .record_exits = 1};
         CHECK(cm_cluster_solve_boxes(&c, &m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) ==
               CM_OK);
         CHECK(cm_cluster_flatten(&c, &whole, &flat[t], msg, sizeof msg) == CM_OK);
@@ -587,7 +587,7 @@ static void test_figs_4_26_to_4_28(void)
     const cm_lattice lat = {2, {85.4, -12.5}, {0.2, 0.025}};
     const cm_box left = {2, {0, 0}, {1000, 1000}}, right = {2, {1000, 0}, {2000, 1000}};
     const cm_box whole = {2, {0, 0}, {2000, 1000}};
-    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .record_exits = 1};
     const double sw2 = 2 / 0.007;
     char msg[256];
     cm_cluster c;
@@ -641,7 +641,7 @@ static void test_join_stage1(void)
     const cm_lattice lat = {2, {85.4, -12.5}, {0.2, 0.025}};
     const cm_box boxes[2] = {{2, {0, 0}, {1000, 1000}}, {2, {1000, 0}, {2000, 1000}}};
     const cm_box whole = {2, {0, 0}, {2000, 1000}};
-    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .record_exits = 1};
     char msg[256];
     cm_region parts[2], flat;
     uint8_t *pending[2];

@@ -191,7 +191,7 @@ static void solve_until_eviction(const char *db)
     cm_box boxes[16];
     for (int k = 0; k < 16; k++)
         boxes[k] = (cm_box){2, {100 * (k % 4), 100 * (k / 4)}, {100 * (k % 4) + 100, 100 * (k / 4) + 100}};
-    const cm_scm_options opt = {1, 1, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
     cm_cluster_solve_boxes(&c, &m, boxes, 16, &opt, count_commit, s, NULL, msg, sizeof msg);
     _exit(2); /* no region was ever saved in a join: the test cannot run */
 }

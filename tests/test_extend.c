@@ -28,7 +28,7 @@ static cm_model fig_model(void)
 
 static void add_boxes(cm_cluster *c, const cm_model *m, const cm_box *boxes, uint32_t n)
 {
-    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .record_exits = 1};
     char msg[256];
     CHECK(cm_cluster_solve_boxes(c, m, boxes, n, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
 }
@@ -251,7 +251,7 @@ static void test_fig_4_25(void)
             85.4 + 0.2 * (double)choice.box.lo[0], 85.4 + 0.2 * (double)choice.box.hi[0]);
     CHECK(2 * choice.escaping > choice.all_escaping); /* most of them */
     cm_join_stats stats;
-    const cm_scm_options opt = {1, 0, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .record_exits = 1};
     CHECK(cm_cluster_solve_boxes(&c, &m, &choice.box, 1, &opt, NULL, NULL, &stats, msg,
                                  sizeof msg) == CM_OK);
     CHECK(stats.straddling_groups > 0);

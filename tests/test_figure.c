@@ -37,7 +37,7 @@ static void solve(scene *s, const char *model, const char *params, const cm_latt
     CHECK(cm_model_create(model, texts, 1, &s->m, msg, sizeof msg) == CM_OK);
     s->lat = *lat;
     CHECK(cm_region_alloc(&s->r, box, msg, sizeof msg) == CM_OK);
-    const cm_scm_options opt = {1, 0, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = 1};
     CHECK(cm_scm_solve(&s->m, lat, &opt, &s->r, msg, sizeof msg) == CM_OK);
     s->g = calloc(s->r.ngroups + 1, sizeof *s->g);
     cm_scm_groups(&s->r, lat, s->g, NULL);

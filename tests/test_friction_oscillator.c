@@ -525,7 +525,7 @@ static void test_mirror_basins(void)
             k ? "S=0.32,S0=0.4,Omega=0.5,phi=3.141592653589793" : "S=0.32,S0=0.4,Omega=0.5,phi=0";
         cm_model m;
         CHECK(cm_model_create("friction-oscillator", &text, 1, &m, msg, sizeof msg) == CM_OK);
-        const cm_scm_options opt = {1000, 0, NULL, NULL, 0};
+        const cm_scm_options opt = {.max_steps = 1000};
         CHECK(cm_region_alloc(&r[k], &box, msg, sizeof msg) == CM_OK);
         CHECK(cm_scm_solve(&m, &lat, &opt, &r[k], msg, sizeof msg) == CM_OK);
         cm_model_release(&m);

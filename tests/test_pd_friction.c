@@ -316,7 +316,7 @@ static void test_sticking_groups(void)
         cm_model m;
         cm_region r;
         char msg[256];
-        const cm_scm_options opt = {100000, 0, NULL, NULL, 0};
+        const cm_scm_options opt = {.max_steps = 100000};
         CHECK(cm_model_create("microchaos-pd-friction", &texts[t], 1, &m, msg, sizeof msg) ==
               CM_OK);
         CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);

@@ -63,7 +63,7 @@ int main(void)
     cm_region r;
     char msg[256];
     CHECK(cm_region_alloc(&r, &box, msg, sizeof msg) == CM_OK);
-    const cm_scm_options opt = {1, 1, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1};
     CHECK(cm_scm_solve(&m, &lat, &opt, &r, msg, sizeof msg) == CM_OK);
     cm_group_info *g = calloc(r.ngroups, sizeof *g);
     cm_scm_groups(&r, &lat, g, NULL);

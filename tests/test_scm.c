@@ -92,7 +92,7 @@ static cm_status solve(const cm_model *m, const cm_lattice *lat, const cm_box *b
 {
     char msg[256];
     cm_status st = cm_region_alloc(r, box, msg, sizeof msg);
-    const cm_scm_options opt = {max_steps, threads, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = max_steps, .threads = threads};
     if (st == CM_OK)
         st = cm_scm_solve(m, lat, &opt, r, msg, sizeof msg);
     if (st != CM_OK)
@@ -395,7 +395,7 @@ static void solve_recorded(double by, cm_region *r)
     m.ctx = &by;
     const cm_lattice lat = {1, {0}, {1}};
     const cm_box box = {1, {0}, {1000}};
-    const cm_scm_options opt = {1, 2, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .threads = 2, .record_exits = 1};
     char msg[256];
     CHECK(cm_region_alloc(r, &box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(&m, &lat, &opt, r, msg, sizeof msg) == CM_OK);
@@ -523,7 +523,7 @@ static void test_step_n_equals_step(void)
                 box.hi[d] = d ? 90 : 300; /* rows of more than one batch */
             }
             cm_region a, b;
-            const cm_scm_options opt = {5, 2, NULL, NULL, 1};
+            const cm_scm_options opt = {.max_steps = 5, .threads = 2, .record_exits = 1};
             CHECK(cm_region_alloc(&a, &box, msg, sizeof msg) == CM_OK);
             CHECK(cm_region_alloc(&b, &box, msg, sizeof msg) == CM_OK);
             CHECK(cm_scm_images(&m, &lat, &opt, &a, msg, sizeof msg) == CM_OK);

@@ -120,7 +120,7 @@ static void solve_tiles(const cm_model *m, const char *path, int budget_regions,
         cm_store_attach(s, &c);
         c.mem_budget = (uint64_t)budget_regions * 12 * cm_box_cells(&boxes[0]);
     }
-    const cm_scm_options opt = {1, threads, NULL, NULL, 1};
+    const cm_scm_options opt = {.max_steps = 1, .threads = threads, .record_exits = 1};
     CHECK(cm_cluster_solve_boxes(&c, m, boxes, TX * TY, &opt,
                                  s && commit_each ? cm_store_commit_join : NULL, s, NULL, msg,
                                  sizeof msg) == CM_OK);

@@ -27,7 +27,7 @@ static solved run_model(const char *model, const char *params, double x0, double
     }
     const cm_lattice lat = {2, {x0, v0}, {(x1 - x0) / (double)nx, (v1 - v0) / (double)nv}};
     const cm_box box = {2, {0, 0}, {nx, nv}};
-    const cm_scm_options opt = {max_steps, 0, NULL, NULL, 0};
+    const cm_scm_options opt = {.max_steps = max_steps};
     CHECK(cm_region_alloc(&s.r, &box, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_solve(&m, &lat, &opt, &s.r, msg, sizeof msg) == CM_OK);
     CHECK(cm_scm_describe(&m, &lat, &s.r, &s.g, NULL, msg, sizeof msg) == CM_OK);
