@@ -10,7 +10,8 @@
  *
  * The contract, for every function here:
  * - Status. A function that can fail returns a cm_status: CM_OK (0) or a
- *   negative code (cellmap/status.h; cm_strerror names it). When msg is not
+ *   positive code (cellmap/status.h; cm_strerror describes it, cm_status_name
+ *   gives its symbol, e.g. "CM_EINVAL"). When msg is not
  *   NULL it receives a one-line reason that names the problem and its fix,
  *   NUL-terminated within msg_size bytes (256 is always enough to be
  *   useful). On failure no output object is made (*out is NULL) and no file
@@ -67,8 +68,10 @@ extern "C" {
 const char *cm_version(void);
 int cm_version_number(void);
 
-/* The name of a status code ("out of memory", ...). */
+/* The description of a status code ("out of memory", ...), and its
+ * symbolic name ("CM_ENOMEM"); static strings, never NULL. */
 const char *cm_strerror(cm_status st);
+const char *cm_status_name(cm_status st);
 
 /* ---- models -------------------------------------------------------------- */
 
@@ -205,7 +208,11 @@ void cm_result_free(cm_result *r);
 typedef struct cm_db cm_db;
 
 /* Opens a database read-only; a model from a plugin is loaded from the
- * path the file records (and refused if it changed). */
+ * path the file records (and refused if it changed). Regions are read
+ * back on demand and at most 256 MiB of them stay in memory (a larger
+ * cluster is paged: cm_db_read of a view reads only the regions it
+ * meets). A file being written by another process may be read: a reader
+ * sees one snapshot, the commits up to its open (docs/format.md). */
 cm_status cm_db_open(const char *path, cm_db **out, char *msg, size_t msg_size);
 /* The file's model: name, parameters as a JSON object. */
 const char *cm_db_model(const cm_db *db);

@@ -52,6 +52,10 @@ static void test_versions_and_errors(void)
     snprintf(text, sizeof text, "%d.%d.%d", CELLMAP_VERSION_MAJOR, CELLMAP_VERSION_MINOR,
              CELLMAP_VERSION_PATCH);
     CHECK(strcmp(cm_version(), text) == 0);
+    /* status codes: positive, described and named by the shared library */
+    CHECK(CM_OK == 0 && CM_EINVAL > 0 && CM_ENOTFOUND > 0);
+    CHECK(strcmp(cm_status_name(CM_EINVAL), "CM_EINVAL") == 0);
+    CHECK(strcmp(cm_strerror(CM_ENOMEM), "out of memory") == 0);
     cm_system *s = (cm_system *)1;
     char msg[256];
     CHECK(cm_system_new(NULL, "no-such-model", NULL, &s, msg, sizeof msg) == CM_ENOTFOUND);
