@@ -2,6 +2,8 @@
  * node records and new regions, one transaction per commit. */
 #include "cellmap/store_db.h"
 
+#include "cellmap/clock.h"
+
 #include "cellmap/codec.h"
 
 #include <stdio.h>
@@ -163,7 +165,7 @@ cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_
 
 cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
-    const double t0 = store_seconds_now();
+    const double t0 = cm_seconds();
     cm_status st = store_begin(s, msg, msg_size);
     if (st == CM_OK)
         st = store_write_changes(s, c, msg, msg_size);
@@ -173,7 +175,7 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
         return store_abandon(s, st);
     s->in_transaction = 0;
     cm_cluster_saved(c); /* the file now holds everything */
-    s->stats.commit_seconds += store_seconds_now() - t0;
+    s->stats.commit_seconds += cm_seconds() - t0;
     return CM_OK;
 }
 

@@ -67,7 +67,6 @@ extern const char *const store_tables_sql;
     " cells BLOB NOT NULL);"
 
 /* ---- store_sql.c: the lowest helpers, which call no other store file ---- */
-double store_seconds_now(void);
 int store_exec(sqlite3 *db, const char *sql);
 int64_t store_query_int(sqlite3 *db, const char *sql);
 /* The text of the first column of the first row of sql into out. */

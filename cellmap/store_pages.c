@@ -2,6 +2,8 @@
  * exit and node tables; the pager; loading a saved cluster. */
 #include "cellmap/store_db.h"
 
+#include "cellmap/clock.h"
+
 #include "cellmap/classify.h"
 #include "cellmap/codec.h"
 #include "cellmap/grow.h"
@@ -177,7 +179,7 @@ static cm_status check_cells(const cm_store *s, uint32_t k, const cm_region *r, 
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size)
 {
     cm_store *s = user;
-    const double t0 = store_seconds_now();
+    const double t0 = cm_seconds();
     cm_status st = read_pages(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = read_exits(s, k, r->nexits, r->box.dim, &r->exit_target, msg, msg_size);
@@ -190,7 +192,7 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
         r->image = r->group = r->step = NULL;
     }
     s->stats.regions_read++;
-    s->stats.read_seconds += store_seconds_now() - t0;
+    s->stats.read_seconds += cm_seconds() - t0;
     return st;
 }
 
@@ -301,13 +303,13 @@ cm_status store_nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, cha
                           size_t msg_size)
 {
     cm_store *s = user;
-    const double t0 = store_seconds_now();
+    const double t0 = cm_seconds();
     cm_status st = read_nodes(s, k, n, nodes, msg, msg_size);
     char why[256];
     if (st == CM_OK && s->cluster &&
         cm_cluster_check_nodes(s->cluster, k, nodes, s->cluster->ngroups, why, sizeof why) != CM_OK)
         st = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: %s", s->path, why);
-    s->stats.read_seconds += store_seconds_now() - t0;
+    s->stats.read_seconds += cm_seconds() - t0;
     return st;
 }
 
@@ -771,11 +773,11 @@ cm_status store_write_region(cm_store *s, const cm_cluster *c, uint32_t k, char 
 cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
 {
     cm_store *s = user;
-    const double t0 = store_seconds_now();
+    const double t0 = cm_seconds();
     cm_status st = store_begin(s, msg, msg_size);
     if (st == CM_OK)
         st = store_write_region(s, c, k, msg, msg_size);
     s->stats.regions_evicted++;
-    s->stats.evict_seconds += store_seconds_now() - t0;
+    s->stats.evict_seconds += cm_seconds() - t0;
     return st == CM_OK ? CM_OK : store_abandon(s, st);
 }

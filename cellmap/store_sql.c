@@ -7,6 +7,7 @@
 #include "cellmap/store_db.h"
 
 #include "cellmap/classify.h"
+#include "cellmap/clock.h"
 #include "cellmap/numtext.h"
 #include "cellmap/output.h"
 
@@ -95,13 +96,6 @@ cm_status store_db_error(sqlite3 *db, const char *what, char *msg, size_t msg_si
         return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, why);
     }
     return cm_fail(CM_EDB, msg, msg_size, "%s: %s", what, db ? sqlite3_errmsg(db) : "no database");
-}
-
-double store_seconds_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 int store_exec(sqlite3 *db, const char *sql) { return sqlite3_exec(db, sql, NULL, NULL, NULL); }

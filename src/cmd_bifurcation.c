@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/clock.h"
 #include "models/friction_oscillator.h"
 #include "models/params.h"
 #include "src/args.h"
@@ -450,7 +451,7 @@ int cmd_bifurcation(int argc, char **argv)
         for (int r = 0; r < a.runs; r++)
             s.res[(size_t)i * (size_t)a.runs + (size_t)r].valid = true;
     }
-    const double t0 = omp_get_wtime();
+    const double t0 = cm_seconds();
     progress pr;
     progress_start(&pr, "bifurcation", "runs", n_runs, a.out.quiet);
     interrupt_catch();
@@ -470,7 +471,7 @@ int cmd_bifurcation(int argc, char **argv)
         return interrupt_stopped("bifurcation", done, n_runs, "runs");
     }
     if (!a.out.quiet || a.out.json)
-        print_summary(&a, &base, &s, omp_get_wtime() - t0);
+        print_summary(&a, &base, &s, cm_seconds() - t0);
     bool ok = n_valid > 0;
     if (!ok)
         fprintf(stderr,

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/clock.h"
 #include "models/friction_oscillator.h"
 #include "models/map_lyapunov.h"
 #include "models/registry.h"
@@ -404,7 +405,7 @@ int cmd_lyapunov(int argc, char **argv)
         return EXIT_FAIL;
     }
     int invalid = 0;
-    const double t0 = omp_get_wtime();
+    const double t0 = cm_seconds();
     progress pr;
     progress_start(&pr, "lyapunov", "grid points", n, a.quiet);
     interrupt_catch();
@@ -426,7 +427,7 @@ int cmd_lyapunov(int argc, char **argv)
         overlay_free(&ov);
         return interrupt_stopped("lyapunov", done, n, "grid points");
     }
-    const double secs = omp_get_wtime() - t0;
+    const double secs = cm_seconds() - t0;
     size_t positive = 0, computed = 0, best = 0;
     for (size_t k = 0; k < n; k++) {
         computed += !isnan(v[k]);

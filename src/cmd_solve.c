@@ -1,6 +1,8 @@
 /* cellmap solve: simple cell mapping of one region, with a summary, a basin
  * PNG and a .cmdb database. */
 #include <math.h>
+
+#include "cellmap/clock.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -396,16 +398,16 @@ static cm_status solve_whole(const solve_args *a, const cm_model *m, const cm_la
                                 .record_exits = 1};
     *t = (timing){"images", "classification", 0, 0};
     cm_status st = cm_region_alloc(r, box, msg, msg_size);
-    const double t0 = progress_now();
+    const double t0 = cm_seconds();
     if (st == CM_OK)
         st = cm_scm_images(m, lat, &opt, r, msg, msg_size);
-    const double t1 = progress_now();
+    const double t1 = cm_seconds();
     if (st == CM_OK && interrupt_requested()) /* classification cannot stop half-way */
         st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     if (st == CM_OK)
         st = cm_scm_classify(r, a->threads, msg, msg_size);
     t->t1 = t1 - t0;
-    t->t2 = progress_now() - t1;
+    t->t2 = cm_seconds() - t1;
     return st;
 }
 
@@ -422,7 +424,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
     cm_status st =
         boxes && parts ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
     *t = (timing){"regions", "stage 1", 0, 0};
-    const double t0 = progress_now();
+    const double t0 = cm_seconds();
     if (st == CM_OK)
         project_split(plan, box, boxes);
     for (uint32_t k = 0; k < n && st == CM_OK; k++) {
@@ -430,7 +432,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
         if (st == CM_OK)
             st = cm_scm_solve(m, lat, &opt, &parts[k], msg, msg_size);
     }
-    const double t1 = progress_now();
+    const double t1 = cm_seconds();
     cm_stage1_stats stats;
     if (st == CM_OK)
         st = cm_join_stage1(parts, n, NULL, &stats, msg, msg_size);
@@ -439,7 +441,7 @@ static cm_status solve_stage1(const solve_args *a, const project_plan *plan, con
     for (uint32_t k = 0; k < n && st == CM_OK; k++)
         cm_flat_copy(&parts[k], r);
     t->t1 = t1 - t0;
-    t->t2 = progress_now() - t1;
+    t->t2 = cm_seconds() - t1;
     if (st == CM_OK && !a->json)
         fprintf(a->report, "stage 1 of the join of %u regions: of %llu sink cells, %llu now lead to groups, "
                "%llu leave every region, %llu are pending (left to Stage 2, drawn as the sink)\n",
@@ -577,14 +579,14 @@ static cm_status solve_cluster(const solve_args *a, const project_plan *plan, co
     rn->c.threads = a->threads;
     rn->c.mem_budget = a->mem;
     *t = (timing){"regions and joins", "summary", 0, 0};
-    const double t0 = progress_now();
+    const double t0 = cm_seconds();
     if (st == CM_OK)
         st = project_add_box(&rn->c, rn->store, m, plan, box, NULL, msg, msg_size);
     step_report rep = {a, lat, log};
     if (st == CM_OK && a->extend > 0)
         st = project_extend(&rn->c, rn->store, m, plan, box, report_step, &rep, &log->n,
                             log->stop, sizeof log->stop, msg, msg_size);
-    t->t1 = progress_now() - t0;
+    t->t1 = cm_seconds() - t0;
     return st;
 }
 
@@ -738,7 +740,7 @@ int cmd_solve(int argc, char **argv)
     cm_status st;
     if (!a.stage1 && (a.n_split || a.extend || a.db || a.png.has_view)) {
         /* a view is cut from a cluster */
-        const double t0 = progress_now();
+        const double t0 = cm_seconds();
         st = solve_cluster(&a, &plan, command, &m, &lat, &box, &rn, &t, log, msg, sizeof msg);
         progress_end(&pr);
         if (st == CM_ECANCELED) {
@@ -747,7 +749,7 @@ int cmd_solve(int argc, char **argv)
         }
         if (st != CM_OK || summarise_cluster(&rn, &m, &sum, msg, sizeof msg) != CM_OK)
             goto fail;
-        t.t2 = progress_now() - t0 - t.t1;
+        t.t2 = cm_seconds() - t0 - t.t1;
     } else {
         st = a.stage1 ? solve_stage1(&a, &plan, &m, &lat, &box, &r, &t, msg, sizeof msg)
                       : solve_whole(&a, &m, &lat, &box, &r, &t, &pr, msg, sizeof msg);
@@ -768,7 +770,7 @@ int cmd_solve(int argc, char **argv)
         if (cm_scm_describe(&m, &lat, &r, &sum.groups, &sum.sink, msg, sizeof msg) != CM_OK)
             goto fail;
     }
-    const double ta = progress_now();
+    const double ta = cm_seconds();
     a.att.threads = a.threads;
     /* the cells' groups: the region's, or the cluster's (resolved on the way) */
     cm_status found = r.group ? cm_region_attractors(&m, &lat, &r, a.max_steps, &sum.exits,
@@ -783,7 +785,7 @@ int cmd_solve(int argc, char **argv)
         sum.att.outside_steps = 0;
         sum.att.outside_cells = sum.sink;
     }
-    sum.att_seconds = progress_now() - ta;
+    sum.att_seconds = cm_seconds() - ta;
     cm_attractor_options used;
     cm_attractor_defaults(&m, &a.att, &used);
     used.threads = 0;

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/clock.h"
 #include "cellmap/scm.h"
 #include "src/args.h"
 #include "src/attractor_report.h"
@@ -183,7 +184,7 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
 {
     memset(pt, 0, sizeof *pt);
     pt->value = value;
-    const double t0 = omp_get_wtime();
+    const double t0 = cm_seconds();
     cm_model m;
     const char *name = a->name;
     if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
@@ -219,7 +220,7 @@ static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_b
     free(groups);
     cm_region_free(&r);
     cm_model_release(&m);
-    pt->seconds = omp_get_wtime() - t0;
+    pt->seconds = cm_seconds() - t0;
     return st;
 }
 

@@ -1,4 +1,6 @@
 #include "src/explore.h"
+
+#include "cellmap/clock.h"
 #include "src/json.h"
 
 #include <math.h>
@@ -43,13 +45,6 @@ const char session_help[] =
 /* By default a command may compute at most this many new cells (12 bytes each). */
 #define MAX_NEW_CELLS (UINT64_C(1) << 28)
 enum { MAX_TOKENS = 24, VIEW_TEXT = 512 };
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- the view ------------------------------------------------------------ */
 
@@ -135,10 +130,10 @@ static cm_status compute_boxes(session *s, const cm_box *boxes, uint32_t n, comp
                                 .threads = s->threads,
                                 .record_exits = 1};
     cm_join_stats stats;
-    const double t0 = now_seconds();
+    const double t0 = cm_seconds();
     cm_status st = cm_cluster_solve_boxes(&s->c, &s->model, boxes, n, &opt, cm_store_commit_join,
                                           s->store, &stats, msg, msg_size);
-    done->seconds += now_seconds() - t0;
+    done->seconds += cm_seconds() - t0;
     s->grew |= n > 0;
     if (st != CM_OK)
         return st;
@@ -557,7 +552,7 @@ static cm_status extend_step(session *s, const cm_box *tile, int step, const cm_
     cm_extend_choice choice;
     memset(&choice, 0, sizeof choice);
     computed done = {0};
-    const double t0 = now_seconds();
+    const double t0 = cm_seconds();
     cm_status st = CM_OK;
     if (given)
         choice.box = *given;
@@ -580,7 +575,7 @@ static cm_status extend_step(session *s, const cm_box *tile, int step, const cm_
                 "group%s (%u across borders); %.1f ms\n",
                 step, box, where, (unsigned long long)done.cells, done.regions,
                 done.regions == 1 ? "" : "s", done.new_groups, done.new_groups == 1 ? "" : "s",
-                done.straddling, 1e3 * (now_seconds() - t0));
+                done.straddling, 1e3 * (cm_seconds() - t0));
         fflush(s->out);
     }
     return CM_OK;
@@ -738,7 +733,7 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
         st = need_view(s, "render", msg, msg_size);
     if (st != CM_OK)
         return st;
-    const double t0 = now_seconds();
+    const double t0 = cm_seconds();
     cm_region flat;
     cm_group_info *groups = NULL;
     memset(&flat, 0, sizeof flat);
@@ -766,7 +761,7 @@ static cm_status session_render(session *s, char **t, int n, char *msg, size_t m
     if (st == CM_OK && write_basin_png("explore", &png) != EXIT_OK)
         st = cm_fail(CM_ERENDER, msg, msg_size, "render: %s was not written (see above)", t[1]);
     if (st == CM_OK && s->out) {
-        fprintf(s->out, "render %s: %.1f ms\n", t[1], 1e3 * (now_seconds() - t0));
+        fprintf(s->out, "render %s: %.1f ms\n", t[1], 1e3 * (cm_seconds() - t0));
         fflush(s->out);
     }
     cm_region_free(&flat);

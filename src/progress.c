@@ -1,21 +1,16 @@
 /* src/progress.c - the progress line (src/progress.h). */
 #include "src/progress.h"
 
+#include "cellmap/clock.h"
+
 #include <omp.h>
 #include <stdio.h>
 #include <time.h>
 #include <unistd.h>
 
-double progress_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void progress_start(progress *p, const char *cmd, const char *unit, uint64_t total, bool quiet)
 {
-    *p = (progress){cmd, unit, total, !quiet && isatty(STDERR_FILENO), 0, progress_now(), 0};
+    *p = (progress){cmd, unit, total, !quiet && isatty(STDERR_FILENO), 0, cm_seconds(), 0};
 }
 
 /* n units as people read them: 950, 12.3 k, 1.2 M */
@@ -31,7 +26,7 @@ static void amount(double n, char *out, size_t size)
 
 void progress_say(progress *p, uint64_t done, const char *what)
 {
-    const double t = progress_now();
+    const double t = cm_seconds();
     if (!p->show || t - p->last < 0.2)
         return;
     p->last = t;

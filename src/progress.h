@@ -30,7 +30,4 @@ void progress_tick(progress *p, uint64_t *done);
  * an error) starts at the left; the next progress_say draws it again. */
 void progress_end(progress *p);
 
-/* Seconds on a monotonic clock. */
-double progress_now(void);
-
 #endif

@@ -1,5 +1,7 @@
 #include "src/project.h"
 
+#include "cellmap/clock.h"
+
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -315,13 +317,6 @@ cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const p
     return st;
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Extension steps a resumed cluster has done, and the tile of a step that
  * was interrupted between its regions (or the empty box). */
 static int steps_done(const project_plan *p, const cm_cluster *c, const cm_box *tile,
@@ -347,7 +342,7 @@ cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const pr
     snprintf(stop, stop_size, "%d extension steps done", p->extend);
     for (*steps = 0; done + *steps < p->extend && st == CM_OK; ++*steps) {
         cm_extend_choice choice;
-        const double t0 = now_seconds();
+        const double t0 = cm_seconds();
         st = cm_extend_choose(c, tile, p->bounds, &choice, msg, msg_size);
         const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
         if (st == CM_OK && fraction < p->escape_below) {
@@ -366,7 +361,7 @@ cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const pr
             break;
         const project_step step = {choice.box,           choice.escaping,  choice.all_escaping,
                                    choice.cluster_cells, stats.new_groups, stats.straddling_groups,
-                                   now_seconds() - t0};
+                                   cm_seconds() - t0};
         if (step_done)
             step_done(user, &step, *steps);
     }
