@@ -70,25 +70,6 @@ static int parse_render(cli *c, render_args *a)
     return err;
 }
 
-/* The view explore saved ("X0:X1 Y0:Y1 ..."), if any and readable. */
-static bool saved_view(cm_store *s, int dims, double lo[2], double hi[2])
-{
-    char text[1024], msg[256];
-    if (cm_store_get_note(s, "note.explore.view", text, sizeof text, msg, sizeof msg) != CM_OK)
-        return false;
-    char *p = text;
-    for (int d = 0; d < dims; d++) {
-        const size_t n = strcspn(p, " ");
-        char range[256];
-        int count = 0;
-        snprintf(range, sizeof range, "%.*s", (int)n, p);
-        if (!parse_ranges(range, &lo[d], &hi[d], &count, 1) || count != 1)
-            return false;
-        p += n + (p[n] == ' ');
-    }
-    return true;
-}
-
 /* The cells to draw: the view's rectangle, and the slice in dims 3... */
 static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const cm_cluster *cl,
                          double lo[2], double hi[2], cm_box *box)
@@ -100,7 +81,7 @@ static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const 
     if (a->png.has_view) {
         memcpy(lo, a->png.lo, 2 * sizeof *lo);
         memcpy(hi, a->png.hi, 2 * sizeof *hi);
-    } else if (!saved_view(s, dims, lo, hi)) {
+    } else if (project_view_note(s, dims, lo, hi, (char[256]){0}, 256) != CM_OK) {
         for (int d = 0; d < dims; d++) {
             lo[d] = lat->origin[d] + (double)bounds.lo[d] * lat->width[d];
             hi[d] = lat->origin[d] + (double)bounds.hi[d] * lat->width[d];

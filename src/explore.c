@@ -1170,21 +1170,17 @@ static int restore_depth(session *s)
 /* The view saved by the last session, or the cluster's bounding box. */
 static int restore_view(session *s)
 {
-    char text[VIEW_TEXT], msg[256], *t[MAX_TOKENS];
-    if (cm_store_get_note(s->store, "note.explore.view", text, sizeof text, msg, sizeof msg) ==
-        CM_OK) {
-        const int n = tokenize(text, t, MAX_TOKENS, msg, sizeof msg);
-        double lo[2], hi[2];
-        for (int d = 0; d < s->view_dims; d++) {
-            int count = 0;
-            if (d >= n || !parse_ranges(t[d], &lo[d], &hi[d], &count, 1))
-                return open_error("%s is damaged: its view note is not a view", s->path);
-        }
+    char msg[256], slice[VIEW_TEXT];
+    double lo[2], hi[2];
+    const cm_status noted = project_view_note(s->store, s->view_dims, lo, hi, slice, sizeof slice);
+    if (noted == CM_EFORMAT)
+        return open_error("%s is damaged: its view note is not a view", s->path);
+    if (noted == CM_OK) {
         if (check_view(s, lo, hi, "the view note", msg, sizeof msg) != CM_OK)
             return open_error("%s is damaged: %s", s->path, msg);
         memcpy(s->lo, lo, sizeof lo);
         memcpy(s->hi, hi, sizeof hi);
-        if (n == s->view_dims + 2 && parse_slice(s, t[n - 1], s->slice, msg, sizeof msg) != CM_OK)
+        if (slice[0] && parse_slice(s, slice, s->slice, msg, sizeof msg) != CM_OK)
             return open_error("%s is damaged: its view note: %s", s->path, msg);
         s->have_view = 1;
     } else if (s->c.nregions > 0) {

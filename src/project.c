@@ -56,6 +56,31 @@ int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm
     return EXIT_OK;
 }
 
+cm_status project_view_note(cm_store *s, int dims, double lo[2], double hi[2], char *slice,
+                            size_t slice_size)
+{
+    char text[1024], ignored[64];
+    slice[0] = '\0';
+    if (cm_store_get_note(s, "note.explore.view", text, sizeof text, ignored, sizeof ignored) !=
+        CM_OK)
+        return CM_ENOTFOUND;
+    const char *p = text;
+    for (int d = 0; d < dims; d++) {
+        const size_t n = strcspn(p, " ");
+        char range[256];
+        int count = 0;
+        snprintf(range, sizeof range, "%.*s", (int)(n < 255 ? n : 255), p);
+        if (n == 0 || n > 255 || !parse_ranges(range, &lo[d], &hi[d], &count, 1) || count != 1)
+            return CM_EFORMAT;
+        p += n + (p[n] == ' ');
+    }
+    if (strncmp(p, "at ", 3) == 0 && p[3] && !strchr(p + 3, ' '))
+        snprintf(slice, slice_size, "%s", p + 3);
+    else if (*p)
+        return CM_EFORMAT;
+    return CM_OK;
+}
+
 void project_close(cm_store *s, cm_cluster *c)
 {
     char msg[256];

@@ -33,6 +33,15 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
 int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
                       cm_store_info *info, cm_cluster *c);
 
+/* The view an explore session saved in the file, note.explore.view:
+ * "X0:X1 Y0:Y1[ at V3,V4,...]" (explore writes it; V3.. are the slice's
+ * states in dimensions 3..). The ranges of the first dims (1 or 2)
+ * dimensions go to lo and hi, the text after " at " to slice (""
+ * without). CM_ENOTFOUND when the file has none, CM_EFORMAT when the
+ * note is not such a view. */
+cm_status project_view_note(cm_store *s, int dims, double lo[2], double hi[2], char *slice,
+                            size_t slice_size);
+
 /* Closes what project_open_read, project_create or project_resume opened. */
 void project_close(cm_store *s, cm_cluster *c);
 
