@@ -1115,13 +1115,6 @@ static int model_of_file(session *s, const session_options *o, const cm_store_in
     return EXIT_OK;
 }
 
-/* max-steps from a file's plan ("... max-steps K ..."); 1 if it has none. */
-static int plan_max_steps(const char *plan)
-{
-    const char *p = strstr(plan, "max-steps ");
-    return p ? atoi(p + 10) : 1;
-}
-
 static void format_depth(const session *s, char *out, size_t size)
 {
     size_t used = 0;
@@ -1262,7 +1255,15 @@ static cm_status fits_session(void *user, const cm_store_info *info, const cm_mo
                               char *msg, size_t msg_size)
 {
     explore_fit *f = user;
-    f->s->max_steps = plan_max_steps(info->plan);
+    f->s->max_steps = 1; /* a plan without max-steps; 0 (a solve's default) is 1 too */
+    if (project_plan_int(info->plan, "max-steps", 0, MAX_STEPS_LIMIT, &f->s->max_steps) ==
+        CM_EFORMAT) {
+        f->rc = open_error("%s is damaged: its plan '%s' has no valid max-steps", f->s->path,
+                           info->plan);
+        return cm_fail(CM_EINVAL, msg, msg_size, "refused"); /* reported */
+    }
+    if (f->s->max_steps < 1)
+        f->s->max_steps = 1;
     f->rc = model_of_file(f->s, f->o, info);
     if (f->rc == EXIT_OK)
         f->rc = check_same(f->s, f->o, info);

@@ -3,6 +3,7 @@
 #include "cellmap/clock.h"
 
 #include <stdbool.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -264,6 +265,23 @@ void project_plan_text(const project_plan *p, const cm_box *box, char *out, size
         snprintf(out + used, size - used, " max-steps %d extend %d escape-below %.17g bounds %s",
                  p->opt.max_steps, p->extend, p->escape_below,
                  p->bounds_text ? p->bounds_text : "-");
+}
+
+cm_status project_plan_int(const char *plan, const char *key, int lo, int hi, int *value)
+{
+    const size_t n = strlen(key);
+    for (const char *p = plan; p && *p; p = strchr(p, ' '), p = p ? p + 1 : NULL) {
+        if (strncmp(p, key, n) != 0 || p[n] != ' ')
+            continue;
+        char *end;
+        errno = 0;
+        const long v = strtol(p + n + 1, &end, 10);
+        if (end == p + n + 1 || (*end && *end != ' ') || errno || v < lo || v > hi)
+            return CM_EFORMAT;
+        *value = (int)v;
+        return CM_OK;
+    }
+    return CM_ENOTFOUND;
 }
 
 /* Splits into more boxes than this are joined in scan order along their

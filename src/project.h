@@ -97,6 +97,11 @@ typedef struct project_plan {
  * split, the steps). */
 void project_plan_text(const project_plan *p, const cm_box *box, char *out, size_t size);
 
+/* The whole number after the word `key` in a plan's text ("... max-steps
+ * 50 ..."), within lo..hi: CM_OK, CM_ENOTFOUND when the plan has no such
+ * word, CM_EFORMAT when what follows it is not such a number. */
+cm_status project_plan_int(const char *plan, const char *key, int lo, int hi, int *value);
+
 /* The box cut as the plan says: returns the number of parts; boxes (may be
  * NULL: only counted) receives them. */
 uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes);
