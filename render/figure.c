@@ -1,5 +1,7 @@
 #include "render/figure.h"
 
+#include "cellmap/clock.h"
+
 #include "render/figure_parts.h"
 
 #include <math.h>
@@ -17,13 +19,6 @@ enum { OVERLAY_CAP = 1 << 16 }; /* more lines than this would paint the view ove
 
 static const cm_rgb ink = {0, 0, 0};
 static const cm_rgb paper = {255, 255, 255};
-
-static double seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 /* ---- legend --------------------------------------------------------------------- */
 
@@ -517,9 +512,9 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
 {
     memset(info, 0, sizeof *info);
     figure F;
-    double t0 = seconds();
+    double t0 = cm_seconds();
     cm_status st = figure_begin(lat, r, groups, opt, &F, msg, msg_size);
-    info->raster_s = seconds() - t0;
+    info->raster_s = cm_seconds() - t0;
     const cm_render_options *o = &F.o;
     const cm_plot *p = &F.p;
     const cm_canvas c = {rgba, o->width, o->height};
@@ -529,14 +524,14 @@ cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_g
         cm_fill_rect(&c, 0, p->y + p->h, o->width, o->height - p->y - p->h, paper);
         cm_fill_rect(&c, 0, p->y, p->x, p->h, paper);
         cm_fill_rect(&c, p->x + p->w, p->y, o->width - p->x - p->w, p->h, paper);
-        t0 = seconds();
+        t0 = cm_seconds();
         st = cm_plot_draw(p, rgba, o->width, &info->tiles, msg, msg_size);
-        info->gl_s = seconds() - t0;
+        info->gl_s = cm_seconds() - t0;
     }
     if (st == CM_OK && F.w.font) {
-        t0 = seconds();
+        t0 = cm_seconds();
         draw_text_layers(o, &F.w, &F.L, p, &c);
-        info->text_s = seconds() - t0;
+        info->text_s = cm_seconds() - t0;
     }
     if (st == CM_OK) {
         info->plot_x = p->x + p->basin.x;
