@@ -48,6 +48,32 @@ static int partial_field(const cm_model *m, double t, const double *x, double *f
     return x[0] < 1 ? 0 : 1;
 }
 
+/* y' = 1 - e^(1000 (y - 5)): rises at rate 1 to a stiff wall at y = 5,
+ * where it stops. A step that the error control grows on the flat part
+ * overshoots the wall so far that the exponential overflows. */
+static int wall_field(const cm_model *m, double t, const double *x, double *f)
+{
+    (void)m, (void)t;
+    f[0] = 1 - exp(1000 * (x[0] - 5));
+    return 0;
+}
+
+/* The rotation, recording the time of the first field evaluation after
+ * the start (the first trial step's second stage). */
+typedef struct first_probe {
+    double t0, first;
+} first_probe;
+
+static int probed_rotation(const cm_model *m, double t, const double *x, double *f)
+{
+    first_probe *p = m->ctx;
+    if (t > p->t0 && p->first == 0)
+        p->first = t - p->t0;
+    f[0] = x[1];
+    f[1] = -x[0];
+    return 0;
+}
+
 static cm_model flow_model(int dim, cm_flow f, void *ctx)
 {
     cm_model m;
@@ -143,6 +169,28 @@ static void test_sinks(void)
     char msg[256];
     CHECK(cm_flow_attach(&bad, msg, sizeof msg) == CM_EINVAL);
     CHECK(strstr(msg, "period") != NULL);
+}
+
+/* The integrator's two guards against a step it cannot take (issue 45,
+ * item 4): the first trial step is at most a hundredth of the time the
+ * field takes to change the state by its size (|y| + 1), whatever the
+ * period; a step accepted with a non-finite state (its error estimate
+ * NaN) is taken back and tried shorter, so an orbit that never blows up
+ * is not called one. */
+static void test_step_guards(void)
+{
+    first_probe probe = {0, 0};
+    cm_model rot = flow_model(2, (cm_flow){.field = probed_rotation, .period = 640}, &probe);
+    const double start[2] = {1, 0};
+    double y[2];
+    CHECK_INT(rot.step(&rot, start, y), CM_STEP_OK);
+    /* scale |y| + 1 = 2, rate 1: a first step of at most 0.02 (period/64 is 10) */
+    CHECK(probe.first > 0 && probe.first <= 0.02);
+    CHECK_NEAR(y[0], cos(640), 1e-6);
+    cm_model wall = flow_model(1, (cm_flow){.field = wall_field, .period = 20}, NULL);
+    const double low[1] = {0};
+    CHECK_INT(wall.step(&wall, low, y), CM_STEP_OK);
+    CHECK_NEAR(y[0], 5, 1e-6);
 }
 
 /* step_n gives what step gives, bit for bit. */
@@ -332,6 +380,7 @@ int main(void)
     test_lyapunov();
     test_known_flows();
     test_sinks();
+    test_step_guards();
     test_duffing_basins();
     CHECK_DONE();
 }
