@@ -161,9 +161,8 @@ void cm_box_text(const cm_lattice *lat, const cm_box *box, char *out, size_t siz
         const double tol = CM_CELL_TOLERANCE * lat->width[d];
         used += (size_t)snprintf(
             out + used, size - used, "%s%s:%s", d ? "," : "",
-            cm_num_text_near(lat->origin[d] + (double)box->lo[d] * lat->width[d], tol,
-                             (char[CM_NUM_TEXT]){0}),
-            cm_num_text_near(lat->origin[d] + (double)box->hi[d] * lat->width[d], tol,
+            cm_num_text_near(cm_lattice_edge(lat, d, box->lo[d]), tol, (char[CM_NUM_TEXT]){0}),
+            cm_num_text_near(cm_lattice_edge(lat, d, box->hi[d]), tol,
                              (char[CM_NUM_TEXT]){0}));
     }
 }
@@ -177,4 +176,30 @@ void cm_point_text(const cm_lattice *lat, const double *x, const char *sep, char
         used += (size_t)snprintf(out + used, size - used, "%s%s", d ? sep : "",
                                  cm_num_text_near(x[d], CM_CELL_TOLERANCE * lat->width[d],
                                                   (char[CM_NUM_TEXT]){0}));
+}
+
+double cm_lattice_edge(const cm_lattice *lat, int d, int64_t border)
+{
+    return lat->origin[d] + (double)border * lat->width[d];
+}
+
+int64_t cm_lattice_border(const cm_lattice *lat, int d, double x, int round_up)
+{
+    const double c = (x - lat->origin[d]) / lat->width[d], nearest = floor(c + 0.5);
+    const double limit = (double)CM_WORLD_LIMIT; /* beyond it, the world's edge */
+    if (!(c > -limit))
+        return -CM_WORLD_LIMIT;
+    if (!(c < limit))
+        return CM_WORLD_LIMIT;
+    if (fabs(c - nearest) < 1e-9 * (fabs(c) + 1))
+        return (int64_t)nearest;
+    return (int64_t)(round_up ? ceil(c) : floor(c));
+}
+
+void cm_box_rect(const cm_lattice *lat, const cm_box *box, int n, double *lo, double *hi)
+{
+    for (int d = 0; d < n; d++) {
+        lo[d] = cm_lattice_edge(lat, d, box->lo[d]);
+        hi[d] = cm_lattice_edge(lat, d, box->hi[d]);
+    }
 }

@@ -92,4 +92,15 @@ void cm_box_text(const cm_lattice *lat, const cm_box *box, char *out, size_t siz
 void cm_point_text(const cm_lattice *lat, const double *x, const char *sep, char *out,
                    size_t size);
 
+/* The one rule between boxes of cells and rectangles of states.
+ * cm_lattice_edge: the state of cell border `border` in dimension d
+ * (origin + border * width). cm_lattice_border: the cell border at state x,
+ * below it (round_up 0) or above it (1), where x within a billionth of a
+ * cell of a border (relative to |x - origin| / width + 1, so that the rule
+ * is the same far from the origin) counts as on it; clamped to the world. */
+double cm_lattice_edge(const cm_lattice *lat, int d, int64_t border);
+int64_t cm_lattice_border(const cm_lattice *lat, int d, double x, int round_up);
+/* The rectangle of box's first n dimensions: lo[d], hi[d] for d < n. */
+void cm_box_rect(const cm_lattice *lat, const cm_box *box, int n, double *lo, double *hi);
+
 #endif

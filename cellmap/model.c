@@ -131,8 +131,8 @@ cm_status cm_model_check_box(const cm_model *m, const cm_lattice *lat, const cm_
         if (!cm_model_periodic(m, d))
             continue;
         const double w = lat->width[d], slack = 1e-9 * w;
-        const double lo = lat->origin[d] + (double)box->lo[d] * w;
-        const double hi = lat->origin[d] + (double)box->hi[d] * w;
+        const double lo = cm_lattice_edge(lat, d, box->lo[d]);
+        const double hi = cm_lattice_edge(lat, d, box->hi[d]);
         const double p = m->period[d], from = m->period_lo[d];
         const char *name = cm_model_coord_name(m, d);
         if (hi - lo > p + slack)

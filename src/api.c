@@ -356,11 +356,9 @@ void cm_result_grid(const cm_result *r, cm_grid *g)
 {
     const cm_box *b = &r->cells.box;
     *g = (cm_grid){b->dim, {0}, {0}, {0}};
-    for (int d = 0; d < b->dim; d++) {
-        g->lo[d] = r->lat.origin[d] + (double)b->lo[d] * r->lat.width[d];
-        g->hi[d] = r->lat.origin[d] + (double)b->hi[d] * r->lat.width[d];
+    cm_box_rect(&r->lat, b, b->dim, g->lo, g->hi);
+    for (int d = 0; d < b->dim; d++)
         g->cells[d] = b->hi[d] - b->lo[d];
-    }
 }
 
 uint64_t cm_result_cells(const cm_result *r) { return r->cells.ncells; }
@@ -526,11 +524,9 @@ void cm_db_grid(const cm_db *db, cm_grid *g)
     cm_cluster_bounds(&db->cluster, &box);
     const cm_lattice *lat = &db->cluster.lat;
     *g = (cm_grid){box.dim, {0}, {0}, {0}};
-    for (int d = 0; d < box.dim; d++) {
-        g->lo[d] = lat->origin[d] + (double)box.lo[d] * lat->width[d];
-        g->hi[d] = lat->origin[d] + (double)box.hi[d] * lat->width[d];
+    cm_box_rect(lat, &box, box.dim, g->lo, g->hi);
+    for (int d = 0; d < box.dim; d++)
         g->cells[d] = box.hi[d] - box.lo[d];
-    }
 }
 
 /* The cells of the lattice that meet lo..hi, within the cluster's bounds. */
@@ -548,12 +544,10 @@ static cm_status view_box(const cm_db *db, const double *lo, const double *hi, c
     for (int d = 0; d < lat->dim; d++) {
         if (!(lo[d] < hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size, "view dimension %d: lo must be below hi", d);
-        /* a billionth of a cell of slack: a view edge on a cell border
-         * takes no cell beyond it */
-        const double a = floor((lo[d] - lat->origin[d]) / lat->width[d] + 1e-9);
-        const double b = ceil((hi[d] - lat->origin[d]) / lat->width[d] - 1e-9);
-        box->lo[d] = (int64_t)fmax(a, (double)bounds.lo[d]);
-        box->hi[d] = (int64_t)fmin(b, (double)bounds.hi[d]);
+        /* a view edge on a cell border takes no cell beyond it */
+        const int64_t a = cm_lattice_border(lat, d, lo[d], 0), b = cm_lattice_border(lat, d, hi[d], 1);
+        box->lo[d] = a > bounds.lo[d] ? a : bounds.lo[d];
+        box->hi[d] = b < bounds.hi[d] ? b : bounds.hi[d];
         if (box->lo[d] >= box->hi[d])
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "the view misses the cluster in dimension %d (cellmap info lists "

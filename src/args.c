@@ -290,19 +290,6 @@ void join_argv(int argc, char **argv, char *buf, size_t size)
         used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? " " : "", argv[i]);
 }
 
-int64_t border_cell(double x, double origin, double width, int round_up)
-{
-    const double c = (x - origin) / width, nearest = floor(c + 0.5);
-    const double limit = (double)CM_WORLD_LIMIT; /* beyond it, the world's edge */
-    if (!(c > -limit))
-        return -CM_WORLD_LIMIT;
-    if (!(c < limit))
-        return CM_WORLD_LIMIT;
-    if (fabs(c - nearest) < 1e-9 * (fabs(c) + 1))
-        return (int64_t)nearest;
-    return (int64_t)(round_up ? ceil(c) : floor(c));
-}
-
 bool lattice_opts_take(cli *c, lattice_opts *lo, int *error)
 {
     if (cli_is(c, "--region", true, error)) {

@@ -109,11 +109,6 @@ bool lattice_opts_take(cli *c, lattice_opts *lo, int *error);
 int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
                        const cm_model_set *models, cm_lattice *lat, cm_box *box);
 
-/* The lattice coordinate of the cell border at or beyond state x (below
- * it, or above it if round_up), snapped to a border within rounding of x;
- * beyond the world (or NaN), the world's edge (+-CM_WORLD_LIMIT). */
-int64_t border_cell(double x, double origin, double width, int round_up);
-
 /* Command line joined by spaces (for provenance). */
 void join_argv(int argc, char **argv, char *buf, size_t size);
 

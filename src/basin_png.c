@@ -214,8 +214,8 @@ void view_cells(const cm_lattice *lat, const double lo[2], const double hi[2], c
 {
     *out = *within;
     for (int d = 0; d < lat->dim && d < 2; d++) {
-        out->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
-        out->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+        out->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
+        out->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
     }
     for (int d = 2; d < lat->dim; d++) {
         out->lo[d] = within->lo[d] + (within->hi[d] - within->lo[d]) / 2;
@@ -462,8 +462,8 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
         if (!ro.width || !ro.height)
             figure_size(lat, &shown, ro.layers, &ro.width, &ro.height);
         for (int d = 0; d < 2 && d < lat->dim; d++) {
-            ro.lo[d] = po->has_view ? po->lo[d] : lat->origin[d] + (double)box->lo[d] * lat->width[d];
-            ro.hi[d] = po->has_view ? po->hi[d] : lat->origin[d] + (double)box->hi[d] * lat->width[d];
+            ro.lo[d] = po->has_view ? po->lo[d] : cm_lattice_edge(lat, d, box->lo[d]);
+            ro.hi[d] = po->has_view ? po->hi[d] : cm_lattice_edge(lat, d, box->hi[d]);
         }
         ro.model = m;
         ro.font_path = figure_font();

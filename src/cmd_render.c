@@ -82,10 +82,7 @@ static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const 
         memcpy(lo, a->png.lo, 2 * sizeof *lo);
         memcpy(hi, a->png.hi, 2 * sizeof *hi);
     } else if (project_view_note(s, dims, lo, hi, (char[256]){0}, 256) != CM_OK) {
-        for (int d = 0; d < dims; d++) {
-            lo[d] = lat->origin[d] + (double)bounds.lo[d] * lat->width[d];
-            hi[d] = lat->origin[d] + (double)bounds.hi[d] * lat->width[d];
-        }
+        cm_box_rect(lat, &bounds, dims, lo, hi);
     }
     if (lat->dim == 1)
         lo[1] = hi[1] = 0;

@@ -210,8 +210,8 @@ static int make_bounds(const cli *c, const solve_args *a, const cm_lattice *lat,
         if (fabs(lo[d]) > 1e15 || fabs(hi[d]) > 1e15 ||
             fabs((hi[d] - lo[d]) / lat->width[d]) > 1e15)
             return cli_usage_error(c, "--bounds: range %d is too large for the lattice", d + 1);
-        bounds->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
-        bounds->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+        bounds->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
+        bounds->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
         if (bounds->lo[d] > box->lo[d] || bounds->hi[d] < box->hi[d])
             return cli_usage_error(c, "--bounds must contain the region (dimension %d)", d + 1);
     }

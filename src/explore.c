@@ -57,8 +57,8 @@ static void view_box(const session *s, const double *lo, const double *hi, cm_bo
     box->dim = s->dim;
     for (int d = 0; d < s->dim; d++) {
         if (d < s->view_dims) {
-            box->lo[d] = border_cell(lo[d], lat->origin[d], lat->width[d], 0);
-            box->hi[d] = border_cell(hi[d], lat->origin[d], lat->width[d], 1);
+            box->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
+            box->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
         } else {
             box->lo[d] = s->depth_lo[d];
             box->hi[d] = s->depth_hi[d];
@@ -1179,10 +1179,7 @@ static int restore_view(session *s)
     } else if (s->c.nregions > 0) {
         cm_box b;
         cm_cluster_bounds(&s->c, &b);
-        for (int d = 0; d < s->view_dims; d++) {
-            s->lo[d] = s->c.lat.origin[d] + (double)b.lo[d] * s->c.lat.width[d];
-            s->hi[d] = s->c.lat.origin[d] + (double)b.hi[d] * s->c.lat.width[d];
-        }
+        cm_box_rect(&s->c.lat, &b, s->view_dims, s->lo, s->hi);
         s->have_view = 1;
     }
     return EXIT_OK;
@@ -1311,8 +1308,8 @@ static int new_depth(session *s, const session_options *o)
         return EXIT_USAGE;
     }
     for (int d = 2; d < s->dim; d++) {
-        s->depth_lo[d] = border_cell(lo[d], s->c.lat.origin[d], s->c.lat.width[d], 0);
-        s->depth_hi[d] = border_cell(hi[d], s->c.lat.origin[d], s->c.lat.width[d], 1);
+        s->depth_lo[d] = cm_lattice_border(&s->c.lat, d, lo[d], 0);
+        s->depth_hi[d] = cm_lattice_border(&s->c.lat, d, hi[d], 1);
         s->slice[d] = s->depth_lo[d] + (s->depth_hi[d] - s->depth_lo[d]) / 2;
     }
     char depth[512], msg[512];

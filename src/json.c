@@ -153,8 +153,8 @@ void json_box(json *j, const char *key, const cm_lattice *lat, const cm_box *box
     for (int d = 0; d < box->dim; d++) {
         const double tol = CM_CELL_TOLERANCE * lat->width[d];
         json_array(j, NULL);
-        json_num_near(j, NULL, lat->origin[d] + (double)box->lo[d] * lat->width[d], tol);
-        json_num_near(j, NULL, lat->origin[d] + (double)box->hi[d] * lat->width[d], tol);
+        json_num_near(j, NULL, cm_lattice_edge(lat, d, box->lo[d]), tol);
+        json_num_near(j, NULL, cm_lattice_edge(lat, d, box->hi[d]), tol);
         json_array_end(j);
     }
     json_array_end(j);

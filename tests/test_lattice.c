@@ -140,8 +140,38 @@ static void test_idmap(void)
     cm_idmap_free(&m);
 }
 
+/* The one rule between rectangles and boxes: an edge within a billionth
+ * of a cell (relative) of a border is on it, near the origin and far from
+ * it alike; otherwise the box holds every cell the rectangle meets; a
+ * box's rectangle gives the box back. */
+static void rectangle_box_rule(void)
+{
+    const cm_lattice lat = {2, {-3.0, 100.0}, {0.25, 0.1}};
+    CHECK_INT(cm_lattice_border(&lat, 0, -3.0 + 4 * 0.25, 0), 4);
+    CHECK_INT(cm_lattice_border(&lat, 0, -3.0 + 4 * 0.25, 1), 4);
+    CHECK_INT(cm_lattice_border(&lat, 0, -2.1, 0), 3); /* c = 3.6 */
+    CHECK_INT(cm_lattice_border(&lat, 0, -2.1, 1), 4);
+    /* 10^7 cells out: 0.1 + 10^7 * 0.1 is not exactly representable */
+    const double far = 100.0 + 1e7 * 0.1;
+    CHECK_INT(cm_lattice_border(&lat, 1, far, 0), 10000000);
+    CHECK_INT(cm_lattice_border(&lat, 1, far, 1), 10000000);
+    CHECK_INT(cm_lattice_border(&lat, 1, far - 0.05, 0), 9999999);
+    CHECK_INT(cm_lattice_border(&lat, 1, far - 0.05, 1), 10000000);
+    CHECK_INT(cm_lattice_border(&lat, 0, 1e300, 1), CM_WORLD_LIMIT);
+    CHECK_INT(cm_lattice_border(&lat, 0, -1e300, 0), -CM_WORLD_LIMIT);
+    const cm_box box = {2, {-7, 9999990}, {12, 10000003}};
+    double lo[2], hi[2];
+    cm_box_rect(&lat, &box, 2, lo, hi);
+    for (int d = 0; d < 2; d++) {
+        CHECK_INT(cm_lattice_border(&lat, d, lo[d], 0), box.lo[d]);
+        CHECK_INT(cm_lattice_border(&lat, d, hi[d], 1), box.hi[d]);
+        CHECK(lo[d] == cm_lattice_edge(&lat, d, box.lo[d]));
+    }
+}
+
 int main(void)
 {
+    rectangle_box_rule();
     test_idmap();
     point_cell_round_trip();
     edges();
