@@ -165,6 +165,9 @@ expect_usage "the directory nodir does not exist" export plain.cmdb --labels nod
 expect_usage "the directory nodir does not exist" orbit --from 10,0 --steps 3 --csv nodir/x.csv
 mkdir adir
 expect_usage "the script adir is a directory" explore plain.cmdb adir
+long=$(printf 'n%.0s' $(seq 4190))
+expect_usage "the output file name nnnn" render plain.cmdb --png "$long.png"
+expect_usage "the output file name nnnn" export plain.cmdb --cells "$long.csv"
 # one wording for a stray argument, in every command
 for cmd in solve sweep render info export models orbit fixed-points lyapunov simulate bifurcation \
            continue amplitude escape stability horseshoe partition; do
