@@ -146,6 +146,20 @@ for stop in "line 2 step 2" "line 4 step 3" "line 4 step 7"; do
   wait $pid 2> /dev/null
 done
 journal ext-kill.cmdb | grep -q "line 4 step" || fail "not killed inside the second extend: $(journal ext-kill.cmdb)"
+# killed between two lines, after the first extend line was done: the
+# replay does not extend that line again (the zoom between takes ~0.3 s)
+printf 'view 100:150 -4:4\nextend auto 3\nzoom 0.5\nextend auto 2\n' > ext2.explore
+"$CM" explore ext2-ref.cmdb ext2.explore $pd $fine > /dev/null || fail "the reference of the second extend session"
+"$CM" explore ext2-kill.cmdb ext2.explore $pd $fine > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 3000); do journal ext2-kill.cmdb | grep -q "line 2 done" && break; sleep 0.005; done
+kill -9 $pid 2> /dev/null || fail "the second extend session ended before it was killed"
+wait $pid 2> /dev/null
+journal ext2-kill.cmdb | grep -q "line 2 done" || fail "not killed between the lines: $(journal ext2-kill.cmdb)"
+"$CM" explore ext2-kill.cmdb ext2.explore $pd $fine > ext2-replay.out || fail "the replay after a kill between lines"
+grep -q "^resuming this script's run that stopped after line 2" ext2-replay.out || fail "the replay: $(head -2 ext2-replay.out)"
+same_rows ext2-kill.cmdb ext2-ref.cmdb "SELECT lo || ' ' || hi FROM regions ORDER BY lo, hi" ||
+  fail "a kill between lines: the regions differ from one run's (the done extend line ran again?)"
 "$CM" explore ext-kill.cmdb ext.explore $pd $fine > ext-replay.out || fail "the replay after kills in extend auto"
 grep -q "^resuming this script's run that stopped in line 4 (extend auto, step [0-9]*)" ext-replay.out \
   || fail "the replay did not say it resumes: $(head -3 ext-replay.out)"

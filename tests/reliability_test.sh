@@ -175,6 +175,8 @@ for cmd in solve sweep render info export models orbit fixed-points lyapunov sim
   expect_usage "unexpected argument 'stray'" $cmd $file stray
   expect_usage "unknown option '--stray'" $cmd $file --stray
 done
+# a lone "-" is a stray word, not an option (where no output takes it)
+for cmd in solve models orbit stability partition; do expect_usage "unexpected argument '-'" $cmd -; done
 [ ! -e x.png ] && [ ! -e x.csv ] && [ ! -e x.cmdb ] || fail "a refused command wrote an output"
 ! compgen -G "*.tmp-*" > /dev/null || fail "refused commands left temporary files: $(ls ./*.tmp-*)"
 
