@@ -134,11 +134,11 @@ printf 'view 100:150 -4:4\nextend auto 2\n' > extend.explore
 # before it is computed, so the replay completes the interrupted step and
 # does not repeat the steps done (a replay used to extend N times more)
 fine="--cell-size 0.05,0.008"
-printf 'view 100:150 -4:4\nextend auto 3\npan right 10%%\nextend auto 9\nview 100:150 -4:4\n' > ext.explore
+printf 'view 100:150 -4:4\nextend auto 2\npan right 10%%\nextend auto 5\nview 100:150 -4:4\n' > ext.explore
 "$CM" explore ext-ref.cmdb ext.explore $pd $fine > /dev/null || fail "the reference extend session"
 journal() { sqlite3 -readonly "$1" "SELECT value FROM meta WHERE key = 'note.explore.journal'" 2> /dev/null; }
 journal ext-ref.cmdb | grep -q " complete$" || fail "the finished run's journal: $(journal ext-ref.cmdb)"
-for stop in "line 2 step 2" "line 4 step 3" "line 4 step 7"; do
+for stop in "line 2 step 2" "line 4 step 2" "line 4 step 4"; do
   "$CM" explore ext-kill.cmdb ext.explore $pd $fine > /dev/null 2>&1 &
   pid=$!
   for _ in $(seq 1500); do journal ext-kill.cmdb | grep -q "$stop" && break; sleep 0.01; done
@@ -148,7 +148,7 @@ done
 journal ext-kill.cmdb | grep -q "line 4 step" || fail "not killed inside the second extend: $(journal ext-kill.cmdb)"
 # killed between two lines, after the first extend line was done: the
 # replay does not extend that line again (the zoom between takes ~0.3 s)
-printf 'view 100:150 -4:4\nextend auto 3\nzoom 0.5\nextend auto 2\n' > ext2.explore
+printf 'view 100:150 -4:4\nextend auto 1\nzoom 0.5\nextend auto 2\n' > ext2.explore
 "$CM" explore ext2-ref.cmdb ext2.explore $pd $fine > /dev/null || fail "the reference of the second extend session"
 "$CM" explore ext2-kill.cmdb ext2.explore $pd $fine > /dev/null 2>&1 &
 pid=$!
@@ -170,7 +170,7 @@ same_rows ext-kill.cmdb ext-ref.cmdb "SELECT lo || ' ' || hi FROM regions ORDER 
 # a run of another script, or of this one after its end, is a new run
 "$CM" explore ext-ref.cmdb ext.explore $pd $fine > ext-again.out || fail "the finished script run again"
 grep -q "resuming" ext-again.out && fail "a finished run was resumed"
-[ "$(grep -c '^extend auto [0-9]*: tile' ext-again.out)" -eq 12 ] || fail "a new run of the script did not extend 12 times"
+[ "$(grep -c '^extend auto [0-9]*: tile' ext-again.out)" -eq 7 ] || fail "a new run of the script did not extend 7 times"
 
 # --- malformed commands: line number, message, exit 1, work kept ---------
 check_bad() { # check_bad 'line' 'needle'
