@@ -545,7 +545,8 @@ static cm_status view_box(const cm_db *db, const double *lo, const double *hi, c
         if (!(lo[d] < hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size, "view dimension %d: lo must be below hi", d);
         /* a view edge on a cell border takes no cell beyond it */
-        const int64_t a = cm_lattice_border(lat, d, lo[d], 0), b = cm_lattice_border(lat, d, hi[d], 1);
+        const int64_t a = cm_lattice_border(lat, d, lo[d], 0);
+        const int64_t b = cm_lattice_border(lat, d, hi[d], 1);
         box->lo[d] = a > bounds.lo[d] ? a : bounds.lo[d];
         box->hi[d] = b < bounds.hi[d] ? b : bounds.hi[d];
         if (box->lo[d] >= box->hi[d])

@@ -595,25 +595,20 @@ static cm_status cmd_extend(session *s, char **t, int n, char *msg, size_t msg_s
     if (st != CM_OK)
         return st;
     /* a resumed run: the extend lines before the one that stopped are done,
-     * and that one goes on from its recorded step */
-    int first = 1;
-    const bool resumed_here = s->script_hash && s->line == s->resume_line && s->resume_step;
-    if (s->script_hash && (s->line < s->resume_line || (s->line == s->resume_line && !s->resume_step))) {
+     * and that one goes on from its recorded step, whose tile it completes */
+    const bool here = s->script_hash && s->line == s->resume_line;
+    if (s->script_hash && (s->line < s->resume_line || (here && !s->resume_step))) {
         if (s->out)
             fprintf(s->out, "extend auto: done in the run that stopped; not repeated\n");
         return CM_OK;
     }
+    const int64_t first = here ? s->resume_step : 1;
+    s->resume_step = 0; /* resumed once */
     cm_box tile;
     view_box(s, s->lo, s->hi, &tile);
-    if (resumed_here) {
-        first = s->resume_step;
-        s->resume_step = 0; /* resumed once */
-        if (first <= steps)
-            st = extend_step(s, &tile, first, &s->resume_tile, msg, msg_size);
-        first++;
-    }
     for (int64_t k = first; k <= steps && st == CM_OK; k++) {
-        st = extend_step(s, &tile, (int)k, NULL, msg, msg_size);
+        const cm_box *given = here && k == first ? &s->resume_tile : NULL;
+        st = extend_step(s, &tile, (int)k, given, msg, msg_size);
         if (st == CM_ENOTFOUND) { /* nothing escapes next to the cluster: done, not an error */
             if (s->out)
                 fprintf(s->out, "extend auto: stopped, %s\n", msg);
