@@ -57,35 +57,6 @@ bool cli_is(cli *c, const char *name, bool needs_value, int *error)
     return true;
 }
 
-bool parse_int64(const char *s, int64_t *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const long long v = strtoll(s, &end, 10);
-    if (end == s || *end != '\0' || errno == ERANGE)
-        return false;
-    *out = v;
-    return true;
-}
-
-bool parse_bytes(const char *s, uint64_t *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const unsigned long long v = strtoull(s, &end, 10);
-    if (end == s || *s == '-' || errno == ERANGE)
-        return false;
-    const char units[] = "KMG";
-    const char *u = *end ? strchr(units, *end) : NULL;
-    if (*end && (!u || end[1] != '\0'))
-        return false;
-    const int shift = u ? 10 * (int)(u - units + 1) : 0;
-    if (v > (UINT64_MAX >> shift))
-        return false;
-    *out = (uint64_t)v << shift;
-    return true;
-}
-
 bool cli_take_mem(cli *c, uint64_t *mem, int *error)
 {
     if (!cli_is(c, "--mem", true, error))
@@ -126,90 +97,6 @@ bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, i
     return true;
 }
 
-bool parse_double(const char *s, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v))
-        return false;
-    *out = v;
-    return true;
-}
-
-/* Copies the piece of s up to sep (or the end) into piece, at most 255
- * characters; returns where the next piece starts, s's end if this was
- * the last, or NULL for an empty or too long piece. */
-static const char *take_piece(const char *s, char sep, char piece[256])
-{
-    const char *end = strchr(s, sep);
-    const size_t len = end ? (size_t)(end - s) : strlen(s);
-    if (len == 0 || len >= 256)
-        return NULL;
-    memcpy(piece, s, len);
-    piece[len] = '\0';
-    return end ? end + 1 : s + len;
-}
-
-/* Calls parse_one on each piece of s between seps, at most max pieces; the
- * count, or -1 if a piece is malformed, empty or one too many. */
-static int parse_pieces(const char *s, char sep, int max, void *out,
-                        bool (*parse_one)(char *piece, void *out, int index))
-{
-    char piece[256];
-    int n = 0;
-    for (const char *p = s; p && *p; n++) {
-        if (n == max || !(p = take_piece(p, sep, piece)) || !parse_one(piece, out, n))
-            return -1;
-        if (p[-1] == sep && *p == '\0')
-            return -1; /* a trailing separator */
-    }
-    return n > 0 ? n : -1;
-}
-
-typedef struct ranges_out {
-    double *lo, *hi;
-} ranges_out;
-
-static bool parse_range(char *piece, void *out, int d)
-{
-    ranges_out *r = out;
-    char *colon = strchr(piece, ':');
-    if (!colon)
-        return false;
-    *colon = '\0';
-    return parse_double(piece, &r->lo[d]) && parse_double(colon + 1, &r->hi[d]) &&
-           r->lo[d] < r->hi[d];
-}
-
-static bool parse_count(char *piece, void *out, int d)
-{
-    int64_t *v = out;
-    return parse_int64(piece, &v[d]) && v[d] >= 1;
-}
-
-static bool parse_one_double(char *piece, void *out, int d)
-{
-    return parse_double(piece, (double *)out + d);
-}
-
-bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max)
-{
-    ranges_out r = {lo, hi};
-    const int n = parse_pieces(s, ',', max, &r, parse_range);
-    if (n > 0)
-        *count = n;
-    return n > 0;
-}
-
-bool parse_counts(const char *s, int64_t *v, int *count, int max)
-{
-    const int n = parse_pieces(s, 'x', max, v, parse_count);
-    if (n > 0)
-        *count = n;
-    return n > 0;
-}
-
 bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *error)
 {
     if (cli_is(c, "--csv", true, error))
@@ -232,14 +119,6 @@ int chart_outputs_check(const cli *c, const chart_outputs *o)
     if (cm_output_names_stdout(o->csv) && cm_output_names_stdout(o->png))
         return cli_usage_error(c, "--csv - and --png -: only one can go to standard output");
     return 0;
-}
-
-bool parse_doubles(const char *s, double *v, int *count, int max)
-{
-    const int n = parse_pieces(s, ',', max, v, parse_one_double);
-    if (n > 0)
-        *count = n;
-    return n > 0;
 }
 
 FILE *report_stream(const char *out1, const char *out2, const char *out3)
@@ -342,4 +221,32 @@ int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
         cm_model_check_box(m, lat, box, msg, sizeof msg) != CM_OK)
         return cli_usage_error(c, "%s", msg);
     return EXIT_OK;
+}
+
+int cli_input_check(const char *cmd, const char *path)
+{
+    char msg[1024];
+    if (project_probe(path, msg, sizeof msg) == CM_OK)
+        return EXIT_OK;
+    fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return EXIT_USAGE;
+}
+
+int cli_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
+                  cm_store_info *info, cm_cluster *c)
+{
+    char msg[1024];
+    if (project_open_cluster(path, mem_budget, s, info, c, msg, sizeof msg) == CM_OK)
+        return EXIT_OK;
+    fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+    return EXIT_FAIL;
+}
+
+void cli_said_upgrade(const char *cmd, const char *path, int from)
+{
+    if (from)
+        fprintf(stderr,
+                "cellmap %s: upgraded %s from format version %d to %d (older cellmap versions "
+                "cannot open it any more)\n",
+                cmd, path, from, CM_STORE_VERSION);
 }

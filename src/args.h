@@ -10,6 +10,8 @@
 #include "cellmap/lattice.h"
 #include "cellmap/model.h"
 #include "models/registry.h"
+#include "lib/parse.h"
+#include "lib/project.h"
 
 /* EXIT_INTERRUPTED: stopped by Ctrl-C (128 + SIGINT, as shells report it). */
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
@@ -38,11 +40,6 @@ bool cli_next(cli *c);
  * needs_value (a missing value is reported and *error set). */
 bool cli_is(cli *c, const char *name, bool needs_value, int *error);
 
-/* Parsers: false on malformed input. */
-bool parse_int64(const char *s, int64_t *out);
-bool parse_double(const char *s, double *out);
-/* A size in bytes: digits with an optional K, M or G (powers of 1024). */
-bool parse_bytes(const char *s, uint64_t *out);
 /* Handles --mem BYTES (at least 1M); true if the current option was it. */
 bool cli_take_mem(cli *c, uint64_t *mem, int *error);
 /* Handles option `name` with an integer in lo..hi; true if the current
@@ -69,15 +66,9 @@ bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *err
 int chart_outputs_check(const cli *c, const chart_outputs *o);
 /* The limits of --max-steps and --threads, which several commands take. */
 enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
-/* "LO:HI,LO:HI,..." -> lo[], hi[], count. */
-bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
-/* "NxMx..." -> counts, count. */
-bool parse_counts(const char *s, int64_t *n, int *count, int max);
 /* Where a command's report goes: stdout, or stderr when one of its
  * outputs (any may be NULL) is standard output ("-", /dev/stdout). */
 FILE *report_stream(const char *out1, const char *out2, const char *out3);
-/* "X,Y,..." -> values. */
-bool parse_doubles(const char *s, double *v, int *count, int max);
 
 /* The options every model-driven command shares. */
 typedef struct model_opts {
@@ -108,6 +99,20 @@ bool lattice_opts_take(cli *c, lattice_opts *lo, int *error);
  * failure. */
 int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
                        const cm_model_set *models, cm_lattice *lat, cm_box *box);
+
+/* The database a command is given to read or resume, checked before any
+ * work (project_probe). Prints "cellmap CMD: problem" and returns
+ * EXIT_USAGE if it is not one this cellmap reads; EXIT_OK. */
+int cli_input_check(const char *cmd, const char *path);
+
+/* project_open_cluster, saying "cellmap CMD: problem" on failure
+ * (EXIT_FAIL, nothing left open); EXIT_OK. */
+int cli_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
+                  cm_store_info *info, cm_cluster *c);
+
+/* Tells the user that a resumed file was upgraded from format version
+ * `from` (project_resume; nothing when from is 0). */
+void cli_said_upgrade(const char *cmd, const char *path, int from);
 
 /* Command line joined by spaces (for provenance). */
 void join_argv(int argc, char **argv, char *buf, size_t size);

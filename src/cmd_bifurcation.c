@@ -14,7 +14,7 @@
 #include "models/friction_oscillator.h"
 #include "models/params.h"
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
 #include "src/interrupt.h"
 #include "src/outfile.h"

@@ -12,8 +12,8 @@
 #include "models/params.h"
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/json.h"
-#include "src/basin_png.h"
+#include "lib/json.h"
+#include "src/figure_opts.h"
 #include "src/outfile.h"
 
 static const char continue_help[] =

@@ -13,9 +13,9 @@
 #include "models/params.h"
 #include "models/transient_escape.h"
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
-#include "src/json.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
 

@@ -13,11 +13,12 @@
 #include "src/args.h"
 #include "src/outfile.h"
 #include "src/commands.h"
-#include "src/attractor_report.h"
+#include "lib/attractor_report.h"
+#include "src/attractor_opts.h"
 #include "src/export_arrays.h"
 #include "src/interrupt.h"
 #include "src/progress.h"
-#include "src/project.h"
+#include "lib/project.h"
 
 static const char export_help[] =
     "usage: cellmap export FILE.cmdb [--groups OUT.csv] [--cells OUT.csv|OUT.npy]\n"
@@ -701,7 +702,7 @@ int cmd_export(int argc, char **argv)
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
     const char *const outs[] = {a.groups, a.cells, a.flat, a.labels, a.steps};
-    int werr = project_input_check("export", a.file);
+    int werr = cli_input_check("export", a.file);
     if (werr == EXIT_OK)
         werr = outfiles_check("export", outs, 5);
     if (werr != EXIT_OK)
@@ -714,7 +715,7 @@ int cmd_export(int argc, char **argv)
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;
-    if (project_open_read("export", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+    if (cli_open_read("export", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
         return EXIT_FAIL;
     const int result = run_export(&c, &a, s, &info, &cl);
     project_close(s, &cl);

@@ -5,11 +5,11 @@
 #include <string.h>
 
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
-#include "src/attractor_report.h"
-#include "src/json.h"
-#include "src/project.h"
+#include "lib/attractor_report.h"
+#include "lib/json.h"
+#include "lib/project.h"
 
 static const char info_help[] =
     "usage: cellmap info FILE.cmdb [--json]\n\n"
@@ -145,7 +145,7 @@ int cmd_info(int argc, char **argv)
         return err;
     if (!path)
         return cli_usage_error(&c, "which file? usage: cellmap info FILE.cmdb");
-    if ((err = project_input_check("info", path)) != EXIT_OK)
+    if ((err = cli_input_check("info", path)) != EXIT_OK)
         return err;
     cm_store *s = NULL;
     cm_store_info info;

@@ -14,7 +14,7 @@
 #include "models/map_lyapunov.h"
 #include "models/registry.h"
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
 #include "src/interrupt.h"
 #include "src/outfile.h"

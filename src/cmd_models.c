@@ -5,7 +5,7 @@
 #include "models/registry.h"
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/json.h"
+#include "lib/json.h"
 
 static const char models_help[] =
     "usage: cellmap models [--model-lib PLUGIN.so ...] [--json]\n\n"

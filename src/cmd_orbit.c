@@ -6,7 +6,7 @@
 #include "models/registry.h"
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/json.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 
 static const char orbit_help[] =

@@ -9,9 +9,9 @@
 #include "models/delay_partition.h"
 #include "models/params.h"
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
-#include "src/json.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 #include "src/param_grid.h"
 

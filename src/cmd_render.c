@@ -6,13 +6,14 @@
 #include <string.h>
 
 #include "src/args.h"
-#include "src/attractor_report.h"
+#include "lib/attractor_report.h"
+#include "src/attractor_opts.h"
 #include "src/outfile.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
 #include "src/interrupt.h"
 #include "src/progress.h"
-#include "src/project.h"
+#include "lib/project.h"
 
 static const char render_help[] =
     "usage: cellmap render FILE.cmdb --png OUT.png|--svg OUT.svg [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
@@ -176,7 +177,7 @@ int cmd_render(int argc, char **argv)
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
     const char *const outs[] = {a.png.path, a.png.svg};
-    int werr = project_input_check("render", a.file);
+    int werr = cli_input_check("render", a.file);
     if (werr == EXIT_OK)
         werr = outfiles_check("render", outs, 2);
     if (werr != EXIT_OK)
@@ -184,7 +185,7 @@ int cmd_render(int argc, char **argv)
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster cl;
-    if (project_open_read("render", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
+    if (cli_open_read("render", a.file, a.mem, &s, &info, &cl) != EXIT_OK)
         return EXIT_FAIL;
     const int result = run_render(&c, &a, s, &info, &cl);
     project_close(s, &cl);

@@ -11,9 +11,9 @@
 #include "models/friction_oscillator.h"
 #include "models/params.h"
 #include "src/args.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
-#include "src/json.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 
 static const char simulate_help[] =

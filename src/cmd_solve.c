@@ -19,13 +19,14 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 #include "src/interrupt.h"
-#include "src/json.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 #include "src/progress.h"
-#include "src/project.h"
+#include "lib/project.h"
 #include "src/args.h"
-#include "src/attractor_report.h"
-#include "src/basin_png.h"
+#include "lib/attractor_report.h"
+#include "src/attractor_opts.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
 
 static const char solve_help[] =
@@ -521,7 +522,7 @@ static int check_db_arg(const solve_args *a)
     if (!a->db)
         return EXIT_OK;
     if (a->resume)
-        return project_input_check("solve", a->db);
+        return cli_input_check("solve", a->db);
     if (stat(a->db, &sb) == 0 && S_ISREG(sb.st_mode) && cm_store_probe(a->db, why, sizeof why) != CM_OK) {
         fprintf(stderr, "cellmap solve: refusing to overwrite %s: %s; choose another --db file\n",
                 a->db, why);
@@ -545,8 +546,11 @@ static cm_status open_store(const solve_args *a, const char *command, const cm_m
     }
     solve_fit fit = {m, lat, plan, a->db};
     cm_store_info info;
-    return project_resume("solve", a->db, same_solve, &fit, &rn->store, &info, &rn->c, msg,
-                          msg_size);
+    int upgraded_from = 0;
+    const cm_status st = project_resume(a->db, same_solve, &fit, &rn->store, &info, &rn->c,
+                                        &upgraded_from, msg, msg_size);
+    cli_said_upgrade("solve", a->db, upgraded_from);
+    return st;
 }
 
 /* The project's plan from --split, --max-steps, --threads, --extend,

@@ -1,7 +1,7 @@
 #include "src/explore.h"
 
 #include "cellmap/clock.h"
-#include "src/json.h"
+#include "lib/json.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -15,10 +15,10 @@
 #include "cellmap/output.h"
 #include "models/registry.h"
 #include "render/figure.h"
-#include "src/attractor_report.h"
-#include "src/basin_png.h"
+#include "lib/attractor_report.h"
+#include "src/figure_opts.h"
 #include "src/commands.h"
-#include "src/project.h"
+#include "lib/project.h"
 
 const char session_help[] =
     "  view X0:X1 [Y0:Y1] [at Z[,W...]]   look at this box of state space (and, for\n"
@@ -1270,8 +1270,11 @@ static int open_existing(session *s, const session_options *o)
     char msg[1024];
     cm_store_info info;
     explore_fit fit = {s, o, EXIT_OK};
-    if (project_resume("explore", s->path, fits_session, &fit, &s->store, &info, &s->c, msg,
-                       sizeof msg) != CM_OK)
+    int upgraded_from = 0;
+    const cm_status st = project_resume(s->path, fits_session, &fit, &s->store, &info, &s->c,
+                                        &upgraded_from, msg, sizeof msg);
+    cli_said_upgrade("explore", s->path, upgraded_from);
+    if (st != CM_OK)
         return fit.rc != EXIT_OK ? fit.rc : open_error("%s", msg);
     int rc;
     s->dim = info.lattice.dim;

@@ -9,8 +9,8 @@
 
 #include "render/palette.h"
 #include "src/interrupt.h"
-#include "src/attractor_report.h"
-#include "src/json.h"
+#include "lib/attractor_report.h"
+#include "lib/json.h"
 #include "src/outfile.h"
 
 enum { SLAB_CELLS = 1 << 22 }; /* cells flattened at a time */

@@ -8,15 +8,8 @@
 #include <stdbool.h>
 #include <stdio.h>
 
-#include "cellmap/output.h"
-#include "render/chart.h"
-#include "render/png_out.h"
+#include "lib/outfile.h"
 #include "src/args.h"
-
-typedef struct outfile {
-    cm_output out;
-    FILE *f;
-} outfile;
 
 /* Checks an output path before the work that fills it (NULL: none): a
  * directory, a missing or read-only directory, or a device where a

@@ -11,7 +11,7 @@
 #include "cellmap/model.h"
 #include "models/params.h"
 #include "src/args.h"
-#include "src/json.h"
+#include "lib/json.h"
 
 #define PARAM_AXIS_MAX 2000
 

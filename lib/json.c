@@ -1,5 +1,5 @@
-/* src/json.c - the --json writer (src/json.h). */
-#include "src/json.h"
+/* lib/json.c - the --json writer (lib/json.h). */
+#include "lib/json.h"
 
 #include <math.h>
 

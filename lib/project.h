@@ -1,22 +1,22 @@
-/* src/project.h - a .cmdb project as the commands use one: opened to read
+/* lib/project.h - a .cmdb project as the commands use one: opened to read
  * (render, export, info), created or resumed to be extended (solve --db,
  * explore), with the rules they share: a file is checked read-only before
  * anything is written to it, older formats are upgraded only once the file
  * proves to be the caller's, new files carry the command line, plan and a
  * reproducible creation time. */
-#ifndef CM_SRC_PROJECT_H
-#define CM_SRC_PROJECT_H
+#ifndef CM_LIB_PROJECT_H
+#define CM_LIB_PROJECT_H
 
 #include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/store.h"
 #include "models/registry.h"
 
-/* The database a command is given to read or resume, checked before any
- * work (cm_store_probe: it exists, is readable and is a cellmap database
- * this version reads). Prints "cellmap CMD: problem" and returns
- * EXIT_USAGE if not; EXIT_OK. Damage inside is found when it is opened. */
-int project_input_check(const char *cmd, const char *path);
+/* Whether path is a database this cellmap reads, checked before any work
+ * (cm_store_probe: it exists, is readable and is a cellmap database of a
+ * format this version reads): CM_OK, else why not in msg. Damage inside
+ * is found when it is opened. */
+cm_status project_probe(const char *path, char *msg, size_t msg_size);
 
 /* Opens path read-only in a snapshot and reads what it says about itself;
  * a file with no region yet is refused. map_reads: reads through a memory
@@ -28,10 +28,9 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
 
 /* Opens path read-only, reads what it says about itself and restores its
  * cluster (paged out; regions are read back on demand within mem_budget
- * bytes). Prints "cellmap CMD: problem" and returns EXIT_FAIL on failure,
- * leaving nothing open. */
-int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
-                      cm_store_info *info, cm_cluster *c);
+ * bytes). On failure nothing is left open (*s NULL) and msg says why. */
+cm_status project_open_cluster(const char *path, uint64_t mem_budget, cm_store **s,
+                               cm_store_info *info, cm_cluster *c, char *msg, size_t msg_size);
 
 /* The view an explore session saved in the file, note.explore.view:
  * "X0:X1 Y0:Y1[ at V3,V4,...]" (explore writes it; V3.. are the slice's
@@ -67,11 +66,12 @@ typedef cm_status (*project_fits_fn)(void *user, const cm_store_info *info,
 
 /* Resumes path to extend it: reads what it says about itself (into *info)
  * read-only, asks `fits`, upgrades a file of an older format in place
- * (said on stderr as "cellmap CMD: ..."), opens it for writing and restores
- * its cluster into c (paged out, the store attached as pager). A refused
- * file is left byte-identical. */
-cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits, void *user,
-                         cm_store **s, cm_store_info *info, cm_cluster *c, char *msg,
+ * (*upgraded_from: the version it had, 0 when none was needed; the caller
+ * tells its user), opens it for writing and restores its cluster into c
+ * (paged out, the store attached as pager). A refused file is left
+ * byte-identical. */
+cm_status project_resume(const char *path, project_fits_fn fits, void *user, cm_store **s,
+                         cm_store_info *info, cm_cluster *c, int *upgraded_from, char *msg,
                          size_t msg_size);
 
 /* How a solve grows its project: each box cut into split[d] nearly equal

@@ -1,9 +1,9 @@
-/* src/attractor_view.h - a flat region drawn by the system's attractors
+/* lib/attractor_view.h - a flat region drawn by the system's attractors
  * (cellmap/attractors.h): the cells relabelled, the attractors as the
  * figure's groups and the legend's names. For the command's figures and
  * libcellmap's (cm_result_png); no other part of the command is needed. */
-#ifndef CM_SRC_ATTRACTOR_VIEW_H
-#define CM_SRC_ATTRACTOR_VIEW_H
+#ifndef CM_LIB_ATTRACTOR_VIEW_H
+#define CM_LIB_ATTRACTOR_VIEW_H
 
 #include "cellmap/attractors.h"
 #include "cellmap/scm.h"

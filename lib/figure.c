@@ -1,7 +1,8 @@
-#include "src/basin_png.h"
+/* lib/figure.c - the one basin-figure pipeline (lib/figure.h): PNG, SVG
+ * and indexed PNG, by groups or by attractors. */
+#include "lib/figure.h"
 
 #include "cellmap/output.h"
-
 #include "render/svg.h"
 
 #include <errno.h>
@@ -15,8 +16,9 @@
 #include "render/palette.h"
 #include "render/png_out.h"
 #include "render/raster.h"
-#include "src/attractor_report.h"
-#include "src/outfile.h"
+#include "lib/attractor_report.h"
+#include "lib/outfile.h"
+#include "lib/parse.h"
 
 enum { MAX_DEFAULT_SIDE = 4096, FIGURE_SIDE = 1000 };
 
@@ -136,67 +138,7 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
     return ok;
 }
 
-bool png_opts_take(cli *c, png_opts *po, int *err)
-{
-    if (by_option_take(c, &po->by, err)) {
-    } else if (cli_is(c, "--png", true, err)) {
-        po->path = c->value;
-    } else if (cli_is(c, "--svg", true, err)) {
-        po->svg = c->value;
-    } else if (cli_take_size(c, 1, 1, CM_RENDER_MAX_SIDE, &po->width, &po->height, err)) {
-    } else if (cli_is(c, "--layers", true, err)) {
-        char bad[64];
-        if (c->value && !parse_layers(c->value, &po->layers, bad, sizeof bad))
-            *err = cli_usage_error(c,
-                                   "--layers: unknown layer '%s' (use basin, steps, attractors, "
-                                   "overlays, axes, legend, title or all, separated by commas)",
-                                   bad);
-    } else if (cli_is(c, "--png-mode", true, err)) {
-        if (c->value && !parse_png_mode(c->value, &po->indexed))
-            *err = cli_usage_error(c, "--png-mode: '%s' must be rgb or indexed", c->value);
-    } else if (cli_is(c, "--min-basin", true, err)) {
-        int64_t v = 0;
-        if (c->value && (!parse_int64(c->value, &v) || v < 1))
-            *err = cli_usage_error(c, "--min-basin: '%s' must be a whole number of cells, 1 or more",
-                                   c->value);
-        po->min_basin = (uint64_t)v;
-    } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
-    } else if (cli_is(c, "--labels", true, err)) {
-        char msg[512];
-        if (c->value && !png_opts_labels(c->value, po, msg, sizeof msg))
-            *err = cli_usage_error(c, "--labels: %s", msg);
-    } else if (cli_is(c, "--palette", true, err)) {
-        char msg[512];
-        if (c->value && !png_opts_palette(c->value, po, msg, sizeof msg))
-            *err = cli_usage_error(c, "--palette: %s", msg);
-    } else if (cli_is(c, "--view", true, err)) {
-        int n = 0;
-        if (c->value && (!parse_ranges(c->value, po->lo, po->hi, &n, 2) || n != 2 ||
-                         !(po->lo[0] < po->hi[0] && po->lo[1] < po->hi[1])))
-            *err = cli_usage_error(c, "--view: '%s' must be X0:X1,Y0:Y1 with X0 < X1, Y0 < Y1",
-                                   c->value);
-        po->has_view = 1;
-    } else {
-        return false;
-    }
-    return true;
-}
 
-int png_opts_check(const cli *c, const png_opts *po)
-{
-    if (!po->path && !po->svg &&
-        (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups ||
-         po->palette))
-        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend and "
-                                  "--palette describe the image; add --png FILE (or --svg FILE)");
-    if (po->svg && po->indexed)
-        return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
-                                  "only");
-    if (po->indexed && (po->width || po->layers))
-        return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
-                                  "classes; leave out --size and --layers");
-    return EXIT_OK;
-}
 
 bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *msg,
                     size_t msg_size)
@@ -441,81 +383,76 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
     return st;
 }
 
-int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
-                    const cm_lattice *lat, const cm_box *box)
+cm_status figure_check_layout(const png_opts *po, const cm_model *m, const cm_lattice *lat,
+                              const cm_box *box, char *msg, size_t msg_size)
 {
-    char msg[512];
-    const char *const outs[] = {po->path, po->svg};
-    const int rc = outfiles_check(cmd, outs, 2);
-    if (rc != EXIT_OK)
-        return rc;
-    cm_status st = CM_OK;
-    if (!po->indexed) {
-        cm_render_options ro;
-        memset(&ro, 0, sizeof ro);
-        ro.layers = layers_of(po);
-        ro.width = po->width;
-        ro.height = po->height;
-        cm_box shown = *box;
-        if (po->has_view)
-            view_cells(lat, po->lo, po->hi, box, &shown);
-        if (!ro.width || !ro.height)
-            figure_size(lat, &shown, ro.layers, &ro.width, &ro.height);
-        for (int d = 0; d < 2 && d < lat->dim; d++) {
-            ro.lo[d] = po->has_view ? po->lo[d] : cm_lattice_edge(lat, d, box->lo[d]);
-            ro.hi[d] = po->has_view ? po->hi[d] : cm_lattice_edge(lat, d, box->hi[d]);
-        }
-        ro.model = m;
-        ro.font_path = figure_font();
-        st = cm_render_check(&ro, lat->dim, msg, sizeof msg);
+    if (po->indexed)
+        return CM_OK;
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.layers = layers_of(po);
+    ro.width = po->width;
+    ro.height = po->height;
+    cm_box shown = *box;
+    if (po->has_view)
+        view_cells(lat, po->lo, po->hi, box, &shown);
+    if (!ro.width || !ro.height)
+        figure_size(lat, &shown, ro.layers, &ro.width, &ro.height);
+    for (int d = 0; d < 2 && d < lat->dim; d++) {
+        ro.lo[d] = po->has_view ? po->lo[d] : cm_lattice_edge(lat, d, box->lo[d]);
+        ro.hi[d] = po->has_view ? po->hi[d] : cm_lattice_edge(lat, d, box->hi[d]);
     }
-    if (st != CM_OK) {
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-        return EXIT_FAIL;
-    }
-    return EXIT_OK;
+    ro.model = m;
+    ro.font_path = figure_font();
+    return cm_render_check(&ro, lat->dim, msg, msg_size);
+}
+
+cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *lat,
+                       const cm_box *box, char *msg, size_t msg_size)
+{
+    cm_status st = outfile_check_path(po->path, false, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(po->svg, false, msg, msg_size);
+    return st == CM_OK ? figure_check_layout(po, m, lat, box, msg, msg_size) : st;
 }
 
 /* The same figure as SVG (render/svg.h), written then renamed. */
-static int write_svg(const char *cmd, const basin_png *b)
+static cm_status write_svg(const basin_png *b, char *msg, size_t msg_size)
 {
     cm_render_options ro;
     figure_options(b, &ro);
-    char msg[512];
     outfile o;
-    if (!outfile_open(cmd, b->opts->svg, &o))
-        return EXIT_FAIL;
-    const cm_status st = cm_render_svg(b->lat, b->cells, b->groups, &ro, o.f, msg, sizeof msg);
+    cm_status st = outfile_begin(b->opts->svg, &o, msg, msg_size);
     if (st != CM_OK)
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-    return outfile_close(cmd, &o, st == CM_OK) && st == CM_OK ? EXIT_OK : EXIT_FAIL;
+        return st;
+    st = cm_render_svg(b->lat, b->cells, b->groups, &ro, o.f, msg, msg_size);
+    const cm_status end = outfile_end(&o, st == CM_OK, st == CM_OK ? msg : (char[64]){0},
+                                      st == CM_OK ? msg_size : 64);
+    return st != CM_OK ? st : end;
 }
 
 /* b's figure drawn by attractors: its cells relabelled in a copy. */
-static int write_by_attractors(const char *cmd, const basin_png *b)
+static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_size)
 {
-    char msg[512];
     cm_region view;
-    cm_status st = cm_region_alloc(&view, &b->cells->box, msg, sizeof msg);
+    cm_status st = cm_region_alloc(&view, &b->cells->box, msg, msg_size);
     cm_group_info *groups = NULL;
     uint32_t n = 0;
     png_opts *po = malloc(sizeof *po);
     if (st == CM_OK && !po)
-        st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the figure");
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
     int32_t *label = st == CM_OK ? malloc((view.ncells + 1) * sizeof *label) : NULL;
     if (st == CM_OK && !label)
-        st = cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for the figure");
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
     if (st == CM_OK)
-        st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, label, msg,
-                                      sizeof msg);
+        st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, label, msg, msg_size);
     if (st == CM_OK) {
         memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
         memcpy(view.step, b->cells->step, view.ncells * sizeof *view.step);
         memcpy(view.image, b->cells->image, view.ncells * sizeof *view.image);
-        st = attractor_view(b->attractors, &view, label, &groups, &n, msg, sizeof msg);
+        st = attractor_view(b->attractors, &view, label, &groups, &n, msg, msg_size);
     }
     free(label);
-    int rc = EXIT_FAIL;
     if (st == CM_OK) {
         *po = *b->opts;
         po->n_labels = attractor_legend(b->attractors, n, po->labels, po->n_labels,
@@ -526,27 +463,22 @@ static int write_by_attractors(const char *cmd, const basin_png *b)
         by.cells = &view;
         by.groups = groups;
         by.attractors = NULL;
-        rc = write_basin_png(cmd, &by);
-    } else {
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
+        st = figure_write(&by, msg, msg_size);
     }
     cm_region_free(&view);
     free(groups);
     free(po);
-    return rc;
+    return st;
 }
 
-int write_basin_png(const char *cmd, const basin_png *b)
+cm_status figure_write(const basin_png *b, char *msg, size_t msg_size)
 {
     if (b->attractors)
-        return write_by_attractors(cmd, b);
-    char msg[512];
+        return write_by_attractors(b, msg, msg_size);
     cm_status st = CM_OK;
     if (b->opts->path)
-        st = b->opts->indexed ? write_indexed(b, msg, sizeof msg) : write_figure(b, msg, sizeof msg);
-    if (st != CM_OK) {
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-        return EXIT_FAIL;
-    }
-    return b->opts->svg ? write_svg(cmd, b) : EXIT_OK;
+        st = b->opts->indexed ? write_indexed(b, msg, msg_size) : write_figure(b, msg, msg_size);
+    if (st == CM_OK && b->opts->svg)
+        st = write_svg(b, msg, msg_size);
+    return st;
 }

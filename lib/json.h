@@ -1,4 +1,4 @@
-/* src/json.h - the --json output of every command, in one schema
+/* lib/json.h - the --json output of every command, in one schema
  * (docs/cellmap.schema.json).
  *
  * A document is one object with "command" first. Shared parts are written
@@ -7,8 +7,8 @@
  * {id, kind, period, basin_cells, centre} - the names of the CSV columns
  * and SQL tables. Numbers are the shortest text that reads back exactly;
  * a non-finite number is null. */
-#ifndef CM_SRC_JSON_H
-#define CM_SRC_JSON_H
+#ifndef CM_LIB_JSON_H
+#define CM_LIB_JSON_H
 
 #include <stdbool.h>
 #include <stdint.h>

@@ -18,9 +18,9 @@
 #include "models/registry.h"
 #include "render/figure.h"
 #include "render/png_out.h"
-#include "src/args.h"
-#include "src/attractor_view.h"
-#include "src/project.h"
+#include "lib/parse.h"
+#include "lib/attractor_view.h"
+#include "lib/project.h"
 
 
 struct cm_models {

@@ -1,9 +1,9 @@
-/* src/attractor_report.h - the attractors of a solve (cellmap/attractors.h)
- * as the commands report them: the options that set the check, the text
- * summary's table and the JSON's "attractors", and what each group's
- * cells became. */
-#ifndef CM_SRC_ATTRACTOR_REPORT_H
-#define CM_SRC_ATTRACTOR_REPORT_H
+/* lib/attractor_report.h - the attractors of a solve (cellmap/attractors.h)
+ * as the commands and the library report them: the text summary's table
+ * and the JSON's "attractors", where sink cells go, the attractors a file
+ * holds, and what each group's cells became. */
+#ifndef CM_LIB_ATTRACTOR_REPORT_H
+#define CM_LIB_ATTRACTOR_REPORT_H
 
 #include <stdio.h>
 
@@ -11,29 +11,8 @@
 #include "cellmap/cluster.h"
 #include "cellmap/outside.h"
 #include "cellmap/store.h"
-#include "src/attractor_view.h"
-#include "src/args.h"
-#include "src/json.h"
-
-#define ATTRACTOR_OPTIONS_HELP                                                                     \
-    "  --attractor-steps T,R[,MAX]  the true-orbit check of each cell group: T steps of\n"         \
-    "                      transient, a record of R steps (doubled while undecided), at most\n"    \
-    "                      MAX steps a group (default 16,500,1048576; MAX 8192 for ODE flows)\n"         \
-    "  --attractor-tol TOL[,MATCH]  recurrence within TOL cell widths is periodic; cycles\n"      \
-    "                      within MATCH cell widths are one attractor (default 1e-4,1e-2)\n"  \
-    "  --outside-steps N   follow an orbit that leaves the computed cells N steps on the\n"      \
-    "                      true map: back in, it goes where the cell it lands in goes;\n"        \
-    "                      beyond the world, it diverges; else it is outside (default 100;\n"   \
-    "                      0: not followed, every such cell outside)\n"
-
-#define BY_OPTION_HELP                                                                             \
-    "  --by attractors|groups  figures and labels by the system's attractors (default;\n"      \
-    "                      their footprints marked) or by cell mapping's groups (the\n"          \
-    "                      thesis' figures are drawn by groups)\n"
-
-/* Handles --attractor-steps, --attractor-tol and --outside-steps; true if the current option
- * was one of them (a bad value is reported and *error set). */
-bool attractor_options_take(cli *c, cm_attractor_options *o, int *error);
+#include "lib/attractor_view.h"
+#include "lib/json.h"
 
 /* The text summary's attractor lines (the largest basins first, at most
  * `rows`), and the cells that reach none: diverged (groups whose orbits
@@ -56,9 +35,8 @@ void attractor_json(json *j, const cm_lattice *lat, const cm_attractor_set *s);
  * attractors are not the ones asked for). */
 bool attractor_options_given(const cm_attractor_options *o);
 
-/* --by groups|attractors: what figures and labels show (default: attractors). */
+/* What figures and labels show (--by): the attractors (default) or groups. */
 enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
-bool by_option_take(cli *c, int *by, int *error);
 
 /* Where the sink cells of a cluster's views go (cellmap/outside.h): its
  * exits and the adapter over them; `computed` points into the struct, which

@@ -1,6 +1,6 @@
-/* src/attractor_view.c - a flat region drawn by the system's attractors
- * (src/attractor_view.h). */
-#include "src/attractor_view.h"
+/* lib/attractor_view.c - a flat region drawn by the system's attractors
+ * (lib/attractor_view.h). */
+#include "lib/attractor_view.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-#include "src/project.h"
+#include "lib/project.h"
 
 #include "cellmap/clock.h"
 
@@ -12,7 +12,7 @@
 #include "cellmap/cover.h"
 #include "cellmap/extend.h"
 #include "models/registry.h"
-#include "src/args.h"
+#include "lib/parse.h"
 
 cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
                                cm_store_info *info, char *msg, size_t msg_size)
@@ -29,32 +29,26 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
     return st;
 }
 
-int project_input_check(const char *cmd, const char *path)
+cm_status project_probe(const char *path, char *msg, size_t msg_size)
 {
-    char msg[1024];
-    if (cm_store_probe(path, msg, sizeof msg) == CM_OK)
-        return EXIT_OK;
-    fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
-    return EXIT_USAGE;
+    return cm_store_probe(path, msg, msg_size);
 }
 
-int project_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_store **s,
-                      cm_store_info *info, cm_cluster *c)
+cm_status project_open_cluster(const char *path, uint64_t mem_budget, cm_store **s,
+                               cm_store_info *info, cm_cluster *c, char *msg, size_t msg_size)
 {
-    char msg[1024];
     cm_cluster_init(c, &(cm_lattice){1, {0}, {1}});
-    cm_status st = project_open_records(path, false, s, info, msg, sizeof msg);
+    cm_status st = project_open_records(path, false, s, info, msg, msg_size);
     if (st == CM_OK)
-        st = cm_store_load_cluster(*s, c, msg, sizeof msg);
+        st = cm_store_load_cluster(*s, c, msg, msg_size);
     cm_store_snapshot_end(*s);
     if (st != CM_OK) {
-        fprintf(stderr, "cellmap %s: %s\n", cmd, msg);
         project_close(*s, c);
         *s = NULL;
-        return EXIT_FAIL;
+        return st;
     }
     c->mem_budget = mem_budget;
-    return EXIT_OK;
+    return CM_OK;
 }
 
 cm_status project_view_note(cm_store *s, int dims, double lo[2], double hi[2], char *slice,
@@ -111,8 +105,8 @@ cm_status project_create(const char *path, const cm_model *m, const cm_model_lib
     return st;
 }
 
-cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits, void *user,
-                         cm_store **s, cm_store_info *info, cm_cluster *c, char *msg,
+cm_status project_resume(const char *path, project_fits_fn fits, void *user, cm_store **s,
+                         cm_store_info *info, cm_cluster *c, int *upgraded_from, char *msg,
                          size_t msg_size)
 {
     /* read-only until the file proves to be the caller's: a refused file
@@ -134,13 +128,11 @@ cm_status project_resume(const char *cmd, const char *path, project_fits_fn fits
     if (st == CM_OK)
         st = fits(user, info, &model, msg, msg_size);
     int upgraded = 0;
+    *upgraded_from = 0;
     if (st == CM_OK && info->version < CM_STORE_VERSION) {
         st = cm_store_upgrade(path, model, &upgraded, msg, msg_size);
         if (st == CM_OK && upgraded)
-            fprintf(stderr,
-                    "cellmap %s: upgraded %s from format version %d to %d (older cellmap "
-                    "versions cannot open it any more)\n",
-                    cmd, path, info->version, CM_STORE_VERSION);
+            *upgraded_from = info->version;
     }
     if (st == CM_OK)
         st = cm_store_open(path, 1, s, msg, msg_size);

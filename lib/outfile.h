@@ -1,0 +1,47 @@
+/* lib/outfile.h - output files of the analysis drivers and the commands
+ * (CSV, JSON, chart PNGs), written to a temporary file that reaches PATH
+ * only when complete (cellmap/output.h: "-" is stdout, devices and FIFOs
+ * are written in place, never replaced), so that a failed run never
+ * leaves a half-written file. Every call returns a status with the
+ * problem, the user's path and the fix in msg; nothing is printed. */
+#ifndef CM_LIB_OUTFILE_H
+#define CM_LIB_OUTFILE_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "cellmap/output.h"
+#include "render/chart.h"
+#include "render/png_out.h"
+
+/* A stream being written to its temporary file. */
+typedef struct outfile {
+    cm_output out;
+    FILE *f;
+} outfile;
+
+/* Checks an output path before the work that fills it: a directory, a
+ * missing or read-only directory, or a device where a database must go
+ * (needs_regular) is refused at once with CM_EINVAL (the user's to fix);
+ * another status is a failure of the system (e.g. no file descriptor).
+ * NULL: nothing to check. */
+cm_status outfile_check_path(const char *path, bool needs_regular, char *msg, size_t msg_size);
+
+/* outfile_check_path for a chart PNG, which also needs OSMesa: loaded now
+ * (render/gl_loader.h), so that a missing library stops the caller before
+ * its work. */
+cm_status outfile_check_chart(const char *path, char *msg, size_t msg_size);
+
+/* Opens the temporary file of path for writing into o->f. */
+cm_status outfile_begin(const char *path, outfile *o, char *msg, size_t msg_size);
+
+/* Closes o and, when ok (and every write succeeded), renames it into
+ * place; else removes it. CM_OK when the file is in place. */
+cm_status outfile_end(outfile *o, bool ok, char *msg, size_t msg_size);
+
+/* Draws the charts one below the other (all of the first one's width) and
+ * writes them as a PNG at path with the given texts (plus Software). */
+cm_status outfile_charts(const char *path, const cm_chart *charts, int n_charts,
+                         const cm_png_text *texts, int n_texts, char *msg, size_t msg_size);
+
+#endif
