@@ -1,6 +1,8 @@
 /* src/progress.c - the progress line (src/progress.h). */
 #include "src/progress.h"
 
+#include "src/interrupt.h"
+
 #include "cellmap/clock.h"
 
 #include <omp.h>
@@ -67,3 +69,13 @@ void progress_end(progress *p)
     fflush(stderr);
     p->width = 0;
 }
+
+static void said_done(void *user, uint64_t done) { progress_say(user, done, NULL); }
+
+static const char *ctrl_c(void *user)
+{
+    (void)user;
+    return interrupt_requested() ? "interrupted (Ctrl-C)" : NULL;
+}
+
+work_hooks progress_hooks(progress *p) { return (work_hooks){said_done, ctrl_c, p}; }

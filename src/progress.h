@@ -9,6 +9,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "lib/work.h"
+
 typedef struct progress {
     const char *cmd;  /* "solve" */
     const char *unit; /* what is counted: "cells", "grid points", "runs" */
@@ -29,5 +31,10 @@ void progress_tick(progress *p, uint64_t *done);
 /* Erases the line, if one is shown, so that what follows (a report line,
  * an error) starts at the left; the next progress_say draws it again. */
 void progress_end(progress *p);
+
+/* The library's hooks (lib/work.h) for a command's long call: progress
+ * said on p, and Ctrl-C (src/interrupt.h) as the request to stop, with
+ * the reason "interrupted (Ctrl-C)". p must outlive the call. */
+work_hooks progress_hooks(progress *p);
 
 #endif

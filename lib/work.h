@@ -1,0 +1,35 @@
+/* lib/work.h - what a caller of the library's long drivers (exports,
+ * solves, sessions) may hook into them: a progress count and a request to
+ * stop. Both are optional, called on the thread that called the driver,
+ * between units of work (a slab of cells, a region joined): never inside
+ * a parallel loop. A driver that stops writes no partial output. */
+#ifndef CM_LIB_WORK_H
+#define CM_LIB_WORK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct work_hooks {
+    /* units of work done so far (cells, regions: the driver's header
+     * says); NULL: not told */
+    void (*progress)(void *user, uint64_t done);
+    /* NULL to go on, else why to stop now ("interrupted (Ctrl-C)"); the
+     * driver then returns CM_ECANCELED with that reason first in its
+     * message. NULL: never stops. */
+    const char *(*stop)(void *user);
+    void *user;
+} work_hooks;
+
+/* The hooks' calls, for drivers; h may be NULL. */
+static inline void work_progress(const work_hooks *h, uint64_t done)
+{
+    if (h && h->progress)
+        h->progress(h->user, done);
+}
+
+static inline const char *work_stop(const work_hooks *h)
+{
+    return h && h->stop ? h->stop(h->user) : NULL;
+}
+
+#endif
