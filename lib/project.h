@@ -12,6 +12,20 @@
 #include "cellmap/store.h"
 #include "models/registry.h"
 
+/* The most steps a cell's sequence is followed in one solve (--max-steps). */
+enum { PROJECT_MAX_STEPS = 1000000 };
+
+/* A model as a user names it: the name, its parameter texts ("k=v,...",
+ * each applied in turn over the defaults) and the plugins it may come from
+ * (the built-in models and those loaded into set). */
+enum { MODEL_SPEC_TEXTS = 32 };
+typedef struct model_spec {
+    const char *name;
+    const char *texts[MODEL_SPEC_TEXTS];
+    int n_texts;
+    cm_model_set set;
+} model_spec;
+
 /* Whether path is a database this cellmap reads, checked before any work
  * (cm_store_probe: it exists, is readable and is a cellmap database of a
  * format this version reads): CM_OK, else why not in msg. Damage inside

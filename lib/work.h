@@ -9,6 +9,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The one clock callers time work with: cm_seconds, monotonic seconds. */
+#include "cellmap/clock.h"
+
 typedef struct work_hooks {
     /* units of work done so far (cells, regions: the driver's header
      * says); NULL: not told */

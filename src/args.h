@@ -15,7 +15,7 @@
 
 /* EXIT_INTERRUPTED: stopped by Ctrl-C (128 + SIGINT, as shells report it). */
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
-#define MAX_PARAM_TEXTS 32
+#define MAX_PARAM_TEXTS MODEL_SPEC_TEXTS
 
 /* Cursor over argv; options are "--name VALUE" or "--name=VALUE". */
 typedef struct cli {
@@ -65,18 +65,14 @@ bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *err
  * both on it, are usage errors. Returns 0 or the error's status. */
 int chart_outputs_check(const cli *c, const chart_outputs *o);
 /* The limits of --max-steps and --threads, which several commands take. */
-enum { MAX_STEPS_LIMIT = 1000000, THREADS_LIMIT = 1024 };
+enum { MAX_STEPS_LIMIT = PROJECT_MAX_STEPS, THREADS_LIMIT = 1024 };
 /* Where a command's report goes: stdout, or stderr when one of its
  * outputs (any may be NULL) is standard output ("-", /dev/stdout). */
 FILE *report_stream(const char *out1, const char *out2, const char *out3);
 
-/* The options every model-driven command shares. */
-typedef struct model_opts {
-    const char *name;
-    const char *texts[MAX_PARAM_TEXTS];
-    int n_texts;
-    cm_model_set set; /* the plugins of --model-lib */
-} model_opts;
+/* The options every model-driven command shares: a model_spec
+ * (lib/project.h). */
+typedef model_spec model_opts;
 
 /* Handles --model, --param and --model-lib (loaded at once); returns true
  * if the current option was one. */

@@ -84,17 +84,17 @@ static int parse_explore(cli *c, explore_args *a)
 }
 
 /* Runs the lines of f; a bad line stops the session (exit 1). */
-static int run_script(session *s, FILE *f, const char *name)
+static int run_script(explore *e, FILE *f, const char *name)
 {
     char line[8192], msg[1024];
-    for (long lineno = 1; !s->quit && fgets(line, sizeof line, f); lineno++) {
-        s->line = lineno;
+    for (long lineno = 1; !e->quit && fgets(line, sizeof line, f); lineno++) {
+        e->s.line = lineno;
         if (!strchr(line, '\n') && !feof(f)) {
             fprintf(stderr, "%s:%ld: the line is longer than %zu characters\n", name, lineno,
                     sizeof line - 2);
             return EXIT_FAIL;
         }
-        if (session_exec(s, line, msg, sizeof msg) != CM_OK) {
+        if (explore_exec(e, line, msg, sizeof msg) != CM_OK) {
             fprintf(stderr, "%s:%ld: %s\n", name, lineno, msg);
             return EXIT_FAIL;
         }
@@ -107,17 +107,17 @@ static int run_script(session *s, FILE *f, const char *name)
 }
 
 /* The prompt: errors are reported and the session goes on. */
-static int run_prompt(session *s)
+static int run_prompt(explore *e)
 {
     char msg[1024];
-    printf("cellmap explore %s: type help for the commands, quit to end\n", s->path);
-    for (long lineno = 1; !s->quit; lineno++) {
+    printf("cellmap explore %s: type help for the commands, quit to end\n", e->s.path);
+    for (long lineno = 1; !e->quit; lineno++) {
         char *line = readline("explore> ");
         if (!line)
             break; /* end of input */
         if (line[strspn(line, " \t")])
             add_history(line);
-        if (session_exec(s, line, msg, sizeof msg) != CM_OK)
+        if (explore_exec(e, line, msg, sizeof msg) != CM_OK)
             fprintf(stderr, "line %ld: %s\n", lineno, msg);
         free(line);
     }
@@ -127,22 +127,22 @@ static int run_prompt(session *s)
 /* A script file's run, journaled in the file (session_journal_begin): a
  * run of the same script that was killed is resumed without repeating
  * its extensions. A pipe is not journaled (it cannot be read twice). */
-static int run_journaled(session *s, const char *script, FILE *f)
+static int run_journaled(explore *e, const char *script, FILE *f)
 {
     char hash[24], msg[1024];
     struct stat sb;
     if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode))
-        return run_script(s, f, script);
+        return run_script(e, f, script);
     cm_status st = cm_file_hash(script, hash, msg, sizeof msg);
     const uint64_t h = strtoull(hash, NULL, 16);
     if (st == CM_OK)
-        st = session_journal_begin(s, h ? h : 1, msg, sizeof msg);
+        st = explore_journal_begin(e, h ? h : 1, msg, sizeof msg);
     if (st != CM_OK) {
         fprintf(stderr, "cellmap explore: %s\n", msg);
         return EXIT_FAIL;
     }
-    int rc = run_script(s, f, script);
-    if (rc == EXIT_OK && session_journal_end(s, msg, sizeof msg) != CM_OK) {
+    int rc = run_script(e, f, script);
+    if (rc == EXIT_OK && session_journal_end(&e->s, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "cellmap explore: %s\n", msg);
         rc = EXIT_FAIL;
     }
@@ -151,13 +151,13 @@ static int run_journaled(session *s, const char *script, FILE *f)
 
 /* The session's input: the script file (opened before the session, so
  * that a missing one makes no file), standard input or the prompt. */
-static int run_input(session *s, const char *script, FILE *f)
+static int run_input(explore *e, const char *script, FILE *f)
 {
     if (f)
-        return run_journaled(s, script, f);
+        return run_journaled(e, script, f);
     if (!script && isatty(STDIN_FILENO))
-        return run_prompt(s);
-    return run_script(s, stdin, "stdin");
+        return run_prompt(e);
+    return run_script(e, stdin, "stdin");
 }
 
 int cmd_explore(int argc, char **argv)
@@ -171,7 +171,6 @@ int cmd_explore(int argc, char **argv)
         return rc < 0 ? EXIT_OK : rc;
     join_argv(argc + 1, argv - 1, command, sizeof command);
     a.o.command = command;
-    a.o.out = stdout;
     FILE *f = NULL;
     if (a.script && strcmp(a.script, "-") != 0 && !(f = fopen(a.script, "r"))) {
         fprintf(stderr, "cellmap explore: cannot open the script %s: %s (check the path)\n",
@@ -188,14 +187,14 @@ int cmd_explore(int argc, char **argv)
         fclose(f);
         return EXIT_USAGE;
     }
-    session s;
-    rc = session_open(&s, &a.o);
+    explore e;
+    rc = explore_open(&e, &a.o, stdout);
     if (rc == EXIT_OK)
-        rc = run_input(&s, a.script, f);
+        rc = run_input(&e, a.script, f);
     if (f)
         fclose(f);
     /* what the session did is saved in any case */
-    if (session_close(&s, msg, sizeof msg) != CM_OK) {
+    if (explore_close(&e, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "cellmap explore: %s\n", msg);
         rc = EXIT_FAIL;
     }

@@ -6,6 +6,7 @@
 
 #include "lib/export.h"
 #include "lib/project.h"
+#include "lib/session.h"
 #include "src/args.h"
 #include "src/attractor_opts.h"
 #include "src/commands.h"
@@ -215,4 +216,23 @@ int cmd_export(int argc, char **argv)
     const int result = run_export(&c, &a, s, &info, &cl);
     project_close(s, &cl);
     return result;
+}
+
+int cmd_export_in(int argc, char **argv, session *open)
+{
+    cli c = {"export", argc, argv, 0, NULL, NULL};
+    export_args a;
+    memset(&a, 0, sizeof a);
+    const int rc = parse_export(&c, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+    const char *const outs[] = {a.groups, a.cells, a.flat, a.labels, a.steps};
+    const int werr = outfiles_check("export", outs, 5);
+    if (werr != EXIT_OK)
+        return werr;
+    char msg[1024];
+    cm_store_info info;
+    if (session_records(open, &info, msg, sizeof msg) != CM_OK)
+        return export_failed(msg, CM_EIO);
+    return run_export(&c, &a, open->store, &info, &open->c);
 }

@@ -9,6 +9,11 @@ int cmd_orbit(int argc, char **argv);
 int cmd_fixed_points(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
+/* `export` inside an explore session: cellmap export's words (argv[1] the
+ * session's file) over the session's own open database and cluster, which
+ * is not opened a second time. */
+struct session;
+int cmd_export_in(int argc, char **argv, struct session *open);
 int cmd_explore(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_lyapunov(int argc, char **argv);

@@ -53,7 +53,7 @@ static const preset presets[] = {
 };
 
 /* Opens s in place: the session's store keeps a pointer to its model. */
-static void open_session(session *s, const preset *p, const char *path)
+static void open_session(explore *s, const preset *p, const char *path)
 {
     session_options o;
     memset(&o, 0, sizeof o);
@@ -67,26 +67,26 @@ static void open_session(session *s, const preset *p, const char *path)
     o.n_cell_size = o.n_origin = 2;
     o.max_steps = p->max_steps;
     o.command = "bench_explore";
-    if (session_open(s, &o) != 0)
+    if (explore_open(s, &o, NULL) != 0)
         exit(1);
 }
 
 /* Runs a line and returns its time. */
-static double timed(session *s, const char *line)
+static double timed(explore *s, const char *line)
 {
     char msg[1024];
     const double t0 = now();
-    if (session_exec(s, line, msg, sizeof msg) != CM_OK) {
+    if (explore_exec(s, line, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "bench_explore: %s: %s\n", line, msg);
         exit(1);
     }
     return now() - t0;
 }
 
-static void close_session(session *s)
+static void close_session(explore *s)
 {
     char msg[512];
-    if (session_close(s, msg, sizeof msg) != CM_OK) {
+    if (explore_close(s, msg, sizeof msg) != CM_OK) {
         fprintf(stderr, "bench_explore: %s\n", msg);
         exit(1);
     }
@@ -104,7 +104,7 @@ int main(int argc, char **argv)
     snprintf(png, sizeof png, "%s/bench_explore.png", dir);
     snprintf(render, sizeof render, "render %s 1000x1000", png);
 
-    session s;
+    explore s;
     open_session(&s, p, db);
     const double first = timed(&s, p->view), first_render = timed(&s, render);
     const int pans = argc > 3 ? atoi(argv[3]) : 20;
@@ -123,14 +123,14 @@ int main(int argc, char **argv)
         printf("%4d %12.1f %12.1f %12.1f\n", k + 1, 1e3 * pan[k], 1e3 * draw[k], 1e3 * total[k]);
     }
     char final_view[256];
-    snprintf(final_view, sizeof final_view, "view %.17g:%.17g %.17g:%.17g", s.lo[0], s.hi[0],
-             s.lo[1], s.hi[1]);
+    snprintf(final_view, sizeof final_view, "view %.17g:%.17g %.17g:%.17g", s.s.lo[0], s.s.hi[0],
+             s.s.lo[1], s.s.hi[1]);
     close_session(&s);
 
     /* the same view from scratch, three times */
     double full[3], full_compute[3];
     for (int k = 0; k < 3; k++) {
-        session f;
+        explore f;
         open_session(&f, p, db);
         full_compute[k] = timed(&f, final_view);
         full[k] = full_compute[k] + timed(&f, render);

@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "render/palette.h"
-#include "src/basin_png.h"
+#include "src/figure_opts.h"
 #include "src/cmd_lyapunov.c"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)

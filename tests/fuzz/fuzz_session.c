@@ -55,9 +55,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     o.n_cell_size = 2;
     o.threads = 1;
     o.max_new_cells = UINT64_C(1) << 14;
-    session s;
+    explore s;
     empty_directory();
-    if (session_open(&s, &o) != EXIT_OK)
+    if (explore_open(&s, &o, NULL) != EXIT_OK)
         abort(); /* the options are fixed and valid */
     char *text = malloc(size + 1), msg[1024];
     memcpy(text, data, size);
@@ -68,9 +68,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (next)
             *next++ = '\0';
         if (!skipped(line))
-            session_exec(&s, line, msg, sizeof msg);
+            explore_exec(&s, line, msg, sizeof msg);
     }
-    session_close(&s, msg, sizeof msg);
+    explore_close(&s, msg, sizeof msg);
     free(text);
     return 0;
 }
