@@ -283,23 +283,17 @@ static cm_status solve_split(const cm_model *m, const cm_lattice *lat, const cm_
                              const cm_solve_options *opt, const cm_scm_options *scm, cm_cluster *c,
                              cm_region *r, char *msg, size_t msg_size)
 {
-    project_plan plan = {.nsplit = box->dim, .opt = *scm};
+    project_plan plan = {.nsplit = box->dim, .opt = *scm, .joined = region_joined};
     for (int d = 0; d < box->dim; d++)
         plan.split[d] = opt->split[d] > 0 ? opt->split[d] : 1;
-    const uint32_t n = project_split(&plan, box, NULL);
-    cm_box *boxes = malloc(n * sizeof *boxes);
-    if (!boxes)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u regions", n);
-    project_split(&plan, box, boxes);
+    solve_progress sp = {opt, project_split(&plan, box, NULL)};
+    plan.joined_user = &sp;
     cm_cluster_init(c, lat);
     c->keep_exits = 0; /* nothing saves the cluster or reads its images */
     c->threads = opt->threads;
-    solve_progress sp = {opt, n};
-    cm_status st = cm_cluster_solve_boxes(c, m, boxes, n, scm, region_joined, &sp, NULL, msg,
-                                          msg_size);
+    cm_status st = project_add_box(c, NULL, m, &plan, box, NULL, msg, msg_size);
     if (st == CM_OK)
         st = cm_cluster_flatten(c, box, r, msg, msg_size);
-    free(boxes);
     return st;
 }
 

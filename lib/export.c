@@ -591,7 +591,7 @@ static cm_status write_rows(cm_cluster *c, const cm_box *window, const cm_attrac
                          why);
         if (st != CM_OK)
             return st;
-        work_progress(hooks, done);
+        work_progress(hooks, done, NULL);
     }
     return CM_OK;
 }
@@ -816,7 +816,7 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
                          why);
             ok = false;
         }
-        work_progress(hooks, done);
+        work_progress(hooks, done, NULL);
     }
     if (!ok && st == CM_OK)
         st = msg[0] ? CM_EIO : cm_fail(CM_EIO, msg, msg_size, "cannot write the arrays");

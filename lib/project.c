@@ -29,6 +29,13 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
     return st;
 }
 
+const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name)
+{
+    const cm_model_lib *lib = NULL;
+    cm_model_set_find(&spec->set, name, &lib);
+    return lib;
+}
+
 cm_status project_probe(const char *path, char *msg, size_t msg_size)
 {
     return cm_store_probe(path, msg, msg_size);
@@ -332,11 +339,19 @@ static cm_status joined(void *user, cm_cluster *c, uint32_t box, const cm_join_s
     return st;
 }
 
+cm_status project_solve_boxes(cm_cluster *c, cm_store *s, const cm_model *m,
+                              const cm_scm_options *opt, const cm_box *boxes, uint32_t n,
+                              cm_joined_fn then, void *user, cm_join_stats *stats, char *msg,
+                              size_t msg_size)
+{
+    const project_plan p = {.joined = then, .joined_user = user};
+    after_join a = {s, &p};
+    return cm_cluster_solve_boxes(c, m, boxes, n, opt, joined, &a, stats, msg, msg_size);
+}
+
 cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
                           const cm_box *box, cm_join_stats *stats, char *msg, size_t msg_size)
 {
-    cm_scm_options opt = p->opt;
-    opt.record_exits = 1;
     const uint32_t n = project_split(p, box, NULL);
     cm_box *boxes = malloc(n * sizeof *boxes);
     if (!boxes)
@@ -346,8 +361,8 @@ cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const p
     for (uint32_t k = 0; k < n; k++)
         if (!has_box(c, &boxes[k]))
             boxes[todo++] = boxes[k];
-    after_join a = {s, p};
-    cm_status st = cm_cluster_solve_boxes(c, m, boxes, todo, &opt, joined, &a, stats, msg, msg_size);
+    const cm_status st = project_solve_boxes(c, s, m, &p->opt, boxes, todo, p->joined,
+                                             p->joined_user, stats, msg, msg_size);
     free(boxes);
     return st;
 }

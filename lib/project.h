@@ -26,6 +26,9 @@ typedef struct model_spec {
     cm_model_set set;
 } model_spec;
 
+/* The plugin the model `name` of spec's set comes from (NULL: built in). */
+const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
+
 /* Whether path is a database this cellmap reads, checked before any work
  * (cm_store_probe: it exists, is readable and is a cellmap database of a
  * format this version reads): CM_OK, else why not in msg. Damage inside
@@ -120,8 +123,18 @@ cm_status project_plan_int(const char *plan, const char *key, int lo, int hi, in
  * NULL: only counted) receives them. */
 uint32_t project_split(const project_plan *p, const cm_box *box, cm_box *boxes);
 
-/* Solves the parts of box that the cluster lacks and joins them (committing
- * each join to s, which may be NULL); stats (may be NULL) sums the joins. */
+/* The one driver that solves regions and joins them: boxes (disjoint, and
+ * outside the cluster's regions) solved with opt as new regions and joined
+ * to c in order, each join committed to s (NULL: no database) before then
+ * (may be NULL) is called; stats (may be NULL) sums the joins. */
+cm_status project_solve_boxes(cm_cluster *c, cm_store *s, const cm_model *m,
+                              const cm_scm_options *opt, const cm_box *boxes, uint32_t n,
+                              cm_joined_fn then, void *user, cm_join_stats *stats, char *msg,
+                              size_t msg_size);
+
+/* Solves the parts of box (cut as the plan says) that the cluster lacks
+ * with the plan's options and joins them (project_solve_boxes, with the
+ * plan's joined callback); stats (may be NULL) sums the joins. */
 cm_status project_add_box(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
                           const cm_box *box, cm_join_stats *stats, char *msg, size_t msg_size);
 

@@ -98,8 +98,8 @@ static cm_status compute_boxes(session *s, const cm_box *boxes, uint32_t n, sess
                                 .record_exits = 1};
     cm_join_stats stats;
     const double t0 = cm_seconds();
-    cm_status st = cm_cluster_solve_boxes(&s->c, &s->model, boxes, n, &opt, cm_store_commit_join,
-                                          s->store, &stats, msg, msg_size);
+    cm_status st = project_solve_boxes(&s->c, s->store, &s->model, &opt, boxes, n, NULL, NULL,
+                                       &stats, msg, msg_size);
     done->seconds += cm_seconds() - t0;
     s->grew |= n > 0;
     if (st != CM_OK)

@@ -14,8 +14,9 @@
 
 typedef struct work_hooks {
     /* units of work done so far (cells, regions: the driver's header
-     * says); NULL: not told */
-    void (*progress)(void *user, uint64_t done);
+     * says) and what is being done (a phase, "3 regions joined"; may be
+     * NULL); NULL: not told */
+    void (*progress)(void *user, uint64_t done, const char *what);
     /* NULL to go on, else why to stop now ("interrupted (Ctrl-C)"); the
      * driver then returns CM_ECANCELED with that reason first in its
      * message. NULL: never stops. */
@@ -24,10 +25,10 @@ typedef struct work_hooks {
 } work_hooks;
 
 /* The hooks' calls, for drivers; h may be NULL. */
-static inline void work_progress(const work_hooks *h, uint64_t done)
+static inline void work_progress(const work_hooks *h, uint64_t done, const char *what)
 {
     if (h && h->progress)
-        h->progress(h->user, done);
+        h->progress(h->user, done, what);
 }
 
 static inline const char *work_stop(const work_hooks *h)

@@ -70,7 +70,10 @@ void progress_end(progress *p)
     p->width = 0;
 }
 
-static void said_done(void *user, uint64_t done) { progress_say(user, done, NULL); }
+static void said_done(void *user, uint64_t done, const char *what)
+{
+    progress_say(user, done, what);
+}
 
 static const char *ctrl_c(void *user)
 {

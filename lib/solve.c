@@ -1,0 +1,309 @@
+/* lib/solve.c - a solve from the cells to the stored attractors (lib/solve.h). */
+#include "lib/solve.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A cm_progress_fn for a solve in one region: the phase's share of the
+ * cells, and the stop request. */
+static int whole_progress(void *user, const char *phase, double fraction)
+{
+    const solve_request *q = user;
+    char what[64];
+    snprintf(what, sizeof what, "%s %.0f%%", phase, 100 * fraction);
+    work_progress(q->hooks, (uint64_t)(fraction * (double)cm_box_cells(&q->box)), what);
+    return work_stop(q->hooks) != NULL;
+}
+
+/* A cm_joined_fn for a cluster (after the join's commit): the regions
+ * joined, and the stop request, which ends the solve with what is
+ * committed. */
+static cm_status cluster_progress(void *user, cm_cluster *c, uint32_t box,
+                                  const cm_join_stats *stats, char *msg, size_t msg_size)
+{
+    const solve_request *q = user;
+    (void)box, (void)stats;
+    char what[64];
+    snprintf(what, sizeof what, "%u region%s joined", c->nregions, c->nregions == 1 ? "" : "s");
+    work_progress(q->hooks, c->cells, what);
+    const char *why = work_stop(q->hooks);
+    return why ? cm_fail(CM_ECANCELED, msg, msg_size, "%s", why) : CM_OK;
+}
+
+/* Ends a phase that cannot stop half-way when a stop was asked for. */
+static cm_status stop_asked(const solve_request *q, char *msg, size_t msg_size)
+{
+    const char *why = work_stop(q->hooks);
+    return why ? cm_fail(CM_ECANCELED, msg, msg_size, "%s", why) : CM_OK;
+}
+
+static cm_status solve_whole(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
+{
+    /* exits recorded: their orbits are followed (cm_region_settle_exits) */
+    const cm_scm_options opt = {.max_steps = q->plan.opt.max_steps,
+                                .threads = q->plan.opt.threads,
+                                .progress = whole_progress,
+                                .user = (void *)q,
+                                .record_exits = 1};
+    r->first = "images";
+    r->second = "classification";
+    cm_status st = cm_region_alloc(&r->r, &q->box, msg, msg_size);
+    const double t0 = cm_seconds();
+    if (st == CM_OK)
+        st = cm_scm_images(q->model, &q->lat, &opt, &r->r, msg, msg_size);
+    const double t1 = cm_seconds();
+    if (st == CM_OK) /* classification cannot stop half-way */
+        st = stop_asked(q, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_classify(&r->r, q->plan.opt.threads, msg, msg_size);
+    r->t1 = t1 - t0;
+    r->t2 = cm_seconds() - t1;
+    return st;
+}
+
+/* The regions of the split solved alone and taken through Stage 1 of
+ * their join only (thesis Fig. 4.27), flattened into r->r. */
+static cm_status solve_stage1(const solve_request *q, solve_result *r, char *msg,
+                              size_t msg_size)
+{
+    const project_plan *plan = &q->plan;
+    const uint32_t n = project_split(plan, &q->box, NULL);
+    cm_box *boxes = malloc(n * sizeof *boxes);
+    cm_region *parts = calloc(n, sizeof *parts);
+    cm_status st =
+        boxes && parts ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the regions");
+    r->first = "regions";
+    r->second = "stage 1";
+    const double t0 = cm_seconds();
+    if (st == CM_OK)
+        project_split(plan, &q->box, boxes);
+    for (uint32_t k = 0; k < n && st == CM_OK; k++) {
+        st = cm_region_alloc(&parts[k], &boxes[k], msg, msg_size);
+        if (st == CM_OK)
+            st = cm_scm_solve(q->model, &q->lat, &plan->opt, &parts[k], msg, msg_size);
+    }
+    const double t1 = cm_seconds();
+    if (st == CM_OK)
+        st = cm_join_stage1(parts, n, NULL, &r->stage1, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_flat_alloc(&q->box, parts[0].ngroups, &r->r, msg, msg_size);
+    for (uint32_t k = 0; k < n && st == CM_OK; k++)
+        cm_flat_copy(&parts[k], &r->r);
+    r->t1 = t1 - t0;
+    r->t2 = cm_seconds() - t1;
+    r->stage1_regions = n;
+    for (uint32_t k = 0; parts && k < n; k++)
+        cm_region_free(&parts[k]);
+    free(parts);
+    free(boxes);
+    return st;
+}
+
+/* What a resumed file must have been made with. */
+typedef struct solve_fit {
+    const cm_model *m;
+    const cm_lattice *lat;
+    const char *plan, *db;
+} solve_fit;
+
+/* A project_fits_fn: the same model, parameters, lattice and plan. */
+static cm_status same_solve(void *user, const cm_store_info *info, const cm_model **model,
+                            char *msg, size_t msg_size)
+{
+    const solve_fit *f = user;
+    char params[4096];
+    cm_params_json(&f->m->values, params, sizeof params);
+    const char *differs = strcmp(info->model, f->m->name)             ? "model"
+                          : strcmp(info->params, params)              ? "parameters"
+                          : !cm_lattice_equal(&info->lattice, f->lat) ? "lattice (--region, --cells)"
+                          : strcmp(info->plan, f->plan)               ? "plan (--split, --extend, ...)"
+                                                                      : NULL;
+    if (differs)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s was made by another solve (its %s differs): resume with the options "
+                       "of: %s",
+                       f->db, differs, info->command);
+    *model = f->m;
+    return CM_OK;
+}
+
+/* The database: a new one, or the saved cluster, which must come from the
+ * same model, parameters, lattice and plan. */
+static cm_status open_store(const solve_request *q, const char *plan, solve_result *r, char *msg,
+                            size_t msg_size)
+{
+    if (!q->resume)
+        return project_create(q->db, q->model, q->lib, &q->lat, q->command, plan, &r->store,
+                              &r->c, msg, msg_size);
+    solve_fit fit = {q->model, &q->lat, plan, q->db};
+    cm_store_info info;
+    return project_resume(q->db, same_solve, &fit, &r->store, &info, &r->c, &r->upgraded_from,
+                          msg, msg_size);
+}
+
+/* A cluster of regions: the box cut as the plan says, then extended. */
+static cm_status solve_cluster(const solve_request *q, solve_result *r, char *msg,
+                               size_t msg_size)
+{
+    project_plan plan = q->plan;
+    plan.joined = cluster_progress;
+    plan.joined_user = (void *)q;
+    char plan_text[1024];
+    project_plan_text(&plan, &q->box, plan_text, sizeof plan_text);
+    cm_status st = CM_OK;
+    if (q->db)
+        st = open_store(q, plan_text, r, msg, msg_size);
+    else
+        cm_cluster_init(&r->c, &q->lat);
+    r->c.keep_exits = q->db != NULL; /* only a database saves them; no image is read */
+    r->c.threads = plan.opt.threads;
+    r->c.mem_budget = q->mem;
+    r->first = "regions and joins";
+    r->second = "summary";
+    const double t0 = cm_seconds();
+    if (st == CM_OK)
+        st = project_add_box(&r->c, r->store, q->model, &plan, &q->box, NULL, msg, msg_size);
+    if (st == CM_OK && plan.extend > 0)
+        st = project_extend(&r->c, r->store, q->model, &plan, &q->box, q->step_done, q->step_user,
+                            &r->nsteps, r->stop, sizeof r->stop, msg, msg_size);
+    r->t1 = cm_seconds() - t0;
+    return st;
+}
+
+/* The summary of a cluster: from the database when there is one, else
+ * from the periodic cells the cluster noted and its basin counts (no cell
+ * is read either way). */
+static cm_status summarise_cluster(const solve_request *q, solve_result *r, char *msg,
+                                   size_t msg_size)
+{
+    cm_cluster *c = &r->c;
+    cm_cluster_bounds(c, &r->box);
+    r->cells = c->cells;
+    r->ngroups = c->ngroups;
+    r->groups = calloc((size_t)c->ngroups + 1, sizeof *r->groups);
+    if (!r->groups)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", c->ngroups);
+    if (r->store)
+        return cm_store_groups(r->store, r->groups, c->ngroups, &r->sink, msg, msg_size);
+    r->sink = cm_cluster_sink_cells(c);
+    return cm_cluster_describe_new(c, q->model, r->groups, msg, msg_size);
+}
+
+/* The summary of a single region (or Stage 1's flattened regions). */
+static cm_status summarise_region(const solve_request *q, solve_result *r, char *msg,
+                                  size_t msg_size)
+{
+    const int threads = q->plan.opt.threads;
+    cm_status st = q->stage1 ? CM_OK : cm_region_settle_exits(&r->r, threads, &r->exits, msg,
+                                                               msg_size);
+    r->box = r->r.box;
+    r->cells = r->r.ncells;
+    r->ngroups = r->r.ngroups;
+    if (st == CM_OK && q->slow_share)
+        cm_scm_slow_share(&r->r, threads, r->slow);
+    if (st == CM_OK)
+        st = cm_scm_describe(q->model, &q->lat, &r->r, &r->groups, &r->sink, msg, msg_size);
+    return st;
+}
+
+/* The system's attractors over the groups, stored in the database. */
+static cm_status find_attractors(const solve_request *q, solve_result *r, char *msg,
+                                 size_t msg_size)
+{
+    const double t0 = cm_seconds();
+    cm_attractor_options o = q->att;
+    o.threads = q->plan.opt.threads;
+    /* the cells' groups: the region's, or the cluster's (resolved on the way) */
+    cm_status st = r->r.group ? cm_region_attractors(q->model, &q->lat, &r->r,
+                                                     q->plan.opt.max_steps, &r->exits, r->groups,
+                                                     &o, &r->att, msg, msg_size)
+                              : cluster_ends_open(&r->joined, &r->c, msg, msg_size);
+    if (st == CM_OK && !r->r.group)
+        st = cm_cluster_attractors(q->model, &r->joined.cc, r->groups, &o, &r->att, msg,
+                                   msg_size);
+    if (st != CM_OK)
+        return st;
+    if (q->stage1) { /* its sink is Stage 1's: pending, not followed */
+        r->att.outside_steps = 0;
+        r->att.outside_cells = r->sink;
+    }
+    r->att_seconds = cm_seconds() - t0;
+    cm_attractor_options used;
+    cm_attractor_defaults(q->model, &o, &used);
+    used.threads = 0;
+    return r->store ? cm_store_put_attractors(r->store, &r->att, &used, q->lat.dim, msg, msg_size)
+                    : CM_OK;
+}
+
+cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
+{
+    memset(r, 0, sizeof *r);
+    for (int d = 0; d < CM_MAX_DIM; d++)
+        r->slow[d] = NAN; /* known for a single region only */
+    cm_status st;
+    if (!q->stage1 && q->cluster) {
+        const double t0 = cm_seconds();
+        st = solve_cluster(q, r, msg, msg_size);
+        if (st == CM_OK)
+            st = summarise_cluster(q, r, msg, msg_size);
+        r->t2 = cm_seconds() - t0 - r->t1;
+    } else {
+        st = q->stage1 ? solve_stage1(q, r, msg, msg_size) : solve_whole(q, r, msg, msg_size);
+        if (st == CM_OK)
+            st = summarise_region(q, r, msg, msg_size);
+    }
+    return st == CM_OK ? find_attractors(q, r, msg, msg_size) : st;
+}
+
+cm_status solve_draw(const solve_request *q, solve_result *r, const png_opts *po, char *msg,
+                     size_t msg_size)
+{
+    basin_png png = {po, q->model, &q->lat, &r->r, r->groups, {0, 0}, {0, 0}, NULL,
+                     po->by == BY_ATTRACTORS ? &r->att : NULL, NULL};
+    /* where the sink cells' sequences leave the cells drawn */
+    cm_region_cells whole = {&r->r, q->model, &q->lat, q->plan.opt.max_steps};
+    const cm_computed region = cm_region_computed(&whole);
+    png.computed = r->r.group ? &region : &r->joined.computed;
+    cm_status st = CM_OK;
+    if (po->has_view) {
+        cm_box box;
+        view_cells(&q->lat, po->lo, po->hi, &r->box, &box);
+        cm_region_free(&r->r);
+        memcpy(png.lo, po->lo, sizeof png.lo);
+        memcpy(png.hi, po->hi, sizeof png.hi);
+        st = cm_cluster_flatten(&r->c, &box, &r->r, msg, msg_size);
+    } else if (!r->r.group) {
+        st = cm_cluster_flatten(&r->c, &r->box, &r->r, msg, msg_size);
+    }
+    return st == CM_OK ? figure_write(&png, msg, msg_size) : st;
+}
+
+cm_status solve_finish(solve_result *r, char *msg, size_t msg_size)
+{
+    const cm_status st = r->store ? cm_store_finish(r->store, msg, msg_size) : CM_OK;
+    r->store = NULL;
+    return st;
+}
+
+bool solve_replacing(const solve_result *r) { return r->store && cm_store_replacing(r->store); }
+
+void solve_store_stats(const solve_result *r, cm_store_stats *out)
+{
+    cm_store_get_stats(r->store, out);
+}
+
+void solve_result_free(solve_result *r)
+{
+    char ignored[256];
+    cm_store_close(r->store, ignored, sizeof ignored);
+    r->store = NULL;
+    cm_cluster_free(&r->c);
+    free(r->groups);
+    r->groups = NULL;
+    cm_attractors_free(&r->att);
+    cm_exits_free(&r->exits);
+    cluster_ends_close(&r->joined);
+    cm_region_free(&r->r);
+}
