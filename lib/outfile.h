@@ -14,6 +14,16 @@
 #include "render/chart.h"
 #include "render/png_out.h"
 
+/* The outputs of the analysis drivers and commands (escape, stability,
+ * horseshoe, partition, amplitude, simulate, bifurcation): a CSV table
+ * and a chart PNG (either NULL: not written; "-": standard output), JSON
+ * on standard output, no report (quiet), and the chart's size in pixels. */
+typedef struct chart_outputs {
+    const char *csv, *png;
+    bool json, quiet;
+    int width, height;
+} chart_outputs;
+
 /* A stream being written to its temporary file. */
 typedef struct outfile {
     cm_output out;

@@ -250,3 +250,12 @@ void cli_said_upgrade(const char *cmd, const char *path, int from)
                 "cannot open it any more)\n",
                 cmd, path, from, CM_STORE_VERSION);
 }
+
+int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
+                int n_ax, cm_params *base)
+{
+    char msg[512];
+    if (param_sweep_base(mo, only, ax, n_ax, base, msg, sizeof msg) == CM_OK)
+        return EXIT_OK;
+    return cli_usage_error(c, "%s", msg);
+}

@@ -11,6 +11,8 @@
 #include "cellmap/model.h"
 #include "models/registry.h"
 #include "lib/parse.h"
+#include "lib/outfile.h"
+#include "lib/param_grid.h"
 #include "lib/project.h"
 
 /* EXIT_INTERRUPTED: stopped by Ctrl-C (128 + SIGINT, as shells report it). */
@@ -49,15 +51,7 @@ bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error
  * true if the current option was it. */
 bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error);
 
-/* The outputs of the analysis commands (escape, stability, horseshoe,
- * partition, amplitude, simulate, bifurcation): --csv FILE|-, --png FILE|-,
- * --json, --quiet, --size WxH. */
-typedef struct chart_outputs {
-    const char *csv, *png;
-    bool json, quiet;
-    int width, height;
-} chart_outputs;
-
+/* The outputs of the analysis commands (chart_outputs, lib/outfile.h). */
 /* Takes the current option if it is one of those (--size at least min_w x
  * min_h); true if it was. */
 bool chart_outputs_take(cli *c, chart_outputs *o, int min_w, int min_h, int *error);
@@ -109,6 +103,11 @@ int cli_open_read(const char *cmd, const char *path, uint64_t mem_budget, cm_sto
 /* Tells the user that a resumed file was upgraded from format version
  * `from` (project_resume; nothing when from is 0). */
 void cli_said_upgrade(const char *cmd, const char *path, int from);
+
+/* param_sweep_base for the command's model options: the problem said as
+ * a usage error (EXIT_USAGE), else EXIT_OK. */
+int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
+                int n_ax, cm_params *base);
 
 /* Command line joined by spaces (for provenance). */
 void join_argv(int argc, char **argv, char *buf, size_t size);

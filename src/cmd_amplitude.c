@@ -15,7 +15,7 @@
 #include "src/commands.h"
 #include "lib/json.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 
 static const char amplitude_help[] =
     "usage: cellmap amplitude [--model friction-oscillator] [--param k=v[,k=v]]\n"

@@ -16,7 +16,7 @@
 #include "src/commands.h"
 #include "lib/json.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 
 static const char horseshoe_help[] =
     "usage: cellmap horseshoe [--model microchaos-pd] [--param k=v[,k=v]] [--m M0:M1]\n"

@@ -18,7 +18,7 @@
 #include "src/commands.h"
 #include "src/interrupt.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 #include "src/progress.h"
 
 static const char lyapunov_help[] =

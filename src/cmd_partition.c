@@ -13,7 +13,7 @@
 #include "src/commands.h"
 #include "lib/json.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 
 static const char partition_help[] =
     "usage: cellmap partition [--model microchaos-delay] [--param k=v[,k=v]] [--csv FILE|-]\n"

@@ -16,7 +16,7 @@
 #include "src/commands.h"
 #include "lib/json.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 
 static const char stability_help[] =
     "usage: cellmap stability [--model microchaos-pd] [--param k=v[,k=v]] [--P LO:HI:N]\n"

@@ -20,7 +20,7 @@
 #include "lib/json.h"
 #include "src/interrupt.h"
 #include "src/outfile.h"
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 #include "src/progress.h"
 
 static const char sweep_help[] =

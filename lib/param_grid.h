@@ -1,16 +1,16 @@
-/* src/param_grid.h - the parameter axes of the commands that vary a
+/* lib/param_grid.h - the parameter axes of the commands that vary a
  * model's parameters (lyapunov's --grid, bifurcation's --sweep, sweep's
  * --vary), in one syntax: "NAME=LO:HI:N" is N values at the centres of N
  * equal cells of LO..HI; "NAME=V1,V2,..." lists increasing values. */
-#ifndef CM_SRC_PARAM_GRID_H
-#define CM_SRC_PARAM_GRID_H
+#ifndef CM_LIB_PARAM_GRID_H
+#define CM_LIB_PARAM_GRID_H
 
 #include <stdbool.h>
 #include <stddef.h>
 
 #include "cellmap/model.h"
 #include "models/params.h"
-#include "src/args.h"
+#include "lib/project.h"
 #include "lib/json.h"
 
 #define PARAM_AXIS_MAX 2000
@@ -49,22 +49,21 @@ void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax);
 /* "model":NAME,"params":{...}: the parameters besides the axes'. */
 void param_base_json(json *j, const char *model, const cm_params *base);
 
-/* Checks the command's model options for a sweep of a model's parameters:
- * the model exists (and is `only`, unless that is NULL), the --param values
- * are valid and each axis names a parameter. *base receives the parameters
- * without the axes' values (for the PNG texts). Prints the problem and
- * returns EXIT_USAGE, or EXIT_OK. */
-int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
-                int n_ax, cm_params *base);
+/* Checks a model named for a sweep of its parameters: it exists (and is
+ * `only`, unless that is NULL), the parameter texts are valid and each
+ * axis names a parameter (CM_EINVAL, the problem in msg). *base receives
+ * the parameters without the axes' values (for the PNG texts). */
+cm_status param_sweep_base(const model_spec *mo, const char *only, const param_axis *ax,
+                           int n_ax, cm_params *base, char *msg, size_t msg_size);
 
 /* The model of the command's --model and --param with parameters names[k]
  * set to values[k] (n <= 2); false, with the reason in msg, where it
  * cannot be built (e.g. S > S0). */
-bool model_with_values(const model_opts *mo, const char *const *names, const double *values, int n,
+bool model_with_values(const model_spec *mo, const char *const *names, const double *values, int n,
                        cm_model *m, char *msg, size_t msg_size);
 
 /* The model at axis point idx[k] of each axis k (n_ax <= 2). */
-bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
+bool model_at_point(const model_spec *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m);
 
 #endif

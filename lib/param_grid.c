@@ -1,4 +1,4 @@
-#include "src/param_grid.h"
+#include "lib/param_grid.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cellmap/store.h"
+#include "lib/parse.h"
 #include "models/registry.h"
 
 /* NAME=V1,V2,... after the '=' */
@@ -121,32 +122,33 @@ void param_base_json(json *j, const char *model, const cm_params *base)
     json_raw(j, "params", params);
 }
 
-int sweep_check(const cli *c, const model_opts *mo, const char *only, const param_axis *ax,
-                int n_ax, cm_params *base)
+cm_status param_sweep_base(const model_spec *mo, const char *only, const param_axis *ax,
+                           int n_ax, cm_params *base, char *msg, size_t msg_size)
 {
     const cm_model_entry *e = cm_model_set_find(&mo->set, mo->name, NULL);
     if (!e)
-        return cli_usage_error(c, "unknown model '%s' (`cellmap models` lists them)", mo->name);
+        return cm_fail(CM_EINVAL, msg, msg_size, "unknown model '%s' (`cellmap models` lists them)",
+                       mo->name);
     if (only && strcmp(e->name, only) != 0)
-        return cli_usage_error(c, "model %s: this command is implemented for %s only", e->name,
-                               only);
-    char msg[256];
-    cm_status st = cm_params_defaults(e->params, base, msg, sizeof msg);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "model %s: this command is implemented for %s only", e->name, only);
+    cm_status st = cm_params_defaults(e->params, base, msg, msg_size);
     for (int k = 0; k < mo->n_texts && st == CM_OK; k++)
-        st = cm_params_set(base, mo->texts[k], msg, sizeof msg);
+        st = cm_params_set(base, mo->texts[k], msg, msg_size);
     if (st != CM_OK)
-        return cli_usage_error(c, "%s", msg);
+        return st;
     for (int k = 0; k < n_ax; k++)
         if (cm_params_find(base, ax[k].name) < 0)
-            return cli_usage_error(c, "'%s' is not a parameter of %s (`cellmap models`)",
-                                   ax[k].name, e->name);
-    return EXIT_OK;
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "'%s' is not a parameter of %s (`cellmap models`)", ax[k].name,
+                           e->name);
+    return CM_OK;
 }
 
-bool model_with_values(const model_opts *mo, const char *const *names, const double *values, int n,
+bool model_with_values(const model_spec *mo, const char *const *names, const double *values, int n,
                        cm_model *m, char *msg, size_t msg_size)
 {
-    const char *texts[MAX_PARAM_TEXTS + 2];
+    const char *texts[MODEL_SPEC_TEXTS + 2];
     char value_text[2][80];
     int k = 0;
     for (int i = 0; i < mo->n_texts; i++)
@@ -158,7 +160,7 @@ bool model_with_values(const model_opts *mo, const char *const *names, const dou
     return cm_model_set_create(&mo->set, mo->name, texts, k, m, msg, msg_size) == CM_OK;
 }
 
-bool model_at_point(const model_opts *mo, const param_axis *ax, const int *idx, int n_ax,
+bool model_at_point(const model_spec *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m)
 {
     const char *names[2];

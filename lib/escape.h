@@ -1,0 +1,55 @@
+/* lib/escape.h - the transient chaos of the 1-D micro-chaos map with
+ * Coulomb friction (thesis 4.3, Figs. 4.5, 4.7) over
+ * models/transient_escape.h: at one parameter point or along a sweep, the
+ * repeller, the bounds on the escape rate and the mean escape number from
+ * its fractal dimension, the exact mean escape number, an ensemble's and
+ * cell mapping's; written as CSV and as the thesis' figures. Nothing is
+ * printed: a failed write returns false with the problem in msg. */
+#ifndef CM_LIB_ESCAPE_H
+#define CM_LIB_ESCAPE_H
+
+#include <stdbool.h>
+
+#include "lib/outfile.h"
+#include "lib/param_grid.h"
+#include "models/transient_escape.h"
+
+enum { SEED = 20260412, MAX_PARTITION = 1000000 };
+
+typedef struct esc_args {
+    model_spec mo;
+    param_axis sweep;
+    int has_sweep, has_I0, threads;
+    double I0;
+    long cells, ensemble;
+    chart_outputs out;
+} esc_args;
+
+/* Everything at one parameter point. */
+typedef struct esc_point {
+    bool valid;
+    char why[200];
+    cm_te t;
+    double exact;    /* NaN: no finite Markov partition */
+    long partition;
+    cm_te_ensemble ens;
+    double scm_mean; /* NaN: not computed */
+    long scm_stay;   /* cells that never leave: cell-map cycles and their basins */
+} esc_point;
+
+/* The points of the request: the sweep's, or one. */
+int escape_points(const esc_args *a);
+
+/* Computes every point (pts: escape_points of them) on a->threads threads
+ * (0: all); a point that is not the case of 4.3 is !valid with why. */
+void escape_compute(const esc_args *a, esc_point *pts);
+
+/* The points as CSV at a->out.csv. */
+bool escape_write_csv(const esc_args *a, const esc_point *pts, char *msg, size_t msg_size);
+
+/* The figure at a->out.png: Fig. 4.7 along a sweep, else Fig. 4.5 at the
+ * point; params: the fixed parameters' text. */
+bool escape_write_png(const esc_args *a, const esc_point *pts, const char *params, char *msg,
+                      size_t msg_size);
+
+#endif
