@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "lib/figure.h"
-
 void horseshoe_item_at(double alpha, double beta, double P, double D, int64_t m, int n, hs_item *it)
 {
     it->P = P;

@@ -6,8 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "models/delay_partition.h"
-#include "models/params.h"
+#include "lib/partition.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -32,11 +31,6 @@ static const char partition_help[] =
     "  --json              the partition as JSON on standard output\n"
     "  --quiet             no summary\n";
 
-typedef struct part_args {
-    model_opts mo;
-    chart_outputs out;
-} part_args;
-
 static int parse_args(cli *c, part_args *a)
 {
     int err = 0;
@@ -53,72 +47,6 @@ static int parse_args(cli *c, part_args *a)
     if (!err)
         err = chart_outputs_check(c, &a->out);
     return err;
-}
-
-static void row_text(const cm_delay_partition *p, int i, char *out)
-{
-    for (int j = 0; j < p->r; j++)
-        out[j] = (char)('0' + p->P[i][j]);
-    out[p->r] = '\0';
-}
-
-static bool write_csv(const part_args *a, const cm_delay_partition *p)
-{
-    outfile o;
-    if (!outfile_open("partition", a->out.csv, &o))
-        return false;
-    fprintf(o.f, "region,branch,lo,hi,row\n");
-    char row[CM_DELAY_MAX_REGIONS + 1];
-    for (int i = 0; i < p->r; i++) {
-        row_text(p, i, row);
-        fprintf(o.f, "%d,%s,%.17g,%.17g,%s\n", i + 1, p->branch[i] ? "lower" : "upper", p->lo[i],
-                p->hi[i], row);
-    }
-    return outfile_close("partition", &o, true);
-}
-
-static bool write_png(const part_args *a, const cm_delay_partition *p, const char *params)
-{
-    double x[2][2 * CM_DELAY_MAX_REGIONS], y[2][2 * CM_DELAY_MAX_REGIONS];
-    size_t n[2] = {0, 0};
-    double top = 0, bottom = 0;
-    for (int i = 0; i < p->r; i++) {
-        const int c = i % 2, k = p->branch[i];
-        for (int e = 0; e < 2; e++) {
-            const double s = e ? p->hi[i] : p->lo[i];
-            x[c][n[c]] = s;
-            y[c][n[c]++] = p->a * s - p->b * k;
-            top = fmax(top, p->a * s - p->b * k);
-            bottom = fmin(bottom, p->a * s - p->b * k);
-        }
-    }
-    const double one_x[2] = {1, 1}, one_y[2] = {bottom - 0.1, top + 0.1};
-    const cm_rgb red = {215, 48, 39}, blue = {69, 117, 180}, grey = {150, 150, 150};
-    const cm_series series[] = {
-        {CM_SERIES_SEGMENTS, one_x, one_y, 2, grey, 1},
-        {CM_SERIES_SEGMENTS, x[0], y[0], n[0], red, 4},
-        {CM_SERIES_SEGMENTS, x[1], y[1], n[1], blue, 4},
-    };
-    char title[600];
-    snprintf(title, sizeof title,
-             "partition I_1..I_%d (alternating colours), x_(j-1) = 1 grey; %s",
-             p->r, params);
-    const cm_chart chart = {a->out.width,
-                            a->out.height,
-                            {p->x_l - 0.1, bottom - 0.1},
-                            {p->x_r + 0.1, top + 0.1},
-                            "x_(j-1)",
-                            "x_j",
-                            title,
-                            NULL,
-                            series,
-                            3,
-                            figure_font(),
-                            0,
-                            NULL,
-                            0};
-    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    return write_chart_png("partition", a->out.png, &chart, 1, texts, 2);
 }
 
 int cmd_partition(int argc, char **argv)
@@ -151,7 +79,7 @@ int cmd_partition(int argc, char **argv)
         json_nums(&j, "ends", (const double[2]){p.x_l, p.x_r}, 2);
         json_array(&j, "regions");
         for (int i = 0; i < p.r; i++) {
-            row_text(&p, i, row);
+            partition_row_text(&p, i, row);
             json_object(&j, NULL);
             json_str(&j, "branch", p.branch[i] ? "lower" : "upper");
             json_nums(&j, "range", (const double[2]){p.lo[i], p.hi[i]}, 2);
@@ -168,7 +96,7 @@ int cmd_partition(int argc, char **argv)
                    "(lower), x_(j-1) in (%.9g, %.9g):\n",
                 p.r, p.x_l, p.x_r);
         for (int i = 0; i < p.r; i++) {
-            row_text(&p, i, row);
+            partition_row_text(&p, i, row);
             fprintf(f, "  I_%-2d %s (%.9g, %.9g)  %s\n", i + 1, p.branch[i] ? "lower" : "upper",
                     p.lo[i], p.hi[i], row);
         }
@@ -179,10 +107,13 @@ int cmd_partition(int argc, char **argv)
         else
             fprintf(f, "%s, not primitive\n", p.irreducible ? "irreducible" : "not irreducible");
     }
+    char msg[1024];
     bool ok = true;
     if (a.out.csv)
-        ok = write_csv(&a, &p);
+        ok = partition_write_csv(&a, &p, msg, sizeof msg);
     if (ok && a.out.png)
-        ok = write_png(&a, &p, params);
+        ok = partition_write_png(&a, &p, params, msg, sizeof msg);
+    if (!ok)
+        fprintf(stderr, "cellmap partition: %s\n", msg);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

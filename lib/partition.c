@@ -1,0 +1,75 @@
+/* lib/partition.c - the delayed map's Markov partition written (lib/partition.h). */
+#include "lib/partition.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/figure.h"
+
+void partition_row_text(const cm_delay_partition *p, int i, char *out)
+{
+    for (int j = 0; j < p->r; j++)
+        out[j] = (char)('0' + p->P[i][j]);
+    out[p->r] = '\0';
+}
+
+bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *msg, size_t msg_size)
+{
+    outfile o;
+    if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
+        return false;
+    fprintf(o.f, "region,branch,lo,hi,row\n");
+    char row[CM_DELAY_MAX_REGIONS + 1];
+    for (int i = 0; i < p->r; i++) {
+        partition_row_text(p, i, row);
+        fprintf(o.f, "%d,%s,%.17g,%.17g,%s\n", i + 1, p->branch[i] ? "lower" : "upper", p->lo[i],
+                p->hi[i], row);
+    }
+    return (outfile_end(&o, true, msg, msg_size) == CM_OK);
+}
+
+bool partition_write_png(const part_args *a, const cm_delay_partition *p, const char *params, char *msg, size_t msg_size)
+{
+    double x[2][2 * CM_DELAY_MAX_REGIONS], y[2][2 * CM_DELAY_MAX_REGIONS];
+    size_t n[2] = {0, 0};
+    double top = 0, bottom = 0;
+    for (int i = 0; i < p->r; i++) {
+        const int c = i % 2, k = p->branch[i];
+        for (int e = 0; e < 2; e++) {
+            const double s = e ? p->hi[i] : p->lo[i];
+            x[c][n[c]] = s;
+            y[c][n[c]++] = p->a * s - p->b * k;
+            top = fmax(top, p->a * s - p->b * k);
+            bottom = fmin(bottom, p->a * s - p->b * k);
+        }
+    }
+    const double one_x[2] = {1, 1}, one_y[2] = {bottom - 0.1, top + 0.1};
+    const cm_rgb red = {215, 48, 39}, blue = {69, 117, 180}, grey = {150, 150, 150};
+    const cm_series series[] = {
+        {CM_SERIES_SEGMENTS, one_x, one_y, 2, grey, 1},
+        {CM_SERIES_SEGMENTS, x[0], y[0], n[0], red, 4},
+        {CM_SERIES_SEGMENTS, x[1], y[1], n[1], blue, 4},
+    };
+    char title[600];
+    snprintf(title, sizeof title,
+             "partition I_1..I_%d (alternating colours), x_(j-1) = 1 grey; %s",
+             p->r, params);
+    const cm_chart chart = {a->out.width,
+                            a->out.height,
+                            {p->x_l - 0.1, bottom - 0.1},
+                            {p->x_r + 0.1, top + 0.1},
+                            "x_(j-1)",
+                            "x_j",
+                            title,
+                            NULL,
+                            series,
+                            3,
+                            figure_font(),
+                            0,
+                            NULL,
+                            0};
+    const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
+    return (outfile_charts(a->out.png, &chart, 1, texts, 2, msg, msg_size) == CM_OK);
+}
