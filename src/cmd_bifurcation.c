@@ -11,8 +11,7 @@
 #include <string.h>
 
 #include "cellmap/clock.h"
-#include "models/friction_oscillator.h"
-#include "models/params.h"
+#include "lib/bifurcation.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -52,17 +51,6 @@ static const char bifurcation_help[] =
     "                      Psi per period against NAME\n"
     "  --size WxH          image size, all three panels (default 900x1200)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
-
-enum { LAST_STOPS = 10 };
-
-typedef struct bif_args {
-    model_opts mo;
-    param_axis sweep;
-    int has_sweep, runs, transient, record, threads;
-    long long seed;
-    const char *runs_csv;
-    chart_outputs out;
-} bif_args;
 
 static int parse_args(cli *c, bif_args *a)
 {
@@ -116,244 +104,7 @@ static int parse_args(cli *c, bif_args *a)
 
 /* ---- one run ---- */
 
-/* splitmix64 (Steele, Lea, Flood 2014): a good 64-bit mix for seeding. */
-static uint64_t mix64(uint64_t z)
-{
-    z += 0x9e3779b97f4a7c15u;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-/* Three numbers in [-1, 1) that depend only on the seed, the value and the run. */
-static void random_start(long long seed, int value, int run, double u[3])
-{
-    uint64_t h = mix64(mix64((uint64_t)seed) ^ ((uint64_t)value << 32 | (uint64_t)run));
-    for (int k = 0; k < 3; k++) {
-        h = mix64(h);
-        u[k] = (double)(h >> 11) * 0x1p-52 - 1;
-    }
-}
-
-typedef struct run_result {
-    double x0, v0, t0, psi;
-    double stops[LAST_STOPS]; /* a ring: the last sticking displacements */
-    int sticks;               /* in all of the recorded periods */
-    bool ok, valid;           /* valid: the parameter value admits the model */
-} run_result;
-
-static void on_event(void *user, const cm_fo_event *e)
-{
-    run_result *res = user;
-    if (e->kind == CM_FO_EV_STICK)
-        res->stops[res->sticks++ % LAST_STOPS] = e->x;
-}
-
-/* How many of the sticking displacements the ring holds. */
-static int stops_kept(const run_result *res)
-{
-    return res->sticks < LAST_STOPS ? res->sticks : LAST_STOPS;
-}
-
-/* Runs from the random start; sections[2 k], [2 k + 1]: the k-th recorded Poincare point. */
-static void run(const bif_args *a, const cm_fo *o, int value, int r, run_result *res,
-                double *sections)
-{
-    double u[3];
-    random_start(a->seed, value, r, u);
-    res->x0 = u[0];
-    res->v0 = u[1];
-    res->t0 = u[2] * o->T;
-    cm_fo_run fr;
-    cm_fo_run_start(o, res->t0, res->x0, res->v0, &fr);
-    res->ok = true;
-    for (int p = 0; p < a->transient && res->ok; p++)
-        res->ok = cm_fo_run_period(o, &fr, NULL, NULL, NULL);
-    double zero_sum = 0;
-    for (int p = 0; p < a->record && res->ok; p++) {
-        cm_fo_tally t;
-        cm_fo_tally_start(&t, fr.st.x);
-        res->ok = cm_fo_run_period(o, &fr, &t, on_event, res);
-        zero_sum += t.x_zero_sum;
-        sections[2 * p] = fr.st.x;
-        sections[2 * p + 1] = fr.st.v;
-    }
-    res->psi = fabs(zero_sum);
-}
-
 /* ---- output ---- */
-
-typedef struct sweep_results {
-    int n_values, runs, record;
-    run_result *res;  /* res[value * runs + run] */
-    double *sections; /* record * 2 per run, in the same order */
-} sweep_results;
-
-static const run_result *result_at(const sweep_results *s, int value, int r)
-{
-    return &s->res[(size_t)value * (size_t)s->runs + (size_t)r];
-}
-
-static const double *sections_at(const sweep_results *s, int value, int r)
-{
-    return s->sections + ((size_t)value * (size_t)s->runs + (size_t)r) * 2 * (size_t)s->record;
-}
-
-/* The recorded sticking displacements of a run in time order. */
-static double stop_at(const run_result *res, int j)
-{
-    return res->stops[(res->sticks - stops_kept(res) + j) % LAST_STOPS];
-}
-
-/* What a followed run recorded, one point at a time, value by value. */
-enum point_kind { POINT_STICK, POINT_SECTION, POINT_PSI };
-typedef void (*point_fn)(void *user, int kind, double p, int run, double x, double v);
-
-static void visit_points(const bif_args *a, const sweep_results *s, point_fn fn, void *user)
-{
-    for (int i = 0; i < s->n_values; i++)
-        for (int r = 0; r < s->runs; r++) {
-            const run_result *res = result_at(s, i, r);
-            if (!res->valid || !res->ok)
-                continue;
-            const double p = param_axis_value(&a->sweep, i), *z = sections_at(s, i, r);
-            for (int j = 0; j < stops_kept(res); j++)
-                fn(user, POINT_STICK, p, r, stop_at(res, j), 0);
-            for (int k = 0; k < s->record; k++)
-                fn(user, POINT_SECTION, p, r, z[2 * k], z[2 * k + 1]);
-            fn(user, POINT_PSI, p, r, res->psi / s->record, 0);
-        }
-}
-
-static void print_point(void *user, int kind, double p, int run, double x, double v)
-{
-    if (kind != POINT_PSI)
-        fprintf(user, "%.17g,%d,%s,%.17g,%.17g\n", p, run,
-                kind == POINT_STICK ? "stick" : "section", x, v);
-}
-
-static bool write_points_csv(const bif_args *a, const sweep_results *s)
-{
-    outfile o;
-    if (!outfile_open("bifurcation", a->out.csv, &o))
-        return false;
-    fprintf(o.f, "%s,run,kind,x,v\n", a->sweep.name);
-    visit_points(a, s, print_point, o.f);
-    return outfile_close("bifurcation", &o, true);
-}
-
-static bool write_runs_csv(const bif_args *a, const sweep_results *s)
-{
-    outfile o;
-    if (!outfile_open("bifurcation", a->runs_csv, &o))
-        return false;
-    fprintf(o.f, "%s,run,x0,v0,t0,psi,psi_per_period,sticks_per_period,status\n", a->sweep.name);
-    for (int i = 0; i < s->n_values; i++)
-        for (int r = 0; r < s->runs; r++) {
-            const run_result *res = result_at(s, i, r);
-            if (!res->valid)
-                continue;
-            fprintf(o.f, "%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n",
-                    param_axis_value(&a->sweep, i), r, res->x0, res->v0, res->t0, res->psi,
-                    res->psi / s->record, (double)res->sticks / s->record, res->ok ? "ok" : "lost");
-        }
-    return outfile_close("bifurcation", &o, true);
-}
-
-typedef struct cloud {
-    double *x, *y;
-    size_t n;
-    double lo, hi; /* the range of y */
-} cloud;
-
-static void cloud_add(cloud *c, double x, double y)
-{
-    c->x[c->n] = x;
-    c->y[c->n++] = y;
-    if (c->n == 1 || y < c->lo)
-        c->lo = y;
-    if (c->n == 1 || y > c->hi)
-        c->hi = y;
-}
-
-/* A panel's point: panels 0, 1 and 2 are the point kinds. */
-static void add_to_cloud(void *user, int kind, double p, int run, double x, double v)
-{
-    (void)run;
-    (void)v;
-    cloud_add(&((cloud *)user)[kind], p, x);
-}
-
-/* The three panels' points: sticking displacements, Poincare x, Psi per period. */
-static bool collect_clouds(const bif_args *a, const sweep_results *s, cloud c[3])
-{
-    const size_t runs = (size_t)s->n_values * (size_t)s->runs,
-                 cap[3] = {runs * LAST_STOPS, runs * (size_t)s->record, runs};
-    bool ok = true;
-    for (int k = 0; k < 3; k++) {
-        c[k] = (cloud){malloc(cap[k] * sizeof(double)), malloc(cap[k] * sizeof(double)), 0, 0, 0};
-        ok = ok && c[k].x && c[k].y;
-    }
-    if (ok)
-        visit_points(a, s, add_to_cloud, c);
-    return ok;
-}
-
-static bool write_png(const bif_args *a, const cm_params *base, const sweep_results *s)
-{
-    cloud c[3];
-    bool ok = collect_clouds(a, s, c);
-    if (!ok)
-        fprintf(stderr, "cellmap bifurcation: out of memory for the picture\n");
-    static const cm_rgb colours[3] = {{0, 0, 0}, {30, 60, 200}, {200, 30, 30}};
-    static const float sizes[3] = {2, 1, 3};
-    static const char *const y_names[3] = {"x stick", "x", "Psi/n"};
-    char params[400], sweep[200], runs[160], titles[3][600];
-    const char *const swept[] = {a->sweep.name, NULL};
-    cm_params_format_with(base, swept, params, sizeof params);
-    param_axes_format(&a->sweep, 1, sweep, sizeof sweep);
-    snprintf(titles[0], sizeof titles[0], "sticking displacements (last %d per run), %s %s",
-             LAST_STOPS, a->mo.name, params);
-    snprintf(titles[1], sizeof titles[1], "Poincare points (phase phi), %d periods per run",
-             a->record);
-    snprintf(titles[2], sizeof titles[2], "asymmetry Psi per period (thesis 2.6.1)");
-    cm_series series[3];
-    cm_chart charts[3];
-    const int h = a->out.height / 3;
-    for (int k = 0; k < 3; k++) {
-        double lo = c[k].n ? c[k].lo : -1, hi = c[k].n ? c[k].hi : 1;
-        const double pad = hi > lo ? 0.05 * (hi - lo) : 0.5;
-        if (k == 2)
-            lo = 0; /* Psi >= 0: its zero is the point of the panel */
-        series[k] = (cm_series){CM_SERIES_POINTS, c[k].x, c[k].y, c[k].n, colours[k], sizes[k]};
-        charts[k] = (cm_chart){a->out.width,
-                               k < 2 ? h : a->out.height - 2 * h,
-                               {a->sweep.lo, lo - pad},
-                               {a->sweep.hi, hi + pad},
-                               a->sweep.name,
-                               y_names[k],
-                               titles[k],
-                               NULL,
-                               &series[k],
-                               1,
-                               figure_font(),
-                               0,
-                               NULL,
-                               0};
-    }
-    snprintf(runs, sizeof runs,
-             "%d runs per value, seed %lld; %d transient and %d recorded periods", a->runs, a->seed,
-             a->transient, a->record);
-    const cm_png_text texts[] = {
-        {"Model", a->mo.name}, {"Parameters", params}, {"Sweep", sweep}, {"Runs", runs}};
-    if (ok)
-        ok = write_chart_png("bifurcation", a->out.png, charts, 3, texts, 4);
-    for (int k = 0; k < 3; k++) {
-        free(c[k].x);
-        free(c[k].y);
-    }
-    return ok;
-}
 
 static void print_summary(const bif_args *a, const cm_params *base, const sweep_results *s,
                           double secs)
@@ -362,7 +113,7 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
     double psi_lo = INFINITY, psi_hi = -INFINITY;
     for (int i = 0; i < s->n_values; i++)
         for (int r = 0; r < s->runs; r++) {
-            const run_result *res = result_at(s, i, r);
+            const run_result *res = bifurcation_result_at(s, i, r);
             valid += res->valid;
             lost += res->valid && !res->ok;
             if (res->valid && res->ok) {
@@ -400,16 +151,6 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
 
 /* ---- the command ---- */
 
-static void sweep_free(sweep_results *s, cm_model *models)
-{
-    for (int i = 0; i < s->n_values && models; i++)
-        if (cm_fo_of_model(&models[i]))
-            cm_model_release(&models[i]);
-    free(models);
-    free(s->res);
-    free(s->sections);
-}
-
 int cmd_bifurcation(int argc, char **argv)
 {
     cli c = {"bifurcation", argc, argv, 0, NULL, NULL};
@@ -438,7 +179,7 @@ int cmd_bifurcation(int argc, char **argv)
     cm_model *models = calloc((size_t)n_values, sizeof *models);
     if (!s.res || !s.sections || !models) {
         fprintf(stderr, "cellmap bifurcation: out of memory for %zu runs\n", n_runs);
-        sweep_free(&s, models);
+        bifurcation_free(&s, models);
         return EXIT_FAIL;
     }
     for (size_t k = 0; k < n_runs * 2 * (size_t)a.record; k++)
@@ -462,16 +203,18 @@ int cmd_bifurcation(int argc, char **argv)
         const int i = (int)(k / (size_t)a.runs), r = (int)(k % (size_t)a.runs);
         if (!s.res[k].valid || interrupt_requested()) /* Ctrl-C: the runs left are skipped */
             continue;
-        run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k], s.sections + k * 2 * (size_t)a.record);
+        bifurcation_run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k],
+                        s.sections + k * 2 * (size_t)a.record);
         progress_tick(&pr, &done);
     }
     progress_end(&pr);
     if (interrupt_requested()) {
-        sweep_free(&s, models);
+        bifurcation_free(&s, models);
         return interrupt_stopped("bifurcation", done, n_runs, "runs");
     }
     if (!a.out.quiet || a.out.json)
         print_summary(&a, &base, &s, cm_seconds() - t0);
+    char msg[1024] = "";
     bool ok = n_valid > 0;
     if (!ok)
         fprintf(stderr,
@@ -479,11 +222,13 @@ int cmd_bifurcation(int argc, char **argv)
                 "anywhere?)\n",
                 a.sweep.name);
     if (ok && a.out.csv)
-        ok = write_points_csv(&a, &s);
+        ok = bifurcation_write_points_csv(&a, &s, msg, sizeof msg);
     if (ok && a.runs_csv)
-        ok = write_runs_csv(&a, &s);
+        ok = bifurcation_write_runs_csv(&a, &s, msg, sizeof msg);
     if (ok && a.out.png)
-        ok = write_png(&a, &base, &s);
-    sweep_free(&s, models);
+        ok = bifurcation_write_png(&a, &base, &s, msg, sizeof msg);
+    if (!ok && msg[0])
+        fprintf(stderr, "cellmap bifurcation: %s\n", msg);
+    bifurcation_free(&s, models);
     return ok ? EXIT_OK : EXIT_FAIL;
 }
