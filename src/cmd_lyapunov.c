@@ -10,9 +10,7 @@
 #include <string.h>
 
 #include "cellmap/clock.h"
-#include "models/friction_oscillator.h"
-#include "models/map_lyapunov.h"
-#include "models/registry.h"
+#include "lib/lyapunov.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -53,18 +51,6 @@ static const char lyapunov_help[] =
     "                      repeat it (up to 8) for the curves of several runs\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
-
-enum { MAX_CURVE_FILES = 8 };
-
-typedef struct lyap_args {
-    model_opts mo;
-    param_axis ax[2];
-    int has_grid, periods, threads, width, height, n_from;
-    double d0, from[CM_MAX_DIM];
-    const char *csv, *png, *curves[MAX_CURVE_FILES];
-    int n_curves;
-    bool json, quiet;
-} lyap_args;
 
 static int parse_args(cli *c, lyap_args *a)
 {
@@ -125,177 +111,6 @@ static int parse_args(cli *c, lyap_args *a)
     if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
     return err;
-}
-
-/* The exponent at grid point (i, j); NaN where the model cannot be built
- * (S > S0) or no sample was accepted. */
-static double point_exponent(const lyap_args *a, int i, int j, int *invalid)
-{
-    const int idx[2] = {i, j};
-    cm_model m;
-    if (!model_at_point(&a->mo, a->ax, idx, 2, &m)) {
-        *invalid = 1;
-        return NAN;
-    }
-    const cm_fo *o = cm_fo_of_model(&m);
-    double lambda = NAN;
-    if (o) {
-        const double x0 = a->n_from ? a->from[0] : 1 + 0.9 * o->S0, v0 = a->n_from ? a->from[1] : 0;
-        if (!cm_fo_lyapunov(o, x0, v0, a->d0, a->periods, &lambda))
-            lambda = NAN;
-    } else if (!cm_map_lyapunov(&m, a->from, a->d0, a->periods, &lambda)) {
-        lambda = NAN;
-    }
-    cm_model_release(&m);
-    return lambda;
-}
-
-static bool write_csv(const lyap_args *a, const double *v)
-{
-    outfile o;
-    if (!outfile_open("lyapunov", a->csv, &o))
-        return false;
-    fprintf(o.f, "%s,%s,lambda\n", a->ax[0].name, a->ax[1].name);
-    for (int j = 0; j < a->ax[1].n; j++)
-        for (int i = 0; i < a->ax[0].n; i++)
-            fprintf(o.f, "%.17g,%.17g,%.17g\n", param_axis_value(&a->ax[0], i),
-                    param_axis_value(&a->ax[1], j), v[(size_t)j * (size_t)a->ax[0].n + (size_t)i]);
-    return outfile_close("lyapunov", &o, true);
-}
-
-/* The curves of `continue --curves` (curve,label,P,P2,x,v) in the grid's
- * axes, as one polyline broken by NaN between curves, and a label at each
- * curve's start; false, with the problem said, if the file does not fit. */
-typedef struct overlay {
-    double *x, *y;
-    size_t n;
-    cm_chart_label labels[64];
-    char texts[64][32];
-    int n_labels;
-} overlay;
-
-/* Appends the curves of one file to ov: EXIT_OK, or the problem said and
- * EXIT_USAGE (the file is not one of curves in the grid's parameters) or
- * EXIT_FAIL (out of memory). */
-static int read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap)
-{
-    FILE *f = NULL;
-    char line[512], n1[64] = "", n2[64] = "", msg[CM_OUTPUT_PATH_MAX + 256];
-    if (cm_input_open(path, "--curves file", UINT64_C(64) << 20, &f, msg, sizeof msg) != CM_OK) {
-        fprintf(stderr, "cellmap lyapunov: %s (make it with cellmap continue --curves)\n", msg);
-        return EXIT_USAGE;
-    }
-    if (!fgets(line, sizeof line, f) ||
-        sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
-        fprintf(stderr, "cellmap lyapunov: --curves %s: not a file of curve,label,P,P2,x,v lines "
-                        "(make it with cellmap continue --curves)\n",
-                path);
-        fclose(f);
-        return EXIT_USAGE;
-    }
-    const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
-    const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
-    if (!same && !swapped) {
-        fprintf(stderr, "cellmap lyapunov: --curves %s is in (%s, %s), the grid in (%s, %s)\n",
-                path, n1, n2, a->ax[0].name, a->ax[1].name);
-        fclose(f);
-        return EXIT_USAGE;
-    }
-    int last = -1;
-    bool ok = true;
-    while (ok && fgets(line, sizeof line, f)) {
-        int id;
-        char label[32];
-        double p1, p2;
-        if (sscanf(line, "%d,%31[^,],%lf,%lf", &id, label, &p1, &p2) != 4)
-            continue;
-        if (ov->n + 2 > *cap) {
-            *cap = *cap ? 2 * *cap : 1024;
-            double *nx = realloc(ov->x, *cap * sizeof *nx), *ny = nx ? realloc(ov->y, *cap * sizeof *ny) : NULL;
-            if (nx)
-                ov->x = nx;
-            ok = ny != NULL;
-            if (ny)
-                ov->y = ny;
-        }
-        if (!ok)
-            break;
-        if (id != last && ov->n > 0) { /* a break between curves */
-            ov->x[ov->n] = ov->y[ov->n] = NAN;
-            ov->n++;
-        }
-        ov->x[ov->n] = same ? p1 : p2;
-        ov->y[ov->n] = same ? p2 : p1;
-        if (id != last && ov->n_labels < 64) { /* each curve's start */
-            snprintf(ov->texts[ov->n_labels], sizeof ov->texts[0], "%s", label);
-            ov->labels[ov->n_labels] = (cm_chart_label){ov->x[ov->n], ov->y[ov->n],
-                                                        ov->texts[ov->n_labels]};
-            ov->n_labels++;
-        }
-        ov->n++;
-        last = id;
-    }
-    fclose(f);
-    if (!ok)
-        fprintf(stderr, "cellmap lyapunov: out of memory for the curves\n");
-    return ok ? EXIT_OK : EXIT_FAIL;
-}
-
-/* Every --curves file, read before the grid is computed (ov is the
- * caller's to free with overlay_free, whatever the result). */
-static int read_curves(const lyap_args *a, overlay *ov)
-{
-    size_t cap = 0;
-    int rc = EXIT_OK;
-    for (int k = 0; k < a->n_curves && rc == EXIT_OK; k++)
-        rc = read_curve_file(a, a->curves[k], ov, &cap);
-    return rc;
-}
-
-static void overlay_free(overlay *ov)
-{
-    free(ov->x);
-    free(ov->y);
-}
-
-static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
-                      overlay *ov)
-{
-    /* both ways of a curve, and curves of one point, start at one place */
-    cm_chart_join_labels(ov->labels, ov->n_labels, ov->texts[0], sizeof ov->texts[0],
-                         0.05 * (a->ax[0].hi - a->ax[0].lo), 0.03 * (a->ax[1].hi - a->ax[1].lo));
-    const cm_series curves = {CM_SERIES_LINE, ov->x, ov->y, ov->n, (cm_rgb){0, 0, 0}, 2};
-    char title[512], params[400], grid[200];
-    const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
-    cm_params_format_with(p, swept, params, sizeof params);
-    param_axes_format(a->ax, 2, grid, sizeof grid);
-    snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d %s", model, a->periods,
-             strcmp(model, "friction-oscillator") == 0 ? "periods" : "iterates");
-    const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};
-    const cm_chart chart = {a->width,
-                            a->height,
-                            {a->ax[0].lo, a->ax[1].lo},
-                            {a->ax[0].hi, a->ax[1].hi},
-                            a->ax[0].name,
-                            a->ax[1].name,
-                            title,
-                            &heat,
-                            &curves,
-                            ov->n > 0,
-                            figure_font(),
-                            0,
-                            ov->labels,
-                            ov->n_labels};
-    char periods[32];
-    snprintf(periods, sizeof periods, "%d", a->periods);
-    const bool fo = strcmp(model, "friction-oscillator") == 0;
-    const cm_png_text texts[] = {{"Model", model},
-                                 {"Parameters", params},
-                                 {"Grid", grid},
-                                 {"Periods", periods},
-                                 {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
-                                                  : "docs/models.md 11.3 (finite differences on the map)"}};
-    return write_chart_png("lyapunov", a->png, &chart, 1, texts, 5);
 }
 
 typedef struct summary {
@@ -393,14 +208,17 @@ int cmd_lyapunov(int argc, char **argv)
     if (!fo && start_of(&c, &a))
         return EXIT_USAGE;
     overlay ov;
+    char msg[1024];
     memset(&ov, 0, sizeof ov);
-    const int cerr = read_curves(&a, &ov);
+    const cm_status read = lyapunov_read_curves(&a, &ov, msg, sizeof msg);
     const size_t nx = (size_t)a.ax[0].n, n = nx * (size_t)a.ax[1].n;
-    double *v = cerr == EXIT_OK ? malloc(n * sizeof *v) : NULL;
+    double *v = read == CM_OK ? malloc(n * sizeof *v) : NULL;
     if (!v) {
-        overlay_free(&ov);
-        if (cerr != EXIT_OK)
-            return cerr;
+        lyapunov_overlay_free(&ov);
+        if (read != CM_OK) {
+            fprintf(stderr, "cellmap lyapunov: %s\n", msg);
+            return read == CM_EINVAL ? EXIT_USAGE : EXIT_FAIL;
+        }
         fprintf(stderr, "cellmap lyapunov: out of memory for %zu grid points\n", n);
         return EXIT_FAIL;
     }
@@ -418,13 +236,13 @@ int cmd_lyapunov(int argc, char **argv)
             v[k] = NAN;
             continue;
         }
-        v[k] = point_exponent(&a, (int)(k % nx), (int)(k / nx), &invalid);
+        v[k] = lyapunov_point(&a, (int)(k % nx), (int)(k / nx), &invalid);
         progress_tick(&pr, &done);
     }
     progress_end(&pr);
     if (interrupt_requested()) {
         free(v);
-        overlay_free(&ov);
+        lyapunov_overlay_free(&ov);
         return interrupt_stopped("lyapunov", done, n, "grid points");
     }
     const double secs = cm_seconds() - t0;
@@ -446,10 +264,12 @@ int cmd_lyapunov(int argc, char **argv)
                 "cellmap lyapunov: no grid point could be computed (%s)\n",
                 fo ? "is S <= S0 anywhere?" : "every orbit from --from left the world or had no image");
     if (ok && a.csv)
-        ok = write_csv(&a, v);
+        ok = lyapunov_write_csv(&a, v, msg, sizeof msg);
     if (ok && a.png)
-        ok = write_png(&a, a.mo.name, &base, v, &ov);
+        ok = lyapunov_write_png(&a, a.mo.name, &base, v, &ov, msg, sizeof msg);
+    if (!ok && computed > 0)
+        fprintf(stderr, "cellmap lyapunov: %s\n", msg);
     free(v);
-    overlay_free(&ov);
+    lyapunov_overlay_free(&ov);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

@@ -1,0 +1,168 @@
+/* lib/lyapunov.c - Lyapunov maps computed and written (lib/lyapunov.h). */
+#include "lib/lyapunov.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/output.h"
+#include "lib/figure.h"
+#include "models/friction_oscillator.h"
+#include "models/map_lyapunov.h"
+#include "models/params.h"
+
+/* The exponent at grid point (i, j); NaN where the model cannot be built
+ * (S > S0) or no sample was accepted. */
+double lyapunov_point(const lyap_args *a, int i, int j, int *invalid)
+{
+    const int idx[2] = {i, j};
+    cm_model m;
+    if (!model_at_point(&a->mo, a->ax, idx, 2, &m)) {
+        *invalid = 1;
+        return NAN;
+    }
+    const cm_fo *o = cm_fo_of_model(&m);
+    double lambda = NAN;
+    if (o) {
+        const double x0 = a->n_from ? a->from[0] : 1 + 0.9 * o->S0, v0 = a->n_from ? a->from[1] : 0;
+        if (!cm_fo_lyapunov(o, x0, v0, a->d0, a->periods, &lambda))
+            lambda = NAN;
+    } else if (!cm_map_lyapunov(&m, a->from, a->d0, a->periods, &lambda)) {
+        lambda = NAN;
+    }
+    cm_model_release(&m);
+    return lambda;
+}
+
+bool lyapunov_write_csv(const lyap_args *a, const double *v, char *msg, size_t msg_size)
+{
+    outfile o;
+    if (outfile_begin(a->csv, &o, msg, msg_size) != CM_OK)
+        return false;
+    fprintf(o.f, "%s,%s,lambda\n", a->ax[0].name, a->ax[1].name);
+    for (int j = 0; j < a->ax[1].n; j++)
+        for (int i = 0; i < a->ax[0].n; i++)
+            fprintf(o.f, "%.17g,%.17g,%.17g\n", param_axis_value(&a->ax[0], i),
+                    param_axis_value(&a->ax[1], j), v[(size_t)j * (size_t)a->ax[0].n + (size_t)i]);
+    return (outfile_end(&o, true, msg, msg_size) == CM_OK);
+}
+
+/* Appends the curves of one file to ov: CM_EINVAL when it is not one of
+ * curves in the grid's parameters, CM_ENOMEM. */
+static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap,
+                                 char *msg, size_t msg_size)
+{
+    FILE *f = NULL;
+    char line[512], n1[64] = "", n2[64] = "", why[CM_OUTPUT_PATH_MAX + 256];
+    if (cm_input_open(path, "--curves file", UINT64_C(64) << 20, &f, why, sizeof why) != CM_OK)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s (make it with cellmap continue --curves)",
+                       why);
+    if (!fgets(line, sizeof line, f) ||
+        sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
+        fclose(f);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--curves %s: not a file of curve,label,P,P2,x,v lines (make it with "
+                       "cellmap continue --curves)",
+                       path);
+    }
+    const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
+    const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
+    if (!same && !swapped) {
+        fclose(f);
+        return cm_fail(CM_EINVAL, msg, msg_size, "--curves %s is in (%s, %s), the grid in (%s, %s)",
+                       path, n1, n2, a->ax[0].name, a->ax[1].name);
+    }
+    int last = -1;
+    bool ok = true;
+    while (ok && fgets(line, sizeof line, f)) {
+        int id;
+        char label[32];
+        double p1, p2;
+        if (sscanf(line, "%d,%31[^,],%lf,%lf", &id, label, &p1, &p2) != 4)
+            continue;
+        if (ov->n + 2 > *cap) {
+            *cap = *cap ? 2 * *cap : 1024;
+            double *nx = realloc(ov->x, *cap * sizeof *nx),
+                   *ny = nx ? realloc(ov->y, *cap * sizeof *ny) : NULL;
+            if (nx)
+                ov->x = nx;
+            ok = ny != NULL;
+            if (ny)
+                ov->y = ny;
+        }
+        if (!ok)
+            break;
+        if (id != last && ov->n > 0) { /* a break between curves */
+            ov->x[ov->n] = ov->y[ov->n] = NAN;
+            ov->n++;
+        }
+        ov->x[ov->n] = same ? p1 : p2;
+        ov->y[ov->n] = same ? p2 : p1;
+        if (id != last && ov->n_labels < 64) { /* each curve's start */
+            snprintf(ov->texts[ov->n_labels], sizeof ov->texts[0], "%s", label);
+            ov->labels[ov->n_labels] = (cm_chart_label){ov->x[ov->n], ov->y[ov->n],
+                                                        ov->texts[ov->n_labels]};
+            ov->n_labels++;
+        }
+        ov->n++;
+        last = id;
+    }
+    fclose(f);
+    return ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the curves");
+}
+
+cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size)
+{
+    size_t cap = 0;
+    cm_status st = CM_OK;
+    for (int k = 0; k < a->n_curves && st == CM_OK; k++)
+        st = read_curve_file(a, a->curves[k], ov, &cap, msg, msg_size);
+    return st;
+}
+
+void lyapunov_overlay_free(overlay *ov)
+{
+    free(ov->x);
+    free(ov->y);
+}
+
+bool lyapunov_write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
+                      overlay *ov, char *msg, size_t msg_size)
+{
+    /* both ways of a curve, and curves of one point, start at one place */
+    cm_chart_join_labels(ov->labels, ov->n_labels, ov->texts[0], sizeof ov->texts[0],
+                         0.05 * (a->ax[0].hi - a->ax[0].lo), 0.03 * (a->ax[1].hi - a->ax[1].lo));
+    const cm_series curves = {CM_SERIES_LINE, ov->x, ov->y, ov->n, (cm_rgb){0, 0, 0}, 2};
+    char title[512], params[400], grid[200];
+    const char *const swept[] = {a->ax[0].name, a->ax[1].name, NULL}; /* in Grid instead */
+    cm_params_format_with(p, swept, params, sizeof params);
+    param_axes_format(a->ax, 2, grid, sizeof grid);
+    snprintf(title, sizeof title, "largest Lyapunov exponent, %s, %d %s", model, a->periods,
+             strcmp(model, "friction-oscillator") == 0 ? "periods" : "iterates");
+    const cm_heat heat = {a->ax[0].n, a->ax[1].n, v, 0, "lambda > 0"};
+    const cm_chart chart = {a->width,
+                            a->height,
+                            {a->ax[0].lo, a->ax[1].lo},
+                            {a->ax[0].hi, a->ax[1].hi},
+                            a->ax[0].name,
+                            a->ax[1].name,
+                            title,
+                            &heat,
+                            &curves,
+                            ov->n > 0,
+                            figure_font(),
+                            0,
+                            ov->labels,
+                            ov->n_labels};
+    char periods[32];
+    snprintf(periods, sizeof periods, "%d", a->periods);
+    const bool fo = strcmp(model, "friction-oscillator") == 0;
+    const cm_png_text texts[] = {{"Model", model},
+                                 {"Parameters", params},
+                                 {"Grid", grid},
+                                 {"Periods", periods},
+                                 {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
+                                                  : "docs/models.md 11.3 (finite differences on the map)"}};
+    return (outfile_charts(a->png, &chart, 1, texts, 5, msg, msg_size) == CM_OK);
+}
