@@ -29,6 +29,48 @@ cm_status project_open_records(const char *path, bool map_reads, cm_store **s,
     return st;
 }
 
+cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_model_set *models,
+                          cm_lattice *lat, cm_box *box, char *msg, size_t msg_size)
+{
+    const cm_model_entry *e = cm_model_set_find(models, m->name, NULL);
+    const char *text = spec->region_text ? spec->region_text : e ? e->region : NULL;
+    double low[CM_MAX_DIM], high[CM_MAX_DIM];
+    int n = 0;
+    if (!text)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--region is required for model %s (one LO:HI per dimension)", m->name);
+    if (!parse_ranges(text, low, high, &n, CM_MAX_DIM))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--region: '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
+    if (n != m->dim)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--region has %d range(s) but model %s has dimension %d", n, m->name,
+                       m->dim);
+    if (spec->n_cells && spec->n_cells != m->dim)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--cells has %d count(s) but model %s has dimension %d", spec->n_cells,
+                       m->name, m->dim);
+    memset(lat, 0, sizeof *lat);
+    memset(box, 0, sizeof *box);
+    lat->dim = box->dim = m->dim;
+    double total = 1.0;
+    for (int d = 0; d < m->dim; d++) {
+        const int64_t cells = spec->n_cells ? spec->cells[d] : (m->dim <= 2 ? 1000 : 100);
+        lat->origin[d] = low[d];
+        lat->width[d] = (high[d] - low[d]) / (double)cells;
+        box->hi[d] = cells;
+        total *= (double)cells;
+    }
+    if (total > (double)CM_REGION_MAX_CELLS)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--cells asks for %.0f cells; one region holds at most %llu", total,
+                       (unsigned long long)CM_REGION_MAX_CELLS);
+    cm_status st = cm_lattice_check(lat, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_model_check_box(m, lat, box, msg, msg_size);
+    return st == CM_OK ? CM_OK : CM_EINVAL;
+}
+
 const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name)
 {
     const cm_model_lib *lib = NULL;

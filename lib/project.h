@@ -26,6 +26,22 @@ typedef struct model_spec {
     cm_model_set set;
 } model_spec;
 
+/* A box of state space cut into cells as a user gives it: its ranges
+ * ("LO:HI[,LO:HI...]"; NULL: the model's example region) and the cells
+ * per dimension (n_cells 0: 1000 a side in 1-D and 2-D, else 100). */
+typedef struct lattice_spec {
+    const char *region_text;
+    int64_t cells[CM_MAX_DIM];
+    int n_cells;
+} lattice_spec;
+
+/* The lattice whose origin is the region's lower corner, and the box of
+ * the region's cells, for model m (its example region from models,
+ * plugins included): CM_EINVAL with the problem in msg when the region or
+ * the cells do not fit the model or a region's limits. */
+cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_model_set *models,
+                          cm_lattice *lat, cm_box *box, char *msg, size_t msg_size);
+
 /* The plugin the model `name` of spec's set comes from (NULL: built in). */
 const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
 

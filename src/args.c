@@ -7,9 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/output.h"
-#include "cellmap/scm.h"
-#include "models/registry.h"
 
 int cli_usage_error(const cli *c, const char *fmt, ...)
 {
@@ -184,43 +181,12 @@ bool lattice_opts_take(cli *c, lattice_opts *lo, int *error)
 }
 
 int lattice_opts_build(const cli *c, const lattice_opts *lo, const cm_model *m,
-                       const cm_model_set *models, cm_lattice *lat,
-                       cm_box *box)
+                       const cm_model_set *models, cm_lattice *lat, cm_box *box)
 {
-    const cm_model_entry *e = cm_model_set_find(models, m->name, NULL);
-    const char *text = lo->region_text ? lo->region_text : e ? e->region : NULL;
-    double low[CM_MAX_DIM], high[CM_MAX_DIM];
-    int n = 0;
-    if (!text)
-        return cli_usage_error(c, "--region is required for model %s (one LO:HI per dimension)",
-                               m->name);
-    if (!parse_ranges(text, low, high, &n, CM_MAX_DIM))
-        return cli_usage_error(c, "--region: '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
-    if (n != m->dim)
-        return cli_usage_error(c, "--region has %d range(s) but model %s has dimension %d", n,
-                               m->name, m->dim);
-    if (lo->n_cells && lo->n_cells != m->dim)
-        return cli_usage_error(c, "--cells has %d count(s) but model %s has dimension %d",
-                               lo->n_cells, m->name, m->dim);
-    memset(lat, 0, sizeof *lat);
-    memset(box, 0, sizeof *box);
-    lat->dim = box->dim = m->dim;
-    double total = 1.0;
-    for (int d = 0; d < m->dim; d++) {
-        const int64_t cells = lo->n_cells ? lo->cells[d] : (m->dim <= 2 ? 1000 : 100);
-        lat->origin[d] = low[d];
-        lat->width[d] = (high[d] - low[d]) / (double)cells;
-        box->hi[d] = cells;
-        total *= (double)cells;
-    }
-    if (total > (double)CM_REGION_MAX_CELLS)
-        return cli_usage_error(c, "--cells asks for %.0f cells; one region holds at most %llu",
-                               total, (unsigned long long)CM_REGION_MAX_CELLS);
     char msg[512];
-    if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK ||
-        cm_model_check_box(m, lat, box, msg, sizeof msg) != CM_OK)
-        return cli_usage_error(c, "%s", msg);
-    return EXIT_OK;
+    if (lattice_of_spec(lo, m, models, lat, box, msg, sizeof msg) == CM_OK)
+        return EXIT_OK;
+    return cli_usage_error(c, "%s", msg);
 }
 
 int cli_input_check(const char *cmd, const char *path)

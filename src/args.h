@@ -7,9 +7,6 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "cellmap/lattice.h"
-#include "cellmap/model.h"
-#include "models/registry.h"
 #include "lib/parse.h"
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
@@ -74,13 +71,8 @@ bool model_opts_take(cli *c, model_opts *mo, int *error);
 /* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);
 
-/* --region LO:HI[,LO:HI...] and --cells N[xM...]: a lattice whose origin
- * is the region's lower corner, and the box of the region's cells. */
-typedef struct lattice_opts {
-    const char *region_text; /* NULL: the model's default region */
-    int64_t cells[CM_MAX_DIM];
-    int n_cells; /* 0: 1000 a side in 1-D and 2-D, else 100 */
-} lattice_opts;
+/* --region LO:HI[,LO:HI...] and --cells N[xM...] (lib/project.h). */
+typedef lattice_spec lattice_opts;
 
 /* Handles --region and --cells; true if the current option was one. */
 bool lattice_opts_take(cli *c, lattice_opts *lo, int *error);

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/clock.h"
+#include "lib/work.h"
 #include "lib/bifurcation.h"
 #include "src/args.h"
 #include "src/figure_opts.h"

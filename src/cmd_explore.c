@@ -12,7 +12,7 @@
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/explore.h"
-#include "models/registry.h"
+#include "lib/project.h"
 
 static const char explore_help_head[] =
     "usage: cellmap explore FILE.cmdb [SCRIPT|-] [--threads T] [--mem BYTES]\n"

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "models/registry.h"
+#include "lib/project.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "lib/json.h"

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/clock.h"
+#include "lib/work.h"
 #include "lib/lyapunov.h"
 #include "src/args.h"
 #include "src/figure_opts.h"

@@ -2,7 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "models/registry.h"
+#include "lib/project.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "lib/json.h"

@@ -11,8 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cellmap/clock.h"
-#include "cellmap/scm.h"
+#include "lib/sweep.h"
 #include "src/args.h"
 #include "lib/attractor_report.h"
 #include "src/attractor_opts.h"
@@ -50,21 +49,6 @@ static const char sweep_help[] =
     "  --quiet             no progress line and no report\n"
     "  --max-steps, --threads, --region, --cells, --by, --attractor-steps,\n"
     "  --attractor-tol: as for solve\n";
-
-enum { MAX_VALUES = 200, MAX_REFINE = 40 };
-
-typedef struct sweep_args {
-    model_opts mo;
-    lattice_opts lat;
-    char name[32];
-    double values[MAX_VALUES];
-    int n_values, max_steps, threads, refine, n_near;
-    double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
-    const char *csv;
-    bool json, quiet;
-    int by;                   /* --by: count attractors (default) or groups */
-    cm_attractor_options att; /* --attractor-steps, --attractor-tol */
-} sweep_args;
 
 /* "NAME=V1,V2,..." (increasing) or "NAME=LO:HI:N", 2..MAX_VALUES values */
 static bool parse_vary(const char *s, sweep_args *a)
@@ -125,106 +109,6 @@ static int parse_args(cli *c, sweep_args *a)
 
 /* ---- one value ---- */
 
-typedef struct sweep_point {
-    double value;
-    uint32_t attractors, sticking, groups; /* attractors and sticking zones in the window */
-    uint64_t attractor_cells, sticking_cells, sink_cells;
-    double seconds;
-} sweep_point;
-
-static bool in_window(const sweep_args *a, const cm_group_info *g)
-{
-    for (int d = 0; d < a->n_near; d++)
-        if (!(g->centre[d] >= a->near_lo[d] && g->centre[d] <= a->near_hi[d]))
-            return false;
-    return true;
-}
-
-/* The system's attractors (cellmap/attractors.h) in the window: sticking
- * zones are kept as cell mapping gives them. */
-static void count_attractors(const sweep_args *a, const cm_attractor_set *s, uint32_t ngroups,
-                             sweep_point *pt)
-{
-    pt->groups = ngroups;
-    for (uint32_t k = 0; k < s->n; k++) {
-        const cm_attractor *at = &s->a[k];
-        cm_group_info as_group = {.kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
-                                                                          : CM_GROUP_ATTRACTOR};
-        memcpy(as_group.centre, at->centre, sizeof at->centre);
-        if (!in_window(a, &as_group))
-            continue;
-        if (at->kind == CM_ATTRACTOR_STICKING) {
-            pt->sticking++;
-            pt->sticking_cells += at->basin_cells;
-        } else {
-            pt->attractors++;
-            pt->attractor_cells += at->basin_cells;
-        }
-    }
-}
-
-static void count_groups(const sweep_args *a, const cm_group_info *groups, uint32_t n,
-                         sweep_point *pt)
-{
-    pt->groups = n;
-    for (uint32_t k = 0; k < n; k++) {
-        if (!in_window(a, &groups[k]))
-            continue;
-        if (groups[k].kind == CM_GROUP_STICKING) {
-            pt->sticking++;
-            pt->sticking_cells += groups[k].basin_cells;
-        } else {
-            pt->attractors++;
-            pt->attractor_cells += groups[k].basin_cells;
-        }
-    }
-}
-
-static cm_status solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
-                          double value, sweep_point *pt, char *msg, size_t msg_size)
-{
-    memset(pt, 0, sizeof *pt);
-    pt->value = value;
-    const double t0 = cm_seconds();
-    cm_model m;
-    const char *name = a->name;
-    if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
-        return CM_EINVAL;
-    const cm_scm_options opt = {.max_steps = a->max_steps,
-                                .threads = a->threads,
-                                .record_exits = 1}; /* exits followed */
-    cm_region r;
-    memset(&r, 0, sizeof r);
-    cm_group_info *groups = NULL;
-    cm_exits exits = {0};
-    cm_status st = cm_region_alloc(&r, box, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_scm_solve(&m, lat, &opt, &r, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_region_settle_exits(&r, a->threads, &exits, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
-    cm_attractor_set att;
-    memset(&att, 0, sizeof att);
-    if (st == CM_OK && a->by == BY_ATTRACTORS) {
-        cm_attractor_options o = a->att;
-        o.threads = a->threads;
-        st = cm_region_attractors(&m, lat, &r, a->max_steps, &exits, groups, &o, &att, msg,
-                                  msg_size);
-        if (st == CM_OK)
-            count_attractors(a, &att, r.ngroups, pt);
-    } else if (st == CM_OK) {
-        count_groups(a, groups, r.ngroups, pt);
-    }
-    cm_attractors_free(&att);
-    cm_exits_free(&exits);
-    free(groups);
-    cm_region_free(&r);
-    cm_model_release(&m);
-    pt->seconds = cm_seconds() - t0;
-    return st;
-}
-
 /* ---- the sweep ---- */
 
 /* Changes are changes of the number of attractors: sticking zones are sets
@@ -259,7 +143,8 @@ static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const
         if (interrupt_requested())
             return cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
         sweep_point *mid = &pts[*n_pts];
-        const cm_status st = solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
+        const cm_status st =
+            sweep_solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
         if (st != CM_OK)
             return st;
         ++*n_pts;
@@ -330,22 +215,6 @@ static int by_value(const void *x, const void *y)
     return (u > v) - (u < v);
 }
 
-static bool write_csv(const sweep_args *a, const sweep_point *pts, int n)
-{
-    outfile o;
-    if (!outfile_open("sweep", a->csv, &o))
-        return false;
-    fprintf(o.f,
-            "%s,attractors,sticking,attractor_cells,sticking_cells,groups,sink_cells,seconds\n",
-            a->name);
-    for (int k = 0; k < n; k++)
-        fprintf(o.f, "%.17g,%u,%u,%llu,%llu,%u,%llu,%.3f\n", pts[k].value, pts[k].attractors,
-                pts[k].sticking, (unsigned long long)pts[k].attractor_cells,
-                (unsigned long long)pts[k].sticking_cells, pts[k].groups,
-                (unsigned long long)pts[k].sink_cells, pts[k].seconds);
-    return outfile_close("sweep", &o, true);
-}
-
 /* Checks the model, the parameter, the window, the lattice and every value. */
 static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_box *box)
 {
@@ -407,7 +276,8 @@ int cmd_sweep(int argc, char **argv)
     interrupt_catch();
     for (int k = 0; k < a.n_values && st == CM_OK; k++) {
         st = interrupt_requested() ? cm_fail(CM_ECANCELED, msg, sizeof msg, "interrupted")
-                                   : solve_at(&a, &lat, &box, a.values[k], &pts[n], msg, sizeof msg);
+                                   : sweep_solve_at(&a, &lat, &box, a.values[k], &pts[n], msg,
+                                                    sizeof msg);
         progress_end(&pr); /* the report's line goes below the progress line */
         if (st == CM_OK && text)
             print_point(text, a.name, &pts[n]);
@@ -440,7 +310,9 @@ int cmd_sweep(int argc, char **argv)
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);
     qsort(pts, (size_t)n, sizeof *pts, by_value);
-    const bool ok = st == CM_OK && (!a.csv || write_csv(&a, pts, n));
+    const bool ok = st == CM_OK && (!a.csv || sweep_write_csv(&a, pts, n, msg, sizeof msg));
+    if (st == CM_OK && !ok)
+        fprintf(stderr, "cellmap sweep: %s\n", msg);
     if (ok && a.json)
         print_json(&a, &lat, &box, pts, n, changes, n_changes);
     free(pts);

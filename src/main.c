@@ -6,7 +6,7 @@
 #include <malloc.h>
 #endif
 
-#include "cellmap/output.h"
+#include "lib/outfile.h"
 #include "src/args.h"
 #include "src/commands.h"
 

@@ -3,7 +3,7 @@
 
 #include "src/interrupt.h"
 
-#include "cellmap/clock.h"
+#include "lib/work.h"
 
 #include <omp.h>
 #include <stdio.h>

@@ -1,0 +1,49 @@
+/* lib/sweep.h - a model solved at each value of one parameter (one region
+ * each, with the system's attractors found by their true orbits, or cell
+ * mapping's groups) and the attractors and sticking zones counted in a
+ * window of state space; the points written as CSV. Nothing is printed:
+ * calls return the problem in msg. */
+#ifndef CM_LIB_SWEEP_H
+#define CM_LIB_SWEEP_H
+
+#include <stdbool.h>
+
+#include "lib/attractor_report.h"
+#include "lib/outfile.h"
+#include "lib/project.h"
+
+/* The most values one sweep takes, and bisection steps of a change. */
+enum { MAX_VALUES = 200, MAX_REFINE = 40 };
+
+/* The parameter's values, the lattice, the window and the check (the
+ * command's options). */
+typedef struct sweep_args {
+    model_spec mo;
+    lattice_spec lat;
+    char name[32];
+    double values[MAX_VALUES];
+    int n_values, max_steps, threads, refine, n_near;
+    double near_lo[CM_MAX_DIM], near_hi[CM_MAX_DIM];
+    const char *csv;
+    bool json, quiet;
+    int by;                   /* --by: count attractors (default) or groups */
+    cm_attractor_options att; /* --attractor-steps, --attractor-tol */
+} sweep_args;
+
+/* What one value gave. */
+typedef struct sweep_point {
+    double value;
+    uint32_t attractors, sticking, groups; /* attractors and sticking zones in the window */
+    uint64_t attractor_cells, sticking_cells, sink_cells;
+    double seconds;
+} sweep_point;
+
+/* Solves the box at a->name = value and counts it into *pt. */
+cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                         double value, sweep_point *pt, char *msg, size_t msg_size);
+
+/* The n points as CSV at a->csv. */
+bool sweep_write_csv(const sweep_args *a, const sweep_point *pts, int n, char *msg,
+                     size_t msg_size);
+
+#endif
