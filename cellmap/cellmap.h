@@ -43,7 +43,18 @@
  *   that leave the computed cells").
  * - Versions. CELLMAP_VERSION_* are this header's; cm_version() the
  *   library's. The same major version keeps source and binary
- *   compatibility (the library's SONAME is libcellmap.so.MAJOR).
+ *   compatibility (the library's SONAME is libcellmap.so.MAJOR) for the
+ *   stable section; the experimental section at the end (defined only
+ *   when CELLMAP_EXPERIMENTAL is defined before this header is included,
+ *   as zstd's static-linking-only section) may change in any release.
+ * - OpenMP. The library runs its loops on OpenMP threads of the process's
+ *   one OpenMP runtime (libgomp on Debian): a program that also uses
+ *   OpenMP shares it, and a call's `threads` option sets the call's team
+ *   only.
+ * - fork(). Fork only while no call of the library runs in another thread
+ *   (OpenMP's threads are not copied); a child may use objects the parent
+ *   made, but not an open cm_db, cm_session or database file the parent
+ *   also goes on using: SQLite connections must not cross a fork.
  */
 #ifndef CM_CELLMAP_H
 #define CM_CELLMAP_H
@@ -51,7 +62,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "cellmap/plugin.h"
+#include "cellmap/status.h"
+
+/* The most state dimensions a model has (as cellmap/lattice.h says). */
+#define CM_MAX_DIM 6
 
 #ifdef __cplusplus
 extern "C" {
@@ -225,6 +239,155 @@ void cm_db_grid(const cm_db *db, cm_grid *grid);
 cm_status cm_db_read(cm_db *db, const double *lo, const double *hi, cm_result **out, char *msg,
                      size_t msg_size);
 void cm_db_close(cm_db *db);
+
+#ifdef CELLMAP_EXPERIMENTAL
+/* ==== experimental: projects, sessions, figures, systems from functions ====
+ * What the command `cellmap` does over whole databases, for C (and the
+ * Python module): the same drivers (lib/), so the same files, images and
+ * arrays. May change in any release. */
+
+/* ---- systems given as a function ---- */
+
+/* y = f(x) for a state x of dim coordinates; 0: an image, > 0: no image
+ * (the cell goes to the sink), < 0: abort the computation. Called from the
+ * threads of the calls that step the system: pure, or serialised by the
+ * caller (a Python function through ctypes holds the interpreter's lock). */
+typedef int (*cm_step_fn)(void *user, const double *x, double *y);
+
+/* A system whose map is fn (user passed along), named name (1..63
+ * characters, for figures and files), of dim coordinates (1..CM_MAX_DIM).
+ * A database made of it records the name only: it is read back with
+ * cm_db_open (labels, steps, stored attractors), not resumed or explored. */
+cm_status cm_system_from_function(const char *name, int dim, cm_step_fn fn, void *user,
+                                  cm_system **out, char *msg, size_t msg_size);
+
+/* ---- figures ---- */
+
+/* Layers of a figure (as `cellmap render --layers` names them). */
+enum {
+    CM_FIGURE_BASIN = 1 << 0,
+    CM_FIGURE_STEPS = 1 << 1,
+    CM_FIGURE_ATTRACTORS = 1 << 2,
+    CM_FIGURE_OVERLAYS = 1 << 3,
+    CM_FIGURE_AXES = 1 << 4,
+    CM_FIGURE_LEGEND = 1 << 5,
+    CM_FIGURE_TITLE = 1 << 6
+};
+
+/* What a figure draws and where it goes: as `cellmap render`'s options. */
+typedef struct cm_figure_options {
+    const char *png;     /* PNG file, or NULL */
+    const char *svg;     /* the same figure as SVG, or NULL */
+    int width, height;   /* pixels; 0, 0: one pixel per cell (at most 4096), 1000 with text */
+    unsigned layers;     /* CM_FIGURE_*; 0: every layer but steps */
+    int indexed;         /* 1: an indexed PNG of one pixel per cell (its value: the colour class) */
+    int by_groups;       /* 1: cell mapping's groups; 0: the system's attractors */
+    const char *palette; /* "tol" (NULL), "okabe-ito", "tab20" or a file of #rrggbb lines */
+    const char *labels;  /* a file of legend names ("ID TEXT" lines), or NULL */
+    uint64_t min_basin;  /* groups of fewer cells drawn as "other"; 0: 2 with a legend, else 1 */
+    int legend;          /* groups the legend lists; 0: 12 */
+} cm_figure_options;
+
+/* The figure of a result (cm_solve, cm_db_read, cm_session_read), through
+ * the pipeline `cellmap solve --png` and `render` use. */
+cm_status cm_result_figure(const cm_result *r, const cm_figure_options *o, char *msg,
+                           size_t msg_size);
+
+/* ---- projects: databases made and grown ---- */
+
+/* How a database is solved: as `cellmap solve --db` with --split, --extend,
+ * --escape-below, --max-steps, --threads and --mem. */
+typedef struct cm_db_options {
+    int threads;          /* 0: all cores */
+    int max_steps;        /* 0: 1 */
+    int64_t split[CM_MAX_DIM]; /* regions per dimension; all 0: one region */
+    int extend;           /* adaptive extension steps (thesis 4.6.4), 0..1000 */
+    double escape_below;  /* stop extending below this escaping fraction (0: never) */
+    uint64_t mem;         /* bytes of cell arrays held in memory; 0: no bound */
+    const char *command;  /* the provenance the file records; NULL: "libcellmap" */
+    cm_solve_progress_fn progress; /* optional: fraction of the grid's cells; nonzero cancels */
+    void *user;
+} cm_db_options;
+
+/* Solves grid for model `name` of set (NULL: the built-in models) with
+ * parameters params ("k=v,..."; NULL: the defaults) into a new database at
+ * path (replacing an older cellmap database there only once complete;
+ * never another file), with the system's attractors stored. Cancelled or
+ * failed, every join done so far is committed: cm_db_resume completes it
+ * (a new file that replaced nothing yet leaves the older one as it was). */
+cm_status cm_db_create(const cm_models *set, const char *name, const char *params,
+                       const cm_grid *grid, const char *path, const cm_db_options *o, char *msg,
+                       size_t msg_size);
+
+/* Completes a database cm_db_create (or `cellmap solve --db`) began, with
+ * the same model, parameters, grid and plan (split, extend, escape_below,
+ * max_steps); anything else is refused and the file left as it is. */
+cm_status cm_db_resume(const cm_models *set, const char *name, const char *params,
+                       const cm_grid *grid, const char *path, const cm_db_options *o, char *msg,
+                       size_t msg_size);
+
+/* The cells of the database's lattice whose centres lie in lo..hi (NULL,
+ * NULL: every cell) as .npy arrays (int32, C order, axis k = dimension k)
+ * with their JSON sidecars, as `cellmap export --labels --steps [--window]`
+ * writes them: labels by the system's attractors (by_groups: by groups),
+ * steps; either path may be NULL. */
+cm_status cm_db_export(const char *path, const double *lo, const double *hi, const char *labels,
+                       const char *steps, int by_groups, char *msg, size_t msg_size);
+
+/* ---- sessions: a view moved over a growing database ---- */
+
+typedef struct cm_session cm_session;
+
+/* How a session's database is made when it does not exist (as `cellmap
+ * explore`'s options); an existing file keeps its own. */
+typedef struct cm_session_options {
+    const char *model;             /* a new file's model; NULL: the file must exist */
+    const char *params;            /* its parameters ("k=v,..."), or NULL */
+    const cm_models *set;          /* where the model comes from; NULL: built in */
+    double cell_size[CM_MAX_DIM];  /* a new file's cells, one width per dimension */
+    double origin[CM_MAX_DIM];     /* its lattice's origin (default 0) */
+    const char *depth;             /* "LO:HI,..." of dimensions 3.. of a new file's model */
+    int max_steps, threads;        /* 0: 1 for a new file; 0: all cores */
+    uint64_t mem;                  /* bytes of cell arrays in memory; 0: no bound */
+    const char *command;           /* provenance; NULL: "libcellmap" */
+} cm_session_options;
+
+/* Opens (or creates) a session's database at path. */
+cm_status cm_session_open(const char *path, const cm_session_options *o, cm_session **out,
+                          char *msg, size_t msg_size);
+
+/* Moves the view to lo..hi (dimensions 0 and 1) and computes exactly the
+ * cells it uncovers, each join committed; *new_cells (may be NULL): how
+ * many. A session without a view (a new file) starts with this. */
+cm_status cm_session_view(cm_session *s, const double *lo, const double *hi,
+                          uint64_t *new_cells, char *msg, size_t msg_size);
+
+/* The view now (dimensions 0 and 1); CM_ENOTFOUND before the first. */
+cm_status cm_session_bounds(const cm_session *s, double *lo, double *hi);
+
+/* The view moved by `by` in dimension d (state units), or zoomed by
+ * factor about its centre (2: twice as close), as `pan` and `zoom` do. */
+cm_status cm_session_pan(cm_session *s, int d, double by, uint64_t *new_cells, char *msg,
+                         size_t msg_size);
+cm_status cm_session_zoom(cm_session *s, double factor, uint64_t *new_cells, char *msg,
+                          size_t msg_size);
+
+/* `extend auto steps`: up to steps (1..1000) times, the tile of the view's
+ * size where the most sequences escape; *done (may be NULL): steps done. */
+cm_status cm_session_extend(cm_session *s, int steps, int *done, char *msg, size_t msg_size);
+
+/* The view's cells (the slice shown) as a result: labels, steps, groups
+ * and the system's attractors found over the whole cluster. */
+cm_status cm_session_read(cm_session *s, cm_result **out, char *msg, size_t msg_size);
+
+/* The view's figure, as `render` in a session draws it (the same bytes). */
+cm_status cm_session_figure(cm_session *s, const cm_figure_options *o, char *msg,
+                            size_t msg_size);
+
+/* Saves the view and the attractors and closes the database (NULL: nothing). */
+cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size);
+
+#endif /* CELLMAP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

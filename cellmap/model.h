@@ -58,8 +58,7 @@ typedef struct cm_fixed_point {
     double x[CM_MAX_DIM];
 } cm_fixed_point;
 
-/* Return values of step(), SUNDIALS style. */
-enum { CM_STEP_OK = 0, CM_STEP_NO_IMAGE = 1, CM_STEP_ABORT = -1 };
+/* step()'s return values, CM_STEP_*, are in cellmap/status.h. */
 
 /* Marks a function whose loops the compiler vectorises (a model's step_n,
  * the engine's image loops): on x86-64 it is built three times, for

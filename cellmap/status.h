@@ -45,4 +45,8 @@ cm_status cm_fail(cm_status status, char *msg, size_t msg_size, const char *fmt,
 #endif
     ;
 
+/* What a model's step (and cm_system_step) returns, SUNDIALS style: an
+ * image, no image (the cell goes to the sink), or abort the run. */
+enum { CM_STEP_OK = 0, CM_STEP_NO_IMAGE = 1, CM_STEP_ABORT = -1 };
+
 #endif

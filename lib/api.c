@@ -1,6 +1,7 @@
 /* libcellmap's public API (cellmap/cellmap.h) over the engine, the models,
  * the .cmdb store and the renderer: the one module of the library that
  * sees all of them, as the command does. */
+#define CELLMAP_EXPERIMENTAL /* this file implements both sections */
 #include "cellmap/cellmap.h"
 #include "cellmap/attractors.h"
 
@@ -18,9 +19,14 @@
 #include "models/registry.h"
 #include "render/figure.h"
 #include "render/png_out.h"
-#include "lib/parse.h"
+#include "cellmap/output.h"
 #include "lib/attractor_view.h"
+#include "lib/export.h"
+#include "lib/figure.h"
+#include "lib/parse.h"
 #include "lib/project.h"
+#include "lib/session.h"
+#include "lib/solve.h"
 
 
 struct cm_models {
@@ -383,59 +389,10 @@ cm_status cm_result_group(const cm_result *r, uint32_t id, cm_group_summary *out
 uint64_t cm_result_sink_cells(const cm_result *r) { return r->sink; }
 
 cm_status cm_result_png(const cm_result *r, const char *path, int width, int height,
-                            char *msg, size_t msg_size)
+                        char *msg, size_t msg_size)
 {
-    if (width == 0 && height == 0) {
-        cm_grid g;
-        cm_result_grid(r, &g);
-        const double w = g.hi[0] - g.lo[0], h = r->lat.dim > 1 ? g.hi[1] - g.lo[1] : w;
-        width = w >= h ? 1000 : (int)fmax(200, 1000 * w / h);
-        height = h >= w ? 1000 : (int)fmax(200, 1000 * h / w);
-    }
-    if (width < 1 || height < 1 || width > CM_RENDER_MAX_SIDE || height > CM_RENDER_MAX_SIDE)
-        return cm_fail(CM_EINVAL, msg, msg_size, "image size %dx%d: each side must be 1..%d",
-                       width, height, CM_RENDER_MAX_SIDE);
-    const char *font = getenv("CELLMAP_FONT");
-    /* by the system's attractors, as `cellmap solve --png` draws it */
-    cm_group_label names[64];
-    cm_render_options o = {
-        .width = width,
-        .height = height,
-        .layers = CM_LAYER_BASIN | CM_LAYER_ATTRACTORS | CM_LAYER_OVERLAYS | CM_LAYER_AXES |
-                  CM_LAYER_LEGEND | CM_LAYER_TITLE,
-        .model = r->model,
-        .font_path = font && font[0] ? font : CELLMAP_FONT_PATH,
-        .min_basin = 2,
-        .labels = names,
-        .sink_label = "diverged",
-    };
-    uint8_t *rgba = malloc((size_t)width * (size_t)height * 4);
-    if (!rgba)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", width, height);
-    cm_render_info info;
-    cm_region view;
-    cm_group_info *groups = NULL;
-    uint32_t n = 0;
-    cm_status st = cm_render_check(&o, r->lat.dim, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_region_alloc(&view, &r->cells.box, msg, msg_size);
-    if (st == CM_OK) {
-        memcpy(view.group, r->cells.group, view.ncells * sizeof *view.group);
-        memcpy(view.step, r->cells.step, view.ncells * sizeof *view.step);
-        memcpy(view.image, r->cells.image, view.ncells * sizeof *view.image);
-        st = attractor_view(&r->att, &view, r->att_labels, &groups, &n, msg, msg_size);
-        o.n_labels = attractor_legend(&r->att, n, names, 0, 64);
-        if (st == CM_OK)
-            st = cm_render_figure(&r->lat, &view, groups, &o, rgba, &info, msg, msg_size);
-        cm_region_free(&view);
-        free(groups);
-    }
-    const cm_png_text texts[] = {{"Software", "libcellmap " CELLMAP_VERSION},
-                                 {"Model", r->model->name}};
-    if (st == CM_OK)
-        st = cm_png_write(path, rgba, width, height, texts, 2, msg, msg_size);
-    free(rgba);
-    return st;
+    const cm_figure_options o = {.png = path, .width = width, .height = height};
+    return cm_result_figure(r, &o, msg, msg_size);
 }
 
 void cm_result_free(cm_result *r)
@@ -581,4 +538,411 @@ void cm_db_close(cm_db *db)
     cm_store_close(db->store, NULL, 0);
     cm_model_set_close(&db->models.set);
     free(db);
+}
+
+/* ==== experimental ======================================================== */
+
+/* ---- systems given as a function ---- */
+
+typedef struct function_model {
+    cm_step_fn fn;
+    void *user;
+    char name[64];
+} function_model;
+
+static int function_step(const cm_model *m, const double *x, double *y)
+{
+    const function_model *f = m->ctx;
+    return f->fn(f->user, x, y);
+}
+
+static void function_free(void *ctx) { free(ctx); }
+
+static const cm_param_spec no_params[] = {{NULL, NULL, 0, 0, 0, NULL, NULL}};
+
+cm_status cm_system_from_function(const char *name, int dim, cm_step_fn fn, void *user,
+                                  cm_system **out, char *msg, size_t msg_size)
+{
+    *out = NULL;
+    if (!name || !name[0] || strlen(name) > 63)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a function system needs a name of 1..63 "
+                       "characters");
+    if (dim < 1 || dim > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "dimension %d: give 1..%d", dim, CM_MAX_DIM);
+    if (!fn)
+        return cm_fail(CM_EINVAL, msg, msg_size, "no step function given");
+    cm_system *s = calloc(1, sizeof *s);
+    function_model *f = calloc(1, sizeof *f);
+    if (!s || !f) {
+        free(s);
+        free(f);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a system");
+    }
+    *f = (function_model){fn, user, {0}};
+    snprintf(f->name, sizeof f->name, "%s", name);
+    cm_model *m = &s->model;
+    m->name = f->name;
+    m->dim = dim;
+    m->params = no_params;
+    m->values.spec = no_params;
+    m->ctx = f;
+    m->destroy = function_free;
+    m->step = function_step;
+    /* a status other than CM_STEP_* stops the run, as a plugin's does */
+    const cm_status st = cm_model_wrap_periods(m, true, msg, msg_size);
+    if (st != CM_OK) {
+        cm_system_free(s);
+        return st;
+    }
+    *out = s;
+    return CM_OK;
+}
+
+/* ---- figures ---- */
+
+/* The figure options as the pipeline takes them (po is filled; files it
+ * names are read now). */
+static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *msg,
+                                size_t msg_size)
+{
+    memset(po, 0, sizeof *po);
+    po->path = o->png;
+    po->svg = o->svg;
+    po->width = o->width;
+    po->height = o->height;
+    po->layers = o->layers;
+    po->default_layers = all_layers;
+    po->indexed = o->indexed != 0;
+    po->by = o->by_groups ? BY_GROUPS : BY_ATTRACTORS;
+    po->min_basin = o->min_basin;
+    po->legend_groups = o->legend;
+    if (!o->png && !o->svg)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png or an svg path");
+    if ((o->width == 0) != (o->height == 0) || o->width < 0 || o->height < 0 ||
+        o->width > CM_RENDER_MAX_SIDE || o->height > CM_RENDER_MAX_SIDE)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "image size %dx%d: give both sides 1..%d, or 0, 0 for the default",
+                       o->width, o->height, CM_RENDER_MAX_SIDE);
+    if (o->layers & ~all_layers & ~(unsigned)CM_FIGURE_STEPS)
+        return cm_fail(CM_EINVAL, msg, msg_size, "layers 0x%x: use CM_FIGURE_* bits", o->layers);
+    if (o->indexed && (o->svg || o->width || o->layers))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "an indexed PNG has one pixel per cell: give no svg, size or layers");
+    if (o->legend < 0 || o->legend > 200)
+        return cm_fail(CM_EINVAL, msg, msg_size, "legend %d: give 0..200 groups", o->legend);
+    char why[400];
+    if (o->palette && !png_opts_palette(o->palette, po, why, sizeof why))
+        return cm_fail(CM_EINVAL, msg, msg_size, "palette: %s", why);
+    if (o->labels && !png_opts_labels(o->labels, po, why, sizeof why))
+        return cm_fail(CM_EINVAL, msg, msg_size, "labels: %s", why);
+    return CM_OK;
+}
+
+cm_status cm_result_figure(const cm_result *r, const cm_figure_options *o, char *msg,
+                           size_t msg_size)
+{
+    png_opts po;
+    cm_status st = figure_opts_of(o, &po, msg, msg_size);
+    if (st == CM_OK)
+        st = figure_check(&po, r->model, &r->lat, &r->cells.box, msg, msg_size);
+    const basin_png b = {&po,  r->model, &r->lat, &r->cells, r->groups, {0, 0}, {0, 0}, NULL,
+                         po.by == BY_ATTRACTORS ? &r->att : NULL, NULL, r->att_labels};
+    return st == CM_OK ? figure_write(&b, msg, msg_size) : st;
+}
+
+/* ---- projects ---- */
+
+/* The progress of a library call told as the caller's fraction, and its
+ * cancel as the stop request. */
+typedef struct call_hooks {
+    cm_solve_progress_fn progress;
+    void *user;
+    double total;
+    int cancelled;
+} call_hooks;
+
+static void call_progress(void *user, uint64_t done, const char *what)
+{
+    call_hooks *h = user;
+    (void)what;
+    if (h->progress && !h->cancelled && h->progress(h->user, fmin(1, (double)done / h->total)))
+        h->cancelled = 1;
+}
+
+static const char *call_stop(void *user)
+{
+    const call_hooks *h = user;
+    return h->cancelled ? "cancelled by the progress callback" : NULL;
+}
+
+static cm_status db_solve(const cm_models *set, const char *name, const char *params,
+                          const cm_grid *grid, const char *path, const cm_db_options *o,
+                          bool resume, char *msg, size_t msg_size)
+{
+    const cm_db_options none = {0};
+    o = o ? o : &none;
+    if (!path || !path[0])
+        return cm_fail(CM_EINVAL, msg, msg_size, "a database needs a path");
+    if (o->extend < 0 || o->extend > SOLVE_MAX_EXTEND || o->threads < 0 || o->max_steps < 0 ||
+        o->max_steps > PROJECT_MAX_STEPS || !(o->escape_below >= 0 && o->escape_below <= 1))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "options: extend 0..%d, threads >= 0, max_steps 0..%d, escape_below 0..1",
+                       SOLVE_MAX_EXTEND, PROJECT_MAX_STEPS);
+    const cm_model_set *ms = set ? &set->set : NULL;
+    const char *texts[1] = {params};
+    cm_model m;
+    cm_status st = cm_model_set_create(ms, name ? name : "", texts, params && params[0] ? 1 : 0,
+                                       &m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    solve_request q;
+    memset(&q, 0, sizeof q);
+    st = grid_lattice(grid, m.dim, &q.lat, &q.box, msg, msg_size);
+    bool split = false;
+    for (int d = 0; d < m.dim; d++)
+        split |= o->split[d] > 0;
+    if (st == CM_OK)
+        st = cm_model_check_box(&m, &q.lat, &q.box, msg, msg_size);
+    q.model = &m;
+    cm_model_set_find(ms, m.name, &q.lib);
+    q.plan.nsplit = split ? m.dim : 0;
+    for (int d = 0; d < m.dim; d++) {
+        q.plan.split[d] = o->split[d] > 0 ? o->split[d] : 1;
+        if (split && q.plan.split[d] > q.box.hi[d] && st == CM_OK)
+            st = cm_fail(CM_EINVAL, msg, msg_size, "split: %lld parts in dimension %d, which "
+                         "has %lld cells", (long long)q.plan.split[d], d, (long long)q.box.hi[d]);
+    }
+    q.plan.opt = (cm_scm_options){.max_steps = o->max_steps, .threads = o->threads,
+                                  .record_exits = 1};
+    q.plan.extend = o->extend;
+    q.plan.escape_below = o->escape_below;
+    q.cluster = true;
+    q.db = path;
+    q.resume = resume;
+    q.command = o->command ? o->command : "libcellmap";
+    q.mem = o->mem;
+    call_hooks h = {o->progress, o->user, (double)cm_box_cells(&q.box), 0};
+    const work_hooks hooks = {call_progress, call_stop, &h};
+    q.hooks = &hooks;
+    solve_result *r = st == CM_OK ? malloc(sizeof *r) : NULL;
+    if (st == CM_OK && !r)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a solve");
+    if (st == CM_OK)
+        st = solve_run(&q, r, msg, msg_size);
+    if (st == CM_OK)
+        st = solve_finish(r, msg, msg_size);
+    if (r)
+        solve_result_free(r);
+    free(r);
+    cm_model_release(&m);
+    return st;
+}
+
+cm_status cm_db_create(const cm_models *set, const char *name, const char *params,
+                       const cm_grid *grid, const char *path, const cm_db_options *o, char *msg,
+                       size_t msg_size)
+{
+    return db_solve(set, name, params, grid, path, o, false, msg, msg_size);
+}
+
+cm_status cm_db_resume(const cm_models *set, const char *name, const char *params,
+                       const cm_grid *grid, const char *path, const cm_db_options *o, char *msg,
+                       size_t msg_size)
+{
+    return db_solve(set, name, params, grid, path, o, true, msg, msg_size);
+}
+
+cm_status cm_db_export(const char *path, const double *lo, const double *hi, const char *labels,
+                       const char *steps, int by_groups, char *msg, size_t msg_size)
+{
+    if (!labels && !steps)
+        return cm_fail(CM_EINVAL, msg, msg_size, "nothing to export: give labels or steps");
+    if ((lo == NULL) != (hi == NULL))
+        return cm_fail(CM_EINVAL, msg, msg_size, "give both lo and hi, or neither");
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_cluster c;
+    cm_status st = project_probe(path, msg, msg_size);
+    if (st == CM_OK)
+        st = project_open_cluster(path, (uint64_t)256 << 20, &s, &info, &c, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_box window, *w = NULL;
+    if (lo) { /* the ranges as text that reads back exactly */
+        char text[CM_MAX_DIM * 2 * CM_NUM_TEXT + 16];
+        size_t used = 0;
+        for (int d = 0; d < c.lat.dim && used < sizeof text; d++)
+            used += (size_t)snprintf(text + used, sizeof text - used, "%s%.17g:%.17g",
+                                     d ? "," : "", lo[d], hi[d]);
+        st = export_window(&c, text, &window, msg, msg_size);
+        w = &window;
+    }
+    exporter x;
+    memset(&x, 0, sizeof x);
+    const cm_attractor_options stored = {0};
+    if (st == CM_OK)
+        st = exporter_open(&x, s, &info, &c, w, path, &stored, msg, msg_size);
+    if (st == CM_OK)
+        st = export_arrays(&x, labels, steps, by_groups != 0, NULL, msg, msg_size);
+    exporter_close(&x);
+    project_close(s, &c);
+    return st;
+}
+
+/* ---- sessions ---- */
+
+struct cm_session {
+    session s;
+    char path[CM_OUTPUT_PATH_MAX];
+};
+
+cm_status cm_session_open(const char *path, const cm_session_options *o, cm_session **out,
+                          char *msg, size_t msg_size)
+{
+    *out = NULL;
+    const cm_session_options none = {0};
+    o = o ? o : &none;
+    if (!path || !path[0] || strlen(path) >= CM_OUTPUT_PATH_MAX)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a session needs a path (shorter than %d)",
+                       CM_OUTPUT_PATH_MAX);
+    cm_session *cs = calloc(1, sizeof *cs);
+    if (!cs)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a session");
+    snprintf(cs->path, sizeof cs->path, "%s", path);
+    session_options so;
+    memset(&so, 0, sizeof so);
+    so.path = cs->path;
+    so.mo.name = o->model;
+    if (o->params && o->params[0])
+        so.mo.texts[so.mo.n_texts++] = o->params;
+    if (o->set)
+        so.mo.set = o->set->set;
+    for (int d = 0; d < CM_MAX_DIM && o->cell_size[d] > 0; d++)
+        so.n_cell_size = d + 1;
+    memcpy(so.cell_size, o->cell_size, sizeof so.cell_size);
+    memcpy(so.origin, o->origin, sizeof so.origin);
+    so.n_origin = so.n_cell_size;
+    so.depth_text = o->depth;
+    so.max_steps = o->max_steps;
+    so.threads = o->threads;
+    so.mem = o->mem;
+    so.command = o->command ? o->command : "libcellmap";
+    session_opened opened;
+    const cm_status st = session_open(&cs->s, &so, &opened, msg, msg_size);
+    if (st != CM_OK) {
+        char ignored[64];
+        session_close(&cs->s, ignored, sizeof ignored);
+        free(cs);
+        return st;
+    }
+    *out = cs;
+    return CM_OK;
+}
+
+static cm_status session_to(cm_session *s, const double *lo, const double *hi, const char *verb,
+                            uint64_t *new_cells, char *msg, size_t msg_size)
+{
+    session_work done;
+    const cm_status st = session_move(&s->s, lo, hi, NULL, verb, &done, msg, msg_size);
+    if (new_cells)
+        *new_cells = st == CM_OK ? done.cells : 0;
+    return st;
+}
+
+cm_status cm_session_view(cm_session *s, const double *lo, const double *hi,
+                          uint64_t *new_cells, char *msg, size_t msg_size)
+{
+    return session_to(s, lo, hi, "view", new_cells, msg, msg_size);
+}
+
+cm_status cm_session_bounds(const cm_session *s, double *lo, double *hi)
+{
+    if (!s->s.have_view)
+        return CM_ENOTFOUND;
+    memcpy(lo, s->s.lo, (size_t)s->s.view_dims * sizeof *lo);
+    memcpy(hi, s->s.hi, (size_t)s->s.view_dims * sizeof *hi);
+    return CM_OK;
+}
+
+cm_status cm_session_pan(cm_session *s, int d, double by, uint64_t *new_cells, char *msg,
+                         size_t msg_size)
+{
+    cm_status st = session_need_view(&s->s, "pan", msg, msg_size);
+    if (st == CM_OK && (d < 0 || d >= s->s.view_dims || !isfinite(by)))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "pan: dimension %d of %d, by a finite amount", d,
+                     s->s.view_dims);
+    if (st != CM_OK)
+        return st;
+    double lo[2] = {s->s.lo[0], s->s.lo[1]}, hi[2] = {s->s.hi[0], s->s.hi[1]};
+    lo[d] += by;
+    hi[d] += by;
+    return session_to(s, lo, hi, "pan", new_cells, msg, msg_size);
+}
+
+cm_status cm_session_zoom(cm_session *s, double factor, uint64_t *new_cells, char *msg,
+                          size_t msg_size)
+{
+    cm_status st = session_need_view(&s->s, "zoom", msg, msg_size);
+    if (st == CM_OK && !(factor > 0 && isfinite(factor)))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "zoom: the factor must be positive");
+    if (st != CM_OK)
+        return st;
+    double lo[2] = {0, 0}, hi[2] = {0, 0};
+    for (int d = 0; d < s->s.view_dims; d++) { /* as the explore language's zoom */
+        const double mid = 0.5 * (s->s.lo[d] + s->s.hi[d]),
+                     half = 0.5 * (s->s.hi[d] - s->s.lo[d]) / factor;
+        lo[d] = mid - half;
+        hi[d] = mid + half;
+    }
+    return session_to(s, lo, hi, "zoom", new_cells, msg, msg_size);
+}
+
+static void count_step(void *user, const session_step *step)
+{
+    (void)step;
+    ++*(int *)user;
+}
+
+cm_status cm_session_extend(cm_session *s, int steps, int *done, char *msg, size_t msg_size)
+{
+    int n = 0;
+    session_extended how;
+    const cm_status st = session_extend(&s->s, steps, count_step, &n, &how, msg, msg_size);
+    if (done)
+        *done = n;
+    return st;
+}
+
+cm_status cm_session_read(cm_session *s, cm_result **out, char *msg, size_t msg_size)
+{
+    *out = NULL;
+    cm_status st = session_need_view(&s->s, "read", msg, msg_size);
+    cm_box box;
+    cm_region r;
+    memset(&r, 0, sizeof r);
+    session_shown_cells(&s->s, &box);
+    if (st == CM_OK)
+        st = cm_cluster_flatten(&s->s.c, &box, &r, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    /* the attractors found over the whole cluster, as render finds them */
+    const result_source cluster = {NULL, &s->s.c, NULL, 0};
+    return make_result(&s->s.model, &s->s.c.lat, &r, &cluster, out, msg, msg_size);
+}
+
+cm_status cm_session_figure(cm_session *s, const cm_figure_options *o, char *msg,
+                            size_t msg_size)
+{
+    png_opts po;
+    const cm_status st = figure_opts_of(o, &po, msg, msg_size);
+    return st == CM_OK ? session_render(&s->s, &po, msg, msg_size) : st;
+}
+
+cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size)
+{
+    if (!s)
+        return CM_OK;
+    const cm_status st = session_close(&s->s, msg, msg_size);
+    free(s);
+    return st;
 }

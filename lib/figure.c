@@ -444,7 +444,9 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
     int32_t *label = st == CM_OK ? malloc((view.ncells + 1) * sizeof *label) : NULL;
     if (st == CM_OK && !label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
-    if (st == CM_OK)
+    if (st == CM_OK && b->labels)
+        memcpy(label, b->labels, view.ncells * sizeof *label);
+    else if (st == CM_OK)
         st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, label, msg, msg_size);
     if (st == CM_OK) {
         memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
@@ -463,6 +465,7 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
         by.cells = &view;
         by.groups = groups;
         by.attractors = NULL;
+        by.labels = NULL;
         st = figure_write(&by, msg, msg_size);
     }
     cm_region_free(&view);

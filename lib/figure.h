@@ -76,6 +76,8 @@ typedef struct basin_png {
                                                   lib/attractor_report.h), else by groups */
     const struct cm_computed *computed; /* by attractors: where the sink cells' sequences go
                                            beyond the cells (NULL: not followed) */
+    const int32_t *labels; /* by attractors: each cell's label found already
+                              (cm_attractor_cell_labels); NULL: found here */
 } basin_png;
 
 /* Checks before anything is computed that the figure of these options can

@@ -423,7 +423,8 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
                            {s->hi[0], s->hi[1]},
                            s->gl,
                            po->by == BY_ATTRACTORS ? &att : NULL,
-                           &ends.computed};
+                           &ends.computed,
+                           NULL};
     if (st == CM_OK)
         st = figure_write(&png, msg, msg_size);
     cm_region_free(&flat);

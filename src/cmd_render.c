@@ -156,7 +156,7 @@ static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_
     } else {
         const basin_png png = {&a->png, &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
                                {hi[0], hi[1]}, NULL, a->png.by == BY_ATTRACTORS ? &att : NULL,
-                               &ends.computed};
+                               &ends.computed, NULL};
         rc = write_basin_png("render", &png);
     }
     cm_region_free(&flat);

@@ -2,6 +2,7 @@
  * library a user links: solving, splitting, cancelling, errors, figures,
  * and reading a database that `cellmap solve --db` wrote.
  * usage: test_api PATH/TO/cellmap */
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
