@@ -19,17 +19,28 @@ computed, as `cellmap export --labels` writes them.
     print(res.attractors[0], (res.attractor_labels == 1).mean())
     view = cellmap.open("file.cmdb").read(view=[(100, 200), (-10, 10)])
 
-The library is found through $CELLMAP_LIB, then next to an installed
-cellmap (PREFIX/lib), then the system's library path.
+The library is found next to an installed cellmap (PREFIX/lib, for a
+module pip installed under the same PREFIX), then where pkg-config says
+cellmap is, then on the system's library path; $CELLMAP_LIB overrides.
+
+Beyond solving and reading (the stable part of libcellmap), the module
+drives the workstation through libcellmap's experimental section:
+databases made and resumed (create, resume), their arrays exported
+(export), explore sessions (Session: view, pan, zoom, extend, read,
+figure), figures with every option (Result.figure), and systems given as a
+Python function (System.from_function).
 """
 import ctypes
 import ctypes.util
+import json
 import os
+import subprocess
+import sysconfig
 
 import numpy as np
 
-__all__ = ["System", "Models", "Result", "Database", "solve", "open", "models",
-           "CellmapError", "LABEL_NONE", "version"]
+__all__ = ["System", "Models", "Result", "Database", "Session", "solve", "open", "create",
+           "resume", "export", "models", "CellmapError", "LABEL_NONE", "version"]
 
 LABEL_NONE = -1
 _MAX_DIM = 6
@@ -48,18 +59,36 @@ def _candidates():
     env = os.environ.get("CELLMAP_LIB")
     if env:
         yield env
+    # installed beside cellmap: PREFIX/lib/libcellmap.so.0, whatever the
+    # site scheme put the package under PREFIX (lib/pythonX.Y/site-packages,
+    # Debian's local/lib/pythonX.Y/dist-packages, a --target directory)
     here = os.path.dirname(os.path.abspath(__file__))
-    # PREFIX/lib/pythonX.Y/site-packages/cellmap -> PREFIX/lib
-    for up in (3, 4):
-        base = os.path.normpath(os.path.join(here, *[".."] * up))
-        for name in ("libcellmap.so.0", "libcellmap.so"):
-            path = os.path.join(base, name)
+    up = here
+    for _ in range(7):
+        up = os.path.dirname(up)
+        for sub in ("lib", "lib64", os.path.join("lib", _multiarch())):
+            path = os.path.join(up, sub, "libcellmap.so.0")
             if os.path.exists(path):
                 yield path
+    # where pkg-config says cellmap is (its default path covers /usr/local)
+    try:
+        libdir = subprocess.run(["pkg-config", "--variable=libdir", "cellmap"],
+                                capture_output=True, text=True, timeout=10).stdout.strip()
+        if libdir:
+            yield os.path.join(libdir, "libcellmap.so.0")
+    except (OSError, subprocess.SubprocessError):
+        pass
     found = ctypes.util.find_library("cellmap")
     if found:
         yield found
     yield "libcellmap.so.0"
+
+
+def _multiarch():
+    try:
+        return sysconfig.get_config_var("MULTIARCH") or ""
+    except Exception:  # noqa: BLE001 - a missing variable is no reason to fail the import
+        return ""
 
 
 def _load():
@@ -210,6 +239,41 @@ class System:
         self.dim = _lib.cm_system_dim(self._h)
         self.coords = [_lib.cm_system_coord(self._h, d).decode() for d in range(self.dim)]
 
+    @classmethod
+    def from_function(cls, name, dim, f):
+        """A system whose map is the Python function f(x) -> y (x, y lists
+        of dim floats; y None: no image, the sink). Called through ctypes
+        once per image, from libcellmap's threads under the interpreter's
+        lock (more threads do not make it faster): about 4-7 microseconds a
+        cell for the Henon map, 13-17 times the same map as a compiled
+        plugin (tests/bench_function_model.py measures both), so a map
+        worth more than a quick look is worth a plugin (examples/plugin).
+        An exception in f stops the solve and is raised from it."""
+        self = cls.__new__(cls)
+        self.models = None
+        self._error = None
+
+        def step(user, x, y):
+            try:
+                image = f([x[d] for d in range(dim)])
+                if image is None:
+                    return 1
+                for d in range(dim):
+                    y[d] = image[d]
+                return 0
+            except BaseException as e:  # noqa: BLE001 - raised again after the call
+                self._error = self._error or e
+                return -1
+
+        self._step = _STEP(step)  # kept alive as long as the system
+        self._h = _P()
+        _call(_lib.cm_system_from_function, _text(name), int(dim), self._step, None,
+              ctypes.byref(self._h))
+        self.name = _lib.cm_system_name(self._h).decode()
+        self.dim = _lib.cm_system_dim(self._h)
+        self.coords = [_lib.cm_system_coord(self._h, d).decode() for d in range(self.dim)]
+        return self
+
     def region(self):
         """The model's default region [(lo, hi), ...], or None."""
         lo, hi = (ctypes.c_double * self.dim)(), (ctypes.c_double * self.dim)()
@@ -285,8 +349,17 @@ class Result:
         return np.ascontiguousarray(flat.view(np.int32).reshape(tuple(reversed(self.cells))).T)
 
     def png(self, path, width=0, height=0):
-        """Writes the basin figure (0, 0: 1000 pixels on the longer side)."""
+        """Writes the basin figure, as `cellmap solve --png` draws it."""
         _call(_lib.cm_result_png, self._h, _text(os.fspath(path)), width, height)
+
+    def figure(self, png=None, **options):
+        """Writes the figure with render's options: png=PATH and/or
+        svg=PATH, width, height, layers (names: basin, steps, attractors,
+        overlays, axes, legend, title; default all but steps), indexed,
+        by ("attractors" or "groups"), palette, labels (a file),
+        min_basin, legend."""
+        o, keep = _figure_options(png, options)
+        _call(_lib.cm_result_figure, self._h, ctypes.byref(o))
 
     def __del__(self):
         if getattr(self, "_h", None):
@@ -322,7 +395,13 @@ def solve(system, region=None, cells=None, threads=0, max_steps=0, split=None, p
         if progress else _PROGRESS()
     opt.progress = callback
     h = _P()
-    _call(_lib.cm_solve, system._h, ctypes.byref(g), ctypes.byref(opt), ctypes.byref(h))
+    try:
+        _call(_lib.cm_solve, system._h, ctypes.byref(g), ctypes.byref(opt), ctypes.byref(h))
+    except CellmapError as e:
+        raised, system._error = getattr(system, "_error", None), None
+        if raised is not None:
+            raise raised from e
+        raise
     return Result(h, system)
 
 
@@ -334,7 +413,7 @@ class Database:
         self._h = _P()
         _call(_lib.cm_db_open, _text(os.fspath(path)), ctypes.byref(self._h))
         self.model = _lib.cm_db_model(self._h).decode()
-        self.params = _lib.cm_db_params(self._h).decode()
+        self.params = json.loads(_lib.cm_db_params(self._h).decode())
         g = _Grid()
         _lib.cm_db_grid(self._h, ctypes.byref(g))
         self.lo = [g.lo[d] for d in range(g.dim)]
@@ -367,3 +446,237 @@ class Database:
 def open(path):  # noqa: A001 - cellmap.open(...) reads like the file it opens
     """Opens a .cmdb file read-only (see Database)."""
     return Database(path)
+
+
+# ---- the experimental section of libcellmap ---------------------------------
+
+_STEP = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ctypes.c_double),
+                         ctypes.POINTER(ctypes.c_double))
+
+
+class _FigureOptions(ctypes.Structure):
+    _fields_ = [("png", ctypes.c_char_p), ("svg", ctypes.c_char_p), ("width", ctypes.c_int),
+                ("height", ctypes.c_int), ("layers", ctypes.c_uint), ("indexed", ctypes.c_int),
+                ("by_groups", ctypes.c_int), ("palette", ctypes.c_char_p),
+                ("labels", ctypes.c_char_p), ("min_basin", ctypes.c_uint64),
+                ("legend", ctypes.c_int)]
+
+
+class _DbOptions(ctypes.Structure):
+    _fields_ = [("threads", ctypes.c_int), ("max_steps", ctypes.c_int),
+                ("split", ctypes.c_int64 * _MAX_DIM), ("extend", ctypes.c_int),
+                ("escape_below", ctypes.c_double), ("mem", ctypes.c_uint64),
+                ("command", ctypes.c_char_p), ("progress", _PROGRESS), ("user", ctypes.c_void_p)]
+
+
+class _SessionOptions(ctypes.Structure):
+    _fields_ = [("model", ctypes.c_char_p), ("params", ctypes.c_char_p), ("set", ctypes.c_void_p),
+                ("cell_size", ctypes.c_double * _MAX_DIM), ("origin", ctypes.c_double * _MAX_DIM),
+                ("depth", ctypes.c_char_p), ("max_steps", ctypes.c_int), ("threads", ctypes.c_int),
+                ("mem", ctypes.c_uint64), ("command", ctypes.c_char_p)]
+
+
+_DOUBLES = ctypes.POINTER(ctypes.c_double)
+_sig("cm_system_from_function", ctypes.c_int, ctypes.c_char_p, ctypes.c_int, _STEP, _P,
+     ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_result_figure", ctypes.c_int, _P, ctypes.POINTER(_FigureOptions), ctypes.c_char_p,
+     ctypes.c_size_t)
+for _name in ("cm_db_create", "cm_db_resume"):
+    _sig(_name, ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(_Grid),
+         ctypes.c_char_p, ctypes.POINTER(_DbOptions), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_db_export", ctypes.c_int, ctypes.c_char_p, _DOUBLES, _DOUBLES, ctypes.c_char_p,
+     ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_open", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_SessionOptions),
+     ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_view", ctypes.c_int, _P, _DOUBLES, _DOUBLES, ctypes.POINTER(ctypes.c_uint64),
+     ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_bounds", ctypes.c_int, _P, _DOUBLES, _DOUBLES)
+_sig("cm_session_pan", ctypes.c_int, _P, ctypes.c_int, ctypes.c_double,
+     ctypes.POINTER(ctypes.c_uint64), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_zoom", ctypes.c_int, _P, ctypes.c_double, ctypes.POINTER(ctypes.c_uint64),
+     ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_extend", ctypes.c_int, _P, ctypes.c_int, ctypes.POINTER(ctypes.c_int),
+     ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_read", ctypes.c_int, _P, ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_figure", ctypes.c_int, _P, ctypes.POINTER(_FigureOptions), ctypes.c_char_p,
+     ctypes.c_size_t)
+_sig("cm_session_close", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_size_t)
+
+_LAYERS = {"basin": 1, "steps": 2, "attractors": 4, "overlays": 8, "axes": 16, "legend": 32,
+           "title": 64}
+_FIGURE_KEYS = {"svg", "width", "height", "layers", "indexed", "by", "palette", "labels",
+                "min_basin", "legend"}
+
+
+def _figure_options(png, options):
+    """The C options of a figure, and the encoded texts they point to."""
+    unknown = set(options) - _FIGURE_KEYS
+    if unknown:
+        raise TypeError("figure(): unknown option(s) %s; known: png, %s"
+                        % (", ".join(sorted(unknown)), ", ".join(sorted(_FIGURE_KEYS))))
+    layers = options.get("layers")
+    bits = 0
+    for name in ([layers] if isinstance(layers, str) else layers or ()):
+        if name not in _LAYERS:
+            raise ValueError("figure(): layer %r; known: %s" % (name, ", ".join(_LAYERS)))
+        bits |= _LAYERS[name]
+    by = options.get("by", "attractors")
+    if by not in ("attractors", "groups"):
+        raise ValueError("figure(): by=%r: 'attractors' or 'groups'" % (by,))
+    keep = [_text(os.fspath(v)) if v is not None else None
+            for v in (png, options.get("svg"), options.get("palette"), options.get("labels"))]
+    o = _FigureOptions(keep[0], keep[1], int(options.get("width", 0)),
+                       int(options.get("height", 0)), bits, int(bool(options.get("indexed"))),
+                       int(by == "groups"), keep[2], keep[3], int(options.get("min_basin", 0)),
+                       int(options.get("legend", 0)))
+    return o, keep
+
+
+def _db_call(fn, path, model, params, plugins, region, cells, split, extend, escape_below,
+             threads, max_steps, mem, command, progress, kw):
+    models = Models(plugins) if plugins else None
+    dim = len(region)
+    g = _grid(dim, region, cells)
+    o = _DbOptions()
+    o.threads, o.max_steps, o.extend, o.escape_below, o.mem = (
+        threads, max_steps, extend, float(escape_below), mem)
+    for d, k in enumerate(split or ()):
+        o.split[d] = int(k)
+    o.command = _text(command)
+    callback = _PROGRESS(lambda user, fraction: 1 if progress(fraction) else 0) \
+        if progress else _PROGRESS()
+    o.progress = callback
+    _call(fn, models._h if models else None, _text(model), _text(_params_text(params, kw)),
+          ctypes.byref(g), _text(os.fspath(path)), ctypes.byref(o))
+
+
+def create(path, model, region, cells, params=None, plugins=(), split=None, extend=0,
+           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None, **kw):
+    """Solves region [(lo, hi), ...] in cells (n0, n1, ...) of `model` into a
+    new database at path, as `cellmap solve --db PATH` with --split, --extend,
+    --escape-below, --max-steps, --threads and --mem; the system's attractors
+    are stored with it. Parameter values as keywords (alpha=0.078) or
+    params="k=v,...". progress(fraction) returning True cancels: the joins
+    done are kept, and resume() completes the file."""
+    _db_call(_lib.cm_db_create, path, model, params, plugins, region, cells, split, extend,
+             escape_below, threads, max_steps, mem, command, progress, kw)
+    return Database(path)
+
+
+def resume(path, model, region, cells, params=None, plugins=(), split=None, extend=0,
+           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None, **kw):
+    """Completes a database create() (or `cellmap solve --db`) began, given
+    the same model, parameters, region, cells and plan."""
+    _db_call(_lib.cm_db_resume, path, model, params, plugins, region, cells, split, extend,
+             escape_below, threads, max_steps, mem, command, progress, kw)
+    return Database(path)
+
+
+def export(path, labels=None, steps=None, view=None, by="attractors"):
+    """The cells of a database (those whose centres lie in view [(lo, hi),
+    ...], default all) as .npy arrays with JSON sidecars, as `cellmap export
+    --labels --steps [--window]` writes them."""
+    if by not in ("attractors", "groups"):
+        raise ValueError("export(): by=%r: 'attractors' or 'groups'" % (by,))
+    lo = hi = None
+    if view is not None:
+        lo = (ctypes.c_double * len(view))(*[float(a) for a, _ in view])
+        hi = (ctypes.c_double * len(view))(*[float(b) for _, b in view])
+    _call(_lib.cm_db_export, _text(os.fspath(path)), lo, hi,
+          _text(None if labels is None else os.fspath(labels)),
+          _text(None if steps is None else os.fspath(steps)), int(by == "groups"))
+
+
+class Session:
+    """An explore session on a database that grows as the view moves: each
+    move computes exactly the cells it uncovers, joins them and commits
+    them, as `cellmap explore` does. A new file needs model= and cell_size=.
+
+        with cellmap.Session("pd.cmdb", model="microchaos-pd", alpha=0.078,
+                             cell_size=(0.5, 0.08)) as s:
+            s.view([(0, 50), (-4, 4)])
+            s.pan(0, 5)                  # by 5 in the first coordinate
+            s.figure("view.png")
+            labels = s.read().attractor_labels
+    """
+
+    def __init__(self, path, model=None, params=None, plugins=(), cell_size=None, origin=None,
+                 depth=None, max_steps=0, threads=0, mem=0, command=None, **kw):
+        self.models = Models(plugins) if plugins else None
+        o = _SessionOptions()
+        self._keep = [_text(model), _text(_params_text(params, kw)) if model else None,
+                      _text(depth), _text(command)]
+        o.model, o.params, o.depth, o.command = self._keep
+        o.set = self.models._h if self.models else None
+        for d, w in enumerate(cell_size or ()):
+            o.cell_size[d] = float(w)
+        for d, x in enumerate(origin or ()):
+            o.origin[d] = float(x)
+        o.max_steps, o.threads, o.mem = max_steps, threads, mem
+        self._h = _P()
+        _call(_lib.cm_session_open, _text(os.fspath(path)), ctypes.byref(o),
+              ctypes.byref(self._h))
+
+    def _moved(self, fn, *args):
+        new = ctypes.c_uint64()
+        _call(fn, self._h, *args, ctypes.byref(new))
+        return new.value
+
+    def view(self, region):
+        """Moves the view to [(x0, x1), (y0, y1)]; returns the new cells computed."""
+        lo = (ctypes.c_double * 2)(*[float(a) for a, _ in region] + [0.0] * (2 - len(region)))
+        hi = (ctypes.c_double * 2)(*[float(b) for _, b in region] + [0.0] * (2 - len(region)))
+        return self._moved(_lib.cm_session_view, lo, hi)
+
+    @property
+    def bounds(self):
+        """The view [(x0, x1), (y0, y1)], or None before the first."""
+        lo, hi = (ctypes.c_double * 2)(), (ctypes.c_double * 2)()
+        if _lib.cm_session_bounds(self._h, lo, hi) != 0:
+            return None
+        return list(zip(lo, hi))
+
+    def pan(self, d, by):
+        """Moves the view by `by` (state units) in coordinate d; new cells computed."""
+        return self._moved(_lib.cm_session_pan, int(d), float(by))
+
+    def zoom(self, factor):
+        """Zooms about the view's centre (2: twice as close); new cells computed."""
+        return self._moved(_lib.cm_session_zoom, float(factor))
+
+    def extend(self, steps=1):
+        """`extend auto steps`; returns the steps done."""
+        done = ctypes.c_int()
+        _call(_lib.cm_session_extend, self._h, int(steps), ctypes.byref(done))
+        return done.value
+
+    def read(self):
+        """The view's cells as a Result (labels, steps, attractors)."""
+        h = _P()
+        _call(_lib.cm_session_read, self._h, ctypes.byref(h))
+        return Result(h, self)
+
+    def figure(self, png=None, **options):
+        """The view's figure, as `render` in a session draws it (options as
+        Result.figure; layers default to basin and attractors, as render's)."""
+        options.setdefault("layers", ("basin", "attractors"))
+        o, keep = _figure_options(png, options)
+        _call(_lib.cm_session_figure, self._h, ctypes.byref(o))
+
+    def close(self):
+        """Saves the view and the attractors and closes the database."""
+        if getattr(self, "_h", None):
+            h, self._h = self._h, None
+            _call(_lib.cm_session_close, h)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except CellmapError:
+            pass

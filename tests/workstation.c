@@ -1,0 +1,103 @@
+/* workstation: the command's work done by a C program through libcellmap's
+ * experimental section alone (built with pkg-config against the installed
+ * library by tests/workstation_test.sh, which compares what it writes with
+ * what the command writes, row for row and byte for byte):
+ *   c_split.cmdb    solve --db --split 2x2
+ *   c_resumed.cmdb  the same solve cancelled after its first join, then
+ *                   resumed (solve --resume)
+ *   c_partial.cmdb  a copy of the cancelled file, for the command to resume
+ *   c_ext.cmdb      solve --db --extend 3
+ *   c_explore.cmdb  an explore session: a view, 20 pans of 10 %, then
+ *   c_view.png      render of the view
+ *   c_labels.npy    export --labels of c_split.cmdb
+ * usage: workstation (in the directory to write in) */
+#define CELLMAP_EXPERIMENTAL
+#include <cellmap/cellmap.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PD "alpha=0.078,beta=0,P=0.007,D=0.02"
+
+static void must(cm_status st, const char *what, const char *msg)
+{
+    if (st != CM_OK) {
+        fprintf(stderr, "workstation: %s: %s (%s)\n", what, msg, cm_status_name(st));
+        exit(1);
+    }
+}
+
+/* Cancels a solve at its first report after some work (the first join). */
+static int cancel_after_first(void *user, double fraction)
+{
+    (void)user;
+    return fraction > 0 && fraction < 1;
+}
+
+static int copy_file(const char *from, const char *to)
+{
+    FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
+    char buf[1 << 16];
+    size_t n;
+    int ok = in && out;
+    while (ok && (n = fread(buf, 1, sizeof buf, in)) > 0)
+        ok = fwrite(buf, 1, n, out) == n;
+    if (in)
+        fclose(in);
+    if (out)
+        ok = fclose(out) == 0 && ok;
+    return ok;
+}
+
+int main(void)
+{
+    char msg[1024];
+    const cm_grid grid = {2, {0, -40}, {500, 40}, {200, 100}};
+    const cm_db_options split = {.split = {2, 2}, .threads = 2};
+    must(cm_db_create(NULL, "microchaos-pd", PD, &grid, "c_split.cmdb", &split, msg, sizeof msg),
+         "create", msg);
+
+    cm_db_options cancelled = split;
+    cancelled.progress = cancel_after_first;
+    const cm_status st =
+        cm_db_create(NULL, "microchaos-pd", PD, &grid, "c_resumed.cmdb", &cancelled, msg,
+                     sizeof msg);
+    if (st != CM_ECANCELED) {
+        fprintf(stderr, "workstation: the cancelled solve gave %s\n", cm_status_name(st));
+        return 1;
+    }
+    if (!copy_file("c_resumed.cmdb", "c_partial.cmdb"))
+        return fprintf(stderr, "workstation: cannot copy the partial file\n"), 1;
+    must(cm_db_resume(NULL, "microchaos-pd", PD, &grid, "c_resumed.cmdb", &split, msg,
+                      sizeof msg),
+         "resume", msg);
+
+    const cm_db_options extend = {.extend = 3, .threads = 2};
+    const cm_grid tile = {2, {0, -40}, {100, 40}, {100, 100}};
+    must(cm_db_create(NULL, "microchaos-pd", PD, &tile, "c_ext.cmdb", &extend, msg, sizeof msg),
+         "create --extend", msg);
+
+    const cm_session_options so = {.model = "microchaos-pd",
+                                   .params = PD,
+                                   .cell_size = {0.5, 0.08},
+                                   .threads = 2};
+    cm_session *s = NULL;
+    must(cm_session_open("c_explore.cmdb", &so, &s, msg, sizeof msg), "session", msg);
+    must(cm_session_view(s, (double[2]){0, -4}, (double[2]){50, 4}, NULL, msg, sizeof msg),
+         "view", msg);
+    for (int k = 0; k < 20; k++) { /* pan right 10% */
+        double lo[2], hi[2];
+        must(cm_session_bounds(s, lo, hi), "bounds", "");
+        must(cm_session_pan(s, 0, 10 * ((hi[0] - lo[0]) / 100), NULL, msg, sizeof msg), "pan",
+             msg);
+    }
+    const cm_figure_options view = {.png = "c_view.png",
+                                    .layers = CM_FIGURE_BASIN | CM_FIGURE_ATTRACTORS};
+    must(cm_session_figure(s, &view, msg, sizeof msg), "render", msg);
+    must(cm_session_close(s, msg, sizeof msg), "close", msg);
+
+    must(cm_db_export("c_split.cmdb", NULL, NULL, "c_labels.npy", NULL, 0, msg, sizeof msg),
+         "export", msg);
+    return 0;
+}

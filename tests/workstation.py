@@ -1,0 +1,41 @@
+"""The command's work done from Python (tests/workstation_test.sh compares
+what it writes with what the command writes, as it does tests/workstation.c's):
+py_split.cmdb (solve --db --split 2x2), py_resumed.cmdb (cancelled after its
+first join, then resumed), py_partial.cmdb (the cancelled file, for the
+command to resume), py_ext.cmdb (--extend 3), py_explore.cmdb and py_view.png
+(20 pans of 10 % and a render), py_labels.npy (export --labels)."""
+import shutil
+
+import cellmap
+
+PD = dict(alpha=0.078, beta=0, P=0.007, D=0.02)
+REGION, CELLS = [(0, 500), (-40, 40)], (200, 100)
+
+cellmap.create("py_split.cmdb", "microchaos-pd", REGION, CELLS, split=(2, 2), threads=2, **PD)
+
+try:
+    cellmap.create("py_resumed.cmdb", "microchaos-pd", REGION, CELLS, split=(2, 2), threads=2,
+                   progress=lambda fraction: 0 < fraction < 1, **PD)
+    raise SystemExit("the cancelled solve was not cancelled")
+except cellmap.CellmapError as e:
+    assert "cancelled" in str(e), e
+shutil.copyfile("py_resumed.cmdb", "py_partial.cmdb")
+db = cellmap.resume("py_resumed.cmdb", "microchaos-pd", REGION, CELLS, split=(2, 2), threads=2,
+                    **PD)
+assert db.params == {"alpha": 0.078, "beta": 0, "P": 0.007, "D": 0.02}, db.params
+
+cellmap.create("py_ext.cmdb", "microchaos-pd", [(0, 100), (-40, 40)], (100, 100), extend=3,
+               threads=2, **PD)
+
+with cellmap.Session("py_explore.cmdb", model="microchaos-pd", cell_size=(0.5, 0.08),
+                     threads=2, **PD) as s:
+    s.view([(0, 50), (-4, 4)])
+    for _ in range(20):  # pan right 10%
+        (lo, hi), _ = s.bounds
+        s.pan(0, 10 * ((hi - lo) / 100))
+    s.figure("py_view.png")
+    view = s.read()
+    assert view.labels.shape == (100, 100) and (view.labels >= 0).all()  # every cell computed
+
+cellmap.export("py_split.cmdb", labels="py_labels.npy")
+print("workstation.py: done")

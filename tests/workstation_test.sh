@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# The workstation from C and from Python (issue 44): libcellmap installed
+# to a prefix, a C program built with pkg-config alone (tests/workstation.c)
+# and the Python module (python/cellmap, pip-installed without network) do
+# what the command does - solve --db --split 2x2, --resume of a cancelled
+# solve, --extend 3, an explore session of 20 pans with a render of the
+# view, export --labels - and what they write equals the command's: every
+# database row (but the recorded command line), the PNG's bytes and the
+# arrays' bytes.
+# usage: workstation_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
+set -u
+SRC=$(realpath "$2")
+BUILD=$(realpath "$3")
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+PY=/usr/bin/python3
+if [ -n "${CELLMAP_SANITIZE:-}" ]; then # an instrumented libcellmap: its runtimes first
+  export LD_PRELOAD="$(gcc -print-file-name=libasan.so) $(gcc -print-file-name=libubsan.so)"
+  export ASAN_OPTIONS=detect_leaks=0
+fi
+
+cmake --install "$BUILD" --prefix "$work/prefix" > install.log 2>&1 || fail "install: $(cat install.log)"
+CM="$work/prefix/bin/cellmap"
+export PKG_CONFIG_PATH="$work/prefix/share/pkgconfig"
+# pkg-config alone says how to build and where the library is
+san=${CELLMAP_SANITIZE:+-fsanitize=address,undefined}
+LD_PRELOAD= cc -std=c11 -Wall -Wextra -Werror $san $(pkg-config --cflags cellmap) -o workstation \
+  "$SRC/tests/workstation.c" $(pkg-config --libs cellmap) \
+  -Wl,-rpath,"$(pkg-config --variable=libdir cellmap)" 2> cc.log || fail "cc: $(cat cc.log)"
+
+# every table's rows, blobs as hex, the provenance left out (the command
+# line, and the journal a script's run keeps)
+rows() {
+  local t
+  for t in $(sqlite3 "$1" "SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name"); do
+    echo "== $t"
+    if [ "$t" = meta ]; then
+      sqlite3 -cmd '.mode quote' "$1" "SELECT * FROM meta WHERE key NOT IN ('command', 'note.explore.journal') ORDER BY key"
+    else
+      sqlite3 -cmd '.mode quote' "$1" "SELECT * FROM \"$t\" ORDER BY rowid"
+    fi
+  done
+}
+same_db() { # A B WHAT
+  rows "$1" > a.rows && rows "$2" > b.rows || { fail "$3: cannot read the rows"; return; }
+  [ "$(grep -c . a.rows)" -gt 20 ] || fail "$3: only $(grep -c . a.rows) rows in $1"
+  cmp -s a.rows b.rows || fail "$3: $1 and $2 differ: $(diff a.rows b.rows | head -5)"
+}
+same_bytes() { # A B WHAT
+  [ -s "$1" ] && cmp -s "$1" "$2" || fail "$3: $1 and $2 differ (or are missing)"
+}
+
+# the command's work
+PD=(--param alpha=0.078,beta=0,P=0.007,D=0.02)
+"$CM" solve "${PD[@]}" --region 0:500,-40:40 --cells 200x100 --split 2x2 --threads 2 \
+  --db cli_split.cmdb --quiet || fail "solve --split"
+"$CM" solve "${PD[@]}" --region 0:100,-40:40 --cells 100x100 --extend 3 --threads 2 \
+  --db cli_ext.cmdb --quiet || fail "solve --extend"
+{
+  echo "view 0:50 -4:4"
+  for k in $(seq 20); do echo "pan right 10%"; done
+  echo "render cli_view.png"
+} > pans.explore
+"$CM" explore cli_explore.cmdb pans.explore --model microchaos-pd "${PD[@]}" \
+  --cell-size 0.5,0.08 --threads 2 > explore.log || fail "explore: $(cat explore.log)"
+"$CM" export cli_split.cmdb --labels cli_labels.npy --quiet || fail "export --labels"
+
+check() { # PREFIX: what the C program or Python wrote, against the command's
+  same_db cli_split.cmdb "$1_split.cmdb" "$1: solve --split 2x2"
+  same_db cli_split.cmdb "$1_resumed.cmdb" "$1: cancelled and resumed"
+  same_db cli_ext.cmdb "$1_ext.cmdb" "$1: solve --extend 3"
+  same_db cli_explore.cmdb "$1_explore.cmdb" "$1: explore's 20 pans"
+  same_bytes cli_view.png "$1_view.png" "$1: render of the view"
+  same_bytes cli_labels.npy "$1_labels.npy" "$1: export --labels"
+  sed "s/$1_/cli_/g" "$1_labels.json" > sidecar.json
+  same_bytes cli_labels.json sidecar.json "$1: export --labels' sidecar"
+  # the command resumes what the library left cancelled, to the same file
+  [ -s "$1_partial.cmdb" ] && [ "$(sqlite3 "$1_partial.cmdb" 'SELECT COUNT(*) FROM regions')" -lt 4 ] \
+    || fail "$1: the cancelled file is not partial"
+  "$CM" solve "${PD[@]}" --region 0:500,-40:40 --cells 200x100 --split 2x2 --threads 2 \
+    --db "$1_partial.cmdb" --resume --quiet || fail "$1: the command's --resume"
+  same_db cli_split.cmdb "$1_partial.cmdb" "$1: resumed by the command"
+}
+
+LD_PRELOAD=${LD_PRELOAD:-} ./workstation > c.log 2>&1 || fail "the C program: $(cat c.log)"
+check c
+
+# the same from Python, installed as the README says: pip without network
+# or build isolation under the prefix cellmap went to, and no CELLMAP_LIB or
+# PKG_CONFIG_PATH: the module finds PREFIX/lib/libcellmap.so.0 itself
+unset CELLMAP_LIB PKG_CONFIG_PATH
+LD_PRELOAD= $PY -m pip install --quiet --no-deps --no-build-isolation --no-index \
+  --prefix "$work/prefix" "$SRC/python" > pip.log 2>&1 || fail "pip install: $(tail -5 pip.log)"
+site=$(dirname "$(find "$work/prefix" -path '*-packages/cellmap/__init__.py' | head -1)")
+export PYTHONPATH=$(dirname "$site")
+$PY "$SRC/tests/workstation.py" > py.log 2>&1 || fail "the Python program: $(tail -20 py.log)"
+check py
+
+# a map given as a Python function agrees with the same map as a plugin
+LD_PRELOAD= cc -shared -fPIC -I"$work/prefix/include" -o libhenon.so "$SRC/examples/plugin/henon.c" \
+  -lm || fail "cc henon"
+$PY "$SRC/tests/bench_function_model.py" ./libhenon.so 100 > bench.log 2>&1 \
+  || fail "the Python function model: $(tail -20 bench.log)"
+cat bench.log
+
+[ "$fails" -eq 0 ] && echo "workstation_test: ok" || exit 1
