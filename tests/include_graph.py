@@ -9,7 +9,9 @@ a function-like macro); a header of declarations and types alone makes no
 dependency of its own (its functions' callers are found by nm). A cycle of modules (A needs B and B needs
 A, through any path) is printed and fails the test, as is an include of a
 layer above: the layers point one way, src -> lib -> models, render ->
-cellmap.
+cellmap. The command (src/) is a client of the library: it includes no
+header of the engine, the models or the renderer but the public
+cellmap/cellmap.h, only lib/'s (and its own), and stays under 6 000 lines.
 
 usage: include_graph.py SOURCE_DIR BUILD_DIR"""
 import glob, os, re, subprocess, sys
@@ -82,6 +84,20 @@ for m, syms in undefined.items():
 if not objects:
     problems.append("no object files under %s/CMakeFiles" % build)
 
+# the command over the library only
+SRC_MAX_LINES = 6000
+src_lines = 0
+for path in sorted(glob.glob(os.path.join(root, "src", "*.[ch]"))):
+    text = open(path).read()
+    src_lines += text.count("\n")
+    for inc in re.findall(r'^\s*#\s*include\s+"([^"]+)"', text, re.M):
+        if inc.split("/")[0] in ("cellmap", "models", "render") and inc != "cellmap/cellmap.h":
+            problems.append("src/%s includes %s: the command reaches the engine, models and "
+                            "renderer through lib/ only" % (os.path.basename(path), inc))
+if src_lines >= SRC_MAX_LINES:
+    problems.append("src/ has %d lines (at most %d): what is not option parsing, printing or "
+                    "exit codes belongs in lib/" % (src_lines, SRC_MAX_LINES - 1))
+
 # Tarjan's strongly connected components: each of more than one module is a cycle
 index, low, on, stack, sccs, counter = {}, {}, set(), [], [], [0]
 def visit(v):
@@ -113,5 +129,5 @@ for scc in sccs:
     problems.append("include cycle: " + " <-> ".join(scc))
 for p in problems:
     print("FAIL: " + p)
-print("include graph: %d modules, %d edges, %d cycles" % (len(edges), sum(map(len, edges.values())), len(sccs)))
+print("include graph: %d modules, %d edges, %d cycles; src/ %d lines" % (len(edges), sum(map(len, edges.values())), len(sccs), src_lines))
 sys.exit(1 if problems else 0)

@@ -3,8 +3,7 @@
  * private directory and read as the command reads it:
  *   0 a palette (--palette FILE: #rrggbb lines), 1 a labels file
  *   (--labels FILE: "ID TEXT" lines), 2 lyapunov's --curves FILE (the CSV
- *   of `continue --curves`), in the grid (S, Omega).
- * lyapunov's reader is static: its file is compiled into this target. */
+ *   of `continue --curves`), in the grid (S, Omega), as lib/lyapunov reads it. */
 #define _DEFAULT_SOURCE /* mkdtemp */
 #include <stdint.h>
 #include <stdio.h>
@@ -14,7 +13,7 @@
 
 #include "render/palette.h"
 #include "src/figure_opts.h"
-#include "src/cmd_lyapunov.c"
+#include "lib/lyapunov.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
@@ -58,8 +57,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         a.n_curves = 1;
         overlay ov;
         memset(&ov, 0, sizeof ov);
-        read_curves(&a, &ov);
-        overlay_free(&ov);
+        lyapunov_read_curves(&a, &ov, msg, sizeof msg);
+        lyapunov_overlay_free(&ov);
     }
     }
     return 0;
