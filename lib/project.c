@@ -422,6 +422,69 @@ static int steps_done(const project_plan *p, const cm_cluster *c, const cm_box *
     return (int)((extra + per_tile - 1) / per_tile);
 }
 
+cm_status project_extend_tiles(cm_cluster *c, const cm_box *tile, const cm_box *bounds, int first,
+                               int last, const cm_box *recorded_first, project_tile_fn compute,
+                               void *user, int *done, char *stop, size_t stop_size, char *msg,
+                               size_t msg_size)
+{
+    *done = 0;
+    for (int k = first; k <= last; k++) {
+        cm_extend_choice choice;
+        memset(&choice, 0, sizeof choice);
+        const double started = cm_seconds();
+        const bool recorded = recorded_first && k == first;
+        cm_status st = CM_OK;
+        if (recorded)
+            choice.box = *recorded_first;
+        else
+            st = cm_extend_choose(c, tile, bounds, &choice, msg, msg_size);
+        if (st == CM_OK)
+            st = compute(user, k, &choice, recorded, started, msg, msg_size);
+        if (st == CM_ENOTFOUND) { /* nothing (enough) escapes next to the cluster: done */
+            snprintf(stop, stop_size, "%s", msg);
+            return CM_OK;
+        }
+        if (st != CM_OK)
+            return st;
+        ++*done;
+    }
+    return CM_OK;
+}
+
+/* A solve's extension step: below the plan's escaping fraction it ends;
+ * else the tile is cut and solved as the plan says, and said. */
+typedef struct plan_extension {
+    cm_cluster *c;
+    cm_store *s;
+    const cm_model *m;
+    const project_plan *p;
+    int before; /* the steps a resumed cluster had done */
+    project_step_fn step_done;
+    void *user;
+} plan_extension;
+
+static cm_status plan_tile(void *user, int k, const cm_extend_choice *choice, bool recorded,
+                           double started, char *msg, size_t msg_size)
+{
+    const plan_extension *x = user;
+    (void)recorded;
+    const double fraction = (double)choice->all_escaping / (double)choice->cluster_cells;
+    if (fraction < x->p->escape_below)
+        return cm_fail(CM_ENOTFOUND, msg, msg_size, "escaping fraction %.4g is below %.4g",
+                       fraction, x->p->escape_below);
+    cm_join_stats stats;
+    const cm_status st = project_add_box(x->c, x->s, x->m, x->p, &choice->box, &stats, msg,
+                                         msg_size);
+    if (st != CM_OK)
+        return st;
+    const project_step step = {choice->box,           choice->escaping,  choice->all_escaping,
+                               choice->cluster_cells, stats.new_groups, stats.straddling_groups,
+                               cm_seconds() - started};
+    if (x->step_done)
+        x->step_done(x->user, &step, k - x->before - 1);
+    return CM_OK;
+}
+
 cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const project_plan *p,
                          const cm_box *tile, project_step_fn step_done, void *user, int *steps,
                          char *stop, size_t stop_size, char *msg, size_t msg_size)
@@ -429,33 +492,13 @@ cm_status project_extend(cm_cluster *c, cm_store *s, const cm_model *m, const pr
     cm_box partial;
     const int done = steps_done(p, c, tile, &partial);
     cm_status st = CM_OK;
+    *steps = 0;
     if (partial.dim) /* a step interrupted between its regions is finished first */
         st = project_add_box(c, s, m, p, &partial, NULL, msg, msg_size);
     snprintf(stop, stop_size, "%d extension steps done", p->extend);
-    for (*steps = 0; done + *steps < p->extend && st == CM_OK; ++*steps) {
-        cm_extend_choice choice;
-        const double t0 = cm_seconds();
-        st = cm_extend_choose(c, tile, p->bounds, &choice, msg, msg_size);
-        const double fraction = (double)choice.all_escaping / (double)choice.cluster_cells;
-        if (st == CM_OK && fraction < p->escape_below) {
-            snprintf(stop, stop_size, "escaping fraction %.4g is below %.4g", fraction,
-                     p->escape_below);
-            break;
-        }
-        if (st == CM_ENOTFOUND) {
-            snprintf(stop, stop_size, "%s", msg);
-            return CM_OK;
-        }
-        cm_join_stats stats;
-        if (st == CM_OK)
-            st = project_add_box(c, s, m, p, &choice.box, &stats, msg, msg_size);
-        if (st != CM_OK)
-            break;
-        const project_step step = {choice.box,           choice.escaping,  choice.all_escaping,
-                                   choice.cluster_cells, stats.new_groups, stats.straddling_groups,
-                                   cm_seconds() - t0};
-        if (step_done)
-            step_done(user, &step, *steps);
-    }
+    const plan_extension x = {c, s, m, p, done, step_done, user};
+    if (st == CM_OK)
+        st = project_extend_tiles(c, tile, p->bounds, done + 1, p->extend, NULL, plan_tile,
+                                  (void *)&x, steps, stop, stop_size, msg, msg_size);
     return st;
 }

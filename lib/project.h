@@ -7,6 +7,7 @@
 #ifndef CM_LIB_PROJECT_H
 #define CM_LIB_PROJECT_H
 
+#include "cellmap/extend.h"
 #include "cellmap/join.h"
 #include "cellmap/model.h"
 #include "cellmap/store.h"
@@ -162,6 +163,25 @@ typedef struct project_step {
     double seconds;
 } project_step;
 typedef void (*project_step_fn)(void *user, const project_step *step, int k);
+
+/* Computes extension step k on the tile chosen (or, recorded, the one a
+ * resumed run recorded; started: when the step began, cm_seconds):
+ * CM_OK, CM_ENOTFOUND to end the extension here (msg says why; no
+ * error), or a failure. */
+typedef cm_status (*project_tile_fn)(void *user, int k, const cm_extend_choice *choice,
+                                     bool recorded, double started, char *msg, size_t msg_size);
+
+/* The one extension loop (thesis 4.6.4), for solves and explore sessions:
+ * steps first..last, each the neighbouring tile of tile's size where most
+ * of the cluster's escaping sequences go (within bounds, NULL: anywhere;
+ * recorded_first, when not NULL: step first's tile, recorded by a run
+ * that stopped), computed by `compute`. Ends early, with CM_OK and why in
+ * stop, when no sequence escapes into a neighbour or compute says so;
+ * *done: the steps computed. No region's cells are read to choose a tile. */
+cm_status project_extend_tiles(cm_cluster *c, const cm_box *tile, const cm_box *bounds, int first,
+                               int last, const cm_box *recorded_first, project_tile_fn compute,
+                               void *user, int *done, char *stop, size_t stop_size, char *msg,
+                               size_t msg_size);
 
 /* The extension of a cluster whose first tile is `tile`: finishes a step a
  * resumed cluster had begun, then adds tiles (calling step_done after each,

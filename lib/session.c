@@ -302,31 +302,34 @@ cm_status session_journal_end(session *s, char *msg, size_t msg_size)
     return journal_write(s, "complete", msg, msg_size);
 }
 
-/* One step: the tile the cluster's escaping sequences lead to most
- * (given: a resumed step's recorded tile), journaled, then computed. */
-static cm_status extend_step(session *s, const cm_box *tile, int step, const cm_box *given,
-                             session_step *done, char *msg, size_t msg_size)
+/* A session's extension step: the tile journaled, then its uncovered
+ * cells computed, and said. */
+typedef struct session_extension {
+    session *s;
+    session_step_fn step_done;
+    void *user;
+} session_extension;
+
+static cm_status session_tile(void *user, int k, const cm_extend_choice *choice, bool recorded,
+                              double started, char *msg, size_t msg_size)
 {
-    cm_extend_choice choice;
-    memset(&choice, 0, sizeof choice);
-    memset(done, 0, sizeof *done);
-    const double t0 = cm_seconds();
-    cm_status st = CM_OK;
-    if (given)
-        choice.box = *given;
-    else
-        st = cm_extend_choose(&s->c, tile, NULL, &choice, msg, msg_size);
+    const session_extension *x = user;
+    session_step done;
+    memset(&done, 0, sizeof done);
+    cm_status st = journal_step(x->s, k, &choice->box, msg, msg_size);
     if (st == CM_OK)
-        st = journal_step(s, step, &choice.box, msg, msg_size);
-    if (st == CM_OK)
-        st = cover_box(s, &choice.box, "extend auto", &done->work, msg, msg_size);
-    done->step = step;
-    done->tile = choice.box;
-    done->recorded = given != NULL;
-    done->escaping = choice.escaping;
-    done->all_escaping = choice.all_escaping;
-    done->work.seconds = cm_seconds() - t0;
-    return st;
+        st = cover_box(x->s, &choice->box, "extend auto", &done.work, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    done.step = k;
+    done.tile = choice->box;
+    done.recorded = recorded;
+    done.escaping = choice->escaping;
+    done.all_escaping = choice->all_escaping;
+    done.work.seconds = cm_seconds() - started;
+    if (x->step_done)
+        x->step_done(x->user, &done);
+    return CM_OK;
 }
 
 cm_status session_extend(session *s, int steps, session_step_fn step_done, void *user,
@@ -350,19 +353,13 @@ cm_status session_extend(session *s, int steps, session_step_fn step_done, void 
     s->resume_step = 0; /* resumed once */
     cm_box tile;
     view_box(s, s->lo, s->hi, &tile);
-    for (int k = first; k <= steps && st == CM_OK; k++) {
-        const cm_box *given = here && k == first ? &s->resume_tile : NULL;
-        session_step done;
-        st = extend_step(s, &tile, k, given, &done, msg, msg_size);
-        if (st == CM_ENOTFOUND) { /* nothing escapes next to the cluster: done, not an error */
-            out->stopped = true;
-            snprintf(out->stop, sizeof out->stop, "%s", msg);
-            st = CM_OK;
-            break;
-        }
-        if (st == CM_OK && step_done)
-            step_done(user, &done);
-    }
+    const session_extension x = {s, step_done, user};
+    int done = 0;
+    out->stop[0] = '\0';
+    st = project_extend_tiles(&s->c, &tile, NULL, first, steps, here ? &s->resume_tile : NULL,
+                              session_tile, (void *)&x, &done, out->stop, sizeof out->stop, msg,
+                              msg_size);
+    out->stopped = out->stop[0] != '\0';
     if (st == CM_OK) {
         char state[48];
         snprintf(state, sizeof state, "line %ld done", s->line);
