@@ -72,7 +72,7 @@ extern "C" {
 #endif
 
 #define CELLMAP_VERSION_MAJOR 0
-#define CELLMAP_VERSION_MINOR 4
+#define CELLMAP_VERSION_MINOR 3
 #define CELLMAP_VERSION_PATCH 0
 /* MAJOR * 10000 + MINOR * 100 + PATCH */
 #define CELLMAP_VERSION_NUMBER                                                                     \
