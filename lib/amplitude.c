@@ -30,7 +30,8 @@ bool amplitude_write_csv(const amp_args *a, const cm_fo_amplitude *v, char *msg,
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool amplitude_write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v, char *msg, size_t msg_size)
+bool amplitude_write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v,
+                         char *msg, size_t msg_size)
 {
     const int n = a->omega.n;
     diagram d;

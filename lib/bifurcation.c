@@ -116,7 +116,8 @@ static void print_point(void *user, int kind, double p, int run, double x, doubl
                 kind == POINT_STICK ? "stick" : "section", x, v);
 }
 
-bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, char *msg, size_t msg_size)
+bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, char *msg,
+                                  size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -126,7 +127,8 @@ bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, cha
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool bifurcation_write_runs_csv(const bif_args *a, const sweep_results *s, char *msg, size_t msg_size)
+bool bifurcation_write_runs_csv(const bif_args *a, const sweep_results *s, char *msg,
+                                size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->runs_csv, &o, msg, msg_size) != CM_OK)
@@ -177,7 +179,8 @@ static bool collect_clouds(const bif_args *a, const sweep_results *s, cloud c[3]
     return ok;
 }
 
-bool bifurcation_write_png(const bif_args *a, const cm_params *base, const sweep_results *s, char *msg, size_t msg_size)
+bool bifurcation_write_png(const bif_args *a, const cm_params *base, const sweep_results *s,
+                           char *msg, size_t msg_size)
 {
     cloud c[3];
     bool ok = collect_clouds(a, s, c);

@@ -121,7 +121,8 @@ bool escape_write_csv(const esc_args *a, const esc_point *pts, char *msg, size_t
 
 /* Fig. 4.5: the escape number of points across [0, 1.05 (a - c)], with
  * the ends of I0 and I_rep. */
-static bool png_structure(const esc_args *a, const esc_point *p, const char *params, char *msg, size_t msg_size)
+static bool png_structure(const esc_args *a, const esc_point *p, const char *params, char *msg,
+                          size_t msg_size)
 {
     const cm_te *t = &p->t;
     const int n = 4 * a->out.width;
@@ -162,7 +163,8 @@ static bool png_structure(const esc_args *a, const esc_point *p, const char *par
 }
 
 /* Fig. 4.7: the mean escape number against the swept parameter. */
-static bool png_sweep(const esc_args *a, const esc_point *pts, const char *params, char *msg, size_t msg_size)
+static bool png_sweep(const esc_args *a, const esc_point *pts, const char *params, char *msg,
+                      size_t msg_size)
 {
     const int n = a->sweep.n;
     double *v = malloc((size_t)n * 6 * sizeof *v);

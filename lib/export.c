@@ -769,7 +769,8 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", x->ngroups);
     }
     cm_status st = has_labels ? outfile_begin(x->labels, &labels, msg, msg_size) : CM_OK;
-    if (st == CM_OK && has_steps && (st = outfile_begin(x->steps, &steps, msg, msg_size)) != CM_OK &&
+    if (st == CM_OK && has_steps && (st = outfile_begin(x->steps, &steps, msg,
+                                                        msg_size)) != CM_OK &&
         has_labels)
         outfile_end(&labels, false, (char[64]){0}, 64);
     if (st != CM_OK) {

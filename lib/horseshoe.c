@@ -15,7 +15,8 @@ void horseshoe_item_at(double alpha, double beta, double P, double D, int64_t m,
     it->entropy = it->periodic ? log((double)it->periodic) / n : NAN;
 }
 
-bool horseshoe_write_csv(const hs_args *a, const hs_item *items, int count, char *msg, size_t msg_size)
+bool horseshoe_write_csv(const hs_args *a, const hs_item *items, int count, char *msg,
+                         size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -49,7 +50,8 @@ static size_t polygon(double (*p)[2], int n, double *x, double *y, size_t k)
 
 /* Figs. 4.15-4.16: per m, L and R, f_l(L) and f_r(R), and SW_m. */
 static bool png_point(const hs_args *a, const hs_item *items, int count, double alpha,
-                      double beta, double P, double D, const char *params, char *msg, size_t msg_size)
+                      double beta, double P, double D, const char *params, char *msg,
+                      size_t msg_size)
 {
     cm_pd_coef k;
     cm_pd_coefficients(alpha, beta, P, D, &k);
@@ -121,7 +123,8 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
 }
 
 /* Writes a chart over the swept P with the PNG's text chunks. */
-static bool write_sweep_chart(const hs_args *a, const cm_chart *chart, const char *params, char *msg, size_t msg_size)
+static bool write_sweep_chart(const hs_args *a, const cm_chart *chart, const char *params,
+                              char *msg, size_t msg_size)
 {
     char range[120];
     param_axes_format(&a->sweep, 1, range, sizeof range);
@@ -190,7 +193,8 @@ static bool png_crisis(const hs_args *a, const hs_item *items, int nm, double al
 }
 
 /* Fig. 4.17: the entropy estimate against P, a line per m. */
-static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char *params, char *msg, size_t msg_size)
+static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char *params,
+                      char *msg, size_t msg_size)
 {
     const int np = a->sweep.n;
     double *v = malloc((size_t)np * (size_t)(nm + 1) * sizeof *v);

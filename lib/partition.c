@@ -15,7 +15,8 @@ void partition_row_text(const cm_delay_partition *p, int i, char *out)
     out[p->r] = '\0';
 }
 
-bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *msg, size_t msg_size)
+bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *msg,
+                         size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -30,7 +31,8 @@ bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool partition_write_png(const part_args *a, const cm_delay_partition *p, const char *params, char *msg, size_t msg_size)
+bool partition_write_png(const part_args *a, const cm_delay_partition *p, const char *params,
+                         char *msg, size_t msg_size)
 {
     double x[2][2 * CM_DELAY_MAX_REGIONS], y[2][2 * CM_DELAY_MAX_REGIONS];
     size_t n[2] = {0, 0};

@@ -219,7 +219,8 @@ static void sticking_band(const cm_fo *o, double ta, double tb, figure_data *d)
     }
 }
 
-bool simulate_write_png(const sim_args *a, const cm_model *m, const cm_fo *o, const track *tr, char *msg, size_t msg_size)
+bool simulate_write_png(const sim_args *a, const cm_model *m, const cm_fo *o, const track *tr,
+                        char *msg, size_t msg_size)
 {
     figure_data d;
     bool ok = figure_data_alloc(&d, tr->n_samples, tr->n_rows);
