@@ -93,6 +93,34 @@ assert m, "the glossary's count of single-cell groups"
 assert run(m.group(1)).strip() == m.group(2), run(m.group(1))
 PY
 [ -s fresh/fig.png ] || fail "the quick start made no fig.png"
+# The README's Python path on that fresh tree, to the letter: the install
+# the first command does (prefix /usr/local), the README's pip command,
+# then its Python example with plain python3 and no environment variable.
+# In a private mount namespace whose /usr/local is an empty tmpfs, so that
+# the machine's is left as it was.
+if [ "$(id -u)" = 0 ]; then ns=(unshare -m); else ns=(unshare -rm); fi
+if "${ns[@]}" true 2> /dev/null; then
+  python3 - "$SRC/README.md" > python.sh <<'PY' || fail "the README's Python install and example"
+import re, sys
+text = open(sys.argv[1]).read()
+part = text[text.index("## From C and Python"):]
+part = part[:part.index("\n## ", 1)]
+pip = [b.strip() for lang, b in re.findall(r"```(\w+)\n(.*?)```", part, re.S)
+       if lang == "sh" and "pip install" in b]
+example = [b for lang, b in re.findall(r"```(\w+)\n(.*?)```", part, re.S) if lang == "python"]
+assert len(pip) == 1 and len(example) == 1, (pip, len(example))
+open("readme_example.py", "w").write(example[0])
+print("set -e\nmount -t tmpfs tmpfs /usr/local\ncd fresh\ncmake --install build > ../py-install.log\n"
+      + pip[0] + " > ../pip.log 2>&1\ncd ../pyrun\nexec python3 ../readme_example.py")
+PY
+  mkdir pyrun && cp fresh/basin.cmdb pyrun/
+  "${ns[@]}" env -i HOME="$work/home" PATH="$syspath" bash python.sh > python.out 2>&1 \
+    || fail "the README's Python install and example, from a fresh tree: $(tail -5 python.out; tail -5 pip.log 2>/dev/null)"
+  [ -s pyrun/duffing.png ] && [ -s pyrun/pd-view.png ] && [ -s pyrun/pd.cmdb ] \
+    || fail "the README's Python example wrote no duffing.png, pd-view.png or pd.cmdb"
+else
+  echo "docs_test: no mount namespace here (unshare -m): the README's Python path is not run"
+fi
 cp fresh/basin.cmdb . 2> /dev/null || "$CM" solve --db basin.cmdb --quiet   # (for what follows)
 # from here on, the cellmap under test (the completion asks it too)
 mkdir bin && ln -s "$CM" bin/cellmap

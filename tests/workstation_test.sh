@@ -97,14 +97,6 @@ export PYTHONPATH=$(dirname "$site")
 $PY "$SRC/tests/workstation.py" > py.log 2>&1 || fail "the Python program: $(tail -20 py.log)"
 check py
 
-# the README's Python example, as it stands there (basin.cmdb: the quick start's)
-"$CM" solve --db basin.cmdb --quiet || fail "the quick start's solve"
-awk '/^## From C and Python/ { on = 1 } on && /^```python/ { code = 1; next }
-     code && /^```/ { exit } code { print }' "$SRC/README.md" > readme_example.py
-[ "$(grep -c . readme_example.py)" -gt 5 ] || fail "no Python example found in the README"
-$PY readme_example.py > readme.log 2>&1 || fail "the README's Python example: $(tail -5 readme.log)"
-[ -s duffing.png ] && [ -s pd-view.png ] || fail "the README's Python example drew no figure"
-
 # a map given as a Python function agrees with the same map as a plugin
 LD_PRELOAD= cc -shared -fPIC -I"$work/prefix/include" -o libhenon.so "$SRC/examples/plugin/henon.c" \
   -lm || fail "cc henon"
