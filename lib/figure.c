@@ -17,6 +17,7 @@
 #include "render/png_out.h"
 #include "render/raster.h"
 #include "lib/attractor_report.h"
+#include "lib/project.h"
 #include "lib/outfile.h"
 #include "lib/parse.h"
 
@@ -483,5 +484,90 @@ cm_status figure_write(const basin_png *b, char *msg, size_t msg_size)
         st = b->opts->indexed ? write_indexed(b, msg, msg_size) : write_figure(b, msg, msg_size);
     if (st == CM_OK && b->opts->svg)
         st = write_svg(b, msg, msg_size);
+    return st;
+}
+
+cm_status figure_file_view(cm_store *s, const cm_cluster *cl, const png_opts *po,
+                           const char *slice_text, double lo[2], double hi[2], cm_box *box,
+                           char *msg, size_t msg_size)
+{
+    const cm_lattice *lat = &cl->lat;
+    cm_box bounds;
+    cm_cluster_bounds(cl, &bounds);
+    const int dims = lat->dim < 2 ? lat->dim : 2;
+    if (po->has_view) {
+        memcpy(lo, po->lo, 2 * sizeof *lo);
+        memcpy(hi, po->hi, 2 * sizeof *hi);
+    } else if (project_view_note(s, dims, lo, hi, (char[256]){0}, 256) != CM_OK) {
+        cm_box_rect(lat, &bounds, dims, lo, hi);
+    }
+    if (lat->dim == 1)
+        lo[1] = hi[1] = 0;
+    view_cells(lat, lo, hi, &bounds, box);
+    if (!slice_text)
+        return CM_OK;
+    double v[CM_MAX_DIM];
+    int n = 0;
+    if (!parse_doubles(slice_text, v, &n, CM_MAX_DIM) || n != lat->dim - 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--slice: '%s' must be %d coordinate(s) of dimensions 3..", slice_text,
+                       lat->dim > 2 ? lat->dim - 2 : 0);
+    for (int d = 2; d < lat->dim; d++) {
+        box->lo[d] = (int64_t)floor((v[d - 2] - lat->origin[d]) / lat->width[d]);
+        box->hi[d] = box->lo[d] + 1;
+    }
+    return CM_OK;
+}
+
+/* A cm_progress_fn of the view's reading, told to the hooks. */
+typedef struct reading {
+    const work_hooks *hooks;
+    uint64_t cells;
+} reading;
+
+static int read_progress(void *user, const char *phase, double fraction)
+{
+    const reading *r = user;
+    (void)phase;
+    work_progress(r->hooks, (uint64_t)(fraction * (double)r->cells), "reading the view");
+    return work_stop(r->hooks) != NULL;
+}
+
+cm_status figure_of_file(cm_store *s, const cm_store_info *info, cm_cluster *cl,
+                         const char *source, const png_opts *po, const cm_box *box,
+                         const double lo[2], const double hi[2], const cm_attractor_options *o,
+                         const work_hooks *hooks, char *msg, size_t msg_size)
+{
+    cm_model m;
+    cm_model_set set = {0};
+    char why[1024];
+    if (model_of_store(info, &set, &m, why, sizeof why) != CM_OK)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "%s: %s", source, why);
+    cm_region flat;
+    memset(&flat, 0, sizeof flat);
+    uint64_t sink = 0;
+    cm_group_info *groups = calloc((size_t)cl->ngroups + 1, sizeof *groups);
+    cm_status st = groups ? cm_store_groups(s, groups, cl->ngroups, &sink, msg, msg_size)
+                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for groups");
+    cm_attractor_set att;
+    memset(&att, 0, sizeof att);
+    cluster_ends ends;
+    memset(&ends, 0, sizeof ends);
+    if (st == CM_OK && po->by == BY_ATTRACTORS)
+        st = cluster_ends_open(&ends, cl, msg, msg_size);
+    if (st == CM_OK && po->by == BY_ATTRACTORS)
+        st = file_attractors(s, info, &m, &ends, groups, o, &att, msg, msg_size);
+    reading r = {hooks, cm_box_cells(box)};
+    if (st == CM_OK)
+        st = cm_cluster_flatten_progress(cl, box, &flat, read_progress, &r, msg, msg_size);
+    const basin_png png = {po,     &m,   &cl->lat, &flat, groups, {lo[0], lo[1]}, {hi[0], hi[1]},
+                           NULL, po->by == BY_ATTRACTORS ? &att : NULL, &ends.computed, NULL};
+    if (st == CM_OK)
+        st = figure_write(&png, msg, msg_size);
+    cm_region_free(&flat);
+    cluster_ends_close(&ends);
+    cm_attractors_free(&att);
+    free(groups);
+    cm_model_release(&m);
     return st;
 }

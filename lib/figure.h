@@ -14,6 +14,10 @@
 #include "render/gl.h"
 #include "render/figure.h"
 #include "render/palette.h"
+#include "cellmap/attractors.h"
+#include "cellmap/cluster.h"
+#include "cellmap/store.h"
+#include "lib/work.h"
 
 enum { PNG_LABELS_MAX = 64 };
 
@@ -95,6 +99,27 @@ cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *
  * opts->svg, either may be NULL), each reaching its path only when
  * complete. */
 cm_status figure_write(const basin_png *b, char *msg, size_t msg_size);
+
+/* The cells a figure of a file's cluster draws: po's view, else the view
+ * an explore session saved in the file (note.explore.view), else the whole
+ * cluster, into lo, hi (dimensions 0 and 1) and box; for models of more
+ * than two dimensions the slice through slice_text ("Z,W,...", state
+ * coordinates of dimensions 3..; NULL: the middle of the cluster).
+ * CM_EINVAL when slice_text is not such coordinates. */
+cm_status figure_file_view(cm_store *s, const cm_cluster *cl, const png_opts *po,
+                           const char *slice_text, double lo[2], double hi[2], cm_box *box,
+                           char *msg, size_t msg_size);
+
+/* The figure of box's cells of a file's cluster (lib/project.h:
+ * project_open_cluster; source names the file in messages): its groups
+ * from the store, by attractors the ones it stores unless o asks for
+ * others (found with the file's model), the cells read as hooks say
+ * (cells done; a stop request ends it with CM_ECANCELED, nothing
+ * written). */
+cm_status figure_of_file(cm_store *s, const cm_store_info *info, cm_cluster *cl,
+                         const char *source, const png_opts *po, const cm_box *box,
+                         const double lo[2], const double hi[2], const cm_attractor_options *o,
+                         const work_hooks *hooks, char *msg, size_t msg_size);
 
 /* The default size of an image of the box: one pixel per cell, scaled
  * down so that neither side exceeds 4096. */

@@ -1,6 +1,5 @@
 /* cellmap render: a figure (or an indexed image) of any view of a .cmdb
  * cluster database, without computing anything. */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,100 +70,33 @@ static int parse_render(cli *c, render_args *a)
     return err;
 }
 
-/* The cells to draw: the view's rectangle, and the slice in dims 3... */
-static int cells_to_draw(const cli *c, const render_args *a, cm_store *s, const cm_cluster *cl,
-                         double lo[2], double hi[2], cm_box *box)
-{
-    const cm_lattice *lat = &cl->lat;
-    cm_box bounds;
-    cm_cluster_bounds(cl, &bounds);
-    const int dims = lat->dim < 2 ? lat->dim : 2;
-    if (a->png.has_view) {
-        memcpy(lo, a->png.lo, 2 * sizeof *lo);
-        memcpy(hi, a->png.hi, 2 * sizeof *hi);
-    } else if (project_view_note(s, dims, lo, hi, (char[256]){0}, 256) != CM_OK) {
-        cm_box_rect(lat, &bounds, dims, lo, hi);
-    }
-    if (lat->dim == 1)
-        lo[1] = hi[1] = 0;
-    view_cells(lat, lo, hi, &bounds, box);
-    if (!a->slice_text)
-        return EXIT_OK;
-    double v[CM_MAX_DIM];
-    int n = 0;
-    if (!parse_doubles(a->slice_text, v, &n, CM_MAX_DIM) || n != lat->dim - 2)
-        return cli_usage_error(c, "--slice: '%s' must be %d coordinate(s) of dimensions 3..",
-                               a->slice_text, lat->dim > 2 ? lat->dim - 2 : 0);
-    for (int d = 2; d < lat->dim; d++) {
-        box->lo[d] = (int64_t)floor((v[d - 2] - lat->origin[d]) / lat->width[d]);
-        box->hi[d] = box->lo[d] + 1;
-    }
-    return EXIT_OK;
-}
-
-/* The progress line while the view's cells are read, and Ctrl-C. */
-static int reading(void *user, const char *phase, double fraction)
-{
-    progress *p = user;
-    (void)phase;
-    progress_say(p, (uint64_t)(fraction * (double)p->total), "reading the view");
-    return interrupt_requested();
-}
-
+/* The figure of the file's view: the problem said, and the exit status. */
 static int run_render(const cli *c, const render_args *a, cm_store *s, const cm_store_info *info,
                       cm_cluster *cl)
 {
     char msg[1024];
-    cm_model m;
-    cm_region flat;
-    cm_box box;
     double lo[2], hi[2];
-    uint64_t sink = 0;
-    memset(&flat, 0, sizeof flat);
-    int rc = cells_to_draw(c, a, s, cl, lo, hi, &box);
-    if (rc != EXIT_OK)
-        return rc;
-    cm_model_set set = {0};
-    if (model_of_store(info, &set, &m, msg, sizeof msg) != CM_OK) {
-        fprintf(stderr, "cellmap render: %s: %s\n", a->file, msg);
-        return EXIT_FAIL;
-    }
-    cm_group_info *groups = calloc((size_t)cl->ngroups + 1, sizeof *groups);
-    cm_status st = groups ? cm_store_groups(s, groups, cl->ngroups, &sink, msg, sizeof msg)
-                          : cm_fail(CM_ENOMEM, msg, sizeof msg, "out of memory for groups");
+    cm_box box;
+    cm_status st = figure_file_view(s, cl, &a->png, a->slice_text, lo, hi, &box, msg, sizeof msg);
+    if (st != CM_OK)
+        return cli_usage_error(c, "%s", msg);
     progress pr;
     progress_start(&pr, "render", "cells", cm_box_cells(&box), a->quiet);
     interrupt_catch();
-    cm_attractor_set att;
-    memset(&att, 0, sizeof att);
-    cluster_ends ends;
-    memset(&ends, 0, sizeof ends);
-    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
-        st = cluster_ends_open(&ends, cl, msg, sizeof msg);
-    if (st == CM_OK && a->png.by == BY_ATTRACTORS)
-        st = file_attractors(s, info, &m, &ends, groups, &a->att, &att, msg, sizeof msg);
-    if (st == CM_OK)
-        st = cm_cluster_flatten_progress(cl, &box, &flat, reading, &pr, msg, sizeof msg);
+    const work_hooks hooks = progress_hooks(&pr);
+    st = figure_of_file(s, info, cl, a->file, &a->png, &box, lo, hi, &a->att, &hooks, msg,
+                        sizeof msg);
     progress_end(&pr);
-    rc = EXIT_FAIL;
     if (st == CM_ECANCELED) {
         fprintf(stderr, "cellmap render: interrupted (Ctrl-C) while reading the view; nothing "
                         "written\n");
-        rc = EXIT_INTERRUPTED;
-    } else if (st != CM_OK) {
-        fprintf(stderr, "cellmap render: %s\n", msg);
-    } else {
-        const basin_png png = {&a->png, &m, &cl->lat, &flat, groups, {lo[0], lo[1]},
-                               {hi[0], hi[1]}, NULL, a->png.by == BY_ATTRACTORS ? &att : NULL,
-                               &ends.computed, NULL};
-        rc = write_basin_png("render", &png);
+        return EXIT_INTERRUPTED;
     }
-    cm_region_free(&flat);
-    cluster_ends_close(&ends);
-    cm_attractors_free(&att);
-    free(groups);
-    cm_model_release(&m);
-    return rc;
+    if (st != CM_OK) {
+        fprintf(stderr, "cellmap render: %s\n", msg);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
 }
 
 int cmd_render(int argc, char **argv)
