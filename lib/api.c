@@ -1,6 +1,6 @@
-/* libcellmap's public API (cellmap/cellmap.h) over the engine, the models,
- * the .cmdb store and the renderer: the one module of the library that
- * sees all of them, as the command does. */
+/* lib/api.c - libcellmap's public API (cellmap/cellmap.h), its stable and
+ * experimental sections, over the library layer (lib/) and, below it, the
+ * engine, the models, the .cmdb store and the renderer. */
 #define CELLMAP_EXPERIMENTAL /* this file implements both sections */
 #include "cellmap/cellmap.h"
 #include "cellmap/attractors.h"

@@ -1,3 +1,4 @@
+/* lib/param_grid.c - parameter axes and sweeps (lib/param_grid.h). */
 #include "lib/param_grid.h"
 
 #include <math.h>

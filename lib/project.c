@@ -1,3 +1,4 @@
+/* lib/project.c - a .cmdb project as a whole (lib/project.h). */
 #include "lib/project.h"
 
 #include "cellmap/clock.h"

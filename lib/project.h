@@ -1,6 +1,6 @@
-/* lib/project.h - a .cmdb project as the commands use one: opened to read
- * (render, export, info), created or resumed to be extended (solve --db,
- * explore), with the rules they share: a file is checked read-only before
+/* lib/project.h - a .cmdb project as the commands and the library use one:
+ * opened to read (render, export, info), created or resumed to be extended
+ * (solve --db, explore), with the rules they share: a file is checked read-only before
  * anything is written to it, older formats are upgraded only once the file
  * proves to be the caller's, new files carry the command line, plan and a
  * reproducible creation time. */
