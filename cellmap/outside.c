@@ -66,7 +66,7 @@ static cm_status box_order(const int64_t *cells, uint64_t n, int dim, uint32_t *
     }
     for (uint64_t i = 0; i < n; i++)
         order[i] = (uint32_t)i;
-    for (int d = 0; d < dim; d++)
+    for (int d = 0; n > 0 && d < dim; d++) /* no cell: cells may be NULL */
         radix_pass_all(order, tmp, n, cells + d, (size_t)dim);
     free(tmp);
     *out = order;

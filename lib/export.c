@@ -603,6 +603,8 @@ cm_status exporter_open(exporter *x, cm_store *s, const cm_store_info *info, cm_
                         char *msg, size_t msg_size)
 {
     memset(x, 0, sizeof *x);
+    if (c->nregions == 0) /* as project_open_records refuses a file */
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s holds no region yet", source);
     x->store = s;
     x->info = info;
     x->c = c;

@@ -244,6 +244,13 @@ printf 'pan left 10%%\n' > first.explore
 out=$("$CM" explore fresh.cmdb first.explore $pd $lattice 2>&1); rc=$?
 [ "$rc" -eq 1 ] && grep -qF "first.explore:1: pan: there is no view yet" <<<"$out" ||
   fail "pan before view: rc $rc, '$out'"
+# an export before any region (the session's own cluster is empty; the
+# fuzz target found the engine reading a NULL array here)
+rm -f fresh.cmdb
+printf 'export --groups g0.csv\n' > empty.explore
+out=$("$CM" explore fresh.cmdb empty.explore $pd $lattice 2>&1); rc=$?
+[ "$rc" -eq 1 ] && grep -qF "fresh.cmdb holds no region yet" <<<"$out" && [ ! -e g0.csv ] ||
+  fail "export before any region: rc $rc, '$out'"
 # bad options
 out=$("$CM" explore nofile.cmdb first.explore 2>&1); rc=$?
 [ "$rc" -eq 2 ] && grep -qF "does not exist; create it with --model" <<<"$out" ||
