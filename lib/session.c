@@ -782,8 +782,7 @@ static cm_status create_new(const opening *op)
         return refuse(op, st, true, "--cell-size/--origin: %s", msg);
     char plan[64];
     snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
-    const cm_model_lib *lib;
-    cm_model_set_find(&o->mo.set, s->model.name, &lib);
+    const cm_model_lib *lib = model_spec_lib(&o->mo, s->model.name);
     st = project_create(s->path, &s->model, lib, &lat, o->command, plan, &s->store, &s->c, msg,
                         sizeof msg);
     if (st != CM_OK)
