@@ -387,6 +387,161 @@ cm_status cm_session_figure(cm_session *s, const cm_figure_options *o, char *msg
 /* Saves the view and the attractors and closes the database (NULL: nothing). */
 cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size);
 
+/* ---- analysis drivers ----
+ * The commands `stability`, `partition`, `amplitude`, `horseshoe`,
+ * `escape`, `simulate`, `bifurcation`, `lyapunov`, `sweep` and `continue`
+ * as calls: the same computation and the same files (CSV tables and PNG
+ * figures, byte for byte) as the command with the same settings. Each
+ * takes the model and outputs (cm_analysis) and its own settings (an
+ * options struct whose cm_*_defaults() are the command's defaults);
+ * nothing is printed. Outputs are written whole or not at all (a
+ * temporary file renamed into place). CM_EINVAL: the request's problem,
+ * named in msg. The threads are OpenMP's (see above). */
+
+/* One parameter's values: n cells evenly over lo..hi, each value a
+ * cell's centre (as the commands' NAME=LO:HI:N). */
+typedef struct cm_axis {
+    const char *name; /* a parameter of the model (a driver's own axis: its name) */
+    double lo, hi;    /* lo < hi */
+    int n;            /* 1.. (each driver says its limit) */
+} cm_axis;
+
+/* The model and the outputs of an analysis. */
+typedef struct cm_analysis {
+    const cm_models *set; /* where the model comes from; NULL: built in */
+    const char *model;    /* NULL: the driver's own model (the command's default) */
+    const char *params;   /* "k=v,..."; NULL: the model's defaults */
+    const char *csv;      /* the table as CSV ("-": standard output), or NULL */
+    const char *png;      /* the figure as PNG, or NULL */
+    int width, height;    /* the figure's pixels; 0, 0: the command's size */
+    int threads;          /* 0: all cores */
+} cm_analysis;
+
+/* microchaos-pd's analytic charts (thesis 4.5, C.4): the stability
+ * domain, fixed points and control error over P (NULL: 1.0025 alpha^2 ..
+ * 1.2 P_max, 400 values) and the fewest fixed points over alpha (NULL:
+ * 0.05..3, 300 values); axes of 2..100000 values. */
+cm_status cm_analysis_stability(const cm_analysis *a, const cm_axis *P, const cm_axis *alpha, char *msg,
+                       size_t msg_size);
+
+/* microchaos-delay's Markov partition of (0, 1) and transition matrix
+ * (thesis 4.4, Fig. 4.11). */
+cm_status cm_analysis_partition(const cm_analysis *a, char *msg, size_t msg_size);
+
+/* friction-oscillator's amplitude-frequency diagram (thesis 2.2) over
+ * Omega (omega->name ignored; 0 < lo, 1..100000 values), against
+ * simulation of `periods` (50..100000; 0: 400) periods; the figure's y
+ * axis up to ymax (0: 5). */
+cm_status cm_analysis_amplitude(const cm_analysis *a, const cm_axis *omega, int periods, double ymax,
+                       char *msg, size_t msg_size);
+
+typedef struct cm_horseshoe_options {
+    int64_t m0, m1;       /* switching lines m0..m1 (1 <= m0, m1 - m0 <= 1000); 0, 0: 1..m_max */
+    int periods;          /* periodic points of this period, 1..20 */
+    const cm_axis *sweep; /* P over 1..10000 values, or NULL: the model's P */
+    int crisis;           /* 1: the crisis chart of the sweep */
+} cm_horseshoe_options;
+cm_horseshoe_options cm_horseshoe_defaults(void); /* lines 1..m_max, period 12 */
+
+/* microchaos-pd's horseshoes at its switching lines (thesis 4.5.3). */
+cm_status cm_analysis_horseshoe(const cm_analysis *a, const cm_horseshoe_options *o, char *msg,
+                       size_t msg_size);
+
+typedef struct cm_escape_options {
+    double I0;            /* |I0| (0 < I0 < 1e6) sets c at each point; 0: the model's c */
+    const cm_axis *sweep; /* a, b or I0 over 1..10000 values, or NULL: one point */
+    long cells;           /* cells of the cell-mapping estimate (0: none), up to 10^8 */
+    long ensemble;        /* states of the ensemble's estimate (0: none), up to 10^9 */
+} cm_escape_options;
+cm_escape_options cm_escape_defaults(void); /* 100000 cells, an ensemble of 10^6 */
+
+/* microchaos-1d-friction's transient chaos (thesis 4.3): the repeller,
+ * its escape rate and mean escape number, exact and estimated. */
+cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, char *msg, size_t msg_size);
+
+typedef struct cm_simulate_options {
+    double x, v;     /* the start */
+    double t0;       /* its time; NaN: the Poincare section's phase phi/Omega */
+    int periods;     /* 1..100000 */
+    int skip;        /* the first periods not recorded, 0..periods - 1 */
+} cm_simulate_options;
+cm_simulate_options cm_simulate_defaults(void); /* from (0, 0), 20 periods */
+
+/* A trajectory of friction-oscillator through its stick and slip phases
+ * (thesis Ch. 2): its events and samples, time history and phase portrait. */
+cm_status cm_analysis_simulate(const cm_analysis *a, const cm_simulate_options *o, char *msg,
+                      size_t msg_size);
+
+typedef struct cm_bifurcation_options {
+    cm_axis sweep;        /* the parameter swept (values x runs x record <= 10^7) */
+    int runs;             /* random starts per value, 1..1000 */
+    int transient;        /* periods dropped, 0..10^6 */
+    int record;           /* periods recorded, 1..10000 */
+    long long seed;       /* of the starts, >= 0 */
+    const char *runs_csv; /* one line per run as CSV, or NULL */
+} cm_bifurcation_options;
+cm_bifurcation_options cm_bifurcation_defaults(void); /* 10 runs, 1000, 50, seed 1 */
+
+/* friction-oscillator's brute-force bifurcation diagram (thesis 2.4):
+ * sticking displacements, Poincare sections and asymmetry of each run. */
+cm_status cm_analysis_bifurcation(const cm_analysis *a, const cm_bifurcation_options *o, char *msg,
+                         size_t msg_size);
+
+typedef struct cm_lyapunov_options {
+    cm_axis x, y;              /* the grid, 1..2000 values each */
+    int periods;               /* 1..10^6 */
+    double d0;                 /* the perturbation, 1e-9..1e-3 */
+    const double *from;        /* the start of a map model (dim values), or NULL: its region's centre */
+    int n_from;
+    const char *const *curves; /* files of `cellmap continue --curves` drawn over the figure */
+    int n_curves;              /* 0..8 */
+} cm_lyapunov_options;
+cm_lyapunov_options cm_lyapunov_defaults(void); /* 600 periods, d0 = 1e-8 */
+
+/* The largest Lyapunov exponent over a grid of two parameters (thesis
+ * 2.6; friction-oscillator by its own estimator, any map model). */
+cm_status cm_analysis_lyapunov(const cm_analysis *a, const cm_lyapunov_options *o, char *msg,
+                      size_t msg_size);
+
+typedef struct cm_sweep_options {
+    const char *name;      /* the parameter */
+    const double *values;  /* 2..200 increasing values */
+    int n_values;
+    const char *region;    /* "LO:HI[,LO:HI...]"; NULL: the model's example region */
+    const int64_t *cells;  /* cells per dimension (n_cells of them), or NULL: 1000 a side */
+    int n_cells;
+    const double *near_lo, *near_hi; /* the window counted (n_near dimensions), or NULL */
+    int n_near;
+    int refine;            /* bisections of each change of the count, 0..40 */
+    int max_steps;         /* of cell mapping, 0: 1 */
+    int by_groups;         /* 1: count cell mapping's groups, not the system's attractors */
+} cm_sweep_options;
+
+/* A model solved at each value of one parameter, its attractors and
+ * sticking zones counted in the window; the table only (no figure). */
+cm_status cm_analysis_sweep(const cm_analysis *a, const cm_sweep_options *o, char *msg, size_t msg_size);
+
+typedef struct cm_continue_options {
+    const char *vary;         /* S, S0, Omega or phi */
+    double lo, hi;            /* its range; the model's value must lie in it */
+    int direction;            /* 1: up, -1: down, 0: both ways */
+    int switch_pd;            /* 1: switch to the period-doubled branches */
+    const double (*from)[3];  /* starts (x, v, value; NaN x: simulate, NaN value: the model's) */
+    int n_from;               /* 0..8; 0: one start simulated at the model's value */
+    int period;               /* 0: the smallest that the start settles on; else 1..64 */
+    int max_points;           /* 2..10^6; 0: 5000 */
+    const char *events;       /* the events as CSV, or NULL */
+    const char *curve;        /* NAME2 (S, S0, Omega) of the fold and PD curves, or NULL */
+    double lo2, hi2;          /* its range */
+    const char *curves;       /* those curves as CSV (with curve) */
+} cm_continue_options;
+cm_continue_options cm_continue_defaults(void); /* up, 5000 points */
+
+/* Branches of friction-oscillator's periodic solutions followed in one
+ * parameter (thesis 2.5): points, events, the diagram and the curves. */
+cm_status cm_analysis_continue(const cm_analysis *a, const cm_continue_options *o, char *msg,
+                      size_t msg_size);
+
 #endif /* CELLMAP_EXPERIMENTAL */
 
 #ifdef __cplusplus

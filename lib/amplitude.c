@@ -2,6 +2,7 @@
 #include "lib/amplitude.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,7 +16,7 @@ typedef struct diagram {
     double *omega, *x0[3], *slip, *turn, *sim, *cols_x, *cols_y;
 } diagram;
 
-bool amplitude_write_csv(const amp_args *a, const cm_fo_amplitude *v, char *msg, size_t msg_size)
+static bool write_csv(const amp_args *a, const cm_fo_amplitude *v, char *msg, size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -30,7 +31,7 @@ bool amplitude_write_csv(const amp_args *a, const cm_fo_amplitude *v, char *msg,
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool amplitude_write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v,
+static bool write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v,
                          char *msg, size_t msg_size)
 {
     const int n = a->omega.n;
@@ -99,4 +100,67 @@ bool amplitude_write_png(const amp_args *a, const cm_params *p, const cm_fo_ampl
     const bool ok = (outfile_charts(a->out.png, &chart, 1, texts, 3, msg, msg_size) == CM_OK);
     free(all);
     return ok;
+}
+
+/* Sections recorded per simulation. */
+enum { RECORD = 40 };
+
+amp_args amplitude_defaults(void)
+{
+    return (amp_args){.mo = {.name = "friction-oscillator"}, .periods = 400, .ymax = 5,
+                      .out = {.width = 1000, .height = 700}};
+}
+
+cm_status amplitude_compute(const amp_args *a, amp_result *r, char *msg, size_t msg_size)
+{
+    *r = (amp_result){0};
+    const param_axis *om = &a->omega;
+    if (!a->has_omega || !(om->lo > 0 && om->lo < om->hi) || om->n < 1 || om->n > 100000 ||
+        !param_axis_even(om))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the frequencies Omega must be LO:HI:N with 0 < LO < HI and 1 <= N <= "
+                       "100000 (e.g. 0.1:3:300)");
+    if (a->periods < 50 || a->periods > 100000)
+        return cm_fail(CM_EINVAL, msg, msg_size, "periods: %d is not in 50..100000", a->periods);
+    cm_status st = param_sweep_base(&a->mo, "friction-oscillator", om, 1, &r->base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = om->n;
+    r->v = calloc((size_t)n, sizeof *r->v);
+    if (!r->v)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d frequencies", n);
+    int invalid = 0;
+    cm_fo_amplitude *v = r->v;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(a->threads ? a->threads : omp_get_max_threads()) reduction(| : invalid)
+    for (int i = 0; i < n; i++) {
+        const int idx[1] = {i};
+        cm_model m;
+        if (!model_at_point(&a->mo, om, idx, 1, &m)) {
+            invalid = 1;
+            v[i] = (cm_fo_amplitude){NAN, NAN, NAN, false, NAN, false, NAN, NAN};
+            continue;
+        }
+        cm_fo_amplitude_at(cm_fo_of_model(&m), a->periods, RECORD, &v[i]);
+        cm_model_release(&m);
+    }
+    r->invalid = invalid;
+    for (int i = 0; i < n; i++) {
+        r->valid += v[i].valid;
+        r->stable += v[i].stable;
+        r->lost += isnan(v[i].sim_amplitude);
+    }
+    return CM_OK;
+}
+
+cm_status amplitude_write(const amp_args *a, const amp_result *r, char *msg, size_t msg_size)
+{
+    const bool ok = (!a->out.csv || write_csv(a, r->v, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, &r->base, r->v, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void amplitude_result_free(amp_result *r)
+{
+    free(r->v);
+    r->v = NULL;
 }

@@ -1,7 +1,7 @@
 /* lib/amplitude.h - the friction oscillator's amplitude-frequency diagram
  * (thesis 2.2, Figs. 2.3-2.4) over models/fo_continuation.h, written as
- * CSV and as the diagram. Nothing is printed: a failed write returns
- * false with the problem in msg. */
+ * CSV and as the diagram. Nothing is printed: calls return a status
+ * with the problem in msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_AMPLITUDE_H
 #define CM_LIB_AMPLITUDE_H
 
@@ -20,12 +20,26 @@ typedef struct amp_args {
     chart_outputs out;
 } amp_args;
 
-/* The diagram's points (a->omega.n of them) as CSV at a->out.csv. */
-bool amplitude_write_csv(const amp_args *a, const cm_fo_amplitude *v, char *msg,
-                         size_t msg_size);
+/* The command's defaults: friction-oscillator, 400 periods, y up to 5,
+ * 1000x700 pixels; a->omega must be given. */
+amp_args amplitude_defaults(void);
 
-/* The diagram at a->out.png. */
-bool amplitude_write_png(const amp_args *a, const cm_params *p, const cm_fo_amplitude *v,
-                         char *msg, size_t msg_size);
+/* The model's parameters and the diagram's points. */
+typedef struct amp_result {
+    cm_params base;
+    cm_fo_amplitude *v; /* a->omega.n of them */
+    int valid, stable, lost; /* points where (2.25) is valid, stable; simulations lost */
+    bool invalid;            /* some frequencies could not be built (S > S0) */
+} amp_result;
+
+/* Checks the request and computes the points on a->threads threads (0:
+ * all); r is freed by amplitude_result_free whatever the status. */
+cm_status amplitude_compute(const amp_args *a, amp_result *r, char *msg, size_t msg_size);
+
+/* The points as CSV at a->out.csv and the diagram at a->out.png (either
+ * may be NULL). */
+cm_status amplitude_write(const amp_args *a, const amp_result *r, char *msg, size_t msg_size);
+
+void amplitude_result_free(amp_result *r);
 
 #endif

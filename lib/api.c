@@ -20,6 +20,7 @@
 #include "render/figure.h"
 #include "render/png_out.h"
 #include "cellmap/output.h"
+#include "lib/api_models.h"
 #include "lib/attractor_view.h"
 #include "lib/export.h"
 #include "lib/figure.h"
@@ -28,10 +29,6 @@
 #include "lib/session.h"
 #include "lib/solve.h"
 
-
-struct cm_models {
-    cm_model_set set;
-};
 
 struct cm_system {
     cm_model model;
@@ -812,11 +809,7 @@ cm_status cm_session_open(const char *path, const cm_session_options *o, cm_sess
     session_options so;
     memset(&so, 0, sizeof so);
     so.path = cs->path;
-    so.mo.name = o->model;
-    if (o->params && o->params[0])
-        so.mo.texts[so.mo.n_texts++] = o->params;
-    if (o->set)
-        so.mo.set = o->set->set;
+    so.mo = api_model_spec(o->set, o->model, o->params, NULL);
     for (int d = 0; d < CM_MAX_DIM && o->cell_size[d] > 0; d++)
         so.n_cell_size = d + 1;
     memcpy(so.cell_size, o->cell_size, sizeof so.cell_size);

@@ -2,6 +2,7 @@
 #include "lib/bifurcation.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,7 +53,7 @@ static int stops_kept(const run_result *res)
 }
 
 /* Runs from the random start; sections[2 k], [2 k + 1]: the k-th recorded Poincare point. */
-void bifurcation_run(const bif_args *a, const cm_fo *o, int value, int r, run_result *res,
+static void bifurcation_run(const bif_args *a, const cm_fo *o, int value, int r, run_result *res,
                 double *sections)
 {
     double u[3];
@@ -116,7 +117,7 @@ static void print_point(void *user, int kind, double p, int run, double x, doubl
                 kind == POINT_STICK ? "stick" : "section", x, v);
 }
 
-bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, char *msg,
+static bool write_points_csv(const bif_args *a, const sweep_results *s, char *msg,
                                   size_t msg_size)
 {
     outfile o;
@@ -127,7 +128,7 @@ bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, cha
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool bifurcation_write_runs_csv(const bif_args *a, const sweep_results *s, char *msg,
+static bool write_runs_csv(const bif_args *a, const sweep_results *s, char *msg,
                                 size_t msg_size)
 {
     outfile o;
@@ -179,7 +180,7 @@ static bool collect_clouds(const bif_args *a, const sweep_results *s, cloud c[3]
     return ok;
 }
 
-bool bifurcation_write_png(const bif_args *a, const cm_params *base, const sweep_results *s,
+static bool write_png(const bif_args *a, const cm_params *base, const sweep_results *s,
                            char *msg, size_t msg_size)
 {
     cloud c[3];
@@ -236,7 +237,7 @@ bool bifurcation_write_png(const bif_args *a, const cm_params *base, const sweep
     return ok;
 }
 
-void bifurcation_free(sweep_results *s, cm_model *models)
+static void free_runs(sweep_results *s, cm_model *models)
 {
     for (int i = 0; i < s->n_values && models; i++)
         if (cm_fo_of_model(&models[i]))
@@ -244,4 +245,104 @@ void bifurcation_free(sweep_results *s, cm_model *models)
     free(models);
     free(s->res);
     free(s->sections);
+}
+
+bif_args bifurcation_defaults(void)
+{
+    return (bif_args){.mo = {.name = "friction-oscillator"}, .runs = 10, .transient = 1000,
+                      .record = 50, .seed = 1, .out = {.width = 900, .height = 1200}};
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(const bif_args *a, char *msg, size_t msg_size)
+{
+    if (!a->has_sweep || a->sweep.n < 1)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a sweep NAME=LO:HI:N is required (e.g. S=0.02:0.4:190)");
+    if (a->runs < 1 || a->runs > 1000 || a->transient < 0 || a->transient > 1000000 ||
+        a->record < 1 || a->record > 10000 || a->seed < 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "runs %d, transient %d, record %d, seed %lld: need 1..1000 runs, a "
+                       "transient of 0..10^6 periods, 1..10000 recorded and a seed >= 0",
+                       a->runs, a->transient, a->record, a->seed);
+    if ((double)a->sweep.n * a->runs * a->record > 1e7)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%d values x %d runs x %d recorded periods is more than 1e7 Poincare "
+                       "points; record fewer",
+                       a->sweep.n, a->runs, a->record);
+    return CM_OK;
+}
+
+/* The models of the values, and which runs are to be followed. */
+static cm_status prepare(const bif_args *a, bif_result *r, char *msg, size_t msg_size)
+{
+    const int n_values = a->sweep.n;
+    const size_t n_runs = (size_t)n_values * (size_t)a->runs;
+    r->s = (sweep_results){n_values, a->runs, a->record, calloc(n_runs, sizeof(run_result)),
+                           malloc(n_runs * 2 * (size_t)a->record * sizeof(double))};
+    r->models = calloc((size_t)n_values, sizeof *r->models);
+    if (!r->s.res || !r->s.sections || !r->models)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %zu runs", n_runs);
+    for (size_t k = 0; k < n_runs * 2 * (size_t)a->record; k++)
+        r->s.sections[k] = NAN;
+    for (int i = 0; i < n_values; i++) {
+        if (!model_at_point(&a->mo, &a->sweep, &i, 1, &r->models[i]))
+            continue;
+        r->n_valid++;
+        for (int k = 0; k < a->runs; k++)
+            r->s.res[(size_t)i * (size_t)a->runs + (size_t)k].valid = true;
+    }
+    return CM_OK;
+}
+
+cm_status bifurcation_compute(const bif_args *a, const work_hooks *h, bif_result *r, char *msg,
+                              size_t msg_size)
+{
+    *r = (bif_result){0};
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK)
+        st = param_sweep_base(&a->mo, "friction-oscillator", &a->sweep, 1, &r->base, msg,
+                              msg_size);
+    if (st == CM_OK)
+        st = prepare(a, r, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const size_t n_runs = (size_t)a->sweep.n * (size_t)a->runs;
+    const double t0 = cm_seconds();
+    uint64_t done = 0;
+    int stopped = 0;
+    sweep_results *s = &r->s;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(a->threads ? a->threads : omp_get_max_threads()) reduction(| : stopped)
+    for (size_t k = 0; k < n_runs; k++) {
+        const int i = (int)(k / (size_t)a->runs), run = (int)(k % (size_t)a->runs);
+        if (!s->res[k].valid || stopped || (stopped = work_stop(h) != NULL))
+            continue; /* stopped: the runs left are skipped */
+        bifurcation_run(a, cm_fo_of_model(&r->models[i]), i, run, &s->res[k],
+                        s->sections + k * 2 * (size_t)a->record);
+        work_tick(h, &done);
+    }
+    r->done = done;
+    r->seconds = cm_seconds() - t0;
+    const char *why = stopped ? work_stop(h) : NULL;
+    if (stopped)
+        return cm_fail(CM_ECANCELED, msg, msg_size, "%s", why ? why : "stopped");
+    return CM_OK;
+}
+
+cm_status bifurcation_write(const bif_args *a, const bif_result *r, char *msg, size_t msg_size)
+{
+    if (r->n_valid == 0)
+        return cm_fail(CM_ERANGE, msg, msg_size,
+                       "no value of %s admits the model (is S <= S0 anywhere?)", a->sweep.name);
+    const bool ok = (!a->out.csv || write_points_csv(a, &r->s, msg, msg_size)) &&
+                    (!a->runs_csv || write_runs_csv(a, &r->s, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, &r->base, &r->s, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void bifurcation_result_free(bif_result *r)
+{
+    free_runs(&r->s, r->models);
+    r->s = (sweep_results){0};
+    r->models = NULL;
 }

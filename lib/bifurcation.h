@@ -3,14 +3,16 @@
  * models/friction_oscillator.h: for each value of the swept parameter,
  * runs from random starts followed past a transient, their sticking
  * displacements, Poincare sections and asymmetry recorded; written as CSV
- * (points, runs) and as the three-panel diagram. Nothing is printed: a
- * failed write returns false with the problem in msg. */
+ * (points, runs) and as the three-panel diagram. Nothing is printed:
+ * calls return a status with the problem in msg (CM_EINVAL: the
+ * request's). */
 #ifndef CM_LIB_BIFURCATION_H
 #define CM_LIB_BIFURCATION_H
 
 #include <stdbool.h>
 
 #include "lib/outfile.h"
+#include "lib/work.h"
 #include "lib/param_grid.h"
 #include "models/friction_oscillator.h"
 
@@ -42,29 +44,35 @@ typedef struct sweep_results {
     double *sections; /* record * 2 per run, in the same order */
 } sweep_results;
 
-/* Runs from the random start; sections[2 k], [2 k + 1]: the k-th recorded Poincare point. */
-/* Run r at value index `value` of o (a random start from a->seed),
- * recording a->record sections into sections (2 doubles each). */
-void bifurcation_run(const bif_args *a, const cm_fo *o, int value, int r, run_result *res,
-                double *sections);
+/* The command's defaults: friction-oscillator, 10 runs, a transient of
+ * 1000 periods, 50 recorded, seed 1, 900x1200 pixels; a->sweep must be
+ * given. */
+bif_args bifurcation_defaults(void);
+
+/* The model's parameters and every run of the sweep. */
+typedef struct bif_result {
+    cm_params base;
+    sweep_results s;
+    cm_model *models;   /* one per value; built where the value admits the model */
+    int n_valid;        /* values that do */
+    uint64_t done;      /* runs followed */
+    double seconds;
+} bif_result;
+
+/* Checks the request and follows every run on a->threads threads (0:
+ * all), progress in runs through h, stopped by h (CM_ECANCELED, with
+ * r->done). r is freed by bifurcation_result_free whatever the status. */
+cm_status bifurcation_compute(const bif_args *a, const work_hooks *h, bif_result *r, char *msg,
+                              size_t msg_size);
+
+/* The recorded points (a->out.csv), one line per run (a->runs_csv) and
+ * the three-panel diagram (a->out.png), each when given; CM_ERANGE when
+ * no value of the sweep admits the model. */
+cm_status bifurcation_write(const bif_args *a, const bif_result *r, char *msg, size_t msg_size);
+
+void bifurcation_result_free(bif_result *r);
 
 /* The result of run r at value index `value`. */
 const run_result *bifurcation_result_at(const sweep_results *s, int value, int r);
-
-/* The recorded points (sticks and sections) as CSV at a->out.csv. */
-bool bifurcation_write_points_csv(const bif_args *a, const sweep_results *s, char *msg,
-                                  size_t msg_size);
-
-/* One line per run (start, asymmetry, sticks) as CSV at a->runs_csv. */
-bool bifurcation_write_runs_csv(const bif_args *a, const sweep_results *s, char *msg,
-                                size_t msg_size);
-
-/* The three-panel diagram at a->out.png. */
-bool bifurcation_write_png(const bif_args *a, const cm_params *base, const sweep_results *s,
-                           char *msg, size_t msg_size);
-
-/* Frees the results and the models of the values (models[k] built where
- * its oscillator is set). */
-void bifurcation_free(sweep_results *s, cm_model *models);
 
 #endif

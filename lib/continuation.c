@@ -66,7 +66,7 @@ static void print_mults(FILE *f, const cm_fo_solution *s)
         fprintf(f, ",%.17g,%.17g", s->mult[k][0], s->mult[k][1]);
 }
 
-cm_status continuation_write_points(const cont_args *a, const collected *c, char *msg,
+static cm_status continuation_write_points(const cont_args *a, const collected *c, char *msg,
                                     size_t msg_size)
 {
     outfile o;
@@ -90,7 +90,7 @@ cm_status continuation_write_points(const cont_args *a, const collected *c, char
     return outfile_end(&o, true, msg, msg_size);
 }
 
-cm_status continuation_write_events(const cont_args *a, const collected *c, char *msg,
+static cm_status continuation_write_events(const cont_args *a, const collected *c, char *msg,
                                     size_t msg_size)
 {
     outfile o;
@@ -150,7 +150,7 @@ static bool already_curved(const collected *c, uint64_t i, const int *points)
     return false;
 }
 
-cm_status continuation_write_curves(const cont_args *a, const cm_fo *o, const collected *c,
+static cm_status continuation_write_curves(const cont_args *a, const cm_fo *o, const collected *c,
                                     int *n_curves, char *msg, size_t msg_size)
 {
     outfile out;
@@ -228,7 +228,7 @@ enum { LABEL_SIZE = 64 };
  * stops and Psi (2.90) against the parameter, those --panels picks in its
  * order; stable green, unstable red, events black with their labels on the
  * top panel. */
-cm_status continuation_write_png(const cont_args *a, const cm_model *m, const collected *c,
+static cm_status continuation_write_png(const cont_args *a, const cm_model *m, const collected *c,
                                  char *msg, size_t msg_size)
 {
     cloud stable[PANELS] = {{0}}, unstable[PANELS] = {{0}}, marks[PANELS] = {{0}};
@@ -386,7 +386,7 @@ static cm_status switch_branches(const cont_args *a, const cm_fo *o, int param, 
 }
 
 /* Every branch: from each start, one way or both; then --switch. */
-cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, double p0,
+static cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, double p0,
                               collected *col, char *msg, size_t msg_size)
 {
     memset(col, 0, sizeof *col);
@@ -402,14 +402,14 @@ cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, dou
         cm_fo_with(o, param, p, &at);
         if (!(p >= a->lo && p <= a->hi) || !(at.S > 0 && at.S0 >= at.S && at.Omega > 0)) {
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "the start's %s = %s is outside --vary %s=%s:%s or the model's domain "
-                           "(S0 >= S > 0, Omega > 0); start inside both",
+                           "the start's %s = %s is outside the range %s=%s:%s or the model's "
+                           "domain (S0 >= S > 0, Omega > 0); start inside both",
                            a->vary, CM_NUM(p), a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
         }
         if (!find_start(a, &at, from, z, &period)) {
             return cm_fail(CM_ENOTFOUND, msg, msg_size,
                            "no periodic solution%s found from (%s, %s) at %s = %s (chaotic "
-                           "there, or a longer period: give --from near one, and --period)",
+                           "there, or a longer period: start near one, and give its period)",
                            a->period ? " of that period" : " of period 1..16", CM_NUM(z[0]),
                            CM_NUM(z[1]), a->vary, CM_NUM(p));
         }
@@ -417,7 +417,7 @@ cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, dou
         if (true_period != period) {
             return cm_fail(CM_ENOTFOUND, msg, msg_size,
                            "the solution found near (%s, %s) repeats after %d period(s), not %d: "
-                           "give --period %d, or --from near a solution of period %d",
+                           "give the period %d, or start near a solution of period %d",
                            CM_NUM(from ? from[0] : z[0]), CM_NUM(from ? from[1] : z[1]),
                            true_period, period, true_period, period);
         }
@@ -430,10 +430,98 @@ cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, dou
     return err;
 }
 
-void continuation_free(collected *col)
+static void continuation_free(collected *col)
 {
     free(col->points);
     free(col->events);
     col->points = NULL;
     col->events = NULL;
+}
+
+cm_status continuation_layout(cont_args *a, char *msg, size_t msg_size)
+{
+    if (a->n_panels == 0)
+        for (int k = 0; k < PANELS; k++)
+            a->panels[a->n_panels++] = k;
+    if (a->height == 0) {
+        a->width = 900;
+        a->height = a->n_panels == PANELS ? 1100 : 450 * a->n_panels;
+    }
+    if (a->height < 150 * a->n_panels || a->width < 300 || a->width > 4096 || a->height > 4096)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%dx%d pixels: %d panels want 300..4096 pixels of width and %d..4096 of "
+                       "height",
+                       a->width, a->height, a->n_panels, 150 * a->n_panels);
+    return CM_OK;
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(cont_args *a, char *msg, size_t msg_size)
+{
+    if (!a->has_vary || cm_fo_param_of(a->vary) < 0 || !(a->lo < a->hi))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a parameter NAME=LO:HI to vary is required, NAME one of S, S0, Omega, "
+                       "phi and LO < HI (e.g. S=0.02:0.4)");
+    if (a->down && a->both)
+        return cm_fail(CM_EINVAL, msg, msg_size, "down and both ways: choose one");
+    if ((a->vary2[0] != '\0') != (a->curves != NULL))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a second parameter NAME2=LO:HI and the curves' file go together");
+    if (a->vary2[0] && (cm_fo_param_of(a->vary2) < 0 || !(a->lo2 < a->hi2) ||
+                        strcmp(a->vary2, a->vary) == 0 || strcmp(a->vary2, "phi") == 0 ||
+                        strcmp(a->vary, "phi") == 0))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the curves' second parameter must be S, S0 or Omega over LO < HI, other "
+                       "than the varied one, and neither may be phi");
+    if (a->n_from < 0 || a->n_from > MAX_STARTS || a->period < 0 || a->period > 64 ||
+        a->max_points < 0 || a->max_points > 1000000)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%d starts, period %d, %d points: need at most %d starts, a period of "
+                       "1..64 and at most 10^6 points",
+                       a->n_from, a->period, a->max_points, MAX_STARTS);
+    return continuation_layout(a, msg, msg_size);
+}
+
+cm_status continuation_compute(cont_args *a, cont_result *r, char *msg, size_t msg_size)
+{
+    *r = (cont_result){0};
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &r->m, msg,
+                                 msg_size);
+    if (st != CM_OK)
+        return st;
+    r->o = cm_fo_of_model(&r->m);
+    if (!r->o)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "model %s: continue follows friction-oscillator only", a->mo.name);
+    r->param = cm_fo_param_of(a->vary);
+    const cm_fo *o = r->o;
+    r->p0 = (double[4]){o->S, o->S0, o->Omega, o->phi}[r->param];
+    if (!(r->p0 >= a->lo && r->p0 <= a->hi))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s = %s (the model's parameter, or its default) is outside the range "
+                       "%s=%s:%s; start inside the range",
+                       a->vary, CM_NUM(r->p0), a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
+    return continuation_follow(a, o, r->param, r->p0, &r->col, msg, msg_size);
+}
+
+cm_status continuation_write(const cont_args *a, cont_result *r, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    if (a->csv)
+        st = continuation_write_points(a, &r->col, msg, msg_size);
+    if (st == CM_OK && a->events)
+        st = continuation_write_events(a, &r->col, msg, msg_size);
+    if (st == CM_OK && a->png)
+        st = continuation_write_png(a, &r->m, &r->col, msg, msg_size);
+    if (st == CM_OK && a->curves)
+        st = continuation_write_curves(a, r->o, &r->col, &r->n_curves, msg, msg_size);
+    return st;
+}
+
+void continuation_result_free(cont_result *r)
+{
+    continuation_free(&r->col);
+    cm_model_release(&r->m);
 }

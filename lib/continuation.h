@@ -62,31 +62,36 @@ typedef struct collected {
     bool out_of_memory;
 } collected;
 
-/* Follows every branch the request asks for into col (zeroed first; freed
- * by continuation_free whatever the status). o: the model's oscillator,
- * param its varied parameter (cm_fo_param_of), p0 its value. */
-cm_status continuation_follow(const cont_args *a, const cm_fo *o, int param, double p0,
-                              collected *col, char *msg, size_t msg_size);
-void continuation_free(collected *col);
+/* What was followed: the model, the varied parameter's index and start
+ * value, the branches, and the curves written. */
+typedef struct cont_result {
+    cm_model m;
+    const cm_fo *o; /* m's oscillator */
+    int param;      /* cm_fo_param_of(a->vary) */
+    double p0;      /* its value in the model */
+    collected col;
+    int n_curves;
+} cont_result;
+
+/* Fills the diagram's panels (all three when none is picked) and size
+ * (900x1100, or 450 per panel) and checks them. */
+cm_status continuation_layout(cont_args *a, char *msg, size_t msg_size);
+
+/* Checks the request, builds the model and follows every branch it asks
+ * for; r is freed by continuation_result_free whatever the status. */
+cm_status continuation_compute(cont_args *a, cont_result *r, char *msg, size_t msg_size);
+
+/* The branch points (a->csv) and events (a->events) as CSV, the diagram
+ * (a->png: the panels a->panels picks, stable green, unstable red, events
+ * black and labelled on the top panel) and, from every fold and period
+ * doubling, its curve in (a->vary, a->vary2) both ways (a->curves; their
+ * number in r->n_curves), each when given. */
+cm_status continuation_write(const cont_args *a, cont_result *r, char *msg, size_t msg_size);
+
+void continuation_result_free(cont_result *r);
 
 /* The thesis' label of an event (SN_2s, PD_1a, CS_s) and its kind in words. */
 void continuation_event_label(const cm_fo_branch_event *e, char *out, size_t size);
 const char *continuation_event_kind(const cm_fo_branch_event *e);
-
-/* The branch points (a->csv) and events (a->events) as CSV. */
-cm_status continuation_write_points(const cont_args *a, const collected *c, char *msg,
-                                    size_t msg_size);
-cm_status continuation_write_events(const cont_args *a, const collected *c, char *msg,
-                                    size_t msg_size);
-
-/* The diagram (a->png): the panels a->panels picks, stable green, unstable
- * red, events black and labelled on the top panel. */
-cm_status continuation_write_png(const cont_args *a, const cm_model *m, const collected *c,
-                                 char *msg, size_t msg_size);
-
-/* From every fold and period doubling, its curve in (a->vary, a->vary2),
- * both ways, as CSV at a->curves; *n_curves: the curves written. */
-cm_status continuation_write_curves(const cont_args *a, const cm_fo *o, const collected *c,
-                                    int *n_curves, char *msg, size_t msg_size);
 
 #endif

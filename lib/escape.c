@@ -89,12 +89,12 @@ static void compute_point(const esc_args *a, int i, esc_point *p)
     cm_model_release(&m);
 }
 
-int escape_points(const esc_args *a)
+static int escape_points(const esc_args *a)
 {
     return a->has_sweep ? a->sweep.n : 1;
 }
 
-bool escape_write_csv(const esc_args *a, const esc_point *pts, char *msg, size_t msg_size)
+static bool write_csv(const esc_args *a, const esc_point *pts, char *msg, size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -222,17 +222,81 @@ static bool png_sweep(const esc_args *a, const esc_point *pts, const char *param
     return ok;
 }
 
-void escape_compute(const esc_args *a, esc_point *pts)
-{
-    const int n = escape_points(a);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(a->threads ? a->threads : omp_get_max_threads())
-    for (int i = 0; i < n; i++)
-        compute_point(a, i, &pts[i]);
-}
-
-bool escape_write_png(const esc_args *a, const esc_point *pts, const char *params, char *msg,
+static bool write_png(const esc_args *a, const esc_point *pts, const char *params, char *msg,
                       size_t msg_size)
 {
     return a->has_sweep ? png_sweep(a, pts, params, msg, msg_size)
                         : png_structure(a, &pts[0], params, msg, msg_size);
+}
+
+esc_args escape_defaults(void)
+{
+    return (esc_args){.mo = {.name = "microchaos-1d-friction"}, .cells = 100000,
+                      .ensemble = 1000000, .out = {.width = 1000, .height = 600}};
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(const esc_args *a, char *msg, size_t msg_size)
+{
+    if (a->has_I0 && !(a->I0 > 0 && a->I0 < 1e6))
+        return cm_fail(CM_EINVAL, msg, msg_size, "I0 = %g must be in (0, 1e6)", a->I0);
+    if (a->has_sweep &&
+        (a->sweep.n < 1 || a->sweep.n > 10000 || !param_axis_even(&a->sweep) ||
+         (strcmp(a->sweep.name, "a") != 0 && strcmp(a->sweep.name, "b") != 0 &&
+          strcmp(a->sweep.name, "I0") != 0)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the sweep must be NAME=LO:HI:N with NAME a, b or I0, LO < HI and 1 <= N "
+                       "<= 10000 (e.g. a=1.2:2.25:64)");
+    if (a->has_sweep && strcmp(a->sweep.name, "I0") == 0 && a->has_I0)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a sweep of I0 and a fixed I0: choose one");
+    if (a->cells < 0 || a->cells > 100000000 || a->ensemble < 0 || a->ensemble > 1000000000)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "cells %ld and ensemble %ld: need 0..10^8 and 0..10^9", a->cells,
+                       a->ensemble);
+    return CM_OK;
+}
+
+cm_status escape_compute(const esc_args *a, esc_result *r, char *msg, size_t msg_size)
+{
+    *r = (esc_result){0};
+    const bool sweeps_param = a->has_sweep && strcmp(a->sweep.name, "I0") != 0;
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK)
+        st = param_sweep_base(&a->mo, "microchaos-1d-friction", sweeps_param ? &a->sweep : NULL,
+                              sweeps_param ? 1 : 0, &r->base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = escape_points(a);
+    esc_point *pts = r->pts = calloc((size_t)n, sizeof *pts);
+    if (!pts)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d points", n);
+    r->n = n;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(a->threads ? a->threads : omp_get_max_threads())
+    for (int i = 0; i < n; i++)
+        compute_point(a, i, &pts[i]);
+    for (int i = 0; i < n; i++)
+        r->valid += pts[i].valid;
+    if (!a->has_sweep && !pts[0].valid)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s; choose other parameters", pts[0].why);
+    return CM_OK;
+}
+
+cm_status escape_write(const esc_args *a, const esc_result *r, char *msg, size_t msg_size)
+{
+    char params[400];
+    const char *const skip[] = {a->has_sweep ? a->sweep.name : "", a->has_I0 ? "c" : "", NULL};
+    cm_params_format_with(&r->base, skip, params, sizeof params);
+    if (a->has_I0) {
+        const size_t used = strlen(params);
+        snprintf(params + used, sizeof params - used, "%s|I0|=%s", used ? "," : "", CM_NUM(a->I0));
+    }
+    const bool ok = (!a->out.csv || write_csv(a, r->pts, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, r->pts, params, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void escape_result_free(esc_result *r)
+{
+    free(r->pts);
+    r->pts = NULL;
 }

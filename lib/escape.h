@@ -4,7 +4,8 @@
  * repeller, the bounds on the escape rate and the mean escape number from
  * its fractal dimension, the exact mean escape number, an ensemble's and
  * cell mapping's; written as CSV and as the thesis' figures. Nothing is
- * printed: a failed write returns false with the problem in msg. */
+ * printed: calls return a status with the problem in msg (CM_EINVAL: the
+ * request's). */
 #ifndef CM_LIB_ESCAPE_H
 #define CM_LIB_ESCAPE_H
 
@@ -37,19 +38,27 @@ typedef struct esc_point {
     long scm_stay;   /* cells that never leave: cell-map cycles and their basins */
 } esc_point;
 
-/* The points of the request: the sweep's, or one. */
-int escape_points(const esc_args *a);
+/* The command's defaults: microchaos-1d-friction, 100000 cells, an
+ * ensemble of 10^6, 1000x600 pixels. */
+esc_args escape_defaults(void);
 
-/* Computes every point (pts: escape_points of them) on a->threads threads
- * (0: all); a point that is not the case of 4.3 is !valid with why. */
-void escape_compute(const esc_args *a, esc_point *pts);
+/* The model's parameters and the points (the sweep's, or one). */
+typedef struct esc_result {
+    cm_params base;
+    esc_point *pts;
+    int n, valid; /* points, and those in the case of 4.3 */
+} esc_result;
 
-/* The points as CSV at a->out.csv. */
-bool escape_write_csv(const esc_args *a, const esc_point *pts, char *msg, size_t msg_size);
+/* Checks the request and computes every point on a->threads threads (0:
+ * all); a point that is not the case of 4.3 is !valid with why, and a
+ * single point that is not fails (CM_EINVAL). r is freed by
+ * escape_result_free whatever the status. */
+cm_status escape_compute(const esc_args *a, esc_result *r, char *msg, size_t msg_size);
 
-/* The figure at a->out.png: Fig. 4.7 along a sweep, else Fig. 4.5 at the
- * point; params: the fixed parameters' text. */
-bool escape_write_png(const esc_args *a, const esc_point *pts, const char *params, char *msg,
-                      size_t msg_size);
+/* The points as CSV at a->out.csv and the figure at a->out.png (either
+ * may be NULL): Fig. 4.7 along a sweep, else Fig. 4.5 at the point. */
+cm_status escape_write(const esc_args *a, const esc_result *r, char *msg, size_t msg_size);
+
+void escape_result_free(esc_result *r);
 
 #endif

@@ -15,7 +15,7 @@ void horseshoe_item_at(double alpha, double beta, double P, double D, int64_t m,
     it->entropy = it->periodic ? log((double)it->periodic) / n : NAN;
 }
 
-bool horseshoe_write_csv(const hs_args *a, const hs_item *items, int count, char *msg,
+static bool write_csv(const hs_args *a, const hs_item *items, int count, char *msg,
                          size_t msg_size)
 {
     outfile o;
@@ -229,11 +229,85 @@ static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char
     return ok;
 }
 
-bool horseshoe_write_png(const hs_args *a, const hs_item *items, int nm, int count, double alpha,
+static bool write_png(const hs_args *a, const hs_item *items, int nm, int count, double alpha,
                          double beta, double P, double D, const char *params, char *msg,
                          size_t msg_size)
 {
     return a->crisis      ? png_crisis(a, items, nm, alpha, params, msg, msg_size)
            : a->has_sweep ? png_sweep(a, items, nm, params, msg, msg_size)
                           : png_point(a, items, count, alpha, beta, P, D, params, msg, msg_size);
+}
+
+hs_args horseshoe_defaults(void)
+{
+    return (hs_args){.mo = {.name = "microchaos-pd"}, .periods = 12,
+                     .out = {.width = 1000, .height = 600}};
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(const hs_args *a, char *msg, size_t msg_size)
+{
+    if (a->has_m && !(a->m0 >= 1 && a->m1 >= a->m0 && a->m1 - a->m0 <= 1000))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "lines %lld:%lld: need 1 <= M0 <= M1 <= M0 + 1000", (long long)a->m0,
+                       (long long)a->m1);
+    if (a->periods < 1 || a->periods > 20)
+        return cm_fail(CM_EINVAL, msg, msg_size, "period %d is not in 1..20", a->periods);
+    if (a->has_sweep && (strcmp(a->sweep.name, "P") != 0 || a->sweep.n < 1 ||
+                         a->sweep.n > 10000 || !param_axis_even(&a->sweep)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the sweep must be P=LO:HI:K with LO < HI and 1 <= K <= 10000");
+    if (a->crisis && !a->has_sweep)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the crisis chart needs a sweep of P");
+    return CM_OK;
+}
+
+cm_status horseshoe_compute(hs_args *a, hs_result *r, char *msg, size_t msg_size)
+{
+    *r = (hs_result){0};
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK)
+        st = param_sweep_base(&a->mo, "microchaos-pd", a->has_sweep ? &a->sweep : NULL,
+                              a->has_sweep, &r->base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    r->alpha = cm_params_get(&r->base, "alpha"), r->beta = cm_params_get(&r->base, "beta");
+    r->P = cm_params_get(&r->base, "P"), r->D = cm_params_get(&r->base, "D");
+    if (!a->has_m) {
+        const int64_t m_max = cm_pd_m_max(r->alpha, r->P);
+        if (m_max < 1 || m_max > 1000)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "m_max = %lld at these parameters (P <= alpha^2, or too many lines); "
+                           "give the lines M0:M1",
+                           (long long)m_max);
+        a->m0 = 1, a->m1 = m_max;
+    }
+    const int nm = (int)(a->m1 - a->m0 + 1), np = a->has_sweep ? a->sweep.n : 1;
+    r->items = calloc((size_t)nm * (size_t)np, sizeof *r->items);
+    if (!r->items)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory");
+    for (int i = 0; i < np; i++)
+        for (int j = 0; j < nm; j++)
+            horseshoe_item_at(r->alpha, r->beta,
+                              a->has_sweep ? param_axis_value(&a->sweep, i) : r->P, r->D,
+                              a->m0 + j, a->periods, &r->items[(size_t)i * (size_t)nm + (size_t)j]);
+    r->nm = nm, r->count = nm * np;
+    return CM_OK;
+}
+
+cm_status horseshoe_write(const hs_args *a, const hs_result *r, char *msg, size_t msg_size)
+{
+    char params[400];
+    const char *const skip[] = {a->has_sweep ? "P" : "", NULL};
+    cm_params_format_with(&r->base, skip, params, sizeof params);
+    const bool ok = (!a->out.csv || write_csv(a, r->items, r->count, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, r->items, r->nm, r->count, r->alpha, r->beta,
+                                              r->P, r->D, params, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void horseshoe_result_free(hs_result *r)
+{
+    free(r->items);
+    r->items = NULL;
 }

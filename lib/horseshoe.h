@@ -3,8 +3,8 @@
  * models/microchaos_pd.h: the trapezoids L and R, the escape conditions of
  * a full binary shift, and the periodic points of the restricted maps,
  * whose growth bounds the topological entropy from below; written as CSV
- * and as the thesis' figures. Nothing is printed: a failed write returns
- * false with the problem in msg. */
+ * and as the thesis' figures. Nothing is printed: calls return a status
+ * with the problem in msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_HORSESHOE_H
 #define CM_LIB_HORSESHOE_H
 
@@ -35,14 +35,26 @@ typedef struct hs_item {
 void horseshoe_item_at(double alpha, double beta, double P, double D, int64_t m, int n,
                        hs_item *it);
 
-/* The items as CSV at a->out.csv. */
-bool horseshoe_write_csv(const hs_args *a, const hs_item *items, int count, char *msg,
-                         size_t msg_size);
+/* The command's defaults: microchaos-pd, period 12, 1000x600 pixels. */
+hs_args horseshoe_defaults(void);
 
-/* The figure at a->out.png: the crisis chart or the sweep (nm lines per
- * value of P), or the horseshoes at one point (alpha, beta, P, D). */
-bool horseshoe_write_png(const hs_args *a, const hs_item *items, int nm, int count, double alpha,
-                         double beta, double P, double D, const char *params, char *msg,
-                         size_t msg_size);
+/* The model's parameters and the lines (m0..m1 at each value of P). */
+typedef struct hs_result {
+    cm_params base;
+    double alpha, beta, P, D; /* the model's */
+    hs_item *items;           /* count = nm lines times the values of P */
+    int nm, count;
+} hs_result;
+
+/* Checks the request, takes the lines 1..m_max when a->has_m is not set,
+ * and computes r (freed by horseshoe_result_free whatever the status). */
+cm_status horseshoe_compute(hs_args *a, hs_result *r, char *msg, size_t msg_size);
+
+/* The lines as CSV at a->out.csv and the figure at a->out.png (either may
+ * be NULL): the crisis chart or the sweep, or the horseshoes at the
+ * model's point. */
+cm_status horseshoe_write(const hs_args *a, const hs_result *r, char *msg, size_t msg_size);
+
+void horseshoe_result_free(hs_result *r);
 
 #endif

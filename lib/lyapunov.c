@@ -2,6 +2,7 @@
 #include "lib/lyapunov.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,11 +11,12 @@
 #include "lib/figure.h"
 #include "models/friction_oscillator.h"
 #include "models/map_lyapunov.h"
+#include "lib/parse.h"
 #include "models/params.h"
 
 /* The exponent at grid point (i, j); NaN where the model cannot be built
  * (S > S0) or no sample was accepted. */
-double lyapunov_point(const lyap_args *a, int i, int j, int *invalid)
+static double lyapunov_point(const lyap_args *a, int i, int j, int *invalid)
 {
     const int idx[2] = {i, j};
     cm_model m;
@@ -35,7 +37,7 @@ double lyapunov_point(const lyap_args *a, int i, int j, int *invalid)
     return lambda;
 }
 
-bool lyapunov_write_csv(const lyap_args *a, const double *v, char *msg, size_t msg_size)
+static bool write_csv(const lyap_args *a, const double *v, char *msg, size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->csv, &o, msg, msg_size) != CM_OK)
@@ -112,7 +114,7 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
     return ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the curves");
 }
 
-cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size)
+static cm_status read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size)
 {
     size_t cap = 0;
     cm_status st = CM_OK;
@@ -121,13 +123,13 @@ cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_
     return st;
 }
 
-void lyapunov_overlay_free(overlay *ov)
+static void overlay_free(overlay *ov)
 {
     free(ov->x);
     free(ov->y);
 }
 
-bool lyapunov_write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
+static bool write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
                       overlay *ov, char *msg, size_t msg_size)
 {
     /* both ways of a curve, and curves of one point, start at one place */
@@ -165,4 +167,134 @@ bool lyapunov_write_png(const lyap_args *a, const char *model, const cm_params *
                                  {"Estimator", fo ? "docs/models.md 9.8 (renormalised two trajectories)"
                                                   : "docs/models.md 11.3 (finite differences on the map)"}};
     return (outfile_charts(a->png, &chart, 1, texts, 5, msg, msg_size) == CM_OK);
+}
+
+lyap_args lyapunov_defaults(void)
+{
+    return (lyap_args){.mo = {.name = "friction-oscillator"}, .periods = 600, .d0 = 1e-8,
+                       .width = 900, .height = 700};
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(const lyap_args *a, char *msg, size_t msg_size)
+{
+    if (!a->has_grid || a->ax[0].n < 1 || a->ax[1].n < 1)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a grid X=LO:HI:N,Y=LO:HI:M is required");
+    for (int k = 0; k < 2; k++)
+        if (!param_axis_even(&a->ax[k]))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the values of %s are not evenly spaced, and the heat map's cells "
+                           "would not sit on them; give %s=LO:HI:N",
+                           a->ax[k].name, a->ax[k].name);
+    if (a->periods < 1 || a->periods > 1000000 || !(a->d0 >= 1e-9 && a->d0 <= 1e-3))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "periods %d, d0 %g: need 1..10^6 periods and d0 in 1e-9..1e-3",
+                       a->periods, a->d0);
+    if (a->n_curves < 0 || a->n_curves > MAX_CURVE_FILES || (a->n_curves && !a->png))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "up to %d curve files, drawn over the heat map (give its PNG too)",
+                       MAX_CURVE_FILES);
+    return CM_OK;
+}
+
+/* The start of a model other than the friction oscillator: a->from, with
+ * its dimension checked, or the centre of the model's example region. */
+static cm_status start_of(lyap_args *a, char *msg, size_t msg_size)
+{
+    const cm_model_entry *e = cm_model_set_find(&a->mo.set, a->mo.name, NULL);
+    cm_model m;
+    const cm_status st =
+        cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int dim = m.dim;
+    cm_model_release(&m);
+    if (a->n_from && a->n_from != dim)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the start has %d value(s) but model %s has dimension %d", a->n_from,
+                       e->name, dim);
+    if (a->n_from)
+        return CM_OK;
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int n = 0;
+    if (!e->region || !parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != dim)
+        return cm_fail(CM_EINVAL, msg, msg_size, "model %s has no default region: give the start",
+                       e->name);
+    for (int d = 0; d < dim; d++)
+        a->from[d] = 0.5 * (lo[d] + hi[d]);
+    a->n_from = dim;
+    return CM_OK;
+}
+
+/* The exponents of every grid point into r->v. */
+static void compute_map(const lyap_args *a, const work_hooks *h, lyap_result *r, int *stopped)
+{
+    const size_t nx = (size_t)a->ax[0].n, n = r->points;
+    double *v = r->v;
+    int invalid = 0, stop = 0;
+    uint64_t done = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(a->threads ? a->threads : omp_get_max_threads()) reduction(| : invalid, stop)
+    for (size_t k = 0; k < n; k++) {
+        if (stop || (stop = work_stop(h) != NULL)) { /* the points left are skipped */
+            v[k] = NAN;
+            continue;
+        }
+        v[k] = lyapunov_point(a, (int)(k % nx), (int)(k / nx), &invalid);
+        work_tick(h, &done);
+    }
+    r->invalid = invalid, r->done = done, *stopped = stop;
+}
+
+cm_status lyapunov_compute(lyap_args *a, const work_hooks *h, lyap_result *r, char *msg,
+                           size_t msg_size)
+{
+    *r = (lyap_result){0};
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK) /* the parameters without the grid's; S0 >= S is checked per point */
+        st = param_sweep_base(&a->mo, NULL, a->ax, 2, &r->base, msg, msg_size);
+    if (st == CM_OK && strcmp(a->mo.name, "friction-oscillator") != 0)
+        st = start_of(a, msg, msg_size);
+    if (st == CM_OK)
+        st = read_curves(a, &r->ov, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    r->points = (size_t)a->ax[0].n * (size_t)a->ax[1].n;
+    r->v = malloc(r->points * sizeof *r->v);
+    if (!r->v)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %zu grid points", r->points);
+    const double t0 = cm_seconds();
+    int stopped = 0;
+    compute_map(a, h, r, &stopped);
+    if (stopped) {
+        const char *why = work_stop(h);
+        return cm_fail(CM_ECANCELED, msg, msg_size, "%s", why ? why : "stopped");
+    }
+    r->seconds = cm_seconds() - t0;
+    for (size_t k = 0; k < r->points; k++) {
+        r->computed += !isnan(r->v[k]);
+        r->positive += r->v[k] > 0;
+        if (!(r->v[r->best] >= r->v[k]))
+            r->best = k;
+    }
+    return CM_OK;
+}
+
+cm_status lyapunov_write(const lyap_args *a, lyap_result *r, char *msg, size_t msg_size)
+{
+    if (r->computed == 0)
+        return cm_fail(CM_ERANGE, msg, msg_size, "no grid point could be computed (%s)",
+                       strcmp(a->mo.name, "friction-oscillator") == 0
+                           ? "is S <= S0 anywhere?"
+                           : "every orbit from the start left the world or had no image");
+    const bool ok = (!a->csv || write_csv(a, r->v, msg, msg_size)) &&
+                    (!a->png || write_png(a, a->mo.name, &r->base, r->v, &r->ov, msg,
+                                          msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void lyapunov_result_free(lyap_result *r)
+{
+    free(r->v);
+    r->v = NULL;
+    overlay_free(&r->ov);
 }

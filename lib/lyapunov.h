@@ -3,7 +3,8 @@
  * oscillator by its own estimator) over models/map_lyapunov.h and
  * models/friction_oscillator.h, with the fold and period-doubling curves
  * of `continue --curves` drawn over the map; written as CSV and as the
- * heat map. Nothing is printed: calls return the problem in msg. */
+ * heat map. Nothing is printed: calls return a status with the problem in
+ * msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_LYAPUNOV_H
 #define CM_LIB_LYAPUNOV_H
 
@@ -11,6 +12,7 @@
 
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
+#include "lib/work.h"
 #include "render/chart.h"
 
 /* The most --curves files a map takes. */
@@ -38,22 +40,33 @@ typedef struct overlay {
     int n_labels;
 } overlay;
 
-/* The exponent at grid point (i, j); NaN where the model cannot be built
- * (S > S0) or no sample was accepted. */
-double lyapunov_point(const lyap_args *a, int i, int j, int *invalid);
+/* The command's defaults: friction-oscillator, 600 periods, d0 = 1e-8,
+ * 900x700 pixels; a->ax must be given. */
+lyap_args lyapunov_defaults(void);
 
-/* The map's values (v[j * nx + i]) as CSV at a->csv. */
-bool lyapunov_write_csv(const lyap_args *a, const double *v, char *msg, size_t msg_size);
+/* The model's parameters, the map and what it holds. */
+typedef struct lyap_result {
+    cm_params base;
+    double *v;     /* the exponents, v[j * nx + i]; NaN where not computed */
+    overlay ov;    /* the curves drawn over the heat map */
+    size_t points, computed, positive, best; /* best: the index of the largest */
+    uint64_t done; /* points computed before a stop */
+    double seconds;
+    bool invalid;  /* some points could not be built (S > S0) */
+} lyap_result;
 
-/* Every --curves file, read before the grid is computed (ov is the
- * caller's to free with lyapunov_overlay_free, whatever the result):
- * CM_EINVAL when a file is not curves in the grid's parameters. */
-cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size);
+/* Checks the request (a model other than the friction oscillator starts
+ * at a->from, or the centre of its example region, set here), reads the
+ * curves and computes the map on a->threads threads (0: all), progress in
+ * grid points through h, stopped by h (CM_ECANCELED, with r->done). r is
+ * freed by lyapunov_result_free whatever the status. */
+cm_status lyapunov_compute(lyap_args *a, const work_hooks *h, lyap_result *r, char *msg,
+                           size_t msg_size);
 
-void lyapunov_overlay_free(overlay *ov);
+/* The map as CSV at a->csv and the heat map with the curves at a->png
+ * (either may be NULL; the curves' labels are joined in place); CM_ERANGE when no point could be computed. */
+cm_status lyapunov_write(const lyap_args *a, lyap_result *r, char *msg, size_t msg_size);
 
-/* The heat map with the curves at a->png. */
-bool lyapunov_write_png(const lyap_args *a, const char *model, const cm_params *p, const double *v,
-                        overlay *ov, char *msg, size_t msg_size);
+void lyapunov_result_free(lyap_result *r);
 
 #endif

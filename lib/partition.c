@@ -15,7 +15,7 @@ void partition_row_text(const cm_delay_partition *p, int i, char *out)
     out[p->r] = '\0';
 }
 
-bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *msg,
+static bool write_csv(const part_args *a, const cm_delay_partition *p, char *msg,
                          size_t msg_size)
 {
     outfile o;
@@ -31,7 +31,7 @@ bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
-bool partition_write_png(const part_args *a, const cm_delay_partition *p, const char *params,
+static bool write_png(const part_args *a, const cm_delay_partition *p, const char *params,
                          char *msg, size_t msg_size)
 {
     double x[2][2 * CM_DELAY_MAX_REGIONS], y[2][2 * CM_DELAY_MAX_REGIONS];
@@ -74,4 +74,31 @@ bool partition_write_png(const part_args *a, const cm_delay_partition *p, const 
                             0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
     return (outfile_charts(a->out.png, &chart, 1, texts, 2, msg, msg_size) == CM_OK);
+}
+
+part_args partition_defaults(void)
+{
+    return (part_args){.mo = {.name = "microchaos-delay"}, .out = {.width = 900, .height = 700}};
+}
+
+cm_status partition_compute(const part_args *a, part_result *r, char *msg, size_t msg_size)
+{
+    const cm_status st =
+        param_sweep_base(&a->mo, "microchaos-delay", NULL, 0, &r->base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    char why[300];
+    if (!cm_delay_partition_01(cm_params_get(&r->base, "a"), cm_params_get(&r->base, "b"), &r->p,
+                               why, sizeof why))
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s; e.g. a=1.3,b=0.66 (Fig. 4.11)", why);
+    return CM_OK;
+}
+
+cm_status partition_write(const part_args *a, const part_result *r, char *msg, size_t msg_size)
+{
+    char params[400];
+    cm_params_format(&r->base, params, sizeof params);
+    const bool ok = (!a->out.csv || write_csv(a, &r->p, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, &r->p, params, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
 }

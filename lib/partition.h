@@ -1,15 +1,15 @@
 /* lib/partition.h - the Markov partition of the delayed micro-chaos map
  * (thesis 4.4, Fig. 4.11) over models/delay_partition.h, written as CSV
  * (its transition matrix row by row) and as the chart of its intervals.
- * Nothing is printed: a failed write returns false with the problem in
- * msg. */
+ * Nothing is printed: calls return a status with the problem in msg
+ * (CM_EINVAL: the request's). */
 #ifndef CM_LIB_PARTITION_H
 #define CM_LIB_PARTITION_H
 
 #include <stdbool.h>
 
 #include "lib/outfile.h"
-#include "lib/project.h"
+#include "lib/param_grid.h"
 #include "models/delay_partition.h"
 
 /* The model and the outputs (the command's options). */
@@ -22,12 +22,21 @@ typedef struct part_args {
  * 4 * p->r characters). */
 void partition_row_text(const cm_delay_partition *p, int i, char *out);
 
-/* The intervals and their rows as CSV at a->out.csv. */
-bool partition_write_csv(const part_args *a, const cm_delay_partition *p, char *msg,
-                         size_t msg_size);
+/* The command's defaults: microchaos-delay, 900x700 pixels. */
+part_args partition_defaults(void);
 
-/* The chart of the intervals at a->out.png. */
-bool partition_write_png(const part_args *a, const cm_delay_partition *p, const char *params,
-                         char *msg, size_t msg_size);
+/* The model's parameters and its partition. */
+typedef struct part_result {
+    cm_params base;
+    cm_delay_partition p;
+} part_result;
+
+/* Checks the model and finds its partition of (0, 1); CM_EINVAL when
+ * there is none at its parameters (the message says why). */
+cm_status partition_compute(const part_args *a, part_result *r, char *msg, size_t msg_size);
+
+/* The intervals and their rows as CSV at a->out.csv and their chart at
+ * a->out.png (either may be NULL). */
+cm_status partition_write(const part_args *a, const part_result *r, char *msg, size_t msg_size);
 
 #endif

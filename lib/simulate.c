@@ -80,7 +80,7 @@ static void record_state(track *tr, const cm_fo_run *r, int kind)
 /* Follows the run for the requested periods, recording those after the
  * skipped ones; *last receives the last period's tally and z_prev the
  * section point before the last one. False when the motion is lost. */
-bool simulate_follow(const cm_fo *o, const sim_args *a, cm_fo_run *r, track *tr, cm_fo_tally *last,
+static bool simulate_follow(const cm_fo *o, const sim_args *a, cm_fo_run *r, track *tr, cm_fo_tally *last,
                    double z_prev[2])
 {
     const int per = samples_per_period(a->periods - a->skip);
@@ -114,7 +114,7 @@ bool simulate_follow(const cm_fo *o, const sim_args *a, cm_fo_run *r, track *tr,
     return true;
 }
 
-bool simulate_write_csv(const char *path, const track *tr, char *msg, size_t msg_size)
+static bool write_csv(const char *path, const track *tr, char *msg, size_t msg_size)
 {
     outfile o;
     if (outfile_begin(path, &o, msg, msg_size) != CM_OK)
@@ -219,7 +219,7 @@ static void sticking_band(const cm_fo *o, double ta, double tb, figure_data *d)
     }
 }
 
-bool simulate_write_png(const sim_args *a, const cm_model *m, const cm_fo *o, const track *tr,
+static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, const track *tr,
                         char *msg, size_t msg_size)
 {
     figure_data d;
@@ -314,4 +314,66 @@ bool simulate_write_png(const sim_args *a, const cm_model *m, const cm_fo *o, co
     ok = (outfile_charts(a->out.png, charts, 2, texts, 4, msg, msg_size) == CM_OK);
     figure_data_free(&d);
     return ok;
+}
+
+sim_args simulate_defaults(void)
+{
+    return (sim_args){.mo = {.name = "friction-oscillator"}, .periods = 20,
+                      .out = {.width = 900, .height = 1000}};
+}
+
+/* The request's own limits (the command checks them as it parses). */
+static cm_status check_request(const sim_args *a, char *msg, size_t msg_size)
+{
+    if (!isfinite(a->from[0]) || !isfinite(a->from[1]))
+        return cm_fail(CM_EINVAL, msg, msg_size, "the start (x, v) must be two finite numbers");
+    if (a->has_t0 && !(fabs(a->t0) <= 1e9))
+        return cm_fail(CM_EINVAL, msg, msg_size, "t0 must be a time within +-1e9");
+    if (a->periods < 1 || a->periods > 100000 || a->skip < 0 || a->skip >= a->periods)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "periods %d, skip %d: need 1..100000 periods and fewer skipped",
+                       a->periods, a->skip);
+    return CM_OK;
+}
+
+cm_status simulate_compute(sim_args *a, sim_result *r, char *msg, size_t msg_size)
+{
+    *r = (sim_result){0};
+    cm_status st = check_request(a, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &r->m, msg,
+                                 msg_size);
+    if (st != CM_OK)
+        return st;
+    r->o = cm_fo_of_model(&r->m);
+    if (!r->o)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "model %s: simulate follows friction-oscillator only", a->mo.name);
+    if (!a->has_t0)
+        a->t0 = r->o->phi / r->o->Omega;
+    cm_fo_run_start(r->o, a->t0, a->from[0], a->from[1], &r->r);
+    const bool followed = simulate_follow(r->o, a, &r->r, &r->tr, &r->last, r->z_prev);
+    if (r->tr.out_of_memory)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the trajectory");
+    if (!followed)
+        return cm_fail(CM_EIO, msg, msg_size,
+                       "the motion could not be followed beyond t = %s (more than %d events in a "
+                       "period)",
+                       CM_NUM(r->r.t_section + r->r.st.s), CM_FO_MAX_EVENTS);
+    return CM_OK;
+}
+
+cm_status simulate_write(const sim_args *a, const sim_result *r, char *msg, size_t msg_size)
+{
+    const bool ok = (!a->out.csv || write_csv(a->out.csv, &r->tr, msg, msg_size)) &&
+                    (!a->out.png || write_png(a, &r->m, r->o, &r->tr, msg, msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void simulate_result_free(sim_result *r)
+{
+    free(r->tr.rows);
+    free(r->tr.samples);
+    r->tr = (track){0};
+    cm_model_release(&r->m);
 }

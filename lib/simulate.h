@@ -2,8 +2,9 @@
  * through its stick and slip phases (thesis Ch. 2) over
  * models/friction_oscillator.h: its events (sticks, breaks, turns, the
  * Poincare section) and samples recorded, written as CSV and as the time
- * history and phase portrait with the sticking band. Nothing is printed: a
- * failed write returns false with the problem in msg. */
+ * history and phase portrait with the sticking band. Nothing is printed:
+ * calls return a status with the problem in msg (CM_EINVAL: the
+ * request's). */
 #ifndef CM_LIB_SIMULATE_H
 #define CM_LIB_SIMULATE_H
 
@@ -46,19 +47,30 @@ typedef struct track {
 /* Follows the run for the requested periods, recording those after the
  * skipped ones; *last receives the last period's tally and z_prev the
  * section point before the last one. False when the motion is lost. */
-/* Follows the motion from r's state for a->periods periods (after
- * a->skip), recording its events and samples in tr (rows and samples
- * freed by the caller; tr->out_of_memory says if they ran out), the last
- * period's tally in *last and the state a period before the end in
- * z_prev. False when a period has more than CM_FO_MAX_EVENTS events. */
-bool simulate_follow(const cm_fo *o, const sim_args *a, cm_fo_run *r, track *tr, cm_fo_tally *last,
-                   double z_prev[2]);
+/* The command's defaults: friction-oscillator, from (0, 0), 20 periods,
+ * 900x1000 pixels; t0 (unless a->has_t0): the section's phase phi/Omega. */
+sim_args simulate_defaults(void);
 
-/* The recorded rows as CSV at path. */
-bool simulate_write_csv(const char *path, const track *tr, char *msg, size_t msg_size);
+/* The model, the motion followed and what it recorded. */
+typedef struct sim_result {
+    cm_model m;
+    const cm_fo *o; /* m's oscillator */
+    cm_fo_run r;    /* at the end */
+    track tr;
+    cm_fo_tally last; /* the last period's */
+    double z_prev[2]; /* the section point a period before the end */
+} sim_result;
 
-/* The time history and the phase portrait at a->out.png. */
-bool simulate_write_png(const sim_args *a, const cm_model *m, const cm_fo *o, const track *tr,
-                        char *msg, size_t msg_size);
+/* Builds the model and follows the motion from a->from at a->t0 for
+ * a->periods periods, recording those after a->skip; r is freed by
+ * simulate_result_free whatever the status (CM_EIO: the motion is lost,
+ * more than CM_FO_MAX_EVENTS events in a period). */
+cm_status simulate_compute(sim_args *a, sim_result *r, char *msg, size_t msg_size);
+
+/* The recorded rows as CSV at a->out.csv and the time history and phase
+ * portrait at a->out.png (either may be NULL). */
+cm_status simulate_write(const sim_args *a, const sim_result *r, char *msg, size_t msg_size);
+
+void simulate_result_free(sim_result *r);
 
 #endif

@@ -28,7 +28,7 @@ static double n_fixed(const stab_row *r)
     return r->m_fix_max >= 0 ? (double)(2 * r->m_fix_max + 1) : NAN;
 }
 
-bool stability_write_csv(const stab_args *a, const stab_row *rows, char *msg, size_t msg_size)
+static bool write_csv(const stab_args *a, const stab_row *rows, char *msg, size_t msg_size)
 {
     outfile o;
     if (outfile_begin(a->out.csv, &o, msg, msg_size) != CM_OK)
@@ -58,7 +58,7 @@ static cm_chart chart_of(const stab_args *a, int k, double xlo, double xhi, doub
                       NULL,      0};
 }
 
-bool stability_write_png(const stab_args *a, const cm_params *p, const stab_row *rows,
+static bool write_png(const stab_args *a, const cm_params *p, const stab_row *rows,
                       double alpha, double beta, double P0, double D0, char *msg, size_t msg_size)
 {
     const int n = a->P.n, na = a->alpha.n;
@@ -156,4 +156,48 @@ bool stability_write_png(const stab_args *a, const cm_params *p, const stab_row 
     const bool ok = (outfile_charts(a->out.png, charts, CHARTS, texts, 2, msg, msg_size) == CM_OK);
     free(v);
     return ok;
+}
+
+stab_args stability_defaults(void)
+{
+    return (stab_args){.mo = {.name = "microchaos-pd"}, .out = {.width = 900, .height = 1200}};
+}
+
+cm_status stability_compute(stab_args *a, stab_result *r, char *msg, size_t msg_size)
+{
+    *r = (stab_result){0};
+    const cm_status st = param_sweep_base(&a->mo, "microchaos-pd", NULL, 0, &r->base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    r->alpha = cm_params_get(&r->base, "alpha"), r->beta = cm_params_get(&r->base, "beta");
+    r->P = cm_params_get(&r->base, "P"), r->D = cm_params_get(&r->base, "D");
+    if (!a->has_P) {
+        a->P = (param_axis){.lo = 1.0025 * r->alpha * r->alpha,
+                            .hi = 1.2 * cm_pd_P_max(r->alpha, r->beta), .n = 400};
+        snprintf(a->P.name, sizeof a->P.name, "P");
+    }
+    if (!a->has_alpha) {
+        a->alpha = (param_axis){.lo = 0.05, .hi = 3, .n = 300};
+        snprintf(a->alpha.name, sizeof a->alpha.name, "alpha");
+    }
+    r->rows = calloc((size_t)a->P.n, sizeof *r->rows);
+    if (!r->rows)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d values of P", a->P.n);
+    for (int i = 0; i < a->P.n; i++)
+        stability_row_at(r->alpha, r->beta, param_axis_value(&a->P, i), r->D, &r->rows[i]);
+    return CM_OK;
+}
+
+cm_status stability_write(const stab_args *a, const stab_result *r, char *msg, size_t msg_size)
+{
+    bool ok = !a->out.csv || write_csv(a, r->rows, msg, msg_size);
+    ok = ok && (!a->out.png || write_png(a, &r->base, r->rows, r->alpha, r->beta, r->P, r->D, msg,
+                                         msg_size));
+    return ok ? CM_OK : CM_EIO;
+}
+
+void stability_result_free(stab_result *r)
+{
+    free(r->rows);
+    r->rows = NULL;
 }

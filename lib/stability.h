@@ -4,8 +4,8 @@
  * eigen-structure curves, the regular fixed points against P with the
  * border collisions, the fewest fixed points a stable choice of gains
  * allows against alpha, and the control error's bounds; written as CSV
- * and charts. Nothing is printed: a failed write returns false with the
- * problem in msg. */
+ * and charts. Nothing is printed: calls return a status with the problem
+ * in msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_STABILITY_H
 #define CM_LIB_STABILITY_H
 
@@ -34,12 +34,25 @@ typedef struct stab_row {
 /* The row at P (alpha, beta, D of the model). */
 void stability_row_at(double alpha, double beta, double P, double D, stab_row *r);
 
-/* The rows (a->P.n of them) as CSV at a->out.csv. */
-bool stability_write_csv(const stab_args *a, const stab_row *rows, char *msg, size_t msg_size);
+/* The command's defaults: microchaos-pd, 900x1200 pixels. */
+stab_args stability_defaults(void);
 
-/* The charts at a->out.png, the model's point (P0, D0) marked. */
-bool stability_write_png(const stab_args *a, const cm_params *p, const stab_row *rows,
-                         double alpha, double beta, double P0, double D0, char *msg,
-                         size_t msg_size);
+/* The model's parameters and a row per value of a->P. */
+typedef struct stab_result {
+    cm_params base;
+    double alpha, beta, P, D; /* the model's */
+    stab_row *rows;           /* a->P.n of them */
+} stab_result;
+
+/* Checks the model and fills the axes not given (P from 1.0025 alpha^2 to
+ * 1.2 P_max in 400 values, alpha 0.05..3 in 300), then computes r (freed
+ * by stability_result_free whatever the status). */
+cm_status stability_compute(stab_args *a, stab_result *r, char *msg, size_t msg_size);
+
+/* The rows as CSV at a->out.csv and the charts at a->out.png (either
+ * may be NULL), the model's point (P, D) marked. */
+cm_status stability_write(const stab_args *a, const stab_result *r, char *msg, size_t msg_size);
+
+void stability_result_free(stab_result *r);
 
 #endif

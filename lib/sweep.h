@@ -11,6 +11,7 @@
 #include "lib/attractor_report.h"
 #include "lib/outfile.h"
 #include "lib/project.h"
+#include "lib/work.h"
 
 /* The most values one sweep takes, and bisection steps of a change. */
 enum { MAX_VALUES = 200, MAX_REFINE = 40 };
@@ -37,6 +38,45 @@ typedef struct sweep_point {
     uint64_t attractor_cells, sticking_cells, sink_cells;
     double seconds;
 } sweep_point;
+
+/* Where the count of attractors changes: between lo and hi. */
+typedef struct sweep_change {
+    sweep_point lo, hi;
+    bool several; /* by more than one: bisection followed one of the changes */
+} sweep_change;
+
+/* What the caller hears as the sweep goes (each may be NULL): a point
+ * solved, a change located (after its bisection, only with a->refine). */
+typedef struct sweep_report {
+    void (*point)(void *user, const sweep_args *a, const sweep_point *pt);
+    void (*change)(void *user, const sweep_args *a, const sweep_change *ch);
+    void *user;
+} sweep_report;
+
+/* The sweep: its lattice and box, the points solved (the values' and the
+ * bisections', by value) and the changes. */
+typedef struct sweep_result {
+    cm_lattice lat;
+    cm_box box;
+    sweep_point *pts;
+    int n;
+    sweep_change *changes;
+    int n_changes;
+    double failed_value; /* the value whose solve failed (the status says how) */
+} sweep_result;
+
+/* Checks the model, the parameter, the window, the lattice and every
+ * value, and sets r's lattice and box. */
+cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size);
+
+/* Checks the setup and solves every value (then bisects each change
+ * a->refine times), progress in values through h, stopped by h
+ * (CM_ECANCELED, r->n values solved); r is freed by sweep_result_free
+ * whatever the status. */
+cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_report *rep,
+                        sweep_result *r, char *msg, size_t msg_size);
+
+void sweep_result_free(sweep_result *r);
 
 /* Solves the box at a->name = value and counts it into *pt. */
 cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,

@@ -36,4 +36,9 @@ static inline const char *work_stop(const work_hooks *h)
     return h && h->stop ? h->stop(h->user) : NULL;
 }
 
+/* In a parallel loop: counts one unit more in *done (atomically) and, on
+ * the loop's first thread only (the hooks need not be thread-safe), says
+ * so through h. */
+void work_tick(const work_hooks *h, uint64_t *done);
+
 #endif

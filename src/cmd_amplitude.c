@@ -3,7 +3,6 @@
  * solution's amplitude (2.25) with its conditions of validity (2.27),
  * (2.29) and its stability, against simulation. */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,8 +43,6 @@ static const char amplitude_help[] =
     "  --quiet             no summary\n"
     "  --threads T         OpenMP threads (default: all cores)\n";
 
-enum { RECORD = 40 };
-
 static int parse_args(cli *c, amp_args *a)
 {
     int err = 0;
@@ -81,25 +78,10 @@ static int parse_args(cli *c, amp_args *a)
     return err;
 }
 
-typedef struct counts {
-    int valid, stable, lost;
-} counts;
-
-static void summarise(const amp_args *a, const cm_fo_amplitude *v, counts *c)
-{
-    *c = (counts){0, 0, 0};
-    for (int i = 0; i < a->omega.n; i++) {
-        c->valid += v[i].valid;
-        c->stable += v[i].stable;
-        c->lost += isnan(v[i].sim_amplitude);
-    }
-}
-
 int cmd_amplitude(int argc, char **argv)
 {
     cli c = {"amplitude", argc, argv, 0, NULL, NULL};
-    amp_args a = {.mo = {.name = "friction-oscillator"}, .periods = 400, .ymax = 5,
-                  .out = {.width = 1000, .height = 700}};
+    amp_args a = amplitude_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -110,52 +92,29 @@ int cmd_amplitude(int argc, char **argv)
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);
     if (verr)
         return verr;
-    const int n = a.omega.n;
-    cm_fo_amplitude *v = calloc((size_t)n, sizeof *v);
-    if (!v) {
-        fprintf(stderr, "cellmap amplitude: out of memory for %d frequencies\n", n);
-        return EXIT_FAIL;
-    }
-    int invalid = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(a.threads ? a.threads : omp_get_max_threads()) reduction(| : invalid)
-    for (int i = 0; i < n; i++) {
-        const int idx[1] = {i};
-        cm_model m;
-        if (!model_at_point(&a.mo, &a.omega, idx, 1, &m)) {
-            invalid = 1;
-            v[i] = (cm_fo_amplitude){NAN, NAN, NAN, false, NAN, false, NAN, NAN};
-            continue;
-        }
-        cm_fo_amplitude_at(cm_fo_of_model(&m), a.periods, RECORD, &v[i]);
-        cm_model_release(&m);
-    }
-    counts cnt;
-    summarise(&a, v, &cnt);
-    if (a.out.json) {
-        json j;
-        json_begin(&j, stdout, "amplitude");
-        param_base_json(&j, a.mo.name, &base);
-        param_axes_json(&j, "omega", &a.omega, 1);
-        json_int(&j, "periods", a.periods);
-        json_int(&j, "valid", cnt.valid);
-        json_int(&j, "stable", cnt.stable);
-        json_int(&j, "lost", cnt.lost);
-        json_end(&j);
-    } else if (!a.out.quiet) {
-        fprintf(report_stream(a.out.csv, a.out.png, NULL),
-                "%d frequencies: (2.25) valid at %d, the symmetric non-sticking solution "
-                "stable at %d; %d simulations lost%s\n",
-                n, cnt.valid, cnt.stable, cnt.lost,
-                invalid ? "; some frequencies could not be built (S > S0)" : "");
-    }
     char msg[1024];
-    bool ok = true;
-    if (a.out.csv)
-        ok = amplitude_write_csv(&a, v, msg, sizeof msg);
-    if (ok && a.out.png)
-        ok = amplitude_write_png(&a, &base, v, msg, sizeof msg);
-    if (!ok)
-        fprintf(stderr, "cellmap amplitude: %s\n", msg);
-    free(v);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    amp_result r;
+    cm_status st = amplitude_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a.out.json) {
+            json j;
+            json_begin(&j, stdout, "amplitude");
+            param_base_json(&j, a.mo.name, &r.base);
+            param_axes_json(&j, "omega", &a.omega, 1);
+            json_int(&j, "periods", a.periods);
+            json_int(&j, "valid", r.valid);
+            json_int(&j, "stable", r.stable);
+            json_int(&j, "lost", r.lost);
+            json_end(&j);
+        } else if (!a.out.quiet) {
+            fprintf(report_stream(a.out.csv, a.out.png, NULL),
+                    "%d frequencies: (2.25) valid at %d, the symmetric non-sticking solution "
+                    "stable at %d; %d simulations lost%s\n",
+                    a.omega.n, r.valid, r.stable, r.lost,
+                    r.invalid ? "; some frequencies could not be built (S > S0)" : "");
+        }
+        st = amplitude_write(&a, &r, msg, sizeof msg);
+    }
+    amplitude_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

@@ -154,12 +154,7 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
 int cmd_bifurcation(int argc, char **argv)
 {
     cli c = {"bifurcation", argc, argv, 0, NULL, NULL};
-    bif_args a = {.mo = {.name = "friction-oscillator"},
-                  .runs = 10,
-                  .transient = 1000,
-                  .record = 50,
-                  .seed = 1,
-                  .out = {.width = 900, .height = 1200}};
+    bif_args a = bifurcation_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -172,63 +167,24 @@ int cmd_bifurcation(int argc, char **argv)
     const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.sweep, 1, &base);
     if (verr)
         return verr;
-    const int n_values = a.sweep.n;
-    const size_t n_runs = (size_t)n_values * (size_t)a.runs;
-    sweep_results s = {n_values, a.runs, a.record, calloc(n_runs, sizeof(run_result)),
-                       malloc(n_runs * 2 * (size_t)a.record * sizeof(double))};
-    cm_model *models = calloc((size_t)n_values, sizeof *models);
-    if (!s.res || !s.sections || !models) {
-        fprintf(stderr, "cellmap bifurcation: out of memory for %zu runs\n", n_runs);
-        bifurcation_free(&s, models);
-        return EXIT_FAIL;
-    }
-    for (size_t k = 0; k < n_runs * 2 * (size_t)a.record; k++)
-        s.sections[k] = NAN;
-    int n_valid = 0;
-    for (int i = 0; i < n_values; i++) {
-        if (!model_at_point(&a.mo, &a.sweep, &i, 1, &models[i]))
-            continue;
-        n_valid++;
-        for (int r = 0; r < a.runs; r++)
-            s.res[(size_t)i * (size_t)a.runs + (size_t)r].valid = true;
-    }
-    const double t0 = cm_seconds();
+    const uint64_t n_runs = (uint64_t)a.sweep.n * (uint64_t)a.runs;
     progress pr;
     progress_start(&pr, "bifurcation", "runs", n_runs, a.out.quiet);
+    const work_hooks hooks = progress_hooks(&pr);
     interrupt_catch();
-    uint64_t done = 0;
-#pragma omp parallel for schedule(dynamic, 1)                                                      \
-    num_threads(a.threads ? a.threads : omp_get_max_threads())
-    for (size_t k = 0; k < n_runs; k++) {
-        const int i = (int)(k / (size_t)a.runs), r = (int)(k % (size_t)a.runs);
-        if (!s.res[k].valid || interrupt_requested()) /* Ctrl-C: the runs left are skipped */
-            continue;
-        bifurcation_run(&a, cm_fo_of_model(&models[i]), i, r, &s.res[k],
-                        s.sections + k * 2 * (size_t)a.record);
-        progress_tick(&pr, &done);
-    }
+    char msg[1024];
+    bif_result r;
+    cm_status st = bifurcation_compute(&a, &hooks, &r, msg, sizeof msg);
     progress_end(&pr);
-    if (interrupt_requested()) {
-        bifurcation_free(&s, models);
-        return interrupt_stopped("bifurcation", done, n_runs, "runs");
+    if (st == CM_ECANCELED) {
+        bifurcation_result_free(&r);
+        return interrupt_stopped("bifurcation", r.done, n_runs, "runs");
     }
-    if (!a.out.quiet || a.out.json)
-        print_summary(&a, &base, &s, cm_seconds() - t0);
-    char msg[1024] = "";
-    bool ok = n_valid > 0;
-    if (!ok)
-        fprintf(stderr,
-                "cellmap bifurcation: no value of %s admits the model (is S <= S0 "
-                "anywhere?)\n",
-                a.sweep.name);
-    if (ok && a.out.csv)
-        ok = bifurcation_write_points_csv(&a, &s, msg, sizeof msg);
-    if (ok && a.runs_csv)
-        ok = bifurcation_write_runs_csv(&a, &s, msg, sizeof msg);
-    if (ok && a.out.png)
-        ok = bifurcation_write_png(&a, &base, &s, msg, sizeof msg);
-    if (!ok && msg[0])
-        fprintf(stderr, "cellmap bifurcation: %s\n", msg);
-    bifurcation_free(&s, models);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    if (st == CM_OK) {
+        if (!a.out.quiet || a.out.json)
+            print_summary(&a, &r.base, &r.s, r.seconds);
+        st = bifurcation_write(&a, &r, msg, sizeof msg);
+    }
+    bifurcation_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

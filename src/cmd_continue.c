@@ -197,16 +197,9 @@ static int parse_args(cli *c, cont_args *a)
     }
     if (!err && !a->has_vary)
         err = cli_usage_error(c, "--vary NAME=LO:HI is required (e.g. --vary S=0.02:0.4)");
-    if (!err && a->n_panels == 0)
-        for (int k = 0; k < PANELS; k++)
-            a->panels[a->n_panels++] = k;
-    if (!err && a->height == 0) {
-        a->width = 900;
-        a->height = a->n_panels == PANELS ? 1100 : 450 * a->n_panels;
-    }
-    if (!err && a->height < 150 * a->n_panels)
-        err = cli_usage_error(c, "--size: %d panels want at least %d pixels of height",
-                              a->n_panels, 150 * a->n_panels);
+    char msg[256];
+    if (!err && continuation_layout(a, msg, sizeof msg) != CM_OK)
+        err = cli_usage_error(c, "--size: %s", msg);
     if (!err && a->json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->events)))
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && (cm_output_names_stdout(a->csv) + cm_output_names_stdout(a->events) +
@@ -308,46 +301,20 @@ int cmd_continue(int argc, char **argv)
         werr = chart_png_check("continue", a.png);
     if (werr != EXIT_OK)
         return werr;
-    cm_model m;
-    const int merr = model_opts_build(&c, &a.mo, &m);
-    if (merr)
-        return merr;
-    const cm_fo *o = cm_fo_of_model(&m);
-    const int param = cm_fo_param_of(a.vary);
-    const double p0 = o ? (double[4]){o->S, o->S0, o->Omega, o->phi}[param] : 0;
-    int err = 0;
-    if (!o)
-        err = cli_usage_error(&c, "model %s: continue follows friction-oscillator only",
-                              a.mo.name);
-    else if (!(p0 >= a.lo && p0 <= a.hi))
-        err = cli_usage_error(&c,
-                              "%s = %s (from --param or the default) is outside --vary %s=%s:%s; "
-                              "start inside the range",
-                              a.vary, CM_NUM(p0), a.vary, CM_NUM(a.lo), CM_NUM(a.hi));
-    collected col = {0};
     char msg[1024];
-    cm_status st = CM_OK;
-    if (!err && (st = continuation_follow(&a, o, param, p0, &col, msg, sizeof msg)) != CM_OK)
-        err = st == CM_EINVAL ? EXIT_USAGE : EXIT_FAIL;
-    if (st == CM_OK && !err && a.json)
-        print_json(&a, &m, &col);
-    else if (st == CM_OK && !err && !a.quiet)
-        print_text(&a, &col);
-    if (st == CM_OK && !err && a.csv)
-        st = continuation_write_points(&a, &col, msg, sizeof msg);
-    if (st == CM_OK && !err && a.events)
-        st = continuation_write_events(&a, &col, msg, sizeof msg);
-    if (st == CM_OK && !err && a.png)
-        st = continuation_write_png(&a, &m, &col, msg, sizeof msg);
-    int n_curves = 0;
-    if (st == CM_OK && !err && a.curves)
-        st = continuation_write_curves(&a, o, &col, &n_curves, msg, sizeof msg);
-    if (st == CM_OK && !err && a.curves && !a.quiet && !a.json)
-        fprintf(report_stream(a.csv, a.events, a.png), "%d curves in (%s, %s) to %s\n", n_curves,
-                a.vary, a.vary2, cm_output_names_stdout(a.curves) ? "standard output" : a.curves);
-    if (st != CM_OK)
-        fprintf(stderr, "cellmap continue: %s\n", msg);
-    continuation_free(&col);
-    cm_model_release(&m);
-    return err ? err : st == CM_OK ? EXIT_OK : EXIT_FAIL;
+    cont_result r;
+    cm_status st = continuation_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a.json)
+            print_json(&a, &r.m, &r.col);
+        else if (!a.quiet)
+            print_text(&a, &r.col);
+        st = continuation_write(&a, &r, msg, sizeof msg);
+    }
+    if (st == CM_OK && a.curves && !a.quiet && !a.json)
+        fprintf(report_stream(a.csv, a.events, a.png), "%d curves in (%s, %s) to %s\n",
+                r.n_curves, a.vary, a.vary2,
+                cm_output_names_stdout(a.curves) ? "standard output" : a.curves);
+    continuation_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

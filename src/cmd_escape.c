@@ -162,8 +162,7 @@ static void print_point(FILE *f, const esc_args *a, const esc_point *p)
 int cmd_escape(int argc, char **argv)
 {
     cli c = {"escape", argc, argv, 0, NULL, NULL};
-    esc_args a = {.mo = {.name = "microchaos-1d-friction"}, .cells = 100000,
-                  .ensemble = 1000000, .out = {.width = 1000, .height = 600}};
+    esc_args a = escape_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -177,59 +176,35 @@ int cmd_escape(int argc, char **argv)
                                  sweeps_param ? 1 : 0, &base);
     if (verr)
         return verr;
-    const int n = escape_points(&a);
-    esc_point *pts = calloc((size_t)n, sizeof *pts);
-    if (!pts) {
-        fprintf(stderr, "cellmap escape: out of memory for %d points\n", n);
-        return EXIT_FAIL;
-    }
-    escape_compute(&a, pts);
-    int valid = 0;
-    for (int i = 0; i < n; i++)
-        valid += pts[i].valid;
-    if (!a.has_sweep && !pts[0].valid) {
-        fprintf(stderr, "cellmap escape: %s; choose other parameters\n", pts[0].why);
-        free(pts);
-        return EXIT_USAGE;
-    }
-    char params[400];
-    const char *const skip[] = {a.has_sweep ? a.sweep.name : "", a.has_I0 ? "c" : "", NULL};
-    cm_params_format_with(&base, skip, params, sizeof params);
-    if (a.has_I0) {
-        const size_t used = strlen(params);
-        snprintf(params + used, sizeof params - used, "%s|I0|=%s", used ? "," : "", CM_NUM(a.I0));
-    }
-    if (a.out.json) {
-        json j;
-        json_begin(&j, stdout, "escape");
-        param_base_json(&j, a.mo.name, &base);
-        if (a.has_I0) /* c at each point from it */
-            json_num(&j, "I0", a.I0);
-        if (a.has_sweep)
-            param_axes_json(&j, "sweep", &a.sweep, 1);
-        json_int(&j, "cells", (int)a.cells);
-        json_int(&j, "ensemble", (int)a.ensemble);
-        json_array(&j, "points");
-        for (int i = 0; i < n; i++)
-            json_point(&j, &pts[i]);
-        json_array_end(&j);
-        json_end(&j);
-    } else if (!a.out.quiet) {
-        FILE *f = report_stream(a.out.csv, a.out.png, NULL);
-        if (a.has_sweep)
-            fprintf(f, "%d points, %d in the case of 4.3 (one positive fixed point in I_rep)\n", n,
-                    valid);
-        else
-            print_point(f, &a, &pts[0]);
-    }
     char msg[1024];
-    bool ok = true;
-    if (a.out.csv)
-        ok = escape_write_csv(&a, pts, msg, sizeof msg);
-    if (ok && a.out.png)
-        ok = escape_write_png(&a, pts, params, msg, sizeof msg);
-    if (!ok)
-        fprintf(stderr, "cellmap escape: %s\n", msg);
-    free(pts);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    esc_result r;
+    cm_status st = escape_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a.out.json) {
+            json j;
+            json_begin(&j, stdout, "escape");
+            param_base_json(&j, a.mo.name, &r.base);
+            if (a.has_I0) /* c at each point from it */
+                json_num(&j, "I0", a.I0);
+            if (a.has_sweep)
+                param_axes_json(&j, "sweep", &a.sweep, 1);
+            json_int(&j, "cells", (int)a.cells);
+            json_int(&j, "ensemble", (int)a.ensemble);
+            json_array(&j, "points");
+            for (int i = 0; i < r.n; i++)
+                json_point(&j, &r.pts[i]);
+            json_array_end(&j);
+            json_end(&j);
+        } else if (!a.out.quiet) {
+            FILE *f = report_stream(a.out.csv, a.out.png, NULL);
+            if (a.has_sweep)
+                fprintf(f, "%d points, %d in the case of 4.3 (one positive fixed point in I_rep)\n",
+                        r.n, r.valid);
+            else
+                print_point(f, &a, &r.pts[0]);
+        }
+        st = escape_write(&a, &r, msg, sizeof msg);
+    }
+    escape_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

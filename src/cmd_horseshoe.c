@@ -97,12 +97,42 @@ static void print_item(FILE *f, const hs_args *a, const hs_item *it)
             it->entropy);
 }
 
+static void print_json(const hs_args *a, const hs_result *r)
+{
+    json j;
+    json_begin(&j, stdout, "horseshoe");
+    param_base_json(&j, a->mo.name, &r->base);
+    if (a->has_sweep)
+        param_axes_json(&j, "sweep", &a->sweep, 1);
+    json_int(&j, "periods", a->periods);
+    json_array(&j, "lines");
+    for (int i = 0; i < r->count; i++) {
+        const cm_pd_horseshoe *h = &r->items[i].h;
+        json_object(&j, NULL);
+        json_num(&j, "P", r->items[i].P);
+        json_int(&j, "m", h->m);
+        json_nums(&j, "RULS", h->RULS, 2);
+        json_nums(&j, "LURS", h->LURS, 2);
+        json_nums(&j, "RUSW", h->RUSW, 2);
+        json_nums(&j, "LUSW", h->LUSW, 2);
+        json_array(&j, "escape");
+        for (int e = 0; e < 4; e++)
+            json_bool(&j, NULL, h->escape[e]);
+        json_array_end(&j);
+        json_str(&j, "kind", h->stretches ? "repeller" : "attractor");
+        json_bool(&j, "full_shift", h->full_shift);
+        json_uint(&j, "periodic", r->items[i].periodic);
+        json_num(&j, "entropy", r->items[i].entropy);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_end(&j);
+}
+
 int cmd_horseshoe(int argc, char **argv)
 {
     cli c = {"horseshoe", argc, argv, 0, NULL, NULL};
-    hs_args a = {.mo = {.name = "microchaos-pd"},
-                 .periods = 12,
-                 .out = {.width = 1000, .height = 600}};
+    hs_args a = horseshoe_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -114,77 +144,23 @@ int cmd_horseshoe(int argc, char **argv)
         sweep_check(&c, &a.mo, "microchaos-pd", a.has_sweep ? &a.sweep : NULL, a.has_sweep, &base);
     if (verr)
         return verr;
-    const double alpha = cm_params_get(&base, "alpha"), beta = cm_params_get(&base, "beta"),
-                 P = cm_params_get(&base, "P"), D = cm_params_get(&base, "D");
-    if (!a.has_m) {
-        const int64_t m_max = cm_pd_m_max(alpha, P);
-        if (m_max < 1 || m_max > 1000) {
-            fprintf(stderr, "cellmap horseshoe: m_max = %lld at these parameters (P <= alpha^2, "
-                            "or too many lines); give --m M0:M1\n",
-                    (long long)m_max);
-            return EXIT_USAGE;
-        }
-        a.m0 = 1, a.m1 = m_max;
-    }
-    const int nm = (int)(a.m1 - a.m0 + 1), np = a.has_sweep ? a.sweep.n : 1;
-    hs_item *items = calloc((size_t)nm * (size_t)np, sizeof *items);
-    if (!items) {
-        fprintf(stderr, "cellmap horseshoe: out of memory\n");
-        return EXIT_FAIL;
-    }
-    for (int i = 0; i < np; i++)
-        for (int j = 0; j < nm; j++)
-            horseshoe_item_at(alpha, beta, a.has_sweep ? param_axis_value(&a.sweep, i) : P, D, a.m0 + j,
-                    a.periods, &items[(size_t)i * (size_t)nm + (size_t)j]);
-    const int count = nm * np;
-    char params[400];
-    const char *const skip[] = {a.has_sweep ? "P" : "", NULL};
-    cm_params_format_with(&base, skip, params, sizeof params);
-    if (a.out.json) {
-        json j;
-        json_begin(&j, stdout, "horseshoe");
-        param_base_json(&j, a.mo.name, &base);
-        if (a.has_sweep)
-            param_axes_json(&j, "sweep", &a.sweep, 1);
-        json_int(&j, "periods", a.periods);
-        json_array(&j, "lines");
-        for (int i = 0; i < count; i++) {
-            const cm_pd_horseshoe *h = &items[i].h;
-            json_object(&j, NULL);
-            json_num(&j, "P", items[i].P);
-            json_int(&j, "m", h->m);
-            json_nums(&j, "RULS", h->RULS, 2);
-            json_nums(&j, "LURS", h->LURS, 2);
-            json_nums(&j, "RUSW", h->RUSW, 2);
-            json_nums(&j, "LUSW", h->LUSW, 2);
-            json_array(&j, "escape");
-            for (int e = 0; e < 4; e++)
-                json_bool(&j, NULL, h->escape[e]);
-            json_array_end(&j);
-            json_str(&j, "kind", h->stretches ? "repeller" : "attractor");
-            json_bool(&j, "full_shift", h->full_shift);
-            json_uint(&j, "periodic", items[i].periodic);
-            json_num(&j, "entropy", items[i].entropy);
-            json_object_end(&j);
-        }
-        json_array_end(&j);
-        json_end(&j);
-    } else if (!a.out.quiet) {
-        FILE *f = report_stream(a.out.csv, a.out.png, NULL);
-        if (a.has_sweep)
-            fprintf(f, "%d values of P at SW_%lld..%lld\n", np, (long long)a.m0, (long long)a.m1);
-        else
-            for (int i = 0; i < count; i++)
-                print_item(f, &a, &items[i]);
-    }
     char msg[1024];
-    bool ok = true;
-    if (a.out.csv)
-        ok = horseshoe_write_csv(&a, items, count, msg, sizeof msg);
-    if (ok && a.out.png)
-        ok = horseshoe_write_png(&a, items, nm, count, alpha, beta, P, D, params, msg, sizeof msg);
-    if (!ok)
-        fprintf(stderr, "cellmap horseshoe: %s\n", msg);
-    free(items);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    hs_result r;
+    cm_status st = horseshoe_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a.out.json) {
+            print_json(&a, &r);
+        } else if (!a.out.quiet) {
+            FILE *f = report_stream(a.out.csv, a.out.png, NULL);
+            if (a.has_sweep)
+                fprintf(f, "%d values of P at SW_%lld..%lld\n", a.sweep.n, (long long)a.m0,
+                        (long long)a.m1);
+            else
+                for (int i = 0; i < r.count; i++)
+                    print_item(f, &a, &r.items[i]);
+        }
+        st = horseshoe_write(&a, &r, msg, sizeof msg);
+    }
+    horseshoe_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

@@ -113,20 +113,14 @@ static int parse_args(cli *c, lyap_args *a)
     return err;
 }
 
-typedef struct summary {
-    size_t points, computed, positive, best;
-    double seconds;
-    bool invalid; /* some points could not be built (S > S0) */
-} summary;
-
-static void print_text(const lyap_args *a, const double *v, const summary *s)
+static void print_text(const lyap_args *a, const lyap_result *s)
 {
     FILE *out = report_stream(a->csv, a->png, NULL);
     const size_t nx = (size_t)a->ax[0].n;
     fprintf(out, "%zu grid points in %.2f s: %zu computed, %zu with lambda > 0", s->points,
             s->seconds, s->computed, s->positive);
-    if (!isnan(v[s->best]))
-        fprintf(out, "; largest %.6g at %s = %s, %s = %s", v[s->best], a->ax[0].name,
+    if (!isnan(s->v[s->best]))
+        fprintf(out, "; largest %.6g at %s = %s, %s = %s", s->v[s->best], a->ax[0].name,
                 CM_NUM(param_axis_value(&a->ax[0], (int)(s->best % nx))), a->ax[1].name,
                 CM_NUM(param_axis_value(&a->ax[1], (int)(s->best / nx))));
     fprintf(out, "\n");
@@ -134,21 +128,20 @@ static void print_text(const lyap_args *a, const double *v, const summary *s)
         fprintf(out, "points where the model cannot be built (S > S0) are not computed\n");
 }
 
-static void print_json(const lyap_args *a, const cm_params *base, const double *v,
-                       const summary *s)
+static void print_json(const lyap_args *a, const lyap_result *s)
 {
     const size_t nx = (size_t)a->ax[0].n;
     json j;
     json_begin(&j, stdout, "lyapunov");
-    param_base_json(&j, a->mo.name, base);
+    param_base_json(&j, a->mo.name, &s->base);
     param_axes_json(&j, "grid", a->ax, 2);
     json_int(&j, "periods", a->periods);
     json_uint(&j, "points", s->points);
     json_uint(&j, "computed", s->computed);
     json_uint(&j, "positive", s->positive);
-    if (!isnan(v[s->best])) {
+    if (!isnan(s->v[s->best])) {
         json_object(&j, "largest");
-        json_num(&j, "lambda", v[s->best]);
+        json_num(&j, "lambda", s->v[s->best]);
         json_num(&j, a->ax[0].name, param_axis_value(&a->ax[0], (int)(s->best % nx)));
         json_num(&j, a->ax[1].name, param_axis_value(&a->ax[1], (int)(s->best / nx)));
         json_object_end(&j);
@@ -157,40 +150,10 @@ static void print_json(const lyap_args *a, const cm_params *base, const double *
     json_end(&j);
 }
 
-/* The start of a model other than the friction oscillator: --from, with
- * its dimension checked, or the centre of the model's default region. */
-static int start_of(const cli *c, lyap_args *a)
-{
-    const cm_model_entry *e = cm_model_set_find(&a->mo.set, a->mo.name, NULL);
-    cm_model m;
-    if (model_opts_build(c, &a->mo, &m) != EXIT_OK)
-        return EXIT_USAGE;
-    const int dim = m.dim;
-    cm_model_release(&m);
-    if (a->n_from && a->n_from != dim)
-        return cli_usage_error(c, "--from has %d value(s) but model %s has dimension %d",
-                               a->n_from, e->name, dim);
-    if (a->n_from)
-        return EXIT_OK;
-    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
-    int n = 0;
-    if (!e->region || !parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != dim)
-        return cli_usage_error(c, "model %s has no default region: give the start with --from",
-                               e->name);
-    for (int d = 0; d < dim; d++)
-        a->from[d] = 0.5 * (lo[d] + hi[d]);
-    a->n_from = dim;
-    return EXIT_OK;
-}
-
 int cmd_lyapunov(int argc, char **argv)
 {
     cli c = {"lyapunov", argc, argv, 0, NULL, NULL};
-    lyap_args a = {.mo = {.name = "friction-oscillator"},
-                   .periods = 600,
-                   .d0 = 1e-8,
-                   .width = 900,
-                   .height = 700};
+    lyap_args a = lyapunov_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -199,77 +162,30 @@ int cmd_lyapunov(int argc, char **argv)
         werr = chart_png_check("lyapunov", a.png);
     if (werr != EXIT_OK)
         return werr;
-    /* the parameters without the grid's; S0 >= S is checked per point */
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, NULL, a.ax, 2, &base);
     if (verr)
         return verr;
-    const bool fo = strcmp(a.mo.name, "friction-oscillator") == 0;
-    if (!fo && start_of(&c, &a))
-        return EXIT_USAGE;
-    overlay ov;
-    char msg[1024];
-    memset(&ov, 0, sizeof ov);
-    const cm_status read = lyapunov_read_curves(&a, &ov, msg, sizeof msg);
-    const size_t nx = (size_t)a.ax[0].n, n = nx * (size_t)a.ax[1].n;
-    double *v = read == CM_OK ? malloc(n * sizeof *v) : NULL;
-    if (!v) {
-        lyapunov_overlay_free(&ov);
-        if (read != CM_OK) {
-            fprintf(stderr, "cellmap lyapunov: %s\n", msg);
-            return read == CM_EINVAL ? EXIT_USAGE : EXIT_FAIL;
-        }
-        fprintf(stderr, "cellmap lyapunov: out of memory for %zu grid points\n", n);
-        return EXIT_FAIL;
-    }
-    int invalid = 0;
-    const double t0 = cm_seconds();
+    const uint64_t n = (uint64_t)a.ax[0].n * (uint64_t)a.ax[1].n;
     progress pr;
     progress_start(&pr, "lyapunov", "grid points", n, a.quiet);
+    const work_hooks hooks = progress_hooks(&pr);
     interrupt_catch();
-    uint64_t done = 0;
-#pragma omp parallel for schedule(dynamic, 1)                                                      \
-    num_threads(a.threads ? a.threads : omp_get_max_threads()) reduction(|                         \
-                                                                         : invalid)
-    for (size_t k = 0; k < n; k++) {
-        if (interrupt_requested()) { /* Ctrl-C: the points left are skipped */
-            v[k] = NAN;
-            continue;
-        }
-        v[k] = lyapunov_point(&a, (int)(k % nx), (int)(k / nx), &invalid);
-        progress_tick(&pr, &done);
-    }
+    char msg[1024];
+    lyap_result r;
+    cm_status st = lyapunov_compute(&a, &hooks, &r, msg, sizeof msg);
     progress_end(&pr);
-    if (interrupt_requested()) {
-        free(v);
-        lyapunov_overlay_free(&ov);
-        return interrupt_stopped("lyapunov", done, n, "grid points");
+    if (st == CM_ECANCELED) {
+        lyapunov_result_free(&r);
+        return interrupt_stopped("lyapunov", r.done, n, "grid points");
     }
-    const double secs = cm_seconds() - t0;
-    size_t positive = 0, computed = 0, best = 0;
-    for (size_t k = 0; k < n; k++) {
-        computed += !isnan(v[k]);
-        positive += v[k] > 0;
-        if (!(v[best] >= v[k]))
-            best = k;
+    if (st == CM_OK) {
+        if (a.json)
+            print_json(&a, &r);
+        else if (!a.quiet)
+            print_text(&a, &r);
+        st = lyapunov_write(&a, &r, msg, sizeof msg);
     }
-    const summary sum = {n, computed, positive, best, secs, invalid != 0};
-    if (a.json)
-        print_json(&a, &base, v, &sum);
-    else if (!a.quiet)
-        print_text(&a, v, &sum);
-    bool ok = computed > 0;
-    if (!ok)
-        fprintf(stderr,
-                "cellmap lyapunov: no grid point could be computed (%s)\n",
-                fo ? "is S <= S0 anywhere?" : "every orbit from --from left the world or had no image");
-    if (ok && a.csv)
-        ok = lyapunov_write_csv(&a, v, msg, sizeof msg);
-    if (ok && a.png)
-        ok = lyapunov_write_png(&a, a.mo.name, &base, v, &ov, msg, sizeof msg);
-    if (!ok && computed > 0)
-        fprintf(stderr, "cellmap lyapunov: %s\n", msg);
-    free(v);
-    lyapunov_overlay_free(&ov);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    lyapunov_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

@@ -118,51 +118,20 @@ static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run 
 int cmd_simulate(int argc, char **argv)
 {
     cli c = {"simulate", argc, argv, 0, NULL, NULL};
-    sim_args a = {
-        .mo = {.name = "friction-oscillator"}, .periods = 20, .out = {.width = 900, .height = 1000}};
+    sim_args a = simulate_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
     const int werr = chart_outputs_writable(&c, &a.out);
     if (werr != EXIT_OK)
         return werr;
-    cm_model m;
-    const int merr = model_opts_build(&c, &a.mo, &m);
-    if (merr)
-        return merr;
-    const cm_fo *o = cm_fo_of_model(&m);
-    if (!o) {
-        cm_model_release(&m);
-        return cli_usage_error(&c, "model %s: simulate follows friction-oscillator only",
-                               a.mo.name);
+    char msg[1024];
+    sim_result r;
+    cm_status st = simulate_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        print_summary(&a, &r.m, &r.r, &r.last, r.z_prev, fabs(r.tr.psi_sum));
+        st = simulate_write(&a, &r, msg, sizeof msg);
     }
-    if (!a.has_t0)
-        a.t0 = o->phi / o->Omega;
-    cm_fo_run r;
-    cm_fo_run_start(o, a.t0, a.from[0], a.from[1], &r);
-    track tr = {0};
-    cm_fo_tally last;
-    double z_prev[2];
-    bool ok = simulate_follow(o, &a, &r, &tr, &last, z_prev) && !tr.out_of_memory;
-    if (tr.out_of_memory)
-        fprintf(stderr, "cellmap simulate: out of memory for the trajectory\n");
-    else if (!ok)
-        fprintf(stderr,
-                "cellmap simulate: the motion could not be followed beyond t = %s (more "
-                "than %d events in a period)\n",
-                CM_NUM(r.t_section + r.st.s), CM_FO_MAX_EVENTS);
-    if (ok) {
-        char msg[1024];
-        print_summary(&a, &m, &r, &last, z_prev, fabs(tr.psi_sum));
-        if (a.out.csv)
-            ok = simulate_write_csv(a.out.csv, &tr, msg, sizeof msg);
-        if (ok && a.out.png)
-            ok = simulate_write_png(&a, &m, o, &tr, msg, sizeof msg);
-        if (!ok)
-            fprintf(stderr, "cellmap simulate: %s\n", msg);
-    }
-    free(tr.rows);
-    free(tr.samples);
-    cm_model_release(&m);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    simulate_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

@@ -139,7 +139,7 @@ static void print_json(const stab_args *a, const cm_params *p, double alpha, dou
 int cmd_stability(int argc, char **argv)
 {
     cli c = {"stability", argc, argv, 0, NULL, NULL};
-    stab_args a = {.mo = {.name = "microchaos-pd"}, .out = {.width = 900, .height = 1200}};
+    stab_args a = stability_defaults();
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
@@ -150,36 +150,16 @@ int cmd_stability(int argc, char **argv)
     const int verr = sweep_check(&c, &a.mo, "microchaos-pd", NULL, 0, &base);
     if (verr)
         return verr;
-    const double alpha = cm_params_get(&base, "alpha"), beta = cm_params_get(&base, "beta"),
-                 P = cm_params_get(&base, "P"), D = cm_params_get(&base, "D");
-    if (!a.has_P) {
-        const double lo = 1.0025 * alpha * alpha, hi = 1.2 * cm_pd_P_max(alpha, beta);
-        a.P = (param_axis){.lo = lo, .hi = hi, .n = 400};
-        snprintf(a.P.name, sizeof a.P.name, "P");
-    }
-    if (!a.has_alpha) {
-        a.alpha = (param_axis){.lo = 0.05, .hi = 3, .n = 300};
-        snprintf(a.alpha.name, sizeof a.alpha.name, "alpha");
-    }
-    stab_row *rows = calloc((size_t)a.P.n, sizeof *rows);
-    if (!rows) {
-        fprintf(stderr, "cellmap stability: out of memory for %d values of P\n", a.P.n);
-        return EXIT_FAIL;
-    }
-    for (int i = 0; i < a.P.n; i++)
-        stability_row_at(alpha, beta, param_axis_value(&a.P, i), D, &rows[i]);
-    if (a.out.json)
-        print_json(&a, &base, alpha, beta, P, D);
-    else if (!a.out.quiet)
-        print_summary(report_stream(a.out.csv, a.out.png, NULL), alpha, beta, P, D);
     char msg[1024];
-    bool ok = true;
-    if (a.out.csv)
-        ok = stability_write_csv(&a, rows, msg, sizeof msg);
-    if (ok && a.out.png)
-        ok = stability_write_png(&a, &base, rows, alpha, beta, P, D, msg, sizeof msg);
-    if (!ok)
-        fprintf(stderr, "cellmap stability: %s\n", msg);
-    free(rows);
-    return ok ? EXIT_OK : EXIT_FAIL;
+    stab_result r;
+    cm_status st = stability_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a.out.json)
+            print_json(&a, &r.base, r.alpha, r.beta, r.P, r.D);
+        else if (!a.out.quiet)
+            print_summary(report_stream(a.out.csv, a.out.png, NULL), r.alpha, r.beta, r.P, r.D);
+        st = stability_write(&a, &r, msg, sizeof msg);
+    }
+    stability_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
 }

@@ -107,55 +107,12 @@ static int parse_args(cli *c, sweep_args *a)
     return err;
 }
 
-/* ---- one value ---- */
-
-/* ---- the sweep ---- */
-
-/* Changes are changes of the number of attractors: sticking zones are sets
- * of rest cells whose count grows with the zones' width. */
-static bool same_counts(const sweep_point *x, const sweep_point *y)
-{
-    return x->attractors == y->attractors;
-}
-
 static void print_point(FILE *out, const char *name, const sweep_point *pt)
 {
     fprintf(out, "%s = %-12.9g %3u attractor(s), %3u sticking group(s) in the window; basins %llu and "
            "%llu cells; %u groups; %.2f s\n",
            name, pt->value, pt->attractors, pt->sticking, (unsigned long long)pt->attractor_cells,
            (unsigned long long)pt->sticking_cells, pt->groups, pt->seconds);
-}
-
-/* Where the count of attractors changes: between lo and hi. */
-typedef struct sweep_change {
-    sweep_point lo, hi;
-    bool several; /* by more than one: bisection followed one of the changes */
-} sweep_change;
-
-/* Bisects between ch->lo and ch->hi (whose counts differ) `refine` times;
- * the solved midpoints are appended to pts. */
-static cm_status refine_change(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
-                               sweep_change *ch, sweep_point *pts, int *n_pts, char *msg,
-                               size_t msg_size)
-{
-    sweep_point lo = ch->lo, hi = ch->hi;
-    for (int k = 0; k < a->refine; k++) {
-        if (interrupt_requested())
-            return cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
-        sweep_point *mid = &pts[*n_pts];
-        const cm_status st =
-            sweep_solve_at(a, lat, box, 0.5 * (lo.value + hi.value), mid, msg, msg_size);
-        if (st != CM_OK)
-            return st;
-        ++*n_pts;
-        if (same_counts(mid, &lo))
-            lo = *mid;
-        else
-            hi = *mid;
-    }
-    ch->lo = lo;
-    ch->hi = hi;
-    return CM_OK;
 }
 
 static void print_change(FILE *out, const char *name, const sweep_change *ch)
@@ -209,37 +166,26 @@ static void print_json(const sweep_args *a, const cm_lattice *lat, const cm_box 
     json_end(&j);
 }
 
-static int by_value(const void *x, const void *y)
+/* The report as the sweep goes: a line per point and per change, below
+ * the progress line. */
+typedef struct reporter {
+    FILE *text; /* NULL: none */
+    progress *pr;
+} reporter;
+
+static void said_point(void *user, const sweep_args *a, const sweep_point *pt)
 {
-    const double u = ((const sweep_point *)x)->value, v = ((const sweep_point *)y)->value;
-    return (u > v) - (u < v);
+    const reporter *r = user;
+    progress_end(r->pr);
+    if (r->text)
+        print_point(r->text, a->name, pt);
 }
 
-/* Checks the model, the parameter, the window, the lattice and every value. */
-static int check_setup(const cli *c, const sweep_args *a, cm_lattice *lat, cm_box *box)
+static void said_change(void *user, const sweep_args *a, const sweep_change *ch)
 {
-    cm_model m;
-    int err = model_opts_build(c, &a->mo, &m);
-    if (err)
-        return err;
-    if (cm_params_find(&m.values, a->name) < 0)
-        err = cli_usage_error(c, "--vary: '%s' is not a parameter of %s (`cellmap models`)",
-                              a->name, m.name);
-    if (!err && a->n_near > m.dim)
-        err = cli_usage_error(c, "--near has %d range(s) but model %s has dimension %d", a->n_near,
-                              m.name, m.dim);
-    if (!err)
-        err = lattice_opts_build(c, &a->lat, &m, &a->mo.set, lat, box);
-    cm_model_release(&m);
-    for (int k = 0; k < a->n_values && !err; k++) {
-        const char *name = a->name;
-        char msg[256];
-        if (!model_with_values(&a->mo, &name, &a->values[k], 1, &m, msg, sizeof msg))
-            err = cli_usage_error(c, "--vary: %s = %s: %s", a->name, CM_NUM(a->values[k]), msg);
-        else
-            cm_model_release(&m);
-    }
-    return err;
+    const reporter *r = user;
+    if (r->text)
+        print_change(r->text, a->name, ch);
 }
 
 int cmd_sweep(int argc, char **argv)
@@ -254,68 +200,34 @@ int cmd_sweep(int argc, char **argv)
     const int werr = outfile_check("sweep", a.csv, false);
     if (werr != EXIT_OK)
         return werr;
-    cm_lattice lat;
-    cm_box box;
-    if ((rc = check_setup(&c, &a, &lat, &box)))
-        return rc;
-    sweep_point *pts = malloc((size_t)(a.n_values * (1 + a.refine)) * sizeof *pts);
-    sweep_change *changes = malloc((size_t)a.n_values * sizeof *changes);
-    if (!pts || !changes) {
-        fprintf(stderr, "cellmap sweep: out of memory\n");
-        free(pts);
-        free(changes);
-        return EXIT_FAIL;
-    }
-    /* the text report goes where no other output goes; not with --json */
-    FILE *text = a.json || a.quiet ? NULL : report_stream(a.csv, NULL, NULL);
     char msg[512];
-    int n = 0, n_changes = 0;
-    cm_status st = CM_OK;
+    sweep_result r = {0};
+    if (sweep_check_setup(&a, &r, msg, sizeof msg) != CM_OK)
+        return cli_usage_error(&c, "%s", msg);
     progress pr;
     progress_start(&pr, "sweep", "values", (uint64_t)a.n_values, a.quiet);
+    const work_hooks hooks = progress_hooks(&pr);
+    /* the text report goes where no other output goes; not with --json */
+    reporter rep = {a.json || a.quiet ? NULL : report_stream(a.csv, NULL, NULL), &pr};
     interrupt_catch();
-    for (int k = 0; k < a.n_values && st == CM_OK; k++) {
-        st = interrupt_requested() ? cm_fail(CM_ECANCELED, msg, sizeof msg, "interrupted")
-                                   : sweep_solve_at(&a, &lat, &box, a.values[k], &pts[n], msg,
-                                                    sizeof msg);
-        progress_end(&pr); /* the report's line goes below the progress line */
-        if (st == CM_OK && text)
-            print_point(text, a.name, &pts[n]);
-        n += st == CM_OK;
-        progress_say(&pr, (uint64_t)n, NULL);
-    }
-    /* the listed values are pts[0 .. n_values-1]; refinements follow them */
-    for (int k = 1; k < a.n_values && st == CM_OK; k++)
-        if (!same_counts(&pts[k - 1], &pts[k])) {
-            sweep_change *ch = &changes[n_changes++];
-            ch->lo = pts[k - 1];
-            ch->hi = pts[k];
-            ch->several = ch->lo.attractors > ch->hi.attractors + 1 ||
-                          ch->hi.attractors > ch->lo.attractors + 1;
-            if (a.refine)
-                st = refine_change(&a, &lat, &box, ch, pts, &n, msg, sizeof msg);
-            if (st == CM_OK && a.refine && text)
-                print_change(text, a.name, ch);
-        }
-    if (st == CM_OK && !n_changes && text)
-        fprintf(text, "no change of the counts between %s = %s and %s\n", a.name,
+    cm_status st =
+        sweep_compute(&a, &hooks, &(sweep_report){said_point, said_change, &rep}, &r, msg, sizeof msg);
+    if (st == CM_OK && !r.n_changes && rep.text)
+        fprintf(rep.text, "no change of the counts between %s = %s and %s\n", a.name,
                 CM_NUM(a.values[0]), CM_NUM(a.values[a.n_values - 1]));
     progress_end(&pr);
     if (st == CM_ECANCELED) {
-        free(pts);
-        free(changes);
-        return interrupt_stopped("sweep", (uint64_t)n, (uint64_t)(n > a.n_values ? n : a.n_values),
-                                 "values");
+        sweep_result_free(&r);
+        return interrupt_stopped("sweep", (uint64_t)r.n,
+                                 (uint64_t)(r.n > a.n_values ? r.n : a.n_values), "values");
     }
     if (st != CM_OK)
-        fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(pts[n].value), msg);
-    qsort(pts, (size_t)n, sizeof *pts, by_value);
-    const bool ok = st == CM_OK && (!a.csv || sweep_write_csv(&a, pts, n, msg, sizeof msg));
+        fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(r.failed_value), msg);
+    const bool ok = st == CM_OK && (!a.csv || sweep_write_csv(&a, r.pts, r.n, msg, sizeof msg));
     if (st == CM_OK && !ok)
         fprintf(stderr, "cellmap sweep: %s\n", msg);
     if (ok && a.json)
-        print_json(&a, &lat, &box, pts, n, changes, n_changes);
-    free(pts);
-    free(changes);
+        print_json(&a, &r.lat, &r.box, r.pts, r.n, r.changes, r.n_changes);
+    sweep_result_free(&r);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

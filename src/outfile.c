@@ -42,6 +42,13 @@ int chart_outputs_writable(const cli *c, const chart_outputs *o)
     return rc != EXIT_OK ? rc : chart_png_check(c->cmd, o->png);
 }
 
+int analysis_said(const char *cmd, cm_status st, const char *msg)
+{
+    if (st == CM_OK)
+        return EXIT_OK;
+    return said(cmd, msg, st == CM_EINVAL ? EXIT_USAGE : EXIT_FAIL);
+}
+
 bool outfile_open(const char *cmd, const char *path, outfile *o)
 {
     char msg[CM_OUTPUT_PATH_MAX + 256];

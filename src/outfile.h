@@ -25,6 +25,10 @@ int outfiles_check(const char *cmd, const char *const *paths, int n);
 int chart_png_check(const char *cmd, const char *path);
 /* Both, for the --csv and --png of a command's chart outputs. */
 int chart_outputs_writable(const cli *c, const chart_outputs *o);
+/* An analysis driver's status: EXIT_OK for CM_OK, else msg said as
+ * "cellmap CMD: msg" and EXIT_USAGE for the request's problem (CM_EINVAL)
+ * or EXIT_FAIL. */
+int analysis_said(const char *cmd, cm_status st, const char *msg);
 /* Opens the temporary file; prints "cellmap CMD: ..." and returns false on failure. */
 bool outfile_open(const char *cmd, const char *path, outfile *o);
 /* Closes and renames it when ok (and every write succeeded), else removes

@@ -503,8 +503,8 @@ PY
 expect_usage "--vary NAME=V1,V2,... is required" sweep --model microchaos-pd-friction
 expect_usage "--vary: 'mu=0.1,0.09'" sweep --model microchaos-pd-friction --vary mu=0.1,0.09
 expect_usage "'Q' is not a parameter" sweep --model microchaos-pd-friction --vary Q=1,2
-expect_usage "--near has 3 range(s)" sweep --model microchaos-pd-friction --vary mu=0,1 --near 0:1,0:1,0:1
-expect_usage "--vary: mu = -1" sweep --model microchaos-pd-friction --vary mu=-1,0.1
+expect_usage "window has 3 range(s)" sweep --model microchaos-pd-friction --vary mu=0,1 --near 0:1,0:1,0:1
+expect_usage "mu = -1: parameter mu = -1 is outside" sweep --model microchaos-pd-friction --vary mu=-1,0.1
 
 # --- files of format versions 2 to 4: read as they are, upgraded to write --
 # tests/data/v3-split.cmdb was written by cellmap with format version 3 (the

@@ -57,7 +57,7 @@ PY
 expect_usage "--vary NAME=LO:HI is required" continue --csv x.csv
 expect_usage "--vary: 'Q=0:1'" continue --vary Q=0:1
 expect_usage "--vary: 'S=0.4:0.1'" continue --vary S=0.4:0.1
-expect_usage "outside --vary S=0.02:0.2" continue --param S=0.3 --vary S=0.02:0.2
+expect_usage "outside the range S=0.02:0.2" continue --param S=0.3 --vary S=0.02:0.2
 expect_usage "continue follows friction-oscillator only" continue --model microchaos-pd --vary S=0:1
 "$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --csv branch.csv \
   --events events.csv > cont.txt || fail "continue the 1a branch"
@@ -78,7 +78,7 @@ PY
 "$CM" continue --param S=0.38 --vary S=0.3:0.4 --down --from 1.33,0.02 --period 1 --quiet \
   --events - | grep -q "^1,SN_2s,branch point,0,0.3333" || fail "continue --from --period: no SN_2s"
 out=$("$CM" continue --vary S=0.02:0.4 --from 1.46,0.04 --period 3 --csv p3.csv 2>&1); rc=$?
-[ $rc -eq 1 ] && grep -q "repeats after 1 period(s), not 3: give --period 1" <<<"$out" && [ ! -e p3.csv ] \
+[ $rc -eq 1 ] && grep -q "repeats after 1 period(s), not 3: give the period 1" <<<"$out" && [ ! -e p3.csv ] \
   || fail "continue --period 3 on a period-1 solution: $rc $out"
 
 # --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
@@ -124,7 +124,7 @@ expect_usage "--panels: 'psi,psi' is not a list" continue --vary S=0.02:0.4 --pa
 expect_usage "--curve: 'Q=1:2' is not NAME2=LO:HI" continue --vary S=0.02:0.4 \
   --curve Q=1:2 --curves bad.csv
 out=$("$CM" continue --vary S=0.02:0.4 --start 0.5 --csv bad.csv 2>&1); rc=$?
-[ "$rc" -eq 2 ] && grep -qF "the start's S = 0.5 is outside --vary S=0.02:0.4" <<<"$out" \
+[ "$rc" -eq 2 ] && grep -qF "the start's S = 0.5 is outside the range S=0.02:0.4" <<<"$out" \
   || fail "continue --start outside the range: exit $rc, $out"
 [ ! -e bad.csv ] && [ ! -e bad.png ] || fail "a rejected continue left a file behind"
 
@@ -178,7 +178,7 @@ for r in rows:
     want = -float(r["delta"]) / 2
     assert abs(float(r["lambda"]) - want) < 2e-3, (r, want)
 PY
-expect_usage "--from has 1 value(s) but model duffing has dimension 2" \
+expect_usage "the start has 1 value(s) but model duffing has dimension 2" \
   lyapunov --model duffing --grid delta=0.1:0.3:2,gamma=0.1:0.2:2 --from 1 --csv x.csv
 "$CM" solve --model duffing --cells 60x60 --threads 2 > duf.txt \
   || fail "solve --model duffing"

@@ -1,0 +1,414 @@
+/* lib/api_analysis.c - the analysis drivers of libcellmap's experimental
+ * section (cellmap/cellmap.h): each fills its lib/ driver's arguments as
+ * the command's options would, checks the outputs before the work, then
+ * computes and writes through the same driver as the command. */
+#define CELLMAP_EXPERIMENTAL
+#include "cellmap/cellmap.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cellmap/output.h"
+#include "lib/amplitude.h"
+#include "lib/api_models.h"
+#include "lib/bifurcation.h"
+#include "lib/continuation.h"
+#include "lib/escape.h"
+#include "lib/horseshoe.h"
+#include "lib/lyapunov.h"
+#include "lib/partition.h"
+#include "lib/simulate.h"
+#include "lib/stability.h"
+#include "lib/sweep.h"
+
+/* ---- what every driver takes ---- */
+
+static const cm_analysis no_analysis = {0};
+
+/* The call's model (its driver's own unless named) into *mo. */
+static void model_of(const cm_analysis *a, const char *own, model_spec *mo)
+{
+    *mo = api_model_spec(a->set, a->model, a->params, own);
+}
+
+/* The outputs: the table and figure are checked before any work (a
+ * directory, a device, a missing folder; PNG needs OSMesa), the size
+ * given or the command's (w0 x h0). */
+static cm_status outputs_of(const cm_analysis *a, int w0, int h0, chart_outputs *out, char *msg,
+                            size_t msg_size)
+{
+    if ((a->width > 0) != (a->height > 0) || a->width < 0 || a->height < 0 ||
+        a->width > 4096 || a->height > 4096 || (a->width > 0 && (a->width < 200 || a->height < 150)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a figure of %dx%d pixels: give both sides, 200x150..4096x4096, or 0, 0 "
+                       "for the driver's size",
+                       a->width, a->height);
+    if (cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the table and the figure both to standard output: choose one");
+    *out = (chart_outputs){.csv = a->csv, .png = a->png, .quiet = true,
+                           .width = a->width ? a->width : w0,
+                           .height = a->height ? a->height : h0};
+    const cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    return st != CM_OK ? st : outfile_check_chart(a->png, msg, msg_size);
+}
+
+/* A cm_axis as the drivers' axis named name (NULL: the axis' own), n in 1..max. */
+static cm_status axis_of(const cm_axis *x, const char *name, int max, param_axis *out, char *msg,
+                         size_t msg_size)
+{
+    name = name ? name : x->name;
+    if (!name || !name[0] || strlen(name) >= sizeof out->name)
+        return cm_fail(CM_EINVAL, msg, msg_size, "an axis needs a parameter's name (1..31 characters)");
+    if (!(x->lo < x->hi) || !isfinite(x->lo) || !isfinite(x->hi) || x->n < 1 || x->n > max)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "axis %s: %g..%g in %d values: need finite LO < HI and 1..%d values", name,
+                       x->lo, x->hi, x->n, max);
+    *out = (param_axis){.lo = x->lo, .hi = x->hi, .n = x->n};
+    snprintf(out->name, sizeof out->name, "%s", name);
+    return CM_OK;
+}
+
+/* ---- the PD map's charts, the delay map's partition ---- */
+
+cm_status cm_analysis_stability(const cm_analysis *a, const cm_axis *P, const cm_axis *alpha, char *msg,
+                       size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    stab_args sa = stability_defaults();
+    model_of(a, sa.mo.name, &sa.mo);
+    cm_status st = outputs_of(a, sa.out.width, sa.out.height, &sa.out, msg, msg_size);
+    if (st == CM_OK && P && (sa.has_P = 1))
+        st = axis_of(P, "P", 100000, &sa.P, msg, msg_size);
+    if (st == CM_OK && alpha && (sa.has_alpha = 1))
+        st = axis_of(alpha, "alpha", 100000, &sa.alpha, msg, msg_size);
+    if (st == CM_OK && ((P && P->n < 2) || (alpha && alpha->n < 2)))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "the axes need at least 2 values");
+    if (st == CM_OK && alpha && alpha->lo <= 0)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "alpha must be positive");
+    if (st != CM_OK)
+        return st;
+    stab_result r;
+    st = stability_compute(&sa, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = stability_write(&sa, &r, msg, msg_size);
+    stability_result_free(&r);
+    return st;
+}
+
+cm_status cm_analysis_partition(const cm_analysis *a, char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    part_args pa = partition_defaults();
+    model_of(a, pa.mo.name, &pa.mo);
+    cm_status st = outputs_of(a, pa.out.width, pa.out.height, &pa.out, msg, msg_size);
+    part_result r;
+    if (st == CM_OK)
+        st = partition_compute(&pa, &r, msg, msg_size);
+    return st == CM_OK ? partition_write(&pa, &r, msg, msg_size) : st;
+}
+
+/* ---- the friction oscillator ---- */
+
+cm_status cm_analysis_amplitude(const cm_analysis *a, const cm_axis *omega, int periods, double ymax,
+                       char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    amp_args aa = amplitude_defaults();
+    model_of(a, aa.mo.name, &aa.mo);
+    aa.threads = a->threads;
+    aa.periods = periods ? periods : aa.periods;
+    aa.ymax = ymax != 0 ? ymax : aa.ymax;
+    cm_status st = outputs_of(a, aa.out.width, aa.out.height, &aa.out, msg, msg_size);
+    if (st == CM_OK && !omega)
+        st = cm_fail(CM_EINVAL, msg, msg_size, "the frequencies Omega are required");
+    if (st == CM_OK && (aa.has_omega = 1))
+        st = axis_of(omega, "Omega", 100000, &aa.omega, msg, msg_size);
+    if (st == CM_OK && !(aa.ymax > 0 && aa.ymax < 1e6))
+        st = cm_fail(CM_EINVAL, msg, msg_size, "ymax %g must be in (0, 1e6)", aa.ymax);
+    if (st != CM_OK)
+        return st;
+    amp_result r;
+    st = amplitude_compute(&aa, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = amplitude_write(&aa, &r, msg, msg_size);
+    amplitude_result_free(&r);
+    return st;
+}
+
+cm_simulate_options cm_simulate_defaults(void)
+{
+    const sim_args d = simulate_defaults();
+    return (cm_simulate_options){.x = d.from[0], .v = d.from[1], .t0 = NAN, .periods = d.periods,
+                                 .skip = d.skip};
+}
+
+cm_status cm_analysis_simulate(const cm_analysis *a, const cm_simulate_options *o, char *msg,
+                      size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_simulate_options d = cm_simulate_defaults();
+    o = o ? o : &d;
+    sim_args sa = simulate_defaults();
+    model_of(a, sa.mo.name, &sa.mo);
+    sa.from[0] = o->x, sa.from[1] = o->v;
+    sa.has_t0 = !isnan(o->t0), sa.t0 = sa.has_t0 ? o->t0 : 0;
+    sa.periods = o->periods, sa.skip = o->skip;
+    cm_status st = outputs_of(a, sa.out.width, sa.out.height, &sa.out, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    sim_result r;
+    st = simulate_compute(&sa, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = simulate_write(&sa, &r, msg, msg_size);
+    simulate_result_free(&r);
+    return st;
+}
+
+cm_bifurcation_options cm_bifurcation_defaults(void)
+{
+    const bif_args d = bifurcation_defaults();
+    return (cm_bifurcation_options){.runs = d.runs, .transient = d.transient, .record = d.record,
+                                    .seed = d.seed};
+}
+
+cm_status cm_analysis_bifurcation(const cm_analysis *a, const cm_bifurcation_options *o, char *msg,
+                         size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    if (!o)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a bifurcation diagram needs its sweep");
+    bif_args ba = bifurcation_defaults();
+    model_of(a, ba.mo.name, &ba.mo);
+    ba.runs = o->runs, ba.transient = o->transient, ba.record = o->record, ba.seed = o->seed;
+    ba.threads = a->threads, ba.runs_csv = o->runs_csv, ba.has_sweep = 1;
+    cm_status st = outputs_of(a, ba.out.width, ba.out.height, &ba.out, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(o->runs_csv, false, msg, msg_size);
+    if (st == CM_OK)
+        st = axis_of(&o->sweep, NULL, PARAM_AXIS_MAX, &ba.sweep, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    bif_result r;
+    st = bifurcation_compute(&ba, NULL, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = bifurcation_write(&ba, &r, msg, msg_size);
+    bifurcation_result_free(&r);
+    return st;
+}
+
+cm_lyapunov_options cm_lyapunov_defaults(void)
+{
+    const lyap_args d = lyapunov_defaults();
+    return (cm_lyapunov_options){.periods = d.periods, .d0 = d.d0};
+}
+
+cm_status cm_analysis_lyapunov(const cm_analysis *a, const cm_lyapunov_options *o, char *msg,
+                      size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    if (!o)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a Lyapunov map needs its grid");
+    lyap_args la = lyapunov_defaults();
+    model_of(a, la.mo.name, &la.mo);
+    chart_outputs out;
+    cm_status st = outputs_of(a, la.width, la.height, &out, msg, msg_size);
+    la.csv = out.csv, la.png = out.png, la.width = out.width, la.height = out.height;
+    la.periods = o->periods, la.d0 = o->d0, la.threads = a->threads, la.has_grid = 1;
+    if (st == CM_OK && (o->n_from < 0 || o->n_from > CM_MAX_DIM || (o->n_from && !o->from) ||
+                        o->n_curves < 0 || o->n_curves > MAX_CURVE_FILES ||
+                        (o->n_curves && !o->curves)))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "a start of at most %d coordinates and at most %d curve files",
+                     CM_MAX_DIM, MAX_CURVE_FILES);
+    for (int k = 0; st == CM_OK && k < 2; k++)
+        st = axis_of(k ? &o->y : &o->x, NULL, PARAM_AXIS_MAX, &la.ax[k], msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    la.n_from = o->n_from;
+    for (int d = 0; d < o->n_from; d++)
+        la.from[d] = o->from[d];
+    la.n_curves = o->n_curves;
+    for (int k = 0; k < o->n_curves; k++)
+        la.curves[k] = o->curves[k];
+    lyap_result r;
+    st = lyapunov_compute(&la, NULL, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = lyapunov_write(&la, &r, msg, msg_size);
+    lyapunov_result_free(&r);
+    return st;
+}
+
+cm_continue_options cm_continue_defaults(void)
+{
+    return (cm_continue_options){.direction = 1};
+}
+
+/* The continuation's request from o into ca. */
+static cm_status continue_args(const cm_continue_options *o, cont_args *ca, char *msg,
+                               size_t msg_size)
+{
+    if (!o->vary || strlen(o->vary) >= sizeof ca->vary || (o->curve && strlen(o->curve) >= sizeof ca->vary2))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a parameter to vary (S, S0, Omega or phi) is required");
+    if (o->n_from < 0 || o->n_from > MAX_STARTS || (o->n_from && !o->from) || o->direction < -1 ||
+        o->direction > 1)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "at most %d starts, and a direction of 1 (up), -1 (down) or 0 (both)",
+                       MAX_STARTS);
+    snprintf(ca->vary, sizeof ca->vary, "%s", o->vary);
+    ca->lo = o->lo, ca->hi = o->hi, ca->has_vary = 1;
+    ca->down = o->direction < 0, ca->both = o->direction == 0, ca->switch_pd = o->switch_pd;
+    ca->n_from = o->n_from;
+    for (int k = 0; k < o->n_from; k++)
+        memcpy(ca->from[k], o->from[k], sizeof ca->from[k]);
+    ca->period = o->period, ca->max_points = o->max_points, ca->events = o->events;
+    if (o->curve)
+        snprintf(ca->vary2, sizeof ca->vary2, "%s", o->curve);
+    ca->lo2 = o->lo2, ca->hi2 = o->hi2, ca->curves = o->curves, ca->quiet = true;
+    return CM_OK;
+}
+
+cm_status cm_analysis_continue(const cm_analysis *a, const cm_continue_options *o, char *msg,
+                      size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    if (!o)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a continuation needs its parameter");
+    cont_args ca = {0};
+    model_of(a, "friction-oscillator", &ca.mo);
+    cm_status st = continue_args(o, &ca, msg, msg_size);
+    chart_outputs out;
+    if (st == CM_OK) /* the diagram's own default size (continuation_layout) */
+        st = outputs_of(a, 0, 0, &out, msg, msg_size);
+    ca.csv = a->csv, ca.png = a->png, ca.width = a->width, ca.height = a->height;
+    if (st == CM_OK)
+        st = outfile_check_path(o->events, false, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(o->curves, false, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cont_result r;
+    st = continuation_compute(&ca, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = continuation_write(&ca, &r, msg, msg_size);
+    continuation_result_free(&r);
+    return st;
+}
+
+/* ---- the micro-chaos maps ---- */
+
+cm_horseshoe_options cm_horseshoe_defaults(void)
+{
+    return (cm_horseshoe_options){.periods = horseshoe_defaults().periods};
+}
+
+cm_status cm_analysis_horseshoe(const cm_analysis *a, const cm_horseshoe_options *o, char *msg,
+                       size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_horseshoe_options d = cm_horseshoe_defaults();
+    o = o ? o : &d;
+    hs_args ha = horseshoe_defaults();
+    model_of(a, ha.mo.name, &ha.mo);
+    ha.has_m = o->m0 != 0 || o->m1 != 0, ha.m0 = o->m0, ha.m1 = o->m1;
+    ha.periods = o->periods, ha.crisis = o->crisis, ha.has_sweep = o->sweep != NULL;
+    cm_status st = outputs_of(a, ha.out.width, ha.out.height, &ha.out, msg, msg_size);
+    if (st == CM_OK && o->sweep)
+        st = axis_of(o->sweep, "P", 10000, &ha.sweep, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    hs_result r;
+    st = horseshoe_compute(&ha, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = horseshoe_write(&ha, &r, msg, msg_size);
+    horseshoe_result_free(&r);
+    return st;
+}
+
+cm_escape_options cm_escape_defaults(void)
+{
+    const esc_args d = escape_defaults();
+    return (cm_escape_options){.cells = d.cells, .ensemble = d.ensemble};
+}
+
+cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_escape_options d = cm_escape_defaults();
+    o = o ? o : &d;
+    esc_args ea = escape_defaults();
+    model_of(a, ea.mo.name, &ea.mo);
+    ea.has_I0 = o->I0 != 0, ea.I0 = o->I0, ea.has_sweep = o->sweep != NULL;
+    ea.cells = o->cells, ea.ensemble = o->ensemble, ea.threads = a->threads;
+    cm_status st = outputs_of(a, ea.out.width, ea.out.height, &ea.out, msg, msg_size);
+    if (st == CM_OK && o->sweep)
+        st = axis_of(o->sweep, NULL, 10000, &ea.sweep, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    esc_result r;
+    st = escape_compute(&ea, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = escape_write(&ea, &r, msg, msg_size);
+    escape_result_free(&r);
+    return st;
+}
+
+/* ---- any model: a parameter swept ---- */
+
+/* The sweep's request from o into sa. */
+static cm_status sweep_args_of(const cm_sweep_options *o, sweep_args *sa, char *msg,
+                               size_t msg_size)
+{
+    if (!o->name || strlen(o->name) >= sizeof sa->name || o->n_values < 2 ||
+        o->n_values > MAX_VALUES || !o->values)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a sweep needs a parameter's name and 2..%d increasing values", MAX_VALUES);
+    for (int k = 1; k < o->n_values; k++)
+        if (!(o->values[k] > o->values[k - 1]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "the values must increase");
+    if (o->n_cells < 0 || o->n_cells > CM_MAX_DIM || (o->n_cells && !o->cells) || o->n_near < 0 ||
+        o->n_near > CM_MAX_DIM || (o->n_near && (!o->near_lo || !o->near_hi)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "cells and the window: at most %d dimensions each", CM_MAX_DIM);
+    snprintf(sa->name, sizeof sa->name, "%s", o->name);
+    sa->n_values = o->n_values;
+    memcpy(sa->values, o->values, (size_t)o->n_values * sizeof *o->values);
+    sa->lat.region_text = o->region;
+    sa->lat.n_cells = o->n_cells;
+    for (int d = 0; d < o->n_cells; d++)
+        sa->lat.cells[d] = o->cells[d];
+    sa->n_near = o->n_near;
+    for (int d = 0; d < o->n_near; d++) {
+        sa->near_lo[d] = o->near_lo[d], sa->near_hi[d] = o->near_hi[d];
+        if (!(sa->near_lo[d] < sa->near_hi[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "the window needs LO < HI in each dimension");
+    }
+    sa->refine = o->refine, sa->max_steps = o->max_steps;
+    sa->by = o->by_groups ? BY_GROUPS : BY_ATTRACTORS, sa->quiet = true;
+    return CM_OK;
+}
+
+cm_status cm_analysis_sweep(const cm_analysis *a, const cm_sweep_options *o, char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    if (!o)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a sweep needs its parameter and values");
+    sweep_args sa;
+    memset(&sa, 0, sizeof sa);
+    model_of(a, "microchaos-pd", &sa.mo);
+    sa.threads = a->threads, sa.csv = a->csv;
+    cm_status st = a->png ? cm_fail(CM_EINVAL, msg, msg_size, "a sweep draws no figure")
+                          : sweep_args_of(o, &sa, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(a->csv, false, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    sweep_result r;
+    st = sweep_compute(&sa, NULL, NULL, &r, msg, msg_size);
+    if (st == CM_OK && sa.csv && !sweep_write_csv(&sa, r.pts, r.n, msg, msg_size))
+        st = CM_EIO;
+    sweep_result_free(&r);
+    return st;
+}
