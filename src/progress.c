@@ -5,7 +5,6 @@
 
 #include "lib/work.h"
 
-#include <omp.h>
 #include <stdio.h>
 #include <time.h>
 #include <unistd.h>
@@ -51,15 +50,6 @@ void progress_say(progress *p, uint64_t done, const char *what)
     fprintf(stderr, "\r%s%*s", line, p->width > n ? p->width - n : 0, "");
     fflush(stderr);
     p->width = n > p->width ? n : p->width;
-}
-
-void progress_tick(progress *p, uint64_t *done)
-{
-    uint64_t now;
-#pragma omp atomic capture
-    now = ++*done;
-    if (omp_get_thread_num() == 0) /* the line is the first thread's alone */
-        progress_say(p, now, NULL);
 }
 
 void progress_end(progress *p)

@@ -24,9 +24,6 @@ typedef struct progress {
 void progress_start(progress *p, const char *cmd, const char *unit, uint64_t total, bool quiet);
 /* Says that `done` units are done (what: an optional note, e.g. a phase). */
 void progress_say(progress *p, uint64_t done, const char *what);
-/* In a parallel loop: counts one unit more in *done (atomically) and, on
- * the first thread only, says so. */
-void progress_tick(progress *p, uint64_t *done);
 
 /* Erases the line, if one is shown, so that what follows (a report line,
  * an error) starts at the left; the next progress_say draws it again. */

@@ -10,6 +10,10 @@
  *   c_explore.cmdb  an explore session: a view, 20 pans of 10 %, then
  *   c_view.png      render of the view
  *   c_labels.npy    export --labels of c_split.cmdb
+ *   c_NAME.csv/png  the analysis commands (stability, partition, amplitude,
+ *                   horseshoe, escape, simulate, bifurcation and its runs,
+ *                   lyapunov, sweep, continue and its events), as
+ *                   tests/workstation_analysis.py does them
  * usage: workstation (in the directory to write in) */
 #define CELLMAP_EXPERIMENTAL
 #include <cellmap/cellmap.h>
@@ -48,6 +52,63 @@ static int copy_file(const char *from, const char *to)
     if (out)
         ok = fclose(out) == 0 && ok;
     return ok;
+}
+
+/* The analysis command NAME's outputs c_NAME.csv and c_NAME.png. */
+static cm_analysis outputs(const char *name, char files[2][64], int png)
+{
+    snprintf(files[0], 64, "c_%s.csv", name);
+    snprintf(files[1], 64, "c_%s.png", name);
+    return (cm_analysis){.csv = files[0], .png = png ? files[1] : NULL};
+}
+
+static void analyses(void)
+{
+    char msg[1024], f[2][64];
+    cm_analysis a = outputs("stability", f, 1);
+    must(cm_analysis_stability(&a, &(cm_axis){"P", 0.007, 0.02, 50},
+                               &(cm_axis){"alpha", 0.1, 1, 20}, msg, sizeof msg),
+         "stability", msg);
+    a = outputs("partition", f, 1);
+    a.params = "a=1.3,b=0.66";
+    must(cm_analysis_partition(&a, msg, sizeof msg), "partition", msg);
+    a = outputs("amplitude", f, 1);
+    must(cm_analysis_amplitude(&a, &(cm_axis){"Omega", 0.2, 2, 20}, 50, 0, msg, sizeof msg),
+         "amplitude", msg);
+    cm_horseshoe_options ho = cm_horseshoe_defaults();
+    ho.m0 = 1, ho.m1 = 3, ho.periods = 6;
+    a = outputs("horseshoe", f, 1);
+    must(cm_analysis_horseshoe(&a, &ho, msg, sizeof msg), "horseshoe", msg);
+    cm_escape_options eo = cm_escape_defaults();
+    eo.cells = 1000, eo.ensemble = 1000;
+    a = outputs("escape", f, 1);
+    must(cm_analysis_escape(&a, &eo, msg, sizeof msg), "escape", msg);
+    cm_simulate_options so = cm_simulate_defaults();
+    so.x = 1, so.periods = 5;
+    a = outputs("simulate", f, 1);
+    must(cm_analysis_simulate(&a, &so, msg, sizeof msg), "simulate", msg);
+    cm_bifurcation_options bo = cm_bifurcation_defaults();
+    bo.sweep = (cm_axis){"S", 0.1, 0.3, 4};
+    bo.runs = 2, bo.transient = 20, bo.record = 5, bo.runs_csv = "c_bifurcation_runs.csv";
+    a = outputs("bifurcation", f, 1);
+    must(cm_analysis_bifurcation(&a, &bo, msg, sizeof msg), "bifurcation", msg);
+    cm_lyapunov_options lo = cm_lyapunov_defaults();
+    lo.x = (cm_axis){"Omega", 0.4, 0.6, 3}, lo.y = (cm_axis){"S", 0.1, 0.2, 3}, lo.periods = 50;
+    a = outputs("lyapunov", f, 1);
+    must(cm_analysis_lyapunov(&a, &lo, msg, sizeof msg), "lyapunov", msg);
+    const cm_sweep_options wo = {.name = "P",
+                                 .values = (const double[]){0.006, 0.007},
+                                 .n_values = 2,
+                                 .region = "0:100,-10:10",
+                                 .cells = (const int64_t[]){50, 50},
+                                 .n_cells = 2};
+    a = outputs("sweep", f, 0);
+    must(cm_analysis_sweep(&a, &wo, msg, sizeof msg), "sweep", msg);
+    cm_continue_options co = cm_continue_defaults();
+    co.vary = "S", co.lo = 0.02, co.hi = 0.4, co.max_points = 50;
+    co.events = "c_continue_events.csv";
+    a = outputs("continue", f, 1);
+    must(cm_analysis_continue(&a, &co, msg, sizeof msg), "continue", msg);
 }
 
 int main(void)
@@ -99,5 +160,6 @@ int main(void)
 
     must(cm_db_export("c_split.cmdb", NULL, NULL, "c_labels.npy", NULL, 0, msg, sizeof msg),
          "export", msg);
+    analyses();
     return 0;
 }

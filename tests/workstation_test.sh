@@ -4,9 +4,9 @@
 # and the Python module (python/cellmap, pip-installed without network) do
 # what the command does - solve --db --split 2x2, --resume of a cancelled
 # solve, --extend 3, an explore session of 20 pans with a render of the
-# view, export --labels - and what they write equals the command's: every
-# database row (but the recorded command line), the PNG's bytes and the
-# arrays' bytes.
+# view, export --labels, and the analysis commands - and what they write
+# equals the command's: every database row (but the recorded command
+# line), the PNGs' and tables' bytes and the arrays' bytes.
 # usage: workstation_test.sh PATH/TO/cellmap SOURCE_DIR BUILD_DIR
 set -u
 SRC=$(realpath "$2")
@@ -51,7 +51,7 @@ same_bytes() { # A B WHAT
   [ -s "$1" ] && cmp -s "$1" "$2" || fail "$3: $1 and $2 differ (or are missing)"
 }
 
-# the command's work
+# the command's work: solves, a session, an export
 PD=(--param alpha=0.078,beta=0,P=0.007,D=0.02)
 "$CM" solve "${PD[@]}" --region 0:500,-40:40 --cells 200x100 --split 2x2 --threads 2 \
   --db cli_split.cmdb --quiet || fail "solve --split"
@@ -65,6 +65,40 @@ PD=(--param alpha=0.078,beta=0,P=0.007,D=0.02)
 "$CM" explore cli_explore.cmdb pans.explore --model microchaos-pd "${PD[@]}" \
   --cell-size 0.5,0.08 --threads 2 > explore.log || fail "explore: $(cat explore.log)"
 "$CM" export cli_split.cmdb --labels cli_labels.npy --quiet || fail "export --labels"
+
+# the analysis commands (cheap settings; tests/workstation_analysis.py and
+# tests/workstation.c make the same calls)
+"$CM" stability --P 0.007:0.02:50 --alpha 0.1:1:20 --csv cli_stability.csv --png cli_stability.png &&
+  "$CM" partition --param a=1.3,b=0.66 --csv cli_partition.csv --png cli_partition.png &&
+  "$CM" amplitude --omega 0.2:2:20 --periods 50 --csv cli_amplitude.csv --png cli_amplitude.png &&
+  "$CM" horseshoe --m 1:3 --periods 6 --csv cli_horseshoe.csv --png cli_horseshoe.png &&
+  "$CM" escape --cells 1000 --ensemble 1000 --csv cli_escape.csv --png cli_escape.png &&
+  "$CM" simulate --from 1,0 --periods 5 --csv cli_simulate.csv --png cli_simulate.png &&
+  "$CM" bifurcation --sweep S=0.1:0.3:4 --runs 2 --transient 20 --record 5 \
+    --csv cli_bifurcation.csv --runs-csv cli_bifurcation_runs.csv --png cli_bifurcation.png &&
+  "$CM" lyapunov --grid Omega=0.4:0.6:3,S=0.1:0.2:3 --periods 50 --csv cli_lyapunov.csv \
+    --png cli_lyapunov.png &&
+  "$CM" sweep --vary P=0.006,0.007 --region 0:100,-10:10 --cells 50x50 --csv cli_sweep.csv &&
+  "$CM" continue --vary S=0.02:0.4 --max-points 50 --csv cli_continue.csv \
+    --events cli_continue_events.csv --png cli_continue.png > analyses.log 2>&1 ||
+  fail "the analysis commands: $(tail -3 analyses.log)"
+ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue"
+
+# without_seconds CSV: the table without its last column (a sweep's timings)
+without_seconds() { sed 's/,[^,]*$//' "$1"; }
+
+check_analyses() { # PREFIX: the analyses' files, against the command's
+  local name
+  for name in $ANALYSES; do
+    same_bytes "cli_$name.csv" "$1_$name.csv" "$1: $name's table"
+    same_bytes "cli_$name.png" "$1_$name.png" "$1: $name's figure"
+  done
+  same_bytes cli_bifurcation_runs.csv "$1_bifurcation_runs.csv" "$1: bifurcation's runs"
+  same_bytes cli_continue_events.csv "$1_continue_events.csv" "$1: continue's events"
+  head -1 cli_sweep.csv | grep -q ',seconds$' || fail "the sweep's table no longer ends in seconds"
+  cmp -s <(without_seconds cli_sweep.csv) <(without_seconds "$1_sweep.csv") &&
+    [ "$(grep -c . "$1_sweep.csv")" -eq 3 ] || fail "$1: sweep's table differs"
+}
 
 check() { # PREFIX: what the C program or Python wrote, against the command's
   same_db cli_split.cmdb "$1_split.cmdb" "$1: solve --split 2x2"
@@ -85,6 +119,7 @@ check() { # PREFIX: what the C program or Python wrote, against the command's
 
 LD_PRELOAD=${LD_PRELOAD:-} ./workstation > c.log 2>&1 || fail "the C program: $(cat c.log)"
 check c
+check_analyses c
 
 # the same from Python, installed as the README says: pip without network
 # or build isolation under the prefix cellmap went to, and no CELLMAP_LIB or
@@ -95,7 +130,10 @@ LD_PRELOAD= $PY -m pip install --quiet --no-deps --no-build-isolation --no-index
 site=$(dirname "$(find "$work/prefix" -path '*-packages/cellmap/__init__.py' | head -1)")
 export PYTHONPATH=$(dirname "$site")
 $PY "$SRC/tests/workstation.py" > py.log 2>&1 || fail "the Python program: $(tail -20 py.log)"
+$PY "$SRC/tests/workstation_analysis.py" py > py_analysis.log 2>&1 ||
+  fail "the Python analyses: $(tail -20 py_analysis.log)"
 check py
+check_analyses py
 
 # a map given as a Python function agrees with the same map as a plugin
 LD_PRELOAD= cc -shared -fPIC -I"$work/prefix/include" -o libhenon.so "$SRC/examples/plugin/henon.c" \

@@ -40,7 +40,7 @@ import sysconfig
 import numpy as np
 
 __all__ = ["System", "Models", "Result", "Database", "Session", "solve", "open", "create",
-           "resume", "export", "models", "CellmapError", "LABEL_NONE", "version"]
+           "resume", "export", "models", "CellmapError", "LABEL_NONE", "version", "analysis"]
 
 LABEL_NONE = -1
 _MAX_DIM = 6
@@ -680,3 +680,6 @@ class Session:
             self.close()
         except CellmapError:
             pass
+
+
+from . import analysis  # noqa: E402 - the drivers build on the definitions above

@@ -1,0 +1,316 @@
+"""The analysis drivers of libcellmap (cm_analysis_* in cellmap/cellmap.h):
+the commands stability, partition, amplitude, horseshoe, escape, simulate,
+bifurcation, lyapunov, sweep and continue as functions. Each computes what
+the command computes and writes the same files (csv=, png=, byte for
+byte); it returns the table as a numpy structured array (columns by name,
+as the CSV's header names them), read from csv= or from a temporary file.
+
+Every function takes, besides its own settings:
+    model=None      the command's model, or another (lyapunov, sweep)
+    params=None     its parameters: "k=v,..." or a dict
+    plugins=()      shared objects with more models (examples/plugin)
+    csv=None, png=None, size=None (width, height), threads=0
+
+An axis is (lo, hi, n): n values at the centres of n cells over lo..hi,
+as the commands' NAME=LO:HI:N; a named axis is (name, lo, hi, n).
+
+    t = cellmap.analysis.bifurcation(("S", 0.02, 0.4, 50), runs=4, png="bif.png")[0]
+    print(t["S"][:5], t["x"][:5])
+"""
+import ctypes
+import math
+import os
+import tempfile
+
+import numpy as np
+
+from . import CellmapError, Models, _call, _lib, _text, _P, _DOUBLES  # noqa: F401
+
+__all__ = ["stability", "partition", "amplitude", "horseshoe", "escape", "simulate",
+           "bifurcation", "lyapunov", "sweep", "continuation"]
+
+
+class _Axis(ctypes.Structure):
+    _fields_ = [("name", ctypes.c_char_p), ("lo", ctypes.c_double), ("hi", ctypes.c_double),
+                ("n", ctypes.c_int)]
+
+
+class _Analysis(ctypes.Structure):
+    _fields_ = [("set", _P), ("model", ctypes.c_char_p), ("params", ctypes.c_char_p),
+                ("csv", ctypes.c_char_p), ("png", ctypes.c_char_p), ("width", ctypes.c_int),
+                ("height", ctypes.c_int), ("threads", ctypes.c_int)]
+
+
+class _Horseshoe(ctypes.Structure):
+    _fields_ = [("m0", ctypes.c_int64), ("m1", ctypes.c_int64), ("periods", ctypes.c_int),
+                ("sweep", ctypes.POINTER(_Axis)), ("crisis", ctypes.c_int)]
+
+
+class _Escape(ctypes.Structure):
+    _fields_ = [("I0", ctypes.c_double), ("sweep", ctypes.POINTER(_Axis)),
+                ("cells", ctypes.c_long), ("ensemble", ctypes.c_long)]
+
+
+class _Simulate(ctypes.Structure):
+    _fields_ = [("x", ctypes.c_double), ("v", ctypes.c_double), ("t0", ctypes.c_double),
+                ("periods", ctypes.c_int), ("skip", ctypes.c_int)]
+
+
+class _Bifurcation(ctypes.Structure):
+    _fields_ = [("sweep", _Axis), ("runs", ctypes.c_int), ("transient", ctypes.c_int),
+                ("record", ctypes.c_int), ("seed", ctypes.c_longlong),
+                ("runs_csv", ctypes.c_char_p)]
+
+
+class _Lyapunov(ctypes.Structure):
+    _fields_ = [("x", _Axis), ("y", _Axis), ("periods", ctypes.c_int), ("d0", ctypes.c_double),
+                ("start", _DOUBLES), ("n_from", ctypes.c_int),
+                ("curves", ctypes.POINTER(ctypes.c_char_p)), ("n_curves", ctypes.c_int)]
+
+
+class _Sweep(ctypes.Structure):
+    _fields_ = [("name", ctypes.c_char_p), ("values", _DOUBLES), ("n_values", ctypes.c_int),
+                ("region", ctypes.c_char_p), ("cells", ctypes.POINTER(ctypes.c_int64)),
+                ("n_cells", ctypes.c_int), ("near_lo", _DOUBLES), ("near_hi", _DOUBLES),
+                ("n_near", ctypes.c_int), ("refine", ctypes.c_int), ("max_steps", ctypes.c_int),
+                ("by_groups", ctypes.c_int)]
+
+
+class _Continue(ctypes.Structure):
+    _fields_ = [("vary", ctypes.c_char_p), ("lo", ctypes.c_double), ("hi", ctypes.c_double),
+                ("direction", ctypes.c_int), ("switch_pd", ctypes.c_int),
+                ("start", ctypes.POINTER(ctypes.c_double * 3)), ("n_from", ctypes.c_int),
+                ("period", ctypes.c_int), ("max_points", ctypes.c_int),
+                ("events", ctypes.c_char_p), ("curve", ctypes.c_char_p),
+                ("lo2", ctypes.c_double), ("hi2", ctypes.c_double), ("curves", ctypes.c_char_p)]
+
+
+def _sig(name, *args):
+    f = getattr(_lib, name)
+    f.restype = ctypes.c_int
+    f.argtypes = [ctypes.POINTER(_Analysis)] + list(args) + [ctypes.c_char_p, ctypes.c_size_t]
+
+
+_AXIS = ctypes.POINTER(_Axis)
+_sig("cm_analysis_stability", _AXIS, _AXIS)
+_sig("cm_analysis_partition")
+_sig("cm_analysis_amplitude", _AXIS, ctypes.c_int, ctypes.c_double)
+for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape), ("simulate", _Simulate),
+                     ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov), ("sweep", _Sweep),
+                     ("continue", _Continue)):
+    _sig("cm_analysis_" + _name, ctypes.POINTER(_opts))
+for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape), ("simulate", _Simulate),
+                     ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov),
+                     ("continue", _Continue)):
+    getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
+    getattr(_lib, "cm_%s_defaults" % _name).argtypes = []
+
+
+def _params(params):
+    if params is None or isinstance(params, str):
+        return params
+    return ",".join("%s=%s" % (k, v if isinstance(v, str) else repr(float(v)))
+                    for k, v in params.items())
+
+
+def _axis(value, name=None, what="axis"):
+    """(lo, hi, n) or (name, lo, hi, n) as a C axis."""
+    try:
+        if name is None:
+            name, lo, hi, n = value
+        else:
+            lo, hi, n = value[-3:]
+        return _Axis(_text(name), float(lo), float(hi), int(n))
+    except (TypeError, ValueError):
+        raise ValueError("%s %r: give %s(lo, hi, n)"
+                         % (what, value, "" if name is not None else "(name, ")) from None
+
+
+def _path(p):
+    return None if p is None else _text(os.fspath(p))
+
+
+class _Run:
+    """One call: the common part, temporary files for tables not asked for,
+    and the tables read back after the call."""
+
+    def __init__(self, model, params, plugins, csv, png, size, threads):
+        self.tmp = tempfile.TemporaryDirectory(prefix="cellmap-")
+        self.models = Models(plugins) if plugins else None
+        self.csv = os.fspath(csv) if csv is not None else os.path.join(self.tmp.name, "t.csv")
+        w, h = size or (0, 0)
+        self.keep = [_text(model), _text(_params(params))]
+        self.a = _Analysis(self.models._h if self.models else None, self.keep[0], self.keep[1],
+                           _path(self.csv), _path(png), int(w), int(h), int(threads))
+
+    def table_path(self, given, name):
+        return os.fspath(given) if given is not None else os.path.join(self.tmp.name, name)
+
+    def call(self, fn, *args):
+        _call(fn, ctypes.byref(self.a), *args)
+
+    @staticmethod
+    def read(path):
+        if path == "-":
+            return None
+        with open(path, encoding="utf-8") as f:
+            rows = f.read().splitlines()
+        if len(rows) <= 1:
+            names = rows[0].split(",") if rows else []
+            return np.zeros(0, dtype=[(n, float) for n in names])
+        return np.atleast_1d(np.genfromtxt(rows, delimiter=",", names=True, dtype=None,
+                                           encoding="utf-8", deletechars=""))
+
+    def close(self):
+        self.tmp.cleanup()
+
+
+def _run(common, fn, *args, tables=()):
+    """Calls fn with the common part and args; returns the main table, or
+    it and the further tables (paths) as a tuple."""
+    r = _Run(**common)
+    try:
+        args = [a(r) if callable(a) else a for a in args]
+        r.call(fn, *args)
+        out = [r.read(r.csv)] + [r.read(p(r)) for p in tables]
+        return out[0] if len(out) == 1 else tuple(out)
+    finally:
+        r.close()
+
+
+def _common(model=None, params=None, plugins=(), csv=None, png=None, size=None, threads=0):
+    return dict(model=model, params=params, plugins=plugins, csv=csv, png=png, size=size,
+                threads=threads)
+
+
+def stability(P=None, alpha=None, **common):
+    """microchaos-pd's charts (`cellmap stability`): P and alpha as (lo, hi, n)."""
+    p = ctypes.byref(_axis(P, "P", "P")) if P is not None else None
+    a = ctypes.byref(_axis(alpha, "alpha", "alpha")) if alpha is not None else None
+    return _run(_common(**common), _lib.cm_analysis_stability, p, a)
+
+
+def partition(**common):
+    """microchaos-delay's Markov partition (`cellmap partition`)."""
+    return _run(_common(**common), _lib.cm_analysis_partition)
+
+
+def amplitude(omega, periods=0, ymax=0.0, **common):
+    """friction-oscillator's amplitude-frequency diagram (`cellmap amplitude`)."""
+    return _run(_common(**common), _lib.cm_analysis_amplitude,
+                ctypes.byref(_axis(omega, "Omega", "omega")), int(periods), float(ymax))
+
+
+def horseshoe(m=None, periods=None, sweep=None, crisis=False, **common):
+    """microchaos-pd's horseshoes (`cellmap horseshoe`): lines m = (m0, m1)."""
+    o = _lib.cm_horseshoe_defaults()
+    if m is not None:
+        o.m0, o.m1 = int(m[0]), int(m[1])
+    if periods is not None:
+        o.periods = int(periods)
+    ax = _axis(sweep, "P", "sweep") if sweep is not None else None
+    o.sweep = ctypes.pointer(ax) if ax is not None else None
+    o.crisis = int(bool(crisis))
+    return _run(_common(**common), _lib.cm_analysis_horseshoe, ctypes.byref(o))
+
+
+def escape(I0=None, sweep=None, cells=None, ensemble=None, **common):
+    """microchaos-1d-friction's transient chaos (`cellmap escape`); sweep:
+    (name, lo, hi, n) of a, b or I0."""
+    o = _lib.cm_escape_defaults()
+    o.I0 = float(I0) if I0 is not None else 0.0
+    ax = _axis(sweep, what="sweep") if sweep is not None else None
+    o.sweep = ctypes.pointer(ax) if ax is not None else None
+    if cells is not None:
+        o.cells = int(cells)
+    if ensemble is not None:
+        o.ensemble = int(ensemble)
+    return _run(_common(**common), _lib.cm_analysis_escape, ctypes.byref(o))
+
+
+def simulate(start=(0.0, 0.0), t0=None, periods=20, skip=0, **common):
+    """A trajectory of friction-oscillator (`cellmap simulate`) from start (x, v)."""
+    o = _Simulate(float(start[0]), float(start[1]), math.nan if t0 is None else float(t0),
+                  int(periods), int(skip))
+    return _run(_common(**common), _lib.cm_analysis_simulate, ctypes.byref(o))
+
+
+def bifurcation(sweep, runs=None, transient=None, record=None, seed=None, runs_csv=None,
+                **common):
+    """friction-oscillator's brute-force diagram (`cellmap bifurcation`);
+    returns (points, runs) tables."""
+    o = _lib.cm_bifurcation_defaults()
+    o.sweep = _axis(sweep, what="sweep")
+    for key, value in (("runs", runs), ("transient", transient), ("record", record),
+                       ("seed", seed)):
+        if value is not None:
+            setattr(o, key, int(value))
+
+    def with_runs(r):
+        r.runs_csv = r.table_path(runs_csv, "runs.csv")
+        o.runs_csv = _path(r.runs_csv)
+        return ctypes.byref(o)
+    return _run(_common(**common), _lib.cm_analysis_bifurcation, with_runs,
+                tables=(lambda r: r.runs_csv,))
+
+
+def lyapunov(x, y, periods=None, d0=None, start=None, curves=(), **common):
+    """The largest Lyapunov exponent over a grid (`cellmap lyapunov`): x, y
+    as (name, lo, hi, n); start: a map model's start state."""
+    o = _lib.cm_lyapunov_defaults()
+    o.x, o.y = _axis(x, what="x"), _axis(y, what="y")
+    if periods is not None:
+        o.periods = int(periods)
+    if d0 is not None:
+        o.d0 = float(d0)
+    st = (ctypes.c_double * len(start))(*map(float, start)) if start else None
+    o.start, o.n_from = st, len(start) if start else 0
+    cv = (ctypes.c_char_p * max(1, len(curves)))(*[_path(c) for c in curves])
+    o.curves, o.n_curves = cv, len(curves)
+    return _run(_common(**common), _lib.cm_analysis_lyapunov, ctypes.byref(o))
+
+
+def sweep(name, values, region=None, cells=None, near=None, refine=0, max_steps=0,
+          by="attractors", **common):
+    """A model solved at each value of one parameter (`cellmap sweep`):
+    region [(lo, hi), ...], cells (n0, n1, ...), the window near [(lo, hi), ...]."""
+    if by not in ("attractors", "groups"):
+        raise ValueError("sweep(): by=%r: 'attractors' or 'groups'" % (by,))
+    vals = (ctypes.c_double * len(values))(*map(float, values))
+    region_text = ",".join("%r:%r" % (float(a), float(b)) for a, b in region) if region else None
+    cl = (ctypes.c_int64 * len(cells))(*map(int, cells)) if cells else None
+    lo = (ctypes.c_double * len(near))(*[float(a) for a, _ in near]) if near else None
+    hi = (ctypes.c_double * len(near))(*[float(b) for _, b in near]) if near else None
+    o = _Sweep(_text(name), vals, len(values), _text(region_text), cl, len(cells or ()), lo, hi,
+               len(near or ()), int(refine), int(max_steps), int(by == "groups"))
+    return _run(_common(**common), _lib.cm_analysis_sweep, ctypes.byref(o))
+
+
+def continuation(vary, direction="up", switch=False, starts=(), period=0, max_points=0,
+                 curve=None, curves=None, events=None, **common):
+    """Branches of friction-oscillator's periodic solutions (`cellmap
+    continue`): vary (name, lo, hi); direction "up", "down" or "both";
+    starts [(x, v, value), ...] (NaN x: simulate; NaN value: the model's);
+    curve (name2, lo2, hi2) with curves= a CSV path. Returns (points, events)."""
+    directions = {"up": 1, "down": -1, "both": 0}
+    if direction not in directions:
+        raise ValueError("continuation(): direction=%r: 'up', 'down' or 'both'" % (direction,))
+    o = _lib.cm_continue_defaults()
+    name, lo, hi = vary
+    keep = [_text(name), _text(curve[0]) if curve else None, _path(curves)]
+    o.vary, o.lo, o.hi = keep[0], float(lo), float(hi)
+    o.direction, o.switch_pd = directions[direction], int(bool(switch))
+    arr = ((ctypes.c_double * 3) * max(1, len(starts)))(
+        *[(ctypes.c_double * 3)(*map(float, s)) for s in starts])
+    o.start, o.n_from = ctypes.cast(arr, ctypes.POINTER(ctypes.c_double * 3)), len(starts)
+    o.period, o.max_points = int(period), int(max_points)
+    if curve:
+        o.curve, o.lo2, o.hi2 = keep[1], float(curve[1]), float(curve[2])
+    o.curves = keep[2]
+
+    def with_events(r):
+        r.events = r.table_path(events, "events.csv")
+        o.events = _path(r.events)
+        return ctypes.byref(o)
+    return _run(_common(**common), _lib.cm_analysis_continue, with_events,
+                tables=(lambda r: r.events,))

@@ -1,0 +1,65 @@
+"""The analysis commands done from Python (tests/workstation_test.sh runs
+the same settings through the command and through tests/workstation.c and
+compares the files byte for byte): PREFIX_NAME.csv and .png for stability,
+partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
+runs), lyapunov, sweep and continue (and its events). The tables the
+functions return are checked against the files they read them from.
+usage: workstation_analysis.py PREFIX"""
+import sys
+
+import numpy as np
+
+import cellmap
+from cellmap import analysis as an
+
+p = sys.argv[1] + "_"
+
+
+def out(name, png=True):
+    return dict(csv=p + name + ".csv", png=p + name + ".png" if png else None)
+
+
+def rows(table, path):
+    """the table has a row per data line of its CSV, and its header's columns"""
+    with open(path, encoding="utf-8") as f:
+        lines = f.read().splitlines()
+    assert list(table.dtype.names) == lines[0].split(","), (path, table.dtype.names, lines[0])
+    assert len(table) == len(lines) - 1 and len(table) > 0, (path, len(table), len(lines))
+    return table
+
+
+rows(an.stability(P=(0.007, 0.02, 50), alpha=(0.1, 1, 20), **out("stability")),
+     p + "stability.csv")
+rows(an.partition(params="a=1.3,b=0.66", **out("partition")), p + "partition.csv")
+amp = rows(an.amplitude((0.2, 2, 20), periods=50, **out("amplitude")), p + "amplitude.csv")
+assert np.allclose(amp["Omega"], 0.2 + (np.arange(20) + 0.5) * 0.09), amp["Omega"]
+rows(an.horseshoe(m=(1, 3), periods=6, **out("horseshoe")), p + "horseshoe.csv")
+rows(an.escape(cells=1000, ensemble=1000, **out("escape")), p + "escape.csv")
+rows(an.simulate((1, 0), periods=5, **out("simulate")), p + "simulate.csv")
+pts, runs = an.bifurcation(("S", 0.1, 0.3, 4), runs=2, transient=20, record=5,
+                           runs_csv=p + "bifurcation_runs.csv", **out("bifurcation"))
+rows(pts, p + "bifurcation.csv")
+assert len(rows(runs, p + "bifurcation_runs.csv")) == 8
+rows(an.lyapunov(("Omega", 0.4, 0.6, 3), ("S", 0.1, 0.2, 3), periods=50, **out("lyapunov")),
+     p + "lyapunov.csv")
+rows(an.sweep("P", [0.006, 0.007], region=[(0, 100), (-10, 10)], cells=(50, 50),
+              **out("sweep", png=False)), p + "sweep.csv")
+pts, events = an.continuation(("S", 0.02, 0.4), max_points=50, events=p + "continue_events.csv",
+                              **out("continue"))
+rows(pts, p + "continue.csv")
+rows(events, p + "continue_events.csv")
+
+# without files: the tables alone, from temporary files
+t = an.partition(params={"a": 1.3, "b": 0.66})
+assert len(t) == 9, t
+# errors name the problem, without command-line flags
+for call, words in ((lambda: an.stability(P=(0.02, 0.01, 5)), "LO < HI"),
+                    (lambda: an.sweep("Q", [1, 2]), "'Q' is not a parameter"),
+                    (lambda: an.continuation(("S", 0.02, 0.2), params="S=0.3"),
+                     "outside the range S=0.02:0.2")):
+    try:
+        call()
+        raise SystemExit("no error where %r was expected" % words)
+    except cellmap.CellmapError as e:
+        assert words in str(e) and "--" not in str(e), str(e)
+print("workstation_analysis.py: done")
