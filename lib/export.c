@@ -587,7 +587,7 @@ static cm_status write_rows(cm_cluster *c, const cm_box *window, const cm_attrac
         cm_region_free(&flat);
         const char *why = st == CM_OK ? work_stop(hooks) : NULL;
         if (why)
-            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: --cells and --flat were not written",
+            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: the cells' table and flat database were not written",
                          why);
         if (st != CM_OK)
             return st;
@@ -646,10 +646,10 @@ cm_status export_window(const cm_cluster *c, const char *text, cm_box *box, char
     int n = 0;
     if (!parse_ranges(text, lo, hi, &n, CM_MAX_DIM))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--window: '%s' is not X0:X1[,Y0:Y1...] with X0 < X1", text);
+                       "the window '%s' is not X0:X1[,Y0:Y1...] with X0 < X1", text);
     if (n != lat->dim)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--window has %d range(s) but the lattice has dimension %d", n, lat->dim);
+                       "the window has %d range(s) but the lattice has dimension %d", n, lat->dim);
     for (int d = 0; d < n; d++) {
         const double a = ceil((lo[d] - lat->origin[d]) / lat->width[d] - 0.5);
         const double b = floor((hi[d] - lat->origin[d]) / lat->width[d] - 0.5) + 1;
@@ -658,7 +658,7 @@ cm_status export_window(const cm_cluster *c, const char *text, cm_box *box, char
         box->hi[d] = b < (double)chi ? (b > (double)box->lo[d] ? (int64_t)b : box->lo[d]) : chi;
         if (box->lo[d] >= box->hi[d]) /* nothing to write: said before any file is made */
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "--window: '%s' holds no cell centre of the file in dimension %d "
+                           "the window '%s' holds no cell centre of the file in dimension %d "
                            "(its cells are %.9g wide, their centres from %.9g to %.9g): widen "
                            "the window",
                            text, d + 1, lat->width[d],
@@ -815,7 +815,7 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
         cm_region_free(&flat);
         const char *why = ok ? work_stop(hooks) : NULL;
         if (why) {
-            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: --labels and --steps were not written",
+            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: the labels and steps arrays were not written",
                          why);
             ok = false;
         }

@@ -116,7 +116,7 @@ bool png_opts_palette(const char *value, png_opts *po, char *msg, size_t msg_siz
 bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 {
     FILE *f;
-    if (cm_input_open(path, "--labels file", 1 << 20, &f, msg, msg_size) != CM_OK)
+    if (cm_input_open(path, "the labels file", 1 << 20, &f, msg, msg_size) != CM_OK)
         return false;
     po->labels_file = path;
     char line[512];
@@ -145,9 +145,9 @@ bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *m
                     size_t msg_size)
 {
     const cm_file_use files[] = {
-        {db, "the database", db_written, true},     {po->path, "--png", true, false},
-        {po->svg, "--svg", true, false},             {po->palette_file, "--palette", false, false},
-        {po->labels_file, "--labels", false, false},
+        {db, "the database", db_written, true},     {po->path, "the PNG", true, false},
+        {po->svg, "the SVG", true, false},             {po->palette_file, "the palette", false, false},
+        {po->labels_file, "the labels file", false, false},
     };
     return cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size) == CM_OK;
 }
@@ -340,7 +340,7 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
     if (s.nx > CM_RENDER_MAX_SIDE || s.ny > CM_RENDER_MAX_SIDE)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "an indexed image has one pixel per cell: %llux%llu cells exceed %d a "
-                       "side; choose a smaller --view",
+                       "side; choose a smaller view",
                        (unsigned long long)s.nx, (unsigned long long)s.ny, CM_RENDER_MAX_SIDE);
     cm_status st =
         cm_raster_build(b->lat, b->cells, b->groups, &s, CM_RASTER_CLASSES,
@@ -510,7 +510,7 @@ cm_status figure_file_view(cm_store *s, const cm_cluster *cl, const png_opts *po
     int n = 0;
     if (!parse_doubles(slice_text, v, &n, CM_MAX_DIM) || n != lat->dim - 2)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--slice: '%s' must be %d coordinate(s) of dimensions 3..", slice_text,
+                       "the slice '%s' must be %d coordinate(s) of dimensions 3..", slice_text,
                        lat->dim > 2 ? lat->dim - 2 : 0);
     for (int d = 2; d < lat->dim; d++) {
         box->lo[d] = (int64_t)floor((v[d - 2] - lat->origin[d]) / lat->width[d]);

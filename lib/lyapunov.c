@@ -57,14 +57,14 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
 {
     FILE *f = NULL;
     char line[512], n1[64] = "", n2[64] = "", why[CM_OUTPUT_PATH_MAX + 256];
-    if (cm_input_open(path, "--curves file", UINT64_C(64) << 20, &f, why, sizeof why) != CM_OK)
+    if (cm_input_open(path, "the curves file", UINT64_C(64) << 20, &f, why, sizeof why) != CM_OK)
         return cm_fail(CM_EINVAL, msg, msg_size, "%s (make it with cellmap continue --curves)",
                        why);
     if (!fgets(line, sizeof line, f) ||
         sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
         fclose(f);
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--curves %s: not a file of curve,label,P,P2,x,v lines (make it with "
+                       "curves file %s: not a file of curve,label,P,P2,x,v lines (make it with "
                        "cellmap continue --curves)",
                        path);
     }
@@ -72,7 +72,7 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
     const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
     if (!same && !swapped) {
         fclose(f);
-        return cm_fail(CM_EINVAL, msg, msg_size, "--curves %s is in (%s, %s), the grid in (%s, %s)",
+        return cm_fail(CM_EINVAL, msg, msg_size, "curves file %s is in (%s, %s), the grid in (%s, %s)",
                        path, n1, n2, a->ax[0].name, a->ax[1].name);
     }
     int last = -1;

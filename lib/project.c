@@ -39,17 +39,17 @@ cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_
     int n = 0;
     if (!text)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--region is required for model %s (one LO:HI per dimension)", m->name);
+                       "a region is required for model %s (one LO:HI per dimension)", m->name);
     if (!parse_ranges(text, low, high, &n, CM_MAX_DIM))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--region: '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
+                       "the region '%s' is not LO:HI[,LO:HI...] with LO < HI", text);
     if (n != m->dim)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--region has %d range(s) but model %s has dimension %d", n, m->name,
+                       "the region has %d range(s) but model %s has dimension %d", n, m->name,
                        m->dim);
     if (spec->n_cells && spec->n_cells != m->dim)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--cells has %d count(s) but model %s has dimension %d", spec->n_cells,
+                       "the cells give %d count(s) but model %s has dimension %d", spec->n_cells,
                        m->name, m->dim);
     memset(lat, 0, sizeof *lat);
     memset(box, 0, sizeof *box);
@@ -64,7 +64,7 @@ cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_
     }
     if (total > (double)CM_REGION_MAX_CELLS)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--cells asks for %.0f cells; one region holds at most %llu", total,
+                       "the cells ask for %.0f cells; one region holds at most %llu", total,
                        (unsigned long long)CM_REGION_MAX_CELLS);
     cm_status st = cm_lattice_check(lat, msg, msg_size);
     if (st == CM_OK)
@@ -255,7 +255,7 @@ static cm_status plugin_of_store(const cm_store_info *info, cm_model_set *set, c
             !cm_model_set_find(set, info->model, &lib))
             return cm_fail(CM_ENOTFOUND, msg, msg_size,
                            "its model '%s' comes from the plugin %s, which cannot be loaded "
-                           "(%.600s): give --model-lib with where it is now",
+                           "(%.600s): load the plugin from where it is now",
                            info->model, info->model_lib, why);
     }
     if (lib && info->model_lib_hash[0] && strcmp(lib->hash, info->model_lib_hash) != 0)

@@ -125,8 +125,8 @@ static cm_status cover_box(session *s, const cm_box *box, const char *verb, sess
                      "%s would compute %llu new cells, more than %llu at once%s; zoom or pan in "
                      "smaller steps%s",
                      verb, (unsigned long long)cells, (unsigned long long)s->max_new_cells,
-                     s->mem_given ? " (what --mem holds, 12 bytes a cell)" : "",
-                     s->mem_given ? ", or give a larger --mem" : "");
+                     s->mem_given ? " (what the memory budget holds, 12 bytes a cell)" : "",
+                     s->mem_given ? ", or give a larger memory budget" : "");
     if (st == CM_OK && n > 0)
         st = compute_boxes(s, boxes, n, done, msg, msg_size);
     free(boxes);
@@ -226,7 +226,7 @@ cm_status session_slice(const session *s, const char *text, int64_t *slice, char
         const double c = floor((v[d - 2] - s->c.lat.origin[d]) / s->c.lat.width[d]);
         if (!(c >= (double)s->depth_lo[d] && c < (double)s->depth_hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "view: %s = %s is outside the session's depth (--depth)", cm_model_coord_name(&s->model, d),
+                           "view: %s = %s is outside the session's depth", cm_model_coord_name(&s->model, d),
                            CM_NUM(v[d - 2]));
         slice[d] = (int64_t)c;
     }
@@ -390,8 +390,8 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
 {
     const cm_file_use files[] = {{s->path, "the session's database", true, true},
                                  {po->path ? po->path : po->svg, "render", true, false},
-                                 {po->palette_file, "--palette", false, false},
-                                 {po->labels_file, "--labels", false, false}};
+                                 {po->palette_file, "the palette", false, false},
+                                 {po->labels_file, "the labels file", false, false}};
     cm_status st = cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size);
     if (st == CM_OK)
         st = session_need_view(s, "render", msg, msg_size);
@@ -629,16 +629,16 @@ static cm_status options_lattice(const opening *op, int dim, cm_lattice *lat)
     memset(lat, 0, sizeof *lat);
     lat->dim = dim;
     if (o->n_cell_size != dim)
-        return refuse(op, CM_EINVAL, true, "--cell-size needs %d width(s) DX[,DY...] for this "
+        return refuse(op, CM_EINVAL, true, "the cell size needs %d width(s) DX[,DY...] for this "
                       "model", dim);
     if (o->n_origin && o->n_origin != dim)
-        return refuse(op, CM_EINVAL, true, "--origin needs %d coordinate(s) for this model", dim);
+        return refuse(op, CM_EINVAL, true, "the origin needs %d coordinate(s) for this model", dim);
     for (int d = 0; d < dim; d++) {
         lat->width[d] = o->cell_size[d];
         lat->origin[d] = o->n_origin ? o->origin[d] : 0.0;
     }
     if (cm_lattice_check(lat, msg, sizeof msg) != CM_OK)
-        return refuse(op, CM_EINVAL, true, "--cell-size/--origin: %s", msg);
+        return refuse(op, CM_EINVAL, true, "the cell size or origin: %s", msg);
     return CM_OK;
 }
 
@@ -659,7 +659,7 @@ static cm_status check_same(const opening *op, const cm_store_info *info)
         cm_model_release(&m);
         if (differs)
             return refuse(op, CM_EINVAL, false,
-                          "%s holds model %s; drop --model/--param to go on with it, or choose "
+                          "%s holds model %s; give no model or parameters to go on with it, or choose "
                           "another file",
                           s->path, info->model);
     }
@@ -667,11 +667,11 @@ static cm_status check_same(const opening *op, const cm_store_info *info)
     if (o->n_cell_size && (options_lattice(op, info->lattice.dim, &lat) != CM_OK ||
                            !cm_lattice_equal(&lat, &info->lattice)))
         return refuse(op, CM_EINVAL, false,
-                      "%s has another lattice; drop --cell-size/--origin to go on with it",
+                      "%s has another lattice; give no cell size or origin to go on with it",
                       s->path);
     if (o->max_steps && o->max_steps != s->max_steps)
         return refuse(op, CM_EINVAL, false,
-                      "%s was computed with another --max-steps; drop it to go on with the "
+                      "%s was computed with other max steps; give none to go on with the "
                       "file's",
                       s->path);
     return CM_OK;
@@ -742,7 +742,7 @@ static cm_status new_depth(const opening *op)
     } else if (!text || !parse_ranges(text, lo + 2, hi + 2, &n, CM_MAX_DIM - 2) ||
                n != s->dim - 2) {
         return refuse(op, CM_EINVAL, true,
-                      "model %s has %d dimensions: --depth LO:HI,... gives the ranges of "
+                      "model %s has %d dimensions: the depth LO:HI,... gives the ranges of "
                       "dimensions 3..%d that every view computes",
                       s->model.name, s->dim, s->dim);
     }
@@ -765,8 +765,8 @@ static cm_status create_new(const opening *op)
     cm_lattice lat;
     if (!o->mo.name)
         return refuse(op, CM_EINVAL, true,
-                      "%s does not exist; create it with --model NAME [--param k=v,...] "
-                      "--cell-size DX[,DY...] [--origin X,Y...]",
+                      "%s does not exist; a new file needs a model (and its parameters) and "
+                      "the size of its cells (and their origin)",
                       s->path);
     cm_status st = cm_model_set_create(&o->mo.set, o->mo.name, o->mo.texts, o->mo.n_texts,
                                        &s->model, msg, sizeof msg);
@@ -779,7 +779,7 @@ static cm_status create_new(const opening *op)
     if ((st = options_lattice(op, s->dim, &lat)) != CM_OK)
         return st;
     if ((st = cm_model_check_lattice(&s->model, &lat, msg, sizeof msg)) != CM_OK)
-        return refuse(op, st, true, "--cell-size/--origin: %s", msg);
+        return refuse(op, st, true, "the cell size or origin: %s", msg);
     char plan[64];
     snprintf(plan, sizeof plan, "explore max-steps %d", s->max_steps);
     const cm_model_lib *lib = model_spec_lib(&o->mo, s->model.name);

@@ -117,8 +117,8 @@ static cm_status same_solve(void *user, const cm_store_info *info, const cm_mode
     cm_params_json(&f->m->values, params, sizeof params);
     const char *differs = strcmp(info->model, f->m->name)             ? "model"
                           : strcmp(info->params, params)              ? "parameters"
-                          : !cm_lattice_equal(&info->lattice, f->lat) ? "lattice (--region, --cells)"
-                          : strcmp(info->plan, f->plan)               ? "plan (--split, --extend, ...)"
+                          : !cm_lattice_equal(&info->lattice, f->lat) ? "lattice (region, cells)"
+                          : strcmp(info->plan, f->plan)               ? "plan (split, extend, ...)"
                                                                       : NULL;
     if (differs)
         return cm_fail(CM_EINVAL, msg, msg_size,

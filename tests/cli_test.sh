@@ -285,12 +285,12 @@ expect_usage "unknown model" solve --model nope
 expect_usage "unknown parameter 'gamma'" solve --param gamma=1
 expect_usage "alpha = -1 is outside" solve --param alpha=-1
 expect_usage "not a finite number" solve --param P=abc
-expect_usage "--region: '5:1,0:1'" solve --region 5:1,0:1
-expect_usage "--region: 'abc'" solve --region abc
-expect_usage "--region has 1 range(s)" solve --region 0:1
+expect_usage "the region '5:1,0:1'" solve --region 5:1,0:1
+expect_usage "the region 'abc'" solve --region abc
+expect_usage "the region has 1 range(s)" solve --region 0:1
 expect_usage "--cells: '0x10'" solve --cells 0x10
-expect_usage "--cells has 3 count(s)" solve --cells 10x10x10
-expect_usage "--cells asks for" solve --cells 100000x100000
+expect_usage "the cells give 3 count(s)" solve --cells 10x10x10
+expect_usage "the cells ask for" solve --cells 100000x100000
 expect_usage "--max-steps" solve --max-steps 0
 # --extend: from the left region of Figs. 4.25-4.28 the right neighbour
 # comes first; the JSON reports each step; the PNG covers the bounding box
@@ -328,7 +328,7 @@ expect_usage "--threads" solve --threads x
 expect_usage "--size" solve --size 10
 expect_usage "--png needs a value" solve --png
 expect_usage "--json takes no value" solve --json=1
-expect_usage "--region is required" solve --model microchaos-general
+expect_usage "a region is required" solve --model microchaos-general
 expect_usage "--from and --steps are required" orbit
 expect_usage "--from has 1 value(s)" orbit --from 1 --steps 3
 expect_usage "--steps" orbit --from 1,2 --steps -1
@@ -394,7 +394,7 @@ for path, iz in ((sys.argv[3], 5), (sys.argv[4], 12)):   # z = -3.25 and 0.25: c
     images.append(rows)
 assert images[0] != images[1]    # the slices differ: --slice is obeyed
 PY
-expect_usage "--slice" render s3.cmdb --png x.png --slice 1,2
+expect_usage "the slice '1,2' must be 1" render s3.cmdb --png x.png --slice 1,2
 # --- 2-D indexed PNGs: row 0 is the top (high y), column 0 the left (low x) --
 "$CM" solve --cells 40x30 --split 2x1 --db o2.cmdb --png o2.png --png-mode indexed --by groups > /dev/null \
   || fail "2-D indexed solve"

@@ -204,7 +204,7 @@ for z in 1.75 -2 2 -2.01; do
   case $z in # a slice is shown at its cell's centre
     1.75|-2) [ $rc -eq 0 ] && grep -qF "view -2:2 -2:2 at ${z/#-2/-1.75}; computed 512 cells" <<<"$out" \
       || fail "at $z inside the depth: rc $rc, '$out'" ;;
-    *) [ $rc -eq 1 ] && grep -qF "stdin:1: view: x = $z is outside the session's depth (--depth)" <<<"$out" \
+    *) [ $rc -eq 1 ] && grep -qF "stdin:1: view: x = $z is outside the session's depth" <<<"$out" \
       || fail "at $z outside the depth: rc $rc, '$out'" ;;
   esac
 done
@@ -253,13 +253,13 @@ out=$("$CM" explore fresh.cmdb empty.explore $pd $lattice 2>&1); rc=$?
   fail "export before any region: rc $rc, '$out'"
 # bad options
 out=$("$CM" explore nofile.cmdb first.explore 2>&1); rc=$?
-[ "$rc" -eq 2 ] && grep -qF "does not exist; create it with --model" <<<"$out" ||
+[ "$rc" -eq 2 ] && grep -qF "does not exist; a new file needs a model" <<<"$out" ||
   fail "missing file without --model: rc $rc, '$out'"
 out=$("$CM" explore union1.cmdb first.explore --model microchaos-1d 2>&1); rc=$?
 [ "$rc" -eq 1 ] && grep -qF "holds model microchaos-pd" <<<"$out" ||
   fail "another model for an existing file: rc $rc, '$out'"
 out=$("$CM" explore x.cmdb --model microchaos-pd 2>&1); rc=$?
-[ "$rc" -eq 2 ] && grep -qF -- "--cell-size needs 2" <<<"$out" || fail "no --cell-size: rc $rc, '$out'"
+[ "$rc" -eq 2 ] && grep -qF -- "the cell size needs 2" <<<"$out" || fail "no --cell-size: rc $rc, '$out'"
 out=$("$CM" explore x.cmdb missing.explore $pd $lattice 2>&1); rc=$?
 [ "$rc" -eq 2 ] && grep -qF "cannot open the script missing.explore" <<<"$out" && [ ! -e x.cmdb ] ||
   fail "missing script: rc $rc, '$out'"

@@ -59,7 +59,7 @@ pan right $long_amount
 EOS
 [ $? -eq 1 ] && grep -q "is too long" err.txt || fail "a long pan amount: $(cat err.txt)"
 # export --window 0 read before a stack array
-expect_usage "--window: '0'" export good.cmdb --flat f.sqlite --window 0
+expect_usage "the window '0'" export good.cmdb --flat f.sqlite --window 0
 [ -e f.sqlite ] && fail "export --window 0 left f.sqlite"
 # cells naming groups that do not exist
 cp good.cmdb nogroups.cmdb

@@ -27,8 +27,8 @@ refused_apart() {
 }
 
 for f in a d e g h p; do cp plain.cmdb $f.cmdb; done
-refused_apart "--png a.cmdb is the database a.cmdb" a.cmdb render a.cmdb --png a.cmdb
-refused_apart "--svg a.cmdb is the database a.cmdb" a.cmdb render a.cmdb --svg a.cmdb
+refused_apart "the PNG a.cmdb is the database a.cmdb" a.cmdb render a.cmdb --png a.cmdb
+refused_apart "the SVG a.cmdb is the database a.cmdb" a.cmdb render a.cmdb --svg a.cmdb
 refused_apart "--groups d.cmdb is the database d.cmdb" d.cmdb export d.cmdb --groups d.cmdb
 refused_apart "--groups d.cmdb is the database" d.cmdb export d.cmdb --cells - --groups d.cmdb
 refused_apart "--flat e.cmdb is the database e.cmdb" e.cmdb export e.cmdb --flat e.cmdb
@@ -37,9 +37,9 @@ refused_apart "-shm file of the database e.cmdb" e.cmdb export e.cmdb --cells e.
   --flat e.cmdb-shm
 # through a symlink, a hard link and another spelling of the path
 ln -s g.cmdb g.png
-refused_apart "--png g.png is the database g.cmdb" g.cmdb render g.cmdb --png g.png
+refused_apart "the PNG g.png is the database g.cmdb" g.cmdb render g.cmdb --png g.png
 ln h.cmdb h-link.png
-refused_apart "--png h-link.png is the database h.cmdb" h.cmdb render h.cmdb --png h-link.png
+refused_apart "the PNG h-link.png is the database h.cmdb" h.cmdb render h.cmdb --png h-link.png
 mkdir sub
 refused_apart "is the database" p.cmdb render p.cmdb --png sub/../p.cmdb
 refused_apart "is the database" p.cmdb render p.cmdb --png "$PWD/p.cmdb"
@@ -54,15 +54,15 @@ expect_usage "the database r.cmdb" solve --cells 60x60 --db r.cmdb --resume --sv
 printf '#112233\n#445566\n' > pal.txt
 printf '1 first\n' > lab.txt
 cp pal.txt pal.orig; cp lab.txt lab.orig
-expect_usage "--png pal.txt is --palette pal.txt" render a.cmdb --palette pal.txt --png pal.txt
-expect_usage "--svg lab.txt is --labels lab.txt" render a.cmdb --labels lab.txt --svg lab.txt
+expect_usage "the PNG pal.txt is the palette pal.txt" render a.cmdb --palette pal.txt --png pal.txt
+expect_usage "the SVG lab.txt is the labels file lab.txt" render a.cmdb --labels lab.txt --svg lab.txt
 cmp -s pal.txt pal.orig && cmp -s lab.txt lab.orig || fail "a palette or label file was changed"
 # two outputs of one command, an array's JSON sidecar included
 refused_apart "--steps x.npy and --labels x.npy are the same file" plain.cmdb \
   export plain.cmdb --labels x.npy --steps x.npy
 refused_apart "--labels' JSON y.json and --groups y.json" plain.cmdb \
   export plain.cmdb --labels y.npy --groups y.json
-refused_apart "--svg z.png and --png z.png" plain.cmdb render plain.cmdb --png z.png --svg z.png
+refused_apart "the SVG z.png and the PNG z.png" plain.cmdb render plain.cmdb --png z.png --svg z.png
 # explore: render and export onto the session's own file
 cp plain.cmdb f.cmdb
 printf 'render f.cmdb\n' > s1.explore
@@ -94,7 +94,7 @@ out=$("$CM" explore new.cmdb missing.explore --model microchaos-pd --cell-size 1
 # one explore step computes no more than --mem holds (12 bytes a cell)
 out=$(printf 'view 0:20 -40:40\nview 0:500 -40:40\n' |
   "$CM" explore mem.cmdb - --model microchaos-pd --cell-size 0.5,0.08 --mem 1M 2>&1 > /dev/null); rc=$?
-[ $rc -eq 1 ] && grep -q "more than 87381 at once (what --mem holds" <<<"$out" \
+[ $rc -eq 1 ] && grep -q "more than 87381 at once (what the memory budget holds" <<<"$out" \
   || fail "explore beyond --mem: rc $rc, '$out'"
 [ "$(sqlite3 mem.cmdb 'SELECT SUM(cells) FROM regions')" = 40000 ] || fail "explore beyond --mem computed cells"
 
@@ -155,7 +155,7 @@ expect_usage "missing.cmdb does not exist" info missing.cmdb
 expect_usage "missing.cmdb does not exist" render missing.cmdb --png x.png
 expect_usage "missing.cmdb does not exist" export missing.cmdb --groups x.csv
 expect_usage "missing.cmdb does not exist" solve --cells 20x20 --db missing.cmdb --resume
-expect_usage "cannot read --curves file missing.csv" lyapunov --grid Omega=0.3:0.7:2,S=0.02:0.4:2 --periods 2 --png x.png --curves missing.csv
+expect_usage "cannot read the curves file missing.csv" lyapunov --grid Omega=0.3:0.7:2,S=0.02:0.4:2 --periods 2 --png x.png --curves missing.csv
 expect_usage "an output file name is empty" sweep --vary P=0.006,0.007 --cells 40x20 --csv ""
 expect_usage "an output file name is empty" export plain.cmdb --groups ""
 expect_usage "the directory nodir does not exist" render plain.cmdb --png nodir/x.png
