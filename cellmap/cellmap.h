@@ -334,6 +334,26 @@ cm_status cm_db_resume(const cm_models *set, const char *name, const char *param
 cm_status cm_db_export(const char *path, const double *lo, const double *hi, const char *labels,
                        const char *steps, int by_groups, char *msg, size_t msg_size);
 
+/* The cells of the rectangle lo..hi (every dimension of the file's
+ * lattice; a cell is in when the rectangle covers it by the lattice's
+ * rule, as a session's view) that the database at path lacks, solved as
+ * new regions, joined exactly and committed one join at a time;
+ * *new_cells (may be NULL): how many. The file keeps its model, lattice
+ * and max steps (o->max_steps, when given, must be the file's); o (may be
+ * NULL) gives threads, mem and the provenance. At most 2^28 new cells per
+ * call (with o->mem: what it holds, 12 bytes a cell). */
+cm_status cm_db_add_box(const char *path, const double *lo, const double *hi,
+                        const cm_db_options *o, uint64_t *new_cells, char *msg, size_t msg_size);
+
+/* Adaptive extension (thesis 4.6.4) of the database at path: up to steps
+ * (1..1000) times, the tile of lo..hi's size (its cells per dimension)
+ * next to the cluster where the most sequences escape is computed and
+ * joined, as `cellmap solve --extend` does from its region; *done (may be
+ * NULL): the steps done (fewer when nothing escapes any more). o as for
+ * cm_db_add_box. */
+cm_status cm_db_extend(const char *path, const double *lo, const double *hi, int steps,
+                       const cm_db_options *o, int *done, char *msg, size_t msg_size);
+
 /* ---- sessions: a view moved over a growing database ---- */
 
 typedef struct cm_session cm_session;

@@ -900,7 +900,7 @@ cm_status cm_session_extend(cm_session *s, int steps, int *done, char *msg, size
 {
     int n = 0;
     session_extended how;
-    const cm_status st = session_extend(&s->s, steps, count_step, &n, &how, msg, msg_size);
+    const cm_status st = session_extend(&s->s, NULL, steps, count_step, &n, &how, msg, msg_size);
     if (done)
         *done = n;
     return st;
@@ -938,4 +938,55 @@ cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size)
     const cm_status st = session_close(&s->s, msg, msg_size);
     free(s);
     return st;
+}
+
+/* ---- databases grown in place ---- */
+
+/* The session a database is grown through: the file's own model, lattice
+ * and max steps; o's threads, memory and provenance. */
+static cm_status grown_session(const char *path, const cm_db_options *o, cm_session **s,
+                               char *msg, size_t msg_size)
+{
+    const cm_db_options none = {0};
+    o = o ? o : &none;
+    const cm_session_options so = {.max_steps = o->max_steps, .threads = o->threads,
+                                   .mem = o->mem, .command = o->command};
+    return cm_session_open(path, &so, s, msg, msg_size);
+}
+
+cm_status cm_db_add_box(const char *path, const double *lo, const double *hi,
+                        const cm_db_options *o, uint64_t *new_cells, char *msg, size_t msg_size)
+{
+    cm_session *s = NULL;
+    cm_status st = grown_session(path, o, &s, msg, msg_size);
+    cm_box box;
+    session_work work = {0};
+    if (st == CM_OK)
+        st = session_rect_box(&s->s, lo, hi, &box, msg, msg_size);
+    if (st == CM_OK)
+        st = session_add_box(&s->s, &box, &work, msg, msg_size);
+    if (new_cells)
+        *new_cells = work.cells;
+    char close_msg[512];
+    const cm_status closed = cm_session_close(s, close_msg, sizeof close_msg);
+    return st != CM_OK || closed == CM_OK ? st : cm_fail(closed, msg, msg_size, "%s", close_msg);
+}
+
+cm_status cm_db_extend(const char *path, const double *lo, const double *hi, int steps,
+                       const cm_db_options *o, int *done, char *msg, size_t msg_size)
+{
+    cm_session *s = NULL;
+    cm_status st = grown_session(path, o, &s, msg, msg_size);
+    cm_box tile;
+    int n = 0;
+    session_extended how;
+    if (st == CM_OK)
+        st = session_rect_box(&s->s, lo, hi, &tile, msg, msg_size);
+    if (st == CM_OK)
+        st = session_extend(&s->s, &tile, steps, count_step, &n, &how, msg, msg_size);
+    if (done)
+        *done = n;
+    char close_msg[512];
+    const cm_status closed = cm_session_close(s, close_msg, sizeof close_msg);
+    return st != CM_OK || closed == CM_OK ? st : cm_fail(closed, msg, msg_size, "%s", close_msg);
 }

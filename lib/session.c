@@ -200,6 +200,29 @@ cm_status session_move(session *s, const double *given_lo, const double *given_h
     return done->regions ? session_save(s, msg, msg_size) : CM_OK;
 }
 
+cm_status session_rect_box(const session *s, const double *lo, const double *hi, cm_box *box,
+                           char *msg, size_t msg_size)
+{
+    memset(box, 0, sizeof *box);
+    box->dim = s->dim;
+    for (int d = 0; d < s->dim; d++) {
+        if (!(lo[d] < hi[d]) || !isfinite(lo[d]) || !isfinite(hi[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the box needs finite LO < HI in each of the %d dimensions", s->dim);
+        box->lo[d] = cm_lattice_border(&s->c.lat, d, lo[d], 0);
+        box->hi[d] = cm_lattice_border(&s->c.lat, d, hi[d], 1);
+    }
+    return CM_OK;
+}
+
+cm_status session_add_box(session *s, const cm_box *box, session_work *done, char *msg,
+                          size_t msg_size)
+{
+    memset(done, 0, sizeof *done);
+    const cm_status st = cover_box(s, box, "add", done, msg, msg_size);
+    return st == CM_OK && done->regions ? session_save(s, msg, msg_size) : st;
+}
+
 cm_status session_need_view(const session *s, const char *verb, char *msg, size_t msg_size)
 {
     return s->have_view ? CM_OK
@@ -332,14 +355,14 @@ static cm_status session_tile(void *user, int k, const cm_extend_choice *choice,
     return CM_OK;
 }
 
-cm_status session_extend(session *s, int steps, session_step_fn step_done, void *user,
-                         session_extended *out, char *msg, size_t msg_size)
+cm_status session_extend(session *s, const cm_box *tile, int steps, session_step_fn step_done,
+                         void *user, session_extended *out, char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);
     if (steps < 1 || steps > 1000)
         return cm_fail(CM_EINVAL, msg, msg_size, "extend auto: %d steps is not in 1..1000",
                        steps);
-    cm_status st = session_need_view(s, "extend", msg, msg_size);
+    cm_status st = tile ? CM_OK : session_need_view(s, "extend", msg, msg_size);
     if (st != CM_OK)
         return st;
     /* a resumed run: the extend lines before the one that stopped are done,
@@ -351,12 +374,13 @@ cm_status session_extend(session *s, int steps, session_step_fn step_done, void 
     }
     const int first = here ? s->resume_step : 1;
     s->resume_step = 0; /* resumed once */
-    cm_box tile;
-    view_box(s, s->lo, s->hi, &tile);
+    cm_box view;
+    if (!tile)
+        view_box(s, s->lo, s->hi, &view);
     const session_extension x = {s, step_done, user};
     int done = 0;
     out->stop[0] = '\0';
-    st = project_extend_tiles(&s->c, &tile, NULL, first, steps, here ? &s->resume_tile : NULL,
+    st = project_extend_tiles(&s->c, tile ? tile : &view, NULL, first, steps, here ? &s->resume_tile : NULL,
                               session_tile, (void *)&x, &done, out->stop, sizeof out->stop, msg,
                               msg_size);
     out->stopped = out->stop[0] != '\0';

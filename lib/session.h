@@ -131,13 +131,23 @@ typedef struct session_extended {
     char stop[256];
 } session_extended;
 
-/* Up to `steps` times (1..1000) adds the tile of the view's size where the
- * most sequences escape, calling step_done (may be NULL) after each; in a
- * journaled run (session_journal_begin), a line done before is not
- * repeated and the step that was interrupted is completed on its recorded
- * tile. */
-cm_status session_extend(session *s, int steps, session_step_fn step_done, void *user,
-                         session_extended *out, char *msg, size_t msg_size);
+/* Up to `steps` times (1..1000) adds the tile of tile's size (NULL: the
+ * view's) where the most sequences escape, calling step_done (may be
+ * NULL) after each; in a journaled run (session_journal_begin), a line
+ * done before is not repeated and the step that was interrupted is
+ * completed on its recorded tile. */
+cm_status session_extend(session *s, const cm_box *tile, int steps, session_step_fn step_done,
+                         void *user, session_extended *out, char *msg, size_t msg_size);
+
+/* The cells of the rectangle lo..hi (every dimension), by the lattice's
+ * rectangle-to-box rule. */
+cm_status session_rect_box(const session *s, const double *lo, const double *hi, cm_box *box,
+                           char *msg, size_t msg_size);
+
+/* The cells of box the cluster lacks, computed and joined, each join
+ * committed; the view stays. */
+cm_status session_add_box(session *s, const cm_box *box, session_work *done, char *msg,
+                          size_t msg_size);
 
 /* A script file's run is journaled in the file (note.explore.journal):
  * each `extend auto` step's tile before it is computed, each extend line

@@ -10,6 +10,10 @@
  *   c_explore.cmdb  an explore session: a view, 20 pans of 10 %, then
  *   c_view.png      render of the view
  *   c_labels.npy    export --labels of c_split.cmdb
+ *   c_added.cmdb    c_ext's first tile solved alone, then a box added
+ *                   beside it (explore's `view` on the file)
+ *   c_extended.cmdb that tile extended 3 times from tiles of its size
+ *                   (explore's `view` of the tile, then `extend auto 3`)
  *   c_NAME.csv/png  the analysis commands (stability, partition, amplitude,
  *                   horseshoe, escape, simulate, bifurcation and its runs,
  *                   lyapunov, sweep, continue and its events), as
@@ -160,6 +164,25 @@ int main(void)
 
     must(cm_db_export("c_split.cmdb", NULL, NULL, "c_labels.npy", NULL, 0, msg, sizeof msg),
          "export", msg);
+    const cm_db_options plain = {.threads = 2};
+    must(cm_db_create(NULL, "microchaos-pd", PD, &tile, "c_added.cmdb", &plain, msg, sizeof msg),
+         "create a tile", msg);
+    uint64_t added = 0;
+    must(cm_db_add_box("c_added.cmdb", (double[2]){100, -40}, (double[2]){200, 40}, &plain,
+                       &added, msg, sizeof msg),
+         "add a box", msg);
+    if (added != 100 * 100)
+        return fprintf(stderr, "workstation: add_box computed %llu cells\n",
+                       (unsigned long long)added), 1;
+    must(cm_db_create(NULL, "microchaos-pd", PD, &tile, "c_extended.cmdb", &plain, msg,
+                      sizeof msg),
+         "create a tile", msg);
+    int steps = 0;
+    must(cm_db_extend("c_extended.cmdb", (double[2]){0, -40}, (double[2]){100, 40}, 3, &plain,
+                      &steps, msg, sizeof msg),
+         "extend", msg);
+    if (steps != 3)
+        return fprintf(stderr, "workstation: extend did %d steps\n", steps), 1;
     analyses();
     return 0;
 }

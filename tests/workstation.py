@@ -3,7 +3,8 @@ what it writes with what the command writes, as it does tests/workstation.c's):
 py_split.cmdb (solve --db --split 2x2), py_resumed.cmdb (cancelled after its
 first join, then resumed), py_partial.cmdb (the cancelled file, for the
 command to resume), py_ext.cmdb (--extend 3), py_explore.cmdb and py_view.png
-(20 pans of 10 % and a render), py_labels.npy (export --labels)."""
+(20 pans of 10 % and a render), py_added.cmdb and py_extended.cmdb (a tile
+grown by a box and by 3 extension steps), py_labels.npy (export --labels)."""
 import shutil
 
 import cellmap
@@ -36,6 +37,13 @@ with cellmap.Session("py_explore.cmdb", model="microchaos-pd", cell_size=(0.5, 0
     s.figure("py_view.png")
     view = s.read()
     assert view.labels.shape == (100, 100) and (view.labels >= 0).all()  # every cell computed
+
+cellmap.create("py_added.cmdb", "microchaos-pd", [(0, 100), (-40, 40)], (100, 100), threads=2,
+               **PD)
+assert cellmap.add_box("py_added.cmdb", [(100, 200), (-40, 40)], threads=2) == 100 * 100
+cellmap.create("py_extended.cmdb", "microchaos-pd", [(0, 100), (-40, 40)], (100, 100),
+               threads=2, **PD)
+assert cellmap.extend("py_extended.cmdb", [(0, 100), (-40, 40)], 3, threads=2) == 3
 
 cellmap.export("py_split.cmdb", labels="py_labels.npy")
 print("workstation.py: done")

@@ -36,12 +36,13 @@ rows() {
   for t in $(sqlite3 "$1" "SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name"); do
     echo "== $t"
     if [ "$t" = meta ]; then
-      sqlite3 -cmd '.mode quote' "$1" "SELECT * FROM meta WHERE key NOT IN ('command', 'note.explore.journal') ORDER BY key"
+      sqlite3 -cmd '.mode quote' "$1" "SELECT * FROM meta WHERE key NOT IN ('command', 'note.explore.journal') AND NOT ($VIEWLESS AND key LIKE 'note.explore.%') ORDER BY key"
     else
       sqlite3 -cmd '.mode quote' "$1" "SELECT * FROM \"$t\" ORDER BY rowid"
     fi
   done
 }
+VIEWLESS=0 # 1: leave out the view and depth an explore session notes
 same_db() { # A B WHAT
   rows "$1" > a.rows && rows "$2" > b.rows || { fail "$3: cannot read the rows"; return; }
   [ "$(grep -c . a.rows)" -gt 20 ] || fail "$3: only $(grep -c . a.rows) rows in $1"
@@ -66,9 +67,20 @@ PD=(--param alpha=0.078,beta=0,P=0.007,D=0.02)
   --cell-size 0.5,0.08 --threads 2 > explore.log || fail "explore: $(cat explore.log)"
 "$CM" export cli_split.cmdb --labels cli_labels.npy --quiet || fail "export --labels"
 
+# a file grown in place: a box added beside a solved tile, and the tile
+# extended 3 times, as explore's `view` and `extend auto 3` grow a file
+"$CM" solve "${PD[@]}" --region 0:100,-40:40 --cells 100x100 --threads 2 --db cli_added.cmdb \
+  --quiet || fail "solve a tile"
+cp cli_added.cmdb cli_extended.cmdb
+echo "view 100:200 -40:40" > add.explore
+printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
+"$CM" explore cli_added.cmdb add.explore --threads 2 > add.log 2>&1 || fail "explore's view: $(cat add.log)"
+"$CM" explore cli_extended.cmdb extend.explore --threads 2 > ext.log 2>&1 ||
+  fail "explore's extend: $(cat ext.log)"
+
 # the analysis commands (cheap settings; tests/workstation_analysis.py and
 # tests/workstation.c make the same calls)
-"$CM" stability --P 0.007:0.02:50 --alpha 0.1:1:20 --csv cli_stability.csv --png cli_stability.png &&
+{ "$CM" stability --P 0.007:0.02:50 --alpha 0.1:1:20 --csv cli_stability.csv --png cli_stability.png &&
   "$CM" partition --param a=1.3,b=0.66 --csv cli_partition.csv --png cli_partition.png &&
   "$CM" amplitude --omega 0.2:2:20 --periods 50 --csv cli_amplitude.csv --png cli_amplitude.png &&
   "$CM" horseshoe --m 1:3 --periods 6 --csv cli_horseshoe.csv --png cli_horseshoe.png &&
@@ -80,7 +92,7 @@ PD=(--param alpha=0.078,beta=0,P=0.007,D=0.02)
     --png cli_lyapunov.png &&
   "$CM" sweep --vary P=0.006,0.007 --region 0:100,-10:10 --cells 50x50 --csv cli_sweep.csv &&
   "$CM" continue --vary S=0.02:0.4 --max-points 50 --csv cli_continue.csv \
-    --events cli_continue_events.csv --png cli_continue.png > analyses.log 2>&1 ||
+    --events cli_continue_events.csv --png cli_continue.png; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
 ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue"
 
@@ -105,6 +117,10 @@ check() { # PREFIX: what the C program or Python wrote, against the command's
   same_db cli_split.cmdb "$1_resumed.cmdb" "$1: cancelled and resumed"
   same_db cli_ext.cmdb "$1_ext.cmdb" "$1: solve --extend 3"
   same_db cli_explore.cmdb "$1_explore.cmdb" "$1: explore's 20 pans"
+  VIEWLESS=1
+  same_db cli_added.cmdb "$1_added.cmdb" "$1: a box added"
+  same_db cli_extended.cmdb "$1_extended.cmdb" "$1: extended 3 times"
+  VIEWLESS=0
   same_bytes cli_view.png "$1_view.png" "$1: render of the view"
   same_bytes cli_labels.npy "$1_labels.npy" "$1: export --labels"
   sed "s/$1_/cli_/g" "$1_labels.json" > sidecar.json

@@ -25,7 +25,8 @@ cellmap is, then on the system's library path; $CELLMAP_LIB overrides.
 
 Beyond solving and reading (the stable part of libcellmap), the module
 drives the workstation through libcellmap's experimental section:
-databases made and resumed (create, resume), their arrays exported
+databases made, resumed and grown (create, resume, add_box, extend),
+their arrays exported
 (export), explore sessions (Session: view, pan, zoom, extend, read,
 figure), figures with every option (Result.figure), and systems given as a
 Python function (System.from_function).
@@ -40,7 +41,7 @@ import sysconfig
 import numpy as np
 
 __all__ = ["System", "Models", "Result", "Database", "Session", "solve", "open", "create",
-           "resume", "export", "models", "CellmapError", "LABEL_NONE", "version", "analysis"]
+           "resume", "add_box", "extend", "export", "models", "CellmapError", "LABEL_NONE", "version", "analysis"]
 
 LABEL_NONE = -1
 _MAX_DIM = 6
@@ -484,6 +485,11 @@ _sig("cm_result_figure", ctypes.c_int, _P, ctypes.POINTER(_FigureOptions), ctype
 for _name in ("cm_db_create", "cm_db_resume"):
     _sig(_name, ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(_Grid),
          ctypes.c_char_p, ctypes.POINTER(_DbOptions), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_db_add_box", ctypes.c_int, ctypes.c_char_p, _DOUBLES, _DOUBLES,
+     ctypes.POINTER(_DbOptions), ctypes.POINTER(ctypes.c_uint64), ctypes.c_char_p,
+     ctypes.c_size_t)
+_sig("cm_db_extend", ctypes.c_int, ctypes.c_char_p, _DOUBLES, _DOUBLES, ctypes.c_int,
+     ctypes.POINTER(_DbOptions), ctypes.POINTER(ctypes.c_int), ctypes.c_char_p, ctypes.c_size_t)
 _sig("cm_db_export", ctypes.c_int, ctypes.c_char_p, _DOUBLES, _DOUBLES, ctypes.c_char_p,
      ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_size_t)
 _sig("cm_session_open", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_SessionOptions),
@@ -570,6 +576,39 @@ def resume(path, model, region, cells, params=None, plugins=(), split=None, exte
     _db_call(_lib.cm_db_resume, path, model, params, plugins, region, cells, split, extend,
              escape_below, threads, max_steps, mem, command, progress, kw)
     return Database(path)
+
+
+def _grown_options(threads, max_steps, mem, command):
+    o = _DbOptions()
+    o.threads, o.max_steps, o.mem, o.command = threads, max_steps, mem, _text(command)
+    return o
+
+
+def _rect(region):
+    lo = (ctypes.c_double * len(region))(*[float(a) for a, _ in region])
+    hi = (ctypes.c_double * len(region))(*[float(b) for _, b in region])
+    return lo, hi
+
+
+def add_box(path, region, threads=0, max_steps=0, mem=0, command=None):
+    """Computes the cells of region [(lo, hi), ...] (every dimension of the
+    file) that the database at path lacks, joined and committed as new
+    regions; returns how many cells were new."""
+    n = ctypes.c_uint64()
+    _call(_lib.cm_db_add_box, _text(os.fspath(path)), *_rect(region),
+          ctypes.byref(_grown_options(threads, max_steps, mem, command)), ctypes.byref(n))
+    return n.value
+
+
+def extend(path, tile, steps, threads=0, max_steps=0, mem=0, command=None):
+    """Adaptive extension (thesis 4.6.4) of the database at path by up to
+    steps tiles of tile's size [(lo, hi), ...], each where the most
+    sequences escape, as `cellmap solve --extend` does; returns the steps
+    done."""
+    n = ctypes.c_int()
+    _call(_lib.cm_db_extend, _text(os.fspath(path)), *_rect(tile), int(steps),
+          ctypes.byref(_grown_options(threads, max_steps, mem, command)), ctypes.byref(n))
+    return n.value
 
 
 def export(path, labels=None, steps=None, view=None, by="attractors"):
