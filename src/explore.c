@@ -286,7 +286,7 @@ static cm_status cmd_extend(explore *e, char **t, int n, char *msg, size_t msg_s
     if (st != CM_OK)
         return st;
     session_extended how;
-    st = session_extend(&e->s, (int)steps, said_step, e, &how, msg, msg_size);
+    st = session_extend(&e->s, NULL, (int)steps, said_step, e, &how, msg, msg_size);
     if (st == CM_OK && e->out && how.repeated)
         fprintf(e->out, "extend auto: done in the run that stopped; not repeated\n");
     if (st == CM_OK && e->out && how.stopped)
