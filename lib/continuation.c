@@ -1,5 +1,6 @@
 /* lib/continuation.c - branches followed and written (lib/continuation.h). */
 #include "lib/continuation.h"
+#include "lib/simulate.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -487,14 +488,9 @@ cm_status continuation_compute(cont_args *a, cont_result *r, char *msg, size_t m
     *r = (cont_result){0};
     cm_status st = check_request(a, msg, msg_size);
     if (st == CM_OK)
-        st = cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &r->m, msg,
-                                 msg_size);
+        st = simulate_oscillator(&a->mo, "continue", &r->m, &r->o, msg, msg_size);
     if (st != CM_OK)
         return st;
-    r->o = cm_fo_of_model(&r->m);
-    if (!r->o)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "model %s: continue follows friction-oscillator only", a->mo.name);
     r->param = cm_fo_param_of(a->vary);
     const cm_fo *o = r->o;
     r->p0 = (double[4]){o->S, o->S0, o->Omega, o->phi}[r->param];

@@ -204,7 +204,7 @@ static cm_status start_of(lyap_args *a, char *msg, size_t msg_size)
     const cm_model_entry *e = cm_model_set_find(&a->mo.set, a->mo.name, NULL);
     cm_model m;
     const cm_status st =
-        cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &m, msg, msg_size);
+        model_spec_build(&a->mo, &m, msg, msg_size);
     if (st != CM_OK)
         return st;
     const int dim = m.dim;

@@ -72,6 +72,12 @@ cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_
     return st == CM_OK ? CM_OK : CM_EINVAL;
 }
 
+cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_t msg_size)
+{
+    return cm_model_set_create(&spec->set, spec->name, spec->texts, spec->n_texts, m, msg,
+                               msg_size);
+}
+
 const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name)
 {
     const cm_model_lib *lib = NULL;

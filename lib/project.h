@@ -46,6 +46,10 @@ cm_status lattice_of_spec(const lattice_spec *spec, const cm_model *m, const cm_
 /* The plugin the model `name` of spec's set comes from (NULL: built in). */
 const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
 
+/* The model spec names, built with its parameters' texts (*m released by
+ * the caller with cm_model_release). */
+cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_t msg_size);
+
 /* Whether path is a database this cellmap reads, checked before any work
  * (cm_store_probe: it exists, is readable and is a cellmap database of a
  * format this version reads): CM_OK, else why not in msg. Damage inside

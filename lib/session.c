@@ -674,8 +674,7 @@ static cm_status check_same(const opening *op, const cm_store_info *info)
     cm_model m;
     char msg[512], params[4096];
     if (o->mo.name) {
-        const cm_status st = cm_model_set_create(&o->mo.set, o->mo.name, o->mo.texts,
-                                                 o->mo.n_texts, &m, msg, sizeof msg);
+        const cm_status st = model_spec_build(&o->mo, &m, msg, sizeof msg);
         if (st != CM_OK)
             return refuse(op, st, false, "%s", msg);
         cm_params_json(&m.values, params, sizeof params);
@@ -792,8 +791,7 @@ static cm_status create_new(const opening *op)
                       "%s does not exist; a new file needs a model (and its parameters) and "
                       "the size of its cells (and their origin)",
                       s->path);
-    cm_status st = cm_model_set_create(&o->mo.set, o->mo.name, o->mo.texts, o->mo.n_texts,
-                                       &s->model, msg, sizeof msg);
+    cm_status st = model_spec_build(&o->mo, &s->model, msg, sizeof msg);
     if (st != CM_OK)
         return refuse(op, st, true, "%s", msg);
     s->have_model = 1;

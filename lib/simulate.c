@@ -316,6 +316,18 @@ static bool write_png(const sim_args *a, const cm_model *m, const cm_fo *o, cons
     return ok;
 }
 
+cm_status simulate_oscillator(const model_spec *mo, const char *what, cm_model *m,
+                              const cm_fo **o, char *msg, size_t msg_size)
+{
+    const cm_status st = model_spec_build(mo, m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    *o = cm_fo_of_model(m);
+    return *o ? CM_OK
+              : cm_fail(CM_EINVAL, msg, msg_size, "model %s: %s follows friction-oscillator only",
+                        mo->name, what);
+}
+
 sim_args simulate_defaults(void)
 {
     return (sim_args){.mo = {.name = "friction-oscillator"}, .periods = 20,
@@ -341,14 +353,9 @@ cm_status simulate_compute(sim_args *a, sim_result *r, char *msg, size_t msg_siz
     *r = (sim_result){0};
     cm_status st = check_request(a, msg, msg_size);
     if (st == CM_OK)
-        st = cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &r->m, msg,
-                                 msg_size);
+        st = simulate_oscillator(&a->mo, "simulate", &r->m, &r->o, msg, msg_size);
     if (st != CM_OK)
         return st;
-    r->o = cm_fo_of_model(&r->m);
-    if (!r->o)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "model %s: simulate follows friction-oscillator only", a->mo.name);
     if (!a->has_t0)
         a->t0 = r->o->phi / r->o->Omega;
     cm_fo_run_start(r->o, a->t0, a->from[0], a->from[1], &r->r);

@@ -47,6 +47,12 @@ typedef struct track {
 /* Follows the run for the requested periods, recording those after the
  * skipped ones; *last receives the last period's tally and z_prev the
  * section point before the last one. False when the motion is lost. */
+/* The model mo names, built, which must be the friction oscillator (*o:
+ * its oscillator); what: the driver, for the message. *m is the caller's
+ * to release whatever the status. */
+cm_status simulate_oscillator(const model_spec *mo, const char *what, cm_model *m,
+                              const cm_fo **o, char *msg, size_t msg_size);
+
 /* The command's defaults: friction-oscillator, from (0, 0), 20 periods,
  * 900x1000 pixels; t0 (unless a->has_t0): the section's phase phi/Omega. */
 sim_args simulate_defaults(void);

@@ -129,7 +129,7 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
                        PROJECT_MAX_STEPS);
     cm_model m;
     cm_status st =
-        cm_model_set_create(&a->mo.set, a->mo.name, a->mo.texts, a->mo.n_texts, &m, msg, msg_size);
+        model_spec_build(&a->mo, &m, msg, msg_size);
     if (st != CM_OK)
         return st;
     if (cm_params_find(&m.values, a->name) < 0)

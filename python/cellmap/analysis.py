@@ -165,15 +165,19 @@ class _Run:
         self.tmp.cleanup()
 
 
-def _run(common, fn, *args, tables=()):
-    """Calls fn with the common part and args; returns the main table, or
-    it and the further tables (paths) as a tuple."""
+def _run(common, fn, *args, second=None):
+    """Calls fn with the common part and args; returns the table, or, with
+    second = (options, field, path or None), it and the table the options'
+    field names (a temporary file unless a path is given)."""
     r = _Run(**common)
     try:
-        args = [a(r) if callable(a) else a for a in args]
+        path = None
+        if second is not None:
+            options, field, given = second
+            path = r.table_path(given, field + ".csv")
+            setattr(options, field, _path(path))
         r.call(fn, *args)
-        out = [r.read(r.csv)] + [r.read(p(r)) for p in tables]
-        return out[0] if len(out) == 1 else tuple(out)
+        return r.read(r.csv) if path is None else (r.read(r.csv), r.read(path))
     finally:
         r.close()
 
@@ -245,13 +249,8 @@ def bifurcation(sweep, runs=None, transient=None, record=None, seed=None, runs_c
                        ("seed", seed)):
         if value is not None:
             setattr(o, key, int(value))
-
-    def with_runs(r):
-        r.runs_csv = r.table_path(runs_csv, "runs.csv")
-        o.runs_csv = _path(r.runs_csv)
-        return ctypes.byref(o)
-    return _run(_common(**common), _lib.cm_analysis_bifurcation, with_runs,
-                tables=(lambda r: r.runs_csv,))
+    return _run(_common(**common), _lib.cm_analysis_bifurcation, ctypes.byref(o),
+                second=(o, "runs_csv", runs_csv))
 
 
 def lyapunov(x, y, periods=None, d0=None, start=None, curves=(), **common):
@@ -307,10 +306,5 @@ def continuation(vary, direction="up", switch=False, starts=(), period=0, max_po
     if curve:
         o.curve, o.lo2, o.hi2 = keep[1], float(curve[1]), float(curve[2])
     o.curves = keep[2]
-
-    def with_events(r):
-        r.events = r.table_path(events, "events.csv")
-        o.events = _path(r.events)
-        return ctypes.byref(o)
-    return _run(_common(**common), _lib.cm_analysis_continue, with_events,
-                tables=(lambda r: r.events,))
+    return _run(_common(**common), _lib.cm_analysis_continue, ctypes.byref(o),
+                second=(o, "events", events))
