@@ -34,16 +34,16 @@ static void model_of(const cm_analysis *a, const char *own, model_spec *mo)
 
 /* The outputs: the table and figure are checked before any work (a
  * directory, a device, a missing folder; PNG needs OSMesa), the size
- * given or the command's (w0 x h0). */
-static cm_status outputs_of(const cm_analysis *a, int w0, int h0, chart_outputs *out, char *msg,
-                            size_t msg_size)
+ * given (at least the command's min_w x min_h) or the command's (w0 x h0). */
+static cm_status outputs_of(const cm_analysis *a, int w0, int h0, int min_w, int min_h,
+                            chart_outputs *out, char *msg, size_t msg_size)
 {
-    if ((a->width > 0) != (a->height > 0) || a->width < 0 || a->height < 0 ||
-        a->width > 4096 || a->height > 4096 || (a->width > 0 && (a->width < 200 || a->height < 150)))
+    if ((a->width != 0 || a->height != 0) &&
+        !(a->width >= min_w && a->height >= min_h && a->width <= 4096 && a->height <= 4096))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "a figure of %dx%d pixels: give both sides, 200x150..4096x4096, or 0, 0 "
+                       "a figure of %dx%d pixels: give both sides, %dx%d..4096x4096, or 0, 0 "
                        "for the driver's size",
-                       a->width, a->height);
+                       a->width, a->height, min_w, min_h);
     if (cm_output_names_stdout(a->csv) && cm_output_names_stdout(a->png))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the table and the figure both to standard output: choose one");
@@ -78,7 +78,7 @@ cm_status cm_analysis_stability(const cm_analysis *a, const cm_axis *P, const cm
     a = a ? a : &no_analysis;
     stab_args sa = stability_defaults();
     model_of(a, sa.mo.name, &sa.mo);
-    cm_status st = outputs_of(a, sa.out.width, sa.out.height, &sa.out, msg, msg_size);
+    cm_status st = outputs_of(a, sa.out.width, sa.out.height, 300, 450, &sa.out, msg, msg_size);
     if (st == CM_OK && P && (sa.has_P = 1))
         st = axis_of(P, "P", 100000, &sa.P, msg, msg_size);
     if (st == CM_OK && alpha && (sa.has_alpha = 1))
@@ -102,7 +102,7 @@ cm_status cm_analysis_partition(const cm_analysis *a, char *msg, size_t msg_size
     a = a ? a : &no_analysis;
     part_args pa = partition_defaults();
     model_of(a, pa.mo.name, &pa.mo);
-    cm_status st = outputs_of(a, pa.out.width, pa.out.height, &pa.out, msg, msg_size);
+    cm_status st = outputs_of(a, pa.out.width, pa.out.height, 300, 200, &pa.out, msg, msg_size);
     part_result r;
     if (st == CM_OK)
         st = partition_compute(&pa, &r, msg, msg_size);
@@ -120,7 +120,7 @@ cm_status cm_analysis_amplitude(const cm_analysis *a, const cm_axis *omega, int 
     aa.threads = a->threads;
     aa.periods = periods ? periods : aa.periods;
     aa.ymax = ymax != 0 ? ymax : aa.ymax;
-    cm_status st = outputs_of(a, aa.out.width, aa.out.height, &aa.out, msg, msg_size);
+    cm_status st = outputs_of(a, aa.out.width, aa.out.height, 300, 200, &aa.out, msg, msg_size);
     if (st == CM_OK && !omega)
         st = cm_fail(CM_EINVAL, msg, msg_size, "the frequencies Omega are required");
     if (st == CM_OK && (aa.has_omega = 1))
@@ -155,7 +155,7 @@ cm_status cm_analysis_simulate(const cm_analysis *a, const cm_simulate_options *
     sa.from[0] = o->x, sa.from[1] = o->v;
     sa.has_t0 = !isnan(o->t0), sa.t0 = sa.has_t0 ? o->t0 : 0;
     sa.periods = o->periods, sa.skip = o->skip;
-    cm_status st = outputs_of(a, sa.out.width, sa.out.height, &sa.out, msg, msg_size);
+    cm_status st = outputs_of(a, sa.out.width, sa.out.height, 300, 400, &sa.out, msg, msg_size);
     if (st != CM_OK)
         return st;
     sim_result r;
@@ -183,7 +183,7 @@ cm_status cm_analysis_bifurcation(const cm_analysis *a, const cm_bifurcation_opt
     model_of(a, ba.mo.name, &ba.mo);
     ba.runs = o->runs, ba.transient = o->transient, ba.record = o->record, ba.seed = o->seed;
     ba.threads = a->threads, ba.runs_csv = o->runs_csv, ba.has_sweep = 1;
-    cm_status st = outputs_of(a, ba.out.width, ba.out.height, &ba.out, msg, msg_size);
+    cm_status st = outputs_of(a, ba.out.width, ba.out.height, 300, 450, &ba.out, msg, msg_size);
     if (st == CM_OK)
         st = outfile_check_path(o->runs_csv, false, msg, msg_size);
     if (st == CM_OK)
@@ -213,7 +213,7 @@ cm_status cm_analysis_lyapunov(const cm_analysis *a, const cm_lyapunov_options *
     lyap_args la = lyapunov_defaults();
     model_of(a, la.mo.name, &la.mo);
     chart_outputs out;
-    cm_status st = outputs_of(a, la.width, la.height, &out, msg, msg_size);
+    cm_status st = outputs_of(a, la.width, la.height, 200, 150, &out, msg, msg_size);
     la.csv = out.csv, la.png = out.png, la.width = out.width, la.height = out.height;
     la.periods = o->periods, la.d0 = o->d0, la.threads = a->threads, la.has_grid = 1;
     if (st == CM_OK && (o->n_from < 0 || o->n_from > CM_MAX_DIM || (o->n_from && !o->from) ||
@@ -281,7 +281,7 @@ cm_status cm_analysis_continue(const cm_analysis *a, const cm_continue_options *
     cm_status st = continue_args(o, &ca, msg, msg_size);
     chart_outputs out;
     if (st == CM_OK) /* the diagram's own default size (continuation_layout) */
-        st = outputs_of(a, 0, 0, &out, msg, msg_size);
+        st = outputs_of(a, 0, 0, 300, 300, &out, msg, msg_size);
     ca.csv = a->csv, ca.png = a->png, ca.width = a->width, ca.height = a->height;
     if (st == CM_OK)
         st = outfile_check_path(o->events, false, msg, msg_size);
@@ -314,7 +314,7 @@ cm_status cm_analysis_horseshoe(const cm_analysis *a, const cm_horseshoe_options
     model_of(a, ha.mo.name, &ha.mo);
     ha.has_m = o->m0 != 0 || o->m1 != 0, ha.m0 = o->m0, ha.m1 = o->m1;
     ha.periods = o->periods, ha.crisis = o->crisis, ha.has_sweep = o->sweep != NULL;
-    cm_status st = outputs_of(a, ha.out.width, ha.out.height, &ha.out, msg, msg_size);
+    cm_status st = outputs_of(a, ha.out.width, ha.out.height, 300, 200, &ha.out, msg, msg_size);
     if (st == CM_OK && o->sweep)
         st = axis_of(o->sweep, "P", 10000, &ha.sweep, msg, msg_size);
     if (st != CM_OK)
@@ -342,7 +342,7 @@ cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, c
     model_of(a, ea.mo.name, &ea.mo);
     ea.has_I0 = o->I0 != 0, ea.I0 = o->I0, ea.has_sweep = o->sweep != NULL;
     ea.cells = o->cells, ea.ensemble = o->ensemble, ea.threads = a->threads;
-    cm_status st = outputs_of(a, ea.out.width, ea.out.height, &ea.out, msg, msg_size);
+    cm_status st = outputs_of(a, ea.out.width, ea.out.height, 300, 200, &ea.out, msg, msg_size);
     if (st == CM_OK && o->sweep)
         st = axis_of(o->sweep, NULL, 10000, &ea.sweep, msg, msg_size);
     if (st != CM_OK)

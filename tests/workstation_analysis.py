@@ -5,6 +5,7 @@ partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
 runs), lyapunov, sweep and continue (and its events). The tables the
 functions return are checked against the files they read them from.
 usage: workstation_analysis.py PREFIX"""
+import os
 import sys
 
 import numpy as np
@@ -56,10 +57,15 @@ assert len(t) == 9, t
 for call, words in ((lambda: an.stability(P=(0.02, 0.01, 5)), "LO < HI"),
                     (lambda: an.sweep("Q", [1, 2]), "'Q' is not a parameter"),
                     (lambda: an.continuation(("S", 0.02, 0.2), params="S=0.3"),
-                     "outside the range S=0.02:0.2")):
+                     "outside the range S=0.02:0.2"),
+                    (lambda: an.partition(params="a=1.3,b=0.66", png="x.png", size=(10, 10)),
+                     "300x200..4096x4096"),
+                    (lambda: an.simulate(periods=5, csv=".", png="y.png"), "."),
+                    (lambda: an.bifurcation(("S", 0.1, 0.3, 0)), "1..2000 values")):
     try:
         call()
         raise SystemExit("no error where %r was expected" % words)
     except cellmap.CellmapError as e:
         assert words in str(e) and "--" not in str(e), str(e)
+assert not os.path.exists("x.png") and not os.path.exists("y.png"), "a refused call wrote"
 print("workstation_analysis.py: done")
