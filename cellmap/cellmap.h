@@ -400,6 +400,23 @@ cm_status cm_session_extend(cm_session *s, int steps, int *done, char *msg, size
  * and the system's attractors found over the whole cluster. */
 cm_status cm_session_read(cm_session *s, cm_result **out, char *msg, size_t msg_size);
 
+/* What a session knows of the cell that holds a state. */
+typedef struct cm_cell_info {
+    int64_t cell[CM_MAX_DIM];  /* its index in the file's lattice */
+    double centre[CM_MAX_DIM]; /* its centre */
+    uint32_t label;            /* 0 the sink, k group k, CM_LABEL_NONE not computed */
+    uint32_t step;             /* steps to its group's cycle (cm_result_steps) */
+    int32_t attractor;         /* the system's attractor, as cm_result_attractor_labels */
+} cm_cell_info;
+
+/* The cell of the file's lattice that holds state x (one coordinate per
+ * dimension of the model), computed or not: its group, step and attractor
+ * (the attractors found over the whole cluster, as cm_session_read does;
+ * each query finds them again). Nothing is computed or moved. CM_EINVAL:
+ * x is not finite or outside the lattice's world. */
+cm_status cm_session_query(cm_session *s, const double *x, cm_cell_info *out, char *msg,
+                           size_t msg_size);
+
 /* The view's figure, as `render` in a session draws it (the same bytes). */
 cm_status cm_session_figure(cm_session *s, const cm_figure_options *o, char *msg,
                             size_t msg_size);

@@ -923,6 +923,37 @@ cm_status cm_session_read(cm_session *s, cm_result **out, char *msg, size_t msg_
     return make_result(&s->s.model, &s->s.c.lat, &r, &cluster, out, msg, msg_size);
 }
 
+cm_status cm_session_query(cm_session *s, const double *x, cm_cell_info *out, char *msg,
+                           size_t msg_size)
+{
+    memset(out, 0, sizeof *out);
+    const cm_lattice *lat = &s->s.c.lat;
+    for (int d = 0; d < lat->dim; d++)
+        if (!isfinite(x[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "a query needs %d finite coordinates",
+                           lat->dim);
+    if (!cm_lattice_cell(lat, x, out->cell))
+        return cm_fail(CM_EINVAL, msg, msg_size, "the state is outside the lattice's world");
+    cm_lattice_centre(lat, out->cell, out->centre);
+    cm_box box = {.dim = lat->dim};
+    for (int d = 0; d < lat->dim; d++)
+        box.lo[d] = out->cell[d], box.hi[d] = out->cell[d] + 1;
+    cm_region r;
+    memset(&r, 0, sizeof r);
+    cm_status st = cm_cluster_flatten(&s->s.c, &box, &r, msg, msg_size);
+    cm_result *res = NULL;
+    const result_source cluster = {NULL, &s->s.c, NULL, 0};
+    if (st == CM_OK)
+        st = make_result(&s->s.model, lat, &r, &cluster, &res, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_result_labels(res, &out->label);
+    cm_result_steps(res, &out->step);
+    cm_result_attractor_labels(res, &out->attractor);
+    cm_result_free(res);
+    return CM_OK;
+}
+
 cm_status cm_session_figure(cm_session *s, const cm_figure_options *o, char *msg,
                             size_t msg_size)
 {

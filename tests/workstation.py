@@ -37,6 +37,13 @@ with cellmap.Session("py_explore.cmdb", model="microchaos-pd", cell_size=(0.5, 0
     s.figure("py_view.png")
     view = s.read()
     assert view.labels.shape == (100, 100) and (view.labels >= 0).all()  # every cell computed
+    # a point query says what read() says of the cell holding the state
+    width = [(view.hi[d] - view.lo[d]) / view.cells[d] for d in range(2)]
+    for i, j in ((0, 0), (37, 81), (99, 99), (50, 3)):
+        q = s.query([view.lo[0] + (i + 0.3) * width[0], view.lo[1] + (j + 0.6) * width[1]])
+        assert (q["label"], q["step"], q["attractor"]) == (
+            view.labels[i, j], view.steps[i, j], view.attractor_labels[i, j]), (i, j, q)
+    assert s.query([view.hi[0] + 100, 0])["label"] == -1  # a cell no region covers
 
 cellmap.create("py_added.cmdb", "microchaos-pd", [(0, 100), (-40, 40)], (100, 100), threads=2,
                **PD)

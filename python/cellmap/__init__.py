@@ -477,6 +477,12 @@ class _SessionOptions(ctypes.Structure):
                 ("mem", ctypes.c_uint64), ("command", ctypes.c_char_p)]
 
 
+class _CellInfo(ctypes.Structure):
+    _fields_ = [("cell", ctypes.c_int64 * _MAX_DIM), ("centre", ctypes.c_double * _MAX_DIM),
+                ("label", ctypes.c_uint32), ("step", ctypes.c_uint32),
+                ("attractor", ctypes.c_int32)]
+
+
 _DOUBLES = ctypes.POINTER(ctypes.c_double)
 _sig("cm_system_from_function", ctypes.c_int, ctypes.c_char_p, ctypes.c_int, _STEP, _P,
      ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
@@ -504,6 +510,8 @@ _sig("cm_session_zoom", ctypes.c_int, _P, ctypes.c_double, ctypes.POINTER(ctypes
 _sig("cm_session_extend", ctypes.c_int, _P, ctypes.c_int, ctypes.POINTER(ctypes.c_int),
      ctypes.c_char_p, ctypes.c_size_t)
 _sig("cm_session_read", ctypes.c_int, _P, ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_session_query", ctypes.c_int, _P, _DOUBLES, ctypes.POINTER(_CellInfo), ctypes.c_char_p,
+     ctypes.c_size_t)
 _sig("cm_session_figure", ctypes.c_int, _P, ctypes.POINTER(_FigureOptions), ctypes.c_char_p,
      ctypes.c_size_t)
 _sig("cm_session_close", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_size_t)
@@ -694,6 +702,19 @@ class Session:
         h = _P()
         _call(_lib.cm_session_read, self._h, ctypes.byref(h))
         return Result(h, self)
+
+    def query(self, x):
+        """What the session knows of the cell holding state x (a coordinate
+        per dimension): {'cell', 'centre', 'label' (-1: not computed), 'step',
+        'attractor'}, as read() gives them for that cell; nothing is computed."""
+        x = [float(v) for v in x]
+        info = _CellInfo()
+        _call(_lib.cm_session_query, self._h, (ctypes.c_double * len(x))(*x), ctypes.byref(info))
+        dim = len(x)
+        return {"cell": [int(info.cell[d]) for d in range(dim)],
+                "centre": [info.centre[d] for d in range(dim)],
+                "label": ctypes.c_int32(info.label).value, "step": ctypes.c_int32(info.step).value,
+                "attractor": info.attractor}
 
     def figure(self, png=None, **options):
         """The view's figure, as `render` in a session draws it (options as
