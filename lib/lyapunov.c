@@ -114,7 +114,7 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
     return ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the curves");
 }
 
-static cm_status read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size)
+cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size)
 {
     size_t cap = 0;
     cm_status st = CM_OK;
@@ -123,7 +123,7 @@ static cm_status read_curves(const lyap_args *a, overlay *ov, char *msg, size_t 
     return st;
 }
 
-static void overlay_free(overlay *ov)
+void lyapunov_overlay_free(overlay *ov)
 {
     free(ov->x);
     free(ov->y);
@@ -255,7 +255,7 @@ cm_status lyapunov_compute(lyap_args *a, const work_hooks *h, lyap_result *r, ch
     if (st == CM_OK && strcmp(a->mo.name, "friction-oscillator") != 0)
         st = start_of(a, msg, msg_size);
     if (st == CM_OK)
-        st = read_curves(a, &r->ov, msg, msg_size);
+        st = lyapunov_read_curves(a, &r->ov, msg, msg_size);
     if (st != CM_OK)
         return st;
     r->points = (size_t)a->ax[0].n * (size_t)a->ax[1].n;
@@ -296,5 +296,5 @@ void lyapunov_result_free(lyap_result *r)
 {
     free(r->v);
     r->v = NULL;
-    overlay_free(&r->ov);
+    lyapunov_overlay_free(&r->ov);
 }

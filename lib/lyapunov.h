@@ -69,4 +69,11 @@ cm_status lyapunov_write(const lyap_args *a, lyap_result *r, char *msg, size_t m
 
 void lyapunov_result_free(lyap_result *r);
 
+/* Every curves file of a, read into ov (the caller's to free with
+ * lyapunov_overlay_free, whatever the result): CM_EINVAL when a file is
+ * not curves in the grid's parameters. lyapunov_compute reads them; the
+ * fuzz target of files reads them alone. */
+cm_status lyapunov_read_curves(const lyap_args *a, overlay *ov, char *msg, size_t msg_size);
+void lyapunov_overlay_free(overlay *ov);
+
 #endif
