@@ -1,0 +1,258 @@
+/* Equilibria of flows and their branches (models/flow_equilibria): the
+ * Hopf normal form (Hopf at mu = 0, omega = 1), a saddle-node (fold at
+ * mu = 0), and Palmai's chip formation flow (thesis (3.27)-(3.31),
+ * ../shared/MODELS.md 12.1) against the thesis and an independent
+ * implementation: at zeta = 21 its equilibrium loses and regains stability
+ * in Hopf points at xi = 4.428083 and 11.803875 (thesis: 4.42808,
+ * 11.8039) with eigenvalues +-28.00i and +-34.33i; at xi = 4.8, zeta = 40
+ * its eigenvalues are -6.23 +- 30.14i, -35.9 and -123.3. Each located
+ * point is checked again on its own: its residual, and the real part of
+ * the pair on the axis recomputed at it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "models/flow_equilibria.h"
+
+/* ---- the flows ---------------------------------------------------------- */
+
+/* x' = mu x - y - x r^2, y' = x + mu y - y r^2: Hopf at mu = 0. */
+static int hopf_field(const cm_model *m, double t, const double *x, double *f)
+{
+    (void)t;
+    const double mu = *(const double *)m->ctx, r2 = x[0] * x[0] + x[1] * x[1];
+    f[0] = mu * x[0] - x[1] - x[0] * r2;
+    f[1] = x[0] + mu * x[1] - x[1] * r2;
+    return 0;
+}
+
+/* x' = mu - x^2, y' = -y: a fold at mu = 0. */
+static int fold_field(const cm_model *m, double t, const double *x, double *f)
+{
+    (void)t;
+    const double mu = *(const double *)m->ctx;
+    f[0] = mu - x[0] * x[0];
+    f[1] = -x[1];
+    return 0;
+}
+
+/* Palmai's flow: state (tau2, T0, T1, T2). */
+typedef struct chip {
+    double a, b, T_Phi, eta, p, xi, zeta;
+} chip;
+
+static int chip_field(const cm_model *m, double t, const double *z, double *f)
+{
+    (void)t;
+    const chip *c = m->ctx;
+    const double tau2 = z[0], T0 = z[1], T1 = z[2], T2 = z[3];
+    if (!(T1 > -1 && T2 > -1))
+        return 1;
+    const double F1 = (T1 + 1) / (c->T_Phi + 1) *
+                      exp((c->p * tau2 - c->p + c->a * (T1 - c->T_Phi)) / (c->b * (T1 + 1)));
+    const double F2 = (T2 + 1) / (c->T_Phi + 1) *
+                      exp((tau2 - 1 + c->a * (T2 - c->T_Phi)) / (c->b * (T2 + 1)));
+    f[0] = 1 - (F1 + F2);
+    f[1] = c->zeta * (T1 - 2 * T0) - c->xi * T0;
+    f[2] = c->eta * (c->p * tau2 + 1 - c->p) * F1 - c->zeta * (2 * T1 - T2 - T0) -
+           c->xi * (T1 - T0);
+    f[3] = c->eta * tau2 * F2 - (c->xi + c->zeta) * (T2 - T1);
+    return 0;
+}
+
+/* A model of field with its context copied (freed by cm_model_release). */
+static cm_status model_of(const char *name, int dim,
+                          int (*field)(const cm_model *, double, const double *, double *),
+                          const void *ctx, size_t size, cm_model *m)
+{
+    memset(m, 0, sizeof *m);
+    m->name = name;
+    m->dim = dim;
+    m->ctx = malloc(size);
+    if (!m->ctx)
+        return CM_ENOMEM;
+    memcpy(m->ctx, ctx, size);
+    m->destroy = free;
+    m->flow.field = field;
+    return CM_OK;
+}
+
+static cm_status hopf_at(void *user, double mu, cm_model *m, char *msg, size_t msg_size)
+{
+    (void)user, (void)msg, (void)msg_size;
+    return model_of("hopf", 2, hopf_field, &mu, sizeof mu, m);
+}
+
+static cm_status fold_at(void *user, double mu, cm_model *m, char *msg, size_t msg_size)
+{
+    (void)user, (void)msg, (void)msg_size;
+    return model_of("fold", 2, fold_field, &mu, sizeof mu, m);
+}
+
+/* The chip flow at xi (user: zeta). */
+static cm_status chip_at(void *user, double xi, cm_model *m, char *msg, size_t msg_size)
+{
+    (void)msg, (void)msg_size;
+    const chip c = {0.3, 0.012, 1, 4.4, 1.03, xi, *(const double *)user};
+    return model_of("chip-4d", 4, chip_field, &c, sizeof c, m);
+}
+
+/* ---- what a branch reports ---------------------------------------------- */
+
+typedef struct seen {
+    cm_eq_event ev[8];
+    int n_events, points;
+    double p_min, p_max;
+} seen;
+
+static int on_point(void *user, const cm_equilibrium *e)
+{
+    seen *s = user;
+    s->p_min = s->points ? fmin(s->p_min, e->p) : e->p;
+    s->p_max = s->points ? fmax(s->p_max, e->p) : e->p;
+    s->points++;
+    return 0;
+}
+
+static int on_event(void *user, const cm_eq_event *ev)
+{
+    seen *s = user;
+    if (s->n_events < 8)
+        s->ev[s->n_events] = *ev;
+    s->n_events++;
+    return 0;
+}
+
+/* The event checked on its own: the model at its p, its state an
+ * equilibrium (residual), and for a Hopf point a pair with |re| tiny. */
+static void check_independently(cm_model_at_fn at, void *user, const cm_eq_event *ev)
+{
+    cm_model m;
+    char msg[256];
+    CHECK(at(user, ev->at.p, &m, msg, sizeof msg) == CM_OK);
+    double f[CM_MAX_DIM], J[CM_MAX_DIM * CM_MAX_DIM], re[CM_MAX_DIM], im[CM_MAX_DIM];
+    CHECK(m.flow.field(&m, 0, ev->at.x, f) == 0);
+    for (int i = 0; i < m.dim; i++)
+        CHECK(fabs(f[i]) < 1e-8);
+    CHECK(cm_flow_jacobian(&m, ev->at.x, J) == CM_OK);
+    CHECK(cm_eigenvalues(m.dim, J, re, im) == CM_OK);
+    double nearest = INFINITY;
+    for (int i = 0; i < m.dim; i++)
+        if (ev->kind == CM_EQ_HOPF ? im[i] != 0 : im[i] == 0)
+            nearest = fmin(nearest, fabs(re[i]));
+    CHECK(nearest < 1e-6 * (1 + fabs(re[m.dim - 1])));
+    cm_model_release(&m);
+}
+
+static void test_hopf_normal_form(void)
+{
+    const double x0[2] = {0, 0};
+    const cm_eq_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
+    seen s = {0};
+    int why = 0;
+    char msg[256];
+    CHECK(cm_flow_equilibrium_branch(hopf_at, NULL, -0.9, x0, &o, on_point, on_event, &s, &why,
+                                     msg, sizeof msg) == CM_OK);
+    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(s.n_events, 1);
+    CHECK_INT(s.ev[0].kind, CM_EQ_HOPF);
+    CHECK(fabs(s.ev[0].at.p) < 1e-9);
+    CHECK_NEAR(s.ev[0].omega, 1, 1e-7);
+    CHECK(s.p_max > 0.95 && s.points > 10);
+    check_independently(hopf_at, NULL, &s.ev[0]);
+}
+
+static void test_fold(void)
+{
+    /* from x = 1 at mu = 1 down to the fold at mu = 0, x = 0, and back up
+     * on the other side, x = -sqrt(mu) */
+    const double x0[2] = {1.2, 0.3};
+    const cm_eq_branch_options o = {.lo = -0.5, .hi = 1, .direction = -1};
+    seen s = {0};
+    int why = 0;
+    char msg[256];
+    CHECK(cm_flow_equilibrium_branch(fold_at, NULL, 1, x0, &o, on_point, on_event, &s, &why,
+                                     msg, sizeof msg) == CM_OK);
+    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(s.n_events, 1);
+    CHECK_INT(s.ev[0].kind, CM_EQ_FOLD);
+    CHECK(fabs(s.ev[0].at.p) < 1e-9 && fabs(s.ev[0].at.x[0]) < 1e-4);
+    CHECK(s.p_min > -1e-6); /* the fold turned the branch back */
+    check_independently(fold_at, NULL, &s.ev[0]);
+}
+
+static void test_chip_equilibrium(void)
+{
+    double zeta = 40, z[4] = {1, 0.1, 0.3, 0.4};
+    cm_model m;
+    cm_equilibrium e;
+    char msg[256];
+    CHECK(chip_at(&zeta, 4.8, &m, msg, sizeof msg) == CM_OK);
+    CHECK(cm_flow_equilibrium(&m, 4.8, z, &e, msg, sizeof msg) == CM_OK);
+    cm_model_release(&m);
+    /* -6.23 +- 30.14i, -35.9, -123.3 (MODELS.md 12.1, point a of Fig. 3.8) */
+    CHECK_NEAR(e.re[0], -6.23, 2e-3);
+    CHECK_NEAR(e.im[0], 30.14, 2e-3);
+    CHECK_NEAR(e.re[1], -6.23, 2e-3);
+    CHECK_NEAR(e.re[2], -35.9, 2e-3);
+    CHECK_NEAR(e.re[3], -123.3, 2e-3);
+    CHECK_INT(e.unstable, 0);
+}
+
+static void test_chip_hopf_points(void)
+{
+    double zeta = 21, z[4] = {1, 0.1, 0.3, 0.4};
+    cm_model m;
+    char msg[256];
+    CHECK(chip_at(&zeta, 1, &m, msg, sizeof msg) == CM_OK);
+    CHECK(cm_flow_equilibrium(&m, 1, z, NULL, msg, sizeof msg) == CM_OK);
+    cm_model_release(&m);
+    const cm_eq_branch_options o = {.lo = 0.5, .hi = 15, .direction = 1};
+    seen s = {0};
+    int why = 0;
+    CHECK(cm_flow_equilibrium_branch(chip_at, &zeta, 1, z, &o, on_point, on_event, &s, &why, msg,
+                                     sizeof msg) == CM_OK);
+    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(s.n_events, 2);
+    CHECK_INT(s.ev[0].kind, CM_EQ_HOPF);
+    CHECK_INT(s.ev[1].kind, CM_EQ_HOPF);
+    /* the thesis' 4.42808 and 11.8039 (+- 1e-4); independently 4.428083, 11.803875 */
+    CHECK(fabs(s.ev[0].at.p - 4.428083) < 2e-5);
+    CHECK(fabs(s.ev[1].at.p - 11.803875) < 2e-5);
+    CHECK_NEAR(s.ev[0].omega, 28.00, 5e-4);
+    CHECK_NEAR(s.ev[1].omega, 34.33, 5e-4);
+    /* unstable between them: two eigenvalues with re > 0 */
+    CHECK_INT(s.ev[0].at.unstable + s.ev[1].at.unstable >= 2, 1);
+    printf("chip-4d, zeta = 21: Hopf points at xi = %.7f (omega %.4f) and %.7f (omega %.4f), "
+           "%d branch points\n",
+           s.ev[0].at.p, s.ev[0].omega, s.ev[1].at.p, s.ev[1].omega, s.points);
+    for (int k = 0; k < 2; k++)
+        check_independently(chip_at, &zeta, &s.ev[k]);
+}
+
+static void test_bad_input(void)
+{
+    /* Newton from far away on the fold's flow at mu < 0 (no equilibrium) */
+    cm_model m;
+    char msg[256] = "";
+    double x[2] = {3, 1};
+    CHECK(fold_at(NULL, -1, &m, msg, sizeof msg) == CM_OK);
+    CHECK(cm_flow_equilibrium(&m, -1, x, NULL, msg, sizeof msg) == CM_ENOTFOUND);
+    CHECK(strstr(msg, "start nearer one") != NULL);
+    cm_model_release(&m);
+    const cm_eq_branch_options bad = {.lo = 1, .hi = 0, .direction = 1};
+    int why;
+    CHECK(cm_flow_equilibrium_branch(fold_at, NULL, 0.5, x, &bad, NULL, NULL, NULL, &why, msg,
+                                     sizeof msg) == CM_EINVAL);
+}
+
+int main(void)
+{
+    test_hopf_normal_form();
+    test_fold();
+    test_chip_equilibrium();
+    test_chip_hopf_points();
+    test_bad_input();
+    return check_failures;
+}
