@@ -241,10 +241,11 @@ cm_status cm_db_read(cm_db *db, const double *lo, const double *hi, cm_result **
 void cm_db_close(cm_db *db);
 
 #ifdef CELLMAP_EXPERIMENTAL
-/* ==== experimental: projects, sessions, figures, systems from functions ====
- * What the command `cellmap` does over whole databases, for C (and the
- * Python module): the same drivers (lib/), so the same files, images and
- * arrays. May change in any release. */
+/* ==== experimental: projects, sessions, figures, systems from functions,
+ *      analysis drivers ====
+ * What the command `cellmap` does over whole databases and its analysis
+ * commands, for C (and the Python module): the same drivers (lib/), so
+ * the same files, images and arrays. May change in any release. */
 
 /* ---- systems given as a function ---- */
 
