@@ -427,3 +427,59 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
         *why = CM_EQ_CALLER;
     return st;
 }
+
+/* ---- Hopf curves ------------------------------------------------------------ */
+
+/* One q of a curve: the two-parameter builder at that q, and the caller's
+ * callback. */
+typedef struct at_q {
+    cm_model_at2_fn at;
+    void *at_user;
+    double q;
+    int (*hopf)(void *user, double q, const cm_eq_event *ev);
+    void *user;
+} at_q;
+
+static cm_status model_at_q(void *user, double p, cm_model *m, char *msg, size_t msg_size)
+{
+    const at_q *a = user;
+    return a->at(a->at_user, p, a->q, m, msg, msg_size);
+}
+
+static int hopf_at_q(void *user, const cm_eq_event *ev)
+{
+    const at_q *a = user;
+    return ev->kind == CM_EQ_HOPF && a->hopf && a->hopf(a->user, a->q, ev);
+}
+
+cm_status cm_flow_hopf_curve(cm_model_at2_fn at, void *at_user, double p0, const double *x0,
+                             const double *q, int n, const cm_eq_branch_options *o,
+                             int (*hopf)(void *user, double q, const cm_eq_event *ev), void *user,
+                             char *msg, size_t msg_size)
+{
+    if (n < 1 || n > 100000)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a Hopf curve needs 1..100000 values of q");
+    double start[CM_MAX_DIM];
+    cm_status st = CM_OK;
+    for (int k = 0; k < n && st == CM_OK; k++) {
+        at_q a = {at, at_user, q[k], hopf, user};
+        cm_model m;
+        if ((st = model_at_q(&a, p0, &m, msg, msg_size)) != CM_OK)
+            break;
+        if (k == 0)
+            memcpy(start, x0, (size_t)m.dim * sizeof *x0);
+        st = cm_flow_equilibrium(&m, p0, start, NULL, msg, msg_size);
+        cm_model_release(&m);
+        int why = 0;
+        if (st == CM_OK)
+            st = cm_flow_equilibrium_branch(model_at_q, &a, p0, start, o, NULL, hopf_at_q, &a,
+                                            &why, msg, msg_size);
+        else
+            st = cm_fail(CM_ENOTFOUND, msg, msg_size,
+                         "the start equilibrium is lost at q = %.9g: take smaller steps in q",
+                         q[k]);
+        if (why == CM_EQ_CALLER)
+            break;
+    }
+    return st;
+}

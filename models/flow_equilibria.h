@@ -77,4 +77,19 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
                                      int (*event)(void *user, const cm_eq_event *ev),
                                      void *user, int *why, char *msg, size_t msg_size);
 
+/* The model at parameters (p, q), built by the caller; the kernel
+ * releases it. */
+typedef cm_status (*cm_model_at2_fn)(void *user, double p, double q, cm_model *m, char *msg,
+                                     size_t msg_size);
+
+/* A Hopf curve in the plane (p, q), as points: at each q[k] (n values,
+ * in order) the branch in p over o's range from p0 (its equilibrium found
+ * from x0 at the first q, then from the previous q's), calling hopf for
+ * each Hopf point on it; hopf returning nonzero stops. Folds are passed
+ * over. CM_ENOTFOUND when the start is lost at some q (msg says which). */
+cm_status cm_flow_hopf_curve(cm_model_at2_fn at, void *at_user, double p0, const double *x0,
+                             const double *q, int n, const cm_eq_branch_options *o,
+                             int (*hopf)(void *user, double q, const cm_eq_event *ev), void *user,
+                             char *msg, size_t msg_size);
+
 #endif

@@ -231,6 +231,69 @@ static void test_chip_hopf_points(void)
         check_independently(chip_at, &zeta, &s.ev[k]);
 }
 
+/* x' = (mu - nu) x - y - x r^2, ...: the Hopf curve mu = nu. */
+static cm_status hopf2_at(void *user, double mu, double nu, cm_model *m, char *msg,
+                          size_t msg_size)
+{
+    (void)user, (void)msg, (void)msg_size;
+    const double shifted = mu - nu;
+    return model_of("hopf", 2, hopf_field, &shifted, sizeof shifted, m);
+}
+
+static cm_status chip2_at(void *user, double xi, double zeta, cm_model *m, char *msg,
+                          size_t msg_size)
+{
+    (void)user;
+    return chip_at(&zeta, xi, m, msg, msg_size);
+}
+
+typedef struct curve {
+    double q[16], p[16];
+    int n;
+} curve;
+
+static int on_hopf(void *user, double q, const cm_eq_event *ev)
+{
+    curve *c = user;
+    if (c->n < 16)
+        c->q[c->n] = q, c->p[c->n] = ev->at.p;
+    c->n++;
+    return 0;
+}
+
+static void test_hopf_curves(void)
+{
+    const double nu[] = {-0.5, 0, 0.3}, x0[2] = {0, 0};
+    const cm_eq_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
+    curve c = {0};
+    char msg[256];
+    CHECK(cm_flow_hopf_curve(hopf2_at, NULL, -0.9, x0, nu, 3, &o, on_hopf, &c, msg,
+                             sizeof msg) == CM_OK);
+    CHECK_INT(c.n, 3);
+    for (int k = 0; k < 3 && k < c.n; k++)
+        CHECK(c.q[k] == nu[k] && fabs(c.p[k] - nu[k]) < 1e-9);
+    /* the chip flow's curve through zeta = 21 meets the branch's points
+     * there; the oscillating range of xi narrows as zeta grows (it closes
+     * between 21 and 22: no Hopf point on [0.5, 15] at 22) */
+    const double zeta[] = {20, 20.5, 21};
+    double z[4] = {1, 0.1, 0.3, 0.4};
+    const cm_eq_branch_options oc = {.lo = 0.5, .hi = 15, .direction = 1};
+    curve cc = {0};
+    CHECK(cm_flow_hopf_curve(chip2_at, NULL, 1, z, zeta, 3, &oc, on_hopf, &cc, msg,
+                             sizeof msg) == CM_OK);
+    CHECK_INT(cc.n, 6);
+    CHECK(cc.n == 6 && cc.q[4] == 21 && fabs(cc.p[4] - 4.428083) < 2e-5 &&
+          fabs(cc.p[5] - 11.803875) < 2e-5);
+    CHECK(cc.p[0] < cc.p[2] && cc.p[2] < cc.p[4] && cc.p[5] < cc.p[3] && cc.p[3] < cc.p[1]);
+    printf("chip-4d Hopf curve: zeta = 20: xi = %.6f, %.6f; 20.5: %.6f, %.6f; 21: %.6f, %.6f\n",
+           cc.p[0], cc.p[1], cc.p[2], cc.p[3], cc.p[4], cc.p[5]);
+    const double beyond[] = {22};
+    curve none = {0};
+    CHECK(cm_flow_hopf_curve(chip2_at, NULL, 1, z, beyond, 1, &oc, on_hopf, &none, msg,
+                             sizeof msg) == CM_OK);
+    CHECK_INT(none.n, 0);
+}
+
 static void test_bad_input(void)
 {
     /* Newton from far away on the fold's flow at mu < 0 (no equilibrium) */
@@ -253,6 +316,7 @@ int main(void)
     test_fold();
     test_chip_equilibrium();
     test_chip_hopf_points();
+    test_hopf_curves();
     test_bad_input();
     return check_failures;
 }
