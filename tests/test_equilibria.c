@@ -1,8 +1,8 @@
 /* Equilibria of flows and their branches (models/flow_equilibria): the
  * Hopf normal form (Hopf at mu = 0, omega = 1), a saddle-node (fold at
- * mu = 0), and Palmai's chip formation flow (thesis (3.27)-(3.31),
- * ../shared/MODELS.md 12.1) against the thesis and an independent
- * implementation: at zeta = 21 its equilibrium loses and regains stability
+ * mu = 0), and Palmai's chip formation flow (thesis (3.27)-(3.31), Sec.
+ * 3.2; its equations are written out in chip_field below) against the
+ * thesis and an independent implementation: at zeta = 21 its equilibrium loses and regains stability
  * in Hopf points at xi = 4.428083 and 11.803875 (thesis: 4.42808,
  * 11.8039) with eigenvalues +-28.00i and +-34.33i; at xi = 4.8, zeta = 40
  * its eigenvalues are -6.23 +- 30.14i, -35.9 and -123.3. Each located
@@ -191,7 +191,7 @@ static void test_chip_equilibrium(void)
     CHECK(chip_at(&zeta, 4.8, &m, msg, sizeof msg) == CM_OK);
     CHECK(cm_flow_equilibrium(&m, 4.8, z, &e, msg, sizeof msg) == CM_OK);
     cm_model_release(&m);
-    /* -6.23 +- 30.14i, -35.9, -123.3 (MODELS.md 12.1, point a of Fig. 3.8) */
+    /* -6.23 +- 30.14i, -35.9, -123.3 (the thesis' point a of Fig. 3.8) */
     CHECK_NEAR(e.re[0], -6.23, 2e-3);
     CHECK_NEAR(e.im[0], 30.14, 2e-3);
     CHECK_NEAR(e.re[1], -6.23, 2e-3);
