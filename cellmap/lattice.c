@@ -203,3 +203,11 @@ void cm_box_rect(const cm_lattice *lat, const cm_box *box, int n, double *lo, do
         hi[d] = cm_lattice_edge(lat, d, box->hi[d]);
     }
 }
+
+void cm_rect_box(const cm_lattice *lat, int n, const double *lo, const double *hi, cm_box *box)
+{
+    for (int d = 0; d < n; d++) {
+        box->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
+        box->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
+    }
+}

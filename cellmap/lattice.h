@@ -102,5 +102,9 @@ double cm_lattice_edge(const cm_lattice *lat, int d, int64_t border);
 int64_t cm_lattice_border(const cm_lattice *lat, int d, double x, int round_up);
 /* The rectangle of box's first n dimensions: lo[d], hi[d] for d < n. */
 void cm_box_rect(const cm_lattice *lat, const cm_box *box, int n, double *lo, double *hi);
+/* The reverse: box's first n dimensions from the rectangle lo..hi (a
+ * cell is in when the rectangle covers it; edges by cm_lattice_border);
+ * box's other dimensions are left as they are. */
+void cm_rect_box(const cm_lattice *lat, int n, const double *lo, const double *hi, cm_box *box);
 
 #endif

@@ -122,6 +122,8 @@ cm_status amplitude_compute(const amp_args *a, amp_result *r, char *msg, size_t 
                        "100000 (e.g. 0.1:3:300)");
     if (a->periods < 50 || a->periods > 100000)
         return cm_fail(CM_EINVAL, msg, msg_size, "periods: %d is not in 50..100000", a->periods);
+    if (!(a->ymax > 0 && a->ymax < 1e6))
+        return cm_fail(CM_EINVAL, msg, msg_size, "ymax %g must be in (0, 1e6)", a->ymax);
     cm_status st = param_sweep_base(&a->mo, "friction-oscillator", om, 1, &r->base, msg, msg_size);
     if (st != CM_OK)
         return st;

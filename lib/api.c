@@ -985,6 +985,15 @@ static cm_status grown_session(const char *path, const cm_db_options *o, cm_sess
     return cm_session_open(path, &so, s, msg, msg_size);
 }
 
+/* Closes the session of a grown database: st, or the close's failure
+ * when the work succeeded (its message then in msg). */
+static cm_status grown_close(cm_session *s, cm_status st, char *msg, size_t msg_size)
+{
+    char close_msg[512];
+    const cm_status closed = cm_session_close(s, close_msg, sizeof close_msg);
+    return st != CM_OK || closed == CM_OK ? st : cm_fail(closed, msg, msg_size, "%s", close_msg);
+}
+
 cm_status cm_db_add_box(const char *path, const double *lo, const double *hi,
                         const cm_db_options *o, uint64_t *new_cells, char *msg, size_t msg_size)
 {
@@ -998,9 +1007,7 @@ cm_status cm_db_add_box(const char *path, const double *lo, const double *hi,
         st = session_add_box(&s->s, &box, &work, msg, msg_size);
     if (new_cells)
         *new_cells = work.cells;
-    char close_msg[512];
-    const cm_status closed = cm_session_close(s, close_msg, sizeof close_msg);
-    return st != CM_OK || closed == CM_OK ? st : cm_fail(closed, msg, msg_size, "%s", close_msg);
+    return grown_close(s, st, msg, msg_size);
 }
 
 cm_status cm_db_extend(const char *path, const double *lo, const double *hi, int steps,
@@ -1017,7 +1024,5 @@ cm_status cm_db_extend(const char *path, const double *lo, const double *hi, int
         st = session_extend(&s->s, &tile, steps, count_step, &n, &how, msg, msg_size);
     if (done)
         *done = n;
-    char close_msg[512];
-    const cm_status closed = cm_session_close(s, close_msg, sizeof close_msg);
-    return st != CM_OK || closed == CM_OK ? st : cm_fail(closed, msg, msg_size, "%s", close_msg);
+    return grown_close(s, st, msg, msg_size);
 }

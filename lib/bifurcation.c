@@ -323,10 +323,7 @@ cm_status bifurcation_compute(const bif_args *a, const work_hooks *h, bif_result
     }
     r->done = done;
     r->seconds = cm_seconds() - t0;
-    const char *why = stopped ? work_stop(h) : NULL;
-    if (stopped)
-        return cm_fail(CM_ECANCELED, msg, msg_size, "%s", why ? why : "stopped");
-    return CM_OK;
+    return stopped ? work_canceled(h, msg, msg_size) : CM_OK;
 }
 
 cm_status bifurcation_write(const bif_args *a, const bif_result *r, char *msg, size_t msg_size)

@@ -156,10 +156,7 @@ void view_cells(const cm_lattice *lat, const double lo[2], const double hi[2], c
                 cm_box *out)
 {
     *out = *within;
-    for (int d = 0; d < lat->dim && d < 2; d++) {
-        out->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
-        out->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
-    }
+    cm_rect_box(lat, lat->dim < 2 ? lat->dim : 2, lo, hi, out);
     for (int d = 2; d < lat->dim; d++) {
         out->lo[d] = within->lo[d] + (within->hi[d] - within->lo[d]) / 2;
         out->hi[d] = out->lo[d] + 1;

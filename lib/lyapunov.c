@@ -265,10 +265,8 @@ cm_status lyapunov_compute(lyap_args *a, const work_hooks *h, lyap_result *r, ch
     const double t0 = cm_seconds();
     int stopped = 0;
     compute_map(a, h, r, &stopped);
-    if (stopped) {
-        const char *why = work_stop(h);
-        return cm_fail(CM_ECANCELED, msg, msg_size, "%s", why ? why : "stopped");
-    }
+    if (stopped)
+        return work_canceled(h, msg, msg_size);
     r->seconds = cm_seconds() - t0;
     for (size_t k = 0; k < r->points; k++) {
         r->computed += !isnan(r->v[k]);

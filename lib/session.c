@@ -27,14 +27,10 @@ static void view_box(const session *s, const double *lo, const double *hi, cm_bo
     const cm_lattice *lat = &s->c.lat;
     memset(box, 0, sizeof *box);
     box->dim = s->dim;
-    for (int d = 0; d < s->dim; d++) {
-        if (d < s->view_dims) {
-            box->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
-            box->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
-        } else {
-            box->lo[d] = s->depth_lo[d];
-            box->hi[d] = s->depth_hi[d];
-        }
+    cm_rect_box(lat, s->view_dims, lo, hi, box);
+    for (int d = s->view_dims; d < s->dim; d++) {
+        box->lo[d] = s->depth_lo[d];
+        box->hi[d] = s->depth_hi[d];
     }
 }
 
@@ -205,13 +201,11 @@ cm_status session_rect_box(const session *s, const double *lo, const double *hi,
 {
     memset(box, 0, sizeof *box);
     box->dim = s->dim;
-    for (int d = 0; d < s->dim; d++) {
+    for (int d = 0; d < s->dim; d++)
         if (!(lo[d] < hi[d]) || !isfinite(lo[d]) || !isfinite(hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "the box needs finite LO < HI in each of the %d dimensions", s->dim);
-        box->lo[d] = cm_lattice_border(&s->c.lat, d, lo[d], 0);
-        box->hi[d] = cm_lattice_border(&s->c.lat, d, hi[d], 1);
-    }
+    cm_rect_box(&s->c.lat, s->dim, lo, hi, box);
     return CM_OK;
 }
 

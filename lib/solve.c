@@ -28,15 +28,7 @@ static cm_status cluster_progress(void *user, cm_cluster *c, uint32_t box,
     char what[64];
     snprintf(what, sizeof what, "%u region%s joined", c->nregions, c->nregions == 1 ? "" : "s");
     work_progress(q->hooks, c->cells, what);
-    const char *why = work_stop(q->hooks);
-    return why ? cm_fail(CM_ECANCELED, msg, msg_size, "%s", why) : CM_OK;
-}
-
-/* Ends a phase that cannot stop half-way when a stop was asked for. */
-static cm_status stop_asked(const solve_request *q, char *msg, size_t msg_size)
-{
-    const char *why = work_stop(q->hooks);
-    return why ? cm_fail(CM_ECANCELED, msg, msg_size, "%s", why) : CM_OK;
+    return work_check(q->hooks, msg, msg_size);
 }
 
 static cm_status solve_whole(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
@@ -55,7 +47,7 @@ static cm_status solve_whole(const solve_request *q, solve_result *r, char *msg,
         st = cm_scm_images(q->model, &q->lat, &opt, &r->r, msg, msg_size);
     const double t1 = cm_seconds();
     if (st == CM_OK) /* classification cannot stop half-way */
-        st = stop_asked(q, msg, msg_size);
+        st = work_check(q->hooks, msg, msg_size);
     if (st == CM_OK)
         st = cm_scm_classify(&r->r, q->plan.opt.threads, msg, msg_size);
     r->t1 = t1 - t0;

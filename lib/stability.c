@@ -166,6 +166,10 @@ stab_args stability_defaults(void)
 cm_status stability_compute(stab_args *a, stab_result *r, char *msg, size_t msg_size)
 {
     *r = (stab_result){0};
+    if ((a->has_P && a->P.n < 2) || (a->has_alpha && a->alpha.n < 2))
+        return cm_fail(CM_EINVAL, msg, msg_size, "the axes need at least 2 values");
+    if (a->has_alpha && a->alpha.lo <= 0)
+        return cm_fail(CM_EINVAL, msg, msg_size, "alpha must be positive");
     const cm_status st = param_sweep_base(&a->mo, "microchaos-pd", NULL, 0, &r->base, msg, msg_size);
     if (st != CM_OK)
         return st;

@@ -120,6 +120,7 @@ bool sweep_write_csv(const sweep_args *a, const sweep_point *pts, int n, char *m
 
 cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size)
 {
+    *r = (sweep_result){0};
     if (a->n_values < 2 || a->n_values > MAX_VALUES || a->refine < 0 || a->refine > MAX_REFINE ||
         a->max_steps < 0 || a->max_steps > PROJECT_MAX_STEPS)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -127,9 +128,14 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
                        "and 0..%d steps",
                        a->n_values, a->refine, a->max_steps, MAX_VALUES, MAX_REFINE,
                        PROJECT_MAX_STEPS);
+    for (int k = 1; k < a->n_values; k++)
+        if (!(a->values[k] > a->values[k - 1]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "the values must increase");
+    for (int d = 0; d < a->n_near; d++)
+        if (!(a->near_lo[d] < a->near_hi[d]))
+            return cm_fail(CM_EINVAL, msg, msg_size, "the window needs LO < HI in each dimension");
     cm_model m;
-    cm_status st =
-        model_spec_build(&a->mo, &m, msg, msg_size);
+    cm_status st = model_spec_build(&a->mo, &m, msg, msg_size);
     if (st != CM_OK)
         return st;
     if (cm_params_find(&m.values, a->name) < 0)
@@ -165,9 +171,9 @@ static bool same_counts(const sweep_point *x, const sweep_point *y)
 static cm_status solve_next(const sweep_args *a, const work_hooks *h, sweep_result *r,
                             double value, char *msg, size_t msg_size)
 {
-    const char *why = work_stop(h);
-    if (why)
-        return cm_fail(CM_ECANCELED, msg, msg_size, "%s", why);
+    const cm_status stopped = work_check(h, msg, msg_size);
+    if (stopped != CM_OK)
+        return stopped;
     r->failed_value = value;
     const cm_status st = sweep_solve_at(a, &r->lat, &r->box, value, &r->pts[r->n], msg, msg_size);
     r->n += st == CM_OK;
@@ -204,10 +210,7 @@ static int by_value(const void *x, const void *y)
 cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_report *rep,
                         sweep_result *r, char *msg, size_t msg_size)
 {
-    *r = (sweep_result){0};
-    cm_status st = sweep_check_setup(a, r, msg, msg_size);
-    if (st != CM_OK)
-        return st;
+    cm_status st = CM_OK;
     r->pts = malloc((size_t)(a->n_values * (1 + a->refine)) * sizeof *r->pts);
     r->changes = malloc((size_t)a->n_values * sizeof *r->changes);
     if (!r->pts || !r->changes)

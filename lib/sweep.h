@@ -65,14 +65,14 @@ typedef struct sweep_result {
     double failed_value; /* the value whose solve failed (the status says how) */
 } sweep_result;
 
-/* Checks the model, the parameter, the window, the lattice and every
- * value, and sets r's lattice and box. */
+/* Checks the request (values increasing, the window), the model, the
+ * parameter, the lattice and every value, and starts r (zeroed) with the
+ * lattice and box; r is freed by sweep_result_free whatever happens next. */
 cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size);
 
-/* Checks the setup and solves every value (then bisects each change
- * a->refine times), progress in values through h, stopped by h
- * (CM_ECANCELED, r->n values solved); r is freed by sweep_result_free
- * whatever the status. */
+/* Solves every value of the setup sweep_check_setup made in r (then
+ * bisects each change a->refine times), progress in values through h,
+ * stopped by h (CM_ECANCELED, r->n values solved). */
 cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_report *rep,
                         sweep_result *r, char *msg, size_t msg_size);
 

@@ -11,6 +11,7 @@
 
 /* The one clock callers time work with: cm_seconds, monotonic seconds. */
 #include "cellmap/clock.h"
+#include "cellmap/status.h"
 
 typedef struct work_hooks {
     /* units of work done so far (cells, regions: the driver's header
@@ -35,6 +36,14 @@ static inline const char *work_stop(const work_hooks *h)
 {
     return h && h->stop ? h->stop(h->user) : NULL;
 }
+
+/* CM_ECANCELED, the hooks' reason to stop first in msg ("stopped" when
+ * they no longer give one): for a driver whose work was stopped. */
+cm_status work_canceled(const work_hooks *h, char *msg, size_t msg_size);
+
+/* work_canceled when the hooks ask to stop now, else CM_OK: for a driver
+ * between two units of work. */
+cm_status work_check(const work_hooks *h, char *msg, size_t msg_size);
 
 /* In a parallel loop: counts one unit more in *done (atomically) and, on
  * the loop's first thread only (the hooks need not be thread-safe), says
