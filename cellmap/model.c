@@ -4,12 +4,20 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *cm_model_coord_name(const cm_model *m, int d)
+const char *cm_flow_coord_name(const cm_model *m, int d)
 {
     static const char *const generic[CM_MAX_DIM] = {"x0", "x1", "x2", "x3", "x4", "x5"};
     if (d < 0 || d >= CM_MAX_DIM)
         return "?";
-    return m->coord_names && d < m->dim ? m->coord_names[d] : generic[d];
+    return m->coord_names && d < cm_flow_dim(m) ? m->coord_names[d] : generic[d];
+}
+
+const char *cm_model_coord_name(const cm_model *m, int d)
+{
+    const int k = m->flow.plane - 1;
+    if (d >= 0 && d < m->dim && k >= 0 && d >= k)
+        d++; /* the map of a section on the plane x_k drops x_k */
+    return cm_flow_coord_name(m, d);
 }
 
 void cm_param_choice_name(const char *choices, int k, char *buf, size_t size)

@@ -73,15 +73,32 @@ typedef struct cm_fixed_point {
 #endif
 
 /* Integrators of a flow (cm_flow.method): GSL's explicit embedded
- * Runge-Kutta pairs, and the classical fourth-order method with step
- * doubling (gsl_odeiv2_step_rk8pd, _rkf45, _rkck, _rk4). */
-enum { CM_FLOW_RK8PD = 0, CM_FLOW_RKF45, CM_FLOW_RKCK, CM_FLOW_RK4 };
+ * Runge-Kutta pairs, the classical fourth-order method with step doubling
+ * (gsl_odeiv2_step_rk8pd, _rkf45, _rkck, _rk4), and for stiff flows its
+ * implicit ones, which take the field's Jacobian by central differences:
+ * the variable-order BDF method, the implicit Gauss fourth-order
+ * Runge-Kutta method and Bulirsch-Stoer's (_msbdf, _rk4imp, _bsimp). */
+enum {
+    CM_FLOW_RK8PD = 0,
+    CM_FLOW_RKF45,
+    CM_FLOW_RKCK,
+    CM_FLOW_RK4,
+    CM_FLOW_MSBDF,
+    CM_FLOW_RK4IMP,
+    CM_FLOW_BSIMP,
+    CM_FLOW_METHODS
+};
 
 /* A map made of an ODE flow x' = f(t, x), which cellmap integrates with
  * GSL (gsl_odeiv2) from time t0: the stroboscopic map (the state at
- * t0 + period) when section is NULL, else the Poincare map of the section
- * g(t, x) = 0 (the state where g next changes sign in `direction`,
- * located to event_tol in time). A start that leaves the world box
+ * t0 + period) when section is NULL and plane 0, else the Poincare map of
+ * the section g(t, x) = 0 (the state where g next changes sign in
+ * `direction`, located to event_tol in time). A section on a state plane
+ * x_k = level of an autonomous flow (plane = k + 1) makes the map's state
+ * the flow's without x_k: the model's dim is then the flow's dimension
+ * less one (cm_flow_dim), its coord_names (if any) name the flow's
+ * coordinates, and the map lifts a state onto the plane, integrates to the
+ * next crossing and drops x_k again. A start that leaves the world box
  * (|x_d| > world), gives a non-finite value, makes field() fail, takes
  * more than CM_FLOW_MAX_STEPS steps or, for a section, does not reach it
  * before t0 + t_max has no image (the sink). Zero settings take the
@@ -101,6 +118,8 @@ typedef struct cm_flow {
     double t_max;   /* a section's longest flight, default 1000 */
     double world;   /* default 1e6 */
     double event_tol; /* default 1e-12 */
+    int plane;        /* 0, or k + 1: the section is the plane x_k = level */
+    double level;
 } cm_flow;
 #define CM_FLOW_MAX_STEPS 1000000
 
@@ -108,8 +127,9 @@ typedef struct cm_flow {
  * same for built-in models and plugins: put CM_FLOW_PARAM_SPECS at the end
  * of a spec (before its terminator) and cellmap reads them. */
 #define CM_FLOW_PARAM_SPECS                                                                    \
-    {"method", "rk8pd", 0, 3, 1, "rk8pd|rkf45|rkck|rk4",                                       \
-     "integrator: GSL's Runge-Kutta Prince-Dormand 8(9), Fehlberg 4(5), Cash-Karp 4(5), RK4"},  \
+    {"method", "rk8pd", 0, CM_FLOW_METHODS - 1, 1, "rk8pd|rkf45|rkck|rk4|msbdf|rk4imp|bsimp",    \
+     "integrator: GSL's Runge-Kutta Prince-Dormand 8(9), Fehlberg 4(5), Cash-Karp 4(5), RK4; "  \
+     "for stiff flows BDF, implicit Gauss RK4, Bulirsch-Stoer"},                                 \
         {"abs_tol", "1e-9", 1e-15, 1e-2, 1, NULL, "absolute error per integration step"},       \
         {"rel_tol", "1e-9", 0, 1e-2, 1, NULL, "relative error per integration step"},           \
         {"world", "1e6", 1e-6, 1e300, 1, NULL, "|x_i| beyond this: the orbit has no image"}
@@ -117,6 +137,16 @@ typedef struct cm_flow {
 #define CM_FLOW_SECTION_PARAM_SPECS                                                            \
     {"t_max", "1000", 1e-6, 1e12, 1, NULL, "the longest flight to the section (else no image)"}, \
         {"event_tol", "1e-12", 1e-15, 1, 1, NULL, "the section's crossing time to this"}
+
+/* And, for a section on a state plane of an autonomous flow, its
+ * settings: the coordinate (one of coords, '|'-separated, the flow's
+ * coordinate names in order), its level and the crossing's direction
+ * (up, down or either), the defaults given. */
+#define CM_FLOW_PLANE_PARAM_SPECS(coords, coord, level, crossing)                                \
+    {"section", coord, 0, CM_MAX_DIM - 1, 1, coords, "the section is the plane SECTION = level"}, \
+        {"level", level, -1e300, 1e300, 1, NULL, "the level of the section's plane"},            \
+        {"crossing", crossing, 0, 2, 1, "up|down|either",                                      \
+         "the crossings the map takes: upwards (increasing), downwards or either"}
 
 typedef struct cm_model {
     const char *name;
@@ -150,8 +180,9 @@ typedef struct cm_model {
      * zones. Pure, like step(). */
     void (*overlays)(const struct cm_model *m, const double lo[2], const double hi[2],
                      cm_overlay_list *out);
-    /* Optional. Names of the state coordinates (dim entries) for axis labels;
-     * NULL: x0, x1, ... */
+    /* Optional. Names of the state coordinates (dim entries; for a section
+     * on a state plane, the flow's: dim + 1) for axis labels; NULL: x0,
+     * x1, ... */
     const char *const *coord_names;
     void (*destroy)(void *ctx);
     cm_flow flow; /* flow.field NULL: a map given by step */
@@ -169,6 +200,10 @@ typedef struct cm_model {
     void (*own_step_n)(const struct cm_model *m, size_t n, const double *const *x,
                        double *const *y, int *rc);
 } cm_model;
+
+/* The dimension of m's flow: its map's, or one more for a section on a
+ * state plane. */
+static inline int cm_flow_dim(const cm_model *m) { return m->dim + (m->flow.plane ? 1 : 0); }
 
 /* Whether coordinate d of m is periodic (cm_model.period). */
 static inline bool cm_model_periodic(const cm_model *m, int d) { return m->period[d] > 0; }
@@ -208,6 +243,11 @@ cm_status cm_model_check_lattice(const cm_model *m, const cm_lattice *lat, char 
  * else x0, x1, ... (d < CM_MAX_DIM). The same names head CSV columns, JSON
  * arrays and SQL columns. */
 const char *cm_model_coord_name(const cm_model *m, int d);
+
+/* The name of coordinate d of m's flow (d < cm_flow_dim(m)): the same as
+ * cm_model_coord_name's but for a section on a state plane, whose
+ * coordinate the map's state drops. */
+const char *cm_flow_coord_name(const cm_model *m, int d);
 
 /* Word k of a parameter's '|'-separated choices into buf (k itself, as a
  * number, past the last word). */

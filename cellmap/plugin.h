@@ -26,7 +26,8 @@
 
 #include "cellmap/model.h"
 
-#define CM_PLUGIN_ABI 3 /* 2: cm_model.flow; 3: cm_model.period (angles) */
+#define CM_PLUGIN_ABI 4 /* 2: cm_model.flow; 3: cm_model.period (angles); 4: stiff
+                          * integrators, sections on state planes */
 
 typedef struct cm_plugin_model {
     const char *name;   /* as --model takes it */

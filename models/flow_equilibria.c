@@ -1,6 +1,7 @@
 /* models/flow_equilibria.c - equilibria of flows, their eigenvalues and
  * branches (models/flow_equilibria.h). */
 #include "models/flow_equilibria.h"
+#include "models/ode_flow.h"
 
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_errno.h>
@@ -26,7 +27,7 @@ static int field_at(const cm_model *m, const double *x, double *f)
 {
     if (m->flow.field(m, m->flow.t0, x, f))
         return 1;
-    for (int i = 0; i < m->dim; i++)
+    for (int i = 0; i < cm_flow_dim(m); i++)
         if (!isfinite(f[i]))
             return 1;
     return 0;
@@ -34,21 +35,7 @@ static int field_at(const cm_model *m, const double *x, double *f)
 
 cm_status cm_flow_jacobian(const cm_model *m, const double *x, double *J)
 {
-    const int n = m->dim;
-    double xs[CM_MAX_DIM], fp[CM_MAX_DIM], fm[CM_MAX_DIM];
-    for (int j = 0; j < n; j++) {
-        const double h = 1e-7 * fmax(1, fabs(x[j]));
-        memcpy(xs, x, (size_t)n * sizeof *x);
-        xs[j] = x[j] + h;
-        if (field_at(m, xs, fp))
-            return CM_EMODEL;
-        xs[j] = x[j] - h;
-        if (field_at(m, xs, fm))
-            return CM_EMODEL;
-        for (int i = 0; i < n; i++)
-            J[i * n + j] = (fp[i] - fm[i]) / (2 * h);
-    }
-    return CM_OK;
+    return cm_flow_jacobian_at(m, m->flow.t0, x, J);
 }
 
 typedef struct eigen {
@@ -95,7 +82,7 @@ cm_status cm_eigenvalues(int n, const double *J, double *re, double *im)
 /* x, p into e with its eigenvalues, unstable count and det's sign. */
 static cm_status classify(const cm_model *m, double p, const double *x, cm_equilibrium *e)
 {
-    const int n = m->dim;
+    const int n = cm_flow_dim(m);
     double J[CM_MAX_DIM * CM_MAX_DIM];
     memset(e, 0, sizeof *e);
     e->dim = n;
@@ -142,7 +129,7 @@ cm_status cm_flow_equilibrium(const cm_model *m, double p, double *x, cm_equilib
                               char *msg, size_t msg_size)
 {
     gsl_set_error_handler_off();
-    const int n = m->dim;
+    const int n = cm_flow_dim(m);
     double f[CM_MAX_DIM], J[CM_MAX_DIM * CM_MAX_DIM], dx[CM_MAX_DIM], xt[CM_MAX_DIM],
         ft[CM_MAX_DIM], start[CM_MAX_DIM];
     memcpy(start, x, (size_t)n * sizeof *x);

@@ -1,8 +1,9 @@
 /* models/flow_equilibria.h - equilibria of an autonomous flow x' = f(x)
- * (a model's cm_flow.field, evaluated at its t0), their eigenvalues, and
- * a branch of them followed in one parameter by pseudo-arclength
- * continuation with its folds and Hopf points located (thesis 3.2: the
- * chip formation flow's Hopf points at xi = 4.42808 and 11.8039).
+ * (a model's cm_flow.field, evaluated at its t0, in cm_flow_dim(m)
+ * coordinates), their eigenvalues, and a branch of them followed in one
+ * parameter by pseudo-arclength continuation with its folds and Hopf
+ * points located (thesis 3.2: the chip formation flow's Hopf points at
+ * xi = 4.42808 and 11.8039).
  *
  * Jacobians are central differences of the field (steps 1e-7 relative to
  * the coordinate, at least 1e-7), good to about 1e-8 relative for fields
