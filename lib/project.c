@@ -3,6 +3,7 @@
 
 #include "cellmap/clock.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <errno.h>
 #include <stdio.h>
@@ -12,6 +13,7 @@
 
 #include "cellmap/cover.h"
 #include "cellmap/extend.h"
+#include "models/ode_flow.h"
 #include "models/registry.h"
 #include "lib/parse.h"
 
@@ -76,6 +78,21 @@ cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_
 {
     return cm_model_set_create(&spec->set, spec->name, spec->texts, spec->n_texts, m, msg,
                                msg_size);
+}
+
+int model_image(const cm_model *m, const double *x, double *y, double *flight)
+{
+    if (!cm_model_is_flow(m)) {
+        *flight = NAN;
+        return m->step(m, x, y);
+    }
+    double t_end;
+    const int rc = cm_flow_map(m, x, y, &t_end, NULL);
+    *flight = t_end - m->flow.t0;
+    /* the engine's step takes states into periodic coordinates' periods */
+    for (int d = 0; rc == CM_STEP_OK && d < m->dim; d++)
+        y[d] = cm_model_wrap(m, d, y[d]);
+    return rc;
 }
 
 const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name)

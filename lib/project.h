@@ -50,6 +50,11 @@ const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
  * the caller with cm_model_release). */
 cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_t msg_size);
 
+/* The image y of x under m's map, with step's return value, and the
+ * flow's time it took in *flight: a stroboscopic map's period, a Poincare
+ * map's return time to its section; NAN for a map that is no flow's. */
+int model_image(const cm_model *m, const double *x, double *y, double *flight);
+
 /* Whether path is a database this cellmap reads, checked before any work
  * (cm_store_probe: it exists, is readable and is a cellmap database of a
  * format this version reads): CM_OK, else why not in msg. Damage inside

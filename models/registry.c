@@ -22,6 +22,9 @@
 #define CM_PD_FRICTION_REGION "-100000:100000,-300:300"
 /* The attractors of the thesis' parameter points (|x| < 2 at Omega = 0.5). */
 #define CM_FO_REGION "-3:3,-3:3"
+/* The attractors of chip-4d on its section (xi 3.5 to 11 at zeta = 21:
+ * tau2 1.00-1.15, T1 0.190-0.214, T2 0.245-0.30). */
+#define CM_CHIP_REGION "0.9:1.25,0.15:0.25,0.2:0.35"
 
 static const cm_model_entry entries[] = {
     {"microchaos-1d", "x = x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
@@ -46,6 +49,9 @@ static const cm_model_entry entries[] = {
     {"duffing", "x, v (position and velocity at the forcing phase)",
      "stroboscopic map of the forced Duffing oscillator x'' + delta x' - x + x^3 = gamma cos(omega t), integrated by GSL",
      "-2.5:2.5,-2.5:2.5", cm_duffing_spec, cm_duffing_create},
+    {"chip-4d", "tau2, T1, T2 (stress and temperatures where the flow crosses the plane T0 = 0.1 downwards)",
+     "Poincare map of Palmai's chip formation flow (3.27)-(3.31), integrated by GSL",
+     CM_CHIP_REGION, cm_chip_4d_spec, cm_chip_4d_create},
 };
 
 size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }

@@ -17,7 +17,9 @@ static const char orbit_help[] =
     "against it: to standard output, or to FILE with --csv. --json prints one JSON\n"
     "document instead (\"points\", and \"end\": \"steps\" or \"sink\"). Stops early\n"
     "(exit 0) when the map has no image (the sink); the CSV's last line then says\n"
-    "so in a comment.\n";
+    "so in a comment. For the map of an ODE flow a column t (JSON: \"t\") gives the\n"
+    "flow's time at each point: the sum of the periods, or of the return times to\n"
+    "a Poincare map's section.\n";
 
 typedef struct orbit_args {
     model_opts mo;
@@ -63,30 +65,43 @@ static int parse_args(cli *c, orbit_args *a)
 /* Follows the orbit, writing CSV to f or JSON points to j. */
 static int follow(const orbit_args *a, const cm_model *m, FILE *f, json *j)
 {
-    double x[CM_MAX_DIM], y[CM_MAX_DIM];
+    double x[CM_MAX_DIM], y[CM_MAX_DIM], t = 0, flight;
+    double *times = NULL; /* JSON: the flow's times, after the points */
+    const bool flow = m->flow.field != NULL;
     memcpy(x, a->from, sizeof x);
     if (f) {
         fprintf(f, "j");
         for (int d = 0; d < m->dim; d++)
             fprintf(f, ",%s", cm_model_coord_name(m, d));
-        fprintf(f, "\n");
+        fprintf(f, flow ? ",t\n" : "\n");
     } else {
         json_array(j, "points");
+        if (flow && !(times = malloc(((size_t)a->steps + 1) * sizeof *times))) {
+            fprintf(stderr, "cellmap orbit: out of memory for %lld times\n",
+                    (long long)a->steps + 1);
+            return EXIT_FAIL;
+        }
     }
     const char *end = "steps";
     int status = EXIT_OK;
-    for (int64_t step = 0; step <= a->steps; step++) {
+    int64_t step;
+    for (step = 0; step <= a->steps; step++) {
         if (f) {
             fprintf(f, "%lld", (long long)step);
             for (int d = 0; d < m->dim; d++)
                 fprintf(f, ",%.17g", x[d]);
+            if (flow)
+                fprintf(f, ",%.17g", t);
             fprintf(f, "\n");
         } else {
             json_nums(j, NULL, x, m->dim);
+            if (times)
+                times[step] = t;
         }
         if (step == a->steps)
             break;
-        const int rc = m->step(m, x, y);
+        const int rc = model_image(m, x, y, &flight);
+        t += flight;
         if (rc > 0) {
             end = "sink";
             if (f)
@@ -102,8 +117,11 @@ static int follow(const orbit_args *a, const cm_model *m, FILE *f, json *j)
     }
     if (j) {
         json_array_end(j);
+        if (times)
+            json_nums(j, "t", times, (int)step + 1); /* the points written */
         json_str(j, "end", end);
     }
+    free(times);
     return status;
 }
 

@@ -1,8 +1,8 @@
 /* Equilibria of flows and their branches (models/flow_equilibria): the
  * Hopf normal form (Hopf at mu = 0, omega = 1), a saddle-node (fold at
  * mu = 0), and Palmai's chip formation flow (thesis (3.27)-(3.31), Sec.
- * 3.2; its equations are written out in chip_field below) against the
- * thesis and an independent implementation: at zeta = 21 its equilibrium loses and regains stability
+ * 3.2; the model chip-4d's flow) against the thesis and an independent
+ * implementation: at zeta = 21 its equilibrium loses and regains stability
  * in Hopf points at xi = 4.428083 and 11.803875 (thesis: 4.42808,
  * 11.8039) with eigenvalues +-28.00i and +-34.33i; at xi = 4.8, zeta = 40
  * its eigenvalues are -6.23 +- 30.14i, -35.9 and -123.3. Each located
@@ -14,6 +14,7 @@
 
 #include "check.h"
 #include "models/flow_equilibria.h"
+#include "models/registry.h"
 
 /* ---- the flows ---------------------------------------------------------- */
 
@@ -34,30 +35,6 @@ static int fold_field(const cm_model *m, double t, const double *x, double *f)
     const double mu = *(const double *)m->ctx;
     f[0] = mu - x[0] * x[0];
     f[1] = -x[1];
-    return 0;
-}
-
-/* Palmai's flow: state (tau2, T0, T1, T2). */
-typedef struct chip {
-    double a, b, T_Phi, eta, p, xi, zeta;
-} chip;
-
-static int chip_field(const cm_model *m, double t, const double *z, double *f)
-{
-    (void)t;
-    const chip *c = m->ctx;
-    const double tau2 = z[0], T0 = z[1], T1 = z[2], T2 = z[3];
-    if (!(T1 > -1 && T2 > -1))
-        return 1;
-    const double F1 = (T1 + 1) / (c->T_Phi + 1) *
-                      exp((c->p * tau2 - c->p + c->a * (T1 - c->T_Phi)) / (c->b * (T1 + 1)));
-    const double F2 = (T2 + 1) / (c->T_Phi + 1) *
-                      exp((tau2 - 1 + c->a * (T2 - c->T_Phi)) / (c->b * (T2 + 1)));
-    f[0] = 1 - (F1 + F2);
-    f[1] = c->zeta * (T1 - 2 * T0) - c->xi * T0;
-    f[2] = c->eta * (c->p * tau2 + 1 - c->p) * F1 - c->zeta * (2 * T1 - T2 - T0) -
-           c->xi * (T1 - T0);
-    f[3] = c->eta * tau2 * F2 - (c->xi + c->zeta) * (T2 - T1);
     return 0;
 }
 
@@ -90,12 +67,14 @@ static cm_status fold_at(void *user, double mu, cm_model *m, char *msg, size_t m
     return model_of("fold", 2, fold_field, &mu, sizeof mu, m);
 }
 
-/* The chip flow at xi (user: zeta). */
+/* The chip flow (model chip-4d, its flow in (tau2, T0, T1, T2)) at xi
+ * (user: zeta). */
 static cm_status chip_at(void *user, double xi, cm_model *m, char *msg, size_t msg_size)
 {
-    (void)msg, (void)msg_size;
-    const chip c = {0.3, 0.012, 1, 4.4, 1.03, xi, *(const double *)user};
-    return model_of("chip-4d", 4, chip_field, &c, sizeof c, m);
+    char text[96];
+    snprintf(text, sizeof text, "xi=%.17g,zeta=%.17g", xi, *(const double *)user);
+    const char *texts[] = {text};
+    return cm_model_create("chip-4d", texts, 1, m, msg, msg_size);
 }
 
 /* ---- what a branch reports ---------------------------------------------- */

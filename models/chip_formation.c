@@ -1,0 +1,78 @@
+/* Chip formation in orthogonal cutting (thesis Ch. 3, docs/models.md 12):
+ * Palmai's autonomous flow of the shear stress and the temperatures of
+ * the chip's layers, (3.27)-(3.31), as the Poincare map of a state plane
+ * (by default T0 = 0.1 crossed downwards, where the successive tau2 make
+ * the thesis' one-dimensional map of Fig. 3.6: the map's state is (tau2,
+ * T1, T2) there). */
+#include <math.h>
+
+#include "models/chip_formation.h"
+#include "models/models.h"
+#include "models/ode_flow.h"
+#include "models/params.h"
+
+const cm_param_spec cm_chip_4d_spec[] = {
+    {"xi", "4.8", -100, 100, 1, NULL, "xi: heat carried away with the chip (3.28)-(3.30)"},
+    {"zeta", "21", 0, 1000, 1, NULL, "zeta: heat conduction between the layers"},
+    {"eta", "4.4", 0, 1000, 1, NULL, "eta: plastic work turned into heat"},
+    {"p", "1.03", 0, 10, 1, NULL, "p: tau1 = p tau2 + 1 - p (3.6)"},
+    {"a", "0.3", 0, 10, 1, NULL, "a: the flow stress' temperature coefficient (3.31)"},
+    {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity (3.31); small is stiff"},
+    {"T_Phi", "1", -0.99, 100, 1, NULL, "T_Phi: the reference temperature (3.31)"},
+    CM_FLOW_PLANE_PARAM_SPECS("tau2|T0|T1|T2", "T0", "0.1", "down"),
+    {"t_max", "50", 1e-6, 1e12, 1, NULL,
+     "the longest flight to the section (else no image; about 90 returns at the defaults)"},
+    {"event_tol", "1e-12", 1e-15, 1, 1, NULL, "the section's crossing time to this"},
+    CM_FLOW_PARAM_SPECS,
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+static const char *const chip_coord_names[] = {"tau2", "T0", "T1", "T2"};
+
+void cm_chip_rates(const cm_chip *c, double tau2, double T1, double T2, double *F1, double *F2)
+{
+    *F1 = (T1 + 1) / (c->T_Phi + 1) *
+          exp((c->p * tau2 - c->p + c->a * (T1 - c->T_Phi)) / (c->b * (T1 + 1)));
+    *F2 = (T2 + 1) / (c->T_Phi + 1) * exp((tau2 - 1 + c->a * (T2 - c->T_Phi)) / (c->b * (T2 + 1)));
+}
+
+/* (3.27)-(3.30); defined where the layers are above absolute zero of the
+ * law's scale (T > -1). */
+static int chip_field(const cm_model *m, double t, const double *z, double *f)
+{
+    (void)t;
+    const cm_chip *c = m->ctx;
+    const double tau2 = z[0], T0 = z[1], T1 = z[2], T2 = z[3];
+    if (!(T1 > -1 && T2 > -1))
+        return 1;
+    double F1, F2;
+    cm_chip_rates(c, tau2, T1, T2, &F1, &F2);
+    f[0] = 1 - (F1 + F2);
+    f[1] = c->zeta * (T1 - 2 * T0) - c->xi * T0;
+    f[2] = c->eta * (c->p * tau2 + 1 - c->p) * F1 - c->zeta * (2 * T1 - T2 - T0) -
+           c->xi * (T1 - T0);
+    f[3] = c->eta * tau2 * F2 - (c->xi + c->zeta) * (T2 - T1);
+    return 0;
+}
+
+cm_status cm_chip_4d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    /* the map lives on the section's plane: one coordinate fewer */
+    cm_status st = cm_model_setup(m, "chip-4d", 3, p, sizeof(cm_chip), msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_chip *c = m->ctx;
+    c->xi = cm_params_get(p, "xi");
+    c->zeta = cm_params_get(p, "zeta");
+    c->eta = cm_params_get(p, "eta");
+    c->p = cm_params_get(p, "p");
+    c->a = cm_params_get(p, "a");
+    c->b = cm_params_get(p, "b");
+    c->T_Phi = cm_params_get(p, "T_Phi");
+    m->coord_names = chip_coord_names;
+    m->flow.field = chip_field;
+    st = cm_flow_attach(m, msg, msg_size);
+    if (st != CM_OK)
+        cm_model_release(m);
+    return st;
+}
