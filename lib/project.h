@@ -52,7 +52,9 @@ cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_
 
 /* The image y of x under m's map, with step's return value, and the
  * flow's time it took in *flight: a stroboscopic map's period, a Poincare
- * map's return time to its section; NAN for a map that is no flow's. */
+ * map's return time to its section (without an image: how long the orbit
+ * was followed, m->flow.t_max when the section was not reached); NAN for
+ * a map that is no flow's. */
 int model_image(const cm_model *m, const double *x, double *y, double *flight);
 
 /* Whether path is a database this cellmap reads, checked before any work

@@ -419,6 +419,7 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
     double z[CM_MAX_DIM];
     w->steps = 0;
     lift(m, x, z);
+    *t_end = f->t0;
     if (!in_world(m, z))
         return CM_STEP_NO_IMAGE;
     if (!has_section(f)) {
@@ -432,9 +433,11 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
     gsl_odeiv2_step_reset(w->step);
     double t = f->t0, h = first_step(m, f->t0, z, f->t_max), image[CM_MAX_DIM];
     bool lost;
-    /* not reached in time, or lost: no image */
-    if (!next_crossing(w, &t, f->t0 + f->t_max, &h, z, image, t_end, &lost))
+    /* not reached in time (t is then t0 + t_max), or lost: no image */
+    if (!next_crossing(w, &t, f->t0 + f->t_max, &h, z, image, t_end, &lost)) {
+        *t_end = t;
         return CM_STEP_NO_IMAGE;
+    }
     drop(m, image, y);
     return CM_STEP_OK;
 }

@@ -13,7 +13,9 @@ cm_status cm_flow_attach(cm_model *m, char *msg, size_t msg_size);
 
 /* The flow's map from x at time t0 into y, as step gives it; *t_end (if
  * not NULL) gets the time the image was taken at (for a Poincare map:
- * t0 plus the return time) and *steps the integration steps taken. */
+ * t0 plus the return time) or, without an image, the time the orbit was
+ * followed to (t0 + t_max: the section was not reached; earlier: the
+ * orbit was lost), and *steps the integration steps taken. */
 int cm_flow_map(const cm_model *m, const double *x, double *y, double *t_end, long *steps);
 
 /* Follows m's flow from x (cm_flow_dim(m) entries) at time t0 to t1 > t0

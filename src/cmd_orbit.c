@@ -101,6 +101,16 @@ static int follow(const orbit_args *a, const cm_model *m, FILE *f, json *j)
         if (step == a->steps)
             break;
         const int rc = model_image(m, x, y, &flight);
+        if (rc > 0 && step == 0 && flow && flight >= m->flow.t_max &&
+            (m->flow.section || m->flow.plane)) {
+            fprintf(stderr,
+                    "cellmap orbit: the flow from --from does not reach the model's section "
+                    "within t_max = %g time units: start elsewhere, choose a section the orbit "
+                    "crosses (section, level, crossing) or raise t_max\n",
+                    m->flow.t_max);
+            status = EXIT_FAIL;
+            break;
+        }
         t += flight;
         if (rc > 0) {
             end = "sink";

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# The chip formation model chip-4d from the command line (docs/models.md
+# 12.1): the flow's time in orbit and the mean return time, the cell
+# mapping of its section map split and whole, the largest exponent on 1
+# and 2 threads, and bad input (a section never crossed, unknown words).
+# test_chip checks the dynamics themselves.
+# usage: chip_test.sh PATH/TO/cellmap
+set -u
+CM=$1
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+
+# --- orbit: the section map's points and the flow's time at each --------
+"$CM" orbit --model chip-4d --from 1.05,0.2,0.27 --steps 2200 --csv orbit.csv \
+  || fail "orbit --model chip-4d"
+python3 - orbit.csv <<'PY' || fail "orbit's time column and mean return time"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert list(rows[0]) == ["j", "tau2", "T1", "T2", "t"], list(rows[0])
+t = [float(r["t"]) for r in rows]
+assert t[0] == 0 and all(b > a for a, b in zip(t, t[1:])), "t does not grow"
+mean = (t[-1] - t[200]) / (len(t) - 1 - 200)
+assert abs(mean / 0.558 - 1) < 0.01, mean   # thesis: 0.558
+PY
+"$CM" orbit --model chip-4d --from 1.05,0.2,0.27 --steps 3 --json > orbit.json || fail "orbit --json"
+python3 - orbit.json <<'PY' || fail "orbit --json's t"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert len(d["t"]) == len(d["points"]) == 4 and d["t"][0] == 0, d
+PY
+
+# --- the cell mapping of the section map: --split as the single solve ----
+cells=(--model chip-4d --param xi=3.5 --cells 20x20x20 --threads 2 --json)
+"$CM" solve "${cells[@]}" > whole.json || fail "solve chip-4d"
+"$CM" solve "${cells[@]}" --split 2x2x2 > split.json || fail "solve chip-4d --split 2x2x2"
+python3 - whole.json split.json <<'PY' || fail "chip-4d: --split differs from the single solve"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+assert len(a["attractors"]) == 1 and a["attractors"][0]["period"] == 2, a["attractors"]
+assert a["attractors"] == b["attractors"], (a["attractors"], b["attractors"])
+for key in ("cells", "sink_cells", "diverged_cells", "returned_cells", "outside_cells"):
+    assert a[key] == b[key], key
+groups = lambda d: sorted((g["period"], g["basin_cells"], g["centre"], g["attractor"]) for g in d["groups"])
+assert groups(a) == groups(b)
+PY
+
+# --- lyapunov: chaos at xi = 4.8, the same on 1 and 2 threads ------------
+ly=(lyapunov --model chip-4d --grid xi=4.8,5.2,zeta=21 --from 1.05,0.2,0.27 --d0 1e-6
+    --periods 3000 --quiet)
+"$CM" "${ly[@]}" --threads 1 --csv l1.csv || fail "lyapunov chip-4d, 1 thread"
+"$CM" "${ly[@]}" --threads 2 --csv l2.csv || fail "lyapunov chip-4d, 2 threads"
+cmp -s l1.csv l2.csv || fail "chip-4d lyapunov differs between 1 and 2 threads"
+python3 - l1.csv <<'PY' || fail "chip-4d lyapunov at xi = 4.8"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+lam = [float(r["lambda"]) for r in rows if abs(float(r["xi"]) - 4.8) < 1e-12]
+assert len(lam) == 1 and abs(lam[0] / 0.647 - 1) < 0.1, lam   # thesis (TISEAN): 0.647
+PY
+
+# --- bad input -----------------------------------------------------------
+out=$("$CM" orbit --model chip-4d --param level=5 --from 1,0.2,0.25 --steps 3 --csv never.csv 2>&1)
+rc=$?
+[ "$rc" -eq 1 ] || fail "orbit from a start that never crosses the section exited $rc"
+grep -q "does not reach the model's section" <<<"$out" || fail "never crossed: '$out'"
+[ ! -e never.csv ] || fail "orbit wrote never.csv although the section was not reached"
+expect_usage "crossing" orbit --model chip-4d --param crossing=sideways --from 1,0.2,0.25 --steps 1
+expect_usage "section" orbit --model chip-4d --param section=T9 --from 1,0.2,0.25 --steps 1
+expect_usage "t_max" orbit --model chip-4d --param t_max=0 --from 1,0.2,0.25 --steps 1
+expect_usage "dimension 3" orbit --model chip-4d --from 1,0,0.2,0.25 --steps 1
+
+[ "$fails" -eq 0 ] && echo "chip_test: all passed"
+exit $((fails > 0))
