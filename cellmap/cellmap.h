@@ -427,7 +427,7 @@ cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size);
 
 /* ---- analysis drivers ----
  * The commands `stability`, `partition`, `amplitude`, `horseshoe`,
- * `escape`, `simulate`, `bifurcation`, `lyapunov`, `sweep` and `continue`
+ * `escape`, `equilibria`, `simulate`, `bifurcation`, `lyapunov`, `sweep` and `continue`
  * as calls: the same computation and the same files (CSV tables and PNG
  * figures, byte for byte) as the command with the same settings. Each
  * takes the model and outputs (cm_analysis) and its own settings (an
@@ -496,6 +496,27 @@ cm_escape_options cm_escape_defaults(void); /* 100000 cells, an ensemble of 10^6
 /* microchaos-1d-friction's transient chaos (thesis 4.3): the repeller,
  * its escape rate and mean escape number, exact and estimated. */
 cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, char *msg, size_t msg_size);
+
+typedef struct cm_equilibria_options {
+    const double *from; /* the start of Newton's method, in the flow's coordinates */
+    int n_from;         /* the flow's dimension */
+    const char *branch; /* NULL: one equilibrium; else the parameter its branch follows */
+    double lo, hi;      /* the branch's range, holding the model's value of it */
+    int direction;      /* +1 or -1: that way only; 0: both */
+    double ds_max;      /* the longest arclength step; 0: (hi - lo) / 50 */
+    int max_points;     /* points each way, 10..1000000 */
+    const cm_axis *curve; /* NULL, or the Hopf points of the branch at each of these
+                             values (1..2000) of a second parameter */
+} cm_equilibria_options;
+cm_equilibria_options cm_equilibria_defaults(void); /* both ways, 10000 points */
+
+/* The equilibria of a flow model (default chip-4d; `cellmap
+ * equilibria`): Newton from o->from with the eigenvalues; the branch in
+ * o->branch with its folds and Hopf points; Hopf points over o->curve.
+ * The table only (a->png must be NULL). CM_ENOTFOUND: Newton did not
+ * converge. */
+cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_options *o, char *msg,
+                                 size_t msg_size);
 
 typedef struct cm_simulate_options {
     double x, v;     /* the start */

@@ -14,6 +14,7 @@
 #include "lib/api_models.h"
 #include "lib/bifurcation.h"
 #include "lib/continuation.h"
+#include "lib/equilibria.h"
 #include "lib/escape.h"
 #include "lib/horseshoe.h"
 #include "lib/lyapunov.h"
@@ -346,6 +347,55 @@ cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, c
     if (st == CM_OK)
         st = escape_write(&ea, &r, msg, msg_size);
     escape_result_free(&r);
+    return st;
+}
+
+/* ---- flows: equilibria ---- */
+
+cm_equilibria_options cm_equilibria_defaults(void)
+{
+    const eq_args d = equilibria_defaults();
+    return (cm_equilibria_options){.max_points = d.max_points};
+}
+
+cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_options *o, char *msg,
+                                 size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_equilibria_options d = cm_equilibria_defaults();
+    o = o ? o : &d;
+    eq_args ea = equilibria_defaults();
+    model_of(a, ea.mo.name, &ea.mo);
+    if (a->png)
+        return cm_fail(CM_EINVAL, msg, msg_size, "equilibria draws no figure: give csv only");
+    if (!o->from || o->n_from < 1 || o->n_from > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "equilibria need a start (from) of 1..%d coordinates", CM_MAX_DIM);
+    if (o->branch && (!o->branch[0] || strlen(o->branch) >= sizeof ea.branch))
+        return cm_fail(CM_EINVAL, msg, msg_size, "a branch needs a parameter's name");
+    if (o->max_points < 10 || o->max_points > 1000000 || o->direction < -1 ||
+        o->direction > 1 || !(o->ds_max >= 0) || (!o->branch && (o->curve || o->direction)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a branch's settings: 10..1000000 points, a direction of -1, 0 or 1, "
+                       "ds_max >= 0; a direction or a Hopf curve only with a branch");
+    memcpy(ea.from, o->from, (size_t)o->n_from * sizeof *o->from);
+    ea.n_from = o->n_from;
+    if (o->branch)
+        snprintf(ea.branch, sizeof ea.branch, "%s", o->branch);
+    ea.lo = o->lo, ea.hi = o->hi, ea.direction = o->direction, ea.ds_max = o->ds_max;
+    ea.max_points = o->max_points, ea.csv = a->csv;
+    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    if (st == CM_OK && o->curve) {
+        ea.has_curve = true;
+        st = axis_of(o->curve, NULL, PARAM_AXIS_MAX, &ea.curve, msg, msg_size);
+    }
+    if (st != CM_OK)
+        return st;
+    eq_result r;
+    st = equilibria_compute(&ea, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = equilibria_write(&ea, &r, msg, msg_size);
+    equilibria_result_free(&r);
     return st;
 }
 

@@ -344,6 +344,25 @@ static cm_status events_between(const branch *b, const double *ya, const cm_equi
     return CM_OK;
 }
 
+/* The branch's point at the end of the range that the step from y to yn
+ * (beyond it) crosses, into yn: Newton at that parameter value from the
+ * state interpolated there. False where it does not converge. */
+static bool end_point(const branch *b, const cm_eq_branch_options *o, const double *y,
+                      double *yn)
+{
+    const int n = b->n;
+    const double bound = yn[n] > o->hi ? o->hi : o->lo, s = (bound - y[n]) / (yn[n] - y[n]);
+    for (int i = 0; i < n; i++)
+        yn[i] = y[i] + s * (yn[i] - y[i]);
+    yn[n] = bound;
+    cm_model m;
+    if (b->at(b->at_user, bound, &m, b->msg, b->msg_size) != CM_OK)
+        return false;
+    const bool ok = cm_flow_equilibrium(&m, bound, yn, NULL, b->msg, b->msg_size) == CM_OK;
+    cm_model_release(&m);
+    return ok;
+}
+
 cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0,
                                      const double *x0, const cm_eq_branch_options *o,
                                      int (*point)(void *user, const cm_equilibrium *e),
@@ -358,8 +377,8 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
     cm_status st = at(at_user, p0, &m, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const branch b = {at, at_user, m.dim, msg, msg_size};
-    const int n = m.dim, N = n + 1;
+    const branch b = {at, at_user, cm_flow_dim(&m), msg, msg_size};
+    const int n = cm_flow_dim(&m), N = n + 1;
     double y[NMAX], t[NMAX], along[NMAX] = {0}, yp[NMAX], yn[NMAX], tn[NMAX];
     memcpy(y, x0, (size_t)n * sizeof *x0);
     y[n] = p0;
@@ -391,12 +410,13 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
             }
             continue;
         }
-        if (!(yn[n] >= o->lo && yn[n] <= o->hi)) {
-            *why = CM_EQ_LEFT_RANGE;
+        const bool last = !(yn[n] >= o->lo && yn[n] <= o->hi);
+        if (last && !end_point(&b, o, y, yn)) {
+            *why = CM_EQ_LEFT_RANGE; /* the range's end cannot be reached: stop short */
             break;
         }
         st = classify_at(&b, yn, &en);
-        if (st == CM_OK)
+        if (st == CM_OK && !last)
             st = tangent(&b, yn, t, tn);
         if (st == CM_OK)
             st = events_between(&b, y, &e, yn, &en, event, user, &stopped);
@@ -404,6 +424,10 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
             break;
         stopped = point && point(user, &en);
         points++;
+        if (last && !stopped) {
+            *why = CM_EQ_LEFT_RANGE;
+            break;
+        }
         memcpy(y, yn, sizeof y);
         memcpy(t, tn, sizeof t);
         e = en;
@@ -454,7 +478,7 @@ cm_status cm_flow_hopf_curve(cm_model_at2_fn at, void *at_user, double p0, const
         if ((st = model_at_q(&a, p0, &m, msg, msg_size)) != CM_OK)
             break;
         if (k == 0)
-            memcpy(start, x0, (size_t)m.dim * sizeof *x0);
+            memcpy(start, x0, (size_t)cm_flow_dim(&m) * sizeof *x0);
         st = cm_flow_equilibrium(&m, p0, start, NULL, msg, msg_size);
         cm_model_release(&m);
         int why = 0;

@@ -69,9 +69,10 @@ typedef struct cm_eq_branch_options {
 } cm_eq_branch_options;
 
 /* Follows the branch through the equilibrium near x0 at p0 (in lo..hi),
- * calling point for each point (the first included) and event for each
- * fold and Hopf point between two, in order; either returning nonzero
- * stops the branch (CM_EQ_CALLER). *why: CM_EQ_*. */
+ * calling point for each point (the first included; the last one on the
+ * range's end where the branch leaves it) and event for each fold and
+ * Hopf point between two, in order; either returning nonzero stops the
+ * branch (CM_EQ_CALLER). *why: CM_EQ_*. */
 cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0,
                                      const double *x0, const cm_eq_branch_options *o,
                                      int (*point)(void *user, const cm_equilibrium *e),

@@ -25,6 +25,8 @@ static const struct {
     {"export", cmd_export, "a .cmdb file's groups and cells as CSV, .npy or a flat SQLite table"},
     {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},
     {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
+    {"equilibria", cmd_equilibria,
+     "equilibria of a flow: eigenvalues, branches in a parameter, folds and Hopf points"},
     {"lyapunov", cmd_lyapunov, "largest Lyapunov exponent over a grid of two parameters (any model)"},
     {"simulate", cmd_simulate,
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},

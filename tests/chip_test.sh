@@ -2,7 +2,8 @@
 # The chip formation model chip-4d from the command line (docs/models.md
 # 12.1): the flow's time in orbit and the mean return time, the cell
 # mapping of its section map split and whole, the largest exponent on 1
-# and 2 threads, and bad input (a section never crossed, unknown words).
+# and 2 threads, the equilibria's branch and Hopf points, and bad input (a
+# section never crossed, unknown words, a start where Newton fails).
 # test_chip checks the dynamics themselves.
 # usage: chip_test.sh PATH/TO/cellmap
 set -u
@@ -58,7 +59,44 @@ lam = [float(r["lambda"]) for r in rows if abs(float(r["xi"]) - 4.8) < 1e-12]
 assert len(lam) == 1 and abs(lam[0] / 0.647 - 1) < 0.1, lam   # thesis (TISEAN): 0.647
 PY
 
+# --- equilibria: the Hopf points of the branch in xi at zeta = 21 --------
+"$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=0.5:15 --csv eq.csv > eq.out \
+  || fail "equilibria --branch"
+python3 - eq.csv <<'PY' || fail "equilibria's Hopf points"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+hopf = [r for r in rows if r["kind"] == "hopf"]
+assert [r["kind"] for r in rows].count("point") > 50, len(rows)
+xi = [float(r["xi"]) for r in rows if r["kind"] == "point"]
+assert xi == sorted(xi) and xi[0] < 0.6 and xi[-1] > 14.9, (xi[0], xi[-1])
+assert len(hopf) == 2, hopf
+assert abs(float(hopf[0]["xi"]) - 4.42808) < 1e-4 and abs(float(hopf[1]["xi"]) - 11.8039) < 1e-4, hopf
+assert abs(float(hopf[0]["omega"]) - 28.00) < 5e-3 and abs(float(hopf[1]["omega"]) - 34.33) < 5e-3
+# unstable (a pair to the right) between the Hopf points, stable outside them
+for r in rows:
+    if r["kind"] == "point":
+        inside = float(hopf[0]["xi"]) < float(r["xi"]) < float(hopf[1]["xi"])
+        assert (int(r["unstable"]) == 2) == inside, r
+PY
+grep -q "^hopf at xi = 4.4280" eq.out || fail "equilibria's summary: $(cat eq.out)"
+"$CM" equilibria --from 1,0.1,0.2,0.25 --param zeta=40 --json > eq40.json || fail "equilibria --json"
+python3 - eq40.json <<'PY' || fail "the equilibrium at xi = 4.8, zeta = 40 (Fig. 3.8 a)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["unstable"] == 0 and abs(d["re"][0] + 6.23) < 5e-3 and abs(d["im"][0] - 30.14) < 5e-3, d
+assert abs(d["re"][2] + 35.9) < 5e-2 and abs(d["re"][3] + 123.3) < 5e-2, d
+PY
+
 # --- bad input -----------------------------------------------------------
+expect_usage "the flow of model chip-4d has 4 coordinates (tau2, T0, T1, T2)" \
+  equilibria --from 1,0.2,0.25
+expect_usage "must hold the model's xi = 4.8" equilibria --from 1,0.1,0.2,0.25 --branch xi=5:6
+expect_usage "is a map, not a flow" equilibria --model microchaos-1d --from 1
+expect_usage "need --branch" equilibria --from 1,0.1,0.2,0.25 --curve zeta=20,21
+out=$("$CM" equilibria --from 1,0.1,1e6,-0.999 --csv noeq.csv 2>&1); rc=$?
+[ "$rc" -eq 1 ] || fail "equilibria from a start where Newton fails exited $rc: $out"
+grep -qi "newton" <<<"$out" || fail "equilibria where Newton fails: '$out'"
+[ ! -e noeq.csv ] || fail "equilibria wrote noeq.csv although Newton failed"
 out=$("$CM" orbit --model chip-4d --param level=5 --from 1,0.2,0.25 --steps 3 --csv never.csv 2>&1)
 rc=$?
 [ "$rc" -eq 1 ] || fail "orbit from a start that never crosses the section exited $rc"

@@ -32,6 +32,11 @@ run fixed-points fixed-points --range -2:2 --json
 run fixed-points-friction fixed-points --model microchaos-pd-friction --range -2:2 --json
 run orbit orbit --from 10,0 --steps 5 --json
 run orbit-sink orbit --model microchaos-1d --from 1e300 --steps 5 --json
+run orbit-flow orbit --model chip-4d --from 1.05,0.2,0.27 --steps 2 --json
+run equilibria equilibria --model chip-4d --from 1,0.1,0.2,0.25 --json
+run equilibria-branch equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=4:12 --json
+run equilibria-curve equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=1:15 \
+  --curve zeta=21,21.5 --json
 run lyapunov lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --periods 50 --json
 run bifurcation bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 20 --record 5 --json
 run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json

@@ -113,6 +113,12 @@ static void analyses(void)
     co.events = "c_continue_events.csv";
     a = outputs("continue", f, 1);
     must(cm_analysis_continue(&a, &co, msg, sizeof msg), "continue", msg);
+    cm_equilibria_options eqo = cm_equilibria_defaults();
+    eqo.from = (const double[]){1, 0.1, 0.2, 0.25}, eqo.n_from = 4;
+    eqo.branch = "xi", eqo.lo = 3, eqo.hi = 15;
+    eqo.curve = &(cm_axis){"zeta", 20, 21, 2};
+    a = outputs("equilibria", f, 0);
+    must(cm_analysis_equilibria(&a, &eqo, msg, sizeof msg), "equilibria", msg);
 }
 
 int main(void)

@@ -2,7 +2,8 @@
 the same settings through the command and through tests/workstation.c and
 compares the files byte for byte): PREFIX_NAME.csv and .png for stability,
 partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
-runs), lyapunov, sweep and continue (and its events). The tables the
+runs), lyapunov, sweep, continue (and its events) and equilibria (its
+table). The tables the
 functions return are checked against the files they read them from.
 usage: workstation_analysis.py PREFIX"""
 import os
@@ -49,6 +50,9 @@ pts, events = an.continuation(("S", 0.02, 0.4), max_points=50, events=p + "conti
                               **out("continue"))
 rows(pts, p + "continue.csv")
 rows(events, p + "continue_events.csv")
+eq = rows(an.equilibria((1, 0.1, 0.2, 0.25), branch=("xi", 3, 15), curve=("zeta", 20, 21, 2),
+                        csv=p + "equilibria.csv"), p + "equilibria.csv")
+assert list(eq["kind"]) == ["hopf"] * 4 and list(eq["zeta"]) == [20.25] * 2 + [20.75] * 2, eq
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})
@@ -61,7 +65,10 @@ for call, words in ((lambda: an.stability(P=(0.02, 0.01, 5)), "LO < HI"),
                     (lambda: an.partition(params="a=1.3,b=0.66", png="x.png", size=(10, 10)),
                      "300x200..4096x4096"),
                     (lambda: an.simulate(periods=5, csv=".", png="y.png"), "."),
-                    (lambda: an.bifurcation(("S", 0.1, 0.3, 0)), "1..2000 values")):
+                    (lambda: an.bifurcation(("S", 0.1, 0.3, 0)), "1..2000 values"),
+                    (lambda: an.equilibria((1, 0.1, 0.2)), "the flow of model chip-4d has 4"),
+                    (lambda: an.equilibria((1, 0.1, 0.2, 0.25), branch=("xi", 5, 6)),
+                     "must hold the model's xi = 4.8")):
     try:
         call()
         raise SystemExit("no error where %r was expected" % words)

@@ -1,6 +1,7 @@
 """The analysis drivers of libcellmap (cm_analysis_* in cellmap/cellmap.h):
-the commands stability, partition, amplitude, horseshoe, escape, simulate,
-bifurcation, lyapunov, sweep and continue as functions. Each computes what
+the commands stability, partition, amplitude, horseshoe, escape,
+equilibria, simulate, bifurcation, lyapunov, sweep and continue as
+functions. Each computes what
 the command computes and writes the same files (csv=, png=, byte for
 byte); it returns the table as a numpy structured array (columns by name,
 as the CSV's header names them), read from csv= or from a temporary file.
@@ -26,8 +27,8 @@ import numpy as np
 
 from . import CellmapError, Models, _call, _lib, _text, _P, _DOUBLES  # noqa: F401
 
-__all__ = ["stability", "partition", "amplitude", "horseshoe", "escape", "simulate",
-           "bifurcation", "lyapunov", "sweep", "continuation"]
+__all__ = ["stability", "partition", "amplitude", "horseshoe", "escape", "equilibria",
+           "simulate", "bifurcation", "lyapunov", "sweep", "continuation"]
 
 
 class _Axis(ctypes.Structure):
@@ -49,6 +50,13 @@ class _Horseshoe(ctypes.Structure):
 class _Escape(ctypes.Structure):
     _fields_ = [("I0", ctypes.c_double), ("sweep", ctypes.POINTER(_Axis)),
                 ("cells", ctypes.c_long), ("ensemble", ctypes.c_long)]
+
+
+class _Equilibria(ctypes.Structure):
+    _fields_ = [("start", _DOUBLES), ("n_from", ctypes.c_int), ("branch", ctypes.c_char_p),
+                ("lo", ctypes.c_double), ("hi", ctypes.c_double), ("direction", ctypes.c_int),
+                ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int),
+                ("curve", ctypes.POINTER(_Axis))]
 
 
 class _Simulate(ctypes.Structure):
@@ -95,11 +103,13 @@ _AXIS = ctypes.POINTER(_Axis)
 _sig("cm_analysis_stability", _AXIS, _AXIS)
 _sig("cm_analysis_partition")
 _sig("cm_analysis_amplitude", _AXIS, ctypes.c_int, ctypes.c_double)
-for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape), ("simulate", _Simulate),
+for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
+                     ("equilibria", _Equilibria), ("simulate", _Simulate),
                      ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov), ("sweep", _Sweep),
                      ("continue", _Continue)):
     _sig("cm_analysis_" + _name, ctypes.POINTER(_opts))
-for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape), ("simulate", _Simulate),
+for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
+                     ("equilibria", _Equilibria), ("simulate", _Simulate),
                      ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov),
                      ("continue", _Continue)):
     getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
@@ -230,6 +240,38 @@ def escape(I0=None, sweep=None, cells=None, ensemble=None, **common):
     if ensemble is not None:
         o.ensemble = int(ensemble)
     return _run(_common(**common), _lib.cm_analysis_escape, ctypes.byref(o))
+
+
+def equilibria(start, branch=None, direction=0, ds_max=None, max_points=None, curve=None,
+               **common):
+    """Equilibria of a flow (`cellmap equilibria`; model chip-4d unless
+    named): Newton from start (the flow's coordinates) and the eigenvalues;
+    branch = (name, lo, hi): the branch in that parameter with its folds
+    and Hopf points (direction +1 or -1: one way only); curve = (name, lo,
+    hi, n): the branch's Hopf points at each of n values of a second
+    parameter. The rows: kind, the parameters, the state, re_k/im_k,
+    unstable, omega."""
+    o = _lib.cm_equilibria_defaults()
+    st = (ctypes.c_double * len(start))(*map(float, start))
+    o.start, o.n_from = st, len(start)
+    keep = None
+    if branch is not None:
+        try:
+            name, lo, hi = branch
+            keep = _text(name)
+            o.branch, o.lo, o.hi = keep, float(lo), float(hi)
+        except (TypeError, ValueError):
+            raise ValueError("branch %r: give (name, lo, hi)" % (branch,)) from None
+    o.direction = int(direction)
+    if ds_max is not None:
+        o.ds_max = float(ds_max)
+    if max_points is not None:
+        o.max_points = int(max_points)
+    ax = _axis(curve, what="curve") if curve is not None else None
+    o.curve = ctypes.pointer(ax) if ax is not None else None
+    table = _run(_common(**common), _lib.cm_analysis_equilibria, ctypes.byref(o))
+    del keep, st
+    return table
 
 
 def simulate(start=(0.0, 0.0), t0=None, periods=20, skip=0, **common):

@@ -1,0 +1,303 @@
+/* lib/equilibria.c - equilibria, their branches and Hopf curves of flow
+ * models (lib/equilibria.h). */
+#include "lib/equilibria.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/outfile.h"
+#include "models/ode_flow.h"
+#include "models/params.h"
+
+eq_args equilibria_defaults(void)
+{
+    eq_args a;
+    memset(&a, 0, sizeof a);
+    a.mo.name = "chip-4d";
+    a.max_points = 10000;
+    return a;
+}
+
+const char *equilibria_event_name(int kind) { return kind == CM_EQ_HOPF ? "hopf" : "fold"; }
+
+const char *equilibria_why(int why)
+{
+    switch (why) {
+    case CM_EQ_LEFT_RANGE: return "left the range";
+    case CM_EQ_MAX_POINTS: return "reached the most points";
+    case CM_EQ_LOST: return "lost (Newton failed at the smallest step)";
+    case CM_EQ_CALLER: return "stopped";
+    default: return "not followed";
+    }
+}
+
+/* Room for n + 1 entries of size bytes in *p (capacity *cap). */
+static bool room(void **p, size_t *cap, size_t n, size_t size)
+{
+    if (n < *cap)
+        return true;
+    const size_t grown = *cap ? 2 * *cap : 64;
+    void *q = realloc(*p, grown * size);
+    if (!q)
+        return false;
+    *p = q;
+    *cap = grown;
+    return true;
+}
+
+typedef struct at_user {
+    const model_spec *mo;
+    const char *p_name, *q_name;
+} at_user;
+
+static cm_status model_at(void *user, double p, cm_model *m, char *msg, size_t msg_size)
+{
+    const at_user *u = user;
+    const char *names[1] = {u->p_name};
+    return model_with_values(u->mo, names, &p, 1, m, msg, msg_size) ? CM_OK : CM_EINVAL;
+}
+
+static cm_status model_at2(void *user, double p, double q, cm_model *m, char *msg,
+                           size_t msg_size)
+{
+    const at_user *u = user;
+    const char *names[2] = {u->p_name, u->q_name};
+    const double values[2] = {p, q};
+    return model_with_values(u->mo, names, values, 2, m, msg, msg_size) ? CM_OK : CM_EINVAL;
+}
+
+static int on_point(void *user, const cm_equilibrium *e)
+{
+    eq_result *r = user;
+    if (!room((void **)&r->pts, &r->cap_pts, r->n_pts, sizeof *r->pts))
+        return 1;
+    r->pts[r->n_pts++] = *e;
+    return 0;
+}
+
+static int on_event(void *user, const cm_eq_event *ev)
+{
+    eq_result *r = user;
+    if (!room((void **)&r->events, &r->cap_events, r->n_events, sizeof *r->events))
+        return 1;
+    r->events[r->n_events++] = (eq_event){*ev, r->n_pts};
+    return 0;
+}
+
+static int on_hopf(void *user, double q, const cm_eq_event *ev)
+{
+    eq_result *r = user;
+    if (!room((void **)&r->hopf, &r->cap_hopf, r->n_hopf, sizeof *r->hopf))
+        return 1;
+    r->hopf[r->n_hopf++] = (eq_hopf){q, *ev};
+    return 0;
+}
+
+/* A scalar parameter of m named name: its value in *v. */
+static cm_status scalar_param(const cm_model *m, const char *name, const char *what, double *v,
+                              char *msg, size_t msg_size)
+{
+    const int k = cm_params_find(&m->values, name);
+    if (k < 0 || m->values.spec[k].max_count != 1 || m->values.spec[k].choices)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the %s '%s' is not a number parameter of model %s (`cellmap models` "
+                       "lists them)",
+                       what, name, m->name);
+    *v = m->values.value[k].v[0];
+    return CM_OK;
+}
+
+static cm_status check_request(const eq_args *a, const cm_model *m, double *p0, char *msg,
+                               size_t msg_size)
+{
+    if (!cm_model_is_flow(m))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "model %s is a map, not a flow: equilibria are those of an ODE's vector "
+                       "field (e.g. chip-4d, duffing, a plugin's flow)",
+                       m->name);
+    const int n = cm_flow_dim(m);
+    if (a->n_from != n) {
+        char names[256] = "";
+        for (int d = 0; d < n; d++)
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", d ? ", " : "",
+                     cm_flow_coord_name(m, d));
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the start has %d value(s) but the flow of model %s has %d coordinates "
+                       "(%s)",
+                       a->n_from, m->name, n, names);
+    }
+    *p0 = NAN;
+    if (!a->branch[0]) {
+        if (a->has_curve)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "a Hopf curve needs a branch: name the parameter the branch follows");
+        return CM_OK;
+    }
+    if (a->has_curve && a->direction)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a Hopf curve takes the branch over its whole range: give no direction");
+    cm_status st = scalar_param(m, a->branch, "branch's parameter", p0, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (!(a->lo < a->hi && isfinite(a->lo) && isfinite(a->hi)) || *p0 < a->lo || *p0 > a->hi)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the branch's range %s=%g:%g must hold the model's %s = %g (set it with "
+                       "the parameters, e.g. %s=%g)",
+                       a->branch, a->lo, a->hi, a->branch, *p0, a->branch,
+                       0.5 * (a->lo + a->hi));
+    if (a->has_curve) {
+        double q;
+        if (strcmp(a->curve.name, a->branch) == 0)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "the Hopf curve's parameter must differ from the branch's (%s)",
+                           a->branch);
+        st = scalar_param(m, a->curve.name, "Hopf curve's parameter", &q, msg, msg_size);
+    }
+    return st;
+}
+
+/* The way just followed, whose points are pts[pts_from ..] and events
+ * events[events_from ..], put in the branch's order: the way down
+ * reversed; the way up without its first point when the way down has
+ * given it already. */
+static void join_way(eq_result *r, int direction, size_t pts_from, size_t events_from)
+{
+    const size_t m = r->n_pts - pts_from;
+    if (direction < 0) {
+        for (size_t i = pts_from, j = r->n_pts; i + 1 < j; i++, j--) {
+            const cm_equilibrium t = r->pts[i];
+            r->pts[i] = r->pts[j - 1], r->pts[j - 1] = t;
+        }
+        for (size_t i = events_from, j = r->n_events; i + 1 < j; i++, j--) {
+            const eq_event t = r->events[i];
+            r->events[i] = r->events[j - 1], r->events[j - 1] = t;
+        }
+        for (size_t k = events_from; k < r->n_events; k++)
+            r->events[k].before = pts_from + (m - (r->events[k].before - pts_from));
+    } else if (pts_from > 0 && m > 0) {
+        memmove(&r->pts[pts_from], &r->pts[pts_from + 1], (m - 1) * sizeof *r->pts);
+        r->n_pts--;
+        for (size_t k = events_from; k < r->n_events; k++)
+            r->events[k].before--;
+    }
+}
+
+/* Both ways (or the one asked for) from the start, lo side first. */
+static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *msg,
+                               size_t msg_size)
+{
+    at_user u = {&a->mo, a->branch, NULL};
+    for (int way = 0; way < 2; way++) {
+        const int direction = way == 0 ? -1 : 1;
+        if (a->direction && a->direction != direction)
+            continue;
+        const cm_eq_branch_options o = {a->lo, a->hi, direction, 0, a->ds_max, a->max_points};
+        const size_t pts_from = r->n_pts, events_from = r->n_events;
+        const cm_status st =
+            cm_flow_equilibrium_branch(model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
+                                       &r->why[way], msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (r->why[way] == CM_EQ_CALLER)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the branch's points");
+        join_way(r, direction, pts_from, events_from);
+    }
+    return CM_OK;
+}
+
+cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t msg_size)
+{
+    memset(r, 0, sizeof *r);
+    cm_status st = model_spec_build(&a->mo, &r->m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    r->base = r->m.values;
+    double p0 = NAN;
+    if ((st = check_request(a, &r->m, &p0, msg, msg_size)) != CM_OK)
+        return st;
+    double x[CM_MAX_DIM];
+    memcpy(x, a->from, sizeof x);
+    if ((st = cm_flow_equilibrium(&r->m, p0, x, &r->start, msg, msg_size)) != CM_OK)
+        return st;
+    if (a->branch[0] && (st = follow_branch(a, r, p0, msg, msg_size)) != CM_OK)
+        return st;
+    if (!a->has_curve)
+        return CM_OK;
+    double q[PARAM_AXIS_MAX];
+    for (int k = 0; k < a->curve.n; k++)
+        q[k] = param_axis_value(&a->curve, k);
+    /* each value's branch from the lowest point of this one, upwards */
+    at_user u = {&a->mo, a->branch, a->curve.name};
+    const cm_eq_branch_options o = {a->lo, a->hi, 1, 0, a->ds_max, a->max_points};
+    const cm_equilibrium *low = r->n_pts ? &r->pts[0] : &r->start;
+    return cm_flow_hopf_curve(model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
+                              msg_size);
+}
+
+/* One CSV row: kind, the branch's and curve's values (when asked), the
+ * equilibrium and its eigenvalues, omega. */
+static void row(FILE *f, const eq_args *a, const char *kind, double q, const cm_equilibrium *e,
+                double omega)
+{
+    fprintf(f, "%s", kind);
+    if (a->branch[0])
+        fprintf(f, ",%.17g", e->p);
+    if (a->has_curve)
+        fprintf(f, ",%.17g", q);
+    for (int d = 0; d < e->dim; d++)
+        fprintf(f, ",%.17g", e->x[d]);
+    for (int d = 0; d < e->dim; d++)
+        fprintf(f, ",%.17g,%.17g", e->re[d], e->im[d]);
+    fprintf(f, ",%d,%.17g\n", e->unstable, omega);
+}
+
+cm_status equilibria_write(const eq_args *a, const eq_result *r, char *msg, size_t msg_size)
+{
+    if (!a->csv)
+        return CM_OK;
+    outfile o;
+    cm_status st = outfile_begin(a->csv, &o, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = cm_flow_dim(&r->m);
+    fprintf(o.f, "kind");
+    if (a->branch[0])
+        fprintf(o.f, ",%s", a->branch);
+    if (a->has_curve)
+        fprintf(o.f, ",%s", a->curve.name);
+    for (int d = 0; d < n; d++)
+        fprintf(o.f, ",%s", cm_flow_coord_name(&r->m, d));
+    for (int d = 1; d <= n; d++)
+        fprintf(o.f, ",re_%d,im_%d", d, d);
+    fprintf(o.f, ",unstable,omega\n");
+    if (a->has_curve) {
+        for (size_t k = 0; k < r->n_hopf; k++)
+            row(o.f, a, "hopf", r->hopf[k].q, &r->hopf[k].ev.at, r->hopf[k].ev.omega);
+    } else if (!a->branch[0]) {
+        row(o.f, a, "equilibrium", NAN, &r->start, NAN);
+    } else {
+        /* the points and, between them, the events in branch order */
+        size_t e = 0;
+        for (size_t k = 0; k <= r->n_pts; k++) {
+            for (; e < r->n_events && r->events[e].before <= k; e++) {
+                const cm_eq_event *ev = &r->events[e].ev;
+                row(o.f, a, equilibria_event_name(ev->kind), NAN, &ev->at,
+                    ev->kind == CM_EQ_HOPF ? ev->omega : NAN);
+            }
+            if (k < r->n_pts)
+                row(o.f, a, "point", NAN, &r->pts[k], NAN);
+        }
+    }
+    return outfile_end(&o, true, msg, msg_size);
+}
+
+void equilibria_result_free(eq_result *r)
+{
+    cm_model_release(&r->m);
+    free(r->pts);
+    free(r->events);
+    free(r->hopf);
+    memset(r, 0, sizeof *r);
+}
