@@ -25,10 +25,10 @@ const char *equilibria_event_name(int kind) { return kind == CM_EQ_HOPF ? "hopf"
 const char *equilibria_why(int why)
 {
     switch (why) {
-    case CM_EQ_LEFT_RANGE: return "left the range";
-    case CM_EQ_MAX_POINTS: return "reached the most points";
-    case CM_EQ_LOST: return "lost (Newton failed at the smallest step)";
-    case CM_EQ_CALLER: return "stopped";
+    case CM_BRANCH_LEFT_RANGE: return "left the range";
+    case CM_BRANCH_MAX_POINTS: return "reached the most points";
+    case CM_BRANCH_LOST: return "lost (Newton failed at the smallest step)";
+    case CM_BRANCH_CALLER: return "stopped";
     default: return "not followed";
     }
 }
@@ -193,14 +193,14 @@ static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *
         const int direction = way == 0 ? -1 : 1;
         if (a->direction && a->direction != direction)
             continue;
-        const cm_eq_branch_options o = {a->lo, a->hi, direction, 0, a->ds_max, a->max_points};
+        const cm_branch_options o = {a->lo, a->hi, direction, 0, a->ds_max, a->max_points};
         const size_t pts_from = r->n_pts, events_from = r->n_events;
         const cm_status st =
             cm_flow_equilibrium_branch(model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
                                        &r->why[way], msg, msg_size);
         if (st != CM_OK)
             return st;
-        if (r->why[way] == CM_EQ_CALLER)
+        if (r->why[way] == CM_BRANCH_CALLER)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the branch's points");
         join_way(r, direction, pts_from, events_from);
     }
@@ -230,7 +230,7 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
         q[k] = param_axis_value(&a->curve, k);
     /* each value's branch from the lowest point of this one, upwards */
     at_user u = {&a->mo, a->branch, a->curve.name};
-    const cm_eq_branch_options o = {a->lo, a->hi, 1, 0, a->ds_max, a->max_points};
+    const cm_branch_options o = {a->lo, a->hi, 1, 0, a->ds_max, a->max_points};
     const cm_equilibrium *low = r->n_pts ? &r->pts[0] : &r->start;
     return cm_flow_hopf_curve(model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
                               msg_size);

@@ -49,7 +49,7 @@ typedef struct eq_result {
     size_t n_pts, cap_pts;
     eq_event *events; /* in the same order */
     size_t n_events, cap_events;
-    int why[2]; /* how each way ended (CM_EQ_*; 0: not followed) */
+    int why[2]; /* how each way ended (CM_BRANCH_*; 0: not followed) */
     eq_hopf *hopf;
     size_t n_hopf, cap_hopf;
 } eq_result;

@@ -1,9 +1,9 @@
 /* models/flow_equilibria.h - equilibria of an autonomous flow x' = f(x)
  * (a model's cm_flow.field, evaluated at its t0, in cm_flow_dim(m)
  * coordinates), their eigenvalues, and a branch of them followed in one
- * parameter by pseudo-arclength continuation with its folds and Hopf
- * points located (thesis 3.2: the chip formation flow's Hopf points at
- * xi = 4.42808 and 11.8039).
+ * parameter by pseudo-arclength continuation (models/arclength.h) with
+ * its folds and Hopf points located (thesis 3.2: the chip formation
+ * flow's Hopf points at xi = 4.42808 and 11.8039).
  *
  * Jacobians are central differences of the field (steps 1e-7 relative to
  * the coordinate, at least 1e-7), good to about 1e-8 relative for fields
@@ -17,6 +17,7 @@
 #include <stdbool.h>
 
 #include "cellmap/model.h"
+#include "models/arclength.h"
 
 /* An equilibrium at parameter value p and its linearisation's
  * eigenvalues, by decreasing real part (a complex pair: +im first). */
@@ -43,11 +44,6 @@ cm_status cm_eigenvalues(int n, const double *J, double *re, double *im);
 cm_status cm_flow_equilibrium(const cm_model *m, double p, double *x, cm_equilibrium *e,
                               char *msg, size_t msg_size);
 
-/* The model at parameter value p, built by the caller; the kernel releases
- * it (cm_model_release). Nonzero status: p is outside the model's range. */
-typedef cm_status (*cm_model_at_fn)(void *user, double p, cm_model *m, char *msg,
-                                    size_t msg_size);
-
 /* What a branch finds between two of its points. */
 enum { CM_EQ_FOLD = 1, CM_EQ_HOPF = 2 };
 typedef struct cm_eq_event {
@@ -57,24 +53,13 @@ typedef struct cm_eq_event {
     double omega;     /* Hopf: the imaginary part of the pair on the axis */
 } cm_eq_event;
 
-/* Why a branch ended. */
-enum { CM_EQ_LEFT_RANGE = 1, CM_EQ_MAX_POINTS, CM_EQ_LOST, CM_EQ_CALLER };
-
-typedef struct cm_eq_branch_options {
-    double lo, hi;  /* the parameter's range */
-    int direction;  /* +1: p increases first; -1: decreases */
-    double ds;      /* the first arclength step; 0: (hi - lo) / 200 */
-    double ds_max;  /* 0: (hi - lo) / 50 */
-    int max_points; /* 0: 10000 */
-} cm_eq_branch_options;
-
 /* Follows the branch through the equilibrium near x0 at p0 (in lo..hi),
  * calling point for each point (the first included; the last one on the
  * range's end where the branch leaves it) and event for each fold and
  * Hopf point between two, in order; either returning nonzero stops the
- * branch (CM_EQ_CALLER). *why: CM_EQ_*. */
+ * branch (CM_BRANCH_CALLER). *why: CM_BRANCH_*. */
 cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0,
-                                     const double *x0, const cm_eq_branch_options *o,
+                                     const double *x0, const cm_branch_options *o,
                                      int (*point)(void *user, const cm_equilibrium *e),
                                      int (*event)(void *user, const cm_eq_event *ev),
                                      void *user, int *why, char *msg, size_t msg_size);
@@ -90,7 +75,7 @@ typedef cm_status (*cm_model_at2_fn)(void *user, double p, double q, cm_model *m
  * each Hopf point on it; hopf returning nonzero stops. Folds are passed
  * over. CM_ENOTFOUND when the start is lost at some q (msg says which). */
 cm_status cm_flow_hopf_curve(cm_model_at2_fn at, void *at_user, double p0, const double *x0,
-                             const double *q, int n, const cm_eq_branch_options *o,
+                             const double *q, int n, const cm_branch_options *o,
                              int (*hopf)(void *user, double q, const cm_eq_event *ev), void *user,
                              char *msg, size_t msg_size);
 

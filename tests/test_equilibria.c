@@ -129,13 +129,13 @@ static void check_independently(cm_model_at_fn at, void *user, const cm_eq_event
 static void test_hopf_normal_form(void)
 {
     const double x0[2] = {0, 0};
-    const cm_eq_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
+    const cm_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
     seen s = {0};
     int why = 0;
     char msg[256];
     CHECK(cm_flow_equilibrium_branch(hopf_at, NULL, -0.9, x0, &o, on_point, on_event, &s, &why,
                                      msg, sizeof msg) == CM_OK);
-    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(why, CM_BRANCH_LEFT_RANGE);
     CHECK_INT(s.n_events, 1);
     CHECK_INT(s.ev[0].kind, CM_EQ_HOPF);
     CHECK(fabs(s.ev[0].at.p) < 1e-9);
@@ -149,13 +149,13 @@ static void test_fold(void)
     /* from x = 1 at mu = 1 down to the fold at mu = 0, x = 0, and back up
      * on the other side, x = -sqrt(mu) */
     const double x0[2] = {1.2, 0.3};
-    const cm_eq_branch_options o = {.lo = -0.5, .hi = 1, .direction = -1};
+    const cm_branch_options o = {.lo = -0.5, .hi = 1, .direction = -1};
     seen s = {0};
     int why = 0;
     char msg[256];
     CHECK(cm_flow_equilibrium_branch(fold_at, NULL, 1, x0, &o, on_point, on_event, &s, &why,
                                      msg, sizeof msg) == CM_OK);
-    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(why, CM_BRANCH_LEFT_RANGE);
     CHECK_INT(s.n_events, 1);
     CHECK_INT(s.ev[0].kind, CM_EQ_FOLD);
     CHECK(fabs(s.ev[0].at.p) < 1e-9 && fabs(s.ev[0].at.x[0]) < 1e-4);
@@ -189,12 +189,12 @@ static void test_chip_hopf_points(void)
     CHECK(chip_at(&zeta, 1, &m, msg, sizeof msg) == CM_OK);
     CHECK(cm_flow_equilibrium(&m, 1, z, NULL, msg, sizeof msg) == CM_OK);
     cm_model_release(&m);
-    const cm_eq_branch_options o = {.lo = 0.5, .hi = 15, .direction = 1};
+    const cm_branch_options o = {.lo = 0.5, .hi = 15, .direction = 1};
     seen s = {0};
     int why = 0;
     CHECK(cm_flow_equilibrium_branch(chip_at, &zeta, 1, z, &o, on_point, on_event, &s, &why, msg,
                                      sizeof msg) == CM_OK);
-    CHECK_INT(why, CM_EQ_LEFT_RANGE);
+    CHECK_INT(why, CM_BRANCH_LEFT_RANGE);
     CHECK_INT(s.n_events, 2);
     CHECK_INT(s.ev[0].kind, CM_EQ_HOPF);
     CHECK_INT(s.ev[1].kind, CM_EQ_HOPF);
@@ -245,7 +245,7 @@ static int on_hopf(void *user, double q, const cm_eq_event *ev)
 static void test_hopf_curves(void)
 {
     const double nu[] = {-0.5, 0, 0.3}, x0[2] = {0, 0};
-    const cm_eq_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
+    const cm_branch_options o = {.lo = -1, .hi = 1, .direction = 1};
     curve c = {0};
     char msg[256];
     CHECK(cm_flow_hopf_curve(hopf2_at, NULL, -0.9, x0, nu, 3, &o, on_hopf, &c, msg,
@@ -258,7 +258,7 @@ static void test_hopf_curves(void)
      * between 21 and 22: no Hopf point on [0.5, 15] at 22) */
     const double zeta[] = {20, 20.5, 21};
     double z[4] = {1, 0.1, 0.3, 0.4};
-    const cm_eq_branch_options oc = {.lo = 0.5, .hi = 15, .direction = 1};
+    const cm_branch_options oc = {.lo = 0.5, .hi = 15, .direction = 1};
     curve cc = {0};
     CHECK(cm_flow_hopf_curve(chip2_at, NULL, 1, z, zeta, 3, &oc, on_hopf, &cc, msg,
                              sizeof msg) == CM_OK);
@@ -285,7 +285,7 @@ static void test_bad_input(void)
     CHECK(cm_flow_equilibrium(&m, -1, x, NULL, msg, sizeof msg) == CM_ENOTFOUND);
     CHECK(strstr(msg, "start nearer one") != NULL);
     cm_model_release(&m);
-    const cm_eq_branch_options bad = {.lo = 1, .hi = 0, .direction = 1};
+    const cm_branch_options bad = {.lo = 1, .hi = 0, .direction = 1};
     int why;
     CHECK(cm_flow_equilibrium_branch(fold_at, NULL, 0.5, x, &bad, NULL, NULL, NULL, &why, msg,
                                      sizeof msg) == CM_EINVAL);
