@@ -12,7 +12,13 @@
  *   - the images of the default integrator (rk8pd, 1e-9) against 1e-12;
  *   - the cell mapping of the section map at xi = 3.5 and 11 finds one
  *     attractor where the simulation does (tests/chip_test.sh: the same
- *     with --split, from the command line). */
+ *     with --split, from the command line);
+ *   - the period-doubling cascades of Table 3.1 (PD1 up from xi = 2.9,
+ *     PD2 down from 11; each doubling located on the branch of periodic
+ *     points, the next branch switched to there; +- 2e-4) and the folds
+ *     of the periodic branches at xi = -1.85529 and 13.5244: three and two
+ *     doublings here, all five of each cascade and the folds with --long
+ *     (13 s; ctest's test_chip_long in the release build). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +29,7 @@
 #include "check.h"
 #include "models/flow_equilibria.h"
 #include "models/map_lyapunov.h"
+#include "models/map_periodic.h"
 #include "models/ode_flow.h"
 #include "models/registry.h"
 
@@ -298,8 +305,134 @@ static void test_cell_mapping(const char *params, int period, const double *wher
     cm_model_release(&m);
 }
 
-int main(void)
+/* chip-4d at xi with tolerances 1e-12 (multipliers by differences need
+ * them) on the plane T0 = level (user: the level's text). */
+static cm_status chip_tight(void *user, double xi, cm_model *m, char *msg, size_t msg_size)
 {
+    char text[160];
+    snprintf(text, sizeof text, "xi=%.17g,abs_tol=1e-12,rel_tol=1e-12,level=%s", xi,
+             (const char *)user);
+    const char *texts[] = {text};
+    return cm_model_create("chip-4d", texts, 1, m, msg, msg_size);
+}
+
+typedef struct watch {
+    cm_po_event first; /* the first event of the kind wanted */
+    int kind, found;
+} watch;
+
+static int stop_at(void *user, const cm_po_event *ev)
+{
+    watch *w = user;
+    if (ev->kind != w->kind || w->found)
+        return 0;
+    w->first = *ev;
+    w->found = 1;
+    return 1; /* the branch stops there */
+}
+
+/* The simulated period-1 orbit's point at xi on the plane T0 = level. */
+static void settled(double xi, const char *level, double *x)
+{
+    char params[96];
+    snprintf(params, sizeof params, "xi=%.17g,level=%s", xi, level);
+    cm_model m = chip(params);
+    x[0] = 1.05, x[1] = 0.2, x[2] = 0.27;
+    CHECK(iterate(&m, x, 400));
+    cm_model_release(&m);
+}
+
+/* A cascade: the period-1 branch from the orbit at xi0 followed in
+ * `direction`, to its doubling; the doubled branch from next to it, to
+ * its doubling; `levels` times. Each doubling against the thesis' value. */
+static void test_cascade(double xi0, int direction, int levels, const double *thesis,
+                         const char *name)
+{
+    double x[3], xi = xi0, found[5];
+    settled(xi0, "0.1", x);
+    int period = 1;
+    char msg[512];
+    for (int k = 0; k < levels; k++) {
+        watch w = {.kind = CM_PO_PD};
+        const cm_branch_options o = {direction > 0 ? xi - 1e-9 : 9.0,
+                                     direction > 0 ? 4.36 : xi + 1e-9, direction, 0,
+                                     direction > 0 ? 0.05 : 0.1, 2000};
+        int why;
+        CHECK(cm_map_periodic_branch(chip_tight, "0.1", period, xi, x, &o, NULL, stop_at, &w,
+                                     &why, msg, sizeof msg) == CM_OK);
+        CHECK(w.found);
+        if (!w.found)
+            return;
+        found[k] = w.first.at.p;
+        printf("%s: period %d doubles at xi = %.7f (thesis %.6g, difference %.1e)\n", name,
+               period, found[k], thesis[k], found[k] - thesis[k]);
+        CHECK(fabs(found[k] - thesis[k]) < 2e-4);
+        /* the multiplier there is -1 */
+        CHECK(fabs(w.first.at.re[w.first.at.dim - 1] + 1) < 1e-3 ||
+              fabs(w.first.at.re[0] + 1) < 1e-3);
+        const double dp = direction * 1e-4 * pow(4.669, -k);
+        CHECK(cm_map_period_doubled(chip_tight, "0.1", &w.first, dp, x, &xi, msg, sizeof msg) ==
+              CM_OK);
+        period *= 2;
+    }
+    for (int k = 1; k + 1 < levels; k++)
+        printf("%s: Feigenbaum ratio %d: %.4f\n", name, k,
+               (found[k] - found[k - 1]) / (found[k + 1] - found[k]));
+    if (levels >= 4) { /* the onset of chaos from the last two and delta = 4.669 */
+        const double onset =
+            found[levels - 1] + (found[levels - 1] - found[levels - 2]) / (4.669201609 - 1);
+        printf("%s: the cascade accumulates at xi = %.5f\n", name, onset);
+    }
+}
+
+/* A fold of the period-1 branch from the orbit at xi0 in direction, on
+ * the plane T0 = level (one the orbits near the fold cross), near the
+ * thesis' value (5e-4) and checked on its own: 1e-4 inside the fold the
+ * map from the fold's point settles on the stable orbit, 1e-4 beyond it
+ * drifts away. */
+static void test_fold(double xi0, int direction, const char *level, double thesis)
+{
+    double x[3];
+    settled(xi0, level, x);
+    char msg[512];
+    watch w = {.kind = CM_PO_FOLD};
+    const cm_branch_options o = {direction > 0 ? xi0 - 1e-9 : -4, direction > 0 ? 16 : xi0 + 1e-9,
+                                 direction, 0, 0.05, 3000};
+    int why;
+    CHECK(cm_map_periodic_branch(chip_tight, (void *)level, 1, xi0, x, &o, NULL, stop_at, &w,
+                                 &why, msg, sizeof msg) == CM_OK);
+    CHECK(w.found);
+    if (!w.found)
+        return;
+    const double fold = w.first.at.p;
+    printf("chip-4d: the period-1 branch folds at xi = %.7f (thesis %.6g, difference %.1e)\n",
+           fold, thesis, fold - thesis);
+    CHECK(fabs(fold - thesis) < 5e-4);
+    /* inside the fold (towards xi0) the stable orbit is there: the map
+     * from the fold's point settles on a fixed point; beyond it the orbit
+     * drifts away */
+    for (int side = 0; side < 2; side++) {
+        char params[128];
+        const double xi = fold - (side ? -1 : 1) * direction * 1e-4;
+        snprintf(params, sizeof params, "xi=%.17g,abs_tol=1e-12,rel_tol=1e-12,level=%s", xi,
+                 level);
+        cm_model m = chip(params);
+        double y[3], z[3];
+        memcpy(y, w.first.at.x, sizeof y);
+        const bool went = iterate(&m, y, 3000);
+        memcpy(z, y, sizeof z);
+        const bool fixed = went && iterate(&m, z, 1) && distance(y, z) < 1e-9 &&
+                           distance(y, w.first.at.x) < 0.05;
+        printf("  at xi = %.5f the map from the fold's point %s\n", xi,
+               fixed ? "settles on a fixed point" : "drifts away");
+        CHECK(fixed == (side == 0));
+        cm_model_release(&m);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const bool full = argc > 1 && strcmp(argv[1], "--long") == 0;
     double p2[3], p1[3];
     test_periodic("xi=3.5", 2, p2);
     test_periodic("xi=11", 1, p1);
@@ -308,5 +441,14 @@ int main(void)
     test_integrator_error();
     test_cell_mapping("xi=3.5", 2, p2, 24);
     test_cell_mapping("xi=11", 1, p1, 24);
+    static const double pd1[] = {3.11285, 4.03007, 4.26861, 4.32524, 4.33763};
+    static const double pd2[] = {10.6639, 9.52126, 9.20174, 9.1282, 9.11215};
+    test_cascade(2.9, 1, full ? 5 : 3, pd1, "PD1");
+    test_cascade(11, -1, full ? 5 : 2, pd2, "PD2");
+    if (full) {
+        /* the thesis' -1.85529 is 3e-4 off: the orbit is still there at -1.8554 */
+        test_fold(2.9, -1, "0.13", -1.85529);
+        test_fold(11, 1, "0.07", 13.5244);
+    }
     CHECK_DONE();
 }
