@@ -427,7 +427,8 @@ cm_status cm_session_close(cm_session *s, char *msg, size_t msg_size);
 
 /* ---- analysis drivers ----
  * The commands `stability`, `partition`, `amplitude`, `horseshoe`,
- * `escape`, `equilibria`, `simulate`, `bifurcation`, `lyapunov`, `sweep` and `continue`
+ * `escape`, `equilibria`, `periodic`, `simulate`, `bifurcation`, `lyapunov`, `sweep`
+ * and `continue`
  * as calls: the same computation and the same files (CSV tables and PNG
  * figures, byte for byte) as the command with the same settings. Each
  * takes the model and outputs (cm_analysis) and its own settings (an
@@ -517,6 +518,29 @@ cm_equilibria_options cm_equilibria_defaults(void); /* both ways, 10000 points *
  * converge. */
 cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_options *o, char *msg,
                                  size_t msg_size);
+
+typedef struct cm_periodic_options {
+    const double *from; /* the start, in the map's coordinates */
+    int n_from;         /* the map's dimension */
+    int settle;         /* iterates of the map before Newton, 0..1e7 */
+    int period;         /* 1..4096 */
+    const char *branch; /* NULL: one orbit; else the parameter its branch follows */
+    double lo, hi;      /* the branch's range, holding the model's value of it */
+    int direction;      /* +1 or -1: that way only; 0: both (not with a cascade) */
+    double ds_max;      /* the longest arclength step; 0: (hi - lo) / 50 */
+    int max_points;     /* points each way, 10..1000000 */
+    int cascade;        /* period doublings to follow, 0..12 (needs a direction) */
+} cm_periodic_options;
+cm_periodic_options cm_periodic_defaults(void); /* period 1, both ways, 10000 points */
+
+/* Periodic orbits of a model's map (default chip-4d; `cellmap
+ * periodic`): Newton on P^k from o->from (after o->settle iterates) with
+ * the multipliers; the branch in o->branch with its folds, period
+ * doublings and Neimark-Sacker points; a cascade of doublings. A flow's
+ * tolerances become 1e-12 unless a->params sets them. The table only
+ * (a->png must be NULL). CM_ENOTFOUND: Newton did not converge. */
+cm_status cm_analysis_periodic(const cm_analysis *a, const cm_periodic_options *o, char *msg,
+                               size_t msg_size);
 
 typedef struct cm_simulate_options {
     double x, v;     /* the start */

@@ -16,6 +16,7 @@
 #include "lib/continuation.h"
 #include "lib/equilibria.h"
 #include "lib/escape.h"
+#include "lib/periodic.h"
 #include "lib/horseshoe.h"
 #include "lib/lyapunov.h"
 #include "lib/partition.h"
@@ -396,6 +397,52 @@ cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_optio
     if (st == CM_OK)
         st = equilibria_write(&ea, &r, msg, msg_size);
     equilibria_result_free(&r);
+    return st;
+}
+
+/* ---- any map: periodic orbits ---- */
+
+cm_periodic_options cm_periodic_defaults(void)
+{
+    const po_args d = periodic_defaults();
+    return (cm_periodic_options){.period = d.period, .max_points = d.max_points};
+}
+
+cm_status cm_analysis_periodic(const cm_analysis *a, const cm_periodic_options *o, char *msg,
+                               size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_periodic_options d = cm_periodic_defaults();
+    o = o ? o : &d;
+    po_args pa = periodic_defaults();
+    model_of(a, pa.mo.name, &pa.mo);
+    if (a->png)
+        return cm_fail(CM_EINVAL, msg, msg_size, "periodic draws no figure: give csv only");
+    if (!o->from || o->n_from < 1 || o->n_from > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "periodic orbits need a start (from) of 1..%d coordinates", CM_MAX_DIM);
+    if (o->branch && (!o->branch[0] || strlen(o->branch) >= sizeof pa.branch))
+        return cm_fail(CM_EINVAL, msg, msg_size, "a branch needs a parameter's name");
+    if (o->max_points < 10 || o->max_points > 1000000 || o->direction < -1 ||
+        o->direction > 1 || !(o->ds_max >= 0) || o->cascade < 0 ||
+        (!o->branch && (o->cascade || o->direction)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a branch's settings: 10..1000000 points, a direction of -1, 0 or 1, "
+                       "ds_max >= 0, cascade >= 0; a direction or a cascade only with a branch");
+    memcpy(pa.from, o->from, (size_t)o->n_from * sizeof *o->from);
+    pa.n_from = o->n_from, pa.settle = o->settle, pa.period = o->period;
+    if (o->branch)
+        snprintf(pa.branch, sizeof pa.branch, "%s", o->branch);
+    pa.lo = o->lo, pa.hi = o->hi, pa.direction = o->direction, pa.ds_max = o->ds_max;
+    pa.max_points = o->max_points, pa.cascade = o->cascade, pa.csv = a->csv;
+    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    po_result r;
+    st = periodic_compute(&pa, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = periodic_write(&pa, &r, msg, msg_size);
+    periodic_result_free(&r);
     return st;
 }
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "lib/outfile.h"
+#include "lib/rows.h"
 #include "models/ode_flow.h"
 #include "models/params.h"
 
@@ -33,45 +34,10 @@ const char *equilibria_why(int why)
     }
 }
 
-/* Room for n + 1 entries of size bytes in *p (capacity *cap). */
-static bool room(void **p, size_t *cap, size_t n, size_t size)
-{
-    if (n < *cap)
-        return true;
-    const size_t grown = *cap ? 2 * *cap : 64;
-    void *q = realloc(*p, grown * size);
-    if (!q)
-        return false;
-    *p = q;
-    *cap = grown;
-    return true;
-}
-
-typedef struct at_user {
-    const model_spec *mo;
-    const char *p_name, *q_name;
-} at_user;
-
-static cm_status model_at(void *user, double p, cm_model *m, char *msg, size_t msg_size)
-{
-    const at_user *u = user;
-    const char *names[1] = {u->p_name};
-    return model_with_values(u->mo, names, &p, 1, m, msg, msg_size) ? CM_OK : CM_EINVAL;
-}
-
-static cm_status model_at2(void *user, double p, double q, cm_model *m, char *msg,
-                           size_t msg_size)
-{
-    const at_user *u = user;
-    const char *names[2] = {u->p_name, u->q_name};
-    const double values[2] = {p, q};
-    return model_with_values(u->mo, names, values, 2, m, msg, msg_size) ? CM_OK : CM_EINVAL;
-}
-
 static int on_point(void *user, const cm_equilibrium *e)
 {
     eq_result *r = user;
-    if (!room((void **)&r->pts, &r->cap_pts, r->n_pts, sizeof *r->pts))
+    if (!rows_room((void **)&r->pts, &r->cap_pts, r->n_pts, sizeof *r->pts))
         return 1;
     r->pts[r->n_pts++] = *e;
     return 0;
@@ -80,7 +46,7 @@ static int on_point(void *user, const cm_equilibrium *e)
 static int on_event(void *user, const cm_eq_event *ev)
 {
     eq_result *r = user;
-    if (!room((void **)&r->events, &r->cap_events, r->n_events, sizeof *r->events))
+    if (!rows_room((void **)&r->events, &r->cap_events, r->n_events, sizeof *r->events))
         return 1;
     r->events[r->n_events++] = (eq_event){*ev, r->n_pts};
     return 0;
@@ -89,7 +55,7 @@ static int on_event(void *user, const cm_eq_event *ev)
 static int on_hopf(void *user, double q, const cm_eq_event *ev)
 {
     eq_result *r = user;
-    if (!room((void **)&r->hopf, &r->cap_hopf, r->n_hopf, sizeof *r->hopf))
+    if (!rows_room((void **)&r->hopf, &r->cap_hopf, r->n_hopf, sizeof *r->hopf))
         return 1;
     r->hopf[r->n_hopf++] = (eq_hopf){q, *ev};
     return 0;
@@ -166,14 +132,8 @@ static void join_way(eq_result *r, int direction, size_t pts_from, size_t events
 {
     const size_t m = r->n_pts - pts_from;
     if (direction < 0) {
-        for (size_t i = pts_from, j = r->n_pts; i + 1 < j; i++, j--) {
-            const cm_equilibrium t = r->pts[i];
-            r->pts[i] = r->pts[j - 1], r->pts[j - 1] = t;
-        }
-        for (size_t i = events_from, j = r->n_events; i + 1 < j; i++, j--) {
-            const eq_event t = r->events[i];
-            r->events[i] = r->events[j - 1], r->events[j - 1] = t;
-        }
+        rows_reverse(r->pts, pts_from, r->n_pts, sizeof *r->pts);
+        rows_reverse(r->events, events_from, r->n_events, sizeof *r->events);
         for (size_t k = events_from; k < r->n_events; k++)
             r->events[k].before = pts_from + (m - (r->events[k].before - pts_from));
     } else if (pts_from > 0 && m > 0) {
@@ -188,7 +148,7 @@ static void join_way(eq_result *r, int direction, size_t pts_from, size_t events
 static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *msg,
                                size_t msg_size)
 {
-    at_user u = {&a->mo, a->branch, NULL};
+    param_builder u = {&a->mo, {a->branch, NULL}};
     for (int way = 0; way < 2; way++) {
         const int direction = way == 0 ? -1 : 1;
         if (a->direction && a->direction != direction)
@@ -196,7 +156,7 @@ static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *
         const cm_branch_options o = {a->lo, a->hi, direction, 0, a->ds_max, a->max_points};
         const size_t pts_from = r->n_pts, events_from = r->n_events;
         const cm_status st =
-            cm_flow_equilibrium_branch(model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
+            cm_flow_equilibrium_branch(param_model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
                                        &r->why[way], msg, msg_size);
         if (st != CM_OK)
             return st;
@@ -229,10 +189,10 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
     for (int k = 0; k < a->curve.n; k++)
         q[k] = param_axis_value(&a->curve, k);
     /* each value's branch from the lowest point of this one, upwards */
-    at_user u = {&a->mo, a->branch, a->curve.name};
+    param_builder u = {&a->mo, {a->branch, a->curve.name}};
     const cm_branch_options o = {a->lo, a->hi, 1, 0, a->ds_max, a->max_points};
     const cm_equilibrium *low = r->n_pts ? &r->pts[0] : &r->start;
-    return cm_flow_hopf_curve(model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
+    return cm_flow_hopf_curve(param_model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
                               msg_size);
 }
 

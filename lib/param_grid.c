@@ -161,6 +161,20 @@ bool model_with_values(const model_spec *mo, const char *const *names, const dou
     return cm_model_set_create(&mo->set, mo->name, texts, k, m, msg, msg_size) == CM_OK;
 }
 
+cm_status param_model_at(void *user, double p, cm_model *m, char *msg, size_t msg_size)
+{
+    const param_builder *b = user;
+    return model_with_values(b->mo, b->names, &p, 1, m, msg, msg_size) ? CM_OK : CM_EINVAL;
+}
+
+cm_status param_model_at2(void *user, double p, double q, cm_model *m, char *msg,
+                          size_t msg_size)
+{
+    const param_builder *b = user;
+    const double values[2] = {p, q};
+    return model_with_values(b->mo, b->names, values, 2, m, msg, msg_size) ? CM_OK : CM_EINVAL;
+}
+
 bool model_at_point(const model_spec *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m)
 {

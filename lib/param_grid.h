@@ -62,6 +62,17 @@ cm_status param_sweep_base(const model_spec *mo, const char *only, const param_a
 bool model_with_values(const model_spec *mo, const char *const *names, const double *values, int n,
                        cm_model *m, char *msg, size_t msg_size);
 
+/* Builders of the model of mo with one or two parameters (names[0],
+ * names[1]) set, for the continuation kernels (models/arclength.h's
+ * cm_model_at_fn; user: a param_builder). */
+typedef struct param_builder {
+    const model_spec *mo;
+    const char *names[2];
+} param_builder;
+cm_status param_model_at(void *user, double p, cm_model *m, char *msg, size_t msg_size);
+cm_status param_model_at2(void *user, double p, double q, cm_model *m, char *msg,
+                          size_t msg_size);
+
 /* The model at axis point idx[k] of each axis k (n_ax <= 2). */
 bool model_at_point(const model_spec *mo, const param_axis *ax, const int *idx, int n_ax,
                     cm_model *m);

@@ -180,11 +180,14 @@ cm_status cm_flow_equilibrium(const cm_model *m, double p, double *x, cm_equilib
     eq_problem q = {m, NULL, NULL, msg, msg_size};
     const cm_arc_problem pr = eq_arc(&q, n);
     if (cm_arc_newton(&pr, p, x) != CM_OK) {
+        char at[48] = ""; /* p is NAN where no parameter is varied */
+        if (isfinite(p))
+            snprintf(at, sizeof at, " at %.9g", p);
         field_at(m, x, f);
         return cm_fail(CM_ENOTFOUND, msg, msg_size,
-                       "Newton's method finds no equilibrium of %s from (%.6g, %.6g%s) at %.9g "
+                       "Newton's method finds no equilibrium of %s from (%.6g, %.6g%s)%s "
                        "(residual %.3g): start nearer one",
-                       m->name, start[0], n > 1 ? start[1] : 0, n > 2 ? ", ..." : "", p,
+                       m->name, start[0], n > 1 ? start[1] : 0, n > 2 ? ", ..." : "", at,
                        norm(n, f));
     }
     const cm_status st = e ? classify(m, p, x, e) : CM_OK;

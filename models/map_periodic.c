@@ -178,11 +178,15 @@ cm_status cm_map_periodic_point(const cm_model *m, double p, int period, double 
     memcpy(start, x, (size_t)m->dim * sizeof *x);
     po_problem q = {m, NULL, NULL, period, msg, msg_size};
     const cm_arc_problem pr = po_arc(&q, m->dim);
-    if (cm_arc_newton(&pr, p, x) != CM_OK)
+    if (cm_arc_newton(&pr, p, x) != CM_OK) {
+        char at[48] = ""; /* p is NAN where no parameter is varied */
+        if (isfinite(p))
+            snprintf(at, sizeof at, " at %.9g", p);
         return cm_fail(CM_ENOTFOUND, msg, msg_size,
-                       "Newton's method finds no period-%d point of %s from (%.6g%s) at %.9g: "
-                       "start nearer one (e.g. a point the orbit settles on)",
-                       period, m->name, start[0], m->dim > 1 ? ", ..." : "", p);
+                       "Newton's method finds no period-%d point of %s from (%.6g%s)%s: start "
+                       "nearer one (e.g. a point the orbit settles on)",
+                       period, m->name, start[0], m->dim > 1 ? ", ..." : "", at);
+    }
     const cm_status st = pt ? classify(m, period, p, x, pt) : CM_OK;
     return st == CM_OK
                ? CM_OK

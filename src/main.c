@@ -27,6 +27,8 @@ static const struct {
     {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
     {"equilibria", cmd_equilibria,
      "equilibria of a flow: eigenvalues, branches in a parameter, folds and Hopf points"},
+    {"periodic", cmd_periodic,
+     "periodic orbits of a map: multipliers, branches, folds and period-doubling cascades"},
     {"lyapunov", cmd_lyapunov, "largest Lyapunov exponent over a grid of two parameters (any model)"},
     {"simulate", cmd_simulate,
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},

@@ -87,7 +87,28 @@ assert d["unstable"] == 0 and abs(d["re"][0] + 6.23) < 5e-3 and abs(d["im"][0] -
 assert abs(d["re"][2] + 35.9) < 5e-2 and abs(d["re"][3] + 123.3) < 5e-2, d
 PY
 
+# --- periodic: the first doublings of the cascade PD1 (Table 3.1) ---------
+"$CM" periodic --param xi=2.9 --from 1.05,0.2,0.27 --settle 400 --branch xi=2.9:4.36 \
+  --direction up --cascade 3 --csv casc.csv > casc.out || fail "periodic --cascade 3"
+python3 - casc.csv <<'PY' || fail "periodic's doublings"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+pd = [(int(r["period"]), float(r["xi"]), float(r["re_1"])) for r in rows if r["kind"] == "pd"]
+assert [p for p, _, _ in pd] == [1, 2, 4], pd
+for (_, xi, mu), thesis in zip(pd, (3.11285, 4.03007, 4.26861)):
+    assert abs(xi - thesis) < 2e-4 and abs(mu + 1) < 1e-3, (xi, thesis, mu)
+assert all(int(r["outside"]) == 0 for r in rows if r["kind"] == "point" and r["period"] == "1"
+           and float(r["xi"]) < 3.11), "period 1 unstable before its doubling"
+PY
+grep -q "^Feigenbaum ratio 1: 3.84" casc.out || fail "periodic's Feigenbaum ratio: $(cat casc.out)"
+
 # --- bad input -----------------------------------------------------------
+expect_usage "--cascade needs --direction" periodic --from 1,0.2,0.25 --branch xi=2.9:4.36 --cascade 2
+expect_usage "the start has 2 value(s)" periodic --from 1,0.2
+out=$("$CM" periodic --param xi=4.8 --period 3 --from 3,3,3 --csv nope.csv 2>&1); rc=$?
+[ "$rc" -eq 1 ] || fail "periodic where Newton fails exited $rc: $out"
+grep -q "Newton's method finds no period-3 point" <<<"$out" || fail "periodic where Newton fails: '$out'"
+[ ! -e nope.csv ] || fail "periodic wrote nope.csv although Newton failed"
 expect_usage "the flow of model chip-4d has 4 coordinates (tau2, T0, T1, T2)" \
   equilibria --from 1,0.2,0.25
 expect_usage "must hold the model's xi = 4.8" equilibria --from 1,0.1,0.2,0.25 --branch xi=5:6

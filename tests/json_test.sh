@@ -34,6 +34,9 @@ run orbit orbit --from 10,0 --steps 5 --json
 run orbit-sink orbit --model microchaos-1d --from 1e300 --steps 5 --json
 run orbit-flow orbit --model chip-4d --from 1.05,0.2,0.27 --steps 2 --json
 run equilibria equilibria --model chip-4d --from 1,0.1,0.2,0.25 --json
+run periodic periodic --param xi=11 --from 1.05,0.2,0.27 --settle 100 --json
+run periodic-cascade periodic --param xi=2.9 --from 1.05,0.2,0.27 --settle 100 --branch xi=2.9:4.1 \
+  --direction up --cascade 2 --json
 run equilibria-branch equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=4:12 --json
 run equilibria-curve equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=1:15 \
   --curve zeta=21,21.5 --json

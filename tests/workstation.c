@@ -119,6 +119,12 @@ static void analyses(void)
     eqo.curve = &(cm_axis){"zeta", 20, 21, 2};
     a = outputs("equilibria", f, 0);
     must(cm_analysis_equilibria(&a, &eqo, msg, sizeof msg), "equilibria", msg);
+    cm_periodic_options po = cm_periodic_defaults();
+    po.from = (const double[]){1.05, 0.2, 0.27}, po.n_from = 3, po.settle = 100;
+    po.branch = "xi", po.lo = 2.9, po.hi = 4.1, po.direction = 1, po.cascade = 2;
+    a = outputs("periodic", f, 0);
+    a.params = "xi=2.9";
+    must(cm_analysis_periodic(&a, &po, msg, sizeof msg), "periodic", msg);
 }
 
 int main(void)

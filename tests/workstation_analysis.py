@@ -2,8 +2,8 @@
 the same settings through the command and through tests/workstation.c and
 compares the files byte for byte): PREFIX_NAME.csv and .png for stability,
 partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
-runs), lyapunov, sweep, continue (and its events) and equilibria (its
-table). The tables the
+runs), lyapunov, sweep, continue (and its events), equilibria and
+periodic (their tables). The tables the
 functions return are checked against the files they read them from.
 usage: workstation_analysis.py PREFIX"""
 import os
@@ -53,6 +53,9 @@ rows(events, p + "continue_events.csv")
 eq = rows(an.equilibria((1, 0.1, 0.2, 0.25), branch=("xi", 3, 15), curve=("zeta", 20, 21, 2),
                         csv=p + "equilibria.csv"), p + "equilibria.csv")
 assert list(eq["kind"]) == ["hopf"] * 4 and list(eq["zeta"]) == [20.25] * 2 + [20.75] * 2, eq
+po = rows(an.periodic((1.05, 0.2, 0.27), settle=100, branch=("xi", 2.9, 4.1), direction=1,
+                      cascade=2, params="xi=2.9", csv=p + "periodic.csv"), p + "periodic.csv")
+assert list(po["period"][po["kind"] == "pd"]) == [1, 2], po
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})

@@ -94,7 +94,9 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
   "$CM" continue --vary S=0.02:0.4 --max-points 50 --csv cli_continue.csv \
     --events cli_continue_events.csv --png cli_continue.png &&
   "$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:15 --curve zeta=20:21:2 \
-    --csv cli_equilibria.csv; } > analyses.log 2>&1 ||
+    --csv cli_equilibria.csv &&
+  "$CM" periodic --param xi=2.9 --from 1.05,0.2,0.27 --settle 100 --branch xi=2.9:4.1 \
+    --direction up --cascade 2 --csv cli_periodic.csv; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
 ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue"
 
@@ -110,6 +112,7 @@ check_analyses() { # PREFIX: the analyses' files, against the command's
   same_bytes cli_bifurcation_runs.csv "$1_bifurcation_runs.csv" "$1: bifurcation's runs"
   same_bytes cli_continue_events.csv "$1_continue_events.csv" "$1: continue's events"
   same_bytes cli_equilibria.csv "$1_equilibria.csv" "$1: equilibria's table"
+  same_bytes cli_periodic.csv "$1_periodic.csv" "$1: periodic's table"
   head -1 cli_sweep.csv | grep -q ',seconds$' || fail "the sweep's table no longer ends in seconds"
   without_seconds cli_sweep.csv > a_sweep.csv && without_seconds "$1_sweep.csv" > b_sweep.csv &&
     [ "$(grep -c . b_sweep.csv)" -eq 3 ] && cmp -s a_sweep.csv b_sweep.csv ||

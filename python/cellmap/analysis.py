@@ -1,7 +1,7 @@
 """The analysis drivers of libcellmap (cm_analysis_* in cellmap/cellmap.h):
 the commands stability, partition, amplitude, horseshoe, escape,
-equilibria, simulate, bifurcation, lyapunov, sweep and continue as
-functions. Each computes what
+equilibria, periodic, simulate, bifurcation, lyapunov, sweep and continue
+as functions. Each computes what
 the command computes and writes the same files (csv=, png=, byte for
 byte); it returns the table as a numpy structured array (columns by name,
 as the CSV's header names them), read from csv= or from a temporary file.
@@ -28,7 +28,7 @@ import numpy as np
 from . import CellmapError, Models, _call, _lib, _text, _P, _DOUBLES  # noqa: F401
 
 __all__ = ["stability", "partition", "amplitude", "horseshoe", "escape", "equilibria",
-           "simulate", "bifurcation", "lyapunov", "sweep", "continuation"]
+           "periodic", "simulate", "bifurcation", "lyapunov", "sweep", "continuation"]
 
 
 class _Axis(ctypes.Structure):
@@ -57,6 +57,14 @@ class _Equilibria(ctypes.Structure):
                 ("lo", ctypes.c_double), ("hi", ctypes.c_double), ("direction", ctypes.c_int),
                 ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int),
                 ("curve", ctypes.POINTER(_Axis))]
+
+
+class _Periodic(ctypes.Structure):
+    _fields_ = [("start", _DOUBLES), ("n_from", ctypes.c_int), ("settle", ctypes.c_int),
+                ("period", ctypes.c_int), ("branch", ctypes.c_char_p), ("lo", ctypes.c_double),
+                ("hi", ctypes.c_double), ("direction", ctypes.c_int),
+                ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int),
+                ("cascade", ctypes.c_int)]
 
 
 class _Simulate(ctypes.Structure):
@@ -104,14 +112,14 @@ _sig("cm_analysis_stability", _AXIS, _AXIS)
 _sig("cm_analysis_partition")
 _sig("cm_analysis_amplitude", _AXIS, ctypes.c_int, ctypes.c_double)
 for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
-                     ("equilibria", _Equilibria), ("simulate", _Simulate),
-                     ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov), ("sweep", _Sweep),
-                     ("continue", _Continue)):
+                     ("equilibria", _Equilibria), ("periodic", _Periodic),
+                     ("simulate", _Simulate), ("bifurcation", _Bifurcation),
+                     ("lyapunov", _Lyapunov), ("sweep", _Sweep), ("continue", _Continue)):
     _sig("cm_analysis_" + _name, ctypes.POINTER(_opts))
 for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
-                     ("equilibria", _Equilibria), ("simulate", _Simulate),
-                     ("bifurcation", _Bifurcation), ("lyapunov", _Lyapunov),
-                     ("continue", _Continue)):
+                     ("equilibria", _Equilibria), ("periodic", _Periodic),
+                     ("simulate", _Simulate), ("bifurcation", _Bifurcation),
+                     ("lyapunov", _Lyapunov), ("continue", _Continue)):
     getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
     getattr(_lib, "cm_%s_defaults" % _name).argtypes = []
 
@@ -270,6 +278,36 @@ def equilibria(start, branch=None, direction=0, ds_max=None, max_points=None, cu
     ax = _axis(curve, what="curve") if curve is not None else None
     o.curve = ctypes.pointer(ax) if ax is not None else None
     table = _run(_common(**common), _lib.cm_analysis_equilibria, ctypes.byref(o))
+    del keep, st
+    return table
+
+
+def periodic(start, settle=0, period=1, branch=None, direction=0, ds_max=None,
+             max_points=None, cascade=0, **common):
+    """Periodic orbits of a map (`cellmap periodic`; model chip-4d unless
+    named): Newton on P^period from start (after settle iterates) and the
+    multipliers; branch = (name, lo, hi): the branch in that parameter with
+    its folds, period doublings and Neimark-Sacker points (direction +1 or
+    -1: one way only); cascade = n: n doublings, each next branch switched
+    to at the last (needs a direction). The rows: kind, period, the
+    parameter, the state, re_k/im_k, outside."""
+    o = _lib.cm_periodic_defaults()
+    st = (ctypes.c_double * len(start))(*map(float, start))
+    o.start, o.n_from, o.settle, o.period = st, len(start), int(settle), int(period)
+    keep = None
+    if branch is not None:
+        try:
+            name, lo, hi = branch
+            keep = _text(name)
+            o.branch, o.lo, o.hi = keep, float(lo), float(hi)
+        except (TypeError, ValueError):
+            raise ValueError("branch %r: give (name, lo, hi)" % (branch,)) from None
+    o.direction, o.cascade = int(direction), int(cascade)
+    if ds_max is not None:
+        o.ds_max = float(ds_max)
+    if max_points is not None:
+        o.max_points = int(max_points)
+    table = _run(_common(**common), _lib.cm_analysis_periodic, ctypes.byref(o))
     del keep, st
     return table
 

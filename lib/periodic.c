@@ -1,0 +1,302 @@
+/* lib/periodic.c - periodic orbits of maps, their branches and cascades
+ * (lib/periodic.h). */
+#include "lib/periodic.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/outfile.h"
+#include "lib/rows.h"
+#include "models/ode_flow.h"
+#include "models/params.h"
+
+#define FEIGENBAUM_DELTA 4.669201609102990
+
+po_args periodic_defaults(void)
+{
+    po_args a;
+    memset(&a, 0, sizeof a);
+    a.mo.name = "chip-4d";
+    a.period = 1;
+    a.max_points = 10000;
+    return a;
+}
+
+const char *periodic_event_name(int kind)
+{
+    return kind == CM_PO_PD ? "pd" : kind == CM_PO_NS ? "ns" : "fold";
+}
+
+double periodic_accumulation(const po_result *r)
+{
+    const int n = r->n_doublings;
+    if (n < 2)
+        return NAN;
+    return r->doublings[n - 1] + (r->doublings[n - 1] - r->doublings[n - 2]) / (FEIGENBAUM_DELTA - 1);
+}
+
+/* What the branch callbacks fill: the result, and for a cascade the
+ * first doubling of the branch (which stops it). */
+typedef struct collect {
+    po_result *r;
+    bool cascade;
+    bool doubled;
+    cm_po_event pd;
+} collect;
+
+static int on_point(void *user, const cm_periodic_point *pt)
+{
+    po_result *r = ((collect *)user)->r;
+    if (!rows_room((void **)&r->pts, &r->cap_pts, r->n_pts, sizeof *r->pts))
+        return 1;
+    r->pts[r->n_pts++] = *pt;
+    return 0;
+}
+
+static int on_event(void *user, const cm_po_event *ev)
+{
+    collect *c = user;
+    po_result *r = c->r;
+    if (!rows_room((void **)&r->events, &r->cap_events, r->n_events, sizeof *r->events))
+        return 1;
+    r->events[r->n_events++] = (po_found){*ev, r->n_pts};
+    if (c->cascade && ev->kind == CM_PO_PD) {
+        c->doubled = true;
+        c->pd = *ev;
+        return 1; /* a cascade goes on from its first doubling */
+    }
+    return 0;
+}
+
+/* A scalar parameter of m named name: its value in *v. */
+static cm_status branch_param(const cm_model *m, const char *name, double *v, char *msg,
+                              size_t msg_size)
+{
+    const int k = cm_params_find(&m->values, name);
+    if (k < 0 || m->values.spec[k].max_count != 1 || m->values.spec[k].choices)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the branch's parameter '%s' is not a number parameter of model %s "
+                       "(`cellmap models` lists them)",
+                       name, m->name);
+    *v = m->values.value[k].v[0];
+    return CM_OK;
+}
+
+static cm_status check_request(const po_args *a, const cm_model *m, double *p0, char *msg,
+                               size_t msg_size)
+{
+    if (a->n_from != m->dim)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the start has %d value(s) but model %s's map has dimension %d", a->n_from,
+                       m->name, m->dim);
+    if (a->period < 1 || a->period > 4096 || a->settle < 0 || a->settle > 10000000)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a period of %d and %d settling iterates: give a period of 1..4096 and "
+                       "0..1e7 iterates",
+                       a->period, a->settle);
+    *p0 = NAN;
+    if (!a->branch[0])
+        return a->cascade ? cm_fail(CM_EINVAL, msg, msg_size,
+                                    "a cascade needs a branch: name the parameter it follows")
+                          : CM_OK;
+    if (a->cascade && (a->direction == 0 || a->cascade > PERIODIC_MAX_CASCADE))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a cascade of %d doublings: give 1..%d and the direction it goes (up or "
+                       "down)",
+                       a->cascade, PERIODIC_MAX_CASCADE);
+    cm_status st = branch_param(m, a->branch, p0, msg, msg_size);
+    if (st == CM_OK &&
+        (!(a->lo < a->hi && isfinite(a->lo) && isfinite(a->hi)) || *p0 < a->lo || *p0 > a->hi))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "the branch's range %s=%g:%g must hold the model's %s = %g (set it with the "
+                     "parameters, e.g. %s=%g)",
+                     a->branch, a->lo, a->hi, a->branch, *p0, a->branch, 0.5 * (a->lo + a->hi));
+    return st;
+}
+
+/* The way just followed (points from pts_from, events from events_from)
+ * in the branch's order: the way down reversed, the way up without its
+ * first point when the way down has given it already. */
+static void join_way(po_result *r, int direction, size_t pts_from, size_t events_from,
+                     bool both)
+{
+    const size_t m = r->n_pts - pts_from;
+    if (direction < 0) {
+        rows_reverse(r->pts, pts_from, r->n_pts, sizeof *r->pts);
+        rows_reverse(r->events, events_from, r->n_events, sizeof *r->events);
+        for (size_t k = events_from; k < r->n_events; k++)
+            r->events[k].before = pts_from + (m - (r->events[k].before - pts_from));
+    } else if (both && m > 0) {
+        memmove(&r->pts[pts_from], &r->pts[pts_from + 1], (m - 1) * sizeof *r->pts);
+        r->n_pts--;
+        for (size_t k = events_from; k < r->n_events; k++)
+            r->events[k].before--;
+    }
+}
+
+/* The branch of period `period` from x at p, one way or both. */
+static cm_status follow(const po_args *a, const param_builder *u, int period, double p,
+                        const double *x, int direction, collect *c, char *msg, size_t msg_size)
+{
+    po_result *r = c->r;
+    for (int way = 0; way < 2; way++) {
+        const int dir = way == 0 ? -1 : 1;
+        if (direction && direction != dir)
+            continue;
+        const cm_branch_options o = {a->lo, a->hi, dir, 0, a->ds_max, a->max_points};
+        const size_t pts_from = r->n_pts, events_from = r->n_events;
+        int why = 0;
+        const cm_status st =
+            cm_map_periodic_branch(param_model_at, (void *)u, period, p, x, &o, on_point,
+                                   on_event, c, &why, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (why == CM_BRANCH_CALLER && !c->doubled)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the branch's points");
+        if (r->why[way] == 0)
+            r->why[way] = why;
+        join_way(r, dir, pts_from, events_from, direction == 0);
+    }
+    return CM_OK;
+}
+
+/* Doubling after doubling: each branch followed to its first period
+ * doubling, the next one started next to it. */
+static cm_status cascade(const po_args *a, const param_builder *u, po_result *r, double p0,
+                         char *msg, size_t msg_size)
+{
+    double x[CM_MAX_DIM], p = p0;
+    memcpy(x, r->start.x, sizeof x);
+    int period = a->period;
+    for (int k = 0; k < a->cascade; k++) {
+        collect c = {r, true, false, {0}};
+        cm_status st = follow(a, u, period, p, x, a->direction, &c, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        if (!c.doubled)
+            return k > 0 ? CM_OK /* the range holds no more doublings */
+                         : cm_fail(CM_ENOTFOUND, msg, msg_size,
+                                   "the period-%d branch has no period doubling in %s=%g:%g",
+                                   period, a->branch, a->lo, a->hi);
+        r->doublings[r->n_doublings++] = c.pd.at.p;
+        if (k + 1 == a->cascade)
+            break;
+        /* the step from the doubling: 1e-4 shrinking as the cascade's
+         * spacing does */
+        const double dp = a->direction * 1e-4 * pow(FEIGENBAUM_DELTA, -k);
+        st = cm_map_period_doubled(param_model_at, (void *)u, &c.pd, dp, x, &p, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        period *= 2;
+    }
+    return CM_OK;
+}
+
+/* The model spec with the flow's tolerances at 1e-12 first (the user's
+ * parameters after them win). */
+static void tightened(const model_spec *mo, model_spec *out)
+{
+    *out = *mo;
+    out->texts[0] = "abs_tol=1e-12,rel_tol=1e-12";
+    for (int i = 0; i < mo->n_texts && i + 1 < MODEL_SPEC_TEXTS; i++)
+        out->texts[i + 1] = mo->texts[i];
+    out->n_texts = mo->n_texts + 1 < MODEL_SPEC_TEXTS ? mo->n_texts + 1 : MODEL_SPEC_TEXTS;
+}
+
+/* Whether the user's parameters set the integrator's tolerances. */
+static bool sets_tolerances(const model_spec *mo)
+{
+    for (int i = 0; i < mo->n_texts; i++)
+        if (strstr(mo->texts[i], "abs_tol") || strstr(mo->texts[i], "rel_tol"))
+            return true;
+    return false;
+}
+
+cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg_size)
+{
+    memset(r, 0, sizeof *r);
+    model_spec mo = a->mo;
+    cm_status st = model_spec_build(&a->mo, &r->m, msg, msg_size);
+    if (st == CM_OK && cm_model_is_flow(&r->m) && !sets_tolerances(&a->mo) &&
+        a->mo.n_texts < MODEL_SPEC_TEXTS) {
+        tightened(&a->mo, &mo);
+        cm_model_release(&r->m);
+        r->tightened = true;
+        st = model_spec_build(&mo, &r->m, msg, msg_size);
+    }
+    double p0 = NAN, x[CM_MAX_DIM];
+    if (st == CM_OK)
+        st = check_request(a, &r->m, &p0, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    memcpy(x, a->from, sizeof x);
+    for (int k = 0; k < a->settle; k++)
+        if (r->m.step(&r->m, x, x) != CM_STEP_OK)
+            return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                           "the orbit from the start has no image after %d iterates: start "
+                           "elsewhere or settle fewer",
+                           k);
+    if ((st = cm_map_periodic_point(&r->m, p0, a->period, x, &r->start, msg, msg_size)) != CM_OK)
+        return st;
+    if (!a->branch[0])
+        return CM_OK;
+    const param_builder u = {&mo, {a->branch, NULL}};
+    if (a->cascade)
+        return cascade(a, &u, r, p0, msg, msg_size);
+    collect c = {r, false, false, {0}};
+    return follow(a, &u, a->period, p0, r->start.x, a->direction, &c, msg, msg_size);
+}
+
+/* One CSV row. */
+static void row(FILE *f, const po_args *a, const char *kind, const cm_periodic_point *pt)
+{
+    fprintf(f, "%s,%d", kind, pt->period);
+    if (a->branch[0])
+        fprintf(f, ",%.17g", pt->p);
+    for (int d = 0; d < pt->dim; d++)
+        fprintf(f, ",%.17g", pt->x[d]);
+    for (int d = 0; d < pt->dim; d++)
+        fprintf(f, ",%.17g,%.17g", pt->re[d], pt->im[d]);
+    fprintf(f, ",%d\n", pt->outside);
+}
+
+cm_status periodic_write(const po_args *a, const po_result *r, char *msg, size_t msg_size)
+{
+    if (!a->csv)
+        return CM_OK;
+    outfile o;
+    cm_status st = outfile_begin(a->csv, &o, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = r->m.dim;
+    fprintf(o.f, "kind,period");
+    if (a->branch[0])
+        fprintf(o.f, ",%s", a->branch);
+    for (int d = 0; d < n; d++)
+        fprintf(o.f, ",%s", cm_model_coord_name(&r->m, d));
+    for (int d = 1; d <= n; d++)
+        fprintf(o.f, ",re_%d,im_%d", d, d);
+    fprintf(o.f, ",outside\n");
+    if (!a->branch[0]) {
+        row(o.f, a, "point", &r->start);
+    } else {
+        size_t e = 0;
+        for (size_t k = 0; k <= r->n_pts; k++) {
+            for (; e < r->n_events && r->events[e].before <= k; e++)
+                row(o.f, a, periodic_event_name(r->events[e].ev.kind), &r->events[e].ev.at);
+            if (k < r->n_pts)
+                row(o.f, a, "point", &r->pts[k]);
+        }
+    }
+    return outfile_end(&o, true, msg, msg_size);
+}
+
+void periodic_result_free(po_result *r)
+{
+    cm_model_release(&r->m);
+    free(r->pts);
+    free(r->events);
+    memset(r, 0, sizeof *r);
+}

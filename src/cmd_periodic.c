@@ -1,0 +1,212 @@
+/* cellmap periodic: periodic orbits of any map model (a flow's section
+ * map included), their branches in a parameter and period-doubling
+ * cascades (thesis 3.2, Table 3.1) over lib/periodic.h. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/json.h"
+#include "lib/parse.h"
+#include "lib/periodic.h"
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/outfile.h"
+
+static const char periodic_help[] =
+    "usage: cellmap periodic [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                        --from X[,Y...] [--settle N] [--period K]\n"
+    "                        [--branch P=LO:HI [--direction up|down] [--ds-max D]\n"
+    "                        [--max-points N] [--cascade N]] [--csv FILE|-] [--json] [--quiet]\n\n"
+    "Periodic orbits of a model's map (chip-4d, the default, or any other; a flow's\n"
+    "Poincare or stroboscopic map included): a point of period K by Newton's method on\n"
+    "P^K(x) - x from --from (after N iterates of the map with --settle, to start\n"
+    "from where a simulated orbit settles), and its multipliers (the eigenvalues of\n"
+    "DP^K by central differences; stable when all lie inside the unit circle).\n"
+    "For a flow the integrator's tolerances become 1e-12 unless --param sets them.\n"
+    "With --branch the orbit is followed in parameter P over LO:HI by\n"
+    "pseudo-arclength continuation and its folds (a multiplier through +1), period\n"
+    "doublings (through -1) and Neimark-Sacker points (a pair through the circle)\n"
+    "are located. With --cascade N (and a direction) the branch is followed to its\n"
+    "first period doubling, the branch of twice the period is started there, and so\n"
+    "on N times; the doublings, the Feigenbaum ratios of their spacings and the\n"
+    "accumulation point they give are printed (docs/models.md 12.1: chip-4d's\n"
+    "cascades at zeta = 21, PD1 from 3.11285 and PD2 from 10.6639).\n\n"
+    "  --from X,Y,...      the start, in the map's coordinates\n"
+    "  --settle N          iterate the map N times first (0..1e7, default 0)\n"
+    "  --period K          the period, 1..4096 (default 1)\n"
+    "  --branch P=LO:HI    follow the orbit in P over LO:HI\n"
+    "  --direction up|down only towards HI or LO (default: both; a cascade needs one)\n"
+    "  --ds-max D          the longest arclength step (default (HI - LO)/50)\n"
+    "  --max-points N      points each way, 10..1000000 (default 10000)\n"
+    "  --cascade N         follow N period doublings, 1..12\n"
+    "  --csv FILE|-        rows kind (point, fold, pd, ns), period, P, the state,\n"
+    "                      re_k,im_k of the multipliers by decreasing modulus,\n"
+    "                      outside (how many lie outside the unit circle)\n"
+    "  --json              the summary as JSON on standard output\n"
+    "  --quiet             no summary\n";
+
+/* "P=LO:HI" into a->branch, lo, hi; 0 or the usage error. */
+static int parse_branch(cli *c, po_args *a)
+{
+    const char *v = c->value, *eq = strchr(v, '='), *colon = eq ? strchr(eq + 1, ':') : NULL;
+    char lo[64], hi[64];
+    if (!eq || eq == v || (size_t)(eq - v) >= sizeof a->branch || !colon ||
+        (size_t)(colon - eq - 1) >= sizeof lo || strlen(colon + 1) >= sizeof hi)
+        return cli_usage_error(c, "--branch: '%s' is not P=LO:HI (e.g. xi=2.9:4.36)", v);
+    memcpy(a->branch, v, (size_t)(eq - v));
+    a->branch[eq - v] = 0;
+    memcpy(lo, eq + 1, (size_t)(colon - eq - 1));
+    lo[colon - eq - 1] = 0;
+    strcpy(hi, colon + 1);
+    if (!parse_double(lo, &a->lo) || !parse_double(hi, &a->hi) || !(a->lo < a->hi))
+        return cli_usage_error(c, "--branch: '%s' needs numbers LO < HI (e.g. xi=2.9:4.36)", v);
+    return 0;
+}
+
+/* 0: go on; -1: --help was printed; else the usage error. */
+static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(periodic_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (cli_is(c, "--from", true, &err)) {
+            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
+                err = cli_usage_error(c, "--from: '%s' is not a list of numbers X[,Y...]",
+                                      c->value);
+        } else if (cli_take_int(c, "--settle", 0, 10000000, &a->settle, &err)) {
+        } else if (cli_take_int(c, "--period", 1, 4096, &a->period, &err)) {
+        } else if (cli_is(c, "--branch", true, &err)) {
+            if (c->value)
+                err = parse_branch(c, a);
+        } else if (cli_is(c, "--direction", true, &err)) {
+            if (c->value && strcmp(c->value, "up") && strcmp(c->value, "down"))
+                err = cli_usage_error(c, "--direction: '%s' is not up or down", c->value);
+            else if (c->value)
+                a->direction = strcmp(c->value, "up") == 0 ? 1 : -1;
+        } else if (cli_is(c, "--ds-max", true, &err)) {
+            if (c->value && (!parse_double(c->value, &a->ds_max) || !(a->ds_max > 0)))
+                err = cli_usage_error(c, "--ds-max: '%s' must be a number above 0", c->value);
+        } else if (cli_take_int(c, "--max-points", 10, 1000000, &a->max_points, &err)) {
+        } else if (cli_take_int(c, "--cascade", 1, PERIODIC_MAX_CASCADE, &a->cascade, &err)) {
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            *json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            *quiet = true;
+        } else {
+            err = cli_stray(c);
+        }
+    }
+    if (!err && a->n_from == 0)
+        err = cli_usage_error(c, "--from X[,Y...] is required: where Newton's method starts");
+    if (!err && (a->cascade || a->direction || a->ds_max > 0) && !a->branch[0])
+        err = cli_usage_error(c, "--cascade, --direction and --ds-max need --branch P=LO:HI");
+    if (!err && a->cascade && !a->direction)
+        err = cli_usage_error(c, "--cascade needs --direction up or down: the way it goes");
+    return err;
+}
+
+static void print_point(FILE *f, const cm_model *m, const cm_periodic_point *pt)
+{
+    for (int d = 0; d < pt->dim; d++)
+        fprintf(f, "%s%s = %.9g", d ? ", " : "", cm_model_coord_name(m, d), pt->x[d]);
+    fprintf(f, "; multipliers ");
+    for (int d = 0; d < pt->dim; d++) {
+        if (pt->im[d] < 0)
+            continue; /* a pair prints once */
+        fprintf(f, "%s%.6g", d ? ", " : "", pt->re[d]);
+        if (pt->im[d] > 0)
+            fprintf(f, " +- %.6gi", pt->im[d]);
+    }
+}
+
+static void print_summary(FILE *f, const po_args *a, const po_result *r)
+{
+    if (r->tightened)
+        fprintf(f, "(the flow's tolerances: 1e-12)\n");
+    fprintf(f, "period-%d point: ", a->period);
+    print_point(f, &r->m, &r->start);
+    fprintf(f, "\n%s\n", r->start.outside ? "unstable" : "stable");
+    if (!a->branch[0])
+        return;
+    fprintf(f, "%s over %g:%g: %zu points\n", a->branch, a->lo, a->hi, r->n_pts);
+    for (size_t k = 0; k < r->n_events; k++) {
+        const cm_po_event *ev = &r->events[k].ev;
+        fprintf(f, "%s of period %d at %s = %.9g (", periodic_event_name(ev->kind),
+                ev->at.period, a->branch, ev->at.p);
+        print_point(f, &r->m, &ev->at);
+        fprintf(f, ")\n");
+    }
+    for (int k = 1; k + 1 < r->n_doublings; k++)
+        fprintf(f, "Feigenbaum ratio %d: %.4f\n", k,
+                (r->doublings[k] - r->doublings[k - 1]) / (r->doublings[k + 1] - r->doublings[k]));
+    if (r->n_doublings >= 2)
+        fprintf(f, "the cascade accumulates near %s = %.6g (delta = 4.6692)\n", a->branch,
+                periodic_accumulation(r));
+}
+
+static void print_json(const po_args *a, const po_result *r)
+{
+    json j;
+    json_begin(&j, stdout, "periodic");
+    json_model(&j, &r->m);
+    json_nums(&j, "from", a->from, a->n_from);
+    json_int(&j, "period", a->period);
+    json_nums(&j, "point", r->start.x, r->start.dim);
+    json_nums(&j, "re", r->start.re, r->start.dim);
+    json_nums(&j, "im", r->start.im, r->start.dim);
+    json_int(&j, "outside", r->start.outside);
+    if (a->branch[0]) {
+        json_str(&j, "branch", a->branch);
+        json_int(&j, "points", (long long)r->n_pts);
+        json_array(&j, "events");
+        for (size_t k = 0; k < r->n_events; k++) {
+            const cm_po_event *ev = &r->events[k].ev;
+            json_object(&j, NULL);
+            json_str(&j, "kind", periodic_event_name(ev->kind));
+            json_int(&j, "period", ev->at.period);
+            json_num(&j, "p", ev->at.p);
+            json_nums(&j, "x", ev->at.x, ev->at.dim);
+            json_object_end(&j);
+        }
+        json_array_end(&j);
+    }
+    if (a->cascade) {
+        json_nums(&j, "doublings", r->doublings, r->n_doublings);
+        if (r->n_doublings >= 2)
+            json_num(&j, "accumulation", periodic_accumulation(r));
+    }
+    json_end(&j);
+}
+
+int cmd_periodic(int argc, char **argv)
+{
+    cli c = {"periodic", argc, argv, 0, NULL, NULL};
+    po_args a = periodic_defaults();
+    bool json = false, quiet = false;
+    const int perr = parse_args(&c, &a, &json, &quiet);
+    if (perr)
+        return perr < 0 ? EXIT_OK : perr;
+    if (json && a.csv && strcmp(a.csv, "-") == 0)
+        return cli_usage_error(&c, "--json and --csv -: both want standard output");
+    const int werr = outfile_check("periodic", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
+    char msg[1024];
+    po_result r;
+    cm_status st = periodic_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (json)
+            print_json(&a, &r);
+        else if (!quiet)
+            print_summary(report_stream(a.csv, NULL, NULL), &a, &r);
+        st = periodic_write(&a, &r, msg, sizeof msg);
+    }
+    periodic_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
+}
