@@ -498,14 +498,21 @@ cm_escape_options cm_escape_defaults(void); /* 100000 cells, an ensemble of 10^6
  * its escape rate and mean escape number, exact and estimated. */
 cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, char *msg, size_t msg_size);
 
-typedef struct cm_equilibria_options {
-    const double *from; /* the start of Newton's method, in the flow's coordinates */
-    int n_from;         /* the flow's dimension */
-    const char *branch; /* NULL: one equilibrium; else the parameter its branch follows */
+/* A start and, with a name, the branch through it in one parameter (the
+ * commands' --from, --branch NAME=LO:HI, --direction, --ds-max and
+ * --max-points). */
+typedef struct cm_branch {
+    const double *from; /* the start */
+    int n_from;         /* its coordinates */
+    const char *name;   /* NULL: the start's solution only; else the parameter */
     double lo, hi;      /* the branch's range, holding the model's value of it */
     int direction;      /* +1 or -1: that way only; 0: both */
     double ds_max;      /* the longest arclength step; 0: (hi - lo) / 50 */
-    int max_points;     /* points each way, 10..1000000 */
+    int max_points;     /* points each way, 10..1000000 (the defaults: 10000) */
+} cm_branch;
+
+typedef struct cm_equilibria_options {
+    cm_branch b;          /* from: in the flow's coordinates */
     const cm_axis *curve; /* NULL, or the Hopf points of the branch at each of these
                              values (1..2000) of a second parameter */
 } cm_equilibria_options;
@@ -520,16 +527,10 @@ cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_optio
                                  size_t msg_size);
 
 typedef struct cm_periodic_options {
-    const double *from; /* the start, in the map's coordinates */
-    int n_from;         /* the map's dimension */
-    int settle;         /* iterates of the map before Newton, 0..1e7 */
-    int period;         /* 1..4096 */
-    const char *branch; /* NULL: one orbit; else the parameter its branch follows */
-    double lo, hi;      /* the branch's range, holding the model's value of it */
-    int direction;      /* +1 or -1: that way only; 0: both (not with a cascade) */
-    double ds_max;      /* the longest arclength step; 0: (hi - lo) / 50 */
-    int max_points;     /* points each way, 10..1000000 */
-    int cascade;        /* period doublings to follow, 0..12 (needs a direction) */
+    cm_branch b; /* from: in the map's coordinates; a cascade needs a direction */
+    int settle;  /* iterates of the map before Newton, 0..1e7 */
+    int period;  /* 1..4096 */
+    int cascade; /* period doublings to follow, 0..12 */
 } cm_periodic_options;
 cm_periodic_options cm_periodic_defaults(void); /* period 1, both ways, 10000 points */
 

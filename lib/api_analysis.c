@@ -353,10 +353,33 @@ cm_status cm_analysis_escape(const cm_analysis *a, const cm_escape_options *o, c
 
 /* ---- flows: equilibria ---- */
 
+/* A cm_branch as the drivers' branch_spec; extra: a setting that needs a
+ * branch (a Hopf curve, a cascade) is given. */
+static cm_status branch_of(const cm_branch *in, bool extra, branch_spec *b, char *msg,
+                           size_t msg_size)
+{
+    if (!in->from || in->n_from < 1 || in->n_from > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a start (from) of 1..%d coordinates is needed",
+                       CM_MAX_DIM);
+    if (in->name && (!in->name[0] || strlen(in->name) >= sizeof b->name))
+        return cm_fail(CM_EINVAL, msg, msg_size, "a branch needs a parameter's name");
+    if (in->max_points < 10 || in->max_points > 1000000 || in->direction < -1 ||
+        in->direction > 1 || !(in->ds_max >= 0) || (!in->name && (extra || in->direction)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a branch's settings: 10..1000000 points, a direction of -1, 0 or 1, "
+                       "ds_max >= 0; a direction, a Hopf curve or a cascade only with a branch");
+    memcpy(b->from, in->from, (size_t)in->n_from * sizeof *in->from);
+    b->n_from = in->n_from;
+    snprintf(b->name, sizeof b->name, "%s", in->name ? in->name : "");
+    b->lo = in->lo, b->hi = in->hi, b->direction = in->direction, b->ds_max = in->ds_max;
+    b->max_points = in->max_points;
+    return CM_OK;
+}
+
 cm_equilibria_options cm_equilibria_defaults(void)
 {
     const eq_args d = equilibria_defaults();
-    return (cm_equilibria_options){.max_points = d.max_points};
+    return (cm_equilibria_options){.b = {.max_points = d.b.max_points}};
 }
 
 cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_options *o, char *msg,
@@ -367,25 +390,12 @@ cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_optio
     o = o ? o : &d;
     eq_args ea = equilibria_defaults();
     model_of(a, ea.mo.name, &ea.mo);
-    if (a->png)
-        return cm_fail(CM_EINVAL, msg, msg_size, "equilibria draws no figure: give csv only");
-    if (!o->from || o->n_from < 1 || o->n_from > CM_MAX_DIM)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "equilibria need a start (from) of 1..%d coordinates", CM_MAX_DIM);
-    if (o->branch && (!o->branch[0] || strlen(o->branch) >= sizeof ea.branch))
-        return cm_fail(CM_EINVAL, msg, msg_size, "a branch needs a parameter's name");
-    if (o->max_points < 10 || o->max_points > 1000000 || o->direction < -1 ||
-        o->direction > 1 || !(o->ds_max >= 0) || (!o->branch && (o->curve || o->direction)))
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "a branch's settings: 10..1000000 points, a direction of -1, 0 or 1, "
-                       "ds_max >= 0; a direction or a Hopf curve only with a branch");
-    memcpy(ea.from, o->from, (size_t)o->n_from * sizeof *o->from);
-    ea.n_from = o->n_from;
-    if (o->branch)
-        snprintf(ea.branch, sizeof ea.branch, "%s", o->branch);
-    ea.lo = o->lo, ea.hi = o->hi, ea.direction = o->direction, ea.ds_max = o->ds_max;
-    ea.max_points = o->max_points, ea.csv = a->csv;
-    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    ea.csv = a->csv;
+    cm_status st = a->png ? cm_fail(CM_EINVAL, msg, msg_size,
+                                    "equilibria draws no figure: give csv only")
+                          : branch_of(&o->b, o->curve != NULL, &ea.b, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(a->csv, false, msg, msg_size);
     if (st == CM_OK && o->curve) {
         ea.has_curve = true;
         st = axis_of(o->curve, NULL, PARAM_AXIS_MAX, &ea.curve, msg, msg_size);
@@ -405,7 +415,7 @@ cm_status cm_analysis_equilibria(const cm_analysis *a, const cm_equilibria_optio
 cm_periodic_options cm_periodic_defaults(void)
 {
     const po_args d = periodic_defaults();
-    return (cm_periodic_options){.period = d.period, .max_points = d.max_points};
+    return (cm_periodic_options){.b = {.max_points = d.b.max_points}, .period = d.period};
 }
 
 cm_status cm_analysis_periodic(const cm_analysis *a, const cm_periodic_options *o, char *msg,
@@ -416,26 +426,12 @@ cm_status cm_analysis_periodic(const cm_analysis *a, const cm_periodic_options *
     o = o ? o : &d;
     po_args pa = periodic_defaults();
     model_of(a, pa.mo.name, &pa.mo);
-    if (a->png)
-        return cm_fail(CM_EINVAL, msg, msg_size, "periodic draws no figure: give csv only");
-    if (!o->from || o->n_from < 1 || o->n_from > CM_MAX_DIM)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "periodic orbits need a start (from) of 1..%d coordinates", CM_MAX_DIM);
-    if (o->branch && (!o->branch[0] || strlen(o->branch) >= sizeof pa.branch))
-        return cm_fail(CM_EINVAL, msg, msg_size, "a branch needs a parameter's name");
-    if (o->max_points < 10 || o->max_points > 1000000 || o->direction < -1 ||
-        o->direction > 1 || !(o->ds_max >= 0) || o->cascade < 0 ||
-        (!o->branch && (o->cascade || o->direction)))
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "a branch's settings: 10..1000000 points, a direction of -1, 0 or 1, "
-                       "ds_max >= 0, cascade >= 0; a direction or a cascade only with a branch");
-    memcpy(pa.from, o->from, (size_t)o->n_from * sizeof *o->from);
-    pa.n_from = o->n_from, pa.settle = o->settle, pa.period = o->period;
-    if (o->branch)
-        snprintf(pa.branch, sizeof pa.branch, "%s", o->branch);
-    pa.lo = o->lo, pa.hi = o->hi, pa.direction = o->direction, pa.ds_max = o->ds_max;
-    pa.max_points = o->max_points, pa.cascade = o->cascade, pa.csv = a->csv;
-    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    pa.settle = o->settle, pa.period = o->period, pa.cascade = o->cascade, pa.csv = a->csv;
+    cm_status st = a->png ? cm_fail(CM_EINVAL, msg, msg_size,
+                                    "periodic draws no figure: give csv only")
+                          : branch_of(&o->b, o->cascade != 0, &pa.b, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(a->csv, false, msg, msg_size);
     if (st != CM_OK)
         return st;
     po_result r;

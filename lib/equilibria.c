@@ -17,7 +17,7 @@ eq_args equilibria_defaults(void)
     eq_args a;
     memset(&a, 0, sizeof a);
     a.mo.name = "chip-4d";
-    a.max_points = 10000;
+    a.b.max_points = 10000;
     return a;
 }
 
@@ -61,20 +61,6 @@ static int on_hopf(void *user, double q, const cm_eq_event *ev)
     return 0;
 }
 
-/* A scalar parameter of m named name: its value in *v. */
-static cm_status scalar_param(const cm_model *m, const char *name, const char *what, double *v,
-                              char *msg, size_t msg_size)
-{
-    const int k = cm_params_find(&m->values, name);
-    if (k < 0 || m->values.spec[k].max_count != 1 || m->values.spec[k].choices)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the %s '%s' is not a number parameter of model %s (`cellmap models` "
-                       "lists them)",
-                       what, name, m->name);
-    *v = m->values.value[k].v[0];
-    return CM_OK;
-}
-
 static cm_status check_request(const eq_args *a, const cm_model *m, double *p0, char *msg,
                                size_t msg_size)
 {
@@ -84,7 +70,7 @@ static cm_status check_request(const eq_args *a, const cm_model *m, double *p0, 
                        "field (e.g. chip-4d, duffing, a plugin's flow)",
                        m->name);
     const int n = cm_flow_dim(m);
-    if (a->n_from != n) {
+    if (a->b.n_from != n) {
         char names[256] = "";
         for (int d = 0; d < n; d++)
             snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", d ? ", " : "",
@@ -92,34 +78,20 @@ static cm_status check_request(const eq_args *a, const cm_model *m, double *p0, 
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the start has %d value(s) but the flow of model %s has %d coordinates "
                        "(%s)",
-                       a->n_from, m->name, n, names);
+                       a->b.n_from, m->name, n, names);
     }
-    *p0 = NAN;
-    if (!a->branch[0]) {
-        if (a->has_curve)
-            return cm_fail(CM_EINVAL, msg, msg_size,
-                           "a Hopf curve needs a branch: name the parameter the branch follows");
-        return CM_OK;
-    }
-    if (a->has_curve && a->direction)
+    if (a->has_curve && (!a->b.name[0] || a->b.direction))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "a Hopf curve takes the branch over its whole range: give no direction");
-    cm_status st = scalar_param(m, a->branch, "branch's parameter", p0, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    if (!(a->lo < a->hi && isfinite(a->lo) && isfinite(a->hi)) || *p0 < a->lo || *p0 > a->hi)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the branch's range %s=%g:%g must hold the model's %s = %g (set it with "
-                       "the parameters, e.g. %s=%g)",
-                       a->branch, a->lo, a->hi, a->branch, *p0, a->branch,
-                       0.5 * (a->lo + a->hi));
-    if (a->has_curve) {
+                       "a Hopf curve needs a branch over its whole range: name the parameter it "
+                       "follows and give no direction");
+    cm_status st = branch_spec_check(&a->b, m, p0, msg, msg_size);
+    if (st == CM_OK && a->has_curve) {
         double q;
-        if (strcmp(a->curve.name, a->branch) == 0)
+        if (strcmp(a->curve.name, a->b.name) == 0)
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "the Hopf curve's parameter must differ from the branch's (%s)",
-                           a->branch);
-        st = scalar_param(m, a->curve.name, "Hopf curve's parameter", &q, msg, msg_size);
+                           a->b.name);
+        st = param_number(m, a->curve.name, "the Hopf curve's parameter", &q, msg, msg_size);
     }
     return st;
 }
@@ -148,12 +120,12 @@ static void join_way(eq_result *r, int direction, size_t pts_from, size_t events
 static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *msg,
                                size_t msg_size)
 {
-    param_builder u = {&a->mo, {a->branch, NULL}};
+    param_builder u = {&a->mo, {a->b.name, NULL}};
     for (int way = 0; way < 2; way++) {
         const int direction = way == 0 ? -1 : 1;
-        if (a->direction && a->direction != direction)
+        if (a->b.direction && a->b.direction != direction)
             continue;
-        const cm_branch_options o = {a->lo, a->hi, direction, 0, a->ds_max, a->max_points};
+        const cm_branch_options o = {a->b.lo, a->b.hi, direction, 0, a->b.ds_max, a->b.max_points};
         const size_t pts_from = r->n_pts, events_from = r->n_events;
         const cm_status st =
             cm_flow_equilibrium_branch(param_model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
@@ -178,10 +150,10 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
     if ((st = check_request(a, &r->m, &p0, msg, msg_size)) != CM_OK)
         return st;
     double x[CM_MAX_DIM];
-    memcpy(x, a->from, sizeof x);
+    memcpy(x, a->b.from, sizeof x);
     if ((st = cm_flow_equilibrium(&r->m, p0, x, &r->start, msg, msg_size)) != CM_OK)
         return st;
-    if (a->branch[0] && (st = follow_branch(a, r, p0, msg, msg_size)) != CM_OK)
+    if (a->b.name[0] && (st = follow_branch(a, r, p0, msg, msg_size)) != CM_OK)
         return st;
     if (!a->has_curve)
         return CM_OK;
@@ -189,8 +161,8 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
     for (int k = 0; k < a->curve.n; k++)
         q[k] = param_axis_value(&a->curve, k);
     /* each value's branch from the lowest point of this one, upwards */
-    param_builder u = {&a->mo, {a->branch, a->curve.name}};
-    const cm_branch_options o = {a->lo, a->hi, 1, 0, a->ds_max, a->max_points};
+    param_builder u = {&a->mo, {a->b.name, a->curve.name}};
+    const cm_branch_options o = {a->b.lo, a->b.hi, 1, 0, a->b.ds_max, a->b.max_points};
     const cm_equilibrium *low = r->n_pts ? &r->pts[0] : &r->start;
     return cm_flow_hopf_curve(param_model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
                               msg_size);
@@ -202,7 +174,7 @@ static void row(FILE *f, const eq_args *a, const char *kind, double q, const cm_
                 double omega)
 {
     fprintf(f, "%s", kind);
-    if (a->branch[0])
+    if (a->b.name[0])
         fprintf(f, ",%.17g", e->p);
     if (a->has_curve)
         fprintf(f, ",%.17g", q);
@@ -223,8 +195,8 @@ cm_status equilibria_write(const eq_args *a, const eq_result *r, char *msg, size
         return st;
     const int n = cm_flow_dim(&r->m);
     fprintf(o.f, "kind");
-    if (a->branch[0])
-        fprintf(o.f, ",%s", a->branch);
+    if (a->b.name[0])
+        fprintf(o.f, ",%s", a->b.name);
     if (a->has_curve)
         fprintf(o.f, ",%s", a->curve.name);
     for (int d = 0; d < n; d++)
@@ -235,7 +207,7 @@ cm_status equilibria_write(const eq_args *a, const eq_result *r, char *msg, size
     if (a->has_curve) {
         for (size_t k = 0; k < r->n_hopf; k++)
             row(o.f, a, "hopf", r->hopf[k].q, &r->hopf[k].ev.at, r->hopf[k].ev.omega);
-    } else if (!a->branch[0]) {
+    } else if (!a->b.name[0]) {
         row(o.f, a, "equilibrium", NAN, &r->start, NAN);
     } else {
         /* the points and, between them, the events in branch order */

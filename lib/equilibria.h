@@ -15,13 +15,7 @@
 
 typedef struct eq_args {
     model_spec mo;
-    double from[CM_MAX_DIM]; /* the start of Newton, in the flow's coordinates */
-    int n_from;
-    char branch[32]; /* the branch's parameter; "" for one equilibrium */
-    double lo, hi;   /* its range, holding the model's value of it */
-    int direction;   /* +1 or -1: that way only; 0: both ways */
-    double ds_max;   /* the longest arclength step; 0: (hi - lo) / 50 */
-    int max_points;  /* per direction */
+    branch_spec b;    /* from: the start of Newton, in the flow's coordinates */
     param_axis curve; /* with a branch: the Hopf points at each of these values */
     bool has_curve;
     const char *csv;

@@ -161,6 +161,36 @@ bool model_with_values(const model_spec *mo, const char *const *names, const dou
     return cm_model_set_create(&mo->set, mo->name, texts, k, m, msg, msg_size) == CM_OK;
 }
 
+cm_status param_number(const cm_model *m, const char *name, const char *what, double *v,
+                       char *msg, size_t msg_size)
+{
+    const int k = cm_params_find(&m->values, name);
+    if (k < 0 || m->values.spec[k].max_count != 1 || m->values.spec[k].choices)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s '%s' is not a number parameter of model %s (`cellmap models` lists "
+                       "them)",
+                       what, name, m->name);
+    *v = m->values.value[k].v[0];
+    return CM_OK;
+}
+
+cm_status branch_spec_check(const branch_spec *b, const cm_model *m, double *p0, char *msg,
+                            size_t msg_size)
+{
+    *p0 = NAN;
+    if (!b->name[0])
+        return CM_OK;
+    const cm_status st = param_number(m, b->name, "the branch's parameter", p0, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (!(b->lo < b->hi && isfinite(b->lo) && isfinite(b->hi)) || *p0 < b->lo || *p0 > b->hi)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the branch's range %s=%g:%g must hold the model's %s = %g (set it with "
+                       "the parameters, e.g. %s=%g)",
+                       b->name, b->lo, b->hi, b->name, *p0, b->name, 0.5 * (b->lo + b->hi));
+    return CM_OK;
+}
+
 cm_status param_model_at(void *user, double p, cm_model *m, char *msg, size_t msg_size)
 {
     const param_builder *b = user;

@@ -62,6 +62,30 @@ cm_status param_sweep_base(const model_spec *mo, const char *only, const param_a
 bool model_with_values(const model_spec *mo, const char *const *names, const double *values, int n,
                        cm_model *m, char *msg, size_t msg_size);
 
+/* A branch to follow in one parameter (equilibria, periodic orbits):
+ * the start and, when name is not "", the parameter, its range and how
+ * the continuation steps. */
+typedef struct branch_spec {
+    double from[CM_MAX_DIM]; /* the start, in the coordinates the driver says */
+    int n_from;
+    char name[32];  /* the parameter; "": no branch */
+    double lo, hi;  /* its range, holding the model's value */
+    int direction;  /* +1 or -1: that way only; 0: both */
+    double ds_max;  /* the longest arclength step; 0: (hi - lo) / 50 */
+    int max_points; /* per way */
+} branch_spec;
+
+/* m's value of its number parameter name into *v; CM_EINVAL naming the
+ * parameter (as `what`: "the branch's parameter") when m has none such. */
+cm_status param_number(const cm_model *m, const char *name, const char *what, double *v,
+                       char *msg, size_t msg_size);
+
+/* Checks a branch against model m: the parameter is one of m's numbers
+ * and the range (finite, LO < HI) holds m's value of it, into *p0 (NAN
+ * without a branch). CM_EINVAL naming the fix. */
+cm_status branch_spec_check(const branch_spec *b, const cm_model *m, double *p0, char *msg,
+                            size_t msg_size);
+
 /* Builders of the model of mo with one or two parameters (names[0],
  * names[1]) set, for the continuation kernels (models/arclength.h's
  * cm_model_at_fn; user: a param_builder). */

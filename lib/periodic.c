@@ -20,7 +20,7 @@ po_args periodic_defaults(void)
     memset(&a, 0, sizeof a);
     a.mo.name = "chip-4d";
     a.period = 1;
-    a.max_points = 10000;
+    a.b.max_points = 10000;
     return a;
 }
 
@@ -70,50 +70,24 @@ static int on_event(void *user, const cm_po_event *ev)
     return 0;
 }
 
-/* A scalar parameter of m named name: its value in *v. */
-static cm_status branch_param(const cm_model *m, const char *name, double *v, char *msg,
-                              size_t msg_size)
-{
-    const int k = cm_params_find(&m->values, name);
-    if (k < 0 || m->values.spec[k].max_count != 1 || m->values.spec[k].choices)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the branch's parameter '%s' is not a number parameter of model %s "
-                       "(`cellmap models` lists them)",
-                       name, m->name);
-    *v = m->values.value[k].v[0];
-    return CM_OK;
-}
-
 static cm_status check_request(const po_args *a, const cm_model *m, double *p0, char *msg,
                                size_t msg_size)
 {
-    if (a->n_from != m->dim)
+    if (a->b.n_from != m->dim)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the start has %d value(s) but model %s's map has dimension %d", a->n_from,
+                       "the start has %d value(s) but model %s's map has dimension %d", a->b.n_from,
                        m->name, m->dim);
     if (a->period < 1 || a->period > 4096 || a->settle < 0 || a->settle > 10000000)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "a period of %d and %d settling iterates: give a period of 1..4096 and "
                        "0..1e7 iterates",
                        a->period, a->settle);
-    *p0 = NAN;
-    if (!a->branch[0])
-        return a->cascade ? cm_fail(CM_EINVAL, msg, msg_size,
-                                    "a cascade needs a branch: name the parameter it follows")
-                          : CM_OK;
-    if (a->cascade && (a->direction == 0 || a->cascade > PERIODIC_MAX_CASCADE))
+    if (a->cascade && (!a->b.name[0] || a->b.direction == 0 || a->cascade > PERIODIC_MAX_CASCADE))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "a cascade of %d doublings: give 1..%d and the direction it goes (up or "
-                       "down)",
+                       "a cascade of %d doublings: give 1..%d, the parameter it follows and the "
+                       "direction it goes (up or down)",
                        a->cascade, PERIODIC_MAX_CASCADE);
-    cm_status st = branch_param(m, a->branch, p0, msg, msg_size);
-    if (st == CM_OK &&
-        (!(a->lo < a->hi && isfinite(a->lo) && isfinite(a->hi)) || *p0 < a->lo || *p0 > a->hi))
-        st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "the branch's range %s=%g:%g must hold the model's %s = %g (set it with the "
-                     "parameters, e.g. %s=%g)",
-                     a->branch, a->lo, a->hi, a->branch, *p0, a->branch, 0.5 * (a->lo + a->hi));
-    return st;
+    return branch_spec_check(&a->b, m, p0, msg, msg_size);
 }
 
 /* The way just followed (points from pts_from, events from events_from)
@@ -145,7 +119,7 @@ static cm_status follow(const po_args *a, const param_builder *u, int period, do
         const int dir = way == 0 ? -1 : 1;
         if (direction && direction != dir)
             continue;
-        const cm_branch_options o = {a->lo, a->hi, dir, 0, a->ds_max, a->max_points};
+        const cm_branch_options o = {a->b.lo, a->b.hi, dir, 0, a->b.ds_max, a->b.max_points};
         const size_t pts_from = r->n_pts, events_from = r->n_events;
         int why = 0;
         const cm_status st =
@@ -172,20 +146,20 @@ static cm_status cascade(const po_args *a, const param_builder *u, po_result *r,
     int period = a->period;
     for (int k = 0; k < a->cascade; k++) {
         collect c = {r, true, false, {0}};
-        cm_status st = follow(a, u, period, p, x, a->direction, &c, msg, msg_size);
+        cm_status st = follow(a, u, period, p, x, a->b.direction, &c, msg, msg_size);
         if (st != CM_OK)
             return st;
         if (!c.doubled)
             return k > 0 ? CM_OK /* the range holds no more doublings */
                          : cm_fail(CM_ENOTFOUND, msg, msg_size,
                                    "the period-%d branch has no period doubling in %s=%g:%g",
-                                   period, a->branch, a->lo, a->hi);
+                                   period, a->b.name, a->b.lo, a->b.hi);
         r->doublings[r->n_doublings++] = c.pd.at.p;
         if (k + 1 == a->cascade)
             break;
         /* the step from the doubling: 1e-4 shrinking as the cascade's
          * spacing does */
-        const double dp = a->direction * 1e-4 * pow(FEIGENBAUM_DELTA, -k);
+        const double dp = a->b.direction * 1e-4 * pow(FEIGENBAUM_DELTA, -k);
         st = cm_map_period_doubled(param_model_at, (void *)u, &c.pd, dp, x, &p, msg, msg_size);
         if (st != CM_OK)
             return st;
@@ -231,7 +205,7 @@ cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg
         st = check_request(a, &r->m, &p0, msg, msg_size);
     if (st != CM_OK)
         return st;
-    memcpy(x, a->from, sizeof x);
+    memcpy(x, a->b.from, sizeof x);
     for (int k = 0; k < a->settle; k++)
         if (r->m.step(&r->m, x, x) != CM_STEP_OK)
             return cm_fail(CM_ENOTFOUND, msg, msg_size,
@@ -240,20 +214,20 @@ cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg
                            k);
     if ((st = cm_map_periodic_point(&r->m, p0, a->period, x, &r->start, msg, msg_size)) != CM_OK)
         return st;
-    if (!a->branch[0])
+    if (!a->b.name[0])
         return CM_OK;
-    const param_builder u = {&mo, {a->branch, NULL}};
+    const param_builder u = {&mo, {a->b.name, NULL}};
     if (a->cascade)
         return cascade(a, &u, r, p0, msg, msg_size);
     collect c = {r, false, false, {0}};
-    return follow(a, &u, a->period, p0, r->start.x, a->direction, &c, msg, msg_size);
+    return follow(a, &u, a->period, p0, r->start.x, a->b.direction, &c, msg, msg_size);
 }
 
 /* One CSV row. */
 static void row(FILE *f, const po_args *a, const char *kind, const cm_periodic_point *pt)
 {
     fprintf(f, "%s,%d", kind, pt->period);
-    if (a->branch[0])
+    if (a->b.name[0])
         fprintf(f, ",%.17g", pt->p);
     for (int d = 0; d < pt->dim; d++)
         fprintf(f, ",%.17g", pt->x[d]);
@@ -272,14 +246,14 @@ cm_status periodic_write(const po_args *a, const po_result *r, char *msg, size_t
         return st;
     const int n = r->m.dim;
     fprintf(o.f, "kind,period");
-    if (a->branch[0])
-        fprintf(o.f, ",%s", a->branch);
+    if (a->b.name[0])
+        fprintf(o.f, ",%s", a->b.name);
     for (int d = 0; d < n; d++)
         fprintf(o.f, ",%s", cm_model_coord_name(&r->m, d));
     for (int d = 1; d <= n; d++)
         fprintf(o.f, ",re_%d,im_%d", d, d);
     fprintf(o.f, ",outside\n");
-    if (!a->branch[0]) {
+    if (!a->b.name[0]) {
         row(o.f, a, "point", &r->start);
     } else {
         size_t e = 0;

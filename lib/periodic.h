@@ -19,16 +19,10 @@ enum { PERIODIC_MAX_CASCADE = 12 };
 
 typedef struct po_args {
     model_spec mo;
-    double from[CM_MAX_DIM]; /* in the map's coordinates */
-    int n_from;
-    int settle;  /* iterates of the map from `from` before Newton */
-    int period;  /* 1.. */
-    char branch[32]; /* "" for one point */
-    double lo, hi;
-    int direction;  /* +1 or -1: that way only; 0: both (not with a cascade) */
-    double ds_max;  /* 0: (hi - lo) / 50 */
-    int max_points; /* per branch and way */
-    int cascade;    /* doublings to follow (0: none; needs a direction) */
+    branch_spec b; /* from: in the map's coordinates; a cascade needs a direction */
+    int settle;    /* iterates of the map from b.from before Newton */
+    int period;    /* 1.. */
+    int cascade;   /* doublings to follow (0: none) */
     const char *csv;
 } po_args;
 

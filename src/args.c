@@ -225,3 +225,54 @@ int sweep_check(const cli *c, const model_opts *mo, const char *only, const para
         return EXIT_OK;
     return cli_usage_error(c, "%s", msg);
 }
+
+/* "P=LO:HI" into b's name, lo and hi; 0 or the usage error. */
+static int parse_branch(const cli *c, branch_spec *b)
+{
+    const char *v = c->value, *eq = strchr(v, '='), *colon = eq ? strchr(eq + 1, ':') : NULL;
+    char lo[64], hi[64];
+    if (!eq || eq == v || (size_t)(eq - v) >= sizeof b->name || !colon ||
+        (size_t)(colon - eq - 1) >= sizeof lo || strlen(colon + 1) >= sizeof hi)
+        return cli_usage_error(c, "--branch: '%s' is not P=LO:HI (e.g. xi=0.5:15)", v);
+    memcpy(b->name, v, (size_t)(eq - v));
+    b->name[eq - v] = 0;
+    memcpy(lo, eq + 1, (size_t)(colon - eq - 1));
+    lo[colon - eq - 1] = 0;
+    strcpy(hi, colon + 1);
+    if (!parse_double(lo, &b->lo) || !parse_double(hi, &b->hi) || !(b->lo < b->hi))
+        return cli_usage_error(c, "--branch: '%s' needs numbers LO < HI (e.g. xi=0.5:15)", v);
+    return 0;
+}
+
+bool branch_opts_take(cli *c, branch_spec *b, int *error)
+{
+    if (cli_is(c, "--from", true, error)) {
+        if (c->value && !parse_doubles(c->value, b->from, &b->n_from, CM_MAX_DIM))
+            *error = cli_usage_error(c, "--from: '%s' is not a list of numbers X[,Y...]",
+                                     c->value);
+    } else if (cli_is(c, "--branch", true, error)) {
+        if (c->value)
+            *error = parse_branch(c, b);
+    } else if (cli_is(c, "--direction", true, error)) {
+        if (c->value && strcmp(c->value, "up") && strcmp(c->value, "down"))
+            *error = cli_usage_error(c, "--direction: '%s' is not up or down", c->value);
+        else if (c->value)
+            b->direction = strcmp(c->value, "up") == 0 ? 1 : -1;
+    } else if (cli_is(c, "--ds-max", true, error)) {
+        if (c->value && (!parse_double(c->value, &b->ds_max) || !(b->ds_max > 0)))
+            *error = cli_usage_error(c, "--ds-max: '%s' must be a number above 0", c->value);
+    } else if (!cli_take_int(c, "--max-points", 10, 1000000, &b->max_points, error)) {
+        return false;
+    }
+    return true;
+}
+
+int branch_opts_check(const cli *c, const branch_spec *b, bool extra, const char *extra_name)
+{
+    if (b->n_from == 0)
+        return cli_usage_error(c, "--from X[,Y...] is required: where Newton's method starts");
+    if ((extra || b->direction || b->ds_max > 0) && !b->name[0])
+        return cli_usage_error(c, "%s, --direction and --ds-max need --branch P=LO:HI",
+                               extra_name);
+    return 0;
+}

@@ -71,6 +71,15 @@ bool model_opts_take(cli *c, model_opts *mo, int *error);
 /* Builds the model; prints the problem and returns EXIT_USAGE on failure. */
 int model_opts_build(const cli *c, const model_opts *mo, cm_model *m);
 
+/* A branch's options (branch_spec, lib/param_grid.h): --from X[,Y...],
+ * --branch P=LO:HI, --direction up|down, --ds-max D, --max-points N; true
+ * if the current option was one. */
+bool branch_opts_take(cli *c, branch_spec *b, int *error);
+/* After the options: --from given, and the settings that need a branch
+ * (those of branch_spec, and `extra`, named, when set) only with one.
+ * Returns 0 or the error's status. */
+int branch_opts_check(const cli *c, const branch_spec *b, bool extra, const char *extra_name);
+
 /* --region LO:HI[,LO:HI...] and --cells N[xM...] (lib/project.h). */
 typedef lattice_spec lattice_opts;
 

@@ -8,7 +8,6 @@
 
 #include "lib/equilibria.h"
 #include "lib/json.h"
-#include "lib/parse.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/outfile.h"
@@ -41,26 +40,6 @@ static const char equilibria_help[] =
     "  --json              the summary as JSON on standard output\n"
     "  --quiet             no summary\n";
 
-static int parse_branch(cli *c, eq_args *a, int *err)
-{
-    const char *v = c->value, *eq = v ? strchr(v, '=') : NULL;
-    char lo[64], hi[64];
-    const char *colon = eq ? strchr(eq + 1, ':') : NULL;
-    if (!eq || eq == v || (size_t)(eq - v) >= sizeof a->branch || !colon ||
-        (size_t)(colon - eq - 1) >= sizeof lo || strlen(colon + 1) >= sizeof hi) {
-        *err = cli_usage_error(c, "--branch: '%s' is not P=LO:HI (e.g. xi=0.5:15)", v ? v : "");
-        return 0;
-    }
-    memcpy(a->branch, v, (size_t)(eq - v));
-    a->branch[eq - v] = 0;
-    memcpy(lo, eq + 1, (size_t)(colon - eq - 1));
-    lo[colon - eq - 1] = 0;
-    strcpy(hi, colon + 1);
-    if (!parse_double(lo, &a->lo) || !parse_double(hi, &a->hi) || !(a->lo < a->hi))
-        *err = cli_usage_error(c, "--branch: '%s' needs numbers LO < HI (e.g. xi=0.5:15)", v);
-    return 0;
-}
-
 /* 0: go on; -1: --help was printed; else the usage error. */
 static int parse_args(cli *c, eq_args *a, bool *json, bool *quiet)
 {
@@ -70,22 +49,7 @@ static int parse_args(cli *c, eq_args *a, bool *json, bool *quiet)
             fputs(equilibria_help, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
-        } else if (cli_is(c, "--from", true, &err)) {
-            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
-                err = cli_usage_error(c, "--from: '%s' is not a list of numbers X[,Y...]",
-                                      c->value);
-        } else if (cli_is(c, "--branch", true, &err)) {
-            if (c->value)
-                parse_branch(c, a, &err);
-        } else if (cli_is(c, "--direction", true, &err)) {
-            if (c->value && strcmp(c->value, "up") && strcmp(c->value, "down"))
-                err = cli_usage_error(c, "--direction: '%s' is not up or down", c->value);
-            else if (c->value)
-                a->direction = strcmp(c->value, "up") == 0 ? 1 : -1;
-        } else if (cli_is(c, "--ds-max", true, &err)) {
-            if (c->value && (!parse_double(c->value, &a->ds_max) || !(a->ds_max > 0)))
-                err = cli_usage_error(c, "--ds-max: '%s' must be a number above 0", c->value);
-        } else if (cli_take_int(c, "--max-points", 10, 1000000, &a->max_points, &err)) {
+        } else if (branch_opts_take(c, &a->b, &err)) {
         } else if (cli_is(c, "--curve", true, &err)) {
             if (c->value && !param_axis_parse(c->value, strlen(c->value), &a->curve))
                 err = cli_usage_error(c,
@@ -103,11 +67,7 @@ static int parse_args(cli *c, eq_args *a, bool *json, bool *quiet)
             err = cli_stray(c);
         }
     }
-    if (!err && a->n_from == 0)
-        err = cli_usage_error(c, "--from X[,Y...] is required: where Newton's method starts");
-    if (!err && (a->has_curve || a->direction || a->ds_max > 0) && !a->branch[0])
-        err = cli_usage_error(c, "--curve, --direction and --ds-max need --branch P=LO:HI");
-    return err;
+    return err ? err : branch_opts_check(c, &a->b, a->has_curve, "--curve");
 }
 
 static void print_eigenvalues(FILE *f, const cm_equilibrium *e)
@@ -134,8 +94,8 @@ static void print_summary(FILE *f, const eq_args *a, const eq_result *r)
     fprintf(f, "\neigenvalues: ");
     print_eigenvalues(f, &r->start);
     fprintf(f, "\n%s\n", r->start.unstable ? "unstable" : "stable");
-    if (a->branch[0]) {
-        fprintf(f, "branch in %s over %g:%g: %zu points", a->branch, a->lo, a->hi, r->n_pts);
+    if (a->b.name[0]) {
+        fprintf(f, "branch in %s over %g:%g: %zu points", a->b.name, a->b.lo, a->b.hi, r->n_pts);
         if (r->why[0])
             fprintf(f, "; down: %s", equilibria_why(r->why[0]));
         if (r->why[1])
@@ -143,7 +103,7 @@ static void print_summary(FILE *f, const eq_args *a, const eq_result *r)
         fprintf(f, "\n");
         for (size_t k = 0; !a->has_curve && k < r->n_events; k++) {
             const cm_eq_event *ev = &r->events[k].ev;
-            fprintf(f, "%s at %s = %.9g", equilibria_event_name(ev->kind), a->branch, ev->at.p);
+            fprintf(f, "%s at %s = %.9g", equilibria_event_name(ev->kind), a->b.name, ev->at.p);
             if (ev->kind == CM_EQ_HOPF)
                 fprintf(f, ", omega %.6g", ev->omega);
             fprintf(f, " (");
@@ -153,7 +113,7 @@ static void print_summary(FILE *f, const eq_args *a, const eq_result *r)
     }
     for (size_t k = 0; k < r->n_hopf; k++)
         fprintf(f, "hopf at %s = %.9g, %s = %.9g, omega %.6g\n", a->curve.name, r->hopf[k].q,
-                a->branch, r->hopf[k].ev.at.p, r->hopf[k].ev.omega);
+                a->b.name, r->hopf[k].ev.at.p, r->hopf[k].ev.omega);
 }
 
 static void print_json(const eq_args *a, const eq_result *r)
@@ -161,13 +121,13 @@ static void print_json(const eq_args *a, const eq_result *r)
     json j;
     json_begin(&j, stdout, "equilibria");
     json_model(&j, &r->m);
-    json_nums(&j, "from", a->from, a->n_from);
+    json_nums(&j, "from", a->b.from, a->b.n_from);
     json_nums(&j, "equilibrium", r->start.x, r->start.dim);
     json_nums(&j, "re", r->start.re, r->start.dim);
     json_nums(&j, "im", r->start.im, r->start.dim);
     json_int(&j, "unstable", r->start.unstable);
-    if (a->branch[0]) {
-        json_str(&j, "branch", a->branch);
+    if (a->b.name[0]) {
+        json_str(&j, "branch", a->b.name);
         json_int(&j, "points", (long long)r->n_pts);
         json_array(&j, "events");
         for (size_t k = 0; k < r->n_events; k++) {

@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "lib/json.h"
-#include "lib/parse.h"
 #include "lib/periodic.h"
 #include "src/args.h"
 #include "src/commands.h"
@@ -46,24 +45,6 @@ static const char periodic_help[] =
     "  --json              the summary as JSON on standard output\n"
     "  --quiet             no summary\n";
 
-/* "P=LO:HI" into a->branch, lo, hi; 0 or the usage error. */
-static int parse_branch(cli *c, po_args *a)
-{
-    const char *v = c->value, *eq = strchr(v, '='), *colon = eq ? strchr(eq + 1, ':') : NULL;
-    char lo[64], hi[64];
-    if (!eq || eq == v || (size_t)(eq - v) >= sizeof a->branch || !colon ||
-        (size_t)(colon - eq - 1) >= sizeof lo || strlen(colon + 1) >= sizeof hi)
-        return cli_usage_error(c, "--branch: '%s' is not P=LO:HI (e.g. xi=2.9:4.36)", v);
-    memcpy(a->branch, v, (size_t)(eq - v));
-    a->branch[eq - v] = 0;
-    memcpy(lo, eq + 1, (size_t)(colon - eq - 1));
-    lo[colon - eq - 1] = 0;
-    strcpy(hi, colon + 1);
-    if (!parse_double(lo, &a->lo) || !parse_double(hi, &a->hi) || !(a->lo < a->hi))
-        return cli_usage_error(c, "--branch: '%s' needs numbers LO < HI (e.g. xi=2.9:4.36)", v);
-    return 0;
-}
-
 /* 0: go on; -1: --help was printed; else the usage error. */
 static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
 {
@@ -73,24 +54,9 @@ static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
             fputs(periodic_help, stdout);
             return -1;
         } else if (model_opts_take(c, &a->mo, &err)) {
-        } else if (cli_is(c, "--from", true, &err)) {
-            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
-                err = cli_usage_error(c, "--from: '%s' is not a list of numbers X[,Y...]",
-                                      c->value);
+        } else if (branch_opts_take(c, &a->b, &err)) {
         } else if (cli_take_int(c, "--settle", 0, 10000000, &a->settle, &err)) {
         } else if (cli_take_int(c, "--period", 1, 4096, &a->period, &err)) {
-        } else if (cli_is(c, "--branch", true, &err)) {
-            if (c->value)
-                err = parse_branch(c, a);
-        } else if (cli_is(c, "--direction", true, &err)) {
-            if (c->value && strcmp(c->value, "up") && strcmp(c->value, "down"))
-                err = cli_usage_error(c, "--direction: '%s' is not up or down", c->value);
-            else if (c->value)
-                a->direction = strcmp(c->value, "up") == 0 ? 1 : -1;
-        } else if (cli_is(c, "--ds-max", true, &err)) {
-            if (c->value && (!parse_double(c->value, &a->ds_max) || !(a->ds_max > 0)))
-                err = cli_usage_error(c, "--ds-max: '%s' must be a number above 0", c->value);
-        } else if (cli_take_int(c, "--max-points", 10, 1000000, &a->max_points, &err)) {
         } else if (cli_take_int(c, "--cascade", 1, PERIODIC_MAX_CASCADE, &a->cascade, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
@@ -102,11 +68,9 @@ static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
             err = cli_stray(c);
         }
     }
-    if (!err && a->n_from == 0)
-        err = cli_usage_error(c, "--from X[,Y...] is required: where Newton's method starts");
-    if (!err && (a->cascade || a->direction || a->ds_max > 0) && !a->branch[0])
-        err = cli_usage_error(c, "--cascade, --direction and --ds-max need --branch P=LO:HI");
-    if (!err && a->cascade && !a->direction)
+    if (!err)
+        err = branch_opts_check(c, &a->b, a->cascade != 0, "--cascade");
+    if (!err && a->cascade && !a->b.direction)
         err = cli_usage_error(c, "--cascade needs --direction up or down: the way it goes");
     return err;
 }
@@ -132,13 +96,13 @@ static void print_summary(FILE *f, const po_args *a, const po_result *r)
     fprintf(f, "period-%d point: ", a->period);
     print_point(f, &r->m, &r->start);
     fprintf(f, "\n%s\n", r->start.outside ? "unstable" : "stable");
-    if (!a->branch[0])
+    if (!a->b.name[0])
         return;
-    fprintf(f, "%s over %g:%g: %zu points\n", a->branch, a->lo, a->hi, r->n_pts);
+    fprintf(f, "%s over %g:%g: %zu points\n", a->b.name, a->b.lo, a->b.hi, r->n_pts);
     for (size_t k = 0; k < r->n_events; k++) {
         const cm_po_event *ev = &r->events[k].ev;
         fprintf(f, "%s of period %d at %s = %.9g (", periodic_event_name(ev->kind),
-                ev->at.period, a->branch, ev->at.p);
+                ev->at.period, a->b.name, ev->at.p);
         print_point(f, &r->m, &ev->at);
         fprintf(f, ")\n");
     }
@@ -146,7 +110,7 @@ static void print_summary(FILE *f, const po_args *a, const po_result *r)
         fprintf(f, "Feigenbaum ratio %d: %.4f\n", k,
                 (r->doublings[k] - r->doublings[k - 1]) / (r->doublings[k + 1] - r->doublings[k]));
     if (r->n_doublings >= 2)
-        fprintf(f, "the cascade accumulates near %s = %.6g (delta = 4.6692)\n", a->branch,
+        fprintf(f, "the cascade accumulates near %s = %.6g (delta = 4.6692)\n", a->b.name,
                 periodic_accumulation(r));
 }
 
@@ -155,14 +119,14 @@ static void print_json(const po_args *a, const po_result *r)
     json j;
     json_begin(&j, stdout, "periodic");
     json_model(&j, &r->m);
-    json_nums(&j, "from", a->from, a->n_from);
+    json_nums(&j, "from", a->b.from, a->b.n_from);
     json_int(&j, "period", a->period);
     json_nums(&j, "point", r->start.x, r->start.dim);
     json_nums(&j, "re", r->start.re, r->start.dim);
     json_nums(&j, "im", r->start.im, r->start.dim);
     json_int(&j, "outside", r->start.outside);
-    if (a->branch[0]) {
-        json_str(&j, "branch", a->branch);
+    if (a->b.name[0]) {
+        json_str(&j, "branch", a->b.name);
         json_int(&j, "points", (long long)r->n_pts);
         json_array(&j, "events");
         for (size_t k = 0; k < r->n_events; k++) {

@@ -114,14 +114,14 @@ static void analyses(void)
     a = outputs("continue", f, 1);
     must(cm_analysis_continue(&a, &co, msg, sizeof msg), "continue", msg);
     cm_equilibria_options eqo = cm_equilibria_defaults();
-    eqo.from = (const double[]){1, 0.1, 0.2, 0.25}, eqo.n_from = 4;
-    eqo.branch = "xi", eqo.lo = 3, eqo.hi = 15;
+    eqo.b.from = (const double[]){1, 0.1, 0.2, 0.25}, eqo.b.n_from = 4;
+    eqo.b.name = "xi", eqo.b.lo = 3, eqo.b.hi = 15;
     eqo.curve = &(cm_axis){"zeta", 20, 21, 2};
     a = outputs("equilibria", f, 0);
     must(cm_analysis_equilibria(&a, &eqo, msg, sizeof msg), "equilibria", msg);
     cm_periodic_options po = cm_periodic_defaults();
-    po.from = (const double[]){1.05, 0.2, 0.27}, po.n_from = 3, po.settle = 100;
-    po.branch = "xi", po.lo = 2.9, po.hi = 4.1, po.direction = 1, po.cascade = 2;
+    po.b.from = (const double[]){1.05, 0.2, 0.27}, po.b.n_from = 3, po.settle = 100;
+    po.b.name = "xi", po.b.lo = 2.9, po.b.hi = 4.1, po.b.direction = 1, po.cascade = 2;
     a = outputs("periodic", f, 0);
     a.params = "xi=2.9";
     must(cm_analysis_periodic(&a, &po, msg, sizeof msg), "periodic", msg);

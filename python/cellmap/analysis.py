@@ -52,18 +52,18 @@ class _Escape(ctypes.Structure):
                 ("cells", ctypes.c_long), ("ensemble", ctypes.c_long)]
 
 
-class _Equilibria(ctypes.Structure):
-    _fields_ = [("start", _DOUBLES), ("n_from", ctypes.c_int), ("branch", ctypes.c_char_p),
+class _Branch(ctypes.Structure):
+    _fields_ = [("start", _DOUBLES), ("n_from", ctypes.c_int), ("name", ctypes.c_char_p),
                 ("lo", ctypes.c_double), ("hi", ctypes.c_double), ("direction", ctypes.c_int),
-                ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int),
-                ("curve", ctypes.POINTER(_Axis))]
+                ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int)]
+
+
+class _Equilibria(ctypes.Structure):
+    _fields_ = [("b", _Branch), ("curve", ctypes.POINTER(_Axis))]
 
 
 class _Periodic(ctypes.Structure):
-    _fields_ = [("start", _DOUBLES), ("n_from", ctypes.c_int), ("settle", ctypes.c_int),
-                ("period", ctypes.c_int), ("branch", ctypes.c_char_p), ("lo", ctypes.c_double),
-                ("hi", ctypes.c_double), ("direction", ctypes.c_int),
-                ("ds_max", ctypes.c_double), ("max_points", ctypes.c_int),
+    _fields_ = [("b", _Branch), ("settle", ctypes.c_int), ("period", ctypes.c_int),
                 ("cascade", ctypes.c_int)]
 
 
@@ -250,6 +250,26 @@ def escape(I0=None, sweep=None, cells=None, ensemble=None, **common):
     return _run(_common(**common), _lib.cm_analysis_escape, ctypes.byref(o))
 
 
+def _branch(b, start, branch, direction, ds_max, max_points):
+    """Fills the cm_branch b; returns what must live as long as it."""
+    st = (ctypes.c_double * len(start))(*map(float, start))
+    b.start, b.n_from = st, len(start)
+    name = None
+    if branch is not None:
+        try:
+            name, lo, hi = branch
+            name = _text(name)
+            b.name, b.lo, b.hi = name, float(lo), float(hi)
+        except (TypeError, ValueError):
+            raise ValueError("branch %r: give (name, lo, hi)" % (branch,)) from None
+    b.direction = int(direction)
+    if ds_max is not None:
+        b.ds_max = float(ds_max)
+    if max_points is not None:
+        b.max_points = int(max_points)
+    return st, name
+
+
 def equilibria(start, branch=None, direction=0, ds_max=None, max_points=None, curve=None,
                **common):
     """Equilibria of a flow (`cellmap equilibria`; model chip-4d unless
@@ -260,25 +280,11 @@ def equilibria(start, branch=None, direction=0, ds_max=None, max_points=None, cu
     parameter. The rows: kind, the parameters, the state, re_k/im_k,
     unstable, omega."""
     o = _lib.cm_equilibria_defaults()
-    st = (ctypes.c_double * len(start))(*map(float, start))
-    o.start, o.n_from = st, len(start)
-    keep = None
-    if branch is not None:
-        try:
-            name, lo, hi = branch
-            keep = _text(name)
-            o.branch, o.lo, o.hi = keep, float(lo), float(hi)
-        except (TypeError, ValueError):
-            raise ValueError("branch %r: give (name, lo, hi)" % (branch,)) from None
-    o.direction = int(direction)
-    if ds_max is not None:
-        o.ds_max = float(ds_max)
-    if max_points is not None:
-        o.max_points = int(max_points)
+    keep = _branch(o.b, start, branch, direction, ds_max, max_points)
     ax = _axis(curve, what="curve") if curve is not None else None
     o.curve = ctypes.pointer(ax) if ax is not None else None
     table = _run(_common(**common), _lib.cm_analysis_equilibria, ctypes.byref(o))
-    del keep, st
+    del keep
     return table
 
 
@@ -292,23 +298,10 @@ def periodic(start, settle=0, period=1, branch=None, direction=0, ds_max=None,
     to at the last (needs a direction). The rows: kind, period, the
     parameter, the state, re_k/im_k, outside."""
     o = _lib.cm_periodic_defaults()
-    st = (ctypes.c_double * len(start))(*map(float, start))
-    o.start, o.n_from, o.settle, o.period = st, len(start), int(settle), int(period)
-    keep = None
-    if branch is not None:
-        try:
-            name, lo, hi = branch
-            keep = _text(name)
-            o.branch, o.lo, o.hi = keep, float(lo), float(hi)
-        except (TypeError, ValueError):
-            raise ValueError("branch %r: give (name, lo, hi)" % (branch,)) from None
-    o.direction, o.cascade = int(direction), int(cascade)
-    if ds_max is not None:
-        o.ds_max = float(ds_max)
-    if max_points is not None:
-        o.max_points = int(max_points)
+    keep = _branch(o.b, start, branch, direction, ds_max, max_points)
+    o.settle, o.period, o.cascade = int(settle), int(period), int(cascade)
     table = _run(_common(**common), _lib.cm_analysis_periodic, ctypes.byref(o))
-    del keep, st
+    del keep
     return table
 
 
