@@ -21,7 +21,7 @@
 #include "cellmap/numtext.h" /* models print their parameters with it */
 #include "cellmap/overlay.h"
 
-#define CM_MAX_PARAMS 16
+#define CM_MAX_PARAMS 24
 #define CM_PARAM_MAX_VALUES 64
 
 /* Description of one parameter. A scalar has max_count 1; a vector parameter

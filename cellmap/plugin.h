@@ -27,7 +27,7 @@
 #include "cellmap/model.h"
 
 #define CM_PLUGIN_ABI 4 /* 2: cm_model.flow; 3: cm_model.period (angles); 4: stiff
-                          * integrators, sections on state planes */
+                          * integrators, sections on state planes, 24 parameters */
 
 typedef struct cm_plugin_model {
     const char *name;   /* as --model takes it */

@@ -3,7 +3,9 @@
  * the chip's layers, (3.27)-(3.31), as the Poincare map of a state plane
  * (by default T0 = 0.1 crossed downwards, where the successive tau2 make
  * the thesis' one-dimensional map of Fig. 3.6: the map's state is (tau2,
- * T1, T2) there). */
+ * T1, T2) there); and the same cutting on an elastic workpiece,
+ * (3.12)-(3.16), as the map of the workpiece's largest deflections (its
+ * velocity v = 0 crossed downwards). */
 #include <math.h>
 
 #include "models/chip_formation.h"
@@ -11,14 +13,19 @@
 #include "models/ode_flow.h"
 #include "models/params.h"
 
+/* The coefficients both models share: xi, zeta (its default given),
+ * eta and the law's p, a, b and T_Phi. */
+#define CHIP_SPECS(zeta)                                                                       \
+    {"xi", "4.8", -100, 100, 1, NULL, "xi: heat carried away with the chip (3.28)-(3.30)"},    \
+        {"zeta", zeta, 0, 1000, 1, NULL, "zeta: heat conduction between the layers"},          \
+        {"eta", "4.4", 0, 1000, 1, NULL, "eta: plastic work turned into heat"},                \
+        {"p", "1.03", 0, 10, 1, NULL, "p: tau1 = p tau2 + 1 - p (3.6)"},                       \
+        {"a", "0.3", 0, 10, 1, NULL, "a: the flow stress' temperature coefficient (3.31)"},    \
+        {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity (3.31); small is stiff"}, \
+        {"T_Phi", "1", -0.99, 100, 1, NULL, "T_Phi: the reference temperature (3.31)"}
+
 const cm_param_spec cm_chip_4d_spec[] = {
-    {"xi", "4.8", -100, 100, 1, NULL, "xi: heat carried away with the chip (3.28)-(3.30)"},
-    {"zeta", "21", 0, 1000, 1, NULL, "zeta: heat conduction between the layers"},
-    {"eta", "4.4", 0, 1000, 1, NULL, "eta: plastic work turned into heat"},
-    {"p", "1.03", 0, 10, 1, NULL, "p: tau1 = p tau2 + 1 - p (3.6)"},
-    {"a", "0.3", 0, 10, 1, NULL, "a: the flow stress' temperature coefficient (3.31)"},
-    {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity (3.31); small is stiff"},
-    {"T_Phi", "1", -0.99, 100, 1, NULL, "T_Phi: the reference temperature (3.31)"},
+    CHIP_SPECS("21"),
     CM_FLOW_PLANE_PARAM_SPECS("tau2|T0|T1|T2", "T0", "0.1", "down"),
     {"t_max", "50", 1e-6, 1e12, 1, NULL,
      "the longest flight to the section (else no image; about 90 returns at the defaults)"},
@@ -27,7 +34,20 @@ const cm_param_spec cm_chip_4d_spec[] = {
     {NULL, NULL, 0, 0, 0, NULL, NULL},
 };
 
-static const char *const chip_coord_names[] = {"tau2", "T0", "T1", "T2"};
+const cm_param_spec cm_chip_workpiece_spec[] = {
+    CHIP_SPECS("3.4"),
+    {"A", "0.383", 0, 1000, 1, NULL, "A: the workpiece's dimensionless stiffness (3.16)"},
+    {"V0", "8.07", 1e-6, 1e6, 1, NULL, "V0: the dimensionless reference speed (3.17)"},
+    {"f", "1", 1e-6, 100, 1, NULL, "f: the cutting speed over the reference speed v0 = 3.6 m/s"},
+    CM_FLOW_PLANE_PARAM_SPECS("tau2|T0|T1|T2|z|v", "v", "0", "down"),
+    {"t_max", "100", 1e-6, 1e12, 1, NULL,
+     "the longest flight to the section (else no image; about 10 periods of the workpiece)"},
+    {"event_tol", "1e-12", 1e-15, 1, 1, NULL, "the section's crossing time to this"},
+    CM_FLOW_PARAM_SPECS,
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+static const char *const chip_coord_names[] = {"tau2", "T0", "T1", "T2", "z", "v"};
 
 void cm_chip_rates(const cm_chip *c, double tau2, double T1, double T2, double *F1, double *F2)
 {
@@ -55,10 +75,35 @@ static int chip_field(const cm_model *m, double t, const double *z, double *f)
     return 0;
 }
 
-cm_status cm_chip_4d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+/* (3.12)-(3.16): the 4-D flow at the effective speed ratio
+ * g = f (1 - v/(V0 f)), driving the workpiece z'' = tau2 - A z. */
+static int workpiece_field(const cm_model *m, double t, const double *y, double *f)
 {
-    /* the map lives on the section's plane: one coordinate fewer */
-    cm_status st = cm_model_setup(m, "chip-4d", 3, p, sizeof(cm_chip), msg, msg_size);
+    (void)t;
+    const cm_chip *c = m->ctx;
+    const double tau2 = y[0], T0 = y[1], T1 = y[2], T2 = y[3], z = y[4], v = y[5];
+    if (!(T1 > -1 && T2 > -1))
+        return 1;
+    const double g = c->f - v / c->V0;
+    double F1, F2;
+    cm_chip_rates(c, tau2, T1, T2, &F1, &F2);
+    f[0] = g * (1 - (F1 + F2));
+    f[1] = c->zeta * (T1 - 2 * T0) - g * c->xi * T0;
+    f[2] = g * (c->eta * (c->p * tau2 + 1 - c->p) * F1 - c->xi * (T1 - T0)) -
+           c->zeta * (2 * T1 - T2 - T0);
+    f[3] = c->eta * g * tau2 * F2 - (g * c->xi + c->zeta) * (T2 - T1);
+    f[4] = v;
+    f[5] = tau2 - c->A * z;
+    return 0;
+}
+
+/* A chip model of flow dimension n (its map one fewer, on the section's
+ * plane) with field. */
+static cm_status chip_create(const char *name, int n,
+                             int (*field)(const cm_model *, double, const double *, double *),
+                             const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    cm_status st = cm_model_setup(m, name, n - 1, p, sizeof(cm_chip), msg, msg_size);
     if (st != CM_OK)
         return st;
     cm_chip *c = m->ctx;
@@ -69,10 +114,25 @@ cm_status cm_chip_4d_create(const cm_params *p, cm_model *m, char *msg, size_t m
     c->a = cm_params_get(p, "a");
     c->b = cm_params_get(p, "b");
     c->T_Phi = cm_params_get(p, "T_Phi");
+    if (n == 6) {
+        c->A = cm_params_get(p, "A");
+        c->V0 = cm_params_get(p, "V0");
+        c->f = cm_params_get(p, "f");
+    }
     m->coord_names = chip_coord_names;
-    m->flow.field = chip_field;
+    m->flow.field = field;
     st = cm_flow_attach(m, msg, msg_size);
     if (st != CM_OK)
         cm_model_release(m);
     return st;
+}
+
+cm_status cm_chip_4d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    return chip_create("chip-4d", 4, chip_field, p, m, msg, msg_size);
+}
+
+cm_status cm_chip_workpiece_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size)
+{
+    return chip_create("chip-workpiece", 6, workpiece_field, p, m, msg, msg_size);
 }

@@ -5,9 +5,12 @@
 #ifndef CM_MODELS_CHIP_FORMATION_H
 #define CM_MODELS_CHIP_FORMATION_H
 
-/* The dimensionless coefficients of Palmai's model (thesis App. B.1). */
+/* The dimensionless coefficients of Palmai's model (thesis App. B.1) and,
+ * for the elastic workpiece (B.2-B.3), its stiffness A, the reference
+ * speed V0 and the speed ratio f. */
 typedef struct cm_chip {
     double xi, zeta, eta, p, a, b, T_Phi;
+    double A, V0, f;
 } cm_chip;
 
 /* The plastic strain rates F1, F2 of the layers at stress tau2 and

@@ -24,6 +24,7 @@ extern const cm_param_spec cm_microchaos_general_spec[];
 extern const cm_param_spec cm_friction_oscillator_spec[];
 extern const cm_param_spec cm_duffing_spec[];
 extern const cm_param_spec cm_chip_4d_spec[];
+extern const cm_param_spec cm_chip_workpiece_spec[];
 
 cm_status cm_microchaos_1d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_microchaos_1d_friction_create(const cm_params *p, cm_model *m, char *msg,
@@ -39,6 +40,7 @@ cm_status cm_friction_oscillator_create(const cm_params *p, cm_model *m, char *m
                                         size_t msg_size);
 cm_status cm_duffing_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 cm_status cm_chip_4d_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
+cm_status cm_chip_workpiece_create(const cm_params *p, cm_model *m, char *msg, size_t msg_size);
 
 
 #endif

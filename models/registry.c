@@ -25,6 +25,8 @@
 /* The attractors of chip-4d on its section (xi 3.5 to 11 at zeta = 21:
  * tau2 1.00-1.15, T1 0.190-0.214, T2 0.245-0.30). */
 #define CM_CHIP_REGION "0.9:1.25,0.15:0.25,0.2:0.35"
+/* chip-workpiece's largest deflections at f = 1 (z up to about 21). */
+#define CM_CHIP_WORKPIECE_REGION "0:2,0:1,0:1.5,0:2.5,0:25"
 
 static const cm_model_entry entries[] = {
     {"microchaos-1d", "x = x_j", "1D micro-chaos map x' = a x - b Int(x) (4.1)", "-15:15",
@@ -52,6 +54,10 @@ static const cm_model_entry entries[] = {
     {"chip-4d", "tau2, T1, T2 (stress and temperatures where the flow crosses the plane T0 = 0.1 downwards)",
      "Poincare map of Palmai's chip formation flow (3.27)-(3.31), integrated by GSL",
      CM_CHIP_REGION, cm_chip_4d_spec, cm_chip_4d_create},
+    {"chip-workpiece",
+     "tau2, T0, T1, T2, z (where the workpiece's velocity v crosses 0 downwards: its largest deflections)",
+     "Poincare map of chip formation on an elastic workpiece (3.12)-(3.16), integrated by GSL",
+     CM_CHIP_WORKPIECE_REGION, cm_chip_workpiece_spec, cm_chip_workpiece_create},
 };
 
 size_t cm_model_count(void) { return sizeof entries / sizeof entries[0]; }

@@ -13,6 +13,8 @@
  *   - the cell mapping of the section map at xi = 3.5 and 11 finds one
  *     attractor where the simulation does (tests/chip_test.sh: the same
  *     with --split, from the command line);
+ *   - chip-workpiece at f = 1: the deflection's band settles with its top
+ *     at the thesis' 18.25;
  *   - the period-doubling cascades of Table 3.1 (PD1 up from xi = 2.9,
  *     PD2 down from 11; each doubling located on the branch of periodic
  *     points, the next branch switched to there; +- 2e-4) and the folds
@@ -305,6 +307,37 @@ static void test_cell_mapping(const char *params, int period, const double *wher
     cm_model_release(&m);
 }
 
+/* chip-workpiece at f = 1 (thesis 3.3.1, Figs. 3.9-3.10): from tau2 = 1
+ * and everything else 0, the workpiece's largest deflections grow from
+ * about 4.5 (a swing of 2.2 about the static 2.6) and settle, after t of
+ * about 2000, into a quasi-periodic band whose top is the thesis' 18.25;
+ * t 2000-4000 and 4000-6000 give the same band. */
+static void test_workpiece(void)
+{
+    const char *texts[] = {"f=1"};
+    cm_model m;
+    char msg[256];
+    CHECK(cm_model_create("chip-workpiece", texts, 1, &m, msg, sizeof msg) == CM_OK);
+    CHECK_INT(m.dim, 5);
+    double x[5] = {1, 0, 0, 0, 0}, t = 0, t_end, first = 0, top[2] = {0, 0}, low[2] = {1e9, 1e9};
+    while (t < 6000) {
+        CHECK(cm_flow_map(&m, x, x, &t_end, NULL) == CM_STEP_OK);
+        t += t_end - m.flow.t0;
+        if (first == 0)
+            first = x[4];
+        const int w = t < 2000 ? -1 : t < 4000 ? 0 : 1;
+        if (w >= 0)
+            top[w] = fmax(top[w], x[4]), low[w] = fmin(low[w], x[4]);
+    }
+    printf("chip-workpiece f = 1: first deflection %.3f; largest deflections over t 2000-4000 "
+           "%.3f..%.3f, 4000-6000 %.3f..%.3f (thesis: amplitude 18.25)\n",
+           first, low[0], top[0], low[1], top[1]);
+    CHECK(fabs(first - 4.46) < 0.05);
+    CHECK(fabs(top[0] / 18.25 - 1) < 0.01);
+    CHECK(fabs(top[1] / top[0] - 1) < 0.005 && fabs(low[1] / low[0] - 1) < 0.005);
+    cm_model_release(&m);
+}
+
 /* chip-4d at xi with tolerances 1e-12 (multipliers by differences need
  * them) on the plane T0 = level (user: the level's text). */
 static cm_status chip_tight(void *user, double xi, cm_model *m, char *msg, size_t msg_size)
@@ -441,6 +474,7 @@ int main(int argc, char **argv)
     test_integrator_error();
     test_cell_mapping("xi=3.5", 2, p2, 24);
     test_cell_mapping("xi=11", 1, p1, 24);
+    test_workpiece();
     static const double pd1[] = {3.11285, 4.03007, 4.26861, 4.32524, 4.33763};
     static const double pd2[] = {10.6639, 9.52126, 9.20174, 9.1282, 9.11215};
     test_cascade(2.9, 1, full ? 5 : 3, pd1, "PD1");
