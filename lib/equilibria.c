@@ -128,8 +128,8 @@ static cm_status follow_branch(const eq_args *a, eq_result *r, double p0, char *
         const cm_branch_options o = {a->b.lo, a->b.hi, direction, 0, a->b.ds_max, a->b.max_points};
         const size_t pts_from = r->n_pts, events_from = r->n_events;
         const cm_status st =
-            cm_flow_equilibrium_branch(param_model_at, &u, p0, r->start.x, &o, on_point, on_event, r,
-                                       &r->why[way], msg, msg_size);
+            cm_flow_equilibrium_branch(param_model_at, &u, p0, r->start.x, &o, on_point,
+                                       on_event, r, &r->why[way], msg, msg_size);
         if (st != CM_OK)
             return st;
         if (r->why[way] == CM_BRANCH_CALLER)
@@ -164,8 +164,8 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
     param_builder u = {&a->mo, {a->b.name, a->curve.name}};
     const cm_branch_options o = {a->b.lo, a->b.hi, 1, 0, a->b.ds_max, a->b.max_points};
     const cm_equilibrium *low = r->n_pts ? &r->pts[0] : &r->start;
-    return cm_flow_hopf_curve(param_model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf, r, msg,
-                              msg_size);
+    return cm_flow_hopf_curve(param_model_at2, &u, low->p, low->x, q, a->curve.n, &o, on_hopf,
+                              r, msg, msg_size);
 }
 
 /* One CSV row: kind, the branch's and curve's values (when asked), the

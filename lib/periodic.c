@@ -34,7 +34,8 @@ double periodic_accumulation(const po_result *r)
     const int n = r->n_doublings;
     if (n < 2)
         return NAN;
-    return r->doublings[n - 1] + (r->doublings[n - 1] - r->doublings[n - 2]) / (FEIGENBAUM_DELTA - 1);
+    const double last = r->doublings[n - 1], spacing = last - r->doublings[n - 2];
+    return last + spacing / (FEIGENBAUM_DELTA - 1);
 }
 
 /* What the branch callbacks fill: the result, and for a cascade the
@@ -169,14 +170,13 @@ static cm_status cascade(const po_args *a, const param_builder *u, po_result *r,
 }
 
 /* The model spec with the flow's tolerances at 1e-12 first (the user's
- * parameters after them win). */
+ * parameters after them win); mo has room for one more text. */
 static void tightened(const model_spec *mo, model_spec *out)
 {
     *out = *mo;
     out->texts[0] = "abs_tol=1e-12,rel_tol=1e-12";
-    for (int i = 0; i < mo->n_texts && i + 1 < MODEL_SPEC_TEXTS; i++)
-        out->texts[i + 1] = mo->texts[i];
-    out->n_texts = mo->n_texts + 1 < MODEL_SPEC_TEXTS ? mo->n_texts + 1 : MODEL_SPEC_TEXTS;
+    memcpy(&out->texts[1], mo->texts, (size_t)mo->n_texts * sizeof *mo->texts);
+    out->n_texts = mo->n_texts + 1;
 }
 
 /* Whether the user's parameters set the integrator's tolerances. */

@@ -17,6 +17,24 @@ typedef struct state_buf {
     alignas(max_align_t) unsigned char b[CM_ARC_STATE_MAX];
 } state_buf;
 
+cm_status cm_model_source_at(const cm_model_source *s, double p, cm_model *own,
+                             const cm_model **m, char *msg, size_t msg_size)
+{
+    if (s->fixed) {
+        *m = s->fixed;
+        return CM_OK;
+    }
+    const cm_status st = s->at(s->at_user, p, own, msg, msg_size);
+    *m = own;
+    return st;
+}
+
+void cm_model_source_done(const cm_model_source *s, cm_model *own)
+{
+    if (!s->fixed)
+        cm_model_release(own);
+}
+
 static double norm(int n, const double *v)
 {
     double s = 0;

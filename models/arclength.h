@@ -22,6 +22,20 @@
 typedef cm_status (*cm_model_at_fn)(void *user, double p, cm_model *m, char *msg,
                                     size_t msg_size);
 
+/* Where a problem's model comes from: one fixed model (fixed not NULL),
+ * or the caller's builder at each parameter value. */
+typedef struct cm_model_source {
+    const cm_model *fixed;
+    cm_model_at_fn at;
+    void *at_user;
+} cm_model_source;
+
+/* The model at p into *m: the fixed one, or one built into *own, which
+ * cm_model_source_done releases (call it after a CM_OK only). */
+cm_status cm_model_source_at(const cm_model_source *s, double p, cm_model *own,
+                             const cm_model **m, char *msg, size_t msg_size);
+void cm_model_source_done(const cm_model_source *s, cm_model *own);
+
 /* The most bytes a problem keeps of a point (its classification). */
 #define CM_ARC_STATE_MAX 1024
 /* The most tests a problem has. */

@@ -21,7 +21,7 @@
         {"eta", "4.4", 0, 1000, 1, NULL, "eta: plastic work turned into heat"},                \
         {"p", "1.03", 0, 10, 1, NULL, "p: tau1 = p tau2 + 1 - p (3.6)"},                       \
         {"a", "0.3", 0, 10, 1, NULL, "a: the flow stress' temperature coefficient (3.31)"},    \
-        {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity (3.31); small is stiff"}, \
+        {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity; small is stiff"},   \
         {"T_Phi", "1", -0.99, 100, 1, NULL, "T_Phi: the reference temperature (3.31)"}
 
 const cm_param_spec cm_chip_4d_spec[] = {

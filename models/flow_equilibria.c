@@ -101,34 +101,24 @@ static cm_status classify(const cm_model *m, double p, const double *x, cm_equil
     return CM_OK;
 }
 
-/* The problem of equilibria: f the field of the model at p (a fixed
- * model, or the caller's builder's), and the classification. */
+/* The problem of equilibria: f the field of the model at p, and the
+ * classification. */
 typedef struct eq_problem {
-    const cm_model *fixed; /* or NULL: build with at */
-    cm_model_at_fn at;
-    void *at_user;
+    cm_model_source src;
     char *msg;
     size_t msg_size;
 } eq_problem;
 
-static cm_status eq_eval_model(const cm_model *m, const double *x, double *f, double *J)
-{
-    if (field_at(m, x, f))
-        return CM_EMODEL;
-    return J ? cm_flow_jacobian(m, x, J) : CM_OK;
-}
-
 static cm_status eq_eval(void *ctx, double p, const double *x, double *f, double *J)
 {
     const eq_problem *q = ctx;
-    if (q->fixed)
-        return eq_eval_model(q->fixed, x, f, J);
-    cm_model m;
-    cm_status st = q->at(q->at_user, p, &m, q->msg, q->msg_size);
-    if (st == CM_OK) {
-        st = eq_eval_model(&m, x, f, J);
-        cm_model_release(&m);
-    }
+    const cm_model *m;
+    cm_model own;
+    cm_status st = cm_model_source_at(&q->src, p, &own, &m, q->msg, q->msg_size);
+    if (st != CM_OK)
+        return st;
+    st = field_at(m, x, f) ? CM_EMODEL : J ? cm_flow_jacobian(m, x, J) : CM_OK;
+    cm_model_source_done(&q->src, &own);
     return st;
 }
 
@@ -138,17 +128,13 @@ static cm_status eq_classify(void *ctx, double p, const double *x, void *state, 
 {
     const eq_problem *q = ctx;
     cm_equilibrium *e = state;
-    cm_status st;
-    if (q->fixed) {
-        st = classify(q->fixed, p, x, e);
-    } else {
-        cm_model m;
-        st = q->at(q->at_user, p, &m, q->msg, q->msg_size);
-        if (st == CM_OK) {
-            st = classify(&m, p, x, e);
-            cm_model_release(&m);
-        }
-    }
+    const cm_model *m;
+    cm_model own;
+    cm_status st = cm_model_source_at(&q->src, p, &own, &m, q->msg, q->msg_size);
+    if (st != CM_OK)
+        return st;
+    st = classify(m, p, x, e);
+    cm_model_source_done(&q->src, &own);
     tests[0] = e->det_sign;
     tests[1] = e->unstable;
     return st;
@@ -177,7 +163,7 @@ cm_status cm_flow_equilibrium(const cm_model *m, double p, double *x, cm_equilib
     if (field_at(m, x, f))
         return cm_fail(CM_EMODEL, msg, msg_size, "the field of %s is not defined at the start",
                        m->name);
-    eq_problem q = {m, NULL, NULL, msg, msg_size};
+    eq_problem q = {{m, NULL, NULL}, msg, msg_size};
     const cm_arc_problem pr = eq_arc(&q, n);
     if (cm_arc_newton(&pr, p, x) != CM_OK) {
         char at[48] = ""; /* p is NAN where no parameter is varied */
@@ -240,7 +226,7 @@ cm_status cm_flow_equilibrium_branch(cm_model_at_fn at, void *at_user, double p0
     cm_model_release(&m);
     if (st != CM_OK)
         return st;
-    eq_problem q = {NULL, at, at_user, msg, msg_size};
+    eq_problem q = {{NULL, at, at_user}, msg, msg_size};
     const cm_arc_problem pr = eq_arc(&q, n);
     eq_follow f = {point, event, user};
     return cm_arc_follow(&pr, p0, x, o, eq_point, eq_event, &f, why);

@@ -88,46 +88,31 @@ static cm_status classify(const cm_model *m, int period, double p, const double 
     return CM_OK;
 }
 
-/* The problem of period-k points: a fixed model or the caller's builder. */
+/* The problem of period-k points: f = P^k(x) - x of the model at p. */
 typedef struct po_problem {
-    const cm_model *fixed;
-    cm_model_at_fn at;
-    void *at_user;
+    cm_model_source src;
     int period;
     char *msg;
     size_t msg_size;
 } po_problem;
 
-static cm_status model_of(const po_problem *q, double p, cm_model *m)
-{
-    return q->at(q->at_user, p, m, q->msg, q->msg_size);
-}
-
-static cm_status po_eval_model(const cm_model *m, int period, const double *x, double *f,
-                               double *J)
-{
-    const int n = m->dim;
-    if (!iterate(m, period, x, f))
-        return CM_EMODEL;
-    for (int i = 0; i < n; i++)
-        f[i] -= x[i];
-    cm_status st = J ? cm_map_jacobian(m, period, x, J) : CM_OK;
-    for (int i = 0; J && st == CM_OK && i < n; i++)
-        J[i * n + i] -= 1;
-    return st;
-}
-
 static cm_status po_eval(void *ctx, double p, const double *x, double *f, double *J)
 {
     const po_problem *q = ctx;
-    if (q->fixed)
-        return po_eval_model(q->fixed, q->period, x, f, J);
-    cm_model m;
-    cm_status st = model_of(q, p, &m);
-    if (st == CM_OK) {
-        st = po_eval_model(&m, q->period, x, f, J);
-        cm_model_release(&m);
-    }
+    const cm_model *m;
+    cm_model own;
+    cm_status st = cm_model_source_at(&q->src, p, &own, &m, q->msg, q->msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = m->dim;
+    st = iterate(m, q->period, x, f) ? CM_OK : CM_EMODEL;
+    for (int i = 0; st == CM_OK && i < n; i++)
+        f[i] -= x[i];
+    if (st == CM_OK && J)
+        st = cm_map_jacobian(m, q->period, x, J);
+    for (int i = 0; J && st == CM_OK && i < n; i++)
+        J[i * n + i] -= 1;
+    cm_model_source_done(&q->src, &own);
     return st;
 }
 
@@ -138,17 +123,13 @@ static cm_status po_classify(void *ctx, double p, const double *x, void *state, 
 {
     const po_problem *q = ctx;
     cm_periodic_point *pt = state;
-    cm_status st;
-    if (q->fixed) {
-        st = classify(q->fixed, q->period, p, x, pt);
-    } else {
-        cm_model m;
-        st = model_of(q, p, &m);
-        if (st == CM_OK) {
-            st = classify(&m, q->period, p, x, pt);
-            cm_model_release(&m);
-        }
-    }
+    const cm_model *m;
+    cm_model own;
+    cm_status st = cm_model_source_at(&q->src, p, &own, &m, q->msg, q->msg_size);
+    if (st != CM_OK)
+        return st;
+    st = classify(m, q->period, p, x, pt);
+    cm_model_source_done(&q->src, &own);
     tests[0] = pt->fold_sign;
     tests[1] = pt->flip_sign;
     tests[2] = pt->outside;
@@ -176,7 +157,7 @@ cm_status cm_map_periodic_point(const cm_model *m, double p, int period, double 
         return cm_fail(CM_EINVAL, msg, msg_size, "a period of %d: give 1..1000000", period);
     double start[CM_MAX_DIM];
     memcpy(start, x, (size_t)m->dim * sizeof *x);
-    po_problem q = {m, NULL, NULL, period, msg, msg_size};
+    po_problem q = {{m, NULL, NULL}, period, msg, msg_size};
     const cm_arc_problem pr = po_arc(&q, m->dim);
     if (cm_arc_newton(&pr, p, x) != CM_OK) {
         char at[48] = ""; /* p is NAN where no parameter is varied */
@@ -230,7 +211,7 @@ cm_status cm_map_periodic_branch(cm_model_at_fn at, void *at_user, int period, d
     cm_model_release(&m);
     if (st != CM_OK)
         return st;
-    po_problem q = {NULL, at, at_user, period, msg, msg_size};
+    po_problem q = {{NULL, at, at_user}, period, msg, msg_size};
     const cm_arc_problem pr = po_arc(&q, n);
     po_follow f = {point, event, user};
     return cm_arc_follow(&pr, p0, x, o, po_point, po_event, &f, why);

@@ -11,15 +11,13 @@
 
 #include "models/params.h"
 
-/* What one thread integrates with: GSL's driver, which owns the stepper,
- * error control and evolution (the implicit steppers reach the control
- * through it), allocated once per step_n batch. w->sys must stay where
- * work_open put it: the driver points to it. */
+/* What one thread integrates with: GSL's driver, which owns the stepper
+ * (driver->s), error control (->c) and evolution (->e) (the implicit
+ * steppers reach the control through it), allocated once per step_n
+ * batch. w->sys must stay where work_open put it: the driver points to
+ * it. */
 typedef struct flow_work {
     gsl_odeiv2_driver *driver;
-    gsl_odeiv2_step *step;
-    gsl_odeiv2_control *control;
-    gsl_odeiv2_evolve *evolve;
     gsl_odeiv2_system sys;
     const cm_model *m;
     int n; /* the flow's dimension */
@@ -112,12 +110,7 @@ static bool work_open(flow_work *w, const cm_model *m)
     /* the first step is set per integration (first_step) */
     w->driver = gsl_odeiv2_driver_alloc_y_new(&w->sys, step_type(m->flow.method), 1e-3,
                                               m->flow.abs_tol, m->flow.rel_tol);
-    if (!w->driver)
-        return false;
-    w->step = w->driver->s;
-    w->control = w->driver->c;
-    w->evolve = w->driver->e;
-    return true;
+    return w->driver != NULL;
 }
 
 static bool in_world(const cm_model *m, const double *y)
@@ -148,6 +141,13 @@ static double first_step(const cm_model *m, double t, const double *y, double sp
     return h < span ? h : span;
 }
 
+/* Forgets the steps taken: the next one starts a new integration. */
+static void restart(flow_work *w)
+{
+    gsl_odeiv2_evolve_reset(w->driver->e);
+    gsl_odeiv2_step_reset(w->driver->s);
+}
+
 /* One accepted step towards t1 from (*t, y); false when the orbit has no
  * image (the field failed, the world was left, too many steps). A step
  * GSL accepts with a non-finite state (its error estimate NaN, which its
@@ -161,8 +161,8 @@ static bool advance(flow_work *w, double *t, double t1, double *h, double *y)
     double y0[CM_MAX_DIM];
     memcpy(y0, y, (size_t)dim * sizeof *y);
     for (;;) {
-        if (gsl_odeiv2_evolve_apply(w->evolve, w->control, w->step, &w->sys, t, t1, h, y) !=
-            GSL_SUCCESS)
+        if (gsl_odeiv2_evolve_apply(w->driver->e, w->driver->c, w->driver->s, &w->sys, t, t1, h,
+                                    y) != GSL_SUCCESS)
             return false;
         if (++w->steps > CM_FLOW_MAX_STEPS)
             return false;
@@ -174,8 +174,7 @@ static bool advance(flow_work *w, double *t, double t1, double *h, double *y)
         *t = t0;
         *h = 0.1 * tried;
         memcpy(y, y0, (size_t)dim * sizeof *y);
-        gsl_odeiv2_evolve_reset(w->evolve);
-        gsl_odeiv2_step_reset(w->step);
+        restart(w);
     }
 }
 
@@ -191,8 +190,7 @@ static bool integrate_on(flow_work *w, double *t, double t1, double *h, double *
 /* y from time t to time t1 (> t), afresh. */
 static bool integrate(flow_work *w, double t, double t1, double *y)
 {
-    gsl_odeiv2_evolve_reset(w->evolve);
-    gsl_odeiv2_step_reset(w->step);
+    restart(w);
     double h = first_step(w->m, t, y, t1 - t);
     return integrate_on(w, &t, t1, &h, y);
 }
@@ -429,8 +427,7 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
         drop(m, z, y);
         return CM_STEP_OK;
     }
-    gsl_odeiv2_evolve_reset(w->evolve);
-    gsl_odeiv2_step_reset(w->step);
+    restart(w);
     double t = f->t0, h = first_step(m, f->t0, z, f->t_max), image[CM_MAX_DIM];
     bool lost;
     /* not reached in time (t is then t0 + t_max), or lost: no image */
@@ -538,7 +535,7 @@ cm_status cm_flow_attach(cm_model *m, char *msg, size_t msg_size)
         : f->direction < -1 || f->direction > 1                      ? "a direction not in -1..1"
         : f->plane < 0 || f->plane > cm_flow_dim(m) || cm_flow_dim(m) > CM_MAX_DIM
             ? "a section plane that is not one of its coordinates"
-        : f->plane && f->section                                      ? "both a section plane and a section function"
+        : f->plane && f->section                                      ? "both a plane and a section function"
         : f->plane && !isfinite(f->level)                             ? "a level that is not finite"
         : !has_section(f) && !(f->period > 0 && f->period < 1e12)     ? "no period > 0"
         : !(f->t0 > -1e12 && f->t0 < 1e12)                            ? "a t0 that is not finite"
