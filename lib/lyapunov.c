@@ -215,15 +215,8 @@ static cm_status start_of(lyap_args *a, char *msg, size_t msg_size)
                        e->name, dim);
     if (a->n_from)
         return CM_OK;
-    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
-    int n = 0;
-    if (!e->region || !parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != dim)
-        return cm_fail(CM_EINVAL, msg, msg_size, "model %s has no default region: give the start",
-                       e->name);
-    for (int d = 0; d < dim; d++)
-        a->from[d] = 0.5 * (lo[d] + hi[d]);
     a->n_from = dim;
-    return CM_OK;
+    return model_spec_centre(&a->mo, dim, a->from, msg, msg_size);
 }
 
 /* The exponents of every grid point into r->v. */

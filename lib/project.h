@@ -50,6 +50,11 @@ const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
  * the caller with cm_model_release). */
 cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_t msg_size);
 
+/* The centre of the example region of the model spec names (dim
+ * coordinates) into x: CM_EINVAL when it has none. */
+cm_status model_spec_centre(const model_spec *spec, int dim, double *x, char *msg,
+                            size_t msg_size);
+
 /* The image y of x under m's map, with step's return value, and the
  * flow's time it took in *flight: a stroboscopic map's period, a Poincare
  * map's return time to its section (without an image: how long the orbit

@@ -14,10 +14,14 @@
 /* P^period(x) into y; false where an iterate has no image. */
 static bool iterate(const cm_model *m, int period, const double *x, double *y)
 {
+    /* step() need not take its image in place */
+    double z[CM_MAX_DIM];
     memcpy(y, x, (size_t)m->dim * sizeof *x);
-    for (int k = 0; k < period; k++)
-        if (m->step(m, y, y) != CM_STEP_OK)
+    for (int k = 0; k < period; k++) {
+        memcpy(z, y, (size_t)m->dim * sizeof *y);
+        if (m->step(m, z, y) != CM_STEP_OK)
             return false;
+    }
     for (int d = 0; d < m->dim; d++)
         if (!isfinite(y[d]))
             return false;

@@ -82,7 +82,7 @@ static int jacobian_gsl(double t, const double y[], double *dfdy, double dfdt[],
     return GSL_SUCCESS;
 }
 
-static const gsl_odeiv2_step_type *step_type(int method)
+const gsl_odeiv2_step_type *cm_flow_stepper(int method)
 {
     switch (method) {
     case CM_FLOW_RKF45: return gsl_odeiv2_step_rkf45;
@@ -108,7 +108,7 @@ static bool work_open(flow_work *w, const cm_model *m)
     w->n = cm_flow_dim(m);
     w->sys = (gsl_odeiv2_system){field_gsl, jacobian_gsl, (size_t)w->n, (void *)m};
     /* the first step is set per integration (first_step) */
-    w->driver = gsl_odeiv2_driver_alloc_y_new(&w->sys, step_type(m->flow.method), 1e-3,
+    w->driver = gsl_odeiv2_driver_alloc_y_new(&w->sys, cm_flow_stepper(m->flow.method), 1e-3,
                                               m->flow.abs_tol, m->flow.rel_tol);
     return w->driver != NULL;
 }
@@ -252,9 +252,7 @@ static bool locate(flow_work *w, double ta, const double *ya, double tb, const d
     return true;
 }
 
-/* The flow's state y (w->n entries) of the map's state x: x itself, or
- * for a plane section x with x_k = level put in. */
-static void lift(const cm_model *m, const double *x, double *y)
+void cm_flow_lift(const cm_model *m, const double *x, double *y)
 {
     const int k = m->flow.plane - 1;
     for (int d = 0, i = 0; d < cm_flow_dim(m); d++)
@@ -416,7 +414,7 @@ static int map_one(flow_work *w, const double *x, double *y, double *t_end)
     const cm_flow *f = &m->flow;
     double z[CM_MAX_DIM];
     w->steps = 0;
-    lift(m, x, z);
+    cm_flow_lift(m, x, z);
     *t_end = f->t0;
     if (!in_world(m, z))
         return CM_STEP_NO_IMAGE;

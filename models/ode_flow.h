@@ -3,6 +3,8 @@
 #ifndef CM_MODELS_ODE_FLOW_H
 #define CM_MODELS_ODE_FLOW_H
 
+#include <gsl/gsl_odeiv2.h>
+
 #include "cellmap/model.h"
 
 /* Makes m, whose create() filled m->flow and left step NULL, a map:
@@ -36,6 +38,14 @@ int cm_flow_follow(const cm_model *m, const double *x, double t0, double t1, dou
  * differences (steps 1e-7 max(1, |x_j|)): CM_EMODEL where the field fails
  * or is not finite there. The implicit integrators' Jacobian. */
 cm_status cm_flow_jacobian_at(const cm_model *m, double t, const double *x, double *J);
+
+/* GSL's stepper for a cm_flow.method. */
+const gsl_odeiv2_step_type *cm_flow_stepper(int method);
+
+/* The flow's state y (cm_flow_dim(m) entries) of the map's state x (m->dim
+ * entries): x itself, or for a section on a plane x with x_k = level put
+ * in. */
+void cm_flow_lift(const cm_model *m, const double *x, double *y);
 
 /* Whether m is the map of a flow. */
 static inline bool cm_model_is_flow(const cm_model *m) { return m->flow.field != NULL; }

@@ -8,6 +8,7 @@ int cmd_solve(int argc, char **argv);
 int cmd_orbit(int argc, char **argv);
 int cmd_equilibria(int argc, char **argv);
 int cmd_periodic(int argc, char **argv);
+int cmd_exponents(int argc, char **argv);
 int cmd_fixed_points(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);

@@ -29,6 +29,8 @@ static const struct {
      "equilibria of a flow: eigenvalues, branches in a parameter, folds and Hopf points"},
     {"periodic", cmd_periodic,
      "periodic orbits of a map: multipliers, branches, folds and period-doubling cascades"},
+    {"exponents", cmd_exponents,
+     "the Lyapunov spectrum of one orbit (flows and maps) and its Kaplan-Yorke dimension"},
     {"lyapunov", cmd_lyapunov, "largest Lyapunov exponent over a grid of two parameters (any model)"},
     {"simulate", cmd_simulate,
      "a trajectory of the friction oscillator: events as CSV, x(t) and phase portrait"},

@@ -1,0 +1,59 @@
+/* lib/exponents.h - the Lyapunov spectrum of one orbit of any model over
+ * models/lyapunov_spectrum.h: a flow's by its variational equations, a
+ * map's (a flow's section or stroboscopic map included) by the QR of its
+ * Jacobian, with the Kaplan-Yorke dimension and, for a flow's map, the
+ * mean flight between iterates, which turns exponents per iterate into
+ * exponents per unit of the flow's time (thesis 3.2: lambda_flow =
+ * lambda_map / mean return time). The running estimates are written as
+ * CSV. Nothing is printed: calls return a status with the problem in msg
+ * (CM_EINVAL: the request's). */
+#ifndef CM_LIB_EXPONENTS_H
+#define CM_LIB_EXPONENTS_H
+
+#include <stdbool.h>
+
+#include "lib/project.h"
+#include "models/lyapunov_spectrum.h"
+
+typedef struct exp_args {
+    model_spec mo;
+    double from[CM_MAX_DIM]; /* the flow's coordinates (of_map: the map's) */
+    int n_from;              /* 0: the centre of the model's example region */
+    bool of_map;             /* the map's spectrum (a map model always) */
+    cm_spectrum_options o;
+    const char *csv;
+} exp_args;
+
+/* The command's defaults: chip-4d; flows 100 time units after 10 of
+ * transient, renormalised every 0.1; maps 10000 iterates after 100. */
+exp_args exponents_defaults(void);
+
+/* One row of the running estimates. */
+typedef struct exp_row {
+    double t; /* the time (flows) or iterates (maps) averaged over */
+    double lambda[CM_MAX_DIM];
+} exp_row;
+
+typedef struct exp_result {
+    cm_model m;
+    cm_spectrum s;
+    bool of_map;
+    double mean_flight; /* a flow's map: the mean time between iterates; NAN otherwise */
+    exp_row *rows;      /* at most about 10000, evenly thinned, the last always */
+    size_t n_rows, cap_rows;
+    long stride, seen;
+} exp_result;
+
+/* Checks the request (the start's dimension, the settings) and computes.
+ * r is freed by exponents_result_free whatever the status; CM_EMODEL when
+ * the orbit is lost. */
+cm_status exponents_compute(const exp_args *a, exp_result *r, char *msg, size_t msg_size);
+
+/* The running estimates as CSV at a->csv (NULL: nothing): t (time or
+ * iterates), lambda_1..lambda_k (decreasing), kaplan_yorke, and for a
+ * flow's map flow_time. */
+cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, size_t msg_size);
+
+void exponents_result_free(exp_result *r);
+
+#endif

@@ -1,0 +1,165 @@
+/* cellmap exponents: the Lyapunov spectrum of one orbit of any model (a
+ * flow by its variational equations, a map by the QR of its Jacobian),
+ * the Kaplan-Yorke dimension, and for a flow's map the exponents per unit
+ * of the flow's time (thesis 3.2, Fig. 3.7) over lib/exponents.h. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/exponents.h"
+#include "lib/json.h"
+#include "lib/parse.h"
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/outfile.h"
+
+static const char exponents_help[] =
+    "usage: cellmap exponents [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                         [--from X[,Y...]] [--of flow|map] [--count K]\n"
+    "                         [--time T] [--transient T] [--renorm DT]\n"
+    "                         [--iterations N] [--skip N] [--csv FILE|-] [--json] [--quiet]\n\n"
+    "The Lyapunov spectrum of one orbit (Benettin's method: K tangent vectors\n"
+    "re-orthonormalised by Gram-Schmidt) and its Kaplan-Yorke dimension.\n"
+    "A flow model (chip-4d, the default, duffing, a plugin's flow): by default the\n"
+    "flow's spectrum from its variational equations, integrated with the state by\n"
+    "the model's method and tolerances (one exponent is zero along the orbit).\n"
+    "With --of map, or for a map model: the map's spectrum per iterate (the\n"
+    "Jacobian by central differences at every iterate); for a flow's Poincare or\n"
+    "stroboscopic map also the mean flight between iterates and the exponents per\n"
+    "unit of the flow's time (lambda_map / mean return time, thesis 3.2).\n"
+    "`cellmap lyapunov` maps the largest exponent over a grid of parameters.\n\n"
+    "  --from X,Y,...      the start: the flow's coordinates (--of map: the map's);\n"
+    "                      default the centre of the model's example region\n"
+    "  --of flow|map       whose spectrum (default: flow for a flow model)\n"
+    "  --count K           the K largest exponents (default all)\n"
+    "  --time T            flows: the time averaged over (default 100)\n"
+    "  --transient T       flows: the time before averaging starts (default 10)\n"
+    "  --renorm DT         flows: the time between Gram-Schmidt steps (default 0.1)\n"
+    "  --iterations N      maps: the iterates averaged over (default 10000)\n"
+    "  --skip N            maps: the iterates of transient (default 100)\n"
+    "  --csv FILE|-        the running estimates: t (time or iterates), lambda_1..K,\n"
+    "                      kaplan_yorke (and flow_time for a flow's map); about\n"
+    "                      10000 rows, the last the result\n"
+    "  --json              the result as JSON on standard output\n"
+    "  --quiet             no summary\n";
+
+/* --NAME's value into *out, a finite number in lo..hi. */
+static bool take_number(cli *c, const char *name, double lo, double hi, double *out, int *err)
+{
+    if (!cli_is(c, name, true, err))
+        return false;
+    if (c->value && (!parse_double(c->value, out) || !(*out >= lo && *out <= hi)))
+        *err = cli_usage_error(c, "%s: '%s' must be a number in %g..%g", name, c->value, lo, hi);
+    return true;
+}
+
+static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
+{
+    int err = 0, iterations = (int)a->o.iterations, skip = (int)a->o.skip;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(exponents_help, stdout);
+            return -1;
+        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (cli_is(c, "--from", true, &err)) {
+            if (c->value && !parse_doubles(c->value, a->from, &a->n_from, CM_MAX_DIM))
+                err = cli_usage_error(c, "--from: '%s' is not X[,Y...] (numbers)", c->value);
+        } else if (cli_is(c, "--of", true, &err)) {
+            if (c->value && strcmp(c->value, "flow") && strcmp(c->value, "map"))
+                err = cli_usage_error(c, "--of: '%s' is neither flow nor map", c->value);
+            a->of_map = c->value && strcmp(c->value, "map") == 0;
+        } else if (cli_take_int(c, "--count", 1, CM_MAX_DIM, &a->o.count, &err)) {
+        } else if (take_number(c, "--time", 1e-9, 1e9, &a->o.time, &err)) {
+        } else if (take_number(c, "--transient", 0, 1e9, &a->o.transient, &err)) {
+        } else if (take_number(c, "--renorm", 1e-9, 1e9, &a->o.renorm, &err)) {
+        } else if (cli_take_int(c, "--iterations", 1, 100000000, &iterations, &err)) {
+        } else if (cli_take_int(c, "--skip", 0, 100000000, &skip, &err)) {
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            *json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            *quiet = true;
+        } else {
+            err = cli_stray(c);
+        }
+    }
+    a->o.iterations = iterations, a->o.skip = skip;
+    if (!err && a->o.renorm > a->o.time)
+        err = cli_usage_error(c, "--renorm %g is longer than --time %g", a->o.renorm, a->o.time);
+    if (!err && a->o.time / a->o.renorm > 1e8)
+        err = cli_usage_error(c, "--time / --renorm is over 1e8 renormalisations: renorm less often");
+    if (!err && *json && a->csv && strcmp(a->csv, "-") == 0)
+        err = cli_usage_error(c, "--json and --csv -: both want standard output");
+    return err;
+}
+
+static void print_summary(FILE *f, const exp_result *r)
+{
+    const cm_spectrum *s = &r->s;
+    double sum = 0;
+    fprintf(f, "%s spectrum of %s (%d of %d exponents%s):", r->of_map ? "map" : "flow",
+            r->m.name, s->count, s->n, r->of_map ? ", per iterate" : ", per unit time");
+    for (int j = 0; j < s->count; j++) {
+        fprintf(f, " %.6g", s->lambda[j]);
+        sum += s->lambda[j];
+    }
+    fprintf(f, "\nsum %.6g; Kaplan-Yorke dimension ", sum);
+    if (isnan(s->kaplan_yorke))
+        fprintf(f, "above %d (more exponents needed)\n", s->count);
+    else
+        fprintf(f, "%.4f\n", s->kaplan_yorke);
+    if (!isnan(r->mean_flight)) {
+        fprintf(f, "mean flight between iterates %.6g; per unit of the flow's time:",
+                r->mean_flight);
+        for (int j = 0; j < s->count; j++)
+            fprintf(f, " %.6g", s->lambda[j] / r->mean_flight);
+        fprintf(f, "\n");
+    }
+}
+
+static void print_json(const exp_result *r)
+{
+    const cm_spectrum *s = &r->s;
+    json j;
+    json_begin(&j, stdout, "exponents");
+    json_model(&j, &r->m);
+    json_str(&j, "of", r->of_map ? "map" : "flow");
+    json_nums(&j, "lambda", s->lambda, s->count);
+    json_num(&j, "kaplan_yorke", s->kaplan_yorke);
+    if (!isnan(r->mean_flight)) {
+        double per_time[CM_MAX_DIM];
+        for (int k = 0; k < s->count; k++)
+            per_time[k] = s->lambda[k] / r->mean_flight;
+        json_num(&j, "mean_flight", r->mean_flight);
+        json_nums(&j, "lambda_per_time", per_time, s->count);
+    }
+    json_nums(&j, "end", s->x, s->n);
+    json_end(&j);
+}
+
+int cmd_exponents(int argc, char **argv)
+{
+    cli c = {"exponents", argc, argv, 0, NULL, NULL};
+    exp_args a = exponents_defaults();
+    bool json = false, quiet = false;
+    const int perr = parse_args(&c, &a, &json, &quiet);
+    if (perr)
+        return perr < 0 ? EXIT_OK : perr;
+    const int werr = outfile_check("exponents", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
+    char msg[1024];
+    exp_result r;
+    cm_status st = exponents_compute(&a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (json)
+            print_json(&r);
+        else if (!quiet)
+            print_summary(report_stream(a.csv, NULL, NULL), &r);
+        st = exponents_write(&a, &r, msg, sizeof msg);
+    }
+    exponents_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
+}
