@@ -136,3 +136,69 @@ cm_status cm_chip_workpiece_create(const cm_params *p, cm_model *m, char *msg, s
 {
     return chip_create("chip-workpiece", 6, workpiece_field, p, m, msg, msg_size);
 }
+
+/* ---- the built-up-edge delay model ---- */
+
+#define TWO_PI 6.283185307179586476925286766559
+
+cm_chip_bue cm_chip_bue_defaults(void)
+{
+    return (cm_chip_bue){.a = 0.3, .b = 0.012, .n = 0.2, .T_Phi = 1.2, .eps = 2.44, .dt = 0.4,
+                         .eta = 4, .zeta = 30, .H = 0.1, .Omega = 0.18};
+}
+
+double cm_chip_bue_rate(const cm_chip_bue *c, double T, double tau, double gamma)
+{
+    const double en = pow(c->eps, c->n);
+    const double hardening = (1 + en * (gamma > 0 ? pow(gamma, c->n) : 0)) / (1 + en);
+    return (T + 1) / (c->T_Phi + 1) *
+           exp((tau - hardening + c->a * (T - c->T_Phi)) / (c->b * (T + 1)));
+}
+
+/* The state's coordinates. */
+enum { BUE_T0, BUE_T, BUE_GAMMA, BUE_TAU };
+
+static int bue_field(const void *ctx, double t, const double *x, const double *xd, double *f)
+{
+    const cm_chip_bue *c = ctx;
+    if (!(x[BUE_T] > -1 && xd[BUE_T] > -1))
+        return 1;
+    const double F = cm_chip_bue_rate(c, x[BUE_T], x[BUE_TAU], x[BUE_GAMMA]);
+    /* the saw tooth of the cut layer (3.24)-(3.26) */
+    const double period = TWO_PI / c->Omega, rate = c->H * c->Omega / (TWO_PI);
+    const double grown = 1 + rate * fmod(t, period);
+    f[BUE_TAU] = (1 - F) / (grown * grown) - 2 * x[BUE_TAU] * rate / grown;
+    if (t < c->dt) { /* the start-up: the band forms, nothing else moves */
+        f[BUE_T0] = f[BUE_T] = f[BUE_GAMMA] = 0;
+        return !isfinite(f[BUE_TAU]);
+    }
+    const double Fd = cm_chip_bue_rate(c, xd[BUE_T], xd[BUE_TAU], xd[BUE_GAMMA]);
+    f[BUE_T0] = c->zeta * (x[BUE_T] - 2 * x[BUE_T0]) - x[BUE_T0] / c->dt;
+    f[BUE_T] = c->eta * x[BUE_TAU] * F - c->zeta * (x[BUE_T] - x[BUE_T0]) -
+               (x[BUE_T] - xd[BUE_T0]) / c->dt;
+    f[BUE_GAMMA] = (F - Fd) / c->dt;
+    return !(isfinite(f[BUE_T0]) && isfinite(f[BUE_T]) && isfinite(f[BUE_GAMMA]) &&
+             isfinite(f[BUE_TAU]));
+}
+
+static void bue_history(const void *ctx, double t, double *x)
+{
+    (void)ctx, (void)t;
+    x[BUE_T0] = x[BUE_T] = x[BUE_GAMMA] = x[BUE_TAU] = 0;
+}
+
+/* The saw tooth's drops and the start-up's end. */
+static double bue_next_break(const void *ctx, double t)
+{
+    const cm_chip_bue *c = ctx;
+    const double period = TWO_PI / c->Omega;
+    const double drop = (floor(t / period + 1e-12) + 1) * period;
+    return t < c->dt ? fmin(c->dt, drop) : drop;
+}
+
+void cm_chip_bue_dde(const cm_chip_bue *c, cm_dde *d)
+{
+    *d = (cm_dde){.dim = 4, .delay = c->dt, .field = bue_field, .history = bue_history,
+                  .next_break = bue_next_break, .ctx = c, .method = CM_FLOW_RK8PD,
+                  .abs_tol = 1e-9, .rel_tol = 1e-9};
+}
