@@ -202,3 +202,37 @@ void cm_chip_bue_dde(const cm_chip_bue *c, cm_dde *d)
                   .next_break = bue_next_break, .ctx = c, .method = CM_FLOW_RK8PD,
                   .abs_tol = 1e-9, .rel_tol = 1e-9};
 }
+
+const cm_param_spec cm_chip_bue_spec[] = {
+    {"a", "0.3", 0, 10, 1, NULL, "a: the flow stress' temperature coefficient (3.22)"},
+    {"b", "0.012", 1e-6, 10, 1, NULL, "b: the strain rate's sensitivity; small is stiff"},
+    {"n", "0.2", 0, 10, 1, NULL, "n: strain hardening (3.22, B.36)"},
+    {"T_Phi", "1.2", -0.99, 100, 1, NULL, "T_Phi: the reference temperature"},
+    {"eps", "2.44", 0, 100, 1, NULL, "eps: the reference strain eps_Phi"},
+    {"dt", "0.4", 1e-6, 1e6, 1, NULL, "dt: the delay, the time across the shear band"},
+    {"eta", "4", 0, 1000, 1, NULL, "eta: plastic work turned into heat (3.21)"},
+    {"zeta", "30", 0, 1000, 1, NULL, "zeta: heat conduction between the layers (3.21)"},
+    {"H", "0.1", 0, 100, 1, NULL, "H: the built-up edge's thickening of the cut layer (3.24)"},
+    {"Omega", "0.18", 1e-6, 1e6, 1, NULL, "Omega: the built-up edge's frequency (3.25)"},
+    {"method", "rk8pd", 0, CM_FLOW_RK4, 1, "rk8pd|rkf45|rkck|rk4",
+     "integrator: GSL's explicit Runge-Kutta steppers"},
+    {"abs_tol", "1e-9", 1e-15, 1e-2, 1, NULL, "absolute error per integration step"},
+    {"rel_tol", "1e-9", 0, 1e-2, 1, NULL, "relative error per integration step"},
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
+
+const char *const cm_chip_bue_coords[4] = {"T0", "T", "gamma", "tau"};
+
+void cm_chip_bue_of(const cm_params *p, cm_chip_bue *c, cm_dde *d)
+{
+    *c = (cm_chip_bue){
+        .a = cm_params_get(p, "a"), .b = cm_params_get(p, "b"), .n = cm_params_get(p, "n"),
+        .T_Phi = cm_params_get(p, "T_Phi"), .eps = cm_params_get(p, "eps"),
+        .dt = cm_params_get(p, "dt"), .eta = cm_params_get(p, "eta"),
+        .zeta = cm_params_get(p, "zeta"), .H = cm_params_get(p, "H"),
+        .Omega = cm_params_get(p, "Omega")};
+    cm_chip_bue_dde(c, d);
+    d->method = (int)cm_params_get(p, "method");
+    d->abs_tol = cm_params_get(p, "abs_tol");
+    d->rel_tol = cm_params_get(p, "rel_tol");
+}

@@ -5,6 +5,7 @@
 #ifndef CM_MODELS_CHIP_FORMATION_H
 #define CM_MODELS_CHIP_FORMATION_H
 
+#include "cellmap/model.h"
 #include "models/dde.h"
 
 /* The dimensionless coefficients of Palmai's model (thesis App. B.1) and,
@@ -52,3 +53,14 @@ double cm_chip_bue_rate(const cm_chip_bue *c, double T, double tau, double gamma
 /* c as a delay equation from t = 0 (d->ctx = c, which must outlive d;
  * method rk8pd, tolerances 1e-9). */
 void cm_chip_bue_dde(const cm_chip_bue *c, cm_dde *d);
+
+/* chip-bue's parameters as the commands take them (the coefficients
+ * above, dt the delay, and the integrator's method, abs_tol, rel_tol). */
+extern const cm_param_spec cm_chip_bue_spec[];
+
+/* c and d (as cm_chip_bue_dde, with the integrator settings) from values
+ * p of cm_chip_bue_spec. */
+void cm_chip_bue_of(const cm_params *p, cm_chip_bue *c, cm_dde *d);
+
+/* The names of chip-bue's coordinates: T0, T, gamma, tau. */
+extern const char *const cm_chip_bue_coords[4];

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "models/ode_flow.h"
+#include "models/ode_steps.h"
 
 /* One accepted point of the solution: time, state and rate. */
 typedef struct knot {
@@ -129,38 +130,6 @@ static double next_stop(const cm_dde *d, double t0, double t, double sample)
     return stop;
 }
 
-/* One accepted step from (*t, x) towards stop, going on from step *h. A
- * step whose stages leave the field's domain or overflow (a stiff
- * exponential rate in a trial stage too long) is taken back and tried
- * ten times shorter; false when that goes on below steps of 1e-12. */
-static bool step_to(gsl_odeiv2_driver *drv, gsl_odeiv2_system *sys, double *t, double stop,
-                    double *h, double *x, int dim)
-{
-    double saved[CM_DDE_MAX_DIM];
-    memcpy(saved, x, (size_t)dim * sizeof *x);
-    const double t_was = *t;
-    for (;;) {
-        const double h_was = *h;
-        bool ok = gsl_odeiv2_evolve_apply(drv->e, drv->c, drv->s, sys, t, stop, h, x) ==
-                  GSL_SUCCESS;
-        for (int i = 0; i < dim && ok; i++)
-            ok = isfinite(x[i]);
-        if (ok) {
-            if (*t == stop && *h < h_was)
-                *h = h_was; /* cut short to land: the next step need not be */
-            return true;
-        }
-        const double tried = fmin(h_was, stop - t_was);
-        if (!(tried > 1e-12))
-            return false;
-        *t = t_was;
-        *h = 0.1 * tried;
-        memcpy(x, saved, (size_t)dim * sizeof *x);
-        gsl_odeiv2_evolve_reset(drv->e);
-        gsl_odeiv2_step_reset(drv->s);
-    }
-}
-
 cm_status cm_dde_solve(const cm_dde *d, double t0, double t1, double dt, cm_dde_observer observe,
                        void *user, double *x1, char *msg, size_t msg_size)
 {
@@ -175,7 +144,7 @@ cm_status cm_dde_solve(const cm_dde *d, double t0, double t1, double dt, cm_dde_
     gsl_odeiv2_driver *drv = gsl_odeiv2_driver_alloc_y_new(&sys, cm_flow_stepper(d->method),
                                                            fmin(1e-3, d->delay / 8), abs_tol,
                                                            rel_tol);
-    double x[CM_DDE_MAX_DIM], t = t0, h = fmin(1e-3, d->delay / 8);
+    double x[CM_DDE_MAX_DIM], saved[CM_DDE_MAX_DIM], t = t0, h = fmin(1e-3, d->delay / 8);
     d->history(d->ctx, t0, x);
     int rc = 0;
     st = drv ? add_knot(&r, t, x) : CM_ENOMEM;
@@ -190,15 +159,13 @@ cm_status cm_dde_solve(const cm_dde *d, double t0, double t1, double dt, cm_dde_
                 t = stop;
                 continue;
             }
-            if (!step_to(drv, &sys, &t, stop, &h, x, dim)) {
+            if (!cm_ode_step(drv, (size_t)dim, &t, stop, &h, x, saved)) {
                 st = CM_EMODEL;
                 break;
             }
             st = add_knot(&r, t, x);
-            if (t == stop && st == CM_OK) { /* a jump may follow: start the next step afresh */
-                gsl_odeiv2_evolve_reset(drv->e);
-                gsl_odeiv2_step_reset(drv->s);
-            }
+            if (t == stop && st == CM_OK)
+                cm_ode_restart(drv); /* a jump may follow: start the next step afresh */
         }
         if (st == CM_OK && observe)
             rc = observe(user, t, x);
@@ -217,99 +184,5 @@ cm_status cm_dde_solve(const cm_dde *d, double t0, double t1, double dt, cm_dde_
     free(r.k);
     if (st == CM_OK && rc)
         st = cm_fail(CM_ECANCELED, msg, msg_size, "stopped at t = %.9g", t);
-    return st;
-}
-
-/* ---- the synchronisation estimate ---- */
-
-typedef struct coupled {
-    const cm_dde *d;
-    double q, offset;
-} coupled;
-
-static int coupled_field(const void *ctx, double t, const double *x, const double *xd,
-                         double *f)
-{
-    const coupled *c = ctx;
-    const int n = c->d->dim;
-    /* both halves read the first one's delayed state (3.38)-(3.39) */
-    if (c->d->field(c->d->ctx, t, x, xd, f) || c->d->field(c->d->ctx, t, x + n, xd, f + n))
-        return 1;
-    for (int i = 0; i < n; i++)
-        f[i] += c->q * (x[n + i] - x[i]);
-    return 0;
-}
-
-static void coupled_history(const void *ctx, double t, double *x)
-{
-    const coupled *c = ctx;
-    const int n = c->d->dim;
-    c->d->history(c->d->ctx, t, x);
-    for (int i = 0; i < n; i++)
-        x[n + i] = x[i] + c->offset;
-}
-
-static double coupled_break(const void *ctx, double t)
-{
-    const coupled *c = ctx;
-    return c->d->next_break ? c->d->next_break(c->d->ctx, t) : INFINITY;
-}
-
-typedef struct gap {
-    int n;
-    double from, largest;
-} gap;
-
-static int watch_gap(void *user, double t, const double *x)
-{
-    gap *g = user;
-    if (t >= g->from)
-        for (int i = 0; i < g->n; i++)
-            g->largest = fmax(g->largest, fabs(x[g->n + i] - x[i]));
-    return 0;
-}
-
-/* Whether the copies synchronise at coupling q. */
-static cm_status synchronises(const cm_dde *d, const cm_sync_options *o, double q, bool *yes,
-                              char *msg, size_t msg_size)
-{
-    const coupled c = {d, q, o->offset};
-    cm_dde both = *d;
-    both.dim = 2 * d->dim;
-    both.field = coupled_field, both.history = coupled_history, both.ctx = &c;
-    both.next_break = coupled_break;
-    gap g = {d->dim, o->t1 - 0.1 * (o->t1 - o->t0), 0};
-    const cm_status st = cm_dde_solve(&both, o->t0, o->t1, (o->t1 - o->t0) / 1000, watch_gap, &g,
-                                      NULL, msg, msg_size);
-    *yes = st == CM_OK && g.largest < 1e-3 * o->offset;
-    return st;
-}
-
-cm_status cm_dde_sync_estimate(const cm_dde *d, const cm_sync_options *o, double *q_sync,
-                               char *msg, size_t msg_size)
-{
-    if (d->dim > CM_DDE_MAX_DIM / 2)
-        return cm_fail(CM_EINVAL, msg, msg_size, "the coupled copies need 2 x %d coordinates: "
-                       "at most %d", d->dim, CM_DDE_MAX_DIM);
-    if (!(o->offset > 0 && o->lo >= 0 && o->hi > o->lo && o->q_tol > 0))
-        return cm_fail(CM_EINVAL, msg, msg_size, "the estimate needs offset > 0, 0 <= lo < hi "
-                       "and q_tol > 0");
-    double lo = o->lo, hi = o->hi;
-    bool yes;
-    cm_status st = synchronises(d, o, lo, &yes, msg, msg_size);
-    if (st == CM_OK && yes)
-        return cm_fail(CM_ERANGE, msg, msg_size, "the copies synchronise already at q = %g: "
-                       "lower lo (the largest exponent is below it)", lo);
-    if (st == CM_OK)
-        st = synchronises(d, o, hi, &yes, msg, msg_size);
-    if (st == CM_OK && !yes)
-        return cm_fail(CM_ERANGE, msg, msg_size, "the copies do not synchronise even at q = %g: "
-                       "raise hi or lengthen the run", hi);
-    while (st == CM_OK && hi - lo > o->q_tol) {
-        const double mid = 0.5 * (lo + hi);
-        st = synchronises(d, o, mid, &yes, msg, msg_size);
-        *(yes ? &hi : &lo) = mid;
-    }
-    *q_sync = 0.5 * (lo + hi);
     return st;
 }

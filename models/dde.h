@@ -46,19 +46,4 @@ typedef int (*cm_dde_observer)(void *user, double t, const double *x);
 cm_status cm_dde_solve(const cm_dde *d, double t0, double t1, double dt, cm_dde_observer observe,
                        void *user, double *x1, char *msg, size_t msg_size);
 
-/* The synchronisation estimate of the largest Lyapunov exponent
- * (Stefanski, Kapitaniak and Dabrowski; thesis (3.38)-(3.39)): the system
- * x' = f(x, x_d) + q (y - x) coupled to its copy y' = f(y, x_d), y
- * started `offset` away in every coordinate (over the whole history); the
- * two synchronise when q exceeds the largest exponent. Over t0..t1 a run
- * counts as synchronised when max |x - y| over its last tenth is below
- * 1e-3 offset; q is bisected in lo..hi (lo not synchronising, hi
- * synchronising, else CM_ERANGE) to within q_tol. *q_sync gets the
- * threshold. */
-typedef struct cm_sync_options {
-    double t0, t1, offset, lo, hi, q_tol;
-} cm_sync_options;
-cm_status cm_dde_sync_estimate(const cm_dde *d, const cm_sync_options *o, double *q_sync,
-                               char *msg, size_t msg_size);
-
 #endif

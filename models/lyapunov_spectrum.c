@@ -2,7 +2,6 @@
  * Jacobian), by Benettin's method with modified Gram-Schmidt. */
 #include "models/lyapunov_spectrum.h"
 
-#include <float.h>
 #include <gsl/gsl_errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -12,6 +11,7 @@
 #include "models/linalg.h"
 #include "models/map_periodic.h"
 #include "models/ode_flow.h"
+#include "models/ode_steps.h"
 
 bool cm_gram_schmidt(int n, int k, double *v, double *log_norm)
 {
@@ -181,46 +181,6 @@ static cm_status check_flow_options(const cm_model *m, const cm_spectrum_options
     return check_count(cm_flow_dim(m), o, count, msg, msg_size);
 }
 
-/* The augmented state y (size entries) from *t to t1 with d's stepper,
- * control and evolution, going on from step *h. A step that gives a
- * non-finite state (a stage overflowing in a stiff flow's exponential,
- * whose NaN error estimate GSL's control takes as small) is taken back
- * and tried ten times shorter, as the flow's map does (models/ode_flow.c);
- * false when the field fails, or the state is still not finite at steps
- * below 1e-12. */
-static bool advance_to(gsl_odeiv2_driver *d, size_t size, double *t, double t1, double *h,
-                       double *y, double *saved)
-{
-    while (*t < t1) {
-        /* a remainder below the times' resolution is no step to GSL */
-        if (t1 - *t <= 8 * DBL_EPSILON * fabs(t1)) {
-            *t = t1;
-            break;
-        }
-        const double t_was = *t, h_was = *h;
-        memcpy(saved, y, size * sizeof *y);
-        if (gsl_odeiv2_evolve_apply(d->e, d->c, d->s, d->sys, t, t1, h, y) != GSL_SUCCESS)
-            return false;
-        /* a step cut short to land on t1 does not shorten the next one */
-        if (*t == t1 && *h < h_was)
-            *h = h_was;
-        bool finite = true;
-        for (size_t i = 0; i < size && finite; i++)
-            finite = isfinite(y[i]);
-        if (finite)
-            continue;
-        const double tried = *t - t_was;
-        if (!(tried > 1e-12))
-            return false;
-        *t = t_was;
-        *h = 0.1 * tried;
-        memcpy(y, saved, size * sizeof *y);
-        gsl_odeiv2_evolve_reset(d->e);
-        gsl_odeiv2_step_reset(d->s);
-    }
-    return true;
-}
-
 cm_status cm_flow_spectrum(const cm_model *m, const double *x0, const cm_spectrum_options *o,
                            cm_spectrum_trace trace, void *user, cm_spectrum *out, char *msg,
                            size_t msg_size)
@@ -266,11 +226,11 @@ cm_status cm_flow_spectrum(const cm_model *m, const double *x0, const cm_spectru
     const long renorms = (long)ceil(o->time / o->renorm - 1e-9);
     /* the transient in renorm steps too, so the vectors stay bounded */
     for (double next = t + o->renorm; st == CM_OK && t < t_start; next += o->renorm)
-        if (!advance_to(d, size, &t, fmin(next, t_start), &h, y, saved) ||
+        if (!cm_ode_advance(d, size, &t, fmin(next, t_start), &h, y, saved) ||
             !cm_gram_schmidt(n, k, y + n, logs))
             st = CM_EMODEL;
     for (long r = 1; st == CM_OK && r <= renorms; r++) {
-        if (!advance_to(d, size, &t, t_start + fmin((double)r * o->renorm, o->time), &h, y, saved) ||
+        if (!cm_ode_advance(d, size, &t, t_start + fmin((double)r * o->renorm, o->time), &h, y, saved) ||
             !cm_gram_schmidt(n, k, y + n, logs)) {
             st = CM_EMODEL;
             break;

@@ -7,7 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/series.h"
 #include "lib/simulate.h"
+#include "lib/parse.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -17,7 +19,11 @@
 static const char simulate_help[] =
     "usage: cellmap simulate [--model friction-oscillator] [--param k=v[,k=v]] [--from X,V]\n"
     "                        [--t0 T0] [--periods N] [--skip P] [--csv FILE|-] [--png FILE]\n"
-    "                        [--json] [--quiet] [--size WxH]\n\n"
+    "                        [--json] [--quiet] [--size WxH]\n"
+    "       cellmap simulate --model FLOW|chip-bue [--model-lib P.so] [--param k=v[,k=v]]\n"
+    "                        [--from X,Y,...] [--time T] [--skip T0] [--dt DT] [--of NAME]\n"
+    "                        [--time-unit SECONDS] [--fmax F] [--spectrum FILE|-]\n"
+    "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n\n"
     "A trajectory of the dry friction oscillator x'' + x = cos(Omega t) - S f(x')\n"
     "(thesis eq. (2.3)) from (x, x') = (X, V) at time T0, followed exactly\n"
     "(docs/models.md 9) up to the N-th section instant (forcing phase phi) after T0.\n"
@@ -33,37 +39,123 @@ static const char simulate_help[] =
     "  --png FILE          top: x(t) with the sticking region |x - cos(Omega t)| < S0\n"
     "                      (blue); bottom: the phase portrait with the sticking\n"
     "                      segment and the section points (black). Slip red, stick green\n"
-    "  --size WxH          image size, both panels (default 900x1000)\n";
+    "  --size WxH          image size, both panels (default 900x1000)\n\n"
+    "The time series of a flow model (chip-4d, chip-workpiece, duffing, a plugin's\n"
+    "flow; integrated as its maps are) or of the built-up-edge delay model chip-bue\n"
+    "(docs/models.md 12.3; from its start-up), sampled every DT from the model's t0 to\n"
+    "t0 + T, and the power spectrum of one coordinate (FFTW, Hann window, the mean\n"
+    "taken out) over the samples after the transient, with its largest peaks.\n\n"
+    "  --from X,Y,...      the start in the flow's coordinates (default: the centre of\n"
+    "                      the model's example region, on its section plane)\n"
+    "  --time T            the time followed (default 100)\n"
+    "  --skip T0           the transient: samples before t0 + T0 are not kept\n"
+    "  --dt DT             the sample interval (default 0.01)\n"
+    "  --of NAME           the coordinate drawn and transformed (default the first)\n"
+    "  --time-unit S       seconds per unit of the model's time: frequencies also in Hz\n"
+    "                      (the chip models: K0 = 1.64e-4, thesis 3.3)\n"
+    "  --fmax F            the spectrum drawn up to F (in Hz with --time-unit)\n"
+    "  --csv FILE|-        t and every coordinate per sample (%.17g)\n"
+    "  --spectrum FILE|-   frequency[,frequency_hz],power\n"
+    "  --png FILE          top: the coordinate against t; bottom: log10 of its power\n"
+    "                      spectrum (default size 900x800)\n";
 
-static int parse_args(cli *c, sim_args *a)
+/* What either kind of simulation was asked, and which options were seen
+ * (an option of the other kind is a usage error). */
+typedef struct request {
+    sim_args fo;
+    series_args se;
+    double skip;
+    const char *fo_only, *se_only; /* an option seen that only one kind takes */
+    bool has_skip, has_size;
+} request;
+
+/* --NAME's value into *out, a finite number in lo..hi. */
+static bool take_number(cli *c, const char *name, double lo, double hi, double *out, int *err)
+{
+    if (!cli_is(c, name, true, err))
+        return false;
+    if (c->value && (!parse_double(c->value, out) || !(*out >= lo && *out <= hi)))
+        *err = cli_usage_error(c, "%s: '%s' must be a number in %g..%g", name, c->value, lo, hi);
+    return true;
+}
+
+static int parse_options(cli *c, request *q)
 {
     int err = 0;
     while (cli_next(c) && !err) {
-        int n = 0;
-        if (strcmp(c->opt, "--help") == 0) {
+        const char *opt = c->opt;
+        if (strcmp(opt, "--help") == 0) {
             fputs(simulate_help, stdout);
             return -1;
-        } else if (model_opts_take(c, &a->mo, &err)) {
+        } else if (model_opts_take(c, &q->fo.mo, &err)) {
         } else if (cli_is(c, "--from", true, &err)) {
-            if (c->value && (!parse_doubles(c->value, a->from, &n, 2) || n != 2 ||
-                             !isfinite(a->from[0]) || !isfinite(a->from[1])))
-                err = cli_usage_error(c, "--from: '%s' is not X,V (two finite numbers)", c->value);
+            if (c->value && (!parse_doubles(c->value, q->se.from, &q->se.n_from, SERIES_MAX_DIM)))
+                err = cli_usage_error(c, "--from: '%s' is not a list of numbers X,Y,...",
+                                      c->value);
         } else if (cli_is(c, "--t0", true, &err)) {
-            if (c->value && (!parse_double(c->value, &a->t0) || !(fabs(a->t0) <= 1e9)))
+            if (c->value && (!parse_double(c->value, &q->fo.t0) || !(fabs(q->fo.t0) <= 1e9)))
                 err = cli_usage_error(c, "--t0: '%s' must be a time within +-1e9", c->value);
-            a->has_t0 = 1;
-        } else if (cli_take_int(c, "--periods", 1, 100000, &a->periods, &err)) {
-        } else if (cli_take_int(c, "--skip", 0, 100000, &a->skip, &err)) {
-        } else if (chart_outputs_take(c, &a->out, 300, 400, &err)) {
+            q->fo.has_t0 = 1, q->fo_only = opt;
+        } else if (cli_take_int(c, "--periods", 1, 100000, &q->fo.periods, &err)) {
+            q->fo_only = opt;
+        } else if (take_number(c, "--skip", 0, 1e9, &q->skip, &err)) {
+            q->has_skip = true;
+        } else if (take_number(c, "--time", 1e-9, 1e9, &q->se.time, &err) ||
+                   take_number(c, "--dt", 1e-12, 1e9, &q->se.dt, &err) ||
+                   take_number(c, "--time-unit", 0, 1e9, &q->se.time_unit, &err) ||
+                   take_number(c, "--fmax", 0, 1e300, &q->se.fmax, &err)) {
+            q->se_only = opt;
+        } else if (cli_is(c, "--of", true, &err)) {
+            q->se.of = c->value, q->se_only = opt;
+        } else if (cli_is(c, "--spectrum", true, &err)) {
+            q->se.spectrum_csv = c->value, q->se_only = opt;
+        } else if (chart_outputs_take(c, &q->fo.out, 300, 400, &err)) {
+            q->has_size |= strcmp(opt, "--size") == 0;
         } else {
             err = cli_stray(c);
         }
     }
-    if (!err)
-        err = chart_outputs_check(c, &a->out);
-    if (!err && a->skip >= a->periods)
-        err = cli_usage_error(c, "--skip %d leaves nothing of %d periods to show", a->skip,
-                              a->periods);
+    return err;
+}
+
+/* The friction oscillator's request out of q. */
+static int check_oscillator(cli *c, request *q)
+{
+    if (q->se_only)
+        return cli_usage_error(c, "%s is for flows and chip-bue, not friction-oscillator",
+                               q->se_only);
+    if (q->se.n_from && q->se.n_from != 2)
+        return cli_usage_error(c, "--from: friction-oscillator starts from X,V (two numbers)");
+    if (q->se.n_from)
+        q->fo.from[0] = q->se.from[0], q->fo.from[1] = q->se.from[1];
+    if (q->has_skip && q->skip != floor(q->skip))
+        return cli_usage_error(c, "--skip: friction-oscillator skips whole periods");
+    q->fo.skip = (int)q->skip;
+    int err = chart_outputs_check(c, &q->fo.out);
+    if (!err && q->fo.skip >= q->fo.periods)
+        err = cli_usage_error(c, "--skip %d leaves nothing of %d periods to show", q->fo.skip,
+                              q->fo.periods);
+    return err;
+}
+
+/* A flow's or chip-bue's request out of q. */
+static int check_series(cli *c, request *q)
+{
+    if (q->fo_only)
+        return cli_usage_error(c, "%s is for friction-oscillator; a flow takes --time, --skip "
+                               "and --dt", q->fo_only);
+    q->se.mo = q->fo.mo;
+    q->se.skip = q->skip;
+    const int w = q->se.out.width, h = q->se.out.height;
+    q->se.out = q->fo.out;
+    if (!q->has_size)
+        q->se.out.width = w, q->se.out.height = h;
+    int err = chart_outputs_check(c, &q->se.out);
+    if (!err && q->se.out.json && cm_output_names_stdout(q->se.spectrum_csv))
+        err = cli_usage_error(c, "--json and --spectrum -: both want standard output");
+    if (!err && cm_output_names_stdout(q->se.spectrum_csv) &&
+        (cm_output_names_stdout(q->se.out.csv) || cm_output_names_stdout(q->se.out.png)))
+        err = cli_usage_error(c, "only one output can go to standard output");
     return err;
 }
 
@@ -115,23 +207,96 @@ static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run 
            psi / (a->periods - a->skip));
 }
 
-int cmd_simulate(int argc, char **argv)
+static void print_series(const series_args *a, const series_result *r)
 {
-    cli c = {"simulate", argc, argv, 0, NULL, NULL};
-    sim_args a = simulate_defaults();
-    const int perr = parse_args(&c, &a);
-    if (perr)
-        return perr < 0 ? EXIT_OK : perr;
-    const int werr = chart_outputs_writable(&c, &a.out);
+    FILE *out = report_stream(a->out.csv, a->out.png, a->spectrum_csv);
+    fprintf(out, "followed %s to t = %s: %zu samples of %d coordinates from t = %s\n", r->model,
+            CM_NUM(a->time), r->n, r->dim, CM_NUM(r->t[0]));
+    fprintf(out, "%s in [%.9g, %.9g], mean %.9g\n", r->names[r->of], r->lo, r->hi, r->mean);
+    fprintf(out, "spectrum of %s, largest peaks:", r->names[r->of]);
+    for (size_t k = 0; k < r->n_peaks; k++) {
+        const double f = r->freq[r->peaks[k]];
+        fprintf(out, "%s %.6g", k ? "," : "", f);
+        if (a->time_unit > 0)
+            fprintf(out, " (%.6g Hz)", f / a->time_unit);
+    }
+    fprintf(out, "\n");
+}
+
+static void print_series_json(const series_args *a, const series_result *r)
+{
+    json j;
+    json_begin(&j, stdout, "simulate");
+    json_str(&j, "model", r->model);
+    json_str(&j, "params_text", r->params);
+    json_num(&j, "time", a->time);
+    json_num(&j, "skip", a->skip);
+    json_num(&j, "dt", a->dt);
+    json_uint(&j, "samples", r->n);
+    json_str(&j, "of", r->names[r->of]);
+    json_nums(&j, "range", (const double[2]){r->lo, r->hi}, 2);
+    json_num(&j, "mean", r->mean);
+    json_array(&j, "peaks");
+    for (size_t k = 0; k < r->n_peaks; k++) {
+        json_object(&j, NULL);
+        json_num(&j, "frequency", r->freq[r->peaks[k]]);
+        if (a->time_unit > 0)
+            json_num(&j, "frequency_hz", r->freq[r->peaks[k]] / a->time_unit);
+        json_num(&j, "power", r->power[r->peaks[k]]);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_end(&j);
+}
+
+static int run_series(cli *c, series_args *a)
+{
+    int werr = outfile_check(c->cmd, a->spectrum_csv, false);
+    if (werr == EXIT_OK)
+        werr = chart_outputs_writable(c, &a->out);
+    if (werr != EXIT_OK)
+        return werr;
+    char msg[1024];
+    series_result r;
+    cm_status st = series_compute(a, &r, msg, sizeof msg);
+    if (st == CM_OK) {
+        if (a->out.json)
+            print_series_json(a, &r);
+        else if (!a->out.quiet)
+            print_series(a, &r);
+        st = series_write(a, &r, msg, sizeof msg);
+    }
+    series_result_free(&r);
+    return analysis_said(c->cmd, st, msg);
+}
+
+static int run_oscillator(cli *c, sim_args *a)
+{
+    const int werr = chart_outputs_writable(c, &a->out);
     if (werr != EXIT_OK)
         return werr;
     char msg[1024];
     sim_result r;
-    cm_status st = simulate_compute(&a, &r, msg, sizeof msg);
+    cm_status st = simulate_compute(a, &r, msg, sizeof msg);
     if (st == CM_OK) {
-        print_summary(&a, &r.m, &r.r, &r.last, r.z_prev, fabs(r.tr.psi_sum));
-        st = simulate_write(&a, &r, msg, sizeof msg);
+        print_summary(a, &r.m, &r.r, &r.last, r.z_prev, fabs(r.tr.psi_sum));
+        st = simulate_write(a, &r, msg, sizeof msg);
     }
     simulate_result_free(&r);
-    return analysis_said(c.cmd, st, msg);
+    return analysis_said(c->cmd, st, msg);
+}
+
+int cmd_simulate(int argc, char **argv)
+{
+    cli c = {"simulate", argc, argv, 0, NULL, NULL};
+    request q = {.fo = simulate_defaults(), .se = series_defaults()};
+    int err = parse_options(&c, &q);
+    if (err)
+        return err < 0 ? EXIT_OK : err;
+    if (series_model(&q.fo.mo)) {
+        err = check_series(&c, &q);
+        return err ? err : run_series(&c, &q.se);
+    }
+    err = check_oscillator(&c, &q);
+    return err ? err : run_oscillator(&c, &q.fo);
 }

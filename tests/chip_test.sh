@@ -3,7 +3,9 @@
 # 12.1): the flow's time in orbit and the mean return time, the cell
 # mapping of its section map split and whole, the largest exponent on 1
 # and 2 threads, the equilibria's branch and Hopf points, and bad input (a
-# section never crossed, unknown words, a start where Newton fails).
+# section never crossed, unknown words, a start where Newton fails); the
+# time series and spectra of chip-workpiece and chip-bue (simulate) and
+# chip-4d's Lyapunov spectra (exponents).
 # test_chip checks the dynamics themselves.
 # usage: chip_test.sh PATH/TO/cellmap
 set -u
@@ -102,7 +104,77 @@ assert all(int(r["outside"]) == 0 for r in rows if r["kind"] == "point" and r["p
 PY
 grep -q "^Feigenbaum ratio 1: 3.84" casc.out || fail "periodic's Feigenbaum ratio: $(cat casc.out)"
 
+# --- time series and spectra (thesis 3.3, Figs. 3.9-3.10) -----------------
+"$CM" simulate --model chip-workpiece --from 1,0,0,0,0,0 --time 6000 --skip 2000 --dt 0.05 \
+  --of z --time-unit 1.64e-4 --spectrum wp_z.csv --csv wp.csv --png wp.png --fmax 20000 \
+  > wp.out || fail "simulate chip-workpiece"
+"$CM" simulate --model chip-workpiece --from 1,0,0,0,0,0 --time 6000 --skip 2000 --dt 0.05 \
+  --time-unit 1.64e-4 --spectrum wp_tau2.csv --json > wp.json || fail "simulate --json"
+python3 - wp.csv wp_z.csv wp_tau2.csv wp.json <<'PY' || fail "chip-workpiece's series and spectra"
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert list(rows[0]) == ["t", "tau2", "T0", "T1", "T2", "z", "v"], list(rows[0])
+assert len(rows) == 80001 and float(rows[0]["t"]) == 2000 and float(rows[-1]["t"]) == 6000
+# the settled band's top is the thesis' amplitude 18.25
+zmax = max(float(r["z"]) for r in rows)
+assert 18.0 < zmax < 18.5, zmax
+def peaks(path, lo, hi):
+    s = [(float(r["frequency_hz"]), float(r["power"])) for r in csv.DictReader(open(path))]
+    return max((p, f) for f, p in s if lo < f < hi)[1]
+# z: the workpiece's 600 Hz (sqrt(A)/(2 pi K0) = 600.2 Hz, one bin = 1.5 Hz)
+assert abs(peaks(sys.argv[2], 100, 5000) - 600.2) < 2, peaks(sys.argv[2], 100, 5000)
+# tau2: the chip's segmentation near 12 000 Hz (thesis: "about 12000 Hz")
+f = peaks(sys.argv[3], 5000, 30000)
+assert 11000 < f < 13500, f
+d = json.load(open(sys.argv[4]))
+assert d["of"] == "tau2" and d["samples"] == 80001 and d["peaks"][0]["frequency_hz"] > 0, d
+PY
+[ -s wp.png ] || fail "simulate --png wrote no figure"
+"$CM" simulate --model chip-bue --param H=0.1 --time 200 --dt 0.05 --of tau --csv bue.csv \
+  > bue.out || fail "simulate chip-bue"
+python3 - bue.csv <<'PY' || fail "chip-bue's series"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert list(rows[0]) == ["t", "T0", "T", "gamma", "tau"], list(rows[0])
+# the start-up: only tau moves before the delay
+early = [r for r in rows if float(r["t"]) < 0.4]
+assert all(float(r["T"]) == 0 and float(r["gamma"]) == 0 for r in early)
+assert max(float(r["T"]) for r in rows) > 1, "no bursts"
+PY
+
+# --- Lyapunov spectra ------------------------------------------------------
+"$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 300 --transient 20 --json \
+  > flowexp.json || fail "exponents chip-4d"
+"$CM" exponents --param xi=4.8 --of map --from 1,0.2,0.3 --iterations 600 --skip 50 --json \
+  --csv mapexp.csv > mapexp.json || fail "exponents --of map"
+python3 - flowexp.json mapexp.json mapexp.csv <<'PY' || fail "chip-4d's spectra"
+import csv, json, sys
+fl, mp = (json.load(open(p)) for p in sys.argv[1:3])
+l = fl["lambda"]
+# the flow: one positive (thesis 0.647), one zero along the orbit, two strongly negative
+assert 0.5 < l[0] < 0.75 and abs(l[1]) < 0.02 and l[2] < -30 and l[3] < -60, l
+assert 2.0 < fl["kaplan_yorke"] < 2.05, fl
+# the section map: 0.361 per return in the thesis, about 0.56 time units apart
+assert abs(mp["mean_flight"] / 0.558 - 1) < 0.01 and 0.28 < mp["lambda"][0] < 0.42, mp
+assert abs(mp["lambda_per_time"][0] / l[0] - 1) < 0.15, (mp, l)
+rows = list(csv.DictReader(open(sys.argv[3])))
+assert list(rows[0])[:2] == ["t", "lambda_1"] and "flow_time" in rows[0], list(rows[0])
+assert float(rows[-1]["lambda_1"]) == mp["lambda"][0], (rows[-1], mp)
+PY
+
 # --- bad input -----------------------------------------------------------
+expect_usage "dt" simulate --model chip-bue --param dt=0 --time 10
+expect_usage "leave out --from" simulate --model chip-bue --from 1,2,3,4 --time 10
+expect_usage "coordinates are" simulate --model chip-4d --of x --time 10
+expect_usage "--periods is for friction-oscillator" simulate --model chip-4d --periods 3
+expect_usage "--dt is for flows" simulate --dt 0.1
+expect_usage "is a map: simulate follows flows" simulate --model microchaos-1d --time 10
+expect_usage "--renorm 5 is longer than --time 1" exponents --renorm 5 --time 1
+expect_usage "the flow of model chip-4d has 4 coordinates" exponents --from 1,2
+out=$("$CM" simulate --model chip-4d --from 1,0.1,1e7,0 --time 10 --csv lost.csv 2>&1); rc=$?
+[ "$rc" -eq 1 ] || fail "simulate of a lost orbit exited $rc: $out"
+[ ! -e lost.csv ] || fail "simulate wrote lost.csv although the orbit was lost"
+
 expect_usage "--cascade needs --direction" periodic --from 1,0.2,0.25 --branch xi=2.9:4.36 --cascade 2
 expect_usage "the start has 2 value(s)" periodic --from 1,0.2
 out=$("$CM" periodic --param xi=4.8 --period 3 --from 3,3,3 --csv nope.csv 2>&1); rc=$?

@@ -11,7 +11,7 @@
 
 #include "check.h"
 #include "models/chip_formation.h"
-#include "models/dde.h"
+#include "models/dde_lyapunov.h"
 
 static int lag_field(const void *ctx, double t, const double *x, const double *xd, double *f)
 {

@@ -15,6 +15,7 @@
 #include "check.h"
 #include "models/lyapunov_spectrum.h"
 #include "models/ode_flow.h"
+#include "models/power_spectrum.h"
 
 #define TWO_PI 6.283185307179586476925286766559
 
@@ -202,8 +203,36 @@ static void test_henon(void)
     CHECK(strstr(msg, "iterate") != NULL);
 }
 
+/* Two sines on bins of a 4096-sample series and a constant: the two peaks
+ * at their frequencies, first the stronger, with A^2/4 each (Hann on a
+ * bin), the mean gone; bad input refused. */
+static void test_power_spectrum(void)
+{
+    enum { N = 4096 };
+    static double x[N], f[N / 2 + 1], p[N / 2 + 1];
+    const double dt = 0.01, f1 = 100.0 / (N * dt), f2 = 700.0 / (N * dt);
+    for (int i = 0; i < N; i++)
+        x[i] = 5 + 2 * sin(TWO_PI * f1 * i * dt) + 0.5 * cos(TWO_PI * f2 * i * dt);
+    char msg[256];
+    CHECK(cm_power_spectrum(x, N, dt, f, p, msg, sizeof msg) == CM_OK);
+    size_t peaks[4];
+    const size_t n = cm_spectrum_peaks(p, N / 2 + 1, 4, peaks);
+    printf("spectrum: peaks at %.6g (%.4g) and %.6g (%.4g); f1 %.6g f2 %.6g; p[0] %.3g\n",
+           f[peaks[0]], p[peaks[0]], f[peaks[1]], p[peaks[1]], f1, f2, p[0]);
+    CHECK(n >= 2);
+    CHECK(peaks[0] == 100 && peaks[1] == 700);
+    CHECK(fabs(f[peaks[0]] - f1) < 1e-12 && fabs(f[peaks[1]] - f2) < 1e-12);
+    /* the window's sum differs from N/2 by 1/(N-1) of it */
+    CHECK(fabs(p[peaks[0]] - 1.0) < 2e-3 && fabs(p[peaks[1]] - 0.0625) < 2e-4);
+    CHECK(p[0] < 1e-6);
+    x[7] = NAN;
+    CHECK(cm_power_spectrum(x, N, dt, f, p, msg, sizeof msg) == CM_EINVAL);
+    CHECK(cm_power_spectrum(x, 3, dt, f, p, msg, sizeof msg) == CM_EINVAL);
+}
+
 int main(void)
 {
+    test_power_spectrum();
     test_gram_schmidt();
     test_kaplan_yorke();
     test_lorenz();
