@@ -6,9 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/figure.h"
 #include "lib/outfile.h"
 #include "lib/rows.h"
+#include "models/chip_formation.h"
+#include "models/dde_lyapunov.h"
 #include "models/ode_flow.h"
+#include "models/params.h"
 
 /* The running estimates kept: about this many rows whatever the run's length. */
 enum { EXP_ROWS = 10000 };
@@ -20,6 +24,8 @@ exp_args exponents_defaults(void)
     a.mo.name = "chip-4d";
     a.o = (cm_spectrum_options){.transient = 10, .time = 100, .renorm = 0.1, .iterations = 10000,
                                 .skip = 100};
+    a.samples = 20, a.gs = 10, a.q_max = 20;
+    a.width = 900, a.height = 500;
     return a;
 }
 
@@ -79,10 +85,75 @@ static cm_status start_of(const exp_args *a, const cm_model *m, double *x, char 
     return st;
 }
 
+/* Keeps the result as the last row unless the trace gave it already. */
+static cm_status last_row(exp_result *r, double t, char *msg, size_t msg_size)
+{
+    if (r->n_rows && r->rows[r->n_rows - 1].t == t)
+        return CM_OK;
+    if (!rows_room((void **)&r->rows, &r->cap_rows, r->n_rows, sizeof *r->rows))
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the running estimates");
+    exp_row *last = &r->rows[r->n_rows++];
+    last->t = t;
+    memcpy(last->lambda, r->s.lambda, sizeof last->lambda);
+    return CM_OK;
+}
+
+/* chip-bue's exponents: Farmer's map, or the synchronisation estimate. */
+static cm_status delay_exponents(const exp_args *a, exp_result *r, char *msg, size_t msg_size)
+{
+    cm_params p;
+    cm_status st = cm_chip_bue_params(a->mo.texts, a->mo.n_texts, &p, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_chip_bue_describe(&p, &r->m);
+    r->delay = true;
+    if (a->n_from || a->of_map)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "chip-bue starts from its start-up and has no map: leave out --from and "
+                       "--of map");
+    cm_chip_bue c;
+    cm_dde d;
+    cm_chip_bue_of(&p, &c, &d);
+    if (a->sync) {
+        const cm_sync_options so = {.t0 = 0, .t1 = a->o.transient + a->o.time, .offset = 1e-3,
+                                    .lo = 0, .hi = a->q_max, .q_tol = 1e-3 * a->q_max,
+                                    .own_delay = a->own_delay};
+        st = cm_dde_sync_estimate(&d, &so, &r->sync_q, msg, msg_size);
+        r->s.n = 4, r->s.count = 1, r->s.lambda[0] = r->sync_q, r->s.kaplan_yorke = NAN;
+        return st == CM_OK ? last_row(r, so.t1, msg, msg_size) : st;
+    }
+    const cm_farmer_options fo = {.samples = a->samples, .gs = a->gs,
+                                  .count = a->o.count ? a->o.count : 4,
+                                  .transient = a->o.transient, .time = a->o.time,
+                                  .euler_tangent = a->euler_tangent};
+    if (fo.count > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "at most %d exponents", CM_MAX_DIM);
+    r->stride = fo.time / (c.dt / fo.samples) / fo.gs > EXP_ROWS
+                    ? (long)ceil(fo.time / (c.dt / fo.samples) / fo.gs / EXP_ROWS)
+                    : 1;
+    cm_farmer_result fr;
+    st = cm_dde_farmer(&d, &fo, on_trace, r, &fr, msg, msg_size);
+    if (st != CM_OK)
+        return st == CM_ECANCELED
+                   ? cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the running estimates")
+                   : st;
+    r->farmer_dim = fr.dim;
+    r->s.n = 4, r->s.count = fr.count, r->s.time = fr.time, r->s.kaplan_yorke = fr.kaplan_yorke;
+    memcpy(r->s.lambda, fr.lambda, (size_t)fr.count * sizeof *fr.lambda);
+    return last_row(r, fr.time, msg, msg_size);
+}
+
 cm_status exponents_compute(const exp_args *a, exp_result *r, char *msg, size_t msg_size)
 {
     memset(r, 0, sizeof *r);
     r->mean_flight = NAN;
+    r->sync_q = NAN;
+    r->stride = 1;
+    if (a->mo.name && strcmp(a->mo.name, "chip-bue") == 0)
+        return delay_exponents(a, r, msg, msg_size);
+    if (a->sync || a->euler_tangent)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--sync and --euler-tangent are for the delay model chip-bue");
     cm_status st = model_spec_build(&a->mo, &r->m, msg, msg_size);
     if (st != CM_OK)
         return st;
@@ -104,21 +175,13 @@ cm_status exponents_compute(const exp_args *a, exp_result *r, char *msg, size_t 
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the running estimates");
     if (st == CM_OK && r->of_map && cm_model_is_flow(m))
         r->mean_flight = r->s.time / (double)a->o.iterations;
-    /* the last row is the result itself */
-    if (st == CM_OK && r->n_rows && r->rows[r->n_rows - 1].t != (r->of_map ? steps : r->s.time)) {
-        if (!rows_room((void **)&r->rows, &r->cap_rows, r->n_rows, sizeof *r->rows))
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the running estimates");
-        exp_row *last = &r->rows[r->n_rows++];
-        last->t = r->of_map ? steps : r->s.time;
-        memcpy(last->lambda, r->s.lambda, sizeof last->lambda);
-    }
+    if (st == CM_OK) /* the last row is the result itself */
+        st = last_row(r, r->of_map ? steps : r->s.time, msg, msg_size);
     return st;
 }
 
-cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, size_t msg_size)
+static cm_status write_csv(const exp_args *a, const exp_result *r, char *msg, size_t msg_size)
 {
-    if (!a->csv)
-        return CM_OK;
     outfile o;
     cm_status st = outfile_begin(a->csv, &o, msg, msg_size);
     if (st != CM_OK)
@@ -140,6 +203,59 @@ cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, siz
         fprintf(o.f, "\n");
     }
     return outfile_end(&o, true, msg, msg_size);
+}
+
+/* The running estimates of the (at most 4) largest exponents against t,
+ * as Figs. 3.7 and 3.18 show their convergence; the others are far below. */
+static cm_status write_png(const exp_args *a, const exp_result *r, char *msg, size_t msg_size)
+{
+    enum { SHOWN = 4 };
+    static const cm_rgb ink[SHOWN] = {{20, 60, 160}, {200, 40, 30}, {0, 140, 60}, {120, 60, 160}};
+    const int k = r->s.count < SHOWN ? r->s.count : SHOWN;
+    const size_t n = r->n_rows;
+    double *t = malloc((size_t)(k + 1) * (n ? n : 1) * sizeof *t);
+    if (!t || n == 0) {
+        free(t);
+        return t ? cm_fail(CM_EINVAL, msg, msg_size, "no estimates to draw")
+                 : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
+    }
+    cm_series series[SHOWN];
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; i++)
+        t[i] = r->rows[i].t;
+    for (int j = 0; j < k; j++) {
+        double *y = t + (size_t)(j + 1) * n;
+        for (size_t i = 0; i < n; i++) {
+            y[i] = r->rows[i].lambda[j];
+            /* the first tenth is the estimates' own transient: not in the range */
+            if (i >= n / 10 && isfinite(y[i]))
+                lo = fmin(lo, y[i]), hi = fmax(hi, y[i]);
+        }
+        series[j] = (cm_series){CM_SERIES_LINE, t, y, n, ink[j], 1.5f};
+    }
+    const double pad = hi > lo ? 0.1 * (hi - lo) : 0.5;
+    char title[256], params[512];
+    cm_params_format(&r->m.values, params, sizeof params);
+    snprintf(title, sizeof title, "running Lyapunov exponents of %s (%s)%s", r->m.name,
+             r->of_map ? "its map, per iterate" : "per unit time",
+             k > 1 ? ": lambda_1 blue, lambda_2 red, lambda_3 green, lambda_4 violet" : "");
+    const cm_chart chart = {a->width, a->height, {t[0], lo - pad}, {t[n - 1], hi + pad},
+                            r->of_map ? "iterates" : "t", "lambda", title, NULL, series, k,
+                            figure_font(), 0, NULL, 0};
+    const cm_png_text texts[] = {{"Model", r->m.name}, {"Parameters", params}};
+    const cm_status st = outfile_charts(a->png, &chart, 1, texts, 2, msg, msg_size);
+    free(t);
+    return st;
+}
+
+cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    if (a->csv)
+        st = write_csv(a, r, msg, msg_size);
+    if (st == CM_OK && a->png)
+        st = write_png(a, r, msg, msg_size);
+    return st;
 }
 
 void exponents_result_free(exp_result *r)

@@ -4,8 +4,9 @@
  * Jacobian, with the Kaplan-Yorke dimension and, for a flow's map, the
  * mean flight between iterates, which turns exponents per iterate into
  * exponents per unit of the flow's time (thesis 3.2: lambda_flow =
- * lambda_map / mean return time). The running estimates are written as
- * CSV. Nothing is printed: calls return a status with the problem in msg
+ * lambda_map / mean return time). The delay model chip-bue by Farmer's
+ * discretised map or the synchronisation estimate (models/dde_lyapunov.h,
+ * thesis 3.4.2). The running estimates are written as CSV. Nothing is printed: calls return a status with the problem in msg
  * (CM_EINVAL: the request's). */
 #ifndef CM_LIB_EXPONENTS_H
 #define CM_LIB_EXPONENTS_H
@@ -21,11 +22,20 @@ typedef struct exp_args {
     int n_from;              /* 0: the centre of the model's example region */
     bool of_map;             /* the map's spectrum (a map model always) */
     cm_spectrum_options o;
-    const char *csv;
+    /* chip-bue: Farmer's map on `samples` per delay, Gram-Schmidt every
+     * gs steps (the thesis' Euler tangents with euler_tangent), or with
+     * sync the synchronisation estimate, q bisected in 0..q_max */
+    int samples, gs;
+    bool euler_tangent, sync, own_delay;
+    double q_max;
+    const char *csv, *png;
+    int width, height;
 } exp_args;
 
 /* The command's defaults: chip-4d; flows 100 time units after 10 of
- * transient, renormalised every 0.1; maps 10000 iterates after 100. */
+ * transient, renormalised every 0.1; maps 10000 iterates after 100;
+ * chip-bue 20 samples a delay, Gram-Schmidt every 10 steps, q up to 20;
+ * the figure 900x500. */
 exp_args exponents_defaults(void);
 
 /* One row of the running estimates. */
@@ -37,7 +47,9 @@ typedef struct exp_row {
 typedef struct exp_result {
     cm_model m;
     cm_spectrum s;
-    bool of_map;
+    bool of_map, delay; /* delay: chip-bue's (m describes it, it has no map) */
+    double sync_q;      /* the synchronisation estimate; NAN unless asked */
+    long farmer_dim;    /* Farmer's map's dimension (0: not used) */
     double mean_flight; /* a flow's map: the mean time between iterates; NAN otherwise */
     exp_row *rows;      /* at most about 10000, evenly thinned, the last always */
     size_t n_rows, cap_rows;
@@ -51,7 +63,7 @@ cm_status exponents_compute(const exp_args *a, exp_result *r, char *msg, size_t 
 
 /* The running estimates as CSV at a->csv (NULL: nothing): t (time or
  * iterates), lambda_1..lambda_k (decreasing), kaplan_yorke, and for a
- * flow's map flow_time. */
+ * flow's map flow_time; and as a chart against t at a->png. */
 cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, size_t msg_size);
 
 void exponents_result_free(exp_result *r);

@@ -117,11 +117,9 @@ static cm_status find_of(const series_args *a, series_result *r, char *msg, size
 static cm_status follow_bue(const series_args *a, series_result *r, char *msg, size_t msg_size)
 {
     cm_params p;
-    cm_status st = cm_params_defaults(cm_chip_bue_spec, &p, msg, msg_size);
-    for (int i = 0; i < a->mo.n_texts && st == CM_OK; i++)
-        st = cm_params_set(&p, a->mo.texts[i], msg, msg_size);
+    cm_status st = cm_chip_bue_params(a->mo.texts, a->mo.n_texts, &p, msg, msg_size);
     if (st != CM_OK)
-        return CM_EINVAL; /* the user's parameters: msg names the one and its range */
+        return st;
     if (a->n_from)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "chip-bue starts from its start-up (only tau moves until the delay, "

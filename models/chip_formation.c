@@ -7,6 +7,7 @@
  * (3.12)-(3.16), as the map of the workpiece's largest deflections (its
  * velocity v = 0 crossed downwards). */
 #include <math.h>
+#include <string.h>
 
 #include "models/chip_formation.h"
 #include "models/models.h"
@@ -235,4 +236,22 @@ void cm_chip_bue_of(const cm_params *p, cm_chip_bue *c, cm_dde *d)
     d->method = (int)cm_params_get(p, "method");
     d->abs_tol = cm_params_get(p, "abs_tol");
     d->rel_tol = cm_params_get(p, "rel_tol");
+}
+
+cm_status cm_chip_bue_params(const char *const *texts, int n_texts, cm_params *p, char *msg,
+                             size_t msg_size)
+{
+    cm_status st = cm_params_defaults(cm_chip_bue_spec, p, msg, msg_size);
+    for (int i = 0; i < n_texts && st == CM_OK; i++)
+        st = cm_params_set(p, texts[i], msg, msg_size);
+    return st == CM_OK ? CM_OK : CM_EINVAL; /* msg names the parameter and its range */
+}
+
+void cm_chip_bue_describe(const cm_params *p, cm_model *m)
+{
+    memset(m, 0, sizeof *m);
+    m->name = "chip-bue";
+    m->dim = 4;
+    m->values = *p;
+    m->coord_names = cm_chip_bue_coords;
 }

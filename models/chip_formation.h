@@ -64,3 +64,12 @@ void cm_chip_bue_of(const cm_params *p, cm_chip_bue *c, cm_dde *d);
 
 /* The names of chip-bue's coordinates: T0, T, gamma, tau. */
 extern const char *const cm_chip_bue_coords[4];
+
+/* chip-bue's values from command-line texts ("k=v,..." each) over its
+ * defaults: CM_EINVAL (msg: which and its range) for a bad one. */
+cm_status cm_chip_bue_params(const char *const *texts, int n_texts, cm_params *p, char *msg,
+                             size_t msg_size);
+
+/* m describes chip-bue at values p for the reports (its name, values and
+ * the 4 coordinates' names); it has no map (step NULL). */
+void cm_chip_bue_describe(const cm_params *p, cm_model *m);

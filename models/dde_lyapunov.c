@@ -341,26 +341,31 @@ cm_status cm_dde_farmer(const cm_dde *d, const cm_farmer_options *o, cm_spectrum
         farmer_close(&r);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for Farmer's map");
     }
-    const double D = r.step.D, t_start = ceil(o->transient / D - 1e-9) * D;
+    /* the equation itself up to the first delay (the map's first state),
+     * then the map through the transient, its vectors aligning, then the sums */
+    const double D = r.step.D, t_map = r.N * D;
+    const long skip = (long)ceil((o->transient - t_map) / D - 1e-9);
     const long steps = (long)ceil(o->time / D - 1e-9);
-    st = farmer_start(&r, d, t_start, msg, msg_size);
+    st = farmer_start(&r, d, t_map, msg, msg_size);
     double sum[CM_FARMER_MAX] = {0}, logs[CM_FARMER_MAX], running[CM_FARMER_MAX];
-    double h = fmin(1e-3, D), t = t_start;
-    long s = 0;
-    for (; st == CM_OK && s < steps; s++) {
-        t = t_start + (double)s * D;
+    double h = fmin(1e-3, D), t = t_map;
+    for (long s = -skip; st == CM_OK && s < steps; s++) {
+        t = t_map + (double)(s + skip) * D;
         if (!farmer_advance(&r, t, &h)) {
             st = cm_fail(CM_EMODEL, msg, msg_size,
                          "Farmer's map lost the orbit at t = %.9g: tighten the tolerances", t);
             break;
         }
-        if ((s + 1) % o->gs && s + 1 < steps)
+        const bool last = s + 1 == steps;
+        if ((s + 1) % o->gs && !last && s + 1 != 0)
             continue;
         if (!cm_gram_schmidt((int)r.len, r.k, r.v, logs)) {
             st = cm_fail(CM_EMODEL, msg, msg_size,
                          "Farmer's map's tangent vectors collapsed at t = %.9g", t + D);
             break;
         }
+        if (s < 0)
+            continue; /* the transient: aligning only */
         const double span = (double)(s + 1) * D;
         for (int j = 0; j < r.k; j++) {
             sum[j] += logs[j];

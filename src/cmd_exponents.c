@@ -18,7 +18,12 @@ static const char exponents_help[] =
     "usage: cellmap exponents [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
     "                         [--from X[,Y...]] [--of flow|map] [--count K]\n"
     "                         [--time T] [--transient T] [--renorm DT]\n"
-    "                         [--iterations N] [--skip N] [--csv FILE|-] [--json] [--quiet]\n\n"
+    "                         [--iterations N] [--skip N] [--csv FILE|-] [--png FILE]\n"
+    "                         [--size WxH] [--json] [--quiet]\n"
+    "       cellmap exponents --model chip-bue [--param k=v[,k=v]] [--samples N] [--gs G]\n"
+    "                         [--count K] [--time T] [--transient T] [--euler-tangent]\n"
+    "                         [--csv FILE|-] [--png FILE] [--json] [--quiet]\n"
+    "       cellmap exponents --model chip-bue --sync [--own-delay] [--q-max Q] [--time T]\n\n"
     "The Lyapunov spectrum of one orbit (Benettin's method: K tangent vectors\n"
     "re-orthonormalised by Gram-Schmidt) and its Kaplan-Yorke dimension.\n"
     "A flow model (chip-4d, the default, duffing, a plugin's flow): by default the\n"
@@ -28,6 +33,12 @@ static const char exponents_help[] =
     "Jacobian by central differences at every iterate); for a flow's Poincare or\n"
     "stroboscopic map also the mean flight between iterates and the exponents per\n"
     "unit of the flow's time (lambda_map / mean return time, thesis 3.2).\n"
+    "The delay model chip-bue (docs/models.md 12.3) by Farmer's method: the equation\n"
+    "discretised on N samples per delay into a map of 4 (N + 1) coordinates whose\n"
+    "steps are integrated, K exponents of its tangent map re-orthonormalised every G\n"
+    "steps (thesis Table 3.2); or with --sync the synchronisation estimate of the\n"
+    "largest (3.38)-(3.39): the least coupling q under which a copy started 1e-3\n"
+    "away is pulled in by t = transient + time.\n"
     "`cellmap lyapunov` maps the largest exponent over a grid of parameters.\n\n"
     "  --from X,Y,...      the start: the flow's coordinates (--of map: the map's);\n"
     "                      default the centre of the model's example region\n"
@@ -38,6 +49,14 @@ static const char exponents_help[] =
     "  --renorm DT         flows: the time between Gram-Schmidt steps (default 0.1)\n"
     "  --iterations N      maps: the iterates averaged over (default 10000)\n"
     "  --skip N            maps: the iterates of transient (default 100)\n"
+    "  --samples N         chip-bue: samples per delay, 1..2000 (default 20)\n"
+    "  --gs G              chip-bue: steps between Gram-Schmidt steps (default 10)\n"
+    "  --euler-tangent     chip-bue: the thesis' variant, tangents by Euler steps\n"
+    "  --sync              chip-bue: the synchronisation estimate instead\n"
+    "  --own-delay         with --sync: the copy reads its own delayed state\n"
+    "  --q-max Q           with --sync: q is bisected in 0..Q (default 20)\n"
+    "  --png FILE          the running estimates of the 4 largest against t\n"
+    "  --size WxH          its size (default 900x500)\n"
     "  --csv FILE|-        the running estimates: t (time or iterates), lambda_1..K,\n"
     "                      kaplan_yorke (and flow_time for a flow's map); about\n"
     "                      10000 rows, the last the result\n"
@@ -75,8 +94,20 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
         } else if (take_number(c, "--renorm", 1e-9, 1e9, &a->o.renorm, &err)) {
         } else if (cli_take_int(c, "--iterations", 1, 100000000, &iterations, &err)) {
         } else if (cli_take_int(c, "--skip", 0, 100000000, &skip, &err)) {
+        } else if (cli_take_int(c, "--samples", 1, 2000, &a->samples, &err)) {
+        } else if (cli_take_int(c, "--gs", 1, 1000000, &a->gs, &err)) {
+        } else if (cli_is(c, "--euler-tangent", false, &err)) {
+            a->euler_tangent = true;
+        } else if (cli_is(c, "--sync", false, &err)) {
+            a->sync = true;
+        } else if (cli_is(c, "--own-delay", false, &err)) {
+            a->own_delay = true;
+        } else if (take_number(c, "--q-max", 1e-6, 1e6, &a->q_max, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             *json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -90,17 +121,28 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
         err = cli_usage_error(c, "--renorm %g is longer than --time %g", a->o.renorm, a->o.time);
     if (!err && a->o.time / a->o.renorm > 1e8)
         err = cli_usage_error(c, "--time / --renorm is over 1e8 renormalisations: renorm less often");
-    if (!err && *json && a->csv && strcmp(a->csv, "-") == 0)
-        err = cli_usage_error(c, "--json and --csv -: both want standard output");
+    if (!err && *json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
+        err = cli_usage_error(c, "--json and an output to standard output: choose one");
+    if (!err && a->own_delay && !a->sync)
+        err = cli_usage_error(c, "--own-delay goes with --sync");
     return err;
 }
 
 static void print_summary(FILE *f, const exp_result *r)
 {
     const cm_spectrum *s = &r->s;
+    if (!isnan(r->sync_q)) {
+        fprintf(f, "synchronisation estimate of %s's largest exponent: q = %.4g\n", r->m.name,
+                r->sync_q);
+        return;
+    }
     double sum = 0;
-    fprintf(f, "%s spectrum of %s (%d of %d exponents%s):", r->of_map ? "map" : "flow",
-            r->m.name, s->count, s->n, r->of_map ? ", per iterate" : ", per unit time");
+    if (r->farmer_dim)
+        fprintf(f, "Farmer's map of %s (%ld coordinates; %d exponents, per unit time):",
+                r->m.name, r->farmer_dim, s->count);
+    else
+        fprintf(f, "%s spectrum of %s (%d of %d exponents%s):", r->of_map ? "map" : "flow",
+                r->m.name, s->count, s->n, r->of_map ? ", per iterate" : ", per unit time");
     for (int j = 0; j < s->count; j++) {
         fprintf(f, " %.6g", s->lambda[j]);
         sum += s->lambda[j];
@@ -125,7 +167,7 @@ static void print_json(const exp_result *r)
     json j;
     json_begin(&j, stdout, "exponents");
     json_model(&j, &r->m);
-    json_str(&j, "of", r->of_map ? "map" : "flow");
+    json_str(&j, "of", !isnan(r->sync_q) ? "sync" : r->farmer_dim ? "farmer" : r->of_map ? "map" : "flow");
     json_nums(&j, "lambda", s->lambda, s->count);
     json_num(&j, "kaplan_yorke", s->kaplan_yorke);
     if (!isnan(r->mean_flight)) {
@@ -135,7 +177,10 @@ static void print_json(const exp_result *r)
         json_num(&j, "mean_flight", r->mean_flight);
         json_nums(&j, "lambda_per_time", per_time, s->count);
     }
-    json_nums(&j, "end", s->x, s->n);
+    if (r->farmer_dim)
+        json_int(&j, "farmer_dim", r->farmer_dim);
+    if (!r->delay)
+        json_nums(&j, "end", s->x, s->n);
     json_end(&j);
 }
 
@@ -147,7 +192,9 @@ int cmd_exponents(int argc, char **argv)
     const int perr = parse_args(&c, &a, &json, &quiet);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
-    const int werr = outfile_check("exponents", a.csv, false);
+    int werr = outfile_check("exponents", a.csv, false);
+    if (werr == EXIT_OK)
+        werr = chart_png_check("exponents", a.png);
     if (werr != EXIT_OK)
         return werr;
     char msg[1024];
@@ -157,7 +204,7 @@ int cmd_exponents(int argc, char **argv)
         if (json)
             print_json(&r);
         else if (!quiet)
-            print_summary(report_stream(a.csv, NULL, NULL), &r);
+            print_summary(report_stream(a.csv, a.png, NULL), &r);
         st = exponents_write(&a, &r, msg, sizeof msg);
     }
     exponents_result_free(&r);

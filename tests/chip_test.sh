@@ -162,6 +162,22 @@ assert list(rows[0])[:2] == ["t", "lambda_1"] and "flow_time" in rows[0], list(r
 assert float(rows[-1]["lambda_1"]) == mp["lambda"][0], (rows[-1], mp)
 PY
 
+"$CM" exponents --model chip-bue --samples 10 --time 150 --transient 20 --json --png bue.png \
+  > bue_farmer.json || fail "exponents --model chip-bue"
+"$CM" exponents --model chip-bue --sync --time 150 --transient 20 --json > bue_sync.json \
+  || fail "exponents --model chip-bue --sync"
+python3 - bue_farmer.json bue_sync.json <<'PY' || fail "chip-bue's exponents"
+import json, sys
+fa, sy = (json.load(open(p)) for p in sys.argv[1:3])
+# docs/models.md 12.3: a small positive largest exponent, one near zero, by both
+# methods (the thesis' Table 3.2 and 2.78 are not reproduced)
+l = fa["lambda"]
+assert fa["of"] == "farmer" and fa["farmer_dim"] == 44 and 0.05 < l[0] < 0.5 and abs(l[1]) < 0.15, fa
+assert l[2] < -3 and 2.0 < fa["kaplan_yorke"] < 2.1, fa
+assert sy["of"] == "sync" and 0.05 < sy["lambda"][0] < 0.5, sy
+PY
+[ -s bue.png ] || fail "exponents --png wrote no figure"
+
 # --- bad input -----------------------------------------------------------
 expect_usage "dt" simulate --model chip-bue --param dt=0 --time 10
 expect_usage "leave out --from" simulate --model chip-bue --from 1,2,3,4 --time 10
@@ -171,6 +187,10 @@ expect_usage "--dt is for flows" simulate --dt 0.1
 expect_usage "is a map: simulate follows flows" simulate --model microchaos-1d --time 10
 expect_usage "--renorm 5 is longer than --time 1" exponents --renorm 5 --time 1
 expect_usage "the flow of model chip-4d has 4 coordinates" exponents --from 1,2
+expect_usage "leave out --from" exponents --model chip-bue --from 1,2,3,4
+expect_usage "--sync and --euler-tangent are for the delay model" exponents --sync
+expect_usage "--own-delay goes with --sync" exponents --model chip-bue --own-delay
+expect_usage "dt = -1" exponents --model chip-bue --param dt=-1
 out=$("$CM" simulate --model chip-4d --from 1,0.1,1e7,0 --time 10 --csv lost.csv 2>&1); rc=$?
 [ "$rc" -eq 1 ] || fail "simulate of a lost orbit exited $rc: $out"
 [ ! -e lost.csv ] || fail "simulate wrote lost.csv although the orbit was lost"

@@ -39,6 +39,9 @@ run periodic-cascade periodic --param xi=2.9 --from 1.05,0.2,0.27 --settle 100 -
   --direction up --cascade 2 --json
 run exponents exponents --param xi=4.8,zeta=21 --from 1,0.1,0.2,0.3 --time 5 --transient 1 --json
 run exponents-map exponents --param xi=4.8,zeta=21 --of map --from 1,0.2,0.3 --iterations 20 --skip 5 --json
+run exponents-farmer exponents --model chip-bue --samples 5 --time 20 --json
+run exponents-sync exponents --model chip-bue --sync --time 40 --json
+run simulate-flow simulate --model chip-4d --from 1,0.1,0.2,0.3 --time 5 --json
 run exponents-henon-like exponents --model microchaos-pd --from 0.1,0.01 --iterations 100 --skip 0 --json
 run equilibria-branch equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=4:12 --json
 run equilibria-curve equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=1:15 \

@@ -129,6 +129,42 @@ static void test_sync(void)
     CHECK(cm_dde_sync_estimate(&d, &high, &q, msg, sizeof msg) == CM_ERANGE);
 }
 
+/* Farmer's map of x' = a x + b x(t - 1), a = -2, b = 1: the exponents are
+ * the real parts of the characteristic roots of mu = a + b exp(-mu), the
+ * rightmost real (mu = -0.44285...); the discretised map's largest
+ * converges to it at second order in the sample spacing. */
+static void test_farmer(void)
+{
+    const double ab[2] = {-2, 1};
+    cm_dde d = {.dim = 1, .delay = 1, .field = linear_field, .history = one_before, .ctx = ab,
+                .abs_tol = 1e-12, .rel_tol = 1e-12};
+    double mu = -0.4;
+    for (int i = 0; i < 50; i++) /* Newton on mu - a - b exp(-mu) */
+        mu -= (mu - ab[0] - ab[1] * exp(-mu)) / (1 + ab[1] * exp(-mu));
+    double err[2];
+    char msg[256];
+    for (int k = 0; k < 2; k++) {
+        const cm_farmer_options o = {.samples = 10 << k, .gs = 5, .count = 3, .transient = 12,
+                                     .time = 40};
+        cm_farmer_result r;
+        CHECK(cm_dde_farmer(&d, &o, NULL, NULL, &r, msg, sizeof msg) == CM_OK);
+        err[k] = fabs(r.lambda[0] - mu);
+        printf("farmer N = %d: %.6f %.6f %.6f (root %.6f), %ld coordinates\n", o.samples,
+               r.lambda[0], r.lambda[1], r.lambda[2], mu, r.dim);
+        CHECK(r.dim == o.samples + 1 && r.count == 3);
+        CHECK(r.lambda[0] >= r.lambda[1] && r.lambda[1] >= r.lambda[2]);
+    }
+    CHECK(err[1] < 2e-3);
+    CHECK(err[0] / err[1] > 3); /* second order: about 4 */
+    const cm_farmer_options bad[] = {{.samples = 0, .gs = 1, .count = 1, .transient = 2, .time = 1},
+                                     {.samples = 10, .gs = 1, .count = 20, .transient = 2, .time = 1},
+                                     {.samples = 10, .gs = 1, .count = 1, .transient = 0.5, .time = 1}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        cm_farmer_result r;
+        CHECK(cm_dde_farmer(&d, &bad[i], NULL, NULL, &r, msg, sizeof msg) == CM_EINVAL);
+    }
+}
+
 static int keep(void *user, double t, const double *x)
 {
     (void)t;
@@ -206,6 +242,7 @@ int main(void)
     test_exact();
     test_bad();
     test_sync();
+    test_farmer();
     test_chip_bue();
     CHECK_DONE();
 }
