@@ -543,6 +543,54 @@ cm_periodic_options cm_periodic_defaults(void); /* period 1, both ways, 10000 po
 cm_status cm_analysis_periodic(const cm_analysis *a, const cm_periodic_options *o, char *msg,
                                size_t msg_size);
 
+typedef struct cm_exponents_options {
+    double start[CM_MAX_DIM]; /* the flow's coordinates (of_map: the map's) */
+    int n_from;               /* 0: the centre of the model's example region */
+    int of_map;               /* nonzero: the map's spectrum (a map model's always) */
+    int count;                /* exponents, 0: all */
+    double time, transient, renorm; /* flows (and chip-bue: time, transient) */
+    long iterations, skip;          /* maps */
+    int samples, gs;          /* chip-bue: Farmer's map */
+    int sync;                 /* chip-bue: the synchronisation estimate instead */
+    double q_max;             /* with sync: q in 0..q_max */
+} cm_exponents_options;
+/* flows 100 after 10, renormalised every 0.1; maps 10000 after 100;
+ * chip-bue 20 samples a delay, Gram-Schmidt every 10 steps, q up to 20 */
+cm_exponents_options cm_exponents_defaults(void);
+
+typedef struct cm_exponents {
+    int count;
+    double lambda[CM_MAX_DIM]; /* decreasing: per unit time (flows, chip-bue), per iterate (maps) */
+    double kaplan_yorke;       /* NAN when more exponents are needed */
+    double mean_flight;        /* a flow's map: the mean time between iterates; else NAN */
+} cm_exponents;
+
+/* The Lyapunov spectrum of one orbit (default model chip-4d; `cellmap
+ * exponents`): a flow's by its variational equations, a map's by the QR
+ * of its Jacobian, chip-bue's by Farmer's discretised map or the
+ * synchronisation estimate. out (may be NULL) gets the result; a->csv the
+ * running estimates, a->png their chart. CM_EMODEL: the orbit was lost. */
+cm_status cm_analysis_exponents(const cm_analysis *a, const cm_exponents_options *o,
+                                cm_exponents *out, char *msg, size_t msg_size);
+
+typedef struct cm_series_options {
+    double start[2 * CM_MAX_DIM]; /* the flow's coordinates */
+    int n_from;                   /* 0: the centre of the example region (chip-bue: its start-up) */
+    double time, skip, dt;        /* followed to time, kept after skip, every dt */
+    const char *of;               /* the coordinate drawn and transformed; NULL: the first */
+    double time_unit;             /* seconds per unit of time (0: no Hz) */
+    double fmax;                  /* the spectrum drawn up to this (Hz given time_unit); 0: all */
+    const char *spectrum_csv;     /* frequency[,frequency_hz],power, or NULL */
+} cm_series_options;
+cm_series_options cm_series_defaults(void); /* 100 time units every 0.01, none skipped */
+
+/* The time series of a flow model or chip-bue (`cellmap simulate --model
+ * FLOW`; there is no default model: a->model must name one) and the power
+ * spectrum of one coordinate (FFTW): a->csv the samples, a->png the
+ * history over the spectrum. */
+cm_status cm_analysis_series(const cm_analysis *a, const cm_series_options *o, char *msg,
+                             size_t msg_size);
+
 typedef struct cm_simulate_options {
     double x, v;     /* the start */
     double t0;       /* its time; NaN: the Poincare section's phase phi/Omega */

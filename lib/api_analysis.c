@@ -17,6 +17,9 @@
 #include "lib/equilibria.h"
 #include "lib/escape.h"
 #include "lib/periodic.h"
+#include "lib/exponents.h"
+#include "lib/series.h"
+#include "models/dde_lyapunov.h"
 #include "lib/horseshoe.h"
 #include "lib/lyapunov.h"
 #include "lib/partition.h"
@@ -159,6 +162,98 @@ cm_status cm_analysis_simulate(const cm_analysis *a, const cm_simulate_options *
     if (st == CM_OK)
         st = simulate_write(&sa, &r, msg, msg_size);
     simulate_result_free(&r);
+    return st;
+}
+
+/* ---- any model: Lyapunov spectra and time series ---- */
+
+cm_exponents_options cm_exponents_defaults(void)
+{
+    const exp_args d = exponents_defaults();
+    return (cm_exponents_options){.time = d.o.time, .transient = d.o.transient,
+                                  .renorm = d.o.renorm, .iterations = d.o.iterations,
+                                  .skip = d.o.skip, .samples = d.samples, .gs = d.gs,
+                                  .q_max = d.q_max};
+}
+
+cm_status cm_analysis_exponents(const cm_analysis *a, const cm_exponents_options *o,
+                                cm_exponents *out, char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_exponents_options d = cm_exponents_defaults();
+    o = o ? o : &d;
+    exp_args ea = exponents_defaults();
+    model_of(a, ea.mo.name, &ea.mo);
+    if (o->n_from < 0 || o->n_from > CM_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "n_from must be 0..%d", CM_MAX_DIM);
+    memcpy(ea.from, o->start, sizeof ea.from);
+    ea.n_from = o->n_from, ea.of_map = o->of_map != 0, ea.sync = o->sync != 0;
+    ea.o = (cm_spectrum_options){.count = o->count, .transient = o->transient, .time = o->time,
+                                 .renorm = o->renorm, .iterations = o->iterations,
+                                 .skip = o->skip};
+    ea.samples = o->samples, ea.gs = o->gs, ea.q_max = o->q_max;
+    ea.csv = a->csv, ea.png = a->png;
+    chart_outputs co;
+    cm_status st = outputs_of(a, ea.width, ea.height, 300, 200, &co, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    ea.width = co.width, ea.height = co.height;
+    if (!(o->samples >= 1 && o->samples <= CM_FARMER_MAX_SAMPLES && o->gs >= 1 && o->q_max > 0))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "samples must be 1..%d, gs >= 1 and q_max > 0 (start from "
+                       "cm_exponents_defaults())",
+                       CM_FARMER_MAX_SAMPLES);
+    exp_result r;
+    st = exponents_compute(&ea, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = exponents_write(&ea, &r, msg, msg_size);
+    if (st == CM_OK && out) {
+        *out = (cm_exponents){.count = r.s.count, .kaplan_yorke = r.s.kaplan_yorke,
+                              .mean_flight = r.mean_flight};
+        memcpy(out->lambda, r.s.lambda, sizeof out->lambda);
+    }
+    exponents_result_free(&r);
+    return st;
+}
+
+cm_series_options cm_series_defaults(void)
+{
+    const series_args d = series_defaults();
+    return (cm_series_options){.time = d.time, .skip = d.skip, .dt = d.dt};
+}
+
+cm_status cm_analysis_series(const cm_analysis *a, const cm_series_options *o, char *msg,
+                             size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_series_options d = cm_series_defaults();
+    o = o ? o : &d;
+    series_args sa = series_defaults();
+    if (!a->model)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a time series needs a model: a flow (chip-4d, chip-workpiece, duffing, "
+                       "a plugin's) or chip-bue");
+    model_of(a, NULL, &sa.mo);
+    if (!series_model(&sa.mo))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "model %s: a time series follows flows and chip-bue (friction-oscillator: "
+                       "cm_analysis_simulate)",
+                       a->model);
+    if (o->n_from < 0 || o->n_from > SERIES_MAX_DIM)
+        return cm_fail(CM_EINVAL, msg, msg_size, "n_from must be 0..%d", SERIES_MAX_DIM);
+    memcpy(sa.from, o->start, sizeof sa.from);
+    sa.n_from = o->n_from, sa.time = o->time, sa.skip = o->skip, sa.dt = o->dt, sa.of = o->of;
+    sa.time_unit = o->time_unit, sa.fmax = o->fmax, sa.spectrum_csv = o->spectrum_csv;
+    cm_status st = outputs_of(a, sa.out.width, sa.out.height, 300, 400, &sa.out, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(o->spectrum_csv, false, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    series_result r;
+    st = series_compute(&sa, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = series_write(&sa, &r, msg, msg_size);
+    series_result_free(&r);
     return st;
 }
 

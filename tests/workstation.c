@@ -125,6 +125,23 @@ static void analyses(void)
     a = outputs("periodic", f, 0);
     a.params = "xi=2.9";
     must(cm_analysis_periodic(&a, &po, msg, sizeof msg), "periodic", msg);
+    cm_exponents_options xo = cm_exponents_defaults();
+    xo.start[0] = 1, xo.start[1] = 0.1, xo.start[2] = 0.2, xo.start[3] = 0.3, xo.n_from = 4;
+    xo.time = 20, xo.transient = 5;
+    a = outputs("exponents", f, 1);
+    a.params = "xi=4.8";
+    cm_exponents ex;
+    must(cm_analysis_exponents(&a, &xo, &ex, msg, sizeof msg), "exponents", msg);
+    if (ex.count != 4 || !(ex.lambda[0] > 0 && ex.lambda[3] < -30)) {
+        fprintf(stderr, "exponents: %d, %g .. %g\n", ex.count, ex.lambda[0], ex.lambda[3]);
+        exit(1);
+    }
+    cm_series_options so2 = cm_series_defaults();
+    so2.time = 50, so2.dt = 0.05, so2.of = "tau", so2.time_unit = 1e-3;
+    so2.spectrum_csv = "c_series_spectrum.csv";
+    a = outputs("series", f, 1);
+    a.model = "chip-bue";
+    must(cm_analysis_series(&a, &so2, msg, sizeof msg), "series", msg);
 }
 
 int main(void)

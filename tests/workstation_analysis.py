@@ -2,8 +2,9 @@
 the same settings through the command and through tests/workstation.c and
 compares the files byte for byte): PREFIX_NAME.csv and .png for stability,
 partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
-runs), lyapunov, sweep, continue (and its events), equilibria and
-periodic (their tables). The tables the
+runs), lyapunov, sweep, continue (and its events), exponents, the time
+series of chip-bue (and its spectrum), equilibria and periodic (their
+tables). The tables the
 functions return are checked against the files they read them from.
 usage: workstation_analysis.py PREFIX"""
 import os
@@ -56,6 +57,15 @@ assert list(eq["kind"]) == ["hopf"] * 4 and list(eq["zeta"]) == [20.25] * 2 + [2
 po = rows(an.periodic((1.05, 0.2, 0.27), settle=100, branch=("xi", 2.9, 4.1), direction=1,
                       cascade=2, params="xi=2.9", csv=p + "periodic.csv"), p + "periodic.csv")
 assert list(po["period"][po["kind"] == "pd"]) == [1, 2], po
+ex, table = an.exponents((1, 0.1, 0.2, 0.3), time=20, transient=5, params="xi=4.8",
+                         **out("exponents"))
+rows(table, p + "exponents.csv")
+assert len(ex["lambda"]) == 4 and ex["lambda"][0] == table["lambda_1"][-1], (ex, table[-1])
+samples, spectrum = an.series("chip-bue", time=50, dt=0.05, of="tau", time_unit=1e-3,
+                              spectrum_csv=p + "series_spectrum.csv", **out("series"))
+rows(samples, p + "series.csv")
+rows(spectrum, p + "series_spectrum.csv")
+assert list(samples.dtype.names) == ["t", "T0", "T", "gamma", "tau"], samples.dtype.names
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})

@@ -96,9 +96,13 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
   "$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:15 --curve zeta=20:21:2 \
     --csv cli_equilibria.csv &&
   "$CM" periodic --param xi=2.9 --from 1.05,0.2,0.27 --settle 100 --branch xi=2.9:4.1 \
-    --direction up --cascade 2 --csv cli_periodic.csv; } > analyses.log 2>&1 ||
+    --direction up --cascade 2 --csv cli_periodic.csv &&
+  "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 20 --transient 5 \
+    --csv cli_exponents.csv --png cli_exponents.png &&
+  "$CM" simulate --model chip-bue --time 50 --dt 0.05 --of tau --time-unit 1e-3 \
+    --csv cli_series.csv --png cli_series.png --spectrum cli_series_spectrum.csv; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
-ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue"
+ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue exponents series"
 
 # without_seconds CSV: the table without its last column (a sweep's timings)
 without_seconds() { sed 's/,[^,]*$//' "$1"; }
@@ -113,6 +117,7 @@ check_analyses() { # PREFIX: the analyses' files, against the command's
   same_bytes cli_continue_events.csv "$1_continue_events.csv" "$1: continue's events"
   same_bytes cli_equilibria.csv "$1_equilibria.csv" "$1: equilibria's table"
   same_bytes cli_periodic.csv "$1_periodic.csv" "$1: periodic's table"
+  same_bytes cli_series_spectrum.csv "$1_series_spectrum.csv" "$1: the series' spectrum"
   head -1 cli_sweep.csv | grep -q ',seconds$' || fail "the sweep's table no longer ends in seconds"
   without_seconds cli_sweep.csv > a_sweep.csv && without_seconds "$1_sweep.csv" > b_sweep.csv &&
     [ "$(grep -c . b_sweep.csv)" -eq 3 ] && cmp -s a_sweep.csv b_sweep.csv ||

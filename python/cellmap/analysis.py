@@ -1,6 +1,7 @@
 """The analysis drivers of libcellmap (cm_analysis_* in cellmap/cellmap.h):
 the commands stability, partition, amplitude, horseshoe, escape,
-equilibria, periodic, simulate, bifurcation, lyapunov, sweep and continue
+equilibria, periodic, exponents, simulate (and series, simulate's time
+series of flows and chip-bue), bifurcation, lyapunov, sweep and continue
 as functions. Each computes what
 the command computes and writes the same files (csv=, png=, byte for
 byte); it returns the table as a numpy structured array (columns by name,
@@ -28,7 +29,8 @@ import numpy as np
 from . import CellmapError, Models, _call, _lib, _text, _P, _DOUBLES  # noqa: F401
 
 __all__ = ["stability", "partition", "amplitude", "horseshoe", "escape", "equilibria",
-           "periodic", "simulate", "bifurcation", "lyapunov", "sweep", "continuation"]
+           "periodic", "exponents", "series", "simulate", "bifurcation", "lyapunov", "sweep",
+           "continuation"]
 
 
 class _Axis(ctypes.Structure):
@@ -65,6 +67,27 @@ class _Equilibria(ctypes.Structure):
 class _Periodic(ctypes.Structure):
     _fields_ = [("b", _Branch), ("settle", ctypes.c_int), ("period", ctypes.c_int),
                 ("cascade", ctypes.c_int)]
+
+
+class _Exponents(ctypes.Structure):
+    _fields_ = [("start", ctypes.c_double * 6), ("n_from", ctypes.c_int), ("of_map", ctypes.c_int),
+                ("count", ctypes.c_int), ("time", ctypes.c_double),
+                ("transient", ctypes.c_double), ("renorm", ctypes.c_double),
+                ("iterations", ctypes.c_long), ("skip", ctypes.c_long),
+                ("samples", ctypes.c_int), ("gs", ctypes.c_int), ("sync", ctypes.c_int),
+                ("q_max", ctypes.c_double)]
+
+
+class _ExponentsOut(ctypes.Structure):
+    _fields_ = [("count", ctypes.c_int), ("lam", ctypes.c_double * 6),
+                ("kaplan_yorke", ctypes.c_double), ("mean_flight", ctypes.c_double)]
+
+
+class _Series(ctypes.Structure):
+    _fields_ = [("start", ctypes.c_double * 12), ("n_from", ctypes.c_int),
+                ("time", ctypes.c_double), ("skip", ctypes.c_double), ("dt", ctypes.c_double),
+                ("of", ctypes.c_char_p), ("time_unit", ctypes.c_double),
+                ("fmax", ctypes.c_double), ("spectrum_csv", ctypes.c_char_p)]
 
 
 class _Simulate(ctypes.Structure):
@@ -116,8 +139,11 @@ for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
                      ("simulate", _Simulate), ("bifurcation", _Bifurcation),
                      ("lyapunov", _Lyapunov), ("sweep", _Sweep), ("continue", _Continue)):
     _sig("cm_analysis_" + _name, ctypes.POINTER(_opts))
+_sig("cm_analysis_series", ctypes.POINTER(_Series))
+_sig("cm_analysis_exponents", ctypes.POINTER(_Exponents), ctypes.POINTER(_ExponentsOut))
 for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
                      ("equilibria", _Equilibria), ("periodic", _Periodic),
+                     ("exponents", _Exponents), ("series", _Series),
                      ("simulate", _Simulate), ("bifurcation", _Bifurcation),
                      ("lyapunov", _Lyapunov), ("continue", _Continue)):
     getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
@@ -303,6 +329,62 @@ def periodic(start, settle=0, period=1, branch=None, direction=0, ds_max=None,
     table = _run(_common(**common), _lib.cm_analysis_periodic, ctypes.byref(o))
     del keep
     return table
+
+
+def exponents(start=None, of_map=False, count=0, time=None, transient=None, renorm=None,
+              iterations=None, skip=None, samples=None, gs=None, sync=False, q_max=None,
+              **common):
+    """The Lyapunov spectrum of one orbit (`cellmap exponents`; model chip-4d
+    unless named): a flow's by its variational equations (time, transient,
+    renorm), a map's (of_map=True, or a map model) by the QR of its Jacobian
+    (iterations, skip), chip-bue's by Farmer's map (samples, gs) or the
+    synchronisation estimate (sync=True, q_max). Returns (result, table):
+    result a dict of lambda (decreasing), kaplan_yorke (None when more
+    exponents are needed) and mean_flight (a flow's map), the table the
+    running estimates (t, lambda_1.., kaplan_yorke)."""
+    o = _lib.cm_exponents_defaults()
+    if start is not None:
+        if len(start) > 6:
+            raise ValueError("start: at most 6 coordinates")
+        o.n_from = len(start)
+        for i, v in enumerate(start):
+            o.start[i] = float(v)
+    o.of_map, o.count, o.sync = int(bool(of_map)), int(count), int(bool(sync))
+    for key, value, kind in (("time", time, float), ("transient", transient, float),
+                             ("renorm", renorm, float), ("iterations", iterations, int),
+                             ("skip", skip, int), ("samples", samples, int), ("gs", gs, int),
+                             ("q_max", q_max, float)):
+        if value is not None:
+            setattr(o, key, kind(value))
+    res = _ExponentsOut()
+    table = _run(_common(**common), _lib.cm_analysis_exponents, ctypes.byref(o),
+                 ctypes.byref(res))
+    ky = res.kaplan_yorke
+    return ({"lambda": [res.lam[i] for i in range(res.count)],
+             "kaplan_yorke": None if math.isnan(ky) else ky,
+             "mean_flight": None if math.isnan(res.mean_flight) else res.mean_flight}, table)
+
+
+def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
+           spectrum_csv=None, **common):
+    """The time series of a flow model or chip-bue (`cellmap simulate
+    --model FLOW`) and the power spectrum (FFTW) of coordinate `of`:
+    returns (samples, spectrum) tables; time_unit (seconds per unit) adds
+    frequency_hz."""
+    o = _lib.cm_series_defaults()
+    if start is not None:
+        if len(start) > 12:
+            raise ValueError("start: at most 12 coordinates")
+        o.n_from = len(start)
+        for i, v in enumerate(start):
+            o.start[i] = float(v)
+    for key, value in (("time", time), ("skip", skip), ("dt", dt)):
+        if value is not None:
+            setattr(o, key, float(value))
+    o.of = _text(of) if of is not None else None
+    o.time_unit, o.fmax = float(time_unit), float(fmax)
+    return _run(_common(model=model, **common), _lib.cm_analysis_series, ctypes.byref(o),
+                second=(o, "spectrum_csv", spectrum_csv))
 
 
 def simulate(start=(0.0, 0.0), t0=None, periods=20, skip=0, **common):
