@@ -29,11 +29,10 @@ static uint64_t mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-/* Three numbers in [-1, 1) that depend only on the seed, the value and the run. */
-static void random_start(long long seed, int value, int run, double u[3])
+void bifurcation_random(long long seed, int value, int run, int n, double *u)
 {
     uint64_t h = mix64(mix64((uint64_t)seed) ^ ((uint64_t)value << 32 | (uint64_t)run));
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < n; k++) {
         h = mix64(h);
         u[k] = (double)(h >> 11) * 0x1p-52 - 1;
     }
@@ -57,7 +56,7 @@ static void bifurcation_run(const bif_args *a, const cm_fo *o, int value, int r,
                 double *sections)
 {
     double u[3];
-    random_start(a->seed, value, r, u);
+    bifurcation_random(a->seed, value, r, 3, u);
     res->x0 = u[0];
     res->v0 = u[1];
     res->t0 = u[2] * o->T;

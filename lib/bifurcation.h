@@ -27,6 +27,12 @@ typedef struct bif_args {
     long long seed;
     const char *runs_csv;
     chart_outputs out;
+    /* a map model's (lib/map_bifurcation.h): the coordinate recorded (NULL:
+     * the first) and branch tables drawn over the points */
+    const char *of;
+    const char *branches[8];
+    int n_branches;
+    bool has_size; /* the size was given (a map's diagram is otherwise 900x600) */
 } bif_args;
 
 /* What one run recorded. */
@@ -71,6 +77,9 @@ cm_status bifurcation_compute(const bif_args *a, const work_hooks *h, bif_result
 cm_status bifurcation_write(const bif_args *a, const bif_result *r, char *msg, size_t msg_size);
 
 void bifurcation_result_free(bif_result *r);
+
+/* n numbers in [-1, 1) that depend only on the seed, the value and the run. */
+void bifurcation_random(long long seed, int value, int run, int n, double *u);
 
 /* The result of run r at value index `value`. */
 const run_result *bifurcation_result_at(const sweep_results *s, int value, int r);

@@ -80,18 +80,25 @@ cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_
                                msg_size);
 }
 
-cm_status model_spec_centre(const model_spec *spec, int dim, double *x, char *msg,
+cm_status model_spec_region(const model_spec *spec, int dim, double *lo, double *hi, char *msg,
                             size_t msg_size)
 {
     const cm_model_entry *e = cm_model_set_find(&spec->set, spec->name, NULL);
-    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
     int n = 0;
     if (!e || !e->region || !parse_ranges(e->region, lo, hi, &n, CM_MAX_DIM) || n != dim)
         return cm_fail(CM_EINVAL, msg, msg_size, "model %s has no default region: give the start",
                        spec->name);
-    for (int d = 0; d < dim; d++)
-        x[d] = 0.5 * (lo[d] + hi[d]);
     return CM_OK;
+}
+
+cm_status model_spec_centre(const model_spec *spec, int dim, double *x, char *msg,
+                            size_t msg_size)
+{
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    const cm_status st = model_spec_region(spec, dim, lo, hi, msg, msg_size);
+    for (int d = 0; d < dim && st == CM_OK; d++)
+        x[d] = 0.5 * (lo[d] + hi[d]);
+    return st;
 }
 
 int model_image(const cm_model *m, const double *x, double *y, double *flight)

@@ -50,8 +50,12 @@ const cm_model_lib *model_spec_lib(const model_spec *spec, const char *name);
  * the caller with cm_model_release). */
 cm_status model_spec_build(const model_spec *spec, cm_model *m, char *msg, size_t msg_size);
 
-/* The centre of the example region of the model spec names (dim
- * coordinates) into x: CM_EINVAL when it has none. */
+/* The example region of the model spec names (dim coordinates) into lo
+ * and hi: CM_EINVAL when it has none. */
+cm_status model_spec_region(const model_spec *spec, int dim, double *lo, double *hi, char *msg,
+                            size_t msg_size);
+
+/* Its centre into x. */
 cm_status model_spec_centre(const model_spec *spec, int dim, double *x, char *msg,
                             size_t msg_size);
 

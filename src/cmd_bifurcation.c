@@ -12,6 +12,7 @@
 
 #include "lib/work.h"
 #include "lib/bifurcation.h"
+#include "lib/map_bifurcation.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -50,7 +51,16 @@ static const char bifurcation_help[] =
     "  --png FILE          sticking displacements (as Fig. 2.22, top), Poincare x and\n"
     "                      Psi per period against NAME\n"
     "  --size WxH          image size, all three panels (default 900x1200)\n"
-    "  --threads T         OpenMP threads (default: all cores)\n";
+    "  --threads T         OpenMP threads (default: all cores)\n\n"
+    "Any other model (a map, or a flow's section or stroboscopic map: chip-4d,\n"
+    "Fig. 3.5): R runs a value from random starts in the model's example region,\n"
+    "P iterates of transient and n recorded (--transient, --record count iterates),\n"
+    "one coordinate of each recorded iterate kept.\n"
+    "  --of NAME           the coordinate recorded (default the map's first)\n"
+    "  --branches FILE     a table of `cellmap equilibria` or `cellmap periodic` --csv\n"
+    "                      over the same parameter, drawn over the points (stable\n"
+    "                      black, unstable red); repeat it for more (up to 8)\n"
+    "  --csv FILE          NAME,run,COORD per recorded iterate\n";
 
 static int parse_args(cli *c, bif_args *a)
 {
@@ -79,7 +89,15 @@ static int parse_args(cli *c, bif_args *a)
             a->seed = v;
         } else if (cli_is(c, "--runs-csv", true, &err)) {
             a->runs_csv = c->value;
+        } else if (cli_is(c, "--of", true, &err)) {
+            a->of = c->value;
+        } else if (cli_is(c, "--branches", true, &err)) {
+            if (c->value && a->n_branches == 8)
+                err = cli_usage_error(c, "--branches: at most 8 tables");
+            else if (c->value)
+                a->branches[a->n_branches++] = c->value;
         } else if (chart_outputs_take(c, &a->out, 300, 450, &err)) {
+            a->has_size |= strcmp(c->opt, "--size") == 0;
         } else {
             err = cli_stray(c);
         }
@@ -151,6 +169,62 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
 
 /* ---- the command ---- */
 
+static void print_map_summary(const bif_args *a, const map_bif_result *r)
+{
+    const uint64_t not_computed = (uint64_t)(a->sweep.n - r->n_valid) * (uint64_t)a->runs;
+    if (a->out.json) {
+        json j;
+        json_begin(&j, stdout, "bifurcation");
+        param_base_json(&j, a->mo.name, &r->base);
+        param_axes_json(&j, "sweep", &a->sweep, 1);
+        json_int(&j, "runs", a->runs);
+        json_int(&j, "transient", a->transient);
+        json_int(&j, "record", a->record);
+        json_int(&j, "seed", a->seed);
+        json_uint(&j, "followed", r->followed);
+        json_uint(&j, "lost", r->n_lost);
+        json_uint(&j, "not_computed", not_computed);
+        json_seconds(&j, "seconds", r->seconds);
+        json_end(&j);
+        return;
+    }
+    fprintf(report_stream(a->out.csv, a->out.png, NULL),
+            "%d values of %s x %d runs in %.2f s: %llu runs followed, %llu lost%s\n", a->sweep.n,
+            a->sweep.name, a->runs, r->seconds, (unsigned long long)r->followed,
+            (unsigned long long)r->n_lost,
+            not_computed ? "; values where the model cannot be built are not computed" : "");
+}
+
+/* A map model's diagram (lib/map_bifurcation.h). */
+static int run_map(cli *c, bif_args *a)
+{
+    if (a->runs_csv)
+        return cli_usage_error(c, "--runs-csv is friction-oscillator's: a map's runs are in --csv");
+    const int werr = chart_outputs_writable(c, &a->out);
+    if (werr != EXIT_OK)
+        return werr;
+    const uint64_t n_runs = (uint64_t)a->sweep.n * (uint64_t)a->runs;
+    progress pr;
+    progress_start(&pr, "bifurcation", "runs", n_runs, a->out.quiet);
+    const work_hooks hooks = progress_hooks(&pr);
+    interrupt_catch();
+    char msg[1024];
+    map_bif_result r;
+    cm_status st = map_bifurcation_compute(a, &hooks, &r, msg, sizeof msg);
+    progress_end(&pr);
+    if (st == CM_ECANCELED) {
+        map_bifurcation_free(&r);
+        return interrupt_stopped("bifurcation", r.done, n_runs, "runs");
+    }
+    if (st == CM_OK) {
+        if (!a->out.quiet || a->out.json)
+            print_map_summary(a, &r);
+        st = map_bifurcation_write(a, &r, msg, sizeof msg);
+    }
+    map_bifurcation_free(&r);
+    return analysis_said(c->cmd, st, msg);
+}
+
 int cmd_bifurcation(int argc, char **argv)
 {
     cli c = {"bifurcation", argc, argv, 0, NULL, NULL};
@@ -158,6 +232,13 @@ int cmd_bifurcation(int argc, char **argv)
     const int perr = parse_args(&c, &a);
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
+    if (map_bifurcation_model(&a.mo)) {
+        if (!a.has_size) /* one panel, not friction-oscillator's three */
+            a.out.width = 900, a.out.height = 600;
+        return run_map(&c, &a);
+    }
+    if (a.of || a.n_branches)
+        return cli_usage_error(&c, "--of and --branches are for map models (chip-4d, ...)");
     int werr = chart_outputs_writable(&c, &a.out);
     if (werr == EXIT_OK)
         werr = outfile_check("bifurcation", a.runs_csv, false);

@@ -104,6 +104,30 @@ assert all(int(r["outside"]) == 0 for r in rows if r["kind"] == "point" and r["p
 PY
 grep -q "^Feigenbaum ratio 1: 3.84" casc.out || fail "periodic's Feigenbaum ratio: $(cat casc.out)"
 
+# --- the Monte Carlo bifurcation diagram (Fig. 3.5) -----------------------
+"$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:12 --csv eqb.csv --quiet || fail "equilibria"
+"$CM" bifurcation --model chip-4d --sweep xi=3.5,4.8,11 --runs 2 --transient 100 --record 40 \
+  --of tau2 --branches eqb.csv --csv bif.csv --png bif.png --threads 2 > bif.out \
+  || fail "bifurcation --model chip-4d"
+"$CM" bifurcation --model chip-4d --sweep xi=3.5,4.8,11 --runs 2 --transient 100 --record 40 \
+  --of tau2 --csv bif1.csv --threads 1 --quiet || fail "bifurcation on one thread"
+cmp -s bif.csv bif1.csv || fail "bifurcation: 1 and 2 threads differ"
+python3 - bif.csv <<'PY' || fail "chip-4d's diagram: period 2 at 3.5, chaos at 4.8, period 1 at 11"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert list(rows[0]) == ["xi", "run", "tau2"], list(rows[0])
+def distinct(xi):
+    return len({round(float(r["tau2"]), 6) for r in rows if float(r["xi"]) == xi})
+assert distinct(3.5) == 2 and distinct(11) == 1 and distinct(4.8) > 50, \
+    (distinct(3.5), distinct(4.8), distinct(11))
+PY
+[ -s bif.png ] || fail "bifurcation --png wrote no figure"
+expect_usage "--of x: model chip-4d's map has the coordinates tau2, T1, T2" \
+  bifurcation --model chip-4d --sweep xi=3.5,4 --of x --csv x.csv
+expect_usage "cannot be read" bifurcation --model chip-4d --sweep xi=3.5,4 --branches nope.csv --png x.png
+expect_usage "--runs-csv is friction-oscillator's" bifurcation --model chip-4d --sweep xi=3.5,4 --runs-csv r.csv
+expect_usage "--of and --branches are for map models" bifurcation --sweep S=0.1:0.2:2 --of x --csv x.csv
+
 # --- time series and spectra (thesis 3.3, Figs. 3.9-3.10) -----------------
 "$CM" simulate --model chip-workpiece --from 1,0,0,0,0,0 --time 6000 --skip 2000 --dt 0.05 \
   --of z --time-unit 1.64e-4 --spectrum wp_z.csv --csv wp.csv --png wp.png --fmax 20000 \
