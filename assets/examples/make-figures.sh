@@ -193,3 +193,36 @@ done
 # period-1 attractor's basin is the whole cylinder
 "$CM" solve --model-lib "$tmp/libpendulum.so" --model pendulum --cells 400x400 \
   --png plugin-pendulum.png --size 900x700 > /dev/null
+
+# Chapter 3: chip formation (docs/models.md 12). Fig. 3.5: the section map's
+# points against xi at zeta = 21 (3 random starts a value, 40 returns after
+# 100) over the equilibrium's branch and the period-1 orbits' (stable black,
+# unstable red): period 2 at 3.5, chaos from 4.34 to 9.11, period 1 at 11
+"$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=1:13 --csv "$tmp/eq.csv" --quiet
+"$CM" periodic --param xi=3.5 --from 1.05,0.2,0.27 --settle 200 --branch xi=1:13 \
+  --csv "$tmp/po.csv" --quiet
+"$CM" bifurcation --model chip-4d --sweep xi=1:13:240 --runs 3 --transient 100 --record 40 \
+  --of tau2 --branches "$tmp/eq.csv" --branches "$tmp/po.csv" --png fig-3.5-bifurcation.png \
+  --quiet
+# Fig. 3.7: the flow's Lyapunov exponents at xi = 4.8 converging (0.63, 0, -32.7, -69.3)
+"$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 300 --transient 20 \
+  --png fig-3.7-exponents.png --quiet
+# Figs. 3.9-3.14: the elastic workpiece (K0 = 1.64e-4 s): at f = 1 the deflection
+# growing to its stationary band, then tau2 and its spectrum (12 000 Hz); f = 0.16
+# (chaotic at first) and f = 0.083 (micron-scale aperiodic deflection)
+wp="--model chip-workpiece --from 1,0,0,0,0,0 --time-unit 1.64e-4 --quiet"
+"$CM" simulate $wp --time 2500 --dt 0.05 --of z --fmax 3000 --png fig-3.9-simulate.png
+"$CM" simulate $wp --time 6000 --skip 5900 --dt 0.01 --of tau2 --fmax 20000 \
+  --png fig-3.10-simulate.png
+"$CM" simulate $wp --param f=0.16 --time 1000 --dt 0.05 --of tau2 --fmax 20000 \
+  --png fig-3.11-simulate.png
+"$CM" simulate $wp --param f=0.083 --time 2000 --dt 0.05 --of z --fmax 3000 \
+  --png fig-3.14-simulate.png
+# Figs. 3.17-3.18: the built-up edge (delay model chip-bue): without it (H = 0)
+# the stress settles (the equilibrium is unstable later, docs/models.md 12.3),
+# with it (H = 0.1) bursts at every tooth; the exponents of Farmer's map
+"$CM" simulate --model chip-bue --param H=0 --time 20 --dt 0.01 --of tau --fmax 10 \
+  --png fig-3.17a-simulate.png --quiet
+"$CM" simulate --model chip-bue --time 140 --dt 0.01 --of tau --fmax 10 \
+  --png fig-3.17b-simulate.png --quiet
+"$CM" exponents --model chip-bue --time 300 --transient 20 --png fig-3.18-exponents.png --quiet
