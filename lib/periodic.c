@@ -9,6 +9,7 @@
 
 #include "lib/outfile.h"
 #include "lib/rows.h"
+#include "models/flow_equilibria.h"
 #include "models/ode_flow.h"
 #include "models/params.h"
 
@@ -188,6 +189,69 @@ static bool sets_tolerances(const model_spec *mo)
     return false;
 }
 
+static int stop_at_hopf(void *user, const cm_eq_event *ev)
+{
+    cm_eq_event *found = user;
+    if (ev->kind != CM_EQ_HOPF)
+        return 0;
+    *found = *ev;
+    return 1;
+}
+
+/* The start of a branch born at the first Hopf point of the flow's
+ * equilibrium from a->b.from: its orbit's point on the plane through the
+ * equilibrium (mo gets level=), into r->start; *p0 its parameter value. */
+static cm_status hopf_start(const po_args *a, model_spec *mo, char level_text[64], po_result *r,
+                            double *p0, char *msg, size_t msg_size)
+{
+    const cm_model *m = &r->m;
+    if (!m->flow.plane || a->b.n_from != cm_flow_dim(m) || !a->b.name[0] || a->cascade ||
+        a->period != 1 || a->settle)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--hopf starts from an equilibrium of a flow with a section plane: give "
+                       "its %d flow coordinates, the branch P=LO:HI to search, and no period, "
+                       "settle or cascade",
+                       cm_flow_dim(m));
+    if (mo->n_texts >= MODEL_SPEC_TEXTS)
+        return cm_fail(CM_EINVAL, msg, msg_size, "too many --param options for --hopf");
+    cm_status st = param_number(m, a->b.name, "--branch", p0, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const param_builder eq = {mo, {a->b.name, NULL}};
+    const cm_branch_options o = {a->b.lo, a->b.hi, a->b.direction ? a->b.direction : 1, 0,
+                                 a->b.ds_max, a->b.max_points};
+    cm_eq_event hopf = {0};
+    int why = 0;
+    st = cm_flow_equilibrium_branch(param_model_at, (void *)&eq, *p0, a->b.from, &o, NULL,
+                                    stop_at_hopf, &hopf, &why, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (hopf.kind != CM_EQ_HOPF)
+        return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                       "the equilibrium's branch from %s = %g meets no Hopf point %s to %g",
+                       a->b.name, *p0, o.direction > 0 ? "up" : "down",
+                       o.direction > 0 ? a->b.hi : a->b.lo);
+    /* the section plane through the equilibrium */
+    const int k = m->flow.plane - 1;
+    snprintf(level_text, 64, "level=%.17g", hopf.at.x[k]);
+    mo->texts[mo->n_texts++] = level_text;
+    r->from_hopf = true;
+    r->hopf_p = hopf.at.p, r->hopf_omega = hopf.omega, r->level = hopf.at.x[k];
+    const param_builder u = {mo, {a->b.name, NULL}};
+    const double dp = 1e-3 * fmax(1, fabs(hopf.at.p));
+    double x[CM_MAX_DIM];
+    st = cm_map_hopf_orbit(param_model_at, (void *)&u, &hopf.at, hopf.omega, dp, x, p0, msg,
+                           msg_size);
+    cm_model hm;
+    if (st == CM_OK)
+        st = param_model_at((void *)&u, *p0, &hm, msg, msg_size);
+    if (st == CM_OK) {
+        st = cm_map_periodic_point(&hm, *p0, 1, x, &r->start, msg, msg_size);
+        cm_model_release(&hm);
+    }
+    return st;
+}
+
 cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg_size)
 {
     memset(r, 0, sizeof *r);
@@ -200,18 +264,29 @@ cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg
         r->tightened = true;
         st = model_spec_build(&mo, &r->m, msg, msg_size);
     }
-    double p0 = NAN, x[CM_MAX_DIM];
+    double p0 = NAN, x[CM_MAX_DIM], y[CM_MAX_DIM];
+    char level_text[64];
+    if (st == CM_OK && a->hopf) {
+        st = hopf_start(a, &mo, level_text, r, &p0, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        const param_builder u = {&mo, {a->b.name, NULL}};
+        collect c = {r, false, false, {0}};
+        return follow(a, &u, 1, p0, r->start.x, a->b.direction, &c, msg, msg_size);
+    }
     if (st == CM_OK)
         st = check_request(a, &r->m, &p0, msg, msg_size);
     if (st != CM_OK)
         return st;
     memcpy(x, a->b.from, sizeof x);
-    for (int k = 0; k < a->settle; k++)
-        if (r->m.step(&r->m, x, x) != CM_STEP_OK)
+    for (int k = 0; k < a->settle; k++) {
+        if (r->m.step(&r->m, x, y) != CM_STEP_OK) /* step need not take its image in place */
             return cm_fail(CM_ENOTFOUND, msg, msg_size,
                            "the orbit from the start has no image after %d iterates: start "
                            "elsewhere or settle fewer",
                            k);
+        memcpy(x, y, sizeof x);
+    }
     if ((st = cm_map_periodic_point(&r->m, p0, a->period, x, &r->start, msg, msg_size)) != CM_OK)
         return st;
     if (!a->b.name[0])

@@ -23,6 +23,9 @@ typedef struct po_args {
     int settle;    /* iterates of the map from b.from before Newton */
     int period;    /* 1.. */
     int cascade;   /* doublings to follow (0: none) */
+    bool hopf;     /* start from the flow's first Hopf point on the branch of the
+                      equilibrium near b.from (the flow's coordinates), b.direction's
+                      way (default up); the section plane through it */
     const char *csv;
 } po_args;
 
@@ -48,6 +51,8 @@ typedef struct po_result {
     double doublings[PERIODIC_MAX_CASCADE]; /* a cascade's doublings, in order */
     int n_doublings;
     bool tightened; /* a flow's tolerances were set to 1e-12 */
+    bool from_hopf;
+    double hopf_p, hopf_omega, level; /* the Hopf point and the section's level through it */
 } po_result;
 
 /* Checks the request (the start's dimension, the branch's parameter and

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "models/flow_equilibria.h" /* cm_eigenvalues */
+#include "models/ode_flow.h"
 
 /* P^period(x) into y; false where an iterate has no image. */
 static bool iterate(const cm_model *m, int period, const double *x, double *y)
@@ -309,4 +310,121 @@ cm_status cm_map_period_doubled(cm_model_at_fn at, void *at_user, const cm_po_ev
                    "no orbit of period %d found next to the period doubling at %.9g (steps "
                    "+-%g): try another step",
                    2 * pt->period, pt->p, dp);
+}
+
+/* The eigenvector v = vr + i vi of J (n x n) for the eigenvalue nearest
+ * i omega. */
+static cm_status hopf_vector(int n, const double *J, double omega, double *vr, double *vi)
+{
+    gsl_matrix *A = gsl_matrix_alloc((size_t)n, (size_t)n);
+    gsl_vector_complex *eval = gsl_vector_complex_alloc((size_t)n);
+    gsl_matrix_complex *evec = gsl_matrix_complex_alloc((size_t)n, (size_t)n);
+    gsl_eigen_nonsymmv_workspace *w = gsl_eigen_nonsymmv_alloc((size_t)n);
+    cm_status st = A && eval && evec && w ? CM_OK : CM_ENOMEM;
+    if (st == CM_OK) {
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++)
+                gsl_matrix_set(A, (size_t)i, (size_t)j, J[i * n + j]);
+        gsl_set_error_handler_off();
+        if (gsl_eigen_nonsymmv(A, eval, evec, w) != GSL_SUCCESS)
+            st = CM_EMODEL;
+    }
+    if (st == CM_OK) {
+        size_t best = 0;
+        double gap = INFINITY;
+        for (size_t k = 0; k < (size_t)n; k++) {
+            const gsl_complex z = gsl_vector_complex_get(eval, k);
+            const double d = hypot(GSL_REAL(z), GSL_IMAG(z) - omega);
+            if (d < gap)
+                gap = d, best = k;
+        }
+        for (int i = 0; i < n; i++) {
+            const gsl_complex z = gsl_matrix_complex_get(evec, (size_t)i, best);
+            vr[i] = GSL_REAL(z), vi[i] = GSL_IMAG(z);
+        }
+    }
+    gsl_eigen_nonsymmv_free(w);
+    gsl_matrix_complex_free(evec);
+    gsl_vector_complex_free(eval);
+    gsl_matrix_free(A);
+    return st;
+}
+
+/* Where eq + eps Re(v e^(i theta)) crosses the plane x_k = eq_k the way
+ * direction asks (-1 down, +1 up, 0 either): the direction w in the flow's
+ * coordinates (w_k = 0). The orbit moves with theta (theta = omega t). */
+static void crossing_direction(int n, int k, int direction, const double *vr, const double *vi,
+                               double *w)
+{
+    /* x_k - eq_k = eps (vr_k cos theta - vi_k sin theta) = 0 */
+    double theta = atan2(vr[k], vi[k]);
+    /* its rate: -eps omega (vr_k sin theta + vi_k cos theta) */
+    const double rate = -(vr[k] * sin(theta) + vi[k] * cos(theta));
+    if ((direction < 0 && rate > 0) || (direction > 0 && rate < 0))
+        theta += 3.14159265358979323846;
+    for (int i = 0; i < n; i++)
+        w[i] = i == k ? 0 : vr[i] * cos(theta) - vi[i] * sin(theta);
+    double norm = 0;
+    for (int i = 0; i < n; i++)
+        norm = fmax(norm, fabs(w[i]));
+    for (int i = 0; i < n && norm > 0; i++)
+        w[i] /= norm;
+}
+
+cm_status cm_map_hopf_orbit(cm_model_at_fn at, void *at_user, const struct cm_equilibrium *hopf,
+                            double omega, double dp, double *x, double *p, char *msg,
+                            size_t msg_size)
+{
+    cm_model m;
+    cm_status st = at(at_user, hopf->p, &m, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const int n = cm_flow_dim(&m), k = m.flow.plane - 1, direction = m.flow.direction;
+    double J[CM_MAX_DIM * CM_MAX_DIM], vr[CM_MAX_DIM], vi[CM_MAX_DIM], w[CM_MAX_DIM];
+    if (k < 0 || n != hopf->dim)
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "a Hopf start needs the section map of a plane of the flow's %d coordinates",
+                     hopf->dim);
+    if (st == CM_OK && (cm_flow_jacobian(&m, hopf->x, J) != CM_OK ||
+                        hopf_vector(n, J, omega, vr, vi) != CM_OK))
+        st = cm_fail(CM_EMODEL, msg, msg_size, "the Hopf point's eigenvector cannot be found");
+    cm_model_release(&m);
+    if (st != CM_OK)
+        return st;
+    crossing_direction(n, k, direction, vr, vi, w);
+    double scale = 1;
+    for (int i = 0; i < n; i++)
+        scale = fmax(scale, fabs(hopf->x[i]));
+    static const double sizes[] = {0.3, 1, 3};
+    for (int side = 0; side < 2; side++) {
+        *p = hopf->p + (side ? -dp : dp);
+        if (at(at_user, *p, &m, msg, msg_size) != CM_OK)
+            continue;
+        bool found = false;
+        for (size_t s = 0; s < sizeof sizes / sizeof sizes[0] && !found; s++) {
+            const double eps = sizes[s] * sqrt(fabs(dp)) * scale;
+            double y[CM_MAX_DIM];
+            for (int i = 0; i < n; i++)
+                y[i] = hopf->x[i] + eps * w[i];
+            for (int i = 0, j = 0; i < n; i++)
+                if (i != k)
+                    x[j++] = y[i];
+            cm_periodic_point pt;
+            if (cm_map_periodic_point(&m, *p, 1, x, &pt, msg, msg_size) != CM_OK)
+                continue;
+            /* off the equilibrium: at least a tenth of the smallest size tried */
+            double off = 0;
+            for (int i = 0, j = 0; i < n; i++)
+                if (i != k)
+                    off = fmax(off, fabs(x[j++] - hopf->x[i]));
+            found = off > 0.03 * sqrt(fabs(dp)) * scale;
+        }
+        cm_model_release(&m);
+        if (found)
+            return CM_OK;
+    }
+    return cm_fail(CM_ENOTFOUND, msg, msg_size,
+                   "no periodic orbit found next to the Hopf point at %.9g (steps +-%g): try "
+                   "another step",
+                   hopf->p, dp);
 }

@@ -65,4 +65,20 @@ cm_status cm_map_periodic_branch(cm_model_at_fn at, void *at_user, int period, d
 cm_status cm_map_period_doubled(cm_model_at_fn at, void *at_user, const cm_po_event *pd,
                                 double dp, double *x, double *p, char *msg, size_t msg_size);
 
+/* A point of the periodic orbit born at a Hopf point of a flow (hopf:
+ * the equilibrium, its parameter value and the pair +-i omega on the
+ * axis), on the map of the flow's section plane x_k = hopf->x[k] (at
+ * builds the section maps; the plane through the equilibrium, crossed
+ * one way, as at's models take it). The small orbit near the Hopf point
+ * is the equilibrium plus eps Re(v e^(i omega t)) (v the eigenvector of
+ * i omega), and it crosses the plane where that is tangent to it; from
+ * there, at p = hopf->p +- dp (the side where the orbit exists is found
+ * by trying) with eps = sqrt(|dp|) x (0.3, 1, 3) times the state's scale,
+ * Newton on P(x) - x; the result must lie off the equilibrium. Into x (the
+ * map's coordinates) and *p. CM_ENOTFOUND when no side gives one. */
+struct cm_equilibrium;
+cm_status cm_map_hopf_orbit(cm_model_at_fn at, void *at_user, const struct cm_equilibrium *hopf,
+                            double omega, double dp, double *x, double *p, char *msg,
+                            size_t msg_size);
+
 #endif

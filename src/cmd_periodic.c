@@ -16,7 +16,9 @@ static const char periodic_help[] =
     "usage: cellmap periodic [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
     "                        --from X[,Y...] [--settle N] [--period K]\n"
     "                        [--branch P=LO:HI [--direction up|down] [--ds-max D]\n"
-    "                        [--max-points N] [--cascade N]] [--csv FILE|-] [--json] [--quiet]\n\n"
+    "                        [--max-points N] [--cascade N]] [--csv FILE|-] [--json] [--quiet]\n"
+    "       cellmap periodic [--model FLOW] --hopf --from X,Y,... --branch P=LO:HI\n"
+    "                        [--direction up|down] [--ds-max D] [--max-points N]\n\n"
     "Periodic orbits of a model's map (chip-4d, the default, or any other; a flow's\n"
     "Poincare or stroboscopic map included): a point of period K by Newton's method on\n"
     "P^K(x) - x from --from (after N iterates of the map with --settle, to start\n"
@@ -39,6 +41,11 @@ static const char periodic_help[] =
     "  --ds-max D          the longest arclength step (default (HI - LO)/50)\n"
     "  --max-points N      points each way, 10..1000000 (default 10000)\n"
     "  --cascade N         follow N period doublings, 1..12\n"
+    "  --hopf              start from the first Hopf point of the flow's equilibrium\n"
+    "                      near --from (the flow's coordinates) on its branch in P\n"
+    "                      (--direction's way, default up): the orbit born there, on\n"
+    "                      the section plane through the equilibrium (level set so),\n"
+    "                      followed over LO:HI\n"
     "  --csv FILE|-        rows kind (point, fold, pd, ns), period, P, the state,\n"
     "                      re_k,im_k of the multipliers by decreasing modulus,\n"
     "                      outside (how many lie outside the unit circle)\n"
@@ -58,6 +65,8 @@ static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
         } else if (cli_take_int(c, "--settle", 0, 10000000, &a->settle, &err)) {
         } else if (cli_take_int(c, "--period", 1, 4096, &a->period, &err)) {
         } else if (cli_take_int(c, "--cascade", 1, PERIODIC_MAX_CASCADE, &a->cascade, &err)) {
+        } else if (cli_is(c, "--hopf", false, &err)) {
+            a->hopf = true;
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
@@ -70,6 +79,8 @@ static int parse_args(cli *c, po_args *a, bool *json, bool *quiet)
     }
     if (!err)
         err = branch_opts_check(c, &a->b, a->cascade != 0, "--cascade");
+    if (!err && a->hopf && !a->b.name[0])
+        err = cli_usage_error(c, "--hopf needs --branch P=LO:HI: where to look for the Hopf point");
     if (!err && a->cascade && !a->b.direction)
         err = cli_usage_error(c, "--cascade needs --direction up or down: the way it goes");
     return err;
@@ -93,6 +104,9 @@ static void print_summary(FILE *f, const po_args *a, const po_result *r)
 {
     if (r->tightened)
         fprintf(f, "(the flow's tolerances: 1e-12)\n");
+    if (r->from_hopf)
+        fprintf(f, "Hopf point at %s = %.9g (omega %.6g); the section plane through it: level %.9g\n",
+                a->b.name, r->hopf_p, r->hopf_omega, r->level);
     fprintf(f, "period-%d point: ", a->period);
     print_point(f, &r->m, &r->start);
     fprintf(f, "\n%s\n", r->start.outside ? "unstable" : "stable");

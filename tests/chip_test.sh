@@ -104,6 +104,20 @@ assert all(int(r["outside"]) == 0 for r in rows if r["kind"] == "point" and r["p
 PY
 grep -q "^Feigenbaum ratio 1: 3.84" casc.out || fail "periodic's Feigenbaum ratio: $(cat casc.out)"
 
+# --- the orbit born at the Hopf point (subcritical: it exists below 4.42808) --
+"$CM" periodic --hopf --from 1,0.1,0.2,0.25 --param xi=4 --branch xi=2.5:15 --max-points 200 \
+  --csv hopf.csv > hopf.out || fail "periodic --hopf"
+grep -q "^Hopf point at xi = 4.4280" hopf.out || fail "periodic --hopf's Hopf point: $(cat hopf.out)"
+python3 - hopf.csv <<'PY' || fail "the Hopf orbit's branch"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["kind"] == "point"]
+xi = [float(r["xi"]) for r in rows]
+# from next to the Hopf point down to where the orbit grazes the plane (2.688)
+assert max(xi) < 4.42808 and max(xi) > 4.42 and min(xi) < 2.75, (min(xi), max(xi))
+assert all(r["outside"] == "1" for r in rows), "the small orbit is unstable (subcritical)"
+PY
+expect_usage "--hopf needs --branch" periodic --hopf --from 1,0.1,0.2,0.25
+
 # --- the Monte Carlo bifurcation diagram (Fig. 3.5) -----------------------
 "$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:12 --csv eqb.csv --quiet || fail "equilibria"
 "$CM" bifurcation --model chip-4d --sweep xi=3.5,4.8,11 --runs 2 --transient 100 --record 40 \
