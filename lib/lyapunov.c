@@ -1,5 +1,6 @@
 /* lib/lyapunov.c - Lyapunov maps computed and written (lib/lyapunov.h). */
 #include "lib/lyapunov.h"
+#include "lib/rows.h"
 
 #include <math.h>
 #include <omp.h>
@@ -50,6 +51,76 @@ static bool write_csv(const lyap_args *a, const double *v, char *msg, size_t msg
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
 }
 
+/* Room for two more points in ov. */
+static bool overlay_room(overlay *ov, size_t *cap)
+{
+    if (ov->n + 2 <= *cap)
+        return true;
+    const size_t want = *cap ? 2 * *cap : 1024;
+    double *nx = realloc(ov->x, want * sizeof *nx);
+    if (nx)
+        ov->x = nx;
+    double *ny = nx ? realloc(ov->y, want * sizeof *ny) : NULL;
+    if (ny)
+        ov->y = ny, *cap = want;
+    return ny != NULL;
+}
+
+/* A Hopf curve of `cellmap equilibria --curve` (kind,P,Q,...: rows hopf,
+ * by Q and at each Q by P) as one line: the first Hopf point of each Q
+ * upwards in Q, then the second downwards, so that the two ends of a
+ * curve that turns back in Q meet; later ones (third, ...) apart. */
+static cm_status read_hopf_table(const lyap_args *a, FILE *f, const char *head, const char *path,
+                                 overlay *ov, size_t *cap, char *msg, size_t msg_size)
+{
+    char n1[64] = "", n2[64] = "", line[4096];
+    if (sscanf(head, "kind,%63[^,],%63[^,\n]", n1, n2) != 2)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%s: no kind,P,Q header", path);
+    const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
+    const bool swapped = strcmp(n2, a->ax[0].name) == 0 && strcmp(n1, a->ax[1].name) == 0;
+    if (!same && !swapped)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%s is a table in (%s, %s), the grid in (%s, %s)", path, n1, n2,
+                       a->ax[0].name, a->ax[1].name);
+    double (*pts)[3] = NULL; /* p, q, the point's index at its q */
+    size_t n = 0, cap_pts = 0;
+    double last_q = NAN;
+    int index = 0;
+    bool ok = true;
+    while (ok && fgets(line, sizeof line, f)) {
+        double p, q;
+        if (strncmp(line, "hopf,", 5) != 0 || sscanf(line + 5, "%lf,%lf", &p, &q) != 2)
+            continue;
+        index = q == last_q ? index + 1 : 0;
+        last_q = q;
+        if (!(ok = rows_room((void **)&pts, &cap_pts, n, sizeof *pts)))
+            break;
+        pts[n][0] = same ? p : q, pts[n][1] = same ? q : p, pts[n][2] = index;
+        n++;
+    }
+    const int ways[2] = {0, 1};
+    for (int w = 0; w < 2 && ok; w++)
+        for (size_t i = 0; i < n && ok; i++) {
+            const size_t k = ways[w] == 0 ? i : n - 1 - i; /* the second one backwards */
+            if ((int)pts[k][2] != w || !(ok = overlay_room(ov, cap)))
+                continue;
+            if (ov->n_labels < 64 && w == 0 && i == 0) {
+                if (ov->n > 0) {
+                    ov->x[ov->n] = ov->y[ov->n] = NAN;
+                    ov->n++;
+                }
+                snprintf(ov->texts[ov->n_labels], sizeof ov->texts[0], "Hopf");
+                ov->labels[ov->n_labels] = (cm_chart_label){pts[k][0], pts[k][1],
+                                                            ov->texts[ov->n_labels]};
+                ov->n_labels++;
+            }
+            ov->x[ov->n] = pts[k][0], ov->y[ov->n] = pts[k][1];
+            ov->n++;
+        }
+    free(pts);
+    return ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the curves");
+}
+
 /* Appends the curves of one file to ov: CM_EINVAL when it is not one of
  * curves in the grid's parameters, CM_ENOMEM. */
 static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *ov, size_t *cap,
@@ -60,12 +131,16 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
     if (cm_input_open(path, "the curves file", UINT64_C(64) << 20, &f, why, sizeof why) != CM_OK)
         return cm_fail(CM_EINVAL, msg, msg_size, "%s (make it with cellmap continue --curves)",
                        why);
-    if (!fgets(line, sizeof line, f) ||
-        sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
+    if (fgets(line, sizeof line, f) && strncmp(line, "kind,", 5) == 0) {
+        const cm_status st = read_hopf_table(a, f, line, path, ov, cap, msg, msg_size);
+        fclose(f);
+        return st;
+    }
+    if (sscanf(line, "curve,label,%63[^,],%63[^,],x,v", n1, n2) != 2) {
         fclose(f);
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "curves file %s: not a file of curve,label,P,P2,x,v lines (make it with "
-                       "cellmap continue --curves)",
+                       "cellmap continue --curves) nor a Hopf table of cellmap equilibria --curve",
                        path);
     }
     const bool same = strcmp(n1, a->ax[0].name) == 0 && strcmp(n2, a->ax[1].name) == 0;
@@ -83,17 +158,7 @@ static cm_status read_curve_file(const lyap_args *a, const char *path, overlay *
         double p1, p2;
         if (sscanf(line, "%d,%31[^,],%lf,%lf", &id, label, &p1, &p2) != 4)
             continue;
-        if (ov->n + 2 > *cap) {
-            *cap = *cap ? 2 * *cap : 1024;
-            double *nx = realloc(ov->x, *cap * sizeof *nx),
-                   *ny = nx ? realloc(ov->y, *cap * sizeof *ny) : NULL;
-            if (nx)
-                ov->x = nx;
-            ok = ny != NULL;
-            if (ny)
-                ov->y = ny;
-        }
-        if (!ok)
+        if (!(ok = overlay_room(ov, cap)))
             break;
         if (id != last && ov->n > 0) { /* a break between curves */
             ov->x[ov->n] = ov->y[ov->n] = NAN;

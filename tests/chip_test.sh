@@ -142,6 +142,16 @@ expect_usage "cannot be read" bifurcation --model chip-4d --sweep xi=3.5,4 --bra
 expect_usage "--runs-csv is friction-oscillator's" bifurcation --model chip-4d --sweep xi=3.5,4 --runs-csv r.csv
 expect_usage "--of and --branches are for map models" bifurcation --sweep S=0.1:0.2:2 --of x --csv x.csv
 
+# --- Fig. 3.8: the exponent over (xi, zeta) with the Hopf curve over it ---
+"$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:13 --curve zeta=20:22:4 --csv hc.csv \
+  --quiet || fail "equilibria --curve"
+"$CM" lyapunov --model chip-4d --grid xi=4:6:2,zeta=20:22:2 --periods 30 --curves hc.csv \
+  --png hc.png --quiet || fail "lyapunov --curves with a Hopf table"
+[ -s hc.png ] || fail "lyapunov --curves wrote no figure"
+printf 'kind,xi,T9\nhopf,1,2\n' > wrong.csv
+expect_usage "is a table in (xi, T9), the grid in (xi, zeta)" \
+  lyapunov --model chip-4d --grid xi=4:6:2,zeta=20:22:2 --periods 3 --curves wrong.csv --png w.png
+
 # --- time series and spectra (thesis 3.3, Figs. 3.9-3.10) -----------------
 "$CM" simulate --model chip-workpiece --from 1,0,0,0,0,0 --time 6000 --skip 2000 --dt 0.05 \
   --of z --time-unit 1.64e-4 --spectrum wp_z.csv --csv wp.csv --png wp.png --fmax 20000 \

@@ -226,3 +226,10 @@ wp="--model chip-workpiece --from 1,0,0,0,0,0 --time-unit 1.64e-4 --quiet"
 "$CM" simulate --model chip-bue --time 140 --dt 0.01 --of tau --fmax 10 \
   --png fig-3.17b-simulate.png --quiet
 "$CM" exponents --model chip-bue --time 300 --transient 20 --png fig-3.18-exponents.png --quiet
+# Fig. 3.8: the (xi, zeta) plane: the largest exponent of the section map (coloured
+# where chaotic; grey where the orbit from the region's centre never crosses
+# T0 = 0.1, mostly the stable equilibrium) and the equilibrium's Hopf curve
+"$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=0:14 --curve zeta=2:42:40 \
+  --csv "$tmp/hopf.csv" --quiet
+"$CM" lyapunov --model chip-4d --grid xi=0:14:28,zeta=2:42:20 --periods 200 \
+  --curves "$tmp/hopf.csv" --png fig-3.8-lyapunov.png --quiet
