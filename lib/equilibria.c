@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/json.h"
 #include "lib/outfile.h"
 #include "lib/rows.h"
 #include "models/ode_flow.h"
@@ -223,6 +224,92 @@ cm_status equilibria_write(const eq_args *a, const eq_result *r, char *msg, size
         }
     }
     return outfile_end(&o, true, msg, msg_size);
+}
+
+static void print_eigenvalues(FILE *f, const cm_equilibrium *e)
+{
+    for (int d = 0; d < e->dim; d++) {
+        if (e->im[d] < 0)
+            continue; /* a pair prints once, as re +- im i */
+        fprintf(f, "%s%.6g", d ? ", " : "", e->re[d]);
+        if (e->im[d] > 0)
+            fprintf(f, " +- %.6gi", e->im[d]);
+    }
+}
+
+static void print_state(FILE *f, const cm_model *m, const cm_equilibrium *e)
+{
+    for (int d = 0; d < e->dim; d++)
+        fprintf(f, "%s%s = %.9g", d ? ", " : "", cm_flow_coord_name(m, d), e->x[d]);
+}
+
+void equilibria_report(FILE *f, const eq_args *a, const eq_result *r)
+{
+    fprintf(f, "equilibrium: ");
+    print_state(f, &r->m, &r->start);
+    fprintf(f, "\neigenvalues: ");
+    print_eigenvalues(f, &r->start);
+    fprintf(f, "\n%s\n", r->start.unstable ? "unstable" : "stable");
+    if (a->b.name[0]) {
+        fprintf(f, "branch in %s over %g:%g: %zu points", a->b.name, a->b.lo, a->b.hi, r->n_pts);
+        if (r->why[0])
+            fprintf(f, "; down: %s", equilibria_why(r->why[0]));
+        if (r->why[1])
+            fprintf(f, "; up: %s", equilibria_why(r->why[1]));
+        fprintf(f, "\n");
+        for (size_t k = 0; !a->has_curve && k < r->n_events; k++) {
+            const cm_eq_event *ev = &r->events[k].ev;
+            fprintf(f, "%s at %s = %.9g", equilibria_event_name(ev->kind), a->b.name, ev->at.p);
+            if (ev->kind == CM_EQ_HOPF)
+                fprintf(f, ", omega %.6g", ev->omega);
+            fprintf(f, " (");
+            print_state(f, &r->m, &ev->at);
+            fprintf(f, ")\n");
+        }
+    }
+    for (size_t k = 0; k < r->n_hopf; k++)
+        fprintf(f, "hopf at %s = %.9g, %s = %.9g, omega %.6g\n", a->curve.name, r->hopf[k].q,
+                a->b.name, r->hopf[k].ev.at.p, r->hopf[k].ev.omega);
+}
+
+void equilibria_json(FILE *f, const eq_args *a, const eq_result *r)
+{
+    json j;
+    json_begin(&j, f, "equilibria");
+    json_model(&j, &r->m);
+    json_nums(&j, "from", a->b.from, a->b.n_from);
+    json_nums(&j, "equilibrium", r->start.x, r->start.dim);
+    json_nums(&j, "re", r->start.re, r->start.dim);
+    json_nums(&j, "im", r->start.im, r->start.dim);
+    json_int(&j, "unstable", r->start.unstable);
+    if (a->b.name[0]) {
+        json_str(&j, "branch", a->b.name);
+        json_int(&j, "points", (long long)r->n_pts);
+        json_array(&j, "events");
+        for (size_t k = 0; k < r->n_events; k++) {
+            const cm_eq_event *ev = &r->events[k].ev;
+            json_object(&j, NULL);
+            json_str(&j, "kind", equilibria_event_name(ev->kind));
+            json_num(&j, "p", ev->at.p);
+            json_nums(&j, "x", ev->at.x, ev->at.dim);
+            if (ev->kind == CM_EQ_HOPF)
+                json_num(&j, "omega", ev->omega);
+            json_object_end(&j);
+        }
+        json_array_end(&j);
+    }
+    if (a->has_curve) {
+        json_array(&j, "hopf_curve");
+        for (size_t k = 0; k < r->n_hopf; k++) {
+            json_object(&j, NULL);
+            json_num(&j, "q", r->hopf[k].q);
+            json_num(&j, "p", r->hopf[k].ev.at.p);
+            json_num(&j, "omega", r->hopf[k].ev.omega);
+            json_object_end(&j);
+        }
+        json_array_end(&j);
+    }
+    json_end(&j);
 }
 
 void equilibria_result_free(eq_result *r)

@@ -9,6 +9,7 @@
 #define CM_LIB_EQUILIBRIA_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/param_grid.h"
 #include "models/flow_equilibria.h"
@@ -59,6 +60,12 @@ cm_status equilibria_compute(const eq_args *a, eq_result *r, char *msg, size_t m
  * the flow's coordinates, the eigenvalues (re_k, im_k by decreasing real
  * part), the unstable count and a Hopf point's omega. */
 cm_status equilibria_write(const eq_args *a, const eq_result *r, char *msg, size_t msg_size);
+
+/* The result as text (the equilibrium, the branch's folds and Hopf
+ * points, the Hopf curve) and as the JSON document of `cellmap equilibria
+ * --json` (docs/cellmap.schema.json), to f. */
+void equilibria_report(FILE *f, const eq_args *a, const eq_result *r);
+void equilibria_json(FILE *f, const eq_args *a, const eq_result *r);
 
 void equilibria_result_free(eq_result *r);
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lib/figure.h"
+#include "lib/json.h"
 #include "lib/outfile.h"
 #include "lib/rows.h"
 #include "models/chip_formation.h"
@@ -256,6 +257,62 @@ cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, siz
     if (st == CM_OK && a->png)
         st = write_png(a, r, msg, msg_size);
     return st;
+}
+
+void exponents_report(FILE *f, const exp_result *r)
+{
+    const cm_spectrum *s = &r->s;
+    if (!isnan(r->sync_q)) {
+        fprintf(f, "synchronisation estimate of %s's largest exponent: q = %.4g\n", r->m.name,
+                r->sync_q);
+        return;
+    }
+    double sum = 0;
+    if (r->farmer_dim)
+        fprintf(f, "Farmer's map of %s (%ld coordinates; %d exponents, per unit time):",
+                r->m.name, r->farmer_dim, s->count);
+    else
+        fprintf(f, "%s spectrum of %s (%d of %d exponents%s):", r->of_map ? "map" : "flow",
+                r->m.name, s->count, s->n, r->of_map ? ", per iterate" : ", per unit time");
+    for (int j = 0; j < s->count; j++) {
+        fprintf(f, " %.6g", s->lambda[j]);
+        sum += s->lambda[j];
+    }
+    fprintf(f, "\nsum %.6g; Kaplan-Yorke dimension ", sum);
+    if (isnan(s->kaplan_yorke))
+        fprintf(f, "above %d (more exponents needed)\n", s->count);
+    else
+        fprintf(f, "%.4f\n", s->kaplan_yorke);
+    if (!isnan(r->mean_flight)) {
+        fprintf(f, "mean flight between iterates %.6g; per unit of the flow's time:",
+                r->mean_flight);
+        for (int j = 0; j < s->count; j++)
+            fprintf(f, " %.6g", s->lambda[j] / r->mean_flight);
+        fprintf(f, "\n");
+    }
+}
+
+void exponents_json(FILE *f, const exp_result *r)
+{
+    const cm_spectrum *s = &r->s;
+    json j;
+    json_begin(&j, f, "exponents");
+    json_model(&j, &r->m);
+    json_str(&j, "of", !isnan(r->sync_q) ? "sync" : r->farmer_dim ? "farmer" : r->of_map ? "map" : "flow");
+    json_nums(&j, "lambda", s->lambda, s->count);
+    json_num(&j, "kaplan_yorke", s->kaplan_yorke);
+    if (!isnan(r->mean_flight)) {
+        double per_time[CM_MAX_DIM];
+        for (int k = 0; k < s->count; k++)
+            per_time[k] = s->lambda[k] / r->mean_flight;
+        json_num(&j, "mean_flight", r->mean_flight);
+        json_nums(&j, "lambda_per_time", per_time, s->count);
+    }
+    if (r->farmer_dim)
+        json_int(&j, "farmer_dim", r->farmer_dim);
+    if (!r->delay)
+        json_nums(&j, "end", s->x, s->n);
+    json_end(&j);
 }
 
 void exponents_result_free(exp_result *r)

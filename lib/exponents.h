@@ -12,6 +12,7 @@
 #define CM_LIB_EXPONENTS_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/project.h"
 #include "models/lyapunov_spectrum.h"
@@ -65,6 +66,12 @@ cm_status exponents_compute(const exp_args *a, exp_result *r, char *msg, size_t 
  * iterates), lambda_1..lambda_k (decreasing), kaplan_yorke, and for a
  * flow's map flow_time; and as a chart against t at a->png. */
 cm_status exponents_write(const exp_args *a, const exp_result *r, char *msg, size_t msg_size);
+
+/* The result as text (the exponents, their sum, the Kaplan-Yorke
+ * dimension, per unit time for a flow's map) and as the JSON document of
+ * `cellmap exponents --json` (docs/cellmap.schema.json), to f. */
+void exponents_report(FILE *f, const exp_result *r);
+void exponents_json(FILE *f, const exp_result *r);
 
 void exponents_result_free(exp_result *r);
 

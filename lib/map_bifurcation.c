@@ -10,6 +10,7 @@
 
 #include "cellmap/clock.h"
 #include "lib/figure.h"
+#include "lib/json.h"
 #include "lib/rows.h"
 #include "models/ode_flow.h"
 
@@ -322,6 +323,32 @@ cm_status map_bifurcation_write(const bif_args *a, const map_bif_result *r, char
     if (st == CM_OK && a->out.png)
         st = write_png(a, r, msg, msg_size);
     return st;
+}
+
+void map_bifurcation_report(FILE *f, const bif_args *a, const map_bif_result *r)
+{
+    const uint64_t not_computed = (uint64_t)(a->sweep.n - r->n_valid) * (uint64_t)a->runs;
+    if (a->out.json) {
+        json j;
+        json_begin(&j, f, "bifurcation");
+        param_base_json(&j, a->mo.name, &r->base);
+        param_axes_json(&j, "sweep", &a->sweep, 1);
+        json_int(&j, "runs", a->runs);
+        json_int(&j, "transient", a->transient);
+        json_int(&j, "record", a->record);
+        json_int(&j, "seed", a->seed);
+        json_uint(&j, "followed", r->followed);
+        json_uint(&j, "lost", r->n_lost);
+        json_uint(&j, "not_computed", not_computed);
+        json_seconds(&j, "seconds", r->seconds);
+        json_end(&j);
+        return;
+    }
+    fprintf(f,
+            "%d values of %s x %d runs in %.2f s: %llu runs followed, %llu lost%s\n", a->sweep.n,
+            a->sweep.name, a->runs, r->seconds, (unsigned long long)r->followed,
+            (unsigned long long)r->n_lost,
+            not_computed ? "; values where the model cannot be built are not computed" : "");
 }
 
 void map_bifurcation_free(map_bif_result *r)

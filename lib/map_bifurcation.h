@@ -40,6 +40,10 @@ cm_status map_bifurcation_compute(const bif_args *a, const work_hooks *h, map_bi
 cm_status map_bifurcation_write(const bif_args *a, const map_bif_result *r, char *msg,
                                 size_t msg_size);
 
+/* The runs followed and lost as text, or (a->out.json) as the JSON
+ * document of `cellmap bifurcation --json`, to f. */
+void map_bifurcation_report(FILE *f, const bif_args *a, const map_bif_result *r);
+
 void map_bifurcation_free(map_bif_result *r);
 
 #endif

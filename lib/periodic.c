@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/json.h"
 #include "lib/outfile.h"
 #include "lib/rows.h"
 #include "models/flow_equilibria.h"
@@ -340,6 +341,82 @@ cm_status periodic_write(const po_args *a, const po_result *r, char *msg, size_t
         }
     }
     return outfile_end(&o, true, msg, msg_size);
+}
+
+static void print_point(FILE *f, const cm_model *m, const cm_periodic_point *pt)
+{
+    for (int d = 0; d < pt->dim; d++)
+        fprintf(f, "%s%s = %.9g", d ? ", " : "", cm_model_coord_name(m, d), pt->x[d]);
+    fprintf(f, "; multipliers ");
+    for (int d = 0; d < pt->dim; d++) {
+        if (pt->im[d] < 0)
+            continue; /* a pair prints once */
+        fprintf(f, "%s%.6g", d ? ", " : "", pt->re[d]);
+        if (pt->im[d] > 0)
+            fprintf(f, " +- %.6gi", pt->im[d]);
+    }
+}
+
+void periodic_report(FILE *f, const po_args *a, const po_result *r)
+{
+    if (r->tightened)
+        fprintf(f, "(the flow's tolerances: 1e-12)\n");
+    if (r->from_hopf)
+        fprintf(f, "Hopf point at %s = %.9g (omega %.6g); the section plane through it: level %.9g\n",
+                a->b.name, r->hopf_p, r->hopf_omega, r->level);
+    fprintf(f, "period-%d point: ", a->period);
+    print_point(f, &r->m, &r->start);
+    fprintf(f, "\n%s\n", r->start.outside ? "unstable" : "stable");
+    if (!a->b.name[0])
+        return;
+    fprintf(f, "%s over %g:%g: %zu points\n", a->b.name, a->b.lo, a->b.hi, r->n_pts);
+    for (size_t k = 0; k < r->n_events; k++) {
+        const cm_po_event *ev = &r->events[k].ev;
+        fprintf(f, "%s of period %d at %s = %.9g (", periodic_event_name(ev->kind),
+                ev->at.period, a->b.name, ev->at.p);
+        print_point(f, &r->m, &ev->at);
+        fprintf(f, ")\n");
+    }
+    for (int k = 1; k + 1 < r->n_doublings; k++)
+        fprintf(f, "Feigenbaum ratio %d: %.4f\n", k,
+                (r->doublings[k] - r->doublings[k - 1]) / (r->doublings[k + 1] - r->doublings[k]));
+    if (r->n_doublings >= 2)
+        fprintf(f, "the cascade accumulates near %s = %.6g (delta = 4.6692)\n", a->b.name,
+                periodic_accumulation(r));
+}
+
+void periodic_json(FILE *f, const po_args *a, const po_result *r)
+{
+    json j;
+    json_begin(&j, f, "periodic");
+    json_model(&j, &r->m);
+    json_nums(&j, "from", a->b.from, a->b.n_from);
+    json_int(&j, "period", a->period);
+    json_nums(&j, "point", r->start.x, r->start.dim);
+    json_nums(&j, "re", r->start.re, r->start.dim);
+    json_nums(&j, "im", r->start.im, r->start.dim);
+    json_int(&j, "outside", r->start.outside);
+    if (a->b.name[0]) {
+        json_str(&j, "branch", a->b.name);
+        json_int(&j, "points", (long long)r->n_pts);
+        json_array(&j, "events");
+        for (size_t k = 0; k < r->n_events; k++) {
+            const cm_po_event *ev = &r->events[k].ev;
+            json_object(&j, NULL);
+            json_str(&j, "kind", periodic_event_name(ev->kind));
+            json_int(&j, "period", ev->at.period);
+            json_num(&j, "p", ev->at.p);
+            json_nums(&j, "x", ev->at.x, ev->at.dim);
+            json_object_end(&j);
+        }
+        json_array_end(&j);
+    }
+    if (a->cascade) {
+        json_nums(&j, "doublings", r->doublings, r->n_doublings);
+        if (r->n_doublings >= 2)
+            json_num(&j, "accumulation", periodic_accumulation(r));
+    }
+    json_end(&j);
 }
 
 void periodic_result_free(po_result *r)

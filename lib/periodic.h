@@ -11,6 +11,7 @@
 #define CM_LIB_PERIODIC_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/param_grid.h"
 #include "models/map_periodic.h"
@@ -68,6 +69,13 @@ cm_status periodic_compute(const po_args *a, po_result *r, char *msg, size_t msg
  * (re_k, im_k by decreasing modulus) and how many lie outside the unit
  * circle. */
 cm_status periodic_write(const po_args *a, const po_result *r, char *msg, size_t msg_size);
+
+/* The result as text (the point and its multipliers, the Hopf point it
+ * starts from, the branch's events, a cascade's Feigenbaum ratios and
+ * accumulation) and as the JSON document of `cellmap periodic --json`
+ * (docs/cellmap.schema.json), to f. */
+void periodic_report(FILE *f, const po_args *a, const po_result *r);
+void periodic_json(FILE *f, const po_args *a, const po_result *r);
 
 void periodic_result_free(po_result *r);
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "lib/figure.h"
+#include "lib/json.h"
 #include "lib/rows.h"
 #include "models/ode_flow.h"
 #include "models/params.h"
@@ -336,6 +337,47 @@ cm_status series_write(const series_args *a, const series_result *r, char *msg, 
     if (st == CM_OK && a->out.png)
         st = write_figure(a, r, msg, msg_size);
     return st;
+}
+
+void series_report(FILE *out, const series_args *a, const series_result *r)
+{
+    fprintf(out, "followed %s to t = %s: %zu samples of %d coordinates from t = %s\n", r->model,
+            CM_NUM(a->time), r->n, r->dim, CM_NUM(r->t[0]));
+    fprintf(out, "%s in [%.9g, %.9g], mean %.9g\n", r->names[r->of], r->lo, r->hi, r->mean);
+    fprintf(out, "spectrum of %s, largest peaks:", r->names[r->of]);
+    for (size_t k = 0; k < r->n_peaks; k++) {
+        const double f = r->freq[r->peaks[k]];
+        fprintf(out, "%s %.6g", k ? "," : "", f);
+        if (a->time_unit > 0)
+            fprintf(out, " (%.6g Hz)", f / a->time_unit);
+    }
+    fprintf(out, "\n");
+}
+
+void series_json(FILE *f, const series_args *a, const series_result *r)
+{
+    json j;
+    json_begin(&j, f, "simulate");
+    json_str(&j, "model", r->model);
+    json_str(&j, "params_text", r->params);
+    json_num(&j, "time", a->time);
+    json_num(&j, "skip", a->skip);
+    json_num(&j, "dt", a->dt);
+    json_uint(&j, "samples", r->n);
+    json_str(&j, "of", r->names[r->of]);
+    json_nums(&j, "range", (const double[2]){r->lo, r->hi}, 2);
+    json_num(&j, "mean", r->mean);
+    json_array(&j, "peaks");
+    for (size_t k = 0; k < r->n_peaks; k++) {
+        json_object(&j, NULL);
+        json_num(&j, "frequency", r->freq[r->peaks[k]]);
+        if (a->time_unit > 0)
+            json_num(&j, "frequency_hz", r->freq[r->peaks[k]] / a->time_unit);
+        json_num(&j, "power", r->power[r->peaks[k]]);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_end(&j);
 }
 
 void series_result_free(series_result *r)

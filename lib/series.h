@@ -11,6 +11,7 @@
 #define CM_LIB_SERIES_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/outfile.h"
 #include "lib/project.h"
@@ -60,6 +61,12 @@ cm_status series_compute(const series_args *a, series_result *r, char *msg, size
  * (frequency, [frequency_hz,] power) at a->spectrum_csv, the figure at
  * a->out.png (any may be NULL). */
 cm_status series_write(const series_args *a, const series_result *r, char *msg, size_t msg_size);
+
+/* The run as text (samples, the coordinate's range and mean, the
+ * spectrum's peaks) and as the JSON document of `cellmap simulate --json`
+ * for a flow (docs/cellmap.schema.json), to f. */
+void series_report(FILE *f, const series_args *a, const series_result *r);
+void series_json(FILE *f, const series_args *a, const series_result *r);
 
 void series_result_free(series_result *r);
 

@@ -77,6 +77,15 @@ bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error
     return true;
 }
 
+bool cli_take_double(cli *c, const char *name, double lo, double hi, double *out, int *error)
+{
+    if (!cli_is(c, name, true, error))
+        return false;
+    if (c->value && (!parse_double(c->value, out) || !(*out >= lo && *out <= hi)))
+        *error = cli_usage_error(c, "%s: '%s' must be a number in %g..%g", name, c->value, lo, hi);
+    return true;
+}
+
 bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error)
 {
     int64_t wh[2];

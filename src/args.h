@@ -44,6 +44,8 @@ bool cli_take_mem(cli *c, uint64_t *mem, int *error);
 /* Handles option `name` with an integer in lo..hi; true if the current
  * option was it. */
 bool cli_take_int(cli *c, const char *name, int lo, int hi, int *out, int *error);
+/* The same for a number in lo..hi. */
+bool cli_take_double(cli *c, const char *name, double lo, double hi, double *out, int *error);
 /* Handles --size WxH with W in min_w..max_side and H in min_h..max_side;
  * true if the current option was it. */
 bool cli_take_size(cli *c, int min_w, int min_h, int max_side, int *w, int *h, int *error);

@@ -169,32 +169,6 @@ static void print_summary(const bif_args *a, const cm_params *base, const sweep_
 
 /* ---- the command ---- */
 
-static void print_map_summary(const bif_args *a, const map_bif_result *r)
-{
-    const uint64_t not_computed = (uint64_t)(a->sweep.n - r->n_valid) * (uint64_t)a->runs;
-    if (a->out.json) {
-        json j;
-        json_begin(&j, stdout, "bifurcation");
-        param_base_json(&j, a->mo.name, &r->base);
-        param_axes_json(&j, "sweep", &a->sweep, 1);
-        json_int(&j, "runs", a->runs);
-        json_int(&j, "transient", a->transient);
-        json_int(&j, "record", a->record);
-        json_int(&j, "seed", a->seed);
-        json_uint(&j, "followed", r->followed);
-        json_uint(&j, "lost", r->n_lost);
-        json_uint(&j, "not_computed", not_computed);
-        json_seconds(&j, "seconds", r->seconds);
-        json_end(&j);
-        return;
-    }
-    fprintf(report_stream(a->out.csv, a->out.png, NULL),
-            "%d values of %s x %d runs in %.2f s: %llu runs followed, %llu lost%s\n", a->sweep.n,
-            a->sweep.name, a->runs, r->seconds, (unsigned long long)r->followed,
-            (unsigned long long)r->n_lost,
-            not_computed ? "; values where the model cannot be built are not computed" : "");
-}
-
 /* A map model's diagram (lib/map_bifurcation.h). */
 static int run_map(cli *c, bif_args *a)
 {
@@ -218,7 +192,7 @@ static int run_map(cli *c, bif_args *a)
     }
     if (st == CM_OK) {
         if (!a->out.quiet || a->out.json)
-            print_map_summary(a, &r);
+            map_bifurcation_report(a->out.json ? stdout : report_stream(a->out.csv, a->out.png, NULL), a, &r);
         st = map_bifurcation_write(a, &r, msg, sizeof msg);
     }
     map_bifurcation_free(&r);

@@ -8,7 +8,6 @@
 #include <string.h>
 
 #include "lib/exponents.h"
-#include "lib/json.h"
 #include "lib/parse.h"
 #include "src/args.h"
 #include "src/commands.h"
@@ -63,16 +62,6 @@ static const char exponents_help[] =
     "  --json              the result as JSON on standard output\n"
     "  --quiet             no summary\n";
 
-/* --NAME's value into *out, a finite number in lo..hi. */
-static bool take_number(cli *c, const char *name, double lo, double hi, double *out, int *err)
-{
-    if (!cli_is(c, name, true, err))
-        return false;
-    if (c->value && (!parse_double(c->value, out) || !(*out >= lo && *out <= hi)))
-        *err = cli_usage_error(c, "%s: '%s' must be a number in %g..%g", name, c->value, lo, hi);
-    return true;
-}
-
 static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
 {
     int err = 0, iterations = (int)a->o.iterations, skip = (int)a->o.skip;
@@ -89,9 +78,9 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
                 err = cli_usage_error(c, "--of: '%s' is neither flow nor map", c->value);
             a->of_map = c->value && strcmp(c->value, "map") == 0;
         } else if (cli_take_int(c, "--count", 1, CM_MAX_DIM, &a->o.count, &err)) {
-        } else if (take_number(c, "--time", 1e-9, 1e9, &a->o.time, &err)) {
-        } else if (take_number(c, "--transient", 0, 1e9, &a->o.transient, &err)) {
-        } else if (take_number(c, "--renorm", 1e-9, 1e9, &a->o.renorm, &err)) {
+        } else if (cli_take_double(c, "--time", 1e-9, 1e9, &a->o.time, &err)) {
+        } else if (cli_take_double(c, "--transient", 0, 1e9, &a->o.transient, &err)) {
+        } else if (cli_take_double(c, "--renorm", 1e-9, 1e9, &a->o.renorm, &err)) {
         } else if (cli_take_int(c, "--iterations", 1, 100000000, &iterations, &err)) {
         } else if (cli_take_int(c, "--skip", 0, 100000000, &skip, &err)) {
         } else if (cli_take_int(c, "--samples", 1, 2000, &a->samples, &err)) {
@@ -102,7 +91,7 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
             a->sync = true;
         } else if (cli_is(c, "--own-delay", false, &err)) {
             a->own_delay = true;
-        } else if (take_number(c, "--q-max", 1e-6, 1e6, &a->q_max, &err)) {
+        } else if (cli_take_double(c, "--q-max", 1e-6, 1e6, &a->q_max, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
@@ -128,62 +117,6 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
     return err;
 }
 
-static void print_summary(FILE *f, const exp_result *r)
-{
-    const cm_spectrum *s = &r->s;
-    if (!isnan(r->sync_q)) {
-        fprintf(f, "synchronisation estimate of %s's largest exponent: q = %.4g\n", r->m.name,
-                r->sync_q);
-        return;
-    }
-    double sum = 0;
-    if (r->farmer_dim)
-        fprintf(f, "Farmer's map of %s (%ld coordinates; %d exponents, per unit time):",
-                r->m.name, r->farmer_dim, s->count);
-    else
-        fprintf(f, "%s spectrum of %s (%d of %d exponents%s):", r->of_map ? "map" : "flow",
-                r->m.name, s->count, s->n, r->of_map ? ", per iterate" : ", per unit time");
-    for (int j = 0; j < s->count; j++) {
-        fprintf(f, " %.6g", s->lambda[j]);
-        sum += s->lambda[j];
-    }
-    fprintf(f, "\nsum %.6g; Kaplan-Yorke dimension ", sum);
-    if (isnan(s->kaplan_yorke))
-        fprintf(f, "above %d (more exponents needed)\n", s->count);
-    else
-        fprintf(f, "%.4f\n", s->kaplan_yorke);
-    if (!isnan(r->mean_flight)) {
-        fprintf(f, "mean flight between iterates %.6g; per unit of the flow's time:",
-                r->mean_flight);
-        for (int j = 0; j < s->count; j++)
-            fprintf(f, " %.6g", s->lambda[j] / r->mean_flight);
-        fprintf(f, "\n");
-    }
-}
-
-static void print_json(const exp_result *r)
-{
-    const cm_spectrum *s = &r->s;
-    json j;
-    json_begin(&j, stdout, "exponents");
-    json_model(&j, &r->m);
-    json_str(&j, "of", !isnan(r->sync_q) ? "sync" : r->farmer_dim ? "farmer" : r->of_map ? "map" : "flow");
-    json_nums(&j, "lambda", s->lambda, s->count);
-    json_num(&j, "kaplan_yorke", s->kaplan_yorke);
-    if (!isnan(r->mean_flight)) {
-        double per_time[CM_MAX_DIM];
-        for (int k = 0; k < s->count; k++)
-            per_time[k] = s->lambda[k] / r->mean_flight;
-        json_num(&j, "mean_flight", r->mean_flight);
-        json_nums(&j, "lambda_per_time", per_time, s->count);
-    }
-    if (r->farmer_dim)
-        json_int(&j, "farmer_dim", r->farmer_dim);
-    if (!r->delay)
-        json_nums(&j, "end", s->x, s->n);
-    json_end(&j);
-}
-
 int cmd_exponents(int argc, char **argv)
 {
     cli c = {"exponents", argc, argv, 0, NULL, NULL};
@@ -202,9 +135,9 @@ int cmd_exponents(int argc, char **argv)
     cm_status st = exponents_compute(&a, &r, msg, sizeof msg);
     if (st == CM_OK) {
         if (json)
-            print_json(&r);
+            exponents_json(stdout, &r);
         else if (!quiet)
-            print_summary(report_stream(a.csv, a.png, NULL), &r);
+            exponents_report(report_stream(a.csv, a.png, NULL), &r);
         st = exponents_write(&a, &r, msg, sizeof msg);
     }
     exponents_result_free(&r);

@@ -14,7 +14,10 @@ static const char models_help[] =
     "Parameters are set with --param name=value[,name=value]; vectors as v1:v2:...\n"
     "docs/models.md describes each model. --model-lib (repeatable) adds the models\n"
     "of a plugin (examples/plugin/ shows how to write one); every command that\n"
-    "takes --model takes --model-lib too.\n";
+    "takes --model takes --model-lib too. The built-up-edge delay model chip-bue,\n"
+    "whose state is a function over its delay rather than a point (docs/models.md\n"
+    "12.3), is not listed: `simulate --model chip-bue` and `exponents --model\n"
+    "chip-bue` take it, and `cellmap help simulate` lists its parameters' use.\n";
 
 static void print_text(const cm_model_entry *e, const cm_model *m)
 {

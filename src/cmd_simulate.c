@@ -69,16 +69,6 @@ typedef struct request {
     bool has_skip, has_size;
 } request;
 
-/* --NAME's value into *out, a finite number in lo..hi. */
-static bool take_number(cli *c, const char *name, double lo, double hi, double *out, int *err)
-{
-    if (!cli_is(c, name, true, err))
-        return false;
-    if (c->value && (!parse_double(c->value, out) || !(*out >= lo && *out <= hi)))
-        *err = cli_usage_error(c, "%s: '%s' must be a number in %g..%g", name, c->value, lo, hi);
-    return true;
-}
-
 static int parse_options(cli *c, request *q)
 {
     int err = 0;
@@ -98,12 +88,12 @@ static int parse_options(cli *c, request *q)
             q->fo.has_t0 = 1, q->fo_only = opt;
         } else if (cli_take_int(c, "--periods", 1, 100000, &q->fo.periods, &err)) {
             q->fo_only = opt;
-        } else if (take_number(c, "--skip", 0, 1e9, &q->skip, &err)) {
+        } else if (cli_take_double(c, "--skip", 0, 1e9, &q->skip, &err)) {
             q->has_skip = true;
-        } else if (take_number(c, "--time", 1e-9, 1e9, &q->se.time, &err) ||
-                   take_number(c, "--dt", 1e-12, 1e9, &q->se.dt, &err) ||
-                   take_number(c, "--time-unit", 0, 1e9, &q->se.time_unit, &err) ||
-                   take_number(c, "--fmax", 0, 1e300, &q->se.fmax, &err)) {
+        } else if (cli_take_double(c, "--time", 1e-9, 1e9, &q->se.time, &err) ||
+                   cli_take_double(c, "--dt", 1e-12, 1e9, &q->se.dt, &err) ||
+                   cli_take_double(c, "--time-unit", 0, 1e9, &q->se.time_unit, &err) ||
+                   cli_take_double(c, "--fmax", 0, 1e300, &q->se.fmax, &err)) {
             q->se_only = opt;
         } else if (cli_is(c, "--of", true, &err)) {
             q->se.of = c->value, q->se_only = opt;
@@ -207,48 +197,6 @@ static void print_summary(const sim_args *a, const cm_model *m, const cm_fo_run 
            psi / (a->periods - a->skip));
 }
 
-static void print_series(const series_args *a, const series_result *r)
-{
-    FILE *out = report_stream(a->out.csv, a->out.png, a->spectrum_csv);
-    fprintf(out, "followed %s to t = %s: %zu samples of %d coordinates from t = %s\n", r->model,
-            CM_NUM(a->time), r->n, r->dim, CM_NUM(r->t[0]));
-    fprintf(out, "%s in [%.9g, %.9g], mean %.9g\n", r->names[r->of], r->lo, r->hi, r->mean);
-    fprintf(out, "spectrum of %s, largest peaks:", r->names[r->of]);
-    for (size_t k = 0; k < r->n_peaks; k++) {
-        const double f = r->freq[r->peaks[k]];
-        fprintf(out, "%s %.6g", k ? "," : "", f);
-        if (a->time_unit > 0)
-            fprintf(out, " (%.6g Hz)", f / a->time_unit);
-    }
-    fprintf(out, "\n");
-}
-
-static void print_series_json(const series_args *a, const series_result *r)
-{
-    json j;
-    json_begin(&j, stdout, "simulate");
-    json_str(&j, "model", r->model);
-    json_str(&j, "params_text", r->params);
-    json_num(&j, "time", a->time);
-    json_num(&j, "skip", a->skip);
-    json_num(&j, "dt", a->dt);
-    json_uint(&j, "samples", r->n);
-    json_str(&j, "of", r->names[r->of]);
-    json_nums(&j, "range", (const double[2]){r->lo, r->hi}, 2);
-    json_num(&j, "mean", r->mean);
-    json_array(&j, "peaks");
-    for (size_t k = 0; k < r->n_peaks; k++) {
-        json_object(&j, NULL);
-        json_num(&j, "frequency", r->freq[r->peaks[k]]);
-        if (a->time_unit > 0)
-            json_num(&j, "frequency_hz", r->freq[r->peaks[k]] / a->time_unit);
-        json_num(&j, "power", r->power[r->peaks[k]]);
-        json_object_end(&j);
-    }
-    json_array_end(&j);
-    json_end(&j);
-}
-
 static int run_series(cli *c, series_args *a)
 {
     int werr = outfile_check(c->cmd, a->spectrum_csv, false);
@@ -261,9 +209,9 @@ static int run_series(cli *c, series_args *a)
     cm_status st = series_compute(a, &r, msg, sizeof msg);
     if (st == CM_OK) {
         if (a->out.json)
-            print_series_json(a, &r);
+            series_json(stdout, a, &r);
         else if (!a->out.quiet)
-            print_series(a, &r);
+            series_report(report_stream(a->out.csv, a->out.png, a->spectrum_csv), a, &r);
         st = series_write(a, &r, msg, sizeof msg);
     }
     series_result_free(&r);
