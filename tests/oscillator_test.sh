@@ -307,15 +307,17 @@ ls | grep -q tmp- && fail "temporary files left behind"
 
 # --- simulate and bifurcation errors ----------------------------------------
 expect_usage "--skip 5 leaves nothing" simulate --periods 5 --skip 5 --csv x.csv
-expect_usage "--from: '1' is not X,V" simulate --from 1 --csv x.csv
-expect_usage "simulate follows friction-oscillator only" simulate --model microchaos-pd --csv x.csv
+expect_usage "--from: friction-oscillator starts from X,V" simulate --from 1 --csv x.csv
+expect_usage "is a map: simulate follows flows" simulate --model microchaos-pd --csv x.csv
 expect_usage "S0" simulate --param S=0.5,S0=0.4 --csv x.csv
 expect_usage "--sweep NAME=LO:HI:N is required" bifurcation --csv x.csv
 expect_usage "--sweep: 'S=0.4:0.1:3'" bifurcation --sweep S=0.4:0.1:3 --csv x.csv
 expect_usage "'Q' is not a parameter" bifurcation --sweep Q=0.1:0.4:3 --csv x.csv
 expect_usage "nothing to write" bifurcation --sweep S=0.1:0.4:3
 expect_usage "more than 1e7" bifurcation --sweep S=0.1:0.4:2000 --runs 1000 --record 10 --csv x.csv
-expect_usage "friction-oscillator only" bifurcation --model microchaos-pd --sweep P=0.1:0.2:2 --csv x.csv
+# any other map's diagram is lib/map_bifurcation's (chip_test): its coordinate must be the map's
+expect_usage "--of q: model microchaos-pd's map has the coordinates x, v" \
+  bifurcation --model microchaos-pd --sweep P=0.1:0.2:2 --of q --csv x.csv
 # the two commands' outputs: at most one on standard output, and not with --json
 expect_usage "--json and an output to standard output" simulate --json --csv -
 expect_usage "--csv - and --png -: only one" simulate --csv - --png -
