@@ -222,21 +222,17 @@ cm_status cm_map_periodic_branch(cm_model_at_fn at, void *at_user, int period, d
     return cm_arc_follow(&pr, p0, x, o, po_point, po_event, &f, why);
 }
 
-/* The unit eigenvector of DP^k at the doubling point for its real
- * multiplier nearest -1, into v. */
-static cm_status flip_vector(const cm_model *m, const cm_periodic_point *pt, double *v)
+/* The eigenvector vr + i vi of J (n x n, overwritten) for its eigenvalue
+ * nearest re + i im. */
+static cm_status nearest_eigenvector(int n, double *J, double re, double im, double *vr,
+                                     double *vi)
 {
-    const int n = pt->dim;
-    double J[CM_MAX_DIM * CM_MAX_DIM];
-    cm_status st = cm_map_jacobian(m, pt->period, pt->x, J);
-    if (st != CM_OK)
-        return st;
     gsl_set_error_handler_off();
     gsl_matrix_view A = gsl_matrix_view_array(J, (size_t)n, (size_t)n);
     gsl_vector_complex *val = gsl_vector_complex_alloc((size_t)n);
     gsl_matrix_complex *vec = gsl_matrix_complex_alloc((size_t)n, (size_t)n);
     gsl_eigen_nonsymmv_workspace *w = gsl_eigen_nonsymmv_alloc((size_t)n);
-    st = val && vec && w ? CM_OK : CM_ENOMEM;
+    cm_status st = val && vec && w ? CM_OK : CM_ENOMEM;
     if (st == CM_OK && gsl_eigen_nonsymmv(&A.matrix, val, vec, w) != GSL_SUCCESS)
         st = CM_ERANGE;
     if (st == CM_OK) {
@@ -244,25 +240,37 @@ static cm_status flip_vector(const cm_model *m, const cm_periodic_point *pt, dou
         double gap = INFINITY;
         for (size_t i = 0; i < (size_t)n; i++) {
             const gsl_complex z = gsl_vector_complex_get(val, i);
-            const double d = hypot(GSL_REAL(z) + 1, GSL_IMAG(z));
+            const double d = hypot(GSL_REAL(z) - re, GSL_IMAG(z) - im);
             if (d < gap)
                 gap = d, best = i;
         }
-        double len = 0;
         for (int i = 0; i < n; i++) {
-            v[i] = GSL_REAL(gsl_matrix_complex_get(vec, (size_t)i, best));
-            len += v[i] * v[i];
+            const gsl_complex z = gsl_matrix_complex_get(vec, (size_t)i, best);
+            vr[i] = GSL_REAL(z), vi[i] = GSL_IMAG(z);
         }
-        len = sqrt(len);
-        for (int i = 0; i < n; i++)
-            v[i] = len > 0 ? v[i] / len : 0;
-        if (!(len > 0))
-            st = CM_ERANGE;
     }
     gsl_eigen_nonsymmv_free(w);
     gsl_matrix_complex_free(vec);
     gsl_vector_complex_free(val);
     return st;
+}
+
+/* The unit eigenvector of DP^k at the doubling point for its real
+ * multiplier nearest -1, into v. */
+static cm_status flip_vector(const cm_model *m, const cm_periodic_point *pt, double *v)
+{
+    const int n = pt->dim;
+    double J[CM_MAX_DIM * CM_MAX_DIM], unused[CM_MAX_DIM];
+    cm_status st = cm_map_jacobian(m, pt->period, pt->x, J);
+    if (st == CM_OK)
+        st = nearest_eigenvector(n, J, -1, 0, v, unused);
+    double len = 0;
+    for (int i = 0; i < n && st == CM_OK; i++)
+        len += v[i] * v[i];
+    len = sqrt(len);
+    for (int i = 0; i < n && st == CM_OK; i++)
+        v[i] = len > 0 ? v[i] / len : 0;
+    return st == CM_OK && !(len > 0) ? CM_ERANGE : st;
 }
 
 /* Whether x is a period-2k point of m and no period-k point. */
@@ -312,44 +320,6 @@ cm_status cm_map_period_doubled(cm_model_at_fn at, void *at_user, const cm_po_ev
                    2 * pt->period, pt->p, dp);
 }
 
-/* The eigenvector v = vr + i vi of J (n x n) for the eigenvalue nearest
- * i omega. */
-static cm_status hopf_vector(int n, const double *J, double omega, double *vr, double *vi)
-{
-    gsl_matrix *A = gsl_matrix_alloc((size_t)n, (size_t)n);
-    gsl_vector_complex *eval = gsl_vector_complex_alloc((size_t)n);
-    gsl_matrix_complex *evec = gsl_matrix_complex_alloc((size_t)n, (size_t)n);
-    gsl_eigen_nonsymmv_workspace *w = gsl_eigen_nonsymmv_alloc((size_t)n);
-    cm_status st = A && eval && evec && w ? CM_OK : CM_ENOMEM;
-    if (st == CM_OK) {
-        for (int i = 0; i < n; i++)
-            for (int j = 0; j < n; j++)
-                gsl_matrix_set(A, (size_t)i, (size_t)j, J[i * n + j]);
-        gsl_set_error_handler_off();
-        if (gsl_eigen_nonsymmv(A, eval, evec, w) != GSL_SUCCESS)
-            st = CM_EMODEL;
-    }
-    if (st == CM_OK) {
-        size_t best = 0;
-        double gap = INFINITY;
-        for (size_t k = 0; k < (size_t)n; k++) {
-            const gsl_complex z = gsl_vector_complex_get(eval, k);
-            const double d = hypot(GSL_REAL(z), GSL_IMAG(z) - omega);
-            if (d < gap)
-                gap = d, best = k;
-        }
-        for (int i = 0; i < n; i++) {
-            const gsl_complex z = gsl_matrix_complex_get(evec, (size_t)i, best);
-            vr[i] = GSL_REAL(z), vi[i] = GSL_IMAG(z);
-        }
-    }
-    gsl_eigen_nonsymmv_free(w);
-    gsl_matrix_complex_free(evec);
-    gsl_vector_complex_free(eval);
-    gsl_matrix_free(A);
-    return st;
-}
-
 /* Where eq + eps Re(v e^(i theta)) crosses the plane x_k = eq_k the way
  * direction asks (-1 down, +1 up, 0 either): the direction w in the flow's
  * coordinates (w_k = 0). The orbit moves with theta (theta = omega t). */
@@ -386,7 +356,7 @@ cm_status cm_map_hopf_orbit(cm_model_at_fn at, void *at_user, const struct cm_eq
                      "a Hopf start needs the section map of a plane of the flow's %d coordinates",
                      hopf->dim);
     if (st == CM_OK && (cm_flow_jacobian(&m, hopf->x, J) != CM_OK ||
-                        hopf_vector(n, J, omega, vr, vi) != CM_OK))
+                        nearest_eigenvector(n, J, 0, omega, vr, vi) != CM_OK))
         st = cm_fail(CM_EMODEL, msg, msg_size, "the Hopf point's eigenvector cannot be found");
     cm_model_release(&m);
     if (st != CM_OK)

@@ -331,6 +331,17 @@ def periodic(start, settle=0, period=1, branch=None, direction=0, ds_max=None,
     return table
 
 
+def _start(o, start):
+    """start (None: the model's default) into o.start and o.n_from."""
+    if start is None:
+        return
+    if len(start) > len(o.start):
+        raise ValueError("start: at most %d coordinates" % len(o.start))
+    o.n_from = len(start)
+    for i, v in enumerate(start):
+        o.start[i] = float(v)
+
+
 def exponents(start=None, of_map=False, count=0, time=None, transient=None, renorm=None,
               iterations=None, skip=None, samples=None, gs=None, sync=False, q_max=None,
               **common):
@@ -343,12 +354,7 @@ def exponents(start=None, of_map=False, count=0, time=None, transient=None, reno
     exponents are needed) and mean_flight (a flow's map), the table the
     running estimates (t, lambda_1.., kaplan_yorke)."""
     o = _lib.cm_exponents_defaults()
-    if start is not None:
-        if len(start) > 6:
-            raise ValueError("start: at most 6 coordinates")
-        o.n_from = len(start)
-        for i, v in enumerate(start):
-            o.start[i] = float(v)
+    _start(o, start)
     o.of_map, o.count, o.sync = int(bool(of_map)), int(count), int(bool(sync))
     for key, value, kind in (("time", time, float), ("transient", transient, float),
                              ("renorm", renorm, float), ("iterations", iterations, int),
@@ -372,12 +378,7 @@ def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=
     returns (samples, spectrum) tables; time_unit (seconds per unit) adds
     frequency_hz."""
     o = _lib.cm_series_defaults()
-    if start is not None:
-        if len(start) > 12:
-            raise ValueError("start: at most 12 coordinates")
-        o.n_from = len(start)
-        for i, v in enumerate(start):
-            o.start[i] = float(v)
+    _start(o, start)
     for key, value in (("time", time), ("skip", skip), ("dt", dt)):
         if value is not None:
             setattr(o, key, float(value))
