@@ -57,7 +57,7 @@ static bool keep(series_result *r, double t, const double *x)
 
 typedef struct collect {
     series_result *r;
-    double skip;
+    double skip, first_cross, last_cross;
     bool out_of_memory;
 } collect;
 
@@ -75,7 +75,21 @@ static int on_sample(void *user, double t, const double *x)
 
 static int on_flow(void *user, int kind, double t, const double *y)
 {
-    return kind == CM_FLOW_SAMPLE ? on_sample(user, t, y) : 0;
+    if (kind == CM_FLOW_SAMPLE)
+        return on_sample(user, t, y);
+    collect *c = user;
+    series_result *r = c->r;
+    if (t < c->skip - 1e-9)
+        return 0;
+    if (!rows_room((void **)&r->cross, &r->cap_cross, r->n_cross, sizeof *r->cross)) {
+        c->out_of_memory = true;
+        return 1;
+    }
+    r->cross[r->n_cross++] = y[r->of];
+    if (r->n_cross == 1)
+        c->first_cross = t;
+    c->last_cross = t;
+    return 0;
 }
 
 /* ---- the request ---- */
@@ -135,7 +149,7 @@ static cm_status follow_bue(const series_args *a, series_result *r, char *msg, s
     cm_chip_bue c;
     cm_dde d;
     cm_chip_bue_of(&p, &c, &d);
-    collect co = {r, a->skip, false};
+    collect co = {r, a->skip, 0, 0, false};
     st = cm_dde_solve(&d, 0, a->time, a->dt, on_sample, &co, NULL, msg, msg_size);
     if (co.out_of_memory)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %zu samples", r->n);
@@ -173,7 +187,7 @@ static cm_status follow_flow(const series_args *a, series_result *r, char *msg, 
         cm_flow_lift(&m, centre, r->start);
     }
     if (st == CM_OK) {
-        collect co = {r, m.flow.t0 + a->skip, false};
+        collect co = {r, m.flow.t0 + a->skip, 0, 0, false};
         double reached;
         const int rc = cm_flow_follow(&m, r->start, m.flow.t0, m.flow.t0 + a->time, a->dt,
                                       on_flow, &co, &reached);
@@ -185,6 +199,8 @@ static cm_status follow_flow(const series_args *a, series_result *r, char *msg, 
                          "failed or took too many steps): start elsewhere or tighten the "
                          "tolerances",
                          reached);
+        if (r->n_cross >= 2)
+            r->mean_return = (co.last_cross - co.first_cross) / (double)(r->n_cross - 1);
     }
     cm_model_release(&m);
     return st;
@@ -218,6 +234,7 @@ static cm_status transform(const series_args *a, series_result *r, char *msg, si
 cm_status series_compute(const series_args *a, series_result *r, char *msg, size_t msg_size)
 {
     memset(r, 0, sizeof *r);
+    r->mean_return = NAN;
     cm_status st = check_times(a, msg, msg_size);
     if (st == CM_OK && !(a->time_unit >= 0 && a->fmax >= 0))
         st = cm_fail(CM_EINVAL, msg, msg_size, "the time unit and fmax must not be negative");
@@ -310,19 +327,35 @@ static cm_status write_figure(const series_args *a, const series_result *r, char
              r->names[r->of]);
     snprintf(x_bottom, sizeof x_bottom, "%s", a->time_unit > 0 ? "frequency [Hz]"
                                                                : "frequency [1/time unit]");
-    const int h_top = a->out.height / 2;
-    const cm_chart charts[2] = {
-        {a->out.width, h_top, {r->t[0], ylo}, {r->t[r->n - 1], yhi}, "t", r->names[r->of],
+    /* the return map (x_k, x_k+1) of the crossings, as Fig. 3.6, when there are some */
+    const bool returns = r->n_cross >= 3;
+    const int panels = returns ? 3 : 2, h_panel = a->out.height / panels;
+    double rlo = INFINITY, rhi = -INFINITY;
+    for (size_t k = 0; returns && k < r->n_cross; k++)
+        rlo = fmin(rlo, r->cross[k]), rhi = fmax(rhi, r->cross[k]);
+    pad(&rlo, &rhi);
+    const cm_series return_map = {CM_SERIES_POINTS, r->cross, r->cross + 1,
+                                  returns ? r->n_cross - 1 : 0, ink, 3};
+    char title_returns[160], x_returns[48], y_returns[48];
+    snprintf(title_returns, sizeof title_returns,
+             "return map of %s at the section (%zu crossings, mean return %.4g)", r->names[r->of],
+             r->n_cross, r->mean_return);
+    snprintf(x_returns, sizeof x_returns, "%s_k", r->names[r->of]);
+    snprintf(y_returns, sizeof y_returns, "%s_k+1", r->names[r->of]);
+    const cm_chart charts[3] = {
+        {a->out.width, h_panel, {r->t[0], ylo}, {r->t[r->n - 1], yhi}, "t", r->names[r->of],
          title_top, NULL, &history, 1, figure_font(), 0, NULL, 0},
-        {a->out.width, a->out.height - h_top, {nf ? fx[0] : 0, plo},
+        {a->out.width, returns ? h_panel : a->out.height - h_panel, {nf ? fx[0] : 0, plo},
          {nf ? fx[nf - 1] : 1, phi}, x_bottom, "log10 power", title_bottom, NULL, &spectrum, 1,
          figure_font(), 0, NULL, 0},
+        {a->out.width, a->out.height - 2 * h_panel, {rlo, rlo}, {rhi, rhi}, x_returns, y_returns,
+         title_returns, NULL, &return_map, 1, figure_font(), 0, NULL, 0},
     };
     char times[128];
     snprintf(times, sizeof times, "to %s, shown after %s, every %s", CM_NUM(a->time),
              CM_NUM(a->skip), CM_NUM(a->dt));
     const cm_png_text texts[] = {{"Model", r->model}, {"Parameters", r->params}, {"Times", times}};
-    const cm_status st = outfile_charts(a->out.png, charts, 2, texts, 3, msg, msg_size);
+    const cm_status st = outfile_charts(a->out.png, charts, panels, texts, 3, msg, msg_size);
     free(hist);
     return st;
 }
@@ -344,6 +377,9 @@ void series_report(FILE *out, const series_args *a, const series_result *r)
     fprintf(out, "followed %s to t = %s: %zu samples of %d coordinates from t = %s\n", r->model,
             CM_NUM(a->time), r->n, r->dim, CM_NUM(r->t[0]));
     fprintf(out, "%s in [%.9g, %.9g], mean %.9g\n", r->names[r->of], r->lo, r->hi, r->mean);
+    if (r->n_cross >= 2)
+        fprintf(out, "%zu section crossings, mean return time %.9g\n", r->n_cross,
+                r->mean_return);
     fprintf(out, "spectrum of %s, largest peaks:", r->names[r->of]);
     for (size_t k = 0; k < r->n_peaks; k++) {
         const double f = r->freq[r->peaks[k]];
@@ -367,6 +403,9 @@ void series_json(FILE *f, const series_args *a, const series_result *r)
     json_str(&j, "of", r->names[r->of]);
     json_nums(&j, "range", (const double[2]){r->lo, r->hi}, 2);
     json_num(&j, "mean", r->mean);
+    json_uint(&j, "crossings", r->n_cross);
+    if (r->n_cross >= 2)
+        json_num(&j, "mean_return", r->mean_return);
     json_array(&j, "peaks");
     for (size_t k = 0; k < r->n_peaks; k++) {
         json_object(&j, NULL);
@@ -382,6 +421,7 @@ void series_json(FILE *f, const series_args *a, const series_result *r)
 
 void series_result_free(series_result *r)
 {
+    free(r->cross);
     free(r->t);
     free(r->x);
     free(r->freq);

@@ -50,6 +50,10 @@ typedef struct series_result {
     size_t m;
     size_t peaks[SERIES_PEAKS], n_peaks;
     double lo, hi, mean;                    /* of coordinate `of` over the samples */
+    double *cross;                          /* a flow's section crossings after the transient:
+                                               coordinate `of` at each (the return map) */
+    size_t n_cross, cap_cross;
+    double mean_return;                     /* the mean time between them; NAN with < 2 */
 } series_result;
 
 /* Checks the request and follows the model. r is freed by
@@ -59,7 +63,9 @@ cm_status series_compute(const series_args *a, series_result *r, char *msg, size
 
 /* The samples (t and every coordinate) at a->out.csv, the spectrum
  * (frequency, [frequency_hz,] power) at a->spectrum_csv, the figure at
- * a->out.png (any may be NULL). */
+ * a->out.png (any may be NULL): the history over the spectrum, and for a
+ * flow with a section (a Poincare map's) crossed at least 3 times the
+ * return map of the coordinate at the crossings (Fig. 3.6) beside them. */
 cm_status series_write(const series_args *a, const series_result *r, char *msg, size_t msg_size);
 
 /* The run as text (samples, the coordinate's range and mean, the

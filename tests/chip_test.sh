@@ -178,6 +178,13 @@ d = json.load(open(sys.argv[4]))
 assert d["of"] == "tau2" and d["samples"] == 80001 and d["peaks"][0]["frequency_hz"] > 0, d
 PY
 [ -s wp.png ] || fail "simulate --png wrote no figure"
+"$CM" simulate --model chip-4d --param xi=4.8 --from 1,0.1,0.2,0.3 --time 300 --skip 50 --dt 0.01 --of tau2 \
+  --json > returns.json || fail "simulate chip-4d --json"
+python3 - returns.json <<'PY' || fail "chip-4d's crossings in simulate"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["crossings"] > 400 and abs(d["mean_return"] / 0.558 - 1) < 0.01, d
+PY
 "$CM" simulate --model chip-bue --param H=0.1 --time 200 --dt 0.05 --of tau --csv bue.csv \
   > bue.out || fail "simulate chip-bue"
 python3 - bue.csv <<'PY' || fail "chip-bue's series"
