@@ -581,6 +581,7 @@ typedef struct cm_series_options {
     double time_unit;             /* seconds per unit of time (0: no Hz) */
     double fmax;                  /* the spectrum drawn up to this (Hz given time_unit); 0: all */
     const char *spectrum_csv;     /* frequency[,frequency_hz],power, or NULL */
+    int returns;                  /* nonzero: the figure adds the return map at the section */
 } cm_series_options;
 cm_series_options cm_series_defaults(void); /* 100 time units every 0.01, none skipped */
 

@@ -244,6 +244,7 @@ cm_status cm_analysis_series(const cm_analysis *a, const cm_series_options *o, c
     memcpy(sa.from, o->start, sizeof sa.from);
     sa.n_from = o->n_from, sa.time = o->time, sa.skip = o->skip, sa.dt = o->dt, sa.of = o->of;
     sa.time_unit = o->time_unit, sa.fmax = o->fmax, sa.spectrum_csv = o->spectrum_csv;
+    sa.returns = o->returns != 0;
     cm_status st = outputs_of(a, sa.out.width, sa.out.height, 300, 400, &sa.out, msg, msg_size);
     if (st == CM_OK)
         st = outfile_check_path(o->spectrum_csv, false, msg, msg_size);

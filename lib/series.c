@@ -327,8 +327,8 @@ static cm_status write_figure(const series_args *a, const series_result *r, char
              r->names[r->of]);
     snprintf(x_bottom, sizeof x_bottom, "%s", a->time_unit > 0 ? "frequency [Hz]"
                                                                : "frequency [1/time unit]");
-    /* the return map (x_k, x_k+1) of the crossings, as Fig. 3.6, when there are some */
-    const bool returns = r->n_cross >= 3;
+    /* the return map (x_k, x_k+1) of the crossings, as Fig. 3.6 */
+    const bool returns = a->returns;
     const int panels = returns ? 3 : 2, h_panel = a->out.height / panels;
     double rlo = INFINITY, rhi = -INFINITY;
     for (size_t k = 0; returns && k < r->n_cross; k++)
@@ -363,6 +363,11 @@ static cm_status write_figure(const series_args *a, const series_result *r, char
 cm_status series_write(const series_args *a, const series_result *r, char *msg, size_t msg_size)
 {
     cm_status st = CM_OK;
+    if (a->out.png && a->returns && r->n_cross < 3)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a return map needs 3 crossings of the section after the transient, and "
+                       "%s crossed it %zu times: follow it longer, or leave out --returns",
+                       r->model, r->n_cross);
     if (a->out.csv)
         st = write_samples(a->out.csv, r, msg, msg_size);
     if (st == CM_OK && a->spectrum_csv)

@@ -28,6 +28,7 @@ typedef struct series_args {
     double time_unit;             /* seconds per unit of the model's time (0: no Hz) */
     double fmax;                  /* the spectrum drawn up to this (0: Nyquist); Hz given time_unit */
     const char *spectrum_csv;
+    bool returns;                 /* the figure adds the return map at the section */
     chart_outputs out;            /* csv: the samples; png: history over spectrum */
 } series_args;
 
@@ -63,9 +64,9 @@ cm_status series_compute(const series_args *a, series_result *r, char *msg, size
 
 /* The samples (t and every coordinate) at a->out.csv, the spectrum
  * (frequency, [frequency_hz,] power) at a->spectrum_csv, the figure at
- * a->out.png (any may be NULL): the history over the spectrum, and for a
- * flow with a section (a Poincare map's) crossed at least 3 times the
- * return map of the coordinate at the crossings (Fig. 3.6) beside them. */
+ * a->out.png (any may be NULL): the history over the spectrum and, with
+ * a->returns, the return map of the coordinate at the section's crossings
+ * below them (Fig. 3.6; CM_EINVAL with fewer than 3 crossings). */
 cm_status series_write(const series_args *a, const series_result *r, char *msg, size_t msg_size);
 
 /* The run as text (samples, the coordinate's range and mean, the

@@ -22,7 +22,7 @@ static const char simulate_help[] =
     "                        [--json] [--quiet] [--size WxH]\n"
     "       cellmap simulate --model FLOW|chip-bue [--model-lib P.so] [--param k=v[,k=v]]\n"
     "                        [--from X,Y,...] [--time T] [--skip T0] [--dt DT] [--of NAME]\n"
-    "                        [--time-unit SECONDS] [--fmax F] [--spectrum FILE|-]\n"
+    "                        [--time-unit SECONDS] [--fmax F] [--spectrum FILE|-] [--returns]\n"
     "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n\n"
     "A trajectory of the dry friction oscillator x'' + x = cos(Omega t) - S f(x')\n"
     "(thesis eq. (2.3)) from (x, x') = (X, V) at time T0, followed exactly\n"
@@ -56,8 +56,10 @@ static const char simulate_help[] =
     "  --fmax F            the spectrum drawn up to F (in Hz with --time-unit)\n"
     "  --csv FILE|-        t and every coordinate per sample (%.17g)\n"
     "  --spectrum FILE|-   frequency[,frequency_hz],power\n"
-    "  --png FILE          top: the coordinate against t; bottom: log10 of its power\n"
-    "                      spectrum (default size 900x800)\n";
+    "  --png FILE          top: the coordinate against t; below: log10 of its power\n"
+    "                      spectrum (default size 900x800)\n"
+    "  --returns           a third panel: the coordinate's return map at the model's\n"
+    "                      section (a Poincare map's), x_k+1 against x_k (Fig. 3.6)\n";
 
 /* What either kind of simulation was asked, and which options were seen
  * (an option of the other kind is a usage error). */
@@ -99,6 +101,8 @@ static int parse_options(cli *c, request *q)
             q->se.of = c->value, q->se_only = opt;
         } else if (cli_is(c, "--spectrum", true, &err)) {
             q->se.spectrum_csv = c->value, q->se_only = opt;
+        } else if (cli_is(c, "--returns", false, &err)) {
+            q->se.returns = true, q->se_only = opt;
         } else if (chart_outputs_take(c, &q->fo.out, 300, 400, &err)) {
             q->has_size |= strcmp(opt, "--size") == 0;
         } else {

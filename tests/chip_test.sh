@@ -236,6 +236,7 @@ PY
 # --- bad input -----------------------------------------------------------
 expect_usage "dt" simulate --model chip-bue --param dt=0 --time 10
 expect_usage "leave out --from" simulate --model chip-bue --from 1,2,3,4 --time 10
+expect_usage "a return map needs 3 crossings" simulate --model chip-bue --time 10 --returns --png r.png
 expect_usage "coordinates are" simulate --model chip-4d --of x --time 10
 expect_usage "--periods is for friction-oscillator" simulate --model chip-4d --periods 3
 expect_usage "--dt is for flows" simulate --dt 0.1

@@ -206,7 +206,8 @@ done
   --quiet
 # Fig. 3.6: at xi = 4.8 tau2's history, spectrum and return map at the section (unimodal)
 "$CM" simulate --model chip-4d --param xi=4.8 --from 1,0.1,0.2,0.3 --time 600 --skip 100 \
-  --dt 0.01 --of tau2 --time-unit 1.64e-4 --fmax 10000 --size 900x1000 --png fig-3.6-simulate.png \
+  --dt 0.01 --of tau2 --time-unit 1.64e-4 --fmax 10000 --returns --size 900x1000 \
+  --png fig-3.6-simulate.png \
   --quiet
 # Fig. 3.7: the flow's Lyapunov exponents at xi = 4.8 converging (0.63, 0, -32.7, -69.3)
 "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 300 --transient 20 \

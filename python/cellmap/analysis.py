@@ -87,7 +87,8 @@ class _Series(ctypes.Structure):
     _fields_ = [("start", ctypes.c_double * 12), ("n_from", ctypes.c_int),
                 ("time", ctypes.c_double), ("skip", ctypes.c_double), ("dt", ctypes.c_double),
                 ("of", ctypes.c_char_p), ("time_unit", ctypes.c_double),
-                ("fmax", ctypes.c_double), ("spectrum_csv", ctypes.c_char_p)]
+                ("fmax", ctypes.c_double), ("spectrum_csv", ctypes.c_char_p),
+                ("returns", ctypes.c_int)]
 
 
 class _Simulate(ctypes.Structure):
@@ -372,18 +373,18 @@ def exponents(start=None, of_map=False, count=0, time=None, transient=None, reno
 
 
 def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
-           spectrum_csv=None, **common):
+           spectrum_csv=None, returns=False, **common):
     """The time series of a flow model or chip-bue (`cellmap simulate
     --model FLOW`) and the power spectrum (FFTW) of coordinate `of`:
     returns (samples, spectrum) tables; time_unit (seconds per unit) adds
-    frequency_hz."""
+    frequency_hz; returns=True adds the return map at the section to png."""
     o = _lib.cm_series_defaults()
     _start(o, start)
     for key, value in (("time", time), ("skip", skip), ("dt", dt)):
         if value is not None:
             setattr(o, key, float(value))
     o.of = _text(of) if of is not None else None
-    o.time_unit, o.fmax = float(time_unit), float(fmax)
+    o.time_unit, o.fmax, o.returns = float(time_unit), float(fmax), int(bool(returns))
     return _run(_common(model=model, **common), _lib.cm_analysis_series, ctypes.byref(o),
                 second=(o, "spectrum_csv", spectrum_csv))
 
