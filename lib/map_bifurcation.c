@@ -22,6 +22,10 @@ bool map_bifurcation_model(const model_spec *mo)
 
 /* ---- the runs ---- */
 
+typedef struct branches branches;
+static cm_status check_branches(const bif_args *a, const char *coord, char *msg,
+                                size_t msg_size);
+
 /* Iterates m from a random start in lo..hi (run `run` of value `value`):
  * a->transient iterates, then a->record kept (coordinate of) in out;
  * false when the orbit is lost. */
@@ -89,6 +93,8 @@ cm_status map_bifurcation_compute(const bif_args *a, const work_hooks *h, map_bi
         st = check_request(a, any, r, msg, msg_size);
     if (st == CM_OK)
         st = model_spec_region(&a->mo, any->dim, lo, hi, msg, msg_size);
+    if (st == CM_OK) /* the tables drawn later are checked before the work */
+        st = check_branches(a, r->of_name, msg, msg_size);
     const size_t n_runs = (size_t)n_values * (size_t)a->runs, rec = (size_t)a->record;
     if (st == CM_OK) {
         r->points = malloc(n_runs * rec * sizeof *r->points);
@@ -132,10 +138,10 @@ cm_status map_bifurcation_compute(const bif_args *a, const work_hooks *h, map_bi
 /* ---- the branches drawn over the points ---- */
 
 /* The branches of the tables: stable and unstable polylines (NAN breaks). */
-typedef struct branches {
+struct branches {
     double *x[2], *y[2]; /* [0] stable, [1] unstable */
     size_t n[2], cap[2];
-} branches;
+};
 
 static bool put(branches *b, int k, double x, double y)
 {
@@ -241,6 +247,24 @@ static cm_status read_table(const char *path, const char *param, const char *coo
     return st;
 }
 
+static void branches_free(branches *b)
+{
+    for (int j = 0; j < 2; j++)
+        free(b->x[j]), free(b->y[j]);
+}
+
+static cm_status check_branches(const bif_args *a, const char *coord, char *msg,
+                                size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (int k = 0; k < a->n_branches && st == CM_OK; k++) {
+        branches b = {0};
+        st = read_table(a->branches[k], a->sweep.name, coord, &b, msg, msg_size);
+        branches_free(&b);
+    }
+    return st;
+}
+
 /* ---- writing ---- */
 
 static cm_status write_csv(const bif_args *a, const map_bif_result *r, char *msg,
@@ -272,8 +296,7 @@ static cm_status write_png(const bif_args *a, const map_bif_result *r, char *msg
         st = read_table(a->branches[k], a->sweep.name, r->of_name, &b, msg, msg_size);
     if (st != CM_OK) {
         free(px);
-        for (int j = 0; j < 2; j++)
-            free(b.x[j]), free(b.y[j]);
+        branches_free(&b);
         return st;
     }
     double *py = px + n_all, lo = INFINITY, hi = -INFINITY;
@@ -309,8 +332,7 @@ static cm_status write_png(const bif_args *a, const map_bif_result *r, char *msg
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}, {"Runs", runs}};
     st = outfile_charts(a->out.png, &chart, 1, texts, 3, msg, msg_size);
     free(px);
-    for (int j = 0; j < 2; j++)
-        free(b.x[j]), free(b.y[j]);
+    branches_free(&b);
     return st;
 }
 
