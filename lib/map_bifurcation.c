@@ -145,12 +145,15 @@ struct branches {
 
 static bool put(branches *b, int k, double x, double y)
 {
+    const size_t had = b->cap[k];
     if (!rows_room((void **)&b->x[k], &b->cap[k], b->n[k], sizeof *b->x[k]))
         return false;
-    double *ys = realloc(b->y[k], b->cap[k] * sizeof *ys);
-    if (!ys)
-        return false;
-    b->y[k] = ys;
+    if (b->cap[k] != had || !b->y[k]) { /* y grows with x */
+        double *ys = realloc(b->y[k], b->cap[k] * sizeof *ys);
+        if (!ys)
+            return false;
+        b->y[k] = ys;
+    }
     b->x[k][b->n[k]] = x, b->y[k][b->n[k]] = y;
     b->n[k]++;
     return true;

@@ -42,13 +42,15 @@ bool series_model(const model_spec *mo)
 
 static bool keep(series_result *r, double t, const double *x)
 {
+    const size_t had = r->cap;
     if (!rows_room((void **)&r->t, &r->cap, r->n, sizeof *r->t))
         return false;
-    size_t cap_x = r->cap; /* x grows with t, dim values a sample */
-    double *xs = realloc(r->x, cap_x * (size_t)r->dim * sizeof *xs);
-    if (!xs)
-        return false;
-    r->x = xs;
+    if (r->cap != had || !r->x) { /* x grows with t, dim values a sample */
+        double *xs = realloc(r->x, r->cap * (size_t)r->dim * sizeof *xs);
+        if (!xs)
+            return false;
+        r->x = xs;
+    }
     r->t[r->n] = t;
     memcpy(r->x + r->n * (size_t)r->dim, x, (size_t)r->dim * sizeof *x);
     r->n++;
