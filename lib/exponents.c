@@ -298,7 +298,8 @@ void exponents_json(FILE *f, const exp_result *r)
     json j;
     json_begin(&j, f, "exponents");
     json_model(&j, &r->m);
-    json_str(&j, "of", !isnan(r->sync_q) ? "sync" : r->farmer_dim ? "farmer" : r->of_map ? "map" : "flow");
+    json_str(&j, "of",
+             !isnan(r->sync_q) ? "sync" : r->farmer_dim ? "farmer" : r->of_map ? "map" : "flow");
     json_nums(&j, "lambda", s->lambda, s->count);
     json_num(&j, "kaplan_yorke", s->kaplan_yorke);
     if (!isnan(r->mean_flight)) {

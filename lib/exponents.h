@@ -6,8 +6,9 @@
  * exponents per unit of the flow's time (thesis 3.2: lambda_flow =
  * lambda_map / mean return time). The delay model chip-bue by Farmer's
  * discretised map or the synchronisation estimate (models/dde_lyapunov.h,
- * thesis 3.4.2). The running estimates are written as CSV. Nothing is printed: calls return a status with the problem in msg
- * (CM_EINVAL: the request's). */
+ * thesis 3.4.2). The running estimates are written as CSV and drawn.
+ * Nothing is printed but by the report calls: calls return a status with
+ * the problem in msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_EXPONENTS_H
 #define CM_LIB_EXPONENTS_H
 

@@ -26,7 +26,7 @@ typedef struct series_args {
     double time, skip, dt;        /* followed to `time`, recorded after `skip`, every dt */
     const char *of;               /* the coordinate drawn and transformed (NULL: the first) */
     double time_unit;             /* seconds per unit of the model's time (0: no Hz) */
-    double fmax;                  /* the spectrum drawn up to this (0: Nyquist); Hz given time_unit */
+    double fmax;                  /* the spectrum drawn up to this (0: Nyquist; Hz given the unit) */
     const char *spectrum_csv;
     bool returns;                 /* the figure adds the return map at the section */
     chart_outputs out;            /* csv: the samples; png: history over spectrum */

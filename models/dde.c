@@ -62,7 +62,7 @@ static int field_gsl(double t, const double y[], double f[], void *params)
     run *r = params;
     double xd[CM_DDE_MAX_DIM];
     value_at(r, t - r->d->delay, xd);
-    /* a failure is step_to's to handle: it tries a shorter step */
+    /* a failure is cm_ode_step's to handle: it tries a shorter step */
     return r->d->field(r->d->ctx, t, y, xd, f) ? GSL_EBADFUNC : GSL_SUCCESS;
 }
 

@@ -157,7 +157,8 @@ static int variational_jacobian(double t, const double y[], double *dfdy, double
         return GSL_ENOMEM;
     double *fm = fp + big;
     const double h = 1e-7 * fmax(1, fabs(t));
-    const int rc = variational_field(t + h, y, fp, params) || variational_field(t - h, y, fm, params);
+    const int rc =
+        variational_field(t + h, y, fp, params) || variational_field(t - h, y, fm, params);
     for (int i = 0; i < big && !rc; i++)
         dfdt[i] = (fp[i] - fm[i]) / (2 * h);
     free(fp);
@@ -192,8 +193,8 @@ cm_status cm_flow_spectrum(const cm_model *m, const double *x0, const cm_spectru
         return st;
     const int n = cm_flow_dim(m);
     variational s = {m, n, k};
-    gsl_odeiv2_system sys = {variational_field, variational_jacobian, (size_t)(n * (k + 1)), &s};
     const size_t size = (size_t)(n * (k + 1));
+    gsl_odeiv2_system sys = {variational_field, variational_jacobian, size, &s};
     /* The tangents' error per step is held to max(abs_tol, 1e-8) rather
      * than the state's: Df v by differences carries noise near 1e-9 |f|
      * (more where a stiff field is large), which a tighter control cannot
@@ -230,8 +231,8 @@ cm_status cm_flow_spectrum(const cm_model *m, const double *x0, const cm_spectru
             !cm_gram_schmidt(n, k, y + n, logs))
             st = CM_EMODEL;
     for (long r = 1; st == CM_OK && r <= renorms; r++) {
-        if (!cm_ode_advance(d, size, &t, t_start + fmin((double)r * o->renorm, o->time), &h, y, saved) ||
-            !cm_gram_schmidt(n, k, y + n, logs)) {
+        const double t1 = t_start + fmin((double)r * o->renorm, o->time);
+        if (!cm_ode_advance(d, size, &t, t1, &h, y, saved) || !cm_gram_schmidt(n, k, y + n, logs)) {
             st = CM_EMODEL;
             break;
         }

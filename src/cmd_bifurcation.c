@@ -192,7 +192,8 @@ static int run_map(cli *c, bif_args *a)
     }
     if (st == CM_OK) {
         if (!a->out.quiet || a->out.json)
-            map_bifurcation_report(a->out.json ? stdout : report_stream(a->out.csv, a->out.png, NULL), a, &r);
+            map_bifurcation_report(
+                a->out.json ? stdout : report_stream(a->out.csv, a->out.png, NULL), a, &r);
         st = map_bifurcation_write(a, &r, msg, sizeof msg);
     }
     map_bifurcation_free(&r);

@@ -109,7 +109,8 @@ static int parse_args(cli *c, exp_args *a, bool *json, bool *quiet)
     if (!err && a->o.renorm > a->o.time)
         err = cli_usage_error(c, "--renorm %g is longer than --time %g", a->o.renorm, a->o.time);
     if (!err && a->o.time / a->o.renorm > 1e8)
-        err = cli_usage_error(c, "--time / --renorm is over 1e8 renormalisations: renorm less often");
+        err = cli_usage_error(c,
+                              "--time / --renorm is over 1e8 renormalisations: renorm less often");
     if (!err && *json && (cm_output_names_stdout(a->csv) || cm_output_names_stdout(a->png)))
         err = cli_usage_error(c, "--json and an output to standard output: choose one");
     if (!err && a->own_delay && !a->sync)

@@ -156,9 +156,10 @@ static void test_farmer(void)
     }
     CHECK(err[1] < 2e-3);
     CHECK(err[0] / err[1] > 3); /* second order: about 4 */
-    const cm_farmer_options bad[] = {{.samples = 0, .gs = 1, .count = 1, .transient = 2, .time = 1},
-                                     {.samples = 10, .gs = 1, .count = 20, .transient = 2, .time = 1},
-                                     {.samples = 10, .gs = 1, .count = 1, .transient = 0.5, .time = 1}};
+    const cm_farmer_options bad[] = {
+        {.samples = 0, .gs = 1, .count = 1, .transient = 2, .time = 1},
+        {.samples = 10, .gs = 1, .count = 20, .transient = 2, .time = 1},
+        {.samples = 10, .gs = 1, .count = 1, .transient = 0.5, .time = 1}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         cm_farmer_result r;
         CHECK(cm_dde_farmer(&d, &bad[i], NULL, NULL, &r, msg, sizeof msg) == CM_EINVAL);

@@ -195,8 +195,9 @@ static void test_henon(void)
     CHECK(fabs(s.kaplan_yorke - 1.258) < 0.003);
     CHECK(s.time == 0);
     /* a flow's spectrum of a map is refused */
-    CHECK(cm_flow_spectrum(&m, (const double[]){0.1, 0.1}, &(cm_spectrum_options){.time = 1, .renorm = 1},
-                           NULL, NULL, &s, msg, sizeof msg) == CM_EINVAL);
+    const cm_spectrum_options flow = {.time = 1, .renorm = 1};
+    CHECK(cm_flow_spectrum(&m, (const double[]){0.1, 0.1}, &flow, NULL, NULL, &s, msg,
+                           sizeof msg) == CM_EINVAL);
     /* an orbit that escapes is an error with the iterate */
     CHECK(cm_map_spectrum(&m, (const double[]){5, 5}, &o, NULL, NULL, &s, msg, sizeof msg) ==
           CM_EMODEL);
