@@ -221,6 +221,10 @@ wp="--model chip-workpiece --from 1,0,0,0,0,0 --time-unit 1.64e-4 --quiet"
   --png fig-3.10-simulate.png
 "$CM" simulate $wp --param f=0.16 --time 1000 --dt 0.05 --of tau2 --fmax 20000 \
   --png fig-3.11-simulate.png
+# Fig. 3.13: at f = 0.16 the chaos is transient: after t = 3000 a quasi-periodic
+# motion whose strongest line (628 Hz) lies near the workpiece's 600 Hz
+"$CM" simulate $wp --param f=0.16 --time 6000 --skip 5000 --dt 0.05 --of z --fmax 3000 \
+  --png fig-3.13-simulate.png
 "$CM" simulate $wp --param f=0.083 --time 2000 --dt 0.05 --of z --fmax 3000 \
   --png fig-3.14-simulate.png
 # Figs. 3.17-3.18: the built-up edge (delay model chip-bue): without it (H = 0)
