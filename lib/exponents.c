@@ -30,16 +30,6 @@ exp_args exponents_defaults(void)
     return a;
 }
 
-static void sort_decreasing(double *v, int k)
-{
-    for (int i = 1; i < k; i++)
-        for (int j = i; j > 0 && v[j] > v[j - 1]; j--) {
-            const double t = v[j];
-            v[j] = v[j - 1];
-            v[j - 1] = t;
-        }
-}
-
 static int on_trace(void *user, double t, const double *lambda, int count)
 {
     exp_result *r = user;
@@ -50,7 +40,7 @@ static int on_trace(void *user, double t, const double *lambda, int count)
     exp_row *row = &r->rows[r->n_rows++];
     row->t = t;
     memcpy(row->lambda, lambda, (size_t)count * sizeof *lambda);
-    sort_decreasing(row->lambda, count);
+    cm_sort_decreasing(row->lambda, count);
     return 0;
 }
 

@@ -380,12 +380,7 @@ cm_status cm_dde_farmer(const cm_dde *d, const cm_farmer_options *o, cm_spectrum
         out->time = (double)steps * D;
         for (int j = 0; j < r.k; j++)
             out->lambda[j] = sum[j] / out->time;
-        for (int i = 1; i < r.k; i++) /* decreasing */
-            for (int j = i; j > 0 && out->lambda[j] > out->lambda[j - 1]; j--) {
-                const double tmp = out->lambda[j];
-                out->lambda[j] = out->lambda[j - 1];
-                out->lambda[j - 1] = tmp;
-            }
+        cm_sort_decreasing(out->lambda, r.k);
         out->kaplan_yorke = cm_kaplan_yorke(out->lambda, r.k);
     }
     farmer_close(&r);

@@ -49,9 +49,7 @@ double cm_kaplan_yorke(const double *lambda, int k)
     return NAN;
 }
 
-/* Sorts the first k exponents into decreasing order (Gram-Schmidt gives
- * them so in the limit; a finite run may not). */
-static void sort_decreasing(double *lambda, int k)
+void cm_sort_decreasing(double *lambda, int k)
 {
     for (int i = 1; i < k; i++)
         for (int j = i; j > 0 && lambda[j] > lambda[j - 1]; j--) {
@@ -88,7 +86,7 @@ static void finish(cm_spectrum *out, const double *sum, double span)
 {
     for (int j = 0; j < out->count; j++)
         out->lambda[j] = sum[j] / span;
-    sort_decreasing(out->lambda, out->count);
+    cm_sort_decreasing(out->lambda, out->count);
     out->kaplan_yorke = cm_kaplan_yorke(out->lambda, out->count);
 }
 

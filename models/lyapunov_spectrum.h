@@ -24,6 +24,10 @@
  * then undefined). */
 bool cm_gram_schmidt(int n, int k, double *v, double *log_norm);
 
+/* The first k exponents into decreasing order (Gram-Schmidt gives them
+ * so in the limit; a finite run may not). */
+void cm_sort_decreasing(double *lambda, int k);
+
 /* The Kaplan-Yorke dimension j + (l_1 + ... + l_j) / |l_{j+1}| of k
  * exponents in decreasing order, j the largest with l_1 + ... + l_j >= 0;
  * 0 when l_1 < 0, NAN when all k sum to >= 0 (more exponents needed). */
