@@ -592,6 +592,45 @@ cm_series_options cm_series_defaults(void); /* 100 time units every 0.01, none s
 cm_status cm_analysis_series(const cm_analysis *a, const cm_series_options *o, char *msg,
                              size_t msg_size);
 
+typedef struct cm_embedding_options {
+    const char *input;            /* a CSV file with a header (a column t gives the times), or
+                                     NULL: the orbit of a->model (a flow or chip-bue; chip-4d) */
+    const char *of;               /* the column or coordinate; NULL: the file's first but t,
+                                     the model's first */
+    double start[2 * CM_MAX_DIM]; /* the model's start */
+    int n_from;                   /* 0: the centre of the example region */
+    double time, transient, dt;   /* the model's run: to time, kept after transient, every dt */
+    int values;                   /* +1: successive maxima, -1: minima, 0: every value */
+    int dim_lo, dim_hi;           /* the curves' embedding dimensions; 0: from the false
+                                     neighbours (the least with < 1 %, and 2 more) */
+    int lag, steps, fnn_dim, theiler;
+    double radius[8];             /* the neighbourhoods, fractions of the series' range */
+    int n_radius;
+    int fit_lo, fit_hi;           /* the steps fitted; fit_hi 0: each curve to half its rise */
+    double time_unit;             /* seconds per unit of time (0: no 1/s) */
+} cm_embedding_options;
+/* maxima; lag 1, 40 steps, false neighbours up to 14, radii 0.005, 0.01,
+ * 0.02; the model's run 100 time units every 0.01 */
+cm_embedding_options cm_embedding_defaults(void);
+
+typedef struct cm_embedding {
+    size_t n;                 /* the values analysed */
+    double interval;          /* the mean time between them; NAN when unknown */
+    int embedding_dim;        /* the least with < 1 % false neighbours; 0: none */
+    int fnn_dim;
+    double false_neighbours[64];
+    double lambda, spread;    /* per value: the curves' mean slope, their deviation */
+    double lambda_per_time;   /* lambda / interval */
+} cm_embedding;
+
+/* The largest Lyapunov exponent and the embedding dimension of one series
+ * (`cellmap exponents --series`, thesis Figs. 3.12, 3.15): false nearest
+ * neighbours and Kantz's divergence curves of a model's coordinate or a
+ * file's column. out (may be NULL) gets the result; a->csv the curves,
+ * a->png the delay projection over them. */
+cm_status cm_analysis_embedding(const cm_analysis *a, const cm_embedding_options *o,
+                                cm_embedding *out, char *msg, size_t msg_size);
+
 typedef struct cm_simulate_options {
     double x, v;     /* the start */
     double t0;       /* its time; NaN: the Poincare section's phase phi/Omega */

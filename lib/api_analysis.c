@@ -17,6 +17,7 @@
 #include "lib/equilibria.h"
 #include "lib/escape.h"
 #include "lib/periodic.h"
+#include "lib/embedding.h"
 #include "lib/exponents.h"
 #include "lib/series.h"
 #include "models/dde_lyapunov.h"
@@ -255,6 +256,69 @@ cm_status cm_analysis_series(const cm_analysis *a, const cm_series_options *o, c
     if (st == CM_OK)
         st = series_write(&sa, &r, msg, msg_size);
     series_result_free(&r);
+    return st;
+}
+
+_Static_assert(sizeof((cm_embedding_options){0}.radius) / sizeof(double) == EMBED_MAX_RADII,
+               "cm_embedding_options' radii are the driver's");
+_Static_assert(sizeof((cm_embedding){0}.false_neighbours) / sizeof(double) == CM_EMBED_MAX_DIM,
+               "cm_embedding's false neighbours are the kernel's");
+
+cm_embedding_options cm_embedding_defaults(void)
+{
+    const embed_args d = embedding_defaults();
+    cm_embedding_options o = {.time = d.sim.time, .dt = d.sim.dt, .values = d.extrema,
+                              .lag = d.lag, .steps = d.steps, .fnn_dim = d.fnn_dim,
+                              .n_radius = d.n_radius};
+    memcpy(o.radius, d.radius, sizeof o.radius);
+    return o;
+}
+
+/* The options as the driver's request. */
+static cm_status embedding_request(const cm_analysis *a, const cm_embedding_options *o,
+                                   embed_args *e, char *msg, size_t msg_size)
+{
+    if (o->n_from < 0 || o->n_from > SERIES_MAX_DIM || o->n_radius < 1 ||
+        o->n_radius > EMBED_MAX_RADII)
+        return cm_fail(CM_EINVAL, msg, msg_size, "n_from must be 0..%d and n_radius 1..%d",
+                       SERIES_MAX_DIM, EMBED_MAX_RADII);
+    model_of(a, exponents_defaults().mo.name, &e->sim.mo);
+    memcpy(e->sim.from, o->start, sizeof e->sim.from);
+    e->sim.n_from = o->n_from, e->sim.time = o->transient + o->time;
+    e->sim.skip = o->transient, e->sim.dt = o->dt, e->sim.of = o->of;
+    e->input = o->input, e->column = o->of, e->extrema = o->values;
+    e->dim_lo = o->dim_lo, e->dim_hi = o->dim_hi ? o->dim_hi : o->dim_lo;
+    e->lag = o->lag, e->steps = o->steps, e->fnn_dim = o->fnn_dim, e->theiler = o->theiler;
+    memcpy(e->radius, o->radius, sizeof e->radius);
+    e->n_radius = o->n_radius, e->fit_lo = o->fit_lo, e->fit_hi = o->fit_hi;
+    e->time_unit = o->time_unit, e->csv = a->csv, e->png = a->png;
+    chart_outputs co;
+    const cm_status st = outputs_of(a, e->width, e->height, 300, 400, &co, msg, msg_size);
+    e->width = co.width, e->height = co.height;
+    return st;
+}
+
+cm_status cm_analysis_embedding(const cm_analysis *a, const cm_embedding_options *o,
+                                cm_embedding *out, char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    const cm_embedding_options d = cm_embedding_defaults();
+    o = o ? o : &d;
+    embed_args e = embedding_defaults();
+    cm_status st = embedding_request(a, o, &e, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    embed_result r;
+    st = embedding_compute(&e, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = embedding_write(&e, &r, msg, msg_size);
+    if (st == CM_OK && out) {
+        *out = (cm_embedding){.n = r.n, .interval = r.interval, .embedding_dim = r.embeds,
+                              .fnn_dim = r.fnn_dim, .lambda = r.lambda, .spread = r.spread,
+                              .lambda_per_time = r.lambda / r.interval};
+        memcpy(out->false_neighbours, r.fnn, (size_t)r.fnn_dim * sizeof *r.fnn);
+    }
+    embedding_result_free(&r);
     return st;
 }
 

@@ -26,7 +26,6 @@ exp_args exponents_defaults(void)
     a.o = (cm_spectrum_options){.transient = 10, .time = 100, .renorm = 0.1, .iterations = 10000,
                                 .skip = 100};
     a.samples = 20, a.gs = 10, a.q_max = 20;
-    a.width = 900, a.height = 500;
     return a;
 }
 
@@ -230,7 +229,9 @@ static cm_status write_png(const exp_args *a, const exp_result *r, char *msg, si
     snprintf(title, sizeof title, "running Lyapunov exponents of %s (%s)%s", r->m.name,
              r->of_map ? "its map, per iterate" : "per unit time",
              k > 1 ? ": lambda_1 blue, lambda_2 red, lambda_3 green, lambda_4 violet" : "");
-    const cm_chart chart = {a->width, a->height, {t[0], lo - pad}, {t[n - 1], hi + pad},
+    /* 0: the default size, so that a caller can tell whether one was given */
+    const int width = a->width ? a->width : 900, height = a->width ? a->height : 500;
+    const cm_chart chart = {width, height, {t[0], lo - pad}, {t[n - 1], hi + pad},
                             r->of_map ? "iterates" : "t", "lambda", title, NULL, series, k,
                             figure_font(), 0, NULL, 0};
     const cm_png_text texts[] = {{"Model", r->m.name}, {"Parameters", params}};

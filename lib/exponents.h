@@ -31,13 +31,13 @@ typedef struct exp_args {
     bool euler_tangent, sync, own_delay;
     double q_max;
     const char *csv, *png;
-    int width, height;
+    int width, height; /* 0, 0: 900x500 */
 } exp_args;
 
 /* The command's defaults: chip-4d; flows 100 time units after 10 of
  * transient, renormalised every 0.1; maps 10000 iterates after 100;
  * chip-bue 20 samples a delay, Gram-Schmidt every 10 steps, q up to 20;
- * the figure 900x500. */
+ * the figure's size 0 (900x500). */
 exp_args exponents_defaults(void);
 
 /* One row of the running estimates. */

@@ -121,6 +121,23 @@ bool parse_counts(const char *s, int64_t *v, int *count, int max)
     return n > 0;
 }
 
+bool parse_int_span(const char *s, int *lo, int *hi)
+{
+    char first[32];
+    const char *colon = strchr(s, ':');
+    const size_t len = colon ? (size_t)(colon - s) : strlen(s);
+    int64_t a, b;
+    if (len >= sizeof first)
+        return false;
+    memcpy(first, s, len);
+    first[len] = 0;
+    if (!parse_int64(first, &a) || !parse_int64(colon ? colon + 1 : first, &b) || a > b ||
+        a < INT32_MIN || b > INT32_MAX)
+        return false;
+    *lo = (int)a, *hi = (int)b;
+    return true;
+}
+
 bool parse_doubles(const char *s, double *v, int *count, int max)
 {
     const int n = parse_pieces(s, ',', max, v, parse_one_double);

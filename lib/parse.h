@@ -18,6 +18,8 @@ bool parse_bytes(const char *s, uint64_t *out);
 bool parse_ranges(const char *s, double *lo, double *hi, int *count, int max);
 /* "NxMx..." with positive counts -> n[], *count (at most max). */
 bool parse_counts(const char *s, int64_t *n, int *count, int max);
+/* "N" or "N:M" (whole numbers, N <= M) -> lo, hi (N alone: both). */
+bool parse_int_span(const char *s, int *lo, int *hi);
 /* "X,Y,..." -> v[], *count (at most max). */
 bool parse_doubles(const char *s, double *v, int *count, int max);
 

@@ -89,6 +89,39 @@ assert all(float(r["T"]) == 0 and float(r["gamma"]) == 0 for r in early)
 assert max(float(r["T"]) for r in rows) > 1, "no bursts"
 PY
 
+# --- the workpiece's exponents from tau2's extrema alone, as the thesis ----
+# measured them with TISEAN (Figs. 3.12, 3.15): 462 1/s at f = 0.16 from the
+# maxima (m = 10..12; 930 steps of 0.0005 between maxima in its time, ours
+# times f), 340 1/s at f = 0.083 from the minima (m = 8..9; 507.4 steps)
+kantz="--model chip-workpiece --from 1,0,0,0,0,0 --series tau2 --time 3000 --transient 0
+  --dt 0.005 --time-unit 1.64e-4 --radius 0.02,0.05,0.1 --fit 1:6 --json"
+"$CM" exponents $kantz --param f=0.16 --dims 10:12 > kantz16.json || fail "exponents --series f=0.16"
+"$CM" exponents $kantz --param f=0.083 --values min --dims 8:9 > kantz083.json \
+  || fail "exponents --series f=0.083"
+python3 - kantz16.json kantz083.json <<'PY' || fail "the workpiece's exponents from its series"
+import json, sys
+for path, thesis, interval in ((sys.argv[1], 462, 930 * 0.0005 / 0.16),
+                               (sys.argv[2], 340, 507.4 * 0.0005 / 0.083)):
+    d = json.load(open(path))
+    assert d["n"] > 900, d["n"]
+    assert abs(d["interval"] / interval - 1) < 0.03, (path, d["interval"], interval)
+    assert abs(d["lambda_per_second"] / thesis - 1) < 0.2, (path, d["lambda_per_second"], thesis)
+    assert all(c["references"] > 100 for c in d["curves"]), d["curves"]
+PY
+# chip-4d at xi = 4.8: TISEAN's 0.361 per maximum and 0.647 per unit time
+# (Fig. 3.7); the variational equations give 0.631
+"$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --series tau2 --time 3000 --transient 100 \
+  --dt 0.002 --json > kantz4d.json || fail "exponents --series chip-4d"
+python3 - kantz4d.json <<'PY' || fail "chip-4d's exponent from its maxima"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["embedding_dim"] == 3 and [c["dim"] for c in d["curves"]][::3] == [3, 4, 5], d
+assert abs(d["interval"] / 0.558 - 1) < 0.01, d["interval"]
+assert abs(d["lambda"] / 0.361 - 1) < 0.05, d["lambda"]
+assert abs(d["lambda_per_time"] / 0.647 - 1) < 0.05, d["lambda_per_time"]
+assert abs(d["lambda_per_time"] / 0.631 - 1) < 0.03, d["lambda_per_time"]
+PY
+
 # --- Lyapunov spectra ------------------------------------------------------
 "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 300 --transient 20 --json \
   > flowexp.json || fail "exponents chip-4d"

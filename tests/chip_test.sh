@@ -170,6 +170,41 @@ expect_usage "leave out --from" exponents --model chip-bue --from 1,2,3,4
 expect_usage "--sync and --euler-tangent are for the delay model" exponents --sync
 expect_usage "--own-delay goes with --sync" exponents --model chip-bue --own-delay
 expect_usage "dt = -1" exponents --model chip-bue --param dt=-1
+# the exponent of one series (models/embedding.h): a measurement's file, the
+# logistic map at r = 4 (log 2 per value), and a model's coordinate
+awk 'BEGIN { x = 0.3; print "t,x"; for (i = 0; i < 6000; i++) { x = 4 * x * (1 - x); print i "," x } }' \
+  > logistic.csv
+"$CM" exponents --series x --input logistic.csv --values all --dims 1 --radius 0.0002 \
+  --fit 0:5 --steps 8 --json --csv kantz.csv --png kantz.png > kantz.json \
+  || fail "exponents --series --input"
+python3 - kantz.json kantz.csv <<'PY' || fail "the logistic map's exponent from its series"
+import csv, json, math, sys
+d = json.load(open(sys.argv[1]))
+assert d["of"] == "series" and d["n"] == 6000 and d["interval"] == 1, d
+assert abs(d["lambda"] - math.log(2)) < 0.05, d["lambda"]
+assert d["embedding_dim"] == 1 and d["false_neighbours"][0] < 0.01, d["false_neighbours"]
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len(rows) == 9 and list(rows[0]) == ["dim", "radius", "k", "S"], rows[0]
+assert [int(r["k"]) for r in rows] == list(range(9)) and float(rows[0]["radius"]) < 0.001, rows
+PY
+echo '{"view": [0, 1, 0, 1], "size": [900, 900], "texts": {"Source": "logistic.csv, column x"}}' > kantz.check.json
+python3 "$HERE/pngcheck.py" kantz.png kantz.check.json || fail "exponents --series --png"
+"$CM" exponents --model chip-workpiece --param f=0.16 --from 1,0,0,0,0,0 --series tau2 \
+  --time 150 --transient 0 --dims 2 --fnn-dim 3 --radius 0.1 --steps 4 --quiet \
+  --csv wpkantz.csv || fail "exponents --series of a model"
+[ -s wpkantz.csv ] || fail "exponents --series wrote no curves"
+expect_usage "no column y in its header" exponents --series y --input logistic.csv
+expect_usage "cannot be read" exponents --series x --input nope.csv
+expect_usage "--input, --dims and --fit go with --series NAME" exponents --input logistic.csv
+expect_usage "--values: 'most' is not max, min or all" exponents --series x --values most
+expect_usage "--dims: '3:1' is not M or M:M2" exponents --series x --input logistic.csv --dims 3:1
+expect_usage "radii are fractions of the series' range" \
+  exponents --series x --input logistic.csv --radius 2
+expect_usage "coordinates are" exponents --model chip-4d --series x --time 10
+printf 't,x\n0,1\n1,1\n2,1\n' > flat.csv
+expect_usage "is constant or empty" exponents --series x --input flat.csv --values all
+printf 't,x\n0,1\n1,oops\n' > words.csv
+expect_usage "words.csv:3: 'oops' is not a number" exponents --series x --input words.csv
 out=$("$CM" simulate --model chip-4d --from 1,0.1,1e7,0 --time 10 --csv lost.csv 2>&1); rc=$?
 [ "$rc" -eq 1 ] || fail "simulate of a lost orbit exited $rc: $out"
 [ ! -e lost.csv ] || fail "simulate wrote lost.csv although the orbit was lost"

@@ -41,6 +41,7 @@ run exponents exponents --param xi=4.8,zeta=21 --from 1,0.1,0.2,0.3 --time 5 --t
 run exponents-map exponents --param xi=4.8,zeta=21 --of map --from 1,0.2,0.3 --iterations 20 --skip 5 --json
 run exponents-farmer exponents --model chip-bue --samples 5 --time 20 --json
 run exponents-sync exponents --model chip-bue --sync --time 40 --json
+run exponents-series exponents --model chip-workpiece --param f=0.16 --from 1,0,0,0,0,0 --series tau2 --time 200 --transient 0 --dims 2 --fnn-dim 3 --radius 0.1 --steps 4 --time-unit 1.64e-4 --json
 run simulate-flow simulate --model chip-4d --from 1,0.1,0.2,0.3 --time 5 --json
 run exponents-henon-like exponents --model microchaos-pd --from 0.1,0.01 --iterations 100 --skip 0 --json
 run equilibria-branch equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch xi=4:12 --json

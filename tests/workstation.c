@@ -142,6 +142,17 @@ static void analyses(void)
     a = outputs("series", f, 1);
     a.model = "chip-bue";
     must(cm_analysis_series(&a, &so2, msg, sizeof msg), "series", msg);
+    cm_embedding_options mo = cm_embedding_defaults();
+    mo.of = "tau2", mo.start[0] = 1, mo.start[1] = 0.1, mo.start[2] = 0.2, mo.start[3] = 0.3;
+    mo.n_from = 4, mo.time = 200, mo.transient = 10, mo.dt = 0.005, mo.steps = 10;
+    a = outputs("embedding", f, 1);
+    a.params = "xi=4.8";
+    cm_embedding em;
+    must(cm_analysis_embedding(&a, &mo, &em, msg, sizeof msg), "embedding", msg);
+    if (em.embedding_dim != 3 || !(em.lambda > 0.2 && em.lambda < 0.5)) {
+        fprintf(stderr, "embedding: dimension %d, lambda %g\n", em.embedding_dim, em.lambda);
+        exit(1);
+    }
 }
 
 int main(void)

@@ -66,6 +66,10 @@ samples, spectrum = an.series("chip-bue", time=50, dt=0.05, of="tau", time_unit=
 rows(samples, p + "series.csv")
 rows(spectrum, p + "series_spectrum.csv")
 assert list(samples.dtype.names) == ["t", "T0", "T", "gamma", "tau"], samples.dtype.names
+em, curves = an.embedding("tau2", start=(1, 0.1, 0.2, 0.3), time=200, transient=10, dt=0.005,
+                          steps=10, params="xi=4.8", **out("embedding"))
+rows(curves, p + "embedding.csv")
+assert em["embedding_dim"] == 3 and 0.2 < em["lambda"] < 0.5, em
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})

@@ -100,9 +100,12 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
   "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --time 20 --transient 5 \
     --csv cli_exponents.csv --png cli_exponents.png &&
   "$CM" simulate --model chip-bue --time 50 --dt 0.05 --of tau --time-unit 1e-3 \
-    --csv cli_series.csv --png cli_series.png --spectrum cli_series_spectrum.csv; } > analyses.log 2>&1 ||
+    --csv cli_series.csv --png cli_series.png --spectrum cli_series_spectrum.csv &&
+  "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --series tau2 --time 200 --transient 10 \
+    --dt 0.005 --steps 10 --csv cli_embedding.csv --png cli_embedding.png; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
-ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue exponents series"
+ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue exponents series
+  embedding"
 
 # without_seconds CSV: the table without its last column (a sweep's timings)
 without_seconds() { sed 's/,[^,]*$//' "$1"; }

@@ -227,6 +227,12 @@ wp="--model chip-workpiece --from 1,0,0,0,0,0 --time-unit 1.64e-4 --quiet"
   --png fig-3.13-simulate.png
 "$CM" simulate $wp --param f=0.083 --time 2000 --dt 0.05 --of z --fmax 3000 \
   --png fig-3.14-simulate.png
+# Figs. 3.12, 3.15: the thesis' TISEAN analysis of tau2 alone: its maxima at f = 0.16
+# while chaotic (t < 3000) embedded in 10-12 delays, its minima at f = 0.083 in 8-9;
+# Kantz's divergence curves' slope over k = 1..6: 410 and 345 1/s (thesis 462, 340)
+kz="--series tau2 --time 3000 --transient 0 --dt 0.005 --radius 0.02,0.05,0.1 --fit 1:6"
+"$CM" exponents $wp $kz --param f=0.16 --dims 10:12 --png fig-3.12-exponents.png
+"$CM" exponents $wp $kz --param f=0.083 --values min --dims 8:9 --png fig-3.15-exponents.png
 # Figs. 3.17-3.18: the built-up edge (delay model chip-bue): without it (H = 0)
 # the stress settles (the equilibrium is unstable later, docs/models.md 12.3),
 # with it (H = 0.1) bursts at every tooth; the exponents of Farmer's map

@@ -91,6 +91,24 @@ class _Series(ctypes.Structure):
                 ("returns", ctypes.c_int)]
 
 
+class _Embedding(ctypes.Structure):
+    _fields_ = [("input", ctypes.c_char_p), ("of", ctypes.c_char_p),
+                ("start", ctypes.c_double * 12), ("n_from", ctypes.c_int),
+                ("time", ctypes.c_double), ("transient", ctypes.c_double), ("dt", ctypes.c_double),
+                ("values", ctypes.c_int), ("dim_lo", ctypes.c_int), ("dim_hi", ctypes.c_int),
+                ("lag", ctypes.c_int), ("steps", ctypes.c_int), ("fnn_dim", ctypes.c_int),
+                ("theiler", ctypes.c_int), ("radius", ctypes.c_double * 8),
+                ("n_radius", ctypes.c_int), ("fit_lo", ctypes.c_int), ("fit_hi", ctypes.c_int),
+                ("time_unit", ctypes.c_double)]
+
+
+class _EmbeddingOut(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_size_t), ("interval", ctypes.c_double),
+                ("embedding_dim", ctypes.c_int), ("fnn_dim", ctypes.c_int),
+                ("false_neighbours", ctypes.c_double * 64), ("lam", ctypes.c_double),
+                ("spread", ctypes.c_double), ("lambda_per_time", ctypes.c_double)]
+
+
 class _Simulate(ctypes.Structure):
     _fields_ = [("x", ctypes.c_double), ("v", ctypes.c_double), ("t0", ctypes.c_double),
                 ("periods", ctypes.c_int), ("skip", ctypes.c_int)]
@@ -142,9 +160,10 @@ for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
     _sig("cm_analysis_" + _name, ctypes.POINTER(_opts))
 _sig("cm_analysis_series", ctypes.POINTER(_Series))
 _sig("cm_analysis_exponents", ctypes.POINTER(_Exponents), ctypes.POINTER(_ExponentsOut))
+_sig("cm_analysis_embedding", ctypes.POINTER(_Embedding), ctypes.POINTER(_EmbeddingOut))
 for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
                      ("equilibria", _Equilibria), ("periodic", _Periodic),
-                     ("exponents", _Exponents), ("series", _Series),
+                     ("exponents", _Exponents), ("series", _Series), ("embedding", _Embedding),
                      ("simulate", _Simulate), ("bifurcation", _Bifurcation),
                      ("lyapunov", _Lyapunov), ("continue", _Continue)):
     getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
@@ -370,6 +389,51 @@ def exponents(start=None, of_map=False, count=0, time=None, transient=None, reno
     return ({"lambda": [res.lam[i] for i in range(res.count)],
              "kaplan_yorke": None if math.isnan(ky) else ky,
              "mean_flight": None if math.isnan(res.mean_flight) else res.mean_flight}, table)
+
+
+def embedding(of, input=None, start=None, time=None, transient=None, dt=None, values="max",
+              dims=None, lag=None, steps=None, fnn_dim=None, theiler=None, radius=None, fit=None,
+              time_unit=0.0, **common):
+    """The largest Lyapunov exponent and embedding dimension of one series
+    (`cellmap exponents --series`): the column `of` of the CSV file input,
+    or the coordinate `of` of the model's orbit (chip-4d unless named; from
+    start, over time after transient, every dt); values "max", "min" or
+    "all"; dims M or (M, M2); radius a list of fractions of the range; fit
+    (K0, K1). Returns (result, curves): result a dict of n, interval,
+    embedding_dim (None: none), false_neighbours, lambda (per value),
+    spread and lambda_per_time; curves the table dim, radius, k, S."""
+    o = _lib.cm_embedding_defaults()
+    _start(o, start)
+    if values not in ("max", "min", "all"):
+        raise ValueError("values %r: give 'max', 'min' or 'all'" % (values,))
+    o.values = {"max": 1, "min": -1, "all": 0}[values]
+    keep = [_text(of), _path(input)]
+    o.of, o.input = keep
+    for key, value, kind in (("time", time, float), ("transient", transient, float),
+                             ("dt", dt, float), ("lag", lag, int), ("steps", steps, int),
+                             ("fnn_dim", fnn_dim, int), ("theiler", theiler, int)):
+        if value is not None:
+            setattr(o, key, kind(value))
+    if dims is not None:
+        o.dim_lo, o.dim_hi = (int(dims), int(dims)) if isinstance(dims, int) else map(int, dims)
+    if fit is not None:
+        o.fit_lo, o.fit_hi = map(int, fit)
+    if radius is not None:
+        radius = [float(r) for r in radius]
+        if not 1 <= len(radius) <= 8:
+            raise ValueError("radius: give 1..8 fractions of the series' range")
+        o.radius[:len(radius)] = radius
+        o.n_radius = len(radius)
+    o.time_unit = float(time_unit)
+    res = _EmbeddingOut()
+    curves = _run(_common(**common), _lib.cm_analysis_embedding, ctypes.byref(o),
+                  ctypes.byref(res))
+    return ({"n": res.n, "interval": None if math.isnan(res.interval) else res.interval,
+             "embedding_dim": res.embedding_dim or None,
+             "false_neighbours": list(res.false_neighbours[:res.fnn_dim]),
+             "lambda": res.lam, "spread": res.spread,
+             "lambda_per_time": None if math.isnan(res.lambda_per_time) else res.lambda_per_time},
+            curves)
 
 
 def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
