@@ -750,6 +750,101 @@ cm_status export_cells(exporter *x, const char *cells, const char *flat, const w
     return CM_OK;
 }
 
+/* Called with each slab of a window and its cells' labels by attractors
+ * (NULL without attractors); false stops, the reason in msg. */
+typedef bool (*slab_fn)(void *user, const cm_region *flat, const int32_t *label, char *msg,
+                        size_t msg_size);
+
+/* The window's cells a slab of about SLAB_CELLS at a time along dimension
+ * 0 (the slowest in C order), labelled by att when not NULL; `what` says
+ * what a stop request leaves undone. */
+static cm_status each_slab(cm_cluster *c, const cm_box *window, const cm_attractor_set *att,
+                           const cm_computed *computed, const work_hooks *hooks, const char *what,
+                           slab_fn fn, void *user, char *msg, size_t msg_size)
+{
+    const uint64_t per_layer = cm_box_cells(window) / (uint64_t)(window->hi[0] - window->lo[0]);
+    const int64_t layers = per_layer >= SLAB_CELLS ? 1 : (int64_t)(SLAB_CELLS / per_layer);
+    uint64_t done = 0;
+    cm_status st = CM_OK;
+    msg[0] = '\0';
+    for (int64_t at = window->lo[0]; at < window->hi[0] && st == CM_OK; at += layers) {
+        cm_box slab = *window;
+        slab.lo[0] = at;
+        slab.hi[0] = at + layers < window->hi[0] ? at + layers : window->hi[0];
+        cm_region flat;
+        if ((st = cm_cluster_flatten(c, &slab, &flat, msg, msg_size)) != CM_OK)
+            break;
+        int32_t *label = att ? malloc((flat.ncells + 1) * sizeof *label) : NULL;
+        if (att && !label)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
+        else if (att)
+            st = cm_attractor_cell_labels(att, &flat, computed, label, msg, msg_size);
+        if (st == CM_OK && !fn(user, &flat, label, msg, msg_size))
+            st = msg[0] ? CM_EIO : cm_fail(CM_EIO, msg, msg_size, "cannot write the arrays");
+        free(label);
+        done += flat.ncells;
+        cm_region_free(&flat);
+        const char *why = st == CM_OK ? work_stop(hooks) : NULL;
+        if (why)
+            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: %s", why, what);
+        work_progress(hooks, done, NULL);
+    }
+    return st;
+}
+
+typedef struct slab_files {
+    FILE *labels, *steps; /* either may be NULL */
+    const array_export *x;
+    uint64_t *in_window, *by_label;
+} slab_files;
+
+static bool write_files(void *user, const cm_region *flat, const int32_t *label, char *msg,
+                        size_t msg_size)
+{
+    const slab_files *w = user;
+    errno = 0;
+    const bool ok = write_slab(flat, label, w->labels, w->steps, w->in_window, w->by_label);
+    if (!ok) /* the file a write failed on, and why */
+        cm_output_fail(w->labels && ferror(w->labels) ? w->x->labels : w->x->steps,
+                       errno ? errno : EIO, msg, msg_size);
+    return ok;
+}
+
+typedef struct slab_memory {
+    int32_t *labels;      /* the window's, C order */
+    const cm_box *window;
+} slab_memory;
+
+static bool copy_slab(void *user, const cm_region *flat, const int32_t *label, char *msg,
+                      size_t msg_size)
+{
+    (void)msg, (void)msg_size;
+    const slab_memory *m = user;
+    const cm_box *b = &flat->box, *w = m->window;
+    int64_t stride[CM_MAX_DIM], i[CM_MAX_DIM] = {0};
+    stride[w->dim - 1] = 1;
+    for (int d = w->dim - 2; d >= 0; d--)
+        stride[d] = stride[d + 1] * (w->hi[d + 1] - w->lo[d + 1]);
+    for (uint64_t k = 0; k < flat->ncells; k++) { /* the flat region has dimension 0 fastest */
+        int64_t at = 0;
+        for (int d = 0; d < w->dim; d++)
+            at += (b->lo[d] + i[d] - w->lo[d]) * stride[d];
+        const uint32_t g = flat->group[k];
+        m->labels[at] = label ? label[k] : g == CM_GROUP_NONE ? -1 : (int32_t)g;
+        for (int d = 0; d < w->dim && ++i[d] == b->hi[d] - b->lo[d]; d++)
+            i[d] = 0;
+    }
+    return true;
+}
+
+cm_status export_labels(exporter *ex, int32_t *labels, const work_hooks *hooks, char *msg,
+                        size_t msg_size)
+{
+    slab_memory m = {labels, &ex->window};
+    return each_slab(ex->c, &ex->window, &ex->att, &ex->ends.computed, hooks,
+                     "the labels were not read", copy_slab, &m, msg, msg_size);
+}
+
 cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps_path,
                         bool by_groups, const work_hooks *hooks, char *msg, size_t msg_size)
 {
@@ -780,46 +875,16 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
         free(by_label);
         return st;
     }
+    msg[0] = '\0';
     bool ok = (!has_labels || array_npy_header(labels.f, window)) &&
               (!has_steps || array_npy_header(steps.f, window));
-    /* slabs along dimension 0, the slowest in C order */
-    const uint64_t per_layer = cm_box_cells(window) / (uint64_t)(window->hi[0] - window->lo[0]);
-    const int64_t layers = per_layer >= SLAB_CELLS ? 1 : (int64_t)(SLAB_CELLS / per_layer);
-    uint64_t done = 0;
-    msg[0] = '\0';
-    for (int64_t at = window->lo[0]; at < window->hi[0] && ok; at += layers) {
-        cm_box slab = *window;
-        slab.lo[0] = at;
-        slab.hi[0] = at + layers < window->hi[0] ? at + layers : window->hi[0];
-        cm_region flat;
-        if (cm_cluster_flatten(c, &slab, &flat, msg, msg_size) != CM_OK) {
-            ok = false;
-            break;
-        }
-        int32_t *label = x->attractors ? malloc((flat.ncells + 1) * sizeof *label) : NULL;
-        if (x->attractors && (!label || cm_attractor_cell_labels(x->attractors, &flat, x->computed,
-                                                                  label, msg, msg_size) != CM_OK)) {
-            if (!label)
-                snprintf(msg, msg_size, "out of memory for the labels");
-            ok = false;
-        } else {
-            errno = 0;
-            ok = write_slab(&flat, label, has_labels ? labels.f : NULL,
-                            has_steps ? steps.f : NULL, in_window, by_label);
-            if (!ok) /* the file a write failed on, and why */
-                cm_output_fail(has_labels && ferror(labels.f) ? x->labels : x->steps,
-                               errno ? errno : EIO, msg, msg_size);
-        }
-        free(label);
-        done += flat.ncells;
-        cm_region_free(&flat);
-        const char *why = ok ? work_stop(hooks) : NULL;
-        if (why) {
-            st = cm_fail(CM_ECANCELED, msg, msg_size, "%s: the labels and steps arrays were not written",
-                         why);
-            ok = false;
-        }
-        work_progress(hooks, done, NULL);
+    if (ok) {
+        slab_files files = {has_labels ? labels.f : NULL, has_steps ? steps.f : NULL, x,
+                            in_window, by_label};
+        st = each_slab(ex->c, window, x->attractors, x->computed, hooks,
+                       "the labels and steps arrays were not written", write_files, &files, msg,
+                       msg_size);
+        ok = st == CM_OK;
     }
     if (!ok && st == CM_OK)
         st = msg[0] ? CM_EIO : cm_fail(CM_EIO, msg, msg_size, "cannot write the arrays");

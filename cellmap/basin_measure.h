@@ -1,0 +1,74 @@
+/* cellmap/basin_measure.h - measures of basins on a window of cell labels
+ * (one int32 per cell, as `export --labels` writes them: an attractor's
+ * id, 0 diverged, -2 outside, -1 not computed), any dimension:
+ *
+ *   - basin entropy Sb and boundary basin entropy Sbb (Daza, Wagemakers,
+ *     Georgeot, Guery-Odelin and Sanjuan, Sci. Rep. 6, 31416, 2016): the
+ *     window tiled by boxes of eps cells a side; a box's entropy is
+ *     -sum p_j ln p_j over the shares p_j of its labels; Sb is the mean
+ *     over the boxes, Sbb over the boxes with more than one label. Sbb >
+ *     ln 2 is a sufficient condition for a fractal boundary;
+ *   - the fraction f(eps) of eps-uncertain cells (Grebogi, McDonald, Ott
+ *     and Yorke, Phys. Lett. A 99, 415, 1983): a cell is uncertain when a
+ *     cell eps cells away along some axis has another label; f ~ eps^alpha,
+ *     alpha the uncertainty exponent, d - alpha the boundary's dimension;
+ *   - a Wada test on the lattice: the boundary cells (those with a
+ *     neighbour of another label, the 3^d - 1 around them) and the share
+ *     of them that see every basin within r cells (Chebyshev distance),
+ *     r = 1, 2, ...: near 1 for all r when every boundary point is on the
+ *     boundary of every basin (Wada), as in Daza et al.'s grid method.
+ *
+ * Labels -1 are left out: boxes holding one, and cells with such a
+ * neighbour, are not counted. Every other label, 0 and -2 included, is a
+ * basin. Pure functions of their inputs: thread-safe, the same result
+ * every run. */
+#ifndef CM_CELLMAP_BASIN_MEASURE_H
+#define CM_CELLMAP_BASIN_MEASURE_H
+
+#include <stdint.h>
+
+#include "cellmap/lattice.h"
+#include "cellmap/status.h"
+
+/* Labels over a window: n[d] cells along dimension d, C order (dimension
+ * 0 the slowest), values in lo .. hi (the caller's bounds: -2 .. the
+ * largest attractor id). */
+typedef struct cm_label_grid {
+    int dim;
+    int64_t n[CM_MAX_DIM];
+    const int32_t *label;
+    int32_t lo, hi;
+} cm_label_grid;
+
+typedef struct cm_entropy {
+    int eps;               /* cells a side */
+    uint64_t boxes;        /* full boxes of computed cells */
+    uint64_t boundary;     /* those with more than one label */
+    double sb, sbb;        /* NAN without boxes / boundary boxes */
+} cm_entropy;
+
+/* CM_EINVAL when eps < 1 or the window has no full box of eps cells a
+ * side; CM_ENOMEM. */
+cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, char *msg,
+                           size_t msg_size);
+
+/* The fraction of eps-uncertain cells among those whose 2d neighbours eps
+ * away lie in the window, all computed (*counted of them); NAN when none.
+ * CM_EINVAL when eps < 1. */
+cm_status cm_uncertain_fraction(const cm_label_grid *g, int eps, double *fraction,
+                                uint64_t *counted, char *msg, size_t msg_size);
+
+typedef struct cm_wada {
+    int basins;                /* distinct labels among the computed cells */
+    uint64_t boundary;         /* boundary cells */
+    int radius;                /* fraction[0 .. radius - 1] for r = 1 .. radius */
+    double fraction[16];       /* boundary cells seeing every basin within r */
+} cm_wada;
+
+/* The Wada test with r = 1 .. radius (1..16). CM_EINVAL for a radius out
+ * of range or fewer than 3 basins (with 2 every boundary cell sees both:
+ * the test says nothing); CM_ENOMEM. */
+cm_status cm_wada_test(const cm_label_grid *g, int radius, cm_wada *out, char *msg,
+                       size_t msg_size);
+
+#endif

@@ -1,0 +1,124 @@
+/* Basin measures (cellmap/basin_measure) on windows whose answers are
+ * known: a 4x4 window's box entropies by hand; a straight (slanted)
+ * boundary between two basins, whose basin entropy falls with the box
+ * (Sb ~ eps), whose boundary boxes stay under log 2, and whose uncertain
+ * fraction grows as eps^1 (alpha = 1, Grebogi et al.); three sectors
+ * meeting at one point (not Wada: only cells near the point see all
+ * three); a window where every 3x3 block holds all three labels (Wada at
+ * r = 1); uncomputed cells left out; bad requests. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "cellmap/basin_measure.h"
+#include "check.h"
+
+enum { N = 400 };
+
+static cm_label_grid grid2(int32_t *label, int64_t nx, int64_t ny, int32_t hi)
+{
+    return (cm_label_grid){2, {nx, ny}, label, -2, hi};
+}
+
+static void test_by_hand(void)
+{
+    /* boxes of 2: {1,1,1,1} -> 0; {1,2,1,2} -> ln 2; {2,2,2,3} -> 0.5623;
+     * {3,3,3,3} -> 0 */
+    int32_t l[16] = {1, 1, 1, 2, 1, 1, 1, 2, 2, 2, 3, 3, 2, 3, 3, 3};
+    const cm_label_grid g = grid2(l, 4, 4, 3);
+    cm_entropy e;
+    char msg[256];
+    CHECK(cm_basin_entropy(&g, 2, &e, msg, sizeof msg) == CM_OK);
+    const double h3 = -(0.75 * log(0.75) + 0.25 * log(0.25));
+    CHECK_INT(e.boxes, 4);
+    CHECK_INT(e.boundary, 2);
+    CHECK_NEAR(e.sb, (log(2.0) + h3) / 4, 1e-15);
+    CHECK_NEAR(e.sbb, (log(2.0) + h3) / 2, 1e-15);
+    /* an uncomputed cell takes its box out */
+    l[0] = -1;
+    CHECK(cm_basin_entropy(&g, 2, &e, msg, sizeof msg) == CM_OK);
+    CHECK_INT(e.boxes, 3);
+    CHECK_NEAR(e.sb, (log(2.0) + h3) / 3, 1e-15);
+    CHECK(cm_basin_entropy(&g, 5, &e, msg, sizeof msg) == CM_EINVAL);
+}
+
+static void test_straight_boundary(void)
+{
+    int32_t *l = malloc(N * N * sizeof *l);
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            l[i * N + j] = i + 0.37 * j < 250.3 ? 1 : 2;
+    const cm_label_grid g = grid2(l, N, N, 2);
+    char msg[256];
+    double last = 0;
+    for (int eps = 2; eps <= 16; eps *= 2) {
+        cm_entropy e;
+        CHECK(cm_basin_entropy(&g, eps, &e, msg, sizeof msg) == CM_OK);
+        printf("straight boundary: eps %2d Sb %.5f Sbb %.4f (%llu of %llu boxes)\n", eps, e.sb,
+               e.sbb, (unsigned long long)e.boundary, (unsigned long long)e.boxes);
+        CHECK(e.sb > last);   /* Sb grows with the box: it tends to 0 as they shrink */
+        CHECK(e.sb < 0.02 * eps);
+        CHECK(e.sbb < log(2.0));
+        last = e.sb;
+    }
+    double lf[5], le[5];
+    for (int k = 0; k < 5; k++) {
+        double f;
+        uint64_t counted;
+        CHECK(cm_uncertain_fraction(&g, 1 << k, &f, &counted, msg, sizeof msg) == CM_OK);
+        lf[k] = log(f), le[k] = log(1 << k);
+    }
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < 5; k++)
+        sx += le[k], sy += lf[k], sxx += le[k] * le[k], sxy += le[k] * lf[k];
+    const double alpha = (5 * sxy - sx * sy) / (5 * sxx - sx * sx);
+    printf("straight boundary: uncertainty exponent %.4f\n", alpha);
+    CHECK_NEAR(alpha, 1.0, 0.05);
+    cm_wada w;
+    CHECK(cm_wada_test(&g, 2, &w, msg, sizeof msg) == CM_EINVAL); /* two basins */
+    free(l);
+}
+
+static void test_wada(void)
+{
+    int32_t *l = malloc(N * N * sizeof *l);
+    /* three sectors about the centre: every boundary is between two */
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++) {
+            const double a = atan2(i - N / 2 + 0.5, j - N / 2 + 0.5);
+            l[i * N + j] = a < -1 ? 1 : a < 1.5 ? 2 : 3;
+        }
+    cm_label_grid g = grid2(l, N, N, 3);
+    cm_wada w;
+    char msg[256];
+    CHECK(cm_wada_test(&g, 3, &w, msg, sizeof msg) == CM_OK);
+    printf("three sectors: %d basins, %llu boundary cells, seeing all: %.4f %.4f %.4f\n",
+           w.basins, (unsigned long long)w.boundary, w.fraction[0], w.fraction[1], w.fraction[2]);
+    CHECK_INT(w.basins, 3);
+    CHECK(w.boundary > 3 * N / 2 && w.boundary < 3 * N * 2);
+    CHECK(w.fraction[2] < 0.05 && w.fraction[0] <= w.fraction[2]);
+    /* stripes 1, 2, 3, 1, 2, 3, ...: every boundary cell sees all three
+     * within one cell but those of the window's edge columns */
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            l[i * N + j] = 1 + j % 3;
+    CHECK(cm_wada_test(&g, 1, &w, msg, sizeof msg) == CM_OK);
+    CHECK_INT(w.boundary, N * N);
+    CHECK_NEAR(w.fraction[0], (double)(N - 2) / N, 1e-12);
+    /* the diverged (0) and outside (-2) labels are basins too */
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            l[i * N + j] = (int32_t[]){-2, 0, 1}[j % 3];
+    g.hi = 1;
+    CHECK(cm_wada_test(&g, 1, &w, msg, sizeof msg) == CM_OK);
+    CHECK_INT(w.basins, 3);
+    CHECK(cm_wada_test(&g, 0, &w, msg, sizeof msg) == CM_EINVAL);
+    free(l);
+}
+
+int main(void)
+{
+    test_by_hand();
+    test_straight_boundary();
+    test_wada();
+    CHECK_DONE();
+}
