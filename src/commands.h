@@ -12,6 +12,7 @@ int cmd_exponents(int argc, char **argv);
 int cmd_fixed_points(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_export(int argc, char **argv);
+int cmd_measure(int argc, char **argv);
 /* `export` inside an explore session: cellmap export's words (argv[1] the
  * session's file) over the session's own open database and cluster, which
  * is not opened a second time. */

@@ -23,6 +23,8 @@ static const struct {
     {"render", cmd_render, "draw a figure or an indexed image of a .cmdb file's basins"},
     {"info", cmd_info, "what a .cmdb cluster database holds; its size on disk and in memory"},
     {"export", cmd_export, "a .cmdb file's groups and cells as CSV, .npy or a flat SQLite table"},
+    {"measure", cmd_measure,
+     "a .cmdb file's basins measured: shares, basin entropy, uncertainty exponent, Wada test"},
     {"orbit", cmd_orbit, "print an orbit of a model as CSV (full precision)"},
     {"fixed-points", cmd_fixed_points, "print the regular and virtual fixed points as CSV"},
     {"equilibria", cmd_equilibria,

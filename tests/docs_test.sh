@@ -146,7 +146,7 @@ spell escape --param b=1.3 --I0 0.25 --sweep a=1.3:1.5:2 --cells 1000 --ensemble
 spell stability --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --P 0.65:1.5:20 --csv -
 spell partition --param a=1.3,b=0.66 --csv -
 spell horseshoe --param alpha=0.77,beta=0.02,D=0.83 --m 3:3 --sweep P=0.65:0.72:5 --periods 8 --csv -
-for c in solve sweep explore render info export models orbit fixed-points equilibria periodic exponents lyapunov simulate bifurcation continue amplitude escape stability horseshoe partition; do
+for c in solve sweep explore render info export measure models orbit fixed-points equilibria periodic exponents lyapunov simulate bifurcation continue amplitude escape stability horseshoe partition; do
   spell help $c
   spell $c -h
 done
@@ -163,7 +163,7 @@ import re, subprocess, sys
 man = open(sys.argv[1]).read()
 unescape = lambda s: re.sub(r"^\\&", "", s, flags=re.M).replace("\\e", "\\")
 commands = re.findall(r"^  ([a-z][a-z-]*) ", subprocess.run([sys.argv[2], "--help"], capture_output=True, text=True).stdout, re.M)
-assert len(commands) == 21, commands
+assert len(commands) == 22, commands
 for c in commands:
     section = re.search(r"^\.SS " + re.escape(c) + r"\n\.nf\n(.*?)^\.fi$", man, re.S | re.M)
     assert section, c

@@ -25,7 +25,7 @@ _cellmap()
         words=$("$cm" models 2> /dev/null | sed -n 's/^\([a-z][a-z0-9-]*\)$/\1/p')
         COMPREPLY=($(compgen -W "$words" -- "$cur"))
         return ;;
-    --png|--csv|--db|--groups|--cells|--flat|--runs-csv|--events|--spectrum|--branches|--curves)
+    --png|--csv|--db|--groups|--cells|--flat|--runs-csv|--events|--spectrum|--branches|--curves|--input)
         COMPREPLY=($(compgen -f -- "$cur"))
         return ;;
     esac

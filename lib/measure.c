@@ -1,0 +1,354 @@
+/* Measures of a file's basins (lib/measure.h). */
+#include "lib/measure.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cellmap/clock.h"
+#include "lib/export.h"
+#include "lib/json.h"
+#include "lib/outfile.h"
+#include "lib/project.h"
+
+/* The Wada test's verdicts: every boundary cell sees all basins (but for
+ * this share), or almost none does (isolated meeting points). */
+#define WADA_ALL 0.99
+#define WADA_NONE 0.05
+
+measure_args measure_defaults(void)
+{
+    measure_args a;
+    memset(&a, 0, sizeof a);
+    a.mem = UINT64_C(256) << 20;
+    a.box[0] = 3, a.box[1] = 5, a.box[2] = 7, a.box[3] = 9, a.n_box = 4;
+    a.eps_lo = 1, a.eps_hi = 16;
+    a.wada_radius = 5;
+    return a;
+}
+
+static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
+{
+    if (a->n_box < 0 || a->n_box > MEASURE_MAX_BOXES)
+        return cm_fail(CM_EINVAL, msg, msg_size, "give at most %d box sizes", MEASURE_MAX_BOXES);
+    for (int k = 0; k < a->n_box; k++)
+        if (a->box[k] < 1 || a->box[k] > 1 << 20)
+            return cm_fail(CM_EINVAL, msg, msg_size, "box size %d: give 1 .. 2^20 cells",
+                           a->box[k]);
+    if (a->eps_hi && (a->eps_lo < 1 || a->eps_hi < a->eps_lo || a->eps_hi > 1 << 20))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "eps %d:%d: give 1 <= E0 <= E1 <= 2^20 cells (E0 doubled up to E1)",
+                       a->eps_lo, a->eps_hi);
+    if (a->wada_radius < 0 || a->wada_radius > 16)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the Wada radius must be 1..16 (%d)",
+                       a->wada_radius);
+    return CM_OK;
+}
+
+/* ---- the window's labels ---- */
+
+static cm_status read_labels(const measure_args *a, const work_hooks *hooks, measure_result *r,
+                             cm_label_grid *g, char *msg, size_t msg_size)
+{
+    cm_store *s = NULL;
+    cm_store_info info;
+    cm_cluster c;
+    cm_status st = project_probe(a->file, msg, msg_size);
+    if (st == CM_OK)
+        st = project_open_cluster(a->file, a->mem, &s, &info, &c, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    cm_box window;
+    exporter x;
+    memset(&x, 0, sizeof x);
+    const cm_attractor_options stored = {0};
+    if (a->window)
+        st = export_window(&c, a->window, &window, msg, msg_size);
+    if (st == CM_OK)
+        st = exporter_open(&x, s, &info, &c, a->window ? &window : NULL, a->file, &stored, msg,
+                           msg_size);
+    if (st == CM_OK) {
+        snprintf(r->model, sizeof r->model, "%s", info.model);
+        r->dim = g->dim = c.lat.dim, r->cells = cm_box_cells(&x.window);
+        for (int d = 0; d < r->dim; d++) {
+            r->n[d] = g->n[d] = x.window.hi[d] - x.window.lo[d];
+            r->lo[d] = c.lat.origin[d] + (double)x.window.lo[d] * c.lat.width[d];
+            r->hi[d] = c.lat.origin[d] + (double)x.window.hi[d] * c.lat.width[d];
+        }
+        g->lo = CM_LABEL_OUTSIDE, g->hi = (int32_t)x.att.n;
+        if ((double)r->cells * sizeof *g->label > (double)a->mem)
+            st = cm_fail(CM_EINVAL, msg, msg_size,
+                         "the window's %llu cells need %.0f MiB of labels, over the budget of "
+                         "%.0f MiB: measure a smaller window, or raise the budget",
+                         (unsigned long long)r->cells, (double)r->cells * 4 / 1048576.0,
+                         (double)a->mem / 1048576.0);
+    }
+    int32_t *labels = st == CM_OK ? malloc(r->cells * sizeof *labels) : NULL;
+    if (st == CM_OK && !labels)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu labels",
+                     (unsigned long long)r->cells);
+    if (st == CM_OK)
+        st = export_labels(&x, labels, hooks, msg, msg_size);
+    g->label = labels;
+    exporter_close(&x);
+    project_close(s, &c);
+    return st;
+}
+
+/* Each label's cells and share, the attractors first. */
+static cm_status count_shares(const cm_label_grid *g, measure_result *r, char *msg,
+                              size_t msg_size)
+{
+    const int labels = g->hi - g->lo + 1;
+    uint64_t *count = calloc((size_t)labels, sizeof *count);
+    r->shares = calloc((size_t)labels, sizeof *r->shares);
+    if (!count || !r->shares) {
+        free(count);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d labels", labels);
+    }
+    for (uint64_t k = 0; k < r->cells; k++)
+        count[g->label[k] - g->lo]++;
+    r->computed = r->cells - count[CM_LABEL_UNCOMPUTED - g->lo];
+    for (int32_t k = 0; k < labels; k++) {
+        /* the attractors 1 .. hi, then the diverged (0) and outside (-2) cells */
+        const int32_t label = k < g->hi ? k + 1 : k == g->hi ? CM_LABEL_DIVERGED
+                                                             : CM_LABEL_OUTSIDE;
+        const uint64_t n = k <= g->hi + 1 ? count[label - g->lo] : 0;
+        const double p = n ? (double)n / (double)r->computed : 0;
+        if (n)
+            r->shares[r->n_shares++] = (measure_share){
+                label, n, p, 1.96 * sqrt(p * (1 - p) / (double)r->computed)};
+    }
+    free(count);
+    return CM_OK;
+}
+
+/* ---- the measures ---- */
+
+static void mean_spread(const double *v, int n, double *mean, double *spread)
+{
+    double s = 0, s2 = 0;
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (!isnan(v[i]))
+            s += v[i], s2 += v[i] * v[i], k++;
+    *mean = k ? s / k : NAN;
+    *spread = k ? sqrt(fmax(0, s2 / k - *mean * *mean)) : NAN;
+}
+
+static cm_status entropies(const measure_args *a, const cm_label_grid *g, measure_result *r,
+                           char *msg, size_t msg_size)
+{
+    double sb[MEASURE_MAX_BOXES], sbb[MEASURE_MAX_BOXES];
+    for (int k = 0; k < a->n_box; k++) {
+        const cm_status st = cm_basin_entropy(g, a->box[k], &r->entropy[k], msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        sb[k] = r->entropy[k].sb, sbb[k] = r->entropy[k].sbb;
+        r->n_entropy++;
+    }
+    mean_spread(sb, a->n_box, &r->sb_mean, &r->sb_spread);
+    mean_spread(sbb, a->n_box, &r->sbb_mean, &r->sbb_spread);
+    return CM_OK;
+}
+
+/* log f against log eps by least squares: the slope and R^2. */
+static void fit_alpha(measure_result *r)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    int n = 0;
+    for (int k = 0; k < r->n_eps; k++) {
+        if (!(r->uncertain[k] > 0))
+            continue;
+        const double x = log(r->eps[k]), y = log(r->uncertain[k]);
+        sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y, n++;
+    }
+    const double vx = n * sxx - sx * sx, vy = n * syy - sy * sy, c = n * sxy - sx * sy;
+    r->alpha = n >= 2 && vx > 0 ? c / vx : NAN;
+    r->alpha_r2 = n >= 2 && vx > 0 && vy > 0 ? c * c / (vx * vy) : NAN;
+}
+
+static cm_status uncertain(const measure_args *a, const cm_label_grid *g, measure_result *r,
+                           char *msg, size_t msg_size)
+{
+    for (int e = a->eps_lo; e <= a->eps_hi && r->n_eps < MEASURE_MAX_EPS; e *= 2) {
+        const cm_status st = cm_uncertain_fraction(g, e, &r->uncertain[r->n_eps],
+                                                   &r->counted[r->n_eps], msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        r->eps[r->n_eps++] = e;
+    }
+    fit_alpha(r);
+    return CM_OK;
+}
+
+static cm_status wada(const measure_args *a, const cm_label_grid *g, measure_result *r,
+                      char *msg, size_t msg_size)
+{
+    const cm_status st = cm_wada_test(g, a->wada_radius, &r->wada, msg, msg_size);
+    r->has_wada = st == CM_OK;
+    return st == CM_EINVAL && !a->wada_asked && r->wada.basins < 3 ? CM_OK : st;
+}
+
+cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measure_result *r,
+                          char *msg, size_t msg_size)
+{
+    memset(r, 0, sizeof *r);
+    r->sb_mean = r->sb_spread = r->sbb_mean = r->sbb_spread = r->alpha = r->alpha_r2 = NAN;
+    cm_label_grid g = {0};
+    double t = cm_seconds();
+    cm_status st = check_args(a, msg, msg_size);
+    if (st == CM_OK)
+        st = read_labels(a, hooks, r, &g, msg, msg_size);
+    if (st == CM_OK)
+        st = count_shares(&g, r, msg, msg_size);
+    r->seconds_read = cm_seconds() - t, t = cm_seconds();
+    if (st == CM_OK && a->n_box)
+        st = entropies(a, &g, r, msg, msg_size);
+    r->seconds_entropy = cm_seconds() - t, t = cm_seconds();
+    if (st == CM_OK && a->eps_hi)
+        st = uncertain(a, &g, r, msg, msg_size);
+    r->seconds_uncertain = cm_seconds() - t, t = cm_seconds();
+    if (st == CM_OK && a->wada_radius)
+        st = wada(a, &g, r, msg, msg_size);
+    r->seconds_wada = cm_seconds() - t;
+    free((void *)g.label);
+    return st;
+}
+
+/* ---- writing ---- */
+
+static const char *wada_verdict(const cm_wada *w)
+{
+    const double all = w->fraction[w->radius - 1];
+    return all >= WADA_ALL ? "Wada" : all >= WADA_NONE ? "partially Wada" : "not Wada";
+}
+
+cm_status measure_write(const measure_args *a, const measure_result *r, char *msg,
+                        size_t msg_size)
+{
+    if (!a->csv)
+        return CM_OK;
+    outfile o;
+    const cm_status st = outfile_begin(a->csv, &o, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    fprintf(o.f, "measure,scale,value\n");
+    for (int k = 0; k < r->n_shares; k++)
+        fprintf(o.f, "share,%d,%.17g\n", r->shares[k].label, r->shares[k].share);
+    for (int k = 0; k < r->n_entropy; k++)
+        fprintf(o.f, "sb,%d,%.17g\nsbb,%d,%.17g\n", r->entropy[k].eps, r->entropy[k].sb,
+                r->entropy[k].eps, r->entropy[k].sbb);
+    for (int k = 0; k < r->n_eps; k++)
+        fprintf(o.f, "uncertain,%g,%.17g\n", r->eps[k], r->uncertain[k]);
+    for (int k = 0; r->has_wada && k < r->wada.radius; k++)
+        fprintf(o.f, "wada,%d,%.17g\n", k + 1, r->wada.fraction[k]);
+    return outfile_end(&o, true, msg, msg_size);
+}
+
+static const char *label_name(int32_t label, char *buf, size_t size)
+{
+    if (label == CM_LABEL_DIVERGED)
+        return "diverged";
+    if (label == CM_LABEL_OUTSIDE)
+        return "outside";
+    snprintf(buf, size, "attractor %d", label);
+    return buf;
+}
+
+void measure_report(FILE *f, const measure_result *r)
+{
+    fprintf(f, "%s: %llu cells (", r->model, (unsigned long long)r->cells);
+    for (int d = 0; d < r->dim; d++)
+        fprintf(f, "%s%lld", d ? " x " : "", (long long)r->n[d]);
+    fprintf(f, "), %llu computed\n", (unsigned long long)r->computed);
+    for (int k = 0; k < r->n_shares; k++) {
+        char name[32];
+        const measure_share *s = &r->shares[k];
+        fprintf(f, "  %-13s %12llu cells  %.4f (+- %.4f)\n", label_name(s->label, name, sizeof name),
+                (unsigned long long)s->cells, s->share, s->half_width);
+    }
+    for (int k = 0; k < r->n_entropy; k++) {
+        const cm_entropy *e = &r->entropy[k];
+        fprintf(f, "basin entropy, boxes of %d: Sb %.4f, Sbb %.4f (%llu of %llu boxes on a "
+                   "boundary)\n",
+                e->eps, e->sb, e->sbb, (unsigned long long)e->boundary,
+                (unsigned long long)e->boxes);
+    }
+    if (r->n_entropy)
+        fprintf(f, "Sb %.4f +- %.4f, Sbb %.4f +- %.4f over the boxes: %s\n", r->sb_mean,
+                r->sb_spread, r->sbb_mean, r->sbb_spread,
+                r->sbb_mean > log(2.0) ? "Sbb > log 2, the boundary is fractal"
+                                       : "Sbb <= log 2 (says nothing of the boundary)");
+    for (int k = 0; k < r->n_eps; k++)
+        fprintf(f, "uncertain at eps %g cells: %.5f of %llu cells\n", r->eps[k], r->uncertain[k],
+                (unsigned long long)r->counted[k]);
+    if (r->n_eps)
+        fprintf(f, "uncertainty exponent %.4f (R^2 %.4f), boundary dimension %.4f\n", r->alpha,
+                r->alpha_r2, r->dim - r->alpha);
+    if (r->has_wada) {
+        fprintf(f, "Wada test: %d basins, %llu boundary cells; seeing all within r:",
+                r->wada.basins, (unsigned long long)r->wada.boundary);
+        for (int k = 0; k < r->wada.radius; k++)
+            fprintf(f, " %d: %.4f", k + 1, r->wada.fraction[k]);
+        fprintf(f, "; %s\n", wada_verdict(&r->wada));
+    }
+}
+
+void measure_json(FILE *f, const measure_result *r)
+{
+    json j;
+    json_begin(&j, f, "measure");
+    json_str(&j, "model", r->model);
+    json_uint(&j, "cells", r->cells);
+    json_uint(&j, "computed", r->computed);
+    json_array(&j, "shares");
+    for (int k = 0; k < r->n_shares; k++) {
+        json_object(&j, NULL);
+        json_int(&j, "label", r->shares[k].label);
+        json_uint(&j, "cells", r->shares[k].cells);
+        json_num(&j, "share", r->shares[k].share);
+        json_num(&j, "half_width", r->shares[k].half_width);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_array(&j, "entropy");
+    for (int k = 0; k < r->n_entropy; k++) {
+        const cm_entropy *e = &r->entropy[k];
+        json_object(&j, NULL);
+        json_int(&j, "box", e->eps);
+        json_uint(&j, "boxes", e->boxes);
+        json_uint(&j, "boundary_boxes", e->boundary);
+        json_num(&j, "sb", e->sb);
+        json_num(&j, "sbb", e->sbb);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    if (r->n_entropy) {
+        json_num(&j, "sb_mean", r->sb_mean);
+        json_num(&j, "sb_spread", r->sb_spread);
+        json_num(&j, "sbb_mean", r->sbb_mean);
+        json_num(&j, "sbb_spread", r->sbb_spread);
+    }
+    if (r->n_eps) {
+        json_nums(&j, "eps", r->eps, r->n_eps);
+        json_nums(&j, "uncertain", r->uncertain, r->n_eps);
+        json_num(&j, "alpha", r->alpha);
+        json_num(&j, "alpha_r2", r->alpha_r2);
+    }
+    if (r->has_wada) {
+        json_object(&j, "wada");
+        json_int(&j, "basins", r->wada.basins);
+        json_uint(&j, "boundary_cells", r->wada.boundary);
+        json_nums(&j, "fraction", r->wada.fraction, r->wada.radius);
+        json_str(&j, "verdict", wada_verdict(&r->wada));
+        json_object_end(&j);
+    }
+    json_end(&j);
+}
+
+void measure_result_free(measure_result *r)
+{
+    free(r->shares);
+    memset(r, 0, sizeof *r);
+}

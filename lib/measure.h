@@ -1,0 +1,83 @@
+/* lib/measure.h - measures of a .cmdb file's basins by attractors
+ * (cellmap/basin_measure.h) over a window of its cells: the basins' shares
+ * of the computed cells (each attractor's, the diverged and outside
+ * cells'); basin entropy Sb and boundary basin entropy Sbb for a few box
+ * sizes, with their mean and spread and the log 2 criterion; the fractions
+ * of eps-uncertain cells for eps doubling over a range, the uncertainty
+ * exponent fitted to them and the boundary's dimension; the Wada test.
+ * The window's labels are read a slab at a time into one array of 4 bytes
+ * a cell (the window must fit the memory budget). Written as text, JSON
+ * and CSV. Nothing is printed but by the report calls: calls return a
+ * status with the problem in msg (CM_EINVAL: the request's). */
+#ifndef CM_LIB_MEASURE_H
+#define CM_LIB_MEASURE_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "cellmap/basin_measure.h"
+#include "lib/work.h"
+
+enum { MEASURE_MAX_BOXES = 8, MEASURE_MAX_EPS = 16 };
+
+typedef struct measure_args {
+    const char *file;
+    const char *window;    /* "X0:X1[,Y0:Y1...]" in state units; NULL: every cell */
+    uint64_t mem;          /* the cluster's and the labels' budget in bytes */
+    int box[MEASURE_MAX_BOXES]; /* basin entropy's box sizes in cells (n_box 0: none) */
+    int n_box;
+    int eps_lo, eps_hi;    /* uncertain fractions for eps = lo, 2 lo, ... <= hi (hi 0: none) */
+    int wada_radius;       /* the Wada test for r = 1 .. radius (0: none) */
+    bool wada_asked;       /* fewer than 3 basins is then an error, else the test is skipped */
+    const char *csv;       /* measure,scale,value rows, or NULL */
+} measure_args;
+
+/* Every measure: boxes 3, 5, 7, 9 cells; eps 1 .. 16; Wada to r = 5; the
+ * budget 256 MiB. */
+measure_args measure_defaults(void);
+
+typedef struct measure_share {
+    int32_t label;   /* an attractor's id, 0 diverged, -2 outside */
+    uint64_t cells;
+    double share;    /* of the computed cells */
+    double half_width; /* the share's 95 % interval as if the cells were sampled */
+} measure_share;
+
+typedef struct measure_result {
+    char model[64];
+    int dim;
+    int64_t n[CM_MAX_DIM];     /* the window's cells per dimension */
+    double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* its extent in state units */
+    uint64_t cells, computed;
+    measure_share *shares;     /* by label, the attractors first */
+    int n_shares;
+    cm_entropy entropy[MEASURE_MAX_BOXES];
+    int n_entropy;
+    double sb_mean, sb_spread, sbb_mean, sbb_spread;
+    double eps[MEASURE_MAX_EPS], uncertain[MEASURE_MAX_EPS];
+    uint64_t counted[MEASURE_MAX_EPS];
+    int n_eps;
+    double alpha, alpha_r2;    /* NAN with fewer than 2 fractions above 0 */
+    bool has_wada;
+    cm_wada wada;
+    double seconds_read, seconds_entropy, seconds_uncertain, seconds_wada;
+} measure_result;
+
+/* Checks the request, reads the window's labels (hooks count cells) and
+ * measures. r is freed by measure_result_free whatever the status. */
+cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measure_result *r,
+                          char *msg, size_t msg_size);
+
+/* The rows measure,scale,value at a->csv (NULL: nothing): share (scale:
+ * the label), sb and sbb (the box), uncertain (eps), wada (r). */
+cm_status measure_write(const measure_args *a, const measure_result *r, char *msg,
+                        size_t msg_size);
+
+/* The result as text and as the JSON document of `cellmap measure --json`
+ * (docs/cellmap.schema.json), to f. */
+void measure_report(FILE *f, const measure_result *r);
+void measure_json(FILE *f, const measure_result *r);
+
+void measure_result_free(measure_result *r);
+
+#endif

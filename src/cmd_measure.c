@@ -1,0 +1,127 @@
+/* cellmap measure: a .cmdb file's basins measured (basin shares, basin
+ * entropy, the uncertainty exponent, the Wada test) over lib/measure.h. */
+#include <stdio.h>
+#include <string.h>
+
+#include "lib/measure.h"
+#include "lib/parse.h"
+#include "src/args.h"
+#include "src/commands.h"
+#include "src/interrupt.h"
+#include "src/outfile.h"
+#include "src/progress.h"
+
+static const char measure_help[] =
+    "usage: cellmap measure FILE.cmdb [--window X0:X1[,Y0:Y1...]] [--entropy B[,B...]|none]\n"
+    "                       [--uncertainty E0:E1|none] [--wada R|none] [--mem BYTES]\n"
+    "                       [--csv FILE|-] [--json] [--quiet]\n\n"
+    "Measures the basins of the file's attractors (as `export --labels` labels the\n"
+    "cells: 0 diverged and -2 outside count as basins; cells not computed are left\n"
+    "out), over the window (default every cell):\n"
+    "  - each basin's share of the computed cells (with the 95 % interval of a share\n"
+    "    sampled from that many states);\n"
+    "  - basin entropy Sb and boundary basin entropy Sbb (Daza et al. 2016) in boxes\n"
+    "    of B cells a side, their mean and spread over the sizes; Sbb > log 2 says\n"
+    "    the boundary is fractal;\n"
+    "  - the fraction f(eps) of cells with another basin eps cells away along an\n"
+    "    axis, eps doubling from E0 to E1, and the uncertainty exponent alpha of\n"
+    "    f ~ eps^alpha (Grebogi et al. 1983): the boundary's dimension is d - alpha;\n"
+    "  - the Wada test: the share of boundary cells that see every basin within r\n"
+    "    cells, r = 1..R: Wada (>= 0.99 at R), partially Wada, or not (< 0.05).\n\n"
+    "  --window X0:X1,...  the cells whose centres lie in this box of state space\n"
+    "  --entropy B,...     box sizes in cells (default 3,5,7,9)\n"
+    "  --uncertainty E0:E1 eps in cells (default 1:16)\n"
+    "  --wada R            the largest radius (default 5; with fewer than 3 basins the\n"
+    "                      default test is skipped, an explicit one is an error)\n"
+    "  --mem BYTES         the cluster's and the labels' memory (default 256M)\n"
+    "  --csv FILE|-        rows measure,scale,value: share (the label), sb and sbb (the\n"
+    "                      box), uncertain (eps), wada (r)\n"
+    "  --json              the result as JSON on standard output\n"
+    "  --quiet             no progress line and no summary\n";
+
+/* "none" turns a measure off. */
+static bool none(const char *value) { return value && strcmp(value, "none") == 0; }
+
+static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
+{
+    int err = 0;
+    while (cli_next(c) && !err) {
+        if (strcmp(c->opt, "--help") == 0) {
+            fputs(measure_help, stdout);
+            return -1;
+        } else if (cli_is(c, "--window", true, &err)) {
+            a->window = c->value;
+        } else if (cli_is(c, "--entropy", true, &err)) {
+            double box[MEASURE_MAX_BOXES];
+            a->n_box = 0;
+            if (c->value && !none(c->value) &&
+                !parse_doubles(c->value, box, &a->n_box, MEASURE_MAX_BOXES))
+                err = cli_usage_error(c, "--entropy: '%s' is not B[,B...] (at most %d sizes)",
+                                      c->value, MEASURE_MAX_BOXES);
+            for (int k = 0; k < a->n_box; k++)
+                a->box[k] = box[k] == (int)box[k] ? (int)box[k] : 0;
+        } else if (cli_is(c, "--uncertainty", true, &err)) {
+            a->eps_hi = 0;
+            if (c->value && !none(c->value) && !parse_int_span(c->value, &a->eps_lo, &a->eps_hi))
+                err = cli_usage_error(c, "--uncertainty: '%s' is not E0:E1", c->value);
+        } else if (cli_is(c, "--wada", true, &err)) {
+            a->wada_radius = 0, a->wada_asked = !none(c->value);
+            if (a->wada_asked && c->value && !(parse_int_span(c->value, &a->wada_radius,
+                                                              &a->wada_radius)))
+                err = cli_usage_error(c, "--wada: '%s' is not a radius in cells", c->value);
+        } else if (cli_take_mem(c, &a->mem, &err)) {
+        } else if (cli_is(c, "--csv", true, &err)) {
+            a->csv = c->value;
+        } else if (cli_is(c, "--json", false, &err)) {
+            *json = true;
+        } else if (cli_is(c, "--quiet", false, &err)) {
+            *quiet = true;
+        } else if (c->opt[0] != '-' && !a->file) {
+            a->file = c->opt;
+        } else {
+            err = cli_stray(c);
+        }
+    }
+    if (!err && !a->file)
+        err = cli_usage_error(c, "which file? usage: cellmap measure FILE.cmdb");
+    if (!err && *json && cm_output_names_stdout(a->csv))
+        err = cli_usage_error(c, "--json and --csv - both to standard output: choose one");
+    char why[1024];
+    const cm_file_use files[] = {{a->file, "the database", false, true},
+                                 {a->csv, "--csv", true, false}};
+    if (!err && cm_files_apart(files, 2, why, sizeof why) != CM_OK)
+        err = cli_usage_error(c, "%s", why);
+    return err;
+}
+
+int cmd_measure(int argc, char **argv)
+{
+    cli c = {"measure", argc, argv, 0, NULL, NULL};
+    measure_args a = measure_defaults();
+    bool json = false, quiet = false;
+    const int perr = parse_args(&c, &a, &json, &quiet);
+    if (perr)
+        return perr < 0 ? EXIT_OK : perr;
+    int werr = cli_input_check("measure", a.file);
+    if (werr == EXIT_OK)
+        werr = outfile_check("measure", a.csv, false);
+    if (werr != EXIT_OK)
+        return werr;
+    char msg[1024];
+    progress pr;
+    interrupt_catch();
+    const work_hooks hooks = progress_hooks(&pr);
+    progress_start(&pr, "measure", "cells", 0, quiet || json);
+    measure_result r;
+    cm_status st = measure_compute(&a, &hooks, &r, msg, sizeof msg);
+    progress_end(&pr);
+    if (st == CM_OK) {
+        if (json)
+            measure_json(stdout, &r);
+        else if (!quiet)
+            measure_report(report_stream(a.csv, NULL, NULL), &r);
+        st = measure_write(&a, &r, msg, sizeof msg);
+    }
+    measure_result_free(&r);
+    return analysis_said(c.cmd, st, msg);
+}

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# cellmap measure on basins whose measures are known: a map whose basin
+# boundary is a Weierstrass curve (tests/weierstrass_plugin.c: uncertainty
+# exponent ln 1.5 / ln 3 = 0.369, McDonald et al. 1985) or, with c = 0, the
+# straight line y = 0 (alpha = 1; basin entropy growing with the box, Sbb
+# under log 2); Newton's method for z^3 - 1 (examples/plugin/newton.c),
+# whose three basins are Wada and whose boundary is fractal (Sbb > log 2).
+# The shares against a count of `export --labels`; bad input.
+# usage: measure_test.sh PATH/TO/cellmap
+set -u
+CM=$1
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+
+cc -shared -fPIC -I"$HERE/.." -o libweierstrass.so "$HERE/weierstrass_plugin.c" -lm \
+  || fail "cc weierstrass"
+cc -shared -fPIC -I"$HERE/.." -o libnewton.so "$HERE/../examples/plugin/newton.c" -lm \
+  || fail "cc newton"
+ws=(--model-lib ./libweierstrass.so --model weierstrass --cells 1000x9000 --quiet)
+"$CM" solve "${ws[@]}" --db curve.cmdb || fail "solve weierstrass"
+"$CM" solve "${ws[@]}" --param c=0 --db line.cmdb || fail "solve weierstrass c=0"
+"$CM" solve --model-lib ./libnewton.so --model newton --cells 1000x1000 --db newton.cmdb --quiet \
+  || fail "solve newton"
+
+# the window -2.5006:2.5 starts 2501 rows below the line y = 0: no box size
+# below puts the line on a box's edge
+"$CM" measure curve.cmdb --window 0:1,-2.5006:2.5 --uncertainty 1:64 --entropy none --mem 1G \
+  --json > curve.json || fail "measure curve"
+"$CM" measure line.cmdb --window 0:1,-2.5006:2.5 --uncertainty 1:64 --entropy 4,16,64 \
+  --mem 1G --json --csv line.csv > line.json || fail "measure line"
+"$CM" measure newton.cmdb --json --csv newton.csv > measured.json || fail "measure newton"
+"$CM" export newton.cmdb --labels newton.npy > /dev/null || fail "export newton"
+python3 - curve.json line.json measured.json newton.csv newton.npy <<'PY' || fail "the measures"
+import csv, json, math, struct, sys
+curve, line, newton = (json.load(open(p)) for p in sys.argv[1:4])
+# the Weierstrass curve: alpha = ln(lambda)/ln(3); two basins, no Wada test
+assert abs(curve["alpha"] - math.log(1.5) / math.log(3)) < 0.05, curve["alpha"]
+assert "wada" not in curve and len(curve["shares"]) == 2, curve
+# the straight line: alpha = 1, Sb grows with the box (it tends to 0 as
+# boxes shrink), Sbb under log 2
+assert abs(line["alpha"] - 1) < 0.05 and line["alpha_r2"] > 0.999, line["alpha"]
+sb = [e["sb"] for e in line["entropy"]]
+assert sb[0] < sb[1] < sb[2] and sb[0] < 1e-3, sb
+assert all(e["sbb"] < math.log(2) for e in line["entropy"]), line["entropy"]
+# Newton: Wada (every boundary cell sees all three basins within 5 cells
+# but for under 1 %) and a fractal boundary
+w = newton["wada"]
+assert w["basins"] == 3 and w["fraction"][-1] >= 0.99 and w["verdict"] == "Wada", w
+assert newton["sbb_mean"] > math.log(2) and newton["entropy"][0]["sbb"] > math.log(2), newton
+assert newton["computed"] == newton["cells"] == 10**6, newton
+# the shares are the labels' counts
+data = open(sys.argv[5], "rb").read()
+hlen = struct.unpack("<H", data[8:10])[0]
+labels = struct.unpack("<%di" % 10**6, data[10 + hlen:])
+for s in newton["shares"]:
+    assert labels.count(s["label"]) == s["cells"], s
+assert abs(sum(s["share"] for s in newton["shares"]) - 1) < 1e-12
+rows = list(csv.DictReader(open(sys.argv[4])))
+assert {r["measure"] for r in rows} == {"share", "sb", "sbb", "uncertain", "wada"}, rows[:3]
+assert [float(r["value"]) for r in rows if r["measure"] == "wada"] == w["fraction"], rows
+PY
+
+# bad input: exit 2, nothing written
+expect_usage "do not fit the window" measure line.cmdb --entropy 20000 --csv no.csv
+expect_usage "needs 3 or more basins" measure line.cmdb --wada 3 --csv no.csv
+expect_usage "--uncertainty: '4:2' is not E0:E1" measure line.cmdb --uncertainty 4:2
+expect_usage "which file?" measure --wada 2
+expect_usage "the database" measure line.cmdb --csv line.cmdb
+expect_usage "over the budget" measure curve.cmdb --mem 8M
+[ ! -e no.csv ] || fail "measure wrote no.csv although it failed"
+
+[ "$fails" -eq 0 ] && echo "measure_test: all passed" || exit 1
