@@ -47,55 +47,84 @@ static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
 
 /* ---- the window's labels ---- */
 
-static cm_status read_labels(const measure_args *a, const work_hooks *hooks, measure_result *r,
-                             cm_label_grid *g, char *msg, size_t msg_size)
+/* One file's labels over a window: given as text (a->window), as the
+ * cells of another file's window (box, on the same lattice), or all. */
+typedef struct file_labels {
+    char model[64];
+    cm_lattice lat;
+    cm_box window;
+    uint32_t attractors;
+    int32_t *label; /* the window's cells, C order */
+} file_labels;
+
+static cm_status read_labels(const char *file, uint64_t mem, const char *window_text,
+                             const cm_box *box, const cm_lattice *same, const work_hooks *hooks,
+                             file_labels *out, char *msg, size_t msg_size)
 {
     cm_store *s = NULL;
     cm_store_info info;
     cm_cluster c;
-    cm_status st = project_probe(a->file, msg, msg_size);
+    cm_status st = project_probe(file, msg, msg_size);
     if (st == CM_OK)
-        st = project_open_cluster(a->file, a->mem, &s, &info, &c, msg, msg_size);
+        st = project_open_cluster(file, mem, &s, &info, &c, msg, msg_size);
     if (st != CM_OK)
         return st;
     cm_box window;
     exporter x;
     memset(&x, 0, sizeof x);
     const cm_attractor_options stored = {0};
-    if (a->window)
-        st = export_window(&c, a->window, &window, msg, msg_size);
+    if (same && !cm_lattice_equal(same, &c.lat))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "%s has another lattice than the first file: tipping compares two files "
+                     "cell by cell, solved on one lattice (the same --region and --cells)",
+                     file);
+    else if (window_text)
+        st = export_window(&c, window_text, &window, msg, msg_size);
     if (st == CM_OK)
-        st = exporter_open(&x, s, &info, &c, a->window ? &window : NULL, a->file, &stored, msg,
-                           msg_size);
+        st = exporter_open(&x, s, &info, &c, box ? box : window_text ? &window : NULL, file,
+                           &stored, msg, msg_size);
+    const uint64_t cells = st == CM_OK ? cm_box_cells(&x.window) : 0;
+    if (st == CM_OK && (double)cells * sizeof *out->label > (double)mem)
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "the window's %llu cells need %.0f MiB of labels, over the budget of %.0f "
+                     "MiB: measure a smaller window, or raise the budget",
+                     (unsigned long long)cells, (double)cells * 4 / 1048576.0,
+                     (double)mem / 1048576.0);
     if (st == CM_OK) {
-        snprintf(r->model, sizeof r->model, "%s", info.model);
-        r->dim = g->dim = c.lat.dim, r->cells = cm_box_cells(&x.window);
-        for (int d = 0; d < r->dim; d++) {
-            r->n[d] = g->n[d] = x.window.hi[d] - x.window.lo[d];
-            r->lo[d] = c.lat.origin[d] + (double)x.window.lo[d] * c.lat.width[d];
-            r->hi[d] = c.lat.origin[d] + (double)x.window.hi[d] * c.lat.width[d];
-        }
-        g->lo = CM_LABEL_OUTSIDE, g->hi = (int32_t)x.att.n;
-        if ((double)r->cells * sizeof *g->label > (double)a->mem)
-            st = cm_fail(CM_EINVAL, msg, msg_size,
-                         "the window's %llu cells need %.0f MiB of labels, over the budget of "
-                         "%.0f MiB: measure a smaller window, or raise the budget",
-                         (unsigned long long)r->cells, (double)r->cells * 4 / 1048576.0,
-                         (double)a->mem / 1048576.0);
+        snprintf(out->model, sizeof out->model, "%s", info.model);
+        out->lat = c.lat, out->window = x.window, out->attractors = x.att.n;
+        if (!(out->label = malloc(cells * sizeof *out->label)))
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu labels",
+                         (unsigned long long)cells);
     }
-    int32_t *labels = st == CM_OK ? malloc(r->cells * sizeof *labels) : NULL;
-    if (st == CM_OK && !labels)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu labels",
-                     (unsigned long long)r->cells);
     if (st == CM_OK)
-        st = export_labels(&x, labels, hooks, msg, msg_size);
-    g->label = labels;
+        st = export_labels(&x, out->label, hooks, msg, msg_size);
     exporter_close(&x);
     project_close(s, &c);
     return st;
 }
 
-/* Each label's cells and share, the attractors first. */
+/* The grid of the file's labels, and the window in r. */
+static void grid_of(const file_labels *f, measure_result *r, cm_label_grid *g)
+{
+    snprintf(r->model, sizeof r->model, "%s", f->model);
+    r->dim = g->dim = f->lat.dim, r->cells = cm_box_cells(&f->window);
+    for (int d = 0; d < r->dim; d++) {
+        r->n[d] = g->n[d] = f->window.hi[d] - f->window.lo[d];
+        r->lo[d] = f->lat.origin[d] + (double)f->window.lo[d] * f->lat.width[d];
+        r->hi[d] = f->lat.origin[d] + (double)f->window.hi[d] * f->lat.width[d];
+    }
+    g->label = f->label, g->lo = CM_LABEL_OUTSIDE, g->hi = (int32_t)f->attractors;
+}
+
+/* The k-th label in report order: the attractors 1 .. hi, then the
+ * diverged (0) and outside (-2) cells; k in 0 .. hi + 1. */
+static int32_t ordered_label(int k, int32_t hi)
+{
+    return k < hi ? k + 1 : k == hi ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+}
+
+/* Each label's cells and share. */
 static cm_status count_shares(const cm_label_grid *g, measure_result *r, char *msg,
                               size_t msg_size)
 {
@@ -109,15 +138,48 @@ static cm_status count_shares(const cm_label_grid *g, measure_result *r, char *m
     for (uint64_t k = 0; k < r->cells; k++)
         count[g->label[k] - g->lo]++;
     r->computed = r->cells - count[CM_LABEL_UNCOMPUTED - g->lo];
-    for (int32_t k = 0; k < labels; k++) {
-        /* the attractors 1 .. hi, then the diverged (0) and outside (-2) cells */
-        const int32_t label = k < g->hi ? k + 1 : k == g->hi ? CM_LABEL_DIVERGED
-                                                             : CM_LABEL_OUTSIDE;
-        const uint64_t n = k <= g->hi + 1 ? count[label - g->lo] : 0;
-        const double p = n ? (double)n / (double)r->computed : 0;
+    for (int k = 0; k <= g->hi + 1; k++) {
+        const int32_t label = ordered_label(k, g->hi);
+        const uint64_t n = count[label - g->lo];
+        const double p = (double)n / (double)r->computed;
         if (n)
             r->shares[r->n_shares++] = (measure_share){
                 label, n, p, 1.96 * sqrt(p * (1 - p) / (double)r->computed)};
+    }
+    free(count);
+    return CM_OK;
+}
+
+/* Where each basin of the first file lies in the second's, cell by cell
+ * (cells computed in both). */
+static cm_status tipping(const cm_label_grid *g, const file_labels *to, measure_result *r,
+                         char *msg, size_t msg_size)
+{
+    const int32_t to_hi = (int32_t)to->attractors;
+    const size_t na = (size_t)(g->hi - g->lo + 1), nb = (size_t)to_hi + 3;
+    uint64_t *count = calloc(na * nb, sizeof *count);
+    r->tips = calloc(na * nb, sizeof *r->tips);
+    if (!count || !r->tips) {
+        free(count);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the tipping table");
+    }
+    for (uint64_t k = 0; k < r->cells; k++) {
+        const int32_t from = g->label[k], into = to->label[k];
+        if (from != CM_LABEL_UNCOMPUTED && into != CM_LABEL_UNCOMPUTED)
+            count[(size_t)(from - g->lo) * nb + (size_t)(into - CM_LABEL_OUTSIDE)]++;
+    }
+    for (int i = 0; i <= g->hi + 1; i++) {
+        const int32_t from = ordered_label(i, g->hi);
+        const uint64_t *row = count + (size_t)(from - g->lo) * nb;
+        uint64_t total = 0;
+        for (size_t j = 0; j < nb; j++)
+            total += row[j];
+        for (int j = 0; j <= to_hi + 1; j++) {
+            const int32_t into = ordered_label(j, to_hi);
+            const uint64_t n = row[into - CM_LABEL_OUTSIDE];
+            if (n)
+                r->tips[r->n_tips++] = (measure_tip){from, into, n, (double)n / (double)total};
+        }
     }
     free(count);
     return CM_OK;
@@ -195,13 +257,23 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
 {
     memset(r, 0, sizeof *r);
     r->sb_mean = r->sb_spread = r->sbb_mean = r->sbb_spread = r->alpha = r->alpha_r2 = NAN;
+    file_labels from = {0}, to = {0};
     cm_label_grid g = {0};
     double t = cm_seconds();
     cm_status st = check_args(a, msg, msg_size);
     if (st == CM_OK)
-        st = read_labels(a, hooks, r, &g, msg, msg_size);
-    if (st == CM_OK)
+        st = read_labels(a->file, a->mem, a->window, NULL, NULL, hooks, &from, msg, msg_size);
+    if (st == CM_OK) {
+        grid_of(&from, r, &g);
         st = count_shares(&g, r, msg, msg_size);
+    }
+    if (st == CM_OK && a->to)
+        st = read_labels(a->to, a->mem, NULL, &from.window, &from.lat, hooks, &to, msg,
+                         msg_size);
+    if (st == CM_OK && a->to) {
+        snprintf(r->to_model, sizeof r->to_model, "%s", to.model);
+        st = tipping(&g, &to, r, msg, msg_size);
+    }
     r->seconds_read = cm_seconds() - t, t = cm_seconds();
     if (st == CM_OK && a->n_box)
         st = entropies(a, &g, r, msg, msg_size);
@@ -212,7 +284,8 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
     if (st == CM_OK && a->wada_radius)
         st = wada(a, &g, r, msg, msg_size);
     r->seconds_wada = cm_seconds() - t;
-    free((void *)g.label);
+    free(from.label);
+    free(to.label);
     return st;
 }
 
@@ -243,6 +316,9 @@ cm_status measure_write(const measure_args *a, const measure_result *r, char *ms
         fprintf(o.f, "uncertain,%g,%.17g\n", r->eps[k], r->uncertain[k]);
     for (int k = 0; r->has_wada && k < r->wada.radius; k++)
         fprintf(o.f, "wada,%d,%.17g\n", k + 1, r->wada.fraction[k]);
+    for (int k = 0; k < r->n_tips; k++)
+        fprintf(o.f, "tipping,%d>%d,%.17g\n", r->tips[k].from, r->tips[k].to,
+                r->tips[k].probability);
     return outfile_end(&o, true, msg, msg_size);
 }
 
@@ -292,6 +368,13 @@ void measure_report(FILE *f, const measure_result *r)
         for (int k = 0; k < r->wada.radius; k++)
             fprintf(f, " %d: %.4f", k + 1, r->wada.fraction[k]);
         fprintf(f, "; %s\n", wada_verdict(&r->wada));
+    }
+    for (int k = 0; k < r->n_tips; k++) {
+        char from[32], to[32];
+        const measure_tip *t = &r->tips[k];
+        fprintf(f, "tipping: %-13s -> %-13s %12llu cells  %.4f\n",
+                label_name(t->from, from, sizeof from), label_name(t->to, to, sizeof to),
+                (unsigned long long)t->cells, t->probability);
     }
 }
 
@@ -344,11 +427,24 @@ void measure_json(FILE *f, const measure_result *r)
         json_str(&j, "verdict", wada_verdict(&r->wada));
         json_object_end(&j);
     }
+    if (r->to_model[0]) {
+        json_array(&j, "tipping");
+        for (int k = 0; k < r->n_tips; k++) {
+            json_object(&j, NULL);
+            json_int(&j, "from", r->tips[k].from);
+            json_int(&j, "to", r->tips[k].to);
+            json_uint(&j, "cells", r->tips[k].cells);
+            json_num(&j, "probability", r->tips[k].probability);
+            json_object_end(&j);
+        }
+        json_array_end(&j);
+    }
     json_end(&j);
 }
 
 void measure_result_free(measure_result *r)
 {
     free(r->shares);
+    free(r->tips);
     memset(r, 0, sizeof *r);
 }

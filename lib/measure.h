@@ -4,7 +4,10 @@
  * cells'); basin entropy Sb and boundary basin entropy Sbb for a few box
  * sizes, with their mean and spread and the log 2 criterion; the fractions
  * of eps-uncertain cells for eps doubling over a range, the uncertainty
- * exponent fitted to them and the boundary's dimension; the Wada test.
+ * exponent fitted to them and the boundary's dimension; the Wada test;
+ * and, given a second file solved on the same lattice (another parameter
+ * value), the tipping probabilities: where each basin's cells lie in the
+ * second file's basins.
  * The window's labels are read a slab at a time into one array of 4 bytes
  * a cell (the window must fit the memory budget). Written as text, JSON
  * and CSV. Nothing is printed but by the report calls: calls return a
@@ -29,6 +32,8 @@ typedef struct measure_args {
     int eps_lo, eps_hi;    /* uncertain fractions for eps = lo, 2 lo, ... <= hi (hi 0: none) */
     int wada_radius;       /* the Wada test for r = 1 .. radius (0: none) */
     bool wada_asked;       /* fewer than 3 basins is then an error, else the test is skipped */
+    const char *to;        /* a second file on the same lattice: the tipping probabilities
+                              from the first's basins into its basins, or NULL */
     const char *csv;       /* measure,scale,value rows, or NULL */
 } measure_args;
 
@@ -42,6 +47,14 @@ typedef struct measure_share {
     double share;    /* of the computed cells */
     double half_width; /* the share's 95 % interval as if the cells were sampled */
 } measure_share;
+
+/* Of the cells of basin `from` in the first file, the share that lies in
+ * basin `to` of the second (among the cells computed in both). */
+typedef struct measure_tip {
+    int32_t from, to;
+    uint64_t cells;
+    double probability;
+} measure_tip;
 
 typedef struct measure_result {
     char model[64];
@@ -60,6 +73,9 @@ typedef struct measure_result {
     double alpha, alpha_r2;    /* NAN with fewer than 2 fractions above 0 */
     bool has_wada;
     cm_wada wada;
+    char to_model[64];         /* the second file's model ("" without one) */
+    measure_tip *tips;         /* by source basin, the probabilities summing to 1 */
+    int n_tips;
     double seconds_read, seconds_entropy, seconds_uncertain, seconds_wada;
 } measure_result;
 
@@ -69,7 +85,8 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
                           char *msg, size_t msg_size);
 
 /* The rows measure,scale,value at a->csv (NULL: nothing): share (scale:
- * the label), sb and sbb (the box), uncertain (eps), wada (r). */
+ * the label), sb and sbb (the box), uncertain (eps), wada (r), tipping
+ * (FROM>TO). */
 cm_status measure_write(const measure_args *a, const measure_result *r, char *msg,
                         size_t msg_size);
 

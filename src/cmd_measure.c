@@ -14,7 +14,7 @@
 static const char measure_help[] =
     "usage: cellmap measure FILE.cmdb [--window X0:X1[,Y0:Y1...]] [--entropy B[,B...]|none]\n"
     "                       [--uncertainty E0:E1|none] [--wada R|none] [--mem BYTES]\n"
-    "                       [--csv FILE|-] [--json] [--quiet]\n\n"
+    "                       [--to OTHER.cmdb] [--csv FILE|-] [--json] [--quiet]\n\n"
     "Measures the basins of the file's attractors (as `export --labels` labels the\n"
     "cells: 0 diverged and -2 outside count as basins; cells not computed are left\n"
     "out), over the window (default every cell):\n"
@@ -27,15 +27,19 @@ static const char measure_help[] =
     "    axis, eps doubling from E0 to E1, and the uncertainty exponent alpha of\n"
     "    f ~ eps^alpha (Grebogi et al. 1983): the boundary's dimension is d - alpha;\n"
     "  - the Wada test: the share of boundary cells that see every basin within r\n"
-    "    cells, r = 1..R: Wada (>= 0.99 at R), partially Wada, or not (< 0.05).\n\n"
+    "    cells, r = 1..R: Wada (>= 0.99 at R), partially Wada, or not (< 0.05);\n"
+    "  - with --to, the tipping probabilities: of each basin's cells, the share that\n"
+    "    lies in each basin of OTHER.cmdb (solved on the same lattice, for another\n"
+    "    parameter value), over the cells computed in both.\n\n"
     "  --window X0:X1,...  the cells whose centres lie in this box of state space\n"
     "  --entropy B,...     box sizes in cells (default 3,5,7,9)\n"
     "  --uncertainty E0:E1 eps in cells (default 1:16)\n"
     "  --wada R            the largest radius (default 5; with fewer than 3 basins the\n"
     "                      default test is skipped, an explicit one is an error)\n"
+    "  --to OTHER.cmdb     the second file of the tipping probabilities\n"
     "  --mem BYTES         the cluster's and the labels' memory (default 256M)\n"
     "  --csv FILE|-        rows measure,scale,value: share (the label), sb and sbb (the\n"
-    "                      box), uncertain (eps), wada (r)\n"
+    "                      box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
     "  --json              the result as JSON on standard output\n"
     "  --quiet             no progress line and no summary\n";
 
@@ -69,6 +73,8 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
             if (a->wada_asked && c->value && !(parse_int_span(c->value, &a->wada_radius,
                                                               &a->wada_radius)))
                 err = cli_usage_error(c, "--wada: '%s' is not a radius in cells", c->value);
+        } else if (cli_is(c, "--to", true, &err)) {
+            a->to = c->value;
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
@@ -88,8 +94,9 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
         err = cli_usage_error(c, "--json and --csv - both to standard output: choose one");
     char why[1024];
     const cm_file_use files[] = {{a->file, "the database", false, true},
+                                 {a->to, "--to", false, true},
                                  {a->csv, "--csv", true, false}};
-    if (!err && cm_files_apart(files, 2, why, sizeof why) != CM_OK)
+    if (!err && cm_files_apart(files, 3, why, sizeof why) != CM_OK)
         err = cli_usage_error(c, "%s", why);
     return err;
 }
@@ -103,6 +110,8 @@ int cmd_measure(int argc, char **argv)
     if (perr)
         return perr < 0 ? EXIT_OK : perr;
     int werr = cli_input_check("measure", a.file);
+    if (werr == EXIT_OK && a.to)
+        werr = cli_input_check("measure", a.to);
     if (werr == EXIT_OK)
         werr = outfile_check("measure", a.csv, false);
     if (werr != EXIT_OK)

@@ -27,6 +27,7 @@ run solve-extend solve --cells 60x40 --extend 2 --json
 run solve-friction solve --model microchaos-pd-friction --region -3000:3000,-10:10 --cells 200x100 --json
 run info info basin.cmdb --json
 run measure measure basin.cmdb --json
+run measure-tipping measure basin.cmdb --to basin.cmdb --entropy none --json
 run models models --json
 run sweep sweep --model microchaos-pd-friction --vary mu=0.09:0.1:3 --cells 100x50 --refine 1 --json
 run fixed-points fixed-points --range -2:2 --json

@@ -5,7 +5,8 @@
 # straight line y = 0 (alpha = 1; basin entropy growing with the box, Sbb
 # under log 2); Newton's method for z^3 - 1 (examples/plugin/newton.c),
 # whose three basins are Wada and whose boundary is fractal (Sbb > log 2).
-# The shares against a count of `export --labels`; bad input.
+# The shares against a count of `export --labels`; the tipping probabilities
+# between two files against sqlite3's count on their flat tables; bad input.
 # usage: measure_test.sh PATH/TO/cellmap
 set -u
 CM=$1
@@ -60,6 +61,29 @@ rows = list(csv.DictReader(open(sys.argv[4])))
 assert {r["measure"] for r in rows} == {"share", "sb", "sbb", "uncertain", "wada"}, rows[:3]
 assert [float(r["value"]) for r in rows if r["measure"] == "wada"] == w["fraction"], rows
 PY
+
+# tipping from c = 1 to c = 0.5 on one lattice: each basin's probabilities
+# sum to 1 and are the cells a join of the two files' flat tables counts
+"$CM" solve "${ws[@]/1000x9000/200x1800}" --db tip-a.cmdb || fail "solve tip-a"
+"$CM" solve "${ws[@]/1000x9000/200x1800}" --param c=0.5 --db tip-b.cmdb || fail "solve tip-b"
+"$CM" measure tip-a.cmdb --to tip-b.cmdb --entropy none --uncertainty none --json > tip.json \
+  || fail "measure --to"
+"$CM" export tip-a.cmdb --flat tip-a.sqlite --quiet && "$CM" export tip-b.cmdb --flat tip-b.sqlite \
+  --quiet || fail "export --flat of the tipping files"
+sqlite3 -csv tip-a.sqlite "ATTACH 'tip-b.sqlite' AS b; SELECT a.attractor, c.attractor, COUNT(*)
+  FROM cells a JOIN b.cells c ON a.ix = c.ix AND a.iy = c.iy GROUP BY 1, 2" > tip-sql.csv \
+  || fail "sqlite3's count"
+python3 - tip.json tip-sql.csv <<'PY' || fail "the tipping probabilities"
+import csv, json, sys
+tips = json.load(open(sys.argv[1]))["tipping"]
+sql = {(int(a), int(b)): int(n) for a, b, n in csv.reader(open(sys.argv[2]))}
+assert {(t["from"], t["to"]): t["cells"] for t in tips} == sql, (tips, sql)
+for src in {t["from"] for t in tips}:
+    assert abs(sum(t["probability"] for t in tips if t["from"] == src) - 1) < 1e-12, src
+assert len(tips) == 4 and all(t["probability"] > 0.9 for t in tips if t["from"] == t["to"]), tips
+PY
+"$CM" solve "${ws[@]/1000x9000/100x900}" --db coarse.cmdb || fail "solve coarse"
+expect_usage "another lattice" measure tip-a.cmdb --to coarse.cmdb
 
 # bad input: exit 2, nothing written
 expect_usage "do not fit the window" measure line.cmdb --entropy 20000 --csv no.csv
