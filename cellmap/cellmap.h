@@ -631,6 +631,34 @@ typedef struct cm_embedding {
 cm_status cm_analysis_embedding(const cm_analysis *a, const cm_embedding_options *o,
                                 cm_embedding *out, char *msg, size_t msg_size);
 
+typedef struct cm_measure_options {
+    const char *file;       /* the .cmdb file measured */
+    const char *window;     /* "X0:X1[,Y0:Y1...]" in state units; NULL: every cell */
+    int box[8];             /* basin entropy's box sizes in cells */
+    int n_box;              /* 0: no basin entropy */
+    int eps_lo, eps_hi;     /* uncertain fractions for eps = lo, 2 lo, ... <= hi; hi 0: none */
+    int wada_radius;        /* the Wada test for r = 1 .. radius (1..16); 0: none */
+    int wada_required;      /* nonzero: fewer than 3 basins is an error, else the test is skipped */
+    const char *to;         /* a second file on the same lattice: tipping probabilities, or NULL */
+    uint64_t mem;           /* the cluster's and the labels' budget in bytes */
+} cm_measure_options;
+/* boxes 3, 5, 7, 9; eps 1 .. 16; Wada to r = 5; 256 MiB */
+cm_measure_options cm_measure_defaults(void);
+
+typedef struct cm_measures {
+    uint64_t cells, computed;  /* the window's cells, those computed */
+    double sb, sbb;            /* means over the box sizes; NAN without */
+    double alpha, alpha_r2;    /* the uncertainty exponent and its fit's R^2; NAN without */
+    int wada_basins;           /* 0: no Wada test */
+    double wada_fraction;      /* boundary cells seeing every basin within wada_radius */
+} cm_measures;
+
+/* A file's basins measured (`cellmap measure`): a->csv gets every value as
+ * rows measure,scale,value (share, sb, sbb, uncertain, wada, tipping),
+ * out (may be NULL) the summary; a->model and a->png are not used. */
+cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o, cm_measures *out,
+                              char *msg, size_t msg_size);
+
 typedef struct cm_simulate_options {
     double x, v;     /* the start */
     double t0;       /* its time; NaN: the Poincare section's phase phi/Omega */

@@ -19,6 +19,7 @@
 #include "lib/periodic.h"
 #include "lib/embedding.h"
 #include "lib/exponents.h"
+#include "lib/measure.h"
 #include "lib/series.h"
 #include "models/dde_lyapunov.h"
 #include "lib/horseshoe.h"
@@ -319,6 +320,47 @@ cm_status cm_analysis_embedding(const cm_analysis *a, const cm_embedding_options
         memcpy(out->false_neighbours, r.fnn, (size_t)r.fnn_dim * sizeof *r.fnn);
     }
     embedding_result_free(&r);
+    return st;
+}
+
+_Static_assert(sizeof((cm_measure_options){0}.box) / sizeof(int) == MEASURE_MAX_BOXES,
+               "cm_measure_options' boxes are the driver's");
+
+cm_measure_options cm_measure_defaults(void)
+{
+    const measure_args d = measure_defaults();
+    cm_measure_options o = {.n_box = d.n_box, .eps_lo = d.eps_lo, .eps_hi = d.eps_hi,
+                            .wada_radius = d.wada_radius, .mem = d.mem};
+    memcpy(o.box, d.box, sizeof o.box);
+    return o;
+}
+
+cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o, cm_measures *out,
+                              char *msg, size_t msg_size)
+{
+    a = a ? a : &no_analysis;
+    if (!o || !o->file)
+        return cm_fail(CM_EINVAL, msg, msg_size, "which file? set the options' file");
+    if (a->png)
+        return cm_fail(CM_EINVAL, msg, msg_size, "measure draws no figure: leave png NULL");
+    measure_args m = measure_defaults();
+    m.file = o->file, m.window = o->window, m.to = o->to, m.mem = o->mem;
+    memcpy(m.box, o->box, sizeof m.box);
+    m.n_box = o->n_box, m.eps_lo = o->eps_lo, m.eps_hi = o->eps_hi;
+    m.wada_radius = o->wada_radius, m.wada_asked = o->wada_required != 0, m.csv = a->csv;
+    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
+    measure_result r;
+    if (st == CM_OK)
+        st = measure_compute(&m, NULL, &r, msg, msg_size);
+    else
+        memset(&r, 0, sizeof r);
+    if (st == CM_OK)
+        st = measure_write(&m, &r, msg, msg_size);
+    if (st == CM_OK && out)
+        *out = (cm_measures){r.cells, r.computed, r.sb_mean,
+                             r.sbb_mean, r.alpha, r.alpha_r2, r.has_wada ? r.wada.basins : 0,
+                             r.has_wada ? r.wada.fraction[r.wada.radius - 1] : NAN};
+    measure_result_free(&r);
     return st;
 }
 

@@ -153,6 +153,16 @@ static void analyses(void)
         fprintf(stderr, "embedding: dimension %d, lambda %g\n", em.embedding_dim, em.lambda);
         exit(1);
     }
+    cm_measure_options mso = cm_measure_defaults();
+    mso.file = "c_split.cmdb", mso.to = "c_resumed.cmdb", mso.window = "0:100,-40:40";
+    a = outputs("measure", f, 0);
+    cm_measures ms;
+    must(cm_analysis_measure(&a, &mso, &ms, msg, sizeof msg), "measure", msg);
+    if (ms.computed == 0 || ms.computed > ms.cells || !(ms.alpha > 0)) {
+        fprintf(stderr, "measure: %llu of %llu cells, alpha %g\n",
+                (unsigned long long)ms.computed, (unsigned long long)ms.cells, ms.alpha);
+        exit(1);
+    }
 }
 
 int main(void)

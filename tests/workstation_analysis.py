@@ -3,8 +3,9 @@ the same settings through the command and through tests/workstation.c and
 compares the files byte for byte): PREFIX_NAME.csv and .png for stability,
 partition, amplitude, horseshoe, escape, simulate, bifurcation (and its
 runs), lyapunov, sweep, continue (and its events), exponents, the time
-series of chip-bue (and its spectrum), equilibria and periodic (their
-tables). The tables the
+series of chip-bue (and its spectrum), the exponent of a series
+(embedding), equilibria and periodic (their tables), and the measures of
+a file (their table). The tables the
 functions return are checked against the files they read them from.
 usage: workstation_analysis.py PREFIX"""
 import os
@@ -70,6 +71,11 @@ em, curves = an.embedding("tau2", start=(1, 0.1, 0.2, 0.3), time=200, transient=
                           steps=10, params="xi=4.8", **out("embedding"))
 rows(curves, p + "embedding.csv")
 assert em["embedding_dim"] == 3 and 0.2 < em["lambda"] < 0.5, em
+ms, table = an.measure(p + "split.cmdb", to=p + "resumed.cmdb", window="0:100,-40:40",
+                       csv=p + "measure.csv")
+rows(table, p + "measure.csv")
+shares = table[table["measure"] == "share"]
+assert ms["computed"] > 0 and abs(shares["value"].sum() - 1) < 1e-12, (ms, shares)
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})

@@ -109,6 +109,21 @@ class _EmbeddingOut(ctypes.Structure):
                 ("spread", ctypes.c_double), ("lambda_per_time", ctypes.c_double)]
 
 
+class _Measure(ctypes.Structure):
+    _fields_ = [("file", ctypes.c_char_p), ("window", ctypes.c_char_p),
+                ("box", ctypes.c_int * 8), ("n_box", ctypes.c_int), ("eps_lo", ctypes.c_int),
+                ("eps_hi", ctypes.c_int), ("wada_radius", ctypes.c_int),
+                ("wada_required", ctypes.c_int), ("to", ctypes.c_char_p),
+                ("mem", ctypes.c_uint64)]
+
+
+class _MeasureOut(ctypes.Structure):
+    _fields_ = [("cells", ctypes.c_uint64), ("computed", ctypes.c_uint64), ("sb", ctypes.c_double),
+                ("sbb", ctypes.c_double), ("alpha", ctypes.c_double),
+                ("alpha_r2", ctypes.c_double), ("wada_basins", ctypes.c_int),
+                ("wada_fraction", ctypes.c_double)]
+
+
 class _Simulate(ctypes.Structure):
     _fields_ = [("x", ctypes.c_double), ("v", ctypes.c_double), ("t0", ctypes.c_double),
                 ("periods", ctypes.c_int), ("skip", ctypes.c_int)]
@@ -161,9 +176,11 @@ for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
 _sig("cm_analysis_series", ctypes.POINTER(_Series))
 _sig("cm_analysis_exponents", ctypes.POINTER(_Exponents), ctypes.POINTER(_ExponentsOut))
 _sig("cm_analysis_embedding", ctypes.POINTER(_Embedding), ctypes.POINTER(_EmbeddingOut))
+_sig("cm_analysis_measure", ctypes.POINTER(_Measure), ctypes.POINTER(_MeasureOut))
 for _name, _opts in (("horseshoe", _Horseshoe), ("escape", _Escape),
                      ("equilibria", _Equilibria), ("periodic", _Periodic),
                      ("exponents", _Exponents), ("series", _Series), ("embedding", _Embedding),
+                     ("measure", _Measure),
                      ("simulate", _Simulate), ("bifurcation", _Bifurcation),
                      ("lyapunov", _Lyapunov), ("continue", _Continue)):
     getattr(_lib, "cm_%s_defaults" % _name).restype = _opts
@@ -434,6 +451,37 @@ def embedding(of, input=None, start=None, time=None, transient=None, dt=None, va
              "lambda": res.lam, "spread": res.spread,
              "lambda_per_time": None if math.isnan(res.lambda_per_time) else res.lambda_per_time},
             curves)
+
+
+def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5,
+            wada_required=False, to=None, mem=None, csv=None):
+    """A .cmdb file's basins measured (`cellmap measure`): entropy the box
+    sizes of basin entropy (() for none), uncertainty (E0, E1) the eps range
+    (None for none), wada the Wada test's radius (0 for none), to a second
+    file on the same lattice for the tipping probabilities. Returns
+    (summary, table): summary a dict of cells, computed, sb, sbb (means over
+    the boxes), alpha, alpha_r2, wada_basins and wada_fraction (None where
+    not measured); table the rows measure, scale, value (share, sb, sbb,
+    uncertain, wada, tipping)."""
+    o = _lib.cm_measure_defaults()
+    keep = [_path(file), _text(window) if window is not None else None, _path(to)]
+    o.file, o.window, o.to = keep
+    entropy = [int(b) for b in entropy]
+    if len(entropy) > 8:
+        raise ValueError("entropy: at most 8 box sizes")
+    o.box[:len(entropy)] = entropy
+    o.n_box = len(entropy)
+    o.eps_lo, o.eps_hi = (0, 0) if uncertainty is None else map(int, uncertainty)
+    o.wada_radius, o.wada_required = int(wada), int(bool(wada_required))
+    if mem is not None:
+        o.mem = int(mem)
+    res = _MeasureOut()
+    table = _run(_common(csv=csv), _lib.cm_analysis_measure, ctypes.byref(o), ctypes.byref(res))
+    nan = lambda v: None if math.isnan(v) else v
+    return ({"cells": res.cells, "computed": res.computed, "sb": nan(res.sb), "sbb": nan(res.sbb),
+             "alpha": nan(res.alpha), "alpha_r2": nan(res.alpha_r2),
+             "wada_basins": res.wada_basins or None,
+             "wada_fraction": nan(res.wada_fraction) if res.wada_basins else None}, table)
 
 
 def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
