@@ -75,8 +75,8 @@ static bool count_box(const cm_label_grid *g, const int64_t *s, const int64_t *c
     return computed;
 }
 
-cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, char *msg,
-                           size_t msg_size)
+cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, double *map,
+                           char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);
     out->eps = eps, out->sb = out->sbb = NAN;
@@ -110,6 +110,8 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, cha
             h -= computed ? p * log(p) : 0;
             *c = 0;
         }
+        if (map)
+            *map++ = computed ? h : NAN;
         if (!computed)
             continue;
         out->boxes++, sum += h;

@@ -47,10 +47,12 @@ typedef struct cm_entropy {
     double sb, sbb;        /* NAN without boxes / boundary boxes */
 } cm_entropy;
 
-/* CM_EINVAL when eps < 1 or the window has no full box of eps cells a
+/* map (may be NULL; the caller's, one entry per box, boxes in C order)
+ * gets each box's entropy, NAN for a box holding an uncomputed cell.
+ * CM_EINVAL when eps < 1 or the window has no full box of eps cells a
  * side; CM_ENOMEM. */
-cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, char *msg,
-                           size_t msg_size);
+cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, double *map,
+                           char *msg, size_t msg_size);
 
 /* The fraction of eps-uncertain cells among those whose 2d neighbours eps
  * away lie in the window, all computed (*counted of them); NAN when none.

@@ -655,7 +655,9 @@ typedef struct cm_measures {
 
 /* A file's basins measured (`cellmap measure`): a->csv gets every value as
  * rows measure,scale,value (share, sb, sbb, uncertain, wada, tipping),
- * out (may be NULL) the summary; a->model and a->png are not used. */
+ * a->png the figure of a 2-D window (the entropy map of the first box size
+ * over the uncertain fractions, log-log), out (may be NULL) the summary;
+ * a->model is not used. */
 cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o, cm_measures *out,
                               char *msg, size_t msg_size);
 

@@ -341,19 +341,18 @@ cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o,
     a = a ? a : &no_analysis;
     if (!o || !o->file)
         return cm_fail(CM_EINVAL, msg, msg_size, "which file? set the options' file");
-    if (a->png)
-        return cm_fail(CM_EINVAL, msg, msg_size, "measure draws no figure: leave png NULL");
     measure_args m = measure_defaults();
+    chart_outputs co;
+    cm_status st = outputs_of(a, m.width, m.height, 300, 400, &co, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    m.png = a->png, m.width = co.width, m.height = co.height;
     m.file = o->file, m.window = o->window, m.to = o->to, m.mem = o->mem;
     memcpy(m.box, o->box, sizeof m.box);
     m.n_box = o->n_box, m.eps_lo = o->eps_lo, m.eps_hi = o->eps_hi;
     m.wada_radius = o->wada_radius, m.wada_asked = o->wada_required != 0, m.csv = a->csv;
-    cm_status st = outfile_check_path(a->csv, false, msg, msg_size);
     measure_result r;
-    if (st == CM_OK)
-        st = measure_compute(&m, NULL, &r, msg, msg_size);
-    else
-        memset(&r, 0, sizeof r);
+    st = measure_compute(&m, NULL, &r, msg, msg_size);
     if (st == CM_OK)
         st = measure_write(&m, &r, msg, msg_size);
     if (st == CM_OK && out)

@@ -7,6 +7,7 @@
 
 #include "cellmap/clock.h"
 #include "lib/export.h"
+#include "lib/figure.h"
 #include "lib/json.h"
 #include "lib/outfile.h"
 #include "lib/project.h"
@@ -24,6 +25,7 @@ measure_args measure_defaults(void)
     a.box[0] = 3, a.box[1] = 5, a.box[2] = 7, a.box[3] = 9, a.n_box = 4;
     a.eps_lo = 1, a.eps_hi = 16;
     a.wada_radius = 5;
+    a.width = 800, a.height = 1000;
     return a;
 }
 
@@ -51,6 +53,7 @@ static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
  * cells of another file's window (box, on the same lattice), or all. */
 typedef struct file_labels {
     char model[64];
+    char names[2][32];  /* the first two state coordinates' */
     cm_lattice lat;
     cm_box window;
     uint32_t attractors;
@@ -92,6 +95,10 @@ static cm_status read_labels(const char *file, uint64_t mem, const char *window_
                      (double)mem / 1048576.0);
     if (st == CM_OK) {
         snprintf(out->model, sizeof out->model, "%s", info.model);
+        const char *names[CM_MAX_DIM];
+        project_state_names(&info, names);
+        for (int d = 0; d < 2 && d < c.lat.dim; d++)
+            snprintf(out->names[d], sizeof out->names[d], "%s", names[d]);
         out->lat = c.lat, out->window = x.window, out->attractors = x.att.n;
         if (!(out->label = malloc(cells * sizeof *out->label)))
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu labels",
@@ -108,6 +115,7 @@ static cm_status read_labels(const char *file, uint64_t mem, const char *window_
 static void grid_of(const file_labels *f, measure_result *r, cm_label_grid *g)
 {
     snprintf(r->model, sizeof r->model, "%s", f->model);
+    memcpy(r->names, f->names, sizeof r->names);
     r->dim = g->dim = f->lat.dim, r->cells = cm_box_cells(&f->window);
     for (int d = 0; d < r->dim; d++) {
         r->n[d] = g->n[d] = f->window.hi[d] - f->window.lo[d];
@@ -198,12 +206,32 @@ static void mean_spread(const double *v, int n, double *mean, double *spread)
     *spread = k ? sqrt(fmax(0, s2 / k - *mean * *mean)) : NAN;
 }
 
+/* The first box size's map for the figure, x fastest as a heat map has it
+ * (the kernel's boxes are in C order, dimension 0 slowest). */
+static cm_status entropy_map(const cm_label_grid *g, int box, measure_result *r, char *msg,
+                             size_t msg_size)
+{
+    const int64_t nx = g->n[0] / box, ny = g->n[1] / box;
+    double *boxes = malloc((size_t)(nx * ny) * sizeof *boxes);
+    r->entropy_map = malloc((size_t)(nx * ny) * sizeof *r->entropy_map);
+    cm_entropy e;
+    cm_status st = boxes && r->entropy_map
+                       ? cm_basin_entropy(g, box, &e, boxes, msg, msg_size)
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the entropy map");
+    for (int64_t i = 0; st == CM_OK && i < nx; i++)
+        for (int64_t j = 0; j < ny; j++)
+            r->entropy_map[j * nx + i] = boxes[i * ny + j];
+    r->map_n[0] = nx, r->map_n[1] = ny;
+    free(boxes);
+    return st;
+}
+
 static cm_status entropies(const measure_args *a, const cm_label_grid *g, measure_result *r,
                            char *msg, size_t msg_size)
 {
     double sb[MEASURE_MAX_BOXES], sbb[MEASURE_MAX_BOXES];
     for (int k = 0; k < a->n_box; k++) {
-        const cm_status st = cm_basin_entropy(g, a->box[k], &r->entropy[k], msg, msg_size);
+        const cm_status st = cm_basin_entropy(g, a->box[k], &r->entropy[k], NULL, msg, msg_size);
         if (st != CM_OK)
             return st;
         sb[k] = r->entropy[k].sb, sbb[k] = r->entropy[k].sbb;
@@ -275,8 +303,16 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
         st = tipping(&g, &to, r, msg, msg_size);
     }
     r->seconds_read = cm_seconds() - t, t = cm_seconds();
+    if (st == CM_OK && a->png && (g.dim != 2 || !a->n_box || !a->eps_hi))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "the figure maps basin entropy over a 2-D window beside the uncertain "
+                     "fractions: it needs a 2-D model (this one has %d dimensions), --entropy "
+                     "and --uncertainty",
+                     g.dim);
     if (st == CM_OK && a->n_box)
         st = entropies(a, &g, r, msg, msg_size);
+    if (st == CM_OK && a->png)
+        st = entropy_map(&g, a->box[0], r, msg, msg_size);
     r->seconds_entropy = cm_seconds() - t, t = cm_seconds();
     if (st == CM_OK && a->eps_hi)
         st = uncertain(a, &g, r, msg, msg_size);
@@ -297,9 +333,62 @@ static const char *wada_verdict(const cm_wada *w)
     return all >= WADA_ALL ? "Wada" : all >= WADA_NONE ? "partially Wada" : "not Wada";
 }
 
+/* The entropy map over the uncertain fractions, log-log with the fit. */
+static cm_status write_figure(const measure_args *a, const measure_result *r, char *msg,
+                              size_t msg_size)
+{
+    double lx[MEASURE_MAX_EPS], ly[MEASURE_MAX_EPS], fit_x[2], fit_y[2];
+    double ylo = INFINITY, yhi = -INFINITY, ymean = 0, xmean = 0;
+    int n = 0;
+    for (int k = 0; k < r->n_eps; k++)
+        if (r->uncertain[k] > 0) {
+            lx[n] = log10(r->eps[k]), ly[n] = log10(r->uncertain[k]);
+            ylo = fmin(ylo, ly[n]), yhi = fmax(yhi, ly[n]);
+            xmean += lx[n], ymean += ly[n], n++;
+        }
+    if (n < 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the figure's log-log plot needs 2 eps with uncertain cells, and %d have "
+                       "any: widen --uncertainty",
+                       n);
+    xmean /= n, ymean /= n;
+    fit_x[0] = lx[0], fit_x[1] = lx[n - 1];
+    for (int k = 0; k < 2; k++) /* the fit passes through the means */
+        fit_y[k] = ymean + r->alpha * (fit_x[k] - xmean);
+    const double box = a->box[0], pad = 0.05 * (yhi - ylo) + 0.05;
+    const double hi[2] = {r->lo[0] + (double)r->map_n[0] * box * (r->hi[0] - r->lo[0]) / r->n[0],
+                          r->lo[1] + (double)r->map_n[1] * box * (r->hi[1] - r->lo[1]) / r->n[1]};
+    const cm_heat heat = {(int)r->map_n[0], (int)r->map_n[1], r->entropy_map, 0,
+                          "box entropy"};
+    static const cm_rgb ink = {20, 60, 160}, fit_ink = {200, 60, 30};
+    const cm_series series[2] = {{CM_SERIES_POINTS, lx, ly, (size_t)n, ink, 7},
+                                 {CM_SERIES_LINE, fit_x, fit_y, 2, fit_ink, 2}};
+    char top[160], bottom[160];
+    snprintf(top, sizeof top, "%s: basin entropy in boxes of %d cells (Sb %.4f, Sbb %.4f)",
+             r->model, a->box[0], r->entropy[0].sb, r->entropy[0].sbb);
+    snprintf(bottom, sizeof bottom, "uncertain fraction f(eps): alpha %.4f, boundary dimension "
+             "%.4f", r->alpha, r->dim - r->alpha);
+    const int h_top = a->height * 3 / 5;
+    const cm_chart charts[2] = {
+        {a->width, h_top, {r->lo[0], r->lo[1]}, {hi[0], hi[1]}, r->names[0], r->names[1], top,
+         &heat, NULL, 0,
+         figure_font(), 0, NULL, 0},
+        {a->width, a->height - h_top, {lx[0] - 0.1, ylo - pad}, {lx[n - 1] + 0.1, yhi + pad},
+         "log10 eps [cells]", "log10 f", bottom, NULL, series, 2, figure_font(), 0, NULL, 0},
+    };
+    /* the model, not the file, so that a copy of a file draws the same bytes */
+    const cm_png_text texts[] = {{"Model", r->model}};
+    return outfile_charts(a->png, charts, 2, texts, 1, msg, msg_size);
+}
+
 cm_status measure_write(const measure_args *a, const measure_result *r, char *msg,
                         size_t msg_size)
 {
+    if (a->png) {
+        const cm_status st = write_figure(a, r, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+    }
     if (!a->csv)
         return CM_OK;
     outfile o;
@@ -446,5 +535,6 @@ void measure_result_free(measure_result *r)
 {
     free(r->shares);
     free(r->tips);
+    free(r->entropy_map);
     memset(r, 0, sizeof *r);
 }

@@ -35,10 +35,13 @@ typedef struct measure_args {
     const char *to;        /* a second file on the same lattice: the tipping probabilities
                               from the first's basins into its basins, or NULL */
     const char *csv;       /* measure,scale,value rows, or NULL */
+    const char *png;       /* a 2-D window's figure: the entropy map in the first box size
+                              over the uncertain fractions against eps, log-log; or NULL */
+    int width, height;
 } measure_args;
 
 /* Every measure: boxes 3, 5, 7, 9 cells; eps 1 .. 16; Wada to r = 5; the
- * budget 256 MiB. */
+ * budget 256 MiB; the figure 800x1000. */
 measure_args measure_defaults(void);
 
 typedef struct measure_share {
@@ -58,6 +61,7 @@ typedef struct measure_tip {
 
 typedef struct measure_result {
     char model[64];
+    char names[2][32];         /* the first two state coordinates' */
     int dim;
     int64_t n[CM_MAX_DIM];     /* the window's cells per dimension */
     double lo[CM_MAX_DIM], hi[CM_MAX_DIM]; /* its extent in state units */
@@ -77,6 +81,8 @@ typedef struct measure_result {
     measure_tip *tips;         /* by source basin, the probabilities summing to 1 */
     int n_tips;
     double seconds_read, seconds_entropy, seconds_uncertain, seconds_wada;
+    double *entropy_map;       /* with a->png: the first box size's boxes, x fastest */
+    int64_t map_n[2];          /* boxes along x and y */
 } measure_result;
 
 /* Checks the request, reads the window's labels (hooks count cells) and
@@ -86,7 +92,7 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
 
 /* The rows measure,scale,value at a->csv (NULL: nothing): share (scale:
  * the label), sb and sbb (the box), uncertain (eps), wada (r), tipping
- * (FROM>TO). */
+ * (FROM>TO); the figure at a->png (NULL: none). */
 cm_status measure_write(const measure_args *a, const measure_result *r, char *msg,
                         size_t msg_size);
 

@@ -1,5 +1,4 @@
-/* cellmap measure: a .cmdb file's basins measured (basin shares, basin
- * entropy, the uncertainty exponent, the Wada test) over lib/measure.h. */
+/* cellmap measure: a .cmdb file's basins measured, over lib/measure.h. */
 #include <stdio.h>
 #include <string.h>
 
@@ -14,7 +13,8 @@
 static const char measure_help[] =
     "usage: cellmap measure FILE.cmdb [--window X0:X1[,Y0:Y1...]] [--entropy B[,B...]|none]\n"
     "                       [--uncertainty E0:E1|none] [--wada R|none] [--mem BYTES]\n"
-    "                       [--to OTHER.cmdb] [--csv FILE|-] [--json] [--quiet]\n\n"
+    "                       [--to OTHER.cmdb] [--csv FILE|-] [--png FILE] [--size WxH]\n"
+    "                       [--json] [--quiet]\n\n"
     "Measures the basins of the file's attractors (as `export --labels` labels the\n"
     "cells: 0 diverged and -2 outside count as basins; cells not computed are left\n"
     "out), over the window (default every cell):\n"
@@ -40,10 +40,11 @@ static const char measure_help[] =
     "  --mem BYTES         the cluster's and the labels' memory (default 256M)\n"
     "  --csv FILE|-        rows measure,scale,value: share (the label), sb and sbb (the\n"
     "                      box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
+    "  --png FILE          a 2-D window's entropy map (the first box size) over f(eps)\n"
+    "  --size WxH          its size (default 800x1000)\n"
     "  --json              the result as JSON on standard output\n"
     "  --quiet             no progress line and no summary\n";
 
-/* "none" turns a measure off. */
 static bool none(const char *value) { return value && strcmp(value, "none") == 0; }
 
 static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
@@ -78,6 +79,9 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_take_size(c, 300, 400, 4096, &a->width, &a->height, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             *json = true;
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -90,13 +94,14 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
     }
     if (!err && !a->file)
         err = cli_usage_error(c, "which file? usage: cellmap measure FILE.cmdb");
-    if (!err && *json && cm_output_names_stdout(a->csv))
-        err = cli_usage_error(c, "--json and --csv - both to standard output: choose one");
+    if (!err && *json + cm_output_names_stdout(a->csv) + cm_output_names_stdout(a->png) > 1)
+        err = cli_usage_error(c, "two outputs to standard output: choose one");
     char why[1024];
     const cm_file_use files[] = {{a->file, "the database", false, true},
                                  {a->to, "--to", false, true},
-                                 {a->csv, "--csv", true, false}};
-    if (!err && cm_files_apart(files, 3, why, sizeof why) != CM_OK)
+                                 {a->csv, "--csv", true, false},
+                                 {a->png, "--png", true, false}};
+    if (!err && cm_files_apart(files, 4, why, sizeof why) != CM_OK)
         err = cli_usage_error(c, "%s", why);
     return err;
 }
@@ -114,6 +119,8 @@ int cmd_measure(int argc, char **argv)
         werr = cli_input_check("measure", a.to);
     if (werr == EXIT_OK)
         werr = outfile_check("measure", a.csv, false);
+    if (werr == EXIT_OK)
+        werr = chart_png_check("measure", a.png);
     if (werr != EXIT_OK)
         return werr;
     char msg[1024];
@@ -128,7 +135,7 @@ int cmd_measure(int argc, char **argv)
         if (json)
             measure_json(stdout, &r);
         else if (!quiet)
-            measure_report(report_stream(a.csv, NULL, NULL), &r);
+            measure_report(report_stream(a.csv, a.png, NULL), &r);
         st = measure_write(&a, &r, msg, sizeof msg);
     }
     measure_result_free(&r);

@@ -56,7 +56,7 @@ int main(int argc, char **argv)
     uint64_t counted;
     for (int run = 0; run < 5; run++) {
         double t0 = now();
-        if (cm_basin_entropy(&g, 5, &e, msg, sizeof msg) != CM_OK)
+        if (cm_basin_entropy(&g, 5, &e, NULL, msg, sizeof msg) != CM_OK)
             return fprintf(stderr, "%s\n", msg), 1;
         t[0][run] = now() - t0, t0 = now();
         for (int eps = 1; eps <= 16; eps *= 2)

@@ -30,7 +30,10 @@ ws=(--model-lib ./libweierstrass.so --model weierstrass --cells 1000x9000 --quie
   --json > curve.json || fail "measure curve"
 "$CM" measure line.cmdb --window 0:1,-2.5006:2.5 --uncertainty 1:64 --entropy 4,16,64 \
   --mem 1G --json --csv line.csv > line.json || fail "measure line"
-"$CM" measure newton.cmdb --json --csv newton.csv > measured.json || fail "measure newton"
+"$CM" measure newton.cmdb --json --csv newton.csv --png newton.png --size 600x700 > measured.json \
+  || fail "measure newton"
+echo '{"view": [0, 1, 0, 1], "size": [600, 700], "texts": {"Model": "newton"}}' > png.json
+python3 "$HERE/pngcheck.py" newton.png png.json || fail "measure --png"
 "$CM" export newton.cmdb --labels newton.npy > /dev/null || fail "export newton"
 python3 - curve.json line.json measured.json newton.csv newton.npy <<'PY' || fail "the measures"
 import csv, json, math, struct, sys
@@ -92,6 +95,8 @@ expect_usage "--uncertainty: '4:2' is not E0:E1" measure line.cmdb --uncertainty
 expect_usage "which file?" measure --wada 2
 expect_usage "the database" measure line.cmdb --csv line.cmdb
 expect_usage "over the budget" measure curve.cmdb --mem 8M
-[ ! -e no.csv ] || fail "measure wrote no.csv although it failed"
+"$CM" solve --model microchaos-1d --cells 300 --db one.cmdb --quiet || fail "solve microchaos-1d"
+expect_usage "it needs a 2-D model" measure one.cmdb --png no.png
+[ ! -e no.csv ] && [ ! -e no.png ] || fail "measure wrote no.csv or no.png although it failed"
 
 [ "$fails" -eq 0 ] && echo "measure_test: all passed" || exit 1

@@ -27,18 +27,23 @@ static void test_by_hand(void)
     const cm_label_grid g = grid2(l, 4, 4, 3);
     cm_entropy e;
     char msg[256];
-    CHECK(cm_basin_entropy(&g, 2, &e, msg, sizeof msg) == CM_OK);
+    double map[4];
+    CHECK(cm_basin_entropy(&g, 2, &e, map, msg, sizeof msg) == CM_OK);
     const double h3 = -(0.75 * log(0.75) + 0.25 * log(0.25));
+    CHECK(map[0] == 0 && map[3] == 0); /* boxes in C order */
+    CHECK_NEAR(map[1], log(2.0), 1e-15);
+    CHECK_NEAR(map[2], h3, 1e-15);
     CHECK_INT(e.boxes, 4);
     CHECK_INT(e.boundary, 2);
     CHECK_NEAR(e.sb, (log(2.0) + h3) / 4, 1e-15);
     CHECK_NEAR(e.sbb, (log(2.0) + h3) / 2, 1e-15);
     /* an uncomputed cell takes its box out */
     l[0] = -1;
-    CHECK(cm_basin_entropy(&g, 2, &e, msg, sizeof msg) == CM_OK);
+    CHECK(cm_basin_entropy(&g, 2, &e, map, msg, sizeof msg) == CM_OK);
+    CHECK(isnan(map[0]) && map[3] == 0);
     CHECK_INT(e.boxes, 3);
     CHECK_NEAR(e.sb, (log(2.0) + h3) / 3, 1e-15);
-    CHECK(cm_basin_entropy(&g, 5, &e, msg, sizeof msg) == CM_EINVAL);
+    CHECK(cm_basin_entropy(&g, 5, &e, NULL, msg, sizeof msg) == CM_EINVAL);
 }
 
 static void test_straight_boundary(void)
@@ -52,7 +57,7 @@ static void test_straight_boundary(void)
     double last = 0;
     for (int eps = 2; eps <= 16; eps *= 2) {
         cm_entropy e;
-        CHECK(cm_basin_entropy(&g, eps, &e, msg, sizeof msg) == CM_OK);
+        CHECK(cm_basin_entropy(&g, eps, &e, NULL, msg, sizeof msg) == CM_OK);
         printf("straight boundary: eps %2d Sb %.5f Sbb %.4f (%llu of %llu boxes)\n", eps, e.sb,
                e.sbb, (unsigned long long)e.boundary, (unsigned long long)e.boxes);
         CHECK(e.sb > last);   /* Sb grows with the box: it tends to 0 as they shrink */

@@ -155,7 +155,7 @@ static void analyses(void)
     }
     cm_measure_options mso = cm_measure_defaults();
     mso.file = "c_split.cmdb", mso.to = "c_resumed.cmdb", mso.window = "0:100,-40:40";
-    a = outputs("measure", f, 0);
+    a = outputs("measure", f, 1);
     cm_measures ms;
     must(cm_analysis_measure(&a, &mso, &ms, msg, sizeof msg), "measure", msg);
     if (ms.computed == 0 || ms.computed > ms.cells || !(ms.alpha > 0)) {

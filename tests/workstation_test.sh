@@ -104,7 +104,7 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
   "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --series tau2 --time 200 --transient 10 \
     --dt 0.005 --steps 10 --csv cli_embedding.csv --png cli_embedding.png &&
   "$CM" measure cli_split.cmdb --to cli_split.cmdb --window 0:100,-40:40 --csv cli_measure.csv \
-    --quiet; } > analyses.log 2>&1 ||
+    --png cli_measure.png --quiet; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
 ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue exponents series
   embedding"
@@ -124,6 +124,7 @@ check_analyses() { # PREFIX: the analyses' files, against the command's
   same_bytes cli_periodic.csv "$1_periodic.csv" "$1: periodic's table"
   same_bytes cli_series_spectrum.csv "$1_series_spectrum.csv" "$1: the series' spectrum"
   same_bytes cli_measure.csv "$1_measure.csv" "$1: measure's table"
+  same_bytes cli_measure.png "$1_measure.png" "$1: measure's figure"
   head -1 cli_sweep.csv | grep -q ',seconds$' || fail "the sweep's table no longer ends in seconds"
   without_seconds cli_sweep.csv > a_sweep.csv && without_seconds "$1_sweep.csv" > b_sweep.csv &&
     [ "$(grep -c . b_sweep.csv)" -eq 3 ] && cmp -s a_sweep.csv b_sweep.csv ||

@@ -454,11 +454,12 @@ def embedding(of, input=None, start=None, time=None, transient=None, dt=None, va
 
 
 def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5,
-            wada_required=False, to=None, mem=None, csv=None):
+            wada_required=False, to=None, mem=None, csv=None, png=None, size=None):
     """A .cmdb file's basins measured (`cellmap measure`): entropy the box
     sizes of basin entropy (() for none), uncertainty (E0, E1) the eps range
     (None for none), wada the Wada test's radius (0 for none), to a second
-    file on the same lattice for the tipping probabilities. Returns
+    file on the same lattice for the tipping probabilities, png the figure
+    of a 2-D window. Returns
     (summary, table): summary a dict of cells, computed, sb, sbb (means over
     the boxes), alpha, alpha_r2, wada_basins and wada_fraction (None where
     not measured); table the rows measure, scale, value (share, sb, sbb,
@@ -476,7 +477,8 @@ def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5
     if mem is not None:
         o.mem = int(mem)
     res = _MeasureOut()
-    table = _run(_common(csv=csv), _lib.cm_analysis_measure, ctypes.byref(o), ctypes.byref(res))
+    table = _run(_common(csv=csv, png=png, size=size), _lib.cm_analysis_measure, ctypes.byref(o),
+                 ctypes.byref(res))
     nan = lambda v: None if math.isnan(v) else v
     return ({"cells": res.cells, "computed": res.computed, "sb": nan(res.sb), "sbb": nan(res.sbb),
              "alpha": nan(res.alpha), "alpha_r2": nan(res.alpha_r2),
