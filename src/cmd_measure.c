@@ -37,7 +37,7 @@ static const char measure_help[] =
     "  --wada R            the largest radius (default 5; with fewer than 3 basins the\n"
     "                      default test is skipped, an explicit one is an error)\n"
     "  --to OTHER.cmdb     the second file of the tipping probabilities\n"
-    "  --mem BYTES         the cluster's and the labels' memory (default 256M)\n"
+    "  --mem BYTES         the cluster's memory, and the most the labels take (256M)\n"
     "  --csv FILE|-        rows measure,scale,value: share (the label), sb and sbb (the\n"
     "                      box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
     "  --png FILE          a 2-D window's entropy map (the first box size) over f(eps)\n"
