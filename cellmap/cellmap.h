@@ -641,8 +641,12 @@ typedef struct cm_measure_options {
     int wada_required;      /* nonzero: fewer than 3 basins is an error, else the test is skipped */
     const char *to;         /* a second file on the same lattice: tipping probabilities, or NULL */
     uint64_t mem;           /* the cluster's and the labels' budget in bytes */
+    uint64_t samples;       /* random states of the window followed by their true orbits to
+                               their attractors (at most 10^8; 0: none) */
+    uint64_t seed;          /* their stream: the same states for the same seed */
+    int threads;            /* OpenMP threads following them; 0: the OpenMP default */
 } cm_measure_options;
-/* boxes 3, 5, 7, 9; eps 1 .. 16; Wada to r = 5; 256 MiB */
+/* boxes 3, 5, 7, 9; eps 1 .. 16; Wada to r = 5; 256 MiB; no samples, seed 1 */
 cm_measure_options cm_measure_defaults(void);
 
 typedef struct cm_measures {
@@ -651,10 +655,15 @@ typedef struct cm_measures {
     double alpha, alpha_r2;    /* the uncertainty exponent and its fit's R^2; NAN without */
     int wada_basins;           /* 0: no Wada test */
     double wada_fraction;      /* boundary cells seeing every basin within wada_radius */
+    uint64_t sampled;          /* samples in computed cells (0: none) */
+    uint64_t sampled_as_labelled; /* of them, those whose true orbit ends where their cell's
+                                     label says */
+    int samples_agree;         /* nonzero: every basin's cell share lies within the
+                                  interval of its sampled share */
 } cm_measures;
 
 /* A file's basins measured (`cellmap measure`): a->csv gets every value as
- * rows measure,scale,value (share, sb, sbb, uncertain, wada, tipping),
+ * rows measure,scale,value (share, sampled, sb, sbb, uncertain, wada, tipping),
  * a->png the figure of a 2-D window (the entropy map of the first box size
  * over the uncertain fractions, log-log), out (may be NULL) the summary;
  * a->model is not used. */

@@ -330,7 +330,7 @@ cm_measure_options cm_measure_defaults(void)
 {
     const measure_args d = measure_defaults();
     cm_measure_options o = {.n_box = d.n_box, .eps_lo = d.eps_lo, .eps_hi = d.eps_hi,
-                            .wada_radius = d.wada_radius, .mem = d.mem};
+                            .wada_radius = d.wada_radius, .mem = d.mem, .seed = 1};
     memcpy(o.box, d.box, sizeof o.box);
     return o;
 }
@@ -351,6 +351,7 @@ cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o,
     memcpy(m.box, o->box, sizeof m.box);
     m.n_box = o->n_box, m.eps_lo = o->eps_lo, m.eps_hi = o->eps_hi;
     m.wada_radius = o->wada_radius, m.wada_asked = o->wada_required != 0, m.csv = a->csv;
+    m.samples = o->samples, m.seed = o->seed, m.threads = o->threads;
     measure_result r;
     st = measure_compute(&m, NULL, &r, msg, msg_size);
     if (st == CM_OK)
@@ -358,7 +359,8 @@ cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o,
     if (st == CM_OK && out)
         *out = (cm_measures){r.cells, r.computed, r.sb_mean,
                              r.sbb_mean, r.alpha, r.alpha_r2, r.has_wada ? r.wada.basins : 0,
-                             r.has_wada ? r.wada.fraction[r.wada.radius - 1] : NAN};
+                             r.has_wada ? r.wada.fraction[r.wada.radius - 1] : NAN,
+                             r.sampled, r.sample_same, r.samples_agree};
     measure_result_free(&r);
     return st;
 }

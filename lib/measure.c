@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/attractor_fates.h"
 #include "cellmap/clock.h"
 #include "lib/export.h"
 #include "lib/figure.h"
@@ -41,6 +42,13 @@ static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "eps %d:%d: give 1 <= E0 <= E1 <= 2^20 cells (E0 doubled up to E1)",
                        a->eps_lo, a->eps_hi);
+    if (a->samples > MEASURE_MAX_SAMPLES)
+        return cm_fail(CM_EINVAL, msg, msg_size, "%llu samples: give at most %llu",
+                       (unsigned long long)a->samples, (unsigned long long)MEASURE_MAX_SAMPLES);
+    if (a->sample_steps > PROJECT_MAX_STEPS)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a sample's budget of %llu steps: give at most %d",
+                       (unsigned long long)a->sample_steps, PROJECT_MAX_STEPS);
     if (a->wada_radius < 0 || a->wada_radius > 16)
         return cm_fail(CM_EINVAL, msg, msg_size, "the Wada radius must be 1..16 (%d)",
                        a->wada_radius);
@@ -58,11 +66,63 @@ typedef struct file_labels {
     cm_box window;
     uint32_t attractors;
     int32_t *label; /* the window's cells, C order */
+    int32_t *fate;  /* with samples: each sampled state's fate by its true orbit, or
+                       CM_LABEL_UNCOMPUTED for a state in a cell not computed */
+    uint64_t fate_steps, fate_same; /* steps taken; fates equal to their cell's label */
+    double fate_seconds;
 } file_labels;
+
+/* The fates of a->samples random states of the window by their true
+ * orbits (the file's model rebuilt from its records, plugins included),
+ * those in cells not computed left out (CM_LABEL_UNCOMPUTED). */
+static cm_status sample_fates(const measure_args *a, const exporter *x, file_labels *out,
+                              char *msg, size_t msg_size)
+{
+    cm_model_set set = {0};
+    cm_model m;
+    const int dim = out->lat.dim;
+    double *state = malloc((size_t)a->samples * dim * sizeof *state);
+    out->fate = malloc((size_t)a->samples * sizeof *out->fate);
+    if (!state || !out->fate) {
+        free(state);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu samples",
+                       (unsigned long long)a->samples);
+    }
+    cm_status st = model_of_store(x->info, &set, &m, msg, msg_size);
+    if (st != CM_OK) {
+        cm_model_set_close(&set);
+        free(state);
+        return cm_fail(st, msg, msg_size, "%s: its true orbits cannot be followed: %s", a->file,
+                       msg);
+    }
+    const double t = cm_seconds();
+    cm_sample_states(&out->lat, &out->window, a->seed, a->samples, state);
+    st = cm_attractor_fates(&m, &out->lat, &x->att, state, a->samples, a->sample_steps,
+                            a->threads, out->fate, &out->fate_steps, msg, msg_size);
+    for (uint64_t i = 0; st == CM_OK && i < a->samples; i++) {
+        int64_t cell[CM_MAX_DIM];
+        uint64_t at = 0;
+        const bool in = cm_lattice_cell(&out->lat, state + i * dim, cell) &&
+                        cm_box_contains(&out->window, cell);
+        for (int d = 0; in && d < dim; d++)
+            at = at * (uint64_t)(out->window.hi[d] - out->window.lo[d]) +
+                 (uint64_t)(cell[d] - out->window.lo[d]);
+        if (!in || out->label[at] == CM_LABEL_UNCOMPUTED)
+            out->fate[i] = CM_LABEL_UNCOMPUTED;
+        else
+            out->fate_same += out->fate[i] == out->label[at];
+    }
+    out->fate_seconds = cm_seconds() - t;
+    cm_model_release(&m);
+    cm_model_set_close(&set);
+    free(state);
+    return st;
+}
 
 static cm_status read_labels(const char *file, uint64_t mem, const char *window_text,
                              const cm_box *box, const cm_lattice *same, const work_hooks *hooks,
-                             file_labels *out, char *msg, size_t msg_size)
+                             const measure_args *sample, file_labels *out, char *msg,
+                             size_t msg_size)
 {
     cm_store *s = NULL;
     cm_store_info info;
@@ -106,6 +166,8 @@ static cm_status read_labels(const char *file, uint64_t mem, const char *window_
     }
     if (st == CM_OK)
         st = export_labels(&x, out->label, hooks, msg, msg_size);
+    if (st == CM_OK && sample && sample->samples)
+        st = sample_fates(sample, &x, out, msg, msg_size);
     exporter_close(&x);
     project_close(s, &c);
     return st;
@@ -132,12 +194,41 @@ static int32_t ordered_label(int k, int32_t hi)
     return k < hi ? k + 1 : k == hi ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
 }
 
-/* Each label's cells and share. */
-static cm_status count_shares(const cm_label_grid *g, measure_result *r, char *msg,
-                              size_t msg_size)
+/* The z whose two tails hold alpha of the standard normal distribution
+ * (bisection on erfc: 1e-12 in 60 halvings). */
+static double normal_quantile(double alpha)
+{
+    double lo = 0, hi = 40;
+    for (int k = 0; k < 60; k++) {
+        const double mid = (lo + hi) / 2;
+        if (erfc(mid / sqrt(2.0)) > alpha)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return (lo + hi) / 2;
+}
+
+/* The Wilson score interval of a share p of n samples at z. */
+static void wilson(double p, double n, double z, double *lo, double *hi)
+{
+    const double z2n = z * z / n;
+    const double centre = (p + z2n / 2) / (1 + z2n);
+    const double half = z / (1 + z2n) * sqrt(p * (1 - p) / n + z2n / (4 * n));
+    *lo = centre - half > 0 ? centre - half : 0;
+    *hi = centre + half < 1 ? centre + half : 1;
+}
+
+/* Each label's cells and share, and with samples their fates' shares
+ * with simultaneous 95 % intervals (Bonferroni: each at 1 - 0.05 / k for
+ * k labels, so that a lattice whose shares are the true ones lies within
+ * all of them 95 times in 100): a label is listed when cells or samples
+ * have it. */
+static cm_status count_shares(const cm_label_grid *g, const file_labels *f, uint64_t samples,
+                              measure_result *r, char *msg, size_t msg_size)
 {
     const int labels = g->hi - g->lo + 1;
-    uint64_t *count = calloc((size_t)labels, sizeof *count);
+    uint64_t *count = calloc(2 * (size_t)labels, sizeof *count), *fates = count + labels;
     r->shares = calloc((size_t)labels, sizeof *r->shares);
     if (!count || !r->shares) {
         free(count);
@@ -145,14 +236,32 @@ static cm_status count_shares(const cm_label_grid *g, measure_result *r, char *m
     }
     for (uint64_t k = 0; k < r->cells; k++)
         count[g->label[k] - g->lo]++;
+    for (uint64_t i = 0; i < samples; i++)
+        fates[f->fate[i] - g->lo]++;
     r->computed = r->cells - count[CM_LABEL_UNCOMPUTED - g->lo];
+    r->samples = samples, r->sample_steps = f->fate_steps, r->sample_same = f->fate_same;
+    r->sampled = samples - fates[CM_LABEL_UNCOMPUTED - g->lo];
+    r->samples_agree = r->sampled > 0;
+    int listed = 0;
+    for (int k = 0; k <= g->hi + 1; k++)
+        listed += count[ordered_label(k, g->hi) - g->lo] || fates[ordered_label(k, g->hi) - g->lo];
+    const double z = normal_quantile(0.05 / (listed ? listed : 1));
     for (int k = 0; k <= g->hi + 1; k++) {
         const int32_t label = ordered_label(k, g->hi);
-        const uint64_t n = count[label - g->lo];
+        const uint64_t n = count[label - g->lo], m = fates[label - g->lo];
+        if (!n && !m)
+            continue;
         const double p = (double)n / (double)r->computed;
-        if (n)
-            r->shares[r->n_shares++] = (measure_share){
-                label, n, p, 1.96 * sqrt(p * (1 - p) / (double)r->computed)};
+        measure_share *s = &r->shares[r->n_shares++];
+        memset(s, 0, sizeof *s);
+        s->label = label, s->cells = n, s->share = p;
+        s->half_width = 1.96 * sqrt(p * (1 - p) / (double)r->computed);
+        if (r->sampled) {
+            s->sampled = m, s->sampled_share = (double)m / (double)r->sampled;
+            wilson(s->sampled_share, (double)r->sampled, z, &s->sampled_lo, &s->sampled_hi);
+            s->agrees = p >= s->sampled_lo && p <= s->sampled_hi;
+            r->samples_agree = r->samples_agree && s->agrees;
+        }
     }
     free(count);
     return CM_OK;
@@ -290,19 +399,21 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
     double t = cm_seconds();
     cm_status st = check_args(a, msg, msg_size);
     if (st == CM_OK)
-        st = read_labels(a->file, a->mem, a->window, NULL, NULL, hooks, &from, msg, msg_size);
+        st = read_labels(a->file, a->mem, a->window, NULL, NULL, hooks, a, &from, msg,
+                         msg_size);
     if (st == CM_OK) {
         grid_of(&from, r, &g);
-        st = count_shares(&g, r, msg, msg_size);
+        st = count_shares(&g, &from, a->samples, r, msg, msg_size);
     }
     if (st == CM_OK && a->to)
-        st = read_labels(a->to, a->mem, NULL, &from.window, &from.lat, hooks, &to, msg,
+        st = read_labels(a->to, a->mem, NULL, &from.window, &from.lat, hooks, NULL, &to, msg,
                          msg_size);
     if (st == CM_OK && a->to) {
         snprintf(r->to_model, sizeof r->to_model, "%s", to.model);
         st = tipping(&g, &to, r, msg, msg_size);
     }
-    r->seconds_read = cm_seconds() - t, t = cm_seconds();
+    r->seconds_sample = from.fate_seconds;
+    r->seconds_read = cm_seconds() - t - r->seconds_sample, t = cm_seconds();
     if (st == CM_OK && a->png && (g.dim != 2 || !a->n_box || !a->eps_hi))
         st = cm_fail(CM_EINVAL, msg, msg_size,
                      "the figure maps basin entropy over a 2-D window beside the uncertain "
@@ -321,6 +432,7 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
         st = wada(a, &g, r, msg, msg_size);
     r->seconds_wada = cm_seconds() - t;
     free(from.label);
+    free(from.fate);
     free(to.label);
     return st;
 }
@@ -398,6 +510,8 @@ cm_status measure_write(const measure_args *a, const measure_result *r, char *ms
     fprintf(o.f, "measure,scale,value\n");
     for (int k = 0; k < r->n_shares; k++)
         fprintf(o.f, "share,%d,%.17g\n", r->shares[k].label, r->shares[k].share);
+    for (int k = 0; r->sampled && k < r->n_shares; k++)
+        fprintf(o.f, "sampled,%d,%.17g\n", r->shares[k].label, r->shares[k].sampled_share);
     for (int k = 0; k < r->n_entropy; k++)
         fprintf(o.f, "sb,%d,%.17g\nsbb,%d,%.17g\n", r->entropy[k].eps, r->entropy[k].sb,
                 r->entropy[k].eps, r->entropy[k].sbb);
@@ -430,9 +544,23 @@ void measure_report(FILE *f, const measure_result *r)
     for (int k = 0; k < r->n_shares; k++) {
         char name[32];
         const measure_share *s = &r->shares[k];
-        fprintf(f, "  %-13s %12llu cells  %.4f (+- %.4f)\n", label_name(s->label, name, sizeof name),
+        fprintf(f, "  %-13s %12llu cells  %.4f (+- %.4f)", label_name(s->label, name, sizeof name),
                 (unsigned long long)s->cells, s->share, s->half_width);
+        if (r->sampled)
+            fprintf(f, "  sampled %.4f [%.4f, %.4f]%s", s->sampled_share, s->sampled_lo,
+                    s->sampled_hi, s->agrees ? "" : " differs");
+        fputc('\n', f);
     }
+    if (r->samples)
+        fprintf(f, "true orbits of %llu random states (%llu in computed cells, %.1f steps "
+                   "each, %.2f %% ending where their cell's label says): %s\n",
+                (unsigned long long)r->samples, (unsigned long long)r->sampled,
+                (double)r->sample_steps / (double)r->samples,
+                r->sampled ? 100.0 * (double)r->sample_same / (double)r->sampled : 0.0,
+                !r->sampled        ? "none lies in a computed cell"
+                : r->samples_agree ? "every cell share lies in its interval (95 % together)"
+                                   : "some cell shares lie outside their intervals (95 % "
+                                     "together): the lattice is too coarse for them");
     for (int k = 0; k < r->n_entropy; k++) {
         const cm_entropy *e = &r->entropy[k];
         fprintf(f, "basin entropy, boxes of %d: Sb %.4f, Sbb %.4f (%llu of %llu boxes on a "
@@ -481,9 +609,23 @@ void measure_json(FILE *f, const measure_result *r)
         json_uint(&j, "cells", r->shares[k].cells);
         json_num(&j, "share", r->shares[k].share);
         json_num(&j, "half_width", r->shares[k].half_width);
+        if (r->sampled) {
+            json_uint(&j, "sampled", r->shares[k].sampled);
+            json_num(&j, "sampled_share", r->shares[k].sampled_share);
+            json_num(&j, "sampled_lo", r->shares[k].sampled_lo);
+            json_num(&j, "sampled_hi", r->shares[k].sampled_hi);
+            json_bool(&j, "agrees", r->shares[k].agrees);
+        }
         json_object_end(&j);
     }
     json_array_end(&j);
+    if (r->samples) {
+        json_uint(&j, "samples", r->samples);
+        json_uint(&j, "samples_in_computed_cells", r->sampled);
+        json_uint(&j, "sample_steps", r->sample_steps);
+        json_uint(&j, "samples_as_labelled", r->sample_same);
+        json_bool(&j, "samples_agree", r->samples_agree);
+    }
     json_array(&j, "entropy");
     for (int k = 0; k < r->n_entropy; k++) {
         const cm_entropy *e = &r->entropy[k];

@@ -7,7 +7,10 @@
  * exponent fitted to them and the boundary's dimension; the Wada test;
  * and, given a second file solved on the same lattice (another parameter
  * value), the tipping probabilities: where each basin's cells lie in the
- * second file's basins.
+ * second file's basins; and, given a number of samples, the shares of
+ * random states of the window by their true orbits
+ * (cellmap/attractor_fates.h), with intervals that hold the true shares
+ * together 95 times in 100, which the cells' shares are checked against.
  * The window's labels are read a slab at a time into one array of 4 bytes
  * a cell (the window must fit the memory budget). Written as text, JSON
  * and CSV. Nothing is printed but by the report calls: calls return a
@@ -22,6 +25,7 @@
 #include "lib/work.h"
 
 enum { MEASURE_MAX_BOXES = 8, MEASURE_MAX_EPS = 16 };
+#define MEASURE_MAX_SAMPLES UINT64_C(100000000)
 
 typedef struct measure_args {
     const char *file;
@@ -34,6 +38,11 @@ typedef struct measure_args {
     bool wada_asked;       /* fewer than 3 basins is then an error, else the test is skipped */
     const char *to;        /* a second file on the same lattice: the tipping probabilities
                               from the first's basins into its basins, or NULL */
+    uint64_t samples;      /* random states of the window whose true orbits are followed to
+                              their attractors (cellmap/attractor_fates.h), or 0 */
+    uint64_t seed;         /* their stream (cm_sample_states) */
+    uint64_t sample_steps; /* each one's budget of map steps (0: the default) */
+    int threads;           /* OpenMP threads following them (0: the OpenMP default) */
     const char *csv;       /* measure,scale,value rows, or NULL */
     const char *png;       /* a 2-D window's figure: the entropy map in the first box size
                               over the uncertain fractions against eps, log-log; or NULL */
@@ -49,6 +58,10 @@ typedef struct measure_share {
     uint64_t cells;
     double share;    /* of the computed cells */
     double half_width; /* the share's 95 % interval as if the cells were sampled */
+    uint64_t sampled;  /* with samples: the states whose true orbits end here */
+    double sampled_share, sampled_lo, sampled_hi; /* their share, its Wilson interval at
+                                                     1 - 0.05 / (shares listed) */
+    bool agrees;       /* share lies within that interval */
 } measure_share;
 
 /* Of the cells of basin `from` in the first file, the share that lies in
@@ -80,7 +93,12 @@ typedef struct measure_result {
     char to_model[64];         /* the second file's model ("" without one) */
     measure_tip *tips;         /* by source basin, the probabilities summing to 1 */
     int n_tips;
-    double seconds_read, seconds_entropy, seconds_uncertain, seconds_wada;
+    uint64_t samples;          /* states drawn (0: none) */
+    uint64_t sampled;          /* of them, those in computed cells (the shares' base) */
+    uint64_t sample_steps;     /* map steps their orbits took */
+    uint64_t sample_same;      /* of the sampled, those whose fate is their cell's label */
+    bool samples_agree;        /* every share within its sampled interval */
+    double seconds_read, seconds_sample, seconds_entropy, seconds_uncertain, seconds_wada;
     double *entropy_map;       /* with a->png: the first box size's boxes, x fastest */
     int64_t map_n[2];          /* boxes along x and y */
 } measure_result;

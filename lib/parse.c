@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/status.h"
+
 bool parse_int64(const char *s, int64_t *out)
 {
     char *end = NULL;
@@ -144,4 +146,35 @@ bool parse_doubles(const char *s, double *v, int *count, int max)
     if (n > 0)
         *count = n;
     return n > 0;
+}
+
+int parse_words(char *line, char **tokens, int max, char *msg, size_t msg_size)
+{
+    int n = 0;
+    char *p = line;
+    for (;;) {
+        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
+            p++;
+        if (!*p || *p == '#')
+            return n;
+        if (n == max) {
+            cm_fail(CM_EINVAL, msg, msg_size, "too many words (at most %d)", max);
+            return -1;
+        }
+        if (*p == '"') {
+            tokens[n++] = ++p;
+            while (*p && *p != '"')
+                p++;
+            if (!*p) {
+                cm_fail(CM_EINVAL, msg, msg_size, "a \" is not closed");
+                return -1;
+            }
+        } else {
+            tokens[n++] = p;
+            while (*p && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
+                p++;
+        }
+        if (*p)
+            *p++ = 0;
+    }
 }

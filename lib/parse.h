@@ -6,6 +6,7 @@
 #define CM_LIB_PARSE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 /* A whole number in int64_t's range, nothing before or after it. */
@@ -22,5 +23,9 @@ bool parse_counts(const char *s, int64_t *n, int *count, int max);
 bool parse_int_span(const char *s, int *lo, int *hi);
 /* "X,Y,..." -> v[], *count (at most max). */
 bool parse_doubles(const char *s, double *v, int *count, int max);
+/* Splits a line in place into at most max words (tokens[]; "double
+ * quotes" keep spaces), dropping a # comment: their count, or -1 with the
+ * problem in msg. */
+int parse_words(char *line, char **tokens, int max, char *msg, size_t msg_size);
 
 #endif

@@ -13,8 +13,8 @@
 static const char measure_help[] =
     "usage: cellmap measure FILE.cmdb [--window X0:X1[,Y0:Y1...]] [--entropy B[,B...]|none]\n"
     "                       [--uncertainty E0:E1|none] [--wada R|none] [--mem BYTES]\n"
-    "                       [--to OTHER.cmdb] [--csv FILE|-] [--png FILE] [--size WxH]\n"
-    "                       [--json] [--quiet]\n\n"
+    "                       [--to OTHER.cmdb] [--samples N[:SEED]] [--threads N] [--csv FILE|-]\n"
+    "                       [--png FILE] [--size WxH] [--json] [--quiet]\n\n"
     "Measures the basins of the file's attractors (as `export --labels` labels the\n"
     "cells: 0 diverged and -2 outside count as basins; cells not computed are left\n"
     "out), over the window (default every cell):\n"
@@ -37,9 +37,15 @@ static const char measure_help[] =
     "  --wada R            the largest radius (default 5; with fewer than 3 basins the\n"
     "                      default test is skipped, an explicit one is an error)\n"
     "  --to OTHER.cmdb     the second file of the tipping probabilities\n"
+    "  --samples N[:SEED]  also N random states of the window, each followed by the true\n"
+    "                      map until it settles on an attractor (at most 10000 steps, 2000\n"
+    "                      for flows): the sampled shares, intervals that hold the true\n"
+    "                      ones together 95 times in 100, and whether the cells' shares\n"
+    "                      lie in them (seed default 1)\n"
+    "  --threads N         threads following them (default: all)\n"
     "  --mem BYTES         the cluster's memory, and the most the labels take (256M)\n"
-    "  --csv FILE|-        rows measure,scale,value: share (the label), sb and sbb (the\n"
-    "                      box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
+    "  --csv FILE|-        rows measure,scale,value: share and sampled (the label), sb and\n"
+    "                      sbb (the box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
     "  --png FILE          a 2-D window's entropy map (the first box size) over f(eps)\n"
     "  --size WxH          its size (default 800x1000)\n"
     "  --json              the result as JSON on standard output\n"
@@ -76,6 +82,18 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
                 err = cli_usage_error(c, "--wada: '%s' is not a radius in cells", c->value);
         } else if (cli_is(c, "--to", true, &err)) {
             a->to = c->value;
+        } else if (cli_is(c, "--samples", true, &err)) {
+            int64_t n = 0, seed = 1;
+            char text[64];
+            snprintf(text, sizeof text, "%s", c->value ? c->value : "1");
+            char *colon = strchr(text, ':');
+            if (colon)
+                *colon = 0;
+            if (!parse_int64(text, &n) || n < 1 ||
+                (colon && (!parse_int64(colon + 1, &seed) || seed < 0)))
+                err = cli_usage_error(c, "--samples: give N[:SEED], N >= 1, SEED >= 0");
+            a->samples = (uint64_t)n, a->seed = (uint64_t)seed;
+        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {
             a->csv = c->value;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lib/json.h"
+#include "lib/parse.h"
 #include "lib/stats_report.h"
 #include "lib/work.h"
 #include "src/commands.h"
@@ -71,38 +72,6 @@ static cm_status move(explore *e, const double *lo, const double *hi, const int6
 }
 
 /* ---- parsing --------------------------------------------------------------- */
-
-/* Splits a line into words ("double quotes" keep spaces); drops a # comment. */
-static int tokenize(char *line, char **tokens, int max, char *msg, size_t msg_size)
-{
-    int n = 0;
-    char *p = line;
-    for (;;) {
-        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
-            p++;
-        if (!*p || *p == '#')
-            return n;
-        if (n == max) {
-            cm_fail(CM_EINVAL, msg, msg_size, "too many words (at most %d)", max);
-            return -1;
-        }
-        if (*p == '"') {
-            tokens[n++] = ++p;
-            while (*p && *p != '"')
-                p++;
-            if (!*p) {
-                cm_fail(CM_EINVAL, msg, msg_size, "a \" is not closed");
-                return -1;
-            }
-        } else {
-            tokens[n++] = p;
-            while (*p && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
-                p++;
-        }
-        if (*p)
-            *p++ = 0;
-    }
-}
 
 static cm_status words(int n, int lo, int hi, const char *usage, char *msg, size_t msg_size)
 {
@@ -484,7 +453,7 @@ cm_status explore_exec(explore *e, const char *line, char *msg, size_t msg_size)
         return cm_fail(CM_EINVAL, msg, msg_size, "the line is longer than %zu characters",
                        sizeof copy - 1);
     snprintf(copy, sizeof copy, "%s", line);
-    const int n = tokenize(copy, t, MAX_TOKENS, msg, msg_size);
+    const int n = parse_words(copy, t, MAX_TOKENS, msg, msg_size);
     if (n < 0)
         return CM_EINVAL;
     if (n == 0)

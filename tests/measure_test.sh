@@ -89,6 +89,50 @@ PY
 "$CM" solve "${ws[@]/500x4500/100x900}" --db coarse.cmdb || fail "solve coarse"
 expect_usage "another lattice" measure tip-a.cmdb --to coarse.cmdb
 
+# sampled fractions: 10^5 random states of Newton's window followed by the
+# true map agree with the cells' shares within their 95 % intervals, the
+# same fates for 1 and 2 threads, and most states end where their cell's
+# label says (the rest lie on the fractal boundary)
+for t in 1 2; do
+  "$CM" measure newton.cmdb --samples 100000:3 --threads $t --entropy none --uncertainty none \
+    --wada none --json --csv sampled-$t.csv > sampled-$t.json || fail "measure --samples, $t threads"
+done
+cmp -s sampled-1.csv sampled-2.csv || fail "the sampled shares differ between 1 and 2 threads"
+python3 - sampled-1.json sampled-1.csv <<'PY' || fail "the sampled shares"
+import csv, json, sys
+r = json.load(open(sys.argv[1]))
+assert r["samples"] == r["samples_in_computed_cells"] == 100000, r
+assert r["samples_agree"] and all(s["agrees"] for s in r["shares"]), r["shares"]
+assert 0.98 < r["samples_as_labelled"] / 1e5 < 1, r["samples_as_labelled"]
+assert sum(s["sampled"] for s in r["shares"]) == 100000, r["shares"]
+for s in r["shares"]:
+    assert s["sampled_lo"] <= s["share"] <= s["sampled_hi"] < s["sampled_lo"] + 0.008, s
+rows = [x for x in csv.DictReader(open(sys.argv[2])) if x["measure"] == "sampled"]
+assert [float(x["value"]) for x in rows] == [s["sampled_share"] for s in r["shares"]], rows
+PY
+expect_usage "--samples: give N[:SEED]" measure newton.cmdb --samples 0
+expect_usage "at most 100000000" measure newton.cmdb --samples 100000001
+
+# Duffing (docs/models.md 11.2, four attractors with fractal basins; release
+# build only, 20 s): at 1000 x 1000 cells every cell share lies within the
+# sampled interval; at 300 x 300 the check finds the lattice too coarse
+if [ -z "${CELLMAP_SANITIZE:-}" ]; then
+  "$CM" solve --model duffing --cells 1000x1000 --db duffing.cmdb --quiet || fail "solve duffing"
+  "$CM" solve --model duffing --cells 300x300 --db duffing-300.cmdb --quiet || fail "solve duffing 300"
+  "$CM" measure duffing.cmdb --samples 100000 --entropy none --uncertainty none --wada none \
+    --json > duffing.json || fail "measure duffing --samples"
+  "$CM" measure duffing-300.cmdb --samples 20000 --entropy none --uncertainty none --wada none \
+    > duffing-300.txt || fail "measure duffing-300 --samples"
+  python3 - duffing.json <<'PY' || fail "duffing's sampled shares"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert [s["label"] for s in r["shares"]] == [1, 2, 3, 4], r["shares"]
+assert r["samples_agree"] and all(s["agrees"] for s in r["shares"]), r["shares"]
+PY
+  grep -q "differs" duffing-300.txt && grep -q "the lattice is too coarse" duffing-300.txt \
+    || fail "duffing at 300 x 300: no share outside its sampled interval: $(cat duffing-300.txt)"
+fi
+
 # bad input: exit 2, nothing written
 expect_usage "do not fit the window" measure line.cmdb --entropy 20000 --csv no.csv
 expect_usage "needs 3 or more basins" measure line.cmdb --wada 3 --csv no.csv

@@ -155,10 +155,12 @@ static void analyses(void)
     }
     cm_measure_options mso = cm_measure_defaults();
     mso.file = "c_split.cmdb", mso.to = "c_resumed.cmdb", mso.window = "0:100,-40:40";
+    mso.samples = 2000;
     a = outputs("measure", f, 1);
     cm_measures ms;
     must(cm_analysis_measure(&a, &mso, &ms, msg, sizeof msg), "measure", msg);
-    if (ms.computed == 0 || ms.computed > ms.cells || !(ms.alpha > 0)) {
+    if (ms.computed == 0 || ms.computed > ms.cells || !(ms.alpha > 0) || ms.sampled == 0 ||
+        ms.sampled_as_labelled > ms.sampled) {
         fprintf(stderr, "measure: %llu of %llu cells, alpha %g\n",
                 (unsigned long long)ms.computed, (unsigned long long)ms.cells, ms.alpha);
         exit(1);

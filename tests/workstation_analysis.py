@@ -72,10 +72,13 @@ em, curves = an.embedding("tau2", start=(1, 0.1, 0.2, 0.3), time=200, transient=
 rows(curves, p + "embedding.csv")
 assert em["embedding_dim"] == 3 and 0.2 < em["lambda"] < 0.5, em
 ms, table = an.measure(p + "split.cmdb", to=p + "resumed.cmdb", window="0:100,-40:40",
-                       **out("measure"))
+                       samples=2000, **out("measure"))
 rows(table, p + "measure.csv")
 shares = table[table["measure"] == "share"]
 assert ms["computed"] > 0 and abs(shares["value"].sum() - 1) < 1e-12, (ms, shares)
+sampled = table[table["measure"] == "sampled"]
+assert 0 < ms["sampled_as_labelled"] <= ms["sampled"] <= 2000, ms
+assert abs(sampled["value"].sum() - 1) < 1e-12 and len(sampled) == len(shares), sampled
 
 # without files: the tables alone, from temporary files
 t = an.partition(params={"a": 1.3, "b": 0.66})

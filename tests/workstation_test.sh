@@ -103,8 +103,8 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
     --csv cli_series.csv --png cli_series.png --spectrum cli_series_spectrum.csv &&
   "$CM" exponents --param xi=4.8 --from 1,0.1,0.2,0.3 --series tau2 --time 200 --transient 10 \
     --dt 0.005 --steps 10 --csv cli_embedding.csv --png cli_embedding.png &&
-  "$CM" measure cli_split.cmdb --to cli_split.cmdb --window 0:100,-40:40 --csv cli_measure.csv \
-    --png cli_measure.png --quiet; } > analyses.log 2>&1 ||
+  "$CM" measure cli_split.cmdb --to cli_split.cmdb --window 0:100,-40:40 --samples 2000 \
+    --csv cli_measure.csv --png cli_measure.png --quiet; } > analyses.log 2>&1 ||
   fail "the analysis commands: $(tail -3 analyses.log)"
 ANALYSES="stability partition amplitude horseshoe escape simulate bifurcation lyapunov continue exponents series
   embedding"

@@ -114,14 +114,16 @@ class _Measure(ctypes.Structure):
                 ("box", ctypes.c_int * 8), ("n_box", ctypes.c_int), ("eps_lo", ctypes.c_int),
                 ("eps_hi", ctypes.c_int), ("wada_radius", ctypes.c_int),
                 ("wada_required", ctypes.c_int), ("to", ctypes.c_char_p),
-                ("mem", ctypes.c_uint64)]
+                ("mem", ctypes.c_uint64), ("samples", ctypes.c_uint64),
+                ("seed", ctypes.c_uint64), ("threads", ctypes.c_int)]
 
 
 class _MeasureOut(ctypes.Structure):
     _fields_ = [("cells", ctypes.c_uint64), ("computed", ctypes.c_uint64), ("sb", ctypes.c_double),
                 ("sbb", ctypes.c_double), ("alpha", ctypes.c_double),
                 ("alpha_r2", ctypes.c_double), ("wada_basins", ctypes.c_int),
-                ("wada_fraction", ctypes.c_double)]
+                ("wada_fraction", ctypes.c_double), ("sampled", ctypes.c_uint64),
+                ("sampled_as_labelled", ctypes.c_uint64), ("samples_agree", ctypes.c_int)]
 
 
 class _Simulate(ctypes.Structure):
@@ -454,16 +456,19 @@ def embedding(of, input=None, start=None, time=None, transient=None, dt=None, va
 
 
 def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5,
-            wada_required=False, to=None, mem=None, csv=None, png=None, size=None):
+            wada_required=False, to=None, mem=None, samples=0, seed=1, threads=0, csv=None,
+            png=None, size=None):
     """A .cmdb file's basins measured (`cellmap measure`): entropy the box
     sizes of basin entropy (() for none), uncertainty (E0, E1) the eps range
     (None for none), wada the Wada test's radius (0 for none), to a second
-    file on the same lattice for the tipping probabilities, png the figure
+    file on the same lattice for the tipping probabilities, samples random
+    states (seed their stream) followed by their true orbits, png the figure
     of a 2-D window. Returns
     (summary, table): summary a dict of cells, computed, sb, sbb (means over
-    the boxes), alpha, alpha_r2, wada_basins and wada_fraction (None where
-    not measured); table the rows measure, scale, value (share, sb, sbb,
-    uncertain, wada, tipping)."""
+    the boxes), alpha, alpha_r2, wada_basins and wada_fraction, sampled (in
+    computed cells), sampled_as_labelled and samples_agree (None where not
+    measured); table the rows measure, scale, value (share, sampled, sb,
+    sbb, uncertain, wada, tipping)."""
     o = _lib.cm_measure_defaults()
     keep = [_path(file), _text(window) if window is not None else None, _path(to)]
     o.file, o.window, o.to = keep
@@ -476,6 +481,7 @@ def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5
     o.wada_radius, o.wada_required = int(wada), int(bool(wada_required))
     if mem is not None:
         o.mem = int(mem)
+    o.samples, o.seed, o.threads = int(samples), int(seed), int(threads)
     res = _MeasureOut()
     table = _run(_common(csv=csv, png=png, size=size), _lib.cm_analysis_measure, ctypes.byref(o),
                  ctypes.byref(res))
@@ -483,7 +489,10 @@ def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5
     return ({"cells": res.cells, "computed": res.computed, "sb": nan(res.sb), "sbb": nan(res.sbb),
              "alpha": nan(res.alpha), "alpha_r2": nan(res.alpha_r2),
              "wada_basins": res.wada_basins or None,
-             "wada_fraction": nan(res.wada_fraction) if res.wada_basins else None}, table)
+             "wada_fraction": nan(res.wada_fraction) if res.wada_basins else None,
+             "sampled": res.sampled or None,
+             "sampled_as_labelled": res.sampled_as_labelled if res.sampled else None,
+             "samples_agree": bool(res.samples_agree) if res.sampled else None}, table)
 
 
 def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
