@@ -35,6 +35,31 @@ static bool next(int dim, int64_t *i, const int64_t *n)
     return false;
 }
 
+/* The grid's place in its window (cm_label_grid): the core's rows, and
+ * the window row of its row 0 and the window's rows. */
+typedef struct slab {
+    int64_t core_lo, core_hi, row0, rows;
+} slab;
+
+static slab slab_of(const cm_label_grid *g)
+{
+    if (g->window_rows == 0)
+        return (slab){0, g->n[0], 0, g->n[0]};
+    return (slab){g->core_lo, g->core_hi, g->row0, g->window_rows};
+}
+
+/* next() over first .. n[0] - 1 along dimension 0 and 0 .. n[d] - 1 along
+ * the others. */
+static bool next_from(int dim, int64_t *i, int64_t first, const int64_t *n)
+{
+    for (int d = dim - 1; d >= 0; d--) {
+        if (++i[d] < n[d])
+            return true;
+        i[d] = d ? 0 : first;
+    }
+    return false;
+}
+
 static int64_t index_of(int dim, const int64_t *i, const int64_t *s)
 {
     int64_t k = 0;
@@ -80,15 +105,24 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, dou
 {
     memset(out, 0, sizeof *out);
     out->eps = eps, out->sb = out->sbb = NAN;
+    const slab sl = slab_of(g);
     int64_t boxes[CM_MAX_DIM], s[CM_MAX_DIM], at[CM_MAX_DIM] = {0};
     for (int d = 0; d < g->dim; d++) {
-        boxes[d] = eps >= 1 ? g->n[d] / eps : 0;
+        const int64_t n = d ? g->n[d] : sl.rows;
+        boxes[d] = eps >= 1 ? n / eps : 0;
         if (boxes[d] < 1)
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "boxes of %d cells a side do not fit the window's %lld cells along "
                            "dimension %d: choose a smaller box or a larger window",
-                           eps, (long long)g->n[d], d + 1);
+                           eps, (long long)n, d + 1);
     }
+    /* the boxes along dimension 0 that start in the core (window rows) */
+    const int64_t first = (sl.row0 + sl.core_lo + eps - 1) / eps;
+    int64_t last = (sl.row0 + sl.core_hi + eps - 1) / eps; /* past the last */
+    last = last < boxes[0] ? last : boxes[0];
+    if (first >= last)
+        return CM_OK;
+    at[0] = first, boxes[0] = last;
     strides(g, s);
     const double box_cells = pow(eps, g->dim);
     const size_t labels = (size_t)(g->hi - g->lo + 1); /* a box holds at most these */
@@ -101,7 +135,7 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, dou
     do {
         int64_t corner[CM_MAX_DIM];
         for (int d = 0; d < g->dim; d++)
-            corner[d] = at[d] * eps;
+            corner[d] = at[d] * eps - (d ? 0 : sl.row0);
         const bool computed = count_box(g, s, corner, eps, &t);
         double h = 0;
         for (int k = 0; k < t.n_used; k++) {
@@ -117,8 +151,9 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, dou
         out->boxes++, sum += h;
         if (t.n_used > 1)
             out->boundary++, sum_boundary += h;
-    } while (next(g->dim, at, boxes));
+    } while (next_from(g->dim, at, first, boxes));
     free(t.count), free(t.used);
+    out->sum = sum, out->sum_boundary = sum_boundary;
     if (out->boxes)
         out->sb = sum / (double)out->boxes;
     if (out->boundary)
@@ -129,17 +164,25 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, dou
 /* ---- uncertain cells ---- */
 
 cm_status cm_uncertain_fraction(const cm_label_grid *g, int eps, double *fraction,
-                                uint64_t *counted, char *msg, size_t msg_size)
+                                uint64_t *counted, uint64_t *uncertain_out, char *msg,
+                                size_t msg_size)
 {
     *fraction = NAN, *counted = 0;
+    if (uncertain_out)
+        *uncertain_out = 0;
     if (eps < 1)
         return cm_fail(CM_EINVAL, msg, msg_size, "eps must be at least one cell (%d)", eps);
-    int64_t s[CM_MAX_DIM], i[CM_MAX_DIM] = {0};
+    const slab sl = slab_of(g);
+    if (sl.core_lo >= sl.core_hi)
+        return CM_OK;
+    int64_t s[CM_MAX_DIM], i[CM_MAX_DIM] = {sl.core_lo}, end[CM_MAX_DIM];
+    memcpy(end, g->n, sizeof end);
+    end[0] = sl.core_hi;
     strides(g, s);
     uint64_t uncertain = 0;
     do {
-        bool inside = true;
-        for (int d = 0; d < g->dim && inside; d++)
+        bool inside = sl.row0 + i[0] >= eps && sl.row0 + i[0] + eps < sl.rows;
+        for (int d = 1; d < g->dim && inside; d++)
             inside = i[d] >= eps && i[d] + eps < g->n[d];
         const int64_t k = index_of(g->dim, i, s);
         const int32_t own = g->label[k];
@@ -153,9 +196,11 @@ cm_status cm_uncertain_fraction(const cm_label_grid *g, int eps, double *fractio
         }
         if (computed)
             (*counted)++, uncertain += differs;
-    } while (next(g->dim, i, g->n));
+    } while (next_from(g->dim, i, sl.core_lo, end));
     if (*counted)
         *fraction = (double)uncertain / (double)*counted;
+    if (uncertain_out)
+        *uncertain_out = uncertain;
     return CM_OK;
 }
 
@@ -172,7 +217,7 @@ static int labels_near(const cm_label_grid *g, const int64_t *s, const int64_t *
                        int enough, seen *v)
 {
     int64_t lo[CM_MAX_DIM], side[CM_MAX_DIM], in[CM_MAX_DIM] = {0};
-    for (int d = 0; d < g->dim; d++) {
+    for (int d = 0; d < g->dim; d++) { /* a slab's rows beyond r are the window's edge */
         lo[d] = i[d] - r < 0 ? 0 : i[d] - r;
         side[d] = (i[d] + r >= g->n[d] ? g->n[d] - 1 : i[d] + r) - lo[d] + 1;
     }
@@ -215,7 +260,7 @@ cm_status cm_wada_test(const cm_label_grid *g, int radius, cm_wada *out, char *m
     seen v = {calloc((size_t)(g->hi - g->lo + 1), sizeof *v.stamp), 0};
     if (!v.stamp)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
-    out->basins = count_basins(g, &v), out->radius = radius;
+    out->basins = g->basins ? g->basins : count_basins(g, &v), out->radius = radius;
     if (out->basins < 3) {
         free(v.stamp);
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -223,10 +268,15 @@ cm_status cm_wada_test(const cm_label_grid *g, int radius, cm_wada *out, char *m
                        "every boundary cell touches both",
                        out->basins);
     }
-    int64_t s[CM_MAX_DIM], i[CM_MAX_DIM] = {0};
+    const slab sl = slab_of(g);
+    int64_t s[CM_MAX_DIM], i[CM_MAX_DIM] = {sl.core_lo}, end[CM_MAX_DIM];
+    memcpy(end, g->n, sizeof end);
+    end[0] = sl.core_hi;
     strides(g, s);
-    uint64_t sees_all[16] = {0};
+    uint64_t *sees_all = out->seeing;
     do {
+        if (sl.core_lo >= sl.core_hi)
+            break;
         if (g->label[index_of(g->dim, i, s)] == CM_LABEL_UNCOMPUTED ||
             labels_near(g, s, i, 1, 2, &v) < 2)
             continue;
@@ -238,7 +288,7 @@ cm_status cm_wada_test(const cm_label_grid *g, int radius, cm_wada *out, char *m
                 break;
             }
         }
-    } while (next(g->dim, i, g->n));
+    } while (next_from(g->dim, i, sl.core_lo, end));
     free(v.stamp);
     for (int r = 1; r <= radius; r++)
         out->fraction[r - 1] =

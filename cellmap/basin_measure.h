@@ -32,18 +32,32 @@
 
 /* Labels over a window: n[d] cells along dimension d, C order (dimension
  * 0 the slowest), values in lo .. hi (the caller's bounds: -2 .. the
- * largest attractor id). */
+ * largest attractor id).
+ *
+ * A grid may be a slab of a window too large to hold (window_rows 0: the
+ * grid is the whole window): its rows along dimension 0 are the window's
+ * rows row0 .. row0 + n[0] - 1 of window_rows, and only the cells of its
+ * rows core_lo .. core_hi - 1 are measured (the boxes starting there, for
+ * basin entropy); the rows around the core are their neighbours, and must
+ * reach as far as the measure looks (eps - 1 rows below the core for boxes
+ * of eps, eps rows each side for uncertain cells, the radius each side for
+ * the Wada test) or to the window's edge. The counts of slabs whose cores
+ * tile the window add up to the window's (the sums, boxes, counted,
+ * boundary and seeing fields). */
 typedef struct cm_label_grid {
     int dim;
     int64_t n[CM_MAX_DIM];
     const int32_t *label;
     int32_t lo, hi;
+    int64_t row0, window_rows, core_lo, core_hi;
+    int basins; /* the Wada test's basins in the whole window (0: those of the grid) */
 } cm_label_grid;
 
 typedef struct cm_entropy {
     int eps;               /* cells a side */
     uint64_t boxes;        /* full boxes of computed cells */
     uint64_t boundary;     /* those with more than one label */
+    double sum, sum_boundary; /* of their entropies */
     double sb, sbb;        /* NAN without boxes / boundary boxes */
 } cm_entropy;
 
@@ -55,16 +69,18 @@ cm_status cm_basin_entropy(const cm_label_grid *g, int eps, cm_entropy *out, dou
                            char *msg, size_t msg_size);
 
 /* The fraction of eps-uncertain cells among those whose 2d neighbours eps
- * away lie in the window, all computed (*counted of them); NAN when none.
- * CM_EINVAL when eps < 1. */
+ * away lie in the window, all computed (*counted of them, *uncertain
+ * uncertain; may be NULL); NAN when none. CM_EINVAL when eps < 1. */
 cm_status cm_uncertain_fraction(const cm_label_grid *g, int eps, double *fraction,
-                                uint64_t *counted, char *msg, size_t msg_size);
+                                uint64_t *counted, uint64_t *uncertain, char *msg,
+                                size_t msg_size);
 
 typedef struct cm_wada {
     int basins;                /* distinct labels among the computed cells */
     uint64_t boundary;         /* boundary cells */
     int radius;                /* fraction[0 .. radius - 1] for r = 1 .. radius */
-    double fraction[16];       /* boundary cells seeing every basin within r */
+    uint64_t seeing[16];       /* boundary cells seeing every basin within r */
+    double fraction[16];       /* their share of the boundary cells */
 } cm_wada;
 
 /* The Wada test with r = 1 .. radius (1..16). CM_EINVAL for a radius out

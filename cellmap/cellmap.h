@@ -726,10 +726,14 @@ typedef struct cm_sweep_options {
     int refine;            /* bisections of each change of the count, 0..40 */
     int max_steps;         /* of cell mapping, 0: 1 */
     int by_groups;         /* 1: count cell mapping's groups, not the system's attractors */
+    const char *fractions; /* the tracked attractors' basin shares per value as CSV, or NULL */
+    double match_within;   /* tracking's distance, a share of the region; 0: 0.05 */
 } cm_sweep_options;
 
 /* A model solved at each value of one parameter, its attractors and
- * sticking zones counted in the window; the table only (no figure). */
+ * sticking zones counted in the window, the attractors tracked across the
+ * values (`cellmap sweep`): a->csv the counts per value, o->fractions the
+ * basin shares, a->png those shares stacked against the parameter. */
 cm_status cm_analysis_sweep(const cm_analysis *a, const cm_sweep_options *o, char *msg, size_t msg_size);
 
 typedef struct cm_continue_options {

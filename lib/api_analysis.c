@@ -28,6 +28,7 @@
 #include "lib/simulate.h"
 #include "lib/stability.h"
 #include "lib/sweep.h"
+#include "lib/sweep_report.h"
 
 /* ---- what every driver takes ---- */
 
@@ -670,6 +671,7 @@ static cm_status sweep_args_of(const cm_sweep_options *o, sweep_args *sa, char *
     for (int d = 0; d < o->n_near; d++)
         sa->near_lo[d] = o->near_lo[d], sa->near_hi[d] = o->near_hi[d];
     sa->refine = o->refine, sa->max_steps = o->max_steps;
+    sa->fractions = o->fractions, sa->match = o->match_within;
     sa->by = o->by_groups ? BY_GROUPS : BY_ATTRACTORS, sa->quiet = true;
     return CM_OK;
 }
@@ -682,11 +684,15 @@ cm_status cm_analysis_sweep(const cm_analysis *a, const cm_sweep_options *o, cha
     sweep_args sa;
     memset(&sa, 0, sizeof sa);
     model_of(a, "microchaos-pd", &sa.mo);
-    sa.threads = a->threads, sa.csv = a->csv;
-    cm_status st = a->png ? cm_fail(CM_EINVAL, msg, msg_size, "a sweep draws no figure")
-                          : sweep_args_of(o, &sa, msg, msg_size);
+    sa.threads = a->threads, sa.csv = a->csv, sa.png = a->png;
+    sa.width = a->width, sa.height = a->height;
+    cm_status st = sweep_args_of(o, &sa, msg, msg_size);
     if (st == CM_OK)
         st = outfile_check_path(a->csv, false, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(o->fractions, false, msg, msg_size);
+    if (st == CM_OK && a->png)
+        st = outfile_check_chart(a->png, msg, msg_size);
     if (st != CM_OK)
         return st;
     sweep_result r;
@@ -695,6 +701,8 @@ cm_status cm_analysis_sweep(const cm_analysis *a, const cm_sweep_options *o, cha
         st = sweep_compute(&sa, NULL, NULL, &r, msg, msg_size);
     if (st == CM_OK && sa.csv && !sweep_write_csv(&sa, r.pts, r.n, msg, msg_size))
         st = CM_EIO;
+    if (st == CM_OK)
+        st = sweep_write_tracked(&sa, &r, msg, msg_size);
     sweep_result_free(&r);
     return st;
 }

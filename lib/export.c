@@ -837,11 +837,11 @@ static bool copy_slab(void *user, const cm_region *flat, const int32_t *label, c
     return true;
 }
 
-cm_status export_labels(exporter *ex, int32_t *labels, const work_hooks *hooks, char *msg,
-                        size_t msg_size)
+cm_status export_labels(exporter *ex, const cm_box *box, int32_t *labels,
+                        const work_hooks *hooks, char *msg, size_t msg_size)
 {
-    slab_memory m = {labels, &ex->window};
-    return each_slab(ex->c, &ex->window, &ex->att, &ex->ends.computed, hooks,
+    slab_memory m = {labels, box};
+    return each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
                      "the labels were not read", copy_slab, &m, msg, msg_size);
 }
 

@@ -81,11 +81,11 @@ cm_status export_cells(exporter *x, const char *cells, const char *flat, const w
 cm_status export_arrays(exporter *x, const char *labels, const char *steps, bool by_groups,
                         const work_hooks *hooks, char *msg, size_t msg_size);
 
-/* The window's cells' labels by attractors (as the .npy array of
- * export_arrays has them) into labels (the window's cells, C order, the
- * caller's), read a slab at a time. hooks count cells. */
-cm_status export_labels(exporter *x, int32_t *labels, const work_hooks *hooks, char *msg,
-                        size_t msg_size);
+/* The labels by attractors (as the .npy array of export_arrays has them)
+ * of the cells of box (within the window) into labels (box's cells, C
+ * order, the caller's), read a slab at a time. hooks count cells. */
+cm_status export_labels(exporter *x, const cm_box *box, int32_t *labels,
+                        const work_hooks *hooks, char *msg, size_t msg_size);
 
 /* An array's sidecar path: FILE.npy -> FILE.json. */
 void export_sidecar_path(const char *npy, char *out, size_t size);

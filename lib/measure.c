@@ -57,38 +57,93 @@ static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
 
 /* ---- the window's labels ---- */
 
-/* One file's labels over a window: given as text (a->window), as the
- * cells of another file's window (box, on the same lattice), or all. */
-typedef struct file_labels {
-    char model[64];
-    char names[2][32];  /* the first two state coordinates' */
-    cm_lattice lat;
-    cm_box window;
-    uint32_t attractors;
-    int32_t *label; /* the window's cells, C order */
-    int32_t *fate;  /* with samples: each sampled state's fate by its true orbit, or
-                       CM_LABEL_UNCOMPUTED for a state in a cell not computed */
-    uint64_t fate_steps, fate_same; /* steps taken; fates equal to their cell's label */
-    double fate_seconds;
-} file_labels;
+/* One file open for reading its labels over a window: given as text
+ * (a->window), as the cells of another file's window (box, on the same
+ * lattice), or all. Its cluster is paged within the budget. */
+typedef struct source {
+    cm_store *s;
+    cm_store_info info;
+    cm_cluster c;
+    exporter x;
+    bool cluster, exporting; /* what is open */
+} source;
 
-/* The fates of a->samples random states of the window by their true
- * orbits (the file's model rebuilt from its records, plugins included),
- * those in cells not computed left out (CM_LABEL_UNCOMPUTED). */
-static cm_status sample_fates(const measure_args *a, const exporter *x, file_labels *out,
+static void source_close(source *src)
+{
+    if (src->exporting)
+        exporter_close(&src->x);
+    if (src->cluster)
+        project_close(src->s, &src->c);
+    src->cluster = src->exporting = false;
+}
+
+static cm_status source_open(const char *file, uint64_t mem, const char *window_text,
+                             const cm_box *box, const cm_lattice *same, source *src, char *msg,
+                             size_t msg_size)
+{
+    memset(src, 0, sizeof *src);
+    cm_status st = project_probe(file, msg, msg_size);
+    if (st == CM_OK)
+        st = project_open_cluster(file, mem, &src->s, &src->info, &src->c, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    src->cluster = true;
+    cm_box window;
+    const cm_attractor_options stored = {0};
+    if (same && !cm_lattice_equal(same, &src->c.lat))
+        st = cm_fail(CM_EINVAL, msg, msg_size,
+                     "%s has another lattice than the first file: tipping compares two files "
+                     "cell by cell, solved on one lattice (the same --region and --cells)",
+                     file);
+    else if (window_text)
+        st = export_window(&src->c, window_text, &window, msg, msg_size);
+    if (st == CM_OK)
+        st = exporter_open(&src->x, src->s, &src->info, &src->c,
+                           box ? box : window_text ? &window : NULL, file, &stored, msg,
+                           msg_size);
+    src->exporting = st == CM_OK;
+    if (st != CM_OK)
+        source_close(src);
+    return st;
+}
+
+/* Rows lo .. hi - 1 (along dimension 0, counted from the window's first)
+ * of the window, as a box. */
+static cm_box rows_box(const cm_box *window, int64_t lo, int64_t hi)
+{
+    cm_box b = *window;
+    b.lo[0] = window->lo[0] + lo, b.hi[0] = window->lo[0] + hi;
+    return b;
+}
+
+/* The sampled states (cellmap/attractor_fates.h): each one's fate and its
+ * cell's index in the window (UINT64_MAX: outside it). */
+typedef struct sampled {
+    uint64_t n;
+    int32_t *fate; /* CM_LABEL_UNCOMPUTED once its cell proves not computed */
+    uint64_t *at;
+    uint64_t steps, same;
+    double seconds;
+} sampled;
+
+static cm_status sample_fates(const measure_args *a, const source *src, sampled *out,
                               char *msg, size_t msg_size)
 {
-    cm_model_set set = {0};
-    cm_model m;
-    const int dim = out->lat.dim;
+    const cm_lattice *lat = &src->c.lat;
+    const cm_box *w = &src->x.window;
+    const int dim = lat->dim;
     double *state = malloc((size_t)a->samples * dim * sizeof *state);
+    out->n = a->samples;
     out->fate = malloc((size_t)a->samples * sizeof *out->fate);
-    if (!state || !out->fate) {
+    out->at = malloc((size_t)a->samples * sizeof *out->at);
+    if (!state || !out->fate || !out->at) {
         free(state);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu samples",
                        (unsigned long long)a->samples);
     }
-    cm_status st = model_of_store(x->info, &set, &m, msg, msg_size);
+    cm_model_set set = {0};
+    cm_model m;
+    cm_status st = model_of_store(&src->info, &set, &m, msg, msg_size);
     if (st != CM_OK) {
         cm_model_set_close(&set);
         free(state);
@@ -96,102 +151,105 @@ static cm_status sample_fates(const measure_args *a, const exporter *x, file_lab
                        msg);
     }
     const double t = cm_seconds();
-    cm_sample_states(&out->lat, &out->window, a->seed, a->samples, state);
-    st = cm_attractor_fates(&m, &out->lat, &x->att, state, a->samples, a->sample_steps,
-                            a->threads, out->fate, &out->fate_steps, msg, msg_size);
-    for (uint64_t i = 0; st == CM_OK && i < a->samples; i++) {
+    cm_sample_states(lat, w, a->seed, a->samples, state);
+    st = cm_attractor_fates(&m, lat, &src->x.att, state, a->samples, a->sample_steps,
+                            a->threads, out->fate, &out->steps, msg, msg_size);
+    for (uint64_t i = 0; i < a->samples; i++) {
         int64_t cell[CM_MAX_DIM];
-        uint64_t at = 0;
-        const bool in = cm_lattice_cell(&out->lat, state + i * dim, cell) &&
-                        cm_box_contains(&out->window, cell);
+        const bool in = cm_lattice_cell(lat, state + i * dim, cell) && cm_box_contains(w, cell);
+        out->at[i] = in ? 0 : UINT64_MAX;
         for (int d = 0; in && d < dim; d++)
-            at = at * (uint64_t)(out->window.hi[d] - out->window.lo[d]) +
-                 (uint64_t)(cell[d] - out->window.lo[d]);
-        if (!in || out->label[at] == CM_LABEL_UNCOMPUTED)
-            out->fate[i] = CM_LABEL_UNCOMPUTED;
-        else
-            out->fate_same += out->fate[i] == out->label[at];
+            out->at[i] = out->at[i] * (uint64_t)(w->hi[d] - w->lo[d]) +
+                         (uint64_t)(cell[d] - w->lo[d]);
     }
-    out->fate_seconds = cm_seconds() - t;
+    out->seconds = cm_seconds() - t;
     cm_model_release(&m);
     cm_model_set_close(&set);
     free(state);
     return st;
 }
 
-static cm_status read_labels(const char *file, uint64_t mem, const char *window_text,
-                             const cm_box *box, const cm_lattice *same, const work_hooks *hooks,
-                             const measure_args *sample, file_labels *out, char *msg,
-                             size_t msg_size)
+/* How the window is read: whole when its labels (of every file) fit the
+ * budget, else in slabs of `core` rows along dimension 0 with `halo` rows
+ * each side, their labels within half the budget (the cluster's pages
+ * take the rest). */
+typedef struct plan {
+    int64_t rows, row_cells, core, halo;
+    int files;
+    bool whole;
+} plan;
+
+static cm_status plan_of(const measure_args *a, const cm_box *window, plan *p, char *msg,
+                         size_t msg_size)
 {
-    cm_store *s = NULL;
-    cm_store_info info;
-    cm_cluster c;
-    cm_status st = project_probe(file, msg, msg_size);
-    if (st == CM_OK)
-        st = project_open_cluster(file, mem, &s, &info, &c, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    cm_box window;
-    exporter x;
-    memset(&x, 0, sizeof x);
-    const cm_attractor_options stored = {0};
-    if (same && !cm_lattice_equal(same, &c.lat))
-        st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "%s has another lattice than the first file: tipping compares two files "
-                     "cell by cell, solved on one lattice (the same --region and --cells)",
-                     file);
-    else if (window_text)
-        st = export_window(&c, window_text, &window, msg, msg_size);
-    if (st == CM_OK)
-        st = exporter_open(&x, s, &info, &c, box ? box : window_text ? &window : NULL, file,
-                           &stored, msg, msg_size);
-    const uint64_t cells = st == CM_OK ? cm_box_cells(&x.window) : 0;
-    if (st == CM_OK && (double)cells * sizeof *out->label > (double)mem)
-        st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "the window's %llu cells need %.0f MiB of labels, over the budget of %.0f "
-                     "MiB: measure a smaller window, or raise the budget",
-                     (unsigned long long)cells, (double)cells * 4 / 1048576.0,
-                     (double)mem / 1048576.0);
-    if (st == CM_OK) {
-        snprintf(out->model, sizeof out->model, "%s", info.model);
-        const char *names[CM_MAX_DIM];
-        project_state_names(&info, names);
-        for (int d = 0; d < 2 && d < c.lat.dim; d++)
-            snprintf(out->names[d], sizeof out->names[d], "%s", names[d]);
-        out->lat = c.lat, out->window = x.window, out->attractors = x.att.n;
-        if (!(out->label = malloc(cells * sizeof *out->label)))
-            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu labels",
-                         (unsigned long long)cells);
+    memset(p, 0, sizeof *p);
+    p->rows = window->hi[0] - window->lo[0];
+    p->row_cells = (int64_t)(cm_box_cells(window) / (uint64_t)p->rows);
+    p->files = a->to ? 2 : 1;
+    const double row_bytes = (double)p->row_cells * sizeof(int32_t) * p->files;
+    p->whole = row_bytes * (double)p->rows <= (double)a->mem;
+    if (p->whole) {
+        p->core = p->rows;
+        return CM_OK;
     }
-    if (st == CM_OK)
-        st = export_labels(&x, out->label, hooks, msg, msg_size);
-    if (st == CM_OK && sample && sample->samples)
-        st = sample_fates(sample, &x, out, msg, msg_size);
-    exporter_close(&x);
-    project_close(s, &c);
-    return st;
+    for (int k = 0; k < a->n_box; k++)
+        p->halo = a->box[k] - 1 > p->halo ? a->box[k] - 1 : p->halo;
+    p->halo = a->eps_hi > p->halo ? a->eps_hi : p->halo;
+    p->halo = a->wada_radius > p->halo ? a->wada_radius : p->halo;
+    p->core = (int64_t)((double)a->mem / 2 / row_bytes) - 2 * p->halo;
+    if (p->core < 1)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a slab of the window (a row of %lld cells and the %lld rows each side "
+                       "the measures look at) needs %.1f MiB of labels, over half the budget "
+                       "of %.1f MiB: raise the budget, or measure a narrower window",
+                       (long long)p->row_cells, (long long)p->halo,
+                       row_bytes * (double)(1 + 2 * p->halo) / 1048576.0,
+                       (double)a->mem / 1048576.0);
+    p->core = p->core < p->rows ? p->core : p->rows;
+    return CM_OK;
 }
 
-/* The grid of the file's labels, and the window in r. */
-static void grid_of(const file_labels *f, measure_result *r, cm_label_grid *g)
-{
-    snprintf(r->model, sizeof r->model, "%s", f->model);
-    memcpy(r->names, f->names, sizeof r->names);
-    r->dim = g->dim = f->lat.dim, r->cells = cm_box_cells(&f->window);
-    for (int d = 0; d < r->dim; d++) {
-        r->n[d] = g->n[d] = f->window.hi[d] - f->window.lo[d];
-        r->lo[d] = f->lat.origin[d] + (double)f->window.lo[d] * f->lat.width[d];
-        r->hi[d] = f->lat.origin[d] + (double)f->window.hi[d] * f->lat.width[d];
-    }
-    g->label = f->label, g->lo = CM_LABEL_OUTSIDE, g->hi = (int32_t)f->attractors;
-}
+/* ---- the shares ---- */
 
 /* The k-th label in report order: the attractors 1 .. hi, then the
  * diverged (0) and outside (-2) cells; k in 0 .. hi + 1. */
 static int32_t ordered_label(int k, int32_t hi)
 {
     return k < hi ? k + 1 : k == hi ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+}
+
+/* What the first pass counts over the window's cells (label - lo
+ * indices, lo = CM_LABEL_OUTSIDE). */
+typedef struct tallies {
+    int32_t hi, to_hi;       /* the two files' largest attractor ids */
+    uint64_t *cells;         /* per label */
+    uint64_t *fates;         /* per label: the samples' fates */
+    uint64_t *tips;          /* per (label, to-label) */
+} tallies;
+
+static size_t tip_columns(const tallies *t) { return (size_t)t->to_hi + 3; }
+
+/* Counts the labels of window cells first .. first + n - 1 (and the
+ * second file's), and checks the samples whose cells are among them. */
+static void tally_cells(tallies *t, const int32_t *label, const int32_t *to_label,
+                        uint64_t first, uint64_t n, sampled *smp)
+{
+    for (uint64_t k = 0; k < n; k++) {
+        const int32_t from = label[k];
+        t->cells[from - CM_LABEL_OUTSIDE]++;
+        if (to_label && from != CM_LABEL_UNCOMPUTED && to_label[k] != CM_LABEL_UNCOMPUTED)
+            t->tips[(size_t)(from - CM_LABEL_OUTSIDE) * tip_columns(t) +
+                    (size_t)(to_label[k] - CM_LABEL_OUTSIDE)]++;
+    }
+    for (uint64_t i = 0; i < smp->n; i++) {
+        if (smp->at[i] == UINT64_MAX || smp->at[i] < first || smp->at[i] >= first + n)
+            continue;
+        const int32_t own = label[smp->at[i] - first];
+        if (own == CM_LABEL_UNCOMPUTED)
+            smp->fate[i] = CM_LABEL_UNCOMPUTED;
+        else
+            smp->same += smp->fate[i] == own;
+    }
 }
 
 /* The z whose two tails hold alpha of the standard normal distribution
@@ -224,31 +282,28 @@ static void wilson(double p, double n, double z, double *lo, double *hi)
  * k labels, so that a lattice whose shares are the true ones lies within
  * all of them 95 times in 100): a label is listed when cells or samples
  * have it. */
-static cm_status count_shares(const cm_label_grid *g, const file_labels *f, uint64_t samples,
-                              measure_result *r, char *msg, size_t msg_size)
+static cm_status shares_of(tallies *t, const sampled *smp, measure_result *r, char *msg,
+                           size_t msg_size)
 {
-    const int labels = g->hi - g->lo + 1;
-    uint64_t *count = calloc(2 * (size_t)labels, sizeof *count), *fates = count + labels;
+    const int labels = t->hi - CM_LABEL_OUTSIDE + 1;
     r->shares = calloc((size_t)labels, sizeof *r->shares);
-    if (!count || !r->shares) {
-        free(count);
+    if (!r->shares)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %d labels", labels);
-    }
-    for (uint64_t k = 0; k < r->cells; k++)
-        count[g->label[k] - g->lo]++;
-    for (uint64_t i = 0; i < samples; i++)
-        fates[f->fate[i] - g->lo]++;
-    r->computed = r->cells - count[CM_LABEL_UNCOMPUTED - g->lo];
-    r->samples = samples, r->sample_steps = f->fate_steps, r->sample_same = f->fate_same;
-    r->sampled = samples - fates[CM_LABEL_UNCOMPUTED - g->lo];
+    for (uint64_t i = 0; i < smp->n; i++)
+        t->fates[smp->fate[i] - CM_LABEL_OUTSIDE]++;
+    r->computed = r->cells - t->cells[CM_LABEL_UNCOMPUTED - CM_LABEL_OUTSIDE];
+    r->samples = smp->n, r->sample_steps = smp->steps, r->sample_same = smp->same;
+    r->sampled = smp->n - t->fates[CM_LABEL_UNCOMPUTED - CM_LABEL_OUTSIDE];
     r->samples_agree = r->sampled > 0;
     int listed = 0;
-    for (int k = 0; k <= g->hi + 1; k++)
-        listed += count[ordered_label(k, g->hi) - g->lo] || fates[ordered_label(k, g->hi) - g->lo];
+    for (int k = 0; k <= t->hi + 1; k++)
+        listed += t->cells[ordered_label(k, t->hi) - CM_LABEL_OUTSIDE] ||
+                  t->fates[ordered_label(k, t->hi) - CM_LABEL_OUTSIDE];
     const double z = normal_quantile(0.05 / (listed ? listed : 1));
-    for (int k = 0; k <= g->hi + 1; k++) {
-        const int32_t label = ordered_label(k, g->hi);
-        const uint64_t n = count[label - g->lo], m = fates[label - g->lo];
+    for (int k = 0; k <= t->hi + 1; k++) {
+        const int32_t label = ordered_label(k, t->hi);
+        const uint64_t n = t->cells[label - CM_LABEL_OUTSIDE];
+        const uint64_t m = t->fates[label - CM_LABEL_OUTSIDE];
         if (!n && !m)
             continue;
         const double p = (double)n / (double)r->computed;
@@ -263,42 +318,30 @@ static cm_status count_shares(const cm_label_grid *g, const file_labels *f, uint
             r->samples_agree = r->samples_agree && s->agrees;
         }
     }
-    free(count);
     return CM_OK;
 }
 
 /* Where each basin of the first file lies in the second's, cell by cell
  * (cells computed in both). */
-static cm_status tipping(const cm_label_grid *g, const file_labels *to, measure_result *r,
-                         char *msg, size_t msg_size)
+static cm_status tips_of(const tallies *t, measure_result *r, char *msg, size_t msg_size)
 {
-    const int32_t to_hi = (int32_t)to->attractors;
-    const size_t na = (size_t)(g->hi - g->lo + 1), nb = (size_t)to_hi + 3;
-    uint64_t *count = calloc(na * nb, sizeof *count);
-    r->tips = calloc(na * nb, sizeof *r->tips);
-    if (!count || !r->tips) {
-        free(count);
+    const size_t nb = tip_columns(t);
+    r->tips = calloc((size_t)(t->hi + 3) * nb, sizeof *r->tips);
+    if (!r->tips)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the tipping table");
-    }
-    for (uint64_t k = 0; k < r->cells; k++) {
-        const int32_t from = g->label[k], into = to->label[k];
-        if (from != CM_LABEL_UNCOMPUTED && into != CM_LABEL_UNCOMPUTED)
-            count[(size_t)(from - g->lo) * nb + (size_t)(into - CM_LABEL_OUTSIDE)]++;
-    }
-    for (int i = 0; i <= g->hi + 1; i++) {
-        const int32_t from = ordered_label(i, g->hi);
-        const uint64_t *row = count + (size_t)(from - g->lo) * nb;
+    for (int i = 0; i <= t->hi + 1; i++) {
+        const int32_t from = ordered_label(i, t->hi);
+        const uint64_t *row = t->tips + (size_t)(from - CM_LABEL_OUTSIDE) * nb;
         uint64_t total = 0;
         for (size_t j = 0; j < nb; j++)
             total += row[j];
-        for (int j = 0; j <= to_hi + 1; j++) {
-            const int32_t into = ordered_label(j, to_hi);
+        for (int j = 0; j <= t->to_hi + 1; j++) {
+            const int32_t into = ordered_label(j, t->to_hi);
             const uint64_t n = row[into - CM_LABEL_OUTSIDE];
             if (n)
                 r->tips[r->n_tips++] = (measure_tip){from, into, n, (double)n / (double)total};
         }
     }
-    free(count);
     return CM_OK;
 }
 
@@ -313,42 +356,6 @@ static void mean_spread(const double *v, int n, double *mean, double *spread)
             s += v[i], s2 += v[i] * v[i], k++;
     *mean = k ? s / k : NAN;
     *spread = k ? sqrt(fmax(0, s2 / k - *mean * *mean)) : NAN;
-}
-
-/* The first box size's map for the figure, x fastest as a heat map has it
- * (the kernel's boxes are in C order, dimension 0 slowest). */
-static cm_status entropy_map(const cm_label_grid *g, int box, measure_result *r, char *msg,
-                             size_t msg_size)
-{
-    const int64_t nx = g->n[0] / box, ny = g->n[1] / box;
-    double *boxes = malloc((size_t)(nx * ny) * sizeof *boxes);
-    r->entropy_map = malloc((size_t)(nx * ny) * sizeof *r->entropy_map);
-    cm_entropy e;
-    cm_status st = boxes && r->entropy_map
-                       ? cm_basin_entropy(g, box, &e, boxes, msg, msg_size)
-                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the entropy map");
-    for (int64_t i = 0; st == CM_OK && i < nx; i++)
-        for (int64_t j = 0; j < ny; j++)
-            r->entropy_map[j * nx + i] = boxes[i * ny + j];
-    r->map_n[0] = nx, r->map_n[1] = ny;
-    free(boxes);
-    return st;
-}
-
-static cm_status entropies(const measure_args *a, const cm_label_grid *g, measure_result *r,
-                           char *msg, size_t msg_size)
-{
-    double sb[MEASURE_MAX_BOXES], sbb[MEASURE_MAX_BOXES];
-    for (int k = 0; k < a->n_box; k++) {
-        const cm_status st = cm_basin_entropy(g, a->box[k], &r->entropy[k], NULL, msg, msg_size);
-        if (st != CM_OK)
-            return st;
-        sb[k] = r->entropy[k].sb, sbb[k] = r->entropy[k].sbb;
-        r->n_entropy++;
-    }
-    mean_spread(sb, a->n_box, &r->sb_mean, &r->sb_spread);
-    mean_spread(sbb, a->n_box, &r->sbb_mean, &r->sbb_spread);
-    return CM_OK;
 }
 
 /* log f against log eps by least squares: the slope and R^2. */
@@ -367,26 +374,248 @@ static void fit_alpha(measure_result *r)
     r->alpha_r2 = n >= 2 && vx > 0 && vy > 0 ? c * c / (vx * vy) : NAN;
 }
 
-static cm_status uncertain(const measure_args *a, const cm_label_grid *g, measure_result *r,
-                           char *msg, size_t msg_size)
+/* The second pass's sums over the slabs. */
+typedef struct sums {
+    uint64_t uncertain[MEASURE_MAX_EPS];
+    double *map_boxes; /* the first box size's boxes, C order (dimension 0 slowest) */
+} sums;
+
+/* Basin entropy on one slab g (its first row: window row `row0`),
+ * summed into r, the first box size's map into s->map_boxes. */
+static cm_status slab_entropy(const measure_args *a, const cm_label_grid *g, measure_result *r,
+                              sums *s, char *msg, size_t msg_size)
 {
-    for (int e = a->eps_lo; e <= a->eps_hi && r->n_eps < MEASURE_MAX_EPS; e *= 2) {
-        const cm_status st = cm_uncertain_fraction(g, e, &r->uncertain[r->n_eps],
-                                                   &r->counted[r->n_eps], msg, msg_size);
+    for (int k = 0; k < a->n_box; k++) {
+        const int eps = a->box[k];
+        const int64_t first = (g->row0 + g->core_lo + eps - 1) / eps; /* its first box row */
+        cm_entropy e;
+        double *map = k == 0 && s->map_boxes ? s->map_boxes + first * (g->n[1] / eps) : NULL;
+        const cm_status st = cm_basin_entropy(g, eps, &e, map, msg, msg_size);
         if (st != CM_OK)
             return st;
-        r->eps[r->n_eps++] = e;
+        cm_entropy *t = &r->entropy[k];
+        t->eps = eps, t->boxes += e.boxes, t->boundary += e.boundary;
+        t->sum += e.sum, t->sum_boundary += e.sum_boundary;
     }
-    fit_alpha(r);
     return CM_OK;
 }
 
-static cm_status wada(const measure_args *a, const cm_label_grid *g, measure_result *r,
-                      char *msg, size_t msg_size)
+static cm_status slab_uncertain(const measure_args *a, const cm_label_grid *g,
+                                measure_result *r, sums *s, char *msg, size_t msg_size)
 {
-    const cm_status st = cm_wada_test(g, a->wada_radius, &r->wada, msg, msg_size);
-    r->has_wada = st == CM_OK;
-    return st == CM_EINVAL && !a->wada_asked && r->wada.basins < 3 ? CM_OK : st;
+    int k = 0;
+    for (int e = a->eps_lo; e <= a->eps_hi && k < MEASURE_MAX_EPS; e *= 2, k++) {
+        double f;
+        uint64_t counted, uncertain;
+        const cm_status st = cm_uncertain_fraction(g, e, &f, &counted, &uncertain, msg,
+                                                   msg_size);
+        if (st != CM_OK)
+            return st;
+        r->eps[k] = e, r->counted[k] += counted, s->uncertain[k] += uncertain;
+    }
+    r->n_eps = k;
+    return CM_OK;
+}
+
+static cm_status slab_wada(const measure_args *a, const cm_label_grid *g, measure_result *r,
+                           char *msg, size_t msg_size)
+{
+    cm_wada w;
+    const cm_status st = cm_wada_test(g, a->wada_radius, &w, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    r->wada.basins = w.basins, r->wada.radius = w.radius, r->wada.boundary += w.boundary;
+    for (int k = 0; k < w.radius; k++)
+        r->wada.seeing[k] += w.seeing[k];
+    return CM_OK;
+}
+
+/* The measures' results from the slabs' sums. */
+static void finish_measures(const measure_args *a, const sums *s, measure_result *r)
+{
+    double sb[MEASURE_MAX_BOXES], sbb[MEASURE_MAX_BOXES];
+    for (int k = 0; k < a->n_box; k++) {
+        cm_entropy *e = &r->entropy[k];
+        e->sb = e->boxes ? e->sum / (double)e->boxes : NAN;
+        e->sbb = e->boundary ? e->sum_boundary / (double)e->boundary : NAN;
+        sb[k] = e->sb, sbb[k] = e->sbb;
+    }
+    r->n_entropy = a->n_box;
+    mean_spread(sb, a->n_box, &r->sb_mean, &r->sb_spread);
+    mean_spread(sbb, a->n_box, &r->sbb_mean, &r->sbb_spread);
+    for (int k = 0; k < r->n_eps; k++)
+        r->uncertain[k] = r->counted[k] ? (double)s->uncertain[k] / (double)r->counted[k] : NAN;
+    if (r->n_eps)
+        fit_alpha(r);
+    for (int k = 0; r->has_wada && k < r->wada.radius; k++)
+        r->wada.fraction[k] =
+            r->wada.boundary ? (double)r->wada.seeing[k] / (double)r->wada.boundary : NAN;
+}
+
+/* The entropy map for the figure, x fastest as a heat map has it. */
+static cm_status map_of(const measure_args *a, const sums *s, measure_result *r, char *msg,
+                        size_t msg_size)
+{
+    const int64_t nx = r->n[0] / a->box[0], ny = r->n[1] / a->box[0];
+    r->entropy_map = malloc((size_t)(nx * ny) * sizeof *r->entropy_map);
+    if (!r->entropy_map)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the entropy map");
+    for (int64_t i = 0; i < nx; i++)
+        for (int64_t j = 0; j < ny; j++)
+            r->entropy_map[j * nx + i] = s->map_boxes[i * ny + j];
+    r->map_n[0] = nx, r->map_n[1] = ny;
+    return CM_OK;
+}
+
+/* ---- the passes ---- */
+
+/* The labels of rows lo .. hi - 1 of the window, of both files. */
+static cm_status read_rows(source *src, source *to, int64_t lo, int64_t hi, int32_t *label,
+                           int32_t *to_label, const work_hooks *hooks, double *seconds, char *msg,
+                           size_t msg_size)
+{
+    const double t = cm_seconds();
+    const cm_box box = rows_box(&src->x.window, lo, hi);
+    cm_status st = export_labels(&src->x, &box, label, hooks, msg, msg_size);
+    if (st == CM_OK && to)
+        st = export_labels(&to->x, &box, to_label, hooks, msg, msg_size);
+    *seconds += cm_seconds() - t;
+    return st;
+}
+
+/* The window's place and size in r. */
+static void describe(const source *src, measure_result *r)
+{
+    const cm_lattice *lat = &src->c.lat;
+    const cm_box *w = &src->x.window;
+    snprintf(r->model, sizeof r->model, "%s", src->info.model);
+    const char *names[CM_MAX_DIM];
+    project_state_names(&src->info, names);
+    for (int d = 0; d < 2 && d < lat->dim; d++)
+        snprintf(r->names[d], sizeof r->names[d], "%s", names[d]);
+    r->dim = lat->dim, r->cells = cm_box_cells(w);
+    for (int d = 0; d < r->dim; d++) {
+        r->n[d] = w->hi[d] - w->lo[d];
+        r->lo[d] = lat->origin[d] + (double)w->lo[d] * lat->width[d];
+        r->hi[d] = lat->origin[d] + (double)w->hi[d] * lat->width[d];
+    }
+}
+
+/* What the request asks that the window cannot give, before any reading. */
+static cm_status check_window(const measure_args *a, const measure_result *r, char *msg,
+                              size_t msg_size)
+{
+    if (a->png && (r->dim != 2 || !a->n_box || !a->eps_hi))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the figure maps basin entropy over a 2-D window beside the uncertain "
+                       "fractions: it needs a 2-D model (this one has %d dimensions), --entropy "
+                       "and --uncertainty",
+                       r->dim);
+    for (int k = 0; k < a->n_box; k++)
+        for (int d = 0; d < r->dim; d++)
+            if (r->n[d] < a->box[k])
+                return cm_fail(CM_EINVAL, msg, msg_size,
+                               "boxes of %d cells a side do not fit the window's %lld cells "
+                               "along dimension %d: choose a smaller box or a larger window",
+                               a->box[k], (long long)r->n[d], d + 1);
+    return CM_OK;
+}
+
+/* The first pass: every label counted, the second file's beside it, the
+ * samples checked against their cells. */
+static cm_status count_pass(source *src, source *to, const plan *p, int32_t *label,
+                            int32_t *to_label, tallies *t, sampled *smp,
+                            const work_hooks *hooks, double *reading, char *msg,
+                            size_t msg_size)
+{
+    for (int64_t c0 = 0; c0 < p->rows; c0 += p->core) {
+        const int64_t c1 = c0 + p->core < p->rows ? c0 + p->core : p->rows;
+        const cm_status st = p->whole && c0 > 0 ? CM_OK
+                                                : read_rows(src, to, c0, c1, label, to_label,
+                                                            hooks, reading, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+        tally_cells(t, label, to_label, (uint64_t)(c0 * p->row_cells),
+                    (uint64_t)((c1 - c0) * p->row_cells), smp);
+    }
+    return CM_OK;
+}
+
+/* The second pass: each slab (with the rows around it) measured. */
+static cm_status measure_pass(const measure_args *a, source *src, const plan *p,
+                              int32_t *label, int32_t hi, int basins, measure_result *r,
+                              sums *s, const work_hooks *hooks, char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
+    for (int64_t c0 = 0; st == CM_OK && c0 < p->rows; c0 += p->core) {
+        const int64_t c1 = c0 + p->core < p->rows ? c0 + p->core : p->rows;
+        const int64_t lo = p->whole ? 0 : c0 - p->halo > 0 ? c0 - p->halo : 0;
+        const int64_t top = p->whole ? p->rows : c1 + p->halo < p->rows ? c1 + p->halo : p->rows;
+        if (!p->whole)
+            st = read_rows(src, NULL, lo, top, label, NULL, hooks, &r->seconds_read, msg,
+                           msg_size);
+        cm_label_grid g = {.dim = r->dim, .label = label, .lo = CM_LABEL_OUTSIDE, .hi = hi,
+                           .row0 = lo, .window_rows = p->rows, .core_lo = c0 - lo,
+                           .core_hi = c1 - lo, .basins = basins};
+        memcpy(g.n, r->n, sizeof g.n);
+        g.n[0] = top - lo;
+        double t = cm_seconds();
+        if (st == CM_OK && a->n_box)
+            st = slab_entropy(a, &g, r, s, msg, msg_size);
+        r->seconds_entropy += cm_seconds() - t, t = cm_seconds();
+        if (st == CM_OK && a->eps_hi)
+            st = slab_uncertain(a, &g, r, s, msg, msg_size);
+        r->seconds_uncertain += cm_seconds() - t, t = cm_seconds();
+        if (st == CM_OK && r->has_wada)
+            st = slab_wada(a, &g, r, msg, msg_size);
+        r->seconds_wada += cm_seconds() - t;
+    }
+    return st;
+}
+
+/* The basins the window holds (labels of computed cells). */
+static int basins_of(const tallies *t)
+{
+    int n = 0;
+    for (int32_t l = CM_LABEL_OUTSIDE; l <= t->hi; l++)
+        n += l != CM_LABEL_UNCOMPUTED && t->cells[l - CM_LABEL_OUTSIDE] > 0;
+    return n;
+}
+
+typedef struct buffers {
+    int32_t *label, *to_label;
+    sampled smp;
+    tallies t;
+    sums s;
+} buffers;
+
+static cm_status buffers_alloc(const measure_args *a, const plan *p, const source *src,
+                               const source *to, buffers *b, char *msg, size_t msg_size)
+{
+    const int64_t held = p->whole ? p->rows : p->core + 2 * p->halo;
+    const size_t n = (size_t)((held < p->rows ? held : p->rows) * p->row_cells);
+    b->label = malloc(n * sizeof *b->label);
+    b->to_label = to ? malloc(n * sizeof *b->to_label) : NULL;
+    b->t.hi = (int32_t)src->x.att.n, b->t.to_hi = to ? (int32_t)to->x.att.n : 0;
+    b->t.cells = calloc((size_t)b->t.hi + 3, sizeof *b->t.cells);
+    b->t.fates = calloc((size_t)b->t.hi + 3, sizeof *b->t.fates);
+    b->t.tips = to ? calloc(((size_t)b->t.hi + 3) * tip_columns(&b->t), sizeof *b->t.tips) : NULL;
+    const int64_t map_boxes = a->png ? (p->rows / a->box[0]) * (src->x.window.hi[1] -
+                                                                 src->x.window.lo[1]) / a->box[0]
+                                     : 0;
+    b->s.map_boxes = a->png ? calloc((size_t)map_boxes + 1, sizeof *b->s.map_boxes) : NULL;
+    if (!b->label || (to && (!b->to_label || !b->t.tips)) || !b->t.cells || !b->t.fates ||
+        (a->png && !b->s.map_boxes))
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %zu labels", n);
+    return CM_OK;
+}
+
+static void buffers_free(buffers *b)
+{
+    free(b->label), free(b->to_label);
+    free(b->smp.fate), free(b->smp.at);
+    free(b->t.cells), free(b->t.fates), free(b->t.tips);
+    free(b->s.map_boxes);
 }
 
 cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measure_result *r,
@@ -394,46 +623,50 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
 {
     memset(r, 0, sizeof *r);
     r->sb_mean = r->sb_spread = r->sbb_mean = r->sbb_spread = r->alpha = r->alpha_r2 = NAN;
-    file_labels from = {0}, to = {0};
-    cm_label_grid g = {0};
-    double t = cm_seconds();
+    source src = {0}, to = {0};
+    buffers b;
+    memset(&b, 0, sizeof b);
+    plan p;
     cm_status st = check_args(a, msg, msg_size);
     if (st == CM_OK)
-        st = read_labels(a->file, a->mem, a->window, NULL, NULL, hooks, a, &from, msg,
-                         msg_size);
-    if (st == CM_OK) {
-        grid_of(&from, r, &g);
-        st = count_shares(&g, &from, a->samples, r, msg, msg_size);
-    }
+        st = source_open(a->file, a->mem, a->window, NULL, NULL, &src, msg, msg_size);
     if (st == CM_OK && a->to)
-        st = read_labels(a->to, a->mem, NULL, &from.window, &from.lat, hooks, NULL, &to, msg,
-                         msg_size);
-    if (st == CM_OK && a->to) {
-        snprintf(r->to_model, sizeof r->to_model, "%s", to.model);
-        st = tipping(&g, &to, r, msg, msg_size);
+        st = source_open(a->to, a->mem, NULL, &src.x.window, &src.c.lat, &to, msg, msg_size);
+    if (st == CM_OK) {
+        describe(&src, r);
+        snprintf(r->to_model, sizeof r->to_model, "%s", a->to ? to.info.model : "");
+        st = check_window(a, r, msg, msg_size);
     }
-    r->seconds_sample = from.fate_seconds;
-    r->seconds_read = cm_seconds() - t - r->seconds_sample, t = cm_seconds();
-    if (st == CM_OK && a->png && (g.dim != 2 || !a->n_box || !a->eps_hi))
+    if (st == CM_OK)
+        st = plan_of(a, &src.x.window, &p, msg, msg_size);
+    if (st == CM_OK && a->samples)
+        st = sample_fates(a, &src, &b.smp, msg, msg_size);
+    r->seconds_sample = b.smp.seconds;
+    if (st == CM_OK)
+        st = buffers_alloc(a, &p, &src, a->to ? &to : NULL, &b, msg, msg_size);
+    if (st == CM_OK)
+        st = count_pass(&src, a->to ? &to : NULL, &p, b.label, b.to_label, &b.t, &b.smp, hooks,
+                        &r->seconds_read, msg, msg_size);
+    if (st == CM_OK)
+        st = shares_of(&b.t, &b.smp, r, msg, msg_size);
+    if (st == CM_OK && a->to)
+        st = tips_of(&b.t, r, msg, msg_size);
+    const int basins = st == CM_OK ? basins_of(&b.t) : 0;
+    if (st == CM_OK && a->wada_radius && a->wada_asked && basins < 3)
         st = cm_fail(CM_EINVAL, msg, msg_size,
-                     "the figure maps basin entropy over a 2-D window beside the uncertain "
-                     "fractions: it needs a 2-D model (this one has %d dimensions), --entropy "
-                     "and --uncertainty",
-                     g.dim);
-    if (st == CM_OK && a->n_box)
-        st = entropies(a, &g, r, msg, msg_size);
+                     "the Wada test needs 3 or more basins, and the window has %d: with 2 "
+                     "every boundary cell touches both",
+                     basins);
+    r->has_wada = a->wada_radius && basins >= 3;
+    if (st == CM_OK && (a->n_box || a->eps_hi || r->has_wada))
+        st = measure_pass(a, &src, &p, b.label, b.t.hi, basins, r, &b.s, hooks, msg, msg_size);
+    if (st == CM_OK)
+        finish_measures(a, &b.s, r);
     if (st == CM_OK && a->png)
-        st = entropy_map(&g, a->box[0], r, msg, msg_size);
-    r->seconds_entropy = cm_seconds() - t, t = cm_seconds();
-    if (st == CM_OK && a->eps_hi)
-        st = uncertain(a, &g, r, msg, msg_size);
-    r->seconds_uncertain = cm_seconds() - t, t = cm_seconds();
-    if (st == CM_OK && a->wada_radius)
-        st = wada(a, &g, r, msg, msg_size);
-    r->seconds_wada = cm_seconds() - t;
-    free(from.label);
-    free(from.fate);
-    free(to.label);
+        st = map_of(a, &b.s, r, msg, msg_size);
+    buffers_free(&b);
+    source_close(&to);
+    source_close(&src);
     return st;
 }
 

@@ -17,27 +17,38 @@ static bool in_window(const sweep_args *a, const cm_group_info *g)
     return true;
 }
 
-/* The system's attractors (cellmap/attractors.h) in the window: sticking
- * zones are kept as cell mapping gives them. */
-static void count_attractors(const sweep_args *a, const cm_attractor_set *s, uint32_t ngroups,
-                             sweep_point *pt)
+/* The system's attractors (cellmap/attractors.h) in the window, each
+ * kept for tracking (pt->att): sticking zones are kept as cell mapping
+ * gives them, counted only. */
+static cm_status count_attractors(const sweep_args *a, const cm_attractor_set *s,
+                                  uint32_t ngroups, sweep_point *pt)
 {
     pt->groups = ngroups;
+    pt->diverged_cells = s->diverged_cells + s->sink_diverged_cells;
+    pt->outside_cells = s->outside_cells, pt->undecided_cells = s->unresolved_cells;
+    pt->att = calloc((size_t)s->n + 1, sizeof *pt->att);
+    if (!pt->att)
+        return CM_ENOMEM;
     for (uint32_t k = 0; k < s->n; k++) {
         const cm_attractor *at = &s->a[k];
         cm_group_info as_group = {.kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
                                                                           : CM_GROUP_ATTRACTOR};
         memcpy(as_group.centre, at->centre, sizeof at->centre);
-        if (!in_window(a, &as_group))
-            continue;
-        if (at->kind == CM_ATTRACTOR_STICKING) {
+        if (!in_window(a, &as_group)) {
+            pt->elsewhere_cells += at->basin_cells;
+        } else if (at->kind == CM_ATTRACTOR_STICKING) {
             pt->sticking++;
             pt->sticking_cells += at->basin_cells;
         } else {
-            pt->attractors++;
+            sweep_attractor *t = &pt->att[pt->attractors++];
+            t->kind = at->kind, t->period = at->period, t->basin_cells = at->basin_cells;
+            memcpy(t->centre, at->centre, sizeof t->centre);
+            memcpy(t->lo, at->lo, sizeof t->lo);
+            memcpy(t->hi, at->hi, sizeof t->hi);
             pt->attractor_cells += at->basin_cells;
         }
     }
+    return CM_OK;
 }
 
 static void count_groups(const sweep_args *a, const cm_group_info *groups, uint32_t n,
@@ -61,7 +72,7 @@ cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_bo
                          double value, sweep_point *pt, char *msg, size_t msg_size)
 {
     memset(pt, 0, sizeof *pt);
-    pt->value = value;
+    pt->value = value, pt->cells = cm_box_cells(box);
     const double t0 = cm_seconds();
     cm_model m;
     const char *name = a->name;
@@ -88,12 +99,16 @@ cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_bo
         o.threads = a->threads;
         st = cm_region_attractors(&m, lat, &r, a->max_steps, &exits, groups, &o, &att, msg,
                                   msg_size);
-        if (st == CM_OK)
-            count_attractors(a, &att, r.ngroups, pt);
+        if (st == CM_OK && count_attractors(a, &att, r.ngroups, pt) != CM_OK)
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u attractors", att.n);
     } else if (st == CM_OK) {
         count_groups(a, groups, r.ngroups, pt);
     }
     cm_attractors_free(&att);
+    if (st != CM_OK) {
+        free(pt->att);
+        pt->att = NULL;
+    }
     cm_exits_free(&exits);
     free(groups);
     cm_region_free(&r);
@@ -131,6 +146,12 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
     for (int k = 1; k < a->n_values; k++)
         if (!(a->values[k] > a->values[k - 1]))
             return cm_fail(CM_EINVAL, msg, msg_size, "the values must increase");
+    if ((a->fractions || a->png) && a->by != BY_ATTRACTORS)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "basin shares are the tracked attractors': not with --by groups");
+    if (!(a->match >= 0 && a->match <= 1))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the matching distance %g: give a share of the region, 0 .. 1", a->match);
     for (int d = 0; d < a->n_near; d++)
         if (!(a->near_lo[d] < a->near_hi[d]))
             return cm_fail(CM_EINVAL, msg, msg_size, "the window needs LO < HI in each dimension");
@@ -160,11 +181,93 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
     return st;
 }
 
-/* Changes are changes of the number of attractors: sticking zones are sets
- * of rest cells whose count grows with the zones' width. */
-static bool same_counts(const sweep_point *x, const sweep_point *y)
+/* ---- attractors tracked across values ---- */
+
+double sweep_distance(const sweep_result *r, const sweep_attractor *x, const sweep_attractor *y)
 {
-    return x->attractors == y->attractors;
+    double d = 0;
+    for (int k = 0; k < r->lat.dim; k++) {
+        const double extent = r->lat.width[k] * (double)(r->box.hi[k] - r->box.lo[k]);
+        d = fmax(d, fabs(x->centre[k] - y->centre[k]) / extent);
+    }
+    return d;
+}
+
+typedef struct pairing {
+    double d;
+    uint32_t i, j;
+} pairing;
+
+static int by_distance(const void *x, const void *y)
+{
+    const pairing *u = x, *v = y;
+    if (u->d != v->d)
+        return (u->d > v->d) - (u->d < v->d);
+    if (u->i != v->i)
+        return (u->i > v->i) - (u->i < v->i);
+    return (u->j > v->j) - (u->j < v->j);
+}
+
+cm_status sweep_match(const sweep_args *a, const sweep_result *r, const sweep_point *p,
+                      const sweep_point *q, int *pair, uint32_t *matched)
+{
+    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    pairing *cand = malloc(((size_t)p->attractors * q->attractors + 1) * sizeof *cand);
+    bool *taken = calloc((size_t)p->attractors + 1, sizeof *taken);
+    if (!cand || !taken) {
+        free(cand);
+        free(taken);
+        return CM_ENOMEM;
+    }
+    size_t n = 0;
+    for (uint32_t i = 0; i < p->attractors; i++)
+        for (uint32_t j = 0; j < q->attractors; j++) {
+            const double d = sweep_distance(r, &p->att[i], &q->att[j]);
+            if (d <= within)
+                cand[n++] = (pairing){d, i, j};
+        }
+    qsort(cand, n, sizeof *cand, by_distance);
+    for (uint32_t j = 0; j < q->attractors; j++)
+        pair[j] = -1;
+    *matched = 0;
+    for (size_t k = 0; k < n; k++)
+        if (!taken[cand[k].i] && pair[cand[k].j] < 0) {
+            taken[cand[k].i] = true, pair[cand[k].j] = (int)cand[k].i;
+            ++*matched;
+        }
+    free(cand);
+    free(taken);
+    return CM_OK;
+}
+
+/* Whether attractor x's basin collapses into y's: to less than half its
+ * cells (as when a sticking zone absorbs the attractor and a rest state
+ * too close to tell apart on the lattice is left). */
+static bool collapses(const sweep_attractor *x, const sweep_attractor *y)
+{
+    return 2 * y->basin_cells < x->basin_cells;
+}
+
+/* Whether two points have the same attractors: by attractors, each of
+ * either matched to one of the other (*lost, *gained: those without a
+ * match) and no basin collapsing; by groups, as many of them. */
+static cm_status same_points(const sweep_args *a, const sweep_result *r, const sweep_point *x,
+                             const sweep_point *y, bool *same, uint32_t *lost, uint32_t *gained)
+{
+    uint32_t matched = x->attractors < y->attractors ? x->attractors : y->attractors;
+    int *pair = a->by == BY_ATTRACTORS ? malloc(((size_t)y->attractors + 1) * sizeof *pair)
+                                       : NULL;
+    if (a->by == BY_ATTRACTORS && (!pair || sweep_match(a, r, x, y, pair, &matched) != CM_OK)) {
+        free(pair);
+        return CM_ENOMEM;
+    }
+    bool collapse = false;
+    for (uint32_t j = 0; pair && j < y->attractors; j++)
+        collapse = collapse || (pair[j] >= 0 && collapses(&x->att[pair[j]], &y->att[j]));
+    free(pair);
+    *lost = x->attractors - matched, *gained = y->attractors - matched;
+    *same = !*lost && !*gained && !collapse;
+    return CM_OK;
 }
 
 /* Solves value into the next point of r (r->failed_value on failure). */
@@ -191,13 +294,163 @@ static cm_status refine_change(const sweep_args *a, const work_hooks *h, sweep_r
         if (st != CM_OK)
             return st;
         const sweep_point *mid = &r->pts[r->n - 1];
-        if (same_counts(mid, &lo))
+        bool same;
+        uint32_t lost, gained;
+        if (same_points(a, r, &lo, mid, &same, &lost, &gained) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory matching attractors");
+        if (same)
             lo = *mid;
         else
             hi = *mid;
     }
     ch->lo = lo;
     ch->hi = hi;
+    return CM_OK;
+}
+
+/* A vanished attractor x merges into y of the next value when y is
+ * aperiodic (a chaotic attractor grown over it, as in a merging crisis)
+ * and x's centre lies within y's bounds widened by the matching distance. */
+static bool merges_into(const sweep_args *a, const sweep_result *r, const sweep_attractor *x,
+                        const sweep_attractor *y)
+{
+    if (y->kind != CM_ATTRACTOR_APERIODIC)
+        return false;
+    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    for (int k = 0; k < r->lat.dim; k++) {
+        const double pad = within * r->lat.width[k] * (double)(r->box.hi[k] - r->box.lo[k]);
+        if (!(x->centre[k] >= y->lo[k] - pad && x->centre[k] <= y->hi[k] + pad))
+            return false;
+    }
+    return true;
+}
+
+/* The events between points p and q (q's ids set, pair from sweep_match);
+ * p's attractors that end there join gone[] (*n_gone of them). */
+static void note_events(const sweep_args *a, sweep_result *r, const sweep_point *p,
+                        const sweep_point *q, const int *pair, bool *kept, sweep_attractor *gone,
+                        size_t *n_gone)
+{
+    for (uint32_t i = 0; i < p->attractors; i++)
+        kept[i] = false;
+    for (uint32_t j = 0; j < q->attractors; j++)
+        if (pair[j] >= 0 && collapses(&p->att[pair[j]], &q->att[j]))
+            r->events[r->n_events++] = (sweep_event){SWEEP_COLLAPSES, q->att[j].id, 0, p->value,
+                                                     q->value};
+    for (uint32_t j = 0; j < q->attractors; j++)
+        if (pair[j] >= 0)
+            kept[pair[j]] = true;
+        else
+            r->events[r->n_events++] = (sweep_event){SWEEP_APPEARS, q->att[j].id, 0, p->value,
+                                                     q->value};
+    for (uint32_t i = 0; i < p->attractors; i++) {
+        if (kept[i])
+            continue;
+        sweep_event e = {SWEEP_VANISHES, p->att[i].id, 0, p->value, q->value};
+        gone[(*n_gone)++] = p->att[i];
+        double best = INFINITY;
+        for (uint32_t j = 0; j < q->attractors; j++) {
+            const double d = sweep_distance(r, &p->att[i], &q->att[j]);
+            if (d < best && merges_into(a, r, &p->att[i], &q->att[j]))
+                best = d, e.kind = SWEEP_MERGES, e.into = q->att[j].id;
+        }
+        r->events[r->n_events++] = e;
+    }
+}
+
+static int by_id(const void *x, const void *y)
+{
+    const uint32_t u = ((const sweep_attractor *)x)->id, v = ((const sweep_attractor *)y)->id;
+    return (u > v) - (u < v);
+}
+
+/* The id of q's unmatched attractor t: that of the nearest attractor that
+ * ended before, as it was last seen, within the matching distance (taken
+ * out of gone[]: a lattice too coarse for an attractor at one value loses
+ * it there), else the next new one. */
+static uint32_t id_of_new(const sweep_args *a, sweep_result *r, const sweep_attractor *t,
+                          sweep_attractor *gone, size_t *n_gone)
+{
+    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    size_t best = SIZE_MAX;
+    double d_best = INFINITY;
+    for (size_t i = 0; i < *n_gone; i++) {
+        const double d = sweep_distance(r, &gone[i], t);
+        if (d <= within && d < d_best)
+            d_best = d, best = i;
+    }
+    if (best == SIZE_MAX)
+        return ++r->tracked;
+    const uint32_t id = gone[best].id;
+    gone[best] = gone[--*n_gone];
+    return id;
+}
+
+/* Ids over the points in value order: an attractor matched to one of the
+ * value before keeps its id, any other takes that of one that ended
+ * before (id_of_new) or the next; the events where attractors begin and
+ * end; each point's attractors then in id order. */
+static cm_status track(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size)
+{
+    size_t total = 0, most = 1;
+    for (int k = 0; k < r->n; k++) {
+        total += r->pts[k].attractors;
+        most = r->pts[k].attractors > most ? r->pts[k].attractors : most;
+    }
+    int *pair = malloc(most * sizeof *pair);
+    bool *kept = malloc(most * sizeof *kept);
+    sweep_attractor *gone = malloc((total + 1) * sizeof *gone);
+    size_t n_gone = 0;
+    r->events = malloc((3 * total + 1) * sizeof *r->events);
+    cm_status st = pair && kept && gone && r->events ? CM_OK : CM_ENOMEM;
+    for (uint32_t j = 0; st == CM_OK && r->n && j < r->pts[0].attractors; j++)
+        r->pts[0].att[j].id = ++r->tracked;
+    for (int k = 1; st == CM_OK && k < r->n; k++) {
+        const sweep_point *p = &r->pts[k - 1];
+        sweep_point *q = &r->pts[k];
+        uint32_t matched;
+        st = sweep_match(a, r, p, q, pair, &matched);
+        for (uint32_t j = 0; st == CM_OK && j < q->attractors; j++)
+            q->att[j].id = pair[j] >= 0 ? p->att[pair[j]].id
+                                        : id_of_new(a, r, &q->att[j], gone, &n_gone);
+        if (st == CM_OK)
+            note_events(a, r, p, q, pair, kept, gone, &n_gone);
+    }
+    for (int k = 0; st == CM_OK && k < r->n; k++)
+        qsort(r->pts[k].att, r->pts[k].attractors, sizeof *r->pts[k].att, by_id);
+    free(pair);
+    free(kept);
+    free(gone);
+    return st == CM_OK ? CM_OK : cm_fail(st, msg, msg_size, "out of memory tracking attractors");
+}
+
+/* The changes between listed values k - 1 and k: with a->refine, each
+ * bisected to the first change after its lower end, then the rest of the
+ * interval searched again, up to SWEEP_CHANGES changes. */
+static cm_status find_changes(const sweep_args *a, const work_hooks *h, const sweep_report *rep,
+                              sweep_result *r, int k, char *msg, size_t msg_size)
+{
+    sweep_point lo = r->pts[k - 1];
+    const sweep_point hi = r->pts[k];
+    for (int round = 0; round < (a->refine ? SWEEP_CHANGES : 1); round++) {
+        bool same;
+        uint32_t lost, gained;
+        if (same_points(a, r, &lo, &hi, &same, &lost, &gained) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory matching attractors");
+        if (same)
+            return CM_OK;
+        sweep_change *ch = &r->changes[r->n_changes++];
+        ch->lo = lo, ch->hi = hi;
+        const cm_status st = a->refine ? refine_change(a, h, r, ch, msg, msg_size) : CM_OK;
+        if (st != CM_OK)
+            return st;
+        if (same_points(a, r, &ch->lo, &ch->hi, &same, &lost, &gained) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory matching attractors");
+        ch->several = lost > 1 || gained > 1;
+        if (a->refine && rep && rep->change)
+            rep->change(rep->user, a, ch);
+        lo = ch->hi;
+    }
     return CM_OK;
 }
 
@@ -211,8 +464,8 @@ cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_re
                         sweep_result *r, char *msg, size_t msg_size)
 {
     cm_status st = CM_OK;
-    r->pts = malloc((size_t)(a->n_values * (1 + a->refine)) * sizeof *r->pts);
-    r->changes = malloc((size_t)a->n_values * sizeof *r->changes);
+    r->pts = malloc((size_t)a->n_values * (1 + (size_t)a->refine * SWEEP_CHANGES) * sizeof *r->pts);
+    r->changes = malloc((size_t)a->n_values * SWEEP_CHANGES * sizeof *r->changes);
     if (!r->pts || !r->changes)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory");
     for (int k = 0; k < a->n_values && st == CM_OK; k++) {
@@ -223,25 +476,20 @@ cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_re
     }
     /* the listed values are pts[0 .. n_values-1]; refinements follow them */
     for (int k = 1; k < a->n_values && st == CM_OK; k++)
-        if (!same_counts(&r->pts[k - 1], &r->pts[k])) {
-            sweep_change *ch = &r->changes[r->n_changes++];
-            ch->lo = r->pts[k - 1];
-            ch->hi = r->pts[k];
-            ch->several = ch->lo.attractors > ch->hi.attractors + 1 ||
-                          ch->hi.attractors > ch->lo.attractors + 1;
-            if (a->refine)
-                st = refine_change(a, h, r, ch, msg, msg_size);
-            if (st == CM_OK && a->refine && rep && rep->change)
-                rep->change(rep->user, a, ch);
-        }
+        st = find_changes(a, h, rep, r, k, msg, msg_size);
     if (st == CM_OK)
         qsort(r->pts, (size_t)r->n, sizeof *r->pts, by_value);
+    if (st == CM_OK && a->by == BY_ATTRACTORS)
+        st = track(a, r, msg, msg_size);
     return st;
 }
 
 void sweep_result_free(sweep_result *r)
 {
+    for (int k = 0; r->pts && k < r->n; k++)
+        free(r->pts[k].att);
     free(r->pts);
     free(r->changes);
-    r->pts = NULL, r->changes = NULL;
+    free(r->events);
+    r->pts = NULL, r->changes = NULL, r->events = NULL;
 }

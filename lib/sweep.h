@@ -13,8 +13,9 @@
 #include "lib/project.h"
 #include "lib/work.h"
 
-/* The most values one sweep takes, and bisection steps of a change. */
-enum { MAX_VALUES = 200, MAX_REFINE = 40 };
+/* The most values one sweep takes, bisection steps of a change, and
+ * changes bisected between two neighbouring values. */
+enum { MAX_VALUES = 200, MAX_REFINE = 40, SWEEP_CHANGES = 4 };
 
 /* The parameter's values, the lattice, the window and the check (the
  * command's options). */
@@ -29,20 +30,45 @@ typedef struct sweep_args {
     bool json, quiet;
     int by;                   /* --by: count attractors (default) or groups */
     cm_attractor_options att; /* --attractor-steps, --attractor-tol */
+    double match;             /* attractors of neighbouring values are one within this share of
+                                 the region in every dimension (0: SWEEP_MATCH) */
+    const char *fractions;    /* each value's basin shares by tracked attractor as CSV, or NULL */
+    const char *png;          /* the shares stacked against the parameter, or NULL */
+    int width, height;        /* its size (0: 900 x 560) */
 } sweep_args;
+
+#define SWEEP_MATCH 0.05
+
+/* An attractor of one value (in the window, not a sticking zone), with
+ * the id tracking gives it across values (lib/sweep_track.h). */
+typedef struct sweep_attractor {
+    uint32_t id;       /* 1, 2, ... by first appearance; 0 until tracked */
+    int kind;          /* enum cm_attractor_kind */
+    uint32_t period;   /* 0: aperiodic */
+    double centre[CM_MAX_DIM], lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    uint64_t basin_cells;
+} sweep_attractor;
 
 /* What one value gave. */
 typedef struct sweep_point {
     double value;
     uint32_t attractors, sticking, groups; /* attractors and sticking zones in the window */
     uint64_t attractor_cells, sticking_cells, sink_cells;
+    /* by attractors: the region's cells, and where they go besides the
+     * window's attractors and sticking zones */
+    uint64_t cells, elsewhere_cells, diverged_cells, outside_cells, undecided_cells;
+    sweep_attractor *att; /* the window's attractors (attractors entries), owned by the
+                             result's pts[] (copies of a point share them) */
     double seconds;
 } sweep_point;
 
-/* Where the count of attractors changes: between lo and hi. */
+/* Where the attractors change (by attractors: an attractor of one value
+ * has no match at the other, or a matched one's basin collapses to less
+ * than half its cells; by groups: their count changes): between lo and
+ * hi. */
 typedef struct sweep_change {
     sweep_point lo, hi;
-    bool several; /* by more than one: bisection followed one of the changes */
+    bool several; /* more than one attractor lost or gained within lo .. hi */
 } sweep_change;
 
 /* What the caller hears as the sweep goes (each may be NULL): a point
@@ -55,6 +81,15 @@ typedef struct sweep_report {
 
 /* The sweep: its lattice and box, the points solved (the values' and the
  * bisections', by value) and the changes. */
+/* Where a tracked attractor begins or ends, between two solved values, or
+ * its basin collapses to less than half its cells. */
+enum { SWEEP_APPEARS, SWEEP_VANISHES, SWEEP_MERGES, SWEEP_COLLAPSES };
+typedef struct sweep_event {
+    int kind;
+    uint32_t id, into; /* into: the attractor a merging one joins */
+    double from, to;   /* the values around it */
+} sweep_event;
+
 typedef struct sweep_result {
     cm_lattice lat;
     cm_box box;
@@ -62,6 +97,9 @@ typedef struct sweep_result {
     int n;
     sweep_change *changes;
     int n_changes;
+    sweep_event *events; /* by attractors, after sweep_compute: by value */
+    int n_events;
+    uint32_t tracked;    /* ids given */
     double failed_value; /* the value whose solve failed (the status says how) */
 } sweep_result;
 
@@ -71,7 +109,9 @@ typedef struct sweep_result {
 cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size);
 
 /* Solves every value of the setup sweep_check_setup made in r (then
- * bisects each change a->refine times), progress in values through h,
+ * bisects each change a->refine times, finding up to SWEEP_CHANGES
+ * between two neighbouring values one after the other), progress in
+ * values through h,
  * stopped by h (CM_ECANCELED, r->n values solved). */
 cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_report *rep,
                         sweep_result *r, char *msg, size_t msg_size);
@@ -81,6 +121,17 @@ void sweep_result_free(sweep_result *r);
 /* Solves the box at a->name = value and counts it into *pt. */
 cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
                          double value, sweep_point *pt, char *msg, size_t msg_size);
+
+/* The largest distance between the centres of x and y along a dimension,
+ * as a share of the region's extent there. */
+double sweep_distance(const sweep_result *r, const sweep_attractor *x, const sweep_attractor *y);
+
+/* Matches q's attractors to p's (neighbouring values): pairs within
+ * a->match of each other (sweep_distance), taken nearest first (ties by
+ * index), each attractor in at most one; pair[j]: the index in p of q's
+ * j-th attractor's match, -1 for none; *matched: the pairs. */
+cm_status sweep_match(const sweep_args *a, const sweep_result *r, const sweep_point *p,
+                      const sweep_point *q, int *pair, uint32_t *matched);
 
 /* The n points as CSV at a->csv. */
 bool sweep_write_csv(const sweep_args *a, const sweep_point *pts, int n, char *msg,

@@ -12,11 +12,11 @@
 #include <string.h>
 
 #include "lib/sweep.h"
+#include "lib/sweep_report.h"
 #include "src/args.h"
 #include "lib/attractor_report.h"
 #include "src/attractor_opts.h"
 #include "src/commands.h"
-#include "lib/json.h"
 #include "src/interrupt.h"
 #include "src/outfile.h"
 #include "lib/param_grid.h"
@@ -26,22 +26,31 @@ static const char sweep_help[] =
     "usage: cellmap sweep --model NAME [--model-lib P.so] [--param k=v[,k=v]]\n"
     "                     --vary NAME=V1,V2,...|NAME=LO:HI:N\n"
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
-    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--csv FILE|-] [--json]\n"
-    "                     [--quiet]\n\n"
+    "                     [--near LO:HI[,LO:HI...]] [--refine K] [--match-within F]\n"
+    "                     [--csv FILE|-] [--fractions FILE|-] [--png FILE] [--size WxH]\n"
+    "                     [--json] [--quiet]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
     "the system's attractors (as solve finds them from the groups' true orbits)\n"
     "and the sticking groups (rest cells: a sticking zone is one group per rest\n"
     "cell) whose centre lies in the --near window (default: anywhere), and their\n"
-    "basin cells; --by groups counts cell mapping's groups instead. Where the number of\n"
-    "attractors differs between neighbouring values, --refine K bisects the\n"
-    "interval K times and reports where it changes: e.g. where a sticking\n"
-    "zone absorbs an attractor.\n\n"
+    "basin cells; --by groups counts cell mapping's groups instead. The attractors\n"
+    "are tracked from value to value: two of neighbouring values are one when their\n"
+    "centres lie within F of the region's extent in every dimension (nearest pairs\n"
+    "first); an attractor without a match appears, vanishes, or merges into the one\n"
+    "whose bounds hold its centre. Where the attractors change between neighbouring\n"
+    "values, --refine K bisects the interval K times: e.g. where a sticking zone\n"
+    "absorbs an attractor.\n\n"
     "  --vary NAME=V1,...  the parameter and its values (2..200, increasing); or\n"
     "  --vary NAME=LO:HI:N N values at the centres of N equal steps of LO..HI\n"
     "  --near LO:HI,...    the window of periodic cells counted (one range per\n"
     "                      dimension; fewer ranges leave the other dimensions free)\n"
     "  --refine K          bisection steps per change, 0..40 (default 0)\n"
+    "  --match-within F    the tracking's distance, a share of the region (default 0.05)\n"
+    "  --fractions FILE|-  each value's basin shares: NAME,basin,kind,period,cells,share,\n"
+    "                      centre_0,...; basin an attractor's id, or sticking, elsewhere\n"
+    "                      (attractors outside --near), diverged, outside, undecided\n"
+    "  --png FILE          the shares stacked against the parameter; --size WxH (900x560)\n"
     "  --csv FILE|-        every value solved, sorted: NAME,attractors,sticking,\n"
     "                      attractor_cells,sticking_cells,groups,sink_cells,seconds\n"
     "  --json              the values solved and the changes found as one JSON\n"
@@ -92,6 +101,12 @@ static int parse_args(cli *c, sweep_args *a)
             a->csv = c->value;
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;
+        } else if (cli_is(c, "--fractions", true, &err)) {
+            a->fractions = c->value;
+        } else if (cli_is(c, "--png", true, &err)) {
+            a->png = c->value;
+        } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
+        } else if (cli_take_double(c, "--match-within", 1e-9, 1, &a->match, &err)) {
         } else if (by_option_take(c, &a->by, &err)) {
         } else if (attractor_options_take(c, &a->att, &err)) {
         } else if (cli_is(c, "--quiet", false, &err)) {
@@ -100,70 +115,12 @@ static int parse_args(cli *c, sweep_args *a)
             err = cli_stray(c);
         }
     }
-    if (!err && a->json && a->csv && cm_output_names_stdout(a->csv))
-        err = cli_usage_error(c, "--json and --csv - both go to standard output: choose one");
+    if (!err && a->json + cm_output_names_stdout(a->csv) + cm_output_names_stdout(a->fractions) +
+                        cm_output_names_stdout(a->png) > 1)
+        err = cli_usage_error(c, "two outputs to standard output: choose one");
     if (!err && !has_vary)
         err = cli_usage_error(c, "--vary NAME=V1,V2,... is required (e.g. --vary mu=0.09,0.1)");
     return err;
-}
-
-static void print_point(FILE *out, const char *name, const sweep_point *pt)
-{
-    fprintf(out, "%s = %-12.9g %3u attractor(s), %3u sticking group(s) in the window; basins %llu and "
-           "%llu cells; %u groups; %.2f s\n",
-           name, pt->value, pt->attractors, pt->sticking, (unsigned long long)pt->attractor_cells,
-           (unsigned long long)pt->sticking_cells, pt->groups, pt->seconds);
-}
-
-static void print_change(FILE *out, const char *name, const sweep_change *ch)
-{
-    fprintf(out, "change: %u attractor(s) at %s = %.9g, %u at %.9g (width %.3g)%s\n",
-            ch->lo.attractors, name, ch->lo.value, ch->hi.attractors, ch->hi.value,
-            ch->hi.value - ch->lo.value,
-            ch->several ? "; the interval held more than one change, bisection followed one"
-                        : "");
-}
-
-static void print_json(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
-                       const sweep_point *pts, int n, const sweep_change *changes, int n_changes)
-{
-    cm_model m;
-    char msg[256];
-    if (!model_with_values(&a->mo, NULL, NULL, 0, &m, msg, sizeof msg))
-        return; /* checked before the sweep */
-    json j;
-    json_begin(&j, stdout, "sweep");
-    json_model(&j, &m);
-    cm_model_release(&m);
-    json_lattice(&j, lat);
-    json_box(&j, "box", lat, box);
-    json_str(&j, "parameter", a->name);
-    json_array(&j, "points");
-    for (int k = 0; k < n; k++) {
-        json_object(&j, NULL);
-        json_num(&j, "value", pts[k].value);
-        json_uint(&j, "attractors", pts[k].attractors);
-        json_uint(&j, "sticking", pts[k].sticking);
-        json_uint(&j, "attractor_cells", pts[k].attractor_cells);
-        json_uint(&j, "sticking_cells", pts[k].sticking_cells);
-        json_uint(&j, "groups", pts[k].groups);
-        json_uint(&j, "sink_cells", pts[k].sink_cells);
-        json_seconds(&j, "seconds", pts[k].seconds);
-        json_object_end(&j);
-    }
-    json_array_end(&j);
-    json_array(&j, "changes");
-    for (int k = 0; k < n_changes; k++) {
-        json_object(&j, NULL);
-        json_num(&j, "from", changes[k].lo.value);
-        json_num(&j, "to", changes[k].hi.value);
-        json_uint(&j, "attractors_from", changes[k].lo.attractors);
-        json_uint(&j, "attractors_to", changes[k].hi.attractors);
-        json_bool(&j, "several", changes[k].several);
-        json_object_end(&j);
-    }
-    json_array_end(&j);
-    json_end(&j);
 }
 
 /* The report as the sweep goes: a line per point and per change, below
@@ -178,14 +135,14 @@ static void said_point(void *user, const sweep_args *a, const sweep_point *pt)
     const reporter *r = user;
     progress_end(r->pr);
     if (r->text)
-        print_point(r->text, a->name, pt);
+        sweep_print_point(r->text, a->name, pt);
 }
 
 static void said_change(void *user, const sweep_args *a, const sweep_change *ch)
 {
     const reporter *r = user;
     if (r->text)
-        print_change(r->text, a->name, ch);
+        sweep_print_change(r->text, a->name, ch);
 }
 
 int cmd_sweep(int argc, char **argv)
@@ -197,7 +154,11 @@ int cmd_sweep(int argc, char **argv)
     int rc = parse_args(&c, &a);
     if (rc)
         return rc < 0 ? EXIT_OK : rc;
-    const int werr = outfile_check("sweep", a.csv, false);
+    int werr = outfile_check("sweep", a.csv, false);
+    if (werr == EXIT_OK)
+        werr = outfile_check("sweep", a.fractions, false);
+    if (werr == EXIT_OK)
+        werr = chart_png_check("sweep", a.png);
     if (werr != EXIT_OK)
         return werr;
     char msg[512];
@@ -223,11 +184,17 @@ int cmd_sweep(int argc, char **argv)
     }
     if (st != CM_OK)
         fprintf(stderr, "cellmap sweep: %s = %s: %s\n", a.name, CM_NUM(r.failed_value), msg);
-    const bool ok = st == CM_OK && (!a.csv || sweep_write_csv(&a, r.pts, r.n, msg, sizeof msg));
+    bool ok = st == CM_OK && (!a.csv || sweep_write_csv(&a, r.pts, r.n, msg, sizeof msg));
     if (st == CM_OK && !ok)
         fprintf(stderr, "cellmap sweep: %s\n", msg);
+    if (ok && (a.fractions || a.png) && sweep_write_tracked(&a, &r, msg, sizeof msg) != CM_OK) {
+        fprintf(stderr, "cellmap sweep: %s\n", msg);
+        ok = false;
+    }
     if (ok && a.json)
-        print_json(&a, &r.lat, &r.box, r.pts, r.n, r.changes, r.n_changes);
+        sweep_json(stdout, &a, &r);
+    else if (ok && rep.text)
+        sweep_print_tracked(rep.text, &a, &r);
     sweep_result_free(&r);
     return ok ? EXIT_OK : EXIT_FAIL;
 }

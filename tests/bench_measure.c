@@ -44,7 +44,7 @@ int main(int argc, char **argv)
         for (int j = 0; j < n; j++)
             label[(size_t)i * (size_t)n + (size_t)j] =
                 root_of(-2 + 4 * (i + 0.5) / n, -2 + 4 * (j + 0.5) / n);
-    const cm_label_grid g = {2, {n, n}, label, -2, 3};
+    const cm_label_grid g = {.dim = 2, .n = {n, n}, .label = label, .lo = -2, .hi = 3};
     const double cells = (double)n * n;
     const char *names[3] = {"basin entropy (boxes of 5)", "uncertain fractions (eps 1..16)",
                             "Wada test (r 1..5)"};
@@ -60,7 +60,7 @@ int main(int argc, char **argv)
             return fprintf(stderr, "%s\n", msg), 1;
         t[0][run] = now() - t0, t0 = now();
         for (int eps = 1; eps <= 16; eps *= 2)
-            if (cm_uncertain_fraction(&g, eps, &f, &counted, msg, sizeof msg) != CM_OK)
+            if (cm_uncertain_fraction(&g, eps, &f, &counted, NULL, msg, sizeof msg) != CM_OK)
                 return fprintf(stderr, "%s\n", msg), 1;
         t[1][run] = now() - t0, t0 = now();
         if (cm_wada_test(&g, 5, &w, msg, sizeof msg) != CM_OK)

@@ -48,7 +48,7 @@ small="--cells 100x80 --split 2x2 --threads 2"
 # stack array of the list parser
 "$CM" sweep --vary alpha=0.070,0.071,0.072,0.073,0.074,0.075,0.076 --cells 10x10 > sweep.out \
   || fail "sweep with 7 values"
-[ "$(grep -c '^alpha = ' sweep.out)" = 7 ] || fail "sweep with 7 values: $(cat sweep.out)"
+[ "$(grep -c '^alpha = .* attractor(s), ' sweep.out)" = 7 ] || fail "sweep with 7 values: $(cat sweep.out)"
 expect_usage "--vary" sweep --vary alpha=0.07,0.071, --cells 10x10
 expect_usage "--cells" solve --cells 10x10x10x10x10x10x10x10
 # a pan amount longer than explore's buffer, ending in % (found by fuzz_session)

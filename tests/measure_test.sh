@@ -66,6 +66,19 @@ assert {r["measure"] for r in rows} == {"share", "sb", "sbb", "uncertain", "wada
 assert [float(r["value"]) for r in rows if r["measure"] == "wada"] == w["fraction"], rows
 PY
 
+# a window larger than the budget is measured in slabs (five of Newton's
+# 1000 x 1000 cells under 2 MiB) with the same counts as at once
+"$CM" measure newton.cmdb --mem 2M --json > slabs.json || fail "measure newton --mem 2M"
+python3 - measured.json slabs.json <<'PY' || fail "measured in slabs"
+import json, sys
+whole, slabs = (json.load(open(p)) for p in sys.argv[1:3])
+for key in ("cells", "computed", "shares", "eps", "uncertain", "alpha", "wada"):
+    assert whole[key] == slabs[key], key
+for a, b in zip(whole["entropy"], slabs["entropy"]):
+    assert all(a[k] == b[k] for k in ("box", "boxes", "boundary_boxes")), (a, b)
+    assert abs(a["sb"] - b["sb"]) < 1e-12 and abs(a["sbb"] - b["sbb"]) < 1e-12, (a, b)
+PY
+
 # tipping from c = 1 to c = 0.5 on one lattice: each basin's probabilities
 # sum to 1 and are the cells a join of the two files' flat tables counts
 "$CM" solve "${ws[@]/500x4500/200x1800}" --db tip-a.cmdb || fail "solve tip-a"
@@ -139,7 +152,7 @@ expect_usage "needs 3 or more basins" measure line.cmdb --wada 3 --csv no.csv
 expect_usage "--uncertainty: '4:2' is not E0:E1" measure line.cmdb --uncertainty 4:2
 expect_usage "which file?" measure --wada 2
 expect_usage "the database" measure line.cmdb --csv line.cmdb
-expect_usage "over the budget" measure curve.cmdb --mem 4M
+expect_usage "over half the budget" measure curve.cmdb --uncertainty 1:64 --mem 1M
 "$CM" solve --model microchaos-1d --cells 300 --db one.cmdb --quiet || fail "solve microchaos-1d"
 expect_usage "it needs a 2-D model" measure one.cmdb --png no.png
 [ ! -e no.csv ] && [ ! -e no.png ] || fail "measure wrote no.csv or no.png although it failed"

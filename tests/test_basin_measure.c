@@ -5,7 +5,8 @@
  * fraction grows as eps^1 (alpha = 1, Grebogi et al.); three sectors
  * meeting at one point (not Wada: only cells near the point see all
  * three); a window where every 3x3 block holds all three labels (Wada at
- * r = 1); uncomputed cells left out; bad requests. */
+ * r = 1); uncomputed cells left out; bad requests; slabs of a window,
+ * each with the rows around it, add up to the whole window's counts. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -16,7 +17,7 @@ enum { N = 400 };
 
 static cm_label_grid grid2(int32_t *label, int64_t nx, int64_t ny, int32_t hi)
 {
-    return (cm_label_grid){2, {nx, ny}, label, -2, hi};
+    return (cm_label_grid){.dim = 2, .n = {nx, ny}, .label = label, .lo = -2, .hi = hi};
 }
 
 static void test_by_hand(void)
@@ -69,7 +70,7 @@ static void test_straight_boundary(void)
     for (int k = 0; k < 5; k++) {
         double f;
         uint64_t counted;
-        CHECK(cm_uncertain_fraction(&g, 1 << k, &f, &counted, msg, sizeof msg) == CM_OK);
+        CHECK(cm_uncertain_fraction(&g, 1 << k, &f, &counted, NULL, msg, sizeof msg) == CM_OK);
         lf[k] = log(f), le[k] = log(1 << k);
     }
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -120,10 +121,77 @@ static void test_wada(void)
     free(l);
 }
 
+/* A window of three sectors with wiggly boundaries and a few uncomputed
+ * cells, measured whole and as slabs of 7 rows with 5 rows around them. */
+static void test_slabs(void)
+{
+    enum { NX = 61, NY = 45, CORE = 7, HALO = 5 };
+    int32_t *l = malloc(NX * NY * sizeof *l);
+    for (int i = 0; i < NX; i++)
+        for (int j = 0; j < NY; j++) {
+            const double turn = atan2(j - NY / 2.0, i - NX / 2.0) / (2 * 3.141592653589793) + 1.5;
+            const int sector = (int)floor(3 * turn + 0.4 * sin(0.9 * i) * cos(0.7 * j)) % 3;
+            l[i * NY + j] = (i * 3 + j) % 23 == 0 ? -1 : sector + 1;
+        }
+    const cm_label_grid whole = grid2(l, NX, NY, 3);
+    char msg[256];
+    cm_entropy e_whole[2], e_sum[2] = {{0}};
+    uint64_t counted_whole[3], uncertain_whole[3], counted_sum[3] = {0}, uncertain_sum[3] = {0};
+    cm_wada w_whole, w;
+    uint64_t boundary = 0, seeing[3] = {0};
+    const int boxes[2] = {3, 4}, eps[3] = {1, 2, 5};
+    double f;
+    for (int k = 0; k < 2; k++)
+        CHECK(cm_basin_entropy(&whole, boxes[k], &e_whole[k], NULL, msg, sizeof msg) == CM_OK);
+    for (int k = 0; k < 3; k++)
+        CHECK(cm_uncertain_fraction(&whole, eps[k], &f, &counted_whole[k], &uncertain_whole[k],
+                                    msg, sizeof msg) == CM_OK);
+    CHECK(cm_wada_test(&whole, 3, &w_whole, msg, sizeof msg) == CM_OK);
+    for (int c0 = 0; c0 < NX; c0 += CORE) {
+        const int lo = c0 - HALO < 0 ? 0 : c0 - HALO;
+        const int c1 = c0 + CORE < NX ? c0 + CORE : NX;
+        const int hi = c1 + HALO < NX ? c1 + HALO : NX;
+        cm_label_grid g = grid2(l + lo * NY, hi - lo, NY, 3);
+        g.row0 = lo, g.window_rows = NX, g.core_lo = c0 - lo, g.core_hi = c1 - lo;
+        g.basins = w_whole.basins;
+        for (int k = 0; k < 2; k++) {
+            cm_entropy e;
+            CHECK(cm_basin_entropy(&g, boxes[k], &e, NULL, msg, sizeof msg) == CM_OK);
+            e_sum[k].boxes += e.boxes, e_sum[k].boundary += e.boundary;
+            e_sum[k].sum += e.sum, e_sum[k].sum_boundary += e.sum_boundary;
+        }
+        for (int k = 0; k < 3; k++) {
+            uint64_t counted, uncertain;
+            CHECK(cm_uncertain_fraction(&g, eps[k], &f, &counted, &uncertain, msg,
+                                        sizeof msg) == CM_OK);
+            counted_sum[k] += counted, uncertain_sum[k] += uncertain;
+        }
+        CHECK(cm_wada_test(&g, 3, &w, msg, sizeof msg) == CM_OK);
+        boundary += w.boundary;
+        for (int r = 0; r < 3; r++)
+            seeing[r] += w.seeing[r];
+    }
+    for (int k = 0; k < 2; k++) {
+        CHECK(e_sum[k].boxes == e_whole[k].boxes && e_sum[k].boundary == e_whole[k].boundary);
+        CHECK(e_whole[k].boundary > 10 && e_whole[k].boxes > e_whole[k].boundary);
+        CHECK(fabs(e_sum[k].sum - e_whole[k].sum) < 1e-9 * e_whole[k].sum);
+        CHECK(fabs(e_sum[k].sum_boundary - e_whole[k].sum_boundary) < 1e-9 * e_whole[k].sum);
+    }
+    for (int k = 0; k < 3; k++)
+        CHECK(counted_sum[k] == counted_whole[k] && uncertain_sum[k] == uncertain_whole[k] &&
+              uncertain_whole[k] > 0 && uncertain_whole[k] < counted_whole[k]);
+    CHECK(boundary == w_whole.boundary && boundary > 100);
+    for (int r = 0; r < 3; r++)
+        CHECK(seeing[r] == w_whole.seeing[r]);
+    CHECK(w_whole.seeing[0] < w_whole.seeing[2]);
+    free(l);
+}
+
 int main(void)
 {
     test_by_hand();
     test_straight_boundary();
     test_wada();
+    test_slabs();
     CHECK_DONE();
 }

@@ -105,8 +105,9 @@ static void analyses(void)
                                  .n_values = 2,
                                  .region = "0:100,-10:10",
                                  .cells = (const int64_t[]){50, 50},
-                                 .n_cells = 2};
-    a = outputs("sweep", f, 0);
+                                 .n_cells = 2,
+                                 .fractions = "c_sweep_fractions.csv"};
+    a = outputs("sweep", f, 1);
     must(cm_analysis_sweep(&a, &wo, msg, sizeof msg), "sweep", msg);
     cm_continue_options co = cm_continue_defaults();
     co.vary = "S", co.lo = 0.02, co.hi = 0.4, co.max_points = 50;

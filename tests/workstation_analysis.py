@@ -46,8 +46,12 @@ rows(pts, p + "bifurcation.csv")
 assert len(rows(runs, p + "bifurcation_runs.csv")) == 8
 rows(an.lyapunov(("Omega", 0.4, 0.6, 3), ("S", 0.1, 0.2, 3), periods=50, **out("lyapunov")),
      p + "lyapunov.csv")
-rows(an.sweep("P", [0.006, 0.007], region=[(0, 100), (-10, 10)], cells=(50, 50),
-              **out("sweep", png=False)), p + "sweep.csv")
+counts, shares = an.sweep("P", [0.006, 0.007], region=[(0, 100), (-10, 10)], cells=(50, 50),
+                          fractions_csv=p + "sweep_fractions.csv", **out("sweep"))
+rows(counts, p + "sweep.csv")
+rows(shares, p + "sweep_fractions.csv")
+for value in (0.006, 0.007):
+    assert abs(shares[shares["P"] == value]["share"].sum() - 1) < 1e-12, shares
 pts, events = an.continuation(("S", 0.02, 0.4), max_points=50, events=p + "continue_events.csv",
                               **out("continue"))
 rows(pts, p + "continue.csv")

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# cellmap sweep's attractors tracked across a parameter, against checks
+# that do not use cell mapping:
+#   - Fig. 4.30 (docs/models.md 8.4): the outermost micro-chaotic attractor
+#     near SW_4 is absorbed where its one-cell attractor comes to rest,
+#     mu = 72625 alpha^2 - 3 = 0.0967954: its basin collapses there;
+#   - Duffing (docs/models.md 11.2; release build only, 25 s): its two
+#     large period-1 orbits are born, and its two small ones in the wells
+#     die, at saddle-node folds that pseudo-arclength continuation of the
+#     map's fixed points (`cellmap periodic --branch`) locates; the sweep's
+#     events must bracket them, and the ids of the attractors that live on
+#     must not change.
+# Each value's shares add up to 1; bad input.
+# usage: sweep_test.sh PATH/TO/cellmap
+set -u
+CM=$1
+HERE=$(cd "$(dirname "$0")" && pwd)
+. "$HERE/testlib.sh"
+enter_workdir
+
+# --- Fig. 4.30: the absorption, bracketed by bisection ----------------------
+"$CM" sweep --model microchaos-pd-friction --vary mu=0.095,0.1 \
+  --region=-100000:100000,-601.5:601.5 --cells 800x401 --max-steps 100000 --near 71818:73636 \
+  --refine 8 --fractions mu.csv --png mu.png --json > mu.json || fail "sweep mu"
+python3 - mu.json mu.csv <<'PY' || fail "the absorption of Fig. 4.30"
+import csv, json, sys
+d = json.load(open(sys.argv[1]))
+ev = [e for e in d["events"] if e["event"] == "collapses"]
+assert len(ev) == 1 and ev[0]["id"] == 1, d["events"]
+mu = 72625 * 6.53e-3 ** 2 - 3
+assert ev[0]["from"] < mu < ev[0]["to"] and ev[0]["to"] - ev[0]["from"] < 2e-5, (ev, mu)
+for p in d["points"]:   # one attractor in the window throughout; its basin goes to sticking
+    assert [t["id"] for t in p["tracked"]] == [1], p
+    rest = sum(p[k] for k in ("sticking_cells", "elsewhere_cells", "diverged_cells",
+                              "outside_cells", "undecided_cells"))
+    assert rest + p["tracked"][0]["cells"] == p["cells"], p
+    absorbed = p["value"] >= ev[0]["to"]
+    assert (p["sticking_cells"] > 2000) == absorbed and (p["tracked"][0]["cells"] < 300) == absorbed, p
+rows = list(csv.DictReader(open(sys.argv[2])))
+for v in {r["mu"] for r in rows}:
+    assert abs(sum(float(r["share"]) for r in rows if r["mu"] == v) - 1) < 1e-12, v
+PY
+echo '{"view": [0, 1, 0, 1], "size": [900, 560], "texts": {"Parameter": "mu"}}' > png.json
+python3 "$HERE/pngcheck.py" mu.png png.json || fail "sweep --png"
+
+# --- Duffing: folds from continuation, bracketed by the sweep's events ------
+if [ -z "${CELLMAP_SANITIZE:-}" ]; then
+  "$CM" periodic --model duffing --from -0.704,0.543 --branch gamma=0.01:0.3 --max-points 2000 \
+    --json > folds.json || fail "periodic --branch gamma"
+  "$CM" sweep --model duffing --vary gamma=0.09,0.1 --cells 200x200 --refine 8 --json \
+    > born.json || fail "sweep gamma 0.09..0.1"
+  "$CM" sweep --model duffing --vary gamma=0.253,0.254 --cells 200x200 --refine 7 --json \
+    > dies.json || fail "sweep gamma 0.253..0.254"
+  python3 - folds.json born.json dies.json <<'PY' || fail "Duffing's births and deaths"
+import json, sys
+folds = sorted(e["p"] for e in json.load(open(sys.argv[1]))["events"] if e["kind"] == "fold")
+assert len(folds) == 2 and abs(folds[0] - 0.09645) < 1e-4 and abs(folds[1] - 0.25369) < 1e-4, folds
+born, dies = (json.load(open(p)) for p in sys.argv[2:4])
+# births: the two large orbits appear once their basins hold cells, within
+# 5e-4 above the fold on this 200 x 200 lattice, bracketed to 2e-4 (the
+# lattice may lose one again for a while: it keeps its id when it returns)
+app = {}
+for e in born["events"]:
+    if e["event"] == "appears":
+        app.setdefault(e["id"], e)
+assert sorted(app) == [3, 4] and born["tracked"] == 4, born["events"]
+for e in app.values():
+    assert folds[0] - 1e-5 < e["from"] and e["to"] < folds[0] + 5e-4 and e["to"] - e["from"] < 2e-4, e
+# the wells' small orbits keep ids 1 and 2 over the whole sweep
+for p in born["points"]:
+    t = {a["id"]: a["centre"] for a in p["tracked"]}
+    assert abs(t[1][0] + 0.90) < 0.03 and abs(t[2][0] - 1.10) < 0.03, p
+# deaths: each small orbit (ids 2 and 3 here, |v| < 0.2) vanishes for good
+# within 1e-4 of the fold (near it the lattice may lose and find it again)
+ids0 = {a["id"]: a["centre"] for a in dies["points"][0]["tracked"]}
+small = sorted(i for i, c in ids0.items() if abs(c[1]) < 0.2)
+gone = {}
+for e in dies["events"]:
+    if e["event"] == "vanishes":
+        gone[e["id"]] = e
+assert small == [2, 3] and all(i in gone for i in small), (ids0, dies["events"])
+assert not set(small) & {a["id"] for a in dies["points"][-1]["tracked"]}, dies["points"][-1]
+for e in (gone[i] for i in small):
+    assert folds[1] - 1e-4 < e["from"] < e["to"] < folds[1] + 1e-4, (e, folds)
+PY
+fi
+
+# --- bad input ----------------------------------------------------------------
+expect_usage "--match-within" sweep --vary P=0.006,0.007 --match-within 2
+expect_usage "two outputs to standard output" sweep --vary P=0.006,0.007 --fractions - --json
+expect_usage "--vary: 'P=0.006'" sweep --vary P=0.006 --fractions f.csv
+expect_usage "not with --by groups" sweep --vary P=0.006,0.007 --by groups --fractions f.csv
+[ ! -e f.csv ] || fail "sweep wrote f.csv although it failed"
+
+[ "$fails" -eq 0 ] && echo "sweep_test: all passed" || exit 1
