@@ -645,6 +645,8 @@ typedef struct cm_measure_options {
                                their attractors (at most 10^8; 0: none) */
     uint64_t seed;          /* their stream: the same states for the same seed */
     int threads;            /* OpenMP threads following them; 0: the OpenMP default */
+    double orbit_eps_lo, orbit_eps_hi; /* with samples: uncertain fractions by true orbits for
+                                          eps = lo, 2 lo, ... <= hi cells; hi 0: none */
 } cm_measure_options;
 /* boxes 3, 5, 7, 9; eps 1 .. 16; Wada to r = 5; 256 MiB; no samples, seed 1 */
 cm_measure_options cm_measure_defaults(void);
@@ -660,10 +662,12 @@ typedef struct cm_measures {
                                      label says */
     int samples_agree;         /* nonzero: every basin's cell share lies within the
                                   interval of its sampled share */
+    double orbit_alpha, orbit_alpha_r2; /* the uncertainty exponent by true orbits; NAN without */
 } cm_measures;
 
 /* A file's basins measured (`cellmap measure`): a->csv gets every value as
- * rows measure,scale,value (share, sampled, sb, sbb, uncertain, wada, tipping),
+ * rows measure,scale,value (share, sampled, sb, sbb, uncertain, orbit_uncertain,
+ * wada, tipping),
  * a->png the figure of a 2-D window (the entropy map of the first box size
  * over the uncertain fractions, log-log), out (may be NULL) the summary;
  * a->model is not used. */

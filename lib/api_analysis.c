@@ -353,6 +353,7 @@ cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o,
     m.n_box = o->n_box, m.eps_lo = o->eps_lo, m.eps_hi = o->eps_hi;
     m.wada_radius = o->wada_radius, m.wada_asked = o->wada_required != 0, m.csv = a->csv;
     m.samples = o->samples, m.seed = o->seed, m.threads = o->threads;
+    m.orbit_eps_lo = o->orbit_eps_lo, m.orbit_eps_hi = o->orbit_eps_hi;
     measure_result r;
     st = measure_compute(&m, NULL, &r, msg, msg_size);
     if (st == CM_OK)
@@ -361,7 +362,8 @@ cm_status cm_analysis_measure(const cm_analysis *a, const cm_measure_options *o,
         *out = (cm_measures){r.cells, r.computed, r.sb_mean,
                              r.sbb_mean, r.alpha, r.alpha_r2, r.has_wada ? r.wada.basins : 0,
                              r.has_wada ? r.wada.fraction[r.wada.radius - 1] : NAN,
-                             r.sampled, r.sample_same, r.samples_agree};
+                             r.sampled, r.sample_same, r.samples_agree, r.orbit_alpha,
+                             r.orbit_alpha_r2};
     measure_result_free(&r);
     return st;
 }

@@ -45,6 +45,12 @@ static cm_status check_args(const measure_args *a, char *msg, size_t msg_size)
     if (a->samples > MEASURE_MAX_SAMPLES)
         return cm_fail(CM_EINVAL, msg, msg_size, "%llu samples: give at most %llu",
                        (unsigned long long)a->samples, (unsigned long long)MEASURE_MAX_SAMPLES);
+    if (a->orbit_eps_hi > 0 && (!a->samples || !(a->orbit_eps_lo > 0) ||
+                                a->orbit_eps_lo > a->orbit_eps_hi || a->orbit_eps_hi > 1 << 20))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "uncertainty by true orbits: give samples, and 0 < E0 <= E1 <= 2^20 "
+                       "cells (%g:%g)",
+                       a->orbit_eps_lo, a->orbit_eps_hi);
     if (a->sample_steps > PROJECT_MAX_STEPS)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "a sample's budget of %llu steps: give at most %d",
@@ -126,8 +132,75 @@ typedef struct sampled {
     double seconds;
 } sampled;
 
+/* log f against log eps by least squares over the fractions above 0:
+ * the slope and R^2 (NAN with fewer than 2). */
+static void fit_alpha(const double *eps, const double *f, int count, double *alpha, double *r2)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    int n = 0;
+    for (int k = 0; k < count; k++) {
+        if (!(f[k] > 0))
+            continue;
+        const double x = log(eps[k]), y = log(f[k]);
+        sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y, n++;
+    }
+    const double vx = n * sxx - sx * sx, vy = n * syy - sy * sy, c = n * sxy - sx * sy;
+    *alpha = n >= 2 && vx > 0 ? c / vx : NAN;
+    *r2 = n >= 2 && vx > 0 && vy > 0 ? c * c / (vx * vy) : NAN;
+}
+
+/* The eps-uncertain fractions by true orbits: each sampled state whose
+ * fate is decided, against the 2d states eps cells away along the axes
+ * (all decided too, else the state is not counted). A fraction resting on
+ * fewer than ORBIT_FIT_LEAST uncertain states (its relative error over
+ * 1/3) is left out of the fit. */
+#define ORBIT_FIT_LEAST 10
+static cm_status orbit_uncertainty(const measure_args *a, const cm_model *m, const source *src,
+                                   const double *state, const sampled *smp, measure_result *r,
+                                   char *msg, size_t msg_size)
+{
+    const cm_lattice *lat = &src->c.lat;
+    const int dim = lat->dim;
+    const uint64_t n = a->samples, near = 2 * (uint64_t)dim;
+    double *moved = malloc((size_t)(n * near * dim) * sizeof *moved);
+    int32_t *fate = malloc((size_t)(n * near) * sizeof *fate);
+    double fit_f[MEASURE_MAX_EPS]; /* the fractions fitted */
+    cm_status st = moved && fate ? CM_OK
+                                 : cm_fail(CM_ENOMEM, msg, msg_size,
+                                           "out of memory for the states eps away");
+    for (double eps = a->orbit_eps_lo; st == CM_OK && eps <= a->orbit_eps_hi * (1 + 1e-12) &&
+                                       r->n_orbit_eps < MEASURE_MAX_EPS;
+         eps *= 2) {
+        for (uint64_t i = 0; i < n; i++)
+            for (uint64_t j = 0; j < near; j++) {
+                double *x = moved + (i * near + j) * dim;
+                memcpy(x, state + i * dim, (size_t)dim * sizeof *x);
+                x[j / 2] += (j % 2 ? -eps : eps) * lat->width[j / 2];
+            }
+        uint64_t steps = 0, counted = 0, uncertain = 0;
+        st = cm_attractor_fates(m, lat, &src->x.att, moved, n * near, a->sample_steps,
+                                a->threads, fate, &steps, msg, msg_size);
+        for (uint64_t i = 0; st == CM_OK && i < n; i++) {
+            bool decided = smp->fate[i] != CM_LABEL_OUTSIDE, differs = false;
+            for (uint64_t j = 0; j < near; j++) {
+                decided = decided && fate[i * near + j] != CM_LABEL_OUTSIDE;
+                differs = differs || fate[i * near + j] != smp->fate[i];
+            }
+            counted += decided, uncertain += decided && differs;
+        }
+        const int k = r->n_orbit_eps++;
+        r->orbit_eps[k] = eps, r->orbit_counted[k] = counted;
+        r->orbit_uncertain[k] = counted ? (double)uncertain / (double)counted : NAN;
+        fit_f[k] = uncertain >= ORBIT_FIT_LEAST ? r->orbit_uncertain[k] : 0;
+    }
+    fit_alpha(r->orbit_eps, fit_f, r->n_orbit_eps, &r->orbit_alpha, &r->orbit_alpha_r2);
+    free(moved);
+    free(fate);
+    return st;
+}
+
 static cm_status sample_fates(const measure_args *a, const source *src, sampled *out,
-                              char *msg, size_t msg_size)
+                              measure_result *r, char *msg, size_t msg_size)
 {
     const cm_lattice *lat = &src->c.lat;
     const cm_box *w = &src->x.window;
@@ -154,6 +227,8 @@ static cm_status sample_fates(const measure_args *a, const source *src, sampled 
     cm_sample_states(lat, w, a->seed, a->samples, state);
     st = cm_attractor_fates(&m, lat, &src->x.att, state, a->samples, a->sample_steps,
                             a->threads, out->fate, &out->steps, msg, msg_size);
+    if (st == CM_OK && a->orbit_eps_hi > 0)
+        st = orbit_uncertainty(a, &m, src, state, out, r, msg, msg_size);
     for (uint64_t i = 0; i < a->samples; i++) {
         int64_t cell[CM_MAX_DIM];
         const bool in = cm_lattice_cell(lat, state + i * dim, cell) && cm_box_contains(w, cell);
@@ -358,22 +433,6 @@ static void mean_spread(const double *v, int n, double *mean, double *spread)
     *spread = k ? sqrt(fmax(0, s2 / k - *mean * *mean)) : NAN;
 }
 
-/* log f against log eps by least squares: the slope and R^2. */
-static void fit_alpha(measure_result *r)
-{
-    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-    int n = 0;
-    for (int k = 0; k < r->n_eps; k++) {
-        if (!(r->uncertain[k] > 0))
-            continue;
-        const double x = log(r->eps[k]), y = log(r->uncertain[k]);
-        sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y, n++;
-    }
-    const double vx = n * sxx - sx * sx, vy = n * syy - sy * sy, c = n * sxy - sx * sy;
-    r->alpha = n >= 2 && vx > 0 ? c / vx : NAN;
-    r->alpha_r2 = n >= 2 && vx > 0 && vy > 0 ? c * c / (vx * vy) : NAN;
-}
-
 /* The second pass's sums over the slabs. */
 typedef struct sums {
     uint64_t uncertain[MEASURE_MAX_EPS];
@@ -446,7 +505,7 @@ static void finish_measures(const measure_args *a, const sums *s, measure_result
     for (int k = 0; k < r->n_eps; k++)
         r->uncertain[k] = r->counted[k] ? (double)s->uncertain[k] / (double)r->counted[k] : NAN;
     if (r->n_eps)
-        fit_alpha(r);
+        fit_alpha(r->eps, r->uncertain, r->n_eps, &r->alpha, &r->alpha_r2);
     for (int k = 0; r->has_wada && k < r->wada.radius; k++)
         r->wada.fraction[k] =
             r->wada.boundary ? (double)r->wada.seeing[k] / (double)r->wada.boundary : NAN;
@@ -623,6 +682,7 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
 {
     memset(r, 0, sizeof *r);
     r->sb_mean = r->sb_spread = r->sbb_mean = r->sbb_spread = r->alpha = r->alpha_r2 = NAN;
+    r->orbit_alpha = r->orbit_alpha_r2 = NAN;
     source src = {0}, to = {0};
     buffers b;
     memset(&b, 0, sizeof b);
@@ -639,8 +699,9 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
     }
     if (st == CM_OK)
         st = plan_of(a, &src.x.window, &p, msg, msg_size);
+    r->slabs = st == CM_OK ? (p.rows + p.core - 1) / p.core : 0;
     if (st == CM_OK && a->samples)
-        st = sample_fates(a, &src, &b.smp, msg, msg_size);
+        st = sample_fates(a, &src, &b.smp, r, msg, msg_size);
     r->seconds_sample = b.smp.seconds;
     if (st == CM_OK)
         st = buffers_alloc(a, &p, &src, a->to ? &to : NULL, &b, msg, msg_size);
@@ -750,6 +811,8 @@ cm_status measure_write(const measure_args *a, const measure_result *r, char *ms
                 r->entropy[k].eps, r->entropy[k].sbb);
     for (int k = 0; k < r->n_eps; k++)
         fprintf(o.f, "uncertain,%g,%.17g\n", r->eps[k], r->uncertain[k]);
+    for (int k = 0; k < r->n_orbit_eps; k++)
+        fprintf(o.f, "orbit_uncertain,%.17g,%.17g\n", r->orbit_eps[k], r->orbit_uncertain[k]);
     for (int k = 0; r->has_wada && k < r->wada.radius; k++)
         fprintf(o.f, "wada,%d,%.17g\n", k + 1, r->wada.fraction[k]);
     for (int k = 0; k < r->n_tips; k++)
@@ -812,6 +875,13 @@ void measure_report(FILE *f, const measure_result *r)
     if (r->n_eps)
         fprintf(f, "uncertainty exponent %.4f (R^2 %.4f), boundary dimension %.4f\n", r->alpha,
                 r->alpha_r2, r->dim - r->alpha);
+    for (int k = 0; k < r->n_orbit_eps; k++)
+        fprintf(f, "uncertain by true orbits at eps %g cells: %.5f of %llu states\n",
+                r->orbit_eps[k], r->orbit_uncertain[k], (unsigned long long)r->orbit_counted[k]);
+    if (r->n_orbit_eps)
+        fprintf(f, "uncertainty exponent by true orbits %.4f (R^2 %.4f), boundary dimension "
+                   "%.4f\n",
+                r->orbit_alpha, r->orbit_alpha_r2, r->dim - r->orbit_alpha);
     if (r->has_wada) {
         fprintf(f, "Wada test: %d basins, %llu boundary cells; seeing all within r:",
                 r->wada.basins, (unsigned long long)r->wada.boundary);
@@ -882,6 +952,12 @@ void measure_json(FILE *f, const measure_result *r)
         json_nums(&j, "uncertain", r->uncertain, r->n_eps);
         json_num(&j, "alpha", r->alpha);
         json_num(&j, "alpha_r2", r->alpha_r2);
+    }
+    if (r->n_orbit_eps) {
+        json_nums(&j, "orbit_eps", r->orbit_eps, r->n_orbit_eps);
+        json_nums(&j, "orbit_uncertain", r->orbit_uncertain, r->n_orbit_eps);
+        json_num(&j, "orbit_alpha", r->orbit_alpha);
+        json_num(&j, "orbit_alpha_r2", r->orbit_alpha_r2);
     }
     if (r->has_wada) {
         json_object(&j, "wada");

@@ -11,9 +11,12 @@
  * random states of the window by their true orbits
  * (cellmap/attractor_fates.h), with intervals that hold the true shares
  * together 95 times in 100, which the cells' shares are checked against.
- * The window's labels are read a slab at a time into one array of 4 bytes
- * a cell (the window must fit the memory budget). Written as text, JSON
- * and CSV. Nothing is printed but by the report calls: calls return a
+ * The window's labels (4 bytes a cell, of both files with a second) are
+ * held whole when they fit the budget, else read twice in slabs of rows
+ * along dimension 0 with the rows the measures look at around them (at
+ * most half the budget; the clusters' pages take the rest), the shares
+ * counted on the first pass, the measures on the second: the same counts
+ * either way (cm_label_grid). Written as text, JSON and CSV. Nothing is printed but by the report calls: calls return a
  * status with the problem in msg (CM_EINVAL: the request's). */
 #ifndef CM_LIB_MEASURE_H
 #define CM_LIB_MEASURE_H
@@ -42,6 +45,8 @@ typedef struct measure_args {
                               their attractors (cellmap/attractor_fates.h), or 0 */
     uint64_t seed;         /* their stream (cm_sample_states) */
     uint64_t sample_steps; /* each one's budget of map steps (0: the default) */
+    double orbit_eps_lo, orbit_eps_hi; /* with samples: eps-uncertain fractions by true orbits
+                                          for eps = lo, 2 lo, ... <= hi cells (hi 0: none) */
     int threads;           /* OpenMP threads following them (0: the OpenMP default) */
     const char *csv;       /* measure,scale,value rows, or NULL */
     const char *png;       /* a 2-D window's figure: the entropy map in the first box size
@@ -88,6 +93,12 @@ typedef struct measure_result {
     uint64_t counted[MEASURE_MAX_EPS];
     int n_eps;
     double alpha, alpha_r2;    /* NAN with fewer than 2 fractions above 0 */
+    /* by true orbits: of the sampled states whose fate is decided, the share
+     * with a state eps cells away along an axis that goes elsewhere */
+    double orbit_eps[MEASURE_MAX_EPS], orbit_uncertain[MEASURE_MAX_EPS];
+    uint64_t orbit_counted[MEASURE_MAX_EPS];
+    int n_orbit_eps;
+    double orbit_alpha, orbit_alpha_r2;
     bool has_wada;
     cm_wada wada;
     char to_model[64];         /* the second file's model ("" without one) */
@@ -98,6 +109,7 @@ typedef struct measure_result {
     uint64_t sample_steps;     /* map steps their orbits took */
     uint64_t sample_same;      /* of the sampled, those whose fate is their cell's label */
     bool samples_agree;        /* every share within its sampled interval */
+    int64_t slabs;             /* the window read whole (1) or in this many slabs */
     double seconds_read, seconds_sample, seconds_entropy, seconds_uncertain, seconds_wada;
     double *entropy_map;       /* with a->png: the first box size's boxes, x fastest */
     int64_t map_n[2];          /* boxes along x and y */

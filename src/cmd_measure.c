@@ -13,8 +13,9 @@
 static const char measure_help[] =
     "usage: cellmap measure FILE.cmdb [--window X0:X1[,Y0:Y1...]] [--entropy B[,B...]|none]\n"
     "                       [--uncertainty E0:E1|none] [--wada R|none] [--mem BYTES]\n"
-    "                       [--to OTHER.cmdb] [--samples N[:SEED]] [--threads N] [--csv FILE|-]\n"
-    "                       [--png FILE] [--size WxH] [--json] [--quiet]\n\n"
+    "                       [--to OTHER.cmdb] [--samples N[:SEED] [--orbit-uncertainty E0:E1]]\n"
+    "                       [--threads N] [--csv FILE|-] [--png FILE] [--size WxH] [--json]\n"
+    "                       [--quiet]\n\n"
     "Measures the basins of the file's attractors (as `export --labels` labels the\n"
     "cells: 0 diverged and -2 outside count as basins; cells not computed are left\n"
     "out), over the window (default every cell):\n"
@@ -42,10 +43,15 @@ static const char measure_help[] =
     "                      for flows): the sampled shares, intervals that hold the true\n"
     "                      ones together 95 times in 100, and whether the cells' shares\n"
     "                      lie in them (seed default 1)\n"
+    "  --orbit-uncertainty E0:E1  with --samples, f(eps) and alpha by true orbits: the\n"
+    "                      share of the states with one eps cells away (along an axis)\n"
+    "                      that goes elsewhere, eps doubling from E0 to E1 (may be < 1)\n"
     "  --threads N         threads following them (default: all)\n"
-    "  --mem BYTES         the cluster's memory, and the most the labels take (256M)\n"
+    "  --mem BYTES         the cluster's memory, and the most the labels take (256M):\n"
+    "                      a window whose labels do not fit is measured in slabs\n"
     "  --csv FILE|-        rows measure,scale,value: share and sampled (the label), sb and\n"
-    "                      sbb (the box), uncertain (eps), wada (r), tipping (FROM>TO)\n"
+    "                      sbb (the box), uncertain and orbit_uncertain (eps), wada (r),\n"
+    "                      tipping (FROM>TO)\n"
     "  --png FILE          a 2-D window's entropy map (the first box size) over f(eps)\n"
     "  --size WxH          its size (default 800x1000)\n"
     "  --json              the result as JSON on standard output\n"
@@ -93,6 +99,12 @@ static int parse_args(cli *c, measure_args *a, bool *json, bool *quiet)
                 (colon && (!parse_int64(colon + 1, &seed) || seed < 0)))
                 err = cli_usage_error(c, "--samples: give N[:SEED], N >= 1, SEED >= 0");
             a->samples = (uint64_t)n, a->seed = (uint64_t)seed;
+        } else if (cli_is(c, "--orbit-uncertainty", true, &err)) {
+            int n = 0;
+            if (c->value && (!parse_ranges(c->value, &a->orbit_eps_lo, &a->orbit_eps_hi, &n, 1) ||
+                             !(a->orbit_eps_lo > 0)))
+                err = cli_usage_error(c, "--orbit-uncertainty: '%s' is not E0:E1, 0 < E0 < E1 "
+                                         "(cells)", c->value);
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (cli_take_mem(c, &a->mem, &err)) {
         } else if (cli_is(c, "--csv", true, &err)) {

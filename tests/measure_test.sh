@@ -123,6 +123,26 @@ for s in r["shares"]:
 rows = [x for x in csv.DictReader(open(sys.argv[2])) if x["measure"] == "sampled"]
 assert [float(x["value"]) for x in rows] == [s["sampled_share"] for s in r["shares"]], rows
 PY
+# the uncertainty exponent by true orbits below the cell, where the lattice
+# is too coarse: the Weierstrass curve's 0.369 (the lattice gives 0.393 at
+# these cells), and the straight line's 1
+"$CM" measure curve.cmdb --window 0:1,-2.5012:2.5 --uncertainty none --entropy none \
+  --samples 100000 --orbit-uncertainty 0.015625:1 --json > orbit-curve.json \
+  || fail "measure curve --orbit-uncertainty"
+"$CM" measure line.cmdb --window 0:1,-2.5012:2.5 --uncertainty none --entropy none \
+  --samples 100000 --orbit-uncertainty 1:16 --json --csv orbit-line.csv > orbit-line.json \
+  || fail "measure line --orbit-uncertainty"
+python3 - orbit-curve.json orbit-line.json orbit-line.csv <<'PY' || fail "alpha by true orbits"
+import csv, json, math, sys
+curve, line = (json.load(open(p)) for p in sys.argv[1:3])
+assert abs(curve["orbit_alpha"] - math.log(1.5) / math.log(3)) < 0.01, curve["orbit_alpha"]
+assert curve["orbit_eps"] == [2.0 ** -k for k in range(6, -1, -1)], curve["orbit_eps"]
+assert abs(line["orbit_alpha"] - 1) < 0.05, line["orbit_alpha"]
+rows = [r for r in csv.DictReader(open(sys.argv[3])) if r["measure"] == "orbit_uncertain"]
+assert [float(r["value"]) for r in rows] == line["orbit_uncertain"], rows
+PY
+expect_usage "give samples" measure curve.cmdb --orbit-uncertainty 0.5:1
+expect_usage "--orbit-uncertainty: '0:1'" measure curve.cmdb --samples 10 --orbit-uncertainty 0:1
 expect_usage "--samples: give N[:SEED]" measure newton.cmdb --samples 0
 expect_usage "at most 100000000" measure newton.cmdb --samples 100000001
 

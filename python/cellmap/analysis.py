@@ -115,7 +115,8 @@ class _Measure(ctypes.Structure):
                 ("eps_hi", ctypes.c_int), ("wada_radius", ctypes.c_int),
                 ("wada_required", ctypes.c_int), ("to", ctypes.c_char_p),
                 ("mem", ctypes.c_uint64), ("samples", ctypes.c_uint64),
-                ("seed", ctypes.c_uint64), ("threads", ctypes.c_int)]
+                ("seed", ctypes.c_uint64), ("threads", ctypes.c_int),
+                ("orbit_eps_lo", ctypes.c_double), ("orbit_eps_hi", ctypes.c_double)]
 
 
 class _MeasureOut(ctypes.Structure):
@@ -123,7 +124,8 @@ class _MeasureOut(ctypes.Structure):
                 ("sbb", ctypes.c_double), ("alpha", ctypes.c_double),
                 ("alpha_r2", ctypes.c_double), ("wada_basins", ctypes.c_int),
                 ("wada_fraction", ctypes.c_double), ("sampled", ctypes.c_uint64),
-                ("sampled_as_labelled", ctypes.c_uint64), ("samples_agree", ctypes.c_int)]
+                ("sampled_as_labelled", ctypes.c_uint64), ("samples_agree", ctypes.c_int),
+                ("orbit_alpha", ctypes.c_double), ("orbit_alpha_r2", ctypes.c_double)]
 
 
 class _Simulate(ctypes.Structure):
@@ -457,19 +459,21 @@ def embedding(of, input=None, start=None, time=None, transient=None, dt=None, va
 
 
 def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5,
-            wada_required=False, to=None, mem=None, samples=0, seed=1, threads=0, csv=None,
-            png=None, size=None):
+            wada_required=False, to=None, mem=None, samples=0, seed=1, threads=0,
+            orbit_uncertainty=None, csv=None, png=None, size=None):
     """A .cmdb file's basins measured (`cellmap measure`): entropy the box
     sizes of basin entropy (() for none), uncertainty (E0, E1) the eps range
     (None for none), wada the Wada test's radius (0 for none), to a second
     file on the same lattice for the tipping probabilities, samples random
-    states (seed their stream) followed by their true orbits, png the figure
+    states (seed their stream) followed by their true orbits (and with
+    orbit_uncertainty (E0, E1) the uncertain fractions by them), png the figure
     of a 2-D window. Returns
     (summary, table): summary a dict of cells, computed, sb, sbb (means over
     the boxes), alpha, alpha_r2, wada_basins and wada_fraction, sampled (in
-    computed cells), sampled_as_labelled and samples_agree (None where not
-    measured); table the rows measure, scale, value (share, sampled, sb,
-    sbb, uncertain, wada, tipping)."""
+    computed cells), sampled_as_labelled, samples_agree, orbit_alpha and
+    orbit_alpha_r2 (None where not measured); table the rows measure,
+    scale, value (share, sampled, sb, sbb, uncertain, orbit_uncertain, wada,
+    tipping)."""
     o = _lib.cm_measure_defaults()
     keep = [_path(file), _text(window) if window is not None else None, _path(to)]
     o.file, o.window, o.to = keep
@@ -483,6 +487,8 @@ def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5
     if mem is not None:
         o.mem = int(mem)
     o.samples, o.seed, o.threads = int(samples), int(seed), int(threads)
+    if orbit_uncertainty is not None:
+        o.orbit_eps_lo, o.orbit_eps_hi = map(float, orbit_uncertainty)
     res = _MeasureOut()
     table = _run(_common(csv=csv, png=png, size=size), _lib.cm_analysis_measure, ctypes.byref(o),
                  ctypes.byref(res))
@@ -493,7 +499,9 @@ def measure(file, window=None, entropy=(3, 5, 7, 9), uncertainty=(1, 16), wada=5
              "wada_fraction": nan(res.wada_fraction) if res.wada_basins else None,
              "sampled": res.sampled or None,
              "sampled_as_labelled": res.sampled_as_labelled if res.sampled else None,
-             "samples_agree": bool(res.samples_agree) if res.sampled else None}, table)
+             "samples_agree": bool(res.samples_agree) if res.sampled else None,
+             "orbit_alpha": nan(res.orbit_alpha), "orbit_alpha_r2": nan(res.orbit_alpha_r2)},
+            table)
 
 
 def series(model, start=None, time=None, skip=None, dt=None, of=None, time_unit=0.0, fmax=0.0,
