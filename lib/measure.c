@@ -589,9 +589,8 @@ static cm_status count_pass(source *src, source *to, const plan *p, int32_t *lab
 {
     for (int64_t c0 = 0; c0 < p->rows; c0 += p->core) {
         const int64_t c1 = c0 + p->core < p->rows ? c0 + p->core : p->rows;
-        const cm_status st = p->whole && c0 > 0 ? CM_OK
-                                                : read_rows(src, to, c0, c1, label, to_label,
-                                                            hooks, reading, msg, msg_size);
+        const cm_status st = read_rows(src, to, c0, c1, label, to_label, hooks, reading, msg,
+                                       msg_size);
         if (st != CM_OK)
             return st;
         tally_cells(t, label, to_label, (uint64_t)(c0 * p->row_cells),
@@ -608,8 +607,9 @@ static cm_status measure_pass(const measure_args *a, source *src, const plan *p,
     cm_status st = CM_OK;
     for (int64_t c0 = 0; st == CM_OK && c0 < p->rows; c0 += p->core) {
         const int64_t c1 = c0 + p->core < p->rows ? c0 + p->core : p->rows;
-        const int64_t lo = p->whole ? 0 : c0 - p->halo > 0 ? c0 - p->halo : 0;
-        const int64_t top = p->whole ? p->rows : c1 + p->halo < p->rows ? c1 + p->halo : p->rows;
+        /* a whole window is one slab without a halo, read by the first pass */
+        const int64_t lo = c0 - p->halo > 0 ? c0 - p->halo : 0;
+        const int64_t top = c1 + p->halo < p->rows ? c1 + p->halo : p->rows;
         if (!p->whole)
             st = read_rows(src, NULL, lo, top, label, NULL, hooks, &r->seconds_read, msg,
                            msg_size);
@@ -651,7 +651,7 @@ typedef struct buffers {
 static cm_status buffers_alloc(const measure_args *a, const plan *p, const source *src,
                                const source *to, buffers *b, char *msg, size_t msg_size)
 {
-    const int64_t held = p->whole ? p->rows : p->core + 2 * p->halo;
+    const int64_t held = p->core + 2 * p->halo; /* whole: the rows, no halo */
     const size_t n = (size_t)((held < p->rows ? held : p->rows) * p->row_cells);
     b->label = malloc(n * sizeof *b->label);
     b->to_label = to ? malloc(n * sizeof *b->to_label) : NULL;

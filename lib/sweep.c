@@ -183,12 +183,20 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
 
 /* ---- attractors tracked across values ---- */
 
+/* The region's extent along dimension k, in state units. */
+static double extent(const sweep_result *r, int k)
+{
+    return r->lat.width[k] * (double)(r->box.hi[k] - r->box.lo[k]);
+}
+
+/* The matching distance asked for, or its default. */
+static double match_within(const sweep_args *a) { return a->match > 0 ? a->match : SWEEP_MATCH; }
+
 double sweep_distance(const sweep_result *r, const sweep_attractor *x, const sweep_attractor *y)
 {
     double d = 0;
     for (int k = 0; k < r->lat.dim; k++) {
-        const double extent = r->lat.width[k] * (double)(r->box.hi[k] - r->box.lo[k]);
-        d = fmax(d, fabs(x->centre[k] - y->centre[k]) / extent);
+        d = fmax(d, fabs(x->centre[k] - y->centre[k]) / extent(r, k));
     }
     return d;
 }
@@ -211,7 +219,7 @@ static int by_distance(const void *x, const void *y)
 cm_status sweep_match(const sweep_args *a, const sweep_result *r, const sweep_point *p,
                       const sweep_point *q, int *pair, uint32_t *matched)
 {
-    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    const double within = match_within(a);
     pairing *cand = malloc(((size_t)p->attractors * q->attractors + 1) * sizeof *cand);
     bool *taken = calloc((size_t)p->attractors + 1, sizeof *taken);
     if (!cand || !taken) {
@@ -316,9 +324,9 @@ static bool merges_into(const sweep_args *a, const sweep_result *r, const sweep_
 {
     if (y->kind != CM_ATTRACTOR_APERIODIC)
         return false;
-    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    const double within = match_within(a);
     for (int k = 0; k < r->lat.dim; k++) {
-        const double pad = within * r->lat.width[k] * (double)(r->box.hi[k] - r->box.lo[k]);
+        const double pad = within * extent(r, k);
         if (!(x->centre[k] >= y->lo[k] - pad && x->centre[k] <= y->hi[k] + pad))
             return false;
     }
@@ -371,7 +379,7 @@ static int by_id(const void *x, const void *y)
 static uint32_t id_of_new(const sweep_args *a, sweep_result *r, const sweep_attractor *t,
                           sweep_attractor *gone, size_t *n_gone)
 {
-    const double within = a->match > 0 ? a->match : SWEEP_MATCH;
+    const double within = match_within(a);
     size_t best = SIZE_MAX;
     double d_best = INFINITY;
     for (size_t i = 0; i < *n_gone; i++) {
