@@ -705,3 +705,163 @@ cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
     return cm_attractors_outside(m, &c->lat, cc->exits, &cells, outside_budget(m, opt),
                                  opt ? opt->threads : 0, out, msg, msg_size);
 }
+
+/* ---- a cluster's labels, region by region ------------------------------ */
+
+#define NODE_PENDING INT32_MIN     /* a node label not known yet */
+#define NODE_UNLABELLED (INT32_MIN + 1) /* an open node without an escape record */
+
+/* The label of a node from its saved fields (an open node keeps the fate
+ * of its exit, set from the escapes), or NODE_PENDING when it takes the
+ * label of node nd->next (its exit lands in that node's tree). */
+static cm_status own_node_label(const cm_attractor_set *s, uint32_t id, const cm_node *nd,
+                                int32_t *label, char *msg, size_t msg_size)
+{
+    if (nd->next == CM_NODE_OPEN && *label == NODE_UNLABELLED)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "open node %u is not among the cluster's exits", id);
+    if (nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE)
+        *label = nd->group ? cm_attractor_label(s, nd->group) : CM_LABEL_DIVERGED;
+    else if (nd->next < CM_NODE_MAX)
+        *label = NODE_PENDING;
+    else if (nd->next != CM_NODE_OPEN)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "node %u has no valid link", id);
+    return CM_OK;
+}
+
+/* Every pending node takes the label its chain of links ends on: each
+ * chain is walked once, its nodes then hold the end's label. */
+static cm_status settle_node_labels(uint32_t n, const uint32_t *next, int32_t *label, char *msg,
+                                    size_t msg_size)
+{
+    for (uint32_t id = 0; id < n; id++) {
+        uint32_t end = id;
+        for (uint64_t hops = 0; label[end] == NODE_PENDING; hops++, end = next[end])
+            if (hops > n || next[end] >= n)
+                return cm_fail(CM_EFORMAT, msg, msg_size,
+                               "the links from node %u form a loop or leave the cluster", id);
+        for (uint32_t x = id; label[x] == NODE_PENDING; x = next[x])
+            label[x] = label[end];
+    }
+    return CM_OK;
+}
+
+typedef struct exit_fates {
+    const cm_attractor_set *s;
+    int dim;
+    int32_t *label;
+} exit_fates;
+
+static void label_escape(void *user, uint32_t node, const int64_t *cell)
+{
+    const exit_fates *f = user;
+    f->label[node] = cm_attractor_exit_label(f->s, f->dim, cell);
+}
+
+cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32_t **out,
+                                 char *msg, size_t msg_size)
+{
+    const uint32_t n = c->nnodes;
+    *out = NULL;
+    if (c->resolved_cells)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's sink cells are resolved (a file before version 4): "
+                       "label its flattened cells instead");
+    int32_t *label = malloc(((size_t)n + 1) * sizeof *label);
+    uint32_t *next = malloc(((size_t)n + 1) * sizeof *next);
+    cm_status st = label && next ? CM_OK
+                                 : cm_fail(CM_ENOMEM, msg, msg_size,
+                                           "out of memory for the labels of %u nodes", n);
+    if (st == CM_OK) {
+        for (uint32_t id = 0; id < n; id++)
+            label[id] = NODE_UNLABELLED;
+        exit_fates f = {s, c->lat.dim, label};
+        cm_cluster_each_escape(c, label_escape, &f);
+    }
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        cm_node *table = NULL;
+        if (cr->r.nexits)
+            st = cm_cluster_node_load(c, cr->node_base, &table, msg, msg_size);
+        for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
+            const uint32_t id = cr->node_base + (uint32_t)e;
+            next[id] = table[e].next;
+            st = own_node_label(s, id, &table[e], &label[id], msg, msg_size);
+        }
+        cm_cluster_trim(c); /* one table at a time is enough */
+    }
+    if (st == CM_OK)
+        st = settle_node_labels(n, next, label, msg, msg_size);
+    free(next);
+    if (st != CM_OK)
+        free(label);
+    else
+        *out = label;
+    return st;
+}
+
+/* Cell i of region r: a node reference takes its node's label; a sink
+ * cell's sequence ends in the world's sink inside the region. r NULL: no
+ * cell computed. */
+static int32_t region_cell_label(const cm_region *r, uint64_t i, const int32_t *node_label,
+                                 const cm_attractor_set *s)
+{
+    if (!r)
+        return CM_LABEL_UNCOMPUTED;
+    const uint32_t g = r->group[i];
+    return cm_is_node_ref(g) ? node_label[g & ~CM_NODE_REF]
+           : g == 0          ? CM_LABEL_DIVERGED
+                             : cm_attractor_label(s, g);
+}
+
+/* Labels the cells of `part` (inside r's box and `box`; r NULL: none
+ * computed) into labels with the strides of box, a row along dimension 0
+ * at a time (contiguous in r). */
+static void label_part(const cm_region *r, const int32_t *node_label, const cm_attractor_set *s,
+                       const cm_box *box, const cm_box *part, const int64_t *stride,
+                       int32_t *labels, int threads)
+{
+    const int64_t width = part->hi[0] - part->lo[0];
+    const int64_t rows = (int64_t)(cm_box_cells(part) / (uint64_t)width);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int64_t q = 0; q < rows; q++) {
+        int64_t cell[CM_MAX_DIM];
+        cm_box row = *part;
+        row.hi[0] = row.lo[0] + 1;
+        cm_box_cell(&row, (uint64_t)q, cell);
+        const uint64_t from = r ? cm_box_index(&r->box, cell) : 0;
+        int64_t to = 0;
+        for (int d = 0; d < box->dim; d++)
+            to += (cell[d] - box->lo[d]) * stride[d];
+        for (int64_t i = 0; i < width; i++)
+            labels[to + i * stride[0]] = region_cell_label(r, from + (uint64_t)i, node_label, s);
+    }
+}
+
+cm_status cm_cluster_cell_labels(cm_cluster *c, const cm_attractor_set *s,
+                                 const int32_t *node_label, const cm_box *box,
+                                 const int64_t *stride, int32_t *labels, char *msg,
+                                 size_t msg_size)
+{
+    int64_t own[CM_MAX_DIM];
+    if (!stride) { /* cm_box_index's order */
+        own[0] = 1;
+        for (int d = 1; d < box->dim; d++)
+            own[d] = own[d - 1] * (box->hi[d - 1] - box->lo[d - 1]);
+        stride = own;
+    }
+    const int threads = cm_cluster_threads(c);
+    label_part(NULL, NULL, s, box, box, stride, labels, threads);
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        cm_box part;
+        if (!cm_box_intersect(&c->regions[k].r.box, box, &part))
+            continue;
+        st = cm_cluster_acquire(c, k, msg, msg_size);
+        if (st == CM_OK) /* a region's node references count from its node_base */
+            label_part(&c->regions[k].r, node_label + c->regions[k].node_base, s, box, &part,
+                       stride, labels, threads);
+        cm_cluster_trim(c);
+    }
+    return st;
+}

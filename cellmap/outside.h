@@ -125,6 +125,32 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
                                    const cm_computed *cells, int32_t *labels, char *msg,
                                    size_t msg_size);
 
+/* The label of every node of cluster c (node_label[id]): the label its
+ * exit's chain of links ends on (a group's attractor; for an open node,
+ * the fate s gives its exit, found from the cluster's escape index; 0 when
+ * the chain ends in the world's sink), the group cm_cluster_resolve would
+ * give it, labelled. Each node table is read once, one at a time within
+ * the cluster's budget; the chains are then settled in memory (8 bytes per
+ * node while it runs, 4 kept). *node_label is the caller's to free (NULL
+ * on failure). Not for a cluster of resolved cells (files before version
+ * 4, cm_cluster.resolved_cells: CM_EINVAL), whose sink sequences must be
+ * followed across regions (cm_cluster_flatten and
+ * cm_attractor_cell_labels). CM_EFORMAT for broken links. */
+cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32_t **node_label,
+                                 char *msg, size_t msg_size);
+
+/* The labels cm_attractor_cell_labels gives the flattened cluster, for the
+ * cells of `box`, read region by region from the cells and the node labels
+ * (cm_cluster_node_labels) without flattening: each region that meets the
+ * box is paged in once. labels[sum over d of (cell[d] - box->lo[d]) *
+ * stride[d]] gets the label of cell `cell` (stride NULL: cm_box_index's
+ * order, dimension 0 fastest); cells of no region get -1. Threads: the
+ * cluster's (cm_cluster_threads). */
+cm_status cm_cluster_cell_labels(cm_cluster *c, const cm_attractor_set *s,
+                                 const int32_t *node_label, const cm_box *box,
+                                 const int64_t *stride, int32_t *labels, char *msg,
+                                 size_t msg_size);
+
 /* The attractors of the groups (entry k: group k + 1) with the exits
  * followed: cm_attractors_find, then the exits (a region's x, from
  * cm_region_settle_exits, or the cluster's, cc->exits from

@@ -133,30 +133,40 @@ bool attractor_options_given(const cm_attractor_options *o)
 
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size)
 {
+    if (e->open)
+        return CM_OK;
     e->cc = (cm_cluster_cells){c, &e->exits};
     e->computed = cm_cluster_computed(&e->cc);
-    return cm_cluster_exits(c, &e->exits, msg, msg_size);
+    const cm_status st = cm_cluster_exits(c, &e->exits, msg, msg_size);
+    e->open = st == CM_OK;
+    return st;
 }
 
-void cluster_ends_close(cluster_ends *e) { cm_exits_free(&e->exits); }
+void cluster_ends_close(cluster_ends *e)
+{
+    cm_exits_free(&e->exits);
+    e->open = false;
+}
 
 cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
-                          cluster_ends *ends, const cm_group_info *groups,
+                          cm_cluster *c, cluster_ends *ends, const cm_group_info *groups,
                           const cm_attractor_options *o, cm_attractor_set *out, char *msg,
                           size_t msg_size)
 {
-    const cm_cluster *c = ends->cc.c;
     if (!o || !attractor_options_given(o)) {
         const cm_status st =
             cm_store_get_attractors(s, c->lat.dim, c->ngroups, out, NULL, msg, msg_size);
         if (st != CM_ENOTFOUND)
             return st;
     }
+    cm_status st = cluster_ends_open(ends, c, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     if (m)
         return cm_cluster_attractors(m, &ends->cc, groups, o, out, msg, msg_size);
     cm_model_set set = {0};
     cm_model own;
-    cm_status st = model_of_store(info, &set, &own, msg, msg_size);
+    st = model_of_store(info, &set, &own, msg, msg_size);
     if (st == CM_OK) {
         st = cm_cluster_attractors(&own, &ends->cc, groups, o, out, msg, msg_size);
         cm_model_release(&own);

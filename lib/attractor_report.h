@@ -40,22 +40,24 @@ enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
 
 /* Where the sink cells of a cluster's views go (cellmap/outside.h): its
  * exits and the adapter over them; `computed` points into the struct, which
- * must stay where it is until cluster_ends_close. */
+ * must stay where it is until cluster_ends_close. Zeroed: closed; opening
+ * an open one does nothing (the exits cost 30-40 bytes per open node). */
 typedef struct cluster_ends {
     cm_exits exits;
     cm_cluster_cells cc;
     cm_computed computed;
+    bool open;
 } cluster_ends;
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size);
 void cluster_ends_close(cluster_ends *e);
 
-/* The attractors of a file's cluster (ends: its exits, cluster_ends_open):
- * those it stores, unless o asks for others (a field set) or it stores
- * none; then found with the true map of model m (NULL: the file's, rebuilt
- * from info), the cluster's cells and its exits (cm_cluster_attractors).
- * groups[k]: group k + 1. */
+/* The attractors of a file's cluster c: those it stores, unless o asks for
+ * others (a field set) or it stores none; then found with the true map of
+ * model m (NULL: the file's, rebuilt from info), the cluster's cells and
+ * its exits (cm_cluster_attractors), for which ends is opened (left as it
+ * is when the file's attractors are read). groups[k]: group k + 1. */
 cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model *m,
-                          cluster_ends *ends, const cm_group_info *groups,
+                          cm_cluster *c, cluster_ends *ends, const cm_group_info *groups,
                           const cm_attractor_options *o, cm_attractor_set *out, char *msg,
                           size_t msg_size);
 

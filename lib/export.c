@@ -621,9 +621,7 @@ cm_status exporter_open(exporter *x, cm_store *s, const cm_store_info *info, cm_
     if (st != CM_OK)
         return st;
     char why[1024];
-    st = cluster_ends_open(&x->ends, c, why, sizeof why);
-    if (st == CM_OK)
-        st = file_attractors(s, info, NULL, &x->ends, x->groups, o, &x->att, why, sizeof why);
+    st = file_attractors(s, info, NULL, c, &x->ends, x->groups, o, &x->att, why, sizeof why);
     if (st != CM_OK) /* nothing is written without them */
         cm_fail(st, msg, msg_size, "%s: %s", source, why);
     return st;
@@ -633,8 +631,37 @@ void exporter_close(exporter *x)
 {
     cluster_ends_close(&x->ends);
     cm_attractors_free(&x->att);
+    free(x->node_labels);
+    x->node_labels = NULL;
     free(x->groups);
     x->groups = NULL;
+}
+
+cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size)
+{
+    if (x->c->resolved_cells)
+        return CM_OK;
+    const cm_status st =
+        x->node_labels ? CM_OK : cm_cluster_node_labels(x->c, &x->att, &x->node_labels, msg,
+                                                         msg_size);
+    if (st != CM_OK)
+        return st;
+    free(x->att.exit_cell);
+    free(x->att.exit_label);
+    x->att.exit_cell = NULL;
+    x->att.exit_label = NULL;
+    x->att.nexits = 0;
+    cluster_ends_close(&x->ends);
+    x->labels_only = true;
+    return CM_OK;
+}
+
+/* export_cells and export_arrays need the exits' fates. */
+static cm_status check_not_labels_only(const exporter *x, char *msg, size_t msg_size)
+{
+    return x->labels_only ? cm_fail(CM_EINVAL, msg, msg_size,
+                                    "this exporter was made for labels only (exporter_labels_only)")
+                          : CM_OK;
 }
 
 cm_status export_window(const cm_cluster *c, const char *text, cm_box *box, char *msg,
@@ -719,6 +746,11 @@ cm_status export_cells(exporter *x, const char *cells, const char *flat, const w
     int nouts = 0;
     memset(outs, 0, sizeof outs);
     *rows = 0;
+    cm_status ends = check_not_labels_only(x, msg, msg_size);
+    if (ends == CM_OK)
+        ends = cluster_ends_open(&x->ends, c, msg, msg_size);
+    if (ends != CM_OK)
+        return ends;
     for (int k = 0; k < 2; k++) {
         outs[k].names = x->names;
         outs[k].source = x->source;
@@ -840,9 +872,24 @@ static bool copy_slab(void *user, const cm_region *flat, const int32_t *label, c
 cm_status export_labels(exporter *ex, const cm_box *box, int32_t *labels,
                         const work_hooks *hooks, char *msg, size_t msg_size)
 {
-    slab_memory m = {labels, box};
-    return each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
-                     "the labels were not read", copy_slab, &m, msg, msg_size);
+    if (ex->c->resolved_cells) { /* sink sequences followed across regions */
+        slab_memory m = {labels, box};
+        const cm_status st = cluster_ends_open(&ex->ends, ex->c, msg, msg_size);
+        return st != CM_OK ? st : each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
+                         "the labels were not read", copy_slab, &m, msg, msg_size);
+    }
+    int64_t stride[CM_MAX_DIM]; /* C order: dimension 0 slowest */
+    stride[box->dim - 1] = 1;
+    for (int d = box->dim - 2; d >= 0; d--)
+        stride[d] = stride[d + 1] * (box->hi[d + 1] - box->lo[d + 1]);
+    cm_status st = ex->node_labels ? CM_OK
+                                   : cm_cluster_node_labels(ex->c, &ex->att, &ex->node_labels,
+                                                            msg, msg_size);
+    if (st == CM_OK)
+        st = cm_cluster_cell_labels(ex->c, &ex->att, ex->node_labels, box, stride, labels,
+                                    msg, msg_size);
+    work_progress(hooks, cm_box_cells(box), NULL);
+    return st;
 }
 
 cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps_path,
@@ -850,6 +897,11 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
 {
     cm_cluster *c = ex->c;
     const cm_box *window = &ex->window;
+    cm_status ends = check_not_labels_only(ex, msg, msg_size);
+    if (ends == CM_OK)
+        ends = cluster_ends_open(&ex->ends, c, msg, msg_size);
+    if (ends != CM_OK)
+        return ends;
     const array_export arrays = {labels_path, steps_path, ex->source, ex->info, ex->groups,
                                  ex->info->groups, ex->names,
                                  labels_path && !by_groups ? &ex->att : NULL,

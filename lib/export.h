@@ -39,6 +39,8 @@ typedef struct exporter {
     cluster_ends ends;         /* the cluster's exits */
     const char *names[CM_MAX_DIM]; /* the state coordinates' names */
     cm_box window;             /* the cells written */
+    int32_t *node_labels;      /* the nodes' labels, once export_labels needed them */
+    bool labels_only;          /* exporter_labels_only */
 } exporter;
 
 /* The cells of c whose centres lie in the window text "X0:X1[,Y0:Y1...]"
@@ -83,9 +85,17 @@ cm_status export_arrays(exporter *x, const char *labels, const char *steps, bool
 
 /* The labels by attractors (as the .npy array of export_arrays has them)
  * of the cells of box (within the window) into labels (box's cells, C
- * order, the caller's), read a slab at a time. hooks count cells. */
+ * order, the caller's): region by region from the nodes' labels, made at
+ * the first call (cm_cluster_cell_labels); a cluster of resolved cells
+ * (a file before version 4) a slab at a time. hooks count cells. */
 cm_status export_labels(exporter *x, const cm_box *box, int32_t *labels,
                         const work_hooks *hooks, char *msg, size_t msg_size);
+
+/* Makes x an exporter of labels only: the nodes' labels made now, then the
+ * exits' fates (20 bytes per exit), which only they needed, released;
+ * export_cells and export_arrays refuse afterwards. A cluster of resolved
+ * cells keeps them (export_labels follows its cells' exits). */
+cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size);
 
 /* An array's sidecar path: FILE.npy -> FILE.json. */
 void export_sidecar_path(const char *npy, char *out, size_t size);

@@ -553,7 +553,7 @@ cm_status figure_of_file(cm_store *s, const cm_store_info *info, cm_cluster *cl,
     if (st == CM_OK && po->by == BY_ATTRACTORS)
         st = cluster_ends_open(&ends, cl, msg, msg_size);
     if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = file_attractors(s, info, &m, &ends, groups, o, &att, msg, msg_size);
+        st = file_attractors(s, info, &m, cl, &ends, groups, o, &att, msg, msg_size);
     reading r = {hooks, cm_box_cells(box)};
     if (st == CM_OK)
         st = cm_cluster_flatten_progress(cl, box, &flat, read_progress, &r, msg, msg_size);

@@ -108,6 +108,8 @@ static cm_status source_open(const char *file, uint64_t mem, const char *window_
                            box ? box : window_text ? &window : NULL, file, &stored, msg,
                            msg_size);
     src->exporting = st == CM_OK;
+    if (st == CM_OK) /* the exits' fates are not needed once the nodes have labels */
+        st = exporter_labels_only(&src->x, msg, msg_size);
     if (st != CM_OK)
         source_close(src);
     return st;
@@ -244,15 +246,19 @@ static cm_status sample_fates(const measure_args *a, const source *src, sampled 
     return st;
 }
 
-/* How the window is read: whole when its labels (of every file) fit the
- * budget, else in slabs of `core` rows along dimension 0 with `halo` rows
- * each side, their labels within half the budget (the cluster's pages
- * take the rest). */
+/* How the window is read: whole when its labels (of every file) fit half
+ * the budget, else in slabs of `core` rows along dimension 0 with `halo`
+ * rows each side, their labels within that half (the clusters' pages
+ * share the other: labels_budget, pages_budget). */
 typedef struct plan {
     int64_t rows, row_cells, core, halo;
     int files;
     bool whole;
 } plan;
+
+static uint64_t labels_budget(const measure_args *a) { return a->mem / 2; }
+
+static uint64_t pages_budget(const measure_args *a) { return a->mem / 2 / (a->to ? 2 : 1); }
 
 static cm_status plan_of(const measure_args *a, const cm_box *window, plan *p, char *msg,
                          size_t msg_size)
@@ -262,7 +268,8 @@ static cm_status plan_of(const measure_args *a, const cm_box *window, plan *p, c
     p->row_cells = (int64_t)(cm_box_cells(window) / (uint64_t)p->rows);
     p->files = a->to ? 2 : 1;
     const double row_bytes = (double)p->row_cells * sizeof(int32_t) * p->files;
-    p->whole = row_bytes * (double)p->rows <= (double)a->mem;
+    const double budget = (double)labels_budget(a);
+    p->whole = row_bytes * (double)p->rows <= budget;
     if (p->whole) {
         p->core = p->rows;
         return CM_OK;
@@ -271,7 +278,7 @@ static cm_status plan_of(const measure_args *a, const cm_box *window, plan *p, c
         p->halo = a->box[k] - 1 > p->halo ? a->box[k] - 1 : p->halo;
     p->halo = a->eps_hi > p->halo ? a->eps_hi : p->halo;
     p->halo = a->wada_radius > p->halo ? a->wada_radius : p->halo;
-    p->core = (int64_t)((double)a->mem / 2 / row_bytes) - 2 * p->halo;
+    p->core = (int64_t)(budget / row_bytes) - 2 * p->halo;
     if (p->core < 1)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "a slab of the window (a row of %lld cells and the %lld rows each side "
@@ -689,9 +696,9 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
     plan p;
     cm_status st = check_args(a, msg, msg_size);
     if (st == CM_OK)
-        st = source_open(a->file, a->mem, a->window, NULL, NULL, &src, msg, msg_size);
+        st = source_open(a->file, pages_budget(a), a->window, NULL, NULL, &src, msg, msg_size);
     if (st == CM_OK && a->to)
-        st = source_open(a->to, a->mem, NULL, &src.x.window, &src.c.lat, &to, msg, msg_size);
+        st = source_open(a->to, pages_budget(a), NULL, &src.x.window, &src.c.lat, &to, msg, msg_size);
     if (st == CM_OK) {
         describe(&src, r);
         snprintf(r->to_model, sizeof r->to_model, "%s", a->to ? to.info.model : "");

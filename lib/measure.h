@@ -33,7 +33,7 @@ enum { MEASURE_MAX_BOXES = 8, MEASURE_MAX_EPS = 16 };
 typedef struct measure_args {
     const char *file;
     const char *window;    /* "X0:X1[,Y0:Y1...]" in state units; NULL: every cell */
-    uint64_t mem;          /* the cluster's and the labels' budget in bytes */
+    uint64_t mem;          /* bytes for the labels and the clusters' pages, half each */
     int box[MEASURE_MAX_BOXES]; /* basin entropy's box sizes in cells (n_box 0: none) */
     int n_box;
     int eps_lo, eps_hi;    /* uncertain fractions for eps = lo, 2 lo, ... <= hi (hi 0: none) */

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cellmap/codec.h"
+#include "cellmap/outside.h"
 #include "cellmap/store.h"
 #include "check.h"
 #include "cmdb_hash.h"
@@ -256,6 +257,76 @@ static void test_budgets(const char *dir, const cm_model *m)
         if (!getenv("KEEP")) unlink(path[k]);
 }
 
+/* The labels a paged cluster gives region by region from its node labels
+ * (cm_cluster_cell_labels) are those of its flattened cells
+ * (cm_attractor_cell_labels), cell by cell, for the whole box in either
+ * order and for a window across regions, under a budget of one byte. */
+static void test_cell_labels(const char *path, const cm_model *m)
+{
+    char msg[512];
+    cm_store *s = NULL;
+    cm_cluster c;
+    CHECK(cm_store_open(path, 0, &s, msg, sizeof msg) == CM_OK);
+    CHECK(cm_store_load_cluster(s, &c, msg, sizeof msg) == CM_OK);
+    c.mem_budget = 1;
+    cm_store_info info;
+    CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_OK);
+    cm_group_info *g = calloc(info.groups + 1, sizeof *g);
+    uint64_t sink = 0;
+    CHECK(cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK);
+    cm_exits x;
+    CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
+    cm_cluster_cells cc = {&c, &x};
+    cm_attractor_set att;
+    CHECK(cm_cluster_attractors(m, &cc, g, NULL, &att, msg, sizeof msg) == CM_OK);
+    int32_t *node_label = NULL;
+    CHECK(cm_cluster_node_labels(&c, &att, &node_label, msg, sizeof msg) == CM_OK);
+
+    const cm_box all = {2, {0, 0}, {NX, NY}}, window = {2, {250, 170}, {731, 433}};
+    cm_region flat;
+    CHECK(cm_cluster_flatten(&c, &all, &flat, msg, sizeof msg) == CM_OK);
+    const cm_computed cells = cm_cluster_computed(&cc);
+    int32_t *want = malloc(flat.ncells * sizeof *want), *got = malloc(flat.ncells * sizeof *got);
+    CHECK(cm_attractor_cell_labels(&att, &flat, &cells, want, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_cell_labels(&c, &att, node_label, &all, NULL, got, msg, sizeof msg) == CM_OK);
+    uint64_t differ = 0, returned = 0, outside = 0, attractors = 0;
+    for (uint64_t i = 0; i < flat.ncells; i++) {
+        differ += got[i] != want[i];
+        returned += flat.group[i] == 0 && want[i] > 0;
+        outside += flat.group[i] == 0 && want[i] == CM_LABEL_OUTSIDE;
+        attractors += want[i] > 0;
+    }
+    CHECK_INT(differ, 0);
+    /* not vacuous: sink cells labelled by their exits' fates, both kinds */
+    CHECK(attractors > 0 && returned > 0 && outside > 0);
+    const int64_t ww = window.hi[1] - window.lo[1];
+    const int64_t c_order[2] = {ww, 1}; /* dimension 0 slowest */
+    CHECK(cm_cluster_cell_labels(&c, &att, node_label, &window, c_order, got, msg, sizeof msg) ==
+          CM_OK);
+    differ = 0;
+    for (int64_t i = window.lo[0]; i < window.hi[0]; i++)
+        for (int64_t j = window.lo[1]; j < window.hi[1]; j++) {
+            const int64_t cell[2] = {i, j};
+            differ += got[(i - window.lo[0]) * ww + (j - window.lo[1])] !=
+                      want[cm_box_index(&all, cell)];
+        }
+    CHECK_INT(differ, 0);
+    fprintf(stderr,
+            "cell labels: %llu cells agree; %llu in basins, of the sink's %llu returned, %llu "
+            "outside\n",
+            (unsigned long long)flat.ncells, (unsigned long long)attractors,
+            (unsigned long long)returned, (unsigned long long)outside);
+    free(want);
+    free(got);
+    free(node_label);
+    free(g);
+    cm_region_free(&flat);
+    cm_attractors_free(&att);
+    cm_exits_free(&x);
+    cm_cluster_free(&c);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+}
+
 /* A refused file stays byte-identical, whatever tries to use it. */
 static void check_refused_untouched(const char *path, const cm_model *m, const char *why)
 {
@@ -351,6 +422,7 @@ int main(void)
     test_budgets(dir, &m);
     char good[256];
     snprintf(good, sizeof good, "%s/budget0-2.cmdb", dir);
+    test_cell_labels(good, &m);
     test_refused(dir, good, &m);
     unlink(good);
     rmdir(dir);
