@@ -732,6 +732,8 @@ typedef struct cm_sweep_options {
     int by_groups;         /* 1: count cell mapping's groups, not the system's attractors */
     const char *fractions; /* the tracked attractors' basin shares per value as CSV, or NULL */
     double match_within;   /* tracking's distance, a share of the region; 0: 0.05 */
+    const char *keep;      /* a directory (made if missing): each value solved into
+                              NAME=VALUE.cmdb there, as cm_db_create would; NULL: in memory */
 } cm_sweep_options;
 
 /* A model solved at each value of one parameter, its attractors and

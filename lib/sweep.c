@@ -6,7 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <errno.h>
+#include <sys/stat.h>
+
 #include "lib/param_grid.h"
+#include "lib/solve.h"
 #include "lib/work.h"
 
 static bool in_window(const sweep_args *a, const cm_group_info *g)
@@ -68,6 +72,78 @@ static void count_groups(const sweep_args *a, const cm_group_info *groups, uint3
     }
 }
 
+/* The cells solved in one region in memory, its groups (into *groups) and
+ * the system's attractors (into att, by attractors). */
+static cm_status solve_in_memory(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                                 const cm_model *m, sweep_point *pt, cm_group_info **groups,
+                                 uint32_t *ngroups, cm_attractor_set *att, char *msg,
+                                 size_t msg_size)
+{
+    const cm_scm_options opt = {.max_steps = a->max_steps,
+                                .threads = a->threads,
+                                .record_exits = 1}; /* exits followed */
+    cm_region r;
+    memset(&r, 0, sizeof r);
+    cm_exits exits = {0};
+    cm_status st = cm_region_alloc(&r, box, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_solve(m, lat, &opt, &r, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_region_settle_exits(&r, a->threads, &exits, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_scm_describe(m, lat, &r, groups, &pt->sink_cells, msg, msg_size);
+    *ngroups = r.ngroups;
+    if (st == CM_OK && a->by == BY_ATTRACTORS) {
+        cm_attractor_options o = a->att;
+        o.threads = a->threads;
+        st = cm_region_attractors(m, lat, &r, a->max_steps, &exits, *groups, &o, att, msg,
+                                  msg_size);
+    }
+    cm_exits_free(&exits);
+    cm_region_free(&r);
+    return st;
+}
+
+/* The cells solved as `solve --db a->keep/NAME=VALUE.cmdb` would (one
+ * region, its attractors found and stored, the file completed): the
+ * groups and attractors taken from the solve. */
+static cm_status solve_kept(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
+                            const cm_model *m, double value, sweep_point *pt,
+                            cm_group_info **groups, uint32_t *ngroups, cm_attractor_set *att,
+                            char *msg, size_t msg_size)
+{
+    char path[4096], command[4200];
+    if (snprintf(path, sizeof path, "%s/%s=%s.cmdb", a->keep, a->name, CM_NUM(value)) >=
+        (int)sizeof path)
+        return cm_fail(CM_EINVAL, msg, msg_size, "the directory's path is too long: %s", a->keep);
+    snprintf(command, sizeof command, "%s (%s = %s)", a->command ? a->command : "cellmap sweep",
+             a->name, CM_NUM(value));
+    solve_request q;
+    memset(&q, 0, sizeof q);
+    q.model = m, q.lib = model_spec_lib(&a->mo, m->name);
+    q.lat = *lat, q.box = *box;
+    q.plan.opt = (cm_scm_options){.max_steps = a->max_steps, .threads = a->threads,
+                                  .record_exits = 1};
+    q.cluster = true, q.db = path, q.command = command;
+    q.att = a->att;
+    q.att.threads = a->threads;
+    solve_result *r = malloc(sizeof *r);
+    if (!r)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a solve");
+    cm_status st = solve_run(&q, r, msg, msg_size);
+    if (st == CM_OK)
+        st = solve_finish(r, msg, msg_size);
+    if (st == CM_OK) { /* taken over from the solve */
+        pt->sink_cells = r->sink;
+        *ngroups = r->ngroups, *groups = r->groups, *att = r->att;
+        r->groups = NULL;
+        memset(&r->att, 0, sizeof r->att);
+    }
+    solve_result_free(r);
+    free(r);
+    return st;
+}
+
 cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
                          double value, sweep_point *pt, char *msg, size_t msg_size)
 {
@@ -78,40 +154,26 @@ cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_bo
     const char *name = a->name;
     if (!model_with_values(&a->mo, &name, &value, 1, &m, msg, msg_size))
         return CM_EINVAL;
-    const cm_scm_options opt = {.max_steps = a->max_steps,
-                                .threads = a->threads,
-                                .record_exits = 1}; /* exits followed */
-    cm_region r;
-    memset(&r, 0, sizeof r);
     cm_group_info *groups = NULL;
-    cm_exits exits = {0};
-    cm_status st = cm_region_alloc(&r, box, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_scm_solve(&m, lat, &opt, &r, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_region_settle_exits(&r, a->threads, &exits, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_scm_describe(&m, lat, &r, &groups, &pt->sink_cells, msg, msg_size);
+    uint32_t ngroups = 0;
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
+    cm_status st = a->keep ? solve_kept(a, lat, box, &m, value, pt, &groups, &ngroups, &att, msg,
+                                        msg_size)
+                           : solve_in_memory(a, lat, box, &m, pt, &groups, &ngroups, &att, msg,
+                                             msg_size);
     if (st == CM_OK && a->by == BY_ATTRACTORS) {
-        cm_attractor_options o = a->att;
-        o.threads = a->threads;
-        st = cm_region_attractors(&m, lat, &r, a->max_steps, &exits, groups, &o, &att, msg,
-                                  msg_size);
-        if (st == CM_OK && count_attractors(a, &att, r.ngroups, pt) != CM_OK)
+        if (count_attractors(a, &att, ngroups, pt) != CM_OK)
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u attractors", att.n);
     } else if (st == CM_OK) {
-        count_groups(a, groups, r.ngroups, pt);
+        count_groups(a, groups, ngroups, pt);
     }
     cm_attractors_free(&att);
     if (st != CM_OK) {
         free(pt->att);
         pt->att = NULL;
     }
-    cm_exits_free(&exits);
     free(groups);
-    cm_region_free(&r);
     cm_model_release(&m);
     pt->seconds = cm_seconds() - t0;
     return st;
@@ -131,6 +193,21 @@ bool sweep_write_csv(const sweep_args *a, const sweep_point *pts, int n, char *m
                 (unsigned long long)pts[k].sticking_cells, pts[k].groups,
                 (unsigned long long)pts[k].sink_cells, pts[k].seconds);
     return (outfile_end(&o, true, msg, msg_size) == CM_OK);
+}
+
+/* The directory of the kept files, made when it does not exist (its
+ * parent must). */
+static bool keep_directory(const char *dir, char *msg, size_t msg_size)
+{
+    struct stat st;
+    if (stat(dir, &st) == 0 && !S_ISDIR(st.st_mode))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--keep %s: not a directory; name a directory for the files of the "
+                       "values", dir) == CM_OK;
+    if (stat(dir, &st) != 0 && mkdir(dir, 0777) != 0)
+        return cm_fail(CM_EINVAL, msg, msg_size, "--keep %s: cannot make the directory (%s)",
+                       dir, strerror(errno)) == CM_OK;
+    return true;
 }
 
 cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, size_t msg_size)
@@ -178,6 +255,8 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
         else
             cm_model_release(&m);
     }
+    if (st == CM_OK && a->keep && !keep_directory(a->keep, msg, msg_size))
+        st = CM_EINVAL;
     return st;
 }
 

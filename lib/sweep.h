@@ -35,6 +35,10 @@ typedef struct sweep_args {
     const char *fractions;    /* each value's basin shares by tracked attractor as CSV, or NULL */
     const char *png;          /* the shares stacked against the parameter, or NULL */
     int width, height;        /* its size (0: 900 x 560) */
+    const char *keep;         /* a directory: each value solved into NAME=VALUE.cmdb there
+                                 (as `solve --db`), or NULL: in memory */
+    const char *command;      /* the command line, for the kept files' provenance (NULL:
+                                 "cellmap sweep") */
 } sweep_args;
 
 #define SWEEP_MATCH 0.05
@@ -118,7 +122,8 @@ cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_re
 
 void sweep_result_free(sweep_result *r);
 
-/* Solves the box at a->name = value and counts it into *pt. */
+/* Solves the box at a->name = value (into a file of a->keep, when given)
+ * and counts it into *pt. */
 cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_box *box,
                          double value, sweep_point *pt, char *msg, size_t msg_size);
 

@@ -28,7 +28,7 @@ static const char sweep_help[] =
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
     "                     [--near LO:HI[,LO:HI...]] [--refine K] [--match-within F]\n"
     "                     [--csv FILE|-] [--fractions FILE|-] [--png FILE] [--size WxH]\n"
-    "                     [--json] [--quiet]\n\n"
+    "                     [--keep DIR] [--json] [--quiet]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
     "the system's attractors (as solve finds them from the groups' true orbits)\n"
@@ -52,6 +52,9 @@ static const char sweep_help[] =
     "                      centre_0,...; basin an attractor's id, or sticking, elsewhere\n"
     "                      (attractors outside --near), diverged, outside, undecided\n"
     "  --png FILE          the shares stacked against the parameter; --size WxH (900x560)\n"
+    "  --keep DIR          each value solved into DIR/NAME=VALUE.cmdb (made if missing) as\n"
+    "                      `solve --db` would, its attractors stored: query, render,\n"
+    "                      export or measure each (e.g. tipping: measure A --to B)\n"
     "  --csv FILE|-        every value solved, sorted: NAME,attractors,sticking,\n"
     "                      attractor_cells,sticking_cells,groups,sink_cells,seconds\n"
     "  --json              the values solved and the changes found as one JSON\n"
@@ -106,6 +109,8 @@ static int parse_args(cli *c, sweep_args *a)
             a->fractions = c->value;
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
+        } else if (cli_is(c, "--keep", true, &err)) {
+            a->keep = c->value;
         } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
         } else if (cli_take_double(c, "--match-within", 1e-9, 1, &a->match, &err)) {
         } else if (by_option_take(c, &a->by, &err)) {
@@ -162,7 +167,9 @@ int cmd_sweep(int argc, char **argv)
         werr = chart_png_check("sweep", a.png);
     if (werr != EXIT_OK)
         return werr;
-    char msg[512];
+    char msg[512], command[4096];
+    join_argv(argc + 1, argv - 1, command, sizeof command);
+    a.command = command;
     sweep_result r = {0};
     if (sweep_check_setup(&a, &r, msg, sizeof msg) != CM_OK)
         return cli_usage_error(&c, "%s", msg);

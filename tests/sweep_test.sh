@@ -85,11 +85,44 @@ for e in (gone[i] for i in small):
 PY
 fi
 
+# --- each value kept in a file of its own -----------------------------------
+"$CM" sweep --model duffing --vary gamma=0.1,0.2 --cells 80x80 --keep kept --fractions kept.csv \
+  --json > kept.json || fail "sweep --keep"
+"$CM" sweep --model duffing --vary gamma=0.1,0.2 --cells 80x80 --json > memory.json \
+  || fail "sweep in memory"
+for v in 0.1 0.2; do
+  [ "$(sqlite3 "kept/gamma=$v.cmdb" "SELECT json_extract(value, '$.gamma') FROM meta
+    WHERE key = 'params'")" = "$v" ] || fail "kept/gamma=$v.cmdb's parameters"
+  sqlite3 -csv "kept/gamma=$v.cmdb" "SELECT basin_cells FROM system_attractors" \
+    | sort -n > "stored-$v.txt"
+done
+"$CM" measure kept/gamma=0.1.cmdb --to kept/gamma=0.2.cmdb --entropy none --uncertainty none \
+  --json > kept-tip.json || fail "measure --to between kept values"
+python3 - kept.json memory.json kept.csv kept-tip.json <<'PY' || fail "sweep --keep"
+import csv, json, sys
+kept, memory = (json.load(open(p)) for p in sys.argv[1:3])
+for d in (kept, memory):
+    for p in d["points"]:
+        p.pop("seconds")
+assert kept == memory   # the files change nothing of the sweep
+rows = list(csv.DictReader(open(sys.argv[3])))
+for v in ("0.1", "0.2"):   # the basins the files store are the fractions' cells
+    mine = sorted(int(r["cells"]) for r in rows if r["basin"].isdigit() and float(r["gamma"]) == float(v))
+    stored = [int(x) for x in open(f"stored-{v}.txt").read().split()]
+    assert mine == stored and len(stored) >= 2, (v, mine, stored)
+tips = json.load(open(sys.argv[4]))["tipping"]
+for f in {t["from"] for t in tips}:   # each basin at 0.1 goes somewhere at 0.2
+    assert abs(sum(t["probability"] for t in tips if t["from"] == f) - 1) < 1e-12, tips
+PY
+
 # --- bad input ----------------------------------------------------------------
 expect_usage "--match-within" sweep --vary P=0.006,0.007 --match-within 2
 expect_usage "two outputs to standard output" sweep --vary P=0.006,0.007 --fractions - --json
 expect_usage "--vary: 'P=0.006'" sweep --vary P=0.006 --fractions f.csv
 expect_usage "not with --by groups" sweep --vary P=0.006,0.007 --by groups --fractions f.csv
 [ ! -e f.csv ] || fail "sweep wrote f.csv although it failed"
+touch plain
+expect_usage "--keep plain: not a directory" sweep --vary P=0.006,0.007 --keep plain
+[ ! -s plain ] || fail "sweep wrote into plain"
 
 [ "$fails" -eq 0 ] && echo "sweep_test: all passed" || exit 1

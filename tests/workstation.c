@@ -106,7 +106,8 @@ static void analyses(void)
                                  .region = "0:100,-10:10",
                                  .cells = (const int64_t[]){50, 50},
                                  .n_cells = 2,
-                                 .fractions = "c_sweep_fractions.csv"};
+                                 .fractions = "c_sweep_fractions.csv",
+                                 .keep = "c_kept"};
     a = outputs("sweep", f, 1);
     must(cm_analysis_sweep(&a, &wo, msg, sizeof msg), "sweep", msg);
     cm_continue_options co = cm_continue_defaults();

@@ -47,7 +47,8 @@ assert len(rows(runs, p + "bifurcation_runs.csv")) == 8
 rows(an.lyapunov(("Omega", 0.4, 0.6, 3), ("S", 0.1, 0.2, 3), periods=50, **out("lyapunov")),
      p + "lyapunov.csv")
 counts, shares = an.sweep("P", [0.006, 0.007], region=[(0, 100), (-10, 10)], cells=(50, 50),
-                          fractions_csv=p + "sweep_fractions.csv", **out("sweep"))
+                          fractions_csv=p + "sweep_fractions.csv", keep=p + "kept",
+                          **out("sweep"))
 rows(counts, p + "sweep.csv")
 rows(shares, p + "sweep_fractions.csv")
 for value in (0.006, 0.007):

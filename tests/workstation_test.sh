@@ -91,7 +91,7 @@ printf 'view 0:100 -40:40\nextend auto 3\n' > extend.explore
   "$CM" lyapunov --grid Omega=0.4:0.6:3,S=0.1:0.2:3 --periods 50 --csv cli_lyapunov.csv \
     --png cli_lyapunov.png &&
   "$CM" sweep --vary P=0.006,0.007 --region 0:100,-10:10 --cells 50x50 --csv cli_sweep.csv \
-    --fractions cli_sweep_fractions.csv --png cli_sweep.png &&
+    --fractions cli_sweep_fractions.csv --png cli_sweep.png --keep cli_kept &&
   "$CM" continue --vary S=0.02:0.4 --max-points 50 --csv cli_continue.csv \
     --events cli_continue_events.csv --png cli_continue.png &&
   "$CM" equilibria --from 1,0.1,0.2,0.25 --branch xi=3:15 --curve zeta=20:21:2 \
@@ -128,6 +128,8 @@ check_analyses() { # PREFIX: the analyses' files, against the command's
   same_bytes cli_measure.png "$1_measure.png" "$1: measure's figure"
   same_bytes cli_sweep_fractions.csv "$1_sweep_fractions.csv" "$1: sweep's basin shares"
   same_bytes cli_sweep.png "$1_sweep.png" "$1: sweep's figure"
+  same_db cli_kept/P=0.006.cmdb "$1_kept/P=0.006.cmdb" "$1: sweep's file of P = 0.006"
+  same_db cli_kept/P=0.007.cmdb "$1_kept/P=0.007.cmdb" "$1: sweep's file of P = 0.007"
   head -1 cli_sweep.csv | grep -q ',seconds$' || fail "the sweep's table no longer ends in seconds"
   without_seconds cli_sweep.csv > a_sweep.csv && without_seconds "$1_sweep.csv" > b_sweep.csv &&
     [ "$(grep -c . b_sweep.csv)" -eq 3 ] && cmp -s a_sweep.csv b_sweep.csv ||
