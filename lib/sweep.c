@@ -236,6 +236,7 @@ cm_status sweep_check_setup(const sweep_args *a, sweep_result *r, char *msg, siz
     cm_status st = model_spec_build(&a->mo, &m, msg, msg_size);
     if (st != CM_OK)
         return st;
+    memcpy(r->period, m.period, sizeof r->period);
     if (cm_params_find(&m.values, a->name) < 0)
         st = cm_fail(CM_EINVAL, msg, msg_size, "'%s' is not a parameter of %s (`cellmap models`)",
                      a->name, m.name);
@@ -275,7 +276,10 @@ double sweep_distance(const sweep_result *r, const sweep_attractor *x, const swe
 {
     double d = 0;
     for (int k = 0; k < r->lat.dim; k++) {
-        d = fmax(d, fabs(x->centre[k] - y->centre[k]) / extent(r, k));
+        double apart = fabs(x->centre[k] - y->centre[k]);
+        if (r->period[k] > 0)
+            apart = fmin(apart, r->period[k] - apart);
+        d = fmax(d, apart / extent(r, k));
     }
     return d;
 }

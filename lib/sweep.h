@@ -97,6 +97,7 @@ typedef struct sweep_event {
 typedef struct sweep_result {
     cm_lattice lat;
     cm_box box;
+    double period[CM_MAX_DIM]; /* the model's periodic coordinates (0: not periodic) */
     sweep_point *pts;
     int n;
     sweep_change *changes;
@@ -128,7 +129,8 @@ cm_status sweep_solve_at(const sweep_args *a, const cm_lattice *lat, const cm_bo
                          double value, sweep_point *pt, char *msg, size_t msg_size);
 
 /* The largest distance between the centres of x and y along a dimension,
- * as a share of the region's extent there. */
+ * as a share of the region's extent there (around a periodic coordinate's
+ * circle, the shorter way). */
 double sweep_distance(const sweep_result *r, const sweep_attractor *x, const sweep_attractor *y);
 
 /* Matches q's attractors to p's (neighbouring values): pairs within
