@@ -734,6 +734,8 @@ typedef struct cm_sweep_options {
     double match_within;   /* tracking's distance, a share of the region; 0: 0.05 */
     const char *keep;      /* a directory (made if missing): each value solved into
                               NAME=VALUE.cmdb there, as cm_db_create would; NULL: in memory */
+    int no_seeds;          /* 1: births and deaths where the lattice shows them, no attractor
+                              followed from a neighbouring value's (`sweep --no-seeds`) */
 } cm_sweep_options;
 
 /* A model solved at each value of one parameter, its attractors and

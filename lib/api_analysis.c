@@ -674,6 +674,7 @@ static cm_status sweep_args_of(const cm_sweep_options *o, sweep_args *sa, char *
         sa->near_lo[d] = o->near_lo[d], sa->near_hi[d] = o->near_hi[d];
     sa->refine = o->refine, sa->max_steps = o->max_steps;
     sa->fractions = o->fractions, sa->match = o->match_within, sa->keep = o->keep;
+    sa->no_seeds = o->no_seeds != 0;
     sa->command = "libcellmap cm_analysis_sweep";
     sa->by = o->by_groups ? BY_GROUPS : BY_ATTRACTORS, sa->quiet = true;
     return CM_OK;

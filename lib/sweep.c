@@ -49,6 +49,7 @@ static cm_status count_attractors(const sweep_args *a, const cm_attractor_set *s
             memcpy(t->centre, at->centre, sizeof t->centre);
             memcpy(t->lo, at->lo, sizeof t->lo);
             memcpy(t->hi, at->hi, sizeof t->hi);
+            memcpy(t->anchor, at->anchor, sizeof t->anchor);
             pt->attractor_cells += at->basin_cells;
         }
     }
@@ -333,10 +334,11 @@ cm_status sweep_match(const sweep_args *a, const sweep_result *r, const sweep_po
 
 /* Whether attractor x's basin collapses into y's: to less than half its
  * cells (as when a sticking zone absorbs the attractor and a rest state
- * too close to tell apart on the lattice is left). */
+ * too close to tell apart on the lattice is left). A seeded attractor's
+ * basin is not measured: no collapse to or from it. */
 static bool collapses(const sweep_attractor *x, const sweep_attractor *y)
 {
-    return 2 * y->basin_cells < x->basin_cells;
+    return !x->seeded && !y->seeded && 2 * y->basin_cells < x->basin_cells;
 }
 
 /* Whether two points have the same attractors: by attractors, each of
@@ -361,6 +363,97 @@ static cm_status same_points(const sweep_args *a, const sweep_result *r, const s
     return CM_OK;
 }
 
+/* ---- seeds: attractors the lattice misses, from a neighbouring value's ---- */
+
+/* Whether t lies within the matching distance of one of p's attractors. */
+static bool near_one_of(const sweep_args *a, const sweep_result *r, const sweep_point *p,
+                        const sweep_attractor *t)
+{
+    for (uint32_t j = 0; j < p->attractors; j++)
+        if (sweep_distance(r, &p->att[j], t) <= match_within(a))
+            return true;
+    return false;
+}
+
+/* Appends to `to` the attractor found from seed x (at->anchor, at to's
+ * value) when it lies within the matching distance of x, in the window,
+ * and near none of to's attractors: the lattice lost it there. */
+static cm_status add_seeded(const sweep_args *a, const sweep_result *r, const sweep_attractor *x,
+                            const cm_attractor *at, sweep_point *to)
+{
+    sweep_attractor t = {.kind = at->kind, .period = at->period, .seeded = true};
+    memcpy(t.centre, at->centre, sizeof t.centre);
+    memcpy(t.lo, at->lo, sizeof t.lo);
+    memcpy(t.hi, at->hi, sizeof t.hi);
+    memcpy(t.anchor, at->anchor, sizeof t.anchor);
+    cm_group_info as_group = {.kind = CM_GROUP_ATTRACTOR};
+    memcpy(as_group.centre, at->centre, sizeof at->centre);
+    if (at->kind == CM_ATTRACTOR_STICKING || sweep_distance(r, x, &t) > match_within(a) ||
+        !in_window(a, &as_group) || near_one_of(a, r, to, &t))
+        return CM_OK;
+    sweep_attractor *grown = realloc(to->att, ((size_t)to->attractors + 1) * sizeof *grown);
+    if (!grown)
+        return CM_ENOMEM;
+    to->att = grown;
+    to->att[to->attractors++] = t;
+    return CM_OK;
+}
+
+/* The attractors of `from` that no attractor of `to` matches, followed by
+ * the true map at to's value from their anchor cells (as cm_attractors_find
+ * checks a group): those that persist nearby are added to `to`, seeded. A
+ * lattice too coarse for an attractor's basin near a fold (a newborn one,
+ * or one about to die) then does not move the fold: births and deaths are
+ * where the true orbits say. */
+static cm_status seed_point(const sweep_args *a, const sweep_result *r, const sweep_point *from,
+                            sweep_point *to, char *msg, size_t msg_size)
+{
+    if (a->no_seeds || a->by != BY_ATTRACTORS || !from->attractors)
+        return CM_OK;
+    int *pair = malloc(((size_t)to->attractors + 1) * sizeof *pair);
+    bool *matched = calloc((size_t)from->attractors, sizeof *matched);
+    cm_group_info *seeds = calloc((size_t)from->attractors, sizeof *seeds);
+    uint32_t *seed_of = malloc((size_t)from->attractors * sizeof *seed_of), n = 0, pairs;
+    cm_status st = pair && matched && seeds && seed_of ? sweep_match(a, r, from, to, pair, &pairs)
+                                                       : CM_ENOMEM;
+    for (uint32_t j = 0; st == CM_OK && j < to->attractors; j++)
+        if (pair[j] >= 0)
+            matched[pair[j]] = true;
+    for (uint32_t i = 0; st == CM_OK && i < from->attractors; i++)
+        if (!matched[i]) {
+            seeds[n] = (cm_group_info){.id = n + 1, .period = 1, .basin_cells = 1,
+                                       .kind = CM_GROUP_ATTRACTOR};
+            memcpy(seeds[n].anchor, from->att[i].anchor, sizeof seeds[n].anchor);
+            seed_of[n++] = i;
+        }
+    if (st == CM_ENOMEM)
+        cm_fail(st, msg, msg_size, "out of memory for the seeds");
+    cm_model m;
+    const char *name = a->name;
+    if (st == CM_OK && n && !model_with_values(&a->mo, &name, &to->value, 1, &m, msg, msg_size))
+        st = CM_EINVAL;
+    else if (st == CM_OK && n) {
+        cm_attractor_options o = a->att;
+        o.threads = a->threads;
+        o.outside = CM_OUTSIDE_OFF; /* no cells to return to */
+        cm_attractor_set set;
+        st = cm_attractors_find(&m, &r->lat, seeds, n, NULL, NULL, &o, &set, msg, msg_size);
+        for (uint32_t k = 0; st == CM_OK && k < n; k++) {
+            const uint32_t id = set.of_group[k + 1];
+            if (id != CM_FATE_DIVERGED && id != CM_FATE_UNRESOLVED &&
+                add_seeded(a, r, &from->att[seed_of[k]], &set.a[id - 1], to) != CM_OK)
+                st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for seeded attractors");
+        }
+        cm_attractors_free(&set);
+        cm_model_release(&m);
+    }
+    free(pair);
+    free(matched);
+    free(seeds);
+    free(seed_of);
+    return st;
+}
+
 /* Solves value into the next point of r (r->failed_value on failure). */
 static cm_status solve_next(const sweep_args *a, const work_hooks *h, sweep_result *r,
                             double value, char *msg, size_t msg_size)
@@ -381,10 +474,14 @@ static cm_status refine_change(const sweep_args *a, const work_hooks *h, sweep_r
 {
     sweep_point lo = ch->lo, hi = ch->hi;
     for (int k = 0; k < a->refine; k++) {
-        const cm_status st = solve_next(a, h, r, 0.5 * (lo.value + hi.value), msg, msg_size);
+        cm_status st = solve_next(a, h, r, 0.5 * (lo.value + hi.value), msg, msg_size);
+        sweep_point *mid = &r->pts[r->n - 1];
+        if (st == CM_OK)
+            st = seed_point(a, r, &lo, mid, msg, msg_size);
+        if (st == CM_OK)
+            st = seed_point(a, r, &hi, mid, msg, msg_size);
         if (st != CM_OK)
             return st;
-        const sweep_point *mid = &r->pts[r->n - 1];
         bool same;
         uint32_t lost, gained;
         if (same_points(a, r, &lo, mid, &same, &lost, &gained) != CM_OK)
@@ -561,10 +658,14 @@ cm_status sweep_compute(const sweep_args *a, const work_hooks *h, const sweep_re
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory");
     for (int k = 0; k < a->n_values && st == CM_OK; k++) {
         st = solve_next(a, h, r, a->values[k], msg, msg_size);
+        if (st == CM_OK && k > 0) /* seeds forward as the values come */
+            st = seed_point(a, r, &r->pts[k - 1], &r->pts[k], msg, msg_size);
         if (st == CM_OK && rep && rep->point)
             rep->point(rep->user, a, &r->pts[r->n - 1]);
         work_progress(h, (uint64_t)r->n, NULL);
     }
+    for (int k = a->n_values - 2; k >= 0 && st == CM_OK; k--) /* and back */
+        st = seed_point(a, r, &r->pts[k + 1], &r->pts[k], msg, msg_size);
     /* the listed values are pts[0 .. n_values-1]; refinements follow them */
     for (int k = 1; k < a->n_values && st == CM_OK; k++)
         st = find_changes(a, h, rep, r, k, msg, msg_size);

@@ -39,6 +39,7 @@ typedef struct sweep_args {
                                  (as `solve --db`), or NULL: in memory */
     const char *command;      /* the command line, for the kept files' provenance (NULL:
                                  "cellmap sweep") */
+    bool no_seeds;            /* no attractor looked for from a neighbouring value's */
 } sweep_args;
 
 #define SWEEP_MATCH 0.05
@@ -50,7 +51,10 @@ typedef struct sweep_attractor {
     int kind;          /* enum cm_attractor_kind */
     uint32_t period;   /* 0: aperiodic */
     double centre[CM_MAX_DIM], lo[CM_MAX_DIM], hi[CM_MAX_DIM];
+    int64_t anchor[CM_MAX_DIM]; /* the smallest cell of its footprint (a seed's start) */
     uint64_t basin_cells;
+    bool seeded;       /* found by a true orbit from a neighbouring value's attractor, the
+                          lattice showing no cell of its basin (basin_cells 0) */
 } sweep_attractor;
 
 /* What one value gave. */

@@ -49,12 +49,18 @@ void sweep_print_tracked(FILE *f, const sweep_args *a, const sweep_result *r)
 {
     if (a->by != BY_ATTRACTORS)
         return;
-    fprintf(f, "%u attractor(s) tracked; basin shares of the region's cells:\n", r->tracked);
+    fprintf(f, "%u attractor(s) tracked; basin shares of the region's cells (seeded: found by "
+               "the true map, no cell of its basin on the lattice):\n",
+            r->tracked);
     for (int k = 0; k < r->n; k++) {
         const sweep_point *p = &r->pts[k];
         fprintf(f, "%s = %-12.9g", a->name, p->value);
         for (uint32_t j = 0; j < p->attractors; j++)
-            fprintf(f, "  #%u %.4f", p->att[j].id, (double)p->att[j].basin_cells / (double)p->cells);
+            if (p->att[j].seeded)
+                fprintf(f, "  #%u seeded", p->att[j].id);
+            else
+                fprintf(f, "  #%u %.4f", p->att[j].id,
+                        (double)p->att[j].basin_cells / (double)p->cells);
         for (int i = 0; i < RESTS; i++)
             if (rest_cells(p, i))
                 fprintf(f, "  %s %.4f", rest_name[i], (double)rest_cells(p, i) / (double)p->cells);
@@ -82,6 +88,8 @@ static void json_attractors(json *j, const sweep_point *p, int dim)
         json_nums(j, "centre", t->centre, dim);
         json_uint(j, "cells", t->basin_cells);
         json_num(j, "share", (double)t->basin_cells / (double)p->cells);
+        if (t->seeded)
+            json_bool(j, "seeded", true);
         json_object_end(j);
     }
     json_array_end(j);

@@ -28,7 +28,7 @@ static const char sweep_help[] =
     "                     [--region LO:HI,...] [--cells NxM] [--max-steps S] [--threads T]\n"
     "                     [--near LO:HI[,LO:HI...]] [--refine K] [--match-within F]\n"
     "                     [--csv FILE|-] [--fractions FILE|-] [--png FILE] [--size WxH]\n"
-    "                     [--keep DIR] [--json] [--quiet]\n\n"
+    "                     [--keep DIR] [--no-seeds] [--json] [--quiet]\n\n"
     "Simple cell mapping of the region for each value of one parameter (as\n"
     "`cellmap solve` would, one value after another). For each value it counts\n"
     "the system's attractors (as solve finds them from the groups' true orbits)\n"
@@ -41,7 +41,12 @@ static const char sweep_help[] =
     "vanished there before), vanishes, or merges into a chaotic one whose bounds\n"
     "hold it; a basin that falls below half its cells collapses. Where they change\n"
     "between neighbouring values, --refine K bisects the interval K times (up to\n"
-    "four changes each): e.g. where a sticking zone absorbs an attractor.\n\n"
+    "four changes each): e.g. where a sticking zone absorbs an attractor. An\n"
+    "attractor of one value that no attractor of a neighbouring value matches is\n"
+    "followed there by the true map from its smallest cell: when it persists nearby\n"
+    "it is kept there too, 'seeded', with no basin cells (the lattice shows none),\n"
+    "so births and deaths are where the true orbits have them (--no-seeds: where\n"
+    "the lattice shows them).\n\n"
     "  --vary NAME=V1,...  the parameter and its values (2..200, increasing); or\n"
     "  --vary NAME=LO:HI:N N values at the centres of N equal steps of LO..HI\n"
     "  --near LO:HI,...    the window of periodic cells counted (one range per\n"
@@ -111,6 +116,8 @@ static int parse_args(cli *c, sweep_args *a)
             a->png = c->value;
         } else if (cli_is(c, "--keep", true, &err)) {
             a->keep = c->value;
+        } else if (cli_is(c, "--no-seeds", false, &err)) {
+            a->no_seeds = true;
         } else if (cli_take_size(c, 300, 200, 4096, &a->width, &a->height, &err)) {
         } else if (cli_take_double(c, "--match-within", 1e-9, 1, &a->match, &err)) {
         } else if (by_option_take(c, &a->by, &err)) {

@@ -49,23 +49,33 @@ if [ -z "${CELLMAP_SANITIZE:-}" ]; then
     --json > folds.json || fail "periodic --branch gamma"
   "$CM" sweep --model duffing --vary gamma=0.09,0.1 --cells 200x200 --refine 8 --json \
     > born.json || fail "sweep gamma 0.09..0.1"
+  "$CM" sweep --model duffing --vary gamma=0.09,0.1 --cells 200x200 --refine 8 --no-seeds \
+    --json > born-lattice.json || fail "sweep gamma 0.09..0.1 --no-seeds"
   "$CM" sweep --model duffing --vary gamma=0.253,0.254 --cells 200x200 --refine 7 --json \
     > dies.json || fail "sweep gamma 0.253..0.254"
-  python3 - folds.json born.json dies.json <<'PY' || fail "Duffing's births and deaths"
+  python3 - folds.json born.json dies.json born-lattice.json <<'PY' || fail "Duffing's births and deaths"
 import json, sys
 folds = sorted(e["p"] for e in json.load(open(sys.argv[1]))["events"] if e["kind"] == "fold")
 assert len(folds) == 2 and abs(folds[0] - 0.09645) < 1e-4 and abs(folds[1] - 0.25369) < 1e-4, folds
 born, dies = (json.load(open(p)) for p in sys.argv[2:4])
-# births: the two large orbits appear once their basins hold cells, within
-# 5e-4 above the fold on this 200 x 200 lattice, bracketed to 2e-4 (the
-# lattice may lose one again for a while: it keeps its id when it returns)
+# births: the two large orbits appear at the fold itself, bracketed to the
+# bisection's 0.01 / 2^8: their true orbits, seeded from the values that
+# show them, persist where this 200 x 200 lattice holds no cell of their
+# basins yet (without seeds, 1-4e-4 above it)
 app = {}
 for e in born["events"]:
     if e["event"] == "appears":
         app.setdefault(e["id"], e)
 assert sorted(app) == [3, 4] and born["tracked"] == 4, born["events"]
 for e in app.values():
-    assert folds[0] - 1e-5 < e["from"] and e["to"] < folds[0] + 5e-4 and e["to"] - e["from"] < 2e-4, e
+    assert e["from"] <= folds[0] <= e["to"] and e["to"] - e["from"] < 4e-5, (e, folds)
+assert not [e for e in born["events"] if e["event"] != "appears"], born["events"]
+seeded = [t for p in born["points"] for t in p["tracked"] if t.get("seeded")]
+assert seeded and all(t["cells"] == 0 for t in seeded), seeded
+# without seeds the lattice alone decides, later
+lattice = json.load(open(sys.argv[4]))
+late = [e for e in lattice["events"] if e["event"] == "appears"]
+assert late and all(e["from"] > folds[0] + 5e-5 for e in late), (late, folds)
 # the wells' small orbits keep ids 1 and 2 over the whole sweep
 for p in born["points"]:
     t = {a["id"]: a["centre"] for a in p["tracked"]}

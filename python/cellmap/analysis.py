@@ -151,7 +151,8 @@ class _Sweep(ctypes.Structure):
                 ("n_cells", ctypes.c_int), ("near_lo", _DOUBLES), ("near_hi", _DOUBLES),
                 ("n_near", ctypes.c_int), ("refine", ctypes.c_int), ("max_steps", ctypes.c_int),
                 ("by_groups", ctypes.c_int), ("fractions", ctypes.c_char_p),
-                ("match_within", ctypes.c_double), ("keep", ctypes.c_char_p)]
+                ("match_within", ctypes.c_double), ("keep", ctypes.c_char_p),
+                ("no_seeds", ctypes.c_int)]
 
 
 class _Continue(ctypes.Structure):
@@ -559,14 +560,16 @@ def lyapunov(x, y, periods=None, d0=None, start=None, curves=(), **common):
 
 
 def sweep(name, values, region=None, cells=None, near=None, refine=0, max_steps=0,
-          by="attractors", match_within=0.0, fractions_csv=None, keep=None, **common):
+          by="attractors", match_within=0.0, fractions_csv=None, keep=None, seeds=True,
+          **common):
     """A model solved at each value of one parameter (`cellmap sweep`):
     region [(lo, hi), ...], cells (n0, n1, ...), the window near [(lo, hi), ...];
     its attractors tracked from value to value (match_within: their distance,
     a share of the region). Returns (counts, fractions) tables: fractions the
     tracked attractors' basin shares per value (None with by="groups"; a
     temporary file unless fractions_csv names one); png= draws them stacked;
-    keep= a directory where each value is solved into NAME=VALUE.cmdb."""
+    keep= a directory where each value is solved into NAME=VALUE.cmdb; seeds=False
+    leaves births and deaths where the lattice shows them."""
     if by not in ("attractors", "groups"):
         raise ValueError("sweep(): by=%r: 'attractors' or 'groups'" % (by,))
     vals = (ctypes.c_double * len(values))(*map(float, values))
@@ -576,7 +579,7 @@ def sweep(name, values, region=None, cells=None, near=None, refine=0, max_steps=
     hi = (ctypes.c_double * len(near))(*[float(b) for _, b in near]) if near else None
     o = _Sweep(_text(name), vals, len(values), _text(region_text), cl, len(cells or ()), lo, hi,
                len(near or ()), int(refine), int(max_steps), int(by == "groups"), None,
-               float(match_within), _path(keep))
+               float(match_within), _path(keep), int(not seeds))
     if by == "groups":
         return _run(_common(**common), _lib.cm_analysis_sweep, ctypes.byref(o)), None
     return _run(_common(**common), _lib.cm_analysis_sweep, ctypes.byref(o),
