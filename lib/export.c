@@ -637,13 +637,18 @@ void exporter_close(exporter *x)
     x->groups = NULL;
 }
 
+/* The nodes' labels, made once. */
+static cm_status node_labels(exporter *x, char *msg, size_t msg_size)
+{
+    return x->node_labels ? CM_OK
+                          : cm_cluster_node_labels(x->c, &x->att, &x->node_labels, msg, msg_size);
+}
+
 cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size)
 {
     if (x->c->resolved_cells)
         return CM_OK;
-    const cm_status st =
-        x->node_labels ? CM_OK : cm_cluster_node_labels(x->c, &x->att, &x->node_labels, msg,
-                                                         msg_size);
+    const cm_status st = node_labels(x, msg, msg_size);
     if (st != CM_OK)
         return st;
     free(x->att.exit_cell);
@@ -882,9 +887,7 @@ cm_status export_labels(exporter *ex, const cm_box *box, int32_t *labels,
     stride[box->dim - 1] = 1;
     for (int d = box->dim - 2; d >= 0; d--)
         stride[d] = stride[d + 1] * (box->hi[d + 1] - box->lo[d + 1]);
-    cm_status st = ex->node_labels ? CM_OK
-                                   : cm_cluster_node_labels(ex->c, &ex->att, &ex->node_labels,
-                                                            msg, msg_size);
+    cm_status st = node_labels(ex, msg, msg_size);
     if (st == CM_OK)
         st = cm_cluster_cell_labels(ex->c, &ex->att, ex->node_labels, box, stride, labels,
                                     msg, msg_size);

@@ -698,7 +698,8 @@ cm_status measure_compute(const measure_args *a, const work_hooks *hooks, measur
     if (st == CM_OK)
         st = source_open(a->file, pages_budget(a), a->window, NULL, NULL, &src, msg, msg_size);
     if (st == CM_OK && a->to)
-        st = source_open(a->to, pages_budget(a), NULL, &src.x.window, &src.c.lat, &to, msg, msg_size);
+        st = source_open(a->to, pages_budget(a), NULL, &src.x.window, &src.c.lat, &to, msg,
+                         msg_size);
     if (st == CM_OK) {
         describe(&src, r);
         snprintf(r->to_model, sizeof r->to_model, "%s", a->to ? to.info.model : "");
