@@ -77,6 +77,24 @@ void cm_cluster_free(cm_cluster *c)
     memset(c, 0, sizeof *c);
 }
 
+void cm_cluster_release_open(cm_cluster *c)
+{
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        cm_cluster_region *cr = &c->regions[k];
+        free(cr->open_local);
+        free(cr->open_cells);
+        cr->open_local = NULL, cr->open_cells = NULL;
+        cr->nopen = cr->open_cap = cr->open_stale = 0;
+    }
+    cm_idmap_free(&c->open);
+    cm_bricks_free(c->escape_bricks);
+    c->escape_bricks = NULL;
+    c->open_released = 1;
+#ifdef __GLIBC__
+    malloc_trim(0); /* the room is what the caller asked for */
+#endif
+}
+
 /* ---- where cells and nodes are ------------------------------------------ */
 
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local)
@@ -1046,6 +1064,12 @@ static cm_status take_cells(cm_cluster *c, cm_region *r, uint32_t base)
 cm_status cm_cluster_add_region(cm_cluster *c, cm_region *r, cm_node *nodes, char *msg,
                                 size_t msg_size)
 {
+    if (c->open_released) {
+        free(nodes);
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's open nodes were released (it is only read): no region "
+                       "can join it");
+    }
     if (!r->exits_recorded) {
         free(nodes);
         return cm_fail(CM_EINVAL, msg, msg_size,

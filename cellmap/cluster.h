@@ -115,6 +115,11 @@ typedef cm_status (*cm_page_in_fn)(void *user, uint32_t region, cm_region *r, ch
  * k's n nodes into nodes[0..n) exactly as they were saved. */
 typedef cm_status (*cm_nodes_in_fn)(void *user, uint32_t region, cm_node *nodes, uint64_t n,
                                     char *msg, size_t msg_size);
+/* Reads a paged-out region's groups alone into group[ncells], checked
+ * (cm_groups_check), leaving the region paged out: for readers of labels,
+ * which need no image, step or exit table. */
+typedef cm_status (*cm_groups_in_fn)(void *user, uint32_t region, uint32_t *group, char *msg,
+                                     size_t msg_size);
 
 struct cm_cluster;
 
@@ -140,6 +145,8 @@ typedef struct cm_cluster {
     /* read-only: the regions hold resolved cells (a file of version 2 or
      * 3): a sink cell does not say which exit its sequence leaves by */
     int resolved_cells;
+    /* read-only: its open nodes' index was released (cm_cluster_release_open) */
+    int open_released;
     uint64_t nnodes;                  /* read-only: nodes of all regions */
     uint64_t cells;                   /* read-only: cells of all regions */
     uint64_t *basin;                  /* read-only: cells of group g (1..ngroups); [0] unused */
@@ -159,6 +166,7 @@ typedef struct cm_cluster {
     cm_page_in_fn page_in;   /* public */
     cm_page_out_fn page_out; /* public */
     cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
+    cm_groups_in_fn groups_in; /* public: reads a region's groups alone (NULL: none) */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
     /* public: bytes its owner holds for regions still to join (solved
@@ -193,6 +201,14 @@ typedef struct cm_escape {
 
 void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
 void cm_cluster_free(cm_cluster *c);
+
+/* Releases what the cluster keeps of its open nodes (the weights of paged
+ * out ones, the escape index, the regions' open lists: about 70 bytes per
+ * open node), for an owner that from here on only reads its cells and node
+ * tables (flattening, labels): a region added (a join) or a commit is
+ * refused afterwards (CM_EINVAL), and it has no escapes
+ * (cm_cluster_each_escape, cm_cluster_exits). */
+void cm_cluster_release_open(cm_cluster *c);
 
 /* Threads a join or reader uses: c->threads, or the OpenMP default. */
 int cm_cluster_threads(const cm_cluster *c);

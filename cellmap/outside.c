@@ -244,6 +244,9 @@ static cm_status index_nodes(const escape_list *l, const uint64_t *exit_of, cm_e
 cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);
+    if (c->open_released)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's open nodes were released: its exits are not known");
     if (c->resolved_cells) { /* where sink cells leave is not known: all outside */
         out->unknown_cells = cm_cluster_sink_cells(c);
         return CM_OK;
@@ -708,43 +711,15 @@ cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
 
 /* ---- a cluster's labels, region by region ------------------------------ */
 
-#define NODE_PENDING INT32_MIN     /* a node label not known yet */
-#define NODE_UNLABELLED (INT32_MIN + 1) /* an open node without an escape record */
+/* While node labels are made, a label below NODE_LINK is a link: the node
+ * takes the label of node NODE_LINK - label (its exit lands in that node's
+ * tree); an open node without an escape record is NODE_UNLABELLED. Final
+ * labels are -2 .. the attractors' count. */
+#define NODE_LINK (-3)
+#define NODE_UNLABELLED INT32_MIN
+#define NODE_MOST ((uint64_t)INT32_MAX - 4) /* node ids a link can name */
 
-/* The label of a node from its saved fields (an open node keeps the fate
- * of its exit, set from the escapes), or NODE_PENDING when it takes the
- * label of node nd->next (its exit lands in that node's tree). */
-static cm_status own_node_label(const cm_attractor_set *s, uint32_t id, const cm_node *nd,
-                                int32_t *label, char *msg, size_t msg_size)
-{
-    if (nd->next == CM_NODE_OPEN && *label == NODE_UNLABELLED)
-        return cm_fail(CM_EFORMAT, msg, msg_size,
-                       "open node %u is not among the cluster's exits", id);
-    if (nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE)
-        *label = nd->group ? cm_attractor_label(s, nd->group) : CM_LABEL_DIVERGED;
-    else if (nd->next < CM_NODE_MAX)
-        *label = NODE_PENDING;
-    else if (nd->next != CM_NODE_OPEN)
-        return cm_fail(CM_EFORMAT, msg, msg_size, "node %u has no valid link", id);
-    return CM_OK;
-}
-
-/* Every pending node takes the label its chain of links ends on: each
- * chain is walked once, its nodes then hold the end's label. */
-static cm_status settle_node_labels(uint32_t n, const uint32_t *next, int32_t *label, char *msg,
-                                    size_t msg_size)
-{
-    for (uint32_t id = 0; id < n; id++) {
-        uint32_t end = id;
-        for (uint64_t hops = 0; label[end] == NODE_PENDING; hops++, end = next[end])
-            if (hops > n || next[end] >= n)
-                return cm_fail(CM_EFORMAT, msg, msg_size,
-                               "the links from node %u form a loop or leave the cluster", id);
-        for (uint32_t x = id; label[x] == NODE_PENDING; x = next[x])
-            label[x] = label[end];
-    }
-    return CM_OK;
-}
+static bool is_link(int32_t label) { return label <= NODE_LINK && label != NODE_UNLABELLED; }
 
 typedef struct exit_fates {
     const cm_attractor_set *s;
@@ -758,26 +733,75 @@ static void label_escape(void *user, uint32_t node, const int64_t *cell)
     f->label[node] = cm_attractor_exit_label(f->s, f->dim, cell);
 }
 
-cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32_t **out,
-                                 char *msg, size_t msg_size)
+cm_status cm_node_labels_open(const cm_cluster *c, const cm_attractor_set *s, int32_t **out,
+                              char *msg, size_t msg_size)
 {
-    const uint32_t n = c->nnodes;
     *out = NULL;
     if (c->resolved_cells)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the cluster's sink cells are resolved (a file before version 4): "
                        "label its flattened cells instead");
-    int32_t *label = malloc(((size_t)n + 1) * sizeof *label);
-    uint32_t *next = malloc(((size_t)n + 1) * sizeof *next);
-    cm_status st = label && next ? CM_OK
-                                 : cm_fail(CM_ENOMEM, msg, msg_size,
-                                           "out of memory for the labels of %u nodes", n);
-    if (st == CM_OK) {
-        for (uint32_t id = 0; id < n; id++)
-            label[id] = NODE_UNLABELLED;
-        exit_fates f = {s, c->lat.dim, label};
-        cm_cluster_each_escape(c, label_escape, &f);
+    if (c->open_released)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's open nodes were released: their exits are not known");
+    if (c->nnodes > NODE_MOST)
+        return cm_fail(CM_ETOOBIG, msg, msg_size,
+                       "%llu nodes: labels are made for at most %llu",
+                       (unsigned long long)c->nnodes, (unsigned long long)NODE_MOST);
+    int32_t *label = malloc(((size_t)c->nnodes + 1) * sizeof *label);
+    if (!label)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels of %llu nodes",
+                       (unsigned long long)c->nnodes);
+    for (uint64_t id = 0; id < c->nnodes; id++)
+        label[id] = NODE_UNLABELLED;
+    exit_fates f = {s, c->lat.dim, label};
+    cm_cluster_each_escape(c, label_escape, &f);
+    *out = label;
+    return CM_OK;
+}
+
+/* Node id's label from its saved fields: its group's for a node whose
+ * group is known, the link to node nd->next for one whose exit lands in
+ * that node's tree; an open node keeps the label its exit gave it. */
+static cm_status own_node_label(const cm_attractor_set *s, uint64_t n, uint32_t id,
+                                const cm_node *nd, int32_t *label, char *msg, size_t msg_size)
+{
+    if (nd->next == CM_NODE_OPEN && *label == NODE_UNLABELLED)
+        return cm_fail(CM_EFORMAT, msg, msg_size,
+                       "open node %u is not among the cluster's exits", id);
+    if (nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE)
+        *label = nd->group ? cm_attractor_label(s, nd->group) : CM_LABEL_DIVERGED;
+    else if (nd->next < n)
+        *label = NODE_LINK - (int32_t)nd->next;
+    else if (nd->next != CM_NODE_OPEN)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "node %u has no valid link", id);
+    return CM_OK;
+}
+
+/* Every linked node takes the label its chain of links ends on: each
+ * chain is walked once, its nodes then hold the end's label. */
+static cm_status settle_links(uint64_t n, int32_t *label, char *msg, size_t msg_size)
+{
+    for (uint64_t id = 0; id < n; id++) {
+        uint64_t end = id;
+        for (uint64_t hops = 0; is_link(label[end]); hops++, end = (uint64_t)(NODE_LINK - label[end]))
+            if (hops > n)
+                return cm_fail(CM_EFORMAT, msg, msg_size,
+                               "the links from node %llu form a loop", (unsigned long long)id);
+        const int32_t v = label[end];
+        for (uint64_t x = id; is_link(label[x]);) {
+            const uint64_t next = (uint64_t)(NODE_LINK - label[x]);
+            label[x] = v;
+            x = next;
+        }
     }
+    return CM_OK;
+}
+
+cm_status cm_node_labels_settle(cm_cluster *c, const cm_attractor_set *s, int32_t *label,
+                                char *msg, size_t msg_size)
+{
+    cm_status st = CM_OK;
     for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
         const cm_cluster_region *cr = &c->regions[k];
         cm_node *table = NULL;
@@ -785,41 +809,44 @@ cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32
             st = cm_cluster_node_load(c, cr->node_base, &table, msg, msg_size);
         for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
             const uint32_t id = cr->node_base + (uint32_t)e;
-            next[id] = table[e].next;
-            st = own_node_label(s, id, &table[e], &label[id], msg, msg_size);
+            st = own_node_label(s, c->nnodes, id, &table[e], &label[id], msg, msg_size);
         }
         cm_cluster_trim(c); /* one table at a time is enough */
     }
-    if (st == CM_OK)
-        st = settle_node_labels(n, next, label, msg, msg_size);
-    free(next);
-    if (st != CM_OK)
-        free(label);
-    else
-        *out = label;
+    return st == CM_OK ? settle_links(c->nnodes, label, msg, msg_size) : st;
+}
+
+cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32_t **out,
+                                 char *msg, size_t msg_size)
+{
+    cm_status st = cm_node_labels_open(c, s, out, msg, msg_size);
+    if (st == CM_OK && (st = cm_node_labels_settle(c, s, *out, msg, msg_size)) != CM_OK) {
+        free(*out);
+        *out = NULL;
+    }
     return st;
 }
 
-/* Cell i of region r: a node reference takes its node's label; a sink
- * cell's sequence ends in the world's sink inside the region. r NULL: no
- * cell computed. */
-static int32_t region_cell_label(const cm_region *r, uint64_t i, const int32_t *node_label,
+/* Cell i of a region with groups `group`: a node reference takes its
+ * node's label; a sink cell's sequence ends in the world's sink inside the
+ * region. group NULL: no cell computed. */
+static int32_t region_cell_label(const uint32_t *group, uint64_t i, const int32_t *node_label,
                                  const cm_attractor_set *s)
 {
-    if (!r)
+    if (!group)
         return CM_LABEL_UNCOMPUTED;
-    const uint32_t g = r->group[i];
+    const uint32_t g = group[i];
     return cm_is_node_ref(g) ? node_label[g & ~CM_NODE_REF]
            : g == 0          ? CM_LABEL_DIVERGED
                              : cm_attractor_label(s, g);
 }
 
-/* Labels the cells of `part` (inside r's box and `box`; r NULL: none
- * computed) into labels with the strides of box, a row along dimension 0
- * at a time (contiguous in r). */
-static void label_part(const cm_region *r, const int32_t *node_label, const cm_attractor_set *s,
-                       const cm_box *box, const cm_box *part, const int64_t *stride,
-                       int32_t *labels, int threads)
+/* Labels the cells of `part` (inside the region's box `rbox` and `box`;
+ * group NULL: none computed) into labels with the strides of box, a row
+ * along dimension 0 at a time (contiguous in the region). */
+static void label_part(const cm_box *rbox, const uint32_t *group, const int32_t *node_label,
+                       const cm_attractor_set *s, const cm_box *box, const cm_box *part,
+                       const int64_t *stride, int32_t *labels, int threads)
 {
     const int64_t width = part->hi[0] - part->lo[0];
     const int64_t rows = (int64_t)(cm_box_cells(part) / (uint64_t)width);
@@ -829,12 +856,13 @@ static void label_part(const cm_region *r, const int32_t *node_label, const cm_a
         cm_box row = *part;
         row.hi[0] = row.lo[0] + 1;
         cm_box_cell(&row, (uint64_t)q, cell);
-        const uint64_t from = r ? cm_box_index(&r->box, cell) : 0;
+        const uint64_t from = group ? cm_box_index(rbox, cell) : 0;
         int64_t to = 0;
         for (int d = 0; d < box->dim; d++)
             to += (cell[d] - box->lo[d]) * stride[d];
         for (int64_t i = 0; i < width; i++)
-            labels[to + i * stride[0]] = region_cell_label(r, from + (uint64_t)i, node_label, s);
+            labels[to + i * stride[0]] =
+                region_cell_label(group, from + (uint64_t)i, node_label, s);
     }
 }
 
@@ -851,17 +879,32 @@ cm_status cm_cluster_cell_labels(cm_cluster *c, const cm_attractor_set *s,
         stride = own;
     }
     const int threads = cm_cluster_threads(c);
-    label_part(NULL, NULL, s, box, box, stride, labels, threads);
+    label_part(NULL, NULL, NULL, s, box, box, stride, labels, threads);
+    uint32_t *read = NULL; /* a paged-out region's groups, read alone */
+    uint64_t cap = 0;
     cm_status st = CM_OK;
     for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        const cm_region *r = &c->regions[k].r;
         cm_box part;
-        if (!cm_box_intersect(&c->regions[k].r.box, box, &part))
+        if (!cm_box_intersect(&r->box, box, &part))
             continue;
-        st = cm_cluster_acquire(c, k, msg, msg_size);
+        const uint32_t *group = r->group;
+        if (!group && c->groups_in && r->ncells > cap) {
+            free(read);
+            cap = r->ncells;
+            if (!(read = malloc(cap * sizeof *read)))
+                st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a region's groups");
+        }
+        if (st == CM_OK && !group && c->groups_in &&
+            (st = c->groups_in(c->pager, k, read, msg, msg_size)) == CM_OK)
+            group = read;
+        if (st == CM_OK && !group && (st = cm_cluster_acquire(c, k, msg, msg_size)) == CM_OK)
+            group = r->group;
         if (st == CM_OK) /* a region's node references count from its node_base */
-            label_part(&c->regions[k].r, node_label + c->regions[k].node_base, s, box, &part,
+            label_part(&r->box, group, node_label + c->regions[k].node_base, s, box, &part,
                        stride, labels, threads);
         cm_cluster_trim(c);
     }
+    free(read);
     return st;
 }

@@ -130,14 +130,25 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
  * the fate s gives its exit, found from the cluster's escape index; 0 when
  * the chain ends in the world's sink), the group cm_cluster_resolve would
  * give it, labelled. Each node table is read once, one at a time within
- * the cluster's budget; the chains are then settled in memory (8 bytes per
- * node while it runs, 4 kept). *node_label is the caller's to free (NULL
- * on failure). Not for a cluster of resolved cells (files before version
- * 4, cm_cluster.resolved_cells: CM_EINVAL), whose sink sequences must be
+ * the cluster's budget; the chains are then settled in memory, in the
+ * labels themselves (4 bytes per node, at most 2^31 - 5 nodes:
+ * CM_ETOOBIG). *node_label is the caller's to free (NULL on failure). Not
+ * for a cluster of resolved cells (files before version 4,
+ * cm_cluster.resolved_cells: CM_EINVAL), whose sink sequences must be
  * followed across regions (cm_cluster_flatten and
- * cm_attractor_cell_labels). CM_EFORMAT for broken links. */
+ * cm_attractor_cell_labels); CM_EFORMAT for broken links. */
 cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32_t **node_label,
                                  char *msg, size_t msg_size);
+
+/* The same in two steps, so that an owner who only reads labels can
+ * release the open nodes' index and s's exit fates in between
+ * (cm_cluster_release_open): _open allocates the labels and gives the open
+ * nodes theirs (*node_label NULL on failure); _settle reads the node tables
+ * and settles the chains (node_label stays the caller's to free). */
+cm_status cm_node_labels_open(const cm_cluster *c, const cm_attractor_set *s,
+                              int32_t **node_label, char *msg, size_t msg_size);
+cm_status cm_node_labels_settle(cm_cluster *c, const cm_attractor_set *s, int32_t *node_label,
+                                char *msg, size_t msg_size);
 
 /* The labels cm_attractor_cell_labels gives the flattened cluster, for the
  * cells of `box`, read region by region from the cells and the node labels

@@ -720,13 +720,25 @@ cm_status cm_scm_describe(const cm_model *model, const cm_lattice *lat, const cm
 }
 
 /* What is wrong with cell i's group alone, or NULL. */
-static const char *bad_group(const cm_region *r, uint32_t g, uint32_t max_group, bool node_refs)
+static const char *bad_group(uint64_t nexits, uint32_t g, uint32_t max_group, bool node_refs)
 {
     if (g == 0 || (g < CM_NODE_REF && g <= max_group))
         return NULL;
-    if (node_refs && g >= CM_NODE_REF && g - CM_NODE_REF < r->nexits)
+    if (node_refs && g >= CM_NODE_REF && g - CM_NODE_REF < nexits)
         return NULL;
     return "its group is no group of the file";
+}
+
+cm_status cm_groups_check(const uint32_t *group, uint64_t ncells, uint64_t nexits,
+                          uint32_t max_group, char *msg, size_t msg_size)
+{
+    for (uint64_t i = 0; i < ncells; i++) {
+        const char *why = bad_group(nexits, group[i], max_group, true);
+        if (why)
+            return cm_fail(CM_EFORMAT, msg, msg_size, "cell %llu: %s", (unsigned long long)i,
+                           why);
+    }
+    return CM_OK;
 }
 
 /* What is wrong with cell i given its image, or NULL. Exit cells are
@@ -734,7 +746,7 @@ static const char *bad_group(const cm_region *r, uint32_t g, uint32_t max_group,
 static const char *bad_cell(const cm_region *r, uint64_t i, uint32_t max_group, bool node_refs)
 {
     const uint32_t m = r->image[i], g = r->group[i], s = r->step[i];
-    const char *why = bad_group(r, g, max_group, node_refs);
+    const char *why = bad_group(r->nexits, g, max_group, node_refs);
     if (why)
         return why;
     if (m == CM_IMAGE_SINK)

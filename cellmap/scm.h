@@ -121,6 +121,11 @@ cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg
  * CM_EFORMAT with what is wrong where ("cell 17: ...") in msg. */
 cm_status cm_region_check(const cm_region *r, uint32_t max_group, bool node_refs, int threads,
                           char *msg, size_t msg_size);
+/* The groups alone of a region of ncells cells and nexits exits, as read
+ * without the other arrays: each 0, a group up to max_group or a node of
+ * one of its exits. CM_EFORMAT with the first bad cell in msg. */
+cm_status cm_groups_check(const uint32_t *group, uint64_t ncells, uint64_t nexits,
+                          uint32_t max_group, char *msg, size_t msg_size);
 void cm_region_free(cm_region *r);
 /* Bytes held by the region's per-cell arrays and its exit table. */
 uint64_t cm_region_bytes(const cm_region *r);

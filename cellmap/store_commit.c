@@ -165,6 +165,10 @@ cm_status store_write_changes(cm_store *s, cm_cluster *c, char *msg, size_t msg_
 
 cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
 {
+    if (c->open_released)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's open nodes were released (it is only read): nothing "
+                       "of it is saved");
     const double t0 = cm_seconds();
     cm_status st = store_begin(s, msg, msg_size);
     if (st == CM_OK)

@@ -126,6 +126,7 @@ cm_status store_nodes_in(void *user, uint32_t k, cm_node *nodes, uint64_t n, cha
 /* The pager (cm_page_in_fn and cm_page_out_fn with the store as user):
  * the page out saves a dirty region about to be evicted. */
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size);
+cm_status store_groups_in(void *user, uint32_t k, uint32_t *group, char *msg, size_t msg_size);
 cm_status store_page_out(void *user, const cm_cluster *c, uint32_t k, char *msg,
                          size_t msg_size);
 /* Region k's row, exit table and pages, whole. */

@@ -30,9 +30,10 @@ typedef struct column_ref {
     int col;
 } column_ref;
 
-/* Decodes the columns read, in parallel: a region is 3 x 16 of them. */
-static cm_status decode_columns(const cm_store *s, cm_region *r, const column_ref *refs,
-                                uint64_t nrefs)
+/* Decodes the columns read into arrays (image, group, step), in parallel:
+ * a region is up to 3 x 16 of them. */
+static cm_status decode_columns(const cm_store *s, uint32_t *const arrays[3],
+                                const column_ref *refs, uint64_t nrefs)
 {
     int failed = 0;
 #pragma omp parallel num_threads(s->threads) if (nrefs > 1)
@@ -42,7 +43,6 @@ static cm_status decode_columns(const cm_store *s, cm_region *r, const column_re
 #pragma omp for schedule(dynamic, 1) reduction(| : failed)
         for (int64_t t = 0; t < (int64_t)nrefs; t++) {
             const column_ref *c = &refs[t];
-            uint32_t *const arrays[3] = {r->image, r->group, r->step};
             failed |= !scratch || cm_codec_decode(s->blobs + c->offset, c->len, c->n, 4,
                                                   c->col == 0 ? (int64_t)c->first : -1, scratch,
                                                   arrays[c->col] + c->first) != CM_OK;
@@ -67,9 +67,12 @@ static cm_status keep_column(cm_store *s, sqlite3_stmt *st, int col, uint64_t fi
     return CM_OK;
 }
 
-static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+/* Region k's pages (ncells cells) decoded into the arrays (image, group,
+ * step) that are not NULL; the others' columns are not decoded. */
+static cm_status read_columns(cm_store *s, uint32_t k, uint64_t ncells, uint32_t *const arrays[3],
+                              char *msg, size_t msg_size)
 {
-    const uint64_t pages = npages(r->ncells);
+    const uint64_t pages = npages(ncells);
     column_ref *refs = malloc((3 * pages + 1) * sizeof *refs);
     sqlite3_stmt *st = NULL;
     if (!refs)
@@ -88,13 +91,14 @@ static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, si
     while (status == CM_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         const uint64_t first = (uint64_t)sqlite3_column_int64(st, 0);
         const uint64_t n = (uint64_t)sqlite3_column_int64(st, 1);
-        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > r->ncells ||
-            nrefs == 3 * pages) {
+        if (first != seen || n == 0 || n > CM_STORE_PAGE_CELLS || first + n > ncells ||
+            nrefs + 3 > 3 * pages) {
             status = CM_EFORMAT;
             break;
         }
         for (int col = 0; col < 3 && status == CM_OK; col++)
-            status = keep_column(s, st, col, first, n, &used, &refs[nrefs++]);
+            if (arrays[col])
+                status = keep_column(s, st, col, first, n, &used, &refs[nrefs++]);
         seen += n;
     }
     if (status == CM_OK && rc != SQLITE_DONE) {
@@ -104,16 +108,10 @@ static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, si
         return status;
     }
     sqlite3_finalize(st);
-    if (status == CM_OK && seen != r->ncells)
+    if (status == CM_OK && seen != ncells)
         status = CM_EFORMAT;
-    /* the arrays only once the rows are known to hold the region's cells */
-    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
-    if (status == CM_OK &&
-        (!(r->image = cm_cells_array(bytes)) || !(r->group = cm_cells_array(bytes)) ||
-         !(r->step = cm_cells_array(bytes))))
-        status = CM_ENOMEM;
     if (status == CM_OK)
-        status = decode_columns(s, r, refs, nrefs);
+        status = decode_columns(s, arrays, refs, nrefs);
     free(refs);
     if (status == CM_EFORMAT)
         return cm_fail(status, msg, msg_size,
@@ -122,6 +120,16 @@ static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, si
     return status == CM_OK
                ? CM_OK
                : cm_fail(status, msg, msg_size, "out of memory reading region %u", k + 1);
+}
+
+static cm_status read_pages(cm_store *s, uint32_t k, cm_region *r, char *msg, size_t msg_size)
+{
+    const size_t bytes = (size_t)r->ncells * sizeof(uint32_t);
+    if (!(r->image = cm_cells_array(bytes)) || !(r->group = cm_cells_array(bytes)) ||
+        !(r->step = cm_cells_array(bytes)))
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory reading region %u", k + 1);
+    uint32_t *const arrays[3] = {r->image, r->group, r->step};
+    return read_columns(s, k, r->ncells, arrays, msg, msg_size);
 }
 
 /* Region k's exit targets into a new array of nexits * dim cells. */
@@ -175,6 +183,23 @@ static cm_status check_cells(const cm_store *s, uint32_t k, const cm_region *r, 
                    why);
 }
 
+/* The pager of a region's groups alone (cm_groups_in_fn), checked. */
+cm_status store_groups_in(void *user, uint32_t k, uint32_t *group, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = cm_seconds();
+    const cm_region *r = &s->cluster->regions[k].r;
+    uint32_t *const arrays[3] = {NULL, group, NULL};
+    char why[256];
+    cm_status st = read_columns(s, k, r->ncells, arrays, msg, msg_size);
+    if (st == CM_OK && cm_groups_check(group, r->ncells, r->nexits, s->cluster->ngroups, why,
+                                       sizeof why) != CM_OK)
+        st = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: region %u, %s", s->path, k + 1,
+                     why);
+    s->stats.read_seconds += cm_seconds() - t0;
+    return st;
+}
+
 /* The pager: reads region k's arrays and exit table back. */
 cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t msg_size)
 {
@@ -205,6 +230,7 @@ void cm_store_attach(cm_store *s, cm_cluster *c)
     c->page_in = store_page_in;
     c->page_out = s->writable ? store_page_out : NULL;
     c->nodes_in = store_nodes_in;
+    c->groups_in = s->version >= 4 ? store_groups_in : NULL; /* node references since 4 */
     c->pager = s;
 }
 

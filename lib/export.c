@@ -646,19 +646,26 @@ static cm_status node_labels(exporter *x, char *msg, size_t msg_size)
 
 cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size)
 {
-    if (x->c->resolved_cells)
+    if (x->c->resolved_cells || x->node_labels)
         return CM_OK;
-    const cm_status st = node_labels(x, msg, msg_size);
+    cm_status st = cm_node_labels_open(x->c, &x->att, &x->node_labels, msg, msg_size);
     if (st != CM_OK)
         return st;
+    /* the open nodes have their exits' fates: what gave them goes */
     free(x->att.exit_cell);
     free(x->att.exit_label);
     x->att.exit_cell = NULL;
     x->att.exit_label = NULL;
     x->att.nexits = 0;
     cluster_ends_close(&x->ends);
+    cm_cluster_release_open(x->c);
     x->labels_only = true;
-    return CM_OK;
+    st = cm_node_labels_settle(x->c, &x->att, x->node_labels, msg, msg_size);
+    if (st != CM_OK) {
+        free(x->node_labels);
+        x->node_labels = NULL;
+    }
+    return st;
 }
 
 /* export_cells and export_arrays need the exits' fates. */

@@ -91,10 +91,12 @@ cm_status export_arrays(exporter *x, const char *labels, const char *steps, bool
 cm_status export_labels(exporter *x, const cm_box *box, int32_t *labels,
                         const work_hooks *hooks, char *msg, size_t msg_size);
 
-/* Makes x an exporter of labels only: the nodes' labels made now, then the
- * exits' fates (20 bytes per exit), which only they needed, released;
- * export_cells and export_arrays refuse afterwards. A cluster of resolved
- * cells keeps them (export_labels follows its cells' exits). */
+/* Makes x an exporter of labels only: the nodes' labels made now, the
+ * exits' fates (20 bytes per exit) and the cluster's open nodes' index
+ * (about 70 bytes per open node, cm_cluster_release_open), which only they
+ * needed, released on the way; export_cells and export_arrays refuse
+ * afterwards, and the cluster can no longer be saved or joined. A cluster
+ * of resolved cells keeps them (export_labels follows its cells' exits). */
 cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size);
 
 /* An array's sidecar path: FILE.npy -> FILE.json. */

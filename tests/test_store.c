@@ -257,6 +257,54 @@ static void test_budgets(const char *dir, const cm_model *m)
         if (!getenv("KEEP")) unlink(path[k]);
 }
 
+/* A copy of `path` whose first page of region 1 holds a group no group of
+ * the file (a valid zstd frame, so only the check of the groups read alone
+ * finds it): reading its labels fails, naming the damage. */
+static void damaged_group(const char *path, const cm_attractor_set *att, const int32_t *node_label,
+                          const cm_box *window, int32_t *labels)
+{
+    char copy[300], cmd[700], msg[512];
+    snprintf(copy, sizeof copy, "%s.damaged", path);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", path, copy);
+    CHECK(system(cmd) == 0);
+    sqlite3 *db = NULL;
+    sqlite3_stmt *st = NULL;
+    CHECK(sqlite3_open(copy, &db) == SQLITE_OK);
+    CHECK(sqlite3_prepare_v2(db, "SELECT cells, grp FROM pages WHERE region = 1 AND "
+                                 "first_cell = 0", -1, &st, NULL) == SQLITE_OK);
+    CHECK(sqlite3_step(st) == SQLITE_ROW);
+    const size_t n = (size_t)sqlite3_column_int64(st, 0);
+    uint32_t *group = malloc(4 * n), *scratch = malloc(4 * n);
+    void *blob = malloc(cm_codec_bound(4 * n));
+    size_t len = 0;
+    CHECK(cm_codec_decode(sqlite3_column_blob(st, 1), (size_t)sqlite3_column_bytes(st, 1), n, 4,
+                          -1, scratch, group) == CM_OK);
+    sqlite3_finalize(st);
+    group[5] = 1000000; /* no group of the file, no node reference */
+    CHECK(cm_codec_encode(group, n, 4, -1, scratch, blob, cm_codec_bound(4 * n), &len) == CM_OK);
+    CHECK(sqlite3_prepare_v2(db, "UPDATE pages SET grp = ? WHERE region = 1 AND first_cell = 0",
+                             -1, &st, NULL) == SQLITE_OK);
+    sqlite3_bind_blob(st, 1, blob, (int)len, SQLITE_STATIC);
+    CHECK(sqlite3_step(st) == SQLITE_DONE);
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    cm_store *s = NULL;
+    cm_cluster c;
+    CHECK(cm_store_open(copy, 0, &s, msg, sizeof msg) == CM_OK);
+    CHECK(cm_store_load_cluster(s, &c, msg, sizeof msg) == CM_OK);
+    c.mem_budget = 1;
+    const cm_box first = {2, {0, 0}, {window->hi[0], window->hi[1]}};
+    CHECK(cm_cluster_cell_labels(&c, att, node_label, &first, NULL, labels, msg, sizeof msg) ==
+          CM_EFORMAT);
+    CHECK(strstr(msg, "is damaged") && strstr(msg, "region 1, cell 5: its group is no group"));
+    cm_cluster_free(&c);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+    unlink(copy);
+    free(group);
+    free(scratch);
+    free(blob);
+}
+
 /* The labels a paged cluster gives region by region from its node labels
  * (cm_cluster_cell_labels) are those of its flattened cells
  * (cm_attractor_cell_labels), cell by cell, for the whole box in either
@@ -311,6 +359,7 @@ static void test_cell_labels(const char *path, const cm_model *m)
                       want[cm_box_index(&all, cell)];
         }
     CHECK_INT(differ, 0);
+    damaged_group(path, &att, node_label, &window, got);
     fprintf(stderr,
             "cell labels: %llu cells agree; %llu in basins, of the sink's %llu returned, %llu "
             "outside\n",
