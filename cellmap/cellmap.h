@@ -287,6 +287,8 @@ typedef struct cm_figure_options {
     const char *labels;  /* a file of legend names ("ID TEXT" lines), or NULL */
     uint64_t min_basin;  /* groups of fewer cells drawn as "other"; 0: 2 with a legend, else 1 */
     int legend;          /* groups the legend lists; 0: 12 */
+    const char *title;   /* the title (with CM_FIGURE_TITLE); NULL: the model and its
+                            parameters; wrapped */
 } cm_figure_options;
 
 /* The figure of a result (cm_solve, cm_db_read, cm_session_read), through

@@ -613,6 +613,7 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     po->by = o->by_groups ? BY_GROUPS : BY_ATTRACTORS;
     po->min_basin = o->min_basin;
     po->legend_groups = o->legend;
+    po->title = o->title;
     if (!o->png && !o->svg)
         return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png or an svg path");
     if ((o->width == 0) != (o->height == 0) || o->width < 0 || o->height < 0 ||
@@ -627,6 +628,9 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
                        "an indexed PNG has one pixel per cell: give no svg, size or layers");
     if (o->legend < 0 || o->legend > 200)
         return cm_fail(CM_EINVAL, msg, msg_size, "legend %d: give 0..200 groups", o->legend);
+    if (o->title && strlen(o->title) > 1000)
+        return cm_fail(CM_EINVAL, msg, msg_size, "title: %zu characters; give at most 1000",
+                       strlen(o->title));
     char why[400];
     if (o->palette && !png_opts_palette(o->palette, po, why, sizeof why))
         return cm_fail(CM_EINVAL, msg, msg_size, "palette: %s", why);

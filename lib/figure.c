@@ -273,6 +273,7 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.labels = po->labels;
     ro.n_labels = po->n_labels;
     ro.sink_label = po->sink_label;
+    ro.title = po->title;
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -401,6 +402,7 @@ cm_status figure_check_layout(const png_opts *po, const cm_model *m, const cm_la
         ro.hi[d] = po->has_view ? po->hi[d] : cm_lattice_edge(lat, d, box->hi[d]);
     }
     ro.model = m;
+    ro.title = po->title;
     ro.font_path = figure_font();
     return cm_render_check(&ro, lat->dim, msg, msg_size);
 }

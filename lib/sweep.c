@@ -277,9 +277,7 @@ double sweep_distance(const sweep_result *r, const sweep_attractor *x, const swe
 {
     double d = 0;
     for (int k = 0; k < r->lat.dim; k++) {
-        double apart = fabs(x->centre[k] - y->centre[k]);
-        if (r->period[k] > 0)
-            apart = fmin(apart, r->period[k] - apart);
+        const double apart = fabs(cm_period_diff(r->period, k, x->centre[k], y->centre[k]));
         d = fmax(d, apart / extent(r, k));
     }
     return d;

@@ -36,7 +36,24 @@ static int more_cells_first(const void *a, const void *b)
     return x->id < y->id ? -1 : x->id > y->id;
 }
 
-static double share(uint64_t cells, uint64_t all) { return all ? 100.0 * cells / all : 0.0; }
+/* cells' share of all as a legend shows it: two significant digits
+ * ("0.023%", "1.5%", "68%"), "< 0.01%" for a share too small for that. */
+typedef struct percent_text {
+    char s[16];
+} percent_text;
+
+static percent_text share(uint64_t cells, uint64_t all)
+{
+    percent_text t;
+    const double p = all ? 100.0 * (double)cells / (double)all : 0.0;
+    if (cells > 0 && p < 0.01)
+        snprintf(t.s, sizeof t.s, "< 0.01%%");
+    else if (p >= 9.95)
+        snprintf(t.s, sizeof t.s, "%.0f%%", p);
+    else
+        snprintf(t.s, sizeof t.s, "%.2g%%", p);
+    return t;
+}
 
 static entry *add_entry(legend *lg, cm_rgb swatch, bool has_swatch)
 {
@@ -55,18 +72,18 @@ static void closing_entries(const cm_raster *ras, uint64_t all, int room, legend
     if (ras->other_groups && lg->n < room) {
         entry *e = add_entry(lg, cm_colour_other, true);
         if (ras->min_basin == 2)
-            snprintf(e->text, LABEL, "%u single-cell groups  %.1f%%", ras->other_groups,
-                     share(ras->other_cells, all));
+            snprintf(e->text, LABEL, "%u single-cell groups  %s", ras->other_groups,
+                     share(ras->other_cells, all).s);
         else
-            snprintf(e->text, LABEL, "%u groups < %llu cells  %.1f%%", ras->other_groups,
-                     (unsigned long long)ras->min_basin, share(ras->other_cells, all));
+            snprintf(e->text, LABEL, "%u groups < %llu cells  %s", ras->other_groups,
+                     (unsigned long long)ras->min_basin, share(ras->other_cells, all).s);
     }
     if (ras->colour_repeats && lg->n < room)
         snprintf(add_entry(lg, paper, false)->text, LABEL, "colours repeat: %u groups too many",
                  ras->colour_repeats);
     if (ras->computed < all && lg->n < room)
-        snprintf(add_entry(lg, cm_colour_not_computed, true)->text, LABEL, "not computed  %.1f%%",
-                 share(all - ras->computed, all));
+        snprintf(add_entry(lg, cm_colour_not_computed, true)->text, LABEL, "not computed  %s",
+                 share(all - ras->computed, all).s);
 }
 
 /* Entries for the sink, the groups in view with the most cells (as many as
@@ -122,18 +139,18 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
     int slots = room - (ras->group_cells[0] ? 1 : 0) - (one_sticking_line ? 1 : 0) - closing;
     slots = slots < max_groups + 1 ? slots : max_groups + 1;
     if (ras->group_cells[0] && lg->n < room)
-        snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "%s  %.1f%%",
-                 o->sink_label ? o->sink_label : "sink", share(ras->group_cells[0], all));
+        snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "%s  %s",
+                 o->sink_label ? o->sink_label : "sink", share(ras->group_cells[0], all).s);
     if (one_sticking_line && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sticking, true)->text, LABEL,
-                 "%u sticking zones  %.1f%%", sticking, share(sticking_cells, all));
+                 "%u sticking zones  %s", sticking, share(sticking_cells, all).s);
     for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
         if ((slots == 1 && k + 1 < shown) || k == (uint32_t)max_groups) { /* the rest in one line */
             uint64_t rest = 0;
             for (uint32_t r = k; r < shown; r++)
                 rest += order[r].cells;
-            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more group%s  %.1f%%",
-                     shown - k, shown - k == 1 ? "" : "s", share(rest, all));
+            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more group%s  %s",
+                     shown - k, shown - k == 1 ? "" : "s", share(rest, all).s);
             break;
         }
         const uint32_t g = order[k].id;
@@ -141,11 +158,11 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
         const char *label = label_of(o, gi, dim);
         entry *e = add_entry(lg, cm_class_colour(ras->palette, ras->classes[g]), true);
         if (label)
-            snprintf(e->text, LABEL, "%s  %.1f%%", label, share(order[k].cells, all));
+            snprintf(e->text, LABEL, "%s  %s", label, share(order[k].cells, all).s);
         else
-            snprintf(e->text, LABEL, "#%u%s p=%u  %.1f%%", gi->id,
+            snprintf(e->text, LABEL, "#%u%s p=%u  %s", gi->id,
                      gi->kind == CM_GROUP_STICKING ? " sticking" : "", gi->period,
-                     share(order[k].cells, all));
+                     share(order[k].cells, all).s);
     }
     closing_entries(ras, all, room, lg);
     free(order);
@@ -154,11 +171,27 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
 
 /* ---- title ---------------------------------------------------------------------- */
 
+/* Whether parameter `name` of m is an integrator's or a section's setting
+ * (CM_FLOW_PARAM_SPECS, CM_FLOW_SECTION_PARAM_SPECS), not the system's. */
+static bool integrator_setting(const cm_model *m, const char *name)
+{
+    static const char *const settings[] = {"method", "abs_tol", "rel_tol", "world",
+                                           "t_max",  "event_tol"};
+    if (!m->flow.field)
+        return false;
+    for (size_t k = 0; k < sizeof settings / sizeof settings[0]; k++)
+        if (strcmp(name, settings[k]) == 0)
+            return true;
+    return false;
+}
+
 void figure_title(const cm_model *m, char *out, size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "%s ", m->name);
     const cm_params *p = &m->values;
     for (int k = 0; k < p->count && p->spec && p->spec[k].name && used < size; k++) {
+        if (integrator_setting(m, p->spec[k].name))
+            continue;
         used += (size_t)snprintf(out + used, size - used, " %s=", p->spec[k].name);
         if (p->spec[k].choices && used < size) { /* the word, as --param takes it */
             cm_param_choice_name(p->spec[k].choices, (int)p->value[k].v[0], out + used,
@@ -172,18 +205,45 @@ void figure_title(const cm_model *m, char *out, size_t size)
     }
 }
 
-/* Draws text cut to max_w pixels (with "..." when cut). */
-static void draw_fitted(const cm_font *f, const char *text, int x, int y, int max_w,
-                        const cm_canvas *c)
+/* The title (o->title, else the model's) wrapped at spaces onto lines of
+ * at most max_w pixels; a word wider than a line has one to itself (and
+ * may overflow it), and only a title of more than TITLE_LINES lines is
+ * cut, with "...". */
+static void wrap_title(const cm_render_options *o, const cm_font *f, int max_w, layout *L)
 {
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", text);
-    size_t n = strlen(buf);
-    while (n > 3 && cm_font_width(f, buf) > max_w) {
-        n--;
-        memcpy(buf + n - 3, "...", 4);
+    char text[1024] = "";
+    if (o->title)
+        snprintf(text, sizeof text, "%s", o->title);
+    else if (o->model)
+        figure_title(o->model, text, sizeof text);
+    L->title_lines = 0;
+    const char *p = text;
+    while (*p == ' ')
+        p++;
+    while (*p && L->title_lines < TITLE_LINES) {
+        char *line = L->title[L->title_lines++];
+        size_t n = 0;
+        line[0] = '\0';
+        for (;;) { /* add words while they fit */
+            const size_t word = strcspn(p, " ");
+            char trial[256];
+            snprintf(trial, sizeof trial, "%s%s%.*s", line, n ? " " : "", (int)word, p);
+            if (n && cm_font_width(f, trial) > max_w)
+                break;
+            snprintf(line, 256, "%s", trial);
+            n++;
+            p += word;
+            while (*p == ' ')
+                p++;
+            if (!*p)
+                break;
+        }
     }
-    cm_font_draw(f, buf, x, y, ink, c->rgba, c->w, c->h);
+    if (*p) { /* more than TITLE_LINES lines: the rest cut */
+        char *last = L->title[TITLE_LINES - 1];
+        const size_t n = strlen(last);
+        snprintf(last + (n > 252 ? 252 : n), 4, "...");
+    }
 }
 
 /* ---- layout --------------------------------------------------------------------- */
@@ -206,7 +266,12 @@ static void margins(const cm_render_options *o, const cm_font *f, int dim, layou
     else
         snprintf(L->yname_buf, sizeof L->yname_buf, "%s", names ? names[1] : "x1");
     L->yname = L->yname_buf;
-    L->top = o->layers & CM_LAYER_TITLE ? L->line + 2 * L->pad : f ? L->pad + L->ascent / 2 : 0;
+    L->title_lines = 0;
+    if (o->layers & CM_LAYER_TITLE)
+        wrap_title(o, f, o->width - 2 * L->pad, L);
+    L->top = o->layers & CM_LAYER_TITLE ? L->title_lines * L->line + 2 * L->pad
+             : f                         ? L->pad + L->ascent / 2
+                                         : 0;
     L->bottom = axes ? L->tick + 2 * L->line + L->pad : f ? L->pad : 0;
     L->left = axes ? 2 * L->pad + cm_font_width(f, L->yname) + cm_ticks_widest(f, &L->ty) + L->tick
               : f  ? L->pad
@@ -359,8 +424,8 @@ static cm_status check_options(const cm_render_options *o, char *msg, size_t msg
                        o->width, o->height, CM_RENDER_MAX_SIDE);
     if (has_text(o->layers) && !o->font_path)
         return cm_fail(CM_EINVAL, msg, msg_size, "axes, legend and title need a font");
-    if ((o->layers & CM_LAYER_TITLE) && !o->model)
-        return cm_fail(CM_EINVAL, msg, msg_size, "a title needs the model");
+    if ((o->layers & CM_LAYER_TITLE) && !o->model && !o->title)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a title needs the model or its text");
     return CM_OK;
 }
 
@@ -463,11 +528,9 @@ static void draw_text_layers(const cm_render_options *o, const work *w, const la
             draw_step_bar(&w->lg, &w->ras, L, p->x + p->w + 2 * L->pad,
                           p->y + (w->lg.n + 1) * L->line, w->font, c);
     }
-    if (o->layers & CM_LAYER_TITLE) {
-        char title[1024];
-        figure_title(o->model, title, sizeof title);
-        draw_fitted(w->font, title, L->pad, L->pad + L->ascent, c->w - 2 * L->pad, c);
-    }
+    for (int k = 0; k < L->title_lines; k++)
+        cm_font_draw(w->font, L->title[k], L->pad, L->pad + L->ascent + k * L->line, ink, c->rgba,
+                     c->w, c->h);
 }
 
 cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,

@@ -34,12 +34,16 @@ enum { BAR_LINES = 7 }; /* lines of the legend a step bar takes */
 /* The grey of the step bar at fraction f (0: no steps, 1: the cap). */
 uint8_t figure_bar_grey(int mode, double f);
 
+enum { TITLE_LINES = 6 }; /* a title wraps onto at most this many lines */
+
 typedef struct layout {
     int fs, pad, tick, line, ascent;
     int left, right, top, bottom;
     cm_ticks tx, ty;
     const char *xname, *yname;
     char yname_buf[64];
+    char title[TITLE_LINES][256]; /* the title's lines, wrapped to the image's width */
+    int title_lines;
 } layout;
 
 typedef struct work {
@@ -66,7 +70,8 @@ cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group
                        const cm_render_options *opt, figure *F, char *msg, size_t msg_size);
 void figure_end(figure *F);
 
-/* The model and its parameters, for the title. */
+/* The model and its parameters, for the title (a flow's integrator
+ * settings left to the provenance). */
 void figure_title(const cm_model *m, char *out, size_t size);
 
 #endif

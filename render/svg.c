@@ -342,11 +342,8 @@ static void legend_and_title(FILE *f, const figure *F)
             step_bar(f, F, x, p->y + (F->w.lg.n + 1) * L->line);
         fputs("</g>\n", f);
     }
-    if (F->o.layers & CM_LAYER_TITLE) {
-        char title[1024];
-        figure_title(F->o.model, title, sizeof title);
-        text(f, L->pad, L->pad + L->ascent, "start", title);
-    }
+    for (int k = 0; k < L->title_lines; k++)
+        text(f, L->pad, L->pad + L->ascent + k * L->line, "start", L->title[k]);
 }
 
 static void clip(FILE *f, const char *id, const cm_plot *p, const cm_panel *pn)

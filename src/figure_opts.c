@@ -32,6 +32,11 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
                                    c->value);
         po->min_basin = (uint64_t)v;
     } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
+    } else if (cli_is(c, "--title", true, err)) {
+        po->title = c->value;
+        if (c->value && strlen(c->value) > 1000)
+            *err = cli_usage_error(c, "--title: %zu characters; give at most 1000",
+                                   strlen(c->value));
     } else if (cli_is(c, "--labels", true, err)) {
         char msg[512];
         if (c->value && !png_opts_labels(c->value, po, msg, sizeof msg))
@@ -57,9 +62,10 @@ int png_opts_check(const cli *c, const png_opts *po)
 {
     if (!po->path && !po->svg &&
         (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups ||
-         po->palette))
-        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend and "
-                                  "--palette describe the image; add --png FILE (or --svg FILE)");
+         po->palette || po->title))
+        return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend, "
+                                  "--palette and --title describe the image; add --png FILE (or "
+                                  "--svg FILE)");
     if (po->svg && po->indexed)
         return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
                                   "only");

@@ -33,7 +33,10 @@
     "                      indices as export --groups lists them (e.g. 287,500 SW2)\n"        \
     "  --legend K          list at most K groups in the legend (default 12), the rest in one\n"   \
     "                      line; colours follow each attractor's anchor cell, so the same\n"     \
-    "                      attractor has the same colour in every file and view\n"
+    "                      attractor has the same colour in every file and view\n"        \
+    "  --title TEXT        the title (with the title layer; default: the model and its\n"   \
+    "                      parameters, a flow's integrator settings left to the PNG's\n"   \
+    "                      texts); wrapped onto as many lines as it needs\n"
 
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);

@@ -241,9 +241,12 @@ static void follow_s(const cm_fo *o, double p0, const double z[2], int period, s
 
 /* Fig. 2.17 below PD_1a (S0 = 0.4, Omega = 0.5): the doubled solution 2a
  * is stable from PD_1a down to T (S ~ 0.055787), where the map jumps and the
- * branch ends; 1a,9seg is stable from SS_a (S ~ 0.043479) down to its fold,
- * the thesis' N (S ~ 0.035620); none of the branches (1a, 2s, 2a, 1a,9seg)
- * is stable in between, and simulation finds no periodic attractor there. */
+ * branch ends; 1a,9seg is stable from SS_a down to its fold, the thesis' N
+ * (S ~ 0.035620); none of the branches (1a, 2s, 2a, 1a,9seg) is stable in
+ * between, and simulation finds no periodic attractor there. SS_a is the
+ * model's 0.0437935, not the thesis' printed 0.043479 (an erratum): at
+ * S = 0.0437, inside the thesis' window, simulation settles on the stable
+ * period-1 orbit of 1a,9seg. */
 static void test_fig_2_17_window(void)
 {
     stable_points *sp = calloc(1, sizeof *sp);
@@ -297,7 +300,7 @@ static void test_fig_2_17_window(void)
     CHECK((period = cm_fo_find_periodic(&o, z, 500, 16)) == 1);
     CHECK(stays(&o, CM_FO_P_S, 0.04, z, 0, 1));
     follow_s(&o, 0.04, z, 1, sp, stop);
-    const cm_fo_branch_event *ss = first(&sp->events, CM_FO_EVENT_SS, 0.043479, 1e-3);
+    const cm_fo_branch_event *ss = first(&sp->events, CM_FO_EVENT_SS, 0.0437935, 1e-7);
     const cm_fo_branch_event *n = first(&sp->events, CM_FO_EVENT_SN, 0.035620, 1e-4);
     CHECK(ss != NULL && n != NULL);
     if (ss) {
@@ -316,10 +319,14 @@ static void test_fig_2_17_window(void)
         else
             above = fmin(above, sp->p[i]);
     }
-    if (fabs(below - 0.043479) >= 1e-3 || fabs(above - 0.055787) >= 1e-3)
-        fprintf(stderr, "no stable solution in (%.9g, %.9g), not (0.043479, 0.055787)\n", below,
+    if (fabs(below - 0.0437935) >= 1e-7 || fabs(above - 0.055787) >= 1e-3)
+        fprintf(stderr, "no stable solution in (%.9g, %.9g), not (0.0437935, 0.055787)\n", below,
                 above);
-    CHECK(fabs(below - 0.043479) < 1e-3 && fabs(above - 0.055787) < 1e-3);
+    CHECK(fabs(below - 0.0437935) < 1e-7 && fabs(above - 0.055787) < 1e-3);
+    /* the erratum, independently: a stable period-1 orbit above the printed SS_a */
+    cm_fo_init(&o, 0.0437, 0.4, 0.5, 0);
+    double v[2] = {z[0], z[1]};
+    CHECK_INT(cm_fo_find_periodic(&o, v, 2000, 16), 1);
     for (double S = 0.045; S < 0.055; S += 0.0025) {
         cm_fo_init(&o, S, 0.4, 0.5, 0);
         double w[2] = {1.36, 0};

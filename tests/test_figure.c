@@ -516,15 +516,85 @@ static void test_min_basin_boundary(void)
         CHECK_INT(wrong, 0);
         cm_raster_free(&ras);
     }
-    CHECK(svg_has_text(&s, 5, ">1 groups &lt; 5 cells  26.7%<"));
-    CHECK(svg_has_text(&s, 6, ">2 groups &lt; 6 cells  60.0%<"));
+    CHECK(svg_has_text(&s, 5, ">1 groups &lt; 5 cells  27%<"));
+    CHECK(svg_has_text(&s, 6, ">2 groups &lt; 6 cells  60%<"));
     CHECK(!svg_has_text(&s, 4, "groups &lt;"));
+    cm_region_free(&s.r);
+    free(s.g);
+}
+
+/* The SVG of a scene drawn with ro (the caller frees it). */
+static char *svg_of(const scene *s, const cm_render_options *ro)
+{
+    char *svg = NULL, msg[256];
+    size_t n = 0;
+    FILE *f = open_memstream(&svg, &n);
+    const cm_status st = cm_render_svg(&s->lat, &s->r, s->g, ro, f, msg, sizeof msg);
+    fclose(f);
+    if (st != CM_OK)
+        fprintf(stderr, "cm_render_svg: %s\n", msg);
+    CHECK(st == CM_OK);
+    return svg;
+}
+
+/* Legend shares with two significant digits, "< 0.01%" below; a title
+ * wrapped at spaces onto lines that fit the image, every word kept. */
+static void test_legend_shares_and_title(void)
+{
+    char msg[256];
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.lat = (cm_lattice){2, {0, 0}, {1, 1}};
+    const cm_box box = {2, {0, 0}, {200, 100}}; /* 20 000 cells */
+    CHECK(cm_region_alloc(&s.r, &box, msg, sizeof msg) == CM_OK);
+    s.r.ngroups = 4;
+    s.g = calloc(5, sizeof *s.g);
+    const uint32_t first[5] = {0, 1, 6, 306, 20000}; /* 1, 5, 300 and 19 694 cells */
+    for (uint32_t k = 1; k <= 4; k++) {
+        s.g[k - 1] = (cm_group_info){.id = k, .period = 1, .basin_cells = first[k] - first[k - 1]};
+        s.g[k - 1].anchor[0] = first[k - 1] % 200;
+        s.g[k - 1].anchor[1] = first[k - 1] / 200;
+        for (uint32_t i = first[k - 1]; i < first[k]; i++) {
+            s.r.group[i] = k;
+            s.r.step[i] = i != first[k - 1];
+            s.r.image[i] = first[k - 1];
+        }
+    }
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.width = 900;
+    ro.height = 500;
+    ro.layers = CM_LAYER_BASIN | CM_LAYER_LEGEND;
+    ro.min_basin = 1;
+    ro.font_path = CELLMAP_FONT_PATH;
+    char *svg = svg_of(&s, &ro);
+    CHECK(strstr(svg, "p=1  &lt; 0.01%<") && strstr(svg, "p=1  0.025%<") &&
+          strstr(svg, "p=1  1.5%<") && strstr(svg, "p=1  98%<"));
+    free(svg);
+
+    const char *title = "Basins of a system drawn to show that a long title wraps onto several "
+                        "lines at spaces and loses none of its words on the way";
+    ro.layers = CM_LAYER_BASIN | CM_LAYER_TITLE; /* its lines are the only texts */
+    ro.title = title;
+    ro.width = 400;
+    svg = svg_of(&s, &ro);
+    char joined[1024] = "";
+    int lines = 0;
+    for (const char *t = strstr(svg, "<text "); t; t = strstr(t + 1, "<text ")) {
+        const char *from = strchr(t, '>') + 1, *to = strstr(from, "</text>");
+        snprintf(joined + strlen(joined), sizeof joined - strlen(joined), "%s%.*s",
+                 lines++ ? " " : "", (int)(to - from), from);
+    }
+    CHECK(lines >= 2 && lines <= 4);
+    CHECK(strcmp(joined, title) == 0);
+    free(svg);
     cm_region_free(&s.r);
     free(s.g);
 }
 
 int main(void)
 {
+    test_legend_shares_and_title();
     test_pd_figure();
     test_min_basin_boundary();
     test_svg_raster();
