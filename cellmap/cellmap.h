@@ -289,6 +289,9 @@ typedef struct cm_figure_options {
     int legend;          /* groups the legend lists; 0: 12 */
     const char *title;   /* the title (with CM_FIGURE_TITLE); NULL: the model and its
                             parameters; wrapped */
+    double aspect;       /* a state unit along y drawn `aspect` times as long as one along
+                            x (1: equal); -1: the plot fills its room; 0: 1 for models whose
+                            axes share a unit (cm_model.equal_axes), else -1 */
 } cm_figure_options;
 
 /* The figure of a result (cm_solve, cm_db_read, cm_session_read), through

@@ -194,6 +194,10 @@ typedef struct cm_model {
      * 0: not periodic. Boxes must lie within that period. */
     double period[CM_MAX_DIM];
     double period_lo[CM_MAX_DIM];
+    /* Optional (plugin ABI 5): 1 when state coordinates 0 and 1 share a unit
+     * (nondimensional x and x', the complex plane): figures then draw a
+     * square of state space square unless asked otherwise (--aspect) */
+    int equal_axes;
     /* private: the model's own step functions, which cm_model_wrap_periods
      * wraps */
     int (*own_step)(const struct cm_model *m, const double *x, double *y);

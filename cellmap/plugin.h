@@ -4,8 +4,8 @@
  *
  * A plugin exports one function, cellmap_plugin(), returning a cm_plugin
  * that lives as long as the library is loaded. cellmap refuses a plugin
- * whose abi differs from CM_PLUGIN_ABI (the layouts of cm_model and the
- * structs below changed), naming both versions.
+ * whose abi is not CM_PLUGIN_ABI_OLDEST..CM_PLUGIN_ABI (the layouts of
+ * cm_model and the structs below changed), naming the versions.
  *
  * Each model's create() fills *m from the parameter values p (defaults of
  * params overridden by --param): name, dim (1..CM_MAX_DIM), params, values
@@ -26,8 +26,10 @@
 
 #include "cellmap/model.h"
 
-#define CM_PLUGIN_ABI 4 /* 2: cm_model.flow; 3: cm_model.period (angles); 4: stiff
-                          * integrators, sections on state planes, 24 parameters */
+#define CM_PLUGIN_ABI 5 /* 2: cm_model.flow; 3: cm_model.period (angles); 4: stiff
+                          * integrators, sections on state planes, 24 parameters;
+                          * 5: cm_model.equal_axes (plugins of ABI 4 still load) */
+#define CM_PLUGIN_ABI_OLDEST 4 /* the oldest ABI whose plugins load */
 
 typedef struct cm_plugin_model {
     const char *name;   /* as --model takes it */

@@ -614,6 +614,7 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     po->min_basin = o->min_basin;
     po->legend_groups = o->legend;
     po->title = o->title;
+    po->aspect = o->aspect;
     if (!o->png && !o->svg)
         return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png or an svg path");
     if ((o->width == 0) != (o->height == 0) || o->width < 0 || o->height < 0 ||
@@ -628,6 +629,9 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
                        "an indexed PNG has one pixel per cell: give no svg, size or layers");
     if (o->legend < 0 || o->legend > 200)
         return cm_fail(CM_EINVAL, msg, msg_size, "legend %d: give 0..200 groups", o->legend);
+    if (!(o->aspect == 0 || o->aspect == ASPECT_AUTO || (o->aspect >= 1e-6 && o->aspect <= 1e6)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "aspect %g: give 0 (the model's), -1 (auto) or a ratio 1e-6..1e6", o->aspect);
     if (o->title && strlen(o->title) > 1000)
         return cm_fail(CM_EINVAL, msg, msg_size, "title: %zu characters; give at most 1000",
                        strlen(o->title));

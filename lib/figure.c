@@ -260,6 +260,29 @@ static unsigned layers_of(const png_opts *po)
                                 : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
 }
 
+bool parse_aspect(const char *s, double *aspect)
+{
+    char *end = NULL;
+    if (strcmp(s, "equal") == 0)
+        *aspect = 1;
+    else if (strcmp(s, "auto") == 0)
+        *aspect = ASPECT_AUTO;
+    else if ((*aspect = strtod(s, &end)) > 0 && *end == '\0' && *aspect <= 1e6 &&
+             *aspect >= 1e-6)
+        return true;
+    else
+        return false;
+    return true;
+}
+
+/* The renderer's aspect for the figure of model m (render/figure.h). */
+static double aspect_of(const png_opts *po, const cm_model *m)
+{
+    if (po->aspect > 0)
+        return po->aspect;
+    return po->aspect == 0 && m && m->equal_axes ? 1 : 0;
+}
+
 /* The renderer's options for the figure of b. */
 static void figure_options(const basin_png *b, cm_render_options *out)
 {
@@ -274,6 +297,7 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.n_labels = po->n_labels;
     ro.sink_label = po->sink_label;
     ro.title = po->title;
+    ro.aspect = aspect_of(po, b->model);
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -403,6 +427,7 @@ cm_status figure_check_layout(const png_opts *po, const cm_model *m, const cm_la
     }
     ro.model = m;
     ro.title = po->title;
+    ro.aspect = aspect_of(po, m);
     ro.font_path = figure_font();
     return cm_render_check(&ro, lat->dim, msg, msg_size);
 }

@@ -40,7 +40,14 @@ typedef struct png_opts {
     int by; /* --by: BY_ATTRACTORS (the default) or BY_GROUPS (lib/attractor_report.h) */
     const char *sink_label; /* the legend's name of label 0 (NULL: "sink") */
     const char *title;      /* --title TEXT (NULL: the model and its parameters) */
+    double aspect;          /* --aspect: > 0 the ratio (1: equal), ASPECT_AUTO, or 0: equal
+                               where the model declares equal axes, else auto */
 } png_opts;
+
+#define ASPECT_AUTO (-1.0)
+
+/* --aspect equal|auto|R into *aspect (png_opts.aspect); false if it is none. */
+bool parse_aspect(const char *s, double *aspect);
 
 /* What `all` draws: every layer but steps. */
 extern const unsigned all_layers;

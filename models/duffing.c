@@ -42,6 +42,7 @@ cm_status cm_duffing_create(const cm_params *p, cm_model *m, char *msg, size_t m
     d->gamma = cm_params_get(p, "gamma");
     d->omega = cm_params_get(p, "omega");
     m->coord_names = duffing_coord_names;
+    m->equal_axes = 1; /* figures draw a square of state space square */
     m->flow.field = duffing_field;
     m->flow.period = TWO_PI / d->omega;
     m->flow.t0 = cm_params_get(p, "phase") / d->omega;

@@ -149,13 +149,13 @@ cm_status cm_model_set_load(cm_model_set *s, const char *path, char *msg, size_t
                        "%s is no cellmap plugin: it exports no %s() (see examples/plugin/)", path,
                        CM_PLUGIN_ENTRY_NAME);
     }
-    if (p->abi != CM_PLUGIN_ABI) {
+    if (p->abi < CM_PLUGIN_ABI_OLDEST || p->abi > CM_PLUGIN_ABI) {
         const int abi = p->abi; /* read before the library is unmapped */
         dlclose(h);
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "plugin %s was built for plugin ABI %d, this cellmap has ABI %d: build it "
-                       "again against this cellmap's headers",
-                       path, abi, CM_PLUGIN_ABI);
+                       "plugin %s was built for plugin ABI %d, this cellmap loads ABI %d..%d: "
+                       "build it again against this cellmap's headers",
+                       path, abi, CM_PLUGIN_ABI_OLDEST, CM_PLUGIN_ABI);
     }
     if (p->count < 0 || (p->count > 0 && !p->models)) {
         dlclose(h);
@@ -235,8 +235,10 @@ cm_status cm_model_set_create(const cm_model_set *s, const char *name, const cha
     /* Maps of delayed values name their state after the lags: ..., x_lag1, x */
     static const char *const lag_names[CM_MAX_DIM] = {"x_lag5", "x_lag4", "x_lag3",
                                                       "x_lag2", "x_lag1", "x"};
-    if (st == CM_OK && !m->coord_names && m->dim >= 1 && m->dim <= CM_MAX_DIM)
+    if (st == CM_OK && !m->coord_names && m->dim >= 1 && m->dim <= CM_MAX_DIM) {
         m->coord_names = lag_names + (CM_MAX_DIM - m->dim);
+        m->equal_axes = 1; /* delayed values of one variable share its unit */
+    }
     if (st != CM_OK)
         cm_model_release(m);
     return st;

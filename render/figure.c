@@ -533,6 +533,24 @@ static void draw_text_layers(const cm_render_options *o, const work *w, const la
                      c->w, c->h);
 }
 
+/* The plot shrunk to the largest rectangle of its room whose pixels per
+ * state unit along y are `aspect` times those along x: at the room's left
+ * (the legend follows it), centred from top to bottom. */
+static void keep_aspect(double aspect, const double lo[2], const double hi[2], cm_plot *p)
+{
+    const double ratio = aspect * (hi[1] - lo[1]) / (hi[0] - lo[0]); /* height / width */
+    if (!(ratio > 0) || !isfinite(ratio))
+        return;
+    int w = p->w, h = (int)lround(p->w * ratio);
+    if (h > p->h) {
+        h = p->h;
+        w = (int)lround(p->h / ratio);
+    }
+    w = w < 1 ? 1 : w, h = h < 1 ? 1 : h;
+    p->y += (p->h - h) / 2;
+    p->w = w, p->h = h;
+}
+
 cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                        const cm_render_options *opt, figure *F, char *msg, size_t msg_size)
 {
@@ -559,6 +577,8 @@ cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group
                      {0},
                      0,
                      F->o.gl};
+    if (st == CM_OK && F->o.aspect > 0 && r->box.dim >= 2)
+        keep_aspect(F->o.aspect, F->lo, F->hi, &F->p);
     if (st == CM_OK) {
         const int small = F->p.w < F->p.h ? F->p.w : F->p.h;
         F->p.line_width = small / 700 > 1 ? small / 700 : 1;

@@ -50,6 +50,11 @@ typedef struct cm_render_options {
     const char *sink_label;           /* the legend's name of label 0; NULL: "sink" */
     const char *title;                /* the title; NULL: the model and its parameters (a
                                          flow's integrator settings left out); wrapped */
+    double aspect;                    /* 2-D views: a state unit along dimension 1 drawn
+                                         `aspect` times as long as one along dimension 0 (1:
+                                         equal, a square of state space is square), the plot
+                                         the largest such rectangle in its room;
+                                         0: the plot fills its room */
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

@@ -32,6 +32,12 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
                                    c->value);
         po->min_basin = (uint64_t)v;
     } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
+    } else if (cli_is(c, "--aspect", true, err)) {
+        if (c->value && !parse_aspect(c->value, &po->aspect))
+            *err = cli_usage_error(c,
+                                   "--aspect: '%s' must be equal, auto or a ratio R (1e-6..1e6: a "
+                                   "unit along y drawn R times as long as one along x)",
+                                   c->value);
     } else if (cli_is(c, "--title", true, err)) {
         po->title = c->value;
         if (c->value && strlen(c->value) > 1000)
@@ -62,10 +68,10 @@ int png_opts_check(const cli *c, const png_opts *po)
 {
     if (!po->path && !po->svg &&
         (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups ||
-         po->palette || po->title))
+         po->palette || po->title || po->aspect))
         return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend, "
-                                  "--palette and --title describe the image; add --png FILE (or "
-                                  "--svg FILE)");
+                                  "--palette, --title and --aspect describe the image; add --png "
+                                  "FILE (or --svg FILE)");
     if (po->svg && po->indexed)
         return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
                                   "only");

@@ -34,9 +34,9 @@
     "  --legend K          list at most K groups in the legend (default 12), the rest in one\n"   \
     "                      line; colours follow each attractor's anchor cell, so the same\n"     \
     "                      attractor has the same colour in every file and view\n"        \
-    "  --title TEXT        the title (with the title layer; default: the model and its\n"   \
-    "                      parameters, a flow's integrator settings left to the PNG's\n"   \
-    "                      texts); wrapped onto as many lines as it needs\n"
+    "  --title TEXT        the title (default: the model and its parameters), wrapped\n"  \
+    "  --aspect A          equal (squares drawn square), auto (the plot fills its room) or\n" \
+    "                      R (y units R times x's); default equal if the axes share a unit\n"
 
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);

@@ -141,6 +141,31 @@ assert any(t.startswith("colours repeat") for t in legend("two")), legend("two")
 names = legend("named")
 assert "chaotic at SW1  2.2%" in names and "chaotic at SW3  3.3%" in names, names  # two digits
 PY
+# --aspect: Duffing's axes share a unit, so a square of its phase plane is
+# drawn square by default (the SVG's plot rectangle, which the PNG shares);
+# the quick start's are not, so its plot fills the room; a ratio R draws a
+# unit along y R times as long as one along x; and --title replaces the title
+plot_rect() { grep -o '<clipPath id="basin"><rect[^/]*' "$1" | grep -o '[0-9.]*' | tr '\n' ' '; }
+"$CM" solve --model duffing --cells 60x60 --svg sq.svg --size 800x500 --layers all \
+  --title "Duffing, square" > /dev/null &&
+"$CM" solve --model duffing --cells 60x60 --svg auto.svg --size 800x500 --layers all \
+  --aspect auto > /dev/null &&
+"$CM" solve --cells 300x200 --svg pd.svg --size 800x500 --layers all > /dev/null &&
+"$CM" solve --cells 300x200 --svg pd2.svg --size 800x500 --layers all --aspect 2 > /dev/null ||
+  fail "solve --aspect"
+read -r _ _ w h < <(plot_rect sq.svg)
+[ -n "${h:-}" ] && [ $((w > h ? w - h : h - w)) -le 1 ] || fail "duffing not square: ${w:-?}x${h:-?}"
+grep -q '>Duffing, square<' sq.svg || fail "--title is not the title"
+read -r _ _ w h < <(plot_rect auto.svg)
+[ -n "${h:-}" ] && [ "$w" -gt $((h + 100)) ] || fail "--aspect auto does not fill: ${w:-?}x${h:-?}"
+read -r _ _ w h < <(plot_rect pd.svg)
+[ -n "${h:-}" ] && [ "$w" -gt $((h + 100)) ] || fail "the quick start is not auto: ${w:-?}x${h:-?}"
+read -r _ _ w h < <(plot_rect pd2.svg) # 0:500 x -40:40 at R = 2: h / w = 2 * 80 / 500
+python3 -c "import sys; w, h = map(int, sys.argv[1:]); assert abs(h - round(w * 0.32)) <= 1 or \
+  abs(w - round(h / 0.32)) <= 1, (w, h)" "${w:-0}" "${h:-0}" || fail "--aspect 2: ${w:-?}x${h:-?}"
+expect_usage "--aspect: 'wide' must be equal, auto or a ratio" solve --png x.png --aspect wide
+expect_usage "--aspect: '0' must be equal, auto or a ratio" solve --png x.png --aspect 0
+expect_usage "--aspect describe the image; add --png" solve --aspect equal
 expect_usage "--palette: no palette 'nosuch'" render basin.cmdb --png x.png --palette nosuch
 printf 'x y\n' > bad-names.txt
 expect_usage "bad-names.txt:1:" render basin.cmdb --png x.png --labels bad-names.txt

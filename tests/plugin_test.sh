@@ -157,13 +157,21 @@ sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin pl
   "$SRC/examples/plugin/henon.c" > abi.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libabi.so abi.c -lm
 abi=$(sed -n 's/^#define CM_PLUGIN_ABI \([0-9]*\).*/\1/p' "$SRC/cellmap/plugin.h")
-expect_usage "was built for plugin ABI $((abi + 98)), this cellmap has ABI $abi" \
+oldest=$(sed -n 's/^#define CM_PLUGIN_ABI_OLDEST \([0-9]*\).*/\1/p' "$SRC/cellmap/plugin.h")
+[ "$oldest" -lt "$abi" ] || fail "CM_PLUGIN_ABI_OLDEST '$oldest' is not below CM_PLUGIN_ABI '$abi'"
+expect_usage "was built for plugin ABI $((abi + 98)), this cellmap loads ABI $oldest..$abi" \
   solve --model-lib ./libabi.so --model henon
-# a plugin of the ABI before periodic coordinates (cm_model.period) is refused
-sed 's/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {CM_PLUGIN_ABI - 1,/' \
+# a plugin of the oldest ABI still loads (cm_model only grew at its end since)
+sed "s/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {$oldest,/" \
+  "$SRC/examples/plugin/henon.c" > oldest.c
+cc -shared -fPIC $(pkg-config --cflags cellmap) -o liboldest.so oldest.c -lm
+"$CM" solve --model-lib ./liboldest.so --model henon --cells 40x40 --quiet \
+  || fail "a plugin of ABI $oldest is refused"
+# one before it is refused
+sed "s/static const cm_plugin plugin = {CM_PLUGIN_ABI,/static const cm_plugin plugin = {$((oldest - 1)),/" \
   "$SRC/examples/plugin/henon.c" > old.c
 cc -shared -fPIC $(pkg-config --cflags cellmap) -o libold.so old.c -lm
-expect_usage "was built for plugin ABI $((abi - 1)), this cellmap has ABI $abi: build it again" \
+expect_usage "was built for plugin ABI $((oldest - 1)), this cellmap loads ABI $oldest..$abi: build it again" \
   solve --model-lib ./libold.so --model henon
 
 # the pendulum's angle is periodic (-pi:pi): a rotation goes round instead

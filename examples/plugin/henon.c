@@ -33,6 +33,7 @@ static cm_status henon_create(const cm_params *p, cm_model *m, char *msg, size_t
     m->values = *p;
     m->step = henon_step;
     m->coord_names = henon_state;
+    m->equal_axes = 1; /* figures draw a square of state space square */
     return CM_OK;
 }
 

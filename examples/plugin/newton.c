@@ -41,6 +41,7 @@ static cm_status newton_create(const cm_params *p, cm_model *m, char *msg, size_
     m->values = *p;
     m->step = newton_step;
     m->coord_names = newton_state;
+    m->equal_axes = 1; /* figures draw a square of state space square */
     return CM_OK;
 }
 

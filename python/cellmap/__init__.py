@@ -460,7 +460,8 @@ class _FigureOptions(ctypes.Structure):
                 ("height", ctypes.c_int), ("layers", ctypes.c_uint), ("indexed", ctypes.c_int),
                 ("by_groups", ctypes.c_int), ("palette", ctypes.c_char_p),
                 ("labels", ctypes.c_char_p), ("min_basin", ctypes.c_uint64),
-                ("legend", ctypes.c_int), ("title", ctypes.c_char_p)]
+                ("legend", ctypes.c_int), ("title", ctypes.c_char_p),
+                ("aspect", ctypes.c_double)]
 
 
 class _DbOptions(ctypes.Structure):
@@ -519,7 +520,7 @@ _sig("cm_session_close", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_size_t)
 _LAYERS = {"basin": 1, "steps": 2, "attractors": 4, "overlays": 8, "axes": 16, "legend": 32,
            "title": 64}
 _FIGURE_KEYS = {"svg", "width", "height", "layers", "indexed", "by", "palette", "labels",
-                "min_basin", "legend", "title"}
+                "min_basin", "legend", "title", "aspect"}
 
 
 def _figure_options(png, options):
@@ -540,10 +541,14 @@ def _figure_options(png, options):
     keep = [_text(os.fspath(v)) if v is not None else None
             for v in (png, options.get("svg"), options.get("palette"), options.get("labels"))]
     keep.append(_text(options["title"]) if options.get("title") is not None else None)
+    aspect = options.get("aspect", 0)
+    aspect = {"equal": 1.0, "auto": -1.0}.get(aspect, aspect)
+    if isinstance(aspect, str):
+        raise ValueError("figure(): aspect=%r: 'equal', 'auto' or a ratio" % (aspect,))
     o = _FigureOptions(keep[0], keep[1], int(options.get("width", 0)),
                        int(options.get("height", 0)), bits, int(bool(options.get("indexed"))),
                        int(by == "groups"), keep[2], keep[3], int(options.get("min_basin", 0)),
-                       int(options.get("legend", 0)), keep[4])
+                       int(options.get("legend", 0)), keep[4], float(aspect))
     return o, keep
 
 
