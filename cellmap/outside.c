@@ -784,10 +784,12 @@ static cm_status settle_links(uint64_t n, int32_t *label, char *msg, size_t msg_
 {
     for (uint64_t id = 0; id < n; id++) {
         uint64_t end = id;
-        for (uint64_t hops = 0; is_link(label[end]); hops++, end = (uint64_t)(NODE_LINK - label[end]))
+        for (uint64_t hops = 0; is_link(label[end]); hops++) {
             if (hops > n)
                 return cm_fail(CM_EFORMAT, msg, msg_size,
                                "the links from node %llu form a loop", (unsigned long long)id);
+            end = (uint64_t)(NODE_LINK - label[end]);
+        }
         const int32_t v = label[end];
         for (uint64_t x = id; is_link(label[x]);) {
             const uint64_t next = (uint64_t)(NODE_LINK - label[x]);
