@@ -51,7 +51,7 @@ static percent_text share(uint64_t cells, uint64_t all)
     else if (p >= 9.95)
         snprintf(t.s, sizeof t.s, "%.0f%%", p);
     else
-        snprintf(t.s, sizeof t.s, "%.2g%%", p);
+        snprintf(t.s, sizeof t.s, "%#.2g%%", p); /* "6.0%": both digits */
     return t;
 }
 
