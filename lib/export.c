@@ -658,22 +658,13 @@ cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size)
     x->att.exit_label = NULL;
     x->att.nexits = 0;
     cluster_ends_close(&x->ends);
-    cm_cluster_release_open(x->c);
-    x->labels_only = true;
+    cm_cluster_release_open(x->c); /* cluster_ends_open refuses it from here on */
     st = cm_node_labels_settle(x->c, &x->att, x->node_labels, msg, msg_size);
     if (st != CM_OK) {
         free(x->node_labels);
         x->node_labels = NULL;
     }
     return st;
-}
-
-/* export_cells and export_arrays need the exits' fates. */
-static cm_status check_not_labels_only(const exporter *x, char *msg, size_t msg_size)
-{
-    return x->labels_only ? cm_fail(CM_EINVAL, msg, msg_size,
-                                    "this exporter was made for labels only (exporter_labels_only)")
-                          : CM_OK;
 }
 
 cm_status export_window(const cm_cluster *c, const char *text, cm_box *box, char *msg,
@@ -758,9 +749,7 @@ cm_status export_cells(exporter *x, const char *cells, const char *flat, const w
     int nouts = 0;
     memset(outs, 0, sizeof outs);
     *rows = 0;
-    cm_status ends = check_not_labels_only(x, msg, msg_size);
-    if (ends == CM_OK)
-        ends = cluster_ends_open(&x->ends, c, msg, msg_size);
+    const cm_status ends = cluster_ends_open(&x->ends, c, msg, msg_size);
     if (ends != CM_OK)
         return ends;
     for (int k = 0; k < 2; k++) {
@@ -854,6 +843,15 @@ static bool write_files(void *user, const cm_region *flat, const int32_t *label,
     return ok;
 }
 
+/* The strides of box's cells in C order (dimension 0 slowest), as the
+ * labels arrays hold them. */
+static void c_order_strides(const cm_box *box, int64_t *stride)
+{
+    stride[box->dim - 1] = 1;
+    for (int d = box->dim - 2; d >= 0; d--)
+        stride[d] = stride[d + 1] * (box->hi[d + 1] - box->lo[d + 1]);
+}
+
 typedef struct slab_memory {
     int32_t *labels;      /* the window's, C order */
     const cm_box *window;
@@ -866,9 +864,7 @@ static bool copy_slab(void *user, const cm_region *flat, const int32_t *label, c
     const slab_memory *m = user;
     const cm_box *b = &flat->box, *w = m->window;
     int64_t stride[CM_MAX_DIM], i[CM_MAX_DIM] = {0};
-    stride[w->dim - 1] = 1;
-    for (int d = w->dim - 2; d >= 0; d--)
-        stride[d] = stride[d + 1] * (w->hi[d + 1] - w->lo[d + 1]);
+    c_order_strides(w, stride);
     for (uint64_t k = 0; k < flat->ncells; k++) { /* the flat region has dimension 0 fastest */
         int64_t at = 0;
         for (int d = 0; d < w->dim; d++)
@@ -890,10 +886,8 @@ cm_status export_labels(exporter *ex, const cm_box *box, int32_t *labels,
         return st != CM_OK ? st : each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
                          "the labels were not read", copy_slab, &m, msg, msg_size);
     }
-    int64_t stride[CM_MAX_DIM]; /* C order: dimension 0 slowest */
-    stride[box->dim - 1] = 1;
-    for (int d = box->dim - 2; d >= 0; d--)
-        stride[d] = stride[d + 1] * (box->hi[d + 1] - box->lo[d + 1]);
+    int64_t stride[CM_MAX_DIM];
+    c_order_strides(box, stride);
     cm_status st = node_labels(ex, msg, msg_size);
     if (st == CM_OK)
         st = cm_cluster_cell_labels(ex->c, &ex->att, ex->node_labels, box, stride, labels,
@@ -907,9 +901,7 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
 {
     cm_cluster *c = ex->c;
     const cm_box *window = &ex->window;
-    cm_status ends = check_not_labels_only(ex, msg, msg_size);
-    if (ends == CM_OK)
-        ends = cluster_ends_open(&ex->ends, c, msg, msg_size);
+    const cm_status ends = cluster_ends_open(&ex->ends, c, msg, msg_size);
     if (ends != CM_OK)
         return ends;
     const array_export arrays = {labels_path, steps_path, ex->source, ex->info, ex->groups,

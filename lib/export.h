@@ -40,7 +40,6 @@ typedef struct exporter {
     const char *names[CM_MAX_DIM]; /* the state coordinates' names */
     cm_box window;             /* the cells written */
     int32_t *node_labels;      /* the nodes' labels, once export_labels needed them */
-    bool labels_only;          /* exporter_labels_only */
 } exporter;
 
 /* The cells of c whose centres lie in the window text "X0:X1[,Y0:Y1...]"
@@ -95,7 +94,8 @@ cm_status export_labels(exporter *x, const cm_box *box, int32_t *labels,
  * exits' fates (20 bytes per exit) and the cluster's open nodes' index
  * (about 70 bytes per open node, cm_cluster_release_open), which only they
  * needed, released on the way; export_cells and export_arrays refuse
- * afterwards, and the cluster can no longer be saved or joined. A cluster
+ * afterwards (the cluster's exits are no longer known), and the cluster
+ * can no longer be saved or joined. A cluster
  * of resolved cells keeps them (export_labels follows its cells' exits). */
 cm_status exporter_labels_only(exporter *x, char *msg, size_t msg_size);
 

@@ -1,24 +1,35 @@
 /* lib/sweep.c - a parameter swept (lib/sweep.h). */
 #include "lib/sweep.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include <errno.h>
 #include <sys/stat.h>
 
 #include "lib/param_grid.h"
 #include "lib/solve.h"
 #include "lib/work.h"
 
-static bool in_window(const sweep_args *a, const cm_group_info *g)
+/* Whether an attractor or group centred there lies in the window. */
+static bool in_window(const sweep_args *a, const double *centre)
 {
     for (int d = 0; d < a->n_near; d++)
-        if (!(g->centre[d] >= a->near_lo[d] && g->centre[d] <= a->near_hi[d]))
+        if (!(centre[d] >= a->near_lo[d] && centre[d] <= a->near_hi[d]))
             return false;
     return true;
+}
+
+/* What tracking keeps of an attractor (its id and basin set by the caller). */
+static sweep_attractor tracked_of(const cm_attractor *at)
+{
+    sweep_attractor t = {.kind = at->kind, .period = at->period};
+    memcpy(t.centre, at->centre, sizeof t.centre);
+    memcpy(t.lo, at->lo, sizeof t.lo);
+    memcpy(t.hi, at->hi, sizeof t.hi);
+    memcpy(t.anchor, at->anchor, sizeof t.anchor);
+    return t;
 }
 
 /* The system's attractors (cellmap/attractors.h) in the window, each
@@ -35,21 +46,15 @@ static cm_status count_attractors(const sweep_args *a, const cm_attractor_set *s
         return CM_ENOMEM;
     for (uint32_t k = 0; k < s->n; k++) {
         const cm_attractor *at = &s->a[k];
-        cm_group_info as_group = {.kind = at->kind == CM_ATTRACTOR_STICKING ? CM_GROUP_STICKING
-                                                                          : CM_GROUP_ATTRACTOR};
-        memcpy(as_group.centre, at->centre, sizeof at->centre);
-        if (!in_window(a, &as_group)) {
+        if (!in_window(a, at->centre)) {
             pt->elsewhere_cells += at->basin_cells;
         } else if (at->kind == CM_ATTRACTOR_STICKING) {
             pt->sticking++;
             pt->sticking_cells += at->basin_cells;
         } else {
             sweep_attractor *t = &pt->att[pt->attractors++];
-            t->kind = at->kind, t->period = at->period, t->basin_cells = at->basin_cells;
-            memcpy(t->centre, at->centre, sizeof t->centre);
-            memcpy(t->lo, at->lo, sizeof t->lo);
-            memcpy(t->hi, at->hi, sizeof t->hi);
-            memcpy(t->anchor, at->anchor, sizeof t->anchor);
+            *t = tracked_of(at);
+            t->basin_cells = at->basin_cells;
             pt->attractor_cells += at->basin_cells;
         }
     }
@@ -61,7 +66,7 @@ static void count_groups(const sweep_args *a, const cm_group_info *groups, uint3
 {
     pt->groups = n;
     for (uint32_t k = 0; k < n; k++) {
-        if (!in_window(a, &groups[k]))
+        if (!in_window(a, groups[k].centre))
             continue;
         if (groups[k].kind == CM_GROUP_STICKING) {
             pt->sticking++;
@@ -379,15 +384,10 @@ static bool near_one_of(const sweep_args *a, const sweep_result *r, const sweep_
 static cm_status add_seeded(const sweep_args *a, const sweep_result *r, const sweep_attractor *x,
                             const cm_attractor *at, sweep_point *to)
 {
-    sweep_attractor t = {.kind = at->kind, .period = at->period, .seeded = true};
-    memcpy(t.centre, at->centre, sizeof t.centre);
-    memcpy(t.lo, at->lo, sizeof t.lo);
-    memcpy(t.hi, at->hi, sizeof t.hi);
-    memcpy(t.anchor, at->anchor, sizeof t.anchor);
-    cm_group_info as_group = {.kind = CM_GROUP_ATTRACTOR};
-    memcpy(as_group.centre, at->centre, sizeof at->centre);
+    sweep_attractor t = tracked_of(at);
+    t.seeded = true;
     if (at->kind == CM_ATTRACTOR_STICKING || sweep_distance(r, x, &t) > match_within(a) ||
-        !in_window(a, &as_group) || near_one_of(a, r, to, &t))
+        !in_window(a, at->centre) || near_one_of(a, r, to, &t))
         return CM_OK;
     sweep_attractor *grown = realloc(to->att, ((size_t)to->attractors + 1) * sizeof *grown);
     if (!grown)
