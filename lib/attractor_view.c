@@ -79,7 +79,9 @@ int attractor_legend(const cm_attractor_set *s, uint32_t n, cm_group_label *labe
         bool named = false;
         for (int k = 0; k < used; k++)
             named |= !labels[k].by_anchor && labels[k].id == s->a[a].id;
-        if (named)
+        /* sticking zones share a grey and one legend line (render/figure.h)
+         * unless the user names them */
+        if (named || s->a[a].kind == CM_ATTRACTOR_STICKING)
             continue;
         cm_group_label *l = &labels[used++];
         memset(l, 0, sizeof *l);

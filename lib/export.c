@@ -109,7 +109,7 @@ static void write_sidecar_groups(json *j, const array_export *x, const cm_lattic
 {
     uint8_t *classes = calloc((size_t)x->ngroups + 1, 1);
     if (classes)
-        cm_palette_classes(NULL, x->groups, x->ngroups, lat, in_window + 1, 1, classes);
+        cm_palette_classes(NULL, x->groups, x->ngroups, lat, in_window + 1, 1, NULL, classes);
     json_array(j, "groups");
     for (uint32_t k = 0; k < x->ngroups; k++) {
         if (!in_window[k + 1])

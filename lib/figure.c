@@ -296,6 +296,7 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.labels = po->labels;
     ro.n_labels = po->n_labels;
     ro.sink_label = po->sink_label;
+    ro.group_noun = po->group_noun;
     ro.title = po->title;
     ro.aspect = aspect_of(po, b->model);
     ro.width = po->width;
@@ -369,6 +370,7 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
                         min_basin_of(b->opts, 0), b->opts->palette, &ras, msg, msg_size);
     if (st != CM_OK)
         return st;
+    st = cm_raster_paint(b->lat, b->cells, b->groups, 1, 1, &ras, msg, msg_size);
     const int n = cm_class_count(b->opts->palette);
     uint8_t palette[3 * 256];
     for (int k = 0; k < n; k++) {
@@ -485,6 +487,7 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
         po->n_labels = attractor_legend(b->attractors, n, po->labels, po->n_labels,
                                         PNG_LABELS_MAX);
         po->sink_label = "diverged";
+        po->group_noun = "attractor";
         basin_png by = *b;
         by.opts = po;
         by.cells = &view;

@@ -39,6 +39,7 @@ typedef struct png_opts {
     const char *palette_file, *labels_file; /* the files read, if any */
     int by; /* --by: BY_ATTRACTORS (the default) or BY_GROUPS (lib/attractor_report.h) */
     const char *sink_label; /* the legend's name of label 0 (NULL: "sink") */
+    const char *group_noun; /* what the legend calls a group (NULL: "group") */
     const char *title;      /* --title TEXT (NULL: the model and its parameters) */
     double aspect;          /* --aspect: > 0 the ratio (1: equal), ASPECT_AUTO, or 0: equal
                                where the model declares equal axes, else auto */

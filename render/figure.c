@@ -134,29 +134,37 @@ static cm_status make_legend(const cm_render_options *o, const cm_raster *ras,
               !label_of(o, &groups[g - 1], dim)))
             order[shown++] = (group_cells){ras->group_cells[g], g};
     qsort(order, shown, sizeof *order, more_cells_first);
+    /* max_groups counts coloured groups: named sticking zones (by
+     * attractors: the cells outside) come on top */
+    int named_sticking = 0;
+    for (uint32_t k = 0; k < shown; k++)
+        named_sticking += ras->classes[order[k].id] == CM_CLASS_STICKING;
     const int closing = (ras->other_groups ? 1 : 0) + (ras->colour_repeats ? 1 : 0) +
                         (ras->computed < all ? 1 : 0);
     int slots = room - (ras->group_cells[0] ? 1 : 0) - (one_sticking_line ? 1 : 0) - closing;
-    slots = slots < max_groups + 1 ? slots : max_groups + 1;
+    slots = slots < max_groups + named_sticking + 1 ? slots : max_groups + named_sticking + 1;
     if (ras->group_cells[0] && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sink, true)->text, LABEL, "%s  %s",
                  o->sink_label ? o->sink_label : "sink", share(ras->group_cells[0], all).s);
     if (one_sticking_line && lg->n < room)
         snprintf(add_entry(lg, cm_colour_sticking, true)->text, LABEL,
                  "%u sticking zones  %s", sticking, share(sticking_cells, all).s);
-    for (uint32_t k = 0; k < shown && slots > 0; k++, slots--) {
-        if ((slots == 1 && k + 1 < shown) || k == (uint32_t)max_groups) { /* the rest in one line */
+    const char *noun = o->group_noun ? o->group_noun : "group";
+    for (uint32_t k = 0, listed = 0; k < shown && slots > 0; k++, slots--) {
+        if ((slots == 1 && k + 1 < shown) || listed == (uint32_t)max_groups) { /* the rest */
             uint64_t rest = 0;
             for (uint32_t r = k; r < shown; r++)
                 rest += order[r].cells;
-            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more group%s  %s",
-                     shown - k, shown - k == 1 ? "" : "s", share(rest, all).s);
+            snprintf(add_entry(lg, paper, false)->text, LABEL, "+ %u more %s%s  %s", shown - k,
+                     noun, shown - k == 1 ? "" : "s", share(rest, all).s);
             break;
         }
+        listed += ras->classes[order[k].id] != CM_CLASS_STICKING;
         const uint32_t g = order[k].id;
         const cm_group_info *gi = &groups[g - 1];
         const char *label = label_of(o, gi, dim);
         entry *e = add_entry(lg, cm_class_colour(ras->palette, ras->classes[g]), true);
+        e->group = g; /* its colour is chosen once the plot's size is known */
         if (label)
             snprintf(e->text, LABEL, "%s  %s", label, share(order[k].cells, all).s);
         else
@@ -551,6 +559,24 @@ static void keep_aspect(double aspect, const double lo[2], const double hi[2], c
     p->w = w, p->h = h;
 }
 
+/* The raster's colours, chosen for the basins that touch at the plot's
+ * resolution, and the legend's swatches to match. */
+static cm_status paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                       figure *F, char *msg, size_t msg_size)
+{
+    const cm_slice *s = &F->s;
+    const double view_x = (F->hi[0] - F->lo[0]) / s->dx, view_y = (F->hi[1] - F->lo[1]) / s->dy;
+    const uint32_t reach_x = cm_touching_reach((uint64_t)ceil(view_x), F->p.basin.w);
+    const uint32_t reach_y =
+        r->box.dim > 1 ? cm_touching_reach((uint64_t)ceil(view_y), F->p.basin.h) : 1;
+    cm_status st = cm_raster_paint(lat, r, groups, reach_x, reach_y, &F->w.ras, msg, msg_size);
+    for (int k = 0; st == CM_OK && k < F->w.lg.n; k++)
+        if (F->w.lg.e[k].group)
+            F->w.lg.e[k].swatch =
+                cm_class_colour(F->w.ras.palette, F->w.ras.classes[F->w.lg.e[k].group]);
+    return st;
+}
+
 cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                        const cm_render_options *opt, figure *F, char *msg, size_t msg_size)
 {
@@ -576,13 +602,17 @@ cm_status figure_begin(const cm_lattice *lat, const cm_region *r, const cm_group
                      {0},
                      {0},
                      0,
+                     3,
                      F->o.gl};
     if (st == CM_OK && F->o.aspect > 0 && r->box.dim >= 2)
         keep_aspect(F->o.aspect, F->lo, F->hi, &F->p);
     if (st == CM_OK) {
         const int small = F->p.w < F->p.h ? F->p.w : F->p.h;
         F->p.line_width = small / 700 > 1 ? small / 700 : 1;
+        /* attractors visible in print: 5 px on a 700-px plot, never under 3 */
+        F->p.marker = small / 140.0 > 3 ? small / 140.0 : 3;
         make_panels(&F->p, r->box.dim, F->lo, F->hi, L->line ? L->line / 2 : 4);
+        st = paint(lat, r, groups, F, msg, msg_size);
     }
     return st;
 }

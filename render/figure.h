@@ -48,6 +48,7 @@ typedef struct cm_render_options {
     const cm_group_label *labels;     /* the legend's names of groups (n_labels of them) */
     int n_labels;
     const char *sink_label;           /* the legend's name of label 0; NULL: "sink" */
+    const char *group_noun;           /* what the legend calls a group; NULL: "group" */
     const char *title;                /* the title; NULL: the model and its parameters (a
                                          flow's integrator settings left out); wrapped */
     double aspect;                    /* 2-D views: a state unit along dimension 1 drawn

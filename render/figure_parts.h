@@ -19,6 +19,7 @@ typedef struct entry {
     char text[LABEL];
     cm_rgb swatch;
     bool has_swatch;
+    uint32_t group; /* the group whose colour the swatch shows (0: a fixed colour) */
 } entry;
 
 typedef struct legend {

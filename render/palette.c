@@ -14,7 +14,10 @@ const cm_rgb cm_colour_not_computed = {255, 255, 255};
 const cm_rgb cm_colour_marker = {0, 0, 0};
 const cm_rgb cm_colour_sticking = {180, 180, 180};
 const cm_rgb cm_colour_sticking_marker = {96, 96, 96};
-const cm_rgb cm_colour_other = {236, 226, 208}; /* pale beige: present, not one group */
+/* pale cream: present, not one group; CM_NEIGHBOUR_DISTANCE from the grey
+ * of sticking zones (the cells outside, by attractors) and every colour of
+ * the default palette */
+const cm_rgb cm_colour_other = {250, 244, 184};
 const cm_rgb cm_colour_repeller = {230, 159, 0};
 const cm_rgb cm_colour_escape = {0, 114, 178};
 const cm_rgb cm_colour_collision = {220, 30, 30};
@@ -23,6 +26,19 @@ const cm_rgb cm_colour_collision_higher = {255, 150, 0};
 /* No red (the sink), black (markers), white (not computed) or grey
  * (sticking zones) in any palette. */
 static const cm_palette builtin[] = {
+    /* The default: Tol's bright and vibrant blue, green, yellow, cyan,
+     * purple, orange and teal, then 17 colours each chosen as far as
+     * possible from those before in cm_colour_distance (lightness 40-85,
+     * chroma 25-65, CM_NEIGHBOUR_DISTANCE from the fixed colours):
+     * docs/make-palette.py. */
+    {"cellmap",
+     24,
+     {{0x44, 0x77, 0xaa}, {0x22, 0x88, 0x33}, {0xcc, 0xbb, 0x44}, {0x66, 0xcc, 0xee},
+      {0xaa, 0x33, 0x77}, {0xee, 0x77, 0x33}, {0x00, 0x99, 0x88}, {0xf0, 0xb4, 0x96},
+      {0xa5, 0x87, 0xf0}, {0xa5, 0xe1, 0x78}, {0x87, 0xa5, 0x69}, {0x0f, 0x5a, 0xc3},
+      {0xc3, 0x96, 0xc3}, {0xa5, 0x69, 0x5a}, {0x96, 0xb4, 0xff}, {0xd2, 0xa5, 0x5a},
+      {0x1e, 0x87, 0x96}, {0x4b, 0x69, 0x0f}, {0xd2, 0x78, 0xd2}, {0xff, 0x87, 0x78},
+      {0x5a, 0x5a, 0xa5}, {0x00, 0x78, 0xd2}, {0x96, 0x87, 0x4b}, {0x1e, 0x87, 0x5a}}},
     {"tol", /* Tol's rose is left out: next to the sink's red it vanishes */
      14,
      {{0x33, 0x22, 0x88}, {0x88, 0xcc, 0xee}, {0x44, 0xaa, 0x99}, {0x11, 0x77, 0x33},
@@ -51,8 +67,8 @@ cm_status cm_palette_named(const char *name, const cm_palette **out, char *msg, 
             return CM_OK;
         }
     return cm_fail(CM_ENOTFOUND, msg, msg_size,
-                   "no palette '%s': use tol (the default), okabe-ito or tab20, or a file of "
-                   "#rrggbb lines",
+                   "no palette '%s': use cellmap (the default), tol, okabe-ito or tab20, or a file "
+                   "of #rrggbb lines",
                    name);
 }
 
@@ -163,11 +179,214 @@ cm_rgb cm_class_colour(const cm_palette *p, int cls)
     }
 }
 
+/* ---- colour distances ------------------------------------------------------------ */
+
+/* A colour as seen with normal vision, deuteranopia and protanopia
+ * (Machado, Oliveira and Fernandes 2009, severity 1, on linear RGB), each
+ * in CIELAB (D65). */
+typedef struct seen {
+    double lab[3][3];
+} seen;
+
+static double linear(uint8_t v)
+{
+    const double c = v / 255.0;
+    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+}
+
+static double lab_f(double t)
+{
+    const double e = 6.0 / 29.0;
+    return t > e * e * e ? cbrt(t) : t / (3 * e * e) + 4.0 / 29.0;
+}
+
+static void lab_of(const double rgb[3], double lab[3])
+{
+    double c[3];
+    for (int k = 0; k < 3; k++) /* simulated colours can leave the gamut */
+        c[k] = rgb[k] < 0 ? 0 : rgb[k] > 1 ? 1 : rgb[k];
+    const double x = (0.4124564 * c[0] + 0.3575761 * c[1] + 0.1804375 * c[2]) / 0.95047;
+    const double y = 0.2126729 * c[0] + 0.7151522 * c[1] + 0.0721750 * c[2];
+    const double z = (0.0193339 * c[0] + 0.1191920 * c[1] + 0.9503041 * c[2]) / 1.08883;
+    lab[0] = 116 * lab_f(y) - 16;
+    lab[1] = 500 * (lab_f(x) - lab_f(y));
+    lab[2] = 200 * (lab_f(y) - lab_f(z));
+}
+
+static seen seen_of(cm_rgb c)
+{
+    static const double deficiency[2][3][3] = {
+        {{0.367322, 0.860646, -0.227968}, {0.280085, 0.672501, 0.047413},
+         {-0.011820, 0.042940, 0.968881}}, /* deuteranopia */
+        {{0.152286, 1.052583, -0.204868}, {0.114503, 0.786281, 0.099216},
+         {-0.003882, -0.048116, 1.051998}}, /* protanopia */
+    };
+    const double lin[3] = {linear(c.r), linear(c.g), linear(c.b)};
+    seen s;
+    lab_of(lin, s.lab[0]);
+    for (int v = 0; v < 2; v++) {
+        double sim[3];
+        for (int k = 0; k < 3; k++)
+            sim[k] = deficiency[v][k][0] * lin[0] + deficiency[v][k][1] * lin[1] +
+                     deficiency[v][k][2] * lin[2];
+        lab_of(sim, s.lab[v + 1]);
+    }
+    return s;
+}
+
+static double lab_distance(const double *a, const double *b)
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+static double seen_distance(const seen *a, const seen *b)
+{
+    double d = lab_distance(a->lab[0], b->lab[0]);
+    for (int v = 1; v < 3; v++) {
+        const double dv = 2 * lab_distance(a->lab[v], b->lab[v]);
+        d = dv < d ? dv : d;
+    }
+    return d;
+}
+
+double cm_delta_e(cm_rgb a, cm_rgb b)
+{
+    const seen x = seen_of(a), y = seen_of(b);
+    return lab_distance(x.lab[0], y.lab[0]);
+}
+
+double cm_colour_distance(cm_rgb a, cm_rgb b)
+{
+    const seen x = seen_of(a), y = seen_of(b);
+    return seen_distance(&x, &y);
+}
+
+/* ---- choosing the colours ---------------------------------------------------------- */
+
+/* Who touches whom, by item: groups 1..n, the sink 0, not computed n + 1. */
+typedef struct neighbours {
+    uint32_t *start; /* n + 3 offsets into item */
+    uint32_t *item;
+} neighbours;
+
+static uint32_t item_of(uint32_t label, uint32_t n)
+{
+    return label == CM_GROUP_NONE ? n + 1 : label;
+}
+
+static bool neighbours_build(const cm_touching *t, uint32_t n, neighbours *nb)
+{
+    const size_t items = (size_t)n + 2;
+    nb->start = calloc(items + 1, sizeof *nb->start);
+    nb->item = malloc((2 * t->n + 1) * sizeof *nb->item);
+    if (!nb->start || !nb->item || 2 * t->n >= UINT32_MAX)
+        return false;
+    for (int pass = 0; pass < 2; pass++) { /* count, then place */
+        for (size_t k = 0; k < t->n; k++) {
+            const uint32_t a = item_of((uint32_t)(t->pair[k] >> 32), n);
+            const uint32_t b = item_of((uint32_t)t->pair[k], n);
+            if (a >= items || b >= items)
+                continue;
+            if (pass == 0)
+                nb->start[a + 1]++, nb->start[b + 1]++;
+            else
+                nb->item[nb->start[a]++] = b, nb->item[nb->start[b]++] = a;
+        }
+        if (pass == 0)
+            for (size_t i = 0; i < items; i++)
+                nb->start[i + 1] += nb->start[i];
+        else /* each start moved to the next one's: shift back */
+            for (size_t i = items; i > 0; i--)
+                nb->start[i] = nb->start[i - 1];
+        nb->start[0] = 0;
+    }
+    return true;
+}
+
+/* The smallest distance from palette colour c to the neighbours' classes
+ * (infinite without neighbours). */
+static double distance_to(size_t c, const int *neighbour_class, size_t nneighbours,
+                          const seen *class_seen)
+{
+    double d = INFINITY;
+    for (size_t k = 0; k < nneighbours; k++) {
+        const double dk =
+            seen_distance(&class_seen[CM_CLASS_FIRST_GROUP + c], &class_seen[neighbour_class[k]]);
+        d = dk < d ? dk : d;
+    }
+    return d;
+}
+
+/* The palette colour for a group, counting from its hash's on: the first
+ * one free in this round and CM_NEIGHBOUR_DISTANCE from every neighbour
+ * coloured so far; else the first that far though taken (neighbours
+ * matter more than a colour seen twice); else the free one farthest from
+ * the neighbours. */
+static size_t choose_colour(size_t preferred, size_t size, const bool *taken,
+                            const int *neighbour_class, size_t nneighbours, const seen *class_seen)
+{
+    size_t farthest = size;
+    double farthest_distance = -1;
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t t = 0; t < size; t++) {
+            const size_t c = (preferred + t) % size;
+            if (pass == 0 && taken[c])
+                continue;
+            const double d = distance_to(c, neighbour_class, nneighbours, class_seen);
+            if (d >= CM_NEIGHBOUR_DISTANCE)
+                return c;
+            if (pass == 0 && d > farthest_distance)
+                farthest = c, farthest_distance = d;
+        }
+    return farthest < size ? farthest : preferred;
+}
+
+/* The classes of the coloured groups, in rank order; neighbours (NULL:
+ * none known) keep touching groups apart. */
+static void assign_colours(const cm_palette *p, const ranked *order, uint32_t coloured, uint32_t n,
+                           const neighbours *nb, uint8_t *classes)
+{
+    const size_t size = (size_t)p->n;
+    seen class_seen[CM_CLASS_FIRST_GROUP + CM_PALETTE_MAX];
+    for (int c = 0; nb && c < cm_class_count(p); c++)
+        class_seen[c] = seen_of(cm_class_colour(p, c));
+    int *decided = nb ? malloc(((size_t)n + 2) * sizeof *decided) : NULL; /* class or -1 */
+    int *near = nb ? malloc(((size_t)n + 2) * sizeof *near) : NULL;
+    if (decided && near) {
+        decided[0] = CM_CLASS_SINK;
+        decided[n + 1] = CM_CLASS_NOT_COMPUTED;
+        for (uint32_t k = 0; k < n; k++) /* sticking and "other" are fixed */
+            decided[k + 1] = classes[k] == CM_CLASS_OTHER || classes[k] == CM_CLASS_STICKING
+                                 ? classes[k]
+                                 : -1;
+    }
+    bool taken[CM_PALETTE_MAX];
+    for (uint32_t r = 0; r < coloured; r++) {
+        if (r % size == 0) /* every colour taken: a new round */
+            memset(taken, 0, sizeof taken);
+        const uint32_t item = order[r].index + 1;
+        size_t nnear = 0;
+        for (uint32_t k = decided && near ? nb->start[item] : 0;
+             decided && near && k < nb->start[item + 1]; k++)
+            if (decided[nb->item[k]] >= 0)
+                near[nnear++] = decided[nb->item[k]];
+        const size_t c = choose_colour(order[r].hash % size, size, taken, near, nnear, class_seen);
+        taken[c] = true;
+        classes[order[r].index] = (uint8_t)(CM_CLASS_FIRST_GROUP + c);
+        if (decided && near)
+            decided[item] = classes[order[r].index];
+    }
+    free(decided);
+    free(near);
+}
+
 uint32_t cm_palette_classes(const cm_palette *p, const cm_group_info *groups, uint32_t n,
                             const cm_lattice *lat, const uint64_t *in_view, uint64_t min_basin,
-                            uint8_t *classes)
+                            const cm_touching *touching, uint8_t *classes)
 {
-    const size_t size = (size_t)(p ? p : cm_palette_default())->n;
+    p = p ? p : cm_palette_default();
+    const size_t size = (size_t)p->n;
     ranked *order = malloc(((size_t)n + 1) * sizeof *order);
     uint32_t coloured = 0;
     for (uint32_t k = 0; k < n; k++) {
@@ -185,17 +404,11 @@ uint32_t cm_palette_classes(const cm_palette *p, const cm_group_info *groups, ui
     if (!order)
         return 0;
     qsort(order, coloured, sizeof *order, compare_ranked);
-    bool taken[CM_PALETTE_MAX];
-    memset(taken, 0, sizeof taken);
-    for (uint32_t r = 0; r < coloured; r++) {
-        if (r % size == 0) /* every colour taken: a new round */
-            memset(taken, 0, sizeof taken);
-        size_t c = order[r].hash % size;
-        while (taken[c])
-            c = (c + 1) % size;
-        taken[c] = true;
-        classes[order[r].index] = (uint8_t)(CM_CLASS_FIRST_GROUP + c);
-    }
+    neighbours nb = {0};
+    const bool known = touching && neighbours_build(touching, n, &nb); /* else: no rule */
+    assign_colours(p, order, coloured, n, known ? &nb : NULL, classes);
+    free(nb.start);
+    free(nb.item);
     free(order);
     return coloured > size ? coloured - (uint32_t)size : 0;
 }

@@ -2,7 +2,8 @@
  * identity (its anchor cell on the lattice), not from its id or the other
  * groups of the file, so the same attractor has the same colour in every
  * file, view and pan; only a larger group of the same view whose anchor
- * hashes to the same colour can move it (see cm_palette_classes). */
+ * hashes to the same colour, or a neighbouring basin too close in colour,
+ * can move it (see cm_palette_classes). */
 #ifndef CM_RENDER_PALETTE_H
 #define CM_RENDER_PALETTE_H
 
@@ -10,6 +11,7 @@
 
 #include "cellmap/scm.h"
 #include "cellmap/status.h"
+#include "render/touching.h"
 
 typedef struct cm_rgb {
     uint8_t r, g, b;
@@ -24,12 +26,14 @@ typedef struct cm_palette {
     cm_rgb colour[CM_PALETTE_MAX];
 } cm_palette;
 
-/* Built in: "tol" (the default: 14 colours from Paul Tol's muted, light and
- * bright schemes, which stay distinguishable with the common colour-vision
- * deficiencies), "okabe-ito" (the six of Okabe and Ito's that are neither
- * black nor close to the sink's red) and "tab20" (20 colours, more but not
- * colour-blind safe). No palette holds the sink's red, black, white or the
- * greys of sticking zones. */
+/* Built in: "cellmap" (the default: 24 colours, the first seven Paul Tol's
+ * colour-blind-safe bright and vibrant ones, the rest chosen to stay apart
+ * with normal vision and, at half the distance, with deuteranopia and
+ * protanopia; docs/make-palette.py), "tol" (14 colours of Tol's muted, light and
+ * bright schemes), "okabe-ito" (the six of Okabe and Ito's that are neither
+ * black nor close to the sink's red) and "tab20" (20 colours, not colour-
+ * blind safe). No palette holds the sink's red, black, white or the greys of
+ * sticking zones. */
 const cm_palette *cm_palette_default(void);
 /* The built-in palette `name`; CM_ENOTFOUND (msg lists the names) if none. */
 cm_status cm_palette_named(const char *name, const cm_palette **out, char *msg, size_t msg_size);
@@ -51,6 +55,16 @@ extern const cm_rgb cm_colour_escape;
 extern const cm_rgb cm_colour_collision;
 extern const cm_rgb cm_colour_collision_higher;
 
+/* Colour differences in CIELAB (D65): cm_delta_e is ΔE*ab (CIE 1976) with
+ * normal vision; cm_colour_distance is the smallest of that and twice the
+ * ΔE*ab between the colours as deuteranopes and protanopes see them
+ * (Machado, Oliveira and Fernandes 2009, full severity). Basins that touch
+ * in a view are kept CM_NEIGHBOUR_DISTANCE apart by it: ΔE*ab >= 30 with
+ * normal vision, >= 15 with either deficiency. */
+#define CM_NEIGHBOUR_DISTANCE 30.0
+double cm_delta_e(cm_rgb a, cm_rgb b);
+double cm_colour_distance(cm_rgb a, cm_rgb b);
+
 /* Colour classes: the figure's colours, numbered. An indexed PNG stores
  * the class of each cell; its palette is cm_class_colour of each class. */
 enum cm_colour_class {
@@ -68,16 +82,20 @@ cm_rgb cm_class_colour(const cm_palette *p, int cls);
 
 /* Classes of groups 1..n (entry k for group k+1) in one view. Sticking
  * zones are grey. Groups in view (in_view[k] cells; in_view NULL: all, by
- * basin) whose basins have at least min_basin cells take the palette
- * colour their anchor hashes to; where two collide, the one with more
- * cells in view keeps it and the other takes the next free colour, so up
- * to the palette's size no two groups in view share a colour, and beyond
- * it the largest groups still differ. A group keeps its colour in every
- * file and view unless a larger group of the same view hashes to it.
+ * basin) whose basins have at least min_basin cells take a palette colour,
+ * largest in view first: the colour their anchor hashes to, or the next
+ * one after it that no larger group of the round took and that lies
+ * CM_NEIGHBOUR_DISTANCE from every coloured, sink, "other", sticking or
+ * not-computed neighbour (`touching`: pairs of labels 0 = sink, group ids,
+ * CM_GROUP_NONE; NULL: no neighbour rule); where no free colour is that
+ * far, the free one farthest from the neighbours. So up to the palette's
+ * size no two groups in view share a colour, beyond it colours repeat in
+ * rounds, and a group keeps its colour in every file and view unless a
+ * larger group or a close neighbour of the same view forces a change.
  * Smaller groups are CM_CLASS_OTHER. Returns how many coloured groups
  * exceed the palette (0: every colour in view is one group's). */
 uint32_t cm_palette_classes(const cm_palette *p, const cm_group_info *groups, uint32_t n,
                             const cm_lattice *lat, const uint64_t *in_view, uint64_t min_basin,
-                            uint8_t *classes);
+                            const cm_touching *touching, uint8_t *classes);
 
 #endif

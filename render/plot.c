@@ -125,15 +125,16 @@ static void draw_raster(const cm_raster *ras, const double lo[2], const double h
     glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
 }
 
-/* Periodic cells of one kind as squares of at least 3x3 pixels, so that a
- * one-cell attractor stays visible at any zoom. */
+/* Periodic cells of one kind as squares of at least p->marker pixels a
+ * side, so that a one-cell attractor stays visible at any zoom. */
 static void draw_markers(const cm_plot *p, const cm_panel *pn, int kind, double px, double py)
 {
     const cm_slice *s = &p->ras->s;
-    const double hx = s->dx / 2 > 1.5 * px ? s->dx / 2 : 1.5 * px;
-    const double hy = s->ny == 1             ? (pn->hi[1] - pn->lo[1]) / 2
-                      : s->dy / 2 > 1.5 * py ? s->dy / 2
-                                             : 1.5 * py;
+    const double least = p->marker / 2;
+    const double hx = s->dx / 2 > least * px ? s->dx / 2 : least * px;
+    const double hy = s->ny == 1               ? (pn->hi[1] - pn->lo[1]) / 2
+                      : s->dy / 2 > least * py ? s->dy / 2
+                                               : least * py;
     colour(kind == CM_GROUP_STICKING ? cm_colour_sticking_marker : cm_colour_marker);
     glBegin(GL_QUADS);
     for (uint64_t k = 0; k < p->ras->nperiodic; k++) {

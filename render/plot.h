@@ -57,6 +57,7 @@ typedef struct cm_plot {
     cm_panel basin; /* where the cells go */
     cm_panel graph; /* 1-D models: the map's graph (w == 0: none) */
     int line_width; /* pixels */
+    double marker;  /* pixels: the least side of a periodic cell's square (>= 3) */
     cm_gl *gl;      /* the context to draw with; NULL: one of its own */
 } cm_plot;
 

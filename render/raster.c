@@ -1,6 +1,7 @@
 #include "render/raster.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -157,13 +158,17 @@ static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *s
                         ras->pixels + bytes * (j * s->nx + i));
 }
 
-/* The classes of the groups in view, and what was folded into "other". */
+/* The classes of the groups in view, and what was folded into "other";
+ * touching: NULL before the view's neighbours are known. */
 static void classify_groups(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                            cm_raster *ras)
+                            const cm_touching *touching, cm_raster *ras)
 {
     ras->classes[0] = CM_CLASS_SINK;
-    ras->colour_repeats = cm_palette_classes(ras->palette, groups, r->ngroups, lat, ras->group_cells + 1,
-                                             ras->min_basin, ras->classes + 1);
+    ras->colour_repeats =
+        cm_palette_classes(ras->palette, groups, r->ngroups, lat, ras->group_cells + 1,
+                           ras->min_basin, touching, ras->classes + 1);
+    ras->other_groups = 0;
+    ras->other_cells = 0;
     for (uint32_t g = 1; g <= r->ngroups; g++)
         if (ras->group_cells[g] && ras->classes[g] == CM_CLASS_OTHER) {
             ras->other_groups++;
@@ -201,6 +206,7 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
 {
     memset(ras, 0, sizeof *ras);
     ras->s = *s;
+    ras->mode = mode;
     ras->min_basin = min_basin;
     ras->palette = palette;
     const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
@@ -209,7 +215,6 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
     ras->pixels = malloc(s->nx * s->ny * bytes);
     ras->group_cells = calloc((size_t)r->ngroups + 1, sizeof *ras->group_cells);
     ras->classes = calloc((size_t)r->ngroups + 1, 1);
-    uint16_t *shade = NULL;
     cm_status st = CM_OK;
     if (!ras->pixels || !ras->group_cells || !ras->classes)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
@@ -220,21 +225,47 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for basin counts");
     }
     if (st == CM_OK) {
-        classify_groups(lat, r, groups, ras);
+        classify_groups(lat, r, groups, NULL, ras);
         ras->step_cap = mode == CM_RASTER_SHADED || mode == CM_RASTER_STEPS ? step_cap_of(r, s) : 1;
-        shade = malloc(((size_t)ras->step_cap + 1) * sizeof *shade);
-        if (!shade)
-            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
-    }
-    if (st == CM_OK) {
-        shade_table(ras->step_cap, mode, shade);
-        fill(r, ras, mode, shade);
-    }
-    if (st == CM_OK)
         st = collect_periodic(r, ras, msg, msg_size);
-    free(shade);
+    }
     if (st != CM_OK)
         cm_raster_free(ras);
+    return st;
+}
+
+/* Whether two or more groups in view take palette colours (else no
+ * neighbour can be too close to another). */
+static bool several_coloured(const cm_region *r, const cm_raster *ras)
+{
+    uint32_t coloured = 0;
+    for (uint32_t g = 1; g <= r->ngroups && coloured < 2; g++)
+        coloured += ras->group_cells[g] && ras->classes[g] >= CM_CLASS_FIRST_GROUP;
+    return coloured >= 2 || (coloured == 1 && ras->group_cells[0]);
+}
+
+cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                          uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
+                          size_t msg_size)
+{
+    const cm_slice *s = &ras->s;
+    cm_status st = CM_OK;
+    if (ras->mode != CM_RASTER_STEPS && several_coloured(r, ras)) {
+        cm_touching touching;
+        st = cm_touching_collect(r->group + s->base, s->nx, s->ny, s->row_stride, reach_x, reach_y,
+                                 &touching, msg, msg_size);
+        if (st == CM_OK)
+            classify_groups(lat, r, groups, &touching, ras);
+        cm_touching_free(&touching);
+    }
+    uint16_t *shade = st == CM_OK ? malloc(((size_t)ras->step_cap + 1) * sizeof *shade) : NULL;
+    if (st == CM_OK && !shade)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
+    if (st == CM_OK) {
+        shade_table(ras->step_cap, ras->mode, shade);
+        fill(r, ras, ras->mode, shade);
+    }
+    free(shade);
     return st;
 }
 

@@ -53,6 +53,7 @@ typedef struct cm_raster {
     uint64_t other_cells;  /* their cells in the slice */
     uint32_t colour_repeats; /* coloured groups in the slice beyond the palette's size */
     const cm_palette *palette; /* the group colours (NULL: the default) */
+    int mode;                  /* enum cm_raster_mode */
 } cm_raster;
 
 /* The step shading (logarithmic: transients are mostly short, and the eye
@@ -63,12 +64,23 @@ uint16_t cm_step_shade(double f, int mode);
 /* The step number at fraction f of that scale. */
 uint32_t cm_step_at(double f, uint32_t step_cap);
 
-/* Builds the raster of r's slice; groups with basins of fewer than
- * min_basin cells are drawn as "other" (render/palette.h). Deterministic
- * whatever the thread count. */
+/* A raster in two steps, because the colours depend on which basins touch
+ * in the figure and that on the figure's layout, which the legend (the
+ * counts) decides: cm_raster_build counts the cells of each group, decides
+ * which are drawn as "other" (basins of fewer than min_basin cells,
+ * render/palette.h), the colour repeats and the periodic cells, and gives
+ * provisional colours (no neighbour rule); cm_raster_paint then chooses the
+ * colours with basins kept apart where their cells lie up to reach_x,
+ * reach_y cells apart (cm_touching_reach of the cells and pixels drawn; 1,
+ * 1 for one pixel per cell) and fills the pixels. Which groups are "other"
+ * and the counts stay as built. Deterministic whatever the thread count.
+ * On failure the raster is left to cm_raster_free. */
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                           const cm_slice *s, int mode, uint64_t min_basin,
                           const cm_palette *palette, cm_raster *out, char *msg, size_t msg_size);
+cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                          uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
+                          size_t msg_size);
 void cm_raster_free(cm_raster *ras);
 
 #endif

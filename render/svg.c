@@ -124,15 +124,16 @@ static cm_status raster(FILE *f, const figure *F, char *msg, size_t msg_size)
     return CM_OK;
 }
 
-/* Periodic cells of one kind, at least 3x3 pixels (as the PNG draws them). */
+/* Periodic cells of one kind, at least p.marker pixels a side (as the PNG
+ * draws them). */
 static void markers(FILE *f, const figure *F, int kind)
 {
     const cm_raster *ras = &F->w.ras;
     const cm_slice *s = &ras->s;
     const cm_panel *pn = &F->p.basin;
     const frame_map m = map_of(&F->p, pn);
-    const double w = fmax(fabs(m.sx * s->dx), 3.0);
-    const double h = s->ny == 1 ? pn->h : fmax(fabs(m.sy * s->dy), 3.0);
+    const double w = fmax(fabs(m.sx * s->dx), F->p.marker);
+    const double h = s->ny == 1 ? pn->h : fmax(fabs(m.sy * s->dy), F->p.marker);
     char colour[8];
     hex(kind == CM_GROUP_STICKING ? cm_colour_sticking_marker : cm_colour_marker, colour);
     fprintf(f, "<g fill=\"%s\" clip-path=\"url(#basin)\">\n", colour);

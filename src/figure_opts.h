@@ -26,8 +26,8 @@
     "  --min-basin N       draw groups whose basins have fewer than N cells as 'other' (one\n"   \
     "                      muted colour, one legend line); default 2 in figures with a\n"         \
     "                      legend (single-cell groups folded), else 1 (none)\n"                    \
-    "  --palette P         group colours: tol (default; colour-blind safe), okabe-ito,\n"     \
-    "                      tab20, or a file of #rrggbb lines\n"                                     \
+    "  --palette P         group colours: cellmap (default, 24), tol, okabe-ito, tab20,\n"    \
+    "                      or a file of #rrggbb lines; touching basins kept apart\n"               \
     "  --labels FILE       the legend's names of groups: lines 'ID TEXT' or, for the same\n"   \
     "                      attractor in any file, 'ANCHOR TEXT' with the anchor cell's\n"      \
     "                      indices as export --groups lists them (e.g. 287,500 SW2)\n"        \

@@ -128,7 +128,7 @@ def colours(name):
 def legend(name):
     root = ET.parse(name + ".svg").getroot()
     return [t.text for t in root.iter("{http://www.w3.org/2000/svg}text")]
-sink, other, white = (214, 39, 40), (236, 226, 208), (255, 255, 255)
+sink, other, white = (214, 39, 40), (250, 244, 184), (255, 255, 255)
 assert other not in colours("m1") and other in colours("m100")
 assert any(t.startswith("546 single-cell") for t in legend("oi"))  # the default: 2 in figures
 assert any("groups < 100 cells" in t for t in legend("m100")), legend("m100")
@@ -708,7 +708,7 @@ assert a.keys() == b.keys()
 for name, cells in (("basin", a), ("panned", b)):
     by_colour = {}
     for g, rgb in cells.values():
-        if g and rgb != (236, 226, 208):    # "other": the folded single-cell groups
+        if g and rgb != (250, 244, 184):    # "other": the folded single-cell groups
             by_colour.setdefault(rgb, set()).add(g)
     shared = {rgb: gs for rgb, gs in by_colour.items() if len(gs) > 1}
     assert not shared, (name, shared)

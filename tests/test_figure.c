@@ -28,6 +28,22 @@ typedef struct scene {
     uint8_t *classes;
 } scene;
 
+/* The groups' colours as a figure of the whole region draws them with
+ * `reach` cells per pixel (render/raster.h): the neighbour rule depends on
+ * which basins touch at that resolution. */
+static void scene_colours(scene *s, uint32_t reach)
+{
+    char msg[256];
+    cm_slice sl;
+    cm_raster ras;
+    cm_slice_of(&s->lat, &s->r, NULL, 0, &sl);
+    CHECK(cm_raster_build(&s->lat, &s->r, s->g, &sl, CM_RASTER_BASIN, 0, NULL, &ras, msg,
+                          sizeof msg) == CM_OK);
+    CHECK(cm_raster_paint(&s->lat, &s->r, s->g, reach, reach, &ras, msg, sizeof msg) == CM_OK);
+    memcpy(s->classes, ras.classes + 1, s->r.ngroups);
+    cm_raster_free(&ras);
+}
+
 static void solve(scene *s, const char *model, const char *params, const cm_lattice *lat,
                   const cm_box *box)
 {
@@ -42,7 +58,7 @@ static void solve(scene *s, const char *model, const char *params, const cm_latt
     s->g = calloc(s->r.ngroups + 1, sizeof *s->g);
     cm_scm_groups(&s->r, lat, s->g, NULL);
     s->classes = calloc(s->r.ngroups + 1, 1);
-    cm_palette_classes(NULL, s->g, s->r.ngroups, lat, NULL, 0, s->classes);
+    scene_colours(s, 1);
 }
 
 static void scene_free(scene *s)
@@ -293,7 +309,9 @@ static void test_1d_graph(void)
     const int i = f.graph_x + (int)floor((1.12 + 10) / 20 * f.graph_w);
     const int j = f.graph_y + (int)floor((10 - 1.12) / 20 * f.graph_h);
     CHECK(is(at(a, 600, i, j), white));
-    /* the strip below: the colour of the cell under each column */
+    /* the strip below: the colour of the cell under each column (1000
+     * cells on 600 pixels: those two apart count as touching) */
+    scene_colours(&s, 2);
     int wrong = 0;
     for (int x = 0; x < 600; x++) {
         const uint64_t k = (uint64_t)((x + 0.5) * 1000 / 600);
@@ -506,6 +524,7 @@ static void test_min_basin_boundary(void)
         char msg[256];
         CHECK(cm_raster_build(&s.lat, &s.r, s.g, &sl, CM_RASTER_BASIN, rules[t], NULL, &ras, msg,
                               sizeof msg) == CM_OK);
+        CHECK(cm_raster_paint(&s.lat, &s.r, s.g, 1, 1, &ras, msg, sizeof msg) == CM_OK);
         CHECK_INT(ras.other_groups, t + 1);
         CHECK_INT(ras.other_cells, folded_cells[t]);
         for (uint32_t k = 1; k <= 3; k++)

@@ -9,6 +9,8 @@
 #include "render/figure.h"
 #include "render/palette.h"
 #include "render/png_out.h"
+#include "render/raster.h"
+#include "render/touching.h"
 
 /* Ticks at both ends of a range whose ends are multiples of the step that
  * floating point does not hit exactly. */
@@ -50,9 +52,74 @@ static const uint8_t *pixel(const uint8_t *rgba, int w, int px, int py)
 
 static int same_rgb(const uint8_t *p, cm_rgb c) { return p[0] == c.r && p[1] == c.g && p[2] == c.b; }
 
+/* The pairs of labels side by side in a grid, and those up to two cells
+ * apart (a figure of two cells per pixel). */
+static void check_touching(void)
+{
+    const uint32_t N = CM_GROUP_NONE;
+    const uint32_t grid[3][4] = {{1, 1, 2, 2}, {1, 3, 3, 2}, {4, 4, 4, N}};
+    const uint64_t near[] = {(uint64_t)1 << 32 | 2, (uint64_t)1 << 32 | 3, (uint64_t)1 << 32 | 4,
+                             (uint64_t)2 << 32 | 3, (uint64_t)2 << 32 | N, (uint64_t)3 << 32 | 4,
+                             (uint64_t)4 << 32 | N};
+    cm_touching t;
+    char msg[128];
+    CHECK(cm_touching_collect(&grid[0][0], 4, 3, 4, 1, 1, &t, msg, sizeof msg) == CM_OK);
+    CHECK_INT(t.n, 7);
+    CHECK(t.n == 7 && memcmp(t.pair, near, sizeof near) == 0);
+    cm_touching_free(&t);
+    /* two rows apart, 2 (top right) and 4 (bottom) meet as well */
+    CHECK(cm_touching_collect(&grid[0][0], 4, 3, 4, 2, 2, &t, msg, sizeof msg) == CM_OK);
+    CHECK_INT(t.n, 8);
+    CHECK(t.n == 8 && t.pair[4] == ((uint64_t)2 << 32 | 4));
+    cm_touching_free(&t);
+    CHECK_INT(cm_touching_reach(1000, 400), 3);
+    CHECK_INT(cm_touching_reach(400, 1000), 1);
+}
+
+/* Two touching groups whose palette holds two near-identical colours and
+ * one far from both: they never get the close pair; with only the close
+ * pair, they still get different colours; without neighbours the colours
+ * are those of the anchors' hashes, as with no pairs. */
+static void check_neighbour_rule(void)
+{
+    const cm_lattice lat = {2, {0, 0}, {0.1, 0.1}};
+    cm_group_info g[2];
+    memset(g, 0, sizeof g);
+    g[0] = (cm_group_info){.id = 1, .period = 1, .basin_cells = 10, .anchor = {0, 0}};
+    g[1] = (cm_group_info){.id = 2, .period = 1, .basin_cells = 5, .anchor = {5, 5}};
+    const cm_rgb a = {0x44, 0x77, 0xaa}, close_to_a = {0x4a, 0x7a, 0xaa}, far = {0xcc, 0xbb, 0x44};
+    CHECK(cm_colour_distance(a, close_to_a) < 5 && cm_colour_distance(a, far) > 60);
+    CHECK(cm_delta_e(a, far) >= cm_colour_distance(a, far));
+    uint64_t pair = (uint64_t)1 << 32 | 2;
+    const cm_touching touching = {&pair, 1}, none = {&pair, 0};
+    for (int order = 0; order < 6; order++) { /* every order of the three colours */
+        const cm_rgb three[3] = {a, close_to_a, far};
+        cm_palette p = {"test", 3, {{0}}};
+        for (int k = 0; k < 3; k++)
+            p.colour[k] = three[(k + order) % 3];
+        if (order >= 3) {
+            const cm_rgb kept = p.colour[0];
+            p.colour[0] = p.colour[1], p.colour[1] = kept;
+        }
+        uint8_t cls[2], plain[2], empty[2];
+        cm_palette_classes(&p, g, 2, &lat, NULL, 0, &touching, cls);
+        CHECK(cm_colour_distance(cm_class_colour(&p, cls[0]), cm_class_colour(&p, cls[1])) >=
+              CM_NEIGHBOUR_DISTANCE);
+        cm_palette_classes(&p, g, 2, &lat, NULL, 0, NULL, plain);
+        cm_palette_classes(&p, g, 2, &lat, NULL, 0, &none, empty);
+        CHECK(memcmp(plain, empty, 2) == 0);
+        CHECK(cls[0] == plain[0]); /* the larger keeps its colour */
+        p.n = 2; /* only the close pair: the best there is */
+        cm_palette_classes(&p, g, 2, &lat, NULL, 0, &touching, cls);
+        CHECK(cls[0] != cls[1]);
+    }
+}
+
 int main(void)
 {
     check_ticks();
+    check_touching();
+    check_neighbour_rule();
     cm_model m;
     memset(&m, 0, sizeof m);
     m.name = "test";
@@ -68,10 +135,18 @@ int main(void)
     cm_group_info *g = calloc(r.ngroups, sizeof *g);
     cm_scm_groups(&r, &lat, g, NULL);
     cm_rgb *colours = calloc(r.ngroups, sizeof *colours);
-    uint8_t *classes = calloc(r.ngroups, 1);
-    cm_palette_classes(NULL, g, r.ngroups, &lat, NULL, 0, classes);
+    /* the groups' colours in this view: most cells are fixed, single-cell
+     * groups side by side, so the neighbour rule moves many (reach 1: the
+     * figure has more pixels than cells) */
+    cm_slice slice;
+    cm_slice_of(&lat, &r, NULL, 0, &slice);
+    cm_raster ras;
+    CHECK(cm_raster_build(&lat, &r, g, &slice, CM_RASTER_BASIN, 0, NULL, &ras, msg, sizeof msg) ==
+          CM_OK);
+    CHECK(cm_raster_paint(&lat, &r, g, 1, 1, &ras, msg, sizeof msg) == CM_OK);
     for (uint32_t k = 0; k < r.ngroups; k++)
-        colours[k] = cm_class_colour(NULL, classes[k]);
+        colours[k] = cm_class_colour(NULL, ras.classes[k + 1]);
+    cm_raster_free(&ras);
     cm_render_info ri;
 
     enum { W = 200, H = 100 };
@@ -162,7 +237,6 @@ int main(void)
     free(b);
     free(g);
     free(colours);
-    free(classes);
     cm_region_free(&r);
     CHECK_DONE();
 }

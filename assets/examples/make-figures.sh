@@ -23,15 +23,16 @@ pd=microchaos-pd
   --cells 750x500 --png fig-4.13.png --layers all --size 1200x800 > /dev/null
 
 # Fig. 4.21: twelve tiny attractors at the switching lines (real device),
-# coloured as the thesis colours it, by the steps to reach an attractor, with
-# the sink red. v changes by less than 1.5 per step, so the cells are 0.375
-# tall in v: on 3-unit rows cell mapping cannot follow v's decay and sends 80 %
-# of the box to the sink (docs/engine.md, "Slow directions"); the basins'
-# hundreds of fragments are one colour
-"$CM" solve --by groups --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
+# each basin in its colour (the thesis' coloured domains), the cells that
+# leave the box grey. v changes by less than 1.5 per step, so the cells are
+# 0.375 tall in v: on 3-unit rows cell mapping cannot follow v's decay and
+# sends 80 % of the box outside (docs/engine.md, "Slow directions"). The
+# 480 cell groups are fragments of the twelve attractors' basins: by true
+# orbits they join their attractor (the default --by attractors)
+"$CM" solve --model $pd --param alpha=6.8511e-3,beta=0,P=5.4997e-5,D=2.5665e-3 \
   --region=-125000:125000,-600:600 --cells 4000x3200 --max-steps 100000 \
-  --png fig-4.21-figure.png --layers basin,steps,attractors,overlays,axes,legend,title \
-  --min-basin 100000000 --size 1400x600 > /dev/null
+  --png fig-4.21-figure.png --layers basin,attractors,overlays,axes,legend,title \
+  --size 1400x600 > /dev/null
 
 # Figs. 4.26-4.28 (thesis 4.6.3): the two regions solved apart, after Stage 1
 # of their join, and the cluster that joins them (alpha = 0.078, beta = 0, P = 0.007, D = 0.02)
@@ -49,15 +50,14 @@ ex="--model $pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 
 # Fig. 4.30: the hybrid map with dry friction at mu = 0 and 0.095 (the thesis'
 # two panels) and 0.105, where the outermost attractors are absorbed with the
-# printed parameters; sticking zones grey, coloured by the steps to reach an
-# attractor with the sink red, as Fig. 4.21. v changes by less than 1.5 per
-# step: cells 0.375 tall in v (3 units tall, cell mapping sent 59 % of the box
-# to the sink), a row of them on v = 0 for the rest states
+# printed parameters; sticking zones and their basins grey (one legend line),
+# each attractor's basin in its colour, as Fig. 4.21. v changes by less than
+# 1.5 per step: cells 0.375 tall in v (3 units tall, cell mapping sent 59 %
+# of the box outside), a row of them on v = 0 for the rest states
 for mu in 0 0.095 0.105; do
-  "$CM" solve --by groups --model microchaos-pd-friction --param mu=$mu --region=-100000:100000,-301.5:301.5 \
+  "$CM" solve --model microchaos-pd-friction --param mu=$mu --region=-100000:100000,-301.5:301.5 \
     --cells 3200x1609 --max-steps 100000 --png fig-4.30-mu$mu.png \
-    --layers basin,steps,attractors,overlays,axes,legend,title --min-basin 100000000 \
-    --size 1000x500 > /dev/null
+    --layers basin,attractors,overlays,axes,legend,title --size 1000x500 > /dev/null
 done
 
 # Fig. 4.2: the 1-D micro-chaos map, its graph, cobwebs and basin strip, out
