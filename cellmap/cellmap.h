@@ -283,7 +283,8 @@ typedef struct cm_figure_options {
     unsigned layers;     /* CM_FIGURE_*; 0: every layer but steps */
     int indexed;         /* 1: an indexed PNG of one pixel per cell (its value: the colour class) */
     int by_groups;       /* 1: cell mapping's groups; 0: the system's attractors */
-    const char *palette; /* "tol" (NULL), "okabe-ito", "tab20" or a file of #rrggbb lines */
+    const char *palette; /* "cellmap" (NULL), "tol", "okabe-ito", "tab20" or a file of
+                            #rrggbb lines */
     const char *labels;  /* a file of legend names ("ID TEXT" lines), or NULL */
     uint64_t min_basin;  /* groups of fewer cells drawn as "other"; 0: 2 with a legend, else 1 */
     int legend;          /* groups the legend lists; 0: 12 */
@@ -292,6 +293,10 @@ typedef struct cm_figure_options {
     double aspect;       /* a state unit along y drawn `aspect` times as long as one along
                             x (1: equal); -1: the plot fills its room; 0: 1 for models whose
                             axes share a unit (cm_model.equal_axes), else -1 */
+    double font_size;    /* text in points (1..96; font_size * dpi / 72 pixels); 0: from the
+                            image's size */
+    double dpi;          /* pixels per inch (36..2400): the PNG's pHYs, the SVG's size in
+                            points, the font's pixels; 0: none written (96 for the font) */
 } cm_figure_options;
 
 /* The figure of a result (cm_solve, cm_db_read, cm_session_read), through

@@ -615,6 +615,8 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     po->legend_groups = o->legend;
     po->title = o->title;
     po->aspect = o->aspect;
+    po->font_size = o->font_size;
+    po->dpi = o->dpi;
     if (!o->png && !o->svg)
         return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png or an svg path");
     if ((o->width == 0) != (o->height == 0) || o->width < 0 || o->height < 0 ||
@@ -632,6 +634,11 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     if (!(o->aspect == 0 || o->aspect == ASPECT_AUTO || (o->aspect >= 1e-6 && o->aspect <= 1e6)))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "aspect %g: give 0 (the model's), -1 (auto) or a ratio 1e-6..1e6", o->aspect);
+    if (!(o->font_size == 0 || (o->font_size >= 1 && o->font_size <= 96)))
+        return cm_fail(CM_EINVAL, msg, msg_size, "font_size %g: give 1..96 points, or 0",
+                       o->font_size);
+    if (!(o->dpi == 0 || (o->dpi >= 36 && o->dpi <= 2400)))
+        return cm_fail(CM_EINVAL, msg, msg_size, "dpi %g: give 36..2400, or 0", o->dpi);
     if (o->title && strlen(o->title) > 1000)
         return cm_fail(CM_EINVAL, msg, msg_size, "title: %zu characters; give at most 1000",
                        strlen(o->title));

@@ -275,6 +275,11 @@ bool parse_aspect(const char *s, double *aspect)
     return true;
 }
 
+double png_opts_font_pixels(const png_opts *po)
+{
+    return po->font_size > 0 ? po->font_size * (po->dpi > 0 ? po->dpi : 96) / 72 : 0;
+}
+
 /* The renderer's aspect for the figure of model m (render/figure.h). */
 static double aspect_of(const png_opts *po, const cm_model *m)
 {
@@ -299,6 +304,8 @@ static void figure_options(const basin_png *b, cm_render_options *out)
     ro.group_noun = po->group_noun;
     ro.title = po->title;
     ro.aspect = aspect_of(po, b->model);
+    ro.font_px = png_opts_font_pixels(po);
+    ro.dpi = po->dpi;
     ro.width = po->width;
     ro.height = po->height;
     if (!ro.width || !ro.height)
@@ -333,7 +340,7 @@ static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
                  info.hi[0], info.lo[1], info.hi[1], info.plot_x, info.plot_y, info.plot_w,
                  info.plot_h);
         make_provenance(b, view, ro.layers, &p);
-        st = cm_png_write(po->path, rgba, ro.width, ro.height, p.texts, p.n, msg, msg_size);
+        st = cm_png_write(po->path, rgba, ro.width, ro.height, po->dpi, p.texts, p.n, msg, msg_size);
     }
     free(rgba);
     return st;
@@ -399,7 +406,7 @@ static cm_status write_indexed(const basin_png *b, char *msg, size_t msg_size)
                              "sticking-zone basin, 4 rest cell, 5 other (--min-basin), 6.. group "
                              "colours"};
         p.texts[p.n++] = (cm_png_text){"Group classes", groups};
-        st = cm_png_write_indexed(b->opts->path, rows, (int)s.nx, (int)s.ny, palette, n, p.texts,
+        st = cm_png_write_indexed(b->opts->path, rows, (int)s.nx, (int)s.ny, b->opts->dpi, palette, n, p.texts,
                                   p.n, msg, msg_size);
     }
     free(rows);

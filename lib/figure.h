@@ -43,9 +43,16 @@ typedef struct png_opts {
     const char *title;      /* --title TEXT (NULL: the model and its parameters) */
     double aspect;          /* --aspect: > 0 the ratio (1: equal), ASPECT_AUTO, or 0: equal
                                where the model declares equal axes, else auto */
+    double font_size;       /* --font-size: points (png_opts_font_pixels); 0: from the size */
+    double dpi;             /* --dpi: pixels per inch, written to the PNG (pHYs) and giving
+                               the SVG's size in points; 0: none said */
 } png_opts;
 
 #define ASPECT_AUTO (-1.0)
+
+/* The font's size in pixels for po: --font-size points at --dpi pixels per
+ * inch (96 when not given); 0: the renderer's choice. */
+double png_opts_font_pixels(const png_opts *po);
 
 /* --aspect equal|auto|R into *aspect (png_opts.aspect); false if it is none. */
 bool parse_aspect(const char *s, double *aspect);

@@ -86,7 +86,7 @@ cm_status outfile_charts(const char *path, const cm_chart *charts, int n_charts,
     }
     cm_gl_close(gl);
     if (st == CM_OK)
-        st = cm_png_write(path, rgba, width, height, all, n, msg, msg_size);
+        st = cm_png_write(path, rgba, width, height, 0, all, n, msg, msg_size);
     free(rgba);
     return st;
 }

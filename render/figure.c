@@ -434,6 +434,14 @@ static cm_status check_options(const cm_render_options *o, char *msg, size_t msg
         return cm_fail(CM_EINVAL, msg, msg_size, "axes, legend and title need a font");
     if ((o->layers & CM_LAYER_TITLE) && !o->model && !o->title)
         return cm_fail(CM_EINVAL, msg, msg_size, "a title needs the model or its text");
+    if (!(o->font_px >= 0 && o->font_px <= CM_RENDER_MAX_FONT))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a font of %g pixels: give 0 (from the image's size) up to %d; at --dpi "
+                       "D a font of P points is P*D/72 pixels",
+                       o->font_px, CM_RENDER_MAX_FONT);
+    if (!(o->dpi == 0 || (o->dpi >= 1 && o->dpi <= 1e5)))
+        return cm_fail(CM_EINVAL, msg, msg_size, "%g pixels per inch: give 0 or 1..100000",
+                       o->dpi);
     return CM_OK;
 }
 
@@ -450,6 +458,16 @@ static cm_status check_room(const cm_render_options *o, const layout *L, char *m
     return CM_OK;
 }
 
+/* The text's size in pixels: the options', or 1/45 of the image's
+ * shorter side within 10..48. */
+static int font_pixels(const cm_render_options *o)
+{
+    if (o->font_px > 0)
+        return (int)lround(o->font_px);
+    const int small = o->width < o->height ? o->width : o->height;
+    return small / 45 < 10 ? 10 : small / 45 > 48 ? 48 : small / 45;
+}
+
 cm_status cm_render_check(const cm_render_options *opt, int dim, char *msg, size_t msg_size)
 {
     cm_render_options o = *opt;
@@ -461,8 +479,7 @@ cm_status cm_render_check(const cm_render_options *opt, int dim, char *msg, size
         return st;
     layout L;
     memset(&L, 0, sizeof L);
-    const int small = o.width < o.height ? o.width : o.height;
-    L.fs = small / 45 < 10 ? 10 : small / 45 > 48 ? 48 : small / 45;
+    L.fs = font_pixels(&o);
     cm_font *font = NULL;
     st = cm_font_open(o.font_path, L.fs, &font, msg, msg_size);
     if (st != CM_OK)
@@ -495,8 +512,7 @@ static cm_status prepare(const cm_lattice *lat, const cm_region *r, const cm_gro
         else
             o->model->overlays(o->model, glo, ghi, &w->ov);
     }
-    const int small = o->width < o->height ? o->width : o->height;
-    L->fs = small / 45 < 10 ? 10 : small / 45 > 48 ? 48 : small / 45;
+    L->fs = font_pixels(o);
     if (st == CM_OK && has_text(o->layers))
         st = cm_font_open(o->font_path, L->fs, &w->font, msg, msg_size);
     if (st == CM_OK) {

@@ -21,7 +21,7 @@
 #include "cellmap/scm.h"
 #include "render/plot.h"
 
-enum { CM_RENDER_MAX_SIDE = 16384 };
+enum { CM_RENDER_MAX_SIDE = 16384, CM_RENDER_MAX_FONT = 512 };
 
 /* A legend's own name for a group, by id or by anchor cell (lattice
  * indices: the same attractor in any file of the same lattice). */
@@ -56,6 +56,10 @@ typedef struct cm_render_options {
                                          equal, a square of state space is square), the plot
                                          the largest such rectangle in its room;
                                          0: the plot fills its room */
+    double font_px;                   /* the text's size (the font's em) in pixels; 0: from
+                                         the image's size (1/45 of its shorter side, 10..48) */
+    double dpi;                       /* pixels per inch: the SVG's size in points (width
+                                         72/dpi pt a pixel); 0: its size in pixels */
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

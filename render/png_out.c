@@ -25,6 +25,7 @@ typedef struct png_pixels {
     int width, height;
     const uint8_t *palette; /* NULL: RGBA; else n_colours RGB triples */
     int n_colours;
+    double dpi; /* > 0: written as pHYs */
 } png_pixels;
 
 static cm_status encode(png_job *job, const png_pixels *px, const cm_png_text *texts, int n_texts)
@@ -42,6 +43,10 @@ static cm_status encode(png_job *job, const png_pixels *px, const cm_png_text *t
             colours[k] =
                 (png_color){px->palette[3 * k], px->palette[3 * k + 1], px->palette[3 * k + 2]};
         png_set_PLTE(job->png, job->info, colours, px->n_colours);
+    }
+    if (px->dpi > 0) {
+        const png_uint_32 per_metre = (png_uint_32)(px->dpi / 0.0254 + 0.5);
+        png_set_pHYs(job->png, job->info, per_metre, per_metre, PNG_RESOLUTION_METER);
     }
     /* Basins are flat areas of colour: the Sub filter turns them into runs
      * of zeros, which zlib's RLE strategy at level 3 writes fast (a 4096x4096
@@ -108,28 +113,28 @@ static cm_status write_file(const char *path, const png_pixels *px, const cm_png
                    st == CM_EIO && error ? strerror(error) : cm_strerror(st));
 }
 
-cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height,
+cm_status cm_png_write(const char *path, const uint8_t *rgba, int width, int height, double dpi,
                        const cm_png_text *texts, int n_texts, char *msg, size_t msg_size)
 {
-    const png_pixels px = {rgba, width, height, NULL, 0};
+    const png_pixels px = {rgba, width, height, NULL, 0, dpi};
     return write_file(path, &px, texts, n_texts, msg, msg_size);
 }
 
 cm_status cm_png_write_indexed(const char *path, const uint8_t *index, int width, int height,
-                               const uint8_t *palette, int n_colours, const cm_png_text *texts,
-                               int n_texts, char *msg, size_t msg_size)
+                               double dpi, const uint8_t *palette, int n_colours,
+                               const cm_png_text *texts, int n_texts, char *msg, size_t msg_size)
 {
     if (n_colours < 1 || n_colours > 256)
         return cm_fail(CM_EINVAL, msg, msg_size, "a PNG palette holds 1..256 colours, not %d",
                        n_colours);
-    const png_pixels px = {index, width, height, palette, n_colours};
+    const png_pixels px = {index, width, height, palette, n_colours, dpi};
     return write_file(path, &px, texts, n_texts, msg, msg_size);
 }
 
 cm_status cm_png_encode(const uint8_t *rgba, int width, int height, uint8_t **out, size_t *size,
                         char *msg, size_t msg_size)
 {
-    const png_pixels px = {rgba, width, height, NULL, 0};
+    const png_pixels px = {rgba, width, height, NULL, 0, 0};
     char *buf = NULL;
     png_job job;
     memset(&job, 0, sizeof job);

@@ -365,11 +365,14 @@ cm_status cm_render_svg(const cm_lattice *lat, const cm_region *r, const cm_grou
     const cm_render_options *o = &F.o;
     const cm_plot *p = &F.p;
     const bool has_graph = p->graph.w > 0;
+    /* at a resolution, the size in points (72 an inch) a paper keeps */
+    const double unit = o->dpi > 0 ? 72 / o->dpi : 1;
     fprintf(f,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.6g%s\" height=\"%.6g%s\" "
             "viewBox=\"0 0 %d %d\" font-family=\"DejaVu Sans, sans-serif\" font-size=\"%d\">\n",
-            o->width, o->height, o->width, o->height, F.L.fs);
+            o->width * unit, o->dpi > 0 ? "pt" : "", o->height * unit, o->dpi > 0 ? "pt" : "",
+            o->width, o->height, F.L.fs);
     fputs("<defs>\n", f);
     clip(f, "basin", p, &p->basin);
     clip(f, "panel", p, has_graph ? &p->graph : &p->basin);

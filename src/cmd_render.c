@@ -20,9 +20,11 @@ static const char render_help[] =
     "                      [--quiet]\n\n"
     "Draws the basins of a cluster database (made by solve --db or explore). Cells of the\n"
     "view that were never computed are drawn as not computed.\n\n"
-    "  --png FILE          the image (written to a temporary file, renamed)\n" PNG_OPTIONS_HELP
-    "                      (default here: the view the last explore session saved, else\n"
-    "                      the cluster's bounding box)\n"
+    "  --png FILE          the image (written to a temporary file, renamed)\n" PNG_OPTIONS_HELP;
+/* two strings: one would pass the 4095 characters C11 promises a literal */
+static const char render_help_rest[] =
+    "  --view's default here: the view the last explore session saved, else the cluster's\n"
+    "  bounding box\n"
     "  --slice Z,...       models of more than two dimensions: the point of dimensions\n"
     "                      3.. the 2-D slice passes through (default: the cluster's middle)\n"
     BY_OPTION_HELP ATTRACTOR_OPTIONS_HELP
@@ -44,6 +46,7 @@ static int parse_render(cli *c, render_args *a)
     while (cli_next(c) && !err) {
         if (strcmp(c->opt, "--help") == 0) {
             fputs(render_help, stdout);
+            fputs(render_help_rest, stdout);
             return -1;
         } else if (png_opts_take(c, &a->png, &err)) {
         } else if (attractor_options_take(c, &a->att, &err)) {

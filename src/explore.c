@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/figure_args.h"
 #include "lib/json.h"
 #include "lib/parse.h"
 #include "lib/stats_report.h"
@@ -27,9 +28,8 @@ const char session_help[] =
     "  extend auto [N]                    N times (default 1), add the tile of the view's\n"
     "                                     size where the most sequences escape (4.6.4)\n"
     "  render FILE.png|FILE.svg [WxH]     the view as a basin image (default: a pixel\n"
-    "                                     per cell, at most 4096); --layers, --png-mode,\n"
-    "                                     --palette, --labels, --min-basin, --legend\n"
-    "                                     as `cellmap render` takes them\n"
+    "                                     per cell, at most 4096); `cellmap render`'s\n"
+    "                                     figure options but --view\n"
     "  stats [--json]                     groups and attractors in view, cells, memory, disk\n"
     "  export --groups|--cells|--flat ... as `cellmap export` (--window: the view)\n"
     "  save                               save the view (joins are saved as they happen)\n"
@@ -266,59 +266,42 @@ static cm_status cmd_extend(explore *e, char **t, int n, char *msg, size_t msg_s
 
 /* ---- render, stats, export, save --------------------------------------------- */
 
-/* The words after "render FILE.png": [WIDTHxHEIGHT] [--layers L,...]
- * [--png-mode rgb|indexed], as solve's options. */
+/* The words after "render FILE.png": [WIDTHxHEIGHT] and the figure options
+ * `cellmap render` takes (lib/figure_args.h); the view is the session's. */
 static cm_status render_words(char **t, int n, png_opts *po, char *msg, size_t msg_size)
 {
     for (int k = 2; k < n; k++) {
         int64_t wh[2];
         int count = 0;
-        char bad[64];
         const bool has_value = k + 1 < n;
-        if (strcmp(t[k], "--layers") == 0 && has_value) {
-            if (!parse_layers(t[++k], &po->layers, bad, sizeof bad))
-                return cm_fail(CM_EINVAL, msg, msg_size,
-                               "render: unknown layer '%s' (use basin, steps, attractors, "
-                               "overlays, axes, legend, title or all)",
-                               bad);
-        } else if (strcmp(t[k], "--png-mode") == 0 && has_value) {
-            if (!parse_png_mode(t[++k], &po->indexed))
-                return cm_fail(CM_EINVAL, msg, msg_size, "render: '%s' must be rgb or indexed",
-                               t[k]);
+        bool figure_option = false;
+        for (const char *const *name = png_value_options; *name && !figure_option; name++)
+            figure_option = strcmp(t[k], *name) == 0 && strcmp(*name, "--view") != 0;
+        if (figure_option && has_value) {
+            char why[1024];
+            if (!png_opts_value(po, t[k], t[k + 1], why, sizeof why))
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: %s", why);
+            k++;
         } else if (strcmp(t[k], "--by") == 0 && has_value) {
             const char *by = t[++k];
             if (strcmp(by, "groups") != 0 && strcmp(by, "attractors") != 0)
                 return cm_fail(CM_EINVAL, msg, msg_size,
                                "render: --by '%s' must be attractors or groups", by);
             po->by = strcmp(by, "groups") == 0 ? BY_GROUPS : BY_ATTRACTORS;
-        } else if (strcmp(t[k], "--palette") == 0 && has_value) {
-            char why[400];
-            if (!png_opts_palette(t[++k], po, why, sizeof why))
-                return cm_fail(CM_EINVAL, msg, msg_size, "render: --palette: %s", why);
-        } else if (strcmp(t[k], "--labels") == 0 && has_value) {
-            char why[400];
-            if (!png_opts_labels(t[++k], po, why, sizeof why))
-                return cm_fail(CM_EINVAL, msg, msg_size, "render: --labels: %s", why);
-        } else if ((strcmp(t[k], "--min-basin") == 0 || strcmp(t[k], "--legend") == 0) &&
-                   has_value) {
-            const bool legend = strcmp(t[k], "--legend") == 0;
+        } else if (strcmp(t[k], "--legend") == 0 && has_value) {
             int64_t v = 0;
-            if (!parse_int64(t[++k], &v) || v < 1 || (legend && v > 200))
-                return cm_fail(CM_EINVAL, msg, msg_size, "render: %s takes %s, not '%s'",
-                               t[k - 1], legend ? "1..200" : "a whole number of cells, 1 or more",
+            if (!parse_int64(t[++k], &v) || v < 1 || v > 200)
+                return cm_fail(CM_EINVAL, msg, msg_size, "render: --legend takes 1..200, not '%s'",
                                t[k]);
-            if (legend)
-                po->legend_groups = (int)v;
-            else
-                po->min_basin = (uint64_t)v;
+            po->legend_groups = (int)v;
         } else if (k == 2 && parse_counts(t[k], wh, &count, 2) && count == 2 &&
                    wh[0] <= CM_RENDER_MAX_SIDE && wh[1] <= CM_RENDER_MAX_SIDE) {
             po->width = (int)wh[0];
             po->height = (int)wh[1];
         } else {
             return cm_fail(CM_EINVAL, msg, msg_size,
-                           "render: '%s' is not WIDTHxHEIGHT (each 1..%d), --layers L,... or "
-                           "--png-mode MODE",
+                           "render: '%s' is not WIDTHxHEIGHT (each 1..%d) or an option of "
+                           "`cellmap render` with its value",
                            t[k], CM_RENDER_MAX_SIDE);
         }
     }
@@ -336,9 +319,10 @@ static cm_status cmd_render_view(explore *e, char **t, int n, char *msg, size_t 
     const size_t len = n > 1 ? strlen(t[1]) : 0;
     const bool svg = len > 4 && strcmp(t[1] + len - 4, ".svg") == 0; /* FILE.svg: as SVG */
     *(svg ? &po.svg : &po.path) = n > 1 ? t[1] : NULL;
-    cm_status st = words(n, 2, 17, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
+    cm_status st = words(n, 2, 23, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
                          "[--png-mode M] [--palette P] [--labels FILE] [--min-basin N] [--legend K] "
-                         "[--by attractors|groups]",
+                         "[--by attractors|groups] [--title T] [--aspect A] [--font-size PT] "
+                         "[--dpi N]",
                          msg, msg_size);
     if (st == CM_OK)
         st = render_words(t, n, &po, msg, msg_size);

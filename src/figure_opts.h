@@ -36,7 +36,11 @@
     "                      attractor has the same colour in every file and view\n"        \
     "  --title TEXT        the title (default: the model and its parameters), wrapped\n"  \
     "  --aspect A          equal (squares drawn square), auto (the plot fills its room) or\n" \
-    "                      R (y units R times x's); default equal if the axes share a unit\n"
+    "                      R (y units R times x's); default equal if the axes share a unit\n"    \
+    "  --font-size PT      text size in points: PT*N/72 pixels at --dpi N (96 if not given;\n" \
+    "                      default: from --size)\n"                                                \
+    "  --dpi N             pixels per inch, written to the PNG and giving the SVG's size in\n" \
+    "                      points: --size 1800x1200 --dpi 300 is 6x4 inches\n"
 
 /* Handles the shared options; true if the current option was one of them. */
 bool png_opts_take(cli *c, png_opts *po, int *error);

@@ -96,7 +96,7 @@ int main(int argc, char **argv)
         if (cm_render_figure(&lat, &flat, groups, &ro, rgba, &info, msg, sizeof msg) != CM_OK)
             die(msg);
         const double t1 = now();
-        if (cm_png_write(path, rgba, SIDE, SIDE, chunk, 1, msg, sizeof msg) != CM_OK)
+        if (cm_png_write(path, rgba, SIDE, SIDE, 0, chunk, 1, msg, sizeof msg) != CM_OK)
             die(msg);
         const double t2 = now();
         raster[k] = info.raster_s;

@@ -165,7 +165,41 @@ python3 -c "import sys; w, h = map(int, sys.argv[1:]); assert abs(h - round(w * 
   abs(w - round(h / 0.32)) <= 1, (w, h)" "${w:-0}" "${h:-0}" || fail "--aspect 2: ${w:-?}x${h:-?}"
 expect_usage "--aspect: 'wide' must be equal, auto or a ratio" solve --png x.png --aspect wide
 expect_usage "--aspect: '0' must be equal, auto or a ratio" solve --png x.png --aspect 0
-expect_usage "--aspect describe the image; add --png" solve --aspect equal
+expect_usage "--dpi describe the image; add --png" solve --aspect equal
+# --dpi and --font-size: the PNG's pHYs (pixels per metre) and none without
+# --dpi; the SVG's size in points; the text PT*DPI/72 pixels (the SVG's
+# font-size, and the title's ink twice as tall at twice the points)
+"$CM" solve --cells 300x200 --png print.png --svg print.svg --size 900x600 --layers all \
+  --dpi 150 --font-size 8 > /dev/null &&
+"$CM" solve --cells 300x200 --png big.png --size 900x600 --layers all --dpi 150 --font-size 16 \
+  > /dev/null &&
+"$CM" solve --cells 300x200 --png plain.png --svg plain.svg --size 900x600 --layers all \
+  --font-size 12 > /dev/null || fail "solve --dpi --font-size"
+python3 - "$HERE" print.png big.png plain.png print.svg plain.svg <<'PY' || fail "--dpi, --font-size"
+import re, struct, sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+def phys(path):
+    d = open(path, "rb").read()
+    i = d.find(b"pHYs")
+    return struct.unpack(">IIB", d[i + 4:i + 13]) if i > 0 else None
+assert phys(sys.argv[2]) == (5906, 5906, 1), phys(sys.argv[2])   # 150 / 0.0254
+assert phys(sys.argv[4]) is None
+def svg_head(path):
+    return re.search(r'<svg [^>]*width="([^"]*)" height="([^"]*)"[^>]*font-size="(\d+)"',
+                     open(path).read()).groups()
+assert svg_head(sys.argv[5]) == ("432pt", "288pt", "17"), svg_head(sys.argv[5])  # 8 pt at 150 dpi
+assert svg_head(sys.argv[6]) == ("900", "600", "16"), svg_head(sys.argv[6])      # 12 pt at 96
+def title_rows(path):   # the title's first line: its run of rows with dark ink
+    w, h, bpp, rows, t = read_png(path)
+    ink = [any(rows[y][bpp * x] < 100 for x in range(w // 2)) for y in range(h // 4)]
+    first = ink.index(True)
+    return ink[first:].index(False)
+small, large = title_rows(sys.argv[2]), title_rows(sys.argv[3])
+assert 1.8 <= large / small <= 2.2, (small, large)
+PY
+expect_usage "--font-size: '200' must be a number from 1 to 96" solve --png x.png --font-size 200
+expect_usage "--dpi: 'high' must be a number from 36 to 2400" solve --png x.png --dpi high
 expect_usage "--palette: no palette 'nosuch'" render basin.cmdb --png x.png --palette nosuch
 printf 'x y\n' > bad-names.txt
 expect_usage "bad-names.txt:1:" render basin.cmdb --png x.png --labels bad-names.txt

@@ -334,8 +334,8 @@ static void test_indexed_png(void)
         memcpy(palette + 3 * k, (uint8_t[3]){c.r, c.g, c.b}, 3);
     }
     const cm_png_text texts[] = {{"Software", "cellmap test"}};
-    CHECK(cm_png_write_indexed(path, index, 3, 2, palette, 8, texts, 1, msg, sizeof msg) == CM_OK);
-    CHECK(cm_png_write_indexed(path, index, 3, 2, palette, 300, texts, 1, msg, sizeof msg) ==
+    CHECK(cm_png_write_indexed(path, index, 3, 2, 0, palette, 8, texts, 1, msg, sizeof msg) == CM_OK);
+    CHECK(cm_png_write_indexed(path, index, 3, 2, 0, palette, 300, texts, 1, msg, sizeof msg) ==
           CM_EINVAL);
     FILE *f = fopen(path, "rb");
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);

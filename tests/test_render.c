@@ -207,7 +207,7 @@ int main(void)
     char path[256];
     snprintf(path, sizeof path, "%s/basin.png", dir);
     const cm_png_text texts[] = {{"Software", "cellmap test"}, {"Model", "half-sink"}};
-    CHECK(cm_png_write(path, a, W, H, texts, 2, msg, sizeof msg) == CM_OK);
+    CHECK(cm_png_write(path, a, W, H, 0, texts, 2, msg, sizeof msg) == CM_OK);
     FILE *f = fopen(path, "rb");
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
     png_infop info = png_create_info_struct(png);
@@ -229,7 +229,7 @@ int main(void)
     png_destroy_read_struct(&png, &info, NULL);
     fclose(f);
     /* writing into a missing directory fails cleanly */
-    CHECK(cm_png_write("/nonexistent-dir/x.png", a, W, H, texts, 2, msg, sizeof msg) == CM_EINVAL);
+    CHECK(cm_png_write("/nonexistent-dir/x.png", a, W, H, 0, texts, 2, msg, sizeof msg) == CM_EINVAL);
     unlink(path);
     CHECK(rmdir(dir) == 0); /* empty: no temporary file left behind */
 

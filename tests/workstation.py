@@ -35,6 +35,14 @@ with cellmap.Session("py_explore.cmdb", model="microchaos-pd", cell_size=(0.5, 0
         (lo, hi), _ = s.bounds
         s.pan(0, 10 * ((hi - lo) / 100))
     s.figure("py_view.png")
+    # the print options reach the figure: 150 dpi in the PNG (pHYs, per
+    # metre), the SVG 72/150 pt a pixel with 8-point text (17 pixels)
+    s.figure("py_print.png", svg="py_print.svg", layers=("basin", "axes", "title"), width=600,
+             height=400, title="print", aspect="auto", dpi=150, font_size=8)
+    png = open("py_print.png", "rb").read()
+    assert png[png.index(b"pHYs") + 4:][:9] == bytes.fromhex("0000171200001712 01".replace(" ", "")), png[:80]
+    svg = open("py_print.svg").read()
+    assert 'width="288pt" height="192pt"' in svg and 'font-size="17"' in svg and ">print<" in svg, svg[:300]
     view = s.read()
     assert view.labels.shape == (100, 100) and (view.labels >= 0).all()  # every cell computed
     # a point query says what read() says of the cell holding the state

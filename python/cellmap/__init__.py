@@ -358,7 +358,8 @@ class Result:
         svg=PATH, width, height, layers (names: basin, steps, attractors,
         overlays, axes, legend, title; default all but steps), indexed,
         by ("attractors" or "groups"), palette, labels (a file),
-        min_basin, legend."""
+        min_basin, legend, title, aspect ("equal", "auto" or a ratio),
+        font_size (points), dpi."""
         o, keep = _figure_options(png, options)
         _call(_lib.cm_result_figure, self._h, ctypes.byref(o))
 
@@ -461,7 +462,8 @@ class _FigureOptions(ctypes.Structure):
                 ("by_groups", ctypes.c_int), ("palette", ctypes.c_char_p),
                 ("labels", ctypes.c_char_p), ("min_basin", ctypes.c_uint64),
                 ("legend", ctypes.c_int), ("title", ctypes.c_char_p),
-                ("aspect", ctypes.c_double)]
+                ("aspect", ctypes.c_double), ("font_size", ctypes.c_double),
+                ("dpi", ctypes.c_double)]
 
 
 class _DbOptions(ctypes.Structure):
@@ -520,7 +522,7 @@ _sig("cm_session_close", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_size_t)
 _LAYERS = {"basin": 1, "steps": 2, "attractors": 4, "overlays": 8, "axes": 16, "legend": 32,
            "title": 64}
 _FIGURE_KEYS = {"svg", "width", "height", "layers", "indexed", "by", "palette", "labels",
-                "min_basin", "legend", "title", "aspect"}
+                "min_basin", "legend", "title", "aspect", "font_size", "dpi"}
 
 
 def _figure_options(png, options):
@@ -548,7 +550,8 @@ def _figure_options(png, options):
     o = _FigureOptions(keep[0], keep[1], int(options.get("width", 0)),
                        int(options.get("height", 0)), bits, int(bool(options.get("indexed"))),
                        int(by == "groups"), keep[2], keep[3], int(options.get("min_basin", 0)),
-                       int(options.get("legend", 0)), keep[4], float(aspect))
+                       int(options.get("legend", 0)), keep[4], float(aspect),
+                       float(options.get("font_size", 0)), float(options.get("dpi", 0)))
     return o, keep
 
 
