@@ -90,7 +90,7 @@ typedef struct basin_png {
     const cm_region *cells;      /* the cells to draw (group, step) */
     const cm_group_info *groups; /* the groups' summaries, for the colours */
     double lo[2], hi[2];         /* the view; all 0: the cells' box */
-    cm_gl *gl;                   /* a kept OSMesa context, or NULL */
+    cm_gl *gl;                   /* a kept GL context (render/gl.h), or NULL */
     const struct cm_attractor_set *attractors; /* not NULL: drawn by attractors (the cells'
                                                   groups' attractors, the footprints marked;
                                                   lib/attractor_report.h), else by groups */

@@ -1,6 +1,6 @@
 #include "render/chart.h"
 
-#include <GL/osmesa.h>
+#include <GL/gl.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -132,13 +132,9 @@ static cm_status draw_plot(const cm_chart *c, cm_gl *gl, double hmax, int px, in
     cm_status st = gl ? CM_OK : cm_gl_open(&own, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const OSMesaContext ctx = cm_gl_context(gl ? gl : own);
     uint8_t *origin = rgba + 4 * ((size_t)py * (size_t)c->width + (size_t)px);
-    if (!OSMesaMakeCurrent(ctx, origin, GL_UNSIGNED_BYTE, pw, ph)) {
-        st = cm_fail(CM_ERENDER, msg, msg_size, "OSMesaMakeCurrent failed for %dx%d", pw, ph);
-    } else {
-        OSMesaPixelStore(OSMESA_ROW_LENGTH, c->width);
-        OSMesaPixelStore(OSMESA_Y_UP, 0);
+    st = cm_gl_target(gl ? gl : own, origin, c->width, pw, ph, msg, msg_size);
+    if (st == CM_OK) {
         glViewport(0, 0, pw, ph);
         glClearColor(1, 1, 1, 1);
         glClear(GL_COLOR_BUFFER_BIT);
@@ -151,9 +147,7 @@ static cm_status draw_plot(const cm_chart *c, cm_gl *gl, double hmax, int px, in
             draw_heat(c, hmax);
         for (int k = 0; k < c->n_series; k++)
             draw_series(&c->series[k]);
-        glFinish();
-        if (glGetError() != GL_NO_ERROR)
-            st = cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");
+        st = cm_gl_done(gl ? gl : own, msg, msg_size);
     }
     cm_gl_close(own);
     return st;

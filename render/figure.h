@@ -40,7 +40,7 @@ typedef struct cm_render_options {
     unsigned layers;           /* enum cm_layer; 0: basin and attractors */
     const cm_model *model;     /* overlays, title, axis names, the 1-D graph; may be NULL */
     const char *font_path;     /* TrueType font for axes, legend and title */
-    cm_gl *gl;                 /* a kept OSMesa context (render/gl.h); NULL: a new one */
+    cm_gl *gl;                 /* a kept GL context (render/gl.h); NULL: a new one */
     uint64_t min_basin;        /* groups with smaller basins are drawn and listed as
                                   "other" (0, 1: none) */
     int legend_groups;         /* the most groups the legend lists (0: 12) */

@@ -1,6 +1,6 @@
 #include "render/plot.h"
 
-#include <GL/osmesa.h>
+#include <GL/gl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -33,7 +33,8 @@ static double at_pixel(double lo, double hi, int k, int n)
 
 /* Sets viewport, scissor and projection so that GL draws the part of the
  * panel inside the tile. False when they do not meet. */
-static bool enter_panel(const cm_panel *pn, const tile *t, double *px, double *py)
+static bool enter_panel(const cm_gl *gl, const cm_panel *pn, const tile *t, double *px,
+                        double *py)
 {
     const int x0 = pn->x > t->x ? pn->x : t->x, y0 = pn->y > t->y ? pn->y : t->y;
     const int x1 = pn->x + pn->w < t->x + t->w ? pn->x + pn->w : t->x + t->w;
@@ -42,10 +43,7 @@ static bool enter_panel(const cm_panel *pn, const tile *t, double *px, double *p
         return false;
     *px = (pn->hi[0] - pn->lo[0]) / pn->w; /* state units per pixel */
     *py = (pn->hi[1] - pn->lo[1]) / pn->h;
-    /* GL counts rows from the bottom of the tile; the figure from the top */
-    const int vy = t->h - (y1 - t->y);
-    glViewport(x0 - t->x, vy, x1 - x0, y1 - y0);
-    glScissor(x0 - t->x, vy, x1 - x0, y1 - y0);
+    cm_gl_window(gl, x0 - t->x, y0 - t->y, x1 - x0, y1 - y0);
     glMatrixMode(GL_PROJECTION);
     glLoadIdentity();
     glOrtho(at_pixel(pn->lo[0], pn->hi[0], x0 - pn->x, pn->w),
@@ -300,10 +298,10 @@ static void draw_cobwebs(const cm_plot *p, int lw)
 
 /* ---- one tile ------------------------------------------------------------------- */
 
-static void draw_basin_panel(const cm_plot *p, const tile *t)
+static void draw_basin_panel(const cm_gl *gl, const cm_plot *p, const tile *t)
 {
     double px, py;
-    if (!enter_panel(&p->basin, t, &px, &py))
+    if (!enter_panel(gl, &p->basin, t, &px, &py))
         return;
     if (p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS))
         draw_raster(p->ras, p->basin.lo, p->basin.hi);
@@ -318,10 +316,10 @@ static void draw_basin_panel(const cm_plot *p, const tile *t)
         draw_points(p->overlays, px, py, p->line_width);
 }
 
-static void draw_graph_panel(const cm_plot *p, const tile *t)
+static void draw_graph_panel(const cm_gl *gl, const cm_plot *p, const tile *t)
 {
     double px, py;
-    if (p->graph.w <= 0 || !enter_panel(&p->graph, t, &px, &py))
+    if (p->graph.w <= 0 || !enter_panel(gl, &p->graph, t, &px, &py))
         return;
     draw_graph(p->model, &p->graph, p->line_width);
     if (p->layers & CM_LAYER_ATTRACTORS)
@@ -332,28 +330,23 @@ static void draw_graph_panel(const cm_plot *p, const tile *t)
     }
 }
 
-static cm_status draw_tile(OSMesaContext ctx, const cm_plot *p, const tile *t, uint8_t *rgba,
+static cm_status draw_tile(cm_gl *gl, const cm_plot *p, const tile *t, uint8_t *rgba,
                            int fig_width, char *msg, size_t msg_size)
 {
     uint8_t *origin =
         rgba + 4 * ((size_t)(p->y + t->y) * (size_t)fig_width + (size_t)(p->x + t->x));
-    if (!OSMesaMakeCurrent(ctx, origin, GL_UNSIGNED_BYTE, t->w, t->h))
-        return cm_fail(CM_ERENDER, msg, msg_size, "OSMesaMakeCurrent failed for a %dx%d tile", t->w,
-                       t->h);
-    OSMesaPixelStore(OSMESA_ROW_LENGTH, fig_width);
-    OSMesaPixelStore(OSMESA_Y_UP, 0); /* row 0 at the top, as PNG wants */
+    const cm_status st = cm_gl_target(gl, origin, fig_width, t->w, t->h, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     glDisable(GL_SCISSOR_TEST);
     glViewport(0, 0, t->w, t->h);
     const cm_rgb bg = cm_colour_not_computed;
     glClearColor(bg.r / 255.0f, bg.g / 255.0f, bg.b / 255.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_SCISSOR_TEST);
-    draw_basin_panel(p, t);
-    draw_graph_panel(p, t);
-    glFinish(); /* the buffer is complete only now */
-    if (glGetError() != GL_NO_ERROR)
-        return cm_fail(CM_ERENDER, msg, msg_size, "OpenGL reported an error while drawing");
-    return CM_OK;
+    draw_basin_panel(gl, p, t);
+    draw_graph_panel(gl, p, t);
+    return cm_gl_done(gl, msg, msg_size);
 }
 
 cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tiles, char *msg,
@@ -364,12 +357,12 @@ cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tile
     cm_status st = p->gl ? CM_OK : cm_gl_open(&own, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const OSMesaContext ctx = cm_gl_context(p->gl ? p->gl : own);
+    cm_gl *gl = p->gl ? p->gl : own;
     for (int y = 0; y < p->h && st == CM_OK; y += CM_PLOT_TILE)
         for (int x = 0; x < p->w && st == CM_OK; x += CM_PLOT_TILE) {
             const tile t = {x, y, p->w - x < CM_PLOT_TILE ? p->w - x : CM_PLOT_TILE,
                             p->h - y < CM_PLOT_TILE ? p->h - y : CM_PLOT_TILE};
-            st = draw_tile(ctx, p, &t, rgba, fig_width, msg, msg_size);
+            st = draw_tile(gl, p, &t, rgba, fig_width, msg, msg_size);
             ++*tiles;
         }
     cm_gl_close(own);

@@ -1,12 +1,13 @@
 /* render/plot.h - the OpenGL part of a figure: the basin raster, the
  * attractor markers, the model's overlays and, for 1-D models, the map's
- * graph with a cobweb of each attractor, drawn off-screen with OSMesa.
+ * graph with a cobweb of each attractor, drawn off-screen with OSMesa or EGL
+ * (render/gl.h).
  *
  * The plot is drawn straight into its rectangle of the caller's RGBA figure
  * (row 0 at the top), in tiles of at most PLOT_TILE pixels a side, so the
- * figure may be larger than OSMesa's largest viewport and GL never holds
+ * figure may be larger than the largest viewport and GL never holds
  * more than one tile. Deterministic: the tiling depends on sizes only.
- * Not thread-safe (one OSMesa context at a time per thread).
+ * Not thread-safe (one GL context at a time per thread).
  */
 #ifndef CM_RENDER_PLOT_H
 #define CM_RENDER_PLOT_H
