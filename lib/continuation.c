@@ -225,43 +225,108 @@ static void cloud_range(const cloud *c, double *lo, double *hi)
 
 enum { LABEL_SIZE = 64 };
 
-/* Up to three panels as Figs. 2.17-2.19: the maximal displacement, the
- * stops and Psi (2.90) against the parameter, those --panels picks in its
- * order; stable green, unstable red, events black with their labels on the
- * top panel. */
-static cm_status continuation_write_png(const cont_args *a, const cm_model *m, const collected *c,
-                                 char *msg, size_t msg_size)
+/* The value a panel draws of solution s (for the stops, stop j); false if
+ * it has none. */
+static bool panel_value(int panel, int j, const cm_fo_solution *s, double *v)
 {
-    cloud stable[PANELS] = {{0}}, unstable[PANELS] = {{0}}, marks[PANELS] = {{0}};
+    *v = panel == PANEL_X_MAX ? s->x_max : panel == PANEL_PSI ? s->asymmetry : NAN;
+    if (panel == PANEL_STOPS && j < s->n_stops)
+        *v = s->stops[j];
+    return !isnan(*v);
+}
+
+/* Starts a new line in c (a NaN breaks a polyline) unless it is empty or
+ * broken already. */
+static bool line_break(cloud *c)
+{
+    return c->n == 0 || isnan(c->x[c->n - 1]) || cloud_add(c, NAN, NAN);
+}
+
+/* The branches of one panel as lines (for the stops, the j-th stop's),
+ * stable ones into stable, unstable into unstable: a line goes on while
+ * the branch, its stability and the number of stops stay; where the
+ * stability changes, the new line starts at the last point of the old. */
+static bool trace_panel(const collected *c, int panel, int j, cloud *stable, cloud *unstable)
+{
     bool ok = true;
     for (uint64_t i = 0; i < c->n && ok; i++) {
         const cm_fo_solution *s = &c->points[i].s;
+        const cm_fo_solution *q = i > 0 && c->points[i - 1].branch == c->points[i].branch
+                                      ? &c->points[i - 1].s
+                                      : NULL;
         cloud *into = s->stable ? stable : unstable;
-        ok = cloud_add(&into[PANEL_X_MAX], s->p, s->x_max) &&
-             cloud_add(&into[PANEL_PSI], s->p, s->asymmetry);
-        for (int k = 0; k < s->n_stops && ok; k++)
-            ok = cloud_add(&into[PANEL_STOPS], s->p, s->stops[k]);
+        double v, w;
+        if (!panel_value(panel, j, s, &v))
+            continue;
+        const bool continues = q && q->n_stops == s->n_stops && panel_value(panel, j, q, &w);
+        if (!continues || q->stable != s->stable)
+            ok = line_break(into);
+        if (ok && continues && q->stable != s->stable)
+            ok = cloud_add(into, q->p, w);
+        ok = ok && cloud_add(into, s->p, v);
     }
-    cm_chart_label *labels = calloc(c->n_events + 1, sizeof *labels);
-    char(*texts)[LABEL_SIZE] = calloc(c->n_events + 1, sizeof *texts);
-    ok = ok && labels && texts;
+    return ok;
+}
+
+/* The events as labelled marks of each panel (their texts, joined where
+ * they fall on one place, in texts[panel]); a mark's text (--mark) is
+ * added to the label of the event nearest its value. */
+static bool event_marks(const cont_args *a, const collected *c, cloud *marks,
+                        cm_chart_label *labels[PANELS], char (*texts[PANELS])[LABEL_SIZE])
+{
+    bool ok = true;
     for (uint64_t i = 0; i < c->n_events && ok; i++) {
         const cm_fo_branch_event *e = &c->events[i].e;
-        continuation_event_label(e, texts[i], sizeof texts[i]);
         const double y[PANELS] = {e->at.x_max, e->at.n_stops ? e->at.stops[0] : NAN,
                                   e->at.asymmetry};
-        labels[i] = (cm_chart_label){e->at.p, y[a->panels[0]], texts[i]};
+        for (int k = 0; k < PANELS; k++) {
+            continuation_event_label(e, texts[k][i], LABEL_SIZE);
+            labels[k][i] = (cm_chart_label){e->at.p, y[k], texts[k][i]};
+        }
         ok = cloud_add(&marks[PANEL_X_MAX], e->at.p, e->at.x_max) &&
              cloud_add(&marks[PANEL_PSI], e->at.p, e->at.asymmetry);
         for (int k = 0; k < e->at.n_stops && ok; k++)
             ok = cloud_add(&marks[PANEL_STOPS], e->at.p, e->at.stops[k]);
     }
-    cm_status st = ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the diagram");
+    for (int m = 0; m < a->n_marks && c->n_events; m++) {
+        uint64_t nearest = 0;
+        for (uint64_t i = 1; i < c->n_events; i++)
+            if (fabs(c->events[i].e.at.p - a->mark_at[m]) <
+                fabs(c->events[nearest].e.at.p - a->mark_at[m]))
+                nearest = i;
+        for (int k = 0; k < PANELS; k++) {
+            const size_t used = strlen(texts[k][nearest]);
+            snprintf(texts[k][nearest] + used, LABEL_SIZE - used, " = %s", a->mark_text[m]);
+        }
+    }
     /* branches through one point each report its events, and several
      * events fall on one point: each point is labelled once, legibly */
-    if (ok)
-        cm_chart_join_labels(labels, (int)c->n_events, texts[0], LABEL_SIZE,
+    for (int k = 0; k < PANELS && ok; k++)
+        cm_chart_join_labels(labels[k], (int)c->n_events, texts[k][0], LABEL_SIZE,
                              0.01 * (a->hi - a->lo), 0.02);
+    return ok;
+}
+
+/* Up to three panels as Figs. 2.17-2.19: the maximal displacement, the
+ * stops and Psi (2.90) against the parameter, those --panels picks in its
+ * order; stable branches green, unstable red, events black and labelled. */
+static cm_status continuation_write_png(const cont_args *a, const cm_model *m, const collected *c,
+                                 char *msg, size_t msg_size)
+{
+    cloud stable[PANELS] = {{0}}, unstable[PANELS] = {{0}}, marks[PANELS] = {{0}};
+    bool ok = true;
+    for (int k = 0; k < PANELS && ok; k++)
+        for (int j = 0; j < (k == PANEL_STOPS ? CM_FO_MAX_STOPS : 1) && ok; j++)
+            ok = trace_panel(c, k, j, &stable[k], &unstable[k]);
+    cm_chart_label *labels[PANELS];
+    char(*texts[PANELS])[LABEL_SIZE];
+    for (int k = 0; k < PANELS; k++) {
+        labels[k] = calloc(c->n_events + 1, sizeof *labels[k]);
+        texts[k] = calloc(c->n_events + 1, sizeof *texts[k]);
+        ok = ok && labels[k] && texts[k];
+    }
+    ok = ok && event_marks(a, c, marks, labels, texts);
+    cm_status st = ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the diagram");
     static const char *const y_names[PANELS] = {"x_max", "stops", "Psi"};
     static const char *const panel_titles[PANELS] = {"maximal displacement", "stop positions",
                                                      "asymmetry Psi (2.90)"};
@@ -285,10 +350,10 @@ static cm_status continuation_write_png(const cont_args *a, const cm_model *m, c
         if (!(lo <= hi))
             lo = -1, hi = 1;
         const double pad = hi > lo ? 0.06 * (hi - lo) : 0.5;
-        series[k][0] = (cm_series){CM_SERIES_POINTS, unstable[k].x, unstable[k].y, unstable[k].n,
-                                   red, 3};
-        series[k][1] = (cm_series){CM_SERIES_POINTS, stable[k].x, stable[k].y, stable[k].n,
-                                   green, 3};
+        series[k][0] = (cm_series){CM_SERIES_LINE, unstable[k].x, unstable[k].y, unstable[k].n,
+                                   red, 2};
+        series[k][1] = (cm_series){CM_SERIES_LINE, stable[k].x, stable[k].y, stable[k].n,
+                                   green, 2};
         series[k][2] = (cm_series){CM_SERIES_POINTS, marks[k].x, marks[k].y, marks[k].n, black, 7};
         charts[i] = (cm_chart){a->width,
                                i < n - 1 ? h : a->height - (n - 1) * h,
@@ -302,8 +367,8 @@ static cm_status continuation_write_png(const cont_args *a, const cm_model *m, c
                                3,
                                figure_font(),
                                0,
-                               i == 0 ? labels : NULL,
-                               i == 0 ? (int)c->n_events : 0};
+                               labels[k],
+                               (int)c->n_events};
     }
     char range[96];
     snprintf(range, sizeof range, "%s=%s:%s", a->vary, CM_NUM(a->lo), CM_NUM(a->hi));
@@ -314,9 +379,9 @@ static cm_status continuation_write_png(const cont_args *a, const cm_model *m, c
         free(stable[k].x), free(stable[k].y);
         free(unstable[k].x), free(unstable[k].y);
         free(marks[k].x), free(marks[k].y);
+        free(labels[k]);
+        free(texts[k]);
     }
-    free(labels);
-    free(texts);
     return st;
 }
 

@@ -15,7 +15,7 @@
 #include "lib/project.h"
 #include "models/fo_continuation.h"
 
-enum { MAX_STARTS = 8, MAX_BRANCHES = 64 };
+enum { MAX_STARTS = 8, MAX_BRANCHES = 64, MAX_MARKS = 8 };
 
 /* The diagram's panels. */
 enum { PANEL_X_MAX = 0, PANEL_STOPS, PANEL_PSI, PANELS };
@@ -30,6 +30,9 @@ typedef struct cont_args {
     double from[MAX_STARTS][3];
     int has_vary, n_from, down, both, switch_pd, period, max_points, width, height;
     int panels[PANELS], n_panels;
+    double mark_at[MAX_MARKS]; /* --mark P=TEXT: TEXT added to the label of the event nearest P */
+    const char *mark_text[MAX_MARKS];
+    int n_marks;
     const char *csv, *events, *png, *curves;
     bool json, quiet;
 } cont_args;

@@ -256,8 +256,12 @@ static cm_status measure(const cm_chart *c, cm_font **f, layout *L, cm_chart_inf
     if (!(c->hi[0] > c->lo[0]) || !(c->hi[1] > c->lo[1]) || !isfinite(c->hi[0] - c->lo[0]) ||
         !isfinite(c->hi[1] - c->lo[1]))
         return cm_fail(CM_EINVAL, msg, msg_size, "the chart's ranges must be finite and not empty");
+    /* legible in print: 1/45 of the shorter side, or 1/64 of the width for
+     * the flat panels of a stack (14 pixels in a 900-pixel figure) */
     const int side = c->width < c->height ? c->width : c->height;
-    cm_status st = cm_font_open(c->font_path, side / 45 > 10 ? side / 45 : 10, f, msg, msg_size);
+    const int size = side / 45 > c->width / 64 ? side / 45 : c->width / 64;
+    cm_status st = cm_font_open(c->font_path, size < 12 ? 12 : size > 48 ? 48 : size, f, msg,
+                                msg_size);
     if (st != CM_OK)
         return st;
     const double hmax = c->heat ? heat_max(c->heat) : 0;

@@ -20,7 +20,7 @@ static const char continue_help[] =
     "                        [--start P ...] [--period K]\n"
     "                        [--switch] [--curve NAME2=LO:HI --curves FILE|-]\n"
     "                        [--max-points N] [--csv FILE|-] [--events FILE|-] [--png FILE]\n"
-    "                        [--panels LIST] [--size WxH] [--json] [--quiet]\n\n"
+    "                        [--panels LIST] [--mark P=TEXT] [--size WxH] [--json] [--quiet]\n\n"
     "Follows a periodic solution of the dry friction oscillator in parameter NAME\n"
     "(S, S0, Omega or phi) by pseudo-arclength continuation of the fixed points of\n"
     "P^K, the K-th iterate of the stroboscopic Poincare map, with Newton's method on\n"
@@ -72,8 +72,10 @@ static const char continue_options[] =
     "                      stability, multipliers, signatures before and after\n"
     "  --png FILE          the thesis' diagram (Figs. 2.17-2.19): maximal displacement,\n"
     "                      stop positions and the asymmetry Psi (2.90) against the\n"
-    "                      parameter; stable points green, unstable red, events marked\n"
-    "                      and labelled\n"
+    "                      parameter; stable branches green, unstable red, events\n"
+    "                      marked and labelled in every panel\n"
+    "  --mark P=TEXT       add TEXT to the label of the event nearest P (a name the\n"
+    "                      thesis gives it: --mark 0.03562=N); repeatable\n"
     "  --panels LIST       the diagram's panels, in order: x_max, stops, psi (default\n"
     "                      all three; e.g. psi for Fig. 2.19, stops for Fig. 2.22's\n"
     "                      bottom panel)\n"
@@ -112,6 +114,22 @@ static bool parse_range(const char *text, char *name, double *lo, double *hi)
     memcpy(name, text, (size_t)(eq - text));
     name[eq - text] = '\0';
     return cm_fo_param_of(name) >= 0 && parse_ranges(eq + 1, lo, hi, &n, 1);
+}
+
+/* --mark P=TEXT into a's marks; false if it is not one or there are too many. */
+static bool parse_mark(const char *text, cont_args *a)
+{
+    const char *eq = strchr(text, '=');
+    char at[64];
+    if (a->n_marks == MAX_MARKS || !eq || eq - text >= (ptrdiff_t)sizeof at || !eq[1] ||
+        strlen(eq + 1) > 24)
+        return false;
+    memcpy(at, text, (size_t)(eq - text));
+    at[eq - text] = '\0';
+    if (!parse_double(at, &a->mark_at[a->n_marks]))
+        return false;
+    a->mark_text[a->n_marks++] = eq + 1;
+    return true;
 }
 
 static int parse_vary(cli *c, cont_args *a)
@@ -186,6 +204,11 @@ static int parse_args(cli *c, cont_args *a)
                                       "--panels: '%s' is not a list of x_max, stops and psi, "
                                       "each at most once (e.g. psi or x_max,stops)",
                                       c->value);
+        } else if (cli_is(c, "--mark", true, &err)) {
+            if (c->value && !parse_mark(c->value, a))
+                err = cli_usage_error(c, "--mark: '%s' is not P=TEXT (a number, a name of 1..24 "
+                                         "characters; at most %d marks)",
+                                      c->value, MAX_MARKS);
         } else if (cli_take_size(c, 300, 300, 4096, &a->width, &a->height, &err)) {
         } else if (cli_is(c, "--json", false, &err)) {
             a->json = true;

@@ -81,6 +81,33 @@ out=$("$CM" continue --vary S=0.02:0.4 --from 1.46,0.04 --period 3 --csv p3.csv 
 [ $rc -eq 1 ] && grep -q "repeats after 1 period(s), not 3: give the period 1" <<<"$out" && [ ! -e p3.csv ] \
   || fail "continue --period 3 on a period-1 solution: $rc $out"
 
+# the diagram: branches drawn as lines (a column of pixels crosses the
+# green 1a branch between PD_1a and CS_a with no gap), and --mark's name
+# added to the label of the nearest event in every panel: with and
+# without it, the images differ only right of SN_1a (S = 0.0356), once
+# in each of the three panels
+fig=(--param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --both --start 0.3 --start 0.04 --quiet)
+"$CM" continue "${fig[@]}" --png plain.png && "$CM" continue "${fig[@]}" --mark 0.0356=N \
+  --png marked.png || fail "continue --png, --mark"
+python3 - "$HERE" plain.png marked.png <<'PY' || fail "continue's diagram: lines, --mark"
+import sys
+sys.path.insert(0, sys.argv[1])
+from pngcheck import read_png
+w, h, bpp, a, _ = read_png(sys.argv[2])
+b = read_png(sys.argv[3])[3]
+changed = [(x, y) for y in range(h) for x in range(w) if a[y][bpp * x:bpp * x + 3] != b[y][bpp * x:bpp * x + 3]]
+assert changed, "--mark changed nothing"
+rows = sorted({y for _, y in changed})
+bands = 1 + sum(1 for r, s in zip(rows, rows[1:]) if s - r > 40)
+assert bands == 3, (bands, rows[:5], rows[-5:])      # one label in each panel
+assert min(x for x, _ in changed) > 0.05 * w and max(x for x, _ in changed) < 0.4 * w, changed[:3]
+green = (26, 152, 80)
+def green_rows(x):
+    return [y for y in range(h // 3) if tuple(a[y][bpp * x:bpp * x + 3]) == green]
+assert all(green_rows(x) for x in range(w // 3, 2 * w // 3, 7)), "a gap in the 1a branch"
+PY
+expect_usage "--mark: 'N' is not P=TEXT" continue --vary S=0.02:0.4 --mark N
+
 # --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
 # fixed point, not P's) stable just below the doubling
 "$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --switch --csv pd.csv \

@@ -105,12 +105,15 @@ fo="$fo --max-steps 200"
 # solutions with their bifurcations located and labelled, from the solutions
 # that simulations settle on at the --start values. 2.17: S varied at
 # Omega = 0.5, S0 = 0.4, from 1a (S = 0.3), 2s (0.38) and 1a,9seg (0.04),
-# with the period-doubled 2a switched onto at PD_1a; 2.22 (bottom): the same
+# with the period-doubled 2a switched onto at PD_1a, and the thesis' point N
+# (S = 0.035620, where its continuation diverged) named: it is the fold
+# SN_1a at S = 0.0356144, which natural-parameter continuation cannot
+# pass; 2.22 (bottom): the same
 # branches' stop positions; 2.18: Omega varied at S = 0.32, S0 = 0.4, from
 # 1a (0.5), 0s (0.58), 2s (0.47) and 2a (0.49); 2.19: the asymmetry Psi
 # against Omega at S = 0.22, S0 = 0.4 (left) and 0.3 (right).
 fig217="--param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --both --start 0.3 --start 0.38
-  --start 0.04 --switch"
+  --start 0.04 --switch --mark 0.03562=N"
 # shellcheck disable=SC2086
 "$CM" continue $fig217 --png fig-2.17-continue.png --quiet
 # shellcheck disable=SC2086
