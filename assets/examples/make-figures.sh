@@ -87,6 +87,28 @@ fo="$fo --max-steps 200"
 "$CM" lyapunov --param S0=0.4 --grid Omega=0.2:0.7:60,S=0.005:0.4:48 --periods 600 \
   --curves "$tmp/curves-omega.csv" --curves "$tmp/curves-s.csv" --png fig-2.20-lyapunov.png \
   --size 900x700 > /dev/null
+# Fig. 2.20 (left, S0 = 0.3) and Fig. 2.21 (S0 = 0.5, 0.8): the same curves
+# from continuations where these S0 admit them (S <= S0: at S0 = 0.3 from
+# the solutions at S = 0.22 that Fig. 2.19 follows, but for the period-5
+# one near Omega = 0.45, whose curves take minutes; without the doubled
+# branches' curves, which take seconds each), over coarser heat maps
+"$CM" continue --param S=0.22,S0=0.3,Omega=0.5 --vary Omega=0.2:0.7 --both --start 0.35 \
+  --start 0.4 --start 0.5 --start 0.6 --curve S=0.005:0.3 \
+  --curves "$tmp/curves-omega-0.3.csv" --quiet
+"$CM" continue --param S=0.22,S0=0.3,Omega=0.5 --vary S=0.005:0.3 --both --start 0.22 \
+  --start 0.1 --curve Omega=0.2:0.7 --curves "$tmp/curves-s-0.3.csv" --quiet
+"$CM" lyapunov --param S0=0.3 --grid Omega=0.2:0.7:40,S=0.005:0.3:32 --periods 300 \
+  --curves "$tmp/curves-omega-0.3.csv" --curves "$tmp/curves-s-0.3.csv" \
+  --png fig-2.20-left-lyapunov.png --size 900x700 > /dev/null
+for s0 in 0.5 0.8; do
+  "$CM" continue --param S=0.32,S0=$s0,Omega=0.5 --vary Omega=0.2:0.7 --both --start 0.5 \
+    --start 0.58 --start 0.47 --curve S=0.005:0.5 --curves "$tmp/curves-omega-$s0.csv" --quiet
+  "$CM" continue --param S=0.3,S0=$s0,Omega=0.5 --vary S=0.005:0.5 --both --start 0.3 \
+    --start 0.38 --curve Omega=0.2:0.7 --curves "$tmp/curves-s-$s0.csv" --quiet
+  "$CM" lyapunov --param S0=$s0 --grid Omega=0.2:0.7:40,S=0.005:0.5:32 --periods 300 \
+    --curves "$tmp/curves-omega-$s0.csv" --curves "$tmp/curves-s-$s0.csv" \
+    --png fig-2.21-S0-$s0-lyapunov.png --size 900x700 > /dev/null
+done
 
 # Figs. 2.3 (upper panel) and 2.16: trajectories over the sticking region
 # |x - cos(Omega t)| < S0; slips red, sticks green. 2.16 starts from rest
@@ -95,6 +117,18 @@ fo="$fo --max-steps 200"
   --size 900x900 > /dev/null
 "$CM" simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 12 --png fig-2.16-simulate.png \
   --size 900x900 > /dev/null
+# Fig. 2.9: from the thesis' start (1 + 0.9 S0, 0) at S = S0 = 0.3, Omega =
+# 0.5, the extremal asymmetric solution: x_max = 1 + S, one short stick a
+# period (the last 4 of 400 periods)
+"$CM" simulate --param S=0.3,S0=0.3,Omega=0.5 --from 1.27,0 --periods 400 --skip 396 \
+  --png fig-2.9-simulate.png --size 900x900 > /dev/null
+# Fig. 2.25: at S = 0.0465, S0 = 0.4, Omega = 0.5 the orbit from (1.36, 0)
+# wanders chaotically for 135 periods (left: the first 60), then settles on
+# a period-3 solution (right: periods 150-162)
+"$CM" simulate --param S=0.0465,S0=0.4,Omega=0.5 --from 1.36,0 --periods 60 \
+  --png fig-2.25-chaotic.png --size 900x900 > /dev/null
+"$CM" simulate --param S=0.0465,S0=0.4,Omega=0.5 --from 1.36,0 --periods 162 --skip 150 \
+  --png fig-2.25-period3.png --size 900x900 > /dev/null
 
 # Fig. 2.22: Monte Carlo bifurcation diagram over S at S0 = 0.4, Omega = 0.5:
 # 10 random starts per value, 1000 periods of transients, 50 recorded
@@ -181,6 +215,16 @@ done
 # Figs. 2.4 and 2.7: amplitude-frequency diagrams, (2.25) against simulation
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --png fig-2.4-amplitude.png --quiet
 "$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --png fig-2.7-amplitude.png --quiet
+# Figs. 2.6 (left, with 2.13's simulation: S = S0 = 0.02, finer in Omega to
+# show the resonances near 1/3 and 1/5 and the asymmetric one-stick points
+# at 0.25 and 0.5), 2.6 (right) = 2.12 (a) (S = S0 = 0.3), 2.12 (c) and (d)
+# (0.7, 0.9; (b) is Fig. 2.4), and 2.14 (S = 0.2, S0 = 0.24, where the
+# asymmetric solutions' domain opens up)
+"$CM" amplitude --param S=0.02,S0=0.02 --omega 0.1:1.5:420 --png fig-2.6-2.13-amplitude.png --quiet
+for s in 0.3 0.7 0.9; do
+  "$CM" amplitude --param S=$s,S0=$s --omega 0.1:3:290 --png fig-2.12-S$s-amplitude.png --quiet
+done
+"$CM" amplitude --param S=0.2,S0=0.24 --omega 0.1:1.5:420 --png fig-2.14-amplitude.png --quiet
 
 # The example plugins' attractors (examples/plugin/): Newton's method for
 # z^3 - 1 (three roots), the Henon map (one aperiodic attractor, its
