@@ -215,16 +215,16 @@ done
 # Figs. 2.4 and 2.7: amplitude-frequency diagrams, (2.25) against simulation
 "$CM" amplitude --param S=0.5,S0=0.5 --omega 0.1:3:290 --png fig-2.4-amplitude.png --quiet
 "$CM" amplitude --param S=0.05,S0=0.05 --omega 0.1:3:290 --png fig-2.7-amplitude.png --quiet
-# Figs. 2.6 (left, with 2.13's simulation: S = S0 = 0.02, finer in Omega to
-# show the resonances near 1/3 and 1/5 and the asymmetric one-stick points
-# at 0.25 and 0.5), 2.6 (right) = 2.12 (a) (S = S0 = 0.3), 2.12 (c) and (d)
+# Figs. 2.6 (left, with 2.13's simulation: S = S0 = 0.02, Omega every
+# 0.0025 from 0.1, so that 0.25 and 0.5 are on the grid: the resonances
+# near 1/3 and 1/5 and the asymmetric one-stick points at 0.25 and 0.5), 2.6 (right) = 2.12 (a) (S = S0 = 0.3), 2.12 (c) and (d)
 # (0.7, 0.9; (b) is Fig. 2.4), and 2.14 (S = 0.2, S0 = 0.24, where the
 # asymmetric solutions' domain opens up)
-"$CM" amplitude --param S=0.02,S0=0.02 --omega 0.1:1.5:420 --png fig-2.6-2.13-amplitude.png --quiet
+"$CM" amplitude --param S=0.02,S0=0.02 --omega 0.09875:1.50125:561 --png fig-2.6-2.13-amplitude.png --quiet
 for s in 0.3 0.7 0.9; do
   "$CM" amplitude --param S=$s,S0=$s --omega 0.1:3:290 --png fig-2.12-S$s-amplitude.png --quiet
 done
-"$CM" amplitude --param S=0.2,S0=0.24 --omega 0.1:1.5:420 --png fig-2.14-amplitude.png --quiet
+"$CM" amplitude --param S=0.2,S0=0.24 --omega 0.09875:1.50125:561 --png fig-2.14-amplitude.png --quiet
 
 # The example plugins' attractors (examples/plugin/): Newton's method for
 # z^3 - 1 (three roots), the Henon map (one aperiodic attractor, its
