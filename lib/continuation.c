@@ -1,5 +1,6 @@
 /* lib/continuation.c - branches followed and written (lib/continuation.h). */
 #include "lib/continuation.h"
+#include "lib/parse.h"
 #include "lib/simulate.h"
 
 #include <math.h>
@@ -188,6 +189,42 @@ static cm_status continuation_write_curves(const cont_args *a, const cm_fo *o, c
     }
     free(points);
     return outfile_end(&out, true, msg, msg_size);
+}
+
+/* "x_max,stops,psi" (any of them, in any order, each once) into a->panels. */
+bool continuation_parse_panels(const char *text, cont_args *a)
+{
+    a->n_panels = 0;
+    bool seen[PANELS] = {false};
+    for (const char *p = text;;) {
+        const size_t len = strcspn(p, ",");
+        int k = 0;
+        while (k < PANELS && !(strlen(panel_names[k]) == len && strncmp(p, panel_names[k], len) == 0))
+            k++;
+        if (k == PANELS || seen[k])
+            return false;
+        seen[k] = true;
+        a->panels[a->n_panels++] = k;
+        if (p[len] == '\0')
+            return true;
+        p += len + 1;
+    }
+}
+
+/* --mark P=TEXT into a's marks; false if it is not one or there are too many. */
+bool continuation_parse_mark(const char *text, cont_args *a)
+{
+    const char *eq = strchr(text, '=');
+    char at[64];
+    if (a->n_marks == MAX_MARKS || !eq || eq - text >= (ptrdiff_t)sizeof at || !eq[1] ||
+        strlen(eq + 1) > 24)
+        return false;
+    memcpy(at, text, (size_t)(eq - text));
+    at[eq - text] = '\0';
+    if (!parse_double(at, &a->mark_at[a->n_marks]))
+        return false;
+    a->mark_text[a->n_marks++] = eq + 1;
+    return true;
 }
 
 /* ---- the diagram ---- */

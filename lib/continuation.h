@@ -37,6 +37,11 @@ typedef struct cont_args {
     bool json, quiet;
 } cont_args;
 
+/* --panels "x_max,stops,psi" (any of them, in any order, each once) and
+ * --mark P=TEXT (at most MAX_MARKS) into a; false if the text is none. */
+bool continuation_parse_panels(const char *text, cont_args *a);
+bool continuation_parse_mark(const char *text, cont_args *a);
+
 /* ---- the branches, collected ---- */
 
 typedef struct tagged_point {

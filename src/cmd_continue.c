@@ -84,26 +84,6 @@ static const char continue_options[] =
     "  --json              the summary and events as JSON (docs/cellmap.schema.json)\n"
     "  --quiet             no summary\n";
 
-/* "x_max,stops,psi" (any of them, in any order, each once) into a->panels. */
-static bool parse_panels(const char *text, cont_args *a)
-{
-    a->n_panels = 0;
-    bool seen[PANELS] = {false};
-    for (const char *p = text;;) {
-        const size_t len = strcspn(p, ",");
-        int k = 0;
-        while (k < PANELS && !(strlen(panel_names[k]) == len && strncmp(p, panel_names[k], len) == 0))
-            k++;
-        if (k == PANELS || seen[k])
-            return false;
-        seen[k] = true;
-        a->panels[a->n_panels++] = k;
-        if (p[len] == '\0')
-            return true;
-        p += len + 1;
-    }
-}
-
 /* NAME=LO:HI into name (size 16), lo, hi; false if it is not one. */
 static bool parse_range(const char *text, char *name, double *lo, double *hi)
 {
@@ -114,22 +94,6 @@ static bool parse_range(const char *text, char *name, double *lo, double *hi)
     memcpy(name, text, (size_t)(eq - text));
     name[eq - text] = '\0';
     return cm_fo_param_of(name) >= 0 && parse_ranges(eq + 1, lo, hi, &n, 1);
-}
-
-/* --mark P=TEXT into a's marks; false if it is not one or there are too many. */
-static bool parse_mark(const char *text, cont_args *a)
-{
-    const char *eq = strchr(text, '=');
-    char at[64];
-    if (a->n_marks == MAX_MARKS || !eq || eq - text >= (ptrdiff_t)sizeof at || !eq[1] ||
-        strlen(eq + 1) > 24)
-        return false;
-    memcpy(at, text, (size_t)(eq - text));
-    at[eq - text] = '\0';
-    if (!parse_double(at, &a->mark_at[a->n_marks]))
-        return false;
-    a->mark_text[a->n_marks++] = eq + 1;
-    return true;
 }
 
 static int parse_vary(cli *c, cont_args *a)
@@ -199,13 +163,13 @@ static int parse_args(cli *c, cont_args *a)
         } else if (cli_is(c, "--png", true, &err)) {
             a->png = c->value;
         } else if (cli_is(c, "--panels", true, &err)) {
-            if (c->value && !parse_panels(c->value, a))
+            if (c->value && !continuation_parse_panels(c->value, a))
                 err = cli_usage_error(c,
                                       "--panels: '%s' is not a list of x_max, stops and psi, "
                                       "each at most once (e.g. psi or x_max,stops)",
                                       c->value);
         } else if (cli_is(c, "--mark", true, &err)) {
-            if (c->value && !parse_mark(c->value, a))
+            if (c->value && !continuation_parse_mark(c->value, a))
                 err = cli_usage_error(c, "--mark: '%s' is not P=TEXT (a number, a name of 1..24 "
                                          "characters; at most %d marks)",
                                       c->value, MAX_MARKS);

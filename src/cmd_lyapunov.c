@@ -11,6 +11,7 @@
 
 #include "lib/work.h"
 #include "lib/lyapunov.h"
+#include "lib/lyapunov_sync.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -23,7 +24,9 @@ static const char lyapunov_help[] =
     "usage: cellmap lyapunov [--model NAME] [--model-lib P.so] [--param k=v[,k=v]]\n"
     "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X[,Y...]]\n"
     "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n"
-    "                        [--threads T]\n\n"
+    "                        [--threads T]\n"
+    "       cellmap lyapunov --method sync --q LO:HI:N [--param k=v[,k=v]] [--periods P]\n"
+    "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n\n"
     "The largest Lyapunov exponent at the centres of an N x M grid of parameters\n"
     "X and Y. For the dry friction oscillator (the default model; thesis 2.5.3,\n"
     "e.g. Omega and S at fixed S0 as Figs. 2.20-2.21) by the renormalised\n"
@@ -50,7 +53,13 @@ static const char lyapunov_help[] =
     "                      curves in the grid's two parameters) over the heat map;\n"
     "                      repeat it (up to 8) for the curves of several runs\n"
     "  --size WxH          image size (default 900x700)\n"
-    "  --threads T         OpenMP threads (default: all cores)\n";
+    "  --threads T         OpenMP threads (default: all cores)\n\n"
+    "--method sync: the friction oscillator's exponent bounded from above by\n"
+    "synchronisation (thesis 2.6.1, Fig. 2.23; docs/models.md 9.8): a copy 1e-6\n"
+    "away, coupled one way with strength q, at the N couplings of LO:HI (centres);\n"
+    "the smallest q from which every larger one pulls the copy onto the oscillator\n"
+    "within --periods (default 2000 here; the last 100 watched). --csv: q, largest\n"
+    "difference, synchronised; --png: x1 - x3 at the watched sections against q.\n";
 
 static int parse_args(cli *c, lyap_args *a)
 {
@@ -75,6 +84,16 @@ static int parse_args(cli *c, lyap_args *a)
                                           "%s=LO:HI:N",
                                           a->ax[k].name, a->ax[k].name);
             a->has_grid = 1;
+        } else if (cli_is(c, "--method", true, &err)) {
+            if (c->value && strcmp(c->value, "sync") != 0 && strcmp(c->value, "direct") != 0)
+                err = cli_usage_error(c, "--method: '%s' must be direct or sync", c->value);
+            a->method = c->value && strcmp(c->value, "sync") == 0 ? LYAP_SYNC : LYAP_DIRECT;
+        } else if (cli_is(c, "--q", true, &err)) {
+            char text[128];
+            snprintf(text, sizeof text, "q=%s", c->value ? c->value : "");
+            if (c->value && (!param_axis_parse(text, strlen(text), &a->q) || a->q.listed))
+                err = cli_usage_error(c, "--q: '%s' is not LO:HI:N (0 <= LO < HI, N <= 2000)",
+                                      c->value);
         } else if (cli_take_int(c, "--periods", 1, 1000000, &a->periods, &err)) {
         } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &a->threads, &err)) {
         } else if (cli_is(c, "--d0", true, &err)) {
@@ -102,8 +121,12 @@ static int parse_args(cli *c, lyap_args *a)
             err = cli_stray(c);
         }
     }
-    if (!err && !a->has_grid)
-        err = cli_usage_error(c, "--grid X=LO:HI:N,Y=LO:HI:M is required");
+    if (!err && a->method == LYAP_SYNC && (!a->q.n || a->has_grid || a->n_curves || a->q.lo < 0))
+        err = cli_usage_error(c, "--method sync takes --q LO:HI:N (0 <= LO) instead of --grid "
+                                 "and --curves");
+    if (!err && a->method == LYAP_DIRECT && (!a->has_grid || a->q.n))
+        err = cli_usage_error(c, "--grid X=LO:HI:N,Y=LO:HI:M is required (--q goes with "
+                                 "--method sync)");
     if (!err && a->n_curves && !a->png)
         err = cli_usage_error(c, "--curves draws over the heat map: give --png FILE too");
     if (!err && !a->csv && !a->png && !a->json)
@@ -150,6 +173,31 @@ static void print_json(const lyap_args *a, const lyap_result *s)
     json_end(&j);
 }
 
+/* --method sync: the couplings, the estimate said, the files written. */
+static int run_sync(const cli *c, lyap_args *a)
+{
+    if (a->periods == lyapunov_defaults().periods)
+        a->periods = 2000;
+    progress pr;
+    progress_start(&pr, "lyapunov", "couplings", (uint64_t)a->q.n, a->quiet);
+    const work_hooks hooks = progress_hooks(&pr);
+    interrupt_catch();
+    char msg[1024];
+    sync_result r;
+    cm_status st = lyapunov_sync(a, &hooks, &r, msg, sizeof msg);
+    progress_end(&pr);
+    if (st == CM_ECANCELED) {
+        lyapunov_sync_free(&r);
+        return interrupt_stopped("lyapunov", r.done, (uint64_t)a->q.n, "couplings");
+    }
+    if (st == CM_OK && (a->json || !a->quiet))
+        lyapunov_sync_report(a->json ? stdout : report_stream(a->csv, a->png, NULL), a, &r);
+    if (st == CM_OK)
+        st = lyapunov_sync_write(a, &r, msg, sizeof msg);
+    lyapunov_sync_free(&r);
+    return analysis_said(c->cmd, st, msg);
+}
+
 int cmd_lyapunov(int argc, char **argv)
 {
     cli c = {"lyapunov", argc, argv, 0, NULL, NULL};
@@ -162,6 +210,8 @@ int cmd_lyapunov(int argc, char **argv)
         werr = chart_png_check("lyapunov", a.png);
     if (werr != EXIT_OK)
         return werr;
+    if (a.method == LYAP_SYNC)
+        return run_sync(&c, &a);
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, NULL, a.ax, 2, &base);
     if (verr)

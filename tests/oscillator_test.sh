@@ -108,6 +108,29 @@ assert all(green_rows(x) for x in range(w // 3, 2 * w // 3, 7)), "a gap in the 1
 PY
 expect_usage "--mark: 'N' is not P=TEXT" continue --vary S=0.02:0.4 --mark N
 
+# --method sync (Fig. 2.23): the coupling that pulls a copy onto the
+# oscillator bounds the direct exponent from above, and lies close to it
+# (docs/models.md 9.8); the same CSV on one thread and two; bad input
+"$CM" lyapunov --param S0=0.4 --grid Omega=0.5,S=0.05 --csv direct.csv --quiet &&
+"$CM" lyapunov --method sync --param S=0.05,S0=0.4,Omega=0.5 --q 0:0.01:20 --csv sync.csv \
+  --json > sync.json && "$CM" lyapunov --method sync --param S=0.05,S0=0.4,Omega=0.5 \
+  --q 0:0.01:20 --csv sync1.csv --threads 1 --quiet || fail "lyapunov --method sync"
+cmp -s sync.csv sync1.csv || fail "lyapunov --method sync: the CSV depends on the thread count"
+python3 - direct.csv sync.csv sync.json <<'PY' || fail "lyapunov --method sync: the estimate"
+import csv, json, sys
+direct = float(list(csv.DictReader(open(sys.argv[1])))[0]["lambda"])
+rows = list(csv.DictReader(open(sys.argv[2])))
+q = json.load(open(sys.argv[3]))["q_sync"]
+assert 0.004 < direct < 0.005, direct
+assert direct <= q <= 1.25 * direct, (direct, q)          # an upper bound, and a close one
+assert [r["synchronised"] for r in rows] == ["0"] * 10 + ["1"] * 10, [r["synchronised"] for r in rows]
+assert all(float(r["largest_difference"]) > 1e-3 for r in rows[:10]), rows[:10]
+PY
+expect_usage "--method sync takes --q LO:HI:N" lyapunov --method sync --grid Omega=0.5,S=0.05 --csv x.csv
+expect_usage "--q goes with --method sync" lyapunov --q 0:0.01:10 --csv x.csv
+expect_usage "--method: 'fast' must be direct or sync" lyapunov --method fast --q 0:1:2
+expect_usage "--q: '0.01:0:5' is not LO:HI:N" lyapunov --method sync --q 0.01:0:5
+
 # --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
 # fixed point, not P's) stable just below the doubling
 "$CM" continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --switch --csv pd.csv \
