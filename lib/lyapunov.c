@@ -236,8 +236,15 @@ static bool write_png(const lyap_args *a, const char *model, const cm_params *p,
 
 lyap_args lyapunov_defaults(void)
 {
-    return (lyap_args){.mo = {.name = "friction-oscillator"}, .periods = 600, .d0 = 1e-8,
-                       .width = 900, .height = 700};
+    return (lyap_args){.mo = {.name = "friction-oscillator"},
+                       .periods = 600,
+                       .d0 = 1e-8,
+                       .width = 900,
+                       .height = 700,
+                       .every = 3,
+                       .runs = 200,
+                       .seed = 1,
+                       .escape = 0.01};
 }
 
 /* The request's own limits (the command checks them as it parses). */

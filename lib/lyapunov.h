@@ -18,15 +18,19 @@
 /* The most --curves files a map takes. */
 enum { MAX_CURVE_FILES = 8 };
 
-enum { LYAP_DIRECT = 0, LYAP_SYNC };
+enum { LYAP_DIRECT = 0, LYAP_SYNC, LYAP_STICKMAP };
 
 /* The grid, the estimator's settings and the outputs (the command's options). */
 typedef struct lyap_args {
     model_spec mo;
     param_axis ax[2];
     int has_grid, periods, threads, width, height, n_from;
-    int method;       /* LYAP_DIRECT or LYAP_SYNC (lib/lyapunov_sync.h) */
+    int method;       /* LYAP_DIRECT, LYAP_SYNC (lib/lyapunov_sync.h) or LYAP_STICKMAP
+                         (lib/stick_map.h) */
     param_axis q;     /* --method sync: the couplings */
+    int every, runs;  /* --method stickmap: every k-th stick, from so many starts */
+    long long seed;
+    double escape;
     double d0, from[CM_MAX_DIM];
     const char *csv, *png, *curves[MAX_CURVE_FILES];
     int n_curves;

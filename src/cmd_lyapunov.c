@@ -11,7 +11,7 @@
 
 #include "lib/work.h"
 #include "lib/lyapunov.h"
-#include "lib/lyapunov_sync.h"
+#include "lib/lyapunov_method.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
@@ -25,8 +25,8 @@ static const char lyapunov_help[] =
     "                        --grid X=LO:HI:N,Y=LO:HI:M [--periods P] [--d0 D] [--from X[,Y...]]\n"
     "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n"
     "                        [--threads T]\n"
-    "       cellmap lyapunov --method sync --q LO:HI:N [--param k=v[,k=v]] [--periods P]\n"
-    "                        [--csv FILE|-] [--png FILE] [--json] [--quiet] [--size WxH]\n\n"
+    "       cellmap lyapunov --method sync --q LO:HI:N | --method stickmap [--every K]\n"
+    "                        [--runs N] [--escape E]; --param, --periods and the outputs\n\n"
     "The largest Lyapunov exponent at the centres of an N x M grid of parameters\n"
     "X and Y. For the dry friction oscillator (the default model; thesis 2.5.3,\n"
     "e.g. Omega and S at fixed S0 as Figs. 2.20-2.21) by the renormalised\n"
@@ -54,12 +54,12 @@ static const char lyapunov_help[] =
     "                      repeat it (up to 8) for the curves of several runs\n"
     "  --size WxH          image size (default 900x700)\n"
     "  --threads T         OpenMP threads (default: all cores)\n\n"
-    "--method sync: the friction oscillator's exponent bounded from above by\n"
-    "synchronisation (thesis 2.6.1, Fig. 2.23; docs/models.md 9.8): a copy 1e-6\n"
-    "away, coupled one way with strength q, at the N couplings of LO:HI (centres);\n"
-    "the smallest q from which every larger one pulls the copy onto the oscillator\n"
-    "within --periods (default 2000 here; the last 100 watched). --csv: q, largest\n"
-    "difference, synchronised; --png: x1 - x3 at the watched sections against q.\n";
+    "--method sync: the exponent bounded by synchronisation (thesis 2.6.1, Fig. 2.23): a\n"
+    "copy 1e-6 away coupled one way with strength q at the N couplings of LO:HI; the\n"
+    "smallest q from which every larger one pulls it on (--periods 2000, the last 100\n"
+    "watched). --method stickmap: the map of every K-th (3) stick from N (200) random\n"
+    "starts over --periods (1500), and its chaotic transient's exponent until an orbit\n"
+    "comes within E (0.01) of a fixed point (2.6.2, Fig. 2.26). docs/models.md 9.8.\n";
 
 static int parse_args(cli *c, lyap_args *a)
 {
@@ -85,9 +85,12 @@ static int parse_args(cli *c, lyap_args *a)
                                           a->ax[k].name, a->ax[k].name);
             a->has_grid = 1;
         } else if (cli_is(c, "--method", true, &err)) {
-            if (c->value && strcmp(c->value, "sync") != 0 && strcmp(c->value, "direct") != 0)
-                err = cli_usage_error(c, "--method: '%s' must be direct or sync", c->value);
-            a->method = c->value && strcmp(c->value, "sync") == 0 ? LYAP_SYNC : LYAP_DIRECT;
+            if (c->value && (a->method = lyapunov_method_of(c->value)) < 0)
+                err = cli_usage_error(c, "--method: '%s' must be direct, sync or stickmap",
+                                      c->value);
+        } else if (cli_take_int(c, "--every", 1, 64, &a->every, &err) ||
+                   cli_take_int(c, "--runs", 1, 10000, &a->runs, &err) ||
+                   cli_take_double(c, "--escape", 1e-9, 1, &a->escape, &err)) {
         } else if (cli_is(c, "--q", true, &err)) {
             char text[128];
             snprintf(text, sizeof text, "q=%s", c->value ? c->value : "");
@@ -121,6 +124,8 @@ static int parse_args(cli *c, lyap_args *a)
             err = cli_stray(c);
         }
     }
+    if (!err && a->method == LYAP_STICKMAP && (a->q.n || a->has_grid || a->n_curves))
+        err = cli_usage_error(c, "--method stickmap takes no --grid, --q or --curves");
     if (!err && a->method == LYAP_SYNC && (!a->q.n || a->has_grid || a->n_curves || a->q.lo < 0))
         err = cli_usage_error(c, "--method sync takes --q LO:HI:N (0 <= LO) instead of --grid "
                                  "and --curves");
@@ -173,29 +178,29 @@ static void print_json(const lyap_args *a, const lyap_result *s)
     json_end(&j);
 }
 
-/* --method sync: the couplings, the estimate said, the files written. */
-static int run_sync(const cli *c, lyap_args *a)
+/* --method sync or stickmap: the estimate computed, said and written. */
+static int run_method(const cli *c, lyap_args *a)
 {
+    const bool sync = a->method == LYAP_SYNC;
     if (a->periods == lyapunov_defaults().periods)
-        a->periods = 2000;
+        a->periods = sync ? 2000 : 1500;
+    const uint64_t units = sync ? (uint64_t)a->q.n : (uint64_t)a->runs;
+    const char *unit = sync ? "couplings" : "runs";
     progress pr;
-    progress_start(&pr, "lyapunov", "couplings", (uint64_t)a->q.n, a->quiet);
+    progress_start(&pr, "lyapunov", unit, units, a->quiet);
     const work_hooks hooks = progress_hooks(&pr);
     interrupt_catch();
     char msg[1024];
-    sync_result r;
-    cm_status st = lyapunov_sync(a, &hooks, &r, msg, sizeof msg);
+    lyap_method_result r;
+    cm_status st = lyapunov_method_compute(a, &hooks, &r, msg, sizeof msg);
     progress_end(&pr);
-    if (st == CM_ECANCELED) {
-        lyapunov_sync_free(&r);
-        return interrupt_stopped("lyapunov", r.done, (uint64_t)a->q.n, "couplings");
-    }
     if (st == CM_OK && (a->json || !a->quiet))
-        lyapunov_sync_report(a->json ? stdout : report_stream(a->csv, a->png, NULL), a, &r);
+        lyapunov_method_report(a->json ? stdout : report_stream(a->csv, a->png, NULL), a, &r);
     if (st == CM_OK)
-        st = lyapunov_sync_write(a, &r, msg, sizeof msg);
-    lyapunov_sync_free(&r);
-    return analysis_said(c->cmd, st, msg);
+        st = lyapunov_method_write(a, &r, msg, sizeof msg);
+    lyapunov_method_free(&r);
+    return st == CM_ECANCELED ? interrupt_stopped("lyapunov", r.done, units, unit)
+                              : analysis_said(c->cmd, st, msg);
 }
 
 int cmd_lyapunov(int argc, char **argv)
@@ -210,8 +215,8 @@ int cmd_lyapunov(int argc, char **argv)
         werr = chart_png_check("lyapunov", a.png);
     if (werr != EXIT_OK)
         return werr;
-    if (a.method == LYAP_SYNC)
-        return run_sync(&c, &a);
+    if (a.method != LYAP_DIRECT)
+        return run_method(&c, &a);
     cm_params base;
     const int verr = sweep_check(&c, &a.mo, NULL, a.ax, 2, &base);
     if (verr)

@@ -51,6 +51,7 @@ run equilibria-curve equilibria --model chip-4d --from 1,0.1,0.2,0.25 --branch x
   --curve zeta=21,21.5 --json
 run lyapunov lyapunov --param S0=0.4 --grid Omega=0.49:0.51:2,S=0.3:0.5:2 --periods 50 --json
 run lyapunov_sync lyapunov --method sync --param S=0.05,S0=0.4,Omega=0.5 --q 0:0.01:2 --periods 200 --json
+run lyapunov_stickmap lyapunov --method stickmap --param S=0.0465,S0=0.4,Omega=0.5 --runs 4 --periods 300 --json
 run bifurcation bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.28:0.44:2 --transient 20 --record 5 --json
 run bifurcation-map bifurcation --model chip-4d --sweep xi=3.5,4.8 --runs 1 --transient 10 --record 5 --json
 run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json

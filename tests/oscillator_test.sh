@@ -128,8 +128,31 @@ assert all(float(r["largest_difference"]) > 1e-3 for r in rows[:10]), rows[:10]
 PY
 expect_usage "--method sync takes --q LO:HI:N" lyapunov --method sync --grid Omega=0.5,S=0.05 --csv x.csv
 expect_usage "--q goes with --method sync" lyapunov --q 0:0.01:10 --csv x.csv
-expect_usage "--method: 'fast' must be direct or sync" lyapunov --method fast --q 0:1:2
+expect_usage "--method: 'fast' must be direct, sync or stickmap" lyapunov --method fast --q 0:1:2
 expect_usage "--q: '0.01:0:5' is not LO:HI:N" lyapunov --method sync --q 0.01:0:5
+
+# --method stickmap (Figs. 2.25-2.26): the map of every third stick at S =
+# 0.0465 and its transient's exponent, within 10 % of the thesis' lambda_map
+# = 0.2167 and lambda_flow = 0.005748, a map step three periods (37.7);
+# the same points on one thread and two
+stick=(--method stickmap --param S=0.0465,S0=0.4,Omega=0.5)
+"$CM" lyapunov "${stick[@]}" --csv stick.csv --json > stick.json &&
+"$CM" lyapunov "${stick[@]}" --csv stick1.csv --threads 1 --quiet || fail "lyapunov --method stickmap"
+cmp -s stick.csv stick1.csv || fail "lyapunov --method stickmap: the CSV depends on the thread count"
+python3 - stick.json stick.csv <<'PY' || fail "lyapunov --method stickmap: the estimate"
+import csv, json, math, sys
+j = json.load(open(sys.argv[1]))
+assert abs(j["lambda_map"] - 0.2167) < 0.1 * 0.2167, j
+assert abs(j["lambda_flow"] - 0.005748) < 0.1 * 0.005748, j
+assert abs(j["step_time"] - 3 * 4 * math.pi) < 0.5, j
+rows = list(csv.DictReader(open(sys.argv[2])))
+counted = [r for r in rows if r["counted"] == "1"]
+assert len(counted) == j["counted"] > 10000, (len(counted), j["counted"])
+# the period-3 orbit's three sticks are fixed points of the map (Fig. 2.26's red dots)
+fixed = {round(float(r["x"]), 4) for r in rows if abs(float(r["x"]) - float(r["x_next"])) < 1e-9}
+assert {0.845, 0.8581, 1.0606} <= fixed, sorted(fixed)[:12]
+PY
+expect_usage "--method stickmap takes no --grid" lyapunov --method stickmap --grid Omega=0.5,S=0.05 --csv x.csv
 
 # --switch: the period-doubled branch from PD_1a, a period-2 solution (P^2's
 # fixed point, not P's) stable just below the doubling
