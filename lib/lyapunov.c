@@ -361,3 +361,22 @@ void lyapunov_result_free(lyap_result *r)
     r->v = NULL;
     lyapunov_overlay_free(&r->ov);
 }
+
+cm_status lyapunov_fo_base(const lyap_args *a, const char *method, cm_params *base, char *msg,
+                           size_t msg_size)
+{
+    if (strcmp(a->mo.name, "friction-oscillator") != 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "--method %s follows the dry friction oscillator: use --model "
+                       "friction-oscillator (the default)",
+                       method);
+    const cm_status st = param_sweep_base(&a->mo, NULL, &a->q, 0, base, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    const double S = cm_params_get(base, "S"), S0 = cm_params_get(base, "S0");
+    return S <= S0 ? CM_OK
+                   : cm_fail(CM_EINVAL, msg, msg_size,
+                             "S = %g is above S0 = %g: static friction must be at least the "
+                             "kinetic one",
+                             S, S0);
+}

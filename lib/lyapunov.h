@@ -77,6 +77,11 @@ cm_status lyapunov_write(const lyap_args *a, lyap_result *r, char *msg, size_t m
 
 void lyapunov_result_free(lyap_result *r);
 
+/* For --method `method` (sync, stickmap): the friction oscillator's
+ * parameters of a->mo into base; CM_EINVAL for another model or S > S0. */
+cm_status lyapunov_fo_base(const lyap_args *a, const char *method, cm_params *base, char *msg,
+                           size_t msg_size);
+
 /* Every curves file of a, read into ov (the caller's to free with
  * lyapunov_overlay_free, whatever the result): CM_EINVAL when a file is
  * not curves in the grid's parameters. lyapunov_compute reads them; the

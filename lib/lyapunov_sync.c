@@ -19,22 +19,15 @@ enum { SYNC_STEPS = 200 };
 static cm_status sync_setup(const lyap_args *a, sync_result *r, cm_fo_sync *c, char *msg,
                             size_t msg_size)
 {
-    if (strcmp(a->mo.name, "friction-oscillator") != 0)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--method sync couples two friction oscillators: use --model "
-                       "friction-oscillator (the default)");
     if (a->periods < SYNC_RECORD + 100)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "--method sync watches the last %d periods after a transient of 100 or "
                        "more: give --periods %d or more",
                        SYNC_RECORD, SYNC_RECORD + 100);
-    cm_status st = param_sweep_base(&a->mo, NULL, &a->q, 0, &r->base, msg, msg_size);
+    const cm_status st = lyapunov_fo_base(a, "sync", &r->base, msg, msg_size);
     if (st != CM_OK)
         return st;
     const double S = cm_params_get(&r->base, "S"), S0 = cm_params_get(&r->base, "S0");
-    if (!(S <= S0))
-        return cm_fail(CM_EINVAL, msg, msg_size, "S = %g is above S0 = %g: static friction "
-                       "must be at least the kinetic one", S, S0);
     /* the thesis' start, the copy 1e-6 away: a copy started far off can
      * settle on the mirror-image attractor and needs a stronger coupling
      * than the exponent to be pulled over (docs/models.md 9.8) */

@@ -54,18 +54,11 @@ static void one_run(const lyap_args *a, const cm_fo *o, int run, double *x, doub
 static cm_status setup(const lyap_args *a, stick_map_result *r, cm_fo *o, char *msg,
                        size_t msg_size)
 {
-    if (strcmp(a->mo.name, "friction-oscillator") != 0)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "--method stickmap follows the friction oscillator's sticks: use --model "
-                       "friction-oscillator (the default)");
-    const cm_status st = param_sweep_base(&a->mo, NULL, &a->q, 0, &r->base, msg, msg_size);
+    const cm_status st = lyapunov_fo_base(a, "stickmap", &r->base, msg, msg_size);
     if (st != CM_OK)
         return st;
-    const double S = cm_params_get(&r->base, "S"), S0 = cm_params_get(&r->base, "S0");
-    if (!(S <= S0))
-        return cm_fail(CM_EINVAL, msg, msg_size, "S = %g is above S0 = %g: static friction "
-                       "must be at least the kinetic one", S, S0);
-    cm_fo_init(o, S, S0, cm_params_get(&r->base, "Omega"), 0);
+    cm_fo_init(o, cm_params_get(&r->base, "S"), cm_params_get(&r->base, "S0"),
+               cm_params_get(&r->base, "Omega"), 0);
     const size_t room = (size_t)a->runs * STICKS_PER_RUN;
     r->x = malloc(room * sizeof *r->x);
     r->y = malloc(room * sizeof *r->y);

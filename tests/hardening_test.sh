@@ -217,10 +217,11 @@ for _ in $(seq 200); do [ -s holder.txt ] && break; sleep 0.05; done
 exec 3>&-
 wait $holder || fail "the first writer failed"
 
-# OSMesa is loaded only to draw: commands that draw nothing run without it,
-# and one that would draw stops before its work, naming the library
-ldd "$CM" | grep -q OSMesa && fail "cellmap links OSMesa at start"
-export CELLMAP_OSMESA=$work/no-such-libOSMesa.so
+# The GL stack (OSMesa, else EGL) is loaded only to draw: commands that draw
+# nothing run without either, and one that would draw stops before its
+# work, naming the libraries
+ldd "$CM" | grep -qE "OSMesa|libEGL" && fail "cellmap links OSMesa or EGL at start"
+export CELLMAP_OSMESA=$work/no-such-libOSMesa.so CELLMAP_EGL=$work/no-such-libEGL.so
 "$CM" solve --cells 40x40 > out.txt 2> err.txt || fail "solve without a PNG needs OSMesa: $(cat err.txt)"
 "$CM" info good.cmdb > /dev/null 2> err.txt || fail "info needs OSMesa: $(cat err.txt)"
 "$CM" export good.cmdb --cells cells.csv 2> err.txt || fail "export needs OSMesa: $(cat err.txt)"
@@ -228,12 +229,12 @@ for args in "solve --cells 40x40 --png g.png" "render good.cmdb --png g.png" \
             "lyapunov --grid S=0:0.5:2,Omega=0.5:1:2 --periods 5 --png g.png" \
             "simulate --model friction-oscillator --from 0.1,0 --periods 5 --png g.png"; do
   $CM $args > out.txt 2> err.txt; rc=$?
-  [ $rc -eq 1 ] && grep -q "cannot load OSMesa.*libosmesa6" err.txt \
+  [ $rc -eq 1 ] && grep -q "cannot load a GL library.*no-such-libOSMesa.*no-such-libEGL.*libosmesa6" err.txt \
     || fail "cellmap $args without OSMesa: exit $rc, $(cat err.txt)"
   [ -s out.txt ] && fail "cellmap $args worked before finding OSMesa missing: $(head -2 out.txt)"
   [ -e g.png ] && fail "cellmap $args left g.png"
 done
-unset CELLMAP_OSMESA
+unset CELLMAP_OSMESA CELLMAP_EGL
 
 [ $fails -eq 0 ] && echo "hardening_test: all passed"
 exit $((fails > 0))
