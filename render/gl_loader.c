@@ -132,12 +132,12 @@ static void resolve_gl(any_function (*get)(const char *), cm_gl_backend backend)
 {
 #define CM_GL_RESOLVE(ret, name, params, args)                                                     \
     {                                                                                              \
-        any_function p = get(#name);                                                               \
         const bool needed = strncmp(#name, "OSMesa", 6) == 0 ? backend == CM_GL_OSMESA            \
                             : strstr(#name, "buffer") || strcmp(#name, "glReadPixels") == 0 ||    \
                                     strcmp(#name, "glClipControl") == 0                            \
                                 ? backend == CM_GL_EGL                                             \
                                 : true;                                                            \
+        any_function p = needed ? get(#name) : NULL;                                               \
         if (!p && needed && !load_error[0])                                                        \
             snprintf(load_error, sizeof load_error, "the GL library lacks %s", #name);             \
         memcpy(&entry.name, &p, sizeof p);                                                         \
