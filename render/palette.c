@@ -353,7 +353,8 @@ static void assign_colours(const cm_palette *p, const ranked *order, uint32_t co
         class_seen[c] = seen_of(cm_class_colour(p, c));
     int *decided = nb ? malloc(((size_t)n + 2) * sizeof *decided) : NULL; /* class or -1 */
     int *near = nb ? malloc(((size_t)n + 2) * sizeof *near) : NULL;
-    if (decided && near) {
+    const bool rule = decided && near; /* out of memory: no neighbour rule */
+    if (rule) {
         decided[0] = CM_CLASS_SINK;
         decided[n + 1] = CM_CLASS_NOT_COMPUTED;
         for (uint32_t k = 0; k < n; k++) /* sticking and "other" are fixed */
@@ -367,14 +368,13 @@ static void assign_colours(const cm_palette *p, const ranked *order, uint32_t co
             memset(taken, 0, sizeof taken);
         const uint32_t item = order[r].index + 1;
         size_t nnear = 0;
-        for (uint32_t k = decided && near ? nb->start[item] : 0;
-             decided && near && k < nb->start[item + 1]; k++)
+        for (uint32_t k = rule ? nb->start[item] : 0; rule && k < nb->start[item + 1]; k++)
             if (decided[nb->item[k]] >= 0)
                 near[nnear++] = decided[nb->item[k]];
         const size_t c = choose_colour(order[r].hash % size, size, taken, near, nnear, class_seen);
         taken[c] = true;
         classes[order[r].index] = (uint8_t)(CM_CLASS_FIRST_GROUP + c);
-        if (decided && near)
+        if (rule)
             decided[item] = classes[order[r].index];
     }
     free(decided);
