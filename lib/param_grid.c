@@ -123,6 +123,18 @@ void param_base_json(json *j, const char *model, const cm_params *base)
     json_raw(j, "params", params);
 }
 
+/* Whether name is one of the list "a or b or c". */
+static bool name_listed(const char *name, const char *list)
+{
+    const size_t n = strlen(name);
+    for (const char *p = list;; p += 4) {
+        if (strncmp(p, name, n) == 0 && (p[n] == '\0' || p[n] == ' '))
+            return true;
+        if (!(p = strstr(p, " or ")))
+            return false;
+    }
+}
+
 cm_status param_sweep_base(const model_spec *mo, const char *only, const param_axis *ax,
                            int n_ax, cm_params *base, char *msg, size_t msg_size)
 {
@@ -130,7 +142,7 @@ cm_status param_sweep_base(const model_spec *mo, const char *only, const param_a
     if (!e)
         return cm_fail(CM_EINVAL, msg, msg_size, "unknown model '%s' (`cellmap models` lists them)",
                        mo->name);
-    if (only && strcmp(e->name, only) != 0)
+    if (only && !name_listed(e->name, only))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "model %s: this command is implemented for %s only", e->name, only);
     cm_status st = cm_params_defaults(e->params, base, msg, msg_size);

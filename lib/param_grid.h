@@ -50,7 +50,7 @@ void param_axes_json(json *j, const char *key, const param_axis *ax, int n_ax);
 void param_base_json(json *j, const char *model, const cm_params *base);
 
 /* Checks a model named for a sweep of its parameters: it exists (and is
- * `only`, unless that is NULL), the parameter texts are valid and each
+ * one of `only`, "a or b", unless that is NULL), the parameter texts are valid and each
  * axis names a parameter (CM_EINVAL, the problem in msg). *base receives
  * the parameters without the axes' values (for the PNG texts). */
 cm_status param_sweep_base(const model_spec *mo, const char *only, const param_axis *ax,

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "lib/figure.h"
+#include "lib/json.h"
 #include "models/params.h"
 
 enum { CHARTS = 3 };
@@ -204,4 +205,58 @@ void stability_result_free(stab_result *r)
 {
     free(r->rows);
     r->rows = NULL;
+}
+
+void stability_report(FILE *f, double alpha, double beta, double P, double D)
+{
+    const double Pmax = cm_pd_P_max(alpha, beta), Pq = cm_pd_P_quick(alpha, beta);
+    cm_pd_eigen_curves q;
+    cm_pd_eigen_curves_at(alpha, beta, Pq, &q);
+    fprintf(f, "alpha = %s, beta = %s: x = 0 is stable without quantisation for %.9g < P <= "
+               "%.9g (P_max, where D = %.9g), D_b1(P) < D < D_b0(P) (C.45)-(C.47)\n",
+            CM_NUM(alpha), CM_NUM(beta), alpha * alpha, Pmax, cm_pd_D_at_P_max(alpha, beta));
+    fprintf(f, "  deadbeat (both eigenvalues of S zero): P_quick = %.9g, D = %.9g (C.56)\n", Pq,
+            q.D_0);
+    stab_row r;
+    stability_row_at(alpha, beta, P, D, &r);
+    fprintf(f, "at P = %s, D = %s: %s", CM_NUM(P), CM_NUM(D),
+            r.st.stable ? "stable" : "not stable");
+    if (P > alpha * alpha)
+        fprintf(f, " (D_b1 = %.9g, D_b0 = %.9g)", r.st.D_b1, r.st.D_b0);
+    fprintf(f, "\n");
+    if (r.m_fix_max < 0) {
+        fprintf(f, "  P <= alpha^2: the fixed points are unbounded (4.73 needs P > alpha^2)\n");
+        return;
+    }
+    fprintf(f, "  regular fixed points m = -%lld..%lld: %lld (4.73)-(4.75); strange sets up to "
+               "|m| = %lld at x = m/P (4.76)\n",
+            (long long)r.m_fix_max, (long long)r.m_fix_max, (long long)(2 * r.m_fix_max + 1),
+            (long long)r.m_max);
+    fprintf(f, "  control error: m_max/P = %.9g (4.78), 1/(P - alpha^2) = %.9g (4.79)-(4.80)\n",
+            r.x_max_sw, r.x_max);
+}
+
+void stability_json(const char *model, const cm_params *p, double alpha, double beta, double P,
+                    double D)
+{
+    stab_row r;
+    stability_row_at(alpha, beta, P, D, &r);
+    const double Pq = cm_pd_P_quick(alpha, beta);
+    cm_pd_eigen_curves q;
+    cm_pd_eigen_curves_at(alpha, beta, Pq, &q);
+    json j;
+    json_begin(&j, stdout, "stability");
+    param_base_json(&j, model, p);
+    json_num(&j, "P_min", alpha * alpha);
+    json_num(&j, "P_max", cm_pd_P_max(alpha, beta));
+    json_num(&j, "D_at_P_max", cm_pd_D_at_P_max(alpha, beta));
+    json_nums(&j, "quick", (const double[2]){Pq, q.D_0}, 2);
+    json_bool(&j, "stable", r.st.stable);
+    json_nums(&j, "D_range", (const double[2]){r.st.D_b1, r.st.D_b0}, 2);
+    json_int(&j, "m_fix_max", r.m_fix_max);
+    json_int(&j, "n_fixed", r.m_fix_max >= 0 ? 2 * r.m_fix_max + 1 : -1);
+    json_int(&j, "m_max", r.m_max);
+    json_num(&j, "x_max_sw", r.x_max_sw);
+    json_num(&j, "x_max", r.x_max);
+    json_end(&j);
 }

@@ -10,6 +10,7 @@
 #define CM_LIB_STABILITY_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
@@ -54,5 +55,11 @@ cm_status stability_compute(stab_args *a, stab_result *r, char *msg, size_t msg_
 cm_status stability_write(const stab_args *a, const stab_result *r, char *msg, size_t msg_size);
 
 void stability_result_free(stab_result *r);
+
+/* What the model's point is (stable or not, its fixed points, the control
+ * error), as text to f and as a JSON document on standard output. */
+void stability_report(FILE *f, double alpha, double beta, double P, double D);
+void stability_json(const char *model, const cm_params *p, double alpha, double beta, double P,
+                    double D);
 
 #endif

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib/delay_domains.h"
 #include "lib/stability.h"
 #include "src/args.h"
 #include "src/figure_opts.h"
@@ -18,7 +19,8 @@
 #include "lib/param_grid.h"
 
 static const char stability_help[] =
-    "usage: cellmap stability [--model microchaos-pd] [--param k=v[,k=v]] [--P LO:HI:N]\n"
+    "usage: cellmap stability [--model microchaos-pd|microchaos-delay] [--param k=v[,k=v]]\n"
+    "                         [--P LO:HI:N]\n"
     "                         [--alpha LO:HI:N] [--csv FILE|-] [--png FILE] [--size WxH]\n"
     "                         [--json] [--quiet]\n\n"
     "The analytic charts of the PD-controlled micro-chaos map (thesis 4.5, App. C.4,\n"
@@ -42,7 +44,13 @@ static const char stability_help[] =
     "                      fewest at P_max against alpha (Fig. 4.14, right)\n"
     "  --size WxH          image size (default 900x1200)\n"
     "  --json              the summary as JSON on standard output\n"
-    "  --quiet             no summary\n";
+    "  --quiet             no summary\n\n"
+    "With --model microchaos-delay, the delay map's (a, b) plane (4.39, App. C.3,\n"
+    "docs/models.md 5.4): the stable domain G (Fig. 4.8); the domains '01' and '012'\n"
+    "where the attractor is whole basic branches on U_0, U_1 (and U_2) with their\n"
+    "boundary curves (Fig. 4.10); where the partitions of App. C.3.2 are primitive\n"
+    "(Fig. C.3). The --param point is marked and placed, with the lines U_k its orbit\n"
+    "lands on as the check; --csv gives the curves against a.\n";
 
 static int take_axis(cli *c, const char *opt, const char *name, param_axis *ax, int *has,
                      int *err)
@@ -82,58 +90,22 @@ static int parse_args(cli *c, stab_args *a)
 }
 
 
-static void print_summary(FILE *f, double alpha, double beta, double P, double D)
+/* The delay map's parameter domains (lib/delay_domains.h). */
+static int delay_domains(const cli *c, const stab_args *a, const cm_params *base)
 {
-    const double Pmax = cm_pd_P_max(alpha, beta), Pq = cm_pd_P_quick(alpha, beta);
-    cm_pd_eigen_curves q;
-    cm_pd_eigen_curves_at(alpha, beta, Pq, &q);
-    fprintf(f, "alpha = %s, beta = %s: x = 0 is stable without quantisation for %.9g < P <= "
-               "%.9g (P_max, where D = %.9g), D_b1(P) < D < D_b0(P) (C.45)-(C.47)\n",
-            CM_NUM(alpha), CM_NUM(beta), alpha * alpha, Pmax, cm_pd_D_at_P_max(alpha, beta));
-    fprintf(f, "  deadbeat (both eigenvalues of S zero): P_quick = %.9g, D = %.9g (C.56)\n", Pq,
-            q.D_0);
-    stab_row r;
-    stability_row_at(alpha, beta, P, D, &r);
-    fprintf(f, "at P = %s, D = %s: %s", CM_NUM(P), CM_NUM(D),
-            r.st.stable ? "stable" : "not stable");
-    if (P > alpha * alpha)
-        fprintf(f, " (D_b1 = %.9g, D_b0 = %.9g)", r.st.D_b1, r.st.D_b0);
-    fprintf(f, "\n");
-    if (r.m_fix_max < 0) {
-        fprintf(f, "  P <= alpha^2: the fixed points are unbounded (4.73 needs P > alpha^2)\n");
-        return;
+    const delay_point pt = delay_point_at(cm_params_get(base, "a"), cm_params_get(base, "b"));
+    if (a->out.json) {
+        json j;
+        json_begin(&j, stdout, "stability");
+        param_base_json(&j, a->mo.name, base);
+        delay_domains_json(&j, &pt);
+        json_end(&j);
+    } else if (!a->out.quiet) {
+        delay_domains_report(report_stream(a->out.csv, a->out.png, NULL), &pt);
     }
-    fprintf(f, "  regular fixed points m = -%lld..%lld: %lld (4.73)-(4.75); strange sets up to "
-               "|m| = %lld at x = m/P (4.76)\n",
-            (long long)r.m_fix_max, (long long)r.m_fix_max, (long long)(2 * r.m_fix_max + 1),
-            (long long)r.m_max);
-    fprintf(f, "  control error: m_max/P = %.9g (4.78), 1/(P - alpha^2) = %.9g (4.79)-(4.80)\n",
-            r.x_max_sw, r.x_max);
-}
-
-static void print_json(const stab_args *a, const cm_params *p, double alpha, double beta,
-                       double P, double D)
-{
-    stab_row r;
-    stability_row_at(alpha, beta, P, D, &r);
-    const double Pq = cm_pd_P_quick(alpha, beta);
-    cm_pd_eigen_curves q;
-    cm_pd_eigen_curves_at(alpha, beta, Pq, &q);
-    json j;
-    json_begin(&j, stdout, "stability");
-    param_base_json(&j, a->mo.name, p);
-    json_num(&j, "P_min", alpha * alpha);
-    json_num(&j, "P_max", cm_pd_P_max(alpha, beta));
-    json_num(&j, "D_at_P_max", cm_pd_D_at_P_max(alpha, beta));
-    json_nums(&j, "quick", (const double[2]){Pq, q.D_0}, 2);
-    json_bool(&j, "stable", r.st.stable);
-    json_nums(&j, "D_range", (const double[2]){r.st.D_b1, r.st.D_b0}, 2);
-    json_int(&j, "m_fix_max", r.m_fix_max);
-    json_int(&j, "n_fixed", r.m_fix_max >= 0 ? 2 * r.m_fix_max + 1 : -1);
-    json_int(&j, "m_max", r.m_max);
-    json_num(&j, "x_max_sw", r.x_max_sw);
-    json_num(&j, "x_max", r.x_max);
-    json_end(&j);
+    char msg[1024];
+    return analysis_said(c->cmd, delay_domains_write(&a->out, a->mo.name, base, &pt, msg, sizeof msg),
+                         msg);
 }
 
 int cmd_stability(int argc, char **argv)
@@ -147,17 +119,23 @@ int cmd_stability(int argc, char **argv)
     if (werr != EXIT_OK)
         return werr;
     cm_params base;
-    const int verr = sweep_check(&c, &a.mo, "microchaos-pd", NULL, 0, &base);
+    const bool delay = strcmp(a.mo.name, "microchaos-delay") == 0;
+    if (delay && (a.has_P || a.has_alpha))
+        return cli_usage_error(&c, "--P and --alpha are the PD map's axes; the delay map's "
+                                   "charts span its whole (a, b) plane");
+    const int verr = sweep_check(&c, &a.mo, "microchaos-pd or microchaos-delay", NULL, 0, &base);
     if (verr)
         return verr;
     char msg[1024];
+    if (delay)
+        return delay_domains(&c, &a, &base);
     stab_result r;
     cm_status st = stability_compute(&a, &r, msg, sizeof msg);
     if (st == CM_OK) {
         if (a.out.json)
-            print_json(&a, &r.base, r.alpha, r.beta, r.P, r.D);
+            stability_json(a.mo.name, &r.base, r.alpha, r.beta, r.P, r.D);
         else if (!a.out.quiet)
-            print_summary(report_stream(a.out.csv, a.out.png, NULL), r.alpha, r.beta, r.P, r.D);
+            stability_report(report_stream(a.out.csv, a.out.png, NULL), r.alpha, r.beta, r.P, r.D);
         st = stability_write(&a, &r, msg, sizeof msg);
     }
     stability_result_free(&r);

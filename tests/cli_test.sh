@@ -329,7 +329,8 @@ expect_usage "--sweep: 'x=1:2:3' is not NAME=LO:HI:N" escape --sweep x=1:2:3
 expect_usage "--I0: '-1' must be a number" escape --I0 -1
 expect_usage "implemented for microchaos-1d-friction only" escape --model microchaos-pd
 expect_usage "--P: '1:0:5' is not LO:HI:N" stability --P 1:0:5
-expect_usage "implemented for microchaos-pd only" stability --model microchaos-1d
+expect_usage "implemented for microchaos-pd or microchaos-delay only" stability --model microchaos-1d
+expect_usage "the PD map's axes" stability --model microchaos-delay --P 1:2:3
 expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
 expect_usage "domain '01'" partition --param a=1.5,b=0.6
 expect_usage "--crisis charts a sweep" horseshoe --crisis

@@ -61,6 +61,7 @@ run continue continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --
 run partition partition --param a=1.3,b=0.66 --json
 run horseshoe horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --json
 run stability stability --param alpha=0.8,beta=0.3,P=0.9,D=0.4 --json
+run stability-delay stability --model microchaos-delay --param a=1.3,b=0.66 --json
 run escape escape --param a=1.5,b=1.3 --I0 0.25 --cells 100000 --ensemble 100000 --json
 run escape-sweep escape --param b=1.3 --I0 0.25 --sweep a=1.15:1.55:4 --cells 1000 --ensemble 10000 --json
 "$CM" export basin.cmdb --labels labels.npy --steps steps.npy --window 100:300,-5:5 --by groups \
@@ -116,6 +117,8 @@ assert st["box"] == [[0, 500], [-40, 40]] and st["cells"] == 125 * 80
 assert all("in_view" in g for g in st["groups"])
 sb = load("stability")
 assert sb["stable"] and sb["n_fixed"] == 5 and sb["m_max"] == 3 and abs(sb["P_min"] - 0.64) < 1e-15, sb
+sd = load("stability-delay")
+assert sd["domain_01"] and sd["partition_mu_sl"] and sd["bands"] == [0, 1], sd
 pt = load("partition")
 assert [r["row"] for r in pt["regions"]][3] == "000011000" and pt["primitive_index"] == 65, pt
 hs = load("horseshoe")["lines"]

@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "models/delay_domains.h"
 #include "models/delay_partition.h"
 #include "models/microchaos_pd.h"
 #include "models/params.h"
@@ -684,6 +685,44 @@ static void parameter_errors(void)
     }
 }
 
+/* The parameter domains of App. C.3 (Figs. 4.10, C.3) against the thesis'
+ * numbers and against orbits: inside '01' an orbit lands on U_0 and U_1
+ * only, inside '012' on U_0..U_2; inside the first primitive-partition
+ * domain the partition of Fig. 4.11 is irreducible and primitive. */
+static void delay_domains(void)
+{
+    cm_delay_curves c;
+    cm_delay_curves_at(1.3, &c);
+    CHECK(fabs(c.c_mu - 0.5953) < 5e-5 && fabs(c.c_sl - 0.6766) < 5e-5);
+    cm_delay_curves_at(1.55, &c);
+    CHECK_NEAR(c.g_sup0, 0.6975, 1e-12);
+    cm_delay_curves_at(1.1, &c);
+    CHECK(fabs(c.d1 - 0.231) < 5e-4);
+    int n01 = 0, n012 = 0, nprim = 0;
+    unsigned seed = 7;
+    for (int k = 0; k < 4000; k++) {
+        const double a = urand(&seed, 1, 1.5), b = urand(&seed, 0, 1);
+        cm_delay_domains d;
+        cm_delay_domains_at(a, b, &d);
+        CHECK(d.stable == (b > a - 1 && b < 1));
+        if (d.d01 || d.d012) {
+            const uint32_t bands = cm_delay_bands_visited(a, b, 0.37, 0.61, 2000, 20000);
+            CHECK_INT(bands, d.d01 ? 3 : 7);
+            n01 += d.d01, n012 += d.d012;
+        }
+        CHECK(!(d.d01 && d.d012));
+        cm_delay_partition p;
+        char why[200];
+        if (d.mu_sl) {
+            CHECK(cm_delay_partition_01(a, b, &p, why, sizeof why) && p.primitive_index > 0);
+            nprim++;
+        }
+    }
+    CHECK(n01 > 100 && n012 > 20 && nprim > 20);
+    /* Fig. 4.9 (a = 1.5, b = 0.6): U_1..U_4, in neither domain */
+    CHECK_INT(cm_delay_bands_visited(1.5, 0.6, 0.37, 0.61, 2000, 20000), 0x1e);
+}
+
 int main(void)
 {
     fig_4_2();
@@ -693,6 +732,7 @@ int main(void)
     stability_domain();
     horseshoes();
     delay_partition();
+    delay_domains();
     orbits();
     general_equals_specific();
     friction_and_delay_fixed_points();

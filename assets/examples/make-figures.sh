@@ -205,6 +205,18 @@ done
 
 # Fig. 4.11: the delay map's attractor partitioned (a = 1.3, b = 0.66)
 "$CM" partition --param a=1.3,b=0.66 --png fig-4.11-partition.png --quiet
+# Figs. 4.8, 4.10 and C.3: the delay map's (a, b) plane: the stable domain G,
+# the domains '01' and '012' of whole basic branches with their boundary
+# curves, the primitive partitions' domains; Fig. 4.11's point marked
+"$CM" stability --model microchaos-delay --param a=1.3,b=0.66 --png fig-4.8-4.10-C.3-domains.png \
+  --quiet
+# Figs. C.1 and C.2: the delay map's attractor (black, by true orbits) where a
+# basic branch stretches over its end (a = 1.55, b = 0.8: g_sup^0 = 0.6975 < b)
+# and where one falls into pieces (a = 1.1, b = 0.5: d^1 = 0.231 < b)
+"$CM" solve --model microchaos-delay --param a=1.55,b=0.8 --region=0:3.5,0:3.5 --cells 1050x1050 \
+  --png fig-C.1.png --layers all --size 800x700 > /dev/null
+"$CM" solve --model microchaos-delay --param a=1.1,b=0.5 --region=0:1.5,0:1.5 --cells 900x900 \
+  --png fig-C.2.png --layers all --size 800x700 > /dev/null
 
 # Figs. 4.16 and 4.17: the horseshoes at SW_4..7 (alpha = 0.8, beta = 0.3,
 # P = 0.7, D = 0.6; repellers at 4 and 7) and the entropy estimate against P
