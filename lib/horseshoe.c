@@ -48,60 +48,89 @@ static size_t polygon(double (*p)[2], int n, double *x, double *y, size_t k)
     return k;
 }
 
-/* Figs. 4.15-4.16: per m, L and R, f_l(L) and f_r(R), and SW_m. */
+/* Appends the pieces' outlines as segments to x, y from k on (room for
+ * them all: at most CM_POLYGON_MAX segments a piece). */
+static size_t pieces(cm_polygon *pc, int n, double *x, double *y, size_t k)
+{
+    for (int i = 0; i < n; i++)
+        k = polygon(pc[i].p, pc[i].n, x, y, k);
+    return k;
+}
+
+/* Figs. 4.15, 4.16 and 4.18: per m, L and R, their images (the first:
+ * f_l(L), f_r(R)) and pre-images (models/pd_strips.h), and SW_m. */
 static bool png_point(const hs_args *a, const hs_item *items, int count, double alpha,
                       double beta, double P, double D, const char *params, char *msg,
                       size_t msg_size)
 {
-    cm_pd_coef k;
-    cm_pd_coefficients(alpha, beta, P, D, &k);
-    const size_t cap = (size_t)count * 8 * 2;
-    double *v = malloc(cap * 4 * 2 * sizeof *v);
-    if (!v) {
+    enum { PIECES = 1 << CM_STRIP_MAX_STEPS };
+    /* per m: L, R, and up to PIECES images and pre-images of each */
+    const size_t cap = (size_t)count * (8 + 4 * (size_t)PIECES * CM_POLYGON_MAX) * 2;
+    double *v = malloc(cap * 6 * 2 * sizeof *v);
+    cm_polygon *pc = malloc(PIECES * sizeof *pc);
+    if (!v || !pc) {
+        free(v);
+        free(pc);
         snprintf(msg, msg_size, "out of memory for the figure");
         return false;
     }
-    double *xs[4], *ys[4];
-    size_t ns[4] = {0, 0, 0, 0};
-    for (int s = 0; s < 4; s++)
+    double *xs[6], *ys[6];
+    size_t ns[6] = {0};
+    for (int s = 0; s < 6; s++)
         xs[s] = v + (size_t)s * 2 * cap, ys[s] = xs[s] + cap;
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int i = 0; i < count; i++) {
+    bool ok = true;
+    for (int i = 0; i < count && ok; i++) {
         const cm_pd_horseshoe *h = &items[i].h;
-        double L[4][2] = {{h->x_l[0], h->x_l[1]}, {h->RULS[0], h->RULS[1]},
-                          {h->RUSW[0], h->RUSW[1]}, {h->LUSW[0], h->LUSW[1]}};
-        double R[4][2] = {{h->LUSW[0], h->LUSW[1]}, {h->RUSW[0], h->RUSW[1]},
-                          {h->x_r[0], h->x_r[1]}, {h->LURS[0], h->LURS[1]}};
-        double fL[4][2], fR[4][2];
-        for (int c = 0; c < 4; c++) {
-            const double ql = (double)(h->m - 1), qr = (double)h->m;
-            fL[c][0] = k.A[0] * L[c][0] + k.A[1] * L[c][1] + k.b[0] * ql;
-            fL[c][1] = k.A[2] * L[c][0] + k.A[3] * L[c][1] + k.b[1] * ql;
-            fR[c][0] = k.A[0] * R[c][0] + k.A[1] * R[c][1] + k.b[0] * qr;
-            fR[c][1] = k.A[2] * R[c][0] + k.A[3] * R[c][1] + k.b[1] * qr;
-            for (int d = 0; d < 2; d++) {
-                lo[d] = fmin(lo[d], fmin(L[c][d], R[c][d]));
-                hi[d] = fmax(hi[d], fmax(L[c][d], R[c][d]));
-            }
+        double T[2][4][2] = {{{h->x_l[0], h->x_l[1]}, {h->RULS[0], h->RULS[1]},
+                              {h->RUSW[0], h->RUSW[1]}, {h->LUSW[0], h->LUSW[1]}},
+                             {{h->LUSW[0], h->LUSW[1]}, {h->RUSW[0], h->RUSW[1]},
+                              {h->x_r[0], h->x_r[1]}, {h->LURS[0], h->LURS[1]}}};
+        for (int side = 0; side < 2 && ok; side++) {
+            for (int c = 0; c < 4; c++)
+                for (int d = 0; d < 2; d++)
+                    lo[d] = fmin(lo[d], T[side][c][d]), hi[d] = fmax(hi[d], T[side][c][d]);
+            ns[side] = polygon(T[side], 4, xs[side], ys[side], ns[side]);
+            int n = cm_pd_strip_images(alpha, beta, P, D, h->m, side, a->images, pc, PIECES);
+            ok = n >= 0;
+            ns[2 + side] = pieces(pc, ok ? n : 0, xs[2 + side], ys[2 + side], ns[2 + side]);
+            n = a->preimages ? cm_pd_strip_preimages(alpha, beta, P, D, h->m, side, a->preimages,
+                                                     pc, PIECES)
+                             : 0;
+            ok = ok && n >= 0;
+            ns[4 + side] = pieces(pc, ok ? n : 0, xs[4 + side], ys[4 + side], ns[4 + side]);
         }
-        ns[0] = polygon(L, 4, xs[0], ys[0], ns[0]);
-        ns[1] = polygon(R, 4, xs[1], ys[1], ns[1]);
-        ns[2] = polygon(fL, 4, xs[2], ys[2], ns[2]);
-        ns[3] = polygon(fR, 4, xs[3], ys[3], ns[3]);
+    }
+    free(pc);
+    if (!ok) {
+        free(v);
+        snprintf(msg, msg_size, "a piece of the images or pre-images has too many corners");
+        return false;
     }
     const double pad[2] = {0.15 * (hi[0] - lo[0]), 0.6 * (hi[1] - lo[1])};
     const cm_rgb red = {215, 48, 39}, blue = {69, 117, 180}, pink = {244, 165, 130},
-                 sky = {146, 197, 222};
+                 sky = {146, 197, 222}, dark_red = {165, 0, 38}, dark_blue = {49, 54, 149};
     const cm_series series[] = {
         {CM_SERIES_SEGMENTS, xs[2], ys[2], ns[2], pink, 1},
         {CM_SERIES_SEGMENTS, xs[3], ys[3], ns[3], sky, 1},
+        {CM_SERIES_SEGMENTS, xs[4], ys[4], ns[4], dark_red, 1},
+        {CM_SERIES_SEGMENTS, xs[5], ys[5], ns[5], dark_blue, 1},
         {CM_SERIES_SEGMENTS, xs[0], ys[0], ns[0], red, 2},
         {CM_SERIES_SEGMENTS, xs[1], ys[1], ns[1], blue, 2},
     };
-    char title[600];
-    snprintf(title, sizeof title,
-             "horseshoes: L (red), R (blue), f_l(L) and f_r(R) (light) at SW_%lld..%lld; %s",
-             (long long)items[0].h.m, (long long)items[count - 1].h.m, params);
+    char title[800], what[160];
+    if (a->images == 1 && !a->preimages)
+        snprintf(what, sizeof what, "f_l(L) and f_r(R) (light)");
+    else if (!a->preimages)
+        snprintf(what, sizeof what, "their images f^%d (light)", a->images);
+    else
+        snprintf(what, sizeof what, "images f^%d (light), pre-images f^-%d (dark)",
+                 a->images, a->preimages);
+    char lines[80];
+    snprintf(lines, sizeof lines, count > 1 ? "SW_%lld..%lld" : "SW_%lld", (long long)items[0].h.m,
+             (long long)items[count - 1].h.m);
+    snprintf(title, sizeof title, "horseshoes: L (red), R (blue), %s at %s; %s", what, lines,
+             params);
     const cm_chart chart = {a->out.width,
                             a->out.height,
                             {lo[0] - pad[0], lo[1] - pad[1]},
@@ -111,13 +140,13 @@ static bool png_point(const hs_args *a, const hs_item *items, int count, double 
                             title,
                             NULL,
                             series,
-                            4,
+                            6,
                             figure_font(),
                             0,
                             NULL,
                             0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
-    const bool ok = (outfile_charts(a->out.png, &chart, 1, texts, 2, msg, msg_size) == CM_OK);
+    ok = (outfile_charts(a->out.png, &chart, 1, texts, 2, msg, msg_size) == CM_OK);
     free(v);
     return ok;
 }
@@ -229,18 +258,97 @@ static bool png_sweep(const hs_args *a, const hs_item *items, int nm, const char
     return ok;
 }
 
+/* Fig. 4.19: over the P-D plane, where SW_m is a full binary shift (a
+ * light fill per m, in vertical runs of the plane's cells) and where each
+ * of its four escape conditions changes (dots in m's darker colour: the
+ * thesis' straight lines). */
+static bool png_plane(const hs_args *a, double alpha, double beta, int nm, const char *params,
+                      char *msg, size_t msg_size)
+{
+    const int np = a->sweep.n, nd = a->plane.n, shown = nm < 6 ? nm : 6;
+    const size_t cap = (size_t)np * (size_t)nd * 2 + 2;
+    double *v = malloc(cap * 4 * (size_t)shown * sizeof *v);
+    if (!v) {
+        snprintf(msg, msg_size, "out of memory for the figure");
+        return false;
+    }
+    const cm_rgb fills[6] = {{253, 219, 199}, {209, 229, 240}, {217, 240, 211},
+                             {231, 212, 232}, {254, 224, 182}, {224, 224, 224}},
+                 lines[6] = {{215, 48, 39}, {69, 117, 180}, {26, 152, 80},
+                             {118, 42, 131}, {230, 97, 1}, {0, 0, 0}};
+    cm_series series[12];
+    const double dD = (a->plane.hi - a->plane.lo) / nd;
+    unsigned char *flags = calloc((size_t)nd * 2, 1); /* escape bits of this and the last column */
+    for (int j = 0; j < shown && flags; j++) {
+        double *fx = v + (size_t)j * 4 * cap, *fy = fx + cap, *ex = fy + cap, *ey = ex + cap;
+        size_t nf = 0, ne = 0;
+        for (int i = 0; i < np; i++) {
+            const double P = param_axis_value(&a->sweep, i);
+            unsigned char *col = flags + (size_t)(i % 2) * (size_t)nd,
+                          *last = flags + (size_t)((i + 1) % 2) * (size_t)nd;
+            double start = NAN;
+            for (int r = 0; r <= nd; r++) {
+                const double D = r < nd ? param_axis_value(&a->plane, r) : NAN;
+                cm_pd_horseshoe h = {0};
+                if (r < nd)
+                    cm_pd_horseshoe_at(alpha, beta, P, D, a->m0 + j, &h);
+                if (r < nd && h.full_shift && isnan(start))
+                    start = D - dD / 2;
+                if ((r == nd || !h.full_shift) && !isnan(start)) {
+                    fx[nf] = fx[nf + 1] = P, fy[nf] = start;
+                    fy[nf + 1] = r == nd ? a->plane.hi : D - dD / 2;
+                    nf += 2, start = NAN;
+                }
+                if (r == nd)
+                    break;
+                col[r] = (unsigned char)(h.escape[0] | h.escape[1] << 1 | h.escape[2] << 2 |
+                                         h.escape[3] << 3);
+                if (r > 0 && col[r] != col[r - 1]) /* a line between this row and the last */
+                    ex[ne] = P, ey[ne++] = D - dD / 2;
+                else if (i > 0 && col[r] != last[r]) /* or between this column and the last */
+                    ex[ne] = P - (a->sweep.hi - a->sweep.lo) / np / 2, ey[ne++] = D;
+            }
+        }
+        const float w = (float)ceil((double)a->out.width / np) + 1;
+        series[j] = (cm_series){CM_SERIES_SEGMENTS, fx, fy, nf, fills[j], w};
+        series[shown + j] = (cm_series){CM_SERIES_POINTS, ex, ey, ne, lines[j], 2};
+    }
+    if (!flags) {
+        free(v);
+        snprintf(msg, msg_size, "out of memory for the figure");
+        return false;
+    }
+    free(flags);
+    static const char *const names[6] = {"red", "blue", "green", "purple", "orange", "black"};
+    char title[700], colours[80] = "";
+    for (int j = 0; j < shown; j++)
+        snprintf(colours + strlen(colours), sizeof colours - strlen(colours), "%s%s",
+                 j ? ", " : "", names[j]);
+    snprintf(title, sizeof title, "full binary shifts at SW_%lld..%lld (%s) and their escape "
+             "lines; %s", (long long)a->m0, (long long)(a->m0 + shown - 1), colours, params);
+    const cm_chart chart = {a->out.width,     a->out.height,
+                            {a->sweep.lo, a->plane.lo}, {a->sweep.hi, a->plane.hi},
+                            "P",          "D",       title,  NULL,
+                            series,       2 * shown, figure_font(), 0,
+                            NULL,         0};
+    const bool ok = write_sweep_chart(a, &chart, params, msg, msg_size);
+    free(v);
+    return ok;
+}
+
 static bool write_png(const hs_args *a, const hs_item *items, int nm, int count, double alpha,
                          double beta, double P, double D, const char *params, char *msg,
                          size_t msg_size)
 {
     return a->crisis      ? png_crisis(a, items, nm, alpha, params, msg, msg_size)
+           : a->has_plane ? png_plane(a, alpha, beta, nm, params, msg, msg_size)
            : a->has_sweep ? png_sweep(a, items, nm, params, msg, msg_size)
                           : png_point(a, items, count, alpha, beta, P, D, params, msg, msg_size);
 }
 
 hs_args horseshoe_defaults(void)
 {
-    return (hs_args){.mo = {.name = "microchaos-pd"}, .periods = 12,
+    return (hs_args){.mo = {.name = "microchaos-pd"}, .periods = 12, .images = 1,
                      .out = {.width = 1000, .height = 600}};
 }
 
@@ -257,6 +365,15 @@ static cm_status check_request(const hs_args *a, char *msg, size_t msg_size)
                          a->sweep.n > 10000 || !param_axis_even(&a->sweep)))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the sweep must be P=LO:HI:K with LO < HI and 1 <= K <= 10000");
+    if (a->images < 1 || a->images > CM_STRIP_MAX_STEPS || a->preimages < 0 ||
+        a->preimages > CM_STRIP_MAX_STEPS)
+        return cm_fail(CM_EINVAL, msg, msg_size, "images %d, pre-images %d: need 1..%d and 0..%d",
+                       a->images, a->preimages, CM_STRIP_MAX_STEPS, CM_STRIP_MAX_STEPS);
+    if (a->has_plane && (!a->has_sweep || a->crisis || strcmp(a->plane.name, "D") != 0 ||
+                         a->plane.n < 2 || a->plane.n > 10000 || !param_axis_even(&a->plane)))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the plane needs a sweep of P, no crisis chart, and D=LO:HI:K with LO < HI "
+                       "and 2 <= K <= 10000");
     if (a->crisis && !a->has_sweep)
         return cm_fail(CM_EINVAL, msg, msg_size, "the crisis chart needs a sweep of P");
     return CM_OK;
@@ -298,7 +415,7 @@ cm_status horseshoe_compute(hs_args *a, hs_result *r, char *msg, size_t msg_size
 cm_status horseshoe_write(const hs_args *a, const hs_result *r, char *msg, size_t msg_size)
 {
     char params[400];
-    const char *const skip[] = {a->has_sweep ? "P" : "", NULL};
+    const char *const skip[] = {a->has_sweep ? "P" : "", a->has_plane ? "D" : "", NULL};
     cm_params_format_with(&r->base, skip, params, sizeof params);
     const bool ok = (!a->out.csv || write_csv(a, r->items, r->count, msg, msg_size)) &&
                     (!a->out.png || write_png(a, r->items, r->nm, r->count, r->alpha, r->beta,

@@ -13,13 +13,17 @@
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
 #include "models/microchaos_pd.h"
+#include "models/pd_strips.h" /* the images' limits */
 
 /* What to compute and write (the command's options). */
 typedef struct hs_args {
     model_spec mo;
     int64_t m0, m1;
     int has_m, periods, has_sweep, crisis;
+    int images, preimages; /* the point's figure: f^images, f^-preimages of L and R (1, 0) */
     param_axis sweep;
+    param_axis plane; /* with has_plane: D over the P-D plane (Fig. 4.19) */
+    int has_plane;
     chart_outputs out;
 } hs_args;
 

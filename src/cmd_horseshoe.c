@@ -19,7 +19,8 @@
 
 static const char horseshoe_help[] =
     "usage: cellmap horseshoe [--model microchaos-pd] [--param k=v[,k=v]] [--m M0:M1]\n"
-    "                         [--periods N] [--sweep P=LO:HI:K [--crisis]] [--csv FILE|-]\n"
+    "                         [--periods N] [--sweep P=LO:HI:K [--crisis]] [--images K]\n"
+    "                         [--preimages K] [--plane D=LO:HI:K] [--csv FILE|-]\n"
     "                         [--png FILE] [--size WxH] [--json] [--quiet]\n\n"
     "The horseshoes of the PD micro-chaos map (thesis 4.5.3, docs/models.md 6.6): at\n"
     "each switching line SW_m the parallelogram Q_m between the fixed points x_(m-1)*\n"
@@ -42,6 +43,13 @@ static const char horseshoe_help[] =
     "  --png FILE          one point: L and R (red, blue), their images f_l(L), f_r(R)\n"
     "                      and the switching lines (Figs. 4.15, 4.16); a sweep: the\n"
     "                      entropy estimate against P per m (Fig. 4.17)\n"
+    "  --plane D=LO:HI:K   with --sweep: the PNG is the P-D plane instead, where each SW_m\n"
+    "                      is a full binary shift and its escape conditions' lines\n"
+    "                      (Fig. 4.19; the CSV and JSON stay the sweep's)\n"
+    "  --images K          one point: draw the K-th images of L and R instead, 1..6:\n"
+    "                      f applied to the parts of the previous ones in Q_m\n"
+    "  --preimages K       one point: also the points of Q_m that reach L (dark red) or\n"
+    "                      R (dark blue) in K steps inside Q_m, 0..6 (Fig. 4.18: 3, 2)\n"
     "  --size WxH          image size (default 1000x600)\n"
     "  --json              the summary as JSON on standard output\n"
     "  --quiet             no summary\n";
@@ -65,6 +73,8 @@ static int parse_args(cli *c, hs_args *a)
                 a->m0 = lo, a->m1 = hi;
             a->has_m = 1;
         } else if (cli_take_int(c, "--periods", 1, 20, &a->periods, &err)) {
+        } else if (cli_take_int(c, "--images", 1, CM_STRIP_MAX_STEPS, &a->images, &err)) {
+        } else if (cli_take_int(c, "--preimages", 0, CM_STRIP_MAX_STEPS, &a->preimages, &err)) {
         } else if (cli_is(c, "--crisis", false, &err)) {
             a->crisis = 1;
         } else if (cli_is(c, "--sweep", true, &err)) {
@@ -75,6 +85,13 @@ static int parse_args(cli *c, hs_args *a)
                                          "1 <= K <= 10000",
                                       c->value);
             a->has_sweep = 1;
+        } else if (cli_is(c, "--plane", true, &err)) {
+            if (c->value && (!param_axis_parse(c->value, strlen(c->value), &a->plane) ||
+                             strcmp(a->plane.name, "D") != 0 || a->plane.n > 10000 ||
+                             a->plane.n < 2 || !param_axis_even(&a->plane)))
+                err = cli_usage_error(c, "--plane: '%s' is not D=LO:HI:K with LO < HI and "
+                                         "2 <= K <= 10000", c->value);
+            a->has_plane = 1;
         } else if (chart_outputs_take(c, &a->out, 300, 200, &err)) {
         } else {
             err = cli_stray(c);
@@ -82,6 +99,9 @@ static int parse_args(cli *c, hs_args *a)
     }
     if (!err)
         err = chart_outputs_check(c, &a->out);
+    if (!err && a->has_plane && (!a->has_sweep || a->crisis))
+        err = cli_usage_error(c, "--plane charts the P-D plane: give --sweep P=LO:HI:K too, "
+                                 "without --crisis");
     if (!err && a->crisis && !a->has_sweep)
         err = cli_usage_error(c, "--crisis charts a sweep: give --sweep P=LO:HI:K too");
     return err;

@@ -331,6 +331,9 @@ expect_usage "implemented for microchaos-1d-friction only" escape --model microc
 expect_usage "--P: '1:0:5' is not LO:HI:N" stability --P 1:0:5
 expect_usage "implemented for microchaos-pd or microchaos-delay only" stability --model microchaos-1d
 expect_usage "the PD map's axes" stability --model microchaos-delay --P 1:2:3
+expect_usage "give --sweep P=LO:HI:K too" horseshoe --plane D=0.5:1:10
+expect_usage "is not D=LO:HI:K" horseshoe --sweep P=0.6:0.7:5 --plane P=0.5:1:10
+expect_usage "--images" horseshoe --images 7
 expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
 expect_usage "domain '01'" partition --param a=1.5,b=0.6
 expect_usage "--crisis charts a sweep" horseshoe --crisis

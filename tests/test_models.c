@@ -4,6 +4,7 @@
 #include "check.h"
 #include "models/delay_domains.h"
 #include "models/delay_partition.h"
+#include "models/pd_strips.h"
 #include "models/microchaos_pd.h"
 #include "models/params.h"
 #include "models/registry.h"
@@ -685,6 +686,41 @@ static void parameter_errors(void)
     }
 }
 
+/* Fig. 4.18: the second pre-images and third images of L and R at SW_3
+ * (alpha = 0.77, beta = 0.02, D = 0.83). At P = 0.71, a full shift, every
+ * piece crosses Q_3: 4 third images and 4 second pre-images of each; at
+ * P = 0.655 (two escape conditions fail) fewer. Each pre-image piece is
+ * checked on the map: its centre stays in Q_3 and lands in the trapezoid. */
+static void pd_strips(void)
+{
+    cm_polygon pc[64];
+    for (int side = 0; side < 2; side++) {
+        CHECK_INT(cm_pd_strip_images(0.77, 0.02, 0.71, 0.83, 3, side, 3, pc, 64), 4);
+        const int n = cm_pd_strip_preimages(0.77, 0.02, 0.71, 0.83, 3, side, 2, pc, 64);
+        CHECK_INT(n, 4);
+        cm_pd_horseshoe h;
+        cm_pd_horseshoe_at(0.77, 0.02, 0.71, 0.83, 3, &h);
+        cm_pd_coef k;
+        cm_pd_coefficients(0.77, 0.02, 0.71, 0.83, &k);
+        for (int i = 0; i < n; i++) {
+            double x[2] = {0, 0};
+            for (int c = 0; c < pc[i].n; c++)
+                x[0] += pc[i].p[c][0] / pc[i].n, x[1] += pc[i].p[c][1] / pc[i].n;
+            for (int step = 0; step < 2; step++) { /* the band left or right of SW_3 */
+                const double q = 0.71 * x[0] + 0.83 * x[1] < 3 ? 2 : 3;
+                const double y0 = k.A[0] * x[0] + k.A[1] * x[1] + k.b[0] * q;
+                x[1] = k.A[2] * x[0] + k.A[3] * x[1] + k.b[1] * q, x[0] = y0;
+            }
+            CHECK((0.71 * x[0] + 0.83 * x[1] >= 3) == (side == 1));
+        }
+    }
+    int fewer = 0;
+    for (int side = 0; side < 2; side++)
+        fewer += cm_pd_strip_preimages(0.77, 0.02, 0.655, 0.83, 3, side, 2, pc, 64) < 4;
+    CHECK(fewer > 0);
+    CHECK_INT(cm_pd_strip_images(0.77, 0.02, 0.71, 0.83, 3, 0, 7, pc, 64), -1);
+}
+
 /* The parameter domains of App. C.3 (Figs. 4.10, C.3) against the thesis'
  * numbers and against orbits: inside '01' an orbit lands on U_0 and U_1
  * only, inside '012' on U_0..U_2; inside the first primitive-partition
@@ -733,6 +769,7 @@ int main(void)
     horseshoes();
     delay_partition();
     delay_domains();
+    pd_strips();
     orbits();
     general_equals_specific();
     friction_and_delay_fixed_points();

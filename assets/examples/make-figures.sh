@@ -224,6 +224,15 @@ done
 "$CM" horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --png fig-4.16-horseshoe.png --quiet
 "$CM" horseshoe --param alpha=0.77,beta=0.02,D=0.83 --m 2:5 --sweep P=0.6:0.75:150 \
   --png fig-4.17-entropy.png --quiet
+# Fig. 4.18: at SW_3 (alpha = 0.77, beta = 0.02, D = 0.83) the second
+# pre-images and third images of L and R at three plateaus of Fig. 4.17;
+# Fig. 4.19: where each SW_2..5 is a full binary shift over the P-D plane
+for P in 0.655 0.67 0.71; do
+  "$CM" horseshoe --param alpha=0.77,beta=0.02,D=0.83,P=$P --m 3:3 --images 3 --preimages 2 \
+    --png fig-4.18-P$P.png --size 900x600 --quiet
+done
+"$CM" horseshoe --param alpha=0.77,beta=0.02,D=0.83 --m 2:5 --sweep P=0.62:0.84:440 \
+  --plane D=0.5:1.2:350 --periods 1 --png fig-4.19-plane.png --quiet
 # Fig. 4.20: the crisis chart at alpha = 0.8, beta = 0.3, D = 0.6
 "$CM" horseshoe --param alpha=0.8,beta=0.3,D=0.6 --m 1:10 --sweep P=0.65:1.45:160 --periods 1 \
   --crisis --png fig-4.20-crisis.png --quiet
