@@ -9,6 +9,7 @@
 #define CM_LIB_HORSESHOE_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
@@ -60,5 +61,10 @@ cm_status horseshoe_compute(hs_args *a, hs_result *r, char *msg, size_t msg_size
 cm_status horseshoe_write(const hs_args *a, const hs_result *r, char *msg, size_t msg_size);
 
 void horseshoe_result_free(hs_result *r);
+
+/* One line's summary as a line of text to f; the result as a JSON document
+ * on standard output. */
+void horseshoe_report_item(FILE *f, const hs_args *a, const hs_item *it);
+void horseshoe_json(const hs_args *a, const hs_result *r);
 
 #endif

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lib/figure.h"
+#include "lib/json.h"
 
 void partition_row_text(const cm_delay_partition *p, int i, char *out)
 {
@@ -101,4 +102,47 @@ cm_status partition_write(const part_args *a, const part_result *r, char *msg, s
     const bool ok = (!a->out.csv || write_csv(a, &r->p, msg, msg_size)) &&
                     (!a->out.png || write_png(a, &r->p, params, msg, msg_size));
     return ok ? CM_OK : CM_EIO;
+}
+
+/* The summary: the regions, their rows and whether the matrix is primitive. */
+void partition_report(FILE *f, const cm_delay_partition *p)
+{
+    char row[CM_DELAY_MAX_REGIONS + 1];
+    fprintf(f, "%d regions on the branches x_j = a x_(j-1) (upper) and a x_(j-1) - b "
+               "(lower), x_(j-1) in (%.9g, %.9g):\n",
+            p->r, p->x_l, p->x_r);
+    for (int i = 0; i < p->r; i++) {
+        partition_row_text(p, i, row);
+        fprintf(f, "  I_%-2d %s (%.9g, %.9g)  %s\n", i + 1, p->branch[i] ? "lower" : "upper",
+                p->lo[i], p->hi[i], row);
+    }
+    if (p->primitive_index)
+        fprintf(f, "irreducible and primitive: every entry of P^%d is positive (r^2 - r = "
+                   "%d)\n",
+                p->primitive_index, p->r * p->r - p->r);
+    else
+        fprintf(f, "%s, not primitive\n", p->irreducible ? "irreducible" : "not irreducible");
+}
+
+void partition_json(const part_args *a, const part_result *r)
+{
+    const cm_delay_partition *p = &r->p;
+    char row[CM_DELAY_MAX_REGIONS + 1];
+    json j;
+    json_begin(&j, stdout, "partition");
+    param_base_json(&j, a->mo.name, &r->base);
+    json_nums(&j, "ends", (const double[2]){p->x_l, p->x_r}, 2);
+    json_array(&j, "regions");
+    for (int i = 0; i < p->r; i++) {
+        partition_row_text(p, i, row);
+        json_object(&j, NULL);
+        json_str(&j, "branch", p->branch[i] ? "lower" : "upper");
+        json_nums(&j, "range", (const double[2]){p->lo[i], p->hi[i]}, 2);
+        json_str(&j, "row", row);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_bool(&j, "irreducible", p->irreducible);
+    json_int(&j, "primitive_index", p->primitive_index);
+    json_end(&j);
 }

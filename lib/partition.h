@@ -7,6 +7,7 @@
 #define CM_LIB_PARTITION_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
@@ -38,5 +39,10 @@ cm_status partition_compute(const part_args *a, part_result *r, char *msg, size_
 /* The intervals and their rows as CSV at a->out.csv and their chart at
  * a->out.png (either may be NULL). */
 cm_status partition_write(const part_args *a, const part_result *r, char *msg, size_t msg_size);
+
+/* The summary (the regions, their rows, primitivity) as text to f; the
+ * partition as a JSON document on standard output. */
+void partition_report(FILE *f, const cm_delay_partition *p);
+void partition_json(const part_args *a, const part_result *r);
 
 #endif

@@ -13,7 +13,6 @@
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
-#include "lib/json.h"
 #include "src/outfile.h"
 #include "lib/param_grid.h"
 
@@ -107,48 +106,6 @@ static int parse_args(cli *c, hs_args *a)
     return err;
 }
 
-static void print_item(FILE *f, const hs_args *a, const hs_item *it)
-{
-    const cm_pd_horseshoe *h = &it->h;
-    fprintf(f, "SW_%lld: %s%s; escape conditions %d%d%d%d; N_%d = %llu, entropy >= %.6g\n",
-            (long long)h->m, h->stretches ? "repeller" : "attractor",
-            h->full_shift ? ", a full binary shift" : "", h->escape[0], h->escape[1],
-            h->escape[2], h->escape[3], a->periods, (unsigned long long)it->periodic,
-            it->entropy);
-}
-
-static void print_json(const hs_args *a, const hs_result *r)
-{
-    json j;
-    json_begin(&j, stdout, "horseshoe");
-    param_base_json(&j, a->mo.name, &r->base);
-    if (a->has_sweep)
-        param_axes_json(&j, "sweep", &a->sweep, 1);
-    json_int(&j, "periods", a->periods);
-    json_array(&j, "lines");
-    for (int i = 0; i < r->count; i++) {
-        const cm_pd_horseshoe *h = &r->items[i].h;
-        json_object(&j, NULL);
-        json_num(&j, "P", r->items[i].P);
-        json_int(&j, "m", h->m);
-        json_nums(&j, "RULS", h->RULS, 2);
-        json_nums(&j, "LURS", h->LURS, 2);
-        json_nums(&j, "RUSW", h->RUSW, 2);
-        json_nums(&j, "LUSW", h->LUSW, 2);
-        json_array(&j, "escape");
-        for (int e = 0; e < 4; e++)
-            json_bool(&j, NULL, h->escape[e]);
-        json_array_end(&j);
-        json_str(&j, "kind", h->stretches ? "repeller" : "attractor");
-        json_bool(&j, "full_shift", h->full_shift);
-        json_uint(&j, "periodic", r->items[i].periodic);
-        json_num(&j, "entropy", r->items[i].entropy);
-        json_object_end(&j);
-    }
-    json_array_end(&j);
-    json_end(&j);
-}
-
 int cmd_horseshoe(int argc, char **argv)
 {
     cli c = {"horseshoe", argc, argv, 0, NULL, NULL};
@@ -169,7 +126,7 @@ int cmd_horseshoe(int argc, char **argv)
     cm_status st = horseshoe_compute(&a, &r, msg, sizeof msg);
     if (st == CM_OK) {
         if (a.out.json) {
-            print_json(&a, &r);
+            horseshoe_json(&a, &r);
         } else if (!a.out.quiet) {
             FILE *f = report_stream(a.out.csv, a.out.png, NULL);
             if (a.has_sweep)
@@ -177,7 +134,7 @@ int cmd_horseshoe(int argc, char **argv)
                         (long long)a.m1);
             else
                 for (int i = 0; i < r.count; i++)
-                    print_item(f, &a, &r.items[i]);
+                    horseshoe_report_item(f, &a, &r.items[i]);
         }
         st = horseshoe_write(&a, &r, msg, sizeof msg);
     }

@@ -10,7 +10,6 @@
 #include "src/args.h"
 #include "src/figure_opts.h"
 #include "src/commands.h"
-#include "lib/json.h"
 #include "src/outfile.h"
 #include "lib/param_grid.h"
 
@@ -49,49 +48,6 @@ static int parse_args(cli *c, part_args *a)
     return err;
 }
 
-/* The summary: the regions, their rows and whether the matrix is primitive. */
-static void print_summary(FILE *f, const cm_delay_partition *p)
-{
-    char row[CM_DELAY_MAX_REGIONS + 1];
-    fprintf(f, "%d regions on the branches x_j = a x_(j-1) (upper) and a x_(j-1) - b "
-               "(lower), x_(j-1) in (%.9g, %.9g):\n",
-            p->r, p->x_l, p->x_r);
-    for (int i = 0; i < p->r; i++) {
-        partition_row_text(p, i, row);
-        fprintf(f, "  I_%-2d %s (%.9g, %.9g)  %s\n", i + 1, p->branch[i] ? "lower" : "upper",
-                p->lo[i], p->hi[i], row);
-    }
-    if (p->primitive_index)
-        fprintf(f, "irreducible and primitive: every entry of P^%d is positive (r^2 - r = "
-                   "%d)\n",
-                p->primitive_index, p->r * p->r - p->r);
-    else
-        fprintf(f, "%s, not primitive\n", p->irreducible ? "irreducible" : "not irreducible");
-}
-
-static void print_json(const part_args *a, const part_result *r)
-{
-    const cm_delay_partition *p = &r->p;
-    char row[CM_DELAY_MAX_REGIONS + 1];
-    json j;
-    json_begin(&j, stdout, "partition");
-    param_base_json(&j, a->mo.name, &r->base);
-    json_nums(&j, "ends", (const double[2]){p->x_l, p->x_r}, 2);
-    json_array(&j, "regions");
-    for (int i = 0; i < p->r; i++) {
-        partition_row_text(p, i, row);
-        json_object(&j, NULL);
-        json_str(&j, "branch", p->branch[i] ? "lower" : "upper");
-        json_nums(&j, "range", (const double[2]){p->lo[i], p->hi[i]}, 2);
-        json_str(&j, "row", row);
-        json_object_end(&j);
-    }
-    json_array_end(&j);
-    json_bool(&j, "irreducible", p->irreducible);
-    json_int(&j, "primitive_index", p->primitive_index);
-    json_end(&j);
-}
-
 int cmd_partition(int argc, char **argv)
 {
     cli c = {"partition", argc, argv, 0, NULL, NULL};
@@ -111,9 +67,9 @@ int cmd_partition(int argc, char **argv)
     cm_status st = partition_compute(&a, &r, msg, sizeof msg);
     if (st == CM_OK) {
         if (a.out.json)
-            print_json(&a, &r);
+            partition_json(&a, &r);
         else if (!a.out.quiet)
-            print_summary(report_stream(a.out.csv, a.out.png, NULL), &r.p);
+            partition_report(report_stream(a.out.csv, a.out.png, NULL), &r.p);
         st = partition_write(&a, &r, msg, sizeof msg);
     }
     return analysis_said(c.cmd, st, msg);
