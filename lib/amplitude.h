@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 
+#include "lib/fo_transients.h"
 #include "lib/outfile.h"
 #include "lib/param_grid.h"
 #include "models/fo_continuation.h"
@@ -18,6 +19,7 @@ typedef struct amp_args {
     int has_omega, periods, threads;
     double ymax;
     chart_outputs out;
+    fo_transient_args transient; /* kind 0: the diagram; else lib/fo_transients.h's analysis */
 } amp_args;
 
 /* The command's defaults: friction-oscillator, 400 periods, y up to 5,

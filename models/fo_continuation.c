@@ -980,21 +980,30 @@ bool cm_fo_period_doubled(const cm_fo *o, int param, const cm_fo_branch_event *e
     return false;
 }
 
-double cm_fo_turn_hmax(double Omega)
+double cm_fo_turn_h(double t, double Omega)
 {
-    const double w = Omega, a = 3.14159265358979323846 / w, sa = sin(a), ca = cos(a);
+    const double a = 3.14159265358979323846 / Omega;
+    return (sin(t) + sin(a) * cos(Omega * t) + sin(t - a)) / (Omega * sin(Omega * t) * (1 + cos(a)));
+}
+
+double cm_fo_turn_hmax_at(double Omega, double *t_max)
+{
+    const double w = Omega, a = 3.14159265358979323846 / w;
     double best = 1 / (w * w); /* the limit at t -> 0 (2.30) */
+    *t_max = 0;
     enum { SAMPLES = 4000 };
     for (int i = 0; i < SAMPLES; i++) {
-        const double t = (i + 0.5) * a / SAMPLES;
-        const double den = w * sin(w * t) * (1 + ca);
-        if (den == 0)
-            continue;
-        const double H = (sin(t) + sa * cos(w * t) + sin(t - a)) / den;
+        const double t = (i + 0.5) * a / SAMPLES, H = cm_fo_turn_h(t, w);
         if (isfinite(H) && H > best)
-            best = H;
+            best = H, *t_max = t;
     }
     return best;
+}
+
+double cm_fo_turn_hmax(double Omega)
+{
+    double t;
+    return cm_fo_turn_hmax_at(Omega, &t);
 }
 
 /* The symmetric non-sticking solution at o: from its turnaround (x0, 0) at

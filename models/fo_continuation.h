@@ -152,6 +152,12 @@ typedef struct cm_fo_amplitude {
  * t -> 0 included; sampled finely enough for the figures (4000 points). */
 double cm_fo_turn_hmax(double Omega);
 
+/* H(t, Omega) of (2.29) itself (Fig. 2.5; NaN or infinite where its
+ * denominator vanishes), and H_max with the t where it is taken (0: the
+ * limit 1/Omega^2 at t -> 0). */
+double cm_fo_turn_h(double t, double Omega);
+double cm_fo_turn_hmax_at(double Omega, double *t_max);
+
 void cm_fo_amplitude_at(const cm_fo *o, int periods, int record, cm_fo_amplitude *out);
 
 /* Two-parameter continuation of an SN, PD, CS or SS event e (located on

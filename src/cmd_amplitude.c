@@ -18,7 +18,9 @@
 static const char amplitude_help[] =
     "usage: cellmap amplitude [--model friction-oscillator] [--param k=v[,k=v]]\n"
     "                         --omega LO:HI:N [--periods P] [--csv FILE|-] [--png FILE]\n"
-    "                         [--ymax Y] [--size WxH] [--json] [--quiet] [--threads T]\n\n"
+    "                         [--ymax Y] [--size WxH] [--json] [--quiet] [--threads T]\n"
+    "       cellmap amplitude [--param k=v[,k=v]] --h OMEGA[,...] | --extremal EPS |\n"
+    "                         --converge N [--csv FILE|-] [--png FILE] [--json] [--quiet]\n\n"
     "The amplitude-frequency diagram of the dry friction oscillator (thesis 2.2)\n"
     "at N excitation frequencies Omega (centres of N cells of LO:HI): the amplitude\n"
     "x0 of the symmetric non-sticking solution by (2.25), the slipping condition\n"
@@ -41,7 +43,27 @@ static const char amplitude_help[] =
     "  --size WxH          image size (default 1000x700)\n"
     "  --json              the summary as JSON on standard output\n"
     "  --quiet             no summary\n"
-    "  --threads T         OpenMP threads (default: all cores)\n";
+    "  --threads T         OpenMP threads (default: all cores)\n\n"
+    "Instead of the diagram (docs/models.md 9.11):\n"
+    "  --h OMEGA[,...]     H(t, Omega) of (2.29) over 0 < t < pi/Omega, a panel per\n"
+    "                      frequency (1..6), with 1/Omega^2 and H_max (Fig. 2.5)\n"
+    "  --extremal EPS      the map eps -> eps' of a perturbation that moves the extremal\n"
+    "                      asymmetric solution to x0 = 1 + S - eps, into the sticking\n"
+    "                      region, by simulation, 0 < eps <= EPS < S, against the thesis'\n"
+    "                      eps - 2 eps^2 (Fig. 2.10; the thesis sets S0 = S)\n"
+    "  --converge N        the relative error of the simulation from (1 + 0.9 S0, 0)\n"
+    "                      against the solution it settles on, over N periods (after N\n"
+    "                      to settle), and the envelope |lambda_max|^n of its leading\n"
+    "                      multiplier (Fig. 2.11)\n";
+
+/* One analysis instead of the diagram. */
+static int take_mode(const cli *c, fo_transient_args *t, int kind)
+{
+    if (t->kind && t->kind != kind)
+        return cli_usage_error(c, "--h, --extremal and --converge are different charts: give one");
+    t->kind = kind;
+    return 0;
+}
 
 static int parse_args(cli *c, amp_args *a)
 {
@@ -61,6 +83,18 @@ static int parse_args(cli *c, amp_args *a)
                                       "1 <= N <= 100000 (e.g. 0.1:3:300)",
                                       c->value);
             a->has_omega = 1;
+        } else if (cli_is(c, "--h", true, &err)) {
+            fo_transient_args *t = &a->transient;
+            if (c->value && !parse_doubles(c->value, t->omegas, &t->n_omegas, FO_H_MAX_CURVES))
+                err = cli_usage_error(c, "--h: '%s' is not 1..6 frequencies OMEGA[,OMEGA...]",
+                                      c->value);
+            err = err ? err : take_mode(c, t, FO_H);
+        } else if (cli_is(c, "--extremal", true, &err)) {
+            if (c->value && !parse_double(c->value, &a->transient.eps_max))
+                err = cli_usage_error(c, "--extremal: '%s' is not a number", c->value);
+            err = err ? err : take_mode(c, &a->transient, FO_EXTREMAL);
+        } else if (cli_take_int(c, "--converge", 10, 1000000, &a->transient.periods, &err)) {
+            err = err ? err : take_mode(c, &a->transient, FO_CONVERGE);
         } else if (cli_take_int(c, "--periods", 50, 100000, &a->periods, &err)) {
         } else if (cli_is(c, "--ymax", true, &err)) {
             if (c->value && (!parse_double(c->value, &a->ymax) || !(a->ymax > 0 && a->ymax < 1e6)))
@@ -71,7 +105,7 @@ static int parse_args(cli *c, amp_args *a)
             err = cli_stray(c);
         }
     }
-    if (!err && !a->has_omega)
+    if (!err && !a->has_omega && !a->transient.kind)
         err = cli_usage_error(c, "--omega LO:HI:N is required (e.g. --omega 0.1:3:300)");
     if (!err)
         err = chart_outputs_check(c, &a->out);
@@ -89,10 +123,19 @@ int cmd_amplitude(int argc, char **argv)
     if (werr != EXIT_OK)
         return werr;
     cm_params base;
-    const int verr = sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, 1, &base);
+    const int verr =
+        sweep_check(&c, &a.mo, "friction-oscillator", &a.omega, a.has_omega, &base);
     if (verr)
         return verr;
     char msg[1024];
+    if (a.transient.kind)
+        return analysis_said(c.cmd,
+                             fo_transient_run(&a.transient, a.mo.name, &base, &a.out,
+                                              a.out.quiet || a.out.json
+                                                  ? NULL
+                                                  : report_stream(a.out.csv, a.out.png, NULL),
+                                              msg, sizeof msg),
+                             msg);
     amp_result r;
     cm_status st = amplitude_compute(&a, &r, msg, sizeof msg);
     if (st == CM_OK) {

@@ -334,6 +334,10 @@ expect_usage "the PD map's axes" stability --model microchaos-delay --P 1:2:3
 expect_usage "give --sweep P=LO:HI:K too" horseshoe --plane D=0.5:1:10
 expect_usage "is not D=LO:HI:K" horseshoe --sweep P=0.6:0.7:5 --plane P=0.5:1:10
 expect_usage "--images" horseshoe --images 7
+expect_usage "different charts: give one" amplitude --h 0.5 --converge 100
+expect_usage "is not 1..6 frequencies" amplitude --h 0.1,0.2,0.3,0.4,0.5,0.6,0.7
+expect_usage "--converge" amplitude --converge 5
+expect_usage "0 < eps < S" amplitude --param S=0.1,S0=0.1 --extremal 0.2
 expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
 expect_usage "domain '01'" partition --param a=1.5,b=0.6
 expect_usage "--crisis charts a sweep" horseshoe --crisis

@@ -57,6 +57,9 @@ run bifurcation-map bifurcation --model chip-4d --sweep xi=3.5,4.8 --runs 1 --tr
 run bifurcation-list bifurcation --param S0=0.4,Omega=0.5 --sweep S=0.32,0.4 --transient 20 --record 5 --json
 run simulate simulate --param S=0.4,S0=0.4,Omega=0.5 --periods 3 --json
 run amplitude amplitude --param S=0.5,S0=0.5 --omega 0.2:2:10 --json
+run amplitude-h amplitude --h 0.6,0.4 --json
+run amplitude-extremal amplitude --param S=0.1,S0=0.1,Omega=0.5 --extremal 0.01 --json
+run amplitude-converge amplitude --param S=0.1,S0=0.1,Omega=0.98 --converge 500 --json
 run continue continue --param S=0.3,S0=0.4,Omega=0.5 --vary S=0.02:0.4 --down --json
 run partition partition --param a=1.3,b=0.66 --json
 run horseshoe horseshoe --param alpha=0.8,beta=0.3,P=0.7,D=0.6 --m 4:7 --json
@@ -83,7 +86,7 @@ python3 "$HERE/schema_check.py" "$SCHEMA" $(ls ./*.json | grep -v -e missing.jso
 
 # one document per command; what the JSON says, the other outputs say too
 python3 - <<'PY' || fail "JSON contents"
-import json
+import json, math
 def load(name):
     return json.load(open(name + ".json"))
 s, i = load("solve"), load("info")
@@ -117,6 +120,11 @@ assert st["box"] == [[0, 500], [-40, 40]] and st["cells"] == 125 * 80
 assert all("in_view" in g for g in st["groups"])
 sb = load("stability")
 assert sb["stable"] and sb["n_fixed"] == 5 and sb["m_max"] == 3 and abs(sb["P_min"] - 0.64) < 1e-15, sb
+ah = load("amplitude-h")["h"]
+assert ah[0]["t_max"] == 0 and ah[1]["t_max"] > 0 and ah[1]["H_max"] > ah[1]["limit"], ah
+assert abs(load("amplitude-extremal")["coefficient"] + 2) < 0.01
+ac = load("amplitude-converge")
+assert abs(ac["decay_fit"] / math.log(ac["mult_max"]) - 1) < 0.01, ac
 sd = load("stability-delay")
 assert sd["domain_01"] and sd["partition_mu_sl"] and sd["bands"] == [0, 1], sd
 pt = load("partition")

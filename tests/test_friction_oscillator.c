@@ -14,6 +14,8 @@
 #include "cellmap/scm.h"
 #include "check.h"
 #include "mix.h"
+#include "models/fo_continuation.h"
+#include "models/fo_transients.h"
 #include "models/friction_oscillator.h"
 #include "models/registry.h"
 
@@ -584,6 +586,77 @@ static void test_tangency(void)
     }
 }
 
+/* Fig. 2.5: H(t, Omega) of (2.29) against (2.30), (2.31) and the four
+ * regimes of 2.2.1: the maximum at t -> 0 for Omega >= 1/2, inside
+ * (0, pi/(2 Omega)) below 1/2, in (pi/(2 Omega), pi/Omega) below 1/3, and
+ * again at t -> 0 at Omega = 1/4 (1/Omega^2 = 16). */
+static void test_turnaround_function(void)
+{
+    const double omegas[4] = {0.6, 0.4, 0.3, 0.25};
+    for (int k = 0; k < 4; k++) {
+        const double w = omegas[k], end = PI / w;
+        CHECK_NEAR(cm_fo_turn_h(1e-6, w), 1 / (w * w), 1e-5);
+        for (double t = 0.1; t < end; t += 0.37)
+            CHECK_NEAR(cm_fo_turn_h(end - t, w), -cm_fo_turn_h(t, w), 1e-9);
+    }
+    double t;
+    CHECK(cm_fo_turn_hmax_at(0.6, &t) == 1 / 0.36 && t == 0);
+    CHECK(cm_fo_turn_hmax_at(0.4, &t) > 1 / 0.16 && t > 0 && t < PI / 0.8);
+    CHECK(cm_fo_turn_hmax_at(0.3, &t) > 1 / 0.09 && t > PI / 0.6 && t < PI / 0.3);
+    CHECK(cm_fo_turn_hmax_at(0.25, &t) == 16 && t == 0);
+}
+
+/* Fig. 2.10: the thesis' second-order map eps' = eps - 2 eps^2 of a
+ * perturbation of the extremal asymmetric solution, "independently on the
+ * friction parameter": by simulation at S = S0 = 0.1 and 0.3 (Omega = 0.5)
+ * (eps' - eps)/eps^2 tends to -2 as eps -> 0. */
+static void test_extremal_perturbation(void)
+{
+    const double S[2] = {0.1, 0.3};
+    for (int k = 0; k < 2; k++) {
+        cm_fo o;
+        cm_fo_init(&o, S[k], S[k], 0.5, 0);
+        const double eps = 5e-4, next = cm_fo_extremal_next(&o, eps);
+        CHECK(fabs((next - eps) / (eps * eps) + 2) < 0.005);
+        const double far = cm_fo_extremal_next(&o, 0.02); /* smaller, but not by 2 eps^2 */
+        CHECK(far < 0.02 && fabs((far - 0.02) / 4e-4 + 2) > 0.02);
+    }
+}
+
+/* Fig. 2.11: at S = S0 = 0.1, Omega = 0.98 the simulation from (1.09, 0)
+ * converges to the symmetric solution with an envelope of slope
+ * log|lambda_max|: the least-squares decay rate within 0.5 % of it, and
+ * the error over |lambda_max|^n within a factor of 1.5 all the way. */
+static void test_convergence(void)
+{
+    cm_fo o;
+    cm_fo_init(&o, 0.1, 0.1, 0.98, 0);
+    enum { N = 2000 };
+    static double err[N + 1];
+    cm_fo_convergence c;
+    CHECK(cm_fo_converge(&o, (const double[2]){1.09, 0}, N, N, err, &c));
+    double x0, phase;
+    CHECK(cm_fo_symmetric_amplitude(0.1, 0.98, &x0, &phase));
+    double lo = INFINITY, hi = 0, sn = 0, sy = 0, snn = 0, sny = 0;
+    for (int n = 0; n <= N; n++) {
+        const double r = err[n] / pow(c.mult_max, n), y = log(err[n]);
+        lo = fmin(lo, r), hi = fmax(hi, r);
+        sn += n, sy += y, snn += (double)n * n, sny += n * y;
+    }
+    const double slope = ((N + 1) * sny - sn * sy) / ((N + 1) * snn - sn * sn);
+    CHECK(fabs(slope / log(c.mult_max) - 1) < 0.005);
+    CHECK(hi / lo < 1.5 && c.mult_max > 0.99 && c.mult_max < 1);
+    CHECK(c.mult_arg > 0.1); /* complex multipliers: the secondary frequency of (2.86) */
+    /* the solution it reached is the symmetric non-sticking one: a period
+     * from z_star turns at x0 of (2.25) and never sticks */
+    cm_fo_tally t;
+    cm_fo_tally_start(&t, c.z_star[0]);
+    double end[2];
+    CHECK(cm_fo_poincare(&o, c.z_star, end, &t, NULL, NULL));
+    CHECK_NEAR(t.x_max, x0, 1e-8);
+    CHECK(t.n_stick == 0 && t.n_turn == 2);
+}
+
 int main(void)
 {
     test_tangency();
@@ -597,5 +670,8 @@ int main(void)
     test_chaotic_lyapunov();
     test_sticking_counts();
     test_mirror_basins();
+    test_turnaround_function();
+    test_extremal_perturbation();
+    test_convergence();
     CHECK_DONE();
 }

@@ -260,6 +260,13 @@ for s in 0.3 0.7 0.9; do
   "$CM" amplitude --param S=$s,S0=$s --omega 0.1:3:290 --png fig-2.12-S$s-amplitude.png --quiet
 done
 "$CM" amplitude --param S=0.2,S0=0.24 --omega 0.09875:1.50125:561 --png fig-2.14-amplitude.png --quiet
+# Fig. 2.5: H(t, Omega) of (2.29) in its four regimes; Fig. 2.10: the map of a
+# perturbation of the extremal asymmetric solution (S = S0 = 0.1, Omega =
+# 0.5) against eps - 2 eps^2; Fig. 2.11: the convergence to the symmetric
+# solution at S = S0 = 0.1, Omega = 0.98 against |lambda_max|^n
+"$CM" amplitude --h 0.6,0.4,0.3,0.25 --png fig-2.5-h.png --size 900x1200 --quiet
+"$CM" amplitude --param S=0.1,S0=0.1,Omega=0.5 --extremal 0.03 --png fig-2.10-extremal.png --quiet
+"$CM" amplitude --param S=0.1,S0=0.1,Omega=0.98 --converge 2500 --png fig-2.11-converge.png --quiet
 
 # The example plugins' attractors (examples/plugin/): Newton's method for
 # z^3 - 1 (three roots), the Henon map (one aperiodic attractor, its
