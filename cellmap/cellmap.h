@@ -297,6 +297,8 @@ typedef struct cm_figure_options {
                             image's size */
     double dpi;          /* pixels per inch (36..2400): the PNG's pHYs, the SVG's size in
                             points, the font's pixels; 0: none written (96 for the font) */
+    const char *pdf;     /* the same figure as PDF (the SVG drawn by librsvg and cairo,
+                            loaded when needed), or NULL */
 } cm_figure_options;
 
 /* The figure of a result (cm_solve, cm_db_read, cm_session_read), through

@@ -605,6 +605,7 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     memset(po, 0, sizeof *po);
     po->path = o->png;
     po->svg = o->svg;
+    po->pdf = o->pdf;
     po->width = o->width;
     po->height = o->height;
     po->layers = o->layers;
@@ -617,8 +618,8 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
     po->aspect = o->aspect;
     po->font_size = o->font_size;
     po->dpi = o->dpi;
-    if (!o->png && !o->svg)
-        return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png or an svg path");
+    if (!o->png && !o->svg && !o->pdf)
+        return cm_fail(CM_EINVAL, msg, msg_size, "a figure needs a png, an svg or a pdf path");
     if ((o->width == 0) != (o->height == 0) || o->width < 0 || o->height < 0 ||
         o->width > CM_RENDER_MAX_SIDE || o->height > CM_RENDER_MAX_SIDE)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -626,9 +627,9 @@ static cm_status figure_opts_of(const cm_figure_options *o, png_opts *po, char *
                        o->width, o->height, CM_RENDER_MAX_SIDE);
     if (o->layers & ~all_layers & ~(unsigned)CM_FIGURE_STEPS)
         return cm_fail(CM_EINVAL, msg, msg_size, "layers 0x%x: use CM_FIGURE_* bits", o->layers);
-    if (o->indexed && (o->svg || o->width || o->layers))
+    if (o->indexed && (o->svg || o->pdf || o->width || o->layers))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "an indexed PNG has one pixel per cell: give no svg, size or layers");
+                       "an indexed PNG has one pixel per cell: give no svg, pdf, size or layers");
     if (o->legend < 0 || o->legend > 200)
         return cm_fail(CM_EINVAL, msg, msg_size, "legend %d: give 0..200 groups", o->legend);
     if (!(o->aspect == 0 || o->aspect == ASPECT_AUTO || (o->aspect >= 1e-6 && o->aspect <= 1e6)))

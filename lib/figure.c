@@ -3,6 +3,7 @@
 #include "lib/figure.h"
 
 #include "cellmap/output.h"
+#include "render/pdf.h"
 #include "render/svg.h"
 
 #include <errno.h>
@@ -141,12 +142,15 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
 
 
 
+bool png_opts_draws(const png_opts *po) { return po->path || po->svg || po->pdf; }
+
 bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *msg,
                     size_t msg_size)
 {
     const cm_file_use files[] = {
         {db, "the database", db_written, true},     {po->path, "the PNG", true, false},
-        {po->svg, "the SVG", true, false},             {po->palette_file, "the palette", false, false},
+        {po->svg, "the SVG", true, false},             {po->pdf, "the PDF", true, false},
+        {po->palette_file, "the palette", false, false},
         {po->labels_file, "the labels file", false, false},
     };
     return cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size) == CM_OK;
@@ -447,22 +451,21 @@ cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *
     cm_status st = outfile_check_path(po->path, false, msg, msg_size);
     if (st == CM_OK)
         st = outfile_check_path(po->svg, false, msg, msg_size);
+    if (st == CM_OK)
+        st = outfile_check_path(po->pdf, false, msg, msg_size);
+    if (st == CM_OK && po->pdf) /* a missing librsvg stops the command before its work */
+        st = cm_pdf_load(msg, msg_size);
     return st == CM_OK ? figure_check_layout(po, m, lat, box, msg, msg_size) : st;
 }
 
-/* The same figure as SVG (render/svg.h), written then renamed. */
-static cm_status write_svg(const basin_png *b, char *msg, size_t msg_size)
+/* The figure as SVG (render/svg.h), for outfile_vector. */
+static cm_status figure_svg(FILE *f, void *user, int cell_pixels, char *msg, size_t msg_size)
 {
+    const basin_png *b = user;
     cm_render_options ro;
     figure_options(b, &ro);
-    outfile o;
-    cm_status st = outfile_begin(b->opts->svg, &o, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    st = cm_render_svg(b->lat, b->cells, b->groups, &ro, o.f, msg, msg_size);
-    const cm_status end = outfile_end(&o, st == CM_OK, st == CM_OK ? msg : (char[64]){0},
-                                      st == CM_OK ? msg_size : 64);
-    return st != CM_OK ? st : end;
+    ro.svg_cell_pixels = cell_pixels;
+    return cm_render_svg(b->lat, b->cells, b->groups, &ro, f, msg, msg_size);
 }
 
 /* b's figure drawn by attractors: its cells relabelled in a copy. */
@@ -517,7 +520,9 @@ cm_status figure_write(const basin_png *b, char *msg, size_t msg_size)
     if (b->opts->path)
         st = b->opts->indexed ? write_indexed(b, msg, msg_size) : write_figure(b, msg, msg_size);
     if (st == CM_OK && b->opts->svg)
-        st = write_svg(b, msg, msg_size);
+        st = outfile_vector(b->opts->svg, false, figure_svg, (void *)b, msg, msg_size);
+    if (st == CM_OK && b->opts->pdf)
+        st = outfile_vector(b->opts->pdf, true, figure_svg, (void *)b, msg, msg_size);
     return st;
 }
 

@@ -24,6 +24,7 @@ enum { PNG_LABELS_MAX = 64 };
 typedef struct png_opts {
     const char *path;  /* --png FILE */
     const char *svg;   /* --svg FILE: the same figure as SVG */
+    const char *pdf;   /* --pdf FILE: the same figure as PDF (that SVG drawn by render/pdf.h) */
     int width, height; /* --size WxH; 0: one pixel per cell, at most 4096 a side */
     unsigned layers;   /* --layers; 0: default_layers */
     unsigned default_layers; /* the command's default (0: basin and attractors) */
@@ -69,6 +70,9 @@ bool png_opts_labels(const char *path, png_opts *po, char *msg, size_t msg_size)
  * the database db (NULL: none; db_written: the command writes it), a
  * --palette or --labels file it read, or the other image
  * (cm_files_apart). */
+/* Whether the options name a figure to write (--png, --svg or --pdf). */
+bool png_opts_draws(const png_opts *po);
+
 bool png_opts_apart(const png_opts *po, const char *db, bool db_written, char *msg,
                     size_t msg_size);
 

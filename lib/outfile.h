@@ -37,9 +37,9 @@ typedef struct outfile {
  * NULL: nothing to check. */
 cm_status outfile_check_path(const char *path, bool needs_regular, char *msg, size_t msg_size);
 
-/* outfile_check_path for a chart PNG, which also needs OSMesa: loaded now
- * (render/gl_loader.h), so that a missing library stops the caller before
- * its work. */
+/* outfile_check_path for a chart, which also needs OSMesa for a PNG or
+ * librsvg for a PDF: loaded now (render/gl_loader.h, render/pdf.h), so
+ * that a missing library stops the caller before its work. */
 cm_status outfile_check_chart(const char *path, char *msg, size_t msg_size);
 
 /* Opens the temporary file of path for writing into o->f. */
@@ -49,8 +49,17 @@ cm_status outfile_begin(const char *path, outfile *o, char *msg, size_t msg_size
  * place; else removes it. CM_OK when the file is in place. */
 cm_status outfile_end(outfile *o, bool ok, char *msg, size_t msg_size);
 
+/* Writes an SVG document (the writer's, its rasters up to cell_pixels
+ * pixels a cell: cm_render_options.svg_cell_pixels) at path, or, with pdf,
+ * that SVG drawn as a PDF by render/pdf.h (cell_pixels 16: librsvg smooths
+ * images, and cells of several pixels keep their edges). */
+typedef cm_status (*svg_writer)(FILE *f, void *user, int cell_pixels, char *msg, size_t msg_size);
+cm_status outfile_vector(const char *path, bool pdf, svg_writer write, void *user, char *msg,
+                         size_t msg_size);
+
 /* Draws the charts one below the other (all of the first one's width) and
- * writes them as a PNG at path with the given texts (plus Software). */
+ * writes them at path with the given texts (plus Software): as SVG or PDF
+ * where its name ends in .svg or .pdf (any case), else as PNG. */
 cm_status outfile_charts(const char *path, const cm_chart *charts, int n_charts,
                          const cm_png_text *texts, int n_texts, char *msg, size_t msg_size);
 

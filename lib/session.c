@@ -407,7 +407,8 @@ static cm_status shown_cells(session *s, cm_region *flat, cm_group_info **groups
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
 {
     const cm_file_use files[] = {{s->path, "the session's database", true, true},
-                                 {po->path ? po->path : po->svg, "render", true, false},
+                                 {po->path ? po->path : po->svg ? po->svg : po->pdf, "render",
+                                  true, false},
                                  {po->palette_file, "the palette", false, false},
                                  {po->labels_file, "the labels file", false, false}};
     cm_status st = cm_files_apart(files, sizeof files / sizeof *files, msg, msg_size);

@@ -2,10 +2,14 @@
 
 #include <GL/gl.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "render/axes.h"
+#include "render/png_out.h"
+#include "render/svg.h"
 #include "render/text.h"
 
 static const cm_rgb ink = {0, 0, 0};
@@ -40,6 +44,7 @@ static double heat_max(const cm_heat *h)
 }
 
 typedef struct layout {
+    int font_px; /* the font's size in pixels */
     int left, right, top, bottom, pad, tick, line, ascent, bar;
     cm_ticks tx, ty, tbar;
 } layout;
@@ -260,8 +265,8 @@ static cm_status measure(const cm_chart *c, cm_font **f, layout *L, cm_chart_inf
      * the flat panels of a stack (14 pixels in a 900-pixel figure) */
     const int side = c->width < c->height ? c->width : c->height;
     const int size = side / 45 > c->width / 64 ? side / 45 : c->width / 64;
-    cm_status st = cm_font_open(c->font_path, size < 12 ? 12 : size > 48 ? 48 : size, f, msg,
-                                msg_size);
+    L->font_px = size < 12 ? 12 : size > 48 ? 48 : size;
+    cm_status st = cm_font_open(c->font_path, L->font_px, f, msg, msg_size);
     if (st != CM_OK)
         return st;
     const double hmax = c->heat ? heat_max(c->heat) : 0;
@@ -313,5 +318,198 @@ cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_in
             cm_font_draw(f, c->title, L.pad, L.pad + L.ascent, ink, rgba, c->width, c->height);
     }
     cm_font_close(f);
+    return st;
+}
+
+/* ---- the same chart as SVG ---- */
+
+static double svg_x(const cm_chart *c, const cm_chart_info *in, double x)
+{
+    return in->plot_x + (x - c->lo[0]) / (c->hi[0] - c->lo[0]) * in->plot_w;
+}
+
+static double svg_y(const cm_chart *c, const cm_chart_info *in, double y)
+{
+    return in->plot_y + in->plot_h - (y - c->lo[1]) / (c->hi[1] - c->lo[1]) * in->plot_h;
+}
+
+static void svg_hex(cm_rgb c, char out[8]) { snprintf(out, 8, "#%02x%02x%02x", c.r, c.g, c.b); }
+
+static void svg_text(FILE *f, int x, int y, const char *s)
+{
+    fprintf(f, "<text x=\"%d\" y=\"%d\">", x, y);
+    cm_svg_escaped(f, s);
+    fputs("</text>\n", f);
+}
+
+static void svg_rect(FILE *f, double x, double y, double w, double h, cm_rgb colour)
+{
+    char hex[8];
+    svg_hex(colour, hex);
+    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\"/>\n", x,
+            y, w, h, hex);
+}
+
+/* The heat map as an embedded PNG, each cell k x k pixels (at most about
+ * twice the pixels it covers). */
+static cm_status svg_heat(FILE *f, const cm_chart *c, const cm_chart_info *in, double hmax,
+                          int k, char *msg, size_t msg_size)
+{
+    const cm_heat *h = c->heat;
+    k = (int)fmin(k, fmax(1, ceil(2 * fmax((double)in->plot_w / h->nx, (double)in->plot_h / h->ny))));
+    const size_t w = (size_t)h->nx * (size_t)k, ht = (size_t)h->ny * (size_t)k;
+    uint8_t *rgba = malloc(w * ht * 4);
+    if (!rgba)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the chart's SVG");
+    for (size_t j = 0; j < ht; j++) /* row 0 is the top: the highest cells */
+        for (size_t i = 0; i < w; i++) {
+            const double v = h->v[((size_t)h->ny - 1 - j / (size_t)k) * (size_t)h->nx + i / (size_t)k];
+            const cm_rgb col = v > 0 ? cm_heat_colour(v, hmax) : isnan(v) ? not_computed : paper;
+            uint8_t *p = rgba + 4 * (j * w + i);
+            p[0] = col.r, p[1] = col.g, p[2] = col.b, p[3] = 255;
+        }
+    uint8_t *png = NULL;
+    size_t n = 0;
+    const cm_status st = cm_png_encode(rgba, (int)w, (int)ht, &png, &n, msg, msg_size);
+    free(rgba);
+    if (st != CM_OK)
+        return st;
+    fprintf(f, "<image x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" preserveAspectRatio=\"none\" "
+               "style=\"image-rendering:pixelated\" href=\"data:image/png;base64,",
+            in->plot_x, in->plot_y, in->plot_w, in->plot_h);
+    cm_svg_base64(f, png, n);
+    fputs("\"/>\n", f);
+    free(png);
+    return CM_OK;
+}
+
+/* A series as one path: squares for points (GL's points), segments or a
+ * polyline broken at NaN. */
+static void svg_series(FILE *f, const cm_chart *c, const cm_chart_info *in, const cm_series *s)
+{
+    char hex[8];
+    svg_hex(s->colour, hex);
+    const double size = s->size > 0 ? s->size : 1;
+    if (s->kind == CM_SERIES_POINTS)
+        fprintf(f, "<path fill=\"%s\" d=\"", hex);
+    else
+        fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"%g\" d=\"", hex, size);
+    bool pen_down = false;
+    for (size_t k = 0; k < s->n; k++) {
+        const double x = svg_x(c, in, s->x[k]), y = svg_y(c, in, s->y[k]);
+        if (!isfinite(x) || !isfinite(y)) {
+            pen_down = false;
+            continue;
+        }
+        if (s->kind == CM_SERIES_POINTS)
+            fprintf(f, "M%.2f %.2fh%gv%gh%gz", x - size / 2, y - size / 2, size, size, -size);
+        else if (s->kind == CM_SERIES_SEGMENTS)
+            fprintf(f, "%c%.2f %.2f", k % 2 == 0 ? 'M' : 'L', x, y);
+        else
+            fprintf(f, "%c%.2f %.2f", pen_down ? 'L' : 'M', x, y), pen_down = true;
+    }
+    fputs("\"/>\n", f);
+}
+
+static void svg_axes(FILE *f, const cm_chart *c, const layout *L, const cm_font *font,
+                     const cm_chart_info *in)
+{
+    const int base = in->plot_y + in->plot_h;
+    int last_right = -1000000;
+    for (int k = 0; k < L->tx.n; k++) {
+        const int x = in->plot_x + cm_axis_px(L->tx.v[k], c->lo[0], c->hi[0], in->plot_w);
+        svg_rect(f, x, base, 1, L->tick, ink);
+        const int w = cm_font_width(font, L->tx.label[k]);
+        if (x - w / 2 <= last_right + L->pad)
+            continue;
+        svg_text(f, x - w / 2, base + L->tick + L->ascent, L->tx.label[k]);
+        last_right = x - w / 2 + w;
+    }
+    const int nw = cm_font_width(font, c->x_name);
+    svg_text(f, in->plot_x + in->plot_w / 2 - nw / 2, base + L->tick + L->line + L->ascent,
+             c->x_name);
+    for (int k = 0; k < L->ty.n; k++) {
+        const int y =
+            in->plot_y + in->plot_h - 1 - cm_axis_px(L->ty.v[k], c->lo[1], c->hi[1], in->plot_h);
+        svg_rect(f, in->plot_x - L->tick, y, L->tick, 1, ink);
+        const int w = cm_font_width(font, L->ty.label[k]);
+        svg_text(f, in->plot_x - L->tick - 2 - w, y + L->ascent / 2 - 1, L->ty.label[k]);
+    }
+    svg_text(f, L->pad, in->plot_y + in->plot_h / 2 + L->ascent / 2, c->y_name);
+}
+
+static void svg_colour_bar(FILE *f, const cm_chart *c, const layout *L, double hmax,
+                           const cm_chart_info *in)
+{
+    const int x = in->plot_x + in->plot_w + 3 * L->pad, y = in->plot_y + L->line,
+              h = in->plot_h - L->line;
+    for (int j = 0; j < h; j++)
+        svg_rect(f, x, y + j, L->bar, 1, cm_heat_colour(hmax * (h - 1 - j) / (h - 1), hmax));
+    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%d\" height=\"%d\" fill=\"none\" "
+               "stroke=\"#000000\"/>\n",
+            x - 0.5, y - 0.5, L->bar + 1, h + 1);
+    for (int k = 0; k < L->tbar.n; k++) {
+        const int ty = y + h - 1 - cm_axis_px(L->tbar.v[k], 0, hmax, h - 1);
+        svg_rect(f, x + L->bar, ty, L->tick, 1, ink);
+        svg_text(f, x + L->bar + L->tick + 2, ty + L->ascent / 2 - 1, L->tbar.label[k]);
+    }
+    if (c->heat->name)
+        svg_text(f, x, in->plot_y + L->ascent, c->heat->name);
+}
+
+static void svg_labels(FILE *f, const cm_chart *c, const cm_font *font, const layout *L,
+                       const cm_chart_info *in)
+{
+    for (int k = 0; k < c->n_labels; k++) { /* placed as draw_labels places them */
+        const cm_chart_label *l = &c->labels[k];
+        const double fx = (l->x - c->lo[0]) / (c->hi[0] - c->lo[0]);
+        const double fy = (l->y - c->lo[1]) / (c->hi[1] - c->lo[1]);
+        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) || !l->text)
+            continue;
+        const int w = cm_font_width(font, l->text);
+        int x = in->plot_x + (int)lround(fx * in->plot_w) + 4;
+        int y = in->plot_y + (int)lround((1 - fy) * in->plot_h) - 4;
+        if (x + w > in->plot_x + in->plot_w - 2)
+            x -= w + 8;
+        if (y - L->ascent < in->plot_y + 2)
+            y = in->plot_y + 2 + L->ascent;
+        svg_text(f, x, y, l->text);
+    }
+}
+
+cm_status cm_chart_svg(const cm_chart *c, int index, int top, int cell_pixels, FILE *f, char *msg,
+                       size_t msg_size)
+{
+    cm_font *font = NULL;
+    layout L;
+    cm_chart_info in;
+    cm_status st = measure(c, &font, &L, &in, msg, msg_size);
+    const double hmax = in.heat_max > 0 ? in.heat_max : 1;
+    if (st == CM_OK) {
+        fprintf(f, "<g transform=\"translate(0 %d)\" font-size=\"%d\">\n", top, L.font_px);
+        svg_rect(f, 0, 0, c->width, c->height, paper);
+        fprintf(f, "<clipPath id=\"plot%d\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/>"
+                   "</clipPath>\n",
+                index, in.plot_x, in.plot_y, in.plot_w, in.plot_h);
+        if (c->heat)
+            st = svg_heat(f, c, &in, hmax, cell_pixels > 1 ? cell_pixels : 1, msg, msg_size);
+    }
+    if (st == CM_OK) {
+        fprintf(f, "<g clip-path=\"url(#plot%d)\">\n", index);
+        for (int k = 0; k < c->n_series; k++)
+            svg_series(f, c, &in, &c->series[k]);
+        fputs("</g>\n", f);
+        fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%d\" height=\"%d\" fill=\"none\" "
+                   "stroke=\"#000000\"/>\n",
+                in.plot_x - 0.5, in.plot_y - 0.5, in.plot_w + 1, in.plot_h + 1);
+        svg_axes(f, c, &L, font, &in);
+        svg_labels(f, c, font, &L, &in);
+        if (c->heat)
+            svg_colour_bar(f, c, &L, hmax, &in);
+        if (c->title)
+            svg_text(f, L.pad, L.pad + L.ascent, c->title);
+        fputs("</g>\n", f);
+    }
+    cm_font_close(font);
     return st;
 }

@@ -8,6 +8,7 @@
 #define CM_RENDER_CHART_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "cellmap/status.h"
@@ -84,5 +85,15 @@ cm_status cm_chart_layout(const cm_chart *c, cm_chart_info *info, char *msg, siz
  * context gl (render/gl.h), or a new one when gl is NULL. */
 cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_info *info, char *msg,
                         size_t msg_size);
+
+/* The same chart as SVG elements, a group translated down by top pixels
+ * (stacked panels), for a document render/ writes around it: its own
+ * clip path (index makes its id unique), text in the font's pixels at the
+ * places the PNG has it, the heat map embedded as a PNG of up to
+ * cell_pixels x cell_pixels pixels a cell (about twice the pixels it covers;
+ * 1: one pixel; more for readers that smooth images, render/pdf.h). No
+ * OpenGL. */
+cm_status cm_chart_svg(const cm_chart *c, int index, int top, int cell_pixels, FILE *f, char *msg,
+                       size_t msg_size);
 
 #endif

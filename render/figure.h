@@ -60,6 +60,10 @@ typedef struct cm_render_options {
                                          the image's size (1/45 of its shorter side, 10..48) */
     double dpi;                       /* pixels per inch: the SVG's size in points (width
                                          72/dpi pt a pixel); 0: its size in pixels */
+    int svg_cell_pixels;              /* the SVG's basin raster repeats each cell up to this
+                                         many pixels a side, about twice the pixels it
+                                         covers (0, 1: once): for readers that smooth images
+                                         (librsvg, render/pdf.h) */
 } cm_render_options;
 
 /* What was drawn: for provenance, tests and benchmarks. */

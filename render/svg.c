@@ -31,7 +31,7 @@ static double px_y(const frame_map *m, double y) { return m->y0 + m->sy * (y - m
 
 static void hex(cm_rgb c, char out[8]) { snprintf(out, 8, "#%02x%02x%02x", c.r, c.g, c.b); }
 
-static void text_escaped(FILE *f, const char *s)
+void cm_svg_escaped(FILE *f, const char *s)
 {
     for (; *s; s++) {
         if (*s == '&')
@@ -48,14 +48,14 @@ static void text_escaped(FILE *f, const char *s)
 static void text(FILE *f, double x, double y, const char *anchor, const char *s)
 {
     fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"%s\">", x, y, anchor);
-    text_escaped(f, s);
+    cm_svg_escaped(f, s);
     fputs("</text>\n", f);
 }
 
 static const char base64_digits[] =
     "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
-static void base64(FILE *f, const uint8_t *b, size_t n)
+void cm_svg_base64(FILE *f, const uint8_t *b, size_t n)
 {
     for (size_t i = 0; i < n; i += 3) {
         const uint32_t v = (uint32_t)b[i] << 16 | (i + 1 < n ? (uint32_t)b[i + 1] << 8 : 0) |
@@ -76,7 +76,7 @@ static void visible(double origin, double width, uint64_t n, double lo, double h
     *b = last < (double)*a ? *a : last > (double)n ? n : (uint64_t)last;
 }
 
-/* The cells of the view as an embedded PNG, one pixel per cell. */
+/* The cells of the view as an embedded PNG, a pixel per cell (or k x k). */
 static cm_status raster(FILE *f, const figure *F, char *msg, size_t msg_size)
 {
     const cm_raster *ras = &F->w.ras;
@@ -92,33 +92,40 @@ static cm_status raster(FILE *f, const figure *F, char *msg, size_t msg_size)
     if (w > CM_RENDER_MAX_SIDE * 4 || h > CM_RENDER_MAX_SIDE * 4)
         return cm_fail(CM_EINVAL, msg, msg_size, "%llux%llu cells are too many to embed in an "
                        "SVG; choose a smaller --view", (unsigned long long)w, (unsigned long long)h);
-    uint8_t *rgba = malloc((size_t)(w * h * 4));
-    if (!rgba)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the SVG's raster");
-    for (uint64_t j = 0; j < h; j++) /* PNG row 0 is the top: the highest cells */
-        for (uint64_t i = 0; i < w; i++) {
-            const uint8_t *src = ras->pixels + 3 * ((j1 - 1 - j) * s->nx + i0 + i);
-            uint8_t *dst = rgba + 4 * (j * w + i);
-            memcpy(dst, src, 3);
-            dst[3] = 255;
-        }
-    uint8_t *png = NULL;
-    size_t n = 0;
-    cm_status st = cm_png_encode(rgba, (int)w, (int)h, &png, &n, msg, msg_size);
-    free(rgba);
-    if (st != CM_OK)
-        return st;
     const frame_map m = map_of(&F->p, pn);
     const double x = px_x(&m, s->x0 + (double)i0 * s->dx);
     const double x1 = px_x(&m, s->x0 + (double)i1 * s->dx);
     const double y = s->ny > 1 ? px_y(&m, s->y0 + (double)j1 * s->dy) : m.y0 - pn->h;
     const double y1 = s->ny > 1 ? px_y(&m, s->y0 + (double)j0 * s->dy) : m.y0;
+    /* each cell k x k pixels where asked, about twice the pixels it covers */
+    uint64_t k = 1;
+    if (F->o.svg_cell_pixels > 1) {
+        const double across = fmax((x1 - x) / (double)w, (y1 - y) / (double)h);
+        k = (uint64_t)fmin(F->o.svg_cell_pixels, fmax(1, ceil(2 * across)));
+    }
+    const uint64_t pw = w * k, ph = h * k;
+    uint8_t *rgba = malloc((size_t)(pw * ph * 4));
+    if (!rgba)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the SVG's raster");
+    for (uint64_t j = 0; j < ph; j++) /* PNG row 0 is the top: the highest cells */
+        for (uint64_t i = 0; i < pw; i++) {
+            const uint8_t *src = ras->pixels + 3 * ((j1 - 1 - j / k) * s->nx + i0 + i / k);
+            uint8_t *dst = rgba + 4 * (j * pw + i);
+            memcpy(dst, src, 3);
+            dst[3] = 255;
+        }
+    uint8_t *png = NULL;
+    size_t n = 0;
+    cm_status st = cm_png_encode(rgba, (int)pw, (int)ph, &png, &n, msg, msg_size);
+    free(rgba);
+    if (st != CM_OK)
+        return st;
     fprintf(f,
             "<image x=\"%.3f\" y=\"%.3f\" width=\"%.3f\" height=\"%.3f\" "
             "preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" "
             "clip-path=\"url(#basin)\" href=\"data:image/png;base64,",
             x, y, x1 - x, y1 - y);
-    base64(f, png, n);
+    cm_svg_base64(f, png, n);
     fputs("\"/>\n", f);
     free(png);
     return CM_OK;

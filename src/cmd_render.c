@@ -15,7 +15,7 @@
 #include "lib/project.h"
 
 static const char render_help[] =
-    "usage: cellmap render FILE.cmdb --png OUT.png|--svg OUT.svg [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
+    "usage: cellmap render FILE.cmdb --png OUT.png|--svg|--pdf OUT [--view X0:X1,Y0:Y1] [--slice Z[,W...]]\n"
     "                      [--size WxH] [--layers L,...] [--png-mode rgb|indexed] [--mem BYTES]\n"
     "                      [--quiet]\n\n"
     "Draws the basins of a cluster database (made by solve --db or explore). Cells of the\n"
@@ -63,8 +63,8 @@ static int parse_render(cli *c, render_args *a)
     }
     if (!err && !a->file)
         err = cli_usage_error(c, "which file? usage: cellmap render FILE.cmdb --png OUT.png");
-    if (!err && !a->png.path && !a->png.svg)
-        err = cli_usage_error(c, "where to? add --png OUT.png (or --svg OUT.svg)");
+    if (!err && !png_opts_draws(&a->png))
+        err = cli_usage_error(c, "where to? add --png OUT.png (or --svg OUT.svg, --pdf OUT.pdf)");
     if (!err)
         err = png_opts_check(c, &a->png);
     char why[2048];
@@ -111,10 +111,10 @@ int cmd_render(int argc, char **argv)
     const int rc = parse_render(&c, &a);
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
-    const char *const outs[] = {a.png.path, a.png.svg};
+    const char *const outs[] = {a.png.path, a.png.svg, a.png.pdf};
     int werr = cli_input_check("render", a.file);
     if (werr == EXIT_OK)
-        werr = outfiles_check("render", outs, 2);
+        werr = outfiles_check("render", outs, 3);
     if (werr != EXIT_OK)
         return werr;
     cm_store *s = NULL;

@@ -21,7 +21,7 @@ static const char solve_help[] =
     "                     [--cells N[xM...]] [--split K[xL...]] [--max-steps K]\n"
     "                     [--extend N [--escape-below F] [--bounds LO:HI[,LO:HI...]]]\n"
     "                     [--threads T]\n"
-    "                     [--png FILE] [--svg FILE] [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
+    "                     [--png FILE] [--svg|--pdf FILE] [--size WxH] [--layers L,...] [--png-mode rgb|indexed]\n"
     "                     [--view X0:X1,Y0:Y1] [--db FILE [--resume] [--mem BYTES]] [--json]\n"
     "                     [--stage1]\n\n"
     "Simple cell mapping (centre-point method) of a box of state space cut into\n"
@@ -445,7 +445,7 @@ int cmd_solve(int argc, char **argv)
     memset(r, 0, sizeof *r);
     if ((rc = make_lattice(&c, &a, &m, &q.lat, &q.box)) != EXIT_OK ||
         (rc = make_bounds(&c, &a, &q.lat, &q.box, &bounds)) != EXIT_OK ||
-        ((a.png.path || a.png.svg) &&
+        (png_opts_draws(&a.png) &&
          (rc = check_basin_png("solve", &a.png, &m, &q.lat, &q.box)) != EXIT_OK))
         goto done;
     progress pr;
@@ -490,7 +490,7 @@ int cmd_solve(int argc, char **argv)
         print_text(a.report, &m, &q.lat, r, a.extend > 0);
     if (r->store && !a.json && !a.quiet)
         print_database(a.report, &a, r);
-    if ((a.png.path || a.png.svg) && solve_draw(&q, r, &a.png, msg, sizeof msg) != CM_OK)
+    if (png_opts_draws(&a.png) && solve_draw(&q, r, &a.png, msg, sizeof msg) != CM_OK)
         goto fail;
     if (solve_finish(r, msg, sizeof msg) != CM_OK)
         goto fail;

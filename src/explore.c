@@ -27,7 +27,7 @@ const char session_help[] =
     "  goto X [Y]                         centre the view on a point\n"
     "  extend auto [N]                    N times (default 1), add the tile of the view's\n"
     "                                     size where the most sequences escape (4.6.4)\n"
-    "  render FILE.png|FILE.svg [WxH]     the view as a basin image (default: a pixel\n"
+    "  render FILE.png|.svg|.pdf [WxH]    the view as a basin image (default: a pixel\n"
     "                                     per cell, at most 4096); `cellmap render`'s\n"
     "                                     figure options but --view\n"
     "  stats [--json]                     groups and attractors in view, cells, memory, disk\n"
@@ -317,9 +317,10 @@ static cm_status cmd_render_view(explore *e, char **t, int n, char *msg, size_t 
     png_opts po;
     memset(&po, 0, sizeof po);
     const size_t len = n > 1 ? strlen(t[1]) : 0;
-    const bool svg = len > 4 && strcmp(t[1] + len - 4, ".svg") == 0; /* FILE.svg: as SVG */
-    *(svg ? &po.svg : &po.path) = n > 1 ? t[1] : NULL;
-    cm_status st = words(n, 2, 23, "render FILE.png|FILE.svg [WIDTHxHEIGHT] [--layers L,...] "
+    const char *ext = len > 4 ? t[1] + len - 4 : ""; /* FILE.svg, FILE.pdf: as SVG, PDF */
+    *(strcmp(ext, ".svg") == 0 ? &po.svg : strcmp(ext, ".pdf") == 0 ? &po.pdf : &po.path) =
+        n > 1 ? t[1] : NULL;
+    cm_status st = words(n, 2, 23, "render FILE.png|.svg|.pdf [WIDTHxHEIGHT] [--layers L,...] "
                          "[--png-mode M] [--palette P] [--labels FILE] [--min-basin N] [--legend K] "
                          "[--by attractors|groups] [--title T] [--aspect A] [--font-size PT] "
                          "[--dpi N]",

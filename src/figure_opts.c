@@ -15,6 +15,8 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
         po->path = c->value;
     } else if (cli_is(c, "--svg", true, err)) {
         po->svg = c->value;
+    } else if (cli_is(c, "--pdf", true, err)) {
+        po->pdf = c->value;
     } else if (cli_take_size(c, 1, 1, CM_RENDER_MAX_SIDE, &po->width, &po->height, err)) {
     } else if (cli_take_int(c, "--legend", 1, 200, &po->legend_groups, err)) {
     } else {
@@ -32,15 +34,19 @@ bool png_opts_take(cli *c, png_opts *po, int *err)
 
 int png_opts_check(const cli *c, const png_opts *po)
 {
-    if (!po->path && !po->svg &&
+    if (!po->path && !po->svg && !po->pdf &&
         (po->width || po->layers || po->indexed || po->min_basin || po->legend_groups ||
          po->palette || po->title || po->aspect || po->font_size || po->dpi))
         return cli_usage_error(c, "--size, --layers, --png-mode, --min-basin, --legend, "
                                   "--palette, --title, --aspect, --font-size and --dpi describe "
-                                  "the image; add --png FILE (or --svg FILE)");
-    if (po->svg && po->indexed)
-        return cli_usage_error(c, "--svg draws a figure; --png-mode indexed applies to --png "
-                                  "only");
+                                  "the image; add --png FILE (or --svg, --pdf FILE)");
+    const char *ext = po->path ? strrchr(po->path, '.') : NULL;
+    if (ext && (strcmp(ext, ".svg") == 0 || strcmp(ext, ".pdf") == 0))
+        return cli_usage_error(c, "--png %s: a basin figure's --png is a PNG; use --%s %s",
+                               po->path, ext + 1, po->path);
+    if ((po->svg || po->pdf) && po->indexed)
+        return cli_usage_error(c, "--svg and --pdf draw a figure; --png-mode indexed applies to "
+                                  "--png only");
     if (po->indexed && (po->width || po->layers))
         return cli_usage_error(c, "--png-mode indexed draws one pixel per cell in colour "
                                   "classes; leave out --size and --layers");
@@ -51,8 +57,8 @@ int check_basin_png(const char *cmd, const png_opts *po, const cm_model *m,
                     const cm_lattice *lat, const cm_box *box)
 {
     char msg[512];
-    const char *const outs[] = {po->path, po->svg};
-    const int rc = outfiles_check(cmd, outs, 2);
+    const char *const outs[] = {po->path, po->svg, po->pdf};
+    const int rc = outfiles_check(cmd, outs, 3);
     if (rc != EXIT_OK)
         return rc;
     if (figure_check_layout(po, m, lat, box, msg, sizeof msg) == CM_OK)

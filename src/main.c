@@ -59,6 +59,8 @@ static void usage(FILE *out)
                  "commands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         fprintf(out, "  %-14s %s\n", commands[i].name, commands[i].doc);
+    fprintf(out, "\nFigures: basin figures take --png, --svg and --pdf FILE; a chart's --png FILE\n"
+                 "is written as SVG or PDF where FILE ends in .svg or .pdf.\n");
 }
 
 /* A command's status, made a failure if its standard output was lost (a

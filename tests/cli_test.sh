@@ -806,7 +806,7 @@ out=$(CELLMAP_FONT=/nonexistent.ttf "$CM" render basin.cmdb --layers axes --png 
   || fail "render without its font: $rc $out"
 
 # --- help: "help CMD", "CMD --help" and "CMD -h" say the same ---------------------
-for cmd in $("$CM" help | awk '/^commands:/ {on = 1; next} on && NF {print $1}'); do
+for cmd in $("$CM" help | awk '/^commands:/ {on = 1; next} on && !NF {exit} on {print $1}'); do
   a=$("$CM" help "$cmd") || fail "cellmap help $cmd failed"
   [ -n "$a" ] && [ "$a" = "$("$CM" "$cmd" --help)" ] && [ "$a" = "$("$CM" "$cmd" -h)" ] \
     || fail "help of $cmd differs between 'help $cmd', '--help' and '-h'"

@@ -354,8 +354,8 @@ class Result:
         _call(_lib.cm_result_png, self._h, _text(os.fspath(path)), width, height)
 
     def figure(self, png=None, **options):
-        """Writes the figure with render's options: png=PATH and/or
-        svg=PATH, width, height, layers (names: basin, steps, attractors,
+        """Writes the figure with render's options: png=PATH, svg=PATH
+        and/or pdf=PATH, width, height, layers (names: basin, steps, attractors,
         overlays, axes, legend, title; default all but steps), indexed,
         by ("attractors" or "groups"), palette, labels (a file),
         min_basin, legend, title, aspect ("equal", "auto" or a ratio),
@@ -463,7 +463,7 @@ class _FigureOptions(ctypes.Structure):
                 ("labels", ctypes.c_char_p), ("min_basin", ctypes.c_uint64),
                 ("legend", ctypes.c_int), ("title", ctypes.c_char_p),
                 ("aspect", ctypes.c_double), ("font_size", ctypes.c_double),
-                ("dpi", ctypes.c_double)]
+                ("dpi", ctypes.c_double), ("pdf", ctypes.c_char_p)]
 
 
 class _DbOptions(ctypes.Structure):
@@ -521,7 +521,7 @@ _sig("cm_session_close", ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_size_t)
 
 _LAYERS = {"basin": 1, "steps": 2, "attractors": 4, "overlays": 8, "axes": 16, "legend": 32,
            "title": 64}
-_FIGURE_KEYS = {"svg", "width", "height", "layers", "indexed", "by", "palette", "labels",
+_FIGURE_KEYS = {"svg", "pdf", "width", "height", "layers", "indexed", "by", "palette", "labels",
                 "min_basin", "legend", "title", "aspect", "font_size", "dpi"}
 
 
@@ -543,6 +543,7 @@ def _figure_options(png, options):
     keep = [_text(os.fspath(v)) if v is not None else None
             for v in (png, options.get("svg"), options.get("palette"), options.get("labels"))]
     keep.append(_text(options["title"]) if options.get("title") is not None else None)
+    keep.append(_text(os.fspath(options["pdf"])) if options.get("pdf") is not None else None)
     aspect = options.get("aspect", 0)
     aspect = {"equal": 1.0, "auto": -1.0}.get(aspect, aspect)
     if isinstance(aspect, str):
@@ -551,7 +552,8 @@ def _figure_options(png, options):
                        int(options.get("height", 0)), bits, int(bool(options.get("indexed"))),
                        int(by == "groups"), keep[2], keep[3], int(options.get("min_basin", 0)),
                        int(options.get("legend", 0)), keep[4], float(aspect),
-                       float(options.get("font_size", 0)), float(options.get("dpi", 0)))
+                       float(options.get("font_size", 0)), float(options.get("dpi", 0)),
+                       keep[5])
     return o, keep
 
 
