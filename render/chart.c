@@ -158,62 +158,125 @@ static cm_status draw_plot(const cm_chart *c, cm_gl *gl, double hmax, int px, in
     return st;
 }
 
-/* ---- axes, title, colour bar ---- */
+/* ---- axes, title, colour bar: on the PNG's canvas or as SVG ---- */
 
-static void frame(const cm_canvas *cv, int x, int y, int w, int h)
+static void svg_hex(cm_rgb c, char out[8]) { snprintf(out, 8, "#%02x%02x%02x", c.r, c.g, c.b); }
+
+/* Where the frame, axes, labels, colour bar and title go: the canvas of a
+ * PNG (svg NULL) or an SVG stream; text measured with the same font. */
+typedef struct painter {
+    const cm_canvas *cv;
+    const cm_font *font;
+    FILE *svg;
+} painter;
+
+static void paint_rect(const painter *p, int x, int y, int w, int h, cm_rgb colour)
 {
-    cm_fill_rect(cv, x - 1, y - 1, w + 2, 1, ink);
-    cm_fill_rect(cv, x - 1, y + h, w + 2, 1, ink);
-    cm_fill_rect(cv, x - 1, y - 1, 1, h + 2, ink);
-    cm_fill_rect(cv, x + w, y - 1, 1, h + 2, ink);
+    if (!p->svg) {
+        cm_fill_rect(p->cv, x, y, w, h, colour);
+        return;
+    }
+    char hex[8];
+    svg_hex(colour, hex);
+    fprintf(p->svg, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"%s\"/>\n", x, y,
+            w, h, hex);
 }
 
-static void axes(const cm_chart *c, const layout *L, const cm_font *f, const cm_chart_info *in,
-                 const cm_canvas *cv)
+/* Text with its baseline at y. */
+static void paint_text(const painter *p, int x, int y, const char *text)
+{
+    if (!p->svg) {
+        cm_font_draw(p->font, text, x, y, ink, p->cv->rgba, p->cv->w, p->cv->h);
+        return;
+    }
+    fprintf(p->svg, "<text x=\"%d\" y=\"%d\">", x, y);
+    cm_svg_escaped(p->svg, text);
+    fputs("</text>\n", p->svg);
+}
+
+static void frame(const painter *p, int x, int y, int w, int h)
+{
+    paint_rect(p, x - 1, y - 1, w + 2, 1, ink);
+    paint_rect(p, x - 1, y + h, w + 2, 1, ink);
+    paint_rect(p, x - 1, y - 1, 1, h + 2, ink);
+    paint_rect(p, x + w, y - 1, 1, h + 2, ink);
+}
+
+static void axes(const cm_chart *c, const layout *L, const painter *p, const cm_chart_info *in)
 {
     const int base = in->plot_y + in->plot_h;
     int last_right = -1000000;
     for (int k = 0; k < L->tx.n; k++) {
         const int x = in->plot_x + cm_axis_px(L->tx.v[k], c->lo[0], c->hi[0], in->plot_w);
-        cm_fill_rect(cv, x, base, 1, L->tick, ink);
-        const int w = cm_font_width(f, L->tx.label[k]);
+        paint_rect(p, x, base, 1, L->tick, ink);
+        const int w = cm_font_width(p->font, L->tx.label[k]);
         if (x - w / 2 <= last_right + L->pad)
             continue;
-        cm_font_draw(f, L->tx.label[k], x - w / 2, base + L->tick + L->ascent, ink, cv->rgba, cv->w,
-                     cv->h);
+        paint_text(p, x - w / 2, base + L->tick + L->ascent, L->tx.label[k]);
         last_right = x - w / 2 + w;
     }
-    const int nw = cm_font_width(f, c->x_name);
-    cm_font_draw(f, c->x_name, in->plot_x + in->plot_w / 2 - nw / 2,
-                 base + L->tick + L->line + L->ascent, ink, cv->rgba, cv->w, cv->h);
+    const int nw = cm_font_width(p->font, c->x_name);
+    paint_text(p, in->plot_x + in->plot_w / 2 - nw / 2, base + L->tick + L->line + L->ascent,
+               c->x_name);
     for (int k = 0; k < L->ty.n; k++) {
         const int y =
             in->plot_y + in->plot_h - 1 - cm_axis_px(L->ty.v[k], c->lo[1], c->hi[1], in->plot_h);
-        cm_fill_rect(cv, in->plot_x - L->tick, y, L->tick, 1, ink);
-        const int w = cm_font_width(f, L->ty.label[k]);
-        cm_font_draw(f, L->ty.label[k], in->plot_x - L->tick - 2 - w, y + L->ascent / 2 - 1, ink,
-                     cv->rgba, cv->w, cv->h);
+        paint_rect(p, in->plot_x - L->tick, y, L->tick, 1, ink);
+        const int w = cm_font_width(p->font, L->ty.label[k]);
+        paint_text(p, in->plot_x - L->tick - 2 - w, y + L->ascent / 2 - 1, L->ty.label[k]);
     }
-    cm_font_draw(f, c->y_name, L->pad, in->plot_y + in->plot_h / 2 + L->ascent / 2, ink, cv->rgba,
-                 cv->w, cv->h);
+    paint_text(p, L->pad, in->plot_y + in->plot_h / 2 + L->ascent / 2, c->y_name);
 }
 
-static void colour_bar(const cm_chart *c, const layout *L, const cm_font *f, double hmax,
-                       const cm_chart_info *in, const cm_canvas *cv)
+static void colour_bar(const cm_chart *c, const layout *L, const painter *p, double hmax,
+                       const cm_chart_info *in)
 {
     const int x = in->plot_x + in->plot_w + 3 * L->pad, y = in->plot_y + L->line,
               h = in->plot_h - L->line;
     for (int j = 0; j < h; j++) /* top = max */
-        cm_fill_rect(cv, x, y + j, L->bar, 1, cm_heat_colour(hmax * (h - 1 - j) / (h - 1), hmax));
-    frame(cv, x, y, L->bar, h);
+        paint_rect(p, x, y + j, L->bar, 1, cm_heat_colour(hmax * (h - 1 - j) / (h - 1), hmax));
+    frame(p, x, y, L->bar, h);
     for (int k = 0; k < L->tbar.n; k++) {
         const int ty = y + h - 1 - cm_axis_px(L->tbar.v[k], 0, hmax, h - 1);
-        cm_fill_rect(cv, x + L->bar, ty, L->tick, 1, ink);
-        cm_font_draw(f, L->tbar.label[k], x + L->bar + L->tick + 2, ty + L->ascent / 2 - 1, ink,
-                     cv->rgba, cv->w, cv->h);
+        paint_rect(p, x + L->bar, ty, L->tick, 1, ink);
+        paint_text(p, x + L->bar + L->tick + 2, ty + L->ascent / 2 - 1, L->tbar.label[k]);
     }
     if (c->heat->name)
-        cm_font_draw(f, c->heat->name, x, in->plot_y + L->ascent, ink, cv->rgba, cv->w, cv->h);
+        paint_text(p, x, in->plot_y + L->ascent, c->heat->name);
+}
+
+/* The labels, each right of and above its point, kept inside the plot. */
+static void draw_labels(const cm_chart *c, const layout *L, const painter *p,
+                        const cm_chart_info *in)
+{
+    for (int k = 0; k < c->n_labels; k++) {
+        const cm_chart_label *l = &c->labels[k];
+        const double fx = (l->x - c->lo[0]) / (c->hi[0] - c->lo[0]);
+        const double fy = (l->y - c->lo[1]) / (c->hi[1] - c->lo[1]);
+        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) || !l->text)
+            continue;
+        const int w = cm_font_width(p->font, l->text);
+        int x = in->plot_x + (int)lround(fx * in->plot_w) + 4;
+        int y = in->plot_y + (int)lround((1 - fy) * in->plot_h) - 4;
+        if (x + w > in->plot_x + in->plot_w - 2) /* near the right edge: left of the point */
+            x -= w + 8;
+        if (y - L->ascent < in->plot_y + 2)
+            y = in->plot_y + 2 + L->ascent;
+        paint_text(p, x, y, l->text);
+    }
+}
+
+/* Everything around the plot. */
+static void decorate(const cm_chart *c, const layout *L, const painter *p, double hmax,
+                     const cm_chart_info *in)
+{
+    frame(p, in->plot_x, in->plot_y, in->plot_w, in->plot_h);
+    axes(c, L, p, in);
+    draw_labels(c, L, p, in);
+    if (c->heat)
+        colour_bar(c, L, p, hmax, in);
+    if (c->title)
+        paint_text(p, L->pad, L->pad + L->ascent, c->title);
 }
 
 void cm_chart_join_labels(cm_chart_label *labels, int n, char *texts, size_t text_size, double dx,
@@ -230,27 +293,6 @@ void cm_chart_join_labels(cm_chart_label *labels, int n, char *texts, size_t tex
                 snprintf(into + used, text_size - used, ", %s", labels[i].text);
             labels[i].text = NULL;
         }
-}
-
-/* The labels, each right of and above its point, kept inside the plot. */
-static void draw_labels(const cm_chart *c, const cm_font *f, const layout *L,
-                        const cm_chart_info *in, const cm_canvas *cv)
-{
-    for (int k = 0; k < c->n_labels; k++) {
-        const cm_chart_label *l = &c->labels[k];
-        const double fx = (l->x - c->lo[0]) / (c->hi[0] - c->lo[0]);
-        const double fy = (l->y - c->lo[1]) / (c->hi[1] - c->lo[1]);
-        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) || !l->text)
-            continue;
-        const int w = cm_font_width(f, l->text);
-        int x = in->plot_x + (int)lround(fx * in->plot_w) + 4;
-        int y = in->plot_y + (int)lround((1 - fy) * in->plot_h) - 4;
-        if (x + w > in->plot_x + in->plot_w - 2) /* near the right edge: left of the point */
-            x -= w + 8;
-        if (y - L->ascent < in->plot_y + 2)
-            y = in->plot_y + 2 + L->ascent;
-        cm_font_draw(f, l->text, x, y, ink, cv->rgba, cv->w, cv->h);
-    }
 }
 
 /* Opens the chart's font and plans its layout: info gets the plot's place. */
@@ -308,15 +350,8 @@ cm_status cm_chart_draw(const cm_chart *c, cm_gl *gl, uint8_t *rgba, cm_chart_in
         st = draw_plot(c, gl, hmax, info->plot_x, info->plot_y, info->plot_w, info->plot_h, rgba,
                        msg, msg_size);
     }
-    if (st == CM_OK) {
-        frame(&cv, info->plot_x, info->plot_y, info->plot_w, info->plot_h);
-        axes(c, &L, f, info, &cv);
-        draw_labels(c, f, &L, info, &cv);
-        if (c->heat)
-            colour_bar(c, &L, f, hmax, info, &cv);
-        if (c->title)
-            cm_font_draw(f, c->title, L.pad, L.pad + L.ascent, ink, rgba, c->width, c->height);
-    }
+    if (st == CM_OK)
+        decorate(c, &L, &(const painter){&cv, f, NULL}, hmax, info);
     cm_font_close(f);
     return st;
 }
@@ -331,23 +366,6 @@ static double svg_x(const cm_chart *c, const cm_chart_info *in, double x)
 static double svg_y(const cm_chart *c, const cm_chart_info *in, double y)
 {
     return in->plot_y + in->plot_h - (y - c->lo[1]) / (c->hi[1] - c->lo[1]) * in->plot_h;
-}
-
-static void svg_hex(cm_rgb c, char out[8]) { snprintf(out, 8, "#%02x%02x%02x", c.r, c.g, c.b); }
-
-static void svg_text(FILE *f, int x, int y, const char *s)
-{
-    fprintf(f, "<text x=\"%d\" y=\"%d\">", x, y);
-    cm_svg_escaped(f, s);
-    fputs("</text>\n", f);
-}
-
-static void svg_rect(FILE *f, double x, double y, double w, double h, cm_rgb colour)
-{
-    char hex[8];
-    svg_hex(colour, hex);
-    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\"/>\n", x,
-            y, w, h, hex);
 }
 
 /* The heat map as an embedded PNG, each cell k x k pixels (at most about
@@ -411,72 +429,6 @@ static void svg_series(FILE *f, const cm_chart *c, const cm_chart_info *in, cons
     fputs("\"/>\n", f);
 }
 
-static void svg_axes(FILE *f, const cm_chart *c, const layout *L, const cm_font *font,
-                     const cm_chart_info *in)
-{
-    const int base = in->plot_y + in->plot_h;
-    int last_right = -1000000;
-    for (int k = 0; k < L->tx.n; k++) {
-        const int x = in->plot_x + cm_axis_px(L->tx.v[k], c->lo[0], c->hi[0], in->plot_w);
-        svg_rect(f, x, base, 1, L->tick, ink);
-        const int w = cm_font_width(font, L->tx.label[k]);
-        if (x - w / 2 <= last_right + L->pad)
-            continue;
-        svg_text(f, x - w / 2, base + L->tick + L->ascent, L->tx.label[k]);
-        last_right = x - w / 2 + w;
-    }
-    const int nw = cm_font_width(font, c->x_name);
-    svg_text(f, in->plot_x + in->plot_w / 2 - nw / 2, base + L->tick + L->line + L->ascent,
-             c->x_name);
-    for (int k = 0; k < L->ty.n; k++) {
-        const int y =
-            in->plot_y + in->plot_h - 1 - cm_axis_px(L->ty.v[k], c->lo[1], c->hi[1], in->plot_h);
-        svg_rect(f, in->plot_x - L->tick, y, L->tick, 1, ink);
-        const int w = cm_font_width(font, L->ty.label[k]);
-        svg_text(f, in->plot_x - L->tick - 2 - w, y + L->ascent / 2 - 1, L->ty.label[k]);
-    }
-    svg_text(f, L->pad, in->plot_y + in->plot_h / 2 + L->ascent / 2, c->y_name);
-}
-
-static void svg_colour_bar(FILE *f, const cm_chart *c, const layout *L, double hmax,
-                           const cm_chart_info *in)
-{
-    const int x = in->plot_x + in->plot_w + 3 * L->pad, y = in->plot_y + L->line,
-              h = in->plot_h - L->line;
-    for (int j = 0; j < h; j++)
-        svg_rect(f, x, y + j, L->bar, 1, cm_heat_colour(hmax * (h - 1 - j) / (h - 1), hmax));
-    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%d\" height=\"%d\" fill=\"none\" "
-               "stroke=\"#000000\"/>\n",
-            x - 0.5, y - 0.5, L->bar + 1, h + 1);
-    for (int k = 0; k < L->tbar.n; k++) {
-        const int ty = y + h - 1 - cm_axis_px(L->tbar.v[k], 0, hmax, h - 1);
-        svg_rect(f, x + L->bar, ty, L->tick, 1, ink);
-        svg_text(f, x + L->bar + L->tick + 2, ty + L->ascent / 2 - 1, L->tbar.label[k]);
-    }
-    if (c->heat->name)
-        svg_text(f, x, in->plot_y + L->ascent, c->heat->name);
-}
-
-static void svg_labels(FILE *f, const cm_chart *c, const cm_font *font, const layout *L,
-                       const cm_chart_info *in)
-{
-    for (int k = 0; k < c->n_labels; k++) { /* placed as draw_labels places them */
-        const cm_chart_label *l = &c->labels[k];
-        const double fx = (l->x - c->lo[0]) / (c->hi[0] - c->lo[0]);
-        const double fy = (l->y - c->lo[1]) / (c->hi[1] - c->lo[1]);
-        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) || !l->text)
-            continue;
-        const int w = cm_font_width(font, l->text);
-        int x = in->plot_x + (int)lround(fx * in->plot_w) + 4;
-        int y = in->plot_y + (int)lround((1 - fy) * in->plot_h) - 4;
-        if (x + w > in->plot_x + in->plot_w - 2)
-            x -= w + 8;
-        if (y - L->ascent < in->plot_y + 2)
-            y = in->plot_y + 2 + L->ascent;
-        svg_text(f, x, y, l->text);
-    }
-}
-
 cm_status cm_chart_svg(const cm_chart *c, int index, int top, int cell_pixels, FILE *f, char *msg,
                        size_t msg_size)
 {
@@ -487,7 +439,7 @@ cm_status cm_chart_svg(const cm_chart *c, int index, int top, int cell_pixels, F
     const double hmax = in.heat_max > 0 ? in.heat_max : 1;
     if (st == CM_OK) {
         fprintf(f, "<g transform=\"translate(0 %d)\" font-size=\"%d\">\n", top, L.font_px);
-        svg_rect(f, 0, 0, c->width, c->height, paper);
+        paint_rect(&(const painter){NULL, font, f}, 0, 0, c->width, c->height, paper);
         fprintf(f, "<clipPath id=\"plot%d\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/>"
                    "</clipPath>\n",
                 index, in.plot_x, in.plot_y, in.plot_w, in.plot_h);
@@ -499,15 +451,7 @@ cm_status cm_chart_svg(const cm_chart *c, int index, int top, int cell_pixels, F
         for (int k = 0; k < c->n_series; k++)
             svg_series(f, c, &in, &c->series[k]);
         fputs("</g>\n", f);
-        fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%d\" height=\"%d\" fill=\"none\" "
-                   "stroke=\"#000000\"/>\n",
-                in.plot_x - 0.5, in.plot_y - 0.5, in.plot_w + 1, in.plot_h + 1);
-        svg_axes(f, c, &L, font, &in);
-        svg_labels(f, c, font, &L, &in);
-        if (c->heat)
-            svg_colour_bar(f, c, &L, hmax, &in);
-        if (c->title)
-            svg_text(f, L.pad, L.pad + L.ascent, c->title);
+        decorate(c, &L, &(const painter){NULL, font, f}, hmax, &in);
         fputs("</g>\n", f);
     }
     cm_font_close(font);

@@ -58,20 +58,29 @@ static void load(void)
                  dlerror());
         return;
     }
-    bool ok = bind_symbol(rsvg, "rsvg_handle_new_from_data", &api.new_from_data);
-    ok = bind_symbol(rsvg, "rsvg_handle_get_intrinsic_dimensions", &api.intrinsic_dimensions) && ok;
-    ok = bind_symbol(rsvg, "rsvg_handle_render_document", &api.render_document) && ok;
-    ok = bind_symbol(gobject, "g_object_unref", &api.object_unref) && ok;
-    ok = bind_symbol(glib, "g_error_free", &api.error_free) && ok;
-    ok = bind_symbol(cairo, "cairo_pdf_surface_create_for_stream", &api.pdf_create_for_stream) && ok;
-    ok = bind_symbol(cairo, "cairo_pdf_surface_set_metadata", &api.pdf_set_metadata) && ok;
-    ok = bind_symbol(cairo, "cairo_create", &api.create) && ok;
-    ok = bind_symbol(cairo, "cairo_status", &api.status) && ok;
-    ok = bind_symbol(cairo, "cairo_destroy", &api.destroy) && ok;
-    ok = bind_symbol(cairo, "cairo_surface_finish", &api.surface_finish) && ok;
-    ok = bind_symbol(cairo, "cairo_surface_status", &api.surface_status) && ok;
-    ok = bind_symbol(cairo, "cairo_surface_destroy", &api.surface_destroy) && ok;
-    ok = bind_symbol(cairo, "cairo_status_to_string", &api.status_to_string) && ok;
+    const struct {
+        void *lib;
+        const char *name;
+        void *slot;
+    } entries[] = {
+        {rsvg, "rsvg_handle_new_from_data", &api.new_from_data},
+        {rsvg, "rsvg_handle_get_intrinsic_dimensions", &api.intrinsic_dimensions},
+        {rsvg, "rsvg_handle_render_document", &api.render_document},
+        {gobject, "g_object_unref", &api.object_unref},
+        {glib, "g_error_free", &api.error_free},
+        {cairo, "cairo_pdf_surface_create_for_stream", &api.pdf_create_for_stream},
+        {cairo, "cairo_pdf_surface_set_metadata", &api.pdf_set_metadata},
+        {cairo, "cairo_create", &api.create},
+        {cairo, "cairo_status", &api.status},
+        {cairo, "cairo_destroy", &api.destroy},
+        {cairo, "cairo_surface_finish", &api.surface_finish},
+        {cairo, "cairo_surface_status", &api.surface_status},
+        {cairo, "cairo_surface_destroy", &api.surface_destroy},
+        {cairo, "cairo_status_to_string", &api.status_to_string},
+    };
+    bool ok = true;
+    for (size_t i = 0; i < sizeof entries / sizeof entries[0]; i++)
+        ok = bind_symbol(entries[i].lib, entries[i].name, entries[i].slot) && ok;
     if (ok)
         load_error[0] = '\0';
 }
