@@ -261,10 +261,12 @@ void delay_domains_report(FILE *f, const delay_point *pt)
     bands_text(pt->bands, bands, sizeof bands);
     fprintf(f, "a = %s, b = %s: %s the stable domain G (a > 1, b < 1, b > a - 1; 4.39)\n",
             CM_NUM(pt->a), CM_NUM(pt->b), d->stable ? "in" : "outside");
-    fprintf(f, "  %s\n", d->d01    ? "domain '01': the attractor is whole basic branches on U_0, U_1"
+    const char *domain = d->d01    ? "domain '01': the attractor is whole basic branches on U_0, "
+                                     "U_1"
                          : d->d012 ? "domain '012': the attractor is whole basic branches on "
                                      "U_0, U_1, U_2"
-                                   : "in neither '01' nor '012' (App. C.3.1)");
+                                   : "in neither '01' nor '012' (App. C.3.1)";
+    fprintf(f, "  %s\n", domain);
     if (d->d01)
         fprintf(f, "  primitive partition (App. C.3.2): %s\n",
                 d->mu_sl   ? "c_m^u <= b <= c_s^l (C.38), (C.40)"

@@ -459,7 +459,8 @@ cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *
 }
 
 /* The figure as SVG (render/svg.h), for outfile_vector. */
-static cm_status figure_svg(FILE *f, void *user, int cell_pixels, char *msg, size_t msg_size)
+static cm_status figure_svg(FILE *f, const void *user, int cell_pixels, char *msg,
+                            size_t msg_size)
 {
     const basin_png *b = user;
     cm_render_options ro;
@@ -520,9 +521,9 @@ cm_status figure_write(const basin_png *b, char *msg, size_t msg_size)
     if (b->opts->path)
         st = b->opts->indexed ? write_indexed(b, msg, msg_size) : write_figure(b, msg, msg_size);
     if (st == CM_OK && b->opts->svg)
-        st = outfile_vector(b->opts->svg, false, figure_svg, (void *)b, msg, msg_size);
+        st = outfile_vector(b->opts->svg, false, figure_svg, b, msg, msg_size);
     if (st == CM_OK && b->opts->pdf)
-        st = outfile_vector(b->opts->pdf, true, figure_svg, (void *)b, msg, msg_size);
+        st = outfile_vector(b->opts->pdf, true, figure_svg, b, msg, msg_size);
     return st;
 }
 

@@ -72,8 +72,8 @@ cm_status outfile_end(outfile *o, bool ok, char *msg, size_t msg_size)
  * pixels a cell covers on the page). */
 enum { PDF_CELL_PIXELS = 16 };
 
-cm_status outfile_vector(const char *path, bool pdf, svg_writer write, void *user, char *msg,
-                         size_t msg_size)
+cm_status outfile_vector(const char *path, bool pdf, svg_writer write, const void *user,
+                         char *msg, size_t msg_size)
 {
     char *svg = NULL;
     size_t bytes = 0;
@@ -106,7 +106,8 @@ typedef struct chart_stack {
 
 /* The charts one below the other as an SVG document (pixel units); the
  * texts as its description. */
-static cm_status charts_svg(FILE *f, void *user, int cell_pixels, char *msg, size_t msg_size)
+static cm_status charts_svg(FILE *f, const void *user, int cell_pixels, char *msg,
+                            size_t msg_size)
 {
     const chart_stack *c = user;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "

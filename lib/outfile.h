@@ -53,9 +53,10 @@ cm_status outfile_end(outfile *o, bool ok, char *msg, size_t msg_size);
  * pixels a cell: cm_render_options.svg_cell_pixels) at path, or, with pdf,
  * that SVG drawn as a PDF by render/pdf.h (cell_pixels 16: librsvg smooths
  * images, and cells of several pixels keep their edges). */
-typedef cm_status (*svg_writer)(FILE *f, void *user, int cell_pixels, char *msg, size_t msg_size);
-cm_status outfile_vector(const char *path, bool pdf, svg_writer write, void *user, char *msg,
-                         size_t msg_size);
+typedef cm_status (*svg_writer)(FILE *f, const void *user, int cell_pixels, char *msg,
+                                 size_t msg_size);
+cm_status outfile_vector(const char *path, bool pdf, svg_writer write, const void *user,
+                         char *msg, size_t msg_size);
 
 /* Draws the charts one below the other (all of the first one's width) and
  * writes them at path with the given texts (plus Software): as SVG or PDF

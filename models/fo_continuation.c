@@ -983,7 +983,8 @@ bool cm_fo_period_doubled(const cm_fo *o, int param, const cm_fo_branch_event *e
 double cm_fo_turn_h(double t, double Omega)
 {
     const double a = 3.14159265358979323846 / Omega;
-    return (sin(t) + sin(a) * cos(Omega * t) + sin(t - a)) / (Omega * sin(Omega * t) * (1 + cos(a)));
+    const double den = Omega * sin(Omega * t) * (1 + cos(a));
+    return (sin(t) + sin(a) * cos(Omega * t) + sin(t - a)) / den;
 }
 
 double cm_fo_turn_hmax_at(double Omega, double *t_max)

@@ -18,6 +18,12 @@ double cm_polygon_area(const cm_polygon *p)
     return s / 2;
 }
 
+/* Which side of the line a -> b the point p lies on (positive: left). */
+static double side_of(const double a[2], const double b[2], const double p[2])
+{
+    return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+}
+
 /* The part of the convex polygon in on the inner side of each edge of the
  * convex polygon clip (Sutherland-Hodgman); false when a result would
  * need more than CM_POLYGON_MAX corners. */
@@ -30,8 +36,7 @@ static bool clip_convex(const cm_polygon *in, const cm_polygon *clip, cm_polygon
         cm_polygon next = {0};
         for (int i = 0; i < cur.n; i++) {
             const double *p = cur.p[i], *q = cur.p[(i + 1) % cur.n];
-            const double sp = orient * ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]));
-            const double sq = orient * ((b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0]));
+            const double sp = orient * side_of(a, b, p), sq = orient * side_of(a, b, q);
             if (next.n + 2 > CM_POLYGON_MAX)
                 return false;
             if (sp >= 0)

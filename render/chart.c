@@ -374,14 +374,16 @@ static cm_status svg_heat(FILE *f, const cm_chart *c, const cm_chart_info *in, d
                           int k, char *msg, size_t msg_size)
 {
     const cm_heat *h = c->heat;
-    k = (int)fmin(k, fmax(1, ceil(2 * fmax((double)in->plot_w / h->nx, (double)in->plot_h / h->ny))));
+    const double across = fmax((double)in->plot_w / h->nx, (double)in->plot_h / h->ny);
+    k = (int)fmin(k, fmax(1, ceil(2 * across)));
     const size_t w = (size_t)h->nx * (size_t)k, ht = (size_t)h->ny * (size_t)k;
     uint8_t *rgba = malloc(w * ht * 4);
     if (!rgba)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the chart's SVG");
     for (size_t j = 0; j < ht; j++) /* row 0 is the top: the highest cells */
         for (size_t i = 0; i < w; i++) {
-            const double v = h->v[((size_t)h->ny - 1 - j / (size_t)k) * (size_t)h->nx + i / (size_t)k];
+            const size_t row = (size_t)h->ny - 1 - j / (size_t)k, column = i / (size_t)k;
+            const double v = h->v[row * (size_t)h->nx + column];
             const cm_rgb col = v > 0 ? cm_heat_colour(v, hmax) : isnan(v) ? not_computed : paper;
             uint8_t *p = rgba + 4 * (j * w + i);
             p[0] = col.r, p[1] = col.g, p[2] = col.b, p[3] = 255;

@@ -105,6 +105,9 @@ static int parse_args(cli *c, amp_args *a)
             err = cli_stray(c);
         }
     }
+    if (!err && a->has_omega && a->transient.kind)
+        err = cli_usage_error(c, "--omega sweeps the diagram; --h, --extremal and --converge "
+                                 "take the model's Omega (--param)");
     if (!err && !a->has_omega && !a->transient.kind)
         err = cli_usage_error(c, "--omega LO:HI:N is required (e.g. --omega 0.1:3:300)");
     if (!err)

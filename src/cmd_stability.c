@@ -104,8 +104,8 @@ static int delay_domains(const cli *c, const stab_args *a, const cm_params *base
         delay_domains_report(report_stream(a->out.csv, a->out.png, NULL), &pt);
     }
     char msg[1024];
-    return analysis_said(c->cmd, delay_domains_write(&a->out, a->mo.name, base, &pt, msg, sizeof msg),
-                         msg);
+    const cm_status st = delay_domains_write(&a->out, a->mo.name, base, &pt, msg, sizeof msg);
+    return analysis_said(c->cmd, st, msg);
 }
 
 int cmd_stability(int argc, char **argv)

@@ -337,6 +337,7 @@ expect_usage "--images" horseshoe --images 7
 expect_usage "different charts: give one" amplitude --h 0.5 --converge 100
 expect_usage "is not 1..6 frequencies" amplitude --h 0.1,0.2,0.3,0.4,0.5,0.6,0.7
 expect_usage "--converge" amplitude --converge 5
+expect_usage "take the model's Omega" amplitude --omega 0.1:1:5 --extremal 0.01
 expect_usage "0 < eps < S" amplitude --param S=0.1,S0=0.1 --extremal 0.2
 expect_usage "--m: '0:3' is not M0:M1" horseshoe --m 0:3
 expect_usage "domain '01'" partition --param a=1.5,b=0.6
