@@ -93,23 +93,28 @@ typedef struct named_curve {
     cm_rgb colour;
 } named_curve;
 
-static const cm_rgb black = {0, 0, 0}, red = {215, 48, 39}, blue = {69, 117, 180},
-                    green = {26, 152, 80}, purple = {118, 42, 131}, orange = {230, 97, 1},
-                    brown = {140, 81, 10};
+/* The colours as initialisers (static tables need constant expressions). */
+#define BLACK {0, 0, 0}
+#define RED {215, 48, 39}
+#define BLUE {69, 117, 180}
+#define GREEN {26, 152, 80}
+#define PURPLE {118, 42, 131}
+#define ORANGE {230, 97, 1}
+#define BROWN {140, 81, 10}
 
 /* Fig. 4.10's curves (the first four bound '01', the last five '012'). */
 static const named_curve curves_4_10[] = {
-    {FIELD(n_sup0), "n_sup^0", 1.34, blue},   {FIELD(n_inf1), "n_inf^1", 1.05, blue},
-    {FIELD(d1), "d^1", 1.22, blue},           {FIELD(d0), "d^0", 1.18, brown},
-    {FIELD(d2), "d^2", 1.42, green},          {FIELD(n_sup1), "n_sup^1", 1.30, green},
-    {FIELD(g_sup0), "g_sup^0", 1.36, green},  {FIELD(g_inf2), "g_inf^2", 1.13, green},
+    {FIELD(n_sup0), "n_sup^0", 1.34, BLUE},   {FIELD(n_inf1), "n_inf^1", 1.05, BLUE},
+    {FIELD(d1), "d^1", 1.22, BLUE},           {FIELD(d0), "d^0", 1.18, BROWN},
+    {FIELD(d2), "d^2", 1.42, GREEN},          {FIELD(n_sup1), "n_sup^1", 1.30, GREEN},
+    {FIELD(g_sup0), "g_sup^0", 1.36, GREEN},  {FIELD(g_inf2), "g_inf^2", 1.13, GREEN},
 };
 /* Fig. C.3's. */
 static const named_curve curves_c_3[] = {
-    {FIELD(c_mu), "c_m^u", 1.08, orange},
-    {FIELD(c_sl), "c_s^l", 1.36, orange},
-    {FIELD(c_su), "c_s^u", 1.14, purple},
-    {FIELD(c_ml), "c_m^l", 1.39, purple},
+    {FIELD(c_mu), "c_m^u", 1.08, ORANGE},
+    {FIELD(c_sl), "c_s^l", 1.36, ORANGE},
+    {FIELD(c_su), "c_s^u", 1.14, PURPLE},
+    {FIELD(c_ml), "c_m^l", 1.39, PURPLE},
 };
 
 typedef struct chart_parts {
@@ -148,9 +153,9 @@ static void add_edges_and_point(chart_parts *p, double ahi, const delay_point *p
     xy[4] = 0, xy[5] = 1, xy[6] = 1, xy[7] = 1;       /* their y */
     xy[8] = 1, xy[9] = ahi;                           /* b = a - 1 */
     xy[10] = 0, xy[11] = ahi - 1;
-    p->series[p->n_series++] = (cm_series){CM_SERIES_SEGMENTS, xy, xy + 4, 4, black, 2};
-    p->series[p->n_series++] = (cm_series){CM_SERIES_LINE, xy + 8, xy + 10, 2, black, 2};
-    p->series[p->n_series++] = (cm_series){CM_SERIES_POINTS, &pt->a, &pt->b, 1, red, 9};
+    p->series[p->n_series++] = (cm_series){CM_SERIES_SEGMENTS, xy, xy + 4, 4, (cm_rgb)BLACK, 2};
+    p->series[p->n_series++] = (cm_series){CM_SERIES_LINE, xy + 8, xy + 10, 2, (cm_rgb)BLACK, 2};
+    p->series[p->n_series++] = (cm_series){CM_SERIES_POINTS, &pt->a, &pt->b, 1, (cm_rgb)RED, 9};
 }
 
 static cm_chart chart_of(const chart_outputs *out, int k, double ahi, const char *title,
