@@ -178,11 +178,12 @@ static bool write_png(const chart_outputs *out, const char *model, const cm_para
     const cm_rgb light_blue = {198, 219, 239}, light_green = {199, 233, 192},
                  light_grey = {225, 225, 225}, light_orange = {253, 208, 162},
                  light_purple = {218, 218, 235};
-    fill f[6] = {{0}};
+    enum { FILLS = 5 };
+    fill f[FILLS] = {{0}}; /* G; '01' (in two charts); '012'; the two partition domains */
     double *xy = malloc(sizeof(double) * 2 * DELAY_COLUMNS * 12 + 3 * 12 * sizeof(double));
     bool ok = xy && fill_domain(in_g, 1, a_all, &f[0]) && fill_domain(in_01, 1, a_near, &f[1]) &&
-              fill_domain(in_012, 1, a_near, &f[2]) && fill_domain(in_01, 1, a_near, &f[3]) &&
-              fill_domain(in_mu_sl, 1, a_near, &f[4]) && fill_domain(in_su_ml, 1, a_near, &f[5]);
+              fill_domain(in_012, 1, a_near, &f[2]) && fill_domain(in_mu_sl, 1, a_near, &f[3]) &&
+              fill_domain(in_su_ml, 1, a_near, &f[4]);
     if (!ok) {
         snprintf(msg, msg_size, "out of memory for the charts");
     } else {
@@ -196,9 +197,9 @@ static bool write_png(const chart_outputs *out, const char *model, const cm_para
         add_fill(&parts[1], &f[2], light_green, w, "012");
         add_curves(&parts[1], curves_4_10, 8, 1, a_near, xy);
         add_edges_and_point(&parts[1], a_near, pt, edges + 12);
-        add_fill(&parts[2], &f[3], light_grey, w, NULL);
-        add_fill(&parts[2], &f[4], light_orange, w, NULL);
-        add_fill(&parts[2], &f[5], light_purple, w, NULL);
+        add_fill(&parts[2], &f[1], light_grey, w, NULL);
+        add_fill(&parts[2], &f[3], light_orange, w, NULL);
+        add_fill(&parts[2], &f[4], light_purple, w, NULL);
         add_curves(&parts[2], curves_c_3, 4, 1, a_near, xy + (size_t)16 * DELAY_COLUMNS);
         add_edges_and_point(&parts[2], a_near, pt, edges + 24);
         char params[400];
@@ -215,7 +216,7 @@ static bool write_png(const chart_outputs *out, const char *model, const cm_para
         const cm_png_text texts[] = {{"Model", model}, {"Parameters", params}};
         ok = outfile_charts(out->png, charts, CHARTS, texts, 2, msg, msg_size) == CM_OK;
     }
-    for (int k = 0; k < 6; k++)
+    for (int k = 0; k < FILLS; k++)
         free(f[k].x);
     free(xy);
     return ok;

@@ -269,7 +269,10 @@ static bool png_plane(const hs_args *a, double alpha, double beta, int nm, const
     const int np = a->sweep.n, nd = a->plane.n, shown = nm < 6 ? nm : 6;
     const size_t cap = (size_t)np * (size_t)nd * 2 + 2;
     double *v = malloc(cap * 4 * (size_t)shown * sizeof *v);
-    if (!v) {
+    unsigned char *flags = calloc((size_t)nd * 2, 1); /* escape bits of this and the last column */
+    if (!v || !flags) {
+        free(v);
+        free(flags);
         snprintf(msg, msg_size, "out of memory for the figure");
         return false;
     }
@@ -279,8 +282,7 @@ static bool png_plane(const hs_args *a, double alpha, double beta, int nm, const
                              {118, 42, 131}, {230, 97, 1}, {0, 0, 0}};
     cm_series series[12];
     const double dD = (a->plane.hi - a->plane.lo) / nd;
-    unsigned char *flags = calloc((size_t)nd * 2, 1); /* escape bits of this and the last column */
-    for (int j = 0; j < shown && flags; j++) {
+    for (int j = 0; j < shown; j++) {
         double *fx = v + (size_t)j * 4 * cap, *fy = fx + cap, *ex = fy + cap, *ey = ex + cap;
         size_t nf = 0, ne = 0;
         for (int i = 0; i < np; i++) {
@@ -313,11 +315,6 @@ static bool png_plane(const hs_args *a, double alpha, double beta, int nm, const
         const float w = (float)ceil((double)a->out.width / np) + 1;
         series[j] = (cm_series){CM_SERIES_SEGMENTS, fx, fy, nf, fills[j], w};
         series[shown + j] = (cm_series){CM_SERIES_POINTS, ex, ey, ne, lines[j], 2};
-    }
-    if (!flags) {
-        free(v);
-        snprintf(msg, msg_size, "out of memory for the figure");
-        return false;
     }
     free(flags);
     static const char *const names[6] = {"red", "blue", "green", "purple", "orange", "black"};

@@ -162,16 +162,15 @@ static cm_status write_png(const lyap_args *a, const stick_map_result *r, char *
         {CM_SERIES_LINE, diagonal, diagonal + 2, 2, (cm_rgb){150, 150, 150}, 1},
         {CM_SERIES_POINTS, px + n_kept, py + n_kept, r->n - n_kept, (cm_rgb){215, 48, 39}, 3},
         {CM_SERIES_POINTS, px, py, n_kept, (cm_rgb){0, 0, 0}, 2}};
-    char title[600], params[400], xname[32], yname[32];
+    char title[600], params[400], yname[32];
     cm_params_format_with(&r->base, NULL, params, sizeof params);
     snprintf(title, sizeof title,
              "every %d%s stick: lambda_map %.4g, lambda_flow %.4g (black: counted); %s",
              a->every, a->every == 1 ? "st" : a->every == 2 ? "nd" : a->every == 3 ? "rd" : "th",
              r->lambda_map, r->lambda_flow, params);
-    snprintf(xname, sizeof xname, "x_n");
     snprintf(yname, sizeof yname, "x_n+%d", a->every);
     const cm_chart chart = {a->width, a->height, {lo - pad, lo - pad}, {hi + pad, hi + pad},
-                            xname, yname, title, NULL, series, 3, figure_font(), 0, NULL, 0};
+                            "x_n", yname, title, NULL, series, 3, figure_font(), 0, NULL, 0};
     const cm_png_text texts[] = {{"Model", a->mo.name}, {"Parameters", params}};
     const cm_status st = outfile_charts(a->png, &chart, 1, texts, 2, msg, msg_size);
     free(px);
