@@ -565,7 +565,7 @@ static cm_status write_rows(cm_cluster *c, const cm_box *window, const cm_attrac
         cm_status st = cm_cluster_flatten(c, &slab, &flat, msg, msg_size);
         if (st != CM_OK)
             return st;
-        int32_t *label = malloc((flat.ncells + 1) * sizeof *label);
+        int32_t *label = cm_cells_array((flat.ncells + 1) * sizeof *label);
         st = label ? cm_attractor_cell_labels(att, &flat, computed, label, msg, msg_size)
                    : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
         for (uint64_t i = 0; i < flat.ncells && st == CM_OK; i++) {
@@ -807,7 +807,7 @@ static cm_status each_slab(cm_cluster *c, const cm_box *window, const cm_attract
         cm_region flat;
         if ((st = cm_cluster_flatten(c, &slab, &flat, msg, msg_size)) != CM_OK)
             break;
-        int32_t *label = att ? malloc((flat.ncells + 1) * sizeof *label) : NULL;
+        int32_t *label = att ? cm_cells_array((flat.ncells + 1) * sizeof *label) : NULL;
         if (att && !label)
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
         else if (att)

@@ -264,6 +264,11 @@ static unsigned layers_of(const png_opts *po)
                                 : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
 }
 
+bool figure_needs_gl(const png_opts *po, const cm_model *m)
+{
+    return po->path && !po->indexed && cm_plot_needs_gl(layers_of(po), m, m->dim);
+}
+
 bool parse_aspect(const char *s, double *aspect)
 {
     char *end = NULL;
@@ -327,7 +332,7 @@ static cm_status write_figure(const basin_png *b, char *msg, size_t msg_size)
     const png_opts *po = b->opts;
     cm_render_options ro;
     figure_options(b, &ro);
-    uint8_t *rgba = malloc((size_t)ro.width * (size_t)ro.height * 4);
+    uint8_t *rgba = cm_cells_array((size_t)ro.width * (size_t)ro.height * 4);
     if (!rgba)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d image", ro.width,
                        ro.height);
@@ -479,7 +484,7 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
     png_opts *po = malloc(sizeof *po);
     if (st == CM_OK && !po)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
-    int32_t *label = st == CM_OK ? malloc((view.ncells + 1) * sizeof *label) : NULL;
+    int32_t *label = st == CM_OK ? cm_cells_array((view.ncells + 1) * sizeof *label) : NULL;
     if (st == CM_OK && !label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
     if (st == CM_OK && b->labels)

@@ -115,6 +115,10 @@ cm_status figure_check_layout(const png_opts *po, const cm_model *m, const cm_la
 cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *lat,
                        const cm_box *box, char *msg, size_t msg_size);
 
+/* Whether the PNG of these options draws with GL (cm_plot_needs_gl): a
+ * session keeps a context only for figures that do. */
+bool figure_needs_gl(const png_opts *po, const cm_model *m);
+
 /* Draws and writes the figure's files (the PNG at opts->path, the SVG at
  * opts->svg, either may be NULL), each reaching its path only when
  * complete. */

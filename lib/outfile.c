@@ -129,7 +129,7 @@ static cm_status charts_svg(FILE *f, const void *user, int cell_pixels, char *ms
 /* The panels drawn with one GL context, row 0 at the top, into a PNG. */
 static cm_status charts_png(const char *path, const chart_stack *c, char *msg, size_t msg_size)
 {
-    uint8_t *rgba = malloc((size_t)c->width * (size_t)c->height * 4);
+    uint8_t *rgba = cm_cells_array((size_t)c->width * (size_t)c->height * 4);
     cm_status st = rgba ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the image");
     cm_gl *gl = NULL;
     if (st == CM_OK)

@@ -428,7 +428,7 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
         st = cluster_ends_open(&ends, &s->c, msg, msg_size);
     if (st == CM_OK && po->by == BY_ATTRACTORS)
         st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, &att, msg, msg_size);
-    if (st == CM_OK && !s->gl && !po->indexed && po->path)
+    if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
                            &s->model,
@@ -458,7 +458,7 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
 {
     cluster_ends ends;
     memset(&ends, 0, sizeof ends);
-    int32_t *label = malloc((flat->ncells + 1) * sizeof *label);
+    int32_t *label = cm_cells_array((flat->ncells + 1) * sizeof *label);
     cm_status st = label ? cluster_ends_open(&ends, &s->c, msg, msg_size)
                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
     if (st == CM_OK)

@@ -473,8 +473,8 @@ cm_status cm_render_check(const cm_render_options *opt, int dim, char *msg, size
     cm_render_options o = *opt;
     o.layers = o.layers ? o.layers : CM_LAYER_BASIN | CM_LAYER_ATTRACTORS;
     cm_status st = check_options(&o, msg, msg_size);
-    if (st == CM_OK) /* a missing OSMesa stops the command before its work */
-        st = cm_gl_load(msg, msg_size);
+    if (st == CM_OK && cm_plot_needs_gl(o.layers, o.model, dim))
+        st = cm_gl_load(msg, msg_size); /* a missing OSMesa stops the command before its work */
     if (st != CM_OK || !has_text(o.layers))
         return st;
     layout L;
@@ -585,7 +585,7 @@ static cm_status paint(const cm_lattice *lat, const cm_region *r, const cm_group
     const uint32_t reach_x = cm_touching_reach((uint64_t)ceil(view_x), F->p.basin.w);
     const uint32_t reach_y =
         r->box.dim > 1 ? cm_touching_reach((uint64_t)ceil(view_y), F->p.basin.h) : 1;
-    cm_status st = cm_raster_paint(lat, r, groups, reach_x, reach_y, &F->w.ras, msg, msg_size);
+    cm_status st = cm_raster_choose(lat, r, groups, reach_x, reach_y, &F->w.ras, msg, msg_size);
     for (int k = 0; st == CM_OK && k < F->w.lg.n; k++)
         if (F->w.lg.e[k].group)
             F->w.lg.e[k].swatch =

@@ -40,7 +40,8 @@ typedef struct cm_render_options {
     unsigned layers;           /* enum cm_layer; 0: basin and attractors */
     const cm_model *model;     /* overlays, title, axis names, the 1-D graph; may be NULL */
     const char *font_path;     /* TrueType font for axes, legend and title */
-    cm_gl *gl;                 /* a kept GL context (render/gl.h); NULL: a new one */
+    cm_gl *gl;                 /* a kept GL context (render/gl.h); NULL: a new one if
+                                  the figure needs GL (cm_plot_needs_gl) */
     uint64_t min_basin;        /* groups with smaller basins are drawn and listed as
                                   "other" (0, 1: none) */
     int legend_groups;         /* the most groups the legend lists (0: 12) */
@@ -74,14 +75,16 @@ typedef struct cm_render_info {
                                                over lo[0]..hi[0]); else all 0 */
     int tiles;                              /* GL tiles drawn */
     int overlays_truncated;                 /* the model had more overlays than were drawn */
-    double raster_s, gl_s, text_s;          /* seconds: cells to colours, OpenGL, labels */
+    double raster_s, gl_s, text_s;          /* seconds: cells to colours, the plot drawn (the
+                                               raster, GL's lines), labels */
 } cm_render_info;
 
 /* Checks, before anything is computed, that an image of these options can
  * be drawn (size, font, and room for the plot beside the text layers of a
  * view of o->lo..o->hi in a model of dimension dim); cm_render_figure may
- * still find a legend too wide for it. Loads OSMesa (render/gl_loader.h),
- * so that a missing library stops a command before its work. */
+ * still find a legend too wide for it. Loads OSMesa (render/gl_loader.h)
+ * when the figure draws with GL (cm_plot_needs_gl), so that a missing
+ * library stops a command before its work. */
 cm_status cm_render_check(const cm_render_options *o, int dim, char *msg, size_t msg_size);
 
 cm_status cm_render_figure(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,

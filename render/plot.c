@@ -7,6 +7,7 @@
 
 #include "render/gl.h"
 #include "render/palette.h"
+#include "render/quads.h"
 
 enum { TEX_TILE = 2048, COBWEBS = 12, CIRCLE_SIDES = 24 };
 
@@ -55,34 +56,45 @@ static bool enter_panel(const cm_gl *gl, const cm_panel *pn, const tile *t, doub
     return true;
 }
 
-/* ---- basin raster ------------------------------------------------------------ */
+/* ---- basin raster and markers, on the CPU ------------------------------------- */
 
-static void draw_texture_tile(const cm_raster *ras, uint64_t i0, uint64_t j0, uint64_t w,
-                              uint64_t h)
+/* The panel's axes as GL's projection shows them (render/quads.h). */
+static cm_quad_axis axis_x(const cm_panel *pn)
 {
-    const cm_slice *s = &ras->s;
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, (GLint)s->nx);
-    glPixelStorei(GL_UNPACK_SKIP_PIXELS, (GLint)i0);
-    glPixelStorei(GL_UNPACK_SKIP_ROWS, (GLint)j0);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, (GLsizei)w, (GLsizei)h, 0, GL_RGB, GL_UNSIGNED_BYTE,
-                 ras->pixels);
-    const double x0 = s->x0 + (double)i0 * s->dx, x1 = x0 + (double)w * s->dx;
-    const double y0 = s->y0 + (double)j0 * s->dy, y1 = y0 + (double)h * s->dy;
-    glBegin(GL_QUADS);
-    glTexCoord2d(0, 0);
-    glVertex2d(x0, y0);
-    glTexCoord2d(1, 0);
-    glVertex2d(x1, y0);
-    glTexCoord2d(1, 1);
-    glVertex2d(x1, y1);
-    glTexCoord2d(0, 1);
-    glVertex2d(x0, y1);
-    glEnd();
+    return (cm_quad_axis){pn->lo[0], pn->hi[0], pn->w};
+}
+
+static cm_quad_axis axis_y(const cm_panel *pn)
+{
+    return (cm_quad_axis){pn->lo[1], pn->hi[1], pn->h};
+}
+
+/* The pixel of the panel at column c and window row b (rows from the bottom). */
+static uint8_t *panel_pixel(const cm_plot *p, const cm_panel *pn, uint8_t *rgba, int fig_width,
+                            int c, int b)
+{
+    const size_t y = (size_t)(p->y + pn->y + pn->h - 1 - b), x = (size_t)(p->x + pn->x + c);
+    return rgba + 4 * (y * (size_t)fig_width + x);
+}
+
+static void put(uint8_t *px, cm_rgb c)
+{
+    px[0] = c.r, px[1] = c.g, px[2] = c.b, px[3] = 255;
+}
+
+/* The plot's background: what GL's clear gave, the colour of cells not
+ * computed. */
+static void fill_plot(const cm_plot *p, uint8_t *rgba, int fig_width)
+{
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < p->h; y++)
+        for (int x = 0; x < p->w; x++)
+            put(rgba + 4 * ((size_t)(p->y + y) * (size_t)fig_width + (size_t)(p->x + x)),
+                cm_colour_not_computed);
 }
 
 /* The cells [i0, i1) of n along one axis that show in the state range
- * [lo, hi], rounded outwards to whole texture tiles. */
+ * [lo, hi], rounded outwards to whole texture tiles (the quads GL drew). */
 static void visible_cells(double origin, double width, uint64_t n, double lo, double hi,
                           uint64_t *i0, uint64_t *i1)
 {
@@ -93,62 +105,125 @@ static void visible_cells(double origin, double width, uint64_t n, double lo, do
     *i1 = (uint64_t)b;
 }
 
-static void draw_raster(const cm_raster *ras, const double lo[2], const double hi[2])
+/* The cell shown at each pixel of one axis (-1: none), the raster's tiles
+ * of TEX_TILE cells each one quad as GL drew them. */
+static void cells_of_pixels(const cm_quad_axis *ax, double origin, double width, uint64_t i0,
+                            uint64_t i1, int64_t *cell)
 {
-    const cm_slice *s = &ras->s;
+    for (int k = 0; k < ax->n; k++)
+        cell[k] = -1;
+    for (uint64_t i = i0; i < i1; i += TEX_TILE) {
+        const uint64_t n = i1 - i < TEX_TILE ? i1 - i : TEX_TILE;
+        const double a = origin + (double)i * width;
+        cm_quad_texels(ax, a, a + (double)n * width, n, (int64_t)i, cell);
+    }
+}
+
+static cm_status draw_raster(const cm_plot *p, uint8_t *rgba, int fig_width, char *msg,
+                             size_t msg_size)
+{
+    const cm_panel *pn = &p->basin;
+    const cm_slice *s = &p->ras->s;
     uint64_t i0, i1, j0, j1;
-    visible_cells(s->x0, s->dx, s->nx, lo[0], hi[0], &i0, &i1);
-    visible_cells(s->y0, s->dy, s->ny, lo[1], hi[1], &j0, &j1);
+    visible_cells(s->x0, s->dx, s->nx, pn->lo[0], pn->hi[0], &i0, &i1);
+    visible_cells(s->y0, s->dy, s->ny, pn->lo[1], pn->hi[1], &j0, &j1);
     if (s->ny == 1) { /* a 1-D strip fills its panel's height */
         j0 = 0;
         j1 = 1;
     }
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glEnable(GL_TEXTURE_2D);
-    glColor3ub(255, 255, 255);
-    for (uint64_t j = j0; j < j1; j += TEX_TILE)
-        for (uint64_t i = i0; i < i1; i += TEX_TILE)
-            draw_texture_tile(ras, i, j, i1 - i < TEX_TILE ? i1 - i : TEX_TILE,
-                              j1 - j < TEX_TILE ? j1 - j : TEX_TILE);
-    glDisable(GL_TEXTURE_2D);
-    glDeleteTextures(1, &tex);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
-    glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+    int64_t *col = malloc((size_t)pn->w * sizeof *col), *row = malloc((size_t)pn->h * sizeof *row);
+    if (!col || !row) {
+        free(col);
+        free(row);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the raster's pixels");
+    }
+    const cm_quad_axis ax = axis_x(pn), ay = axis_y(pn);
+    cells_of_pixels(&ax, s->x0, s->dx, i0, i1, col);
+    cells_of_pixels(&ay, s->y0, s->dy, j0, j1, row);
+#pragma omp parallel for schedule(static)
+    for (int b = 0; b < pn->h; b++) {
+        if (row[b] < 0)
+            continue;
+        uint8_t *px = panel_pixel(p, pn, rgba, fig_width, 0, b);
+        const uint64_t line = s->base + (uint64_t)row[b] * s->row_stride;
+        for (int c = 0; c < pn->w; c++, px += 4)
+            if (col[c] >= 0)
+                cm_raster_rgb(p->ras, line + (uint64_t)col[c], px);
+    }
+    free(col);
+    free(row);
+    return CM_OK;
 }
 
-/* Periodic cells of one kind as squares of at least p->marker pixels a
- * side, so that a one-cell attractor stays visible at any zoom. */
-static void draw_markers(const cm_plot *p, const cm_panel *pn, int kind, double px, double py)
+/* Periodic cells are squares of at least p->marker pixels a side, so
+ * that a one-cell attractor stays visible at any zoom: their half sides in
+ * state units. */
+static void marker_half_sides(const cm_plot *p, double *hx, double *hy)
 {
+    const cm_panel *pn = &p->basin;
     const cm_slice *s = &p->ras->s;
+    const double px = (pn->hi[0] - pn->lo[0]) / pn->w, py = (pn->hi[1] - pn->lo[1]) / pn->h;
     const double least = p->marker / 2;
-    const double hx = s->dx / 2 > least * px ? s->dx / 2 : least * px;
-    const double hy = s->ny == 1               ? (pn->hi[1] - pn->lo[1]) / 2
-                      : s->dy / 2 > least * py ? s->dy / 2
-                                               : least * py;
-    colour(kind == CM_GROUP_STICKING ? cm_colour_sticking_marker : cm_colour_marker);
+    *hx = s->dx / 2 > least * px ? s->dx / 2 : least * px;
+    *hy = s->ny == 1               ? (pn->hi[1] - pn->lo[1]) / 2
+          : s->dy / 2 > least * py ? s->dy / 2
+                                   : least * py;
+}
+
+/* The square of periodic cell c in state coordinates: x0, x1, y0, y1. */
+static void marker_square(const cm_plot *p, const cm_periodic_cell *c, double hx, double hy,
+                          double q[4])
+{
+    const cm_panel *pn = &p->basin;
+    const cm_slice *s = &p->ras->s;
+    const double cx = s->x0 + ((double)c->i + 0.5) * s->dx;
+    const double cy =
+        s->ny == 1 ? (pn->lo[1] + pn->hi[1]) / 2 : s->y0 + ((double)c->j + 0.5) * s->dy;
+    q[0] = cx - hx, q[1] = cx + hx, q[2] = cy - hy, q[3] = cy + hy;
+}
+
+static cm_rgb marker_colour(int kind)
+{
+    return kind == CM_GROUP_STICKING ? cm_colour_sticking_marker : cm_colour_marker;
+}
+
+/* The markers of one kind of group, on the CPU (when GL draws nothing
+ * else; else gl_markers). */
+static void cpu_markers(const cm_plot *p, int kind, uint8_t *rgba, int fig_width)
+{
+    double hx, hy, q[4];
+    marker_half_sides(p, &hx, &hy);
+    const cm_quad_axis ax = axis_x(&p->basin), ay = axis_y(&p->basin);
+    for (uint64_t k = 0; k < p->ras->nperiodic; k++) {
+        const cm_periodic_cell *c = &p->ras->periodic[k];
+        if (p->groups[c->group - 1].kind != kind)
+            continue;
+        marker_square(p, c, hx, hy, q);
+        int x0, x1, y0, y1;
+        cm_quad_span(&ax, q[0], q[1], &x0, &x1);
+        cm_quad_span(&ay, q[2], q[3], &y0, &y1);
+        for (int b = y0; b < y1; b++)
+            for (int x = x0; x < x1; x++)
+                put(panel_pixel(p, &p->basin, rgba, fig_width, x, b), marker_colour(kind));
+    }
+}
+
+/* The same with GL, between the overlays' lines and points. */
+static void gl_markers(const cm_plot *p, int kind)
+{
+    double hx, hy, q[4];
+    marker_half_sides(p, &hx, &hy);
+    colour(marker_colour(kind));
     glBegin(GL_QUADS);
     for (uint64_t k = 0; k < p->ras->nperiodic; k++) {
         const cm_periodic_cell *c = &p->ras->periodic[k];
         if (p->groups[c->group - 1].kind != kind)
             continue;
-        const double cx = s->x0 + ((double)c->i + 0.5) * s->dx;
-        const double cy =
-            s->ny == 1 ? (pn->lo[1] + pn->hi[1]) / 2 : s->y0 + ((double)c->j + 0.5) * s->dy;
-        if (cx + hx < pn->lo[0] || cx - hx > pn->hi[0] || cy + hy < pn->lo[1] ||
-            cy - hy > pn->hi[1])
-            continue;
-        glVertex2d(cx - hx, cy - hy);
-        glVertex2d(cx + hx, cy - hy);
-        glVertex2d(cx + hx, cy + hy);
-        glVertex2d(cx - hx, cy + hy);
+        marker_square(p, c, hx, hy, q);
+        glVertex2d(q[0], q[2]);
+        glVertex2d(q[1], q[2]);
+        glVertex2d(q[1], q[3]);
+        glVertex2d(q[0], q[3]);
     }
     glEnd();
 }
@@ -296,23 +371,30 @@ static void draw_cobwebs(const cm_plot *p, int lw)
     glLineWidth(1.0f);
 }
 
-/* ---- one tile ------------------------------------------------------------------- */
+/* ---- GL's layers, tile by tile ------------------------------------------------- */
 
+/* Whether GL has anything to draw: the model's overlays or a 1-D graph. */
+static bool gl_draws(const cm_plot *p)
+{
+    return p->graph.w > 0 ||
+           (p->overlays && p->overlays->count && (p->layers & CM_LAYER_OVERLAYS));
+}
+
+/* The overlays' lines, the markers over them, and the overlays' points
+ * over those (a 1-D plot's overlays go on its graph). */
 static void draw_basin_panel(const cm_gl *gl, const cm_plot *p, const tile *t)
 {
     double px, py;
     if (!enter_panel(gl, &p->basin, t, &px, &py))
         return;
-    if (p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS))
-        draw_raster(p->ras, p->basin.lo, p->basin.hi);
-    const bool graph = p->graph.w > 0;
-    if (p->overlays && !graph && (p->layers & CM_LAYER_OVERLAYS))
+    const bool overlays = p->overlays && p->graph.w <= 0 && (p->layers & CM_LAYER_OVERLAYS);
+    if (overlays)
         draw_overlay_lines(p->overlays, p->line_width, cm_layers_on_paper(p->layers));
     if (p->layers & CM_LAYER_ATTRACTORS) { /* attractors last: they stay black */
-        draw_markers(p, &p->basin, CM_GROUP_STICKING, px, py);
-        draw_markers(p, &p->basin, CM_GROUP_ATTRACTOR, px, py);
+        gl_markers(p, CM_GROUP_STICKING);
+        gl_markers(p, CM_GROUP_ATTRACTOR);
     }
-    if (p->overlays && !graph && (p->layers & CM_LAYER_OVERLAYS))
+    if (overlays)
         draw_points(p->overlays, px, py, p->line_width);
 }
 
@@ -330,41 +412,84 @@ static void draw_graph_panel(const cm_gl *gl, const cm_plot *p, const tile *t)
     }
 }
 
-static cm_status draw_tile(cm_gl *gl, const cm_plot *p, const tile *t, uint8_t *rgba,
-                           int fig_width, char *msg, size_t msg_size)
+/* One tile, drawn onto a transparent scratch image and laid over the
+ * figure where GL drew (nothing blends, so a drawn pixel is opaque). */
+static cm_status draw_tile(cm_gl *gl, const cm_plot *p, const tile *t, uint8_t *scratch,
+                           uint8_t *rgba, int fig_width, char *msg, size_t msg_size)
 {
-    uint8_t *origin =
-        rgba + 4 * ((size_t)(p->y + t->y) * (size_t)fig_width + (size_t)(p->x + t->x));
-    const cm_status st = cm_gl_target(gl, origin, fig_width, t->w, t->h, msg, msg_size);
+    cm_status st = cm_gl_target(gl, scratch, t->w, t->w, t->h, msg, msg_size);
     if (st != CM_OK)
         return st;
     glDisable(GL_SCISSOR_TEST);
     glViewport(0, 0, t->w, t->h);
-    const cm_rgb bg = cm_colour_not_computed;
-    glClearColor(bg.r / 255.0f, bg.g / 255.0f, bg.b / 255.0f, 1.0f);
+    glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_SCISSOR_TEST);
     draw_basin_panel(gl, p, t);
     draw_graph_panel(gl, p, t);
-    return cm_gl_done(gl, msg, msg_size);
+    st = cm_gl_done(gl, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < t->h; y++) {
+        const uint8_t *from = scratch + 4 * (size_t)y * (size_t)t->w;
+        uint8_t *to = rgba + 4 * ((size_t)(p->y + t->y + y) * (size_t)fig_width +
+                                  (size_t)(p->x + t->x));
+        for (int x = 0; x < t->w; x++)
+            if (from[4 * x + 3])
+                memcpy(to + 4 * x, from + 4 * x, 4);
+    }
+    return CM_OK;
+}
+
+static cm_status draw_gl(cm_gl *gl, const cm_plot *p, uint8_t *rgba, int fig_width, int *tiles,
+                         char *msg, size_t msg_size)
+{
+    const int side_w = p->w < CM_PLOT_TILE ? p->w : CM_PLOT_TILE;
+    const int side_h = p->h < CM_PLOT_TILE ? p->h : CM_PLOT_TILE;
+    uint8_t *scratch = cm_cells_array(4 * (size_t)side_w * (size_t)side_h); /* few page faults */
+    if (!scratch)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %dx%d GL tile", side_w,
+                       side_h);
+    cm_status st = CM_OK;
+    for (int y = 0; y < p->h && st == CM_OK; y += CM_PLOT_TILE)
+        for (int x = 0; x < p->w && st == CM_OK; x += CM_PLOT_TILE) {
+            const tile t = {x, y, p->w - x < CM_PLOT_TILE ? p->w - x : CM_PLOT_TILE,
+                            p->h - y < CM_PLOT_TILE ? p->h - y : CM_PLOT_TILE};
+            st = draw_tile(gl, p, &t, scratch, rgba, fig_width, msg, msg_size);
+            ++*tiles;
+        }
+    free(scratch);
+    return st;
+}
+
+bool cm_plot_needs_gl(unsigned layers, const cm_model *m, int dim)
+{
+    return m && (dim == 1 || ((layers & CM_LAYER_OVERLAYS) && m->overlays));
 }
 
 cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tiles, char *msg,
                        size_t msg_size)
 {
     *tiles = 0;
-    cm_gl *own = NULL;
-    cm_status st = p->gl ? CM_OK : cm_gl_open(&own, msg, msg_size);
+    fill_plot(p, rgba, fig_width);
+    cm_status st = p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS)
+                       ? draw_raster(p, rgba, fig_width, msg, msg_size)
+                       : CM_OK;
     if (st != CM_OK)
         return st;
-    cm_gl *gl = p->gl ? p->gl : own;
-    for (int y = 0; y < p->h && st == CM_OK; y += CM_PLOT_TILE)
-        for (int x = 0; x < p->w && st == CM_OK; x += CM_PLOT_TILE) {
-            const tile t = {x, y, p->w - x < CM_PLOT_TILE ? p->w - x : CM_PLOT_TILE,
-                            p->h - y < CM_PLOT_TILE ? p->h - y : CM_PLOT_TILE};
-            st = draw_tile(gl, p, &t, rgba, fig_width, msg, msg_size);
-            ++*tiles;
+    if (!gl_draws(p)) {
+        if (p->layers & CM_LAYER_ATTRACTORS) { /* attractors last: they stay black */
+            cpu_markers(p, CM_GROUP_STICKING, rgba, fig_width);
+            cpu_markers(p, CM_GROUP_ATTRACTOR, rgba, fig_width);
         }
+        return CM_OK;
+    }
+    cm_gl *own = NULL;
+    if (!p->gl)
+        st = cm_gl_open(&own, msg, msg_size);
+    if (st == CM_OK)
+        st = draw_gl(p->gl ? p->gl : own, p, rgba, fig_width, tiles, msg, msg_size);
     cm_gl_close(own);
     return st;
 }

@@ -1,13 +1,18 @@
-/* render/plot.h - the OpenGL part of a figure: the basin raster, the
- * attractor markers, the model's overlays and, for 1-D models, the map's
- * graph with a cobweb of each attractor, drawn off-screen with OSMesa or EGL
- * (render/gl.h).
+/* render/plot.h - the plot of a figure: the basin raster, the attractor
+ * markers, the model's overlays and, for 1-D models, the map's graph with a
+ * cobweb of each attractor.
  *
- * The plot is drawn straight into its rectangle of the caller's RGBA figure
- * (row 0 at the top), in tiles of at most PLOT_TILE pixels a side, so the
- * figure may be larger than the largest viewport and GL never holds
- * more than one tile. Deterministic: the tiling depends on sizes only.
- * Not thread-safe (one GL context at a time per thread).
+ * The raster is drawn on the CPU, at the pixels GL gives a texture
+ * (render/quads.h), and so are the markers when nothing else is drawn: a
+ * figure without lines needs no GL. The lines and points (overlays, the
+ * 1-D graph) are drawn off-screen with OSMesa or EGL (render/gl.h) onto a
+ * transparent tile, with the markers between them, and laid over the
+ * plot. GL draws in
+ * tiles of at most CM_PLOT_TILE pixels a side, so the figure may be larger
+ * than the largest viewport. Everything goes straight into the plot's
+ * rectangle of the caller's RGBA figure (row 0 at the top). Deterministic:
+ * the tiling depends on sizes only. Not thread-safe (one GL context at a
+ * time per thread).
  */
 #ifndef CM_RENDER_PLOT_H
 #define CM_RENDER_PLOT_H
@@ -59,8 +64,12 @@ typedef struct cm_plot {
     cm_panel graph; /* 1-D models: the map's graph (w == 0: none) */
     int line_width; /* pixels */
     double marker;  /* pixels: the least side of a periodic cell's square (>= 3) */
-    cm_gl *gl;      /* the context to draw with; NULL: one of its own */
+    cm_gl *gl;      /* the context to draw with; NULL: one of its own when needed */
 } cm_plot;
+
+/* Whether a plot of these layers of model m (NULL: none) of dimension dim
+ * may draw with GL: the model's overlays and a 1-D map's graph. */
+bool cm_plot_needs_gl(unsigned layers, const cm_model *m, int dim);
 
 /* Draws the plot into rgba, a figure of fig_width columns (and at least
  * y + h rows). Returns the number of GL tiles drawn in *tiles. */

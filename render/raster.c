@@ -82,36 +82,38 @@ static void put_rgb(uint8_t *p, cm_rgb c)
     p[2] = c.b;
 }
 
-static void colour_cell(const cm_region *r, const cm_raster *ras, uint64_t k, int mode,
-                        const uint16_t *shade, uint8_t *p)
+/* A class-mode pixel: the cell's colour class, periodic cells marked. */
+static uint8_t class_of_cell(const cm_region *r, const cm_raster *ras, uint64_t k)
 {
     const uint32_t grp = r->group[k];
-    if (grp == CM_GROUP_NONE) {
-        if (mode == CM_RASTER_CLASSES)
-            *p = CM_CLASS_NOT_COMPUTED;
-        else
-            put_rgb(p, cm_colour_not_computed);
-        return;
-    }
+    if (grp == CM_GROUP_NONE)
+        return CM_CLASS_NOT_COMPUTED;
     const int cls = grp == 0 ? CM_CLASS_SINK : ras->classes[grp];
-    if (mode == CM_RASTER_CLASSES) {
-        const int marker = cls == CM_CLASS_STICKING ? CM_CLASS_STICKING_MARKER : CM_CLASS_MARKER;
-        *p = (uint8_t)(cm_is_periodic(r, k) ? marker : cls);
+    const int marker = cls == CM_CLASS_STICKING ? CM_CLASS_STICKING_MARKER : CM_CLASS_MARKER;
+    return (uint8_t)(cm_is_periodic(r, k) ? marker : cls);
+}
+
+void cm_raster_rgb(const cm_raster *ras, uint64_t k, uint8_t *p)
+{
+    const cm_region *r = ras->cells;
+    const uint32_t grp = r->group[k];
+    if (grp == CM_GROUP_NONE) {
+        put_rgb(p, cm_colour_not_computed);
         return;
     }
-    const uint32_t t = r->step[k] < ras->step_cap ? r->step[k] : ras->step_cap;
-    if (mode == CM_RASTER_STEPS) {
-        p[0] = p[1] = p[2] = (uint8_t)shade[t];
+    const uint8_t *c = ras->rgb + 3 * (size_t)grp;
+    if (ras->mode == CM_RASTER_BASIN) {
+        p[0] = c[0], p[1] = c[1], p[2] = c[2];
         return;
     }
-    const cm_rgb c = cm_class_colour(ras->palette, cls);
-    if (mode == CM_RASTER_BASIN) {
-        put_rgb(p, c);
+    const uint16_t shade = ras->shade[r->step[k] < ras->step_cap ? r->step[k] : ras->step_cap];
+    if (ras->mode == CM_RASTER_STEPS) {
+        p[0] = p[1] = p[2] = (uint8_t)shade;
         return;
     }
-    p[0] = (uint8_t)((c.r * shade[t]) >> 8);
-    p[1] = (uint8_t)((c.g * shade[t]) >> 8);
-    p[2] = (uint8_t)((c.b * shade[t]) >> 8);
+    p[0] = (uint8_t)((c[0] * shade) >> 8);
+    p[1] = (uint8_t)((c[1] * shade) >> 8);
+    p[2] = (uint8_t)((c[2] * shade) >> 8);
 }
 
 /* The cells of each group in the slice, in parallel over rows: the
@@ -147,15 +149,21 @@ static void count_cells(const cm_region *r, cm_raster *ras)
 }
 
 /* The pixels, in parallel over rows. */
-static void fill(const cm_region *r, cm_raster *ras, int mode, const uint16_t *shade)
+static void fill(cm_raster *ras)
 {
     const cm_slice *s = &ras->s;
-    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
+    const bool classes = ras->mode == CM_RASTER_CLASSES;
+    const size_t bytes = classes ? 1 : 3;
 #pragma omp parallel for schedule(static)
     for (uint64_t j = 0; j < s->ny; j++)
-        for (uint64_t i = 0; i < s->nx; i++)
-            colour_cell(r, ras, s->base + j * s->row_stride + i, mode, shade,
-                        ras->pixels + bytes * (j * s->nx + i));
+        for (uint64_t i = 0; i < s->nx; i++) {
+            const uint64_t k = s->base + j * s->row_stride + i;
+            uint8_t *p = ras->pixels + bytes * (j * s->nx + i);
+            if (classes)
+                *p = class_of_cell(ras->cells, ras, k);
+            else
+                cm_raster_rgb(ras, k, p);
+        }
 }
 
 /* The classes of the groups in view, and what was folded into "other";
@@ -209,14 +217,14 @@ cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_gr
     ras->mode = mode;
     ras->min_basin = min_basin;
     ras->palette = palette;
-    const size_t bytes = mode == CM_RASTER_CLASSES ? 1 : 3;
+    ras->cells = r;
     if (s->nx > UINT32_MAX || s->ny > UINT32_MAX)
         return cm_fail(CM_EINVAL, msg, msg_size, "the slice is too large to draw");
-    ras->pixels = malloc(s->nx * s->ny * bytes);
     ras->group_cells = calloc((size_t)r->ngroups + 1, sizeof *ras->group_cells);
     ras->classes = calloc((size_t)r->ngroups + 1, 1);
+    ras->rgb = malloc(3 * ((size_t)r->ngroups + 1));
     cm_status st = CM_OK;
-    if (!ras->pixels || !ras->group_cells || !ras->classes)
+    if (!ras->group_cells || !ras->classes || !ras->rgb)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
                      (unsigned long long)s->nx, (unsigned long long)s->ny);
     if (st == CM_OK) {
@@ -244,9 +252,9 @@ static bool several_coloured(const cm_region *r, const cm_raster *ras)
     return coloured >= 2 || (coloured == 1 && ras->group_cells[0]);
 }
 
-cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
-                          uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
-                          size_t msg_size)
+cm_status cm_raster_choose(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                           uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
+                           size_t msg_size)
 {
     const cm_slice *s = &ras->s;
     cm_status st = CM_OK;
@@ -258,20 +266,39 @@ cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_gr
             classify_groups(lat, r, groups, &touching, ras);
         cm_touching_free(&touching);
     }
-    uint16_t *shade = st == CM_OK ? malloc(((size_t)ras->step_cap + 1) * sizeof *shade) : NULL;
-    if (st == CM_OK && !shade)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
-    if (st == CM_OK) {
-        shade_table(ras->step_cap, ras->mode, shade);
-        fill(r, ras, ras->mode, shade);
-    }
-    free(shade);
+    free(ras->shade);
+    ras->shade = st == CM_OK ? malloc(((size_t)ras->step_cap + 1) * sizeof *ras->shade) : NULL;
+    if (st == CM_OK && !ras->shade)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
+    if (st != CM_OK)
+        return st;
+    shade_table(ras->step_cap, ras->mode, ras->shade);
+    for (uint32_t g = 0; g <= r->ngroups; g++)
+        put_rgb(ras->rgb + 3 * (size_t)g, cm_class_colour(ras->palette, ras->classes[g]));
+    return CM_OK;
+}
+
+cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                          uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
+                          size_t msg_size)
+{
+    cm_status st = cm_raster_choose(lat, r, groups, reach_x, reach_y, ras, msg, msg_size);
+    const size_t bytes = ras->mode == CM_RASTER_CLASSES ? 1 : 3;
+    free(ras->pixels);
+    ras->pixels = st == CM_OK ? malloc(ras->s.nx * ras->s.ny * bytes) : NULL;
+    if (st == CM_OK && !ras->pixels)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
+                       (unsigned long long)ras->s.nx, (unsigned long long)ras->s.ny);
+    if (st == CM_OK)
+        fill(ras);
     return st;
 }
 
 void cm_raster_free(cm_raster *ras)
 {
     free(ras->pixels);
+    free(ras->rgb);
+    free(ras->shade);
     free(ras->periodic);
     free(ras->group_cells);
     free(ras->classes);

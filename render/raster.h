@@ -41,7 +41,11 @@ enum cm_raster_mode {
 
 typedef struct cm_raster {
     cm_slice s;
-    uint8_t *pixels; /* nx*ny*3 RGB, or nx*ny classes; row 0 is the lowest */
+    const cm_region *cells; /* the region it shows (borrowed) */
+    uint8_t *pixels; /* nx*ny*3 RGB, or nx*ny classes; row 0 is the lowest;
+                        NULL until cm_raster_paint */
+    uint8_t *rgb;    /* RGB of each group ([0] the sink), from cm_raster_choose */
+    uint16_t *shade; /* shade of each step number 0..step_cap, from cm_raster_choose */
     cm_periodic_cell *periodic;
     uint64_t nperiodic;
     uint64_t *group_cells; /* cells of each group in the slice; [0] the sink */
@@ -64,23 +68,32 @@ uint16_t cm_step_shade(double f, int mode);
 /* The step number at fraction f of that scale. */
 uint32_t cm_step_at(double f, uint32_t step_cap);
 
-/* A raster in two steps, because the colours depend on which basins touch
+/* A raster in steps, because the colours depend on which basins touch
  * in the figure and that on the figure's layout, which the legend (the
  * counts) decides: cm_raster_build counts the cells of each group, decides
  * which are drawn as "other" (basins of fewer than min_basin cells,
  * render/palette.h), the colour repeats and the periodic cells, and gives
- * provisional colours (no neighbour rule); cm_raster_paint then chooses the
- * colours with basins kept apart where their cells lie up to reach_x,
+ * provisional colours (no neighbour rule); cm_raster_choose then chooses
+ * the colours with basins kept apart where their cells lie up to reach_x,
  * reach_y cells apart (cm_touching_reach of the cells and pixels drawn; 1,
- * 1 for one pixel per cell) and fills the pixels. Which groups are "other"
- * and the counts stay as built. Deterministic whatever the thread count.
- * On failure the raster is left to cm_raster_free. */
+ * 1 for one pixel per cell), after which cm_raster_rgb gives any cell's
+ * colour; cm_raster_paint chooses and fills the pixels. Which groups are
+ * "other" and the counts stay as built. Deterministic whatever the thread
+ * count. On failure the raster is left to cm_raster_free. The region must
+ * outlive the raster. */
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                           const cm_slice *s, int mode, uint64_t min_basin,
                           const cm_palette *palette, cm_raster *out, char *msg, size_t msg_size);
+cm_status cm_raster_choose(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
+                           uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
+                           size_t msg_size);
 cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,
                           uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
                           size_t msg_size);
 void cm_raster_free(cm_raster *ras);
+
+/* The colour of local cell k of the raster's region in an RGB mode (not
+ * CM_RASTER_CLASSES), after cm_raster_choose: p[0..2]. */
+void cm_raster_rgb(const cm_raster *ras, uint64_t k, uint8_t *p);
 
 #endif

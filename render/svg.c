@@ -109,9 +109,8 @@ static cm_status raster(FILE *f, const figure *F, char *msg, size_t msg_size)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the SVG's raster");
     for (uint64_t j = 0; j < ph; j++) /* PNG row 0 is the top: the highest cells */
         for (uint64_t i = 0; i < pw; i++) {
-            const uint8_t *src = ras->pixels + 3 * ((j1 - 1 - j / k) * s->nx + i0 + i / k);
             uint8_t *dst = rgba + 4 * (j * pw + i);
-            memcpy(dst, src, 3);
+            cm_raster_rgb(ras, s->base + (j1 - 1 - j / k) * s->row_stride + i0 + i / k, dst);
             dst[3] = 255;
         }
     uint8_t *png = NULL;

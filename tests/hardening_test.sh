@@ -225,7 +225,12 @@ export CELLMAP_OSMESA=$work/no-such-libOSMesa.so CELLMAP_EGL=$work/no-such-libEG
 "$CM" solve --cells 40x40 > out.txt 2> err.txt || fail "solve without a PNG needs OSMesa: $(cat err.txt)"
 "$CM" info good.cmdb > /dev/null 2> err.txt || fail "info needs OSMesa: $(cat err.txt)"
 "$CM" export good.cmdb --cells cells.csv 2> err.txt || fail "export needs OSMesa: $(cat err.txt)"
-for args in "solve --cells 40x40 --png g.png" "render good.cmdb --png g.png" \
+# a figure without lines needs no GL at all
+"$CM" render good.cmdb --png g.png --layers basin,attractors > /dev/null 2> err.txt \
+  || fail "a bare figure needs OSMesa: $(cat err.txt)"
+[ -s g.png ] || fail "the bare figure without OSMesa was not written"
+rm -f g.png
+for args in "solve --cells 40x40 --png g.png" "render good.cmdb --png g.png --layers basin,overlays" \
             "lyapunov --grid S=0:0.5:2,Omega=0.5:1:2 --periods 5 --png g.png" \
             "simulate --model friction-oscillator --from 0.1,0 --periods 5 --png g.png"; do
   $CM $args > out.txt 2> err.txt; rc=$?

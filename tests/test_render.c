@@ -115,6 +115,43 @@ static void check_neighbour_rule(void)
     }
 }
 
+/* Every pixel of a basin raster shows the cell its centre lies in (the
+ * CPU draws it, render/quads.h), ties included: at 3 pixels for 2 cells
+ * and at 177 for 150 (Fig. 4.13's zoom) some centres lie exactly on cell
+ * edges, and show the cell above the edge (cells are half-open). The
+ * reference is the figure of one pixel per cell, whose centres are the
+ * cells' centres; the views are the region's, so the cells' colours are
+ * the same in all of them (the neighbour rule's reach stays 1). */
+static void check_pixel_centres(const cm_lattice *lat, const cm_region *r, const cm_group_info *g)
+{
+    const int nx = (int)(r->box.hi[0] - r->box.lo[0]), ny = (int)(r->box.hi[1] - r->box.lo[1]);
+    const int sizes[][2] = {{15, 15}, {20, 10}, {177, 59}, {59, 177}, {10, 10}};
+    char msg[256];
+    cm_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.layers = CM_LAYER_BASIN;
+    ro.width = nx, ro.height = ny;
+    uint8_t *one = calloc((size_t)nx * (size_t)ny, 4);
+    cm_render_info ri;
+    CHECK(cm_render_figure(lat, r, g, &ro, one, &ri, msg, sizeof msg) == CM_OK);
+    for (size_t v = 0; v < sizeof sizes / sizeof sizes[0]; v++) {
+        const int W = sizes[v][0], H = sizes[v][1];
+        uint8_t *img = calloc((size_t)W * (size_t)H, 4);
+        ro.width = W, ro.height = H;
+        CHECK(cm_render_figure(lat, r, g, &ro, img, &ri, msg, sizeof msg) == CM_OK);
+        int wrong = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) { /* the cell of the centre, in integers */
+                const int i = (2 * x + 1) * nx / (2 * W), b = H - 1 - y;
+                const int j = (2 * b + 1) * ny / (2 * H);
+                wrong += memcmp(pixel(img, W, x, y), pixel(one, nx, i, ny - 1 - j), 4) != 0;
+            }
+        CHECK(wrong == 0);
+        free(img);
+    }
+    free(one);
+}
+
 int main(void)
 {
     check_ticks();
@@ -148,6 +185,7 @@ int main(void)
         colours[k] = cm_class_colour(NULL, ras.classes[k + 1]);
     cm_raster_free(&ras);
     cm_render_info ri;
+    check_pixel_centres(&lat, &r, g);
 
     enum { W = 200, H = 100 };
     uint8_t *a = calloc(W * H, 4), *b = calloc(W * H, 4);
