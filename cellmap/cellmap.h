@@ -316,7 +316,8 @@ typedef struct cm_db_options {
     int64_t split[CM_MAX_DIM]; /* regions per dimension; all 0: one region */
     int extend;           /* adaptive extension steps (thesis 4.6.4), 0..1000 */
     double escape_below;  /* stop extending below this escaping fraction (0: never) */
-    uint64_t mem;         /* bytes of cell arrays held in memory; 0: no bound */
+    uint64_t mem;         /* bytes of cell arrays held in memory; 0: an eighth of the
+                             machine's memory, 16..128 MiB */
     const char *command;  /* the provenance the file records; NULL: "libcellmap" */
     cm_solve_progress_fn progress; /* optional: fraction of the grid's cells; nonzero cancels */
     void *user;
@@ -381,7 +382,8 @@ typedef struct cm_session_options {
     double origin[CM_MAX_DIM];     /* its lattice's origin (default 0) */
     const char *depth;             /* "LO:HI,..." of dimensions 3.. of a new file's model */
     int max_steps, threads;        /* 0: 1 for a new file; 0: all cores */
-    uint64_t mem;                  /* bytes of cell arrays in memory; 0: no bound */
+    uint64_t mem;                  /* bytes of cell arrays in memory; 0: an eighth of the
+                                      machine's memory, 16..128 MiB */
     const char *command;           /* provenance; NULL: "libcellmap" */
 } cm_session_options;
 

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "cellmap/cover.h"
 #include "cellmap/extend.h"
@@ -175,6 +176,16 @@ void project_close(cm_store *s, cm_cluster *c)
     char msg[256];
     cm_cluster_free(c);
     cm_store_close(s, msg, sizeof msg);
+}
+
+uint64_t project_default_mem(void)
+{
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    const uint64_t most = (uint64_t)PROJECT_MEM_MAX_MIB << 20, least = (uint64_t)PROJECT_MEM_MIN_MIB << 20;
+    if (pages <= 0 || page <= 0)
+        return most;
+    const uint64_t eighth = (uint64_t)pages * (uint64_t)page / 8;
+    return eighth > most ? most : eighth < least ? least : eighth;
 }
 
 cm_status project_create(const char *path, const cm_model *m, const cm_model_lib *lib,

@@ -103,6 +103,14 @@ void project_close(cm_store *s, cm_cluster *c);
 cm_status model_of_store(const cm_store_info *info, cm_model_set *set, cm_model *m, char *msg,
                          size_t msg_size);
 
+/* The memory budget (bytes of cell arrays) of a cluster in a file when
+ * none is given (an explore session, solve --db): an eighth of the
+ * machine's memory, at most 128 MiB and at least 16 MiB, so that a long
+ * session's memory stays flat; regions beyond it are paged to the file
+ * (they are there already) and read back on demand. */
+enum { PROJECT_MEM_MAX_MIB = 128, PROJECT_MEM_MIN_MIB = 16 };
+uint64_t project_default_mem(void);
+
 /* A new file at path for model m, lattice, command line and plan (created
  * at SOURCE_DATE_EPOCH, else time 0), replacing an older cellmap database
  * there once cm_store_finish says the new cluster is complete (never

@@ -817,7 +817,8 @@ cm_status session_open(session *s, const session_options *o, session_opened *ope
     s->threads = o->threads;
     s->max_new_cells = o->max_new_cells ? o->max_new_cells : MAX_NEW_CELLS;
     /* under --mem, one step computes no more than its cell arrays (12 bytes
-     * a cell) hold: a region being solved is resident whole */
+     * a cell) hold: a region being solved is resident whole (the default
+     * budget bounds what is kept, not what one step may compute) */
     if (o->mem && o->mem / 12 < s->max_new_cells)
         s->max_new_cells = o->mem / 12 > 4096 ? o->mem / 12 : 4096;
     s->mem_given = o->mem != 0;
@@ -826,7 +827,7 @@ cm_status session_open(session *s, const session_options *o, session_opened *ope
     if (st != CM_OK)
         return st;
     s->c.threads = o->threads;
-    s->c.mem_budget = o->mem;
+    s->c.mem_budget = o->mem ? o->mem : project_default_mem();
     return CM_OK;
 }
 

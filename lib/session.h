@@ -37,7 +37,7 @@ typedef struct session_options {
     const char *depth_text; /* LO:HI,... of dimensions 3.. (models of more than two) */
     int max_steps;          /* 0: 1 for a new file */
     int threads;            /* 0: every core */
-    uint64_t mem;           /* 0: no budget */
+    uint64_t mem;           /* 0: project_default_mem() */
     uint64_t max_new_cells; /* most cells one command may compute; 0: 2^28 */
     const char *command;    /* for provenance */
 } session_options;

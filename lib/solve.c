@@ -151,7 +151,7 @@ static cm_status solve_cluster(const solve_request *q, solve_result *r, char *ms
         cm_cluster_init(&r->c, &q->lat);
     r->c.keep_exits = q->db != NULL; /* only a database saves them; no image is read */
     r->c.threads = plan.opt.threads;
-    r->c.mem_budget = q->mem;
+    r->c.mem_budget = q->mem ? q->mem : q->db ? project_default_mem() : 0;
     r->first = "regions and joins";
     r->second = "summary";
     const double t0 = cm_seconds();

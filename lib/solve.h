@@ -40,7 +40,8 @@ typedef struct solve_request {
     const char *db;      /* the database, or NULL */
     bool resume;         /* resume db instead of replacing it */
     const char *command; /* the command line, for the file's provenance */
-    uint64_t mem;        /* the cluster's memory budget in bytes (0: none) */
+    uint64_t mem;        /* the cluster's memory budget in bytes (0: with a database
+                            project_default_mem(), else none: nothing to page to) */
     cm_attractor_options att;
     bool slow_share;     /* measure a single region's slow directions (cm_scm_slow_share) */
     const work_hooks *hooks;

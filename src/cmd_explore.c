@@ -39,7 +39,8 @@ static const char explore_help_head[] =
     "  --max-steps K      re-step while the image stays in its own cell (default 1)\n"
     "  --threads T        OpenMP threads (default: all cores)\n"
     "  --mem BYTES        bound the cell arrays held in memory (regions are paged; one\n"
-    "                     step computes at most BYTES / 12 new cells)\n\n"
+    "                     step computes at most BYTES / 12 new cells); default: an\n"
+    "                     eighth of the machine's memory, 16M..128M\n\n"
     "commands (one per line, # starts a comment):\n";
 
 typedef struct explore_args {
