@@ -548,6 +548,7 @@ static cm_status close_db(cm_store *s, char *msg, size_t msg_size)
     if (s->lock_fd >= 0)
         close(s->lock_fd); /* after SQLite's: its locks live while the file is open */
     free(s->blobs);
+    store_free_encoders(s);
     return st;
 }
 

@@ -98,21 +98,17 @@ cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *m
     if (cm_cluster_open_nodes(c, k, &local, &weight, &cells, &n) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
     const size_t dim = (size_t)c->lat.dim, values = n * (2 + dim);
-    int64_t *v = malloc((values + 1) * sizeof *v);
-    unsigned char *scratch = malloc(8 * (values + 1));
-    const size_t bound = cm_codec_bound(8 * (values + 1));
-    unsigned char *blob = malloc(bound);
+    int64_t *v = store_table_values(s, values * sizeof *v);
+    const unsigned char *blob = NULL;
     size_t len = 0;
-    cm_status st = v && scratch && blob ? CM_OK
-                                        : cm_fail(CM_ENOMEM, msg, msg_size,
-                                                  "out of memory writing open nodes");
+    cm_status st = v ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
     for (uint64_t i = 0; st == CM_OK && i < n; i++) {
         v[i] = local[i];
         v[n + i] = (int64_t)weight[i];
     }
     if (st == CM_OK) {
         memcpy(v + 2 * n, cells, n * dim * sizeof *v);
-        if (cm_codec_encode(v, values, 8, -1, scratch, blob, bound, &len) != CM_OK)
+        if (store_encode(s, v, values, 8, &blob, &len) != CM_OK)
             st = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the open nodes of region %u", k + 1);
     }
     sqlite3_stmt *ins = NULL;
@@ -130,9 +126,6 @@ cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *m
     free(local);
     free(weight);
     free(cells);
-    free(v);
-    free(scratch);
-    free(blob);
     return st;
 }
 

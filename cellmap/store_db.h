@@ -12,6 +12,7 @@
 
 #include <sqlite3.h>
 
+#include "cellmap/codec.h"
 #include "cellmap/store.h"
 
 struct cm_store {
@@ -31,9 +32,36 @@ struct cm_store {
     int failed;                     /* a write failed: the cluster and the file differ */
     unsigned char *blobs; /* a region's encoded pages, read or to write */
     uint64_t blobs_cap;
+    /* page encoders, one per thread, kept from one batch of pages to the
+     * next: a new zstd context and scratch for every batch cost their
+     * memory's first touch each time (store_pages.c) */
+    struct store_encoder *encoders;
+    int n_encoders;
+    /* the buffers store_encode reuses for tables (exits, nodes, open nodes) */
+    unsigned char *table_values, *table_scratch, *table_blob;
+    uint64_t table_values_cap, table_scratch_cap, table_blob_cap;
     int threads;     /* for encoding and decoding pages: the cluster's */
     cm_store_stats stats;
 };
+
+typedef struct store_encoder {
+    cm_codec_ctx *ctx;
+    unsigned char *scratch; /* 4 * CM_STORE_PAGE_CELLS bytes */
+} store_encoder;
+
+/* Frees s's page encoders and table buffers. */
+void store_free_encoders(cm_store *s);
+
+/* A buffer of at least `bytes` for a table's values, s's until the next
+ * call (NULL: out of memory). */
+void *store_table_values(cm_store *s, size_t bytes);
+
+/* Encodes n values of `width` bytes (cm_codec_encode, no index delta) with
+ * s's first encoder into s's table blob: *blob and *len stay valid until the
+ * next call. Reuses the encoder and buffers, whose first touch costs more
+ * than the encoding on small tables. */
+cm_status store_encode(cm_store *s, const void *v, size_t n, int width, const unsigned char **blob,
+                       size_t *len);
 
 /* Node records as saved: little-endian uint32 columns of n entries, encoded
  * as one BLOB: next, dist, group, target, tree, then (version 5) first_in

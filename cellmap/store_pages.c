@@ -9,6 +9,7 @@
 #include "cellmap/grow.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -611,11 +612,9 @@ cm_status store_insert_region(cm_store *s, uint32_t k, const cm_region *r, char 
         return status;
     /* the exit table: nexits * dim little-endian int64 cell coordinates */
     const uint64_t n = r->nexits * (uint64_t)r->box.dim;
-    unsigned char *scratch = malloc(8 * (n + 1)), *out = malloc(cm_codec_bound(8 * (n + 1)));
+    const unsigned char *out = NULL;
     size_t len = 0;
-    if (!scratch || !out ||
-        cm_codec_encode(r->exit_target, n, 8, -1, scratch, out, cm_codec_bound(8 * (n + 1)),
-                        &len) != CM_OK)
+    if (store_encode(s, r->exit_target, n, 8, &out, &len) != CM_OK)
         status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing exits");
     if (status == CM_OK &&
         sqlite3_prepare_v2(s->db, "INSERT INTO exits VALUES(?, ?, ?)", -1, &st, NULL))
@@ -628,40 +627,94 @@ cm_status store_insert_region(cm_store *s, uint32_t k, const cm_region *r, char 
         sqlite3_finalize(st);
         s->stats.bytes_written += len;
     }
-    free(scratch);
-    free(out);
     return status;
 }
 
 /* Pages encoded at once: 8 x 3 columns of up to cm_codec_bound(256 KiB). */
 #define WRITE_BATCH 8
 
+/* At least `threads` page encoders in s. */
+static cm_status ensure_encoders(cm_store *s, int threads)
+{
+    if (s->n_encoders >= threads)
+        return CM_OK;
+    store_encoder *e = realloc(s->encoders, (size_t)threads * sizeof *e);
+    if (!e)
+        return CM_ENOMEM;
+    s->encoders = e;
+    for (; s->n_encoders < threads; s->n_encoders++) {
+        store_encoder *n = &e[s->n_encoders];
+        n->ctx = NULL;
+        n->scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
+        if (!n->scratch || cm_codec_ctx_new(&n->ctx) != CM_OK) {
+            free(n->scratch);
+            cm_codec_ctx_free(n->ctx);
+            return CM_ENOMEM;
+        }
+    }
+    return CM_OK;
+}
+
+void store_free_encoders(cm_store *s)
+{
+    for (int k = 0; k < s->n_encoders; k++) {
+        cm_codec_ctx_free(s->encoders[k].ctx);
+        free(s->encoders[k].scratch);
+    }
+    free(s->encoders);
+    free(s->table_values);
+    free(s->table_scratch);
+    free(s->table_blob);
+    s->encoders = NULL;
+    s->n_encoders = 0;
+    s->table_values = s->table_scratch = s->table_blob = NULL;
+    s->table_values_cap = s->table_scratch_cap = s->table_blob_cap = 0;
+}
+
+void *store_table_values(cm_store *s, size_t bytes)
+{
+    return cm_grow((void **)&s->table_values, &s->table_values_cap, bytes + 1, 1) == CM_OK
+               ? s->table_values
+               : NULL;
+}
+
+cm_status store_encode(cm_store *s, const void *v, size_t n, int width, const unsigned char **blob,
+                       size_t *len)
+{
+    const size_t bytes = (size_t)width * (n + 1), bound = cm_codec_bound(bytes);
+    if (ensure_encoders(s, 1) != CM_OK ||
+        cm_grow((void **)&s->table_scratch, &s->table_scratch_cap, bytes, 1) != CM_OK ||
+        cm_grow((void **)&s->table_blob, &s->table_blob_cap, bound, 1) != CM_OK)
+        return CM_ENOMEM;
+    *blob = s->table_blob;
+    return cm_codec_encode_with(s->encoders[0].ctx, v, n, width, -1, s->table_scratch,
+                                s->table_blob, bound, len);
+}
+
 /* Encodes the three columns (image, grp, step) of pages first .. first +
  * n - 1 into s->blobs, part bytes apart, in parallel; lens[t] is task t's
- * size (task t: page t / 3, column t % 3). */
+ * size (task t: page t / 3, column t % 3). An encoder's output does not
+ * depend on what it encoded before: the bytes are the same whichever thread
+ * encodes a page. */
 static cm_status encode_batch(cm_store *s, const cm_region *r, uint64_t first, int n, size_t part,
                               size_t *lens)
 {
+    const int tasks = 3 * n, threads = s->threads > 0 ? s->threads : 1;
+    if (ensure_encoders(s, threads) != CM_OK)
+        return CM_ENOMEM;
     int failed = 0;
-    const int tasks = 3 * n;
-#pragma omp parallel num_threads(s->threads) if (tasks > 1) reduction(| : failed)
+#pragma omp parallel num_threads(threads) if (tasks > 1) reduction(| : failed)
     {
-        unsigned char *scratch = malloc(4 * (size_t)CM_STORE_PAGE_CELLS);
-        cm_codec_ctx *ctx = NULL;
-        const int ready = scratch && cm_codec_ctx_new(&ctx) == CM_OK;
-        failed |= !ready;
+        const store_encoder *e = &s->encoders[omp_get_thread_num()];
 #pragma omp for schedule(dynamic, 1)
         for (int t = 0; t < tasks; t++) {
             const uint64_t page = first + (uint64_t)(t / 3), cell = page * CM_STORE_PAGE_CELLS;
             const int col = t % 3;
             const uint32_t *const arrays[3] = {r->image, r->group, r->step};
-            failed |= !ready ||
-                      cm_codec_encode_with(ctx, arrays[col] + cell, page_cells(r->ncells, page),
-                                           4, col == 0 ? (int64_t)cell : -1, scratch,
+            failed |= cm_codec_encode_with(e->ctx, arrays[col] + cell, page_cells(r->ncells, page),
+                                           4, col == 0 ? (int64_t)cell : -1, e->scratch,
                                            s->blobs + (size_t)t * part, part, &lens[t]) != CM_OK;
         }
-        cm_codec_ctx_free(ctx);
-        free(scratch);
     }
     return failed ? CM_ENOMEM : CM_OK;
 }
@@ -734,13 +787,10 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
 {
     const cm_cluster_region *cr = &c->regions[k];
     const uint64_t chunk = CM_NODE_CHUNK;
-    uint32_t *cols = malloc((NODE_FIELDS * chunk + 1) * sizeof *cols);
-    unsigned char *scratch = malloc(4 * (NODE_FIELDS * chunk + 1));
-    const size_t bound = cm_codec_bound(4 * (NODE_FIELDS * chunk + 1));
-    unsigned char *blob = malloc(bound);
+    uint32_t *cols = store_table_values(s, NODE_FIELDS * chunk * sizeof *cols);
     sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
-    if (!cols || !scratch || !blob)
+    if (!cols)
         status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
     else if (sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?, ?)", -1, &st,
                                 NULL))
@@ -761,7 +811,8 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
             cols[6 * n + e] = nd->sibling;
         }
         size_t len = 0;
-        if (cm_codec_encode(cols, NODE_FIELDS * n, 4, -1, scratch, blob, bound, &len) != CM_OK) {
+        const unsigned char *blob = NULL;
+        if (store_encode(s, cols, NODE_FIELDS * n, 4, &blob, &len) != CM_OK) {
             status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
             break;
         }
@@ -774,9 +825,6 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
         s->stats.node_tables_written++;
     }
     sqlite3_finalize(st);
-    free(cols);
-    free(scratch);
-    free(blob);
     return status;
 }
 
