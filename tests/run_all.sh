@@ -18,8 +18,15 @@ cmake --build build-sanitize -j "$jobs"
 # (OpenMP's, llvmpipe's) wind down ("Tracer caught signal 11 ... LeakSanitizer
 # has encountered a fatal error", google/sanitizers#1353; seen once here in a
 # render): a test that fails is run once more, so that only a failure that
-# repeats fails the suite.
-ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
+# repeats fails the suite. It repeats, every time, at the exit of a figure
+# of 3000 pixels or more with both GL's lines and text (`render --size
+# 3000x3000 --layers all` since the raster is drawn without GL), where the
+# tracer walks the main thread's dynamic TLS and finds a block of Mesa's at
+# a nonsense address ("DTLS 8 at 0x6f5-0x18000017f7" with log_threads=1).
+# use_tls=0 leaves thread-local storage out of the leak roots, so the walk is
+# not made; cellmap keeps no heap pointer in thread-local storage. valgrind's
+# memcheck of the same command (release build) finds no invalid access.
+ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0:use_tls=0 \
 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" --repeat until-pass:2
 # an attacker's campaign of damaged files against every command (sanitizer build)
