@@ -83,8 +83,9 @@ static void put_rgb(uint8_t *p, cm_rgb c)
 }
 
 /* A class-mode pixel: the cell's colour class, periodic cells marked. */
-static uint8_t class_of_cell(const cm_region *r, const cm_raster *ras, uint64_t k)
+static uint8_t class_of_cell(const cm_raster *ras, uint64_t k)
 {
+    const cm_region *r = ras->cells;
     const uint32_t grp = r->group[k];
     if (grp == CM_GROUP_NONE)
         return CM_CLASS_NOT_COMPUTED;
@@ -160,7 +161,7 @@ static void fill(cm_raster *ras)
             const uint64_t k = s->base + j * s->row_stride + i;
             uint8_t *p = ras->pixels + bytes * (j * s->nx + i);
             if (classes)
-                *p = class_of_cell(ras->cells, ras, k);
+                *p = class_of_cell(ras, k);
             else
                 cm_raster_rgb(ras, k, p);
         }
@@ -266,12 +267,12 @@ cm_status cm_raster_choose(const cm_lattice *lat, const cm_region *r, const cm_g
             classify_groups(lat, r, groups, &touching, ras);
         cm_touching_free(&touching);
     }
-    free(ras->shade);
-    ras->shade = st == CM_OK ? malloc(((size_t)ras->step_cap + 1) * sizeof *ras->shade) : NULL;
-    if (st == CM_OK && !ras->shade)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
     if (st != CM_OK)
         return st;
+    free(ras->shade);
+    ras->shade = malloc(((size_t)ras->step_cap + 1) * sizeof *ras->shade);
+    if (!ras->shade)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for shades");
     shade_table(ras->step_cap, ras->mode, ras->shade);
     for (uint32_t g = 0; g <= r->ngroups; g++)
         put_rgb(ras->rgb + 3 * (size_t)g, cm_class_colour(ras->palette, ras->classes[g]));
@@ -282,16 +283,16 @@ cm_status cm_raster_paint(const cm_lattice *lat, const cm_region *r, const cm_gr
                           uint32_t reach_x, uint32_t reach_y, cm_raster *ras, char *msg,
                           size_t msg_size)
 {
-    cm_status st = cm_raster_choose(lat, r, groups, reach_x, reach_y, ras, msg, msg_size);
-    const size_t bytes = ras->mode == CM_RASTER_CLASSES ? 1 : 3;
+    const cm_status st = cm_raster_choose(lat, r, groups, reach_x, reach_y, ras, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     free(ras->pixels);
-    ras->pixels = st == CM_OK ? malloc(ras->s.nx * ras->s.ny * bytes) : NULL;
-    if (st == CM_OK && !ras->pixels)
+    ras->pixels = malloc(ras->s.nx * ras->s.ny * (ras->mode == CM_RASTER_CLASSES ? 1 : 3));
+    if (!ras->pixels)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a %llux%llu raster",
                        (unsigned long long)ras->s.nx, (unsigned long long)ras->s.ny);
-    if (st == CM_OK)
-        fill(ras);
-    return st;
+    fill(ras);
+    return CM_OK;
 }
 
 void cm_raster_free(cm_raster *ras)
