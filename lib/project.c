@@ -181,7 +181,8 @@ void project_close(cm_store *s, cm_cluster *c)
 uint64_t project_default_mem(void)
 {
     const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    const uint64_t most = (uint64_t)PROJECT_MEM_MAX_MIB << 20, least = (uint64_t)PROJECT_MEM_MIN_MIB << 20;
+    const uint64_t most = (uint64_t)PROJECT_MEM_MAX_MIB << 20;
+    const uint64_t least = (uint64_t)PROJECT_MEM_MIN_MIB << 20;
     if (pages <= 0 || page <= 0)
         return most;
     const uint64_t eighth = (uint64_t)pages * (uint64_t)page / 8;
