@@ -101,9 +101,10 @@ typedef struct cm_group_info {
 } cm_group_info;
 
 /* Memory for one of a region's per-cell arrays, `bytes` long, freed by
- * free(): its whole 2 MiB in transparent huge pages where the system has
- * them (whose first touch costs a tenth of 4 KiB pages' here), the rest in
- * 4 KiB pages. cm_region_alloc and the store's page-in use it. */
+ * free(): in transparent huge pages where the system has them (whose first
+ * touch costs a tenth of 4 KiB pages' here), rounded up to whole ones when
+ * that adds at most a quarter to `bytes`, else with the tail in 4 KiB
+ * pages. cm_region_alloc and the store's page-in use it. */
 void *cm_cells_array(size_t bytes);
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size);
