@@ -318,17 +318,24 @@ static bool cluster_holds(const void *user, const int64_t *cell)
     return cm_cluster_locate(((const cm_cluster_cells *)user)->c, cell, &local) >= 0;
 }
 
-/* The exit open node id leads to (cm_cluster_exits' node index). */
-static const int64_t *node_exit(const cm_exits *x, int dim, uint32_t id)
+/* The first place in ascending a[0..n) whose id is not below id. */
+static uint64_t first_not_below(const uint32_t *a, uint64_t n, uint32_t id)
 {
-    uint64_t lo = 0, hi = x->nnodes;
+    uint64_t lo = 0, hi = n;
     while (lo < hi) {
         const uint64_t mid = lo + (hi - lo) / 2;
-        if (x->node[mid] < id)
+        if (a[mid] < id)
             lo = mid + 1;
         else
             hi = mid;
     }
+    return lo;
+}
+
+/* The exit open node id leads to (cm_cluster_exits' node index). */
+static const int64_t *node_exit(const cm_exits *x, int dim, uint32_t id)
+{
+    const uint64_t lo = first_not_below(x->node, x->nnodes, id);
     return lo < x->nnodes && x->node[lo] == id && x->node_exit[lo] < x->n
                ? x->cell + x->node_exit[lo] * (uint64_t)dim
                : NULL;
@@ -440,13 +447,13 @@ static void place_points(const cm_lattice *lat, const cm_box *bounds, int n, fol
  * computed cell, diverges or runs out of steps (outside). Returns the
  * steps taken. */
 static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
-                             const cm_exits *x, uint64_t first, int n, uint32_t steps,
+                             const int64_t *exit_cell, uint64_t first, int n, uint32_t steps,
                              follow_buf *b, followed *out)
 {
     const int dim = lat->dim;
     for (int i = 0; i < n; i++) {
         double c[CM_MAX_DIM];
-        cm_lattice_centre(lat, x->cell + (first + (uint64_t)i) * (uint64_t)dim, c);
+        cm_lattice_centre(lat, exit_cell + (first + (uint64_t)i) * (uint64_t)dim, c);
         for (int d = 0; d < dim; d++)
             b->x[d][i] = c[d];
         b->who[i] = i;
@@ -548,6 +555,38 @@ static void count_fates(const cm_exits *x, cm_attractor_set *s)
     }
 }
 
+/* The true orbits from the centres of n exit cells (dim coordinates each),
+ * in batches on `threads` threads, into f[0..n); the steps taken added to
+ * *taken. CM_EMODEL when the model aborts. */
+static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
+                            const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
+                            followed *f, uint64_t *taken, char *msg, size_t msg_size)
+{
+    const int64_t batches = (int64_t)((n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
+    uint64_t sum = 0;
+    int no_memory = 0;
+#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : sum) reduction(| : no_memory)
+    {
+        follow_buf *buf = malloc(sizeof *buf);
+        no_memory |= !buf;
+#pragma omp for schedule(dynamic, 1)
+        for (int64_t b = 0; b < batches; b++) {
+            const uint64_t first = (uint64_t)b * FOLLOW_BATCH;
+            const int k = (int)(n - first < FOLLOW_BATCH ? n - first : FOLLOW_BATCH);
+            if (buf)
+                sum += follow_batch(m, lat, cells, exit_cell, first, k, steps, buf, f + first);
+        }
+        free(buf);
+    }
+    *taken += sum;
+    if (no_memory)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following the exits");
+    for (uint64_t e = 0; e < n; e++)
+        if (f[e].how == FOLLOW_ABORTED)
+            return cm_fail(CM_EMODEL, msg, msg_size, "the model aborted following an exit's orbit");
+    return CM_OK;
+}
+
 cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
                                 const cm_computed *cells, uint32_t steps, int threads,
                                 cm_attractor_set *s, char *msg, size_t msg_size)
@@ -567,31 +606,10 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                  (unsigned long long)x->n);
     uint64_t taken = 0;
-    int no_memory = 0;
     if (st == CM_OK) {
         if (x->n)
             memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
-        const int64_t batches = (int64_t)((x->n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
-#pragma omp parallel num_threads(threads_of(threads)) reduction(+ : taken) \
-    reduction(| : no_memory)
-        {
-            follow_buf *buf = malloc(sizeof *buf);
-            no_memory |= !buf;
-#pragma omp for schedule(dynamic, 1)
-            for (int64_t b = 0; b < batches; b++) {
-                const uint64_t first = (uint64_t)b * FOLLOW_BATCH;
-                const int n = (int)(x->n - first < FOLLOW_BATCH ? x->n - first : FOLLOW_BATCH);
-                if (buf)
-                    taken += follow_batch(m, lat, cells, x, first, n, steps, buf, f + first);
-            }
-            free(buf);
-        }
-        if (no_memory)
-            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following the exits");
-        for (uint64_t e = 0; st == CM_OK && e < x->n; e++)
-            if (f[e].how == FOLLOW_ABORTED)
-                st = cm_fail(CM_EMODEL, msg, msg_size,
-                             "the model aborted following an exit's orbit");
+        st = follow_all(m, lat, cells, x->cell, x->n, steps, threads, f, &taken, msg, msg_size);
     }
     for (uint64_t e = 0; st == CM_OK && e < x->n; e++) {
         next[e] = NEXT_LABEL;
@@ -613,9 +631,16 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
 /* The label of a sink cell whose sequence leaves the flat region at cell j
  * (local index): into an uncomputed cell of the box, or out of the box,
  * where `cells` knows where it goes. */
-static cm_status leaving_label(const cm_attractor_set *s, const cm_region *flat, uint64_t j,
-                               const cm_computed *cells, int32_t *v, char *msg, size_t msg_size)
+typedef struct leaving_cells {
+    const cm_attractor_set *s;
+    const cm_computed *cells;
+} leaving_cells;
+
+static cm_status leaving_label(void *user, const cm_region *flat, uint64_t j, int32_t *v,
+                               char *msg, size_t msg_size)
 {
+    const leaving_cells *lc = user;
+    const cm_attractor_set *s = lc->s;
     const int dim = flat->box.dim;
     int64_t at[CM_MAX_DIM], exit[CM_MAX_DIM];
     const uint32_t image = flat->image[j];
@@ -626,21 +651,27 @@ static cm_status leaving_label(const cm_attractor_set *s, const cm_region *flat,
     }
     uint32_t g;
     bool out;
-    if (!cells) { /* orbits not followed */
+    if (!lc->cells) { /* orbits not followed */
         *v = CM_LABEL_OUTSIDE;
         return CM_OK;
     }
     cm_box_cell(&flat->box, j, at);
-    const cm_status st = cells->end(cells->user, at, &g, &out, exit, msg, msg_size);
+    const cm_status st = lc->cells->end(lc->cells->user, at, &g, &out, exit, msg, msg_size);
     *v = g != 0 ? cm_attractor_label(s, g)
          : out  ? cm_attractor_exit_label(s, dim, exit)
                 : CM_LABEL_DIVERGED;
     return st;
 }
 
-cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *flat,
-                                   const cm_computed *cells, int32_t *labels, char *msg,
-                                   size_t msg_size)
+/* The label of a sink cell of flat whose sequence leaves it at cell j. */
+typedef cm_status (*leaving_fn)(void *user, const cm_region *flat, uint64_t j, int32_t *v,
+                                char *msg, size_t msg_size);
+
+/* Labels flat's cells: a group's cell its attractor's label, a sink cell
+ * the label its sequence ends on (diverged in the world's sink, else what
+ * `leave` gives at the cell where it leaves flat's cells). */
+static cm_status label_cells(const cm_attractor_set *s, const cm_region *flat, leaving_fn leave,
+                             void *user, int32_t *labels, char *msg, size_t msg_size)
 {
     const int32_t unknown = LABEL_PENDING;
     for (uint64_t i = 0; i < flat->ncells; i++)
@@ -655,7 +686,7 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
             if (image == CM_IMAGE_SINK)
                 v = CM_LABEL_DIVERGED;
             else if (leaves(flat, image)) {
-                const cm_status st = leaving_label(s, flat, j, cells, &v, msg, msg_size);
+                const cm_status st = leave(user, flat, j, &v, msg, msg_size);
                 if (st != CM_OK)
                     return st;
             } else if (labels[image] != unknown)
@@ -672,12 +703,389 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
     return CM_OK;
 }
 
+cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *flat,
+                                   const cm_computed *cells, int32_t *labels, char *msg,
+                                   size_t msg_size)
+{
+    leaving_cells lc = {s, cells};
+    return label_cells(s, flat, leaving_label, &lc, labels, msg, msg_size);
+}
+
 /* The budget opt asks (0 when not followed). */
 static uint32_t outside_budget(const cm_model *m, const cm_attractor_options *opt)
 {
     cm_attractor_options o;
     cm_attractor_defaults(m, opt, &o);
     return o.outside == CM_OUTSIDE_OFF ? 0 : o.outside;
+}
+
+/* ---- a view's labels: only the exits its cells reach ------------------- */
+
+/* While a view is labelled, a cell whose sequence leaves the cluster
+ * through an exit holds VIEW_EXIT - k, k the exit's slot (the exit cells in
+ * the order they were found), and one whose sequence leaves the view where
+ * only the cluster knows its end holds VIEW_END - p, p the place of that
+ * cell in the list of such ends: they are looked up region by region, so
+ * that a paged cluster reads each region once. */
+#define VIEW_EXIT (-16)
+#define VIEW_MOST ((uint64_t)1 << 30) /* slots, and ends */
+#define VIEW_END (VIEW_EXIT - (int32_t)VIEW_MOST)
+
+static bool is_slot(int32_t label) { return label <= VIEW_EXIT && label > VIEW_END; }
+static bool is_end(int32_t label) { return label <= VIEW_END && label > LABEL_WALKING; }
+
+typedef struct view_exits {
+    cm_cluster *c;
+    const cm_attractor_set *s;
+    int dim;
+    int64_t *cell;  /* each slot's exit cell, dim coordinates */
+    uint64_t n, cap;
+    int64_t *end;   /* the cells whose ends the cluster knows, dim coordinates */
+    uint64_t nend, end_cap;
+    uint32_t *hash; /* open addressing by cell: slot + 1, 0 empty; hash_size a power of 2 */
+    uint64_t hash_size;
+} view_exits;
+
+static uint64_t cell_hash(const int64_t *cell, int dim)
+{
+    uint64_t h = 0x9E3779B97F4A7C15ULL;
+    for (int d = 0; d < dim; d++)
+        h = (h ^ (uint64_t)cell[d]) * 0xBF58476D1CE4E5B9ULL;
+    return h ^ (h >> 31);
+}
+
+/* Where cell's slot is, or the empty place it would take. */
+static uint64_t hash_place(const view_exits *v, const int64_t *cell)
+{
+    uint64_t i = cell_hash(cell, v->dim) & (v->hash_size - 1);
+    while (v->hash[i] &&
+           memcmp(v->cell + (v->hash[i] - 1) * (uint64_t)v->dim, cell, (size_t)v->dim * 8) != 0)
+        i = (i + 1) & (v->hash_size - 1);
+    return i;
+}
+
+/* Room for one more slot: the cells, and the hash at most half full. */
+static cm_status view_room(view_exits *v)
+{
+    if (v->n >= VIEW_MOST - 64)
+        return CM_ETOOBIG;
+    if (v->n == v->cap) {
+        const uint64_t cap = v->cap ? 2 * v->cap : 1024;
+        int64_t *cell = realloc(v->cell, (size_t)cap * (size_t)v->dim * sizeof *cell);
+        if (!cell)
+            return CM_ENOMEM;
+        v->cell = cell;
+        v->cap = cap;
+    }
+    if (2 * (v->n + 1) <= v->hash_size)
+        return CM_OK;
+    const uint64_t size = v->hash_size ? 2 * v->hash_size : 2048;
+    uint32_t *hash = calloc((size_t)size, sizeof *hash);
+    if (!hash)
+        return CM_ENOMEM;
+    free(v->hash);
+    v->hash = hash;
+    v->hash_size = size;
+    for (uint64_t k = 0; k < v->n; k++)
+        v->hash[hash_place(v, v->cell + k * (uint64_t)v->dim)] = (uint32_t)(k + 1);
+    return CM_OK;
+}
+
+/* The slot of exit cell `cell`, added when new. */
+static cm_status view_slot(view_exits *v, const int64_t *cell, uint64_t *slot, char *msg,
+                           size_t msg_size)
+{
+    if (v->hash_size) {
+        const uint64_t i = hash_place(v, cell);
+        if (v->hash[i]) {
+            *slot = v->hash[i] - 1;
+            return CM_OK;
+        }
+    }
+    const cm_status st = view_room(v);
+    if (st == CM_ETOOBIG)
+        return cm_fail(st, msg, msg_size, "the view reaches more than %llu exits",
+                       (unsigned long long)(VIEW_MOST - 64));
+    if (st != CM_OK)
+        return cm_fail(st, msg, msg_size, "out of memory for the view's exits");
+    memcpy(v->cell + v->n * (uint64_t)v->dim, cell, (size_t)v->dim * sizeof *cell);
+    v->hash[hash_place(v, cell)] = (uint32_t)(v->n + 1);
+    *slot = v->n++;
+    return CM_OK;
+}
+
+/* The exit cell of open node id: from its region's open list (kept in
+ * memory, in node order), else from its exit table (paged in). */
+static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
+                           size_t msg_size)
+{
+    const uint32_t k = cm_cluster_node_region(c, id);
+    const cm_cluster_region *cr = &c->regions[k];
+    const uint32_t e = id - cr->node_base;
+    const size_t bytes = (size_t)c->lat.dim * sizeof *cell;
+    const uint64_t lo = first_not_below(cr->open_local, cr->nopen, e);
+    if (lo < cr->nopen && cr->open_local[lo] == e) {
+        memcpy(cell, cr->open_cells + lo * (uint64_t)c->lat.dim, bytes);
+        return CM_OK;
+    }
+    const cm_status st = cm_cluster_acquire(c, k, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (!cr->r.exit_target)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u kept no exit table", k);
+    memcpy(cell, cm_region_exit(&cr->r, e), bytes);
+    return CM_OK;
+}
+
+/* The label a computed cell's sequence ends on: its group's attractor,
+ * diverged in the world's sink, or VIEW_EXIT - slot of the exit it leaves
+ * the cluster by. */
+static cm_status view_end(view_exits *v, const int64_t *cell, int32_t *label, char *msg,
+                          size_t msg_size)
+{
+    uint32_t g, open;
+    int64_t exit[CM_MAX_DIM];
+    uint64_t slot;
+    cm_status st = cm_cluster_cell_end(v->c, cell, &g, &open, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (g != 0) {
+        *label = cm_attractor_label(v->s, g);
+        return CM_OK;
+    }
+    if (open == CM_NODE_OPEN) {
+        *label = CM_LABEL_DIVERGED;
+        return CM_OK;
+    }
+    st = open_exit(v->c, open, exit, msg, msg_size);
+    if (st == CM_OK)
+        st = view_slot(v, exit, &slot, msg, msg_size);
+    *label = VIEW_EXIT - (int32_t)slot;
+    return st;
+}
+
+/* A sink cell's sequence leaves the view at cell j: into an uncomputed
+ * cell of the view (the exit itself), else beyond it (the cluster knows
+ * where it ends). */
+static cm_status view_leaving(void *user, const cm_region *flat, uint64_t j, int32_t *v,
+                              char *msg, size_t msg_size)
+{
+    int64_t at[CM_MAX_DIM];
+    const uint32_t image = flat->image[j];
+    if (image < flat->ncells) {
+        uint64_t slot;
+        cm_box_cell(&flat->box, image, at);
+        const cm_status st = view_slot(user, at, &slot, msg, msg_size);
+        *v = VIEW_EXIT - (int32_t)slot;
+        return st;
+    }
+    view_exits *x = user;
+    if (x->nend >= VIEW_MOST - 64)
+        return cm_fail(CM_ETOOBIG, msg, msg_size, "the view leaves itself at more than %llu cells",
+                       (unsigned long long)(VIEW_MOST - 64));
+    if (cm_grow((void **)&x->end, &x->end_cap, (x->nend + 1) * (uint64_t)x->dim,
+                sizeof *x->end) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's ends");
+    cm_box_cell(&flat->box, j, x->end + x->nend * (uint64_t)x->dim);
+    *v = VIEW_END - (int32_t)x->nend++;
+    return CM_OK;
+}
+
+/* The ends (view_end) of n cells (dim coordinates each) into label[0..n),
+ * looked up region by region. */
+static cm_status ends_by_region(view_exits *v, const int64_t *cell, uint64_t n, int32_t *label,
+                                char *msg, size_t msg_size)
+{
+    cm_cluster *c = v->c;
+    uint64_t *start = calloc((size_t)c->nregions + 2, sizeof *start);
+    uint32_t *region = malloc(((size_t)n + 1) * sizeof *region);
+    uint64_t *order = malloc(((size_t)n + 1) * sizeof *order);
+    cm_status st = start && region && order
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's ends");
+    for (uint64_t i = 0; st == CM_OK && i < n; i++) {
+        uint64_t local;
+        const int64_t k = cm_cluster_locate(c, cell + i * (uint64_t)v->dim, &local);
+        region[i] = k < 0 ? c->nregions : (uint32_t)k; /* none: last */
+        start[region[i] + 1]++;
+    }
+    for (uint32_t k = 0; st == CM_OK && k <= c->nregions; k++)
+        start[k + 1] += start[k];
+    for (uint64_t i = 0; st == CM_OK && i < n; i++)
+        order[start[region[i]]++] = i;
+    for (uint64_t i = 0; st == CM_OK && i < n; i++)
+        st = view_end(v, cell + order[i] * (uint64_t)v->dim, &label[order[i]], msg, msg_size);
+    free(start);
+    free(region);
+    free(order);
+    return st;
+}
+
+/* The view's labels that wait for the cluster's ends get them. */
+static cm_status settle_ends(view_exits *v, int32_t *labels, uint64_t ncells, int threads,
+                             char *msg, size_t msg_size)
+{
+    int32_t *end = malloc(((size_t)v->nend + 1) * sizeof *end);
+    cm_status st = end ? ends_by_region(v, v->end, v->nend, end, msg, msg_size)
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's ends");
+    if (st == CM_OK) {
+        const int64_t n = (int64_t)ncells;
+#pragma omp parallel for schedule(static) num_threads(threads_of(threads))
+        for (int64_t i = 0; i < n; i++)
+            if (is_end(labels[i]))
+                labels[i] = end[VIEW_END - labels[i]];
+    }
+    free(end);
+    return st;
+}
+
+/* The labels of n followed exits: diverged, outside, or the end of the
+ * cell their orbit returned to (found region by region). */
+static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int32_t *label,
+                               char *msg, size_t msg_size)
+{
+    const int dim = v->dim;
+    uint64_t back = 0;
+    for (uint64_t e = 0; e < n; e++)
+        back += f[e].how == FOLLOW_RETURNED;
+    int64_t *cell = malloc(((size_t)back + 1) * (size_t)dim * sizeof *cell);
+    int32_t *end = malloc(((size_t)back + 1) * sizeof *end);
+    cm_status st =
+        cell && end ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+    uint64_t k = 0;
+    for (uint64_t e = 0; st == CM_OK && e < n; e++)
+        if (f[e].how == FOLLOW_RETURNED)
+            memcpy(cell + (k++) * (uint64_t)dim, f[e].cell, (size_t)dim * sizeof *cell);
+    if (st == CM_OK)
+        st = ends_by_region(v, cell, back, end, msg, msg_size);
+    k = 0;
+    for (uint64_t e = 0; st == CM_OK && e < n; e++)
+        label[e] = f[e].how == FOLLOW_RETURNED ? end[k++]
+                   : f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED
+                                                 : CM_LABEL_OUTSIDE;
+    free(cell);
+    free(end);
+    return st;
+}
+
+/* The fates of the view's exits into label[0..v->n): followed in rounds,
+ * as orbits that return into the sink's domain reach exits not found yet,
+ * then their chains settled. */
+static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, int threads,
+                            int32_t **label, uint64_t *taken, char *msg, size_t msg_size)
+{
+    cm_cluster *c = v->c;
+    cm_cluster_cells cc = {c, NULL};
+    const cm_computed cells = cm_cluster_computed(&cc); /* holds only: ends come from view_end */
+    followed *f = NULL;
+    uint64_t *next = NULL, done = 0;
+    *label = calloc(1, sizeof **label); /* no exit: no fate, but an array */
+    cm_status st = *label ? CM_OK
+                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+    while (st == CM_OK && done < v->n) {
+        const uint64_t to = v->n;
+        followed *f2 = realloc(f, (size_t)to * sizeof *f);
+        f = f2 ? f2 : f;
+        uint64_t *next2 = f2 ? realloc(next, (size_t)to * sizeof *next) : NULL;
+        next = next2 ? next2 : next;
+        int32_t *label2 = next2 ? realloc(*label, (size_t)to * sizeof **label) : NULL;
+        *label = label2 ? label2 : *label;
+        if (!label2) {
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+            break;
+        }
+        st = follow_all(m, &c->lat, &cells, v->cell + done * (uint64_t)c->lat.dim, to - done,
+                        steps, threads, f + done, taken, msg, msg_size);
+        if (st == CM_OK)
+            st = returned_ends(v, f + done, to - done, *label + done, msg, msg_size);
+        for (uint64_t e = done; st == CM_OK && e < to; e++) {
+            int32_t *l = &(*label)[e];
+            next[e] = NEXT_LABEL;
+            if (is_slot(*l)) {
+                next[e] = (uint64_t)(VIEW_EXIT - *l);
+                *l = LABEL_PENDING;
+            }
+        }
+        done = to;
+    }
+    if (st == CM_OK)
+        settle_chains(v->n, next, *label);
+    free(f);
+    free(next);
+    return st;
+}
+
+/* s's exits: the view's exit cells in box order, with their fates and
+ * weights (the view's cells that leave by them); the counts from them. */
+static cm_status view_exit_set(const view_exits *v, const int32_t *label, const uint64_t *weight,
+                               cm_attractor_set *s)
+{
+    cm_exits x;
+    memset(&x, 0, sizeof x);
+    uint64_t *exit_of = malloc(((size_t)v->n + 1) * sizeof *exit_of);
+    cm_status st = exit_of ? exits_of_targets(v->cell, weight, v->n, v->dim, &x, exit_of)
+                           : CM_ENOMEM;
+    free(s->exit_cell);
+    free(s->exit_label);
+    s->exit_cell = x.cell;
+    s->exit_label = st == CM_OK ? malloc(((size_t)x.n + 1) * sizeof *s->exit_label) : NULL;
+    s->nexits = st == CM_OK && s->exit_label ? x.n : 0;
+    if (st == CM_OK && !s->exit_label)
+        st = CM_ENOMEM;
+    for (uint64_t e = 0; st == CM_OK && e < v->n; e++)
+        s->exit_label[exit_of[e]] = label[e];
+    if (st == CM_OK)
+        count_fates(&x, s);
+    x.cell = NULL; /* s's now */
+    cm_exits_free(&x);
+    free(exit_of);
+    return st;
+}
+
+cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
+                                 const cm_attractor_options *opt, cm_attractor_set *s,
+                                 int32_t *labels, char *msg, size_t msg_size)
+{
+    if (c->resolved_cells || c->open_released || !c->keep_exits)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster does not know its exits (an old file, or released)");
+    view_exits v;
+    memset(&v, 0, sizeof v);
+    v.c = c;
+    v.s = s;
+    v.dim = c->lat.dim;
+    const uint32_t steps = outside_budget(m, opt);
+    const int threads = opt ? opt->threads : 0;
+    int32_t *fate = NULL;
+    uint64_t *weight = NULL, taken = 0;
+    cm_status st = label_cells(s, flat, view_leaving, &v, labels, msg, msg_size);
+    if (st == CM_OK)
+        st = settle_ends(&v, labels, flat->ncells, threads, msg, msg_size);
+    if (st == CM_OK)
+        st = view_fates(m, &v, steps, threads, &fate, &taken, msg, msg_size);
+    weight = st == CM_OK ? calloc((size_t)v.n + 1, sizeof *weight) : NULL;
+    if (st == CM_OK && !weight)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+    for (uint64_t i = 0; st == CM_OK && i < flat->ncells; i++)
+        if (is_slot(labels[i]))
+            weight[VIEW_EXIT - labels[i]]++;
+    if (st == CM_OK && view_exit_set(&v, fate, weight, s) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+    if (st == CM_OK) {
+        s->outside_steps = steps;
+        s->outside_steps_taken = taken;
+        const int64_t n = (int64_t)flat->ncells;
+#pragma omp parallel for schedule(static) num_threads(threads_of(threads))
+        for (int64_t i = 0; i < n; i++)
+            if (is_slot(labels[i]))
+                labels[i] = fate[VIEW_EXIT - labels[i]];
+    }
+    free(fate);
+    free(weight);
+    free(v.cell);
+    free(v.hash);
+    free(v.end);
+    return st;
 }
 
 cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const cm_region *r,

@@ -125,6 +125,24 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
                                    const cm_computed *cells, int32_t *labels, char *msg,
                                    size_t msg_size);
 
+/* The labels of a flattened part of cluster c (flat: cm_cluster_flatten of
+ * a box) by the attractors s found on the cluster's groups
+ * (cm_attractors_find), as cm_attractor_cell_labels gives them with every
+ * exit of the cluster followed; here only the exits the part's sequences
+ * reach are followed (opt->outside steps each), and those the orbits from
+ * them return to, so that the cost follows the part, not the cluster. s
+ * then holds those exits (exit_cell, exit_label), and its counts are of
+ * their weights only (the cells whose sequences leave through the open
+ * nodes found): outside_cells, returned_cells, the returned cells in the
+ * attractors' basin_cells (the cluster's when the part holds every
+ * computed cell), and sink_diverged_cells without the cells that end in
+ * the world's sink. Reads (and pages in) the regions its sequences
+ * and orbits reach; threads: opt->threads. CM_EINVAL for a cluster that
+ * keeps no exits (keep_exits 0, released, or resolved cells). */
+cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
+                                 const cm_attractor_options *opt, cm_attractor_set *s,
+                                 int32_t *labels, char *msg, size_t msg_size);
+
 /* The label of every node of cluster c (node_label[id]): the label its
  * exit's chain of links ends on (a group's attractor; for an open node,
  * the fate s gives its exit, found from the cluster's escape index; 0 when

@@ -174,6 +174,36 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
     return st;
 }
 
+cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
+                      const cm_group_info *groups, cm_attractor_set *att, int32_t **labels,
+                      char *msg, size_t msg_size)
+{
+    *labels = cm_cells_array((flat->ncells + 1) * sizeof **labels);
+    if (!*labels)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
+    cm_status st;
+    if (c->keep_exits && !c->resolved_cells && !c->open_released) {
+        st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c, NULL,
+                                att, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_view_labels(m, c, flat, NULL, att, *labels, msg, msg_size);
+    } else {
+        cluster_ends ends;
+        memset(&ends, 0, sizeof ends);
+        st = cluster_ends_open(&ends, c, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_attractors(m, &ends.cc, groups, NULL, att, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_attractor_cell_labels(att, flat, &ends.computed, *labels, msg, msg_size);
+        cluster_ends_close(&ends);
+    }
+    if (st != CM_OK) {
+        free(*labels);
+        *labels = NULL;
+    }
+    return st;
+}
+
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g)
 {
     const int32_t label = cm_attractor_label(s, g);

@@ -61,6 +61,16 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
                           const cm_attractor_options *o, cm_attractor_set *out, char *msg,
                           size_t msg_size);
 
+/* The attractors of cluster c's groups (groups[k]: group k + 1) with model
+ * m's defaults, and the label of every cell of flat (a flattened part of
+ * c) into *labels (ncells entries, the caller's to free; NULL on
+ * failure): following only the exits the part reaches
+ * (cm_cluster_view_labels), so that the cost follows the part, where the
+ * cluster knows its exits; else every exit (cm_cluster_attractors). */
+cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
+                      const cm_group_info *groups, cm_attractor_set *att, int32_t **labels,
+                      char *msg, size_t msg_size);
+
 /* Group g's label by attractors: its attractor's id, or 0 when its orbit
  * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */
 uint32_t attractor_label(const cm_attractor_set *s, uint32_t g);

@@ -474,33 +474,33 @@ static cm_status figure_svg(FILE *f, const void *user, int cell_pixels, char *ms
     return cm_render_svg(b->lat, b->cells, b->groups, &ro, f, msg, msg_size);
 }
 
-/* b's figure drawn by attractors: its cells relabelled in a copy. */
+/* b's figure drawn by attractors: its cells relabelled in a copy of their
+ * groups and steps (attractor_view does not change images). */
 static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_size)
 {
-    cm_region view;
-    cm_status st = cm_region_alloc(&view, &b->cells->box, msg, msg_size);
+    cm_region view = *b->cells;
+    const uint64_t n = view.ncells;
+    view.group = cm_cells_array((n + 1) * sizeof *view.group);
+    view.step = cm_cells_array((n + 1) * sizeof *view.step);
     cm_group_info *groups = NULL;
-    uint32_t n = 0;
+    uint32_t count = 0;
     png_opts *po = malloc(sizeof *po);
-    if (st == CM_OK && !po)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
-    int32_t *label = st == CM_OK ? cm_cells_array((view.ncells + 1) * sizeof *label) : NULL;
-    if (st == CM_OK && !label)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
-    if (st == CM_OK && b->labels)
-        memcpy(label, b->labels, view.ncells * sizeof *label);
-    else if (st == CM_OK)
-        st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, label, msg, msg_size);
+    int32_t *own = b->labels ? NULL : cm_cells_array((n + 1) * sizeof *own);
+    const int32_t *label = b->labels ? b->labels : own;
+    cm_status st = view.group && view.step && po && label
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
+    if (st == CM_OK && !b->labels)
+        st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, own, msg, msg_size);
     if (st == CM_OK) {
-        memcpy(view.group, b->cells->group, view.ncells * sizeof *view.group);
-        memcpy(view.step, b->cells->step, view.ncells * sizeof *view.step);
-        memcpy(view.image, b->cells->image, view.ncells * sizeof *view.image);
-        st = attractor_view(b->attractors, &view, label, &groups, &n, msg, msg_size);
+        memcpy(view.group, b->cells->group, n * sizeof *view.group);
+        memcpy(view.step, b->cells->step, n * sizeof *view.step);
+        st = attractor_view(b->attractors, &view, label, &groups, &count, msg, msg_size);
     }
-    free(label);
+    free(own);
     if (st == CM_OK) {
         *po = *b->opts;
-        po->n_labels = attractor_legend(b->attractors, n, po->labels, po->n_labels,
+        po->n_labels = attractor_legend(b->attractors, count, po->labels, po->n_labels,
                                         PNG_LABELS_MAX);
         po->sink_label = "diverged";
         po->group_noun = "attractor";
@@ -512,7 +512,8 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
         by.labels = NULL;
         st = figure_write(&by, msg, msg_size);
     }
-    cm_region_free(&view);
+    free(view.group);
+    free(view.step);
     free(groups);
     free(po);
     return st;

@@ -422,12 +422,9 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
     st = shown_cells(s, &flat, &groups, msg, msg_size);
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
-    cluster_ends ends;
-    memset(&ends, 0, sizeof ends);
+    int32_t *labels = NULL;
     if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = cluster_ends_open(&ends, &s->c, msg, msg_size);
-    if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, &att, msg, msg_size);
+        st = part_labels(&s->model, &s->c, &flat, groups, &att, &labels, msg, msg_size);
     if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
@@ -439,19 +436,20 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
                            {s->hi[0], s->hi[1]},
                            s->gl,
                            po->by == BY_ATTRACTORS ? &att : NULL,
-                           &ends.computed,
-                           NULL};
+                           NULL,
+                           labels};
     if (st == CM_OK)
         st = figure_write(&png, msg, msg_size);
     cm_region_free(&flat);
-    cluster_ends_close(&ends);
     cm_attractors_free(&att);
+    free(labels);
     free(groups);
     return st;
 }
 
-/* The view's cells by attractor label (cm_attractor_cell_labels), the
- * attractors found first (as render finds them). */
+/* The view's cells by attractor label (cm_attractor_cell_labels, the same
+ * labels render finds), the attractors found with every exit followed, so
+ * that their basins are the cluster's. */
 static cm_status count_by_attractors(session *s, const cm_region *flat, const cm_group_info *groups,
                                      cm_attractor_set *att, uint64_t **by_label, char *msg,
                                      size_t msg_size)

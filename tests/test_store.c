@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cellmap/codec.h"
+#include "cellmap/join.h"
 #include "cellmap/outside.h"
 #include "cellmap/store.h"
 #include "check.h"
@@ -305,6 +306,106 @@ static void damaged_group(const char *path, const cm_attractor_set *att, const i
     free(blob);
 }
 
+/* The labels of a flattened part that follows only the exits its cells
+ * reach (cm_cluster_view_labels) are the cluster-wide ones (want, of the
+ * box all), cell by cell; for the whole box its counts are the
+ * cluster's too. Returns the exits it followed. */
+static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_group_info *g,
+                                  const cm_attractor_set *full, const cm_box *all,
+                                  const int32_t *want, const cm_box *view)
+{
+    char msg[512];
+    cm_region part;
+    CHECK(cm_cluster_flatten(c, view, &part, msg, sizeof msg) == CM_OK);
+    cm_attractor_set vs;
+    CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, &vs, msg,
+                             sizeof msg) == CM_OK);
+    int32_t *labels = malloc(part.ncells * sizeof *labels);
+    const cm_status vst = cm_cluster_view_labels(m, c, &part, NULL, &vs, labels, msg, sizeof msg);
+    if (vst != CM_OK)
+        fprintf(stderr, "view labels: %s\n", msg);
+    CHECK(vst == CM_OK);
+    uint64_t differ = 0;
+    for (uint64_t i = 0; i < part.ncells; i++) {
+        int64_t cell[2];
+        cm_box_cell(view, i, cell);
+        differ += labels[i] != want[cm_box_index(all, cell)];
+    }
+    CHECK_INT(differ, 0);
+    CHECK(vs.nexits <= full->nexits && vs.n == full->n);
+    if (view->lo[0] == all->lo[0] && view->lo[1] == all->lo[1] && view->hi[0] == all->hi[0] &&
+        view->hi[1] == all->hi[1]) {
+        CHECK_INT(vs.nexits, full->nexits);
+        CHECK_INT(vs.returned_cells, full->returned_cells);
+        CHECK_INT(vs.outside_cells, full->outside_cells);
+        for (uint32_t a = 0; a < vs.n; a++)
+            CHECK_INT(vs.a[a].basin_cells, full->a[a].basin_cells);
+    }
+    const uint64_t followed = vs.nexits;
+    free(labels);
+    cm_attractors_free(&vs);
+    cm_region_free(&part);
+    return followed;
+}
+
+/* x moves 5 right until 40, where a fixed point waits at 45.5; y stays. */
+static int shift_step(const cm_model *m, const double *x, double *y)
+{
+    (void)m;
+    y[0] = x[0] < 40 ? x[0] + 5 : 45.5;
+    y[1] = x[1];
+    return CM_STEP_OK;
+}
+
+/* Three regions apart, A = 0..10, B = 20..30 and C = 40..50 (x, cells of
+ * width 1, four rows): A's sequences leave through exits whose orbits land
+ * in B's sink cells, which leave through exits whose orbits land on C's
+ * fixed points. A view of A alone must follow B's exits too, which none of
+ * its cells reaches, to find its cells' attractors (one per row). */
+static void test_view_closure(void)
+{
+    char msg[512];
+    const cm_model m = {.name = "shift", .dim = 2, .step = shift_step};
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    const cm_box boxes[3] = {{2, {0, 0}, {10, 4}}, {2, {20, 0}, {30, 4}}, {2, {40, 0}, {50, 4}}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
+    CHECK(cm_cluster_solve_boxes(&c, &m, boxes, 3, &opt, NULL, NULL, NULL, msg, sizeof msg) ==
+          CM_OK);
+    cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
+    CHECK(cm_cluster_describe_new(&c, &m, g, msg, sizeof msg) == CM_OK);
+    cm_exits x;
+    CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
+    cm_cluster_cells cc = {&c, &x};
+    cm_attractor_set full, view;
+    CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &full, msg, sizeof msg) == CM_OK);
+    CHECK_INT(full.n, 4);
+    cm_region a;
+    CHECK(cm_cluster_flatten(&c, &boxes[0], &a, msg, sizeof msg) == CM_OK);
+    int32_t want[40], got[40];
+    const cm_computed cells = cm_cluster_computed(&cc);
+    CHECK(cm_attractor_cell_labels(&full, &a, &cells, want, msg, sizeof msg) == CM_OK);
+    CHECK(cm_attractors_find(&m, &lat, g, c.ngroups, cm_cluster_cell_group, &c, NULL, &view, msg,
+                             sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(&m, &c, &a, NULL, &view, got, msg, sizeof msg) == CM_OK);
+    for (int i = 0; i < 40; i++)
+        CHECK_INT(got[i], want[i]);
+    for (int row = 0; row < 4; row++) /* every cell of a row: the row's fixed point */
+        for (int i = 0; i < 10; i++)
+            CHECK(want[row * 10 + i] > 0 && want[row * 10 + i] == want[row * 10]);
+    CHECK(want[0] != want[10]);
+    /* A's cells reach its 20 exit cells (x 10..14), whose orbits land in
+     * B's sink cells, which leave through B's 20 (x 30..34) */
+    CHECK_INT(view.nexits, 40);
+    cm_region_free(&a);
+    cm_attractors_free(&full);
+    cm_attractors_free(&view);
+    cm_exits_free(&x);
+    free(g);
+    cm_cluster_free(&c);
+}
+
 /* The labels a paged cluster gives region by region from its node labels
  * (cm_cluster_cell_labels) are those of its flattened cells
  * (cm_attractor_cell_labels), cell by cell, for the whole box in either
@@ -359,12 +460,30 @@ static void test_cell_labels(const char *path, const cm_model *m)
                       want[cm_box_index(&all, cell)];
         }
     CHECK_INT(differ, 0);
+    /* the view's own labels: the whole box, the window, and random boxes
+     * (some within one region, most across several) */
+    uint64_t followed = check_view_labels(&c, m, g, &att, &all, want, &all);
+    CHECK(check_view_labels(&c, m, g, &att, &all, want, &window) < followed);
+    uint64_t seed = 12345;
+    for (int k = 0; k < 12; k++) {
+        cm_box b = {2, {0, 0}, {1, 1}};
+        for (int d = 0; d < 2; d++) {
+            const int64_t side = d == 0 ? NX : NY;
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            const int64_t lo = (int64_t)((seed >> 33) % (uint64_t)side);
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            b.lo[d] = lo;
+            b.hi[d] = lo + 1 + (int64_t)((seed >> 33) % (uint64_t)(side - lo));
+        }
+        check_view_labels(&c, m, g, &att, &all, want, &b);
+    }
     damaged_group(path, &att, node_label, &window, got);
     fprintf(stderr,
             "cell labels: %llu cells agree; %llu in basins, of the sink's %llu returned, %llu "
-            "outside\n",
+            "outside; a view of the whole box follows %llu exits\n",
             (unsigned long long)flat.ncells, (unsigned long long)attractors,
-            (unsigned long long)returned, (unsigned long long)outside);
+            (unsigned long long)returned, (unsigned long long)outside,
+            (unsigned long long)followed);
     free(want);
     free(got);
     free(node_label);
@@ -468,6 +587,7 @@ int main(void)
     const char *const params[] = {"alpha=0.8,beta=0.3,P=0.7,D=0.6"};
     CHECK(cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) == CM_OK);
     test_codec();
+    test_view_closure();
     test_budgets(dir, &m);
     char good[256];
     snprintf(good, sizeof good, "%s/budget0-2.cmdb", dir);
