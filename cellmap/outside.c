@@ -587,6 +587,10 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
     return CM_OK;
 }
 
+/* Exits followed at a time by cm_attractors_outside, so that what it keeps
+ * of an orbit stays small (a cluster can have millions of exits). */
+#define FOLLOW_CHUNK ((uint64_t)1 << 16)
+
 cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
                                 const cm_computed *cells, uint32_t steps, int threads,
                                 cm_attractor_set *s, char *msg, size_t msg_size)
@@ -599,24 +603,28 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
     s->outside_steps_taken = 0;
     s->exit_cell = malloc(((size_t)x->n + 1) * (size_t)dim * sizeof *s->exit_cell);
     s->exit_label = malloc(((size_t)x->n + 1) * sizeof *s->exit_label);
-    followed *f = malloc(((size_t)x->n + 1) * sizeof *f);
+    const uint64_t chunk = x->n < FOLLOW_CHUNK ? x->n : FOLLOW_CHUNK;
+    followed *f = malloc(((size_t)chunk + 1) * sizeof *f);
     uint64_t *next = malloc(((size_t)x->n + 1) * sizeof *next);
     cm_status st = s->exit_cell && s->exit_label && f && next
                        ? CM_OK
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                  (unsigned long long)x->n);
     uint64_t taken = 0;
-    if (st == CM_OK) {
-        if (x->n)
-            memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
-        st = follow_all(m, lat, cells, x->cell, x->n, steps, threads, f, &taken, msg, msg_size);
-    }
-    for (uint64_t e = 0; st == CM_OK && e < x->n; e++) {
-        next[e] = NEXT_LABEL;
-        s->exit_label[e] = f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
-        if (f[e].how == FOLLOW_RETURNED)
-            st = returned_to(cells, x, dim, s, f[e].cell, &s->exit_label[e], &next[e], msg,
-                             msg_size);
+    if (st == CM_OK && x->n)
+        memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
+    for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
+        const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
+        st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f,
+                        &taken, msg, msg_size);
+        for (uint64_t i = 0; st == CM_OK && i < n; i++) {
+            const uint64_t e = first + i;
+            next[e] = NEXT_LABEL;
+            s->exit_label[e] = f[i].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+            if (f[i].how == FOLLOW_RETURNED)
+                st = returned_to(cells, x, dim, s, f[i].cell, &s->exit_label[e], &next[e], msg,
+                                 msg_size);
+        }
     }
     if (st == CM_OK) {
         settle_chains(x->n, next, s->exit_label);
