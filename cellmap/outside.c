@@ -853,7 +853,7 @@ static cm_status view_end(view_exits *v, const int64_t *cell, int32_t *label, ch
 {
     uint32_t g, open;
     int64_t exit[CM_MAX_DIM];
-    uint64_t slot;
+    uint64_t slot = 0;
     cm_status st = cm_cluster_cell_end(v->c, cell, &g, &open, msg, msg_size);
     if (st != CM_OK)
         return st;
@@ -881,7 +881,7 @@ static cm_status view_leaving(void *user, const cm_region *flat, uint64_t j, int
     int64_t at[CM_MAX_DIM];
     const uint32_t image = flat->image[j];
     if (image < flat->ncells) {
-        uint64_t slot;
+        uint64_t slot = 0;
         cm_box_cell(&flat->box, image, at);
         const cm_status st = view_slot(user, at, &slot, msg, msg_size);
         *v = VIEW_EXIT - (int32_t)slot;
