@@ -175,14 +175,14 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
 }
 
 cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                      const cm_group_info *groups, cm_attractor_set *att, int32_t **labels,
-                      char *msg, size_t msg_size)
+                      const cm_group_info *groups, bool every_exit, cm_attractor_set *att,
+                      int32_t **labels, char *msg, size_t msg_size)
 {
     *labels = cm_cells_array((flat->ncells + 1) * sizeof **labels);
     if (!*labels)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
     cm_status st;
-    if (c->keep_exits && !c->resolved_cells && !c->open_released) {
+    if (!every_exit && c->keep_exits && !c->resolved_cells && !c->open_released) {
         st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c, NULL,
                                 att, msg, msg_size);
         if (st == CM_OK)

@@ -424,7 +424,7 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
     memset(&att, 0, sizeof att);
     int32_t *labels = NULL;
     if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = part_labels(&s->model, &s->c, &flat, groups, &att, &labels, msg, msg_size);
+        st = part_labels(&s->model, &s->c, &flat, groups, false, &att, &labels, msg, msg_size);
     if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
@@ -454,21 +454,13 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
                                      cm_attractor_set *att, uint64_t **by_label, char *msg,
                                      size_t msg_size)
 {
-    cluster_ends ends;
-    memset(&ends, 0, sizeof ends);
-    int32_t *label = cm_cells_array((flat->ncells + 1) * sizeof *label);
-    cm_status st = label ? cluster_ends_open(&ends, &s->c, msg, msg_size)
-                         : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
-    if (st == CM_OK)
-        st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, att, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_attractor_cell_labels(att, flat, &ends.computed, label, msg, msg_size);
+    int32_t *label = NULL;
+    cm_status st = part_labels(&s->model, &s->c, flat, groups, true, att, &label, msg, msg_size);
     *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
     if (st == CM_OK && !*by_label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors in view");
     for (uint64_t i = 0; st == CM_OK && i < flat->ncells; i++)
         (*by_label)[label[i] + 2]++;
-    cluster_ends_close(&ends);
     free(label);
     return st;
 }
