@@ -1,3 +1,4 @@
+#include <omp.h>
 #include <png.h>
 #include <stdlib.h>
 #include <string.h>
@@ -152,9 +153,69 @@ static void check_pixel_centres(const cm_lattice *lat, const cm_region *r, const
     free(one);
 }
 
+/* An RGBA image of w x h: noise (no two rows alike, nothing to compress)
+ * or flat bands with noise in every 97th row, so that matches cross the
+ * PNG's deflate segments. */
+static uint8_t *test_image(int w, int h, bool noise)
+{
+    uint8_t *a = malloc(4 * (size_t)w * (size_t)h);
+    uint64_t x = 0x9E3779B97F4A7C15u;
+    for (size_t k = 0; a && k < 4 * (size_t)w * (size_t)h; k++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        const size_t y = k / (4 * (size_t)w);
+        a[k] = noise || y % 97 == 0 ? (uint8_t)x : (uint8_t)(y / 50 * 40 + k % 4);
+    }
+    return a;
+}
+
+/* cm_png_encode against libpng's reader: every pixel back, the same bytes
+ * on one thread as on two, for images of one segment, many, and scanlines
+ * longer than a segment (render/png_out.c cuts the image data in pieces
+ * of 256 KiB deflated apart). */
+static void check_png_segments(void)
+{
+    const struct {
+        int w, h;
+        bool noise;
+    } cases[] = {{1, 1, true},      {1200, 700, true}, {2000, 2000, false},
+                 {90000, 3, true},  {300, 1, false},   {7, 5000, false}};
+    char msg[256];
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        const int w = cases[c].w, h = cases[c].h;
+        uint8_t *a = test_image(w, h, cases[c].noise), *back = malloc(3 * (size_t)w * (size_t)h);
+        uint8_t *png2 = NULL, *png1 = NULL;
+        size_t n2 = 0, n1 = 0;
+        CHECK(a && back);
+        omp_set_num_threads(2);
+        CHECK(cm_png_encode(a, w, h, &png2, &n2, msg, sizeof msg) == CM_OK);
+        omp_set_num_threads(1);
+        CHECK(cm_png_encode(a, w, h, &png1, &n1, msg, sizeof msg) == CM_OK);
+        omp_set_num_threads(2);
+        CHECK(n1 == n2 && png1 && png2 && memcmp(png1, png2, n1) == 0);
+        png_image im;
+        memset(&im, 0, sizeof im);
+        im.version = PNG_IMAGE_VERSION;
+        CHECK(png_image_begin_read_from_memory(&im, png2, n2) != 0);
+        im.format = PNG_FORMAT_RGB;
+        CHECK(png_image_finish_read(&im, NULL, back, 0, NULL) != 0);
+        CHECK_INT(im.width, w);
+        CHECK_INT(im.height, h);
+        size_t wrong = 0;
+        for (size_t k = 0; k < (size_t)w * (size_t)h; k++)
+            wrong += memcmp(back + 3 * k, a + 4 * k, 3) != 0;
+        CHECK_INT(wrong, 0);
+        png_image_free(&im);
+        free(a);
+        free(back);
+        free(png1);
+        free(png2);
+    }
+}
+
 int main(void)
 {
     check_ticks();
+    check_png_segments();
     check_touching();
     check_neighbour_rule();
     cm_model m;
