@@ -151,13 +151,17 @@ cm_status cm_gl_target(cm_gl *gl, uint8_t *origin, int row_pixels, int w, int h,
     return CM_OK;
 }
 
-void cm_gl_window(const cm_gl *gl, int x, int y_top, int w, int h)
+/* EGL's framebuffer counts rows from the top (glClipControl), GL's window
+ * (OSMesa) from the bottom: the row GL knows r's bottom by. */
+static int window_y(const cm_gl *gl, const cm_gl_rect *r)
 {
-    /* EGL's framebuffer counts rows from the top (glClipControl), GL's
-     * window (OSMesa) from the bottom */
-    const int y = gl->backend == CM_GL_EGL ? y_top : gl->h - y_top - h;
-    glViewport(x, y, w, h);
-    glScissor(x, y, w, h);
+    return gl->backend == CM_GL_EGL ? r->y_top : gl->h - r->y_top - r->h;
+}
+
+void cm_gl_window(const cm_gl *gl, const cm_gl_rect *view, const cm_gl_rect *scissor)
+{
+    glViewport(view->x, window_y(gl, view), view->w, view->h);
+    glScissor(scissor->x, window_y(gl, scissor), scissor->w, scissor->h);
 }
 
 cm_status cm_gl_done(cm_gl *gl, char *msg, size_t msg_size)

@@ -32,9 +32,14 @@ const char *cm_gl_backend_name(const cm_gl *gl);
 
 cm_status cm_gl_target(cm_gl *gl, uint8_t *origin, int row_pixels, int w, int h, char *msg,
                        size_t msg_size);
-/* Viewport and scissor on the w x h rectangle whose top left pixel is (x,
- * y_top) of the tile (rows counted from its top). */
-void cm_gl_window(const cm_gl *gl, int x, int y_top, int w, int h);
+/* A w x h rectangle of the tile whose top left pixel is (x, y_top), rows
+ * counted from the tile's top; it may reach beyond the tile. */
+typedef struct cm_gl_rect {
+    int x, y_top, w, h;
+} cm_gl_rect;
+
+/* The viewport on `view` and the scissor on `scissor`. */
+void cm_gl_window(const cm_gl *gl, const cm_gl_rect *view, const cm_gl_rect *scissor);
 cm_status cm_gl_done(cm_gl *gl, char *msg, size_t msg_size);
 
 #endif

@@ -63,6 +63,7 @@
     X(void, glDisable, (GLenum cap), (cap))                                                        \
     X(void, glClearColor, (GLclampf r, GLclampf g, GLclampf b, GLclampf a), (r, g, b, a))          \
     X(void, glClear, (GLbitfield mask), (mask))                                                    \
+    X(void, glGetIntegerv, (GLenum pname, GLint *data), (pname, data))                             \
     X(void, glFinish, (void), ())
 
 /* EGL draws into a framebuffer object and reads it back (OSMesa has them

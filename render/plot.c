@@ -33,7 +33,12 @@ static double at_pixel(double lo, double hi, int k, int n)
 }
 
 /* Sets viewport, scissor and projection so that GL draws the part of the
- * panel inside the tile. False when they do not meet. */
+ * panel inside the tile. False when they do not meet. The viewport is the
+ * whole panel, shifted by the tile's offset, and the scissor the part in
+ * the tile: every tile projects the panel as one tile would, so tiles
+ * rasterise the lines at the same pixels (the plot's tile size is a
+ * matter of speed only). A panel wider than GL's largest viewport is
+ * projected part by part instead. */
 static bool enter_panel(const cm_gl *gl, const cm_panel *pn, const tile *t, double *px,
                         double *py)
 {
@@ -44,13 +49,21 @@ static bool enter_panel(const cm_gl *gl, const cm_panel *pn, const tile *t, doub
         return false;
     *px = (pn->hi[0] - pn->lo[0]) / pn->w; /* state units per pixel */
     *py = (pn->hi[1] - pn->lo[1]) / pn->h;
-    cm_gl_window(gl, x0 - t->x, y0 - t->y, x1 - x0, y1 - y0);
+    GLint most[2];
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, most);
+    const cm_gl_rect part = {x0 - t->x, y0 - t->y, x1 - x0, y1 - y0};
+    const bool whole = pn->w <= most[0] && pn->h <= most[1];
+    const cm_gl_rect view = whole ? (cm_gl_rect){pn->x - t->x, pn->y - t->y, pn->w, pn->h} : part;
+    cm_gl_window(gl, &view, &part);
     glMatrixMode(GL_PROJECTION);
     glLoadIdentity();
-    glOrtho(at_pixel(pn->lo[0], pn->hi[0], x0 - pn->x, pn->w),
-            at_pixel(pn->lo[0], pn->hi[0], x1 - pn->x, pn->w),
-            at_pixel(pn->hi[1], pn->lo[1], y1 - pn->y, pn->h),
-            at_pixel(pn->hi[1], pn->lo[1], y0 - pn->y, pn->h), -1, 1);
+    if (whole)
+        glOrtho(pn->lo[0], pn->hi[0], pn->lo[1], pn->hi[1], -1, 1);
+    else
+        glOrtho(at_pixel(pn->lo[0], pn->hi[0], x0 - pn->x, pn->w),
+                at_pixel(pn->lo[0], pn->hi[0], x1 - pn->x, pn->w),
+                at_pixel(pn->hi[1], pn->lo[1], y1 - pn->y, pn->h),
+                at_pixel(pn->hi[1], pn->lo[1], y0 - pn->y, pn->h), -1, 1);
     glMatrixMode(GL_MODELVIEW);
     glLoadIdentity();
     return true;
