@@ -215,26 +215,6 @@ static void add_escape(void *user, uint32_t node, const int64_t *cell)
     l->node[l->n++] = node;
 }
 
-static void count_escape(void *user, uint32_t node, const int64_t *cell)
-{
-    (void)node, (void)cell;
-    ++*(uint64_t *)user;
-}
-
-uint64_t cm_cluster_exits_bytes(const cm_cluster *c)
-{
-    uint64_t n = 0;
-    cm_cluster_each_escape(c, count_escape, &n);
-    /* cm_cluster_exits: the list (cell, node id), weights and exit
-     * indices, the node index's order, scratch and ids, its result (cell,
-     * weight, node, node's exit); then the attractor pass's exit cells,
-     * labels and chain links */
-    const uint64_t cell = (uint64_t)c->lat.dim * sizeof(int64_t);
-    const uint64_t listing = cell + 4 + 8 + 8 + 4 + 4 + 8;
-    const uint64_t result = cell + 8 + 4 + 8, following = cell + 4 + 8;
-    return n * (result + (listing > following ? listing : following));
-}
-
 /* Each open node's exit (exit_of[i] for node l->node[i]), by node id. */
 static cm_status index_nodes(const escape_list *l, const uint64_t *exit_of, cm_exits *x)
 {

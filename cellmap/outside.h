@@ -68,12 +68,6 @@ cm_status cm_region_settle_exits(cm_region *r, int threads, cm_exits *out, char 
  * weights (no cell is read). */
 cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size);
 
-/* The bytes that cm_cluster_exits (while it sorts them, and its result)
- * and then cm_cluster_attractors (following them) hold at most for c's
- * exits: what an owner under a memory budget reserves for a pass over the
- * whole cluster (about 100 bytes per open node in 2-D). O(open nodes). */
-uint64_t cm_cluster_exits_bytes(const cm_cluster *c);
-
 void cm_exits_free(cm_exits *x);
 
 /* Where a computed cell's sequence ends: its group (1..G; 0: the sink's

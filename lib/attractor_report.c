@@ -137,23 +137,14 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
         return CM_OK;
     e->cc = (cm_cluster_cells){c, &e->exits};
     e->computed = cm_cluster_computed(&e->cc);
-    e->reserved = c->mem_budget ? cm_cluster_exits_bytes(c) : 0;
-    c->mem_reserved += e->reserved;
-    cm_cluster_trim(c);
     const cm_status st = cm_cluster_exits(c, &e->exits, msg, msg_size);
-    e->open = true;
-    if (st != CM_OK)
-        cluster_ends_close(e);
+    e->open = st == CM_OK;
     return st;
 }
 
 void cluster_ends_close(cluster_ends *e)
 {
-    if (!e->open)
-        return;
     cm_exits_free(&e->exits);
-    e->cc.c->mem_reserved -= e->reserved;
-    e->reserved = 0;
     e->open = false;
 }
 
