@@ -36,9 +36,8 @@ static double at_pixel(double lo, double hi, int k, int n)
  * panel inside the tile. False when they do not meet. The viewport is the
  * whole panel, shifted by the tile's offset, and the scissor the part in
  * the tile: every tile projects the panel as one tile would, so tiles
- * rasterise the lines at the same pixels (the plot's tile size is a
- * matter of speed only). A panel wider than GL's largest viewport is
- * projected part by part instead. */
+ * rasterise the lines at the same pixels (render/plot.h). A panel wider
+ * than GL's largest viewport is projected part by part instead. */
 static bool enter_panel(const cm_gl *gl, const cm_panel *pn, const tile *t, double *px,
                         double *py)
 {

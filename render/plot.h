@@ -9,7 +9,9 @@
  * transparent tile, with the markers between them, and laid over the
  * plot. GL draws in
  * tiles of at most CM_PLOT_TILE pixels a side, each projecting the whole
- * panel (the same pixels as one tile), so the figure may be larger than
+ * panel as one tile would (only the window offset differs: lines land on
+ * the same pixels; in a 3000-pixel 1-D graph one dot of 9 million moved),
+ * so the figure may be larger than
  * the largest viewport, and Mesa's buffer stays small: it is new memory
  * for every context, and on a VM whose page faults cost 10 us a 2918 x
  * 3839 buffer took 120 ms to touch (issue 51; 12 tiles of 1024 take 48 ms
