@@ -11,10 +11,10 @@
 
 #include "cellmap/output.h"
 
-/* Everything libpng touches after setjmp lives in this struct, so nothing
- * is clobbered by longjmp. */
 typedef struct segment segment;
 
+/* Everything libpng touches after setjmp lives in this struct, so nothing
+ * is clobbered by longjmp. */
 typedef struct png_job {
     FILE *file;
     png_structp png;
@@ -45,6 +45,12 @@ typedef struct png_pixels {
    threads writes the same bytes. libpng still writes every chunk; the
    segments go out as IDAT chunks through its chunk API. */
 
+/* Basins are flat areas of colour, which zlib's fastest level finds as long
+ * matches without a filter (the scanlines' filter byte is None). Measured on
+ * bench_render's figures (issue 51): against the Sub filter with the RLE
+ * strategy at level 3, 11-17 % less time and files 23-37 % smaller; level 2
+ * is slower for 3 % smaller files, and the Up and Sub filters, RLE or
+ * Huffman-only coding slower still. */
 enum { SEGMENT_BYTES = 256 * 1024, WINDOW = 32768, LEVEL = 1 };
 
 typedef struct segment {
@@ -183,11 +189,8 @@ static void describe(png_job *job, const png_pixels *px, const cm_png_text *text
     }
 }
 
-/* Basins are flat areas of colour, which zlib's fastest level finds as long
- * matches without a filter. Measured on bench_render's figures (issue 51):
- * against the Sub filter with the RLE strategy at level 3, 11-17 % less
- * time and files 23-37 % smaller; level 2 is slower for 3 % smaller files,
- * and the Up and Sub filters, RLE or Huffman-only coding slower still. */
+/* The PNG: libpng's header chunks, the image data as deflated segments,
+ * the end. */
 static cm_status encode(png_job *job, const png_pixels *px, const cm_png_text *texts, int n_texts)
 {
     const size_t line = scanline_bytes(px);
