@@ -64,6 +64,15 @@ bool cm_box_intersect(const cm_box *a, const cm_box *b, cm_box *out);
 /* Grows box to the smallest box holding both it and b. */
 void cm_box_grow(cm_box *box, const cm_box *b);
 
+/* A hash of a cell's dim coordinates, for open-addressing tables of cells. */
+static inline uint64_t cm_cell_hash(const int64_t *cell, int dim)
+{
+    uint64_t h = 0x9E3779B97F4A7C15ULL;
+    for (int d = 0; d < dim; d++)
+        h = (h ^ (uint64_t)cell[d]) * 0xBF58476D1CE4E5B9ULL;
+    return h ^ (h >> 31);
+}
+
 /* Local row-major index of a cell inside the box (caller checked contains). */
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 

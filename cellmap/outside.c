@@ -1,6 +1,7 @@
 /* Orbits that leave the computed cells (cellmap/outside.h). */
 #include "cellmap/outside.h"
 
+#include "cellmap/exit_memo.h"
 #include "cellmap/grow.h"
 
 #include <omp.h>
@@ -378,6 +379,7 @@ cm_computed cm_cluster_computed(cm_cluster_cells *cc)
 enum { FOLLOW_DIVERGED = 0, FOLLOW_OUTSIDE, FOLLOW_RETURNED, FOLLOW_ABORTED };
 typedef struct followed {
     int how;
+    uint32_t taken;           /* steps the orbit took */
     int64_t cell[CM_MAX_DIM]; /* FOLLOW_RETURNED: the computed cell it lands in */
 } followed;
 
@@ -442,22 +444,40 @@ static void place_points(const cm_lattice *lat, const cm_box *bounds, int n, fol
     }
 }
 
+/* Point i's box (box + 2 dim i: lo, hi inclusive) grown by its cell. */
+static void grow_path_box(int64_t *box, int dim, int i, const int64_t *cell)
+{
+    int64_t *lo = box + (uint64_t)i * 2 * (uint64_t)dim, *hi = lo + dim;
+    for (int d = 0; d < dim; d++) {
+        lo[d] = cell[d] < lo[d] ? cell[d] : lo[d];
+        hi[d] = cell[d] > hi[d] ? cell[d] : hi[d];
+    }
+}
+
 /* The true orbits from the centres of exits first..first+n-1 (n at most
  * FOLLOW_BATCH), at most `steps` steps each, until each lands in a
  * computed cell, diverges or runs out of steps (outside). Returns the
- * steps taken. */
+ * steps taken. box (NULL: not wanted) gets each orbit's box of the cells
+ * it visited, exit and landing cell included (2 dim words per exit, as
+ * out). */
 static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
                              const int64_t *exit_cell, uint64_t first, int n, uint32_t steps,
-                             follow_buf *b, followed *out)
+                             follow_buf *b, followed *out, int64_t *box)
 {
     const int dim = lat->dim;
     for (int i = 0; i < n; i++) {
         double c[CM_MAX_DIM];
-        cm_lattice_centre(lat, exit_cell + (first + (uint64_t)i) * (uint64_t)dim, c);
+        const int64_t *cell = exit_cell + (first + (uint64_t)i) * (uint64_t)dim;
+        cm_lattice_centre(lat, cell, c);
         for (int d = 0; d < dim; d++)
             b->x[d][i] = c[d];
         b->who[i] = i;
         out[i].how = FOLLOW_OUTSIDE;
+        out[i].taken = steps;
+        if (box) {
+            memcpy(box + (uint64_t)i * 2 * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
+            memcpy(box + ((uint64_t)i * 2 + 1) * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
+        }
     }
     uint64_t taken = 0;
     for (uint32_t k = 1; k <= steps && n > 0; k++) {
@@ -469,12 +489,16 @@ static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_
             followed *f = &out[b->who[i]];
             if (b->world[i] == 0.0) {
                 f->how = b->rc[i] < 0 ? FOLLOW_ABORTED : FOLLOW_DIVERGED;
+                f->taken = k;
                 continue;
             }
             for (int d = 0; d < dim; d++)
                 f->cell[d] = (int64_t)b->at[d][i];
+            if (box)
+                grow_path_box(box, dim, b->who[i], f->cell);
             if (b->near[i] != 0.0 && cells->holds(cells->user, f->cell)) {
                 f->how = FOLLOW_RETURNED;
+                f->taken = k;
                 continue;
             }
             for (int d = 0; d < dim; d++) /* still outside: on to the next step */
@@ -556,11 +580,13 @@ static void count_fates(const cm_exits *x, cm_attractor_set *s)
 }
 
 /* The true orbits from the centres of n exit cells (dim coordinates each),
- * in batches on `threads` threads, into f[0..n); the steps taken added to
- * *taken. CM_EMODEL when the model aborts. */
+ * in batches on `threads` threads, into f[0..n) (and their boxes into box,
+ * unless NULL: follow_batch); the steps taken added to *taken. CM_EMODEL
+ * when the model aborts. */
 static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
                             const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
-                            followed *f, uint64_t *taken, char *msg, size_t msg_size)
+                            followed *f, int64_t *box, uint64_t *taken, char *msg,
+                            size_t msg_size)
 {
     const int64_t batches = (int64_t)((n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
     uint64_t sum = 0;
@@ -574,7 +600,8 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
             const uint64_t first = (uint64_t)b * FOLLOW_BATCH;
             const int k = (int)(n - first < FOLLOW_BATCH ? n - first : FOLLOW_BATCH);
             if (buf)
-                sum += follow_batch(m, lat, cells, exit_cell, first, k, steps, buf, f + first);
+                sum += follow_batch(m, lat, cells, exit_cell, first, k, steps, buf, f + first,
+                                    box ? box + first * 2 * (uint64_t)lat->dim : NULL);
         }
         free(buf);
     }
@@ -615,7 +642,7 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
         memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
-        st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f,
+        st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
             const uint64_t e = first + i;
@@ -754,18 +781,10 @@ typedef struct view_exits {
     uint64_t hash_size;
 } view_exits;
 
-static uint64_t cell_hash(const int64_t *cell, int dim)
-{
-    uint64_t h = 0x9E3779B97F4A7C15ULL;
-    for (int d = 0; d < dim; d++)
-        h = (h ^ (uint64_t)cell[d]) * 0xBF58476D1CE4E5B9ULL;
-    return h ^ (h >> 31);
-}
-
 /* Where cell's slot is, or the empty place it would take. */
 static uint64_t hash_place(const view_exits *v, const int64_t *cell)
 {
-    uint64_t i = cell_hash(cell, v->dim) & (v->hash_size - 1);
+    uint64_t i = cm_cell_hash(cell, v->dim) & (v->hash_size - 1);
     while (v->hash[i] &&
            memcmp(v->cell + (v->hash[i] - 1) * (uint64_t)v->dim, cell, (size_t)v->dim * 8) != 0)
         i = (i + 1) & (v->hash_size - 1);
@@ -976,11 +995,60 @@ static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int
     return st;
 }
 
-/* The fates of the view's exits into label[0..v->n): followed in rounds,
- * as orbits that return into the sink's domain reach exits not found yet,
- * then their chains settled. */
+/* What the orbits of n exit cells (dim coordinates each) do, into f[0..n):
+ * from the memo where it knows them, the others followed (follow_all) and
+ * added to it. Steps taken, as if every exit were followed, to *taken. */
+static cm_status follow_memo(const cm_model *m, const cm_computed *cells, const cm_lattice *lat,
+                             const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
+                             cm_exit_memo *memo, followed *f, uint64_t *taken, char *msg,
+                             size_t msg_size)
+{
+    const int dim = lat->dim;
+    const size_t bytes = (size_t)dim * sizeof *exit_cell;
+    uint64_t *miss = malloc(((size_t)n + 1) * sizeof *miss), nmiss = 0;
+    int64_t *miss_cell = malloc(((size_t)n + 1) * bytes);
+    cm_exit_fate known;
+    for (uint64_t e = 0; miss && miss_cell && e < n; e++) {
+        const int64_t *cell = exit_cell + e * (uint64_t)dim;
+        if (cm_exit_memo_find(memo, cell, &known)) {
+            f[e].how = known.how;
+            f[e].taken = known.taken;
+            memcpy(f[e].cell, known.cell, bytes);
+            *taken += known.taken;
+        } else {
+            memcpy(miss_cell + nmiss * (uint64_t)dim, cell, bytes);
+            miss[nmiss++] = e;
+        }
+    }
+    followed *fm = malloc(((size_t)nmiss + 1) * sizeof *fm);
+    int64_t *box = malloc(((size_t)nmiss + 1) * 2 * bytes);
+    cm_status st = miss && miss_cell && fm && box
+                       ? follow_all(m, lat, cells, miss_cell, nmiss, steps, threads, fm, box, taken,
+                                    msg, msg_size)
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+    for (uint64_t i = 0; st == CM_OK && i < nmiss; i++) {
+        f[miss[i]] = fm[i];
+        known.how = fm[i].how;
+        known.taken = fm[i].taken;
+        memcpy(known.cell, fm[i].cell, bytes);
+        memcpy(known.lo, box + i * 2 * (uint64_t)dim, bytes);
+        memcpy(known.hi, box + (i * 2 + 1) * (uint64_t)dim, bytes);
+        /* a memo that cannot grow only forgets: it saves work, nothing more */
+        (void)cm_exit_memo_put(memo, miss_cell + i * (uint64_t)dim, &known);
+    }
+    free(miss);
+    free(miss_cell);
+    free(fm);
+    free(box);
+    return st;
+}
+
+/* The fates of the view's exits into label[0..v->n): followed in rounds
+ * (through the memo unless NULL), as orbits that return into the sink's
+ * domain reach exits not found yet, then their chains settled. */
 static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, int threads,
-                            int32_t **label, uint64_t *taken, char *msg, size_t msg_size)
+                            cm_exit_memo *memo, int32_t **label, uint64_t *taken, char *msg,
+                            size_t msg_size)
 {
     cm_cluster *c = v->c;
     cm_cluster_cells cc = {c, NULL};
@@ -1002,8 +1070,11 @@ static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, in
             st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
             break;
         }
-        st = follow_all(m, &c->lat, &cells, v->cell + done * (uint64_t)c->lat.dim, to - done,
-                        steps, threads, f + done, taken, msg, msg_size);
+        const int64_t *first = v->cell + done * (uint64_t)c->lat.dim;
+        st = memo ? follow_memo(m, &cells, &c->lat, first, to - done, steps, threads, memo,
+                                f + done, taken, msg, msg_size)
+                  : follow_all(m, &c->lat, &cells, first, to - done, steps, threads, f + done,
+                               NULL, taken, msg, msg_size);
         if (st == CM_OK)
             st = returned_ends(v, f + done, to - done, *label + done, msg, msg_size);
         for (uint64_t e = done; st == CM_OK && e < to; e++) {
@@ -1051,8 +1122,8 @@ static cm_status view_exit_set(const view_exits *v, const int32_t *label, const 
 }
 
 cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                                 const cm_attractor_options *opt, cm_attractor_set *s,
-                                 int32_t *labels, char *msg, size_t msg_size)
+                                 const cm_attractor_options *opt, cm_exit_memo *memo,
+                                 cm_attractor_set *s, int32_t *labels, char *msg, size_t msg_size)
 {
     if (c->resolved_cells || c->open_released || !c->keep_exits)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -1066,11 +1137,15 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     const int threads = opt ? opt->threads : 0;
     int32_t *fate = NULL;
     uint64_t *weight = NULL, taken = 0;
+    if (memo)
+        cm_exit_memo_sync(memo, c, steps);
     cm_status st = label_cells(s, flat, view_leaving, &v, labels, msg, msg_size);
     if (st == CM_OK)
         st = settle_ends(&v, labels, flat->ncells, threads, msg, msg_size);
     if (st == CM_OK)
-        st = view_fates(m, &v, steps, threads, &fate, &taken, msg, msg_size);
+        st = view_fates(m, &v, steps, threads, memo, &fate, &taken, msg, msg_size);
+    if (memo)
+        cm_exit_memo_keep_used(memo);
     weight = st == CM_OK ? calloc((size_t)v.n + 1, sizeof *weight) : NULL;
     if (st == CM_OK && !weight)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");

@@ -37,6 +37,7 @@
 
 #include "cellmap/attractors.h"
 #include "cellmap/cluster.h"
+#include "cellmap/exit_memo.h"
 #include "cellmap/model.h"
 #include "cellmap/scm.h"
 
@@ -137,11 +138,15 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
  * attractors' basin_cells (the cluster's when the part holds every
  * computed cell), and sink_diverged_cells without the cells that end in
  * the world's sink. Reads (and pages in) the regions its sequences
- * and orbits reach; threads: opt->threads. CM_EINVAL for a cluster that
- * keeps no exits (keep_exits 0, released, or resolved cells). */
+ * and orbits reach; threads: opt->threads. memo (NULL: none) is what
+ * earlier calls on this cluster and model found following exits
+ * (cellmap/exit_memo.h): exits it knows are not followed again, and it
+ * keeps what this call used; the labels and s are the same with or
+ * without it. CM_EINVAL for a cluster that keeps no exits (keep_exits 0,
+ * released, or resolved cells). */
 cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                                 const cm_attractor_options *opt, cm_attractor_set *s,
-                                 int32_t *labels, char *msg, size_t msg_size);
+                                 const cm_attractor_options *opt, cm_exit_memo *memo,
+                                 cm_attractor_set *s, int32_t *labels, char *msg, size_t msg_size);
 
 /* The label of every node of cluster c (node_label[id]): the label its
  * exit's chain of links ends on (a group's attractor; for an open node,

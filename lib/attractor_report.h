@@ -67,12 +67,13 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
  * c) into *labels (ncells entries, the caller's to free; NULL on
  * failure): following only the exits the part reaches
  * (cm_cluster_view_labels), so that the cost follows the part, where the
- * cluster knows its exits and every_exit is false; else every exit
- * (cm_cluster_attractors: the attractors' basins are then the cluster's).
- * The labels are the same either way. */
+ * cluster knows its exits and every_exit is false, through memo (NULL:
+ * none; cellmap/exit_memo.h); else every exit (cm_cluster_attractors: the
+ * attractors' basins are then the cluster's). The labels are the same
+ * either way. */
 cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                      const cm_group_info *groups, bool every_exit, cm_attractor_set *att,
-                      int32_t **labels, char *msg, size_t msg_size);
+                      const cm_group_info *groups, bool every_exit, cm_exit_memo *memo,
+                      cm_attractor_set *att, int32_t **labels, char *msg, size_t msg_size);
 
 /* Group g's label by attractors: its attractor's id, or 0 when its orbit
  * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */

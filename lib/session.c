@@ -423,8 +423,11 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
     int32_t *labels = NULL;
+    if (st == CM_OK && po->by == BY_ATTRACTORS && !s->exit_memo)
+        s->exit_memo = cm_exit_memo_new(); /* NULL: labels without it */
     if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = part_labels(&s->model, &s->c, &flat, groups, false, &att, &labels, msg, msg_size);
+        st = part_labels(&s->model, &s->c, &flat, groups, false, s->exit_memo, &att, &labels,
+                         msg, msg_size);
     if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
@@ -455,7 +458,7 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
                                      size_t msg_size)
 {
     int32_t *label = NULL;
-    cm_status st = part_labels(&s->model, &s->c, flat, groups, true, att, &label, msg, msg_size);
+    cm_status st = part_labels(&s->model, &s->c, flat, groups, true, NULL, att, &label, msg, msg_size);
     *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
     if (st == CM_OK && !*by_label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors in view");
@@ -871,6 +874,8 @@ cm_status session_close(session *s, char *msg, size_t msg_size)
     cm_cluster_free(&s->c);
     cm_gl_close(s->gl);
     s->gl = NULL;
+    cm_exit_memo_free(s->exit_memo);
+    s->exit_memo = NULL;
     if (s->have_model)
         cm_model_release(&s->model);
     s->have_model = 0;

@@ -62,6 +62,10 @@ typedef struct session {
     uint64_t max_new_cells; /* most cells one step computes (bounded by --mem) */
     int mem_given;          /* --mem was given */
     cm_gl *gl; /* kept between renders (made by the first); NULL until then */
+    /* what renders found following the view's exits, so that a pan's
+     * render follows only the exits it has not met (made by the first
+     * render; NULL until then, or when there was no memory for it) */
+    cm_exit_memo *exit_memo;
     /* the journal of a script's run (session_journal_begin): which line
      * runs, and where a killed run of the same script stopped */
     uint64_t script_hash; /* 0: no journal (stdin, the prompt) */

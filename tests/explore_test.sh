@@ -46,6 +46,15 @@ render fresh-$f.png 400x400 --layers basin,steps,axes" ;;
   cmp -s "$f.png" "fresh-$f.png" || fail "render $f in a session differs from a fresh process's"
 done
 
+# --- renders after pans equal a fresh process's -----------------------------
+# A session keeps what its renders found following exits (exit_memo.h) and
+# drops what each pan's regions may change; a new process follows every
+# exit of its view. The file's last view is the session's.
+{ echo "view 100:200 -8:8"; for k in 1 2 3 4 5 6; do echo "pan right 10%"; echo "render pan$k.png"; done; } |
+  "$CM" explore memo.cmdb - $pd_opts > /dev/null || fail "session of pans and renders"
+"$CM" explore memo.cmdb - > /dev/null <<<"render fresh-pan6.png" || fail "fresh render after pans"
+cmp -s pan6.png fresh-pan6.png || fail "a render after pans differs from a fresh process's"
+
 # --- a session equals a single solve of the union of its views ------------
 # Views inside 100:300 x -16:16 with pans and zooms, then the whole box.
 pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"

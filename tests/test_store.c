@@ -321,7 +321,7 @@ static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_gro
     CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, &vs, msg,
                              sizeof msg) == CM_OK);
     int32_t *labels = malloc(part.ncells * sizeof *labels);
-    const cm_status vst = cm_cluster_view_labels(m, c, &part, NULL, &vs, labels, msg, sizeof msg);
+    const cm_status vst = cm_cluster_view_labels(m, c, &part, NULL, NULL, &vs, labels, msg, sizeof msg);
     if (vst != CM_OK)
         fprintf(stderr, "view labels: %s\n", msg);
     CHECK(vst == CM_OK);
@@ -388,7 +388,7 @@ static void test_view_closure(void)
     CHECK(cm_attractor_cell_labels(&full, &a, &cells, want, msg, sizeof msg) == CM_OK);
     CHECK(cm_attractors_find(&m, &lat, g, c.ngroups, cm_cluster_cell_group, &c, NULL, &view, msg,
                              sizeof msg) == CM_OK);
-    CHECK(cm_cluster_view_labels(&m, &c, &a, NULL, &view, got, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(&m, &c, &a, NULL, NULL, &view, got, msg, sizeof msg) == CM_OK);
     for (int i = 0; i < 40; i++)
         CHECK_INT(got[i], want[i]);
     for (int row = 0; row < 4; row++) /* every cell of a row: the row's fixed point */
@@ -495,6 +495,118 @@ static void test_cell_labels(const char *path, const cm_model *m)
     CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
 }
 
+/* The labels of one view with and without the memo of followed exits:
+ * the same cells, and the same exits with the same fates and counts.
+ * Returns the cells in attractors' basins. */
+static uint64_t check_memo_labels(cm_cluster *c, const cm_model *m, const cm_group_info *g,
+                              cm_exit_memo *memo, const cm_box *view)
+{
+    char msg[512];
+    cm_region part;
+    CHECK(cm_cluster_flatten(c, view, &part, msg, sizeof msg) == CM_OK);
+    cm_attractor_set with, without;
+    int32_t *a = malloc(part.ncells * sizeof *a), *b = malloc(part.ncells * sizeof *b);
+    CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, &with,
+                             msg, sizeof msg) == CM_OK);
+    CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cell_group, c, NULL, &without,
+                             msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &part, NULL, memo, &with, a, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &part, NULL, NULL, &without, b, msg, sizeof msg) == CM_OK);
+    uint64_t differ = 0, in_basins = 0;
+    for (uint64_t i = 0; i < part.ncells; i++) {
+        differ += a[i] != b[i];
+        in_basins += b[i] > 0;
+    }
+    CHECK_INT(differ, 0);
+    CHECK_INT(with.nexits, without.nexits);
+    CHECK(with.nexits == 0 ||
+          memcmp(with.exit_cell, without.exit_cell, with.nexits * 2 * sizeof *with.exit_cell) == 0);
+    CHECK(with.nexits == 0 ||
+          memcmp(with.exit_label, without.exit_label, with.nexits * sizeof *with.exit_label) == 0);
+    CHECK_INT(with.returned_cells, without.returned_cells);
+    CHECK_INT(with.outside_cells, without.outside_cells);
+    CHECK_INT(with.outside_steps_taken, without.outside_steps_taken);
+    free(a);
+    free(b);
+    cm_attractors_free(&with);
+    cm_attractors_free(&without);
+    cm_region_free(&part);
+    return in_basins;
+}
+
+/* Solves box into c, then labels each view with and without the memo
+ * (check_memo_labels); adds the memo's entries kept across the join to
+ * *kept, those it dropped to *dropped. Returns the cells of the views in
+ * attractors' basins. */
+static uint64_t grow_and_check(cm_cluster *c, const cm_model *m, cm_exit_memo *memo,
+                               const cm_box *box, const cm_box *views, int nviews,
+                               uint64_t *kept, uint64_t *dropped)
+{
+    char msg[512];
+    const cm_scm_options opt = {.max_steps = 1, .threads = 2, .record_exits = 1};
+    CHECK(cm_cluster_solve_boxes(c, m, box, 1, &opt, NULL, NULL, NULL, msg, sizeof msg) == CM_OK);
+    cm_group_info *g = calloc(c->ngroups + 1, sizeof *g);
+    CHECK(cm_cluster_describe_new(c, m, g, msg, sizeof msg) == CM_OK);
+    cm_attractor_options defaults;
+    cm_attractor_defaults(m, NULL, &defaults);
+    const uint64_t before = cm_exit_memo_count(memo);
+    cm_exit_memo_sync(memo, c, defaults.outside); /* the budget cm_cluster_view_labels uses */
+    *kept += cm_exit_memo_count(memo);
+    *dropped += before - cm_exit_memo_count(memo);
+    uint64_t in_basins = 0;
+    for (int v = 0; v < nviews; v++)
+        in_basins += check_memo_labels(c, m, g, memo, &views[v]);
+    free(g);
+    return in_basins;
+}
+
+/* The memo of followed exits (cellmap/exit_memo.h) as a cluster grows by
+ * one region at a time, labels with it against labels without it:
+ *  - the shift map: A's exits' orbits stay outside until C is solved, then
+ *    land on C's fixed points, so an entry the join does not drop gives A
+ *    wrong labels (A's cells must then be in attractors);
+ *  - Fig. 4.16's map (sink cells that return and that stay outside), its
+ *    six tiles in a scattered order, each labelled with the view of the
+ *    whole box, of the new tile and of the tiles left of it.
+ * Not vacuous: entries survive joins (and are found again), and joins drop
+ * entries whose orbits the new region meets. */
+static void test_exit_memo(const cm_model *m)
+{
+    uint64_t kept = 0, dropped = 0;
+    const cm_model shift = {.name = "shift", .dim = 2, .step = shift_step};
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    const cm_box a = {2, {0, 0}, {10, 4}}, b = {2, {20, 0}, {30, 4}}, cbox = {2, {40, 0}, {50, 4}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    cm_exit_memo *memo = cm_exit_memo_new();
+    CHECK(memo != NULL);
+    CHECK_INT(grow_and_check(&c, &shift, memo, &a, &a, 1, &kept, &dropped), 0); /* outside */
+    CHECK(cm_exit_memo_count(memo) > 0);
+    CHECK_INT(grow_and_check(&c, &shift, memo, &cbox, &a, 1, &kept, &dropped), 40);
+    CHECK_INT(grow_and_check(&c, &shift, memo, &b, &a, 1, &kept, &dropped), 40);
+    cm_cluster_free(&c);
+    cm_exit_memo_free(memo);
+
+    cm_box boxes[TX * TY];
+    tiles(boxes);
+    cm_cluster_init(&c, &lat416);
+    memo = cm_exit_memo_new();
+    CHECK(memo != NULL);
+    const int order[TX * TY] = {4, 0, 5, 2, 1, 3};
+    for (int j = 0; j < TX * TY; j++) {
+        const cm_box *box = &boxes[order[j]];
+        cm_box views[3] = {{2, {0, 0}, {NX, NY}}, *box, *box};
+        views[2].lo[0] = 0;
+        views[2].hi[0] = box->lo[0] > 0 ? box->lo[0] : box->hi[0];
+        grow_and_check(&c, m, memo, box, views, 3, &kept, &dropped);
+    }
+    CHECK(kept > 0 && dropped > 0);
+    fprintf(stderr, "exit memo: %llu entries kept across joins, %llu dropped by them\n",
+            (unsigned long long)kept, (unsigned long long)dropped);
+    cm_exit_memo_free(memo);
+    cm_cluster_free(&c);
+}
+
 /* A refused file stays byte-identical, whatever tries to use it. */
 static void check_refused_untouched(const char *path, const cm_model *m, const char *why)
 {
@@ -592,6 +704,7 @@ int main(void)
     char good[256];
     snprintf(good, sizeof good, "%s/budget0-2.cmdb", dir);
     test_cell_labels(good, &m);
+    test_exit_memo(&m);
     test_refused(dir, good, &m);
     unlink(good);
     rmdir(dir);
