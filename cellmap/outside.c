@@ -266,13 +266,15 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
     }
     if (st == CM_OK)
         st = exits_of_targets(l.cell, weight, l.n, l.dim, out, exit_of);
+    /* the targets and their weights are in out now: their room (24 bytes an
+     * open node) is index_nodes' */
+    free(l.cell);
+    free(weight);
     if (st == CM_OK)
         st = index_nodes(&l, exit_of, out);
     const uint64_t sink = cm_cluster_sink_cells(c);
     out->world_cells = sink > open ? sink - open : 0;
-    free(l.cell);
     free(l.node);
-    free(weight);
     free(exit_of);
     if (st != CM_OK) {
         cm_exits_free(out);
