@@ -75,17 +75,23 @@ static cm_status box_order(const int64_t *cells, uint64_t n, int dim, uint32_t *
 }
 
 /* The distinct cells of targets[0..n) (dim coordinates each) in box order
- * into x->cell, their weights summed into x->weight; exit_of[i] (may be
- * NULL) receives the exit of target i. */
+ * into x->cell, their weights summed into x->weight (weight NULL: 0 each,
+ * for the caller to add); exit_of[i] (may be NULL) receives the exit of
+ * target i. */
 static cm_status exits_of_targets(const int64_t *targets, const uint64_t *weight, uint64_t n,
-                                  int dim, cm_exits *x, uint64_t *exit_of)
+                                  int dim, cm_exits *x, uint32_t *exit_of)
 {
     if (n >= UINT32_MAX)
         return CM_ETOOBIG;
     uint32_t *order = NULL;
+    const size_t bytes = (size_t)dim * sizeof *targets;
     cm_status st = box_order(targets, n, dim, &order);
-    x->cell = malloc(((size_t)n + 1) * (size_t)dim * sizeof *x->cell);
-    x->weight = malloc(((size_t)n + 1) * sizeof *x->weight);
+    uint64_t distinct = 0; /* counted first: the listing of a cluster's exits peaks here */
+    for (uint64_t k = 0; st == CM_OK && k < n; k++)
+        distinct += k == 0 || memcmp(targets + (size_t)order[k] * (size_t)dim,
+                                     targets + (size_t)order[k - 1] * (size_t)dim, bytes) != 0;
+    x->cell = st == CM_OK ? malloc(((size_t)distinct + 1) * bytes) : NULL;
+    x->weight = st == CM_OK ? malloc(((size_t)distinct + 1) * sizeof *x->weight) : NULL;
     if (st != CM_OK || !x->cell || !x->weight) {
         free(order);
         return CM_ENOMEM;
@@ -97,9 +103,9 @@ static cm_status exits_of_targets(const int64_t *targets, const uint64_t *weight
             memcpy(x->cell + x->n * (uint64_t)dim, t, (size_t)dim * sizeof *t);
             x->weight[x->n++] = 0;
         }
-        x->weight[x->n - 1] += weight[order[k]];
+        x->weight[x->n - 1] += weight ? weight[order[k]] : 0;
         if (exit_of)
-            exit_of[order[k]] = x->n - 1;
+            exit_of[order[k]] = (uint32_t)(x->n - 1);
     }
     free(order);
     return CM_OK;
@@ -203,6 +209,13 @@ typedef struct escape_list {
     int failed;
 } escape_list;
 
+static void count_escape(void *user, uint32_t node, const int64_t *cell)
+{
+    (void)node;
+    (void)cell;
+    ((escape_list *)user)->cap_node++;
+}
+
 static void add_escape(void *user, uint32_t node, const int64_t *cell)
 {
     escape_list *l = user;
@@ -217,14 +230,16 @@ static void add_escape(void *user, uint32_t node, const int64_t *cell)
 }
 
 /* Each open node's exit (exit_of[i] for node l->node[i]), by node id. */
-static cm_status index_nodes(const escape_list *l, const uint64_t *exit_of, cm_exits *x)
+static cm_status index_nodes(const escape_list *l, const uint32_t *exit_of, cm_exits *x)
 {
     uint32_t *order = malloc(((size_t)l->n + 1) * sizeof *order);
     uint32_t *tmp = malloc(((size_t)l->n + 1) * sizeof *tmp);
-    int64_t *ids = calloc((size_t)l->n + 1, sizeof *ids);
     x->node = malloc(((size_t)l->n + 1) * sizeof *x->node);
     x->node_exit = malloc(((size_t)l->n + 1) * sizeof *x->node_exit);
-    cm_status st = order && tmp && ids && x->node && x->node_exit ? CM_OK : CM_ENOMEM;
+    cm_status st = order && tmp && x->node && x->node_exit ? CM_OK : CM_ENOMEM;
+    /* node_exit holds the sort's keys (the node ids) until they are sorted:
+     * a cluster's listing peaks here, a million open nodes and more */
+    int64_t *ids = (int64_t *)x->node_exit;
     for (uint64_t i = 0; st == CM_OK && i < l->n; i++) {
         order[i] = (uint32_t)i;
         ids[i] = l->node[i];
@@ -238,7 +253,6 @@ static cm_status index_nodes(const escape_list *l, const uint64_t *exit_of, cm_e
     x->nnodes = st == CM_OK ? l->n : 0;
     free(order);
     free(tmp);
-    free(ids);
     return st;
 }
 
@@ -252,24 +266,29 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
         out->unknown_cells = cm_cluster_sink_cells(c);
         return CM_OK;
     }
+    /* counted first, so that the lists take no more than they hold: the
+     * listing of a long session's cluster (a million open nodes and more)
+     * is what its close holds at its peak */
     escape_list l = {c->lat.dim, NULL, NULL, 0, 0, 0, 0};
+    cm_cluster_each_escape(c, count_escape, &l);
+    l.cap = l.cap_node * (uint64_t)l.dim;
+    l.cell = malloc(((size_t)l.cap + 1) * sizeof *l.cell);
+    l.node = malloc(((size_t)l.cap_node + 1) * sizeof *l.node);
+    l.failed = !l.cell || !l.node;
     cm_cluster_each_escape(c, add_escape, &l);
     cm_status st = l.failed ? CM_ENOMEM : CM_OK;
-    uint64_t *weight = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *weight) : NULL;
-    uint64_t *exit_of = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *exit_of) : NULL;
-    if (st == CM_OK && (!weight || !exit_of))
+    uint32_t *exit_of = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *exit_of) : NULL;
+    if (st == CM_OK && !exit_of)
         st = CM_ENOMEM;
+    if (st == CM_OK)
+        st = exits_of_targets(l.cell, NULL, l.n, l.dim, out, exit_of);
+    free(l.cell); /* in out now: its room is index_nodes' */
     uint64_t open = 0;
     for (uint64_t i = 0; st == CM_OK && i < l.n; i++) {
-        weight[i] = cm_cluster_open_weight(c, l.node[i]);
-        open += weight[i];
+        const uint64_t w = cm_cluster_open_weight(c, l.node[i]);
+        out->weight[exit_of[i]] += w;
+        open += w;
     }
-    if (st == CM_OK)
-        st = exits_of_targets(l.cell, weight, l.n, l.dim, out, exit_of);
-    /* the targets and their weights are in out now: their room (24 bytes an
-     * open node) is index_nodes' */
-    free(l.cell);
-    free(weight);
     if (st == CM_OK)
         st = index_nodes(&l, exit_of, out);
     const uint64_t sink = cm_cluster_sink_cells(c);
@@ -312,7 +331,7 @@ static cm_status region_end(void *user, const int64_t *cell, uint32_t *group, bo
 
 cm_computed cm_region_computed(cm_region_cells *rc)
 {
-    return (cm_computed){region_holds, region_end, rc, rc->r->box};
+    return (cm_computed){region_holds, region_end, rc, rc->r->box, NULL};
 }
 
 static bool cluster_holds(const void *user, const int64_t *cell)
@@ -370,9 +389,11 @@ static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, b
     return CM_OK;
 }
 
+static void cluster_between(void *user) { cm_cluster_trim(((cm_cluster_cells *)user)->c); }
+
 cm_computed cm_cluster_computed(cm_cluster_cells *cc)
 {
-    cm_computed out = {cluster_holds, cluster_end, cc, {0}};
+    cm_computed out = {cluster_holds, cluster_end, cc, {0}, cluster_between};
     cm_cluster_bounds(cc->c, &out.bounds);
     return out;
 }
@@ -618,11 +639,36 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
 
 /* Exits followed at a time by cm_attractors_outside, so that what it keeps
  * of an orbit stays small (a cluster can have millions of exits). */
-#define FOLLOW_CHUNK ((uint64_t)1 << 16)
+#define FOLLOW_CHUNK ((uint64_t)1 << 14)
 
-cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
-                                const cm_computed *cells, uint32_t steps, int threads,
-                                cm_attractor_set *s, char *msg, size_t msg_size)
+/* The set's exit cells, once following is done: x's own when it is spent
+ * (its node index and weights freed too), else a copy. */
+static cm_status set_exit_cells(const cm_exits *x, cm_exits *spent, int dim, cm_attractor_set *s)
+{
+    if (spent == x) {
+        s->exit_cell = spent->cell;
+        spent->cell = NULL;
+        free(spent->node);
+        free(spent->node_exit);
+        free(spent->weight);
+        spent->node = NULL;
+        spent->node_exit = NULL;
+        spent->weight = NULL;
+        spent->nnodes = 0;
+        return CM_OK;
+    }
+    s->exit_cell = malloc(((size_t)x->n + 1) * (size_t)dim * sizeof *s->exit_cell);
+    if (!s->exit_cell)
+        return CM_ENOMEM;
+    if (x->n)
+        memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
+    return CM_OK;
+}
+
+/* cm_attractors_outside, x spent (set_exit_cells) when spent is x. */
+static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
+                               cm_exits *spent, const cm_computed *cells, uint32_t steps,
+                               int threads, cm_attractor_set *s, char *msg, size_t msg_size)
 {
     const int dim = lat->dim;
     free(s->exit_cell);
@@ -630,20 +676,20 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
     s->nexits = x->n;
     s->outside_steps = steps;
     s->outside_steps_taken = 0;
-    s->exit_cell = malloc(((size_t)x->n + 1) * (size_t)dim * sizeof *s->exit_cell);
+    s->exit_cell = NULL; /* copied last, once what following holds is freed */
     s->exit_label = malloc(((size_t)x->n + 1) * sizeof *s->exit_label);
     const uint64_t chunk = x->n < FOLLOW_CHUNK ? x->n : FOLLOW_CHUNK;
     followed *f = malloc(((size_t)chunk + 1) * sizeof *f);
     uint64_t *next = malloc(((size_t)x->n + 1) * sizeof *next);
-    cm_status st = s->exit_cell && s->exit_label && f && next
+    cm_status st = s->exit_label && f && next
                        ? CM_OK
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                  (unsigned long long)x->n);
     uint64_t taken = 0;
-    if (st == CM_OK && x->n)
-        memcpy(s->exit_cell, x->cell, (size_t)x->n * (size_t)dim * sizeof *x->cell);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
+        if (cells->between)
+            cells->between(cells->user);
         st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
@@ -662,7 +708,21 @@ cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const 
     }
     free(f);
     free(next);
+    if (cells->between) /* what the last chunk's ends read, before the copy below */
+        cells->between(cells->user);
+    if (st == CM_OK && set_exit_cells(x, spent, dim, s) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                     (unsigned long long)x->n);
+    if (st != CM_OK)
+        s->nexits = 0;
     return st;
+}
+
+cm_status cm_attractors_outside(const cm_model *m, const cm_lattice *lat, const cm_exits *x,
+                                const cm_computed *cells, uint32_t steps, int threads,
+                                cm_attractor_set *s, char *msg, size_t msg_size)
+{
+    return outside_fates(m, lat, x, NULL, cells, steps, threads, s, msg, msg_size);
 }
 
 /* The label of a sink cell whose sequence leaves the flat region at cell j
@@ -1053,7 +1113,7 @@ static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, in
                             size_t msg_size)
 {
     cm_cluster *c = v->c;
-    cm_cluster_cells cc = {c, NULL};
+    cm_cluster_cells cc = {c, NULL, NULL};
     const cm_computed cells = cm_cluster_computed(&cc); /* holds only: ends come from view_end */
     followed *f = NULL;
     uint64_t *next = NULL, done = 0;
@@ -1103,7 +1163,7 @@ static cm_status view_exit_set(const view_exits *v, const int32_t *label, const 
 {
     cm_exits x;
     memset(&x, 0, sizeof x);
-    uint64_t *exit_of = malloc(((size_t)v->n + 1) * sizeof *exit_of);
+    uint32_t *exit_of = malloc(((size_t)v->n + 1) * sizeof *exit_of);
     cm_status st = exit_of ? exits_of_targets(v->cell, weight, v->n, v->dim, &x, exit_of)
                            : CM_ENOMEM;
     free(s->exit_cell);
@@ -1188,18 +1248,40 @@ cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const c
                                  out, msg, msg_size);
 }
 
+/* cm_cluster_cell_group for a whole cluster's attractors: every so many
+ * lookups the cluster sheds what its budget does not hold, the node tables
+ * the chains read in above all (a long explore session's close read 27 MB
+ * of them beyond the budget, finding its 1043 groups' attractors). */
+typedef struct trimming_lookup {
+    cm_cluster *c;
+    uint32_t since;
+} trimming_lookup;
+#define LOOKUPS_PER_TRIM 1024
+
+static cm_status group_trimming(void *user, const int64_t *cell, uint32_t *group, char *msg,
+                                size_t msg_size)
+{
+    trimming_lookup *t = user;
+    if (++t->since == LOOKUPS_PER_TRIM) {
+        t->since = 0;
+        cm_cluster_trim(t->c); /* between lookups: no node is held */
+    }
+    return cm_cluster_cell_group(t->c, cell, group, msg, msg_size);
+}
+
 cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
                                 const cm_group_info *groups, const cm_attractor_options *opt,
                                 cm_attractor_set *out, char *msg, size_t msg_size)
 {
     cm_cluster *c = cc->c;
-    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c,
+    trimming_lookup lookup = {c, 0};
+    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, group_trimming, &lookup,
                                       opt, out, msg, msg_size);
     if (st != CM_OK)
         return st;
     const cm_computed cells = cm_cluster_computed(cc);
-    return cm_attractors_outside(m, &c->lat, cc->exits, &cells, outside_budget(m, opt),
-                                 opt ? opt->threads : 0, out, msg, msg_size);
+    return outside_fates(m, &c->lat, cc->exits, cc->spent, &cells, outside_budget(m, opt),
+                         opt ? opt->threads : 0, out, msg, msg_size);
 }
 
 /* ---- a cluster's labels, region by region ------------------------------ */

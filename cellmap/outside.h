@@ -88,6 +88,10 @@ typedef struct cm_computed {
     cm_cell_end_fn end;
     void *user;
     cm_box bounds; /* every computed cell is in it */
+    /* NULL, or called between chunks of exits followed, when nothing read
+     * through end is held: the cluster's adapter evicts what its budget
+     * does not hold (node tables the ends read) */
+    void (*between)(void *user);
 } cm_computed;
 
 /* The adapters for a resolved region (its exits recorded, else found
@@ -102,6 +106,12 @@ typedef struct cm_region_cells {
 typedef struct cm_cluster_cells {
     cm_cluster *c;
     const cm_exits *exits;
+    /* NULL, or exits itself when its owner needs no more of it than
+     * cm_exits_free once cm_cluster_attractors has run: the set then takes
+     * its cells instead of a copy, and its node index and weights are freed
+     * when the fates are found (36 bytes an exit at the peak of a whole
+     * cluster's pass, a long explore session's close) */
+    cm_exits *spent;
 } cm_cluster_cells;
 cm_computed cm_region_computed(cm_region_cells *rc);
 cm_computed cm_cluster_computed(cm_cluster_cells *cc);

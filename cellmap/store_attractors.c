@@ -24,15 +24,45 @@ static void options_text(const cm_attractor_options *o, const cm_attractor_set *
              (unsigned long long)a->returned_cells);
 }
 
+/* Exit cells per write into a label's blob: a buffer of 64 KiB in 2-D. */
+#define FATES_CHUNK 4096
+
+/* The exit cells of s labelled `label`, in box order, into the blob of its
+ * exit_fates row: written in pieces through SQLite's blob I/O, so that
+ * neither this nor SQLite holds a copy of them all (16 bytes an exit in
+ * 2-D, a million exits and more on a long explore session's cluster). */
+static cm_status write_fate_cells(cm_store *s, const cm_attractor_set *a, int dim, int64_t label,
+                                  int64_t *buf, char *msg, size_t msg_size)
+{
+    sqlite3_blob *blob = NULL;
+    if (sqlite3_blob_open(s->db, "main", "exit_fates", "cells", label, 1, &blob) != SQLITE_OK) {
+        sqlite3_blob_close(blob);
+        return store_db_error(s->db, "open the exits' fates", msg, msg_size);
+    }
+    const int cell_bytes = dim * (int)sizeof *buf;
+    int n = 0, offset = 0, rc = SQLITE_OK;
+    for (uint64_t e = 0; rc == SQLITE_OK && e <= a->nexits; e++) {
+        if (n == FATES_CHUNK || (e == a->nexits && n > 0)) {
+            rc = sqlite3_blob_write(blob, buf, n * cell_bytes, offset);
+            offset += n * cell_bytes;
+            n = 0;
+        }
+        if (e < a->nexits && a->exit_label[e] == label)
+            memcpy(buf + (size_t)n++ * (size_t)dim, a->exit_cell + e * (uint64_t)dim,
+                   (size_t)cell_bytes);
+    }
+    if (sqlite3_blob_close(blob) != SQLITE_OK || rc != SQLITE_OK)
+        return store_db_error(s->db, "write the exits' fates", msg, msg_size);
+    return CM_OK;
+}
+
 /* Exit cells of s in box order, label by label: exit_fates' rows. */
 static cm_status write_exit_fates(cm_store *s, const cm_attractor_set *a, int dim, char *msg,
                                   size_t msg_size)
 {
     sqlite3_stmt *ins = NULL;
-    int64_t *cells = malloc(((size_t)a->nexits + 1) * (size_t)dim * sizeof *cells);
-    cm_status st = cells ? CM_OK
-                         : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
-                                   (unsigned long long)a->nexits);
+    int64_t *buf = malloc((size_t)FATES_CHUNK * (size_t)dim * sizeof *buf);
+    cm_status st = buf ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
     if (st == CM_OK && (store_exec(s->db, "DELETE FROM exit_fates") != SQLITE_OK ||
                         sqlite3_prepare_v2(s->db, "INSERT INTO exit_fates VALUES(?, ?, ?)", -1,
                                            &ins, NULL) != SQLITE_OK))
@@ -40,17 +70,24 @@ static cm_status write_exit_fates(cm_store *s, const cm_attractor_set *a, int di
     for (int64_t label = CM_LABEL_OUTSIDE; st == CM_OK && label <= (int64_t)a->n; label++) {
         uint64_t n = 0;
         for (uint64_t e = 0; e < a->nexits; e++)
-            if (a->exit_label[e] == label)
-                memcpy(cells + n++ * dim, a->exit_cell + e * dim, (size_t)dim * sizeof *cells);
+            n += a->exit_label[e] == label;
         if (n == 0)
             continue;
+        if (n * (uint64_t)dim * sizeof *buf > INT32_MAX) {
+            st = cm_fail(CM_ETOOBIG, msg, msg_size,
+                         "%llu exits of one fate are more than a file's value holds",
+                         (unsigned long long)n);
+            break;
+        }
         sqlite3_bind_int64(ins, 1, label);
         sqlite3_bind_int64(ins, 2, (sqlite3_int64)n);
-        sqlite3_bind_blob64(ins, 3, cells, n * dim * sizeof *cells, SQLITE_STATIC);
+        sqlite3_bind_zeroblob(ins, 3, (int)(n * (uint64_t)dim * sizeof *buf));
         st = store_step_done(s->db, ins, "write the exits' fates", msg, msg_size);
+        if (st == CM_OK)
+            st = write_fate_cells(s, a, dim, label, buf, msg, msg_size);
     }
     sqlite3_finalize(ins);
-    free(cells);
+    free(buf);
     return st;
 }
 

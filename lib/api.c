@@ -213,7 +213,7 @@ static cm_status result_attractors_of(cm_result *res, const result_source *from,
 {
     const cm_model *m = res->model;
     cm_exits x = {0}; /* a cluster's */
-    cm_cluster_cells cc = {from->cluster, &x};
+    cm_cluster_cells cc = {from->cluster, &x, NULL};
     cm_region_cells rc = {&res->cells, m, &res->lat, from->max_steps};
     const cm_computed cells = from->cluster ? cm_cluster_computed(&cc) : cm_region_computed(&rc);
     cm_status st = from->cluster ? cm_cluster_exits(from->cluster, &x, msg, msg_size) : CM_OK;

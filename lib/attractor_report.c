@@ -135,7 +135,7 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
 {
     if (e->open)
         return CM_OK;
-    e->cc = (cm_cluster_cells){c, &e->exits};
+    e->cc = (cm_cluster_cells){c, &e->exits, NULL};
     e->computed = cm_cluster_computed(&e->cc);
     const cm_status st = cm_cluster_exits(c, &e->exits, msg, msg_size);
     e->open = st == CM_OK;

@@ -853,6 +853,7 @@ static cm_status save_attractors(session *s, char *msg, size_t msg_size)
     memset(&ends, 0, sizeof ends);
     if (st == CM_OK)
         st = cluster_ends_open(&ends, &s->c, msg, msg_size);
+    ends.cc.spent = &ends.exits; /* nothing reads them after: the set takes their cells */
     if (st == CM_OK)
         st = cm_cluster_attractors(&s->model, &ends.cc, groups, NULL, &att, msg, msg_size);
     if (st == CM_OK)

@@ -377,7 +377,7 @@ static void test_view_closure(void)
     CHECK(cm_cluster_describe_new(&c, &m, g, msg, sizeof msg) == CM_OK);
     cm_exits x;
     CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
-    cm_cluster_cells cc = {&c, &x};
+    cm_cluster_cells cc = {&c, &x, NULL};
     cm_attractor_set full, view;
     CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &full, msg, sizeof msg) == CM_OK);
     CHECK_INT(full.n, 4);
@@ -425,7 +425,7 @@ static void test_cell_labels(const char *path, const cm_model *m)
     CHECK(cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK);
     cm_exits x;
     CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
-    cm_cluster_cells cc = {&c, &x};
+    cm_cluster_cells cc = {&c, &x, NULL};
     cm_attractor_set att;
     CHECK(cm_cluster_attractors(m, &cc, g, NULL, &att, msg, sizeof msg) == CM_OK);
     int32_t *node_label = NULL;
