@@ -211,9 +211,8 @@ typedef struct escape_list {
 
 static void count_escape(void *user, uint32_t node, const int64_t *cell)
 {
-    (void)node;
-    (void)cell;
-    ((escape_list *)user)->cap_node++;
+    (void)node, (void)cell;
+    ++*(uint64_t *)user;
 }
 
 static void add_escape(void *user, uint32_t node, const int64_t *cell)
@@ -269,9 +268,9 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
     /* counted first, so that the lists take no more than they hold: the
      * listing of a long session's cluster (a million open nodes and more)
      * is what its close holds at its peak */
-    escape_list l = {c->lat.dim, NULL, NULL, 0, 0, 0, 0};
-    cm_cluster_each_escape(c, count_escape, &l);
-    l.cap = l.cap_node * (uint64_t)l.dim;
+    uint64_t escapes = 0;
+    cm_cluster_each_escape(c, count_escape, &escapes);
+    escape_list l = {c->lat.dim, NULL, NULL, 0, escapes * (uint64_t)c->lat.dim, escapes, 0};
     l.cell = malloc(((size_t)l.cap + 1) * sizeof *l.cell);
     l.node = malloc(((size_t)l.cap_node + 1) * sizeof *l.node);
     l.failed = !l.cell || !l.node;
@@ -642,19 +641,13 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
 #define FOLLOW_CHUNK ((uint64_t)1 << 14)
 
 /* The set's exit cells, once following is done: x's own when it is spent
- * (its node index and weights freed too), else a copy. */
+ * (the rest of it freed), else a copy. */
 static cm_status set_exit_cells(const cm_exits *x, cm_exits *spent, int dim, cm_attractor_set *s)
 {
     if (spent == x) {
         s->exit_cell = spent->cell;
         spent->cell = NULL;
-        free(spent->node);
-        free(spent->node_exit);
-        free(spent->weight);
-        spent->node = NULL;
-        spent->node_exit = NULL;
-        spent->weight = NULL;
-        spent->nnodes = 0;
+        cm_exits_free(spent);
         return CM_OK;
     }
     s->exit_cell = malloc(((size_t)x->n + 1) * (size_t)dim * sizeof *s->exit_cell);

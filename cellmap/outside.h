@@ -108,9 +108,9 @@ typedef struct cm_cluster_cells {
     const cm_exits *exits;
     /* NULL, or exits itself when its owner needs no more of it than
      * cm_exits_free once cm_cluster_attractors has run: the set then takes
-     * its cells instead of a copy, and its node index and weights are freed
-     * when the fates are found (36 bytes an exit at the peak of a whole
-     * cluster's pass, a long explore session's close) */
+     * its cells instead of a copy, and the rest of it is freed when the
+     * fates are found (36 bytes an exit at the peak of a whole cluster's
+     * pass, a long explore session's close) */
     cm_exits *spent;
 } cm_cluster_cells;
 cm_computed cm_region_computed(cm_region_cells *rc);

@@ -41,16 +41,19 @@ static cm_status write_fate_cells(cm_store *s, const cm_attractor_set *a, int di
     }
     const int cell_bytes = dim * (int)sizeof *buf;
     int n = 0, offset = 0, rc = SQLITE_OK;
-    for (uint64_t e = 0; rc == SQLITE_OK && e <= a->nexits; e++) {
-        if (n == FATES_CHUNK || (e == a->nexits && n > 0)) {
+    for (uint64_t e = 0; rc == SQLITE_OK && e < a->nexits; e++) {
+        if (a->exit_label[e] != label)
+            continue;
+        memcpy(buf + (size_t)n++ * (size_t)dim, a->exit_cell + e * (uint64_t)dim,
+               (size_t)cell_bytes);
+        if (n == FATES_CHUNK) {
             rc = sqlite3_blob_write(blob, buf, n * cell_bytes, offset);
             offset += n * cell_bytes;
             n = 0;
         }
-        if (e < a->nexits && a->exit_label[e] == label)
-            memcpy(buf + (size_t)n++ * (size_t)dim, a->exit_cell + e * (uint64_t)dim,
-                   (size_t)cell_bytes);
     }
+    if (rc == SQLITE_OK && n > 0)
+        rc = sqlite3_blob_write(blob, buf, n * cell_bytes, offset);
     if (sqlite3_blob_close(blob) != SQLITE_OK || rc != SQLITE_OK)
         return store_db_error(s->db, "write the exits' fates", msg, msg_size);
     return CM_OK;
@@ -62,15 +65,20 @@ static cm_status write_exit_fates(cm_store *s, const cm_attractor_set *a, int di
 {
     sqlite3_stmt *ins = NULL;
     int64_t *buf = malloc((size_t)FATES_CHUNK * (size_t)dim * sizeof *buf);
-    cm_status st = buf ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
+    /* exits per fate, label - CM_LABEL_OUTSIDE: counted in one pass */
+    uint64_t *count = calloc((size_t)a->n + (size_t)(1 - CM_LABEL_OUTSIDE), sizeof *count);
+    cm_status st = buf && count
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits");
+    for (uint64_t e = 0; st == CM_OK && e < a->nexits; e++)
+        if (a->exit_label[e] >= CM_LABEL_OUTSIDE && a->exit_label[e] <= (int64_t)a->n)
+            count[a->exit_label[e] - CM_LABEL_OUTSIDE]++;
     if (st == CM_OK && (store_exec(s->db, "DELETE FROM exit_fates") != SQLITE_OK ||
                         sqlite3_prepare_v2(s->db, "INSERT INTO exit_fates VALUES(?, ?, ?)", -1,
                                            &ins, NULL) != SQLITE_OK))
         st = store_db_error(s->db, "prepare the exits' fates", msg, msg_size);
     for (int64_t label = CM_LABEL_OUTSIDE; st == CM_OK && label <= (int64_t)a->n; label++) {
-        uint64_t n = 0;
-        for (uint64_t e = 0; e < a->nexits; e++)
-            n += a->exit_label[e] == label;
+        const uint64_t n = count[label - CM_LABEL_OUTSIDE];
         if (n == 0)
             continue;
         if (n * (uint64_t)dim * sizeof *buf > INT32_MAX) {
@@ -88,6 +96,7 @@ static cm_status write_exit_fates(cm_store *s, const cm_attractor_set *a, int di
     }
     sqlite3_finalize(ins);
     free(buf);
+    free(count);
     return st;
 }
 
