@@ -169,8 +169,10 @@ typedef struct cm_cluster {
     cm_groups_in_fn groups_in; /* public: reads a region's groups alone (NULL: none) */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
-    /* public: bytes its owner holds for regions still to join (solved
-     * ahead of their joins), which the budget makes room for too */
+    /* public: bytes its owner holds beside the cluster, which the budget
+     * makes room for too: regions solved ahead of their joins (a join adds
+     * them to what was there and takes them off after), a pass over the
+     * cluster's exits (cm_cluster_exits_room) */
     uint64_t mem_reserved;
     /* public: the boxes still to join, in order, if known (NULL: none).
      * Eviction keeps the regions next to the first of them, where their

@@ -617,6 +617,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
                                cm_join_stats *stats, char *msg, size_t msg_size)
 {
     cm_cluster *c = p->c;
+    const uint64_t held = c->mem_reserved; /* the owner's own */
     cm_status st = CM_OK;
     for (uint32_t b = 0; b < p->nboxes && st == CM_OK; b++) {
         const uint32_t s = b % p->window;
@@ -633,7 +634,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         /* its own box while it joins, the boxes after it from then on */
         c->upcoming = p->boxes + b;
         c->nupcoming = p->nboxes - b;
-        c->mem_reserved = solved_ahead(p, b);
+        c->mem_reserved = held + solved_ahead(p, b);
         const plan *pl = p->pl.index ? &p->pl : NULL;
         pin_expected(c, next, pl, next ? p->targets[ns] : NULL, b, 1);
         cm_join_stats one_join;
@@ -655,6 +656,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         atomic_store(&p->ready[s], 0u);
         atomic_store(&p->joined, b + 1);
     }
+    c->mem_reserved = held;
     if (st != CM_OK)
         atomic_store(&p->stop, 1);
     return st;
@@ -768,7 +770,6 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     c->upcoming = NULL;
     c->nupcoming = 0;
-    c->mem_reserved = 0;
     cm_cluster_trim(c);
     return st;
 }

@@ -255,6 +255,15 @@ static cm_status index_nodes(const escape_list *l, const uint32_t *exit_of, cm_e
     return st;
 }
 
+uint64_t cm_cluster_exits_room(const cm_cluster *c)
+{
+    uint64_t escapes = 0;
+    cm_cluster_each_escape(c, count_escape, &escapes);
+    /* the cells, in the listing twice at its peak (targets and exits) */
+    const uint64_t wider = 2 * sizeof(int64_t) * (uint64_t)(c->lat.dim > 2 ? c->lat.dim - 2 : 0);
+    return escapes * (CM_EXITS_PASS_BYTES + wider);
+}
+
 cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);

@@ -69,6 +69,16 @@ cm_status cm_region_settle_exits(cm_region *r, int threads, cm_exits *out, char 
  * weights (no cell is read). */
 cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size);
 
+/* The most a pass over a cluster's exits holds beside the cluster, in
+ * bytes: CM_EXITS_PASS_BYTES per open node (2-D and more per coordinate
+ * beyond two): cm_cluster_exits' listing at its peak, then the exits, their
+ * fates and chains while cm_cluster_attractors follows them. An owner that
+ * pages the cluster adds it to c->mem_reserved for the pass, so that the
+ * budget bounds the pass's arrays too (a long session's close lists a
+ * million open nodes and more). Reads no cell or node table. */
+#define CM_EXITS_PASS_BYTES 56
+uint64_t cm_cluster_exits_room(const cm_cluster *c);
+
 void cm_exits_free(cm_exits *x);
 
 /* Where a computed cell's sequence ends: its group (1..G; 0: the sink's

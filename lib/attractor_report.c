@@ -137,14 +137,22 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
         return CM_OK;
     e->cc = (cm_cluster_cells){c, &e->exits, NULL};
     e->computed = cm_cluster_computed(&e->cc);
+    e->reserved = c->page_in && c->mem_budget ? cm_cluster_exits_room(c) : 0;
+    c->mem_reserved += e->reserved;
+    cm_cluster_trim(c);
     const cm_status st = cm_cluster_exits(c, &e->exits, msg, msg_size);
     e->open = st == CM_OK;
+    if (!e->open)
+        cluster_ends_close(e);
     return st;
 }
 
 void cluster_ends_close(cluster_ends *e)
 {
     cm_exits_free(&e->exits);
+    if (e->cc.c)
+        e->cc.c->mem_reserved -= e->reserved;
+    e->reserved = 0;
     e->open = false;
 }
 

@@ -42,11 +42,15 @@ enum { BY_ATTRACTORS = 0, BY_GROUPS = 1 };
 /* Where the sink cells of a cluster's views go (cellmap/outside.h): its
  * exits and the adapter over them; `computed` points into the struct, which
  * must stay where it is until cluster_ends_close. Zeroed: closed; opening
- * an open one does nothing (the exits cost 30-40 bytes per open node). */
+ * an open one does nothing (the exits cost 30-40 bytes per open node).
+ * While open, the cluster's budget makes room for the pass over them
+ * (cm_cluster_exits_room in c->mem_reserved): resident cells are evicted
+ * to hold it. */
 typedef struct cluster_ends {
     cm_exits exits;
     cm_cluster_cells cc;
     cm_computed computed;
+    uint64_t reserved;
     bool open;
 } cluster_ends;
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size);

@@ -291,11 +291,11 @@ void solve_result_free(solve_result *r)
     char ignored[256];
     cm_store_close(r->store, ignored, sizeof ignored);
     r->store = NULL;
+    cluster_ends_close(&r->joined); /* before its cluster: it gives back its reserve */
     cm_cluster_free(&r->c);
     free(r->groups);
     r->groups = NULL;
     cm_attractors_free(&r->att);
     cm_exits_free(&r->exits);
-    cluster_ends_close(&r->joined);
     cm_region_free(&r->r);
 }
