@@ -896,19 +896,16 @@ static void run_probe(const follow_ctx *f, const int64_t *anchor, probe *p, int6
 }
 
 /* The group index (in anchor order) that group k's window mostly lands in
- * among the groups not known to diverge: k itself when its own basin is
- * among the most, or when no cell of the window has such a group (the
- * sink, cells not computed). */
-static cm_status successor(const int64_t *window, int dim, uint32_t k, const uint32_t *index_of,
-                           uint32_t ngroups, const probe *p, cm_cell_group_fn label, void *user,
-                           uint32_t *next, char *msg, size_t msg_size)
+ * among the groups not known to diverge, from the window cells' groups
+ * (window_group[0..LABEL_WINDOW)): k itself when its own basin is among
+ * the most, or when no cell of the window has such a group (the sink,
+ * cells not computed). */
+static void successor(const uint32_t *window_group, uint32_t k, const uint32_t *index_of,
+                      uint32_t ngroups, const probe *p, uint32_t *next)
 {
     uint32_t seen[LABEL_WINDOW], count[LABEL_WINDOW], n = 0;
     for (int i = 0; i < LABEL_WINDOW; i++) {
-        uint32_t g;
-        cm_status st = label(user, window + (size_t)i * dim, &g, msg, msg_size);
-        if (st != CM_OK)
-            return st;
+        const uint32_t g = window_group[i];
         if (g == 0 || g > ngroups)
             continue; /* the sink, or no cell computed there */
         const uint32_t j = index_of[g];
@@ -933,7 +930,54 @@ static cm_status successor(const int64_t *window, int dim, uint32_t k, const uin
     for (uint32_t m = 0; m < n; m++) /* its own basin among the most: it stays */
         if (seen[m] == k && count[m] == best)
             *next = k;
-    return CM_OK;
+}
+
+/* Whether group k's window is looked up (successor). */
+static bool has_successor(const cm_group_info *g, const probe *p)
+{
+    return g->kind != CM_GROUP_STICKING && !p->diverged;
+}
+
+/* The groups of the windows of the groups that have successors, into
+ * *out (LABEL_WINDOW entries per group, in anchor order; the others'
+ * entries CM_GROUP_NONE): one lookup for them all. */
+static cm_status window_groups(const cm_group_info *groups, const anchored *order, uint32_t n,
+                               const probe *p, const int64_t *window, int dim,
+                               cm_cells_group_fn label, void *user, uint32_t **out, char *msg,
+                               size_t msg_size)
+{
+    const size_t per = (size_t)LABEL_WINDOW * (size_t)dim;
+    uint64_t asked = 0;
+    for (uint32_t k = 0; k < n; k++)
+        asked += has_successor(&groups[order[k].index], &p[k]);
+    int64_t *cells = malloc((asked * per + 1) * sizeof *cells);
+    uint32_t *found = malloc((asked * LABEL_WINDOW + 1) * sizeof *found);
+    *out = malloc(((size_t)n * LABEL_WINDOW + 1) * sizeof **out);
+    cm_status st = cells && found && *out ? CM_OK : CM_ENOMEM;
+    uint64_t j = 0;
+    for (uint32_t k = 0; st == CM_OK && k < n; k++)
+        if (has_successor(&groups[order[k].index], &p[k]))
+            memcpy(cells + (j++) * per, window + (size_t)k * per, per * sizeof *cells);
+    if (st == CM_OK)
+        st = label(user, cells, asked * LABEL_WINDOW, found, msg, msg_size);
+    else
+        cm_fail(st, msg, msg_size, "out of memory following %u groups", n);
+    j = 0;
+    for (uint32_t k = 0; st == CM_OK && k < n; k++) {
+        uint32_t *w = *out + (size_t)k * LABEL_WINDOW;
+        if (has_successor(&groups[order[k].index], &p[k]))
+            memcpy(w, found + (j++) * LABEL_WINDOW, LABEL_WINDOW * sizeof *w);
+        else
+            for (int i = 0; i < LABEL_WINDOW; i++)
+                w[i] = CM_GROUP_NONE;
+    }
+    free(cells);
+    free(found);
+    if (st != CM_OK) {
+        free(*out);
+        *out = NULL;
+    }
+    return st;
 }
 
 /* The groups on cycles of the successor graph (each cycle's first in
@@ -1053,7 +1097,7 @@ static cm_status check_representatives(const follow_ctx *f, const cm_group_info 
  * graph's cycles, on the threads asked for; sticking zones are taken as
  * they are. */
 static cm_status follow_groups(const follow_ctx *f, const cm_group_info *groups,
-                               const anchored *order, uint32_t n, cm_cell_group_fn label,
+                               const anchored *order, uint32_t n, cm_cells_group_fn label,
                                void *user, uint32_t *parent, orbit *r, uint64_t *steps,
                                char *msg, size_t msg_size)
 {
@@ -1077,15 +1121,18 @@ static cm_status follow_groups(const follow_ctx *f, const cm_group_info *groups,
     for (uint32_t k = 0; k < n; k++)
         if (groups[order[k].index].id <= n)
             index_of[groups[order[k].index].id] = k;
+    uint32_t *window_group = NULL;
+    if (label)
+        st = window_groups(groups, order, n, p, window, dim, label, user, &window_group, msg,
+                           msg_size);
     for (uint32_t k = 0; k < n && st == CM_OK; k++) {
-        const cm_group_info *g = &groups[order[k].index];
         next[k] = k;
-        if (label && g->kind != CM_GROUP_STICKING && !p[k].diverged)
-            st = successor(window + (size_t)k * LABEL_WINDOW * dim, dim, k, index_of, n, p,
-                           label, user, &next[k], msg, msg_size);
-        if (st == CM_OK && next[k] != k && groups[order[next[k]].index].kind == CM_GROUP_STICKING)
+        if (label && has_successor(&groups[order[k].index], &p[k]))
+            successor(window_group + (size_t)k * LABEL_WINDOW, k, index_of, n, p, &next[k]);
+        if (next[k] != k && groups[order[next[k]].index].kind == CM_GROUP_STICKING)
             next[k] = k; /* rest states are not an orbit's fate here */
     }
+    free(window_group);
     if (st == CM_OK)
         cycles_of(next, n, parent, rep);
     for (uint32_t k = 0; st == CM_OK && k < n; k++) {
@@ -1110,18 +1157,22 @@ static cm_status follow_groups(const follow_ctx *f, const cm_group_info *groups,
     return st;
 }
 
-cm_status cm_region_cell_group(void *region, const int64_t *cell, uint32_t *group, char *msg,
-                               size_t msg_size)
+cm_status cm_region_cells_group(void *region, const int64_t *cells, uint64_t n, uint32_t *group,
+                                char *msg, size_t msg_size)
 {
     (void)msg, (void)msg_size;
     const cm_region *r = region;
-    *group = cm_box_contains(&r->box, cell) ? r->group[cm_box_index(&r->box, cell)] : CM_GROUP_NONE;
+    for (uint64_t i = 0; i < n; i++) {
+        const int64_t *cell = cells + i * (uint64_t)r->box.dim;
+        group[i] =
+            cm_box_contains(&r->box, cell) ? r->group[cm_box_index(&r->box, cell)] : CM_GROUP_NONE;
+    }
     return CM_OK;
 }
 
 cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
                              const cm_group_info *groups, uint32_t ngroups,
-                             cm_cell_group_fn label, void *label_user,
+                             cm_cells_group_fn label, void *label_user,
                              const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
                              size_t msg_size)
 {

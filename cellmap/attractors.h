@@ -132,14 +132,17 @@ void cm_attractor_defaults(const cm_model *m, const cm_attractor_options *in,
  * that holds the transient and one record): CM_EINVAL naming the bad one. */
 cm_status cm_attractor_check(const cm_attractor_options *o, char *msg, size_t msg_size);
 
-/* The group of a cell (its id; 0: the sink; CM_GROUP_NONE: no cell
- * computed there) into *group. Called on the calling thread only. */
-typedef cm_status (*cm_cell_group_fn)(void *user, const int64_t *cell, uint32_t *group,
-                                      char *msg, size_t msg_size);
+/* The groups of n cells (dim coordinates each, cells[i * dim ..]) into
+ * group[0..n) (its id; 0: the sink; CM_GROUP_NONE: no cell computed
+ * there). Called on the calling thread only, once for all the cells a step
+ * needs, so that a paged cluster reads each region once
+ * (cm_cluster_cells_group). */
+typedef cm_status (*cm_cells_group_fn)(void *user, const int64_t *cells, uint64_t n,
+                                       uint32_t *group, char *msg, size_t msg_size);
 
-/* A cm_cell_group_fn over one resolved region (user: the cm_region). */
-cm_status cm_region_cell_group(void *region, const int64_t *cell, uint32_t *group, char *msg,
-                               size_t msg_size);
+/* A cm_cells_group_fn over one resolved region (user: the cm_region). */
+cm_status cm_region_cells_group(void *region, const int64_t *cells, uint64_t n, uint32_t *group,
+                                char *msg, size_t msg_size);
 
 /* The attractors of groups[0..ngroups) (entry k: group k + 1, as
  * cm_scm_groups and cm_store_groups give them) into *out, which the caller
@@ -148,7 +151,7 @@ cm_status cm_region_cell_group(void *region, const int64_t *cell, uint32_t *grou
  * defaults. */
 cm_status cm_attractors_find(const cm_model *m, const cm_lattice *lat,
                              const cm_group_info *groups, uint32_t ngroups,
-                             cm_cell_group_fn label, void *label_user,
+                             cm_cells_group_fn label, void *label_user,
                              const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
                              size_t msg_size);
 

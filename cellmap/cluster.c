@@ -1391,11 +1391,56 @@ cm_status cm_cluster_cell_end(cm_cluster *c, const int64_t *cell, uint32_t *grou
                               msg, msg_size);
 }
 
-cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
-                                size_t msg_size)
+cm_status cm_cluster_region_order(const cm_cluster *c, const int64_t *cells, uint64_t n,
+                                  uint64_t **order)
 {
-    uint32_t open;
-    return cm_cluster_cell_end(cluster, cell, group, &open, msg, msg_size);
+    const int dim = c->lat.dim;
+    uint64_t *start = calloc((size_t)c->nregions + 2, sizeof *start);
+    uint32_t *region = malloc(((size_t)n + 1) * sizeof *region);
+    *order = malloc(((size_t)n + 1) * sizeof **order);
+    if (!start || !region || !*order) {
+        free(start);
+        free(region);
+        free(*order);
+        *order = NULL;
+        return CM_ENOMEM;
+    }
+    for (uint64_t i = 0; i < n; i++) {
+        uint64_t local;
+        const int64_t k = cm_cluster_locate(c, cells + i * (uint64_t)dim, &local);
+        region[i] = k < 0 ? c->nregions : (uint32_t)k; /* none: last */
+        start[region[i] + 1]++;
+    }
+    for (uint32_t k = 0; k <= c->nregions; k++)
+        start[k + 1] += start[k];
+    for (uint64_t i = 0; i < n; i++)
+        (*order)[start[region[i]]++] = i;
+    free(start);
+    free(region);
+    return CM_OK;
+}
+
+#define LOOKUPS_PER_TRIM 1024
+
+cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n,
+                                 uint32_t *group, char *msg, size_t msg_size)
+{
+    cm_cluster *c = cluster;
+    uint64_t *order = NULL;
+    if (cm_cluster_region_order(c, cells, n, &order) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory ordering %llu cells",
+                       (unsigned long long)n);
+    cm_status st = CM_OK;
+    for (uint64_t i = 0; i < n && st == CM_OK; i++) {
+        if (i % LOOKUPS_PER_TRIM == LOOKUPS_PER_TRIM - 1)
+            cm_cluster_trim(c); /* between lookups: no node is held */
+        uint32_t open;
+        const uint64_t j = order[i];
+        st = cm_cluster_cell_end(c, cells + j * (uint64_t)c->lat.dim, &group[j], &open, msg,
+                                 msg_size);
+    }
+    free(order);
+    return st;
 }
 
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,

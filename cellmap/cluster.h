@@ -264,11 +264,21 @@ cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_
 /* The region holding the cell and the cell's local index, or -1. O(1). */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
 
-/* The cell's resolved group (0: the sink) into *group, CM_GROUP_NONE when
- * no region holds it; reads its region (and node tables) back if paged
- * out. A cm_cell_group_fn (cellmap/attractors.h) with user the cluster. */
-cm_status cm_cluster_cell_group(void *cluster, const int64_t *cell, uint32_t *group, char *msg,
-                                size_t msg_size);
+/* The order in which to look up n cells (dim coordinates each) so that a
+ * paged cluster reads each region once: *order (n entries, the caller's to
+ * free) lists the cells' indices region by region (in region order, cells
+ * of no region last), in their given order within a region. O(n). */
+cm_status cm_cluster_region_order(const cm_cluster *c, const int64_t *cells, uint64_t n,
+                                  uint64_t **order);
+
+/* The resolved groups (0: the sink) of n cells (dim coordinates each) into
+ * group[0..n), CM_GROUP_NONE where no region holds the cell: looked up
+ * region by region (cm_cluster_region_order), reading a paged out region
+ * (and node tables) back once; every 1024 lookups the cluster sheds what
+ * its budget does not hold (cm_cluster_trim). A cm_cells_group_fn
+ * (cellmap/attractors.h) with user the cluster. */
+cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n,
+                                 uint32_t *group, char *msg, size_t msg_size);
 
 /* The same, and the open node the cell's sequence leaves the cluster
  * through (CM_NODE_OPEN if it does not: a group, or the world's sink). */

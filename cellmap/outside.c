@@ -987,27 +987,12 @@ static cm_status view_leaving(void *user, const cm_region *flat, uint64_t j, int
 static cm_status ends_by_region(view_exits *v, const int64_t *cell, uint64_t n, int32_t *label,
                                 char *msg, size_t msg_size)
 {
-    cm_cluster *c = v->c;
-    uint64_t *start = calloc((size_t)c->nregions + 2, sizeof *start);
-    uint32_t *region = malloc(((size_t)n + 1) * sizeof *region);
-    uint64_t *order = malloc(((size_t)n + 1) * sizeof *order);
-    cm_status st = start && region && order
+    uint64_t *order = NULL;
+    cm_status st = cm_cluster_region_order(v->c, cell, n, &order) == CM_OK
                        ? CM_OK
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's ends");
-    for (uint64_t i = 0; st == CM_OK && i < n; i++) {
-        uint64_t local;
-        const int64_t k = cm_cluster_locate(c, cell + i * (uint64_t)v->dim, &local);
-        region[i] = k < 0 ? c->nregions : (uint32_t)k; /* none: last */
-        start[region[i] + 1]++;
-    }
-    for (uint32_t k = 0; st == CM_OK && k <= c->nregions; k++)
-        start[k + 1] += start[k];
-    for (uint64_t i = 0; st == CM_OK && i < n; i++)
-        order[start[region[i]]++] = i;
     for (uint64_t i = 0; st == CM_OK && i < n; i++)
         st = view_end(v, cell + order[i] * (uint64_t)v->dim, &label[order[i]], msg, msg_size);
-    free(start);
-    free(region);
     free(order);
     return st;
 }
@@ -1240,7 +1225,7 @@ cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const c
                                const cm_attractor_options *opt, cm_attractor_set *out, char *msg,
                                size_t msg_size)
 {
-    cm_status st = cm_attractors_find(m, lat, groups, r->ngroups, cm_region_cell_group,
+    cm_status st = cm_attractors_find(m, lat, groups, r->ngroups, cm_region_cells_group,
                                       (void *)r, opt, out, msg, msg_size);
     if (st != CM_OK)
         return st;
@@ -1250,34 +1235,12 @@ cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const c
                                  out, msg, msg_size);
 }
 
-/* cm_cluster_cell_group for a whole cluster's attractors: every so many
- * lookups the cluster sheds what its budget does not hold, the node tables
- * the chains read in above all (a long explore session's close read 27 MB
- * of them beyond the budget, finding its 1043 groups' attractors). */
-typedef struct trimming_lookup {
-    cm_cluster *c;
-    uint32_t since;
-} trimming_lookup;
-#define LOOKUPS_PER_TRIM 1024
-
-static cm_status group_trimming(void *user, const int64_t *cell, uint32_t *group, char *msg,
-                                size_t msg_size)
-{
-    trimming_lookup *t = user;
-    if (++t->since == LOOKUPS_PER_TRIM) {
-        t->since = 0;
-        cm_cluster_trim(t->c); /* between lookups: no node is held */
-    }
-    return cm_cluster_cell_group(t->c, cell, group, msg, msg_size);
-}
-
 cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
                                 const cm_group_info *groups, const cm_attractor_options *opt,
                                 cm_attractor_set *out, char *msg, size_t msg_size)
 {
     cm_cluster *c = cc->c;
-    trimming_lookup lookup = {c, 0};
-    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, group_trimming, &lookup,
+    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cells_group, c,
                                       opt, out, msg, msg_size);
     if (st != CM_OK)
         return st;

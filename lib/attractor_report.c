@@ -191,7 +191,7 @@ cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
     cm_status st;
     if (!every_exit && c->keep_exits && !c->resolved_cells && !c->open_released) {
-        st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cell_group, c, NULL,
+        st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cells_group, c, NULL,
                                 att, msg, msg_size);
         if (st == CM_OK)
             st = cm_cluster_view_labels(m, c, flat, NULL, memo, att, *labels, msg, msg_size);

@@ -90,7 +90,7 @@ static void run_config(const config *c, int repeats)
         const double t1 = now();
         cm_attractor_set s;
         const cm_attractor_options ao = {.threads = 2};
-        if (cm_attractors_find(&m, &lat, g, r.ngroups, cm_region_cell_group, &r, &ao, &s, msg,
+        if (cm_attractors_find(&m, &lat, g, r.ngroups, cm_region_cells_group, &r, &ao, &s, msg,
                                sizeof msg) != CM_OK)
             die(msg);
         const double t2 = now();

@@ -281,7 +281,7 @@ static void test_cell_mapping(const char *params, int period, const double *wher
     CHECK(cm_scm_describe(&m, &lat, &r, &groups, &sink, msg, sizeof msg) == CM_OK);
     cm_attractor_set set;
     const cm_attractor_options ao = {.threads = 2};
-    CHECK(cm_attractors_find(&m, &lat, groups, r.ngroups, cm_region_cell_group, &r, &ao, &set,
+    CHECK(cm_attractors_find(&m, &lat, groups, r.ngroups, cm_region_cells_group, &r, &ao, &set,
                              msg, sizeof msg) == CM_OK);
     printf("chip-4d %s: %d^3 cells, %u groups, %u attractor(s)", params, n, r.ngroups, set.n);
     if (set.n > 0)
