@@ -1420,19 +1420,18 @@ cm_status cm_cluster_region_order(const cm_cluster *c, const int64_t *cells, uin
     return CM_OK;
 }
 
-#define LOOKUPS_PER_TRIM 1024
-
-cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n,
-                                 uint32_t *group, char *msg, size_t msg_size)
+/* The lookups of cm_cluster_cells_group, shedding every `trim_every`
+ * lookups (0: never). */
+static cm_status cells_group(cm_cluster *c, const int64_t *cells, uint64_t n, uint32_t *group,
+                             uint64_t trim_every, char *msg, size_t msg_size)
 {
-    cm_cluster *c = cluster;
     uint64_t *order = NULL;
     if (cm_cluster_region_order(c, cells, n, &order) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory ordering %llu cells",
                        (unsigned long long)n);
     cm_status st = CM_OK;
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
-        if (i % LOOKUPS_PER_TRIM == LOOKUPS_PER_TRIM - 1)
+        if (trim_every && i % trim_every == trim_every - 1)
             cm_cluster_trim(c); /* between lookups: no node is held */
         uint32_t open;
         const uint64_t j = order[i];
@@ -1441,6 +1440,18 @@ cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n
     }
     free(order);
     return st;
+}
+
+cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n,
+                                 uint32_t *group, char *msg, size_t msg_size)
+{
+    return cells_group(cluster, cells, n, group, 0, msg, msg_size);
+}
+
+cm_status cm_cluster_cells_group_shedding(void *cluster, const int64_t *cells, uint64_t n,
+                                          uint32_t *group, char *msg, size_t msg_size)
+{
+    return cells_group(cluster, cells, n, group, 1024, msg, msg_size);
 }
 
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,

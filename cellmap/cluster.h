@@ -274,11 +274,17 @@ cm_status cm_cluster_region_order(const cm_cluster *c, const int64_t *cells, uin
 /* The resolved groups (0: the sink) of n cells (dim coordinates each) into
  * group[0..n), CM_GROUP_NONE where no region holds the cell: looked up
  * region by region (cm_cluster_region_order), reading a paged out region
- * (and node tables) back once; every 1024 lookups the cluster sheds what
- * its budget does not hold (cm_cluster_trim). A cm_cells_group_fn
- * (cellmap/attractors.h) with user the cluster. */
+ * (and node tables) back once. A cm_cells_group_fn (cellmap/attractors.h)
+ * with user the cluster. */
 cm_status cm_cluster_cells_group(void *cluster, const int64_t *cells, uint64_t n,
                                  uint32_t *group, char *msg, size_t msg_size);
+/* The same, shedding what the budget does not hold (cm_cluster_trim) every
+ * 1024 lookups: for a pass over the whole cluster, whose chains read more
+ * node tables than the budget's quarter (a long explore session's close
+ * read 27 MB beyond it). A view's lookups keep them: its other steps read
+ * them again. */
+cm_status cm_cluster_cells_group_shedding(void *cluster, const int64_t *cells, uint64_t n,
+                                          uint32_t *group, char *msg, size_t msg_size);
 
 /* The same, and the open node the cell's sequence leaves the cluster
  * through (CM_NODE_OPEN if it does not: a group, or the world's sink). */

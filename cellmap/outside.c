@@ -1240,8 +1240,8 @@ cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
                                 cm_attractor_set *out, char *msg, size_t msg_size)
 {
     cm_cluster *c = cc->c;
-    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cells_group, c,
-                                      opt, out, msg, msg_size);
+    cm_status st = cm_attractors_find(m, &c->lat, groups, c->ngroups,
+                                      cm_cluster_cells_group_shedding, c, opt, out, msg, msg_size);
     if (st != CM_OK)
         return st;
     const cm_computed cells = cm_cluster_computed(cc);
