@@ -953,15 +953,15 @@ static cm_status window_groups(const cm_group_info *groups, const anchored *orde
     int64_t *cells = malloc((asked * per + 1) * sizeof *cells);
     uint32_t *found = malloc((asked * LABEL_WINDOW + 1) * sizeof *found);
     *out = malloc(((size_t)n * LABEL_WINDOW + 1) * sizeof **out);
-    cm_status st = cells && found && *out ? CM_OK : CM_ENOMEM;
+    cm_status st = cells && found && *out
+                       ? CM_OK
+                       : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following %u groups", n);
     uint64_t j = 0;
     for (uint32_t k = 0; st == CM_OK && k < n; k++)
         if (has_successor(&groups[order[k].index], &p[k]))
             memcpy(cells + (j++) * per, window + (size_t)k * per, per * sizeof *cells);
     if (st == CM_OK)
         st = label(user, cells, asked * LABEL_WINDOW, found, msg, msg_size);
-    else
-        cm_fail(st, msg, msg_size, "out of memory following %u groups", n);
     j = 0;
     for (uint32_t k = 0; st == CM_OK && k < n; k++) {
         uint32_t *w = *out + (size_t)k * LABEL_WINDOW;
