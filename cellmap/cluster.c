@@ -1291,6 +1291,7 @@ typedef struct node_values {
     const cm_node *nodes; /* the region's; NULL: the region has no node references */
     const uint32_t *group, *step;
     const uint8_t *cycle;
+    const uint32_t *open; /* the open node each node's sequence leaves by; NULL: not asked */
 } node_values;
 
 /* Group and step of cell i of r. */
@@ -1309,10 +1310,18 @@ static void resolved_cell(const cm_region *r, uint64_t i, const node_values *nv,
                          : nv->step[e] + r->step[i] - 1;
 }
 
+/* The open node cell i of r leaves the cluster by (CM_NODE_OPEN: none). */
+static uint32_t open_of_cell(const cm_region *r, uint64_t i, const node_values *nv)
+{
+    const uint32_t g = r->group[i];
+    return cm_is_node_ref(g) ? nv->open[g & ~CM_NODE_REF] : CM_NODE_OPEN;
+}
+
 /* Copies the cells of region r inside `both` (their intersection) into
- * out, one row along dimension 0 at a time: rows are contiguous in both. */
+ * out (and their open nodes into open, unless NULL), one row along
+ * dimension 0 at a time: rows are contiguous in both. */
 static void flatten_part(const cm_region *r, const node_values *nv, const cm_box *both,
-                         cm_region *out, int threads)
+                         cm_region *out, uint32_t *open, int threads)
 {
     const int64_t width = both->hi[0] - both->lo[0];
     const int64_t rows = (int64_t)(cm_box_cells(both) / (uint64_t)width);
@@ -1328,6 +1337,9 @@ static void flatten_part(const cm_region *r, const node_values *nv, const cm_box
                           &out->step[to + (uint64_t)i]);
             out->image[to + (uint64_t)i] = flat_image(r, from + (uint64_t)i, &out->box);
         }
+        if (open && nv->nodes)
+            for (int64_t i = 0; i < width; i++)
+                open[to + (uint64_t)i] = open_of_cell(r, from + (uint64_t)i, nv);
     }
 }
 
@@ -1349,22 +1361,23 @@ cm_status cm_flat_alloc(const cm_box *box, uint32_t ngroups, cm_region *out, cha
 void cm_flat_copy(const cm_region *r, cm_region *out)
 {
     cm_box both;
-    const node_values none = {NULL, NULL, NULL, NULL};
+    const node_values none = {NULL, NULL, NULL, NULL, NULL};
     if (cm_box_intersect(&r->box, &out->box, &both))
-        flatten_part(r, &none, &both, out, 1);
+        flatten_part(r, &none, &both, out, NULL, 1);
 }
 
-/* Resolves region k's nodes into nv (arrays of the region's nexits). */
+/* Resolves region k's nodes into the arrays (of the region's nexits; open
+ * may be NULL). */
 static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group, uint32_t *step,
-                                      uint8_t *cycle, char *msg, size_t msg_size)
+                                      uint8_t *cycle, uint32_t *open, char *msg, size_t msg_size)
 {
     const cm_cluster_region *cr = &c->regions[k];
     cm_node *nodes;
     cm_status st = node_table(c, k, &nodes, msg, msg_size);
     for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
         cycle[e] = nodes[e].next == CM_NODE_CYCLE;
-        st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e], NULL, msg,
-                                msg_size);
+        st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e],
+                                open ? &open[e] : NULL, msg, msg_size);
     }
     return st;
 }
@@ -1454,56 +1467,89 @@ cm_status cm_cluster_cells_group_shedding(void *cluster, const int64_t *cells, u
     return cells_group(cluster, cells, n, group, 1024, msg, msg_size);
 }
 
+/* Per-node arrays for the largest region read so far. */
+typedef struct node_arrays {
+    uint32_t *group, *step, *open;
+    uint8_t *cycle;
+    uint64_t cap;
+} node_arrays;
+
+static void node_arrays_free(node_arrays *a)
+{
+    free(a->group);
+    free(a->step);
+    free(a->open);
+    free(a->cycle);
+    memset(a, 0, sizeof *a);
+}
+
+static cm_status node_arrays_room(node_arrays *a, uint64_t n, bool with_open)
+{
+    if (n <= a->cap)
+        return CM_OK;
+    node_arrays_free(a);
+    a->group = malloc(n * sizeof *a->group);
+    a->step = malloc(n * sizeof *a->step);
+    a->open = with_open ? malloc(n * sizeof *a->open) : NULL;
+    a->cycle = malloc(n);
+    a->cap = n;
+    return a->group && a->step && a->cycle && (a->open || !with_open) ? CM_OK : CM_ENOMEM;
+}
+
+/* cm_cluster_flatten_progress, with the open nodes of the cells into open
+ * unless NULL. */
+static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint32_t *open,
+                         cm_progress_fn progress, void *user, char *msg, size_t msg_size)
+{
+    const double total = (double)cm_box_cells(box);
+    uint64_t done = 0;
+    cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
+    _Static_assert(CM_NODE_OPEN == UINT32_MAX, "open cells are filled bytewise");
+    if (st == CM_OK && open)
+        memset(open, 0xFF, (size_t)out->ncells * sizeof *open);
+    node_arrays a;
+    memset(&a, 0, sizeof a);
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
+        cm_box both;
+        if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
+            continue;
+        if (node_arrays_room(&a, c->regions[k].r.nexits + 1, open != NULL) != CM_OK) {
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
+            break;
+        }
+        /* nodes first: settling one can read other regions back */
+        st = resolve_region_nodes(c, k, a.group, a.step, a.cycle, a.open, msg, msg_size);
+        if (st == CM_OK)
+            st = cm_cluster_acquire(c, k, msg, msg_size);
+        const node_values nv = {c->regions[k].nodes, a.group, a.step, a.cycle, a.open};
+        if (st == CM_OK)
+            flatten_part(&c->regions[k].r, &nv, &both, out, open, cm_cluster_threads(c));
+        cm_cluster_trim(c);
+        done += cm_box_cells(&both);
+        if (st == CM_OK && progress && progress(user, "cells", total > 0 ? done / total : 1))
+            st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
+    }
+    node_arrays_free(&a);
+    if (st != CM_OK)
+        cm_region_free(out);
+    return st;
+}
+
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
-    return cm_cluster_flatten_progress(c, box, out, NULL, NULL, msg, msg_size);
+    return flatten(c, box, out, NULL, NULL, NULL, msg, msg_size);
+}
+
+cm_status cm_cluster_flatten_open(cm_cluster *c, const cm_box *box, cm_region *out,
+                                  uint32_t *open, char *msg, size_t msg_size)
+{
+    return flatten(c, box, out, open, NULL, NULL, msg, msg_size);
 }
 
 cm_status cm_cluster_flatten_progress(cm_cluster *c, const cm_box *box, cm_region *out,
                                       cm_progress_fn progress, void *user, char *msg,
                                       size_t msg_size)
 {
-    const double total = (double)cm_box_cells(box);
-    uint64_t done = 0;
-    cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
-    uint32_t *group = NULL, *step = NULL;
-    uint8_t *cycle = NULL;
-    uint64_t cap = 0;
-    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
-        cm_box both;
-        if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
-            continue;
-        const uint64_t n = c->regions[k].r.nexits + 1;
-        if (n > cap) {
-            free(group);
-            free(step);
-            free(cycle);
-            group = malloc(n * sizeof *group);
-            step = malloc(n * sizeof *step);
-            cycle = malloc(n);
-            cap = n;
-            if (!group || !step || !cycle) {
-                st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
-                break;
-            }
-        }
-        /* nodes first: settling one can read other regions back */
-        st = resolve_region_nodes(c, k, group, step, cycle, msg, msg_size);
-        if (st == CM_OK)
-            st = cm_cluster_acquire(c, k, msg, msg_size);
-        const node_values nv = {c->regions[k].nodes, group, step, cycle};
-        if (st == CM_OK)
-            flatten_part(&c->regions[k].r, &nv, &both, out, cm_cluster_threads(c));
-        cm_cluster_trim(c);
-        done += cm_box_cells(&both);
-        if (st == CM_OK && progress && progress(user, "cells", total > 0 ? done / total : 1))
-            st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
-    }
-    free(group);
-    free(step);
-    free(cycle);
-    if (st != CM_OK)
-        cm_region_free(out);
-    return st;
+    return flatten(c, box, out, NULL, progress, user, msg, msg_size);
 }

@@ -437,6 +437,14 @@ void cm_flat_copy(const cm_region *r, cm_region *out);
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size);
 
+/* The same, with open[i] (a caller array of the box's cells) the open node
+ * through which cell i's sequence leaves the cluster, CM_NODE_OPEN where it
+ * does not (a group's cell, the world's sink, no computed cell): what
+ * cm_cluster_cell_end gives, found once per node, so that a view's labels
+ * need not look up the cells whose sequences leave the view. */
+cm_status cm_cluster_flatten_open(cm_cluster *c, const cm_box *box, cm_region *out,
+                                  uint32_t *open, char *msg, size_t msg_size);
+
 /* The same, calling progress(user, "cells", fraction of the box's cells
  * read) after each region it reads; nonzero from it cancels (CM_ECANCELED,
  * out freed). */

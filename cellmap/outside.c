@@ -833,10 +833,18 @@ static uint32_t outside_budget(const cm_model *m, const cm_attractor_options *op
 static bool is_slot(int32_t label) { return label <= VIEW_EXIT && label > VIEW_END; }
 static bool is_end(int32_t label) { return label <= VIEW_END && label > LABEL_WALKING; }
 
+/* Open node ids remembered with their slots (a direct-mapped cache: the
+ * cells of one tree, which share an open node, lie together). */
+#define OPEN_CACHE 4096
+
 typedef struct view_exits {
     cm_cluster *c;
     const cm_attractor_set *s;
     int dim;
+    const cm_region *flat;
+    const uint32_t *open; /* flat's cells' open nodes (NULL: ask the cluster) */
+    uint32_t *cached_open, *cached_slot; /* OPEN_CACHE each, with open */
+    const int32_t *labels; /* flat's labels, once its ends are settled (else NULL) */
     int64_t *cell;  /* each slot's exit cell, dim coordinates */
     uint64_t n, cap;
     int64_t *end;   /* the cells whose ends the cluster knows, dim coordinates */
@@ -955,9 +963,36 @@ static cm_status view_end(view_exits *v, const int64_t *cell, int32_t *label, ch
     return st;
 }
 
+/* The label of a sink cell that leaves the cluster by open node id
+ * (CM_NODE_OPEN: it ends in the world's sink). */
+static cm_status open_label(view_exits *v, uint32_t id, int32_t *label, char *msg,
+                            size_t msg_size)
+{
+    if (id == CM_NODE_OPEN) {
+        *label = CM_LABEL_DIVERGED;
+        return CM_OK;
+    }
+    const uint32_t at = (id * UINT32_C(2654435761)) >> 20; /* 12 bits: OPEN_CACHE */
+    if (v->cached_open[at] == id) {
+        *label = VIEW_EXIT - (int32_t)v->cached_slot[at];
+        return CM_OK;
+    }
+    int64_t exit[CM_MAX_DIM];
+    uint64_t slot = 0;
+    cm_status st = open_exit(v->c, id, exit, msg, msg_size);
+    if (st == CM_OK)
+        st = view_slot(v, exit, &slot, msg, msg_size);
+    if (st == CM_OK) {
+        v->cached_open[at] = id;
+        v->cached_slot[at] = (uint32_t)slot;
+    }
+    *label = VIEW_EXIT - (int32_t)slot;
+    return st;
+}
+
 /* A sink cell's sequence leaves the view at cell j: into an uncomputed
  * cell of the view (the exit itself), else beyond it (the cluster knows
- * where it ends). */
+ * where it ends, and so does v->open when given). */
 static cm_status view_leaving(void *user, const cm_region *flat, uint64_t j, int32_t *v,
                               char *msg, size_t msg_size)
 {
@@ -971,6 +1006,8 @@ static cm_status view_leaving(void *user, const cm_region *flat, uint64_t j, int
         return st;
     }
     view_exits *x = user;
+    if (x->open)
+        return open_label(x, x->open[j], v, msg, msg_size);
     if (x->nend >= VIEW_MOST - 64)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "the view leaves itself at more than %llu cells",
                        (unsigned long long)(VIEW_MOST - 64));
@@ -1015,31 +1052,45 @@ static cm_status settle_ends(view_exits *v, int32_t *labels, uint64_t ncells, in
     return st;
 }
 
+/* The settled label of a computed cell of the view (false: not one, or the
+ * view's labels are not settled yet). */
+static bool view_label(const view_exits *v, const int64_t *cell, int32_t *label)
+{
+    if (!v->labels || !cm_box_contains(&v->flat->box, cell))
+        return false;
+    const uint64_t i = cm_box_index(&v->flat->box, cell);
+    if (v->flat->group[i] == CM_GROUP_NONE)
+        return false;
+    *label = v->labels[i];
+    return true;
+}
+
 /* The labels of n followed exits: diverged, outside, or the end of the
- * cell their orbit returned to (found region by region). */
+ * cell their orbit returned to (the view's label, else found region by
+ * region). */
 static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int32_t *label,
                                char *msg, size_t msg_size)
 {
     const int dim = v->dim;
-    uint64_t back = 0;
-    for (uint64_t e = 0; e < n; e++)
-        back += f[e].how == FOLLOW_RETURNED;
-    int64_t *cell = malloc(((size_t)back + 1) * (size_t)dim * sizeof *cell);
-    int32_t *end = malloc(((size_t)back + 1) * sizeof *end);
-    cm_status st =
-        cell && end ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
-    uint64_t k = 0;
-    for (uint64_t e = 0; st == CM_OK && e < n; e++)
-        if (f[e].how == FOLLOW_RETURNED)
-            memcpy(cell + (k++) * (uint64_t)dim, f[e].cell, (size_t)dim * sizeof *cell);
+    int64_t *cell = malloc(((size_t)n + 1) * (size_t)dim * sizeof *cell);
+    uint64_t *asked = malloc(((size_t)n + 1) * sizeof *asked), nasked = 0;
+    int32_t *end = malloc(((size_t)n + 1) * sizeof *end);
+    cm_status st = cell && asked && end ? CM_OK
+                                        : cm_fail(CM_ENOMEM, msg, msg_size,
+                                                  "out of memory for the view's exits");
+    for (uint64_t e = 0; st == CM_OK && e < n; e++) {
+        label[e] = f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+        if (f[e].how != FOLLOW_RETURNED || view_label(v, f[e].cell, &label[e]))
+            continue;
+        memcpy(cell + nasked * (uint64_t)dim, f[e].cell, (size_t)dim * sizeof *cell);
+        asked[nasked++] = e;
+    }
     if (st == CM_OK)
-        st = ends_by_region(v, cell, back, end, msg, msg_size);
-    k = 0;
-    for (uint64_t e = 0; st == CM_OK && e < n; e++)
-        label[e] = f[e].how == FOLLOW_RETURNED ? end[k++]
-                   : f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED
-                                                 : CM_LABEL_OUTSIDE;
+        st = ends_by_region(v, cell, nasked, end, msg, msg_size);
+    for (uint64_t i = 0; st == CM_OK && i < nasked; i++)
+        label[asked[i]] = end[i];
     free(cell);
+    free(asked);
     free(end);
     return st;
 }
@@ -1171,8 +1222,9 @@ static cm_status view_exit_set(const view_exits *v, const int32_t *label, const 
 }
 
 cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                                 const cm_attractor_options *opt, cm_exit_memo *memo,
-                                 cm_attractor_set *s, int32_t *labels, char *msg, size_t msg_size)
+                                 const uint32_t *open, const cm_attractor_options *opt,
+                                 cm_exit_memo *memo, cm_attractor_set *s, int32_t *labels,
+                                 char *msg, size_t msg_size)
 {
     if (c->resolved_cells || c->open_released || !c->keep_exits)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -1182,6 +1234,18 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     v.c = c;
     v.s = s;
     v.dim = c->lat.dim;
+    v.flat = flat;
+    v.open = open;
+    if (open) {
+        v.cached_open = malloc(OPEN_CACHE * sizeof *v.cached_open);
+        v.cached_slot = malloc(OPEN_CACHE * sizeof *v.cached_slot);
+        if (!v.cached_open || !v.cached_slot) {
+            free(v.cached_open);
+            free(v.cached_slot);
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
+        }
+        memset(v.cached_open, 0xFF, OPEN_CACHE * sizeof *v.cached_open); /* CM_NODE_OPEN */
+    }
     const uint32_t steps = outside_budget(m, opt);
     const int threads = opt ? opt->threads : 0;
     int32_t *fate = NULL;
@@ -1191,6 +1255,7 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     cm_status st = label_cells(s, flat, view_leaving, &v, labels, msg, msg_size);
     if (st == CM_OK)
         st = settle_ends(&v, labels, flat->ncells, threads, msg, msg_size);
+    v.labels = labels;
     if (st == CM_OK)
         st = view_fates(m, &v, steps, threads, memo, &fate, &taken, msg, msg_size);
     if (memo)
@@ -1217,6 +1282,8 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     free(v.cell);
     free(v.hash);
     free(v.end);
+    free(v.cached_open);
+    free(v.cached_slot);
     return st;
 }
 

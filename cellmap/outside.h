@@ -162,11 +162,14 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
  * earlier calls on this cluster and model found following exits
  * (cellmap/exit_memo.h): exits it knows are not followed again, and it
  * keeps what this call used; the labels and s are the same with or
- * without it. CM_EINVAL for a cluster that keeps no exits (keep_exits 0,
- * released, or resolved cells). */
+ * without it. open (NULL: none) is what cm_cluster_flatten_open gave with
+ * flat: the cells whose sequences leave the part are then not looked up in
+ * the cluster; the result is the same. CM_EINVAL for a cluster that keeps
+ * no exits (keep_exits 0, released, or resolved cells). */
 cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                                 const cm_attractor_options *opt, cm_exit_memo *memo,
-                                 cm_attractor_set *s, int32_t *labels, char *msg, size_t msg_size);
+                                 const uint32_t *open, const cm_attractor_options *opt,
+                                 cm_exit_memo *memo, cm_attractor_set *s, int32_t *labels,
+                                 char *msg, size_t msg_size);
 
 /* The label of every node of cluster c (node_label[id]): the label its
  * exit's chain of links ends on (a group's attractor; for an open node,

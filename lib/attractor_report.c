@@ -183,8 +183,9 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
 }
 
 cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                      const cm_group_info *groups, bool every_exit, cm_exit_memo *memo,
-                      cm_attractor_set *att, int32_t **labels, char *msg, size_t msg_size)
+                      const uint32_t *open, const cm_group_info *groups, bool every_exit,
+                      cm_exit_memo *memo, cm_attractor_set *att, int32_t **labels, char *msg,
+                      size_t msg_size)
 {
     *labels = cm_cells_array((flat->ncells + 1) * sizeof **labels);
     if (!*labels)
@@ -194,7 +195,8 @@ cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
         st = cm_attractors_find(m, &c->lat, groups, c->ngroups, cm_cluster_cells_group, c, NULL,
                                 att, msg, msg_size);
         if (st == CM_OK)
-            st = cm_cluster_view_labels(m, c, flat, NULL, memo, att, *labels, msg, msg_size);
+            st = cm_cluster_view_labels(m, c, flat, open, NULL, memo, att, *labels, msg,
+                                        msg_size);
     } else {
         cluster_ends ends;
         memset(&ends, 0, sizeof ends);

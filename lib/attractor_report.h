@@ -74,10 +74,12 @@ cm_status file_attractors(cm_store *s, const cm_store_info *info, const cm_model
  * cluster knows its exits and every_exit is false, through memo (NULL:
  * none; cellmap/exit_memo.h); else every exit (cm_cluster_attractors: the
  * attractors' basins are then the cluster's). The labels are the same
- * either way. */
+ * either way. open (NULL: none): flat's cells' open nodes, from
+ * cm_cluster_flatten_open, which spare the first way lookups. */
 cm_status part_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
-                      const cm_group_info *groups, bool every_exit, cm_exit_memo *memo,
-                      cm_attractor_set *att, int32_t **labels, char *msg, size_t msg_size);
+                      const uint32_t *open, const cm_group_info *groups, bool every_exit,
+                      cm_exit_memo *memo, cm_attractor_set *att, int32_t **labels, char *msg,
+                      size_t msg_size);
 
 /* Group g's label by attractors: its attractor's id, or 0 when its orbit
  * diverges or is undecided (and for the sink, g = 0); CM_GROUP_NONE stays. */

@@ -388,9 +388,11 @@ cm_status session_extend(session *s, const cm_box *tile, int steps, session_step
 
 /* ---- render, stats ------------------------------------------------------------ */
 
-/* The shown layer of the view, flattened, and the cluster's groups. */
-static cm_status shown_cells(session *s, cm_region *flat, cm_group_info **groups, char *msg,
-                             size_t msg_size)
+/* The shown layer of the view, flattened, and the cluster's groups; with
+ * open non-NULL, also the cells' open nodes (cm_cluster_flatten_open) into
+ * a new *open, the caller's to free. */
+static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_group_info **groups,
+                             char *msg, size_t msg_size)
 {
     cm_box box;
     uint64_t sink = 0;
@@ -399,9 +401,12 @@ static cm_status shown_cells(session *s, cm_region *flat, cm_group_info **groups
     if (!*groups)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", s->c.ngroups);
     cm_status st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
-    if (st == CM_OK)
-        st = cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
-    return st;
+    if (st != CM_OK || !open)
+        return st == CM_OK ? cm_cluster_flatten(&s->c, &box, flat, msg, msg_size) : st;
+    *open = cm_cells_array((cm_box_cells(&box) + 1) * sizeof **open);
+    if (!*open)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
+    return cm_cluster_flatten_open(&s->c, &box, flat, *open, msg, msg_size);
 }
 
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
@@ -418,16 +423,19 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
         return st;
     cm_region flat;
     cm_group_info *groups = NULL;
+    uint32_t *open = NULL;
     memset(&flat, 0, sizeof flat);
-    st = shown_cells(s, &flat, &groups, msg, msg_size);
+    const bool by_attractors = po->by == BY_ATTRACTORS;
+    st = shown_cells(s, &flat, by_attractors ? &open : NULL, &groups, msg, msg_size);
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
     int32_t *labels = NULL;
-    if (st == CM_OK && po->by == BY_ATTRACTORS && !s->exit_memo)
+    if (st == CM_OK && by_attractors && !s->exit_memo)
         s->exit_memo = cm_exit_memo_new(); /* NULL: labels without it */
-    if (st == CM_OK && po->by == BY_ATTRACTORS)
-        st = part_labels(&s->model, &s->c, &flat, groups, false, s->exit_memo, &att, &labels,
-                         msg, msg_size);
+    if (st == CM_OK && by_attractors)
+        st = part_labels(&s->model, &s->c, &flat, open, groups, false, s->exit_memo, &att,
+                         &labels, msg, msg_size);
+    free(open);
     if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
@@ -458,7 +466,8 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
                                      size_t msg_size)
 {
     int32_t *label = NULL;
-    cm_status st = part_labels(&s->model, &s->c, flat, groups, true, NULL, att, &label, msg, msg_size);
+    cm_status st = part_labels(&s->model, &s->c, flat, NULL, groups, true, NULL, att, &label, msg,
+                                 msg_size);
     *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
     if (st == CM_OK && !*by_label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors in view");
@@ -474,7 +483,7 @@ cm_status session_count(session *s, session_stats *v, char *msg, size_t msg_size
     cm_status st = session_need_view(s, "stats", msg, msg_size);
     if (st != CM_OK)
         return st;
-    st = shown_cells(s, &v->flat, &v->groups, msg, msg_size);
+    st = shown_cells(s, &v->flat, NULL, &v->groups, msg, msg_size);
     const cm_region *flat = &v->flat;
     v->in_view = st == CM_OK ? calloc((size_t)flat->ngroups + 2, sizeof *v->in_view) : NULL;
     if (st == CM_OK && !v->in_view)

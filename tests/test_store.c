@@ -360,13 +360,64 @@ static void damaged_group(const char *path, const cm_attractor_set *att, const i
     free(blob);
 }
 
+/* The part flattened with its cells' open nodes (cm_cluster_flatten_open)
+ * is the part flattened alone, each cell's open node is the one
+ * cm_cluster_cell_end gives, and the labels and exits found with them are
+ * those found without (want, ws). Returns the cells that leave by an open
+ * node. */
+static uint64_t check_open_labels(cm_cluster *c, const cm_model *m, const cm_group_info *g,
+                              const cm_region *part, const int32_t *want,
+                              const cm_attractor_set *ws)
+{
+    char msg[512];
+    cm_region flat;
+    const uint64_t n = part->ncells;
+    uint32_t *open = malloc(n * sizeof *open);
+    int32_t *labels = malloc(n * sizeof *labels);
+    CHECK(cm_cluster_flatten_open(c, &part->box, &flat, open, msg, sizeof msg) == CM_OK);
+    CHECK(memcmp(flat.group, part->group, n * sizeof *flat.group) == 0);
+    CHECK(memcmp(flat.step, part->step, n * sizeof *flat.step) == 0);
+    CHECK(memcmp(flat.image, part->image, n * sizeof *flat.image) == 0);
+    uint64_t wrong_open = 0, leaving = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        int64_t cell[CM_MAX_DIM];
+        uint32_t group, end;
+        cm_box_cell(&part->box, i, cell);
+        CHECK(cm_cluster_cell_end(c, cell, &group, &end, msg, sizeof msg) == CM_OK);
+        wrong_open += end != open[i];
+        leaving += open[i] != CM_NODE_OPEN;
+    }
+    CHECK_INT(wrong_open, 0);
+    cm_attractor_set s;
+    CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cells_group, c, NULL, &s, msg,
+                             sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &flat, open, NULL, NULL, &s, labels, msg, sizeof msg) ==
+          CM_OK);
+    CHECK(memcmp(labels, want, n * sizeof *labels) == 0);
+    CHECK_INT(s.nexits, ws->nexits);
+    CHECK(s.nexits == 0 ||
+          memcmp(s.exit_cell, ws->exit_cell, s.nexits * c->lat.dim * sizeof *s.exit_cell) == 0);
+    CHECK(s.nexits == 0 ||
+          memcmp(s.exit_label, ws->exit_label, s.nexits * sizeof *s.exit_label) == 0);
+    CHECK_INT(s.returned_cells, ws->returned_cells);
+    CHECK_INT(s.outside_cells, ws->outside_cells);
+    CHECK_INT(s.outside_steps_taken, ws->outside_steps_taken);
+    cm_attractors_free(&s);
+    cm_region_free(&flat);
+    free(open);
+    free(labels);
+    return leaving;
+}
+
 /* The labels of a flattened part that follows only the exits its cells
  * reach (cm_cluster_view_labels) are the cluster-wide ones (want, of the
  * box all), cell by cell; for the whole box its counts are the
- * cluster's too. Returns the exits it followed. */
+ * cluster's too; and so are they with the cells' open nodes given
+ * (check_open_labels, whose count it adds to *leaving). Returns the exits
+ * it followed. */
 static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_group_info *g,
                                   const cm_attractor_set *full, const cm_box *all,
-                                  const int32_t *want, const cm_box *view)
+                                  const int32_t *want, const cm_box *view, uint64_t *leaving)
 {
     char msg[512];
     cm_region part;
@@ -375,7 +426,7 @@ static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_gro
     CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cells_group, c, NULL, &vs, msg,
                              sizeof msg) == CM_OK);
     int32_t *labels = malloc(part.ncells * sizeof *labels);
-    const cm_status vst = cm_cluster_view_labels(m, c, &part, NULL, NULL, &vs, labels, msg, sizeof msg);
+    const cm_status vst = cm_cluster_view_labels(m, c, &part, NULL, NULL, NULL, &vs, labels, msg, sizeof msg);
     if (vst != CM_OK)
         fprintf(stderr, "view labels: %s\n", msg);
     CHECK(vst == CM_OK);
@@ -396,6 +447,7 @@ static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_gro
             CHECK_INT(vs.a[a].basin_cells, full->a[a].basin_cells);
     }
     const uint64_t followed = vs.nexits;
+    *leaving += check_open_labels(c, m, g, &part, labels, &vs);
     free(labels);
     cm_attractors_free(&vs);
     cm_region_free(&part);
@@ -442,7 +494,7 @@ static void test_view_closure(void)
     CHECK(cm_attractor_cell_labels(&full, &a, &cells, want, msg, sizeof msg) == CM_OK);
     CHECK(cm_attractors_find(&m, &lat, g, c.ngroups, cm_cluster_cells_group, &c, NULL, &view, msg,
                              sizeof msg) == CM_OK);
-    CHECK(cm_cluster_view_labels(&m, &c, &a, NULL, NULL, &view, got, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(&m, &c, &a, NULL, NULL, NULL, &view, got, msg, sizeof msg) == CM_OK);
     for (int i = 0; i < 40; i++)
         CHECK_INT(got[i], want[i]);
     for (int row = 0; row < 4; row++) /* every cell of a row: the row's fixed point */
@@ -516,8 +568,9 @@ static void test_cell_labels(const char *path, const cm_model *m)
     CHECK_INT(differ, 0);
     /* the view's own labels: the whole box, the window, and random boxes
      * (some within one region, most across several) */
-    uint64_t followed = check_view_labels(&c, m, g, &att, &all, want, &all);
-    CHECK(check_view_labels(&c, m, g, &att, &all, want, &window) < followed);
+    uint64_t leaving = 0;
+    uint64_t followed = check_view_labels(&c, m, g, &att, &all, want, &all, &leaving);
+    CHECK(check_view_labels(&c, m, g, &att, &all, want, &window, &leaving) < followed);
     uint64_t seed = 12345;
     for (int k = 0; k < 12; k++) {
         cm_box b = {2, {0, 0}, {1, 1}};
@@ -529,15 +582,17 @@ static void test_cell_labels(const char *path, const cm_model *m)
             b.lo[d] = lo;
             b.hi[d] = lo + 1 + (int64_t)((seed >> 33) % (uint64_t)(side - lo));
         }
-        check_view_labels(&c, m, g, &att, &all, want, &b);
+        check_view_labels(&c, m, g, &att, &all, want, &b, &leaving);
     }
+    CHECK(leaving > 0); /* not vacuous: cells whose ends the open nodes give */
     damaged_group(path, &att, node_label, &window, got);
     fprintf(stderr,
             "cell labels: %llu cells agree; %llu in basins, of the sink's %llu returned, %llu "
-            "outside; a view of the whole box follows %llu exits\n",
+            "outside; a view of the whole box follows %llu exits; %llu view cells leave by "
+            "open nodes\n",
             (unsigned long long)flat.ncells, (unsigned long long)attractors,
             (unsigned long long)returned, (unsigned long long)outside,
-            (unsigned long long)followed);
+            (unsigned long long)followed, (unsigned long long)leaving);
     free(want);
     free(got);
     free(node_label);
@@ -549,23 +604,24 @@ static void test_cell_labels(const char *path, const cm_model *m)
     CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
 }
 
-/* The labels of one view with and without the memo of followed exits:
- * the same cells, and the same exits with the same fates and counts.
- * Returns the cells in attractors' basins. */
+/* The labels of one view with the memo of followed exits and the cells'
+ * open nodes, and without either: the same cells, and the same exits with
+ * the same fates and counts. Returns the cells in attractors' basins. */
 static uint64_t check_memo_labels(cm_cluster *c, const cm_model *m, const cm_group_info *g,
                               cm_exit_memo *memo, const cm_box *view)
 {
     char msg[512];
     cm_region part;
-    CHECK(cm_cluster_flatten(c, view, &part, msg, sizeof msg) == CM_OK);
+    uint32_t *open = malloc(cm_box_cells(view) * sizeof *open);
+    CHECK(cm_cluster_flatten_open(c, view, &part, open, msg, sizeof msg) == CM_OK);
     cm_attractor_set with, without;
     int32_t *a = malloc(part.ncells * sizeof *a), *b = malloc(part.ncells * sizeof *b);
     CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cells_group, c, NULL, &with,
                              msg, sizeof msg) == CM_OK);
     CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cells_group, c, NULL, &without,
                              msg, sizeof msg) == CM_OK);
-    CHECK(cm_cluster_view_labels(m, c, &part, NULL, memo, &with, a, msg, sizeof msg) == CM_OK);
-    CHECK(cm_cluster_view_labels(m, c, &part, NULL, NULL, &without, b, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &part, open, NULL, memo, &with, a, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &part, NULL, NULL, NULL, &without, b, msg, sizeof msg) == CM_OK);
     uint64_t differ = 0, in_basins = 0;
     for (uint64_t i = 0; i < part.ncells; i++) {
         differ += a[i] != b[i];
@@ -582,6 +638,7 @@ static uint64_t check_memo_labels(cm_cluster *c, const cm_model *m, const cm_gro
     CHECK_INT(with.outside_steps_taken, without.outside_steps_taken);
     free(a);
     free(b);
+    free(open);
     cm_attractors_free(&with);
     cm_attractors_free(&without);
     cm_region_free(&part);
