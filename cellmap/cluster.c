@@ -788,6 +788,15 @@ static cm_status spill_open_weights(cm_cluster *c, cm_cluster_region *cr)
     return CM_OK;
 }
 
+/* Whether node tables of table_bytes must shrink beside `cells` bytes of
+ * cells: beyond their quarter of the budget, unless the cells leave them
+ * room (the two within the budget and its quarter). */
+static bool tables_over(const cm_cluster *c, uint64_t cells, uint64_t table_bytes)
+{
+    const uint64_t table_budget = c->mem_budget / 4;
+    return table_bytes > table_budget && cells + table_bytes > c->mem_budget + table_budget;
+}
+
 /* Evicts until `extra` more bytes of cells fit the budget, and (with
  * `tables`) the node tables fit a quarter of it (see victims). Region
  * `keep` stays; a region being joined (`joining`, or -1) is not counted. */
@@ -801,8 +810,7 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
     cells += extra + c->mem_reserved;
     if (joining >= 0 && is_resident(&c->regions[joining]))
         cells -= cm_region_bytes(&c->regions[joining].r);
-    const uint64_t table_budget = c->mem_budget / 4;
-    tables = tables && table_bytes > table_budget;
+    tables = tables && tables_over(c, cells, table_bytes);
     if (cells <= c->mem_budget && !tables)
         return CM_OK;
     victim *v = NULL;
@@ -813,7 +821,7 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
     cm_status st = CM_OK;
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
         cm_cluster_region *cr = &c->regions[v[i].k];
-        if (v[i].nodes && table_bytes > table_budget) {
+        if (v[i].nodes && tables_over(c, cells, table_bytes)) {
             if (spill_open_weights(c, cr) != CM_OK)
                 continue; /* the table stays */
             free(cr->nodes);

@@ -161,8 +161,10 @@ typedef struct cm_cluster {
      * within mem_budget (more only while one region alone is bigger); a
      * region never saved is saved through page_out first (kept resident if
      * there is none). cm_cluster_trim also evicts clean node tables, read
-     * back on use through nodes_in, to keep them within mem_budget / 4 (more
-     * only within a join, which never evicts them). */
+     * back on use through nodes_in, to keep them within mem_budget / 4, or
+     * beyond it within the room the cells leave (cells and tables within
+     * mem_budget * 5 / 4); more only within a join, which never evicts
+     * them. */
     cm_page_in_fn page_in;   /* public */
     cm_page_out_fn page_out; /* public */
     cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
