@@ -123,6 +123,48 @@ static void reserve_for_exits(cm_cluster *c)
     c->mem_reserved = held;
 }
 
+/* Bytes of c's resident node tables (only the clean ones, which a trim
+ * may evict, with `clean`). */
+static uint64_t table_bytes(const cm_cluster *c, bool clean)
+{
+    uint64_t bytes = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        const cm_cluster_region *cr = &c->regions[k];
+        if (cr->nodes && !(clean && cr->nodes_dirty))
+            bytes += cr->r.nexits * sizeof(cm_node);
+    }
+    return bytes;
+}
+
+/* Node tables beyond their quarter of the budget stay while the cells
+ * leave them room (cells and tables within the budget and its quarter),
+ * and are shed once the cells do not (all but the changed ones, which a
+ * trim keeps). Reads every table back; c's budget is as it was on
+ * return. */
+static void tables_use_free_room(cm_cluster *c)
+{
+    char msg[256];
+    const uint64_t budget = c->mem_budget;
+    for (uint32_t k = 0; k < c->nregions; k++) { /* every table resident */
+        cm_node *nd;
+        CHECK(cm_cluster_node_load(c, c->regions[k].node_base, &nd, msg, sizeof msg) == CM_OK ||
+              c->regions[k].r.nexits == 0);
+    }
+    const uint64_t tables = table_bytes(c, false);
+    const uint64_t cells = cm_cluster_resident_bytes(c) - tables + c->mem_reserved;
+    /* a budget whose quarter the tables pass, with room for both */
+    c->mem_budget = (cells + tables) * 4 / 5 + 1;
+    CHECK(cells <= c->mem_budget && tables > c->mem_budget / 4); /* else the test says nothing */
+    cm_cluster_trim(c);
+    CHECK_INT(table_bytes(c, false), tables);
+    /* cells that fill it: the tables go back to their quarter */
+    c->mem_budget = cells;
+    cm_cluster_trim(c);
+    CHECK(table_bytes(c, false) <= c->mem_budget / 4 || table_bytes(c, true) == 0);
+    CHECK(table_bytes(c, false) < tables);
+    c->mem_budget = budget;
+}
+
 /* Solves the tiling into path (NULL: in memory only) under a budget of
  * `budget_regions` regions (0: none) with `threads` threads; returns the
  * flattened cluster in flat. */
@@ -159,6 +201,8 @@ static void solve_tiles(const cm_model *m, const char *path, int budget_regions,
     CHECK(cm_cluster_flatten(&c, &all, flat, msg, sizeof msg) == CM_OK);
     if (s) {
         cm_store_get_stats(s, stats);
+        if (budget_regions) /* after the stats: it reads every table */
+            tables_use_free_room(&c);
         CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
     }
     cm_cluster_free(&c);
