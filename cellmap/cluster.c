@@ -798,7 +798,8 @@ static bool tables_over(const cm_cluster *c, uint64_t cells, uint64_t table_byte
 }
 
 /* Evicts until `extra` more bytes of cells fit the budget, and (with
- * `tables`) the node tables fit a quarter of it (see victims). Region
+ * `tables`) the node tables fit a quarter of it or the room the cells
+ * leave (tables_over; see victims). Region
  * `keep` stays; a region being joined (`joining`, or -1) is not counted. */
 static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t extra, int tables,
                       char *msg, size_t msg_size)

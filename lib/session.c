@@ -401,8 +401,10 @@ static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_gr
     if (!*groups)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", s->c.ngroups);
     cm_status st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
-    if (st != CM_OK || !open)
-        return st == CM_OK ? cm_cluster_flatten(&s->c, &box, flat, msg, msg_size) : st;
+    if (st != CM_OK)
+        return st;
+    if (!open)
+        return cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
     *open = cm_cells_array((cm_box_cells(&box) + 1) * sizeof **open);
     if (!*open)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
@@ -466,8 +468,8 @@ static cm_status count_by_attractors(session *s, const cm_region *flat, const cm
                                      size_t msg_size)
 {
     int32_t *label = NULL;
-    cm_status st = part_labels(&s->model, &s->c, flat, NULL, groups, true, NULL, att, &label, msg,
-                                 msg_size);
+    cm_status st =
+        part_labels(&s->model, &s->c, flat, NULL, groups, true, NULL, att, &label, msg, msg_size);
     *by_label = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **by_label) : NULL;
     if (st == CM_OK && !*by_label)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the attractors in view");
