@@ -339,7 +339,7 @@ static cm_status region_end(void *user, const int64_t *cell, uint32_t *group, bo
 
 cm_computed cm_region_computed(cm_region_cells *rc)
 {
-    return (cm_computed){region_holds, region_end, rc, rc->r->box, NULL};
+    return (cm_computed){region_holds, region_end, rc, rc->r->box, NULL, NULL};
 }
 
 static bool cluster_holds(const void *user, const int64_t *cell)
@@ -399,9 +399,14 @@ static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, b
 
 static void cluster_between(void *user) { cm_cluster_trim(((cm_cluster_cells *)user)->c); }
 
+static cm_status cluster_order(void *user, const int64_t *cells, uint64_t n, uint64_t **order)
+{
+    return cm_cluster_region_order(((cm_cluster_cells *)user)->c, cells, n, order);
+}
+
 cm_computed cm_cluster_computed(cm_cluster_cells *cc)
 {
-    cm_computed out = {cluster_holds, cluster_end, cc, {0}, cluster_between};
+    cm_computed out = {cluster_holds, cluster_end, cc, {0}, cluster_between, cluster_order};
     cm_cluster_bounds(cc->c, &out.bounds);
     return out;
 }
@@ -649,6 +654,49 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
  * of an orbit stays small (a cluster can have millions of exits). */
 #define FOLLOW_CHUNK ((uint64_t)1 << 14)
 
+/* The exits whose orbits returned to a computed cell, and those cells:
+ * their ends are asked once every exit is followed, in the order the cells'
+ * owner reads best. Asked chunk by chunk, a paged cluster read a region
+ * back for nearly every one: a 400-pan explore session's close read its
+ * first region about 260 times. */
+typedef struct returned_list {
+    uint64_t n, cap, cell_cap;
+    uint64_t *exit;
+    int64_t *cell;
+} returned_list;
+
+static cm_status returned_add(returned_list *l, int dim, uint64_t e, const int64_t *cell)
+{
+    if (cm_grow((void **)&l->exit, &l->cap, l->n + 1, sizeof *l->exit) != CM_OK ||
+        cm_grow((void **)&l->cell, &l->cell_cap, (l->n + 1) * (uint64_t)dim, sizeof *l->cell) !=
+            CM_OK)
+        return CM_ENOMEM;
+    l->exit[l->n] = e;
+    memcpy(l->cell + l->n++ * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
+    return CM_OK;
+}
+
+/* The returned exits' labels and links (returned_to), in cells->order. */
+static cm_status returned_all(const cm_computed *cells, const cm_exits *x, int dim,
+                              const cm_attractor_set *s, const returned_list *l, int32_t *label,
+                              uint64_t *next, char *msg, size_t msg_size)
+{
+    uint64_t *order = NULL;
+    if (cells->order && cells->order(cells->user, l->cell, l->n, &order) != CM_OK)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory ordering %llu returned orbits",
+                       (unsigned long long)l->n);
+    cm_status st = CM_OK;
+    for (uint64_t k = 0; k < l->n && st == CM_OK; k++) {
+        const uint64_t i = order ? order[k] : k;
+        if (cells->between && k % FOLLOW_CHUNK == FOLLOW_CHUNK - 1)
+            cells->between(cells->user); /* nothing an end read is held here */
+        st = returned_to(cells, x, dim, s, l->cell + i * (uint64_t)dim, &label[l->exit[i]],
+                         &next[l->exit[i]], msg, msg_size);
+    }
+    free(order);
+    return st;
+}
+
 /* The set's exit cells, once following is done: x's own when it is spent
  * (the rest of it freed), else a copy. */
 static cm_status set_exit_cells(const cm_exits *x, cm_exits *spent, int dim, cm_attractor_set *s)
@@ -688,21 +736,24 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                  (unsigned long long)x->n);
     uint64_t taken = 0;
+    returned_list back;
+    memset(&back, 0, sizeof back);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
-        if (cells->between)
-            cells->between(cells->user);
         st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
             const uint64_t e = first + i;
             next[e] = NEXT_LABEL;
             s->exit_label[e] = f[i].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
-            if (f[i].how == FOLLOW_RETURNED)
-                st = returned_to(cells, x, dim, s, f[i].cell, &s->exit_label[e], &next[e], msg,
-                                 msg_size);
+            if (f[i].how == FOLLOW_RETURNED && returned_add(&back, dim, e, f[i].cell) != CM_OK)
+                st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the returned orbits");
         }
     }
+    if (st == CM_OK)
+        st = returned_all(cells, x, dim, s, &back, s->exit_label, next, msg, msg_size);
+    free(back.exit);
+    free(back.cell);
     if (st == CM_OK) {
         settle_chains(x->n, next, s->exit_label);
         s->outside_steps_taken = taken;
@@ -710,7 +761,7 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
     }
     free(f);
     free(next);
-    if (cells->between) /* what the last chunk's ends read, before the copy below */
+    if (cells->between) /* what the ends read, before the copy below */
         cells->between(cells->user);
     if (st == CM_OK && set_exit_cells(x, spent, dim, s) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",

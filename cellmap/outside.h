@@ -102,6 +102,11 @@ typedef struct cm_computed {
      * through end is held: the cluster's adapter evicts what its budget
      * does not hold (node tables the ends read) */
     void (*between)(void *user);
+    /* NULL, or the order in which end() reads n cells (dim coordinates
+     * each) best: *order lists their indices (n entries, the caller's to
+     * free; the cluster's adapter: region by region, so that a paged
+     * cluster reads each region once); CM_ENOMEM */
+    cm_status (*order)(void *user, const int64_t *cells, uint64_t n, uint64_t **order);
 } cm_computed;
 
 /* The adapters for a resolved region (its exits recorded, else found
