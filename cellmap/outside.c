@@ -688,8 +688,8 @@ static cm_status returned_all(const cm_computed *cells, const cm_exits *x, int d
     cm_status st = CM_OK;
     for (uint64_t k = 0; k < l->n && st == CM_OK; k++) {
         const uint64_t i = order ? order[k] : k;
-        if (cells->between && k % FOLLOW_CHUNK == FOLLOW_CHUNK - 1)
-            cells->between(cells->user); /* nothing an end read is held here */
+        if (cells->between && k % 1024 == 1023) /* as cm_cluster_cells_group_shedding */
+            cells->between(cells->user);        /* nothing an end read is held here */
         st = returned_to(cells, x, dim, s, l->cell + i * (uint64_t)dim, &label[l->exit[i]],
                          &next[l->exit[i]], msg, msg_size);
     }
@@ -740,6 +740,8 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
     memset(&back, 0, sizeof back);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
+        if (cells->between)
+            cells->between(cells->user);
         st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
