@@ -1,10 +1,7 @@
 /* cellmap - cell mapping and global dynamics from the command line. */
-#include <stdio.h> /* first: it says whether the C library is glibc */
 #include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 
 #include "lib/outfile.h"
 #include "src/args.h"
@@ -77,13 +74,6 @@ static int finish(const char *name, int status)
 
 int main(int argc, char **argv)
 {
-#ifdef __GLIBC__
-    /* Arrays of a megabyte or more (regions' cells) in their own mappings:
-     * glibc would otherwise raise this threshold after the first frees and
-     * keep evicted regions' arrays as holes in its heap, so that a run
-     * under --mem held far more memory than its budget. */
-    mallopt(M_MMAP_THRESHOLD, 1 << 20);
-#endif
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

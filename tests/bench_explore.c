@@ -13,7 +13,6 @@
  * pan's time (compute + join + commit, render), the medians, the ratio of
  * the last ten pans to pans 11-20 (with 20 pans or more) and the ratio of
  * a pan to the full recompute. */
-#include <malloc.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -95,9 +94,6 @@ static void close_session(explore *s)
 
 int main(int argc, char **argv)
 {
-    /* as cellmap's main (see there), so that the pans cost what explore's
-     * do: arrays of a megabyte or more are mapped afresh each time */
-    mallopt(M_MMAP_THRESHOLD, 1 << 20);
     const preset *p = &presets[0];
     const char *dir = argc > 2 ? argv[2] : "/tmp";
     for (size_t k = 0; argc > 1 && k < sizeof presets / sizeof presets[0]; k++)

@@ -20,7 +20,6 @@
  * usage: bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]
  *        (default 20 10 1000 256 /tmp paged,db,memory,scm) */
 #define _DEFAULT_SOURCE /* wait4: the peak RSS of one child */
-#include <malloc.h> /* glibc: the benchmark runs where cellmap's tests do */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,7 +192,6 @@ static void run_child(const config *cf, const char *name, const char *db, uint64
 
 int main(int argc, char **argv)
 {
-    mallopt(M_MMAP_THRESHOLD, 1 << 20); /* as cellmap's main: see there */
     config cf = {20, 10, 1000, 256, "/tmp"};
     if (argc > 1 && argc != 6 && argc != 7)
         die("usage", "bench_store [TX TY SIDE MEM_MiB DIR [RUNS]]");
