@@ -72,7 +72,9 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
 /* The most a pass over a cluster's exits holds beside the cluster, in
  * bytes: CM_EXITS_PASS_BYTES per open node (2-D and more per coordinate
  * beyond two): cm_cluster_exits' listing at its peak, then the exits, their
- * fates and chains while cm_cluster_attractors follows them. An owner that
+ * fates and chains while cm_cluster_attractors follows them (and 8 bytes
+ * and a cell more for each exit whose orbit returns to a computed cell,
+ * whose end is asked after: 1 % of a 400-pan explore session's). An owner that
  * pages the cluster adds it to c->mem_reserved for the pass, so that the
  * budget bounds the pass's arrays too (a long session's close lists a
  * million open nodes and more). Reads no cell or node table. */
