@@ -622,7 +622,7 @@ static int hop_step(const cm_model *m, const double *x, double *y)
 }
 
 /* The attractors of a paged cluster, under a budget of one byte, are those
- * of the same cluster in memory, and finding them reads each region back a
+ * of the same cluster in memory, and finding them reads each region back
  * twice at most: the ends of the returned orbits are asked region by
  * region (asked in the exits' order, they read one region per hop). */
 static void test_returned_reads(const char *dir)
@@ -665,6 +665,7 @@ static void test_returned_reads(const char *dir)
     CHECK_INT(got.returned_cells, want.returned_cells);
     CHECK(got.returned_cells > 0);
     CHECK_INT(got.n, want.n);
+    CHECK_INT(want.nexits, got.nexits);
     for (uint64_t e = 0; e < got.nexits; e++)
         CHECK_INT(got.exit_label[e], want.exit_label[e]);
     CHECK(counted.reads <= 2 * HOPS); /* 144 when asked in the exits' order */
