@@ -247,32 +247,36 @@ static void lookups_by_region(cm_store *s, cm_cluster *c, const cm_region *flat)
 
 static void test_budgets(const char *dir, const cm_model *m)
 {
-    char path[4][256];
-    cm_region flat[5];
-    cm_store_stats st[4];
-    const int budgets[4] = {0, 4, 1, 0};
-    const int threads[4] = {2, 2, 2, 1};
-    const int commit_each[4] = {1, 1, 0, 1};
-    solve_tiles(m, NULL, 0, 2, 1, &flat[4], NULL);
-    for (int k = 0; k < 4; k++) {
+    enum { RUNS = 6, REF = RUNS }; /* flat[REF]: the cluster solved in memory */
+    char path[RUNS][256];
+    cm_region flat[RUNS + 1];
+    cm_store_stats st[RUNS];
+    const int budgets[RUNS] = {0, 4, 1, 0, 4, 1};
+    const int threads[RUNS] = {2, 2, 2, 1, 1, 1};
+    const int commit_each[RUNS] = {1, 1, 0, 1, 1, 0};
+    solve_tiles(m, NULL, 0, 2, 1, &flat[REF], NULL);
+    for (int k = 0; k < RUNS; k++) {
         snprintf(path[k], sizeof path[k], "%s/budget%d-%d.cmdb", dir, budgets[k], threads[k]);
         solve_tiles(m, path[k], budgets[k], threads[k], commit_each[k], &flat[k], &st[k]);
-        CHECK(same_region(&flat[k], &flat[4]));
+        CHECK(same_region(&flat[k], &flat[REF]));
     }
-    /* unlimited never reads back; 4 and 1 regions do, the smaller more */
+    /* unlimited never reads back; 4 and 1 regions do, the smaller more on
+     * one thread (on two, what the second solves ahead of the joins, and
+     * so the reads, depend on timing: 6 and 7 or 8 here, once not more in CI) */
     CHECK_INT(st[0].regions_read, 0);
-    CHECK(st[1].regions_read > 0);
-    CHECK(st[2].regions_read > st[1].regions_read);
+    CHECK(st[1].regions_read > 0 && st[2].regions_read > 0);
+    CHECK(st[4].regions_read > 0);
+    CHECK(st[5].regions_read > st[4].regions_read);
     /* one region, one commit at the end: regions never saved are saved
      * into the transaction when they are evicted */
     CHECK_INT(st[0].regions_evicted, 0);
     CHECK(st[2].regions_evicted > 0);
     /* same files whatever the budget and the thread count */
     const uint64_t h = cmdb_content_hash(path[0]);
-    for (int k = 1; k < 4; k++)
+    for (int k = 1; k < RUNS; k++)
         CHECK(cmdb_content_hash(path[k]) == h);
     /* the bytes of the pages, kept in meta at every commit, are their sum */
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < RUNS; k++) {
         const int64_t kept = sql_int(path[k], "SELECT value FROM meta WHERE key = 'page_bytes'");
         CHECK(kept > 0);
         CHECK_INT(kept, sql_int(path[k], "SELECT SUM(LENGTH(image) + LENGTH(grp) + "
@@ -280,7 +284,7 @@ static void test_budgets(const char *dir, const cm_model *m)
     }
     /* the groups view: every cell counted once; periodic cells are dim int64 each */
     CHECK_INT(sql_int(path[0], "SELECT SUM(basin_cells) FROM groups"), NX * NY);
-    CHECK_INT(sql_int(path[0], "SELECT COUNT(*) FROM groups WHERE is_sink = 0"), flat[4].ngroups);
+    CHECK_INT(sql_int(path[0], "SELECT COUNT(*) FROM groups WHERE is_sink = 0"), flat[REF].ngroups);
     CHECK_INT(sql_int(path[0], "SELECT SUM(LENGTH(periodic_cells)) / 16 FROM attractors"),
               sql_int(path[0], "SELECT SUM(period) FROM attractors"));
     CHECK(sql_int(path[0], "SELECT COUNT(*) FROM pages") > TX * TY);
@@ -297,14 +301,14 @@ static void test_budgets(const char *dir, const cm_model *m)
     CHECK_INT(cm_cluster_resident_bytes(&c), 0);
     c.mem_budget = 1;
     CHECK(cm_cluster_flatten(&c, &all, &back, msg, sizeof msg) == CM_OK);
-    CHECK(same_region(&back, &flat[4]));
-    lookups_by_region(s, &c, &flat[4]);
+    CHECK(same_region(&back, &flat[REF]));
+    lookups_by_region(s, &c, &flat[REF]);
     cm_store_info info;
     CHECK(cm_store_read_info(s, &info, msg, sizeof msg) == CM_OK);
     CHECK(strcmp(info.model, "microchaos-pd") == 0);
     CHECK_INT(info.regions, TX * TY);
     CHECK_INT(info.cells, NX * NY);
-    CHECK_INT(info.groups, flat[4].ngroups);
+    CHECK_INT(info.groups, flat[REF].ngroups);
     CHECK(info.lattice.width[0] == lat416.width[0] && info.lattice.origin[1] == lat416.origin[1]);
     /* bytes per cell on disk, with compression */
     CHECK(info.page_bytes < 6 * (uint64_t)NX * NY);
@@ -312,7 +316,7 @@ static void test_budgets(const char *dir, const cm_model *m)
                   *ref = calloc(info.groups + 1, sizeof *g);
     uint64_t sink = 0, ref_sink = 0;
     CHECK(cm_store_groups(s, g, info.groups, &sink, msg, sizeof msg) == CM_OK);
-    cm_scm_groups(&flat[4], &lat416, ref, &ref_sink);
+    cm_scm_groups(&flat[REF], &lat416, ref, &ref_sink);
     CHECK_INT(sink, ref_sink);
     for (uint32_t k = 0; k < info.groups; k++)
         CHECK(memcmp(&g[k], &ref[k], sizeof g[k]) == 0);
@@ -350,9 +354,9 @@ static void test_budgets(const char *dir, const cm_model *m)
     cm_region_free(&back);
     cm_cluster_free(&c);
     CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k <= REF; k++)
         cm_region_free(&flat[k]);
-    for (int k = 1; k < 4; k++)
+    for (int k = 1; k < RUNS; k++)
         if (!getenv("KEEP")) unlink(path[k]);
 }
 
