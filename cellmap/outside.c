@@ -738,10 +738,10 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
     uint64_t taken = 0;
     returned_list back;
     memset(&back, 0, sizeof back);
+    if (cells->between) /* what the caller's lookups read: following reads no end */
+        cells->between(cells->user);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
-        if (cells->between)
-            cells->between(cells->user);
         st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
