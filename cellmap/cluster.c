@@ -1375,22 +1375,6 @@ void cm_flat_copy(const cm_region *r, cm_region *out)
         flatten_part(r, &none, &both, out, NULL, 1);
 }
 
-/* Resolves region k's nodes into the arrays (of the region's nexits; open
- * may be NULL). */
-static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group, uint32_t *step,
-                                      uint8_t *cycle, uint32_t *open, char *msg, size_t msg_size)
-{
-    const cm_cluster_region *cr = &c->regions[k];
-    cm_node *nodes;
-    cm_status st = node_table(c, k, &nodes, msg, msg_size);
-    for (uint64_t e = 0; e < cr->r.nexits && st == CM_OK; e++) {
-        cycle[e] = nodes[e].next == CM_NODE_CYCLE;
-        st = cm_cluster_resolve(c, cr->node_base + (uint32_t)e, &group[e], &step[e],
-                                open ? &open[e] : NULL, msg, msg_size);
-    }
-    return st;
-}
-
 cm_status cm_cluster_cell_end(cm_cluster *c, const int64_t *cell, uint32_t *group,
                               uint32_t *open, char *msg, size_t msg_size)
 {
@@ -1505,10 +1489,190 @@ static cm_status node_arrays_room(node_arrays *a, uint64_t n, bool with_open)
     return a->group && a->step && a->cycle && (a->open || !with_open) ? CM_OK : CM_ENOMEM;
 }
 
+/* ---- resolved nodes kept between flattens ----------------------------- */
+
+/* What one region's nodes resolved to (arrays NULL, n 0: nothing kept). */
+typedef struct resolved_nodes {
+    uint64_t n;
+    uint32_t *group, *step, *open;
+    uint8_t *cycle;
+} resolved_nodes;
+
+/* What open nodes met by one flatten resolve to now (direct mapped by id;
+ * CM_NODE_OPEN, never a node's id, marks a free slot). */
+#define ENDS_SEEN 65536
+
+/* A node's outcome now: its group, its cell's step, the open node its
+ * chains leave by (itself while it is open); step ON_CYCLE: it is on a
+ * straddling cycle. */
+typedef struct end_now {
+    uint32_t id, group, step, open;
+} end_now;
+#define ON_CYCLE UINT32_MAX
+
+struct cm_resolve_cache {
+    resolved_nodes *region; /* by region index */
+    uint32_t nregions;
+    end_now seen[ENDS_SEEN];
+};
+
+cm_resolve_cache *cm_resolve_cache_new(void) { return calloc(1, sizeof(cm_resolve_cache)); }
+
+static void resolved_free(resolved_nodes *rn)
+{
+    free(rn->group);
+    free(rn->step);
+    free(rn->open);
+    free(rn->cycle);
+    memset(rn, 0, sizeof *rn);
+}
+
+static void cache_empty(cm_resolve_cache *cache)
+{
+    for (uint32_t k = 0; k < cache->nregions; k++)
+        resolved_free(&cache->region[k]);
+    free(cache->region);
+    cache->region = NULL;
+    cache->nregions = 0;
+}
+
+void cm_resolve_cache_free(cm_resolve_cache *cache)
+{
+    if (!cache)
+        return;
+    cache_empty(cache);
+    free(cache);
+}
+
+uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache)
+{
+    uint64_t bytes = sizeof *cache + cache->nregions * sizeof *cache->region;
+    for (uint32_t k = 0; k < cache->nregions; k++)
+        bytes += cache->region[k].n * (3 * sizeof(uint32_t) + 1);
+    return bytes;
+}
+
+/* An entry for every region of c, and no open node remembered. */
+static cm_status cache_room(cm_resolve_cache *cache, const cm_cluster *c)
+{
+    for (uint32_t i = 0; i < ENDS_SEEN; i++)
+        cache->seen[i].id = CM_NODE_OPEN;
+    if (cache->nregions > c->nregions) /* another cluster */
+        cache_empty(cache);
+    if (cache->nregions == c->nregions)
+        return CM_OK;
+    resolved_nodes *region = realloc(cache->region, (size_t)c->nregions * sizeof *region);
+    if (!region)
+        return CM_ENOMEM;
+    memset(region + cache->nregions, 0, (size_t)(c->nregions - cache->nregions) * sizeof *region);
+    cache->region = region;
+    cache->nregions = c->nregions;
+    return CM_OK;
+}
+
+/* What node id, open when its outcomes were kept, resolves to now. */
+static cm_status end_of(cm_cluster *c, cm_resolve_cache *cache, uint32_t id, const end_now **out,
+                        char *msg, size_t msg_size)
+{
+    end_now *seen = &cache->seen[(id * UINT32_C(2654435761)) >> 16]; /* 16 bits: ENDS_SEEN */
+    *out = seen;
+    if (seen->id == id)
+        return CM_OK;
+    cm_node *nd;
+    cm_status st = cm_cluster_node(c, id, &nd, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    seen->id = CM_NODE_OPEN; /* until known */
+    if (is_open(nd)) {
+        *seen = (end_now){id, 0, 1, id};
+        return CM_OK;
+    }
+    if (nd->next == CM_NODE_CYCLE) {
+        *seen = (end_now){id, 0, ON_CYCLE, CM_NODE_OPEN};
+        return CM_OK;
+    }
+    end_now now = {id, 0, 0, 0};
+    st = cm_cluster_resolve(c, id, &now.group, &now.step, &now.open, msg, msg_size);
+    if (st == CM_OK)
+        *seen = now;
+    return st;
+}
+
+/* Resolves node e of region k (its table `nodes`) into entry e of the arrays. */
+static cm_status resolve_node(cm_cluster *c, uint32_t k, const cm_node *nodes, uint64_t e,
+                              uint32_t *group, uint32_t *step, uint8_t *cycle, uint32_t *open,
+                              char *msg, size_t msg_size)
+{
+    cycle[e] = nodes[e].next == CM_NODE_CYCLE;
+    return cm_cluster_resolve(c, c->regions[k].node_base + (uint32_t)e, &group[e], &step[e],
+                              open ? &open[e] : NULL, msg, msg_size);
+}
+
+/* Resolves region k's nodes into the arrays (of the region's nexits; open
+ * may be NULL). */
+static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group, uint32_t *step,
+                                      uint8_t *cycle, uint32_t *open, char *msg, size_t msg_size)
+{
+    cm_node *nodes;
+    cm_status st = node_table(c, k, &nodes, msg, msg_size);
+    for (uint64_t e = 0; e < c->regions[k].r.nexits && st == CM_OK; e++)
+        st = resolve_node(c, k, nodes, e, group, step, cycle, open, msg, msg_size);
+    return st;
+}
+
+/* Region k's entry of the cache, up to date: resolved afresh when new, else
+ * only the nodes whose chains ended on an open node linked since. */
+static cm_status kept_nodes(cm_cluster *c, uint32_t k, cm_resolve_cache *cache, char *msg,
+                            size_t msg_size)
+{
+    resolved_nodes *rn = &cache->region[k];
+    const uint64_t n = c->regions[k].r.nexits;
+    if (rn->n != n || !rn->group) {
+        resolved_free(rn);
+        rn->group = malloc((n + 1) * sizeof *rn->group);
+        rn->step = malloc((n + 1) * sizeof *rn->step);
+        rn->open = malloc((n + 1) * sizeof *rn->open);
+        rn->cycle = malloc(n + 1);
+        cm_status st = rn->group && rn->step && rn->open && rn->cycle
+                           ? resolve_region_nodes(c, k, rn->group, rn->step, rn->cycle, rn->open,
+                                                  msg, msg_size)
+                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
+        rn->n = n;
+        if (st != CM_OK)
+            resolved_free(rn);
+        return st;
+    }
+    /* A node whose chain ended on open node x (open[e] == x, step[e] the
+     * steps to x's cell plus one) now ends where x does, x's step on: the
+     * chain to x is fixed. Unless x is on a straddling cycle, and so maybe
+     * the node too, whose steps then count differently. */
+    cm_node *nodes;
+    cm_status st = node_table(c, k, &nodes, msg, msg_size); /* flatten_part reads it too */
+    for (uint64_t e = 0; e < n && st == CM_OK; e++) {
+        if (rn->open[e] == CM_NODE_OPEN)
+            continue; /* a final outcome */
+        const end_now *x;
+        st = end_of(c, cache, rn->open[e], &x, msg, msg_size);
+        if (st != CM_OK || x->open == rn->open[e])
+            continue; /* still open */
+        const uint64_t step = (uint64_t)rn->step[e] - 1 + x->step;
+        if (x->step != ON_CYCLE && step < CM_STEP_ON_PATH) {
+            rn->group[e] = x->group;
+            rn->step[e] = (uint32_t)step;
+            rn->open[e] = x->open;
+        } else {
+            st = resolve_node(c, k, nodes, e, rn->group, rn->step, rn->cycle, rn->open, msg,
+                              msg_size);
+        }
+    }
+    return st;
+}
+
 /* cm_cluster_flatten_progress, with the open nodes of the cells into open
- * unless NULL. */
+ * unless NULL, through cache unless NULL. */
 static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint32_t *open,
-                         cm_progress_fn progress, void *user, char *msg, size_t msg_size)
+                         cm_resolve_cache *cache, cm_progress_fn progress, void *user, char *msg,
+                         size_t msg_size)
 {
     const double total = (double)cm_box_cells(box);
     uint64_t done = 0;
@@ -1516,21 +1680,31 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
     _Static_assert(CM_NODE_OPEN == UINT32_MAX, "open cells are filled bytewise");
     if (st == CM_OK && open)
         memset(open, 0xFF, (size_t)out->ncells * sizeof *open);
+    if (st == CM_OK && cache && cache_room(cache, c) != CM_OK)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
     node_arrays a;
     memset(&a, 0, sizeof a);
     for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++) {
         cm_box both;
-        if (!cm_box_intersect(&c->regions[k].r.box, box, &both))
+        if (!cm_box_intersect(&c->regions[k].r.box, box, &both)) {
+            if (cache)
+                resolved_free(&cache->region[k]);
             continue;
-        if (node_arrays_room(&a, c->regions[k].r.nexits + 1, open != NULL) != CM_OK) {
-            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
-            break;
         }
         /* nodes first: settling one can read other regions back */
-        st = resolve_region_nodes(c, k, a.group, a.step, a.cycle, a.open, msg, msg_size);
+        if (cache) {
+            st = kept_nodes(c, k, cache, msg, msg_size);
+        } else if (node_arrays_room(&a, c->regions[k].r.nexits + 1, open != NULL) != CM_OK) {
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
+        } else {
+            st = resolve_region_nodes(c, k, a.group, a.step, a.cycle, a.open, msg, msg_size);
+        }
         if (st == CM_OK)
             st = cm_cluster_acquire(c, k, msg, msg_size);
-        const node_values nv = {c->regions[k].nodes, a.group, a.step, a.cycle, a.open};
+        const resolved_nodes *rn = cache ? &cache->region[k] : NULL;
+        const node_values nv = {c->regions[k].nodes, rn ? rn->group : a.group,
+                                rn ? rn->step : a.step, rn ? rn->cycle : a.cycle,
+                                rn ? rn->open : a.open};
         if (st == CM_OK)
             flatten_part(&c->regions[k].r, &nv, &both, out, open, cm_cluster_threads(c));
         cm_cluster_trim(c);
@@ -1539,6 +1713,8 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
             st = cm_fail(CM_ECANCELED, msg, msg_size, "interrupted");
     }
     node_arrays_free(&a);
+    if (st != CM_OK && cache)
+        cache_empty(cache);
     if (st != CM_OK)
         cm_region_free(out);
     return st;
@@ -1547,18 +1723,24 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
 cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, char *msg,
                              size_t msg_size)
 {
-    return flatten(c, box, out, NULL, NULL, NULL, msg, msg_size);
+    return flatten(c, box, out, NULL, NULL, NULL, NULL, msg, msg_size);
 }
 
 cm_status cm_cluster_flatten_open(cm_cluster *c, const cm_box *box, cm_region *out,
                                   uint32_t *open, char *msg, size_t msg_size)
 {
-    return flatten(c, box, out, open, NULL, NULL, msg, msg_size);
+    return flatten(c, box, out, open, NULL, NULL, NULL, msg, msg_size);
+}
+
+cm_status cm_cluster_flatten_cached(cm_cluster *c, const cm_box *box, cm_resolve_cache *cache,
+                                    cm_region *out, uint32_t *open, char *msg, size_t msg_size)
+{
+    return flatten(c, box, out, open, cache, NULL, NULL, msg, msg_size);
 }
 
 cm_status cm_cluster_flatten_progress(cm_cluster *c, const cm_box *box, cm_region *out,
                                       cm_progress_fn progress, void *user, char *msg,
                                       size_t msg_size)
 {
-    return flatten(c, box, out, NULL, progress, user, msg, msg_size);
+    return flatten(c, box, out, NULL, NULL, progress, user, msg, msg_size);
 }

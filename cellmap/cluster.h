@@ -447,6 +447,30 @@ cm_status cm_cluster_flatten(cm_cluster *c, const cm_box *box, cm_region *out, c
 cm_status cm_cluster_flatten_open(cm_cluster *c, const cm_box *box, cm_region *out,
                                   uint32_t *open, char *msg, size_t msg_size);
 
+/* What cm_cluster_flatten_cached keeps between flattens of one cluster:
+ * what the nodes of the regions it last met resolve to (13 bytes per node).
+ * A node's outcome changes only while its chain ends on an open node, and
+ * then only once that node is linked (links never change once set), so a
+ * later flatten resolves again only those nodes and the regions it had not
+ * met; the result is the same as cm_cluster_flatten_open's. One cache serves
+ * one cluster (a cluster of fewer regions than it knows empties it), one
+ * flatten at a time. */
+typedef struct cm_resolve_cache cm_resolve_cache;
+
+/* An empty cache (NULL when out of memory); _free frees it (NULL: nothing). */
+cm_resolve_cache *cm_resolve_cache_new(void);
+void cm_resolve_cache_free(cm_resolve_cache *cache);
+
+/* Bytes the cache holds. */
+uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache);
+
+/* cm_cluster_flatten_open (open may be NULL) through cache, which then
+ * holds the regions that meet box and no others. On failure the cache is
+ * emptied. */
+cm_status cm_cluster_flatten_cached(cm_cluster *c, const cm_box *box, cm_resolve_cache *cache,
+                                    cm_region *out, uint32_t *open, char *msg,
+                                    size_t msg_size);
+
 /* The same, calling progress(user, "cells", fraction of the box's cells
  * read) after each region it reads; nonzero from it cancels (CM_ECANCELED,
  * out freed). */

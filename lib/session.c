@@ -403,12 +403,17 @@ static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_gr
     cm_status st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
     if (st != CM_OK)
         return st;
-    if (!open)
-        return cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
-    *open = cm_cells_array((cm_box_cells(&box) + 1) * sizeof **open);
-    if (!*open)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
-    return cm_cluster_flatten_open(&s->c, &box, flat, *open, msg, msg_size);
+    if (!s->resolve_cache)
+        s->resolve_cache = cm_resolve_cache_new(); /* NULL: every node resolved */
+    if (open) {
+        *open = cm_cells_array((cm_box_cells(&box) + 1) * sizeof **open);
+        if (!*open)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
+    }
+    return s->resolve_cache ? cm_cluster_flatten_cached(&s->c, &box, s->resolve_cache, flat,
+                                                        open ? *open : NULL, msg, msg_size)
+           : open           ? cm_cluster_flatten_open(&s->c, &box, flat, *open, msg, msg_size)
+                            : cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
 }
 
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
@@ -888,6 +893,8 @@ cm_status session_close(session *s, char *msg, size_t msg_size)
     s->gl = NULL;
     cm_exit_memo_free(s->exit_memo);
     s->exit_memo = NULL;
+    cm_resolve_cache_free(s->resolve_cache);
+    s->resolve_cache = NULL;
     if (s->have_model)
         cm_model_release(&s->model);
     s->have_model = 0;

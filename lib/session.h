@@ -66,6 +66,10 @@ typedef struct session {
      * render follows only the exits it has not met (made by the first
      * render; NULL until then, or when there was no memory for it) */
     cm_exit_memo *exit_memo;
+    /* what the view's nodes resolved to, so that a pan's flatten resolves
+     * only the nodes whose outcome changed (made by the first render or
+     * stats; NULL until then, or when there was no memory for it) */
+    cm_resolve_cache *resolve_cache;
     /* the journal of a script's run (session_journal_begin): which line
      * runs, and where a killed run of the same script stopped */
     uint64_t script_hash; /* 0: no journal (stdin, the prompt) */

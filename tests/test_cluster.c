@@ -96,7 +96,31 @@ static void solve_whole(const cm_model *m, const cm_lattice *lat, const cm_box *
     CHECK(cm_scm_solve(m, lat, &opt, r, msg, sizeof msg) == CM_OK);
 }
 
-/* Solves the boxes one by one, joins them in `order`, flattens over whole. */
+/* A flatten through the cache kept since the last join equals a fresh
+ * flatten of the same cluster, cell by cell, open nodes included. */
+static void check_cached_flatten(cm_cluster *c, const cm_box *view, cm_resolve_cache *cache)
+{
+    char msg[256];
+    cm_region a, b;
+    const uint64_t n = cm_box_cells(view);
+    uint32_t *open_a = malloc(n * sizeof *open_a), *open_b = malloc(n * sizeof *open_b);
+    CHECK(cm_cluster_flatten_cached(c, view, cache, &a, open_a, msg, sizeof msg) == CM_OK);
+    CHECK(cm_cluster_flatten_open(c, view, &b, open_b, msg, sizeof msg) == CM_OK);
+    uint64_t bad = 0;
+    for (uint64_t i = 0; i < n; i++)
+        bad += a.group[i] != b.group[i] || a.step[i] != b.step[i] || a.image[i] != b.image[i] ||
+               open_a[i] != open_b[i];
+    CHECK_INT(bad, 0);
+    CHECK_INT(a.ngroups, b.ngroups);
+    cm_region_free(&a);
+    cm_region_free(&b);
+    free(open_a);
+    free(open_b);
+}
+
+/* Solves the boxes one by one, joins them in `order`, flattens over whole.
+ * After each join a view (whole, or the box just joined) is flattened
+ * through a cache kept since the first join (check_cached_flatten). */
 static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_box *whole,
                             const cm_box *boxes, const uint32_t *order, uint32_t n, int max_steps,
                             cm_region *flat, uint32_t *straddling)
@@ -105,6 +129,8 @@ static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_b
     cm_cluster c;
     cm_cluster_init(&c, lat);
     const cm_scm_options opt = {.max_steps = max_steps, .record_exits = 1};
+    cm_resolve_cache *cache = cm_resolve_cache_new();
+    CHECK(cache != NULL);
     *straddling = 0;
     for (uint32_t k = 0; k < n; k++) {
         cm_region r;
@@ -113,8 +139,10 @@ static void solve_clustered(const cm_model *m, const cm_lattice *lat, const cm_b
         CHECK(cm_scm_solve(m, lat, &opt, &r, msg, sizeof msg) == CM_OK);
         CHECK(cm_cluster_join(&c, &r, &stats, msg, sizeof msg) == CM_OK);
         *straddling += stats.straddling_groups;
+        check_cached_flatten(&c, k % 2 ? &boxes[order[k]] : whole, cache);
     }
     CHECK(cm_cluster_flatten(&c, whole, flat, msg, sizeof msg) == CM_OK);
+    cm_resolve_cache_free(cache);
     cm_cluster_free(&c);
 }
 
