@@ -6,6 +6,7 @@
 #include "lib/outfile.h"
 #include "src/args.h"
 #include "src/commands.h"
+#include "src/wait_policy.h"
 
 static const struct {
     const char *name;
@@ -99,6 +100,8 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *name = asks_help ? argv[2] : argv[1];
+    if (strcmp(name, "explore") == 0 && !asks_help)
+        wait_passively(argv); /* returns unless the user chose a wait policy */
     for (int i = 2; i < argc; i++) /* -h is --help, for every command */
         if (strcmp(argv[i], "-h") == 0)
             argv[i] = help_flag;

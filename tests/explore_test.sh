@@ -309,4 +309,16 @@ _, status = os.waitpid(pid, 0)
 assert os.WEXITSTATUS(status) == 0, status
 PY
 
+# --- its OpenMP threads sleep when idle, unless the user chose -------------
+# (src/wait_policy.h) libgomp shows the spin count it runs with; the
+# command runs itself again with OMP_WAIT_POLICY=passive, so the last
+# display is the one its work runs under.
+spin_of() { # spin_of [VAR=VALUE]: the last spin count explore's libgomp shows
+  env "$@" OMP_DISPLAY_ENV=verbose "$CM" explore whole.cmdb - <<<"stats" 2>&1 >/dev/null |
+    sed -n "s/^ *GOMP_SPINCOUNT = '\([0-9]*\)'.*/\1/p" | tail -1
+}
+[ "$(spin_of X=1)" = 0 ] || fail "explore's threads spin when idle: $(spin_of X=1)"
+[ "$(spin_of OMP_WAIT_POLICY=active)" != 0 ] || fail "explore overrode OMP_WAIT_POLICY=active"
+[ "$(spin_of GOMP_SPINCOUNT=1234)" = 1234 ] || fail "explore overrode GOMP_SPINCOUNT"
+
 [ "$fails" -eq 0 ] && echo "explore_test: all passed" || { echo "explore_test: $fails failed"; exit 1; }
