@@ -1277,21 +1277,67 @@ cm_status cm_cluster_describe_new(cm_cluster *c, const cm_model *model, cm_group
 
 /* ---- readers ---------------------------------------------------------- */
 
-/* Image of a cluster cell as an index of `box`, or CM_IMAGE_EXIT beyond it. */
-static uint32_t flat_image(const cm_region *r, uint64_t i, const cm_box *box)
+/* Where region r's cells lie in a flat box `out`: what flat_image needs,
+ * worked out once per region (every cell of a view is mapped). */
+typedef struct image_map {
+    const cm_region *r;
+    int dim;
+    uint32_t side[CM_MAX_DIM];    /* the region's sides (its cells fit 32 bits) */
+    int64_t shift[CM_MAX_DIM];    /* r's lo less out's lo */
+    int64_t lo[CM_MAX_DIM];       /* out's lo */
+    int64_t out_side[CM_MAX_DIM]; /* out's sides */
+} image_map;
+
+static image_map image_map_of(const cm_region *r, const cm_box *out)
 {
-    int64_t cell[CM_MAX_DIM];
+    image_map im = {.r = r, .dim = out->dim};
+    for (int d = 0; d < out->dim; d++) {
+        im.side[d] = (uint32_t)(r->box.hi[d] - r->box.lo[d]);
+        im.shift[d] = r->box.lo[d] - out->lo[d];
+        im.lo[d] = out->lo[d];
+        im.out_side[d] = out->hi[d] - out->lo[d];
+    }
+    return im;
+}
+
+/* The index in out of the cell at offsets o[d] from out's lo, or
+ * CM_IMAGE_EXIT beyond out. */
+static uint32_t out_index(const image_map *im, const int64_t *o)
+{
+    uint64_t index = 0;
+    for (int d = im->dim - 1; d >= 0; d--) {
+        if (o[d] < 0 || o[d] >= im->out_side[d])
+            return CM_IMAGE_EXIT;
+        index = index * (uint64_t)im->out_side[d] + (uint64_t)o[d];
+    }
+    return (uint32_t)index;
+}
+
+/* Image of cell i of the region as an index of out, or CM_IMAGE_EXIT
+ * beyond it. */
+static uint32_t flat_image(const image_map *im, uint64_t i)
+{
+    const cm_region *r = im->r;
     const uint32_t v = r->image[i];
+    int64_t o[CM_MAX_DIM];
+    if (v < r->ncells) {
+        uint32_t rest = v; /* 32-bit divisions: a region's cells fit */
+        for (int d = 0; d + 1 < im->dim; d++) {
+            o[d] = (int64_t)(rest % im->side[d]) + im->shift[d];
+            rest /= im->side[d];
+        }
+        o[im->dim - 1] = (int64_t)rest + im->shift[im->dim - 1];
+        return out_index(im, o);
+    }
     const int64_t e = cm_image_exit_index(v);
-    if (v < r->ncells)
-        cm_box_cell(&r->box, v, cell);
-    else if (e >= 0 && r->exit_target)
-        memcpy(cell, cm_region_exit(r, (uint64_t)e), (size_t)box->dim * sizeof *cell);
-    else if (e >= 0)
-        return CM_IMAGE_EXIT; /* a cluster that kept no exit table (keep_exits 0) */
-    else
+    if (e < 0)
         return CM_IMAGE_SINK;
-    return cm_box_contains(box, cell) ? (uint32_t)cm_box_index(box, cell) : CM_IMAGE_EXIT;
+    if (!r->exit_target)
+        return CM_IMAGE_EXIT; /* a cluster that kept no exit table (keep_exits 0) */
+    const int64_t *cell = cm_region_exit(r, (uint64_t)e);
+    for (int d = 0; d < im->dim; d++)
+        o[d] = cell[d] - im->lo[d];
+    return out_index(im, o);
 }
 
 /* What a region's nodes resolve to, for copying its cells: group and step
@@ -1334,6 +1380,7 @@ static void flatten_part(const cm_region *r, const node_values *nv, const cm_box
 {
     const int64_t width = both->hi[0] - both->lo[0];
     const int64_t rows = (int64_t)(cm_box_cells(both) / (uint64_t)width);
+    const image_map im = image_map_of(r, &out->box);
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t q = 0; q < rows; q++) {
         int64_t cell[CM_MAX_DIM];
@@ -1344,7 +1391,7 @@ static void flatten_part(const cm_region *r, const node_values *nv, const cm_box
         for (int64_t i = 0; i < width; i++) {
             resolved_cell(r, from + (uint64_t)i, nv, &out->group[to + (uint64_t)i],
                           &out->step[to + (uint64_t)i]);
-            out->image[to + (uint64_t)i] = flat_image(r, from + (uint64_t)i, &out->box);
+            out->image[to + (uint64_t)i] = flat_image(&im, from + (uint64_t)i);
         }
         if (open && nv->nodes)
             for (int64_t i = 0; i < width; i++)

@@ -54,9 +54,8 @@ static int64_t *word(const cm_exit_memo *memo, uint64_t i, int which)
 /* Where cell's entry is in the hash, or the empty place it would take. */
 static uint64_t hash_place(const cm_exit_memo *memo, const int64_t *cell)
 {
-    const size_t bytes = (size_t)memo->dim * sizeof *cell;
     uint64_t i = cm_cell_hash(cell, memo->dim) & (memo->hash_size - 1);
-    while (memo->hash[i] && memcmp(word(memo, memo->hash[i] - 1, KEY), cell, bytes) != 0)
+    while (memo->hash[i] && !cm_cell_same(word(memo, memo->hash[i] - 1, KEY), cell, memo->dim))
         i = (i + 1) & (memo->hash_size - 1);
     return i;
 }

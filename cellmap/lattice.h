@@ -73,6 +73,16 @@ static inline uint64_t cm_cell_hash(const int64_t *cell, int dim)
     return h ^ (h >> 31);
 }
 
+/* Whether two cells are the same (inline: hash probes compare cells often,
+ * and a call to memcmp costs more than the two words of a 2-D cell). */
+static inline bool cm_cell_same(const int64_t *a, const int64_t *b, int dim)
+{
+    int d = 0;
+    while (d < dim && a[d] == b[d])
+        d++;
+    return d == dim;
+}
+
 /* Local row-major index of a cell inside the box (caller checked contains). */
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 

@@ -910,8 +910,7 @@ typedef struct view_exits {
 static uint64_t hash_place(const view_exits *v, const int64_t *cell)
 {
     uint64_t i = cm_cell_hash(cell, v->dim) & (v->hash_size - 1);
-    while (v->hash[i] &&
-           memcmp(v->cell + (v->hash[i] - 1) * (uint64_t)v->dim, cell, (size_t)v->dim * 8) != 0)
+    while (v->hash[i] && !cm_cell_same(v->cell + (v->hash[i] - 1) * (uint64_t)v->dim, cell, v->dim))
         i = (i + 1) & (v->hash_size - 1);
     return i;
 }
