@@ -1507,7 +1507,10 @@ cm_status cm_cluster_cells_group_shedding(void *cluster, const int64_t *cells, u
     return cells_group(cluster, cells, n, group, 1024, msg, msg_size);
 }
 
-/* Per-node arrays for the largest region read so far. */
+/* ---- resolved nodes kept between flattens ----------------------------- */
+
+/* Per-node arrays: what a region's nodes resolve to (a flatten without a
+ * cache reuses one set, for the largest region read so far). */
 typedef struct node_arrays {
     uint32_t *group, *step, *open;
     uint8_t *cycle;
@@ -1536,15 +1539,6 @@ static cm_status node_arrays_room(node_arrays *a, uint64_t n, bool with_open)
     return a->group && a->step && a->cycle && (a->open || !with_open) ? CM_OK : CM_ENOMEM;
 }
 
-/* ---- resolved nodes kept between flattens ----------------------------- */
-
-/* What one region's nodes resolved to (arrays NULL, n 0: nothing kept). */
-typedef struct resolved_nodes {
-    uint64_t n;
-    uint32_t *group, *step, *open;
-    uint8_t *cycle;
-} resolved_nodes;
-
 /* What open nodes met by one flatten resolve to now (direct mapped by id;
  * CM_NODE_OPEN, never a node's id, marks a free slot). */
 #define ENDS_SEEN 65536
@@ -1558,26 +1552,17 @@ typedef struct end_now {
 #define ON_CYCLE UINT32_MAX
 
 struct cm_resolve_cache {
-    resolved_nodes *region; /* by region index */
+    node_arrays *region; /* by region index (cap 0: nothing kept) */
     uint32_t nregions;
     end_now seen[ENDS_SEEN];
 };
 
 cm_resolve_cache *cm_resolve_cache_new(void) { return calloc(1, sizeof(cm_resolve_cache)); }
 
-static void resolved_free(resolved_nodes *rn)
-{
-    free(rn->group);
-    free(rn->step);
-    free(rn->open);
-    free(rn->cycle);
-    memset(rn, 0, sizeof *rn);
-}
-
 static void cache_empty(cm_resolve_cache *cache)
 {
     for (uint32_t k = 0; k < cache->nregions; k++)
-        resolved_free(&cache->region[k]);
+        node_arrays_free(&cache->region[k]);
     free(cache->region);
     cache->region = NULL;
     cache->nregions = 0;
@@ -1591,14 +1576,6 @@ void cm_resolve_cache_free(cm_resolve_cache *cache)
     free(cache);
 }
 
-uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache)
-{
-    uint64_t bytes = sizeof *cache + cache->nregions * sizeof *cache->region;
-    for (uint32_t k = 0; k < cache->nregions; k++)
-        bytes += cache->region[k].n * (3 * sizeof(uint32_t) + 1);
-    return bytes;
-}
-
 /* An entry for every region of c, and no open node remembered. */
 static cm_status cache_room(cm_resolve_cache *cache, const cm_cluster *c)
 {
@@ -1608,7 +1585,7 @@ static cm_status cache_room(cm_resolve_cache *cache, const cm_cluster *c)
         cache_empty(cache);
     if (cache->nregions == c->nregions)
         return CM_OK;
-    resolved_nodes *region = realloc(cache->region, (size_t)c->nregions * sizeof *region);
+    node_arrays *region = realloc(cache->region, (size_t)c->nregions * sizeof *region);
     if (!region)
         return CM_ENOMEM;
     memset(region + cache->nregions, 0, (size_t)(c->nregions - cache->nregions) * sizeof *region);
@@ -1672,21 +1649,15 @@ static cm_status resolve_region_nodes(cm_cluster *c, uint32_t k, uint32_t *group
 static cm_status kept_nodes(cm_cluster *c, uint32_t k, cm_resolve_cache *cache, char *msg,
                             size_t msg_size)
 {
-    resolved_nodes *rn = &cache->region[k];
+    node_arrays *rn = &cache->region[k];
     const uint64_t n = c->regions[k].r.nexits;
-    if (rn->n != n || !rn->group) {
-        resolved_free(rn);
-        rn->group = malloc((n + 1) * sizeof *rn->group);
-        rn->step = malloc((n + 1) * sizeof *rn->step);
-        rn->open = malloc((n + 1) * sizeof *rn->open);
-        rn->cycle = malloc(n + 1);
-        cm_status st = rn->group && rn->step && rn->open && rn->cycle
+    if (rn->cap == 0) {
+        cm_status st = node_arrays_room(rn, n + 1, true) == CM_OK
                            ? resolve_region_nodes(c, k, rn->group, rn->step, rn->cycle, rn->open,
                                                   msg, msg_size)
                            : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");
-        rn->n = n;
         if (st != CM_OK)
-            resolved_free(rn);
+            node_arrays_free(rn);
         return st;
     }
     /* A node whose chain ended on open node x (open[e] == x, step[e] the
@@ -1735,7 +1706,7 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
         cm_box both;
         if (!cm_box_intersect(&c->regions[k].r.box, box, &both)) {
             if (cache)
-                resolved_free(&cache->region[k]);
+                node_arrays_free(&cache->region[k]);
             continue;
         }
         /* nodes first: settling one can read other regions back */
@@ -1748,10 +1719,8 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
         }
         if (st == CM_OK)
             st = cm_cluster_acquire(c, k, msg, msg_size);
-        const resolved_nodes *rn = cache ? &cache->region[k] : NULL;
-        const node_values nv = {c->regions[k].nodes, rn ? rn->group : a.group,
-                                rn ? rn->step : a.step, rn ? rn->cycle : a.cycle,
-                                rn ? rn->open : a.open};
+        const node_arrays *rn = cache ? &cache->region[k] : &a;
+        const node_values nv = {c->regions[k].nodes, rn->group, rn->step, rn->cycle, rn->open};
         if (st == CM_OK)
             flatten_part(&c->regions[k].r, &nv, &both, out, open, cm_cluster_threads(c));
         cm_cluster_trim(c);

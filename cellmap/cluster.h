@@ -448,7 +448,8 @@ cm_status cm_cluster_flatten_open(cm_cluster *c, const cm_box *box, cm_region *o
                                   uint32_t *open, char *msg, size_t msg_size);
 
 /* What cm_cluster_flatten_cached keeps between flattens of one cluster:
- * what the nodes of the regions it last met resolve to (13 bytes per node).
+ * what the nodes of the regions it last met resolve to (13 bytes per node,
+ * and 1 MiB for the open nodes a flatten looks up).
  * A node's outcome changes only while its chain ends on an open node, and
  * then only once that node is linked (links never change once set), so a
  * later flatten resolves again only those nodes and the regions it had not
@@ -460,9 +461,6 @@ typedef struct cm_resolve_cache cm_resolve_cache;
 /* An empty cache (NULL when out of memory); _free frees it (NULL: nothing). */
 cm_resolve_cache *cm_resolve_cache_new(void);
 void cm_resolve_cache_free(cm_resolve_cache *cache);
-
-/* Bytes the cache holds. */
-uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache);
 
 /* cm_cluster_flatten_open (open may be NULL) through cache, which then
  * holds the regions that meet box and no others. On failure the cache is
