@@ -777,52 +777,98 @@ cm_status store_write_pages(cm_store *s, uint32_t k, const cm_region *r, char *m
     return status == CM_OK ? add_page_bytes(s, bytes, msg, msg_size) : status;
 }
 
+/* Node chunks encoded at once. */
+#define NODE_BATCH 16
+
+/* The NODE_FIELDS columns of nodes[0..n) into cols (n values each). Only
+ * the fields that say what a node's exit leads to are saved: a final group
+ * is kept for final and cycle nodes only, so the file does not depend on
+ * what readers resolved. */
+static void node_columns(const cm_node *nodes, uint64_t n, uint32_t *cols)
+{
+    for (uint64_t e = 0; e < n; e++) {
+        const cm_node *nd = &nodes[e];
+        const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
+        cols[e] = nd->next;
+        cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
+        cols[2 * n + e] = known ? nd->group : 0;
+        cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
+        cols[4 * n + e] = nd->tree;
+        cols[5 * n + e] = nd->first_in;
+        cols[6 * n + e] = nd->sibling;
+    }
+}
+
+/* Nodes of the chunk that starts at node `first` of region cr. */
+static uint64_t chunk_nodes(const cm_cluster_region *cr, uint64_t first)
+{
+    return cr->r.nexits - first < CM_NODE_CHUNK ? cr->r.nexits - first : CM_NODE_CHUNK;
+}
+
+/* Encodes the chunks of cr's nodes that start at first[0..n) into
+ * s->blobs, part bytes apart, in parallel (lens[j]: chunk j's size). As
+ * for pages, the bytes do not depend on which thread encodes a chunk. */
+static cm_status encode_node_chunks(cm_store *s, const cm_cluster_region *cr,
+                                    const uint64_t *first, int n, size_t part, size_t *lens)
+{
+    const int threads = s->threads > 0 ? s->threads : 1;
+    if (ensure_encoders(s, threads) != CM_OK)
+        return CM_ENOMEM;
+    int failed = 0;
+#pragma omp parallel num_threads(threads) if (n > 1) reduction(| : failed)
+    {
+        const store_encoder *e = &s->encoders[omp_get_thread_num()];
+        uint32_t *cols = malloc(NODE_FIELDS * CM_NODE_CHUNK * sizeof *cols);
+        failed |= !cols;
+#pragma omp for schedule(dynamic, 1)
+        for (int j = 0; j < n; j++) {
+            const uint64_t count = chunk_nodes(cr, first[j]);
+            if (!cols)
+                continue;
+            node_columns(cr->nodes + first[j], count, cols);
+            failed |= cm_codec_encode_with(e->ctx, cols, NODE_FIELDS * count, 4, -1, e->scratch,
+                                           s->blobs + (size_t)j * part, part, &lens[j]) != CM_OK;
+        }
+        free(cols);
+    }
+    return failed ? CM_ENOMEM : CM_OK;
+}
+
 /* Region k's node records that changed: each chunk of CM_NODE_CHUNK nodes
- * with a changed record, as one row (NODE_FIELDS columns). Only the fields
- * that say what a node's exit leads to are saved: a final group is kept for
- * final and cycle nodes only, so the file does not depend on what readers
- * resolved. */
+ * with a changed record, as one row (NODE_FIELDS columns, node_columns),
+ * encoded NODE_BATCH chunks at a time in parallel and written in order. */
 cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *msg,
                             size_t msg_size)
 {
+    _Static_assert(NODE_FIELDS * CM_NODE_CHUNK <= CM_STORE_PAGE_CELLS,
+                   "a chunk's columns fit an encoder's scratch");
     const cm_cluster_region *cr = &c->regions[k];
-    const uint64_t chunk = CM_NODE_CHUNK;
-    uint32_t *cols = store_table_values(s, NODE_FIELDS * chunk * sizeof *cols);
+    const size_t part = cm_codec_bound(4 * (NODE_FIELDS * (size_t)CM_NODE_CHUNK + 1));
+    uint64_t first[NODE_BATCH];
+    size_t lens[NODE_BATCH];
     sqlite3_stmt *st = NULL;
     cm_status status = CM_OK;
-    if (!cols)
+    if (cm_grow((void **)&s->blobs, &s->blobs_cap, (uint64_t)NODE_BATCH * part, 1) != CM_OK)
         status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing nodes");
     else if (sqlite3_prepare_v2(s->db, "INSERT OR REPLACE INTO nodes VALUES(?, ?, ?, ?)", -1, &st,
                                 NULL))
         status = store_db_error(s->db, "prepare nodes", msg, msg_size);
-    for (uint64_t first = 0; status == CM_OK && first < cr->r.nexits; first += chunk) {
-        if (!cr->dirty_chunks[first / chunk])
-            continue;
-        const uint64_t n = cr->r.nexits - first < chunk ? cr->r.nexits - first : chunk;
-        for (uint64_t e = 0; e < n; e++) {
-            const cm_node *nd = &cr->nodes[first + e];
-            const int known = nd->next == CM_NODE_FINAL || nd->next == CM_NODE_CYCLE;
-            cols[e] = nd->next;
-            cols[n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->dist;
-            cols[2 * n + e] = known ? nd->group : 0;
-            cols[3 * n + e] = nd->next == CM_NODE_OPEN ? 0 : nd->target;
-            cols[4 * n + e] = nd->tree;
-            cols[5 * n + e] = nd->first_in;
-            cols[6 * n + e] = nd->sibling;
-        }
-        size_t len = 0;
-        const unsigned char *blob = NULL;
-        if (store_encode(s, cols, NODE_FIELDS * n, 4, &blob, &len) != CM_OK) {
+    for (uint64_t next = 0; status == CM_OK && next < cr->r.nexits;) {
+        int n = 0;
+        for (; n < NODE_BATCH && next < cr->r.nexits; next += CM_NODE_CHUNK)
+            if (cr->dirty_chunks[next / CM_NODE_CHUNK])
+                first[n++] = next;
+        if (n > 0 && encode_node_chunks(s, cr, first, n, part, lens) != CM_OK)
             status = cm_fail(CM_ENOMEM, msg, msg_size, "encoding the nodes of region %u", k + 1);
-            break;
+        for (int j = 0; status == CM_OK && j < n; j++) {
+            sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+            sqlite3_bind_int64(st, 2, (sqlite3_int64)first[j]);
+            sqlite3_bind_int64(st, 3, (sqlite3_int64)chunk_nodes(cr, first[j]));
+            sqlite3_bind_blob(st, 4, s->blobs + (size_t)j * part, (int)lens[j], SQLITE_STATIC);
+            status = store_step_done(s->db, st, "write nodes", msg, msg_size);
+            s->stats.bytes_written += lens[j];
+            s->stats.node_tables_written++;
         }
-        sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
-        sqlite3_bind_int64(st, 2, (sqlite3_int64)first);
-        sqlite3_bind_int64(st, 3, (sqlite3_int64)n);
-        sqlite3_bind_blob(st, 4, blob, (int)len, SQLITE_STATIC);
-        status = store_step_done(s->db, st, "write nodes", msg, msg_size);
-        s->stats.bytes_written += len;
-        s->stats.node_tables_written++;
     }
     sqlite3_finalize(st);
     return status;
