@@ -1606,7 +1606,6 @@ static cm_status end_of(cm_cluster *c, cm_resolve_cache *cache, uint32_t id, con
     cm_status st = cm_cluster_node(c, id, &nd, msg, msg_size);
     if (st != CM_OK)
         return st;
-    seen->id = CM_NODE_OPEN; /* until known */
     if (is_open(nd)) {
         *seen = (end_now){id, 0, 1, id};
         return CM_OK;

@@ -463,7 +463,8 @@ cm_resolve_cache *cm_resolve_cache_new(void);
 void cm_resolve_cache_free(cm_resolve_cache *cache);
 
 /* cm_cluster_flatten_open (open may be NULL) through cache, which then
- * holds the regions that meet box and no others. On failure the cache is
+ * holds the regions that meet box and no others (NULL: every node resolved
+ * afresh, as cm_cluster_flatten_open does). On failure the cache is
  * emptied. */
 cm_status cm_cluster_flatten_cached(cm_cluster *c, const cm_box *box, cm_resolve_cache *cache,
                                     cm_region *out, uint32_t *open, char *msg,

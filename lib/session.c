@@ -410,10 +410,8 @@ static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_gr
         if (!*open)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
     }
-    return s->resolve_cache ? cm_cluster_flatten_cached(&s->c, &box, s->resolve_cache, flat,
-                                                        open ? *open : NULL, msg, msg_size)
-           : open           ? cm_cluster_flatten_open(&s->c, &box, flat, *open, msg, msg_size)
-                            : cm_cluster_flatten(&s->c, &box, flat, msg, msg_size);
+    return cm_cluster_flatten_cached(&s->c, &box, s->resolve_cache, flat, open ? *open : NULL, msg,
+                                     msg_size);
 }
 
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
