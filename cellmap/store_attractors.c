@@ -177,6 +177,17 @@ cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
     return st == CM_OK ? st : store_abandon(s, st);
 }
 
+cm_status store_forget_attractors(cm_store *s, char *msg, size_t msg_size)
+{
+    if (s->version < 7)
+        return CM_OK;
+    if (store_exec(s->db, "DELETE FROM system_attractors; DELETE FROM group_fates; "
+                          "DELETE FROM exit_fates; DELETE FROM meta WHERE key = '" OPTIONS_KEY
+                          "'") != SQLITE_OK)
+        return store_db_error(s->db, "forget the attractors", msg, msg_size);
+    return CM_OK;
+}
+
 /* The options of the stored attractors and the sink's counts into a;
  * CM_ENOTFOUND if none are stored (a file of version 6 or older, or a
  * solve interrupted before them). */

@@ -95,6 +95,7 @@ cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *m
     uint32_t *local;
     uint64_t *weight, n;
     int64_t *cells;
+    s->cluster_written = 1;
     if (cm_cluster_open_nodes(c, k, &local, &weight, &cells, &n) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
     const size_t dim = (size_t)c->lat.dim, values = n * (2 + dim);
@@ -166,11 +167,14 @@ cm_status cm_store_commit(cm_store *s, cm_cluster *c, char *msg, size_t msg_size
     cm_status st = store_begin(s, msg, msg_size);
     if (st == CM_OK)
         st = store_write_changes(s, c, msg, msg_size);
+    if (st == CM_OK && s->cluster_written)
+        st = store_forget_attractors(s, msg, msg_size);
     if (st == CM_OK && store_exec(s->db, "COMMIT") != SQLITE_OK)
         st = store_db_error(s->db, "commit", msg, msg_size);
     if (st != CM_OK)
         return store_abandon(s, st);
     s->in_transaction = 0;
+    s->cluster_written = 0;
     cm_cluster_saved(c); /* the file now holds everything */
     s->stats.commit_seconds += cm_seconds() - t0;
     return CM_OK;

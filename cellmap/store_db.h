@@ -30,6 +30,8 @@ struct cm_store {
     int version; /* of the file: 2 and 3 are read (regions resolved, no node table) */
     int in_transaction;             /* evictions in a join write into it; the commit ends it */
     int failed;                     /* a write failed: the cluster and the file differ */
+    int cluster_written; /* the open transaction wrote regions or nodes: the commit forgets
+                            the stored attractors (store_forget_attractors) */
     unsigned char *blobs; /* a region's encoded pages, read or to write */
     uint64_t blobs_cap;
     /* page encoders, one per thread, kept from one batch of pages to the
@@ -165,6 +167,13 @@ cm_status store_write_region(cm_store *s, const cm_cluster *c, uint32_t k, char 
 /* Region k's open nodes (replacing the saved ones). */
 cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *msg,
                                  size_t msg_size);
+
+/* ---- store_attractors.c ---- */
+/* Removes the stored system attractors (a file of version 7 on; in the
+ * open transaction): a commit that changes the cluster makes them stale,
+ * and a reader then finds them afresh rather than reading another
+ * cluster's (cm_store_get_attractors: CM_ENOTFOUND). */
+cm_status store_forget_attractors(cm_store *s, char *msg, size_t msg_size);
 
 /* Everything the cluster changed since it was last saved, in the open
  * transaction (cm_store_commit without BEGIN and COMMIT). */

@@ -844,6 +844,7 @@ cm_status store_write_nodes(cm_store *s, const cm_cluster *c, uint32_t k, char *
                    "a chunk's columns fit an encoder's scratch");
     const cm_cluster_region *cr = &c->regions[k];
     const size_t part = cm_codec_bound(4 * (NODE_FIELDS * (size_t)CM_NODE_CHUNK + 1));
+    s->cluster_written = 1;
     uint64_t first[NODE_BATCH];
     size_t lens[NODE_BATCH];
     sqlite3_stmt *st = NULL;
@@ -881,6 +882,7 @@ cm_status store_write_region(cm_store *s, const cm_cluster *c, uint32_t k, char 
     const cm_region *r = &c->regions[k].r;
     if (!r->group)
         return cm_fail(CM_EINVAL, msg, msg_size, "region %u is unsaved but paged out", k);
+    s->cluster_written = 1;
     cm_status st = store_insert_region(s, k, r, msg, msg_size);
     if (st == CM_OK)
         st = store_write_pages(s, k, r, msg, msg_size);

@@ -117,6 +117,7 @@ static cm_status rewrite(cm_store *s, cm_cluster *c, char *msg, size_t msg_size)
     for (uint32_t k = 0; k < c->nregions; k++)
         c->regions[k].written = 0; /* all regions, nodes, counts and groups are unsaved */
     cm_status st = store_write_changes(s, c, msg, msg_size);
+    s->cluster_written = 0; /* the same cluster, rewritten: its attractors hold */
     char pragma[64];
     snprintf(pragma, sizeof pragma, "PRAGMA user_version=%d", CM_STORE_VERSION);
     if (st == CM_OK && store_exec(s->db, pragma) != SQLITE_OK)
