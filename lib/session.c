@@ -388,15 +388,14 @@ cm_status session_extend(session *s, const cm_box *tile, int steps, session_step
 
 /* ---- render, stats ------------------------------------------------------------ */
 
-/* The shown layer of the view, flattened, and the cluster's groups; with
- * open non-NULL, also the cells' open nodes (cm_cluster_flatten_open) into
- * a new *open, the caller's to free. */
-static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_group_info **groups,
-                             char *msg, size_t msg_size)
+/* The cells of box, flattened, and the cluster's groups; with open
+ * non-NULL, also the cells' open nodes (cm_cluster_flatten_open) into a
+ * new *open, the caller's to free. */
+static cm_status box_cells(session *s, const cm_box *shown, cm_region *flat, uint32_t **open,
+                           cm_group_info **groups, char *msg, size_t msg_size)
 {
-    cm_box box;
+    const cm_box box = *shown;
     uint64_t sink = 0;
-    shown_box(s, &box);
     *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
     if (!*groups)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", s->c.ngroups);
@@ -412,6 +411,43 @@ static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_gr
     }
     return cm_cluster_flatten_cached(&s->c, &box, s->resolve_cache, flat, open ? *open : NULL, msg,
                                      msg_size);
+}
+
+/* The shown layer of the view, as box_cells gives it. */
+static cm_status shown_cells(session *s, cm_region *flat, uint32_t **open, cm_group_info **groups,
+                             char *msg, size_t msg_size)
+{
+    cm_box box;
+    shown_box(s, &box);
+    return box_cells(s, &box, flat, open, groups, msg, msg_size);
+}
+
+cm_status session_labels(session *s, const cm_box *box, cm_region *flat, int32_t **labels,
+                         cm_attractor_set *att, char *msg, size_t msg_size)
+{
+    memset(flat, 0, sizeof *flat);
+    memset(att, 0, sizeof *att);
+    *labels = NULL;
+    cm_group_info *groups = NULL;
+    uint32_t *open = NULL;
+    cm_status st = box->dim == s->dim ? CM_OK
+                                      : cm_fail(CM_EINVAL, msg, msg_size,
+                                                "a box of %d dimensions for a model of %d",
+                                                box->dim, s->dim);
+    if (st == CM_OK)
+        st = box_cells(s, box, flat, &open, &groups, msg, msg_size);
+    if (st == CM_OK && !s->exit_memo)
+        s->exit_memo = cm_exit_memo_new(); /* NULL: labels without it */
+    if (st == CM_OK)
+        st = part_labels(&s->model, &s->c, flat, open, groups, false, s->exit_memo, att, labels,
+                         msg, msg_size);
+    free(open);
+    free(groups);
+    if (st != CM_OK) {
+        cm_region_free(flat);
+        cm_attractors_free(att);
+    }
+    return st;
 }
 
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)

@@ -179,6 +179,14 @@ cm_status session_journal_end(session *s, char *msg, size_t msg_size);
  * replace the session's database or a file po reads. */
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size);
 
+/* The cells of box (a slice: dimensions 2.. one cell wide) flattened into
+ * flat and labelled by the system's attractors as render labels them, into
+ * a new *labels (flat->ncells entries, the caller frees it) with the
+ * attractors in att (cm_attractors_free); the view stays. On failure
+ * nothing is left to free. */
+cm_status session_labels(session *s, const cm_box *box, cm_region *flat, int32_t **labels,
+                         cm_attractor_set *att, char *msg, size_t msg_size);
+
 /* What `stats` counts in the view's shown cells. */
 typedef struct session_stats {
     cm_region flat;         /* the shown cells */

@@ -30,5 +30,7 @@ int cmd_horseshoe(int argc, char **argv);
 int cmd_partition(int argc, char **argv);
 int cmd_bifurcation(int argc, char **argv);
 int cmd_sweep(int argc, char **argv);
+/* In the program cellmap-serve only (src/cmd_serve.c). */
+int cmd_serve(int argc, char **argv);
 
 #endif

@@ -1,12 +1,34 @@
 /* cellmap - cell mapping and global dynamics from the command line. */
+#include <errno.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lib/outfile.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/wait_policy.h"
+
+/* `cellmap serve` runs cellmap-serve, the program beside this one: it
+ * alone links the HTTP library (src/cmd_serve.c says why). */
+static int run_serve(int argc, char **argv)
+{
+    (void)argc;
+    static char name[] = "cellmap-serve"; /* what ps and pkill show */
+    char path[4096] = "cellmap-serve";
+    const ssize_t n = readlink("/proc/self/exe", path, sizeof path - sizeof name);
+    if (n > 0 && memchr(path, '/', (size_t)n)) {
+        path[n] = '\0';
+        strcpy(strrchr(path, '/') + 1, name);
+        argv[0] = name;
+        execv(path, argv);
+    }
+    fprintf(stderr, "cellmap serve: cannot run %s: %s (cellmap-serve is built and installed "
+                    "beside cellmap)\n",
+            path, strerror(errno));
+    return EXIT_FAIL;
+}
 
 static const struct {
     const char *name;
@@ -18,6 +40,8 @@ static const struct {
     {"sweep", cmd_sweep,
      "solve a region for several values of a parameter; where attractors are absorbed"},
     {"explore", cmd_explore, "explore basins by panning and zooming a view (script or prompt)"},
+    {"serve", run_serve,
+     "the basin atlas in a browser: pan and zoom a cluster that grows as you look"},
     {"render", cmd_render, "draw a figure or an indexed image of a .cmdb file's basins"},
     {"info", cmd_info, "what a .cmdb cluster database holds; its size on disk and in memory"},
     {"export", cmd_export, "a .cmdb file's groups and cells as CSV, .npy or a flat SQLite table"},

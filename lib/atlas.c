@@ -1,0 +1,424 @@
+/* lib/atlas.c - the basin atlas: tiles and point queries of a session's
+ * cluster (lib/atlas.h). */
+#include "lib/atlas.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lib/attractor_view.h"
+#include "render/palette.h"
+#include "render/png_out.h"
+
+struct atlas_kept {
+    int z;
+    int64_t x, y;
+    uint8_t *png;
+    size_t size;
+    uint64_t used; /* a->clock when last asked */
+};
+
+void atlas_init(atlas *a, session *s, bool compute, uint64_t max_cells)
+{
+    memset(a, 0, sizeof *a);
+    a->s = s;
+    a->compute = compute;
+    a->max_cells = max_cells;
+}
+
+/* Forgets the kept tiles. */
+static void drop_kept(atlas *a)
+{
+    for (uint32_t i = 0; i < a->nkept; i++)
+        free(a->kept[i].png);
+    a->nkept = 0;
+}
+
+void atlas_free(atlas *a)
+{
+    drop_kept(a);
+    free(a->kept);
+    a->kept = NULL;
+}
+
+/* The kept tile (z, x, y), or NULL. */
+static atlas_kept *find_kept(atlas *a, int z, int64_t x, int64_t y)
+{
+    for (uint32_t i = 0; i < a->nkept; i++)
+        if (a->kept[i].z == z && a->kept[i].x == x && a->kept[i].y == y)
+            return &a->kept[i];
+    return NULL;
+}
+
+/* The place of the kept tile asked least recently. */
+static uint32_t least_recent(const atlas *a)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 1; i < a->nkept; i++)
+        k = a->kept[i].used < a->kept[k].used ? i : k;
+    return k;
+}
+
+/* Keeps a copy of tile t (z, x, y) in place of the least recently asked
+ * one when ATLAS_CACHE_TILES are kept; without memory, keeps nothing. */
+static void keep(atlas *a, int z, int64_t x, int64_t y, const atlas_tile *t)
+{
+    if (!a->kept && !(a->kept = calloc(ATLAS_CACHE_TILES, sizeof *a->kept)))
+        return;
+    const uint32_t slot = a->nkept < ATLAS_CACHE_TILES ? a->nkept : least_recent(a);
+    uint8_t *png = malloc(t->size);
+    if (!png)
+        return;
+    memcpy(png, t->png, t->size);
+    if (slot == a->nkept)
+        a->nkept++;
+    else
+        free(a->kept[slot].png);
+    a->kept[slot] = (atlas_kept){z, x, y, png, t->size, a->clock};
+}
+
+/* Cells along a tile's side at zoom z (<= 0). */
+static int64_t tile_side(int z) { return (int64_t)ATLAS_TILE << -z; }
+
+cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *box, char *msg,
+                         size_t msg_size)
+{
+    const session *s = a->s;
+    if (s->dim < 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the atlas draws two state coordinates; model %s has one",
+                       s->model.name);
+    if (z < ATLAS_MIN_ZOOM || z > 0)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "zoom %d: tiles are drawn at zoom %d..0 (0: one pixel per cell)", z,
+                       ATLAS_MIN_ZOOM);
+    const int64_t side = tile_side(z), limit = CM_WORLD_LIMIT / side;
+    if (x < -limit || x >= limit || y < -limit || y >= limit)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "tile %lld,%lld at zoom %d lies beyond the lattice's world (cell "
+                       "coordinates below 2^40)",
+                       (long long)x, (long long)y, z);
+    box->dim = s->dim;
+    box->lo[0] = x * side;
+    box->hi[0] = box->lo[0] + side;
+    box->lo[1] = -(y + 1) * side;
+    box->hi[1] = box->lo[1] + side;
+    for (int d = 2; d < s->dim; d++) {
+        box->lo[d] = s->slice[d];
+        box->hi[d] = s->slice[d] + 1;
+    }
+    return CM_OK;
+}
+
+/* The cells of shown (all of the session's depth) the cluster lacks,
+ * computed when the atlas computes and they are few enough. */
+static cm_status compute_missing(const atlas *a, const cm_box *shown, uint64_t *computed,
+                                 char *msg, size_t msg_size)
+{
+    session *s = a->s;
+    cm_box all = *shown;
+    for (int d = 2; d < s->dim; d++) {
+        all.lo[d] = s->depth_lo[d];
+        all.hi[d] = s->depth_hi[d];
+    }
+    *computed = 0;
+    if (!a->compute || cm_box_cells(&all) > a->max_cells)
+        return CM_OK;
+    session_work done;
+    const cm_status st = session_add_box(s, &all, &done, msg, msg_size);
+    *computed = done.cells;
+    return st;
+}
+
+/* The colours of the figure's groups attractor_view made (0 the sink,
+ * 1..n the attractors, then the grey one), into rgb[0..n]: the palette's
+ * classes over all of them, by basin, no neighbour rule. */
+static cm_status group_colours(const cm_lattice *lat, const cm_group_info *groups, uint32_t n,
+                               cm_rgb *rgb, char *msg, size_t msg_size)
+{
+    uint8_t *classes = malloc((size_t)n + 1);
+    if (!classes)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u colours", n);
+    cm_palette_classes(NULL, groups, n, lat, NULL, 1, NULL, classes);
+    rgb[0] = cm_colour_sink;
+    for (uint32_t g = 1; g <= n; g++)
+        rgb[g] = cm_class_colour(NULL, classes[g - 1]);
+    free(classes);
+    return CM_OK;
+}
+
+/* The label most of the k x k block's cells have (ties: the lowest; a
+ * computed cell's before CM_GROUP_NONE), the block's ids in v (k^2 <= 64). */
+static uint32_t block_mode(uint32_t *v, int n)
+{
+    for (int i = 1; i < n; i++) { /* insertion sort: at most 64 */
+        const uint32_t x = v[i];
+        int j = i;
+        for (; j > 0 && v[j - 1] > x; j--)
+            v[j] = v[j - 1];
+        v[j] = x;
+    }
+    uint32_t best = v[0];
+    int best_run = 0;
+    for (int i = 0; i < n;) {
+        int j = i;
+        while (j < n && v[j] == v[i])
+            j++;
+        if (j - i > best_run) {
+            best_run = j - i;
+            best = v[i];
+        }
+        i = j;
+    }
+    return best;
+}
+
+/* The tile's pixels (RGBA, row 0 at the top) from the relabelled cells
+ * (attractor_view's groups, rgb their colours, n of them). */
+static void paint_tile(const cm_region *flat, const cm_rgb *rgb, uint32_t n, uint32_t attractors,
+                       int z, int threads, uint8_t *rgba)
+{
+    const int k = 1 << -z;
+    const int64_t width = flat->box.hi[0] - flat->box.lo[0];
+#pragma omp parallel for schedule(static) num_threads(threads > 0 ? threads : 1)
+    for (int py = 0; py < ATLAS_TILE; py++) {
+        uint32_t block[64];
+        const int64_t top = (int64_t)(ATLAS_TILE - 1 - py) * k; /* the block's lowest row */
+        for (int px = 0; px < ATLAS_TILE; px++) {
+            int used = 0;
+            for (int r = 0; r < k; r++)
+                for (int c = 0; c < k; c++)
+                    block[used++] = flat->group[(uint64_t)((top + r) * width + px * k + c)];
+            const uint32_t g = k == 1 ? block[0] : block_mode(block, used);
+            const uint64_t at = (uint64_t)(top * width + px * k);
+            const bool marker = k == 1 && g >= 1 && g <= attractors && flat->step[at] == 0;
+            const cm_rgb col = g == CM_GROUP_NONE ? cm_colour_not_computed
+                               : marker           ? cm_colour_marker
+                               : g <= n           ? rgb[g]
+                                                  : cm_colour_other;
+            uint8_t *p = rgba + 4 * ((size_t)py * ATLAS_TILE + (size_t)px);
+            p[0] = col.r;
+            p[1] = col.g;
+            p[2] = col.b;
+            p[3] = 255;
+        }
+    }
+}
+
+/* Draws labelled cells (flat, labels, att: session_labels) as the tile. */
+static cm_status draw_tile(const atlas *a, int z, cm_region *flat, const int32_t *labels,
+                           const cm_attractor_set *att, atlas_tile *out, char *msg,
+                           size_t msg_size)
+{
+    cm_group_info *groups = NULL;
+    uint32_t n = 0;
+    cm_status st = attractor_view(att, flat, labels, &groups, &n, msg, msg_size);
+    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)n + 1) * sizeof *rgb) : NULL;
+    uint8_t *rgba = st == CM_OK ? malloc((size_t)4 * ATLAS_TILE * ATLAS_TILE) : NULL;
+    if (st == CM_OK && (!rgb || !rgba))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
+    if (st == CM_OK)
+        st = group_colours(&a->s->c.lat, groups, n, rgb, msg, msg_size);
+    if (st == CM_OK) {
+        paint_tile(flat, rgb, n, att->n, z, a->s->threads, rgba);
+        st = cm_png_encode(rgba, ATLAS_TILE, ATLAS_TILE, &out->png, &out->size, msg, msg_size);
+    }
+    free(groups);
+    free(rgb);
+    free(rgba);
+    return st;
+}
+
+cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out, char *msg,
+                         size_t msg_size)
+{
+    memset(out, 0, sizeof *out);
+    cm_box box;
+    cm_status st = atlas_tile_box(a, z, x, y, &box, msg, msg_size);
+    if (st == CM_OK)
+        st = compute_missing(a, &box, &out->computed, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (a->kept_regions != a->s->c.nregions) { /* the cluster grew: every tile may change */
+        drop_kept(a);
+        a->kept_regions = a->s->c.nregions;
+    }
+    a->clock++;
+    atlas_kept *k = find_kept(a, z, x, y);
+    if (k) {
+        k->used = a->clock;
+        out->kept = true;
+        out->size = k->size;
+        if (!(out->png = malloc(k->size)))
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
+        memcpy(out->png, k->png, k->size);
+        return CM_OK;
+    }
+    cm_region flat;
+    int32_t *labels = NULL;
+    cm_attractor_set att;
+    st = session_labels(a->s, &box, &flat, &labels, &att, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    st = draw_tile(a, z, &flat, labels, &att, out, msg, msg_size);
+    free(labels);
+    cm_region_free(&flat);
+    cm_attractors_free(&att);
+    if (st == CM_OK)
+        keep(a, z, x, y, out);
+    return st;
+}
+
+/* The cell of the slice at the lattice's origin: any box gives the
+ * cluster's attractors. */
+static void origin_cell(const session *s, cm_box *box)
+{
+    box->dim = s->dim;
+    for (int d = 0; d < s->dim; d++) {
+        box->lo[d] = d < 2 ? 0 : s->slice[d];
+        box->hi[d] = box->lo[d] + 1;
+    }
+}
+
+/* The legend's keys from the labelled cells of any box (session_labels). */
+static cm_status legend_keys(const atlas *a, cm_region *flat, const int32_t *labels,
+                             const cm_attractor_set *att, atlas_key **keys, uint32_t *n,
+                             char *msg, size_t msg_size)
+{
+    cm_group_info *groups = NULL;
+    uint32_t ngroups = 0;
+    cm_status st = attractor_view(att, flat, labels, &groups, &ngroups, msg, msg_size);
+    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)ngroups + 1) * sizeof *rgb) : NULL;
+    cm_group_label *names = st == CM_OK ? calloc((size_t)att->n + 1, sizeof *names) : NULL;
+    *keys = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **keys) : NULL;
+    if (st == CM_OK && (!rgb || !names || !*keys))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
+    if (st == CM_OK)
+        st = group_colours(&a->s->c.lat, groups, ngroups, rgb, msg, msg_size);
+    if (st == CM_OK) {
+        const int named = attractor_legend(att, att->n, names, 0, (int)att->n);
+        uint32_t used = 0;
+        for (int k = 0; k < named; k++, used++) {
+            (*keys)[used] = (atlas_key){(int32_t)names[k].id, rgb[names[k].id], ""};
+            memcpy((*keys)[used].name, names[k].text, sizeof names[k].text);
+        }
+        (*keys)[used++] = (atlas_key){CM_LABEL_DIVERGED, cm_colour_sink, "diverged"};
+        (*keys)[used++] = (atlas_key){CM_LABEL_OUTSIDE, cm_colour_sticking, "outside or undecided"};
+        (*keys)[used++] = (atlas_key){CM_LABEL_UNCOMPUTED, cm_colour_not_computed, "not computed"};
+        *n = used;
+    }
+    if (st != CM_OK) {
+        free(*keys);
+        *keys = NULL;
+    }
+    free(groups);
+    free(rgb);
+    free(names);
+    return st;
+}
+
+cm_status atlas_legend(const atlas *a, atlas_key **keys, uint32_t *n, char *msg,
+                       size_t msg_size)
+{
+    *keys = NULL;
+    *n = 0;
+    if (a->s->dim < 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the atlas draws two state coordinates; model %s has one",
+                       a->s->model.name);
+    cm_box box;
+    origin_cell(a->s, &box);
+    cm_region flat;
+    int32_t *labels = NULL;
+    cm_attractor_set att;
+    cm_status st = session_labels(a->s, &box, &flat, &labels, &att, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    st = legend_keys(a, &flat, labels, &att, keys, n, msg, msg_size);
+    free(labels);
+    cm_region_free(&flat);
+    cm_attractors_free(&att);
+    return st;
+}
+
+/* The true orbit of steps images from p->centre into p->orbit. */
+static cm_status follow_orbit(const cm_model *m, int steps, atlas_point *p, char *msg,
+                              size_t msg_size)
+{
+    const int dim = m->dim;
+    p->orbit = malloc(((size_t)steps + 1) * (size_t)dim * sizeof *p->orbit);
+    if (!p->orbit)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for an orbit of %d steps", steps);
+    memcpy(p->orbit, p->centre, (size_t)dim * sizeof *p->orbit);
+    p->norbit = 1;
+    for (int k = 0; k < steps; k++) {
+        const double *x = p->orbit + (size_t)k * (size_t)dim;
+        double *y = p->orbit + (size_t)(k + 1) * (size_t)dim;
+        const int rc = m->step(m, x, y);
+        if (rc < 0)
+            return cm_fail(CM_EINVAL, msg, msg_size, "model %s stopped the orbit at step %d",
+                           m->name, k + 1);
+        bool finite = rc == 0;
+        for (int d = 0; d < dim && finite; d++)
+            finite = isfinite(y[d]);
+        if (!finite)
+            break; /* no image: the sink */
+        p->norbit++;
+    }
+    return CM_OK;
+}
+
+cm_status atlas_point_query(const atlas *a, double x, double y, int steps, atlas_point *out,
+                            char *msg, size_t msg_size)
+{
+    session *s = a->s;
+    const cm_lattice *lat = &s->c.lat;
+    memset(out, 0, sizeof *out);
+    if (!isfinite(x) || !isfinite(y))
+        return cm_fail(CM_EINVAL, msg, msg_size, "the point needs finite coordinates x and y");
+    if (steps < 0 || steps > ATLAS_ORBIT_MAX)
+        return cm_fail(CM_EINVAL, msg, msg_size, "an orbit of %d steps: give 0..%d", steps,
+                       ATLAS_ORBIT_MAX);
+    if (s->dim < 2)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the atlas draws two state coordinates; model %s has one", s->model.name);
+    double state[CM_MAX_DIM] = {x, y};
+    for (int d = 2; d < s->dim; d++)
+        state[d] = lat->origin[d] + ((double)s->slice[d] + 0.5) * lat->width[d];
+    if (!cm_lattice_cell(lat, state, out->cell))
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the point %g,%g lies beyond the lattice's world (cell coordinates "
+                       "below 2^40)",
+                       x, y);
+    cm_box box = {.dim = s->dim};
+    for (int d = 0; d < s->dim; d++) {
+        box.lo[d] = out->cell[d];
+        box.hi[d] = out->cell[d] + 1;
+        out->centre[d] = lat->origin[d] + ((double)out->cell[d] + 0.5) * lat->width[d];
+    }
+    cm_region flat;
+    int32_t *labels = NULL;
+    cm_attractor_set att;
+    cm_status st = session_labels(s, &box, &flat, &labels, &att, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    out->computed = flat.group[0] != CM_GROUP_NONE;
+    out->group = out->computed ? flat.group[0] : 0;
+    out->step = out->computed ? flat.step[0] : 0;
+    out->label = labels[0];
+    out->attractors = att.n;
+    free(labels);
+    cm_region_free(&flat);
+    cm_attractors_free(&att);
+    st = follow_orbit(&s->model, steps, out, msg, msg_size);
+    if (st != CM_OK)
+        atlas_point_free(out);
+    return st;
+}
+
+void atlas_point_free(atlas_point *p)
+{
+    free(p->orbit);
+    p->orbit = NULL;
+    p->norbit = 0;
+}

@@ -1,0 +1,150 @@
+#!/usr/bin/env bash
+# Integration tests of `cellmap serve` (issue 49) over HTTP with curl: tiles
+# against the labels `export` gives, tiles that compute against a single
+# solve of the union, point queries against `orbit`, bad requests, 50
+# requests at once, a second writer refused and readers served meanwhile,
+# read-only, and SIGTERM leaving the file whole.
+# usage: serve_test.sh PATH/TO/cellmap SOURCE_DIR
+set -u
+CM=$1
+SRC=$2
+. "$SRC/tests/testlib.sh"
+enter_workdir
+export PYTHONPATH="$SRC/tests"
+check() { python3 "$SRC/tests/serve_check.py" "$@"; }
+
+# start FILE [options]: serves FILE on a free port; sets pid and url
+start() {
+  "$CM" serve "$@" --port 0 > serve.out 2> serve.err &
+  pid=$!
+  for _ in $(seq 100); do
+    url=$(sed -n 's|.* at \(http://[^ ]*\)/ .*|\1|p' serve.out)
+    [ -n "$url" ] && return 0
+    sleep 0.1
+  done
+  fail "serve $* did not start: $(cat serve.err)"
+  url=http://127.0.0.1:1
+}
+
+# stop: SIGTERM, and the server ends with status 0
+stop() {
+  kill -TERM "$pid"
+  wait "$pid" || fail "serve ended with status $? on SIGTERM: $(cat serve.err)"
+  grep -q "terminated, stopped" serve.out || fail "serve did not say it stopped"
+}
+
+# status PATH [curl options]: the HTTP status of a request
+status() { local p=$1; shift; curl -s -o /dev/null -w '%{http_code}' "$@" "$url$p"; }
+
+pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
+# the cells of tile (0, 1, -2): x 128..256, v -19.52..0.96, around attractor A at x 144
+"$CM" solve --db s.cmdb $pd --region 128:256,-19.52:0.96 --cells 256x256 > /dev/null ||
+  fail "solve"
+
+# --- the page, Leaflet's files, the info -------------------------------------
+# (tiles compute at zoom 0 only: what the file holds stays a known box)
+start s.cmdb --tile-cells 65536
+grep -q "http://127.0.0.1:" serve.out || fail "serve does not listen on 127.0.0.1 by default"
+curl -sf "$url/" | grep -q "L.CRS.Simple" || fail "the page is not the Leaflet map"
+curl -sf "$url/leaflet/leaflet.js" -o leaflet.js || fail "leaflet.js not served"
+cmp -s leaflet.js /usr/share/javascript/leaflet/leaflet.js || fail "leaflet.js is not Debian's"
+curl -sf "$url/info" -o info.json || fail "/info"
+[ "$(check json info.json lattice computes)" = '{"origin": [128, -19.52], "width": [0.5, 0.08]} true' ] ||
+  fail "/info: $(cat info.json)"
+
+# --- tiles are the labels export gives --------------------------------------
+# window Z X Y: the state rectangle of tile (Z, X, Y), a hundredth of a cell
+# inside. The lattice's origin is the solve's corner (128, -19.52): tile
+# (0, 0, -1) holds its cells.
+window() {
+  python3 -c "
+z, x, y = $1, $2, $3
+n = 256 << -z
+lo0, hi0, lo1, hi1 = x * n, (x + 1) * n, -(y + 1) * n, -y * n
+print('%.6f:%.6f,%.6f:%.6f' % (128 + lo0 * 0.5 + 0.005, 128 + hi0 * 0.5 - 0.005,
+                               -19.52 + lo1 * 0.08 + 0.0008, -19.52 + hi1 * 0.08 - 0.0008))"
+}
+# tile 0/0/-1 drawn and kept before its neighbour grows the cluster: kept
+# tiles must be drawn again (its cells leading there change their labels)
+curl -sf "$url/tiles/0/0/-1.png" -o /dev/null || fail "tile 0/0/-1 before"
+# a tile over cells not computed: 65 536 new cells, joined and committed
+curl -sf "$url/tiles/0/1/-1.png" -o /dev/null || fail "tile 0/1/-1 (computing)"
+# the tiles compared with export below: drawn from the cluster as it ends
+curl -sf "$url/tiles/0/0/-1.png" -o t0.png || fail "tile 0/0/-1"
+curl -sf "$url/tiles/-1/0/-1.png" -o t1.png || fail "tile -1/0/-1"
+curl -sf "$url/tiles/0/1/-1.png" -o t2.png || fail "tile 0/1/-1"
+curl -sf "$url/info" -o legend.json || fail "/info after computing"
+# a reader meanwhile: the file is whole, its attractors found afresh
+"$CM" info s.cmdb > info.txt 2>&1 || fail "info while serving: $(cat info.txt)"
+grep -q "regions 2," info.txt || fail "the computed tile is not in the file: $(head -5 info.txt)"
+# a second writer is refused
+echo "view 0:10 -10:0" | "$CM" explore s.cmdb - > explore.out 2>&1 &&
+  fail "explore ran on a file being served"
+grep -q "in use" explore.out || fail "explore's refusal does not say the file is in use: $(cat explore.out)"
+
+# --- point queries: the cell, its label, its orbit as `orbit` gives it ------
+curl -sf "$url/cell?x=150.3&y=0.1&steps=5" -o cell.json || fail "/cell"
+[ "$(check json cell.json cell computed)" = "[44, 245] true" ] ||
+  fail "/cell of (150.3, 0.1): $(cat cell.json)"
+
+# --- bad requests: a status and a message, never a crash --------------------
+for bad in "/tiles/0/0/x.png" "/tiles/1/0/0.png" "/tiles/-9/0/0.png" "/tiles/0/0/0.jpg" \
+           "/tiles/0/9999999999999999/0.png" "/tiles/0/0/-0000000000000000000001.png" \
+           "/cell?x=nan&y=0" "/cell?x=1e400&y=0" "/cell?x=1&y=" "/cell" "/cell?x=1e300&y=0" \
+           "/cell?x=1&y=2&steps=-1" "/cell?x=1&y=2&steps=1.5" "/cell?x=1&y=2&steps=99999"; do
+  [ "$(status "$bad")" = 400 ] || fail "$bad: status $(status "$bad"), expected 400"
+done
+for missing in "/etc/passwd" "/leaflet/../../../../etc/passwd" "/leaflet/leaflet.js.map" \
+                "/leaflet/%2e%2e/%2e%2e/etc/passwd" "/tiles" "/s.cmdb"; do
+  [ "$(status "$missing" --path-as-is)" = 404 ] || fail "$missing: status $(status "$missing" --path-as-is)"
+done
+[ "$(status / -X POST -d x=1)" = 405 ] || fail "POST: status $(status / -X POST -d x=1)"
+[ "$(status / -X DELETE)" = 405 ] || fail "DELETE answered"
+
+# --- 50 tile requests at once ------------------------------------------------
+(
+  for i in $(seq 0 49); do
+    curl -s -o /dev/null -w '%{http_code}\n' "$url/tiles/$((i % 2 - 1))/0/-1.png" &
+  done
+  wait
+) > many.txt
+[ "$(grep -c '^200$' many.txt)" = 50 ] || fail "50 requests at once: $(sort many.txt | uniq -c)"
+stop
+"$CM" info s.cmdb > info.txt 2>&1 || fail "info after serving: $(cat info.txt)"
+grep -q "^attractors" info.txt || fail "the file lost its attractors: $(cat info.txt)"
+
+"$CM" export s.cmdb --labels l0.npy --window "$(window 0 0 -1)" || fail "export tile 0"
+"$CM" export s.cmdb --labels l1.npy --window "$(window -1 0 -1)" || fail "export tile -1"
+"$CM" export s.cmdb --labels l2.npy --window "$(window 0 1 -1)" || fail "export tile 2"
+check tile t0.png legend.json l0.npy 0 0 -1 || fail "tile 0/0/-1 is not the cells' labels"
+check tile t1.png legend.json l1.npy -1 0 -1 || fail "tile -1/0/-1 is not its blocks' labels"
+check tile t2.png legend.json l2.npy 0 1 -1 || fail "the computing tile is not the cells' labels"
+
+# the cells the tile computed equal a single solve of the union, cell by cell
+"$CM" solve --db union.cmdb $pd --region 128:384,-19.52:0.96 --cells 512x256 > /dev/null ||
+  fail "solve of the union"
+for f in s union; do
+  "$CM" export $f.cmdb --labels $f.labels.npy --steps $f.steps.npy --window "128.005:383.995,-19.5192:0.9592" ||
+    fail "export $f"
+done
+check same s.labels.npy union.labels.npy || fail "the served file's labels differ from a single solve's"
+check equal s.steps.npy union.steps.npy || fail "the served file's steps differ from a single solve's"
+
+# --- read-only: nothing computed, nothing written ----------------------------
+cp s.cmdb before.cmdb
+start s.cmdb --read-only
+curl -sf "$url/tiles/0/2/-1.png" -o t3.png || fail "read-only tile"
+curl -sf "$url/info" -o ro.json || fail "read-only info"
+[ "$(check json ro.json computes regions)" = "false 2" ] || fail "read-only info: $(cat ro.json)"
+stop
+same_rows s.cmdb before.cmdb "SELECT COUNT(*) FROM regions" || fail "read-only serve changed the regions"
+
+# --- usage ---------------------------------------------------------------------
+expect_usage "--port" serve s.cmdb --port 70000
+expect_usage "not an IPv4 or IPv6 address" serve new.cmdb $pd --cell-size 0.5,0.08 --bind 1.2.3
+[ ! -e new.cmdb ] || fail "serve with a bad --bind made the new file"
+expect_usage "which file" serve
+out=$("$CM" serve nothing.cmdb 2>&1); rc=$?
+[ "$rc" = 2 ] && [ ! -e nothing.cmdb ] || fail "serve of a missing file without a model: $rc $out"
+
+exit $((fails > 0))
