@@ -6,9 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/grow.h"
 #include "lib/attractor_view.h"
 #include "render/palette.h"
 #include "render/png_out.h"
+
+struct atlas_colour {
+    int64_t anchor[CM_MAX_DIM];
+    uint8_t cls; /* enum cm_colour_class */
+};
 
 struct atlas_kept {
     int z;
@@ -38,7 +44,9 @@ void atlas_free(atlas *a)
 {
     drop_kept(a);
     free(a->kept);
+    free(a->colours);
     a->kept = NULL;
+    a->colours = NULL;
 }
 
 /* The kept tile (z, x, y), or NULL. */
@@ -130,19 +138,68 @@ static cm_status compute_missing(const atlas *a, const cm_box *shown, uint64_t *
     return st;
 }
 
+/* The colour class an attractor (anchor) had in a tile before, else
+ * CM_CLASS_NOT_COMPUTED. */
+static uint8_t known_class(const atlas *a, const int64_t *anchor, int dim)
+{
+    for (uint32_t i = 0; i < a->ncolours; i++)
+        if (memcmp(a->colours[i].anchor, anchor, (size_t)dim * sizeof *anchor) == 0)
+            return a->colours[i].cls;
+    return CM_CLASS_NOT_COMPUTED;
+}
+
+/* Whether an attractor seen before has class cls. */
+static bool class_taken(const atlas *a, uint8_t cls)
+{
+    for (uint32_t i = 0; i < a->ncolours; i++)
+        if (a->colours[i].cls == cls)
+            return true;
+    return false;
+}
+
+/* The class of a new attractor: the one proposed unless an attractor seen
+ * before has it, else the first free one (all taken: the one proposed). */
+static uint8_t new_class(const atlas *a, uint8_t proposed)
+{
+    const int n = cm_class_count(NULL);
+    for (int cls = CM_CLASS_FIRST_GROUP; class_taken(a, proposed) && cls < n; cls++)
+        if (!class_taken(a, (uint8_t)cls))
+            return (uint8_t)cls;
+    return proposed;
+}
+
 /* The colours of the figure's groups attractor_view made (0 the sink,
  * 1..n the attractors, then the grey one), into rgb[0..n]: the palette's
- * classes over all of them, by basin, no neighbour rule. */
-static cm_status group_colours(const cm_lattice *lat, const cm_group_info *groups, uint32_t n,
-                               cm_rgb *rgb, char *msg, size_t msg_size)
+ * classes over all of them (by basin, no neighbour rule), except that an
+ * attractor keeps the colour it had in the atlas's earlier tiles, and a
+ * new one takes a colour no earlier one has while there is one. Attractor
+ * ids change as the cluster grows; their anchors, and so their colours,
+ * stay. */
+static cm_status group_colours(atlas *a, const cm_group_info *groups, uint32_t n, cm_rgb *rgb,
+                               char *msg, size_t msg_size)
 {
+    const int dim = a->s->c.lat.dim;
     uint8_t *classes = malloc((size_t)n + 1);
-    if (!classes)
+    if (!classes || cm_grow((void **)&a->colours, &a->colours_cap, a->ncolours + n,
+                            sizeof *a->colours) != CM_OK) {
+        free(classes);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u colours", n);
-    cm_palette_classes(NULL, groups, n, lat, NULL, 1, NULL, classes);
+    }
+    cm_palette_classes(NULL, groups, n, &a->s->c.lat, NULL, 1, NULL, classes);
     rgb[0] = cm_colour_sink;
-    for (uint32_t g = 1; g <= n; g++)
-        rgb[g] = cm_class_colour(NULL, classes[g - 1]);
+    for (uint32_t g = 1; g <= n; g++) {
+        uint8_t cls = classes[g - 1];
+        if (cls >= CM_CLASS_FIRST_GROUP) {
+            const uint8_t known = known_class(a, groups[g - 1].anchor, dim);
+            cls = known != CM_CLASS_NOT_COMPUTED ? known : new_class(a, cls);
+            if (known == CM_CLASS_NOT_COMPUTED) {
+                atlas_colour *c = &a->colours[a->ncolours++];
+                memcpy(c->anchor, groups[g - 1].anchor, sizeof c->anchor);
+                c->cls = cls;
+            }
+        }
+        rgb[g] = cm_class_colour(NULL, cls);
+    }
     free(classes);
     return CM_OK;
 }
@@ -206,7 +263,7 @@ static void paint_tile(const cm_region *flat, const cm_rgb *rgb, uint32_t n, uin
 }
 
 /* Draws labelled cells (flat, labels, att: session_labels) as the tile. */
-static cm_status draw_tile(const atlas *a, int z, cm_region *flat, const int32_t *labels,
+static cm_status draw_tile(atlas *a, int z, cm_region *flat, const int32_t *labels,
                            const cm_attractor_set *att, atlas_tile *out, char *msg,
                            size_t msg_size)
 {
@@ -218,7 +275,7 @@ static cm_status draw_tile(const atlas *a, int z, cm_region *flat, const int32_t
     if (st == CM_OK && (!rgb || !rgba))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
     if (st == CM_OK)
-        st = group_colours(&a->s->c.lat, groups, n, rgb, msg, msg_size);
+        st = group_colours(a, groups, n, rgb, msg, msg_size);
     if (st == CM_OK) {
         paint_tile(flat, rgb, n, att->n, z, a->s->threads, rgba);
         st = cm_png_encode(rgba, ATLAS_TILE, ATLAS_TILE, &out->png, &out->size, msg, msg_size);
@@ -281,7 +338,7 @@ static void origin_cell(const session *s, cm_box *box)
 }
 
 /* The legend's keys from the labelled cells of any box (session_labels). */
-static cm_status legend_keys(const atlas *a, cm_region *flat, const int32_t *labels,
+static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
                              const cm_attractor_set *att, atlas_key **keys, uint32_t *n,
                              char *msg, size_t msg_size)
 {
@@ -294,7 +351,7 @@ static cm_status legend_keys(const atlas *a, cm_region *flat, const int32_t *lab
     if (st == CM_OK && (!rgb || !names || !*keys))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
     if (st == CM_OK)
-        st = group_colours(&a->s->c.lat, groups, ngroups, rgb, msg, msg_size);
+        st = group_colours(a, groups, ngroups, rgb, msg, msg_size);
     if (st == CM_OK) {
         const int named = attractor_legend(att, att->n, names, 0, (int)att->n);
         uint32_t used = 0;
@@ -317,7 +374,7 @@ static cm_status legend_keys(const atlas *a, cm_region *flat, const int32_t *lab
     return st;
 }
 
-cm_status atlas_legend(const atlas *a, atlas_key **keys, uint32_t *n, char *msg,
+cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
                        size_t msg_size)
 {
     *keys = NULL;

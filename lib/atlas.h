@@ -16,7 +16,10 @@
  *
  * Colours. An attractor keeps one colour in every tile: the palette's
  * classes are chosen over all the attractors the cluster has (by basin, no
- * neighbour rule, cm_palette_classes), so neighbouring tiles agree.
+ * neighbour rule, cm_palette_classes), so neighbouring tiles agree, and an
+ * attractor (known by its anchor: ids change as the cluster grows) keeps
+ * the colour it had in the atlas's earlier tiles, a new one taking a
+ * colour no earlier one has while the palette has one.
  * Diverged cells are the sink's red, cells whose fate is outside or
  * undecided grey, cells not computed the figures' not-computed colour, and
  * at zoom 0 an attractor's footprint cells are black, as figures mark
@@ -43,15 +46,19 @@
 enum { ATLAS_TILE = 256, ATLAS_MIN_ZOOM = -3, ATLAS_ORBIT_MAX = 10000, ATLAS_CACHE_TILES = 512 };
 
 typedef struct atlas_kept atlas_kept;
+typedef struct atlas_colour atlas_colour;
 
 typedef struct atlas {
     session *s;
     bool compute;       /* compute the cells a tile lacks */
     uint64_t max_cells; /* the most cells a tile computes (its cells, all depth) */
-    /* private: the tiles kept, for the cluster of kept_regions regions */
+    /* private: the tiles kept, for the cluster of kept_regions regions;
+     * the attractors' colours so far */
     atlas_kept *kept;
     uint32_t nkept, kept_regions;
     uint64_t clock;
+    atlas_colour *colours;
+    uint64_t ncolours, colours_cap;
 } atlas;
 
 /* An atlas over s (borrowed); atlas_free frees what it keeps. */
@@ -88,7 +95,7 @@ typedef struct atlas_key {
 /* The legend of the cluster as it is: the attractors (sticking zones
  * share the grey of "outside or undecided"), then diverged, outside or
  * undecided, not computed; *keys (*n of them) the caller frees. */
-cm_status atlas_legend(const atlas *a, atlas_key **keys, uint32_t *n, char *msg,
+cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
                        size_t msg_size);
 
 /* What a point of the map is. */

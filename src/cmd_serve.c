@@ -164,10 +164,10 @@ static unsigned status_code(cm_status st)
 }
 
 /* A JSON document written by fill into memory, answered. */
-typedef cm_status (*json_fill)(const atlas *a, FILE *f, const void *arg, char *msg,
+typedef cm_status (*json_fill)(atlas *a, FILE *f, const void *arg, char *msg,
                                size_t msg_size);
 
-static enum MHD_Result answer_json(struct MHD_Connection *conn, const atlas *a, json_fill fill,
+static enum MHD_Result answer_json(struct MHD_Connection *conn, atlas *a, json_fill fill,
                                    const void *arg)
 {
     char *body = NULL, msg[1024];
@@ -215,7 +215,7 @@ static void first_view(const session *s, cm_box *box)
 }
 
 /* /info: the model, lattice, first view, zooms and legend. */
-static cm_status fill_info(const atlas *a, FILE *f, const void *arg, char *msg, size_t msg_size)
+static cm_status fill_info(atlas *a, FILE *f, const void *arg, char *msg, size_t msg_size)
 {
     (void)arg;
     const session *s = a->s;
@@ -256,7 +256,7 @@ typedef struct cell_query {
 } cell_query;
 
 /* /cell: the cell at x, y and its orbit. */
-static cm_status fill_cell(const atlas *a, FILE *f, const void *arg, char *msg, size_t msg_size)
+static cm_status fill_cell(atlas *a, FILE *f, const void *arg, char *msg, size_t msg_size)
 {
     const cell_query *q = arg;
     atlas_point p;
@@ -341,7 +341,7 @@ static bool parse_number(const char *text, double *v)
     return *end == '\0' && errno == 0 && isfinite(*v);
 }
 
-static enum MHD_Result answer_cell(struct MHD_Connection *conn, const atlas *a)
+static enum MHD_Result answer_cell(struct MHD_Connection *conn, atlas *a)
 {
     cell_query q = {0, 0, 100};
     const char *x = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "x");
