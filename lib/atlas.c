@@ -3,8 +3,10 @@
 #include "lib/atlas.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cellmap/grow.h"
 #include "lib/attractor_view.h"
@@ -12,7 +14,7 @@
 #include "render/png_out.h"
 
 struct atlas_colour {
-    int64_t anchor[CM_MAX_DIM];
+    double anchor[CM_MAX_DIM]; /* the centre of its anchor cell */
     uint8_t cls; /* enum cm_colour_class */
 };
 
@@ -24,12 +26,116 @@ struct atlas_kept {
     uint64_t used; /* a->clock when last asked */
 };
 
-void atlas_init(atlas *a, session *s, bool compute, uint64_t max_cells)
+void atlas_init(atlas *a, session *s, const session_options *o, bool compute, uint64_t max_cells)
 {
     memset(a, 0, sizeof *a);
     a->s = s;
     a->compute = compute;
     a->max_cells = max_cells;
+    a->level[0] = s;
+    if (o) {
+        a->level_options = *o;
+        a->level_options.mo.set = s->models; /* the plugins the file's model came from */
+        a->refines = s->dim == 2;
+    }
+}
+
+void atlas_level_path(const char *base, int level, char *out, size_t size)
+{
+    const size_t n = strlen(base), ext = strlen(".cmdb");
+    const size_t stem = n > ext && strcmp(base + n - ext, ".cmdb") == 0 ? n - ext : n;
+    snprintf(out, size, "%.*s.zoom%d.cmdb", (int)stem, base, level);
+}
+
+int atlas_max_level(const atlas *a)
+{
+    if (!a->refines)
+        return 0;
+    if (a->compute)
+        return ATLAS_MAX_LEVEL;
+    int level = 0;
+    char path[4096];
+    for (; level < ATLAS_MAX_LEVEL; level++) { /* read-only: the levels there are */
+        atlas_level_path(a->s->path, level + 1, path, sizeof path);
+        if (!a->level[level + 1] && access(path, R_OK) != 0)
+            break;
+    }
+    return level;
+}
+
+uint64_t atlas_generation(const atlas *a)
+{
+    uint64_t regions = 0;
+    for (int l = 0; l <= ATLAS_MAX_LEVEL; l++)
+        regions += a->level[l] ? a->level[l]->c.nregions : 0;
+    return regions;
+}
+
+/* Creates the file of refined level `level` at path: the level-0 file's
+ * model on its lattice with cells 2^level times narrower in dimensions 0
+ * and 1, no cells yet. */
+static cm_status create_level(const atlas *a, int level, const char *path, char *msg,
+                              size_t msg_size)
+{
+    const session *base = a->s;
+    cm_lattice lat = base->c.lat;
+    lat.width[0] /= (double)(1 << level);
+    lat.width[1] /= (double)(1 << level);
+    const cm_model_lib *lib = NULL;
+    cm_model_set_find(&a->level_options.mo.set, base->model.name, &lib);
+    char command[4200], plan[64];
+    snprintf(command, sizeof command, "cellmap serve %s: zoom %d", base->path, level);
+    snprintf(plan, sizeof plan, "explore max-steps %d", base->max_steps);
+    cm_store *store = NULL;
+    cm_cluster c;
+    cm_status st = project_create(path, &base->model, lib, &lat, command, plan, &store, &c, msg,
+                                  msg_size);
+    const cm_status closed = store ? cm_store_close(store, msg, msg_size) : CM_OK;
+    cm_cluster_free(&c);
+    return st != CM_OK ? st : closed;
+}
+
+/* The session of refined level `level` (1..ATLAS_MAX_LEVEL): its file
+ * beside the level-0 file (atlas_level_path), made when the atlas computes
+ * and opened on first use. */
+static cm_status level_session(atlas *a, int level, session **out, char *msg, size_t msg_size)
+{
+    *out = a->level[level];
+    if (*out)
+        return CM_OK;
+    char path[4096];
+    atlas_level_path(a->s->path, level, path, sizeof path);
+    cm_status st = CM_OK;
+    if (access(path, F_OK) != 0) {
+        if (!a->compute)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "zoom %d: %s is not there, and the atlas is read-only", level, path);
+        st = create_level(a, level, path, msg, msg_size);
+    }
+    session *s = st == CM_OK ? calloc(1, sizeof *s) : NULL;
+    char *kept_path = s ? strdup(path) : NULL;
+    if (st == CM_OK && !kept_path) {
+        free(s);
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for zoom %d", level);
+    }
+    if (st != CM_OK)
+        return st;
+    session_options o = a->level_options;
+    o.path = kept_path;
+    o.mo.name = NULL; /* the file's own model */
+    o.mo.n_texts = 0;
+    o.depth_text = NULL;
+    session_opened opened;
+    st = session_open(s, &o, &opened, msg, msg_size);
+    if (st != CM_OK) {
+        char ignored[256];
+        session_close(s, ignored, sizeof ignored);
+        free(s);
+        free(kept_path);
+        return st;
+    }
+    a->level[level] = *out = s;
+    return CM_OK;
 }
 
 /* Forgets the kept tiles. */
@@ -40,13 +146,24 @@ static void drop_kept(atlas *a)
     a->nkept = 0;
 }
 
-void atlas_free(atlas *a)
+cm_status atlas_free(atlas *a, char *msg, size_t msg_size)
 {
+    cm_status st = CM_OK;
+    for (int l = 1; l <= ATLAS_MAX_LEVEL; l++) {
+        if (!a->level[l])
+            continue;
+        const cm_status closed = session_close(a->level[l], msg, msg_size);
+        st = st != CM_OK ? st : closed;
+        free((char *)a->level[l]->path);
+        free(a->level[l]);
+        a->level[l] = NULL;
+    }
     drop_kept(a);
     free(a->kept);
     free(a->colours);
     a->kept = NULL;
     a->colours = NULL;
+    return st;
 }
 
 /* The kept tile (z, x, y), or NULL. */
@@ -85,8 +202,8 @@ static void keep(atlas *a, int z, int64_t x, int64_t y, const atlas_tile *t)
     a->kept[slot] = (atlas_kept){z, x, y, png, t->size, a->clock};
 }
 
-/* Cells along a tile's side at zoom z (<= 0). */
-static int64_t tile_side(int z) { return (int64_t)ATLAS_TILE << -z; }
+/* Cells (of its level's lattice) along a tile's side at zoom z. */
+static int64_t tile_side(int z) { return (int64_t)ATLAS_TILE << (z < 0 ? -z : 0); }
 
 cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *box, char *msg,
                          size_t msg_size)
@@ -96,10 +213,11 @@ cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *bo
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "the atlas draws two state coordinates; model %s has one",
                        s->model.name);
-    if (z < ATLAS_MIN_ZOOM || z > 0)
+    if (z < ATLAS_MIN_ZOOM || z > atlas_max_level(a))
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "zoom %d: tiles are drawn at zoom %d..0 (0: one pixel per cell)", z,
-                       ATLAS_MIN_ZOOM);
+                       "zoom %d: tiles are drawn at zoom %d..%d (0: one pixel per cell of the "
+                       "file, above it finer cells)",
+                       z, ATLAS_MIN_ZOOM, atlas_max_level(a));
     const int64_t side = tile_side(z), limit = CM_WORLD_LIMIT / side;
     if (x < -limit || x >= limit || y < -limit || y >= limit)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -120,10 +238,9 @@ cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *bo
 
 /* The cells of shown (all of the session's depth) the cluster lacks,
  * computed when the atlas computes and they are few enough. */
-static cm_status compute_missing(const atlas *a, const cm_box *shown, uint64_t *computed,
-                                 char *msg, size_t msg_size)
+static cm_status compute_missing(const atlas *a, session *s, const cm_box *shown,
+                                 uint64_t *computed, char *msg, size_t msg_size)
 {
-    session *s = a->s;
     cm_box all = *shown;
     for (int d = 2; d < s->dim; d++) {
         all.lo[d] = s->depth_lo[d];
@@ -138,13 +255,20 @@ static cm_status compute_missing(const atlas *a, const cm_box *shown, uint64_t *
     return st;
 }
 
-/* The colour class an attractor (anchor) had in a tile before, else
- * CM_CLASS_NOT_COMPUTED. */
-static uint8_t known_class(const atlas *a, const int64_t *anchor, int dim)
+/* The colour class an attractor had in a tile before, else
+ * CM_CLASS_NOT_COMPUTED: known by where its anchor cell lies, to within a
+ * cell of level 0 (refined levels find the same attractor with other
+ * cells). */
+static uint8_t known_class(const atlas *a, const double *anchor, int dim)
 {
-    for (uint32_t i = 0; i < a->ncolours; i++)
-        if (memcmp(a->colours[i].anchor, anchor, (size_t)dim * sizeof *anchor) == 0)
+    const double *width = a->s->c.lat.width;
+    for (uint32_t i = 0; i < a->ncolours; i++) {
+        bool near = true;
+        for (int d = 0; d < dim && near; d++)
+            near = fabs(a->colours[i].anchor[d] - anchor[d]) <= width[d];
+        if (near)
             return a->colours[i].cls;
+    }
     return CM_CLASS_NOT_COMPUTED;
 }
 
@@ -175,26 +299,29 @@ static uint8_t new_class(const atlas *a, uint8_t proposed)
  * new one takes a colour no earlier one has while there is one. Attractor
  * ids change as the cluster grows; their anchors, and so their colours,
  * stay. */
-static cm_status group_colours(atlas *a, const cm_group_info *groups, uint32_t n, cm_rgb *rgb,
-                               char *msg, size_t msg_size)
+static cm_status group_colours(atlas *a, const cm_lattice *lat, const cm_group_info *groups,
+                               uint32_t n, cm_rgb *rgb, char *msg, size_t msg_size)
 {
-    const int dim = a->s->c.lat.dim;
+    const int dim = lat->dim;
     uint8_t *classes = malloc((size_t)n + 1);
     if (!classes || cm_grow((void **)&a->colours, &a->colours_cap, a->ncolours + n,
                             sizeof *a->colours) != CM_OK) {
         free(classes);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u colours", n);
     }
-    cm_palette_classes(NULL, groups, n, &a->s->c.lat, NULL, 1, NULL, classes);
+    cm_palette_classes(NULL, groups, n, lat, NULL, 1, NULL, classes);
     rgb[0] = cm_colour_sink;
     for (uint32_t g = 1; g <= n; g++) {
         uint8_t cls = classes[g - 1];
         if (cls >= CM_CLASS_FIRST_GROUP) {
-            const uint8_t known = known_class(a, groups[g - 1].anchor, dim);
+            double anchor[CM_MAX_DIM];
+            for (int d = 0; d < dim; d++)
+                anchor[d] = lat->origin[d] + ((double)groups[g - 1].anchor[d] + 0.5) * lat->width[d];
+            const uint8_t known = known_class(a, anchor, dim);
             cls = known != CM_CLASS_NOT_COMPUTED ? known : new_class(a, cls);
             if (known == CM_CLASS_NOT_COMPUTED) {
                 atlas_colour *c = &a->colours[a->ncolours++];
-                memcpy(c->anchor, groups[g - 1].anchor, sizeof c->anchor);
+                memcpy(c->anchor, anchor, sizeof c->anchor);
                 c->cls = cls;
             }
         }
@@ -263,9 +390,9 @@ static void paint_tile(const cm_region *flat, const cm_rgb *rgb, uint32_t n, uin
 }
 
 /* Draws labelled cells (flat, labels, att: session_labels) as the tile. */
-static cm_status draw_tile(atlas *a, int z, cm_region *flat, const int32_t *labels,
-                           const cm_attractor_set *att, atlas_tile *out, char *msg,
-                           size_t msg_size)
+static cm_status draw_tile(atlas *a, const session *s, int z, cm_region *flat,
+                           const int32_t *labels, const cm_attractor_set *att, atlas_tile *out,
+                           char *msg, size_t msg_size)
 {
     cm_group_info *groups = NULL;
     uint32_t n = 0;
@@ -275,9 +402,9 @@ static cm_status draw_tile(atlas *a, int z, cm_region *flat, const int32_t *labe
     if (st == CM_OK && (!rgb || !rgba))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
     if (st == CM_OK)
-        st = group_colours(a, groups, n, rgb, msg, msg_size);
+        st = group_colours(a, &s->c.lat, groups, n, rgb, msg, msg_size);
     if (st == CM_OK) {
-        paint_tile(flat, rgb, n, att->n, z, a->s->threads, rgba);
+        paint_tile(flat, rgb, n, att->n, z < 0 ? z : 0, s->threads, rgba);
         st = cm_png_encode(rgba, ATLAS_TILE, ATLAS_TILE, &out->png, &out->size, msg, msg_size);
     }
     free(groups);
@@ -291,14 +418,17 @@ cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out,
 {
     memset(out, 0, sizeof *out);
     cm_box box;
+    session *s = a->s;
     cm_status st = atlas_tile_box(a, z, x, y, &box, msg, msg_size);
+    if (st == CM_OK && z > 0)
+        st = level_session(a, z, &s, msg, msg_size);
     if (st == CM_OK)
-        st = compute_missing(a, &box, &out->computed, msg, msg_size);
+        st = compute_missing(a, s, &box, &out->computed, msg, msg_size);
     if (st != CM_OK)
         return st;
-    if (a->kept_regions != a->s->c.nregions) { /* the cluster grew: every tile may change */
+    if (a->kept_generation != atlas_generation(a)) { /* a level grew: tiles may change */
         drop_kept(a);
-        a->kept_regions = a->s->c.nregions;
+        a->kept_generation = atlas_generation(a);
     }
     a->clock++;
     atlas_kept *k = find_kept(a, z, x, y);
@@ -314,10 +444,10 @@ cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out,
     cm_region flat;
     int32_t *labels = NULL;
     cm_attractor_set att;
-    st = session_labels(a->s, &box, &flat, &labels, &att, msg, msg_size);
+    st = session_labels(s, &box, &flat, &labels, &att, msg, msg_size);
     if (st != CM_OK)
         return st;
-    st = draw_tile(a, z, &flat, labels, &att, out, msg, msg_size);
+    st = draw_tile(a, s, z, &flat, labels, &att, out, msg, msg_size);
     free(labels);
     cm_region_free(&flat);
     cm_attractors_free(&att);
@@ -351,7 +481,7 @@ static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
     if (st == CM_OK && (!rgb || !names || !*keys))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
     if (st == CM_OK)
-        st = group_colours(a, groups, ngroups, rgb, msg, msg_size);
+        st = group_colours(a, &a->s->c.lat, groups, ngroups, rgb, msg, msg_size);
     if (st == CM_OK) {
         const int named = attractor_legend(att, att->n, names, 0, (int)att->n);
         uint32_t used = 0;
@@ -425,20 +555,64 @@ static cm_status follow_orbit(const cm_model *m, int steps, atlas_point *p, char
     return CM_OK;
 }
 
-cm_status atlas_point_query(const atlas *a, double x, double y, int steps, atlas_point *out,
+/* The colour tiles give the one cell of flat (labelled, session_labels). */
+static cm_status label_colour(atlas *a, const session *s, cm_region *flat, const int32_t *labels,
+                              const cm_attractor_set *att, cm_rgb *out, char *msg,
+                              size_t msg_size)
+{
+    cm_group_info *groups = NULL;
+    uint32_t n = 0;
+    cm_status st = attractor_view(att, flat, labels, &groups, &n, msg, msg_size);
+    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)n + 1) * sizeof *rgb) : NULL;
+    if (st == CM_OK && !rgb)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the colours");
+    if (st == CM_OK)
+        st = group_colours(a, &s->c.lat, groups, n, rgb, msg, msg_size);
+    const uint32_t g = flat->group[0];
+    if (st == CM_OK)
+        *out = g == CM_GROUP_NONE ? cm_colour_not_computed : g <= n ? rgb[g] : cm_colour_other;
+    free(groups);
+    free(rgb);
+    return st;
+}
+
+/* The legend's name of label (an attractor of s, or a fate without one). */
+static void name_label(const cm_attractor_set *s, int32_t label, char *out, size_t size)
+{
+    const cm_attractor *at = label > 0 && (uint32_t)label <= s->n ? &s->a[label - 1] : NULL;
+    if (at && at->kind == CM_ATTRACTOR_PERIODIC)
+        snprintf(out, size, "A%d p=%u", label, at->period);
+    else if (at)
+        snprintf(out, size, "A%d %s", label, cm_attractor_kind_name(at->kind));
+    else
+        snprintf(out, size, "%s", label == CM_LABEL_DIVERGED    ? "diverged"
+                                  : label == CM_LABEL_UNCOMPUTED ? "not computed"
+                                                                 : "outside or undecided");
+}
+
+cm_status atlas_point_query(atlas *a, double x, double y, int zoom, int steps, atlas_point *out,
                             char *msg, size_t msg_size)
 {
-    session *s = a->s;
-    const cm_lattice *lat = &s->c.lat;
     memset(out, 0, sizeof *out);
     if (!isfinite(x) || !isfinite(y))
         return cm_fail(CM_EINVAL, msg, msg_size, "the point needs finite coordinates x and y");
     if (steps < 0 || steps > ATLAS_ORBIT_MAX)
         return cm_fail(CM_EINVAL, msg, msg_size, "an orbit of %d steps: give 0..%d", steps,
                        ATLAS_ORBIT_MAX);
-    if (s->dim < 2)
+    if (a->s->dim < 2)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the atlas draws two state coordinates; model %s has one", s->model.name);
+                       "the atlas draws two state coordinates; model %s has one",
+                       a->s->model.name);
+    const int top = atlas_max_level(a);
+    const int level = zoom < 0 ? 0 : zoom < top ? zoom : top;
+    session *s = a->s;
+    if (level > 0) {
+        const cm_status st = level_session(a, level, &s, msg, msg_size);
+        if (st != CM_OK)
+            return st;
+    }
+    const cm_lattice *lat = &s->c.lat;
+    out->level = level;
     double state[CM_MAX_DIM] = {x, y};
     for (int d = 2; d < s->dim; d++)
         state[d] = lat->origin[d] + ((double)s->slice[d] + 0.5) * lat->width[d];
@@ -464,10 +638,13 @@ cm_status atlas_point_query(const atlas *a, double x, double y, int steps, atlas
     out->step = out->computed ? flat.step[0] : 0;
     out->label = labels[0];
     out->attractors = att.n;
+    name_label(&att, out->label, out->name, sizeof out->name);
+    st = label_colour(a, s, &flat, labels, &att, &out->colour, msg, msg_size);
     free(labels);
     cm_region_free(&flat);
     cm_attractors_free(&att);
-    st = follow_orbit(&s->model, steps, out, msg, msg_size);
+    if (st == CM_OK)
+        st = follow_orbit(&s->model, steps, out, msg, msg_size);
     if (st != CM_OK)
         atlas_point_free(out);
     return st;

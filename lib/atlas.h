@@ -6,7 +6,11 @@
  * ATLAS_MIN_ZOOM) one pixel per k x k cells, k = 2^-z, coloured by the
  * label most of them have (ties: the lowest), never by computing anything
  * coarser. A tile reads all its cells (at ATLAS_MIN_ZOOM 2048 x 2048), so
- * zoom stops there. Tile (z, x, y) is ATLAS_TILE pixels a side and covers the cells
+ * zoom stops there. Zoom z > 0 (up to ATLAS_MAX_LEVEL) draws one pixel per
+ * cell of refined level z: the same model on a lattice of the same origin
+ * and cells 2^z times narrower in dimensions 0 and 1, a cluster of its own
+ * in the file beside (atlas_level_path), computed as level 0 is, so that
+ * zooming in on a boundary shows its detail. Tile (z, x, y) is ATLAS_TILE pixels a side and covers the cells
  * c0 in [x T k, (x + 1) T k) and c1 in [-(y + 1) T k, -y T k) (T =
  * ATLAS_TILE), its row 0 at the top: Leaflet's CRS.Simple with the
  * transformation (1/h0, -o0/h0, -1/h1, o1/h1) (h the cell widths, o the
@@ -43,27 +47,53 @@
 
 #include "lib/session.h"
 
-enum { ATLAS_TILE = 256, ATLAS_MIN_ZOOM = -3, ATLAS_ORBIT_MAX = 10000, ATLAS_CACHE_TILES = 512 };
+enum {
+    ATLAS_TILE = 256,
+    ATLAS_MIN_ZOOM = -3,
+    ATLAS_MAX_LEVEL = 3, /* refined levels: zoom 1..3 */
+    ATLAS_ORBIT_MAX = 10000,
+    ATLAS_CACHE_TILES = 512
+};
 
 typedef struct atlas_kept atlas_kept;
 typedef struct atlas_colour atlas_colour;
 
 typedef struct atlas {
-    session *s;
+    session *s;         /* level 0: the file's session (borrowed) */
     bool compute;       /* compute the cells a tile lacks */
     uint64_t max_cells; /* the most cells a tile computes (its cells, all depth) */
-    /* private: the tiles kept, for the cluster of kept_regions regions;
-     * the attractors' colours so far */
+    /* private: the levels' sessions ([0] = s; the others the atlas's, opened
+     * on first use as level_options say); the tiles kept, for the levels as
+     * they were at kept_generation; the attractors' colours so far */
+    session *level[ATLAS_MAX_LEVEL + 1];
+    session_options level_options;
+    bool refines;
     atlas_kept *kept;
-    uint32_t nkept, kept_regions;
-    uint64_t clock;
+    uint32_t nkept;
+    uint64_t kept_generation, clock;
     atlas_colour *colours;
     uint64_t ncolours, colours_cap;
 } atlas;
 
-/* An atlas over s (borrowed); atlas_free frees what it keeps. */
-void atlas_init(atlas *a, session *s, bool compute, uint64_t max_cells);
-void atlas_free(atlas *a);
+/* An atlas over s (borrowed), which o opened (NULL: no refined levels;
+ * they are opened as o says, their own file's model, for models of two
+ * dimensions); atlas_free closes the levels it opened (their attractors
+ * written, as session_close does) and frees what it keeps, whatever the
+ * status. */
+void atlas_init(atlas *a, session *s, const session_options *o, bool compute, uint64_t max_cells);
+cm_status atlas_free(atlas *a, char *msg, size_t msg_size);
+
+/* The file of refined level `level` beside the file at base: BASE.zoomL.cmdb
+ * (BASE without its .cmdb). */
+void atlas_level_path(const char *base, int level, char *out, size_t size);
+
+/* The highest zoom tiles are drawn at: ATLAS_MAX_LEVEL when the atlas
+ * computes (a model of two dimensions), else the levels whose files are
+ * there (0: none). */
+int atlas_max_level(const atlas *a);
+
+/* The regions of the levels open: it grows whenever one of them does. */
+uint64_t atlas_generation(const atlas *a);
 
 /* The cells of tile (z, x, y): dimensions 0 and 1 by the scheme above,
  * the others the session's slice. CM_EINVAL (why in msg) for a zoom
@@ -100,22 +130,26 @@ cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
 
 /* What a point of the map is. */
 typedef struct atlas_point {
+    int level;      /* the lattice's level (0: the file's) */
     int64_t cell[CM_MAX_DIM];
     double centre[CM_MAX_DIM];
     bool computed;  /* the cluster has the cell */
     uint32_t group; /* its group (0: the sink's domain) */
     uint32_t step;  /* its step number */
     int32_t label;  /* its attractor (> 0), or CM_LABEL_DIVERGED, _OUTSIDE, _UNCOMPUTED */
+    char name[64];  /* the label as the legend names it ("A3 p=1"; ids are the level's) */
+    cm_rgb colour;  /* the label's colour in the tiles (a footprint cell's too: not black) */
     uint32_t attractors; /* how many the cluster has */
     double *orbit;  /* the true orbit from the cell's centre: norbit states of dim numbers */
     int norbit;     /* up to the steps asked, fewer where the map gives no image */
 } atlas_point;
 
-/* The cell at state (x, y) (the slice's other coordinates), with the
+/* The cell at state (x, y) (the slice's other coordinates) of the level
+ * that zoom shows (0 for zoom <= 0, at most atlas_max_level), with the
  * orbit of `steps` (0..ATLAS_ORBIT_MAX) images of its centre;
  * atlas_point_free frees it. CM_EINVAL for a point that is not finite or
  * beyond the world. */
-cm_status atlas_point_query(const atlas *a, double x, double y, int steps, atlas_point *out,
+cm_status atlas_point_query(atlas *a, double x, double y, int zoom, int steps, atlas_point *out,
                             char *msg, size_t msg_size);
 void atlas_point_free(atlas_point *p);
 

@@ -499,6 +499,27 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
     return st;
 }
 
+cm_status session_figure(session *s, const png_opts *po, const double lo[2], const double hi[2],
+                         char *msg, size_t msg_size)
+{
+    cm_store_info info;
+    cm_box box;
+    cm_status st = check_view(s, lo, hi, "figure", msg, msg_size);
+    if (st == CM_OK)
+        st = cm_store_read_info(s->store, &info, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    view_box(s, lo, hi, &box);
+    for (int d = 2; d < s->dim; d++) { /* the slice shown */
+        box.lo[d] = s->slice[d];
+        box.hi[d] = s->slice[d] + 1;
+    }
+    st = figure_check(po, &s->model, &s->c.lat, &box, msg, msg_size);
+    return st == CM_OK ? figure_of_file(s->store, &info, &s->c, s->path, po, &box, lo, hi, NULL,
+                                        NULL, msg, msg_size)
+                       : st;
+}
+
 /* The view's cells by attractor label (cm_attractor_cell_labels, the same
  * labels render finds), the attractors found with every exit followed, so
  * that their basins are the cluster's. */

@@ -187,6 +187,13 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size);
 cm_status session_labels(session *s, const cm_box *box, cm_region *flat, int32_t **labels,
                          cm_attractor_set *att, char *msg, size_t msg_size);
 
+/* The figure of the rectangle lo..hi (dimensions 0 and 1; the slice in
+ * the others) as `render` draws a file's (po: its files and options, its
+ * attractors found afresh when the cluster grew since they were stored);
+ * the view stays. */
+cm_status session_figure(session *s, const png_opts *po, const double lo[2], const double hi[2],
+                         char *msg, size_t msg_size);
+
 /* What `stats` counts in the view's shown cells. */
 typedef struct session_stats {
     cm_region flat;         /* the shown cells */

@@ -57,18 +57,7 @@ static int parse_explore(cli *c, explore_args *a)
             fputs(explore_help_head, stdout);
             fputs(session_help, stdout);
             return -1;
-        } else if (model_opts_take(c, &o->mo, &err)) {
-        } else if (cli_is(c, "--cell-size", true, &err)) {
-            if (c->value && !parse_doubles(c->value, o->cell_size, &o->n_cell_size, CM_MAX_DIM))
-                err = cli_usage_error(c, "--cell-size: '%s' is not DX[,DY...]", c->value);
-        } else if (cli_is(c, "--origin", true, &err)) {
-            if (c->value && !parse_doubles(c->value, o->origin, &o->n_origin, CM_MAX_DIM))
-                err = cli_usage_error(c, "--origin: '%s' is not X[,Y...]", c->value);
-        } else if (cli_is(c, "--depth", true, &err)) {
-            o->depth_text = c->value;
-        } else if (cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &o->max_steps, &err)) {
-        } else if (cli_take_int(c, "--threads", 1, THREADS_LIMIT, &o->threads, &err)) {
-        } else if (cli_take_mem(c, &o->mem, &err)) {
+        } else if (session_opts_take(c, o, &err)) {
         } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !o->path) {
             o->path = c->opt;
         } else if ((c->opt[0] != '-' || strcmp(c->opt, "-") == 0) && !a->script) {

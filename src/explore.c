@@ -459,6 +459,27 @@ cm_status explore_exec(explore *e, const char *line, char *msg, size_t msg_size)
 
 /* ---- opening and closing ------------------------------------------------------ */
 
+bool session_opts_take(cli *c, session_options *o, int *err)
+{
+    if (model_opts_take(c, &o->mo, err) ||
+        cli_take_int(c, "--max-steps", 1, MAX_STEPS_LIMIT, &o->max_steps, err) ||
+        cli_take_int(c, "--threads", 1, THREADS_LIMIT, &o->threads, err) ||
+        cli_take_mem(c, &o->mem, err))
+        return true;
+    if (cli_is(c, "--cell-size", true, err)) {
+        if (c->value && !parse_doubles(c->value, o->cell_size, &o->n_cell_size, CM_MAX_DIM))
+            *err = cli_usage_error(c, "--cell-size: '%s' is not DX[,DY...]", c->value);
+    } else if (cli_is(c, "--origin", true, err)) {
+        if (c->value && !parse_doubles(c->value, o->origin, &o->n_origin, CM_MAX_DIM))
+            *err = cli_usage_error(c, "--origin: '%s' is not X[,Y...]", c->value);
+    } else if (cli_is(c, "--depth", true, err)) {
+        o->depth_text = c->value;
+    } else {
+        return false;
+    }
+    return true;
+}
+
 int explore_open(explore *e, const session_options *o, FILE *out)
 {
     char msg[2048];

@@ -36,4 +36,10 @@ cm_status explore_close(explore *e, char *msg, size_t msg_size);
 /* The commands, one per line, for `help` and --help. */
 extern const char session_help[];
 
+/* The options that open (or make) a session's file, as explore and serve
+ * take them: the model (--model, --model-lib, --param), the lattice
+ * (--cell-size, --origin), --depth, --max-steps, --threads, --mem; true
+ * if the current option was one of them. */
+bool session_opts_take(cli *c, session_options *o, int *err);
+
 #endif

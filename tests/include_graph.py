@@ -11,7 +11,7 @@ A, through any path) is printed and fails the test, as is an include of a
 layer above: the layers point one way, src -> lib -> models, render ->
 cellmap. The command (src/) is a client of the library: it includes no
 header of the engine, the models or the renderer but the public
-cellmap/cellmap.h, only lib/'s (and its own), and stays under 6 000 lines.
+cellmap/cellmap.h, only lib/'s (and its own), and stays under 6 250 lines.
 
 usage: include_graph.py SOURCE_DIR BUILD_DIR"""
 import glob, os, re, subprocess, sys
@@ -84,8 +84,10 @@ for m, syms in undefined.items():
 if not objects:
     problems.append("no object files under %s/CMakeFiles" % build)
 
-# the command over the library only
-SRC_MAX_LINES = 6000
+# the command over the library only (6 000 lines for cellmap's 23
+# commands; 250 more for serve's options, signals and messages, whose
+# HTTP layer is lib/serve.c)
+SRC_MAX_LINES = 6250
 src_lines = 0
 for path in sorted(glob.glob(os.path.join(root, "src", "*.[ch]"))):
     text = open(path).read()

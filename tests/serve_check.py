@@ -8,6 +8,10 @@ struct alone (no imaging library or numpy on CI).
       frequent label of its block): each pixel has its label's legend
       colour in INFO.json (/info), or black on an attractor's footprint
       (zoom 0).
+  serve_check.py tile-ids TILE.png LABELS.npy Z X Y
+      the same where the attractors' colours are not known (a refined
+      level's ids): each attractor's pixels one colour of its own, the
+      fates without one their fixed colours.
   serve_check.py same A.npy B.npy
       two label arrays are equal up to the numbering of attractors (a
       one-to-one map of ids above 0; every other value equal).
@@ -39,15 +43,22 @@ def colour_of(hex_text):
     return tuple(int(hex_text[i:i + 2], 16) for i in (1, 3, 5))
 
 
+FATES = {0: (214, 39, 40), -2: (180, 180, 180), -1: (255, 255, 255)}
+
+
 def check_tile(png, info_path, labels_path, zoom, tx, ty):
+    """info_path None: the attractors' colours are not known (their ids are
+    another level's), only that each has one, its own."""
     w, h, bpp, rows, _ = read_png(png)
-    info = json.load(open(info_path))
     shape, labels = read_npy(labels_path)
     first = json.load(open(labels_path[:-4] + ".json"))["first_cell"]
     k = 1 << -zoom
     assert (w, h) == (256, 256), (w, h)
-    colour = {e["label"]: colour_of(e["colour"]) for e in info["legend"]}
-    assert len(set(colour.values())) == len(colour), "two legend entries share a colour"
+    if info_path:
+        colour = {e["label"]: colour_of(e["colour"]) for e in json.load(open(info_path))["legend"]}
+        assert len(set(colour.values())) == len(colour), "two legend entries share a colour"
+    else:
+        colour = dict(FATES)
     lo0, lo1 = tx * 256 * k, -(ty + 1) * 256 * k  # the tile's first cell
 
     def label(c0, c1):  # export's box is the cluster's part of the window
@@ -66,6 +77,8 @@ def check_tile(png, info_path, labels_path, zoom, tx, ty):
             got = tuple(rows[py][px * bpp:px * bpp + 3])
             if got == (0, 0, 0) and k == 1 and want > 0:
                 continue  # a footprint cell of its attractor
+            if not info_path and want > 0 and want not in colour and got not in colour.values():
+                colour[want] = got  # an attractor's colour: one of its own
             if got != colour.get(want):
                 bad.append((px, py, want, got))
     if bad:
@@ -90,6 +103,8 @@ def main():
     what = sys.argv[1]
     if what == "tile":
         check_tile(sys.argv[2], sys.argv[3], sys.argv[4], *map(int, sys.argv[5:8]))
+    elif what == "tile-ids":
+        check_tile(sys.argv[2], None, sys.argv[3], *map(int, sys.argv[4:7]))
     elif what == "same":
         same_up_to_ids(sys.argv[2], sys.argv[3])
     elif what == "equal":

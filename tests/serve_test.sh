@@ -82,16 +82,29 @@ echo "view 0:10 -10:0" | "$CM" explore s.cmdb - > explore.out 2>&1 &&
   fail "explore ran on a file being served"
 grep -q "in use" explore.out || fail "explore's refusal does not say the file is in use: $(cat explore.out)"
 
+# --- a refined level: the tile of zoom 1 over the attractor at x 144 -------
+curl -sf "$url/tiles/1/0/-2.png" -o r1.png || fail "tile 1/0/-2"
+[ -f s.zoom1.cmdb ] || fail "zoom 1 made no file s.zoom1.cmdb"
+curl -sf "$url/cell?x=144.2&y=0&zoom=1&steps=0" -o rcell.json || fail "/cell at zoom 1"
+[ "$(check json rcell.json level computed)" = "1 true" ] || fail "/cell at zoom 1: $(cat rcell.json)"
+
+# --- the figure of a view: what `render --layers all` draws, byte for byte --
+fig="x0=128&x1=256&y0=-19.52&y1=0.96"
+curl -sf "$url/figure.png?$fig&w=800&h=600" -o fig.png || fail "/figure.png"
+curl -sf "$url/figure.svg?$fig" -o fig.svg || fail "/figure.svg"
+
 # --- point queries: the cell, its label, its orbit as `orbit` gives it ------
 curl -sf "$url/cell?x=150.3&y=0.1&steps=5" -o cell.json || fail "/cell"
 [ "$(check json cell.json cell computed)" = "[44, 245] true" ] ||
   fail "/cell of (150.3, 0.1): $(cat cell.json)"
 
 # --- bad requests: a status and a message, never a crash --------------------
-for bad in "/tiles/0/0/x.png" "/tiles/1/0/0.png" "/tiles/-9/0/0.png" "/tiles/0/0/0.jpg" \
+for bad in "/tiles/0/0/x.png" "/tiles/4/0/0.png" "/tiles/-9/0/0.png" "/tiles/0/0/0.jpg" \
            "/tiles/0/9999999999999999/0.png" "/tiles/0/0/-0000000000000000000001.png" \
            "/cell?x=nan&y=0" "/cell?x=1e400&y=0" "/cell?x=1&y=" "/cell" "/cell?x=1e300&y=0" \
-           "/cell?x=1&y=2&steps=-1" "/cell?x=1&y=2&steps=1.5" "/cell?x=1&y=2&steps=99999"; do
+           "/cell?x=1&y=2&steps=-1" "/cell?x=1&y=2&steps=1.5" "/cell?x=1&y=2&steps=99999" \
+           "/figure.png" "/figure.png?x0=1&x1=0&y0=0&y1=1" "/figure.png?x0=0&x1=1&y0=0&y1=1&w=10" \
+           "/figure.svg?x0=0&x1=1e300&y0=0&y1=1" "/cell?x=1&y=2&zoom=99"; do
   [ "$(status "$bad")" = 400 ] || fail "$bad: status $(status "$bad"), expected 400"
 done
 for missing in "/etc/passwd" "/leaflet/../../../../etc/passwd" "/leaflet/leaflet.js.map" \
@@ -112,6 +125,12 @@ done
 stop
 "$CM" info s.cmdb > info.txt 2>&1 || fail "info after serving: $(cat info.txt)"
 grep -q "^attractors" info.txt || fail "the file lost its attractors: $(cat info.txt)"
+"$CM" render s.cmdb --png render.png --view 128:256,-19.52:0.96 --size 800x600 \
+  --layers all || fail "render"
+cmp -s fig.png render.png || fail "/figure.png differs from render's PNG of the view"
+"$CM" render s.cmdb --svg render.svg --view 128:256,-19.52:0.96 --size 1000x800 --layers all ||
+  fail "render --svg"
+cmp -s fig.svg render.svg || fail "/figure.svg differs from render's SVG of the view"
 
 "$CM" export s.cmdb --labels l0.npy --window "$(window 0 0 -1)" || fail "export tile 0"
 "$CM" export s.cmdb --labels l1.npy --window "$(window -1 0 -1)" || fail "export tile -1"
@@ -130,6 +149,18 @@ done
 check same s.labels.npy union.labels.npy || fail "the served file's labels differ from a single solve's"
 check equal s.steps.npy union.steps.npy || fail "the served file's steps differ from a single solve's"
 
+# the refined level is a solve at half the cell size, its tile its labels
+# (its attractors' ids its own: colours checked as /cell gives them)
+"$CM" solve --db half.cmdb $pd --region 128:192,-9.28:0.96 --cells 256x256 > /dev/null ||
+  fail "solve at half the cell size"
+for f in s.zoom1 half; do
+  "$CM" export $f.cmdb --labels $f.labels.npy --steps $f.steps.npy --window "128.0025:191.9975,-9.2796:0.9596" ||
+    fail "export $f"
+done
+check same s.zoom1.labels.npy half.labels.npy || fail "zoom 1's labels differ from a solve at half the cell size"
+check equal s.zoom1.steps.npy half.steps.npy || fail "zoom 1's steps differ from a solve at half the cell size"
+check tile-ids r1.png s.zoom1.labels.npy 0 0 -2 || fail "the zoom-1 tile is not its cells' labels"
+
 # --- read-only: nothing computed, nothing written ----------------------------
 cp s.cmdb before.cmdb
 start s.cmdb --read-only
@@ -138,6 +169,25 @@ curl -sf "$url/info" -o ro.json || fail "read-only info"
 [ "$(check json ro.json computes regions)" = "false 2" ] || fail "read-only info: $(cat ro.json)"
 stop
 same_rows s.cmdb before.cmdb "SELECT COUNT(*) FROM regions" || fail "read-only serve changed the regions"
+
+# --- a hostile campaign: 10^4 requests, malformed ones, raw garbage ----------
+cp s.cmdb h.cmdb
+start h.cmdb --tile-cells 65536
+python3 "$SRC/tests/serve_campaign.py" 127.0.0.1 "${url##*:}" 10000 || fail "the hostile campaign"
+stop
+"$CM" info h.cmdb > /dev/null 2>&1 || fail "info after the campaign"
+
+# --- killed while computing: the file stays whole, serving goes on ----------
+start h.cmdb
+curl -s -o /dev/null "$url/tiles/-2/3/-1.png" &
+sleep 0.3
+kill -KILL "$pid"
+wait "$pid" 2>/dev/null
+wait
+"$CM" info h.cmdb > info.txt 2>&1 || fail "info after a kill mid-compute: $(cat info.txt)"
+start h.cmdb
+[ "$(status /tiles/-2/3/-1.png)" = 200 ] || fail "the tile after a kill mid-compute"
+stop
 
 # --- usage ---------------------------------------------------------------------
 expect_usage "--port" serve s.cmdb --port 70000
