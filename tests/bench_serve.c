@@ -5,7 +5,7 @@
  * Solves the README's quick start (`cellmap solve --db`, 1000 x 1000 cells
  * of microchaos-pd), serves it (THREADS threads, default 2) and asks, each
  * request on a new connection as a browser's first look makes them:
- * - the 16 zoom-0 tiles over the solved cells, drawn for the first time;
+ * - the 9 zoom-0 tiles inside the solved cells, drawn for the first time;
  * - one of them 200 times again (kept);
  * - 8 zoom-0 tiles beside the solved box, each computing 65 536 new cells
  *   (solved, joined, committed) before it is drawn;
@@ -138,20 +138,20 @@ int main(int argc, char **argv)
     double t[KEPT_ASKS];
     char path[128];
     int n = 0, bad = 0;
-    /* the solved box, cells 0..1000 x -500..500: tiles x 0..3, y -2..1 */
-    for (int y = -2; y <= 1; y++)
-        for (int x = 0; x <= 3; x++) {
+    /* the solved box, cells 0..1000 x 0..1000 (origin 0, -40): tiles x 0..2, y -3..-1 */
+    for (int y = -3; y <= -1; y++)
+        for (int x = 0; x <= 2; x++) {
             snprintf(path, sizeof path, "/tiles/0/%d/%d.png", x, y);
             bad += get(port, path, &t[n++]) != 200;
         }
     report("tile of solved cells, first time", t, n, bad);
     n = bad = 0;
     for (int k = 0; k < KEPT_ASKS; k++)
-        bad += get(port, "/tiles/0/1/-1.png", &t[n++]) != 200;
+        bad += get(port, "/tiles/0/1/-2.png", &t[n++]) != 200;
     report("tile asked again (kept)", t, n, bad);
     n = bad = 0;
-    for (int x = 4; x < 12; x++) { /* x 512..1536, v -19.52..0.96 */
-        snprintf(path, sizeof path, "/tiles/0/%d/-2.png", x);
+    for (int x = 4; x < 12; x++) { /* x 512..1536, v -40..-19.52 */
+        snprintf(path, sizeof path, "/tiles/0/%d/-1.png", x);
         bad += get(port, path, &t[n++]) != 200;
     }
     report("tile over 65536 new cells (compute+draw)", t, n, bad);
