@@ -71,16 +71,47 @@ uint64_t atlas_generation(const atlas *a)
     return regions;
 }
 
+/* The lattice of refined level `level`: level 0's with cells 2^level times
+ * narrower in dimensions 0 and 1. */
+static cm_lattice level_lattice(const atlas *a, int level)
+{
+    cm_lattice lat = a->s->c.lat;
+    lat.width[0] /= (double)(1 << level);
+    lat.width[1] /= (double)(1 << level);
+    return lat;
+}
+
+/* Whether the file a level's session opened is that level's: level 0's
+ * model and parameters on the level's lattice. */
+static cm_status check_level(const atlas *a, int level, const session *s, char *msg,
+                             size_t msg_size)
+{
+    const cm_lattice want = level_lattice(a, level);
+    const cm_model *m = &a->s->model;
+    bool same = strcmp(s->model.name, m->name) == 0 && s->model.values.count == m->values.count &&
+                s->c.lat.dim == want.dim;
+    for (int k = 0; same && k < m->values.count; k++) {
+        const cm_param_value *x = &s->model.values.value[k], *y = &m->values.value[k];
+        same = x->count == y->count;
+        for (int i = 0; same && i < x->count; i++)
+            same = x->v[i] == y->v[i];
+    }
+    for (int d = 0; same && d < want.dim; d++)
+        same = s->c.lat.origin[d] == want.origin[d] && s->c.lat.width[d] == want.width[d];
+    return same ? CM_OK
+                : cm_fail(CM_EINVAL, msg, msg_size,
+                          "%s is not zoom %d of %s (another model, parameters or lattice); move "
+                          "it aside",
+                          s->path, level, a->s->path);
+}
+
 /* Creates the file of refined level `level` at path: the level-0 file's
- * model on its lattice with cells 2^level times narrower in dimensions 0
- * and 1, no cells yet. */
+ * model on the level's lattice, no cells yet. */
 static cm_status create_level(const atlas *a, int level, const char *path, char *msg,
                               size_t msg_size)
 {
     const session *base = a->s;
-    cm_lattice lat = base->c.lat;
-    lat.width[0] /= (double)(1 << level);
-    lat.width[1] /= (double)(1 << level);
+    const cm_lattice lat = level_lattice(a, level);
     const cm_model_lib *lib = NULL;
     cm_model_set_find(&a->level_options.mo.set, base->model.name, &lib);
     char command[4200], plan[64];
@@ -127,6 +158,8 @@ static cm_status level_session(atlas *a, int level, session **out, char *msg, si
     o.depth_text = NULL;
     session_opened opened;
     st = session_open(s, &o, &opened, msg, msg_size);
+    if (st == CM_OK)
+        st = check_level(a, level, s, msg, msg_size);
     if (st != CM_OK) {
         char ignored[256];
         session_close(s, ignored, sizeof ignored);

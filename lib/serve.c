@@ -199,9 +199,9 @@ static bool take_int(const char **p, int64_t *v)
     s += negative;
     int64_t x = 0;
     int digits = 0;
-    for (; *s >= '0' && *s <= '9' && digits < 19; s++, digits++)
+    for (; *s >= '0' && *s <= '9' && digits < 18; s++, digits++)
         x = x * 10 + (*s - '0');
-    if (digits == 0 || digits > 18)
+    if (digits == 0 || (*s >= '0' && *s <= '9')) /* none, or a 19th */
         return false;
     *v = negative ? -x : x;
     *p = s;

@@ -16,17 +16,9 @@ export PYTHONPATH="$SRC/tests"
 pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 # a box of whole zoom-0 tiles (256 x 256 cells) holding the attractor at x 144
 "$CM" solve --db b.cmdb $pd --region 128:256,-19.52:0.96 --cells 256x256 > /dev/null || fail "solve"
-"$CM" serve b.cmdb --port 0 > serve.out 2> serve.err &
-pid=$!
-for _ in $(seq 100); do
-  url=$(sed -n 's|.* at \(http://[^ ]*\)/ .*|\1|p' serve.out)
-  [ -n "$url" ] && break
-  sleep 0.1
-done
-[ -n "$url" ] || fail "serve did not start: $(cat serve.err)"
+serve_start b.cmdb
 python3 "$SRC/tests/browser_test.py" "$url" . || fail "the browser's checks"
-kill -TERM "$pid"
-wait "$pid" || fail "serve ended with status $?: $(cat serve.err)"
+serve_stop
 
 # the zoom past one pixel per cell made refined levels, whole files
 for level in 1 2 3; do

@@ -13,26 +13,6 @@ enter_workdir
 export PYTHONPATH="$SRC/tests"
 check() { python3 "$SRC/tests/serve_check.py" "$@"; }
 
-# start FILE [options]: serves FILE on a free port; sets pid and url
-start() {
-  "$CM" serve "$@" --port 0 > serve.out 2> serve.err &
-  pid=$!
-  for _ in $(seq 100); do
-    url=$(sed -n 's|.* at \(http://[^ ]*\)/ .*|\1|p' serve.out)
-    [ -n "$url" ] && return 0
-    sleep 0.1
-  done
-  fail "serve $* did not start: $(cat serve.err)"
-  url=http://127.0.0.1:1
-}
-
-# stop: SIGTERM, and the server ends with status 0
-stop() {
-  kill -TERM "$pid"
-  wait "$pid" || fail "serve ended with status $? on SIGTERM: $(cat serve.err)"
-  grep -q "terminated, stopped" serve.out || fail "serve did not say it stopped"
-}
-
 # status PATH [curl options]: the HTTP status of a request
 status() { local p=$1; shift; curl -s -o /dev/null -w '%{http_code}' "$@" "$url$p"; }
 
@@ -43,7 +23,7 @@ pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 
 # --- the page, Leaflet's files, the info -------------------------------------
 # (tiles compute at zoom 0 only: what the file holds stays a known box)
-start s.cmdb --tile-cells 65536
+serve_start s.cmdb --tile-cells 65536
 grep -q "http://127.0.0.1:" serve.out || fail "serve does not listen on 127.0.0.1 by default"
 curl -sf "$url/" | grep -q "L.CRS.Simple" || fail "the page is not the Leaflet map"
 curl -sf "$url/leaflet/leaflet.js" -o leaflet.js || fail "leaflet.js not served"
@@ -122,7 +102,7 @@ done
   wait
 ) > many.txt
 [ "$(grep -c '^200$' many.txt)" = 50 ] || fail "50 requests at once: $(sort many.txt | uniq -c)"
-stop
+serve_stop
 "$CM" info s.cmdb > info.txt 2>&1 || fail "info after serving: $(cat info.txt)"
 grep -q "^attractors" info.txt || fail "the file lost its attractors: $(cat info.txt)"
 "$CM" render s.cmdb --png render.png --view 128:256,-19.52:0.96 --size 800x600 \
@@ -163,31 +143,40 @@ check tile-ids r1.png s.zoom1.labels.npy 0 0 -2 || fail "the zoom-1 tile is not 
 
 # --- read-only: nothing computed, nothing written ----------------------------
 cp s.cmdb before.cmdb
-start s.cmdb --read-only
+serve_start s.cmdb --read-only
 curl -sf "$url/tiles/0/2/-1.png" -o t3.png || fail "read-only tile"
 curl -sf "$url/info" -o ro.json || fail "read-only info"
 [ "$(check json ro.json computes regions)" = "false 2" ] || fail "read-only info: $(cat ro.json)"
-stop
+serve_stop
 same_rows s.cmdb before.cmdb "SELECT COUNT(*) FROM regions" || fail "read-only serve changed the regions"
 
 # --- a hostile campaign: 10^4 requests, malformed ones, raw garbage ----------
 cp s.cmdb h.cmdb
-start h.cmdb --tile-cells 65536
+serve_start h.cmdb --tile-cells 65536
 python3 "$SRC/tests/serve_campaign.py" 127.0.0.1 "${url##*:}" 10000 || fail "the hostile campaign"
-stop
+serve_stop
 "$CM" info h.cmdb > /dev/null 2>&1 || fail "info after the campaign"
 
 # --- killed while computing: the file stays whole, serving goes on ----------
-start h.cmdb
+serve_start h.cmdb
 curl -s -o /dev/null "$url/tiles/-2/3/-1.png" &
 sleep 0.3
 kill -KILL "$pid"
 wait "$pid" 2>/dev/null
 wait
 "$CM" info h.cmdb > info.txt 2>&1 || fail "info after a kill mid-compute: $(cat info.txt)"
-start h.cmdb
+serve_start h.cmdb
 [ "$(status /tiles/-2/3/-1.png)" = 200 ] || fail "the tile after a kill mid-compute"
-stop
+serve_stop
+
+# --- a refined level's file of another lattice is refused by name ----------
+cp s.cmdb w.cmdb
+"$CM" solve --db w.zoom1.cmdb $pd --region 0:10,0:1 --cells 10x10 > /dev/null || fail "solve w.zoom1"
+serve_start w.cmdb --read-only
+[ "$(status /tiles/1/0/-1.png)" = 400 ] || fail "zoom 1 of another lattice: status $(status /tiles/1/0/-1.png)"
+curl -s "$url/tiles/1/0/-1.png" | grep -q "w.zoom1.cmdb is not zoom 1 of w.cmdb" ||
+  fail "zoom 1 of another lattice: $(curl -s "$url/tiles/1/0/-1.png")"
+serve_stop
 
 # --- usage ---------------------------------------------------------------------
 expect_usage "--port" serve s.cmdb --port 70000

@@ -39,3 +39,24 @@ same_rows() {
   [ -n "$a" ] || { echo "same_rows: no rows in $1: $3" >&2; return 1; }
   [ "$a" = "$b" ]
 }
+
+# serve_start FILE [options]: `cellmap serve FILE` on a free port in the
+# background, its output in serve.out and serve.err; sets pid and url
+serve_start() {
+  "$CM" serve "$@" --port 0 > serve.out 2> serve.err &
+  pid=$!
+  for _ in $(seq 100); do
+    url=$(sed -n 's|.* at \(http://[^ ]*\)/ .*|\1|p' serve.out)
+    [ -n "$url" ] && return 0
+    sleep 0.1
+  done
+  fail "serve $* did not start: $(cat serve.err)"
+  url=http://127.0.0.1:1
+}
+
+# serve_stop: SIGTERM, and the server ends with status 0 saying so
+serve_stop() {
+  kill -TERM "$pid"
+  wait "$pid" || fail "serve ended with status $? on SIGTERM: $(cat serve.err)"
+  grep -q "terminated, stopped" serve.out || fail "serve did not say it stopped"
+}
