@@ -12,6 +12,7 @@
 #include "lib/attractor_view.h"
 #include "render/palette.h"
 #include "render/png_out.h"
+#include "render/raster.h"
 
 struct atlas_colour {
     double anchor[CM_MAX_DIM]; /* the centre of its anchor cell */
@@ -19,7 +20,7 @@ struct atlas_colour {
 };
 
 struct atlas_kept {
-    int z;
+    int z, layer;
     int64_t x, y;
     uint8_t *png;
     size_t size;
@@ -199,11 +200,12 @@ cm_status atlas_free(atlas *a, char *msg, size_t msg_size)
     return st;
 }
 
-/* The kept tile (z, x, y), or NULL. */
-static atlas_kept *find_kept(atlas *a, int z, int64_t x, int64_t y)
+/* The kept tile (z, x, y) of layer, or NULL. */
+static atlas_kept *find_kept(atlas *a, int z, int64_t x, int64_t y, int layer)
 {
     for (uint32_t i = 0; i < a->nkept; i++)
-        if (a->kept[i].z == z && a->kept[i].x == x && a->kept[i].y == y)
+        if (a->kept[i].z == z && a->kept[i].x == x && a->kept[i].y == y &&
+            a->kept[i].layer == layer)
             return &a->kept[i];
     return NULL;
 }
@@ -217,9 +219,9 @@ static uint32_t least_recent(const atlas *a)
     return k;
 }
 
-/* Keeps a copy of tile t (z, x, y) in place of the least recently asked
- * one when ATLAS_CACHE_TILES are kept; without memory, keeps nothing. */
-static void keep(atlas *a, int z, int64_t x, int64_t y, const atlas_tile *t)
+/* Keeps a copy of tile t (z, x, y, layer) in place of the least recently
+ * asked one when ATLAS_CACHE_TILES are kept; without memory, keeps nothing. */
+static void keep(atlas *a, int z, int64_t x, int64_t y, int layer, const atlas_tile *t)
 {
     if (!a->kept && !(a->kept = calloc(ATLAS_CACHE_TILES, sizeof *a->kept)))
         return;
@@ -232,7 +234,7 @@ static void keep(atlas *a, int z, int64_t x, int64_t y, const atlas_tile *t)
         a->nkept++;
     else
         free(a->kept[slot].png);
-    a->kept[slot] = (atlas_kept){z, x, y, png, t->size, a->clock};
+    a->kept[slot] = (atlas_kept){z, layer, x, y, png, t->size, a->clock};
 }
 
 /* Cells (of its level's lattice) along a tile's side at zoom z. */
@@ -390,29 +392,52 @@ static uint32_t block_mode(uint32_t *v, int n)
     return best;
 }
 
-/* The tile's pixels (RGBA, row 0 at the top) from the relabelled cells
- * (attractor_view's groups, rgb their colours, n of them). */
-static void paint_tile(const cm_region *flat, const cm_rgb *rgb, uint32_t n, uint32_t attractors,
-                       int z, int threads, uint8_t *rgba)
+/* A cell's value as a tile shows it: attractor_view's group (basins), or
+ * the step number (steps); CM_GROUP_NONE where nothing is computed. */
+static uint32_t cell_value(const cm_region *flat, uint64_t i, int layer)
+{
+    return layer == ATLAS_STEPS && flat->group[i] != CM_GROUP_NONE ? flat->step[i]
+                                                                   : flat->group[i];
+}
+
+/* The colour of a tile's pixel of value v (cell_value; the most frequent
+ * of its block). */
+static cm_rgb pixel_colour(uint32_t v, int layer, bool marker, const cm_rgb *rgb, uint32_t n,
+                           const uint8_t *grey)
+{
+    if (v == CM_GROUP_NONE)
+        return cm_colour_not_computed;
+    if (layer == ATLAS_STEPS) {
+        const uint8_t g = grey[v < ATLAS_STEP_CAP ? v : ATLAS_STEP_CAP];
+        return (cm_rgb){g, g, g};
+    }
+    return marker ? cm_colour_marker : v <= n ? rgb[v] : cm_colour_other;
+}
+
+/* The tile's pixels (RGBA, row 0 at the top) from the cells (basins:
+ * relabelled by attractor_view, rgb their n colours). */
+static void paint_tile(const cm_region *flat, int layer, const cm_rgb *rgb, uint32_t n,
+                       uint32_t attractors, int z, int threads, uint8_t *rgba)
 {
     const int k = 1 << -z;
     const int64_t width = flat->box.hi[0] - flat->box.lo[0];
+    uint8_t grey[ATLAS_STEP_CAP + 1];
+    for (int t = 0; t <= ATLAS_STEP_CAP; t++)
+        grey[t] = (uint8_t)cm_step_shade(log1p(t) / log1p(ATLAS_STEP_CAP), CM_RASTER_STEPS);
 #pragma omp parallel for schedule(static) num_threads(threads > 0 ? threads : 1)
     for (int py = 0; py < ATLAS_TILE; py++) {
         uint32_t block[64];
-        const int64_t top = (int64_t)(ATLAS_TILE - 1 - py) * k; /* the block's lowest row */
+        const int64_t low = (int64_t)(ATLAS_TILE - 1 - py) * k; /* the block's lowest row */
         for (int px = 0; px < ATLAS_TILE; px++) {
             int used = 0;
             for (int r = 0; r < k; r++)
                 for (int c = 0; c < k; c++)
-                    block[used++] = flat->group[(uint64_t)((top + r) * width + px * k + c)];
-            const uint32_t g = k == 1 ? block[0] : block_mode(block, used);
-            const uint64_t at = (uint64_t)(top * width + px * k);
-            const bool marker = k == 1 && g >= 1 && g <= attractors && flat->step[at] == 0;
-            const cm_rgb col = g == CM_GROUP_NONE ? cm_colour_not_computed
-                               : marker           ? cm_colour_marker
-                               : g <= n           ? rgb[g]
-                                                  : cm_colour_other;
+                    block[used++] =
+                        cell_value(flat, (uint64_t)((low + r) * width + px * k + c), layer);
+            const uint32_t v = k == 1 ? block[0] : block_mode(block, used);
+            const uint64_t at = (uint64_t)(low * width + px * k);
+            const bool marker = k == 1 && v >= 1 && v <= attractors && flat->step[at] == 0;
+            const cm_rgb col = pixel_colour(v, layer, marker, rgb, n, grey);
             uint8_t *p = rgba + 4 * ((size_t)py * ATLAS_TILE + (size_t)px);
             p[0] = col.r;
             p[1] = col.g;
@@ -423,21 +448,24 @@ static void paint_tile(const cm_region *flat, const cm_rgb *rgb, uint32_t n, uin
 }
 
 /* Draws labelled cells (flat, labels, att: session_labels) as the tile. */
-static cm_status draw_tile(atlas *a, const session *s, int z, cm_region *flat,
+static cm_status draw_tile(atlas *a, const session *s, int z, int layer, cm_region *flat,
                            const int32_t *labels, const cm_attractor_set *att, atlas_tile *out,
                            char *msg, size_t msg_size)
 {
     cm_group_info *groups = NULL;
     uint32_t n = 0;
-    cm_status st = attractor_view(att, flat, labels, &groups, &n, msg, msg_size);
+    cm_status st = layer == ATLAS_BASINS
+                       ? attractor_view(att, flat, labels, &groups, &n, msg, msg_size)
+                       : CM_OK;
     cm_rgb *rgb = st == CM_OK ? malloc(((size_t)n + 1) * sizeof *rgb) : NULL;
     uint8_t *rgba = st == CM_OK ? malloc((size_t)4 * ATLAS_TILE * ATLAS_TILE) : NULL;
     if (st == CM_OK && (!rgb || !rgba))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
-    if (st == CM_OK)
+    if (st == CM_OK && layer == ATLAS_BASINS)
         st = group_colours(a, &s->c.lat, groups, n, rgb, msg, msg_size);
     if (st == CM_OK) {
-        paint_tile(flat, rgb, n, att->n, z < 0 ? z : 0, s->threads, rgba);
+        paint_tile(flat, layer, rgb, n, layer == ATLAS_BASINS ? att->n : 0, z < 0 ? z : 0,
+                   s->threads, rgba);
         st = cm_png_encode(rgba, ATLAS_TILE, ATLAS_TILE, &out->png, &out->size, msg, msg_size);
     }
     free(groups);
@@ -446,10 +474,12 @@ static cm_status draw_tile(atlas *a, const session *s, int z, cm_region *flat,
     return st;
 }
 
-cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out, char *msg,
-                         size_t msg_size)
+cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, int layer, atlas_tile *out,
+                         char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);
+    if (layer != ATLAS_BASINS && layer != ATLAS_STEPS)
+        return cm_fail(CM_EINVAL, msg, msg_size, "layer %d: basins (0) or steps (1)", layer);
     cm_box box;
     session *s = a->s;
     cm_status st = atlas_tile_box(a, z, x, y, &box, msg, msg_size);
@@ -464,7 +494,7 @@ cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out,
         a->kept_generation = atlas_generation(a);
     }
     a->clock++;
-    atlas_kept *k = find_kept(a, z, x, y);
+    atlas_kept *k = find_kept(a, z, x, y, layer);
     if (k) {
         k->used = a->clock;
         out->kept = true;
@@ -480,12 +510,12 @@ cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out,
     st = session_labels(s, &box, &flat, &labels, &att, msg, msg_size);
     if (st != CM_OK)
         return st;
-    st = draw_tile(a, s, z, &flat, labels, &att, out, msg, msg_size);
+    st = draw_tile(a, s, z, layer, &flat, labels, &att, out, msg, msg_size);
     free(labels);
     cm_region_free(&flat);
     cm_attractors_free(&att);
     if (st == CM_OK)
-        keep(a, z, x, y, out);
+        keep(a, z, x, y, layer, out);
     return st;
 }
 
@@ -519,12 +549,16 @@ static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
         const int named = attractor_legend(att, att->n, names, 0, (int)att->n);
         uint32_t used = 0;
         for (int k = 0; k < named; k++, used++) {
-            (*keys)[used] = (atlas_key){(int32_t)names[k].id, rgb[names[k].id], ""};
-            memcpy((*keys)[used].name, names[k].text, sizeof names[k].text);
+            atlas_key *key = &(*keys)[used];
+            *key = (atlas_key){.label = (int32_t)names[k].id, .colour = rgb[names[k].id]};
+            memcpy(key->name, names[k].text, sizeof names[k].text);
+            memcpy(key->centre, att->a[names[k].id - 1].centre, sizeof key->centre);
         }
-        (*keys)[used++] = (atlas_key){CM_LABEL_DIVERGED, cm_colour_sink, "diverged"};
-        (*keys)[used++] = (atlas_key){CM_LABEL_OUTSIDE, cm_colour_sticking, "outside or undecided"};
-        (*keys)[used++] = (atlas_key){CM_LABEL_UNCOMPUTED, cm_colour_not_computed, "not computed"};
+        (*keys)[used++] = (atlas_key){CM_LABEL_DIVERGED, cm_colour_sink, "diverged", {0}};
+        (*keys)[used++] =
+            (atlas_key){CM_LABEL_OUTSIDE, cm_colour_sticking, "outside or undecided", {0}};
+        (*keys)[used++] =
+            (atlas_key){CM_LABEL_UNCOMPUTED, cm_colour_not_computed, "not computed", {0}};
         *n = used;
     }
     if (st != CM_OK) {
@@ -559,6 +593,14 @@ cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
     cm_region_free(&flat);
     cm_attractors_free(&att);
     return st;
+}
+
+void atlas_overlays(const atlas *a, const double lo[2], const double hi[2], cm_overlay_list *out)
+{
+    out->count = 0;
+    out->truncated = false;
+    if (a->s->model.overlays)
+        a->s->model.overlays(&a->s->model, lo, hi, out);
 }
 
 /* The true orbit of steps images from p->centre into p->orbit. */

@@ -45,6 +45,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "cellmap/overlay.h"
 #include "lib/session.h"
 
 enum {
@@ -52,8 +53,15 @@ enum {
     ATLAS_MIN_ZOOM = -3,
     ATLAS_MAX_LEVEL = 3, /* refined levels: zoom 1..3 */
     ATLAS_ORBIT_MAX = 10000,
-    ATLAS_CACHE_TILES = 512
+    ATLAS_CACHE_TILES = 512,
+    ATLAS_STEP_CAP = 64 /* step numbers from here up are the darkest grey */
 };
+
+/* What a tile shows: the basins (as above), or the cells' step numbers in
+ * grey, light (few) to dark (ATLAS_STEP_CAP and more) on the figures'
+ * logarithmic scale (render/raster.h: cm_step_shade), a block of cells at
+ * zoom < 0 its most frequent step number. */
+enum atlas_layer { ATLAS_BASINS = 0, ATLAS_STEPS = 1 };
 
 typedef struct atlas_kept atlas_kept;
 typedef struct atlas_colour atlas_colour;
@@ -108,9 +116,16 @@ typedef struct atlas_tile {
     bool kept;         /* it was drawn before (for this cluster) */
 } atlas_tile;
 
-/* Tile (z, x, y) drawn, after computing what it lacks (a->compute). */
-cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, atlas_tile *out, char *msg,
-                         size_t msg_size);
+/* Tile (z, x, y) of layer (enum atlas_layer) drawn, after computing what
+ * it lacks (a->compute). */
+cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, int layer, atlas_tile *out,
+                         char *msg, size_t msg_size);
+
+/* What the model draws over its basins in the rectangle lo..hi (switching
+ * lines, fixed points, manifolds: cellmap/overlay.h) into out, a list the
+ * caller sized (its truncated flag says whether more there were); none
+ * for a model without overlays. */
+void atlas_overlays(const atlas *a, const double lo[2], const double hi[2], cm_overlay_list *out);
 
 /* One line of the map's legend: an attractor (label > 0, its name as
  * figures' legends give it: "A3 p=1"), or the fates without one
@@ -120,6 +135,7 @@ typedef struct atlas_key {
     int32_t label;
     cm_rgb colour;
     char name[64];
+    double centre[CM_MAX_DIM]; /* an attractor's: the mean of its cycle or recorded orbit */
 } atlas_key;
 
 /* The legend of the cluster as it is: the attractors (sticking zones

@@ -22,6 +22,9 @@
  * a request's line, headers and query arguments live in it. */
 enum { CONNECTION_MEMORY = 256 * 1024 };
 
+/* The most overlays one request lists (as many as a figure draws). */
+enum { OVERLAYS_MAX = 4096 };
+
 struct server {
     struct MHD_Daemon *daemon;
 };
@@ -144,6 +147,8 @@ static cm_status fill_info(atlas *a, FILE *f, const void *arg, char *msg, size_t
         json_int(&j, "label", keys[k].label);
         json_str(&j, "name", keys[k].name);
         json_colour(&j, "colour", keys[k].colour);
+        if (keys[k].label > 0)
+            json_nums(&j, "centre", keys[k].centre, s->dim);
         json_object_end(&j);
     }
     json_array_end(&j);
@@ -228,8 +233,13 @@ static enum MHD_Result answer_tile(struct MHD_Connection *conn, atlas *a, const 
                  ATLAS_MIN_ZOOM, atlas_max_level(a));
         return answer_text(conn, MHD_HTTP_BAD_REQUEST, msg);
     }
+    const char *layer = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "layer");
+    const bool steps = layer && strcmp(layer, "steps") == 0;
+    if (layer && !steps && strcmp(layer, "basins") != 0)
+        return answer_text(conn, MHD_HTTP_BAD_REQUEST, "a tile's layer is basins or steps");
     atlas_tile t;
-    const cm_status st = atlas_tile_png(a, (int)z, x, y, &t, msg, sizeof msg);
+    const cm_status st = atlas_tile_png(a, (int)z, x, y, steps ? ATLAS_STEPS : ATLAS_BASINS, &t,
+                                        msg, sizeof msg);
     if (st != CM_OK)
         return answer_text(conn, status_code(st), msg);
     return answer(conn, MHD_HTTP_OK, "image/png", t.png, t.size);
@@ -279,20 +289,69 @@ static enum MHD_Result answer_cell(struct MHD_Connection *conn, atlas *a)
     return answer_json(conn, a, fill_cell, &q);
 }
 
+/* The rectangle x0:x1,y0:y1 of a request into lo, hi; false if it has none. */
+static bool take_rectangle(struct MHD_Connection *conn, double lo[2], double hi[2])
+{
+    const char *names[] = {"x0", "x1", "y0", "y1"};
+    double *at[] = {&lo[0], &hi[0], &lo[1], &hi[1]};
+    for (int k = 0; k < 4; k++)
+        if (!parse_number(MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, names[k]),
+                          at[k]))
+            return false;
+    return lo[0] < hi[0] && lo[1] < hi[1];
+}
+
+static const char *const overlay_names[CM_OVERLAY_KINDS] = {
+    "switching line", "unstable manifold", "stable manifold", "sticking zone",
+    "regular fixed point", "virtual fixed point", "repeller", "escape", "collision",
+    "higher collision"};
+
+/* /overlays: what the model draws over the rectangle, as JSON. */
+static cm_status fill_overlays(atlas *a, FILE *f, const void *arg, char *msg, size_t msg_size)
+{
+    const double *r = arg; /* lo[2], hi[2] */
+    cm_overlay *items = malloc(OVERLAYS_MAX * sizeof *items);
+    if (!items)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the overlays");
+    cm_overlay_list list = {items, OVERLAYS_MAX, 0, false};
+    atlas_overlays(a, r, r + 2, &list);
+    json j;
+    json_begin(&j, f, "serve-overlays");
+    json_bool(&j, "truncated", list.truncated);
+    json_array(&j, "overlays");
+    for (size_t k = 0; k < list.count; k++) {
+        const int kind = items[k].kind;
+        json_object(&j, NULL);
+        json_str(&j, "kind", kind >= 0 && kind < CM_OVERLAY_KINDS ? overlay_names[kind] : "other");
+        json_nums(&j, "a", items[k].a, 2);
+        json_nums(&j, "b", items[k].b, 2);
+        json_object_end(&j);
+    }
+    json_array_end(&j);
+    json_end(&j);
+    free(items);
+    return CM_OK;
+}
+
+static enum MHD_Result answer_overlays(struct MHD_Connection *conn, atlas *a)
+{
+    double r[4];
+    if (!take_rectangle(conn, r, r + 2))
+        return answer_text(conn, MHD_HTTP_BAD_REQUEST,
+                           "/overlays needs x0 < x1, y0 < y1, finite numbers");
+    return answer_json(conn, a, fill_overlays, r);
+}
+
 /* The figure `render` draws of the rectangle x0:x1,y0:y1 (w x h pixels,
  * default 1000 x 800), as a PNG or SVG file to download: drawn into a
  * temporary file (its directory TMPDIR, else /tmp), read back, removed. */
 static enum MHD_Result answer_figure(struct MHD_Connection *conn, atlas *a, bool svg)
 {
-    const char *names[] = {"x0", "x1", "y0", "y1"};
     double lo[2], hi[2];
-    double *at[] = {&lo[0], &hi[0], &lo[1], &hi[1]};
-    for (int k = 0; k < 4; k++)
-        if (!parse_number(MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, names[k]),
-                          at[k]))
-            return answer_text(conn, MHD_HTTP_BAD_REQUEST,
-                               "a figure needs x0, x1, y0, y1, finite numbers: "
-                               "/figure.png?x0=X0&x1=X1&y0=Y0&y1=Y1[&w=W&h=H]");
+    if (!take_rectangle(conn, lo, hi))
+        return answer_text(conn, MHD_HTTP_BAD_REQUEST,
+                           "a figure needs x0 < x1, y0 < y1, finite numbers: "
+                           "/figure.png?x0=X0&x1=X1&y0=Y0&y1=Y1[&w=W&h=H]");
     png_opts po;
     memset(&po, 0, sizeof po);
     po.default_layers = all_layers;
@@ -410,6 +469,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         return answer_json(conn, a, fill_info, NULL);
     if (strcmp(url, "/cell") == 0)
         return answer_cell(conn, a);
+    if (strcmp(url, "/overlays") == 0)
+        return answer_overlays(conn, a);
     if (strcmp(url, "/figure.png") == 0 || strcmp(url, "/figure.svg") == 0)
         return answer_figure(conn, a, strcmp(url, "/figure.svg") == 0);
     if (starts_with(url, "/tiles/"))

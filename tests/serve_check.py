@@ -12,6 +12,9 @@ struct alone (no imaging library or numpy on CI).
       the same where the attractors' colours are not known (a refined
       level's ids): each attractor's pixels one colour of its own, the
       fates without one their fixed colours.
+  serve_check.py steps TILE.png STEPS.npy Z X Y
+      a steps tile (zoom 0) against `export --steps`: one grey per step
+      number, darker as they rise (to 64), white where none is computed.
   serve_check.py same A.npy B.npy
       two label arrays are equal up to the numbering of attractors (a
       one-to-one map of ids above 0; every other value equal).
@@ -85,6 +88,33 @@ def check_tile(png, info_path, labels_path, zoom, tx, ty):
         sys.exit("%s: %d pixels differ from the labels, first %s" % (png, len(bad), bad[:5]))
 
 
+def check_steps(png, steps_path, zoom, tx, ty):
+    """A steps tile: grey levels that fall (darker) as step numbers rise, to
+    the cap 64; one grey per step number; white where nothing is computed
+    (export's -1)."""
+    w, h, bpp, rows, _ = read_png(png)
+    shape, steps = read_npy(steps_path)
+    first = json.load(open(steps_path[:-4] + ".json"))["first_cell"]
+    lo0, lo1 = tx * 256, -(ty + 1) * 256
+    grey, bad = {}, []
+    for py in range(h):
+        for px in range(w):
+            i, j = lo0 + px - first[0], lo1 + 255 - py - first[1]
+            step = steps[i * shape[1] + j] if 0 <= i < shape[0] and 0 <= j < shape[1] else -1
+            got = tuple(rows[py][px * bpp:px * bpp + 3])
+            if step < 0:
+                if got != (255, 255, 255):
+                    bad.append((px, py, step, got))
+                continue
+            if got[0] != got[1] or got[1] != got[2] or grey.setdefault(min(step, 64), got) != got:
+                bad.append((px, py, step, got))
+    levels = sorted(grey.items())
+    if any(a[1][0] < b[1][0] for a, b in zip(levels, levels[1:])) or len(levels) < 2:
+        bad.append("greys do not darken with the step: %s" % levels[:10])
+    if bad:
+        sys.exit("%s: %d pixels wrong, first %s" % (png, len(bad), bad[:5]))
+
+
 def same_up_to_ids(a_path, b_path):
     sa, a = read_npy(a_path)
     sb, b = read_npy(b_path)
@@ -105,6 +135,8 @@ def main():
         check_tile(sys.argv[2], sys.argv[3], sys.argv[4], *map(int, sys.argv[5:8]))
     elif what == "tile-ids":
         check_tile(sys.argv[2], None, sys.argv[3], *map(int, sys.argv[4:7]))
+    elif what == "steps":
+        check_steps(sys.argv[2], sys.argv[3], *map(int, sys.argv[4:7]))
     elif what == "same":
         same_up_to_ids(sys.argv[2], sys.argv[3])
     elif what == "equal":

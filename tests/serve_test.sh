@@ -68,6 +68,16 @@ curl -sf "$url/tiles/1/0/-2.png" -o r1.png || fail "tile 1/0/-2"
 curl -sf "$url/cell?x=144.2&y=0&zoom=1&steps=0" -o rcell.json || fail "/cell at zoom 1"
 [ "$(check json rcell.json level computed)" = "1 true" ] || fail "/cell at zoom 1: $(cat rcell.json)"
 
+# --- the steps layer: the step numbers export gives, grey by the figures' scale
+curl -sf "$url/tiles/0/0/-1.png?layer=steps" -o st0.png || fail "steps tile"
+curl -sf "$url/overlays?x0=128&x1=256&y0=-19.52&y1=0.96" -o ov.json || fail "/overlays"
+python3 -c "
+import json, sys
+o = json.load(open('ov.json'))
+lines = [v for v in o['overlays'] if v['kind'] == 'switching line']
+sys.exit(0 if lines and not o['truncated'] else 'no switching lines: %r' % o)" ||
+  fail "/overlays of microchaos-pd has no switching line"
+
 # --- the figure of a view: what `render --layers all` draws, byte for byte --
 fig="x0=128&x1=256&y0=-19.52&y1=0.96"
 curl -sf "$url/figure.png?$fig&w=800&h=600" -o fig.png || fail "/figure.png"
@@ -84,7 +94,8 @@ for bad in "/tiles/0/0/x.png" "/tiles/4/0/0.png" "/tiles/-9/0/0.png" "/tiles/0/0
            "/cell?x=nan&y=0" "/cell?x=1e400&y=0" "/cell?x=1&y=" "/cell" "/cell?x=1e300&y=0" \
            "/cell?x=1&y=2&steps=-1" "/cell?x=1&y=2&steps=1.5" "/cell?x=1&y=2&steps=99999" \
            "/figure.png" "/figure.png?x0=1&x1=0&y0=0&y1=1" "/figure.png?x0=0&x1=1&y0=0&y1=1&w=10" \
-           "/figure.svg?x0=0&x1=1e300&y0=0&y1=1" "/cell?x=1&y=2&zoom=99"; do
+           "/figure.svg?x0=0&x1=1e300&y0=0&y1=1" "/cell?x=1&y=2&zoom=99" \
+           "/tiles/0/0/-1.png?layer=x" "/overlays" "/overlays?x0=1&x1=0&y0=0&y1=1"; do
   [ "$(status "$bad")" = 400 ] || fail "$bad: status $(status "$bad"), expected 400"
 done
 for missing in "/etc/passwd" "/leaflet/../../../../etc/passwd" "/leaflet/leaflet.js.map" \
@@ -118,6 +129,8 @@ cmp -s fig.svg render.svg || fail "/figure.svg differs from render's SVG of the 
 check tile t0.png legend.json l0.npy 0 0 -1 || fail "tile 0/0/-1 is not the cells' labels"
 check tile t1.png legend.json l1.npy -1 0 -1 || fail "tile -1/0/-1 is not its blocks' labels"
 check tile t2.png legend.json l2.npy 0 1 -1 || fail "the computing tile is not the cells' labels"
+"$CM" export s.cmdb --steps st0.npy --window "$(window 0 0 -1)" || fail "export steps of tile 0"
+check steps st0.png st0.npy 0 0 -1 || fail "the steps tile is not the cells' step numbers"
 
 # the cells the tile computed equal a single solve of the union, cell by cell
 "$CM" solve --db union.cmdb $pd --region 128:384,-19.52:0.96 --cells 512x256 > /dev/null ||
