@@ -530,6 +530,20 @@ static void origin_cell(const session *s, cm_box *box)
     }
 }
 
+/* The name the user gave attractor at (of level 0), or NULL. */
+static const char *given_name(const atlas *a, const cm_attractor *at)
+{
+    for (int k = 0; k < a->nnames; k++) {
+        const cm_group_label *l = &a->names[k];
+        bool same = l->by_anchor || l->id == at->id;
+        for (int d = 0; l->by_anchor && d < a->s->dim; d++)
+            same = same && l->anchor[d] == at->anchor[d];
+        if (same)
+            return l->text;
+    }
+    return NULL;
+}
+
 /* The legend's keys from the labelled cells of any box (session_labels). */
 static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
                              const cm_attractor_set *att, atlas_key **keys, uint32_t *n,
@@ -551,8 +565,10 @@ static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
         for (int k = 0; k < named; k++, used++) {
             atlas_key *key = &(*keys)[used];
             *key = (atlas_key){.label = (int32_t)names[k].id, .colour = rgb[names[k].id]};
-            memcpy(key->name, names[k].text, sizeof names[k].text);
-            memcpy(key->centre, att->a[names[k].id - 1].centre, sizeof key->centre);
+            const cm_attractor *at = &att->a[names[k].id - 1];
+            const char *given = given_name(a, at);
+            snprintf(key->name, sizeof key->name, "%s", given ? given : names[k].text);
+            memcpy(key->centre, at->centre, sizeof key->centre);
         }
         (*keys)[used++] = (atlas_key){CM_LABEL_DIVERGED, cm_colour_sink, "diverged", {0}};
         (*keys)[used++] =

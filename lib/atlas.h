@@ -70,6 +70,10 @@ typedef struct atlas {
     session *s;         /* level 0: the file's session (borrowed) */
     bool compute;       /* compute the cells a tile lacks */
     uint64_t max_cells; /* the most cells a tile computes (its cells, all depth) */
+    /* the legend's names the user gave (png_opts_labels: by attractor id
+     * or anchor cell, of level 0; borrowed; NULL: none) */
+    const cm_group_label *names;
+    int nnames;
     /* private: the levels' sessions ([0] = s; the others the atlas's, opened
      * on first use as level_options say); the tiles kept, for the levels as
      * they were at kept_generation; the attractors' colours so far */
@@ -139,8 +143,9 @@ typedef struct atlas_key {
 } atlas_key;
 
 /* The legend of the cluster as it is: the attractors (sticking zones
- * share the grey of "outside or undecided"), then diverged, outside or
- * undecided, not computed; *keys (*n of them) the caller frees. */
+ * share the grey of "outside or undecided"; named as a->names say, else as
+ * figures name them), then diverged, outside or undecided, not computed;
+ * *keys (*n of them) the caller frees. */
 cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
                        size_t msg_size);
 

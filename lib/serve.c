@@ -354,6 +354,8 @@ static enum MHD_Result answer_figure(struct MHD_Connection *conn, atlas *a, bool
                            "/figure.png?x0=X0&x1=X1&y0=Y0&y1=Y1[&w=W&h=H]");
     png_opts po;
     memset(&po, 0, sizeof po);
+    po.n_labels = a->nnames < PNG_LABELS_MAX ? a->nnames : PNG_LABELS_MAX;
+    memcpy(po.labels, a->names, (size_t)po.n_labels * sizeof *po.labels);
     po.default_layers = all_layers;
     po.by = BY_ATTRACTORS;
     po.width = 1000;

@@ -19,7 +19,7 @@
 
 static const char serve_help[] =
     "usage: cellmap serve FILE.cmdb [--port N] [--bind ADDR] [--read-only] [--tile-cells N]\n"
-    "                     [--threads T] [--mem BYTES]\n"
+    "                     [--labels FILE] [--threads T] [--mem BYTES]\n"
     "       cellmap serve FILE.cmdb --model NAME [--model-lib P.so] [--param k=v,...]\n"
     "                     --cell-size DX[,DY...] [--origin X,Y...] [--depth LO:HI,...]\n"
     "                     [--max-steps K] [... as above]\n\n"
@@ -39,6 +39,8 @@ static const char serve_help[] =
     "                   only; another address exposes the file to the network)\n"
     "  --read-only      never compute: tiles draw what the file holds\n"
     "  --tile-cells N   the most cells one tile computes (default 1048576)\n"
+    "  --labels FILE    the legend's names of attractors, as render takes them\n"
+    "                   (lines 'ID TEXT', or 'I0,I1 TEXT' for the anchor cell)\n"
     "  --threads T      OpenMP threads (default: all cores)\n"
     "  --mem BYTES      bound the cell arrays held in memory (as explore)\n\n"
     "Requests: / (the page), /info (JSON: lattice, view, legend), /tiles/Z/X/Y.png\n"
@@ -51,6 +53,7 @@ static const char serve_help[] =
 
 typedef struct serve_args {
     session_options o;
+    png_opts names; /* --labels FILE: the legend's names */
     int port;
     const char *bind;
     bool read_only;
@@ -74,6 +77,10 @@ static int parse_serve(cli *c, serve_args *a)
             a->bind = c->value;
         } else if (cli_is(c, "--read-only", false, &err)) {
             a->read_only = true;
+        } else if (cli_is(c, "--labels", true, &err)) {
+            char msg[1024];
+            if (c->value && !png_opts_labels(c->value, &a->names, msg, sizeof msg))
+                err = cli_usage_error(c, "--labels: %s", msg);
         } else if (c->opt[0] != '-' && !o->path) {
             o->path = c->opt;
         } else {
@@ -150,6 +157,8 @@ int cmd_serve(int argc, char **argv)
         atlas at;
         atlas_init(&at, &s, &a.o, !a.read_only,
                    a.tile_cells < s.max_new_cells ? a.tile_cells : s.max_new_cells);
+        at.names = a.names.labels;
+        at.nnames = a.names.n_labels;
         rc = run_server(&a, &at);
         if (atlas_free(&at, msg, sizeof msg) != CM_OK) {
             fprintf(stderr, "cellmap serve: %s\n", msg);

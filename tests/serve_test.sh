@@ -23,7 +23,8 @@ pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 
 # --- the page, Leaflet's files, the info -------------------------------------
 # (tiles compute at zoom 0 only: what the file holds stays a known box)
-serve_start s.cmdb --tile-cells 65536
+printf '# the legend names attractor 1\n1 the first one\n' > names.txt
+serve_start s.cmdb --tile-cells 65536 --labels names.txt
 grep -q "http://127.0.0.1:" serve.out || fail "serve does not listen on 127.0.0.1 by default"
 curl -sf "$url/" | grep -q "L.CRS.Simple" || fail "the page is not the Leaflet map"
 curl -sf "$url/leaflet/leaflet.js" -o leaflet.js || fail "leaflet.js not served"
@@ -31,6 +32,7 @@ cmp -s leaflet.js /usr/share/javascript/leaflet/leaflet.js || fail "leaflet.js i
 curl -sf "$url/info" -o info.json || fail "/info"
 [ "$(check json info.json lattice computes)" = '{"origin": [128, -19.52], "width": [0.5, 0.08]} true' ] ||
   fail "/info: $(cat info.json)"
+grep -q '"label":1,"name":"the first one"' info.json || fail "--labels did not name attractor 1: $(cat info.json)"
 
 # --- tiles are the labels export gives --------------------------------------
 # window Z X Y: the state rectangle of tile (Z, X, Y), a hundredth of a cell
@@ -116,10 +118,10 @@ done
 serve_stop
 "$CM" info s.cmdb > info.txt 2>&1 || fail "info after serving: $(cat info.txt)"
 grep -q "^attractors" info.txt || fail "the file lost its attractors: $(cat info.txt)"
-"$CM" render s.cmdb --png render.png --view 128:256,-19.52:0.96 --size 800x600 \
+"$CM" render s.cmdb --png render.png --view 128:256,-19.52:0.96 --size 800x600 --labels names.txt \
   --layers all || fail "render"
 cmp -s fig.png render.png || fail "/figure.png differs from render's PNG of the view"
-"$CM" render s.cmdb --svg render.svg --view 128:256,-19.52:0.96 --size 1000x800 --layers all ||
+"$CM" render s.cmdb --svg render.svg --view 128:256,-19.52:0.96 --size 1000x800 --layers all --labels names.txt ||
   fail "render --svg"
 cmp -s fig.svg render.svg || fail "/figure.svg differs from render's SVG of the view"
 
@@ -196,6 +198,8 @@ expect_usage "--port" serve s.cmdb --port 70000
 expect_usage "not an IPv4 or IPv6 address" serve new.cmdb $pd --cell-size 0.5,0.08 --bind 1.2.3
 [ ! -e new.cmdb ] || fail "serve with a bad --bind made the new file"
 expect_usage "which file" serve
+echo "one two" > bad-names.txt
+expect_usage "bad-names.txt:1" serve s.cmdb --labels bad-names.txt
 out=$("$CM" serve nothing.cmdb 2>&1); rc=$?
 [ "$rc" = 2 ] && [ ! -e nothing.cmdb ] || fail "serve of a missing file without a model: $rc $out"
 
