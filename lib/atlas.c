@@ -366,6 +366,28 @@ static cm_status group_colours(atlas *a, const cm_lattice *lat, const cm_group_i
     return CM_OK;
 }
 
+/* flat relabelled by the system's attractors (attractor_view) and the
+ * colours of its n groups into a new *rgb (n + 1 of them, group_colours). */
+static cm_status attractor_colours(atlas *a, const cm_lattice *lat, cm_region *flat,
+                                   const int32_t *labels, const cm_attractor_set *att,
+                                   cm_rgb **rgb, uint32_t *n, char *msg, size_t msg_size)
+{
+    cm_group_info *groups = NULL;
+    *rgb = NULL;
+    cm_status st = attractor_view(att, flat, labels, &groups, n, msg, msg_size);
+    *rgb = st == CM_OK ? malloc(((size_t)*n + 1) * sizeof **rgb) : NULL;
+    if (st == CM_OK && !*rgb)
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u colours", *n);
+    if (st == CM_OK)
+        st = group_colours(a, lat, groups, *n, *rgb, msg, msg_size);
+    if (st != CM_OK) {
+        free(*rgb);
+        *rgb = NULL;
+    }
+    free(groups);
+    return st;
+}
+
 /* The label most of the k x k block's cells have (ties: the lowest; a
  * computed cell's before CM_GROUP_NONE), the block's ids in v (k^2 <= 64). */
 static uint32_t block_mode(uint32_t *v, int n)
@@ -452,23 +474,19 @@ static cm_status draw_tile(atlas *a, const session *s, int z, int layer, cm_regi
                            const int32_t *labels, const cm_attractor_set *att, atlas_tile *out,
                            char *msg, size_t msg_size)
 {
-    cm_group_info *groups = NULL;
+    cm_rgb *rgb = NULL; /* the steps layer has no group colours */
     uint32_t n = 0;
-    cm_status st = layer == ATLAS_BASINS
-                       ? attractor_view(att, flat, labels, &groups, &n, msg, msg_size)
-                       : CM_OK;
-    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)n + 1) * sizeof *rgb) : NULL;
+    cm_status st = layer == ATLAS_BASINS ? attractor_colours(a, &s->c.lat, flat, labels, att,
+                                                             &rgb, &n, msg, msg_size)
+                                         : CM_OK;
     uint8_t *rgba = st == CM_OK ? malloc((size_t)4 * ATLAS_TILE * ATLAS_TILE) : NULL;
-    if (st == CM_OK && (!rgb || !rgba))
+    if (st == CM_OK && !rgba)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a tile");
-    if (st == CM_OK && layer == ATLAS_BASINS)
-        st = group_colours(a, &s->c.lat, groups, n, rgb, msg, msg_size);
     if (st == CM_OK) {
         paint_tile(flat, layer, rgb, n, layer == ATLAS_BASINS ? att->n : 0, z < 0 ? z : 0,
                    s->threads, rgba);
         st = cm_png_encode(rgba, ATLAS_TILE, ATLAS_TILE, &out->png, &out->size, msg, msg_size);
     }
-    free(groups);
     free(rgb);
     free(rgba);
     return st;
@@ -549,16 +567,14 @@ static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
                              const cm_attractor_set *att, atlas_key **keys, uint32_t *n,
                              char *msg, size_t msg_size)
 {
-    cm_group_info *groups = NULL;
+    cm_rgb *rgb = NULL;
     uint32_t ngroups = 0;
-    cm_status st = attractor_view(att, flat, labels, &groups, &ngroups, msg, msg_size);
-    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)ngroups + 1) * sizeof *rgb) : NULL;
+    cm_status st = attractor_colours(a, &a->s->c.lat, flat, labels, att, &rgb, &ngroups, msg,
+                                     msg_size);
     cm_group_label *names = st == CM_OK ? calloc((size_t)att->n + 1, sizeof *names) : NULL;
     *keys = st == CM_OK ? calloc((size_t)att->n + 3, sizeof **keys) : NULL;
-    if (st == CM_OK && (!rgb || !names || !*keys))
+    if (st == CM_OK && (!names || !*keys))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the legend");
-    if (st == CM_OK)
-        st = group_colours(a, &a->s->c.lat, groups, ngroups, rgb, msg, msg_size);
     if (st == CM_OK) {
         const int named = attractor_legend(att, att->n, names, 0, (int)att->n);
         uint32_t used = 0;
@@ -581,7 +597,6 @@ static cm_status legend_keys(atlas *a, cm_region *flat, const int32_t *labels,
         free(*keys);
         *keys = NULL;
     }
-    free(groups);
     free(rgb);
     free(names);
     return st;
@@ -651,18 +666,13 @@ static cm_status label_colour(atlas *a, const session *s, cm_region *flat, const
                               const cm_attractor_set *att, cm_rgb *out, char *msg,
                               size_t msg_size)
 {
-    cm_group_info *groups = NULL;
+    cm_rgb *rgb = NULL;
     uint32_t n = 0;
-    cm_status st = attractor_view(att, flat, labels, &groups, &n, msg, msg_size);
-    cm_rgb *rgb = st == CM_OK ? malloc(((size_t)n + 1) * sizeof *rgb) : NULL;
-    if (st == CM_OK && !rgb)
-        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the colours");
-    if (st == CM_OK)
-        st = group_colours(a, &s->c.lat, groups, n, rgb, msg, msg_size);
+    const cm_status st =
+        attractor_colours(a, &s->c.lat, flat, labels, att, &rgb, &n, msg, msg_size);
     const uint32_t g = flat->group[0];
     if (st == CM_OK)
         *out = g == CM_GROUP_NONE ? cm_colour_not_computed : g <= n ? rgb[g] : cm_colour_other;
-    free(groups);
     free(rgb);
     return st;
 }

@@ -2,16 +2,18 @@
 #include "lib/serve.h"
 
 #include <arpa/inet.h>
-#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <microhttpd.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "lib/json.h"
+#include "lib/parse.h"
 #include "lib/serve_page.h"
 
 #ifndef CELLMAP_LEAFLET_DIR
@@ -31,14 +33,12 @@ struct server {
 
 /* ---- answers ------------------------------------------------------------- */
 
-static enum MHD_Result answer(struct MHD_Connection *conn, unsigned code, const char *type,
-                              void *body, size_t size)
+/* Queues response r (NULL: none could be made) with its headers. */
+static enum MHD_Result queue(struct MHD_Connection *conn, unsigned code, const char *type,
+                             struct MHD_Response *r)
 {
-    struct MHD_Response *r = MHD_create_response_from_buffer(size, body, MHD_RESPMEM_MUST_FREE);
-    if (!r) {
-        free(body);
+    if (!r)
         return MHD_NO;
-    }
     MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
     if (code == MHD_HTTP_METHOD_NOT_ALLOWED)
@@ -46,6 +46,34 @@ static enum MHD_Result answer(struct MHD_Connection *conn, unsigned code, const 
     const enum MHD_Result ok = MHD_queue_response(conn, code, r);
     MHD_destroy_response(r);
     return ok;
+}
+
+/* body (size bytes, malloc'd: the answer frees it) as the answer. */
+static enum MHD_Result answer(struct MHD_Connection *conn, unsigned code, const char *type,
+                              void *body, size_t size)
+{
+    struct MHD_Response *r = MHD_create_response_from_buffer(size, body, MHD_RESPMEM_MUST_FREE);
+    if (!r)
+        free(body);
+    return queue(conn, code, type, r);
+}
+
+/* The regular file open at fd as a 200 answer, sent from the file (the
+ * answer closes fd); false (fd closed) if it is not one. */
+static bool answer_file(struct MHD_Connection *conn, int fd, const char *type,
+                        enum MHD_Result *result)
+{
+    struct stat sb;
+    struct MHD_Response *r = fd >= 0 && fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode)
+                                 ? MHD_create_response_from_fd((size_t)sb.st_size, fd)
+                                 : NULL;
+    if (!r) {
+        if (fd >= 0)
+            close(fd);
+        return false;
+    }
+    *result = queue(conn, MHD_HTTP_OK, type, r);
+    return true;
 }
 
 /* A plain-text answer: "cellmap serve: text\n". */
@@ -245,16 +273,8 @@ static enum MHD_Result answer_tile(struct MHD_Connection *conn, atlas *a, const 
     return answer(conn, MHD_HTTP_OK, "image/png", t.png, t.size);
 }
 
-/* A finite number, all of text. */
-static bool parse_number(const char *text, double *v)
-{
-    char *end = NULL;
-    if (!text || !*text)
-        return false;
-    errno = 0;
-    *v = strtod(text, &end);
-    return *end == '\0' && errno == 0 && isfinite(*v);
-}
+/* A finite number, all of text (NULL: a parameter not given). */
+static bool parse_number(const char *text, double *v) { return text && parse_double(text, v); }
 
 /* A whole number lo..hi, all of text. */
 static bool parse_whole(const char *text, int lo, int hi, int *v)
@@ -344,7 +364,8 @@ static enum MHD_Result answer_overlays(struct MHD_Connection *conn, atlas *a)
 
 /* The figure `render` draws of the rectangle x0:x1,y0:y1 (w x h pixels,
  * default 1000 x 800), as a PNG or SVG file to download: drawn into a
- * temporary file (its directory TMPDIR, else /tmp), read back, removed. */
+ * temporary file (its directory TMPDIR, else /tmp), removed once open, and
+ * sent from it. */
 static enum MHD_Result answer_figure(struct MHD_Connection *conn, atlas *a, bool svg)
 {
     double lo[2], hi[2];
@@ -373,22 +394,15 @@ static enum MHD_Result answer_figure(struct MHD_Connection *conn, atlas *a, bool
                            "cannot make a temporary file for the figure (TMPDIR)");
     close(fd);
     *(svg ? &po.svg : &po.path) = path;
-    cm_status st = session_figure(a->s, &po, lo, hi, msg, sizeof msg);
-    FILE *f = st == CM_OK ? fopen(path, "rb") : NULL;
-    char *body = NULL;
-    long size = -1;
-    if (st == CM_OK && !(f && fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0 &&
-                         fseek(f, 0, SEEK_SET) == 0 && (body = malloc((size_t)size + 1)) &&
-                         fread(body, 1, (size_t)size, f) == (size_t)size))
-        st = cm_fail(CM_EIO, msg, sizeof msg, "cannot read the figure back");
-    if (f)
-        fclose(f);
-    unlink(path);
-    if (st != CM_OK) {
-        free(body);
+    const cm_status st = session_figure(a->s, &po, lo, hi, msg, sizeof msg);
+    const int figure = st == CM_OK ? open(path, O_RDONLY) : -1;
+    unlink(path); /* the open file stays until it is sent */
+    enum MHD_Result result;
+    if (st != CM_OK)
         return answer_text(conn, status_code(st), msg);
-    }
-    return answer(conn, MHD_HTTP_OK, svg ? "image/svg+xml" : "image/png", body, (size_t)size);
+    return answer_file(conn, figure, svg ? "image/svg+xml" : "image/png", &result)
+               ? result
+               : answer_text(conn, MHD_HTTP_INTERNAL_SERVER_ERROR, "cannot read the figure back");
 }
 
 /* Leaflet's files, by name: nothing else of the disk is served. */
@@ -409,20 +423,11 @@ static enum MHD_Result answer_leaflet(struct MHD_Connection *conn, const char *n
             continue;
         char path[512];
         snprintf(path, sizeof path, "%s/%s", CELLMAP_LEAFLET_DIR, leaflet_files[i][0]);
-        FILE *f = fopen(path, "rb");
-        char *body = NULL;
-        long size = -1;
-        if (f && fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0 &&
-            fseek(f, 0, SEEK_SET) == 0 && (body = malloc((size_t)size + 1)) &&
-            fread(body, 1, (size_t)size, f) == (size_t)size) {
-            fclose(f);
-            return answer(conn, MHD_HTTP_OK, leaflet_files[i][1], body, (size_t)size);
-        }
-        if (f)
-            fclose(f);
-        free(body);
-        return answer_text(conn, MHD_HTTP_INTERNAL_SERVER_ERROR,
-                           "Leaflet's files are missing: install Debian's libjs-leaflet");
+        enum MHD_Result result;
+        return answer_file(conn, open(path, O_RDONLY), leaflet_files[i][1], &result)
+                   ? result
+                   : answer_text(conn, MHD_HTTP_INTERNAL_SERVER_ERROR,
+                                 "Leaflet's files are missing: install Debian's libjs-leaflet");
     }
     return answer_text(conn, MHD_HTTP_NOT_FOUND, "no such file of Leaflet's");
 }
@@ -500,10 +505,6 @@ static bool listen_address(const char *bind, int port, struct sockaddr_storage *
     return inet_pton(AF_INET, bind, &in4->sin_addr) == 1;
 }
 
-static bool is_loopback(const char *bind)
-{
-    return starts_with(bind, "127.") || strcmp(bind, "::1") == 0;
-}
 
 
 /* ---- the server ---------------------------------------------------------- */
@@ -515,7 +516,10 @@ bool serve_address_valid(const char *bind)
     return listen_address(bind, 0, &addr, &v6);
 }
 
-bool serve_is_loopback(const char *bind) { return is_loopback(bind); }
+bool serve_is_loopback(const char *bind)
+{
+    return starts_with(bind, "127.") || strcmp(bind, "::1") == 0;
+}
 
 cm_status serve_start(atlas *a, const char *bind, int port, server **out, int *bound,
                       char *msg, size_t msg_size)

@@ -391,10 +391,9 @@ cm_status session_extend(session *s, const cm_box *tile, int steps, session_step
 /* The cells of box, flattened, and the cluster's groups; with open
  * non-NULL, also the cells' open nodes (cm_cluster_flatten_open) into a
  * new *open, the caller's to free. */
-static cm_status box_cells(session *s, const cm_box *shown, cm_region *flat, uint32_t **open,
+static cm_status box_cells(session *s, const cm_box *box, cm_region *flat, uint32_t **open,
                            cm_group_info **groups, char *msg, size_t msg_size)
 {
-    const cm_box box = *shown;
     uint64_t sink = 0;
     *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
     if (!*groups)
@@ -405,11 +404,11 @@ static cm_status box_cells(session *s, const cm_box *shown, cm_region *flat, uin
     if (!s->resolve_cache)
         s->resolve_cache = cm_resolve_cache_new(); /* NULL: every node resolved */
     if (open) {
-        *open = cm_cells_array((cm_box_cells(&box) + 1) * sizeof **open);
+        *open = cm_cells_array((cm_box_cells(box) + 1) * sizeof **open);
         if (!*open)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
     }
-    return cm_cluster_flatten_cached(&s->c, &box, s->resolve_cache, flat, open ? *open : NULL, msg,
+    return cm_cluster_flatten_cached(&s->c, box, s->resolve_cache, flat, open ? *open : NULL, msg,
                                      msg_size);
 }
 

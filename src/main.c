@@ -18,7 +18,7 @@ static int run_serve(int argc, char **argv)
     static char name[] = "cellmap-serve"; /* what ps and pkill show */
     char path[4096] = "cellmap-serve";
     const ssize_t n = readlink("/proc/self/exe", path, sizeof path - sizeof name);
-    if (n > 0 && memchr(path, '/', (size_t)n)) {
+    if (n > 0) { /* an absolute path */
         path[n] = '\0';
         strcpy(strrchr(path, '/') + 1, name);
         argv[0] = name;

@@ -49,35 +49,46 @@ def colour_of(hex_text):
 FATES = {0: (214, 39, 40), -2: (180, 180, 180), -1: (255, 255, 255)}
 
 
+def tile_and_cells(png, npy_path, zoom, tx, ty):
+    """Tile (zoom, tx, ty)'s pixels, and for its pixel (px, py) (row 0 at
+    the top) the values of its block of cells in an `export` array (its
+    .json beside it says where its box starts; cells beyond it -1: export's
+    box is the cluster's part of the window)."""
+    w, h, bpp, rows, _ = read_png(png)
+    assert (w, h) == (256, 256), (w, h)
+    shape, values = read_npy(npy_path)
+    first = json.load(open(npy_path[:-4] + ".json"))["first_cell"]
+    k = 1 << -zoom
+    lo0, lo1 = tx * 256 * k, -(ty + 1) * 256 * k  # the tile's first cell
+
+    def value(c0, c1):
+        i, j = c0 - first[0], c1 - first[1]
+        return values[i * shape[1] + j] if 0 <= i < shape[0] and 0 <= j < shape[1] else -1
+
+    pixel = lambda px, py: tuple(rows[py][px * bpp:px * bpp + 3])
+    block = lambda px, py: [value(lo0 + px * k + c, lo1 + (255 - py) * k + r)
+                            for c in range(k) for r in range(k)]
+    return pixel, block, k
+
+
 def check_tile(png, info_path, labels_path, zoom, tx, ty):
     """info_path None: the attractors' colours are not known (their ids are
     another level's), only that each has one, its own."""
-    w, h, bpp, rows, _ = read_png(png)
-    shape, labels = read_npy(labels_path)
-    first = json.load(open(labels_path[:-4] + ".json"))["first_cell"]
-    k = 1 << -zoom
-    assert (w, h) == (256, 256), (w, h)
+    pixel, cells, k = tile_and_cells(png, labels_path, zoom, tx, ty)
     if info_path:
         colour = {e["label"]: colour_of(e["colour"]) for e in json.load(open(info_path))["legend"]}
         assert len(set(colour.values())) == len(colour), "two legend entries share a colour"
     else:
         colour = dict(FATES)
-    lo0, lo1 = tx * 256 * k, -(ty + 1) * 256 * k  # the tile's first cell
-
-    def label(c0, c1):  # export's box is the cluster's part of the window
-        i, j = c0 - first[0], c1 - first[1]
-        return labels[i * shape[1] + j] if 0 <= i < shape[0] and 0 <= j < shape[1] else -1
-
     bad = []
-    for py in range(h):
-        for px in range(w):
-            block = [label(lo0 + px * k + c, lo1 + (255 - py) * k + r)
-                     for c in range(k) for r in range(k)]
+    for py in range(256):
+        for px in range(256):
+            block = cells(px, py)
             # ties: the lowest id the tile gives them (diverged, attractors,
             # outside, not computed)
             rank = lambda v: v if v >= 0 else {-2: 1 << 40, -1: 1 << 41}[v]
             want = min(set(block), key=lambda v: (-block.count(v), rank(v)))
-            got = tuple(rows[py][px * bpp:px * bpp + 3])
+            got = pixel(px, py)
             if got == (0, 0, 0) and k == 1 and want > 0:
                 continue  # a footprint cell of its attractor
             if not info_path and want > 0 and want not in colour and got not in colour.values():
@@ -92,16 +103,13 @@ def check_steps(png, steps_path, zoom, tx, ty):
     """A steps tile: grey levels that fall (darker) as step numbers rise, to
     the cap 64; one grey per step number; white where nothing is computed
     (export's -1)."""
-    w, h, bpp, rows, _ = read_png(png)
-    shape, steps = read_npy(steps_path)
-    first = json.load(open(steps_path[:-4] + ".json"))["first_cell"]
-    lo0, lo1 = tx * 256, -(ty + 1) * 256
+    pixel, cells, _ = tile_and_cells(png, steps_path, zoom, tx, ty)
+    assert zoom == 0, "steps are checked at one pixel per cell"
     grey, bad = {}, []
-    for py in range(h):
-        for px in range(w):
-            i, j = lo0 + px - first[0], lo1 + 255 - py - first[1]
-            step = steps[i * shape[1] + j] if 0 <= i < shape[0] and 0 <= j < shape[1] else -1
-            got = tuple(rows[py][px * bpp:px * bpp + 3])
+    for py in range(256):
+        for px in range(256):
+            step = cells(px, py)[0]
+            got = pixel(px, py)
             if step < 0:
                 if got != (255, 255, 255):
                     bad.append((px, py, step, got))
