@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lib/serve.h"
 #include "src/args.h"
@@ -101,7 +102,7 @@ static int parse_serve(cli *c, serve_args *a)
 
 /* Serves until SIGINT or SIGTERM (blocked here, so that every thread
  * started after leaves them to sigwait). */
-static int run_server(const serve_args *a, atlas *at)
+static int run_server(const serve_args *a, atlas *at, bool *started)
 {
     sigset_t stop;
     sigemptyset(&stop);
@@ -116,6 +117,7 @@ static int run_server(const serve_args *a, atlas *at)
         fprintf(stderr, "cellmap serve: %s\n", msg);
         return EXIT_FAIL;
     }
+    *started = true;
     const bool v6 = strchr(a->bind, ':') != NULL;
     if (!serve_is_loopback(a->bind))
         fprintf(stderr, "cellmap serve: warning: listening on %s: anyone who reaches this "
@@ -146,6 +148,9 @@ int cmd_serve(int argc, char **argv)
     a.o.command = command;
     session s;
     session_opened opened;
+    /* a file made here is removed again if serving never starts */
+    const bool made = access(a.o.path, F_OK) != 0;
+    bool started = false;
     cm_status st = session_open(&s, &a.o, &opened, msg, sizeof msg);
     cli_said_upgrade("serve", a.o.path, opened.upgraded_from);
     if (st == CM_OK && s.dim < 2) {
@@ -159,7 +164,7 @@ int cmd_serve(int argc, char **argv)
                    a.tile_cells < s.max_new_cells ? a.tile_cells : s.max_new_cells);
         at.names = a.names.labels;
         at.nnames = a.names.n_labels;
-        rc = run_server(&a, &at);
+        rc = run_server(&a, &at, &started);
         if (atlas_free(&at, msg, sizeof msg) != CM_OK) {
             fprintf(stderr, "cellmap serve: %s\n", msg);
             rc = EXIT_FAIL;
@@ -172,5 +177,7 @@ int cmd_serve(int argc, char **argv)
         fprintf(stderr, "cellmap serve: %s\n", msg);
         rc = EXIT_FAIL;
     }
+    if (made && !started)
+        unlink(a.o.path);
     return rc;
 }

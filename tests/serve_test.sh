@@ -200,6 +200,13 @@ expect_usage "not an IPv4 or IPv6 address" serve new.cmdb $pd --cell-size 0.5,0.
 expect_usage "which file" serve
 echo "one two" > bad-names.txt
 expect_usage "bad-names.txt:1" serve s.cmdb --labels bad-names.txt
+# a new file whose server cannot listen (the port in use) is not left behind
+serve_start s.cmdb --read-only
+port=${url##*:}
+out=$("$CM" serve made.cmdb $pd --cell-size 0.5,0.08 --port "$port" 2>&1); rc=$?
+[ "$rc" = 1 ] && grep -q "cannot listen" <<<"$out" && [ ! -e made.cmdb ] ||
+  fail "serve of a new file on a port in use: $rc $out; $(ls made.cmdb* 2>&1)"
+serve_stop
 out=$("$CM" serve nothing.cmdb 2>&1); rc=$?
 [ "$rc" = 2 ] && [ ! -e nothing.cmdb ] || fail "serve of a missing file without a model: $rc $out"
 
