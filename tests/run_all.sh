@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite from scratch: install the Debian packages, build a
 # release and an ASan+UBSan build, run ctest in both, run a campaign of
-# damaged files against the sanitizer build, then each fuzz target for 15 s.
+# damaged files against the sanitizer build, then each fuzz target for 10 s.
 # Exit status 0 = green.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,5 +32,5 @@ UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 # an attacker's campaign of damaged files against every command (sanitizer build)
 python3 tests/campaign.py build-sanitize/cellmap 600
 # libFuzzer targets (clang), each for a fixed budget (longer runs: tests/run_fuzz.sh 300)
-tests/run_fuzz.sh 15
+tests/run_fuzz.sh 10
 echo "all tests passed (release and sanitizer builds, fuzz targets)"
