@@ -1,5 +1,6 @@
 #include "cellmap/join.h"
 
+#include "cellmap/clock.h"
 #include "cellmap/grow.h"
 
 #include <stdatomic.h>
@@ -451,6 +452,7 @@ static cm_status join_region(cm_cluster *c, cm_region *r, cm_node *nodes, const 
     if (!stats)
         stats = &local_stats;
     memset(stats, 0, sizeof *stats);
+    const double started = cm_seconds();
     cm_status st = cm_cluster_add_region(c, r, nodes, msg, msg_size);
     if (st != CM_OK)
         return st;
@@ -472,6 +474,7 @@ static cm_status join_region(cm_cluster *c, cm_region *r, cm_node *nodes, const 
         c->regions[added].r.exit_target = NULL;
     }
     stats->new_groups += stats->straddling_groups;
+    stats->seconds = cm_seconds() - started;
     if (st != CM_OK)
         return cm_fail(st, msg, msg_size, "joining region %u: %s", added,
                        detail[0] ? detail : cm_strerror(st));
@@ -491,6 +494,7 @@ static void add_join_stats(cm_join_stats *sum, const cm_join_stats *one)
     sum->nodes += one->nodes;
     sum->new_groups += one->new_groups;
     sum->straddling_groups += one->straddling_groups;
+    sum->seconds += one->seconds;
 }
 
 /* Region `next`'s exits that land in the cluster: their regions stay through

@@ -27,6 +27,7 @@ typedef struct cm_join_stats {
     uint64_t nodes;            /* links made */
     uint32_t new_groups;       /* groups of the new region plus straddling ones */
     uint32_t straddling_groups;
+    double seconds; /* spent joining, on the joining thread (cm_seconds) */
 } cm_join_stats;
 
 /* Joins a region solved with record_exits on the cluster's lattice. The

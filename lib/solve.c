@@ -155,8 +155,10 @@ static cm_status solve_cluster(const solve_request *q, solve_result *r, char *ms
     r->first = "regions and joins";
     r->second = "summary";
     const double t0 = cm_seconds();
+    cm_join_stats joins = {0};
     if (st == CM_OK)
-        st = project_add_box(&r->c, r->store, q->model, &plan, &q->box, NULL, msg, msg_size);
+        st = project_add_box(&r->c, r->store, q->model, &plan, &q->box, &joins, msg, msg_size);
+    r->join_seconds = joins.seconds;
     if (st == CM_OK && plan.extend > 0)
         st = project_extend(&r->c, r->store, q->model, &plan, &q->box, q->step_done, q->step_user,
                             &r->nsteps, r->stop, sizeof r->stop, msg, msg_size);

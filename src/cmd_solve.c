@@ -316,6 +316,8 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat,
     json_object(&j, "time_s");
     json_seconds(&j, sum->first, sum->t1);
     json_seconds(&j, sum->second, sum->t2);
+    if (strcmp(sum->first, "regions and joins") == 0) /* of them, on the joining thread */
+        json_seconds(&j, "joins", sum->join_seconds);
     json_seconds(&j, "attractors", sum->att_seconds);
     json_object_end(&j);
     if (extended)

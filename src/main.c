@@ -8,7 +8,7 @@
 #include "lib/outfile.h"
 #include "src/args.h"
 #include "src/commands.h"
-#include "src/wait_policy.h"
+#include "src/run_env.h"
 
 /* `cellmap serve` runs cellmap-serve, the program beside this one: it
  * alone links the HTTP library (src/cmd_serve.c says why). */
@@ -85,6 +85,18 @@ static void usage(FILE *out)
                  "is written as SVG or PDF where FILE ends in .svg or .pdf.\n");
 }
 
+/* The commands that solve or read clusters: their memory is mostly fresh
+ * arrays, which huge pages fill with fewer page faults (src/run_env.h). */
+static bool builds_cells(const char *name)
+{
+    static const char *const heavy[] = {"solve",  "sweep",  "explore", "serve",
+                                        "render", "export", "measure"};
+    for (size_t i = 0; i < sizeof heavy / sizeof heavy[0]; i++)
+        if (strcmp(name, heavy[i]) == 0)
+            return true;
+    return false;
+}
+
 /* A command's status, made a failure if its standard output was lost (a
  * full device, a closed pipe): output that did not arrive is not success. */
 static int finish(const char *name, int status)
@@ -124,8 +136,9 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *name = asks_help ? argv[2] : argv[1];
-    if (strcmp(name, "explore") == 0 && !asks_help)
-        wait_passively(argv); /* returns unless the user chose a wait policy */
+    if (!asks_help) /* returns unless a setting was missing */
+        run_env_apply(argv, (strcmp(name, "explore") == 0 ? RUN_ENV_PASSIVE_WAIT : 0) |
+                                (builds_cells(name) ? RUN_ENV_HUGE_PAGES : 0));
     for (int i = 2; i < argc; i++) /* -h is --help, for every command */
         if (strcmp(argv[i], "-h") == 0)
             argv[i] = help_flag;

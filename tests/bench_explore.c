@@ -13,14 +13,14 @@
  * pan's time (compute + join + commit, render), the medians, the ratio of
  * the last ten pans to pans 11-20 (with 20 pans or more) and the ratio of
  * a pan to the full recompute. Its threads wait as cellmap explore's do
- * (src/wait_policy.h). */
+ * and use the heap cellmap explore does (src/run_env.h). */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "bench_util.h"
 #include "src/explore.h"
-#include "src/wait_policy.h"
+#include "src/run_env.h"
 
 enum { MAX_PANS = 1000 };
 
@@ -96,7 +96,7 @@ static void close_session(explore *s)
 
 int main(int argc, char **argv)
 {
-    wait_passively(argv); /* as cellmap explore runs */
+    run_env_apply(argv, RUN_ENV_PASSIVE_WAIT | RUN_ENV_HUGE_PAGES); /* as cellmap explore runs */
     const preset *p = &presets[0];
     const char *dir = argc > 2 ? argv[2] : "/tmp";
     for (size_t k = 0; argc > 1 && k < sizeof presets / sizeof presets[0]; k++)

@@ -86,8 +86,9 @@ if not objects:
 
 # the command over the library only (6 000 lines for cellmap's 23
 # commands; 250 more for serve's options, signals and messages, whose
-# HTTP layer is lib/serve.c)
-SRC_MAX_LINES = 6250
+# HTTP layer is lib/serve.c; 50 more for the environment a command asks
+# for by executing itself, src/run_env.c, which cannot live in a library)
+SRC_MAX_LINES = 6300
 src_lines = 0
 for path in sorted(glob.glob(os.path.join(root, "src", "*.[ch]"))):
     text = open(path).read()

@@ -26,6 +26,14 @@ pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 printf '# the legend names attractor 1\n1 the first one\n' > names.txt
 serve_start s.cmdb --tile-cells 65536 --labels names.txt
 grep -q "http://127.0.0.1:" serve.out || fail "serve does not listen on 127.0.0.1 by default"
+# the server runs with the heap in huge pages where the kernel gives them
+# on request, unless the build is sanitized (src/run_env.h); the
+# environment it was executed with is in /proc
+if grep -q '\[madvise\]' /sys/kernel/mm/transparent_hugepage/enabled 2> /dev/null &&
+  ! ldd "$CM" | grep -q libasan; then
+  tr '\0' '\n' < /proc/$pid/environ | grep -qx 'GLIBC_TUNABLES=glibc.malloc.hugetlb=1' ||
+    fail "serve runs without huge pages for its heap"
+fi
 curl -sf "$url/" | grep -q "L.CRS.Simple" || fail "the page is not the Leaflet map"
 curl -sf "$url/leaflet/leaflet.js" -o leaflet.js || fail "leaflet.js not served"
 cmp -s leaflet.js /usr/share/javascript/leaflet/leaflet.js || fail "leaflet.js is not Debian's"
