@@ -1017,9 +1017,11 @@ static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node 
 
 cm_status cm_region_nodes(const cm_region *r, cm_node **out)
 {
-    cm_node *nodes = calloc(r->nexits + 1, sizeof *nodes);
+    /* every record is written below: fresh memory, in huge pages if big */
+    cm_node *nodes = cm_cells_array((r->nexits + 1) * sizeof *nodes);
     if (!nodes)
         return CM_ENOMEM;
+    memset(&nodes[r->nexits], 0, sizeof *nodes);
     for (uint64_t e = 0; e < r->nexits; e++)
         nodes[e] = (cm_node){.next = CM_NODE_OPEN, .up = CM_NODE_OPEN, .first_in = CM_NODE_OPEN,
                              .sibling = CM_NODE_OPEN};

@@ -21,15 +21,16 @@
  * (bench_scm's machine line). The array is asked for in huge pages, rounded
  * up to whole ones when that adds at most a quarter to its bytes: a 1000 x
  * 1000 view's 4 MB array, half in 4 KiB pages, took 4.6 ms to fill there,
- * and 0.3 ms in two huge pages. A smaller array keeps its tail in 4 KiB
+ * and 0.3 ms in two huge pages (so does an array of 1.6 to 2 MiB, a 4x4
+ * split's region of 500 000 cells). A smaller array keeps its tail in 4 KiB
  * pages, so that it takes no more memory than its bytes. */
 void *cm_cells_array(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
-    if (bytes < huge)
-        return malloc(bytes);
     const size_t whole = (bytes + huge - 1) / huge * huge;
     const size_t asked = whole - bytes <= bytes / 4 ? whole : bytes;
+    if (asked < huge)
+        return malloc(bytes);
     void *p = NULL;
     if (posix_memalign(&p, huge, asked) != 0)
         return NULL;
@@ -379,9 +380,12 @@ static int images_of_row_batched(const cm_model *model, const cm_lattice *lat, c
 }
 
 /* Numbers the exits in local index order and moves their targets, kept by
- * the threads that found them, into the region's exit table. */
-static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
-                              const row_exits *rows, uint64_t nrows, char *msg, size_t msg_size)
+ * the threads that found them, into the region's exit table: a lone
+ * thread's list is that table already (it did the rows in order), and
+ * becomes it without a copy (a region of a split solve, or a pan's strip,
+ * has a thread of its own: 16 bytes of fresh memory an exit saved). */
+static cm_status number_exits(cm_region *r, exit_buf *bufs, int threads, const row_exits *rows,
+                              uint64_t nrows, char *msg, size_t msg_size)
 {
     uint64_t nexits = 0;
     for (int t = 0; t < threads; t++) {
@@ -392,10 +396,15 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
     if (nexits > CM_IMAGE_EXIT - CM_IMAGE_EXIT_BASE)
         return cm_fail(CM_ETOOBIG, msg, msg_size, "too many exits; split the region");
     const size_t dim = (size_t)r->box.dim;
-    r->exit_target = malloc((nexits + 1) * dim * sizeof *r->exit_target);
+    const bool adopt = threads == 1 && bufs[0].cells;
+    /* an adopted list gives back the room it grew beyond its exits (in place) */
+    r->exit_target = adopt ? realloc(bufs[0].cells, nexits * dim * sizeof *r->exit_target)
+                           : malloc((nexits + 1) * dim * sizeof *r->exit_target);
     if (!r->exit_target)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                        (unsigned long long)nexits);
+    if (adopt)
+        bufs[0].cells = NULL; /* the region's now */
     const uint64_t nx = r->ncells / nrows;
     uint64_t k = 0;
     for (uint64_t row = 0; row < nrows; row++) {
@@ -405,7 +414,7 @@ static cm_status number_exits(cm_region *r, const exit_buf *bufs, int threads,
         for (uint64_t i = row * nx; i < (row + 1) * nx; i++) {
             if (r->image[i] != CM_IMAGE_EXIT)
                 continue;
-            for (size_t d = 0; d < dim; d++)
+            for (size_t d = 0; d < dim && !adopt; d++)
                 r->exit_target[k * dim + d] = from[at++];
             r->image[i] = CM_IMAGE_EXIT_BASE + (uint32_t)k++;
         }

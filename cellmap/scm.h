@@ -104,7 +104,8 @@ typedef struct cm_group_info {
  * free(): in transparent huge pages where the system has them (whose first
  * touch costs a tenth of 4 KiB pages' here), rounded up to whole ones when
  * that adds at most a quarter to `bytes`, else with the tail in 4 KiB
- * pages. cm_region_alloc and the store's page-in use it. */
+ * pages. cm_region_alloc, the store's page-in and the node tables of
+ * regions about to join (cm_region_nodes) use it. */
 void *cm_cells_array(size_t bytes);
 
 cm_status cm_region_alloc(cm_region *r, const cm_box *box, char *msg, size_t msg_size);
