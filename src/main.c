@@ -1,11 +1,13 @@
 /* cellmap - cell mapping and global dynamics from the command line. */
 #include <errno.h>
 #include <stdbool.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "lib/outfile.h"
+#include "lib/parse.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/run_env.h"
@@ -85,16 +87,29 @@ static void usage(FILE *out)
                  "is written as SVG or PDF where FILE ends in .svg or .pdf.\n");
 }
 
-/* The commands that solve or read clusters: their memory is mostly fresh
- * arrays, which huge pages fill with fewer page faults (src/run_env.h). */
-static bool builds_cells(const char *name)
+/* Whether a command builds enough cells for huge pages to pay for a second
+ * start (src/run_env.h; 1-3 ms): explore and serve always; solve and sweep
+ * unless --cells asks for fewer than 2^18 cells without --split or
+ * --extend (the default is 1000 a dimension). Readers of files (render,
+ * export, measure) page their regions into huge pages anyway. */
+static bool builds_cells(const char *name, int argc, char **argv)
 {
-    static const char *const heavy[] = {"solve",  "sweep",  "explore", "serve",
-                                        "render", "export", "measure"};
-    for (size_t i = 0; i < sizeof heavy / sizeof heavy[0]; i++)
-        if (strcmp(name, heavy[i]) == 0)
+    if (strcmp(name, "explore") == 0 || strcmp(name, "serve") == 0)
+        return true;
+    if (strcmp(name, "solve") != 0 && strcmp(name, "sweep") != 0)
+        return false;
+    uint64_t cells = UINT64_C(1) << 18;
+    for (int i = 2; i < argc; i++) {
+        if (strcmp(argv[i], "--split") == 0 || strcmp(argv[i], "--extend") == 0)
             return true;
-    return false;
+        int64_t n[CM_MAX_DIM];
+        int dims = 0; /* a product that wraps past 2^64 only goes without huge pages */
+        if (strcmp(argv[i], "--cells") == 0 && i + 1 < argc &&
+            parse_counts(argv[i + 1], n, &dims, CM_MAX_DIM))
+            for (cells = 1; dims > 0; dims--)
+                cells *= (uint64_t)n[dims - 1];
+    }
+    return cells >= UINT64_C(1) << 18;
 }
 
 /* A command's status, made a failure if its standard output was lost (a
@@ -138,7 +153,7 @@ int main(int argc, char **argv)
     const char *name = asks_help ? argv[2] : argv[1];
     if (!asks_help) /* returns unless a setting was missing */
         run_env_apply(argv, (strcmp(name, "explore") == 0 ? RUN_ENV_PASSIVE_WAIT : 0) |
-                                (builds_cells(name) ? RUN_ENV_HUGE_PAGES : 0));
+                                (builds_cells(name, argc, argv) ? RUN_ENV_HUGE_PAGES : 0));
     for (int i = 2; i < argc; i++) /* -h is --help, for every command */
         if (strcmp(argv[i], "-h") == 0)
             argv[i] = help_flag;

@@ -1,19 +1,16 @@
 /* src/run_env.h - settings that libraries read from the environment before
- * main, which a command asks for by executing itself once more
- * (docs/engine.md says why, with the measured times).
- *
- * Passive waiting (explore): libgomp's idle threads sleep rather than spin
- * between a session's short parallel regions, which on 2 vCPUs sharing a
- * core slowed the serial work between them (a pan, 18 against 12 ms).
- * Huge pages for the heap (commands that build cells and clusters): glibc
- * (2.35 and later) asks for transparent huge pages for its heaps with the
- * tunable glibc.malloc.hugetlb=1, where the kernel gives them on request
- * (mode "madvise"); a split solve's node tables, exit lists and small
- * regions then cost a page fault per 2 MiB rather than per 4 KiB (a
- * 16x16 split 20 % faster). Neither is set if the user set it
- * (OMP_WAIT_POLICY or GOMP_SPINCOUNT; glibc.malloc.hugetlb in
- * GLIBC_TUNABLES, so =0 turns it off), nor huge pages in a sanitizer
- * build, whose allocator is not glibc's. */
+ * main, which a command asks for by executing itself once more (measured
+ * in docs/engine.md). Passive waiting (explore): libgomp's idle threads
+ * sleep rather than spin between a session's short parallel regions, which
+ * on 2 vCPUs sharing a core slowed the serial work between them. Huge
+ * pages for the heap (commands that build many cells): glibc (2.35 and
+ * later) asks for transparent huge pages for its heaps with the tunable
+ * glibc.malloc.hugetlb=1, where the kernel gives them on request (mode
+ * "madvise"), so that a split solve's node tables, exit lists and small
+ * regions cost a page fault per 2 MiB rather than per 4 KiB. Neither is
+ * set if the user set it (OMP_WAIT_POLICY or GOMP_SPINCOUNT;
+ * glibc.malloc.hugetlb in GLIBC_TUNABLES, so =0 turns it off), nor huge
+ * pages in a sanitizer build, whose allocator is not glibc's. */
 #ifndef CM_SRC_RUN_ENV_H
 #define CM_SRC_RUN_ENV_H
 
