@@ -17,14 +17,22 @@ static int whole_progress(void *user, const char *phase, double fraction)
     return work_stop(q->hooks) != NULL;
 }
 
+/* What cluster_progress reports to and adds the joins' time into. */
+typedef struct cluster_watch {
+    const solve_request *q;
+    solve_result *r;
+} cluster_watch;
+
 /* A cm_joined_fn for a cluster (after the join's commit): the regions
  * joined, and the stop request, which ends the solve with what is
  * committed. */
 static cm_status cluster_progress(void *user, cm_cluster *c, uint32_t box,
                                   const cm_join_stats *stats, char *msg, size_t msg_size)
 {
-    const solve_request *q = user;
-    (void)box, (void)stats;
+    const cluster_watch *w = user;
+    const solve_request *q = w->q;
+    (void)box;
+    w->r->join_seconds += stats->seconds;
     char what[64];
     snprintf(what, sizeof what, "%u region%s joined", c->nregions, c->nregions == 1 ? "" : "s");
     work_progress(q->hooks, c->cells, what);
@@ -140,8 +148,9 @@ static cm_status solve_cluster(const solve_request *q, solve_result *r, char *ms
                                size_t msg_size)
 {
     project_plan plan = q->plan;
+    cluster_watch watch = {q, r};
     plan.joined = cluster_progress;
-    plan.joined_user = (void *)q;
+    plan.joined_user = &watch;
     char plan_text[1024];
     project_plan_text(&plan, &q->box, plan_text, sizeof plan_text);
     cm_status st = CM_OK;
@@ -155,10 +164,8 @@ static cm_status solve_cluster(const solve_request *q, solve_result *r, char *ms
     r->first = "regions and joins";
     r->second = "summary";
     const double t0 = cm_seconds();
-    cm_join_stats joins = {0};
     if (st == CM_OK)
-        st = project_add_box(&r->c, r->store, q->model, &plan, &q->box, &joins, msg, msg_size);
-    r->join_seconds = joins.seconds;
+        st = project_add_box(&r->c, r->store, q->model, &plan, &q->box, NULL, msg, msg_size);
     if (st == CM_OK && plan.extend > 0)
         st = project_extend(&r->c, r->store, q->model, &plan, &q->box, q->step_done, q->step_user,
                             &r->nsteps, r->stop, sizeof r->stop, msg, msg_size);

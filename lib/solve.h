@@ -62,7 +62,7 @@ typedef struct solve_result {
      * regions and joins and the summary, or regions and stage 1 */
     const char *first, *second;
     double t1, t2;
-    double join_seconds; /* of t1, a cluster's: joining regions (on the joining thread) */
+    double join_seconds; /* of t1, a cluster's: its joins (on the joining thread) */
     project_step steps[SOLVE_MAX_EXTEND]; /* the extension's steps */
     int nsteps;
     char stop[1100];       /* why the extension ended */
