@@ -9,6 +9,7 @@
  * of each turn's ratio to the whole solve of the same turn (load that
  * drifts on a shared machine cancels out).
  * usage: bench_join PATH/TO/cellmap [REPS]   (REPS default 5) */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,10 +55,11 @@ static int run(const char *cm, int c, int s, double *solve, double *joins)
         if (!(*r == ' ' && r > out && r[-1] == ':'))
             *w++ = *r;
     *w = '\0';
-    *joins = s ? json_number(out, "joins") : 0;
+    /* a cellmap older than time_s.joins: NaN (the other figures stand) */
+    *joins = !s ? 0 : json_number(out, "joins") >= 0 ? json_number(out, "joins") : NAN;
     *solve = s ? json_number(out, "regions and joins")
                : json_number(out, "images") + json_number(out, "classification");
-    return *solve > 0 && *joins >= 0 ? 0 : -1;
+    return *solve > 0 ? 0 : -1;
 }
 
 int main(int argc, char **argv)
