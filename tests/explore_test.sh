@@ -310,7 +310,7 @@ assert os.WEXITSTATUS(status) == 0, status
 PY
 
 # --- its OpenMP threads sleep when idle, unless the user chose -------------
-# (src/wait_policy.h) libgomp shows the spin count it runs with; the
+# (src/run_env.h) libgomp shows the spin count it runs with; the
 # command runs itself again with OMP_WAIT_POLICY=passive, so the last
 # display is the one its work runs under.
 spin_of() { # spin_of [VAR=VALUE]: the last spin count explore's libgomp shows
