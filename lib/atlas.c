@@ -88,17 +88,11 @@ static cm_status check_level(const atlas *a, int level, const session *s, char *
                              size_t msg_size)
 {
     const cm_lattice want = level_lattice(a, level);
-    const cm_model *m = &a->s->model;
-    bool same = strcmp(s->model.name, m->name) == 0 && s->model.values.count == m->values.count &&
-                s->c.lat.dim == want.dim;
-    for (int k = 0; same && k < m->values.count; k++) {
-        const cm_param_value *x = &s->model.values.value[k], *y = &m->values.value[k];
-        same = x->count == y->count;
-        for (int i = 0; same && i < x->count; i++)
-            same = x->v[i] == y->v[i];
-    }
-    for (int d = 0; same && d < want.dim; d++)
-        same = s->c.lat.origin[d] == want.origin[d] && s->c.lat.width[d] == want.width[d];
+    char params[4096], wanted[4096]; /* compared as a resumed solve's are */
+    cm_params_json(&s->model.values, params, sizeof params);
+    cm_params_json(&a->s->model.values, wanted, sizeof wanted);
+    const bool same = strcmp(s->model.name, a->s->model.name) == 0 &&
+                      strcmp(params, wanted) == 0 && cm_lattice_equal(&s->c.lat, &want);
     return same ? CM_OK
                 : cm_fail(CM_EINVAL, msg, msg_size,
                           "%s is not zoom %d of %s (another model, parameters or lattice); move "
@@ -259,15 +253,11 @@ cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *bo
                        "tile %lld,%lld at zoom %d lies beyond the lattice's world (cell "
                        "coordinates below 2^40)",
                        (long long)x, (long long)y, z);
-    box->dim = s->dim;
+    session_slice_box(s, box);
     box->lo[0] = x * side;
     box->hi[0] = box->lo[0] + side;
     box->lo[1] = -(y + 1) * side;
     box->hi[1] = box->lo[1] + side;
-    for (int d = 2; d < s->dim; d++) {
-        box->lo[d] = s->slice[d];
-        box->hi[d] = s->slice[d] + 1;
-    }
     return CM_OK;
 }
 
@@ -541,10 +531,10 @@ cm_status atlas_tile_png(atlas *a, int z, int64_t x, int64_t y, int layer, atlas
  * cluster's attractors. */
 static void origin_cell(const session *s, cm_box *box)
 {
-    box->dim = s->dim;
-    for (int d = 0; d < s->dim; d++) {
-        box->lo[d] = d < 2 ? 0 : s->slice[d];
-        box->hi[d] = box->lo[d] + 1;
+    session_slice_box(s, box);
+    for (int d = 0; d < 2; d++) {
+        box->lo[d] = 0;
+        box->hi[d] = 1;
     }
 }
 
@@ -680,11 +670,8 @@ static cm_status label_colour(atlas *a, const session *s, cm_region *flat, const
 /* The legend's name of label (an attractor of s, or a fate without one). */
 static void name_label(const cm_attractor_set *s, int32_t label, char *out, size_t size)
 {
-    const cm_attractor *at = label > 0 && (uint32_t)label <= s->n ? &s->a[label - 1] : NULL;
-    if (at && at->kind == CM_ATTRACTOR_PERIODIC)
-        snprintf(out, size, "A%d p=%u", label, at->period);
-    else if (at)
-        snprintf(out, size, "A%d %s", label, cm_attractor_kind_name(at->kind));
+    if (label > 0 && (uint32_t)label <= s->n)
+        attractor_name(&s->a[label - 1], out, size);
     else
         snprintf(out, size, "%s", label == CM_LABEL_DIVERGED    ? "diverged"
                                   : label == CM_LABEL_UNCOMPUTED ? "not computed"

@@ -72,6 +72,14 @@ cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const int32
     return CM_OK;
 }
 
+void attractor_name(const cm_attractor *a, char *out, size_t size)
+{
+    if (a->kind == CM_ATTRACTOR_PERIODIC)
+        snprintf(out, size, "A%u p=%u", a->id, a->period);
+    else
+        snprintf(out, size, "A%u %s", a->id, cm_attractor_kind_name(a->kind));
+}
+
 int attractor_legend(const cm_attractor_set *s, uint32_t n, cm_group_label *labels, int used,
                      int cap)
 {
@@ -86,11 +94,7 @@ int attractor_legend(const cm_attractor_set *s, uint32_t n, cm_group_label *labe
         cm_group_label *l = &labels[used++];
         memset(l, 0, sizeof *l);
         l->id = s->a[a].id;
-        if (s->a[a].kind == CM_ATTRACTOR_PERIODIC)
-            snprintf(l->text, sizeof l->text, "A%u p=%u", s->a[a].id, s->a[a].period);
-        else
-            snprintf(l->text, sizeof l->text, "A%u %s", s->a[a].id,
-                     cm_attractor_kind_name(s->a[a].kind));
+        attractor_name(&s->a[a], l->text, sizeof l->text);
     }
     if (n > s->n && used < cap) {
         cm_group_label *l = &labels[used++];

@@ -20,6 +20,9 @@
 cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const int32_t *label,
                          cm_group_info **groups, uint32_t *n, char *msg, size_t msg_size);
 
+/* An attractor's name in legends: "A3 p=1", "A5 aperiodic". */
+void attractor_name(const cm_attractor *a, char *out, size_t size);
+
 /* The legend's names of the attractors ("A3 p=1", "A5 aperiodic") that
  * labels[0..used) do not name already, and of the grey group n when the
  * view has one (n > s->n), appended up to cap entries; returns the count. */

@@ -131,17 +131,12 @@ static void first_view(const session *s, cm_box *box)
         session_shown_cells(s, box);
         return;
     }
-    box->dim = s->dim;
-    for (int d = 0; d < s->dim; d++) {
-        box->lo[d] = d < 2 ? 0 : s->slice[d];
-        box->hi[d] = d < 2 ? ATLAS_TILE : s->slice[d] + 1;
-    }
-    for (uint32_t k = 0; k < s->c.nregions; k++) {
-        const cm_box *r = &s->c.regions[k].r.box;
-        for (int d = 0; d < 2; d++) {
-            box->lo[d] = k == 0 || r->lo[d] < box->lo[d] ? r->lo[d] : box->lo[d];
-            box->hi[d] = k == 0 || r->hi[d] > box->hi[d] ? r->hi[d] : box->hi[d];
-        }
+    cm_box regions;
+    cm_cluster_bounds(&s->c, &regions);
+    session_slice_box(s, box);
+    for (int d = 0; d < 2; d++) {
+        box->lo[d] = s->c.nregions ? regions.lo[d] : 0;
+        box->hi[d] = s->c.nregions ? regions.hi[d] : ATLAS_TILE;
     }
 }
 
@@ -437,12 +432,11 @@ static enum MHD_Result answer_page(struct MHD_Connection *conn)
     size_t size = 0;
     for (int k = 0; serve_page[k]; k++)
         size += strlen(serve_page[k]);
-    char *body = malloc(size + 1);
+    char *body = malloc(size + 1), *end = body;
     if (!body)
         return MHD_NO;
-    body[0] = '\0';
     for (int k = 0; serve_page[k]; k++)
-        strcat(body, serve_page[k]);
+        end = stpcpy(end, serve_page[k]);
     return answer(conn, MHD_HTTP_OK, "text/html; charset=utf-8", body, size);
 }
 

@@ -34,14 +34,20 @@ static void view_box(const session *s, const double *lo, const double *hi, cm_bo
     }
 }
 
-/* The one layer of the view's box that is drawn (the slice). */
-static void shown_box(const session *s, cm_box *box)
+void session_slice_box(const session *s, cm_box *box)
 {
-    view_box(s, s->lo, s->hi, box);
+    box->dim = s->dim;
     for (int d = 2; d < s->dim; d++) {
         box->lo[d] = s->slice[d];
         box->hi[d] = s->slice[d] + 1;
     }
+}
+
+/* The one layer of the view's box that is drawn (the slice). */
+static void shown_box(const session *s, cm_box *box)
+{
+    view_box(s, s->lo, s->hi, box);
+    session_slice_box(s, box);
 }
 
 static void format_view(const session *s, char *out, size_t size)
@@ -509,10 +515,7 @@ cm_status session_figure(session *s, const png_opts *po, const double lo[2], con
     if (st != CM_OK)
         return st;
     view_box(s, lo, hi, &box);
-    for (int d = 2; d < s->dim; d++) { /* the slice shown */
-        box.lo[d] = s->slice[d];
-        box.hi[d] = s->slice[d] + 1;
-    }
+    session_slice_box(s, &box);
     st = figure_check(po, &s->model, &s->c.lat, &box, msg, msg_size);
     return st == CM_OK ? figure_of_file(s->store, &info, &s->c, s->path, po, &box, lo, hi, NULL,
                                         NULL, msg, msg_size)

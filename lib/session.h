@@ -122,6 +122,10 @@ void session_view_text(const session *s, char *out, size_t size);
 void session_view_cells(const session *s, cm_box *box);
 void session_shown_cells(const session *s, cm_box *box);
 
+/* Sets box's dimension to the session's and its dimensions 2.. to the
+ * slice drawn (one layer), leaving dimensions 0 and 1. */
+void session_slice_box(const session *s, cm_box *box);
+
 /* One `extend auto` step done. */
 typedef struct session_step {
     int step;
