@@ -1395,9 +1395,9 @@ static void flatten_part(const cm_region *r, const node_values *nv, const cm_box
                           &out->step[to + (uint64_t)i]);
             out->image[to + (uint64_t)i] = flat_image(&im, from + (uint64_t)i);
         }
-        if (open && nv->nodes)
-            for (int64_t i = 0; i < width; i++)
-                open[to + (uint64_t)i] = open_of_cell(r, from + (uint64_t)i, nv);
+        for (int64_t i = 0; open && i < width; i++)
+            open[to + (uint64_t)i] = nv->nodes ? open_of_cell(r, from + (uint64_t)i, nv)
+                                               : CM_NODE_OPEN;
     }
 }
 
@@ -1695,9 +1695,18 @@ static cm_status flatten(cm_cluster *c, const cm_box *box, cm_region *out, uint3
 {
     const double total = (double)cm_box_cells(box);
     uint64_t done = 0;
-    cm_status st = cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
+    /* Regions are disjoint: when they cover the box, every cell is copied,
+     * and filling the arrays first would only write them twice. */
+    uint64_t covered = 0;
+    for (uint32_t k = 0; k < c->nregions; k++) {
+        cm_box both;
+        covered += cm_box_intersect(&c->regions[k].r.box, box, &both) ? cm_box_cells(&both) : 0;
+    }
+    cm_status st = covered == cm_box_cells(box) ? cm_region_alloc(out, box, msg, msg_size)
+                                               : cm_flat_alloc(box, c->ngroups, out, msg, msg_size);
+    out->ngroups = c->ngroups;
     _Static_assert(CM_NODE_OPEN == UINT32_MAX, "open cells are filled bytewise");
-    if (st == CM_OK && open)
+    if (st == CM_OK && open && covered < out->ncells)
         memset(open, 0xFF, (size_t)out->ncells * sizeof *open);
     if (st == CM_OK && cache && cache_room(cache, c) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory resolving nodes");

@@ -60,12 +60,22 @@ static uint64_t hash_place(const cm_exit_memo *memo, const int64_t *cell)
     return i;
 }
 
+/* The empty place a cell not in the hash takes: entries are distinct, so a
+ * rehash compares no cells (each comparison is a cache miss). */
+static uint64_t free_place(const cm_exit_memo *memo, const int64_t *cell)
+{
+    uint64_t i = cm_cell_hash(cell, memo->dim) & (memo->hash_size - 1);
+    while (memo->hash[i])
+        i = (i + 1) & (memo->hash_size - 1);
+    return i;
+}
+
 static void rehash(cm_exit_memo *memo)
 {
     if (memo->hash_size)
         memset(memo->hash, 0, (size_t)memo->hash_size * sizeof *memo->hash);
     for (uint64_t i = 0; i < memo->n; i++)
-        memo->hash[hash_place(memo, word(memo, i, KEY))] = (uint32_t)(i + 1);
+        memo->hash[free_place(memo, word(memo, i, KEY))] = (uint32_t)(i + 1);
 }
 
 /* Keeps the entries keep[i] says, in their order, and rehashes. */

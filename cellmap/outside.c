@@ -119,13 +119,6 @@ static bool leaves(const cm_region *r, uint32_t image)
                                        : image < r->ncells && r->group[image] == CM_GROUP_NONE;
 }
 
-/* Whether a sink cell's sequence ends at cell j: its image is the sink, or
- * leaves the region's cells. */
-static bool ends_here(const cm_region *r, uint64_t j)
-{
-    return r->image[j] == CM_IMAGE_SINK || leaves(r, r->image[j]);
-}
-
 /* The exit cell a leaving cell's image lands in: the recorded exit's
  * target, the uncomputed cell of the box it points to, or (an image
  * CM_IMAGE_EXIT, not recorded) found again by the image rule. Returns the
@@ -348,18 +341,20 @@ static bool cluster_holds(const void *user, const int64_t *cell)
     return cm_cluster_locate(((const cm_cluster_cells *)user)->c, cell, &local) >= 0;
 }
 
-/* The first place in ascending a[0..n) whose id is not below id. */
+/* The first place in ascending a[0..n) whose id is not below id: halving
+ * without branches (a compare and a conditional move), since the branches
+ * of a search over a long open list mispredict. */
 static uint64_t first_not_below(const uint32_t *a, uint64_t n, uint32_t id)
 {
-    uint64_t lo = 0, hi = n;
-    while (lo < hi) {
-        const uint64_t mid = lo + (hi - lo) / 2;
-        if (a[mid] < id)
-            lo = mid + 1;
-        else
-            hi = mid;
+    if (n == 0)
+        return 0;
+    const uint32_t *base = a;
+    while (n > 1) {
+        const uint64_t half = n / 2;
+        base = base[half] < id ? base + half : base;
+        n -= half;
     }
-    return lo;
+    return (uint64_t)(base - a) + (*base < id);
 }
 
 /* The exit open node id leads to (cm_cluster_exits' node index). */
@@ -819,40 +814,95 @@ static cm_status leaving_label(void *user, const cm_region *flat, uint64_t j, in
 typedef cm_status (*leaving_fn)(void *user, const cm_region *flat, uint64_t j, int32_t *v,
                                 char *msg, size_t msg_size);
 
+/* Threads share the labels while they walk: a label is read and written
+ * whole (relaxed atomics), and every value a thread may see for a cell is
+ * unknown or that cell's final label. */
+static int32_t label_get(const int32_t *labels, uint64_t i)
+{
+    return __atomic_load_n(&labels[i], __ATOMIC_RELAXED);
+}
+
+static void label_set(int32_t *labels, uint64_t i, int32_t v)
+{
+    __atomic_store_n(&labels[i], v, __ATOMIC_RELAXED);
+}
+
+/* Labels of flat's cells [from, to) that need no walk: a group's cell its
+ * attractor's label, a sink cell whose image is the world's sink diverged,
+ * the others LABEL_PENDING; the sink cells whose image leaves flat's cells
+ * appended to *ends. False: out of memory. */
+static bool first_labels(const cm_attractor_set *s, const cm_region *flat, uint64_t from,
+                         uint64_t to, int32_t *labels, uint64_t **ends, uint64_t *n,
+                         uint64_t *cap)
+{
+    for (uint64_t i = from; i < to; i++) {
+        const uint32_t g = flat->group[i], image = flat->image[i];
+        labels[i] = g != 0                    ? cm_attractor_label(s, g)
+                    : image == CM_IMAGE_SINK ? CM_LABEL_DIVERGED
+                                             : LABEL_PENDING;
+        if (labels[i] != LABEL_PENDING || !leaves(flat, image))
+            continue;
+        if (cm_grow((void **)ends, cap, *n + 1, sizeof **ends) != CM_OK)
+            return false;
+        (*ends)[(*n)++] = i;
+    }
+    return true;
+}
+
+/* Every LABEL_PENDING cell of flat takes the label of the first labelled
+ * cell its sequence reaches, as do the cells on the way. */
+static void walk_to_labels(const cm_region *flat, int threads, int32_t *labels)
+{
+    const int64_t n = (int64_t)flat->ncells;
+#pragma omp parallel for schedule(dynamic, 4096) num_threads(threads)
+    for (int64_t i = 0; i < n; i++) {
+        if (label_get(labels, (uint64_t)i) != LABEL_PENDING)
+            continue;
+        uint64_t j = (uint64_t)i;
+        int32_t v;
+        while ((v = label_get(labels, j)) == LABEL_PENDING)
+            j = flat->image[j];
+        for (uint64_t k = (uint64_t)i; k != j; k = flat->image[k])
+            label_set(labels, k, v);
+    }
+}
+
 /* Labels flat's cells: a group's cell its attractor's label, a sink cell
  * the label its sequence ends on (diverged in the world's sink, else what
- * `leave` gives at the cell where it leaves flat's cells). */
+ * `leave` gives at the cell where it leaves flat's cells).
+ * The cells where sequences leave are labelled first, in cell order on the
+ * calling thread (`leave` may read the cluster and number exits); then the
+ * other sink cells walk to them on every thread. Every walk ends on a
+ * labelled cell, and the label it copies is its sequence's, so the result
+ * does not depend on the threads. */
 static cm_status label_cells(const cm_attractor_set *s, const cm_region *flat, leaving_fn leave,
-                             void *user, int32_t *labels, char *msg, size_t msg_size)
+                             void *user, int threads, int32_t *labels, char *msg,
+                             size_t msg_size)
 {
-    const int32_t unknown = LABEL_PENDING;
-    for (uint64_t i = 0; i < flat->ncells; i++)
-        labels[i] = flat->group[i] == 0 ? unknown : cm_attractor_label(s, flat->group[i]);
-    for (uint64_t i = 0; i < flat->ncells; i++) {
-        if (labels[i] != unknown)
-            continue;
-        uint64_t j = i;
-        int32_t v = unknown;
-        while (v == unknown) { /* a sink chain: it ends */
-            const uint32_t image = flat->image[j];
-            if (image == CM_IMAGE_SINK)
-                v = CM_LABEL_DIVERGED;
-            else if (leaves(flat, image)) {
-                const cm_status st = leave(user, flat, j, &v, msg, msg_size);
-                if (st != CM_OK)
-                    return st;
-            } else if (labels[image] != unknown)
-                v = labels[image];
-            else
-                j = image;
-        }
-        for (j = i; labels[j] == unknown; j = flat->image[j]) {
-            labels[j] = v;
-            if (ends_here(flat, j))
-                break;
-        }
+    const int nt = threads_of(threads);
+    uint64_t **ends = calloc((size_t)nt, sizeof *ends);
+    uint64_t *nends = calloc((size_t)nt, sizeof *nends);
+    bool ok = ends && nends;
+    const uint64_t ncells = flat->ncells;
+#pragma omp parallel num_threads(nt) if (ok) reduction(&& : ok)
+    {
+        const int t = omp_get_thread_num();
+        uint64_t cap = 0;
+        ok = first_labels(s, flat, ncells * (uint64_t)t / (uint64_t)nt,
+                          ncells * (uint64_t)(t + 1) / (uint64_t)nt, labels, &ends[t], &nends[t],
+                          &cap);
     }
-    return CM_OK;
+    cm_status st = ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the labels");
+    for (int t = 0; st == CM_OK && t < nt; t++)
+        for (uint64_t k = 0; st == CM_OK && k < nends[t]; k++)
+            st = leave(user, flat, ends[t][k], &labels[ends[t][k]], msg, msg_size);
+    if (st == CM_OK)
+        walk_to_labels(flat, nt, labels);
+    for (int t = 0; ends && t < nt; t++)
+        free(ends[t]);
+    free(ends);
+    free(nends);
+    return st;
 }
 
 cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *flat,
@@ -860,7 +910,7 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
                                    size_t msg_size)
 {
     leaving_cells lc = {s, cells};
-    return label_cells(s, flat, leaving_label, &lc, labels, msg, msg_size);
+    return label_cells(s, flat, leaving_label, &lc, 0, labels, msg, msg_size);
 }
 
 /* The budget opt asks (0 when not followed). */
@@ -915,30 +965,36 @@ static uint64_t hash_place(const view_exits *v, const int64_t *cell)
     return i;
 }
 
-/* Room for one more slot: the cells, and the hash at most half full. */
-static cm_status view_room(view_exits *v)
+/* Room for `need` slots: the cells, and the hash at most half full. */
+static cm_status view_room(view_exits *v, uint64_t need)
 {
-    if (v->n >= VIEW_MOST - 64)
+    if (need >= VIEW_MOST - 64)
         return CM_ETOOBIG;
-    if (v->n == v->cap) {
-        const uint64_t cap = v->cap ? 2 * v->cap : 1024;
+    if (need > v->cap) {
+        const uint64_t cap = need > 2 * v->cap ? need : v->cap ? 2 * v->cap : 1024;
         int64_t *cell = realloc(v->cell, (size_t)cap * (size_t)v->dim * sizeof *cell);
         if (!cell)
             return CM_ENOMEM;
         v->cell = cell;
         v->cap = cap;
     }
-    if (2 * (v->n + 1) <= v->hash_size)
+    if (2 * need <= v->hash_size)
         return CM_OK;
-    const uint64_t size = v->hash_size ? 2 * v->hash_size : 2048;
+    uint64_t size = v->hash_size ? 2 * v->hash_size : 2048;
+    while (size < 2 * need)
+        size *= 2;
     uint32_t *hash = calloc((size_t)size, sizeof *hash);
     if (!hash)
         return CM_ENOMEM;
     free(v->hash);
     v->hash = hash;
     v->hash_size = size;
-    for (uint64_t k = 0; k < v->n; k++)
-        v->hash[hash_place(v, v->cell + k * (uint64_t)v->dim)] = (uint32_t)(k + 1);
+    for (uint64_t k = 0; k < v->n; k++) { /* distinct cells: no comparing (cache misses) */
+        uint64_t i = cm_cell_hash(v->cell + k * (uint64_t)v->dim, v->dim) & (size - 1);
+        while (v->hash[i])
+            i = (i + 1) & (size - 1);
+        v->hash[i] = (uint32_t)(k + 1);
+    }
     return CM_OK;
 }
 
@@ -953,7 +1009,7 @@ static cm_status view_slot(view_exits *v, const int64_t *cell, uint64_t *slot, c
             return CM_OK;
         }
     }
-    const cm_status st = view_room(v);
+    const cm_status st = view_room(v, v->n + 1);
     if (st == CM_ETOOBIG)
         return cm_fail(st, msg, msg_size, "the view reaches more than %llu exits",
                        (unsigned long long)(VIEW_MOST - 64));
@@ -1273,6 +1329,37 @@ static cm_status view_exit_set(const view_exits *v, const int32_t *label, const 
     return st;
 }
 
+/* Each view cell that leaves by an exit takes the exit's fate, and the
+ * exit's weight (weight[0..v->n), zeroed) counts it: one pass on every
+ * thread, each counting into its own array (summed after, so the counts do
+ * not depend on the threads). */
+static cm_status fates_of_cells(const view_exits *v, const int32_t *fate, int32_t *labels,
+                                int threads, uint64_t *weight)
+{
+    const int nt = threads_of(threads);
+    const uint64_t n = v->n;
+    uint64_t *mine = calloc((size_t)nt * (size_t)n + 1, sizeof *mine);
+    if (!mine)
+        return CM_ENOMEM;
+    const int64_t cells = (int64_t)v->flat->ncells;
+#pragma omp parallel num_threads(nt)
+    {
+        uint64_t *count = mine + (uint64_t)omp_get_thread_num() * n;
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < cells; i++)
+            if (is_slot(labels[i])) {
+                const int32_t slot = VIEW_EXIT - labels[i];
+                count[slot]++;
+                labels[i] = fate[slot];
+            }
+    }
+    for (int t = 0; t < nt; t++)
+        for (uint64_t e = 0; e < n; e++)
+            weight[e] += mine[(uint64_t)t * n + e];
+    free(mine);
+    return CM_OK;
+}
+
 cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_region *flat,
                                  const uint32_t *open, const cm_attractor_options *opt,
                                  cm_exit_memo *memo, cm_attractor_set *s, int32_t *labels,
@@ -1302,10 +1389,12 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     const int threads = opt ? opt->threads : 0;
     int32_t *fate = NULL;
     uint64_t *weight = NULL, taken = 0;
+    if (memo) /* a view like the last: room for its exits at once, no rehashing */
+        (void)view_room(&v, cm_exit_memo_count(memo));
     if (memo)
         cm_exit_memo_sync(memo, c, steps);
-    cm_status st = label_cells(s, flat, view_leaving, &v, labels, msg, msg_size);
-    if (st == CM_OK)
+    cm_status st = label_cells(s, flat, view_leaving, &v, threads, labels, msg, msg_size);
+    if (st == CM_OK && v.nend) /* none when the cells' open nodes are given */
         st = settle_ends(&v, labels, flat->ncells, threads, msg, msg_size);
     v.labels = labels;
     if (st == CM_OK)
@@ -1313,21 +1402,13 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
     if (memo)
         cm_exit_memo_keep_used(memo);
     weight = st == CM_OK ? calloc((size_t)v.n + 1, sizeof *weight) : NULL;
-    if (st == CM_OK && !weight)
+    if (st == CM_OK && (!weight || fates_of_cells(&v, fate, labels, threads, weight) != CM_OK))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
-    for (uint64_t i = 0; st == CM_OK && i < flat->ncells; i++)
-        if (is_slot(labels[i]))
-            weight[VIEW_EXIT - labels[i]]++;
     if (st == CM_OK && view_exit_set(&v, fate, weight, s) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
     if (st == CM_OK) {
         s->outside_steps = steps;
         s->outside_steps_taken = taken;
-        const int64_t n = (int64_t)flat->ncells;
-#pragma omp parallel for schedule(static) num_threads(threads_of(threads))
-        for (int64_t i = 0; i < n; i++)
-            if (is_slot(labels[i]))
-                labels[i] = fate[VIEW_EXIT - labels[i]];
     }
     free(fate);
     free(weight);

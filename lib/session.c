@@ -1,6 +1,7 @@
 /* lib/session.c - an explore session's engine half (lib/session.h). */
 #include "lib/session.h"
 
+#include <malloc.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -871,6 +872,12 @@ static cm_status create_new(const opening *op)
     if (st != CM_OK)
         return refuse(op, st, false, "%s", msg);
     return new_depth(op);
+}
+
+void session_keep_freed(void)
+{
+    (void)mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    (void)mallopt(M_TRIM_THRESHOLD, 64 << 20);
 }
 
 cm_status session_open(session *s, const session_options *o, session_opened *opened, char *msg,

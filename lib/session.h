@@ -87,6 +87,17 @@ typedef struct session_opened {
     bool bad_options;
 } session_opened;
 
+/* For a program that draws view after view (explore, serve), called once
+ * at its start: glibc then keeps the memory one view frees for the next.
+ * Blocks up to 32 MiB come from the heap rather than mappings of their own,
+ * and the heap's top goes back to the system only beyond 64 MiB free.
+ * Otherwise each view's arrays (4 MB each for 1000 x 1000 cells) are mapped
+ * afresh and the kernel zeroes every page on first touch: 2-8 ms of a
+ * 1000 x 1000 render (docs/engine.md). A session's peak memory stays as it
+ * was; what it frees stays resident up to that peak. Process-wide, so it
+ * is the program's call, never made by the library itself. */
+void session_keep_freed(void);
+
 /* Opens path (creating it from the model options if it does not exist).
  * Whatever the status, session_close ends it. */
 cm_status session_open(session *s, const session_options *o, session_opened *opened, char *msg,

@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 int cli_usage_error(const cli *c, const char *fmt, ...)
 {
     va_list ap;

@@ -153,6 +153,7 @@ static int run_input(explore *e, const char *script, FILE *f)
 int cmd_explore(int argc, char **argv)
 {
     cli c = {"explore", argc, argv, 0, NULL, NULL};
+    session_keep_freed(); /* view after view */
     explore_args a;
     char command[4096], msg[1024];
     memset(&a, 0, sizeof a);

@@ -50,8 +50,6 @@ static const char export_help[] =
     "  --mem BYTES         cell arrays to hold in memory while reading (default 256M)\n"
     "  --quiet             no progress line and no count of the cells written\n";
 
-
-
 typedef struct export_args {
     const char *file, *groups, *cells, *flat, *window, *labels, *steps;
     uint64_t mem;

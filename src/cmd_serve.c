@@ -136,6 +136,7 @@ static int run_server(const serve_args *a, atlas *at, bool *started)
 int cmd_serve(int argc, char **argv)
 {
     cli c = {"serve", argc, argv, 0, NULL, NULL};
+    session_keep_freed(); /* view after view */
     serve_args a;
     char command[4096], msg[2048];
     memset(&a, 0, sizeof a);

@@ -219,9 +219,6 @@ static int larger_basin_first(const void *a, const void *b)
  * lists all of them in id order. */
 enum { TEXT_GROUPS = 20 };
 
-
-
-
 /* A share of slow cells (cm_scm_slow_share) above which the summary says so. */
 #define SLOW_SHARE 0.25
 

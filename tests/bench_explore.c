@@ -97,6 +97,7 @@ static void close_session(explore *s)
 int main(int argc, char **argv)
 {
     run_env_apply(argv, RUN_ENV_PASSIVE_WAIT | RUN_ENV_HUGE_PAGES); /* as cellmap explore runs */
+    session_keep_freed();
     const preset *p = &presets[0];
     const char *dir = argc > 2 ? argv[2] : "/tmp";
     for (size_t k = 0; argc > 1 && k < sizeof presets / sizeof presets[0]; k++)

@@ -457,6 +457,23 @@ static uint64_t check_open_labels(cm_cluster *c, const cm_model *m, const cm_gro
     CHECK_INT(s.returned_cells, ws->returned_cells);
     CHECK_INT(s.outside_cells, ws->outside_cells);
     CHECK_INT(s.outside_steps_taken, ws->outside_steps_taken);
+    /* on one thread the same: cells labelled and exits counted on every
+     * thread (label_cells' walks, fates_of_cells) do not depend on how many */
+    const cm_attractor_options one = {.threads = 1};
+    cm_attractor_set s1;
+    int32_t *alone = malloc(n * sizeof *alone);
+    CHECK(cm_attractors_find(m, &c->lat, g, c->ngroups, cm_cluster_cells_group, c, NULL, &s1, msg,
+                             sizeof msg) == CM_OK);
+    CHECK(cm_cluster_view_labels(m, c, &flat, open, &one, NULL, &s1, alone, msg, sizeof msg) ==
+          CM_OK);
+    CHECK(memcmp(alone, labels, n * sizeof *labels) == 0);
+    CHECK_INT(s1.nexits, s.nexits);
+    CHECK_INT(s1.returned_cells, s.returned_cells);
+    CHECK_INT(s1.outside_cells, s.outside_cells);
+    for (uint32_t a = 0; a < s1.n && a < s.n; a++)
+        CHECK_INT(s1.a[a].basin_cells, s.a[a].basin_cells);
+    cm_attractors_free(&s1);
+    free(alone);
     cm_attractors_free(&s);
     cm_region_free(&flat);
     free(open);
