@@ -659,7 +659,7 @@ cm_status cm_result_figure(const cm_result *r, const cm_figure_options *o, char 
     if (st == CM_OK)
         st = figure_check(&po, r->model, &r->lat, &r->cells.box, msg, msg_size);
     const basin_png b = {&po,  r->model, &r->lat, &r->cells, r->groups, {0, 0}, {0, 0}, NULL,
-                         po.by == BY_ATTRACTORS ? &r->att : NULL, NULL, r->att_labels};
+                         po.by == BY_ATTRACTORS ? &r->att : NULL, NULL, r->att_labels, NULL};
     return st == CM_OK ? figure_write(&b, msg, msg_size) : st;
 }
 

@@ -667,10 +667,17 @@ static cm_status label_colour(atlas *a, const session *s, cm_region *flat, const
     return st;
 }
 
-/* The legend's name of label (an attractor of s, or a fate without one). */
-static void name_label(const cm_attractor_set *s, int32_t label, char *out, size_t size)
+/* The legend's name of label (an attractor of s, or a fate without one):
+ * at level 0 the name the user gave it, if any. */
+static void name_label(const atlas *a, int level, const cm_attractor_set *s, int32_t label,
+                       char *out, size_t size)
 {
-    if (label > 0 && (uint32_t)label <= s->n)
+    const char *given = level == 0 && label > 0 && (uint32_t)label <= s->n
+                            ? given_name(a, &s->a[label - 1])
+                            : NULL;
+    if (given)
+        snprintf(out, size, "%s", given);
+    else if (label > 0 && (uint32_t)label <= s->n)
         attractor_name(&s->a[label - 1], out, size);
     else
         snprintf(out, size, "%s", label == CM_LABEL_DIVERGED    ? "diverged"
@@ -726,7 +733,7 @@ cm_status atlas_point_query(atlas *a, double x, double y, int zoom, int steps, a
     out->step = out->computed ? flat.step[0] : 0;
     out->label = labels[0];
     out->attractors = att.n;
-    name_label(&att, out->label, out->name, sizeof out->name);
+    name_label(a, level, &att, out->label, out->name, sizeof out->name);
     st = label_colour(a, s, &flat, labels, &att, &out->colour, msg, msg_size);
     free(labels);
     cm_region_free(&flat);

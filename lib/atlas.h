@@ -158,7 +158,8 @@ typedef struct atlas_point {
     uint32_t group; /* its group (0: the sink's domain) */
     uint32_t step;  /* its step number */
     int32_t label;  /* its attractor (> 0), or CM_LABEL_DIVERGED, _OUTSIDE, _UNCOMPUTED */
-    char name[64];  /* the label as the legend names it ("A3 p=1"; ids are the level's) */
+    char name[64];  /* the label as the legend names it ("A3 p=1", or the name --labels
+                       gives it at level 0; ids are the level's) */
     cm_rgb colour;  /* the label's colour in the tiles (a footprint cell's too: not black) */
     uint32_t attractors; /* how many the cluster has */
     double *orbit;  /* the true orbit from the cell's centre: norbit states of dim numbers */

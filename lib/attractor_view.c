@@ -45,8 +45,10 @@ cm_status attractor_view(const cm_attractor_set *s, cm_region *flat, const int32
     if (!g)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
     const uint32_t outside = s->n + 1; /* the figure's group of cells that reach no attractor known */
-    bool any_outside = false;
-    for (uint64_t i = 0; i < flat->ncells; i++) {
+    int any_outside = 0;
+    const int64_t cells = (int64_t)flat->ncells;
+#pragma omp parallel for schedule(static) reduction(| : any_outside)
+    for (int64_t i = 0; i < cells; i++) {
         const uint32_t was = flat->group[i];
         if (was != CM_GROUP_NONE && was != 0 && flat->step[i] == 0)
             flat->step[i] = 1; /* a cell cycle's cell: the footprints are the markers */

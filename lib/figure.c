@@ -480,8 +480,9 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
 {
     cm_region view = *b->cells;
     const uint64_t n = view.ncells;
-    view.group = cm_cells_array((n + 1) * sizeof *view.group);
-    view.step = cm_cells_array((n + 1) * sizeof *view.step);
+    const bool copy = b->spare != b->cells;
+    view.group = copy ? cm_cells_array((n + 1) * sizeof *view.group) : b->spare->group;
+    view.step = copy ? cm_cells_array((n + 1) * sizeof *view.step) : b->spare->step;
     cm_group_info *groups = NULL;
     uint32_t count = 0;
     png_opts *po = malloc(sizeof *po);
@@ -492,11 +493,12 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the figure");
     if (st == CM_OK && !b->labels)
         st = cm_attractor_cell_labels(b->attractors, b->cells, b->computed, own, msg, msg_size);
-    if (st == CM_OK) {
+    if (st == CM_OK && copy) {
         memcpy(view.group, b->cells->group, n * sizeof *view.group);
         memcpy(view.step, b->cells->step, n * sizeof *view.step);
-        st = attractor_view(b->attractors, &view, label, &groups, &count, msg, msg_size);
     }
+    if (st == CM_OK)
+        st = attractor_view(b->attractors, &view, label, &groups, &count, msg, msg_size);
     free(own);
     if (st == CM_OK) {
         *po = *b->opts;
@@ -510,10 +512,13 @@ static cm_status write_by_attractors(const basin_png *b, char *msg, size_t msg_s
         by.groups = groups;
         by.attractors = NULL;
         by.labels = NULL;
+        by.spare = NULL;
         st = figure_write(&by, msg, msg_size);
     }
-    free(view.group);
-    free(view.step);
+    if (copy) {
+        free(view.group);
+        free(view.step);
+    }
     free(groups);
     free(po);
     return st;
@@ -607,7 +612,7 @@ cm_status figure_of_file(cm_store *s, const cm_store_info *info, cm_cluster *cl,
     if (st == CM_OK)
         st = cm_cluster_flatten_progress(cl, box, &flat, read_progress, &r, msg, msg_size);
     const basin_png png = {po,     &m,   &cl->lat, &flat, groups, {lo[0], lo[1]}, {hi[0], hi[1]},
-                           NULL, po->by == BY_ATTRACTORS ? &att : NULL, &ends.computed, NULL};
+                           NULL, po->by == BY_ATTRACTORS ? &att : NULL, &ends.computed, NULL, &flat};
     if (st == CM_OK)
         st = figure_write(&png, msg, msg_size);
     cm_region_free(&flat);

@@ -102,6 +102,9 @@ typedef struct basin_png {
                                            beyond the cells (NULL: not followed) */
     const int32_t *labels; /* by attractors: each cell's label found already
                               (cm_attractor_cell_labels); NULL: found here */
+    cm_region *spare;      /* by attractors: `cells` itself when its owner needs
+                              them no more, relabelled then in place rather than
+                              in a copy; NULL: a copy */
 } basin_png;
 
 /* Checks before anything is computed that the figure of these options can

@@ -495,7 +495,8 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
                            s->gl,
                            po->by == BY_ATTRACTORS ? &att : NULL,
                            NULL,
-                           labels};
+                           labels,
+                           &flat}; /* freed after the figure */
     if (st == CM_OK)
         st = figure_write(&png, msg, msg_size);
     cm_region_free(&flat);

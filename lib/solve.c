@@ -262,7 +262,7 @@ cm_status solve_draw(const solve_request *q, solve_result *r, const png_opts *po
                      size_t msg_size)
 {
     basin_png png = {po, q->model, &q->lat, &r->r, r->groups, {0, 0}, {0, 0}, NULL,
-                     po->by == BY_ATTRACTORS ? &r->att : NULL, NULL, NULL};
+                     po->by == BY_ATTRACTORS ? &r->att : NULL, NULL, NULL, NULL};
     /* where the sink cells' sequences leave the cells drawn */
     cm_region_cells whole = {&r->r, q->model, &q->lat, q->plan.opt.max_steps};
     const cm_computed region = cm_region_computed(&whole);

@@ -23,7 +23,7 @@ pd="--model microchaos-pd --param alpha=0.078,beta=0,P=0.007,D=0.02"
 
 # --- the page, Leaflet's files, the info -------------------------------------
 # (tiles compute at zoom 0 only: what the file holds stays a known box)
-printf '# the legend names attractor 1\n1 the first one\n' > names.txt
+printf '# the legend names attractors 1 and 2\n1 the first one\n2 the second one\n' > names.txt
 serve_start s.cmdb --tile-cells 65536 --labels names.txt
 grep -q "http://127.0.0.1:" serve.out || fail "serve does not listen on 127.0.0.1 by default"
 # the server runs with the heap in huge pages where the kernel gives them
@@ -97,6 +97,9 @@ curl -sf "$url/figure.svg?$fig" -o fig.svg || fail "/figure.svg"
 curl -sf "$url/cell?x=150.3&y=0.1&steps=5" -o cell.json || fail "/cell"
 [ "$(check json cell.json cell computed)" = "[44, 245] true" ] ||
   fail "/cell of (150.3, 0.1): $(cat cell.json)"
+# its attractor (2) as the legend names it: the name --labels gave
+grep -q '"label":2,"name":"the second one"' cell.json ||
+  fail "/cell does not name attractor 2 as --labels does: $(cat cell.json)"
 
 # --- bad requests: a status and a message, never a crash --------------------
 for bad in "/tiles/0/0/x.png" "/tiles/4/0/0.png" "/tiles/-9/0/0.png" "/tiles/0/0/0.jpg" \
