@@ -479,7 +479,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     if (starts_with(url, "/leaflet/"))
         return answer_leaflet(conn, url + strlen("/leaflet/"));
     return answer_text(conn, MHD_HTTP_NOT_FOUND,
-                       "no such page: /, /info, /tiles/Z/X/Y.png, /cell?x=X&y=Y are served");
+                       "no such page: /, /info, /tiles/Z/X/Y.png, /cell?x=X&y=Y, /overlays, "
+                       "/figure.png, /figure.svg and /leaflet/... are served");
 }
 
 /* The address to listen on, from --bind (IPv4 or IPv6) and --port. */

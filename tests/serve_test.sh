@@ -115,6 +115,9 @@ for missing in "/etc/passwd" "/leaflet/../../../../etc/passwd" "/leaflet/leaflet
                 "/leaflet/%2e%2e/%2e%2e/etc/passwd" "/tiles" "/s.cmdb"; do
   [ "$(status "$missing" --path-as-is)" = 404 ] || fail "$missing: status $(status "$missing" --path-as-is)"
 done
+for page in /info /tiles/Z/X/Y.png /cell /overlays /figure.png /figure.svg /leaflet/; do
+  curl -s "$url/nope" | grep -qF "$page" || fail "the 404 of an unknown page does not list $page"
+done
 [ "$(status / -X POST -d x=1)" = 405 ] || fail "POST: status $(status / -X POST -d x=1)"
 [ "$(status / -X DELETE)" = 405 ] || fail "DELETE answered"
 
