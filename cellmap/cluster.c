@@ -18,7 +18,9 @@
  * final outcome fills later (saved as 0 while the node is open): dist the
  * low 32 bits, group the high ones, target the INDEXED flag (the node is in
  * its region's open list). When its node table is evicted, the weight and
- * the flag go to c->open (INDEXED as bit 63) and come back with the table. */
+ * the flag go beside the node's place in the open list (open_weight,
+ * INDEXED as bit 63: 8 bytes a node), or to c->open for an open node the
+ * list lacks, and come back with the table. */
 #define INDEXED_FLAG 1u
 #define INDEXED (UINT64_C(1) << 63)
 
@@ -62,6 +64,7 @@ void cm_cluster_free(cm_cluster *c)
         free(c->regions[k].dirty_chunks);
         free(c->regions[k].open_local);
         free(c->regions[k].open_cells);
+        free(c->regions[k].open_weight);
     }
     free(c->regions);
     cm_idmap_free(&c->open);
@@ -83,7 +86,8 @@ void cm_cluster_release_open(cm_cluster *c)
         cm_cluster_region *cr = &c->regions[k];
         free(cr->open_local);
         free(cr->open_cells);
-        cr->open_local = NULL, cr->open_cells = NULL;
+        free(cr->open_weight);
+        cr->open_local = NULL, cr->open_cells = NULL, cr->open_weight = NULL;
         cr->nopen = cr->open_cap = cr->open_stale = 0;
     }
     cm_idmap_free(&c->open);
@@ -237,6 +241,12 @@ static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
                 nd->target = spilled & INDEXED ? INDEXED_FLAG : 0;
             }
         }
+        for (uint64_t i = 0; i < cr->nopen; i++)
+            if (cr->open_weight[i] & INDEXED) {
+                cm_node *nd = &cr->nodes[cr->open_local[i]];
+                set_weight(nd, cr->open_weight[i] & ~INDEXED);
+                nd->target = INDEXED_FLAG;
+            }
     }
     *out = cr->nodes;
     return CM_OK;
@@ -256,13 +266,13 @@ cm_status cm_cluster_node_load(cm_cluster *c, uint32_t id, cm_node **out, char *
 }
 
 
-/* Whether node e of region cr, once indexed, is still open. */
-static bool still_indexed(const cm_cluster *c, const cm_cluster_region *cr, uint32_t e)
+/* Whether the node of entry i of region cr's open list is still open. */
+static bool still_indexed(const cm_cluster_region *cr, uint64_t i)
 {
+    const uint32_t e = cr->open_local[i];
     if (cr->nodes)
         return is_open(&cr->nodes[e]) && (cr->nodes[e].target & INDEXED_FLAG);
-    const uint64_t *v = cm_idmap_find(&c->open, cr->node_base + e);
-    return v && (*v & INDEXED);
+    return cr->open_weight[i] & INDEXED;
 }
 
 /* Region cr's open list with room for cap nodes (at least nopen). */
@@ -273,9 +283,12 @@ static cm_status resize_open_list(const cm_cluster *c, cm_cluster_region *cr, ui
     if (local)
         cr->open_local = local;
     int64_t *cells = local ? realloc(cr->open_cells, cap * dim * sizeof *cells) : NULL;
-    if (!cells)
+    if (cells)
+        cr->open_cells = cells;
+    uint64_t *weight = cells ? realloc(cr->open_weight, cap * sizeof *weight) : NULL;
+    if (!weight)
         return CM_ENOMEM;
-    cr->open_cells = cells;
+    cr->open_weight = weight;
     cr->open_cap = cap;
     return CM_OK;
 }
@@ -287,9 +300,10 @@ static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
     const size_t dim = (size_t)c->lat.dim;
     uint64_t kept = 0;
     for (uint64_t i = 0; i < cr->nopen; i++) {
-        if (!still_indexed(c, cr, cr->open_local[i]))
+        if (!still_indexed(cr, i))
             continue;
         cr->open_local[kept] = cr->open_local[i];
+        cr->open_weight[kept] = cr->open_weight[i];
         memmove(cr->open_cells + kept * dim, cr->open_cells + i * dim, dim * sizeof *cr->open_cells);
         kept++;
     }
@@ -305,6 +319,10 @@ uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
     if (cr->nodes)
         return is_open(&cr->nodes[id - cr->node_base]) ? weight_of(&cr->nodes[id - cr->node_base])
                                                         : 0;
+    const uint32_t e = id - cr->node_base;
+    const uint64_t i = cm_first_not_below(cr->open_local, cr->nopen, e);
+    if (i < cr->nopen && cr->open_local[i] == e)
+        return cr->open_weight[i] & INDEXED ? cr->open_weight[i] & ~INDEXED : 0;
     const uint64_t *v = cm_idmap_find(&c->open, id);
     return v ? *v & ~INDEXED : 0;
 }
@@ -371,9 +389,8 @@ cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, u
     if (cr->nodes) {
         set_weight(&cr->nodes[id - cr->node_base], w);
         cr->nodes[id - cr->node_base].target = INDEXED_FLAG;
-    } else if (cm_idmap_put(&c->open, id, w | INDEXED) != CM_OK) { /* back with the table */
-        return CM_ENOMEM;
     }
+    cr->open_weight[cr->nopen] = w | INDEXED; /* back with the table, if it is paged out */
     cr->open_local[cr->nopen] = id - cr->node_base;
     memcpy(cr->open_cells + cr->nopen * dim, cell, dim * sizeof *cell);
     cr->nopen++;
@@ -772,18 +789,22 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
 }
 
 /* Before region cr's node table is evicted: its open nodes' weights and
- * flags into c->open (all or none). */
+ * flags beside their places in the open list, and those of open nodes it
+ * lacks into c->open (all or none). */
 static cm_status spill_open_weights(cm_cluster *c, cm_cluster_region *cr)
 {
     for (uint64_t e = 0; e < cr->r.nexits; e++) {
         const cm_node *nd = &cr->nodes[e];
-        if (is_open(nd) && cm_idmap_put(&c->open, cr->node_base + (uint32_t)e,
-                                        weight_of(nd) | (nd->target & INDEXED_FLAG ? INDEXED : 0)) !=
-                               CM_OK) {
+        if (is_open(nd) && !(nd->target & INDEXED_FLAG) &&
+            cm_idmap_put(&c->open, cr->node_base + (uint32_t)e, weight_of(nd)) != CM_OK) {
             while (e-- > 0)
                 cm_idmap_remove(&c->open, cr->node_base + (uint32_t)e, NULL);
             return CM_ENOMEM;
         }
+    }
+    for (uint64_t i = 0; i < cr->nopen; i++) {
+        const cm_node *nd = &cr->nodes[cr->open_local[i]];
+        cr->open_weight[i] = still_indexed(cr, i) ? weight_of(nd) | INDEXED : 0;
     }
     return CM_OK;
 }

@@ -92,6 +92,10 @@ typedef struct cm_cluster_region {
      * them (cm_cluster_open_nodes) */
     uint32_t *open_local;
     int64_t *open_cells;
+    /* private: while the node table is paged out, the weight of each
+     * listed node, bit 63 set while it is still open (else its record
+     * holds it) */
+    uint64_t *open_weight;
     uint64_t nopen, open_cap, open_stale;
     int open_dirty;
     uint64_t last_used; /* private: paging clock of the last acquire of the cells */
@@ -313,6 +317,22 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
 /* Calls fn for every open node with the target of its exit. */
 typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
 void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
+
+/* The first place in ascending a[0..n) whose value is not below v: halving
+ * without branches (a compare and a conditional move), since the branches
+ * of a search over a long open list mispredict. */
+static inline uint64_t cm_first_not_below(const uint32_t *a, uint64_t n, uint32_t v)
+{
+    if (n == 0)
+        return 0;
+    const uint32_t *base = a;
+    while (n > 1) {
+        const uint64_t half = n / 2;
+        base = base[half] < v ? base + half : base;
+        n -= half;
+    }
+    return (uint64_t)(base - a) + (*base < v);
+}
 
 /* Node ids are indexed by blocks of 2^CM_NODE_BLOCK_BITS: the region of each
  * block's first id (c->node_blocks). */

@@ -341,26 +341,10 @@ static bool cluster_holds(const void *user, const int64_t *cell)
     return cm_cluster_locate(((const cm_cluster_cells *)user)->c, cell, &local) >= 0;
 }
 
-/* The first place in ascending a[0..n) whose id is not below id: halving
- * without branches (a compare and a conditional move), since the branches
- * of a search over a long open list mispredict. */
-static uint64_t first_not_below(const uint32_t *a, uint64_t n, uint32_t id)
-{
-    if (n == 0)
-        return 0;
-    const uint32_t *base = a;
-    while (n > 1) {
-        const uint64_t half = n / 2;
-        base = base[half] < id ? base + half : base;
-        n -= half;
-    }
-    return (uint64_t)(base - a) + (*base < id);
-}
-
 /* The exit open node id leads to (cm_cluster_exits' node index). */
 static const int64_t *node_exit(const cm_exits *x, int dim, uint32_t id)
 {
-    const uint64_t lo = first_not_below(x->node, x->nnodes, id);
+    const uint64_t lo = cm_first_not_below(x->node, x->nnodes, id);
     return lo < x->nnodes && x->node[lo] == id && x->node_exit[lo] < x->n
                ? x->cell + x->node_exit[lo] * (uint64_t)dim
                : NULL;
@@ -1030,7 +1014,7 @@ static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
     const cm_cluster_region *cr = &c->regions[k];
     const uint32_t e = id - cr->node_base;
     const size_t bytes = (size_t)c->lat.dim * sizeof *cell;
-    const uint64_t lo = first_not_below(cr->open_local, cr->nopen, e);
+    const uint64_t lo = cm_first_not_below(cr->open_local, cr->nopen, e);
     if (lo < cr->nopen && cr->open_local[lo] == e) {
         memcpy(cell, cr->open_cells + lo * (uint64_t)c->lat.dim, bytes);
         return CM_OK;
