@@ -187,7 +187,7 @@ typedef struct cm_cluster {
     uint32_t nupcoming;
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
-    cm_idmap open;   /* weights of the open nodes whose node tables are paged out */
+    cm_idmap open;   /* weights of open nodes no open list holds, their node tables paged out */
     uint64_t evicted_since_trim; /* bytes evicted since the heap was last trimmed */
     uint32_t *node_blocks; /* the region of every 1024th node id */
     uint64_t node_blocks_cap;
