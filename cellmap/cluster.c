@@ -684,7 +684,12 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
-    return cm_cluster_resident_bytes(c) + cm_idmap_bytes(&c->open) +
+    uint64_t open_lists = 0; /* not paged: they grow with the open nodes */
+    for (uint32_t k = 0; k < c->nregions; k++)
+        open_lists += c->regions[k].open_cap *
+                      (sizeof *c->regions[k].open_local + sizeof *c->regions[k].open_weight +
+                       (uint64_t)c->lat.dim * sizeof *c->regions[k].open_cells);
+    return cm_cluster_resident_bytes(c) + open_lists + cm_idmap_bytes(&c->open) +
            c->basin_cap * (sizeof *c->basin + 1) + c->periodic_cap * sizeof *c->new_periodic +
            c->cap * sizeof *c->regions + cm_bricks_bytes(c->region_bricks) +
            cm_bricks_bytes(c->escape_bricks);

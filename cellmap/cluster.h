@@ -440,7 +440,8 @@ uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 /* The smallest box holding every region (an empty box: none). */
 void cm_cluster_bounds(const cm_cluster *c, cm_box *box);
 
-/* Bytes held by the resident arrays, the node table, the indexes and counts. */
+/* Bytes held by the resident arrays, the node tables, the open lists, the
+ * indexes and counts. */
 uint64_t cm_cluster_bytes(const cm_cluster *c);
 
 /* A flat region over box with no cell computed (group CM_GROUP_NONE,
