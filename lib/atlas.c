@@ -234,14 +234,20 @@ static void keep(atlas *a, int z, int64_t x, int64_t y, int layer, const atlas_t
 /* Cells (of its level's lattice) along a tile's side at zoom z. */
 static int64_t tile_side(int z) { return (int64_t)ATLAS_TILE << (z < 0 ? -z : 0); }
 
+/* The refusal of a one-dimensional model: the atlas draws two state
+ * coordinates. */
+static cm_status one_coordinate(const session *s, char *msg, size_t msg_size)
+{
+    return cm_fail(CM_EINVAL, msg, msg_size,
+                   "the atlas draws two state coordinates; model %s has one", s->model.name);
+}
+
 cm_status atlas_tile_box(const atlas *a, int z, int64_t x, int64_t y, cm_box *box, char *msg,
                          size_t msg_size)
 {
     const session *s = a->s;
     if (s->dim < 2)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the atlas draws two state coordinates; model %s has one",
-                       s->model.name);
+        return one_coordinate(s, msg, msg_size);
     if (z < ATLAS_MIN_ZOOM || z > atlas_max_level(a))
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "zoom %d: tiles are drawn at zoom %d..%d (0: one pixel per cell of the "
@@ -598,9 +604,7 @@ cm_status atlas_legend(atlas *a, atlas_key **keys, uint32_t *n, char *msg,
     *keys = NULL;
     *n = 0;
     if (a->s->dim < 2)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the atlas draws two state coordinates; model %s has one",
-                       a->s->model.name);
+        return one_coordinate(a->s, msg, msg_size);
     cm_box box;
     origin_cell(a->s, &box);
     cm_region flat;
@@ -672,13 +676,12 @@ static cm_status label_colour(atlas *a, const session *s, cm_region *flat, const
 static void name_label(const atlas *a, int level, const cm_attractor_set *s, int32_t label,
                        char *out, size_t size)
 {
-    const char *given = level == 0 && label > 0 && (uint32_t)label <= s->n
-                            ? given_name(a, &s->a[label - 1])
-                            : NULL;
+    const cm_attractor *at = label > 0 && (uint32_t)label <= s->n ? &s->a[label - 1] : NULL;
+    const char *given = at && level == 0 ? given_name(a, at) : NULL;
     if (given)
         snprintf(out, size, "%s", given);
-    else if (label > 0 && (uint32_t)label <= s->n)
-        attractor_name(&s->a[label - 1], out, size);
+    else if (at)
+        attractor_name(at, out, size);
     else
         snprintf(out, size, "%s", label == CM_LABEL_DIVERGED    ? "diverged"
                                   : label == CM_LABEL_UNCOMPUTED ? "not computed"
@@ -695,9 +698,7 @@ cm_status atlas_point_query(atlas *a, double x, double y, int zoom, int steps, a
         return cm_fail(CM_EINVAL, msg, msg_size, "an orbit of %d steps: give 0..%d", steps,
                        ATLAS_ORBIT_MAX);
     if (a->s->dim < 2)
-        return cm_fail(CM_EINVAL, msg, msg_size,
-                       "the atlas draws two state coordinates; model %s has one",
-                       a->s->model.name);
+        return one_coordinate(a->s, msg, msg_size);
     const int top = atlas_max_level(a);
     const int level = zoom < 0 ? 0 : zoom < top ? zoom : top;
     session *s = a->s;

@@ -56,7 +56,8 @@ static int run(const char *cm, int c, int s, double *solve, double *joins)
             *w++ = *r;
     *w = '\0';
     /* a cellmap older than time_s.joins: NaN (the other figures stand) */
-    *joins = !s ? 0 : json_number(out, "joins") >= 0 ? json_number(out, "joins") : NAN;
+    const double joined = json_number(out, "joins");
+    *joins = !s ? 0 : joined >= 0 ? joined : NAN;
     *solve = s ? json_number(out, "regions and joins")
                : json_number(out, "images") + json_number(out, "classification");
     return *solve > 0 ? 0 : -1;
