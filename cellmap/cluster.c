@@ -89,6 +89,7 @@ void cm_cluster_release_open(cm_cluster *c)
         free(cr->open_weight);
         cr->open_local = NULL, cr->open_cells = NULL, cr->open_weight = NULL;
         cr->nopen = cr->open_cap = cr->open_stale = 0;
+        cr->open_paged = 0;
     }
     cm_idmap_free(&c->open);
     cm_bricks_free(c->escape_bricks);
@@ -169,8 +170,12 @@ static cm_status index_nodes(cm_cluster *c, uint32_t k)
     return CM_OK;
 }
 
-/* A record of escape_bricks: an open node and its exit's target as an
- * offset in the brick (8 bytes, however many dimensions). */
+/* A record of escape_bricks in a cluster that keeps no open lists
+ * (keep_exits 0): an open node and its exit's target as an offset in the
+ * brick (8 bytes, however many dimensions). With open lists, a record is
+ * a region whose list holds open nodes leading into the brick (4 bytes a
+ * region and brick, rather than 8 a node, which a long session gains by
+ * the million): a take reads those lists. */
 typedef struct escape_record {
     uint32_t node, offset;
 } escape_record;
@@ -213,6 +218,68 @@ cm_status cm_cluster_check_nodes(const cm_cluster *c, uint32_t k, const cm_node 
     return CM_OK;
 }
 
+/* Region k's open list, read back if it was paged out. The list was
+ * saved without the nodes linked since, and its node table is out too:
+ * every node it lists is open, its weight beside its place. */
+static cm_status open_list(cm_cluster *c, uint32_t k, char *msg, size_t msg_size)
+{
+    cm_cluster_region *cr = &c->regions[k];
+    cr->nodes_used = ++c->clock;
+    if (!cr->open_paged)
+        return CM_OK;
+    uint32_t *local = NULL;
+    uint64_t *weight = NULL, n = 0;
+    int64_t *cells = NULL;
+    cm_status st = c->open_in(c->pager, k, &local, &weight, &cells, &n, msg, msg_size);
+    if (st == CM_OK && n != cr->nopen)
+        st = cm_fail(CM_EFORMAT, msg, msg_size,
+                     "region %u saved %llu open nodes where the cluster had %llu", k + 1,
+                     (unsigned long long)n, (unsigned long long)cr->nopen);
+    if (st != CM_OK) {
+        free(local);
+        free(weight);
+        free(cells);
+        return st;
+    }
+    for (uint64_t i = 0; i < n; i++)
+        weight[i] |= INDEXED;
+    cr->open_local = local;
+    cr->open_weight = weight;
+    cr->open_cells = cells;
+    cr->open_cap = n;
+    cr->open_stale = 0;
+    cr->open_paged = 0;
+    return CM_OK;
+}
+
+/* Whether region cr's open list may go once its node table is out: it is
+ * saved as it stands (clean, and compacted, as a save leaves it). */
+static bool open_list_saved(const cm_cluster *c, const cm_cluster_region *cr)
+{
+    return c->open_in && !cr->open_paged && !cr->open_dirty && !cr->open_stale;
+}
+
+static bool open_list_evictable(const cm_cluster *c, const cm_cluster_region *cr)
+{
+    return !cr->nodes && open_list_saved(c, cr);
+}
+
+static uint64_t open_list_bytes(const cm_cluster *c, const cm_cluster_region *cr)
+{
+    return cr->open_cap * (sizeof *cr->open_local + sizeof *cr->open_weight +
+                           (uint64_t)c->lat.dim * sizeof *cr->open_cells);
+}
+
+static void evict_open_list(cm_cluster_region *cr)
+{
+    free(cr->open_local);
+    free(cr->open_cells);
+    free(cr->open_weight);
+    cr->open_local = NULL, cr->open_cells = NULL, cr->open_weight = NULL;
+    cr->open_cap = 0;
+    cr->open_paged = 1;
+}
+
 /* Region k's node table, read back if it was paged out. */
 static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg, size_t msg_size)
 {
@@ -222,11 +289,14 @@ static cm_status node_table(cm_cluster *c, uint32_t k, cm_node **out, char *msg,
         if (!c->nodes_in)
             return cm_fail(CM_EINVAL, msg, msg_size,
                            "the nodes of region %u are paged out and there is no pager", k);
+        cm_status st = open_list(c, k, msg, msg_size); /* it holds the open nodes' weights */
+        if (st != CM_OK)
+            return st;
         cr->nodes = calloc(cr->r.nexits + 1, sizeof *cr->nodes);
         if (!cr->nodes)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the nodes of region %u",
                            k);
-        cm_status st = c->nodes_in(c->pager, k, cr->nodes, cr->r.nexits, msg, msg_size);
+        st = c->nodes_in(c->pager, k, cr->nodes, cr->r.nexits, msg, msg_size);
         if (st != CM_OK) {
             free(cr->nodes);
             cr->nodes = NULL;
@@ -313,7 +383,9 @@ static void compact_open_list(cm_cluster *c, cm_cluster_region *cr)
         resize_open_list(c, cr, kept > 16 ? kept : 16);
 }
 
-uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id)
+/* The weight of open node id (0 if it is not open): from its record, its
+ * place in the open list (which must be in memory) or c->open. */
+static uint64_t open_weight(const cm_cluster *c, uint32_t id)
 {
     const cm_cluster_region *cr = &c->regions[cm_cluster_node_region(c, id)];
     if (cr->nodes)
@@ -349,10 +421,13 @@ cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t
 }
 
 cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
-                                int64_t **cells, uint64_t *n)
+                                int64_t **cells, uint64_t *n, char *msg, size_t msg_size)
 {
     cm_cluster_region *cr = &c->regions[k];
     const size_t dim = (size_t)c->lat.dim;
+    cm_status st = open_list(c, k, msg, msg_size); /* a save of every list reads them all */
+    if (st != CM_OK)
+        return st;
     compact_open_list(c, cr);
     const uint64_t kept = cr->nopen;
     *local = malloc((kept + 1) * sizeof **local);
@@ -362,11 +437,12 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
         free(*local);
         free(*weight);
         free(*cells);
-        return CM_ENOMEM;
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes of region %u",
+                       k + 1);
     }
     for (uint64_t i = 0; i < kept; i++) {
         (*local)[i] = cr->open_local[i];
-        (*weight)[i] = cm_cluster_open_weight(c, cr->node_base + cr->open_local[i]);
+        (*weight)[i] = open_weight(c, cr->node_base + cr->open_local[i]);
     }
     if (kept > 0)
         memcpy(*cells, cr->open_cells, kept * dim * sizeof **cells);
@@ -400,8 +476,18 @@ cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, u
 
 cm_status cm_cluster_index_escape(cm_cluster *c, uint32_t id, const int64_t *cell)
 {
-    const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
-    return cm_bricks_add(c->escape_bricks, cell, &e);
+    if (!c->keep_exits) {
+        const escape_record e = {id, cm_bricks_offset(c->escape_bricks, cell)};
+        return cm_bricks_add(c->escape_bricks, cell, &e);
+    }
+    const uint32_t k = cm_cluster_node_region(c, id);
+    int64_t key[CM_MAX_DIM];
+    uint64_t n;
+    cm_bricks_of(c->escape_bricks, cell, key);
+    const uint32_t *listed = cm_bricks_find(c->escape_bricks, key, &n);
+    if (n > 0 && listed[n - 1] == k) /* a region's nodes come in a row */
+        return CM_OK;
+    return cm_bricks_add(c->escape_bricks, cell, &k);
 }
 
 cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w)
@@ -422,14 +508,75 @@ static void visit_escape(void *user, const int64_t *brick, const void *record)
     const escape_record *e = record;
     int64_t cell[CM_MAX_DIM];
     cm_bricks_cell(v->c->escape_bricks, brick, e->offset, cell);
-    v->fn(v->user, e->node, cell);
+    v->fn(v->user, e->node, cell, open_weight(v->c, e->node));
 }
 
-void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user)
+/* The open nodes of region k's list, read back for the visit if it is out
+ * (and let go again after). */
+static cm_status visit_open_list(cm_cluster *c, uint32_t k, cm_escape_fn fn, void *user,
+                                 char *msg, size_t msg_size)
 {
-    escape_visit v = {c, fn, user};
-    if (c->escape_bricks)
-        cm_bricks_each(c->escape_bricks, visit_escape, &v);
+    cm_cluster_region *cr = &c->regions[k];
+    const bool was_paged = cr->open_paged;
+    cm_status st = open_list(c, k, msg, msg_size);
+    for (uint64_t i = 0; st == CM_OK && i < cr->nopen; i++) {
+        const uint32_t id = cr->node_base + cr->open_local[i];
+        if (still_indexed(cr, i))
+            fn(user, id, cr->open_cells + i * (uint64_t)c->lat.dim, open_weight(c, id));
+    }
+    if (st == CM_OK && was_paged && open_list_evictable(c, cr))
+        evict_open_list(cr);
+    return st;
+}
+
+cm_status cm_cluster_each_escape(cm_cluster *c, cm_escape_fn fn, void *user, char *msg,
+                                 size_t msg_size)
+{
+    if (c->open_released)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "the cluster's open nodes were released: their exits are not known");
+    if (!c->keep_exits) { /* no open lists: the index holds them all */
+        escape_visit v = {c, fn, user};
+        if (c->escape_bricks)
+            cm_bricks_each(c->escape_bricks, visit_escape, &v);
+        return CM_OK;
+    }
+    cm_status st = CM_OK;
+    for (uint32_t k = 0; k < c->nregions && st == CM_OK; k++)
+        st = visit_open_list(c, k, fn, user, msg, msg_size);
+    return st;
+}
+
+uint64_t cm_cluster_escape_count(const cm_cluster *c)
+{
+    uint64_t n = 0, records;
+    if (c->open_released)
+        return 0;
+    const uint64_t bricks = c->escape_bricks ? cm_bricks_count(c->escape_bricks) : 0;
+    for (uint64_t b = 0; !c->keep_exits && b < bricks; b++) {
+        cm_bricks_find(c->escape_bricks, cm_bricks_key(c->escape_bricks, b), &records);
+        n += records;
+    }
+    for (uint32_t k = 0; c->keep_exits && k < c->nregions; k++)
+        n += c->regions[k].nopen - c->regions[k].open_stale;
+    return n;
+}
+
+cm_status cm_cluster_open_target(cm_cluster *c, uint32_t id, int64_t *cell, bool *found,
+                                 char *msg, size_t msg_size)
+{
+    const uint32_t k = cm_cluster_node_region(c, id);
+    const cm_cluster_region *cr = &c->regions[k];
+    *found = false;
+    cm_status st = open_list(c, k, msg, msg_size);
+    const uint32_t e = id - cr->node_base;
+    const uint64_t i = st == CM_OK ? cm_first_not_below(cr->open_local, cr->nopen, e) : 0;
+    if (st == CM_OK && i < cr->nopen && cr->open_local[i] == e) {
+        memcpy(cell, cr->open_cells + i * (uint64_t)c->lat.dim,
+               (size_t)c->lat.dim * sizeof *cell);
+        *found = true;
+    }
+    return st;
 }
 
 /* Moves the open nodes of brick `key` whose exits lead into box to out,
@@ -478,13 +625,96 @@ static cm_status sort_escapes(cm_escape *e, uint64_t n)
     return CM_OK;
 }
 
-cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n)
+static void add_regions_of_brick(const cm_cluster *c, const int64_t *key, uint32_t *regions,
+                                 uint64_t *n, uint64_t cap, bool *full)
+{
+    uint64_t count;
+    const uint32_t *k = cm_bricks_find(c->escape_bricks, key, &count);
+    for (uint64_t i = 0; i < count && !*full; i++) {
+        *full = *n == cap;
+        if (!*full)
+            regions[(*n)++] = k[i];
+    }
+}
+
+static int region_cmp(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The regions whose open lists lead into the bricks that meet box (those
+ * of the index's bricks when they are too many), ascending, each once: at
+ * most one for each region and brick of the index. */
+static cm_status regions_toward(const cm_cluster *c, const cm_box *box, uint32_t **out,
+                                uint64_t *n)
+{
+    int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
+    const bool spanned = cm_bricks_span(c->escape_bricks, box, lo, hi);
+    const uint64_t cap = (uint64_t)c->nregions * (spanned ? 4 : 1) + 1;
+    bool full = false;
+    *n = 0;
+    *out = malloc(cap * sizeof **out);
+    if (!*out)
+        return CM_ENOMEM;
+    if (spanned) {
+        memcpy(key, lo, sizeof key);
+        do
+            add_regions_of_brick(c, key, *out, n, cap, &full);
+        while (!full && cm_index_next(c->lat.dim, lo, hi, key));
+    }
+    if (!spanned || full) { /* many bricks: every region that lists an open node */
+        *n = 0;
+        for (uint32_t k = 0; k < c->nregions; k++)
+            if (c->regions[k].nopen > c->regions[k].open_stale)
+                (*out)[(*n)++] = k;
+        return CM_OK;
+    }
+    qsort(*out, *n, sizeof **out, region_cmp);
+    uint64_t kept = 0;
+    for (uint64_t i = 0; i < *n; i++)
+        if (kept == 0 || (*out)[kept - 1] != (*out)[i])
+            (*out)[kept++] = (*out)[i];
+    *n = kept;
+    return CM_OK;
+}
+
+/* The open nodes of region k's list whose exits lead into box. */
+static cm_status take_listed(cm_cluster *c, uint32_t k, const cm_box *box, cm_escape **out,
+                             uint64_t *n, uint64_t *cap, char *msg, size_t msg_size)
+{
+    const cm_cluster_region *cr = &c->regions[k];
+    cm_status st = open_list(c, k, msg, msg_size);
+    for (uint64_t i = 0; st == CM_OK && i < cr->nopen; i++) {
+        const int64_t *cell = cr->open_cells + i * (uint64_t)c->lat.dim;
+        if (!cm_box_contains(box, cell) || !still_indexed(cr, i))
+            continue;
+        if (cm_grow((void **)out, cap, *n + 1, sizeof **out) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+        (*out)[(*n)++] = (cm_escape){cr->node_base + cr->open_local[i],
+                                     (uint32_t)cm_box_index(box, cell)};
+    }
+    return st;
+}
+
+cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n,
+                                  char *msg, size_t msg_size)
 {
     int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
     uint64_t cap = 0;
     cm_status st = CM_OK;
     *out = NULL;
     *n = 0;
+    if (c->keep_exits) { /* regions ascending, each list in node order */
+        uint32_t *regions;
+        uint64_t nregions;
+        if (regions_toward(c, box, &regions, &nregions) != CM_OK)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+        for (uint64_t i = 0; i < nregions && st == CM_OK; i++)
+            st = take_listed(c, regions[i], box, out, n, &cap, msg, msg_size);
+        free(regions);
+        return st;
+    }
     if (cm_bricks_span(c->escape_bricks, box, lo, hi)) {
         memcpy(key, lo, sizeof key);
         do
@@ -496,7 +726,7 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
     }
     if (st == CM_OK && *n > 1)
         st = sort_escapes(*out, *n);
-    return st;
+    return st == CM_OK ? CM_OK : cm_fail(st, msg, msg_size, "out of memory for the open nodes");
 }
 
 /* ---- resolution ----------------------------------------------------------- */
@@ -665,30 +895,35 @@ static uint64_t node_table_bytes(const cm_cluster_region *cr)
     return cr->nodes ? cr->r.nexits * sizeof *cr->nodes : 0;
 }
 
-/* Bytes of the resident cell arrays (and exit tables) and of the resident node tables. */
-static void resident(const cm_cluster *c, uint64_t *cells, uint64_t *tables)
+/* What the budget bounds: bytes of the resident cell arrays (and exit
+ * tables), node tables, and open lists that can be paged (open_in). */
+typedef struct held {
+    uint64_t cells, tables, lists;
+} held;
+
+static held resident(const cm_cluster *c)
 {
-    *cells = *tables = 0;
+    held h = {0, 0, 0};
     for (uint32_t k = 0; k < c->nregions; k++) {
-        *cells += is_resident(&c->regions[k]) ? cm_region_bytes(&c->regions[k].r) : 0;
-        *tables += node_table_bytes(&c->regions[k]);
+        const cm_cluster_region *cr = &c->regions[k];
+        h.cells += is_resident(cr) ? cm_region_bytes(&cr->r) : 0;
+        h.tables += node_table_bytes(cr);
+        h.lists += c->open_in ? open_list_bytes(c, cr) : 0;
     }
+    return h;
 }
 
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c)
 {
-    uint64_t cells, tables;
-    resident(c, &cells, &tables);
-    return cells + tables;
+    const held h = resident(c);
+    return h.cells + h.tables + h.lists;
 }
 
 uint64_t cm_cluster_bytes(const cm_cluster *c)
 {
-    uint64_t open_lists = 0; /* not paged: they grow with the open nodes */
+    uint64_t open_lists = 0; /* those not paged (no open_in) */
     for (uint32_t k = 0; k < c->nregions; k++)
-        open_lists += c->regions[k].open_cap *
-                      (sizeof *c->regions[k].open_local + sizeof *c->regions[k].open_weight +
-                       (uint64_t)c->lat.dim * sizeof *c->regions[k].open_cells);
+        open_lists += c->open_in ? 0 : open_list_bytes(c, &c->regions[k]);
     return cm_cluster_resident_bytes(c) + open_lists + cm_idmap_bytes(&c->open) +
            c->basin_cap * (sizeof *c->basin + 1) + c->periodic_cap * sizeof *c->new_periodic +
            c->cap * sizeof *c->regions + cm_bricks_bytes(c->region_bricks) +
@@ -737,10 +972,12 @@ static void next_uses(const cm_cluster *c, uint32_t *use)
     }
 }
 
-/* Something resident that can be evicted: region k's cells, or its node table. */
+/* Something resident that can be evicted: region k's cells, its node
+ * table, or its open list. */
+enum { VICTIM_CELLS, VICTIM_TABLE, VICTIM_LIST };
 typedef struct victim {
     uint32_t k;
-    int nodes;
+    int kind;
     int unsaved;       /* cells never saved (evicting them saves them first) */
     uint32_t use;      /* next_uses */
     uint64_t last_used;
@@ -748,8 +985,8 @@ typedef struct victim {
 } victim;
 
 /* Saved before unsaved, then those the upcoming boxes need last, then the
- * least recently used; node tables before cells on a tie (they are read
- * back in one piece). */
+ * least recently used; lists and node tables before cells on a tie (they
+ * are read back in one piece). */
 static int victim_cmp(const void *a, const void *b)
 {
     const victim *x = a, *y = b;
@@ -759,14 +996,15 @@ static int victim_cmp(const void *a, const void *b)
         return x->use > y->use ? -1 : 1;
     if (x->last_used != y->last_used)
         return x->last_used < y->last_used ? -1 : 1;
-    if (x->nodes != y->nodes)
-        return y->nodes - x->nodes;
+    if (x->kind != y->kind)
+        return y->kind - x->kind;
     return (x->k > y->k) - (x->k < y->k);
 }
 
 /* The candidates for eviction, other than region `keep`'s cells, in the
- * order to evict them: cells (unsaved ones only with_unsaved), and clean
- * node tables when `tables` (never while a join may hold node pointers). */
+ * order to evict them: cells (unsaved ones only with_unsaved), and when
+ * `tables` (never while a join may hold node pointers) clean node tables
+ * and the saved open lists of regions whose tables are out. */
 static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, int tables,
                          victim **out, uint64_t *n)
 {
@@ -782,10 +1020,13 @@ static cm_status victims(const cm_cluster *c, int64_t keep, int with_unsaved, in
     for (uint32_t k = 0; k < c->nregions; k++) {
         const cm_cluster_region *cr = &c->regions[k];
         if (is_resident(cr) && (int64_t)k != keep && !cr->pinned && (cr->written || with_unsaved))
-            v[(*n)++] = (victim){k, 0, !cr->written, use[k], cr->last_used,
+            v[(*n)++] = (victim){k, VICTIM_CELLS, !cr->written, use[k], cr->last_used,
                                  cm_region_bytes(&cr->r)};
         if (tables && cr->nodes && !cr->nodes_dirty)
-            v[(*n)++] = (victim){k, 1, 0, use[k], cr->nodes_used, node_table_bytes(cr)};
+            v[(*n)++] = (victim){k, VICTIM_TABLE, 0, use[k], cr->nodes_used, node_table_bytes(cr)};
+        else if (tables && open_list_evictable(c, cr) && cr->open_cap > 0)
+            v[(*n)++] = (victim){k, VICTIM_LIST, 0, use[k], cr->nodes_used,
+                                 open_list_bytes(c, cr)};
     }
     free(use);
     qsort(v, *n, sizeof *v, victim_cmp);
@@ -825,19 +1066,19 @@ static bool tables_over(const cm_cluster *c, uint64_t cells, uint64_t table_byte
 
 /* Evicts until `extra` more bytes of cells fit the budget, and (with
  * `tables`) the node tables fit a quarter of it or the room the cells
- * leave (tables_over; see victims). Region
- * `keep` stays; a region being joined (`joining`, or -1) is not counted. */
+ * leave (tables_over) and the open lists that can be paged another quarter
+ * (a table goes for its list too; see victims). Region `keep` stays; a
+ * region being joined (`joining`, or -1) is not counted. */
 static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t extra, int tables,
                       char *msg, size_t msg_size)
 {
     if (!c->page_in || c->mem_budget == 0)
         return CM_OK;
-    uint64_t cells, table_bytes;
-    resident(c, &cells, &table_bytes);
-    cells += extra + c->mem_reserved;
+    held h = resident(c);
+    uint64_t cells = h.cells + extra + c->mem_reserved, table_bytes = h.tables;
     if (joining >= 0 && is_resident(&c->regions[joining]))
         cells -= cm_region_bytes(&c->regions[joining].r);
-    tables = tables && tables_over(c, cells, table_bytes);
+    tables = tables && (tables_over(c, cells, table_bytes) || h.lists > c->mem_budget / 4);
     if (cells <= c->mem_budget && !tables)
         return CM_OK;
     victim *v = NULL;
@@ -848,14 +1089,22 @@ static cm_status shed(cm_cluster *c, int64_t keep, int64_t joining, uint64_t ext
     cm_status st = CM_OK;
     for (uint64_t i = 0; i < n && st == CM_OK; i++) {
         cm_cluster_region *cr = &c->regions[v[i].k];
-        if (v[i].nodes && tables_over(c, cells, table_bytes)) {
+        const bool lists_over = h.lists > c->mem_budget / 4;
+        if (v[i].kind == VICTIM_TABLE &&
+            (tables_over(c, cells, table_bytes) || (lists_over && open_list_saved(c, cr)))) {
             if (spill_open_weights(c, cr) != CM_OK)
                 continue; /* the table stays */
             free(cr->nodes);
             cr->nodes = NULL;
             table_bytes -= v[i].bytes;
             c->evicted_since_trim += v[i].bytes;
-        } else if (!v[i].nodes && cells > c->mem_budget) {
+        }
+        if ((v[i].kind == VICTIM_TABLE || v[i].kind == VICTIM_LIST) && lists_over &&
+            open_list_evictable(c, cr)) {
+            h.lists -= open_list_bytes(c, cr);
+            c->evicted_since_trim += open_list_bytes(c, cr);
+            evict_open_list(cr);
+        } else if (v[i].kind == VICTIM_CELLS && cells > c->mem_budget) {
             if (!cr->written)
                 st = c->page_out(c->pager, c, v[i].k, msg, msg_size);
             if (st != CM_OK)
@@ -985,7 +1234,9 @@ static cm_status make_space(cm_cluster *c, const cm_box *box, uint32_t ngroups)
         int shift[CM_MAX_DIM];
         cm_bricks_shift_for(box, shift);
         if (cm_bricks_alloc(c->lat.dim, shift, sizeof(uint32_t), &c->region_bricks) != CM_OK ||
-            cm_bricks_alloc(c->lat.dim, shift, sizeof(escape_record), &c->escape_bricks) != CM_OK)
+            cm_bricks_alloc(c->lat.dim, shift,
+                            c->keep_exits ? sizeof(uint32_t) : sizeof(escape_record),
+                            &c->escape_bricks) != CM_OK)
             return CM_ENOMEM;
     }
     const uint64_t groups = (uint64_t)c->ngroups + ngroups + 1, had = c->basin_cap;
@@ -1228,7 +1479,7 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
             if (cr->nodes[e].next == CM_NODE_OPEN &&
                 cm_cluster_add_escape(c, cr->node_base + (uint32_t)e,
                                       exits[k] + e * (uint64_t)c->lat.dim,
-                                      cm_cluster_open_weight(c, cr->node_base + (uint32_t)e)) !=
+                                      open_weight(c, cr->node_base + (uint32_t)e)) !=
                     CM_OK)
                 return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exit index");
     }
@@ -1237,23 +1488,37 @@ cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *ba
 }
 
 cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_t *basin,
-                                   const uint32_t *ids, const uint64_t *weights,
-                                   const int64_t *cells, uint64_t n, char *msg,
-                                   size_t msg_size)
+                                   char *msg, size_t msg_size)
 {
     if (make_space(c, &c->regions[0].r.box, groups) != CM_OK)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", groups);
     c->ngroups = groups;
     memcpy(c->basin + 1, basin + 1, (size_t)groups * sizeof *basin);
+    for (uint32_t k = 0; c->open_in && k < c->nregions; k++)
+        c->regions[k].open_paged = 1; /* in the file until used */
+    c->saved_groups = groups;
+    return CM_OK;
+}
+
+cm_status cm_cluster_restored_escapes(cm_cluster *c, const uint32_t *ids, const uint64_t *weights,
+                                      const int64_t *cells, uint64_t n, char *msg,
+                                      size_t msg_size)
+{
     for (uint64_t i = 0; i < n; i++) {
         if (ids[i] >= c->nnodes || (i > 0 && ids[i] <= ids[i - 1]))
             return cm_fail(CM_EFORMAT, msg, msg_size, "the open nodes are damaged (node %u)",
                            ids[i]);
-        if (cm_cluster_add_escape(c, ids[i], cells + i * (uint64_t)c->lat.dim, weights[i]) !=
-            CM_OK)
+        const int64_t *cell = cells + i * (uint64_t)c->lat.dim;
+        cm_status st = CM_OK;
+        if (c->open_in) { /* indexed; the list is counted, and read on use */
+            st = cm_cluster_index_escape(c, ids[i], cell);
+            c->regions[cm_cluster_node_region(c, ids[i])].nopen++;
+        } else {
+            st = cm_cluster_add_escape(c, ids[i], cell, weights[i]);
+        }
+        if (st != CM_OK)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
     }
-    c->saved_groups = groups;
     return CM_OK;
 }
 

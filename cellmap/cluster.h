@@ -29,8 +29,11 @@
  *
  * Open nodes (exits that still leave the cluster) carry weights: the cells
  * whose sequences leave through them, which basins and adaptive extension
- * count. They stay in memory (an id map, the brick index of their targets
- * and each region's open list); node tables, like cell arrays, are paged.
+ * count. Each region lists its open nodes with their exits' cells (its
+ * open list), paged with its node table when the owner can read it back
+ * (open_in); a brick index names, for each brick of the lattice, the
+ * regions whose open nodes lead into it (the open nodes themselves when
+ * no lists are kept). Node tables, like cell arrays, are paged.
  *
  * The invariant (tests/test_cluster.c): for regions tiling a box, the
  * flattened cluster equals cm_scm_solve on the box, cell by cell, up to the
@@ -40,6 +43,7 @@
 #ifndef CM_CLUSTER_H
 #define CM_CLUSTER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -86,10 +90,10 @@ typedef struct cm_cluster_region {
     int written;        /* read-only: the owner holds its arrays (cm_cluster_saved) */
     int nodes_dirty;    /* read-only: node records changed since the owner saved them */
     uint8_t *dirty_chunks; /* read-only: per CM_NODE_CHUNK nodes, whether one of them did */
-    /* read-only: the region's open nodes indexed as escapes, in node order
+    /* private: the region's open nodes indexed as escapes, in node order
      * (open_local[i]: the exit, open_cells[i * dim ..]: its target), some
-     * of them linked since; open_dirty: one changed since the owner saved
-     * them (cm_cluster_open_nodes) */
+     * of them linked since (open_stale of them); open_dirty (read-only):
+     * one changed since the owner saved them (cm_cluster_open_nodes) */
     uint32_t *open_local;
     int64_t *open_cells;
     /* private: while the node table is paged out, the weight of each
@@ -98,6 +102,9 @@ typedef struct cm_cluster_region {
     uint64_t *open_weight;
     uint64_t nopen, open_cap, open_stale;
     int open_dirty;
+    /* private: the list is paged out with the node table (nopen: the
+     * nodes saved, all open); read back through open_in */
+    int open_paged;
     uint64_t last_used; /* private: paging clock of the last acquire of the cells */
     uint64_t nodes_used; /* private: and of the last use of the node table */
     int pinned;          /* private: its cells are needed by the join under way */
@@ -127,6 +134,14 @@ typedef cm_status (*cm_groups_in_fn)(void *user, uint32_t region, uint32_t *grou
 
 struct cm_cluster;
 
+/* Reads back region k's open nodes as the owner saved them from
+ * cm_cluster_open_nodes: *n of them, their exits ascending in *local, their
+ * weights and target cells (dim each), in new arrays the cluster takes
+ * (NULL when *n is 0). */
+typedef cm_status (*cm_open_in_fn)(void *user, uint32_t region, uint32_t **local,
+                                   uint64_t **weight, int64_t **cells, uint64_t *n, char *msg,
+                                   size_t msg_size);
+
 /* Saves a region that was never saved, so that it can be evicted (also in
  * the middle of a join: the owner keeps the write in the transaction that
  * its next commit ends). */
@@ -144,7 +159,9 @@ typedef struct cm_cluster {
      * (cm_cluster_open_nodes) and for the images of cm_cluster_flatten. A
      * cluster that no one saves and whose images no one reads (solve
      * without a database) sets 0: a joined region then drops its exit
-     * table (16 bytes per exit in 2-D) and open lists are not kept. */
+     * table (16 bytes per exit in 2-D) and open lists are not kept. Set
+     * before the first region: the index of escapes is made for one or
+     * the other. */
     int keep_exits;
     /* read-only: the regions hold resolved cells (a file of version 2 or
      * 3): a sink cell does not say which exit its sequence leaves by */
@@ -165,13 +182,17 @@ typedef struct cm_cluster {
      * within mem_budget (more only while one region alone is bigger); a
      * region never saved is saved through page_out first (kept resident if
      * there is none). cm_cluster_trim also evicts clean node tables, read
-     * back on use through nodes_in, to keep them within mem_budget / 4, or
-     * beyond it within the room the cells leave (cells and tables within
-     * mem_budget * 5 / 4); more only within a join, which never evicts
-     * them. */
+     * back on use through nodes_in, and with open_in the clean open lists
+     * of regions whose node tables are out, to keep the two within
+     * mem_budget / 4, or beyond it within the room the cells leave (cells
+     * and tables within mem_budget * 5 / 4); more only within a join, which
+     * never evicts them. Without open_in, open lists stay in memory: 28
+     * bytes an open node in 2-D, which a long explore session gains by the
+     * million. */
     cm_page_in_fn page_in;   /* public */
     cm_page_out_fn page_out; /* public */
     cm_nodes_in_fn nodes_in; /* public: reads node tables back (they are evicted clean) */
+    cm_open_in_fn open_in;   /* public: reads open lists back (they are evicted clean) */
     cm_groups_in_fn groups_in; /* public: reads a region's groups alone (NULL: none) */
     void *pager;             /* public */
     uint64_t mem_budget;     /* public: 0: no limit */
@@ -196,7 +217,7 @@ typedef struct cm_cluster {
     uint32_t *chain; /* nodes walked while settling */
     uint64_t chain_cap;
     cm_bricks *region_bricks; /* brick -> regions meeting it */
-    cm_bricks *escape_bricks; /* brick of the target -> open nodes */
+    cm_bricks *escape_bricks; /* brick of the target -> regions (keep_exits) or open nodes */
     uint32_t *big;            /* regions too big for the brick index */
     uint64_t nbig, big_cap;
 } cm_cluster;
@@ -211,8 +232,7 @@ void cm_cluster_init(cm_cluster *c, const cm_lattice *lat);
 void cm_cluster_free(cm_cluster *c);
 
 /* Releases what the cluster keeps of its open nodes (the weights of paged
- * out ones, the escape index, the regions' open lists: about 70 bytes per
- * open node), for an owner that from here on only reads its cells and node
+ * out ones, the escape index, the regions' open lists), for an owner that from here on only reads its cells and node
  * tables (flattening, labels): a region added (a join) or a commit is
  * refused afterwards (CM_EINVAL), and it has no escapes
  * (cm_cluster_each_escape, cm_cluster_exits). */
@@ -259,13 +279,17 @@ cm_status cm_cluster_check_nodes(const cm_cluster *c, uint32_t k, const cm_node 
 cm_status cm_cluster_restored(cm_cluster *c, uint32_t groups, const uint64_t *basin,
                               int64_t *const *exits, char *msg, size_t msg_size);
 
-/* The same from the open nodes as saved: n of them in node order, ids[i]
- * with weight weights[i] and its exit's target cell cells[i * dim ..]. No
- * node table is read. */
+/* The same from the open nodes as saved, no node table read: first
+ * cm_cluster_restored_open, then cm_cluster_restored_escapes for each
+ * region's saved open nodes, regions in order: n of them in node order,
+ * ids[i] with weight weights[i] and its exit's target cell cells[i * dim
+ * ..]. With open_in, the open lists are left in the file (read back on
+ * use) and only indexed. */
 cm_status cm_cluster_restored_open(cm_cluster *c, uint32_t groups, const uint64_t *basin,
-                                   const uint32_t *ids, const uint64_t *weights,
-                                   const int64_t *cells, uint64_t n, char *msg,
-                                   size_t msg_size);
+                                   char *msg, size_t msg_size);
+cm_status cm_cluster_restored_escapes(cm_cluster *c, const uint32_t *ids, const uint64_t *weights,
+                                      const int64_t *cells, uint64_t n, char *msg,
+                                      size_t msg_size);
 
 /* The region holding the cell and the cell's local index, or -1. O(1). */
 int64_t cm_cluster_locate(const cm_cluster *c, const int64_t *cell, uint64_t *local);
@@ -309,14 +333,34 @@ cm_status cm_cluster_add_escape(cm_cluster *c, uint32_t id, const int64_t *cell,
 cm_status cm_cluster_add_open(cm_cluster *c, uint32_t id, const int64_t *cell, uint64_t w);
 cm_status cm_cluster_index_escape(cm_cluster *c, uint32_t id, const int64_t *cell);
 
-/* Takes the open nodes whose exits lead into `box` (at most 2^32 cells)
- * out of the index: a new array of *n of them (ascending by node id) that
- * the caller frees. */
-cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n);
+/* The open nodes whose exits lead into `box` (at most 2^32 cells): a new
+ * array of *n of them (ascending by node id) that the caller frees. A
+ * cluster without open lists (keep_exits 0) takes them out of its index;
+ * with them, they are found in the lists of the regions the index names
+ * for the box's bricks (read back if paged out), all that are still open,
+ * handed over to the box or not, and leave the lists as they are linked
+ * (cm_cluster_take_open). */
+cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **out, uint64_t *n,
+                                  char *msg, size_t msg_size);
 
-/* Calls fn for every open node with the target of its exit. */
-typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell);
-void cm_cluster_each_escape(const cm_cluster *c, cm_escape_fn fn, void *user);
+/* Calls fn for every open node with the target of its exit and its
+ * weight (the cells whose sequences leave through it), in ascending node
+ * order when the cluster keeps exits (keep_exits), else in the order of
+ * the index. Reads paged out open lists back one at a time (and lets each
+ * go again). CM_EINVAL once the open nodes are released. */
+typedef void (*cm_escape_fn)(void *user, uint32_t node, const int64_t *cell, uint64_t weight);
+cm_status cm_cluster_each_escape(cm_cluster *c, cm_escape_fn fn, void *user, char *msg,
+                                 size_t msg_size);
+
+/* How many open nodes cm_cluster_each_escape visits, read from no list. */
+uint64_t cm_cluster_escape_count(const cm_cluster *c);
+
+/* The target of open node id's exit, from its region's open list (read
+ * back if it is paged out) into cell (dim coordinates); *found false when
+ * the list does not hold it (a node linked since, or a cluster that keeps
+ * no exits). */
+cm_status cm_cluster_open_target(cm_cluster *c, uint32_t id, int64_t *cell, bool *found,
+                                 char *msg, size_t msg_size);
 
 /* The first place in ascending a[0..n) whose value is not below v: halving
  * without branches (a compare and a conditional move), since the branches
@@ -371,19 +415,19 @@ static inline cm_status cm_cluster_node(cm_cluster *c, uint32_t id, cm_node **ou
 }
 
 /* Open nodes and their weights: the cells whose sequences leave the
- * cluster through them (a new node starts with its own tree). The weight
- * of open node id (0 if it is not open); adds w to it; takes it out (no
- * longer open) with its weight into *w. nd is id's record
- * (cm_cluster_node). Both mark the node's region open_dirty. */
-uint64_t cm_cluster_open_weight(const cm_cluster *c, uint32_t id);
+ * cluster through them (a new node starts with its own tree). Adds w to
+ * open node id's weight; takes it out (no longer open) with its weight
+ * into *w. nd is id's record (cm_cluster_node). Both mark the node's
+ * region open_dirty. */
 void cm_cluster_add_open_weight(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t w);
 cm_status cm_cluster_take_open(cm_cluster *c, uint32_t id, cm_node *nd, uint64_t *w);
 
-/* Region k's open nodes now (those of its open list still open): their
- * exits, weights and target cells into new arrays (*n of them; the caller
- * frees them); the list drops the others. */
+/* Region k's open nodes now (those of its open list still open, the list
+ * read back if it is paged out): their exits, weights and target cells
+ * into new arrays (*n of them; the caller frees them); the list drops the
+ * others. */
 cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uint64_t **weight,
-                                int64_t **cells, uint64_t *n);
+                                int64_t **cells, uint64_t *n, char *msg, size_t msg_size);
 
 /* Group and step of node id's cell, following and shortening its chain of
  * links (and settling it, through the cells of its region, when the chain
@@ -434,7 +478,9 @@ cm_status cm_cluster_describe_new(cm_cluster *c, const cm_model *model, cm_group
 /* Cells in the sink's domain: those whose sequences leave the cluster or the world. */
 uint64_t cm_cluster_sink_cells(const cm_cluster *c);
 
-/* Bytes held by the resident regions' cell arrays and exit tables, and node tables. */
+/* Bytes held by the resident regions' cell arrays and exit tables, node
+ * tables and open lists that can be paged (open_in): what mem_budget
+ * bounds. */
 uint64_t cm_cluster_resident_bytes(const cm_cluster *c);
 
 /* The smallest box holding every region (an empty box: none). */

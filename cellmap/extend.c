@@ -140,7 +140,6 @@ static cm_status neighbour_tiles(const tile_list *tiles, const cm_box *tile, con
 }
 
 typedef struct escape_count {
-    const cm_cluster *c;
     const cm_box *tile;
     tile_list *candidates;
     cm_extend_choice *choice;
@@ -148,10 +147,10 @@ typedef struct escape_count {
 
 /* An open node: the cells whose sequences leave the cluster through it
  * (its weight) count for the candidate tile its exit lands in. */
-static void count_escape(void *user, uint32_t node, const int64_t *cell)
+static void count_escape(void *user, uint32_t node, const int64_t *cell, uint64_t w)
 {
+    (void)node;
     const escape_count *ec = user;
-    const uint64_t w = cm_cluster_open_weight(ec->c, node);
     int64_t index[CM_MAX_DIM] = {0};
     ec->choice->all_escaping += w;
     tile_of(ec->tile, cell, index);
@@ -162,16 +161,15 @@ static void count_escape(void *user, uint32_t node, const int64_t *cell)
 
 /* Where the sequences that leave the cluster go, from the node table alone:
  * each open node carries the cells whose sequences reach it. */
-static cm_status count_escapes(const cm_cluster *c, const cm_box *tile, tile_list *candidates,
-                               cm_extend_choice *choice)
+static cm_status count_escapes(cm_cluster *c, const cm_box *tile, tile_list *candidates,
+                               cm_extend_choice *choice, char *msg, size_t msg_size)
 {
-    escape_count ec = {c, tile, candidates, choice};
+    escape_count ec = {tile, candidates, choice};
     choice->cluster_cells = c->cells;
-    cm_cluster_each_escape(c, count_escape, &ec);
-    return CM_OK;
+    return cm_cluster_each_escape(c, count_escape, &ec, msg, msg_size);
 }
 
-cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,
+cm_status cm_extend_choose(cm_cluster *c, const cm_box *tile, const cm_box *bounds,
                            cm_extend_choice *choice, char *msg, size_t msg_size)
 {
     memset(choice, 0, sizeof *choice);
@@ -184,10 +182,10 @@ cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box
     if (st == CM_OK)
         st = neighbour_tiles(&tiles, tile, bounds, &candidates);
     if (st == CM_OK)
-        st = count_escapes(c, tile, &candidates, choice);
-    if (st != CM_OK) {
+        st = count_escapes(c, tile, &candidates, choice, msg, msg_size);
+    else
         st = cm_fail(st, msg, msg_size, "out of memory following the escaping sequences");
-    } else {
+    if (st == CM_OK) {
         int64_t best = -1;
         for (uint64_t k = 0; k < candidates.n; k++)
             if (candidates.items[k].escaping > 0 &&

@@ -40,8 +40,9 @@ bool cm_extend_tile(const cm_box *tile, const cm_box *bounds, const int64_t *cel
 /* Chooses the next tile. `tile` is the grid's tile (0, 0, ...); `bounds`
  * may be NULL (unbounded). Fills choice->all_escaping and cluster_cells in
  * any case; CM_ENOTFOUND when no sequence escapes into a neighbouring tile.
- * Reads the node table only, no region's cells. */
-cm_status cm_extend_choose(const cm_cluster *c, const cm_box *tile, const cm_box *bounds,
+ * Reads the open nodes only (their lists paged back one at a time), no
+ * region's cells. */
+cm_status cm_extend_choose(cm_cluster *c, const cm_box *tile, const cm_box *bounds,
                            cm_extend_choice *choice, char *msg, size_t msg_size);
 
 #endif

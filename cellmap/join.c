@@ -397,12 +397,17 @@ static cm_status collect_jobs(joiner *j, uint32_t added, link_job **jobs, uint64
     const uint64_t nh = h ? h->n : 0;
     cm_escape *in = NULL;
     uint64_t nin = 0, cap = 0;
-    cm_status st = cm_cluster_take_escapes(c, &cr->r.box, &in, &nin);
+    cm_status st = cm_cluster_take_escapes(c, &cr->r.box, &in, &nin, j->msg, j->msg_size);
     if (st == CM_OK &&
         cm_grow((void **)jobs, &cap, nin + nh + cr->r.nexits + 1, sizeof **jobs) != CM_OK)
         st = CM_ENOMEM;
-    for (uint64_t i = 0; i < nin && st == CM_OK; i++)
-        (*jobs)[(*n)++] = (link_job){in[i].node, added, in[i].cell, 0, 0};
+    /* a take from the open lists finds the nodes handed over too: once each */
+    for (uint64_t i = 0, hi = 0; i < nin && st == CM_OK; i++) {
+        while (hi < nh && h->v[hi].node < in[i].node)
+            hi++;
+        if (hi == nh || h->v[hi].node != in[i].node)
+            (*jobs)[(*n)++] = (link_job){in[i].node, added, in[i].cell, 0, 0};
+    }
     free(in);
     for (uint64_t i = 0; i < nh && st == CM_OK; i++)
         (*jobs)[(*n)++] = (link_job){h->v[i].node, added, h->v[i].cell, 0, 0};

@@ -198,26 +198,23 @@ typedef struct escape_list {
     int dim;
     int64_t *cell;
     uint32_t *node;
-    uint64_t n, cap, cap_node;
+    uint64_t *weight;
+    uint64_t n, cap, cap_node, cap_weight;
     int failed;
 } escape_list;
 
-static void count_escape(void *user, uint32_t node, const int64_t *cell)
-{
-    (void)node, (void)cell;
-    ++*(uint64_t *)user;
-}
-
-static void add_escape(void *user, uint32_t node, const int64_t *cell)
+static void add_escape(void *user, uint32_t node, const int64_t *cell, uint64_t weight)
 {
     escape_list *l = user;
     if (l->failed ||
         cm_grow((void **)&l->cell, &l->cap, (l->n + 1) * (uint64_t)l->dim, sizeof *l->cell) != CM_OK ||
-        cm_grow((void **)&l->node, &l->cap_node, l->n + 1, sizeof *l->node) != CM_OK) {
+        cm_grow((void **)&l->node, &l->cap_node, l->n + 1, sizeof *l->node) != CM_OK ||
+        cm_grow((void **)&l->weight, &l->cap_weight, l->n + 1, sizeof *l->weight) != CM_OK) {
         l->failed = 1;
         return;
     }
     memcpy(l->cell + l->n * (uint64_t)l->dim, cell, (size_t)l->dim * sizeof *cell);
+    l->weight[l->n] = weight;
     l->node[l->n++] = node;
 }
 
@@ -250,14 +247,13 @@ static cm_status index_nodes(const escape_list *l, const uint32_t *exit_of, cm_e
 
 uint64_t cm_cluster_exits_room(const cm_cluster *c)
 {
-    uint64_t escapes = 0;
-    cm_cluster_each_escape(c, count_escape, &escapes);
+    const uint64_t escapes = cm_cluster_escape_count(c);
     /* the cells, in the listing twice at its peak (targets and exits) */
     const uint64_t wider = 2 * sizeof(int64_t) * (uint64_t)(c->lat.dim > 2 ? c->lat.dim - 2 : 0);
     return escapes * (CM_EXITS_PASS_BYTES + wider);
 }
 
-cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size)
+cm_status cm_cluster_exits(cm_cluster *c, cm_exits *out, char *msg, size_t msg_size)
 {
     memset(out, 0, sizeof *out);
     if (c->open_released)
@@ -270,14 +266,21 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
     /* counted first, so that the lists take no more than they hold: the
      * listing of a long session's cluster (a million open nodes and more)
      * is what its close holds at its peak */
-    uint64_t escapes = 0;
-    cm_cluster_each_escape(c, count_escape, &escapes);
-    escape_list l = {c->lat.dim, NULL, NULL, 0, escapes * (uint64_t)c->lat.dim, escapes, 0};
+    const uint64_t escapes = cm_cluster_escape_count(c);
+    escape_list l = {.dim = c->lat.dim,
+                     .cap = escapes * (uint64_t)c->lat.dim,
+                     .cap_node = escapes,
+                     .cap_weight = escapes};
     l.cell = malloc(((size_t)l.cap + 1) * sizeof *l.cell);
     l.node = malloc(((size_t)l.cap_node + 1) * sizeof *l.node);
-    l.failed = !l.cell || !l.node;
-    cm_cluster_each_escape(c, add_escape, &l);
-    cm_status st = l.failed ? CM_ENOMEM : CM_OK;
+    l.weight = malloc(((size_t)l.cap_weight + 1) * sizeof *l.weight);
+    l.failed = !l.cell || !l.node || !l.weight;
+    cm_status st = cm_cluster_each_escape(c, add_escape, &l, msg, msg_size);
+    if (st != CM_OK) {
+        free(l.cell), free(l.node), free(l.weight);
+        return st;
+    }
+    st = l.failed ? CM_ENOMEM : CM_OK;
     uint32_t *exit_of = st == CM_OK ? malloc(((size_t)l.n + 1) * sizeof *exit_of) : NULL;
     if (st == CM_OK && !exit_of)
         st = CM_ENOMEM;
@@ -286,10 +289,10 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
     free(l.cell); /* in out now: its room is index_nodes' */
     uint64_t open = 0;
     for (uint64_t i = 0; st == CM_OK && i < l.n; i++) {
-        const uint64_t w = cm_cluster_open_weight(c, l.node[i]);
-        out->weight[exit_of[i]] += w;
-        open += w;
+        out->weight[exit_of[i]] += l.weight[i];
+        open += l.weight[i];
     }
+    free(l.weight);
     if (st == CM_OK)
         st = index_nodes(&l, exit_of, out);
     const uint64_t sink = cm_cluster_sink_cells(c);
@@ -1005,8 +1008,8 @@ static cm_status view_slot(view_exits *v, const int64_t *cell, uint64_t *slot, c
     return CM_OK;
 }
 
-/* The exit cell of open node id: from its region's open list (kept in
- * memory, in node order), else from its exit table (paged in). */
+/* The exit cell of open node id: from its region's open list (in node
+ * order), else from its exit table (paged in). */
 static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
                            size_t msg_size)
 {
@@ -1014,12 +1017,11 @@ static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
     const cm_cluster_region *cr = &c->regions[k];
     const uint32_t e = id - cr->node_base;
     const size_t bytes = (size_t)c->lat.dim * sizeof *cell;
-    const uint64_t lo = cm_first_not_below(cr->open_local, cr->nopen, e);
-    if (lo < cr->nopen && cr->open_local[lo] == e) {
-        memcpy(cell, cr->open_cells + lo * (uint64_t)c->lat.dim, bytes);
-        return CM_OK;
-    }
-    const cm_status st = cm_cluster_acquire(c, k, msg, msg_size);
+    bool listed;
+    cm_status st = cm_cluster_open_target(c, id, cell, &listed, msg, msg_size);
+    if (st != CM_OK || listed)
+        return st;
+    st = cm_cluster_acquire(c, k, msg, msg_size);
     if (st != CM_OK)
         return st;
     if (!cr->r.exit_target)
@@ -1451,13 +1453,14 @@ typedef struct exit_fates {
     int32_t *label;
 } exit_fates;
 
-static void label_escape(void *user, uint32_t node, const int64_t *cell)
+static void label_escape(void *user, uint32_t node, const int64_t *cell, uint64_t weight)
 {
+    (void)weight;
     const exit_fates *f = user;
     f->label[node] = cm_attractor_exit_label(f->s, f->dim, cell);
 }
 
-cm_status cm_node_labels_open(const cm_cluster *c, const cm_attractor_set *s, int32_t **out,
+cm_status cm_node_labels_open(cm_cluster *c, const cm_attractor_set *s, int32_t **out,
                               char *msg, size_t msg_size)
 {
     *out = NULL;
@@ -1479,7 +1482,11 @@ cm_status cm_node_labels_open(const cm_cluster *c, const cm_attractor_set *s, in
     for (uint64_t id = 0; id < c->nnodes; id++)
         label[id] = NODE_UNLABELLED;
     exit_fates f = {s, c->lat.dim, label};
-    cm_cluster_each_escape(c, label_escape, &f);
+    const cm_status st = cm_cluster_each_escape(c, label_escape, &f, msg, msg_size);
+    if (st != CM_OK) {
+        free(label);
+        return st;
+    }
     *out = label;
     return CM_OK;
 }

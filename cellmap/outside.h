@@ -66,8 +66,9 @@ cm_status cm_region_settle_exits(cm_region *r, int threads, cm_exits *out, char 
                                  size_t msg_size);
 
 /* The exits of a cluster: the targets of its open nodes, with their
- * weights (no cell is read). */
-cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t msg_size);
+ * weights (no cell is read; open lists paged out are read back one at a
+ * time, cm_cluster_each_escape). */
+cm_status cm_cluster_exits(cm_cluster *c, cm_exits *out, char *msg, size_t msg_size);
 
 /* The most a pass over a cluster's exits holds beside the cluster, in
  * bytes: CM_EXITS_PASS_BYTES per open node (2-D and more per coordinate
@@ -78,7 +79,7 @@ cm_status cm_cluster_exits(const cm_cluster *c, cm_exits *out, char *msg, size_t
  * pages the cluster adds it to c->mem_reserved for the pass, so that the
  * budget bounds the pass's arrays too (a long session's close lists a
  * million open nodes and more). Reads no cell or node table. */
-#define CM_EXITS_PASS_BYTES 56
+#define CM_EXITS_PASS_BYTES 64
 uint64_t cm_cluster_exits_room(const cm_cluster *c);
 
 void cm_exits_free(cm_exits *x);
@@ -198,7 +199,7 @@ cm_status cm_cluster_node_labels(cm_cluster *c, const cm_attractor_set *s, int32
  * (cm_cluster_release_open): _open allocates the labels and gives the open
  * nodes theirs (*node_label NULL on failure); _settle reads the node tables
  * and settles the chains (node_label stays the caller's to free). */
-cm_status cm_node_labels_open(const cm_cluster *c, const cm_attractor_set *s,
+cm_status cm_node_labels_open(cm_cluster *c, const cm_attractor_set *s,
                               int32_t **node_label, char *msg, size_t msg_size);
 cm_status cm_node_labels_settle(cm_cluster *c, const cm_attractor_set *s, int32_t *node_label,
                                 char *msg, size_t msg_size);

@@ -96,13 +96,14 @@ cm_status store_write_open_nodes(cm_store *s, cm_cluster *c, uint32_t k, char *m
     uint64_t *weight, n;
     int64_t *cells;
     s->cluster_written = 1;
-    if (cm_cluster_open_nodes(c, k, &local, &weight, &cells, &n) != CM_OK)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
+    cm_status st = cm_cluster_open_nodes(c, k, &local, &weight, &cells, &n, msg, msg_size);
+    if (st != CM_OK)
+        return st;
     const size_t dim = (size_t)c->lat.dim, values = n * (2 + dim);
     int64_t *v = store_table_values(s, values * sizeof *v);
     const unsigned char *blob = NULL;
     size_t len = 0;
-    cm_status st = v ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
+    st = v ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory writing open nodes");
     for (uint64_t i = 0; st == CM_OK && i < n; i++) {
         v[i] = local[i];
         v[n + i] = (int64_t)weight[i];

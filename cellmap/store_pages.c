@@ -224,6 +224,9 @@ cm_status store_page_in(void *user, uint32_t k, cm_region *r, char *msg, size_t 
 
 
 
+static cm_status store_open_in(void *user, uint32_t k, uint32_t **local, uint64_t **weight,
+                               int64_t **cells, uint64_t *n, char *msg, size_t msg_size);
+
 void cm_store_attach(cm_store *s, cm_cluster *c)
 {
     s->threads = cm_cluster_threads(c);
@@ -232,6 +235,7 @@ void cm_store_attach(cm_store *s, cm_cluster *c)
     c->page_out = s->writable ? store_page_out : NULL;
     c->nodes_in = store_nodes_in;
     c->groups_in = s->version >= 4 ? store_groups_in : NULL; /* node references since 4 */
+    c->open_in = s->version >= 5 ? store_open_in : NULL; /* a table of open nodes since 5 */
     c->pager = s;
 }
 
@@ -469,10 +473,11 @@ static cm_status load_regions(cm_store *s, cm_cluster *c, int64_t ***exits, char
     return status;
 }
 
-/* Appends region k's saved open nodes (a row of open_nodes) to the arrays. */
-static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, int64_t count,
-                               const void *blob, int len, uint32_t **ids, uint64_t **weights,
-                               int64_t **cells, uint64_t *n, uint64_t *cap)
+/* Appends region k's saved open nodes (a row of open_nodes) to the arrays:
+ * base plus their exits (base node_base: their node ids; 0: the exits). */
+static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, uint32_t base,
+                               int64_t count, const void *blob, int len, uint32_t **ids,
+                               uint64_t **weights, int64_t **cells, uint64_t *n, uint64_t *cap)
 {
     const cm_cluster_region *cr = &c->regions[k];
     const size_t dim = (size_t)c->lat.dim;
@@ -508,7 +513,7 @@ static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, int
             st = CM_EFORMAT;
             break;
         }
-        (*ids)[*n + i] = cr->node_base + (uint32_t)v[i];
+        (*ids)[*n + i] = base + (uint32_t)v[i];
         (*weights)[*n + i] = (uint64_t)v[m + i];
     }
     if (st == CM_OK && m > 0) {
@@ -520,6 +525,42 @@ static cm_status read_open_row(cm_store *s, const cm_cluster *c, uint32_t k, int
     return st;
 }
 
+/* The pager of open lists (cm_open_in_fn): region k's row of open_nodes
+ * (none: no open node). */
+static cm_status store_open_in(void *user, uint32_t k, uint32_t **local, uint64_t **weight,
+                               int64_t **cells, uint64_t *n, char *msg, size_t msg_size)
+{
+    cm_store *s = user;
+    const double t0 = cm_seconds();
+    uint64_t cap = 0;
+    sqlite3_stmt *st = NULL;
+    *local = NULL, *weight = NULL, *cells = NULL, *n = 0;
+    if (sqlite3_prepare_v2(s->db, "SELECT count, data FROM open_nodes WHERE region = ?", -1, &st,
+                           NULL))
+        return store_db_error(s->db, "read open nodes", msg, msg_size);
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)k + 1);
+    const int rc = sqlite3_step(st);
+    cm_status status = CM_OK;
+    if (rc == SQLITE_ROW)
+        status = read_open_row(s, s->cluster, k, 0,
+                               sqlite3_column_int64(st, 0), sqlite3_column_blob(st, 1),
+                               sqlite3_column_bytes(st, 1), local, weight, cells, n, &cap);
+    else if (rc != SQLITE_DONE)
+        status = store_db_error(s->db, "read open nodes", msg, msg_size);
+    sqlite3_finalize(st);
+    if (status == CM_EFORMAT)
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes of region %u",
+                         s->path, k + 1);
+    else if (status == CM_ENOMEM)
+        status = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+    if (status != CM_OK) {
+        free(*local), free(*weight), free(*cells);
+        *local = NULL, *weight = NULL, *cells = NULL, *n = 0;
+    }
+    s->stats.read_seconds += cm_seconds() - t0;
+    return status;
+}
+
 /* The open nodes of a file of version 5 into the cluster. */
 static cm_status load_open_nodes(cm_store *s, cm_cluster *c, uint32_t groups,
                                  const uint64_t *basin, char *msg, size_t msg_size)
@@ -528,11 +569,14 @@ static cm_status load_open_nodes(cm_store *s, cm_cluster *c, uint32_t groups,
     uint64_t *weights = NULL, n = 0, cap = 0;
     int64_t *cells = NULL;
     sqlite3_stmt *st = NULL;
-    cm_status status = CM_OK;
+    cm_status status = cm_cluster_restored_open(c, groups, basin, msg, msg_size);
+    if (status != CM_OK)
+        return status;
     if (sqlite3_prepare_v2(s->db, "SELECT region, count, data FROM open_nodes ORDER BY region", -1,
                            &st, NULL))
         return store_db_error(s->db, "read open nodes", msg, msg_size);
     int64_t last = 0;
+    char why[256] = "";
     while (status == CM_OK && sqlite3_step(st) == SQLITE_ROW) {
         const int64_t region = sqlite3_column_int64(st, 0);
         if (region <= last || region > (int64_t)c->nregions) {
@@ -540,18 +584,19 @@ static cm_status load_open_nodes(cm_store *s, cm_cluster *c, uint32_t groups,
             break;
         }
         last = region;
-        status = read_open_row(s, c, (uint32_t)(region - 1), sqlite3_column_int64(st, 1),
-                               sqlite3_column_blob(st, 2), sqlite3_column_bytes(st, 2), &ids,
-                               &weights, &cells, &n, &cap);
+        n = 0; /* a row at a time: the rows of a long session hold millions */
+        status = read_open_row(s, c, (uint32_t)(region - 1), c->regions[region - 1].node_base,
+                               sqlite3_column_int64(st, 1), sqlite3_column_blob(st, 2),
+                               sqlite3_column_bytes(st, 2), &ids, &weights, &cells, &n, &cap);
+        if (status == CM_OK)
+            status = cm_cluster_restored_escapes(c, ids, weights, cells, n, why, sizeof why);
     }
     sqlite3_finalize(st);
     if (status == CM_EFORMAT)
-        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes of region %lld",
-                         s->path, (long long)last);
+        status = cm_fail(CM_EFORMAT, msg, msg_size, "%s is damaged: open nodes of region %lld%s%s",
+                         s->path, (long long)last, why[0] ? ": " : "", why);
     else if (status != CM_OK)
         status = cm_fail(status, msg, msg_size, "out of memory for the open nodes");
-    if (status == CM_OK)
-        status = cm_cluster_restored_open(c, groups, basin, ids, weights, cells, n, msg, msg_size);
     free(ids);
     free(weights);
     free(cells);

@@ -196,6 +196,11 @@ static void solve_tiles(const cm_model *m, const char *path, int budget_regions,
     }
     if (budget_regions) {
         CHECK(cm_cluster_resident_bytes(&c) <= c.mem_budget + c.mem_budget / 4);
+        /* open lists went with their node tables (the same file below) */
+        uint32_t lists_out = 0;
+        for (uint32_t k = 0; k < c.nregions; k++)
+            lists_out += (uint32_t)c.regions[k].open_paged;
+        CHECK(lists_out > 0);
         reserve_for_exits(&c);
     }
     CHECK(cm_cluster_flatten(&c, &all, flat, msg, sizeof msg) == CM_OK);
@@ -589,8 +594,9 @@ typedef struct counted_pager {
     cm_page_in_fn page_in;
     cm_nodes_in_fn nodes_in;
     cm_groups_in_fn groups_in;
+    cm_open_in_fn open_in;
     void *pager;
-    uint64_t reads;
+    uint64_t reads, open_reads;
 } counted_pager;
 
 static cm_status counted_page_in(void *user, uint32_t region, cm_region *r, char *msg,
@@ -616,13 +622,23 @@ static cm_status counted_groups_in(void *user, uint32_t region, uint32_t *group,
     return p->groups_in(p->pager, region, group, msg, msg_size);
 }
 
+static cm_status counted_open_in(void *user, uint32_t region, uint32_t **local,
+                                 uint64_t **weight, int64_t **cells, uint64_t *n, char *msg,
+                                 size_t msg_size)
+{
+    counted_pager *p = user;
+    p->open_reads++;
+    return p->open_in(p->pager, region, local, weight, cells, n, msg, msg_size);
+}
+
 /* c's pager counted by p (the cluster is read-only from here: no page_out) */
 static void count_reads(cm_cluster *c, counted_pager *p)
 {
-    *p = (counted_pager){c->page_in, c->nodes_in, c->groups_in, c->pager, 0};
+    *p = (counted_pager){c->page_in, c->nodes_in, c->groups_in, c->open_in, c->pager, 0, 0};
     c->page_in = counted_page_in;
     c->nodes_in = counted_nodes_in;
     c->groups_in = c->groups_in ? counted_groups_in : NULL;
+    c->open_in = c->open_in ? counted_open_in : NULL;
     c->page_out = NULL;
     c->pager = p;
 }
@@ -679,6 +695,10 @@ static void test_returned_reads(const char *dir)
     counted_pager counted;
     count_reads(&c, &counted);
     CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
+    /* the open lists stay in the file until read, one at a time, and go again */
+    CHECK_INT(counted.open_reads, HOPS);
+    for (uint32_t k = 0; k < c.nregions; k++)
+        CHECK(c.regions[k].open_paged);
     cc.exits = &x;
     CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &got, msg, sizeof msg) == CM_OK);
     /* not vacuous: every region's exits return, into the next region */
