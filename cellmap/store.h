@@ -215,6 +215,12 @@ cm_status cm_store_put_attractors(cm_store *s, const cm_attractor_set *a,
  * stopped before them), CM_EFORMAT when damaged. Reads no cell. */
 cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
                                   cm_attractor_options *o, char *msg, size_t msg_size);
+/* Whether the file holds them, as cm_store_get_attractors answers, without
+ * reading the exits' cells (their rows are checked by size alone): for an
+ * owner that only needs to know they are there, such as a session closing
+ * on a cluster that did not grow (18 million exits after 800 pans). */
+cm_status cm_store_check_attractors(cm_store *s, int dim, uint32_t ngroups, char *msg,
+                                    size_t msg_size);
 
 /* Parameters as a JSON object text, e.g. {"alpha":0.078,"mode":"output"}. */
 void cm_params_json(const cm_params *p, char *buf, size_t size);

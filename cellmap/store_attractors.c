@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmap/grow.h"
 #include "cellmap/store_db.h"
 
 #define OPTIONS_KEY "attractor_options"
@@ -323,29 +324,92 @@ static cm_status read_fates(cm_store *s, cm_attractor_set *a, char *msg, size_t 
     return st;
 }
 
-typedef struct exit_row {
-    int64_t c[CM_MAX_DIM];
+/* A row of exit_fates as read: its fate, and its cells' place among all
+ * the rows' cells (in box order within the row, as written). */
+typedef struct fate_row {
     int32_t label;
-} exit_row;
+    uint64_t first, end;
+} fate_row;
 
-static int exit_row_less(const void *a, const void *b)
+/* The rows' checks that need no cell: fate, count and size. */
+static bool fate_row_ok(const cm_attractor_set *a, int dim, int64_t label, int64_t count,
+                        uint64_t size)
 {
-    const int64_t *x = ((const exit_row *)a)->c, *y = ((const exit_row *)b)->c;
-    return cm_cell_less(x, y, CM_MAX_DIM) ? -1 : cm_cell_less(y, x, CM_MAX_DIM);
+    return label >= CM_LABEL_OUTSIDE && label != CM_LABEL_UNCOMPUTED && label <= a->n &&
+           count >= 1 && size == (uint64_t)count * (uint64_t)dim * sizeof(int64_t);
 }
 
-/* The exits' fates into a (a->n attractors read), sorted into box order. */
+/* Row heads as a binary heap, the least cell on top. */
+static bool head_less(const fate_row *r, const int64_t *cells, int dim, uint32_t x, uint32_t y)
+{
+    return cm_cell_less(cells + r[x].first * (uint64_t)dim, cells + r[y].first * (uint64_t)dim,
+                        dim);
+}
+
+static void sift_down(const fate_row *r, const int64_t *cells, int dim, uint32_t *heap,
+                      uint32_t n, uint32_t i)
+{
+    for (;;) {
+        uint32_t least = i;
+        const uint32_t l = 2 * i + 1, rr = l + 1;
+        if (l < n && head_less(r, cells, dim, heap[l], heap[least]))
+            least = l;
+        if (rr < n && head_less(r, cells, dim, heap[rr], heap[least]))
+            least = rr;
+        if (least == i)
+            return;
+        const uint32_t t = heap[i];
+        heap[i] = heap[least];
+        heap[least] = t;
+        i = least;
+    }
+}
+
+/* The rows' cells merged into a's exits in box order (each row is in box
+ * order): false when the merge is not strictly ascending, as when a row is
+ * not in order or two rows share a cell (damage). */
+static bool merge_rows(fate_row *r, uint32_t nrows, const int64_t *cells, int dim,
+                       cm_attractor_set *a)
+{
+    const size_t bytes = (size_t)dim * sizeof *cells;
+    uint32_t *heap = malloc(((size_t)nrows + 1) * sizeof *heap), n = nrows;
+    if (!heap)
+        return false;
+    for (uint32_t k = 0; k < nrows; k++)
+        heap[k] = k;
+    for (uint32_t k = nrows / 2; k-- > 0;)
+        sift_down(r, cells, dim, heap, n, k);
+    uint64_t out = 0;
+    bool ok = true;
+    while (n > 0 && ok) {
+        fate_row *top = &r[heap[0]];
+        const int64_t *cell = cells + top->first * (uint64_t)dim;
+        ok = out == 0 || cm_cell_less(a->exit_cell + (out - 1) * (uint64_t)dim, cell, dim);
+        memcpy(a->exit_cell + out * (uint64_t)dim, cell, bytes);
+        a->exit_label[out++] = top->label;
+        if (++top->first == top->end)
+            heap[0] = heap[--n];
+        sift_down(r, cells, dim, heap, n, 0);
+    }
+    free(heap);
+    a->nexits = out;
+    return ok;
+}
+
+/* The exits' fates into a (a->n attractors read), merged into box order. */
 static cm_status read_exit_fates(cm_store *s, int dim, cm_attractor_set *a, char *msg,
                                  size_t msg_size)
 {
     const int64_t bytes = store_query_int(s->db, "SELECT IFNULL(SUM(LENGTH(cells)), 0) FROM "
                                                  "exit_fates");
     const uint64_t cells = bytes > 0 ? (uint64_t)bytes / (dim * sizeof(int64_t)) : 0;
-    exit_row *rows = calloc((size_t)cells + 1, sizeof *rows);
+    int64_t *raw = malloc(((size_t)cells + 1) * dim * sizeof *raw);
     a->exit_cell = malloc(((size_t)cells + 1) * dim * sizeof *a->exit_cell);
     a->exit_label = malloc(((size_t)cells + 1) * sizeof *a->exit_label);
-    if (bytes < 0 || !rows || !a->exit_cell || !a->exit_label) {
-        free(rows);
+    fate_row *rows = NULL;
+    uint64_t nrows = 0, rows_cap = 0, n = 0;
+    if (bytes < 0 || !raw || !a->exit_cell || !a->exit_label) {
+        free(raw);
         return bytes < 0 ? cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates cannot be read")
                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                                    (unsigned long long)cells);
@@ -355,43 +419,53 @@ static cm_status read_exit_fates(cm_store *s, int dim, cm_attractor_set *a, char
     if (sqlite3_prepare_v2(s->db, "SELECT attractor, exits, cells FROM exit_fates", -1, &q,
                            NULL) != SQLITE_OK)
         st = store_db_error(s->db, "read the exits' fates", msg, msg_size);
-    uint64_t n = 0;
     while (st == CM_OK && sqlite3_step(q) == SQLITE_ROW) {
         const int64_t label = sqlite3_column_int64(q, 0), count = sqlite3_column_int64(q, 1);
         const int64_t *blob = sqlite3_column_blob(q, 2);
         const uint64_t size = (uint64_t)sqlite3_column_bytes(q, 2);
-        if (label < CM_LABEL_OUTSIDE || label == CM_LABEL_UNCOMPUTED || label > a->n ||
-            count < 1 || n + (uint64_t)count > cells ||
-            size != (uint64_t)count * dim * sizeof *blob) {
+        if (!fate_row_ok(a, dim, label, count, size) || n + (uint64_t)count > cells) {
             st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
             break;
         }
-        for (int64_t k = 0; k < count; k++, n++) {
-            memcpy(rows[n].c, blob + k * dim, (size_t)dim * sizeof *blob);
-            rows[n].label = (int32_t)label;
+        if (cm_grow((void **)&rows, &rows_cap, nrows + 1, sizeof *rows) != CM_OK) {
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the exits' fates");
+            break;
         }
+        memcpy(raw + n * (uint64_t)dim, blob, size);
+        rows[nrows++] = (fate_row){(int32_t)label, n, n + (uint64_t)count};
+        n += (uint64_t)count;
     }
     sqlite3_finalize(q);
-    if (st == CM_OK && n != cells)
+    if (st == CM_OK && (n != cells || !merge_rows(rows, (uint32_t)nrows, raw, dim, a)))
         st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
-    if (st == CM_OK) {
-        qsort(rows, n, sizeof *rows, exit_row_less);
-        for (uint64_t e = 0; e < n; e++) {
-            if (e && exit_row_less(&rows[e - 1], &rows[e]) == 0) {
-                st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
-                break;
-            }
-            memcpy(a->exit_cell + e * dim, rows[e].c, (size_t)dim * sizeof *a->exit_cell);
-            a->exit_label[e] = rows[e].label;
-        }
-        a->nexits = n;
-    }
     free(rows);
+    free(raw);
     return st;
 }
 
-cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
-                                  cm_attractor_options *o, char *msg, size_t msg_size)
+/* exit_fates' rows checked as read_exit_fates checks them, but by their
+ * sizes: no cell is read (the order and the overlap of the cells are not
+ * checked). */
+static cm_status check_exit_fates(cm_store *s, int dim, const cm_attractor_set *a, char *msg,
+                                  size_t msg_size)
+{
+    sqlite3_stmt *q = NULL;
+    cm_status st = CM_OK;
+    if (sqlite3_prepare_v2(s->db, "SELECT attractor, exits, LENGTH(cells) FROM exit_fates", -1,
+                           &q, NULL) != SQLITE_OK)
+        st = store_db_error(s->db, "read the exits' fates", msg, msg_size);
+    while (st == CM_OK && sqlite3_step(q) == SQLITE_ROW)
+        if (!fate_row_ok(a, dim, sqlite3_column_int64(q, 0), sqlite3_column_int64(q, 1),
+                         (uint64_t)sqlite3_column_int64(q, 2)))
+            st = cm_fail(CM_EFORMAT, msg, msg_size, "its exits' fates are damaged");
+    sqlite3_finalize(q);
+    return st;
+}
+
+/* cm_store_get_attractors, the exits' cells read or only checked by size. */
+static cm_status get_attractors(cm_store *s, int dim, uint32_t ngroups, bool exits,
+                                cm_attractor_set *a, cm_attractor_options *o, char *msg,
+                                size_t msg_size)
 {
     memset(a, 0, sizeof *a);
     cm_attractor_options stored;
@@ -409,7 +483,8 @@ cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_att
     if (st == CM_OK)
         st = read_fates(s, a, msg, msg_size);
     if (st == CM_OK)
-        st = read_exit_fates(s, dim, a, msg, msg_size);
+        st = exits ? read_exit_fates(s, dim, a, msg, msg_size)
+                   : check_exit_fates(s, dim, a, msg, msg_size);
     if (st != CM_OK) {
         cm_attractors_free(a);
         return store_damaged(s, st, msg, msg_size);
@@ -417,4 +492,20 @@ cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_att
     if (o)
         *o = stored;
     return CM_OK;
+}
+
+cm_status cm_store_get_attractors(cm_store *s, int dim, uint32_t ngroups, cm_attractor_set *a,
+                                  cm_attractor_options *o, char *msg, size_t msg_size)
+{
+    return get_attractors(s, dim, ngroups, true, a, o, msg, msg_size);
+}
+
+cm_status cm_store_check_attractors(cm_store *s, int dim, uint32_t ngroups, char *msg,
+                                    size_t msg_size)
+{
+    cm_attractor_set a;
+    const cm_status st = get_attractors(s, dim, ngroups, false, &a, NULL, msg, msg_size);
+    if (st == CM_OK)
+        cm_attractors_free(&a);
+    return st;
 }

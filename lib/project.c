@@ -223,11 +223,8 @@ cm_status project_resume(const char *path, project_fits_fn fits, void *user, cm_
     if (st == CM_OK)
         st = cm_store_read_info(check, info, msg, msg_size);
     if (st == CM_OK) { /* damaged attractors refuse the file as any damage does */
-        cm_attractor_set att;
-        const cm_status a = cm_store_get_attractors(check, info->lattice.dim, info->groups, &att,
-                                                    NULL, msg, msg_size);
-        if (a == CM_OK)
-            cm_attractors_free(&att);
+        const cm_status a =
+            cm_store_check_attractors(check, info->lattice.dim, info->groups, msg, msg_size);
         st = a == CM_ENOTFOUND ? CM_OK : a;
     }
     cm_store_close(check, NULL, 0);

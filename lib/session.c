@@ -915,9 +915,7 @@ static cm_status save_attractors(session *s, char *msg, size_t msg_size)
         return CM_OK;
     if (!s->grew) { /* the file's own groups: what it stores is current, or damaged */
         const cm_status stored =
-            cm_store_get_attractors(s->store, dim, s->c.ngroups, &att, NULL, msg, msg_size);
-        if (stored == CM_OK)
-            cm_attractors_free(&att);
+            cm_store_check_attractors(s->store, dim, s->c.ngroups, msg, msg_size);
         if (stored == CM_EFORMAT)
             s->damaged = 1; /* not written again */
         if (stored != CM_ENOTFOUND)

@@ -1,5 +1,6 @@
 /* The .cmdb store: codec round trips, paged clusters equal to in-memory
  * ones under any budget, reopening, and files that must be refused. */
+#include <math.h>
 #include <sqlite3.h>
 #include <stdlib.h>
 #include <string.h>
@@ -878,6 +879,89 @@ static uint64_t grow_and_check(cm_cluster *c, const cm_model *m, cm_exit_memo *m
     return in_basins;
 }
 
+/* hop_step, but orbits in the upper rows' gaps have no image: their exits
+ * diverge, the lower rows' return (two fates). */
+static int hop_split_step(const cm_model *m, const double *x, double *y)
+{
+    const bool gap = fmod(x[0], 20.0) >= 10.0;
+    return gap && x[1] >= HOP_ROWS / 2 ? CM_STEP_NO_IMAGE : hop_step(m, x, y);
+}
+
+/* A file's exits' fates read back are the set that was written (rows of
+ * one fate each, merged into box order); a row out of order, or two rows
+ * sharing a cell, is damage; checking without the cells sees sizes only. */
+static void test_exit_fates_rows(const char *dir)
+{
+    char msg[512], path[256];
+    snprintf(path, sizeof path, "%s/fates.cmdb", dir);
+    const cm_model m = {.name = "hops", .dim = 2, .step = hop_split_step};
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    cm_box boxes[HOPS];
+    for (int k = 0; k < HOPS; k++)
+        boxes[k] = (cm_box){2, {20 * k, 0}, {20 * k + 10, HOP_ROWS}};
+    cm_cluster c;
+    cm_cluster_init(&c, &lat);
+    cm_store *s = NULL;
+    const cm_store_meta meta = {&m, &lat, "test", "plan", "test", 0, NULL, NULL};
+    CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_OK);
+    cm_store_attach(s, &c);
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
+    CHECK(cm_cluster_solve_boxes(&c, &m, boxes, HOPS, &opt, cm_store_commit_join, s, NULL, msg,
+                                 sizeof msg) == CM_OK);
+    cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
+    uint64_t sink = 0;
+    CHECK(cm_store_groups(s, g, c.ngroups, &sink, msg, sizeof msg) == CM_OK);
+    cm_attractor_set want, got;
+    cm_exits x;
+    CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
+    cm_cluster_cells cc = {&c, &x, NULL};
+    CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &want, msg, sizeof msg) == CM_OK);
+    cm_attractor_options used;
+    cm_attractor_defaults(&m, NULL, &used);
+    CHECK(cm_store_put_attractors(s, &want, &used, 2, msg, sizeof msg) == CM_OK);
+    CHECK(cm_store_get_attractors(s, 2, c.ngroups, &got, NULL, msg, sizeof msg) == CM_OK);
+    CHECK(want.nexits > 100); /* not vacuous: exits of more than one fate */
+    CHECK(sql_int(path, "SELECT COUNT(*) FROM exit_fates") >= 2);
+    CHECK_INT(got.nexits, want.nexits);
+    CHECK(memcmp(got.exit_cell, want.exit_cell, 2 * sizeof(int64_t) * want.nexits) == 0);
+    CHECK(memcmp(got.exit_label, want.exit_label, sizeof(int32_t) * want.nexits) == 0);
+    cm_attractors_free(&got);
+    CHECK(cm_store_close(s, msg, sizeof msg) == CM_OK);
+    const char *const damage[] = {
+        /* a row's first two cells swapped */
+        "UPDATE exit_fates SET cells = CAST(substr(cells, 17, 16) || substr(cells, 1, 16) || "
+        "substr(cells, 33) AS BLOB) WHERE attractor = (SELECT MIN(attractor) FROM exit_fates "
+        "WHERE exits > 1)",
+        /* the last row's cells also in the first's */
+        "UPDATE exit_fates SET cells = (SELECT cells FROM exit_fates ORDER BY attractor DESC "
+        "LIMIT 1), exits = (SELECT exits FROM exit_fates ORDER BY attractor DESC LIMIT 1) "
+        "WHERE attractor = (SELECT MIN(attractor) FROM exit_fates)",
+        /* a count that its cells do not fill */
+        "UPDATE exit_fates SET exits = exits + 1 WHERE attractor = (SELECT MIN(attractor) FROM "
+        "exit_fates)"};
+    for (int d = 0; d < 3; d++) {
+        char copy[300];
+        snprintf(copy, sizeof copy, "%s/fates-%d.cmdb", dir, d);
+        char cmd[700];
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", path, copy);
+        CHECK(system(cmd) == 0);
+        sql_exec(copy, damage[d]);
+        CHECK(cm_store_open(copy, 0, &s, msg, sizeof msg) == CM_OK);
+        CHECK_INT(cm_store_check_attractors(s, 2, c.ngroups, msg, sizeof msg),
+                  (d < 2 ? CM_OK : CM_EFORMAT));
+        CHECK(cm_store_get_attractors(s, 2, c.ngroups, &got, NULL, msg, sizeof msg) ==
+              CM_EFORMAT);
+        CHECK(strstr(msg, "exits' fates are damaged") != NULL);
+        cm_store_close(s, msg, sizeof msg);
+        unlink(copy);
+    }
+    cm_attractors_free(&want);
+    cm_exits_free(&x);
+    free(g);
+    cm_cluster_free(&c);
+    unlink(path);
+}
+
 /* The memo of followed exits (cellmap/exit_memo.h) as a cluster grows by
  * one region at a time, labels with it against labels without it:
  *  - the shift map: A's exits' orbits stay outside until C is solved, then
@@ -1023,6 +1107,7 @@ int main(void)
     snprintf(good, sizeof good, "%s/budget0-2.cmdb", dir);
     test_cell_labels(good, &m);
     test_returned_reads(dir);
+    test_exit_fates_rows(dir);
     test_exit_memo(&m);
     test_refused(dir, good, &m);
     unlink(good);
