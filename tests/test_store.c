@@ -659,6 +659,34 @@ static int hop_step(const cm_model *m, const double *x, double *y)
     return CM_STEP_OK;
 }
 
+/* HOPS regions of model m (hop_step or a variant) solved into a new file
+ * at path, c attached to *s: the file's groups (*g, the caller's to free)
+ * and the attractors of the cluster in memory (*want). */
+static void hops_solved(const char *path, const cm_model *m, cm_cluster *c, cm_store **s,
+                        cm_group_info **g, cm_attractor_set *want)
+{
+    char msg[512];
+    const cm_lattice lat = {2, {0, 0}, {1, 1}};
+    cm_box boxes[HOPS];
+    for (int k = 0; k < HOPS; k++)
+        boxes[k] = (cm_box){2, {20 * k, 0}, {20 * k + 10, HOP_ROWS}};
+    cm_cluster_init(c, &lat);
+    const cm_store_meta meta = {m, &lat, "test", "plan", "test", 0, NULL, NULL};
+    CHECK(cm_store_create(path, &meta, s, msg, sizeof msg) == CM_OK);
+    cm_store_attach(*s, c);
+    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
+    CHECK(cm_cluster_solve_boxes(c, m, boxes, HOPS, &opt, cm_store_commit_join, *s, NULL, msg,
+                                 sizeof msg) == CM_OK);
+    *g = calloc(c->ngroups + 1, sizeof **g);
+    uint64_t sink = 0;
+    CHECK(cm_store_groups(*s, *g, c->ngroups, &sink, msg, sizeof msg) == CM_OK);
+    cm_exits x;
+    CHECK(cm_cluster_exits(c, &x, msg, sizeof msg) == CM_OK);
+    cm_cluster_cells cc = {c, &x, NULL};
+    CHECK(cm_cluster_attractors(m, &cc, *g, NULL, want, msg, sizeof msg) == CM_OK);
+    cm_exits_free(&x);
+}
+
 /* The attractors of a paged cluster, under a budget of one byte, are those
  * of the same cluster in memory, and finding them reads each region back
  * twice at most: the ends of the returned orbits are asked region by
@@ -668,39 +696,23 @@ static void test_returned_reads(const char *dir)
     char msg[512], path[256];
     snprintf(path, sizeof path, "%s/hops.cmdb", dir);
     const cm_model m = {.name = "hops", .dim = 2, .step = hop_step};
-    const cm_lattice lat = {2, {0, 0}, {1, 1}};
-    cm_box boxes[HOPS];
-    for (int k = 0; k < HOPS; k++)
-        boxes[k] = (cm_box){2, {20 * k, 0}, {20 * k + 10, HOP_ROWS}};
     cm_cluster c;
-    cm_cluster_init(&c, &lat);
     cm_store *s = NULL;
-    const cm_store_meta meta = {&m, &lat, "test", "plan", "test", 0, NULL, NULL};
-    CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_OK);
-    cm_store_attach(s, &c);
-    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
-    CHECK(cm_cluster_solve_boxes(&c, &m, boxes, HOPS, &opt, cm_store_commit_join, s, NULL, msg,
-                                 sizeof msg) == CM_OK);
-    cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
-    uint64_t sink = 0;
-    CHECK(cm_store_groups(s, g, c.ngroups, &sink, msg, sizeof msg) == CM_OK);
+    cm_group_info *g = NULL;
     cm_attractor_set want, got;
-    cm_exits x;
-    CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
-    cm_cluster_cells cc = {&c, &x, NULL};
-    CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &want, msg, sizeof msg) == CM_OK);
-    cm_exits_free(&x);
+    hops_solved(path, &m, &c, &s, &g, &want);
     cm_cluster_free(&c);
     CHECK(cm_store_load_cluster(s, &c, msg, sizeof msg) == CM_OK);
     c.mem_budget = 1;
     counted_pager counted;
     count_reads(&c, &counted);
+    cm_exits x;
     CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
     /* the open lists stay in the file until read, one at a time, and go again */
     CHECK_INT(counted.open_reads, HOPS);
     for (uint32_t k = 0; k < c.nregions; k++)
         CHECK(c.regions[k].open_paged);
-    cc.exits = &x;
+    cm_cluster_cells cc = {&c, &x, NULL};
     CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &got, msg, sizeof msg) == CM_OK);
     /* not vacuous: every region's exits return, into the next region */
     CHECK_INT(got.nexits, (HOPS - 1) * 5 * HOP_ROWS);
@@ -895,27 +907,11 @@ static void test_exit_fates_rows(const char *dir)
     char msg[512], path[256];
     snprintf(path, sizeof path, "%s/fates.cmdb", dir);
     const cm_model m = {.name = "hops", .dim = 2, .step = hop_split_step};
-    const cm_lattice lat = {2, {0, 0}, {1, 1}};
-    cm_box boxes[HOPS];
-    for (int k = 0; k < HOPS; k++)
-        boxes[k] = (cm_box){2, {20 * k, 0}, {20 * k + 10, HOP_ROWS}};
     cm_cluster c;
-    cm_cluster_init(&c, &lat);
     cm_store *s = NULL;
-    const cm_store_meta meta = {&m, &lat, "test", "plan", "test", 0, NULL, NULL};
-    CHECK(cm_store_create(path, &meta, &s, msg, sizeof msg) == CM_OK);
-    cm_store_attach(s, &c);
-    const cm_scm_options opt = {.max_steps = 1, .threads = 1, .record_exits = 1};
-    CHECK(cm_cluster_solve_boxes(&c, &m, boxes, HOPS, &opt, cm_store_commit_join, s, NULL, msg,
-                                 sizeof msg) == CM_OK);
-    cm_group_info *g = calloc(c.ngroups + 1, sizeof *g);
-    uint64_t sink = 0;
-    CHECK(cm_store_groups(s, g, c.ngroups, &sink, msg, sizeof msg) == CM_OK);
+    cm_group_info *g = NULL;
     cm_attractor_set want, got;
-    cm_exits x;
-    CHECK(cm_cluster_exits(&c, &x, msg, sizeof msg) == CM_OK);
-    cm_cluster_cells cc = {&c, &x, NULL};
-    CHECK(cm_cluster_attractors(&m, &cc, g, NULL, &want, msg, sizeof msg) == CM_OK);
+    hops_solved(path, &m, &c, &s, &g, &want);
     cm_attractor_options used;
     cm_attractor_defaults(&m, NULL, &used);
     CHECK(cm_store_put_attractors(s, &want, &used, 2, msg, sizeof msg) == CM_OK);
@@ -956,7 +952,6 @@ static void test_exit_fates_rows(const char *dir)
         unlink(copy);
     }
     cm_attractors_free(&want);
-    cm_exits_free(&x);
     free(g);
     cm_cluster_free(&c);
     unlink(path);
