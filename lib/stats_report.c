@@ -91,8 +91,8 @@ void stats_report(FILE *f, const session *s, const session_stats *v)
     print_groups(f, s, v->flat.ngroups, v->groups, v->in_view);
     print_attractors(f, s, v);
     fprintf(f,
-            "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays "
-            "resident %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
+            "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays, "
+            "node tables and open lists %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
             s->c.nregions, (unsigned long long)v->cluster_cells, s->c.ngroups,
             (double)v->memory_bytes / 1048576.0,
             (double)v->resident_bytes / 1048576.0,
