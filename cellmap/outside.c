@@ -344,6 +344,28 @@ static bool cluster_holds(const void *user, const int64_t *cell)
     return cm_cluster_locate(((const cm_cluster_cells *)user)->c, cell, &local) >= 0;
 }
 
+/* The exit cell of open node id: from its region's open list (in node
+ * order), else from its exit table (paged in). */
+static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
+                           size_t msg_size)
+{
+    const uint32_t k = cm_cluster_node_region(c, id);
+    const cm_cluster_region *cr = &c->regions[k];
+    const uint32_t e = id - cr->node_base;
+    const size_t bytes = (size_t)c->lat.dim * sizeof *cell;
+    bool listed;
+    cm_status st = cm_cluster_open_target(c, id, cell, &listed, msg, msg_size);
+    if (st != CM_OK || listed)
+        return st;
+    st = cm_cluster_acquire(c, k, msg, msg_size);
+    if (st != CM_OK)
+        return st;
+    if (!cr->r.exit_target)
+        return cm_fail(CM_EINVAL, msg, msg_size, "region %u kept no exit table", k);
+    memcpy(cell, cm_region_exit(&cr->r, e), bytes);
+    return CM_OK;
+}
+
 /* The exit open node id leads to (cm_cluster_exits' node index). */
 static const int64_t *node_exit(const cm_exits *x, int dim, uint32_t id)
 {
@@ -370,12 +392,14 @@ static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, b
     }
     if (open == CM_NODE_OPEN) /* the world's sink */
         return CM_OK;
+    *out_leaves = true;
+    if (!cc->exits) /* no listing: the open node's list says */
+        return open_exit(cc->c, open, exit, msg, msg_size);
     const int64_t *e = node_exit(cc->exits, dim, open);
     if (!e)
         return cm_fail(CM_EINVAL, msg, msg_size, "open node %u is not among the cluster's exits",
                        open);
     memcpy(exit, e, (size_t)dim * sizeof *exit);
-    *out_leaves = true;
     return CM_OK;
 }
 
@@ -1005,28 +1029,6 @@ static cm_status view_slot(view_exits *v, const int64_t *cell, uint64_t *slot, c
     memcpy(v->cell + v->n * (uint64_t)v->dim, cell, (size_t)v->dim * sizeof *cell);
     v->hash[hash_place(v, cell)] = (uint32_t)(v->n + 1);
     *slot = v->n++;
-    return CM_OK;
-}
-
-/* The exit cell of open node id: from its region's open list (in node
- * order), else from its exit table (paged in). */
-static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
-                           size_t msg_size)
-{
-    const uint32_t k = cm_cluster_node_region(c, id);
-    const cm_cluster_region *cr = &c->regions[k];
-    const uint32_t e = id - cr->node_base;
-    const size_t bytes = (size_t)c->lat.dim * sizeof *cell;
-    bool listed;
-    cm_status st = cm_cluster_open_target(c, id, cell, &listed, msg, msg_size);
-    if (st != CM_OK || listed)
-        return st;
-    st = cm_cluster_acquire(c, k, msg, msg_size);
-    if (st != CM_OK)
-        return st;
-    if (!cr->r.exit_target)
-        return cm_fail(CM_EINVAL, msg, msg_size, "region %u kept no exit table", k);
-    memcpy(cell, cm_region_exit(&cr->r, e), bytes);
     return CM_OK;
 }
 

@@ -123,6 +123,9 @@ typedef struct cm_region_cells {
 } cm_region_cells;
 typedef struct cm_cluster_cells {
     cm_cluster *c;
+    /* cm_cluster_exits' exits, or NULL: an end's exit is read from its open
+     * node's list (cm_cluster_open_target), which serves lookups without
+     * listing the cluster's exits; cm_cluster_attractors needs them */
     const cm_exits *exits;
     /* NULL, or exits itself when its owner needs no more of it than
      * cm_exits_free once cm_cluster_attractors has run: the set then takes

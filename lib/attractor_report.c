@@ -147,6 +147,13 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
     return st;
 }
 
+void cluster_ends_lookup(cluster_ends *e, cm_cluster *c)
+{
+    cluster_ends_close(e);
+    e->cc = (cm_cluster_cells){c, NULL, NULL};
+    e->computed = cm_cluster_computed(&e->cc);
+}
+
 void cluster_ends_close(cluster_ends *e)
 {
     cm_exits_free(&e->exits);

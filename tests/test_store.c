@@ -774,6 +774,27 @@ static void test_cell_labels(const char *path, const cm_model *m)
     CHECK_INT(differ, 0);
     /* not vacuous: sink cells labelled by their exits' fates, both kinds */
     CHECK(attractors > 0 && returned > 0 && outside > 0);
+    { /* ends read from the open lists, without the listing: the same labels (every
+       * cell but a frame, whose sequences leave through the frame) */
+        const cm_box inner = {2, {1, 1}, {NX - 1, NY - 1}};
+        cm_region part;
+        CHECK(cm_cluster_flatten(&c, &inner, &part, msg, sizeof msg) == CM_OK);
+        cm_cluster_cells by_lists = {&c, NULL, NULL};
+        const cm_computed listed = cm_cluster_computed(&by_lists);
+        int32_t *a = malloc(part.ncells * sizeof *a), *b = malloc(part.ncells * sizeof *b);
+        CHECK(cm_attractor_cell_labels(&att, &part, &cells, a, msg, sizeof msg) == CM_OK);
+        CHECK(cm_attractor_cell_labels(&att, &part, &listed, b, msg, sizeof msg) == CM_OK);
+        uint64_t differ_lists = 0, by_exits = 0;
+        for (uint64_t i = 0; i < part.ncells; i++) {
+            differ_lists += a[i] != b[i];
+            by_exits += part.group[i] == 0 && a[i] > 0; /* returned: an exit's fate */
+        }
+        CHECK_INT(differ_lists, 0);
+        CHECK(by_exits > 0);
+        free(a);
+        free(b);
+        cm_region_free(&part);
+    }
     const int64_t ww = window.hi[1] - window.lo[1];
     const int64_t c_order[2] = {ww, 1}; /* dimension 0 slowest */
     CHECK(cm_cluster_cell_labels(&c, &att, node_label, &window, c_order, got, msg, sizeof msg) ==
