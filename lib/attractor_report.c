@@ -149,6 +149,8 @@ cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t ms
 
 void cluster_ends_lookup(cluster_ends *e, cm_cluster *c)
 {
+    if (e->open)
+        return;
     cluster_ends_close(e);
     e->cc = (cm_cluster_cells){c, NULL, NULL};
     e->computed = cm_cluster_computed(&e->cc);

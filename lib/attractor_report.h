@@ -55,10 +55,9 @@ typedef struct cluster_ends {
 } cluster_ends;
 cm_status cluster_ends_open(cluster_ends *e, cm_cluster *c, char *msg, size_t msg_size);
 void cluster_ends_close(cluster_ends *e);
-/* e closed, its adapter set to read each end's exit from its open node's
- * list, without listing the cluster's exits: for labels whose fates come
- * from elsewhere (a file's stored attractors). Opening it later lists
- * them. */
+/* e, unless open, set to read each end's exit from its open node's list,
+ * without listing the cluster's exits: for labels whose fates are known
+ * (a file's attractors, stored or found). Opening it later lists them. */
 void cluster_ends_lookup(cluster_ends *e, cm_cluster *c);
 
 /* The attractors of a file's cluster c: those it stores, unless o asks for

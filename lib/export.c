@@ -749,9 +749,7 @@ cm_status export_cells(exporter *x, const char *cells, const char *flat, const w
     int nouts = 0;
     memset(outs, 0, sizeof outs);
     *rows = 0;
-    const cm_status ends = cluster_ends_open(&x->ends, c, msg, msg_size);
-    if (ends != CM_OK)
-        return ends;
+    cluster_ends_lookup(&x->ends, c); /* the attractors know every exit's fate */
     for (int k = 0; k < 2; k++) {
         outs[k].names = x->names;
         outs[k].source = x->source;
@@ -882,8 +880,8 @@ cm_status export_labels(exporter *ex, const cm_box *box, int32_t *labels,
 {
     if (ex->c->resolved_cells) { /* sink sequences followed across regions */
         slab_memory m = {labels, box};
-        const cm_status st = cluster_ends_open(&ex->ends, ex->c, msg, msg_size);
-        return st != CM_OK ? st : each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
+        cluster_ends_lookup(&ex->ends, ex->c);
+        return each_slab(ex->c, box, &ex->att, &ex->ends.computed, hooks,
                          "the labels were not read", copy_slab, &m, msg, msg_size);
     }
     int64_t stride[CM_MAX_DIM];
@@ -901,9 +899,7 @@ cm_status export_arrays(exporter *ex, const char *labels_path, const char *steps
 {
     cm_cluster *c = ex->c;
     const cm_box *window = &ex->window;
-    const cm_status ends = cluster_ends_open(&ex->ends, c, msg, msg_size);
-    if (ends != CM_OK)
-        return ends;
+    cluster_ends_lookup(&ex->ends, c);
     const array_export arrays = {labels_path, steps_path, ex->source, ex->info, ex->groups,
                                  ex->info->groups, ex->names,
                                  labels_path && !by_groups ? &ex->att : NULL,

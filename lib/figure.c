@@ -606,7 +606,7 @@ cm_status figure_of_file(cm_store *s, const cm_store_info *info, cm_cluster *cl,
     memset(&ends, 0, sizeof ends);
     if (st == CM_OK && po->by == BY_ATTRACTORS) /* lists the exits only to find fates */
         st = file_attractors(s, info, &m, cl, &ends, groups, o, &att, msg, msg_size);
-    if (st == CM_OK && po->by == BY_ATTRACTORS && !ends.open)
+    if (st == CM_OK && po->by == BY_ATTRACTORS)
         cluster_ends_lookup(&ends, cl);
     reading r = {hooks, cm_box_cells(box)};
     if (st == CM_OK)
