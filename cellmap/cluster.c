@@ -710,8 +710,9 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
         uint64_t nregions;
         if (regions_toward(c, box, &regions, &nregions) != CM_OK)
             return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
-        for (uint64_t i = 0; i < nregions && st == CM_OK; i++)
-            st = take_listed(c, regions[i], box, out, n, &cap, msg, msg_size);
+        for (uint64_t i = 0; i < nregions && st == CM_OK; i++) /* lists of open nodes only */
+            if (c->regions[regions[i]].nopen > c->regions[regions[i]].open_stale)
+                st = take_listed(c, regions[i], box, out, n, &cap, msg, msg_size);
         free(regions);
         return st;
     }

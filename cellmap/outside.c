@@ -285,13 +285,11 @@ cm_status cm_cluster_exits(cm_cluster *c, cm_exits *out, char *msg, size_t msg_s
     if (st == CM_OK && !exit_of)
         st = CM_ENOMEM;
     if (st == CM_OK)
-        st = exits_of_targets(l.cell, NULL, l.n, l.dim, out, exit_of);
+        st = exits_of_targets(l.cell, l.weight, l.n, l.dim, out, exit_of);
     free(l.cell); /* in out now: its room is index_nodes' */
     uint64_t open = 0;
-    for (uint64_t i = 0; st == CM_OK && i < l.n; i++) {
-        out->weight[exit_of[i]] += l.weight[i];
+    for (uint64_t i = 0; st == CM_OK && i < l.n; i++)
         open += l.weight[i];
-    }
     free(l.weight);
     if (st == CM_OK)
         st = index_nodes(&l, exit_of, out);
