@@ -851,13 +851,18 @@ cluster_rows() {
 }
 a=$(cluster_rows int.cmdb) && b=$(cluster_rows tty.cmdb) && [ "$a" = "$b" ] \
   || fail "interrupted and resumed differs from an uninterrupted solve"
-# over an older cluster: Ctrl-C keeps the older one
-sum=$(sha256sum < tty.cmdb)
-"$CM" solve "${LONG[@]}" --db tty.cmdb > /dev/null 2> int.txt &
-solver=$!
-for _ in $(seq 2000); do compgen -G "tty.cmdb.tmp-*" > /dev/null && break; sleep 0.01; done
-kill -INT $solver 2> /dev/null || fail "the replacing solve ended before Ctrl-C"
-wait $solver; rc=$?
+# over an older cluster: Ctrl-C keeps the older one (tried again when the
+# solve, half a second long, finished its joins before the signal came: a
+# loaded machine once delayed it so in CI)
+for _ in 1 2 3; do
+  sum=$(sha256sum < tty.cmdb)
+  "$CM" solve "${LONG[@]}" --db tty.cmdb > /dev/null 2> int.txt &
+  solver=$!
+  for _ in $(seq 2000); do compgen -G "tty.cmdb.tmp-*" > /dev/null && break; sleep 0.01; done
+  kill -INT $solver 2> /dev/null || fail "the replacing solve ended before Ctrl-C"
+  wait $solver; rc=$?
+  [ $rc -ne 0 ] && break
+done
 [ $rc -eq 130 ] && grep -q "interrupted; tty.cmdb is unchanged" int.txt || fail "Ctrl-C over an older cluster: exit $rc, $(cat int.txt)"
 [ "$(sha256sum < tty.cmdb)" = "$sum" ] || fail "Ctrl-C changed the older cluster"
 
