@@ -345,6 +345,23 @@ static bool still_indexed(const cm_cluster_region *cr, uint64_t i)
     return cr->open_weight[i] & INDEXED;
 }
 
+/* The weight of entry i of region cr's open list, still open: in its
+ * record while the node table is in memory, else beside its place. */
+static uint64_t listed_weight(const cm_cluster_region *cr, uint64_t i)
+{
+    return cr->nodes ? weight_of(&cr->nodes[cr->open_local[i]]) : cr->open_weight[i] & ~INDEXED;
+}
+
+/* The place of exit e in region cr's open list (in memory), or nopen. */
+static uint64_t listed_place(const cm_cluster_region *cr, uint32_t e)
+{
+    const uint64_t i = cm_first_not_below(cr->open_local, cr->nopen, e);
+    return i < cr->nopen && cr->open_local[i] == e ? i : cr->nopen;
+}
+
+/* Entries of region cr's open list still open (known while it is paged out). */
+static uint64_t live_open(const cm_cluster_region *cr) { return cr->nopen - cr->open_stale; }
+
 /* Region cr's open list with room for cap nodes (at least nopen). */
 static cm_status resize_open_list(const cm_cluster *c, cm_cluster_region *cr, uint64_t cap)
 {
@@ -391,9 +408,8 @@ static uint64_t open_weight(const cm_cluster *c, uint32_t id)
     if (cr->nodes)
         return is_open(&cr->nodes[id - cr->node_base]) ? weight_of(&cr->nodes[id - cr->node_base])
                                                         : 0;
-    const uint32_t e = id - cr->node_base;
-    const uint64_t i = cm_first_not_below(cr->open_local, cr->nopen, e);
-    if (i < cr->nopen && cr->open_local[i] == e)
+    const uint64_t i = listed_place(cr, id - cr->node_base);
+    if (i < cr->nopen)
         return cr->open_weight[i] & INDEXED ? cr->open_weight[i] & ~INDEXED : 0;
     const uint64_t *v = cm_idmap_find(&c->open, id);
     return v ? *v & ~INDEXED : 0;
@@ -440,9 +456,9 @@ cm_status cm_cluster_open_nodes(cm_cluster *c, uint32_t k, uint32_t **local, uin
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes of region %u",
                        k + 1);
     }
-    for (uint64_t i = 0; i < kept; i++) {
+    for (uint64_t i = 0; i < kept; i++) { /* compacted: every entry is open */
         (*local)[i] = cr->open_local[i];
-        (*weight)[i] = open_weight(c, cr->node_base + cr->open_local[i]);
+        (*weight)[i] = listed_weight(cr, i);
     }
     if (kept > 0)
         memcpy(*cells, cr->open_cells, kept * dim * sizeof **cells);
@@ -519,11 +535,10 @@ static cm_status visit_open_list(cm_cluster *c, uint32_t k, cm_escape_fn fn, voi
     cm_cluster_region *cr = &c->regions[k];
     const bool was_paged = cr->open_paged;
     cm_status st = open_list(c, k, msg, msg_size);
-    for (uint64_t i = 0; st == CM_OK && i < cr->nopen; i++) {
-        const uint32_t id = cr->node_base + cr->open_local[i];
+    for (uint64_t i = 0; st == CM_OK && i < cr->nopen; i++)
         if (still_indexed(cr, i))
-            fn(user, id, cr->open_cells + i * (uint64_t)c->lat.dim, open_weight(c, id));
-    }
+            fn(user, cr->node_base + cr->open_local[i], cr->open_cells + i * (uint64_t)c->lat.dim,
+               listed_weight(cr, i));
     if (st == CM_OK && was_paged && open_list_evictable(c, cr))
         evict_open_list(cr);
     return st;
@@ -558,7 +573,7 @@ uint64_t cm_cluster_escape_count(const cm_cluster *c)
         n += records;
     }
     for (uint32_t k = 0; c->keep_exits && k < c->nregions; k++)
-        n += c->regions[k].nopen - c->regions[k].open_stale;
+        n += live_open(&c->regions[k]);
     return n;
 }
 
@@ -569,9 +584,8 @@ cm_status cm_cluster_open_target(cm_cluster *c, uint32_t id, int64_t *cell, bool
     const cm_cluster_region *cr = &c->regions[k];
     *found = false;
     cm_status st = open_list(c, k, msg, msg_size);
-    const uint32_t e = id - cr->node_base;
-    const uint64_t i = st == CM_OK ? cm_first_not_below(cr->open_local, cr->nopen, e) : 0;
-    if (st == CM_OK && i < cr->nopen && cr->open_local[i] == e) {
+    const uint64_t i = st == CM_OK ? listed_place(cr, id - cr->node_base) : cr->nopen;
+    if (i < cr->nopen) {
         memcpy(cell, cr->open_cells + i * (uint64_t)c->lat.dim,
                (size_t)c->lat.dim * sizeof *cell);
         *found = true;
@@ -625,52 +639,39 @@ static cm_status sort_escapes(cm_escape *e, uint64_t n)
     return CM_OK;
 }
 
-static void add_regions_of_brick(const cm_cluster *c, const int64_t *key, uint32_t *regions,
-                                 uint64_t *n, uint64_t cap, bool *full)
-{
-    uint64_t count;
-    const uint32_t *k = cm_bricks_find(c->escape_bricks, key, &count);
-    for (uint64_t i = 0; i < count && !*full; i++) {
-        *full = *n == cap;
-        if (!*full)
-            regions[(*n)++] = k[i];
-    }
-}
-
 static int region_cmp(const void *a, const void *b)
 {
     const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
 }
 
-/* The regions whose open lists lead into the bricks that meet box (those
- * of the index's bricks when they are too many), ascending, each once: at
- * most one for each region and brick of the index. */
+/* The regions whose open lists lead into the bricks that meet box (every
+ * region when it meets very many bricks), ascending, each once. */
 static cm_status regions_toward(const cm_cluster *c, const cm_box *box, uint32_t **out,
                                 uint64_t *n)
 {
     int64_t lo[CM_MAX_DIM], hi[CM_MAX_DIM], key[CM_MAX_DIM];
-    const bool spanned = cm_bricks_span(c->escape_bricks, box, lo, hi);
-    const uint64_t cap = (uint64_t)c->nregions * (spanned ? 4 : 1) + 1;
-    bool full = false;
+    uint64_t cap = 0, count;
+    *out = NULL;
     *n = 0;
-    *out = malloc(cap * sizeof **out);
-    if (!*out)
-        return CM_ENOMEM;
-    if (spanned) {
-        memcpy(key, lo, sizeof key);
-        do
-            add_regions_of_brick(c, key, *out, n, cap, &full);
-        while (!full && cm_index_next(c->lat.dim, lo, hi, key));
-    }
-    if (!spanned || full) { /* many bricks: every region that lists an open node */
-        *n = 0;
+    if (!cm_bricks_span(c->escape_bricks, box, lo, hi)) {
+        if (cm_grow((void **)out, &cap, (uint64_t)c->nregions + 1, sizeof **out) != CM_OK)
+            return CM_ENOMEM;
         for (uint32_t k = 0; k < c->nregions; k++)
-            if (c->regions[k].nopen > c->regions[k].open_stale)
-                (*out)[(*n)++] = k;
+            (*out)[(*n)++] = k;
         return CM_OK;
     }
-    qsort(*out, *n, sizeof **out, region_cmp);
+    memcpy(key, lo, sizeof key);
+    do {
+        const uint32_t *k = cm_bricks_find(c->escape_bricks, key, &count);
+        if (count && cm_grow((void **)out, &cap, *n + count, sizeof **out) != CM_OK)
+            return CM_ENOMEM;
+        if (count)
+            memcpy(*out + *n, k, count * sizeof *k);
+        *n += count;
+    } while (cm_index_next(c->lat.dim, lo, hi, key));
+    if (*n > 1)
+        qsort(*out, *n, sizeof **out, region_cmp);
     uint64_t kept = 0;
     for (uint64_t i = 0; i < *n; i++)
         if (kept == 0 || (*out)[kept - 1] != (*out)[i])
@@ -684,6 +685,8 @@ static cm_status take_listed(cm_cluster *c, uint32_t k, const cm_box *box, cm_es
                              uint64_t *n, uint64_t *cap, char *msg, size_t msg_size)
 {
     const cm_cluster_region *cr = &c->regions[k];
+    if (live_open(cr) == 0) /* nothing to take: a paged list is not read */
+        return CM_OK;
     cm_status st = open_list(c, k, msg, msg_size);
     for (uint64_t i = 0; st == CM_OK && i < cr->nopen; i++) {
         const int64_t *cell = cr->open_cells + i * (uint64_t)c->lat.dim;
@@ -709,10 +712,9 @@ cm_status cm_cluster_take_escapes(cm_cluster *c, const cm_box *box, cm_escape **
         uint32_t *regions;
         uint64_t nregions;
         if (regions_toward(c, box, &regions, &nregions) != CM_OK)
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
-        for (uint64_t i = 0; i < nregions && st == CM_OK; i++) /* lists of open nodes only */
-            if (c->regions[regions[i]].nopen > c->regions[regions[i]].open_stale)
-                st = take_listed(c, regions[i], box, out, n, &cap, msg, msg_size);
+            st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the open nodes");
+        for (uint64_t i = 0; i < nregions && st == CM_OK; i++)
+            st = take_listed(c, regions[i], box, out, n, &cap, msg, msg_size);
         free(regions);
         return st;
     }
