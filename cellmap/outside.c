@@ -344,7 +344,7 @@ static bool cluster_holds(const void *user, const int64_t *cell)
 
 /* The exit cell of open node id: from its region's open list (in node
  * order), else from its exit table (paged in). */
-static cm_status open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
+cm_status cm_cluster_open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
                            size_t msg_size)
 {
     const uint32_t k = cm_cluster_node_region(c, id);
@@ -392,7 +392,7 @@ static cm_status cluster_end(void *user, const int64_t *cell, uint32_t *group, b
         return CM_OK;
     *out_leaves = true;
     if (!cc->exits) /* no listing: the open node's list says */
-        return open_exit(cc->c, open, exit, msg, msg_size);
+        return cm_cluster_open_exit(cc->c, open, exit, msg, msg_size);
     const int64_t *e = node_exit(cc->exits, dim, open);
     if (!e)
         return cm_fail(CM_EINVAL, msg, msg_size, "open node %u is not among the cluster's exits",
@@ -414,14 +414,6 @@ cm_computed cm_cluster_computed(cm_cluster_cells *cc)
     cm_cluster_bounds(cc->c, &out.bounds);
     return out;
 }
-
-/* What following one exit found. */
-enum { FOLLOW_DIVERGED = 0, FOLLOW_OUTSIDE, FOLLOW_RETURNED, FOLLOW_ABORTED };
-typedef struct followed {
-    int how;
-    uint32_t taken;           /* steps the orbit took */
-    int64_t cell[CM_MAX_DIM]; /* FOLLOW_RETURNED: the computed cell it lands in */
-} followed;
 
 /* Exits followed together, through the model's step_n where it has one. */
 #define FOLLOW_BATCH 256
@@ -502,7 +494,7 @@ static void grow_path_box(int64_t *box, int dim, int i, const int64_t *cell)
  * out). */
 static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
                              const int64_t *exit_cell, uint64_t first, int n, uint32_t steps,
-                             follow_buf *b, followed *out, int64_t *box)
+                             follow_buf *b, cm_followed *out, int64_t *box)
 {
     const int dim = lat->dim;
     for (int i = 0; i < n; i++) {
@@ -512,7 +504,7 @@ static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_
         for (int d = 0; d < dim; d++)
             b->x[d][i] = c[d];
         b->who[i] = i;
-        out[i].how = FOLLOW_OUTSIDE;
+        out[i].how = CM_FOLLOW_OUTSIDE;
         out[i].taken = steps;
         if (box) {
             memcpy(box + (uint64_t)i * 2 * (uint64_t)dim, cell, (size_t)dim * sizeof *cell);
@@ -526,9 +518,9 @@ static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_
         taken += (uint64_t)n;
         int kept = 0;
         for (int i = 0; i < n; i++) {
-            followed *f = &out[b->who[i]];
+            cm_followed *f = &out[b->who[i]];
             if (b->world[i] == 0.0) {
-                f->how = b->rc[i] < 0 ? FOLLOW_ABORTED : FOLLOW_DIVERGED;
+                f->how = b->rc[i] < 0 ? CM_FOLLOW_ABORTED : CM_FOLLOW_DIVERGED;
                 f->taken = k;
                 continue;
             }
@@ -537,7 +529,7 @@ static uint64_t follow_batch(const cm_model *m, const cm_lattice *lat, const cm_
             if (box)
                 grow_path_box(box, dim, b->who[i], f->cell);
             if (b->near[i] != 0.0 && cells->holds(cells->user, f->cell)) {
-                f->how = FOLLOW_RETURNED;
+                f->how = CM_FOLLOW_RETURNED;
                 f->taken = k;
                 continue;
             }
@@ -623,9 +615,9 @@ static void count_fates(const cm_exits *x, cm_attractor_set *s)
  * in batches on `threads` threads, into f[0..n) (and their boxes into box,
  * unless NULL: follow_batch); the steps taken added to *taken. CM_EMODEL
  * when the model aborts. */
-static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
+cm_status cm_exits_follow(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
                             const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
-                            followed *f, int64_t *box, uint64_t *taken, char *msg,
+                            cm_followed *f, int64_t *box, uint64_t *taken, char *msg,
                             size_t msg_size)
 {
     const int64_t batches = (int64_t)((n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
@@ -649,7 +641,7 @@ static cm_status follow_all(const cm_model *m, const cm_lattice *lat, const cm_c
     if (no_memory)
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory following the exits");
     for (uint64_t e = 0; e < n; e++)
-        if (f[e].how == FOLLOW_ABORTED)
+        if (f[e].how == CM_FOLLOW_ABORTED)
             return cm_fail(CM_EMODEL, msg, msg_size, "the model aborted following an exit's orbit");
     return CM_OK;
 }
@@ -733,7 +725,7 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
     s->exit_cell = NULL; /* copied last, once what following holds is freed */
     s->exit_label = malloc(((size_t)x->n + 1) * sizeof *s->exit_label);
     const uint64_t chunk = x->n < FOLLOW_CHUNK ? x->n : FOLLOW_CHUNK;
-    followed *f = malloc(((size_t)chunk + 1) * sizeof *f);
+    cm_followed *f = malloc(((size_t)chunk + 1) * sizeof *f);
     uint64_t *next = malloc(((size_t)x->n + 1) * sizeof *next);
     cm_status st = s->exit_label && f && next
                        ? CM_OK
@@ -746,13 +738,13 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
         cells->between(cells->user);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
-        st = follow_all(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
+        st = cm_exits_follow(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
                         &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
             const uint64_t e = first + i;
             next[e] = NEXT_LABEL;
-            s->exit_label[e] = f[i].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
-            if (f[i].how == FOLLOW_RETURNED && returned_add(&back, dim, e, f[i].cell) != CM_OK)
+            s->exit_label[e] = f[i].how == CM_FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+            if (f[i].how == CM_FOLLOW_RETURNED && returned_add(&back, dim, e, f[i].cell) != CM_OK)
                 st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the returned orbits");
         }
     }
@@ -807,7 +799,7 @@ static cm_status leaving_label(void *user, const cm_region *flat, uint64_t j, in
     }
     uint32_t g;
     bool out;
-    if (!lc->cells) { /* orbits not followed */
+    if (!lc->cells) { /* orbits not cm_followed */
         *v = CM_LABEL_OUTSIDE;
         return CM_OK;
     }
@@ -923,7 +915,7 @@ cm_status cm_attractor_cell_labels(const cm_attractor_set *s, const cm_region *f
 }
 
 /* The budget opt asks (0 when not followed). */
-static uint32_t outside_budget(const cm_model *m, const cm_attractor_options *opt)
+uint32_t cm_outside_budget(const cm_model *m, const cm_attractor_options *opt)
 {
     cm_attractor_options o;
     cm_attractor_defaults(m, opt, &o);
@@ -1050,7 +1042,7 @@ static cm_status view_end(view_exits *v, const int64_t *cell, int32_t *label, ch
         *label = CM_LABEL_DIVERGED;
         return CM_OK;
     }
-    st = open_exit(v->c, open, exit, msg, msg_size);
+    st = cm_cluster_open_exit(v->c, open, exit, msg, msg_size);
     if (st == CM_OK)
         st = view_slot(v, exit, &slot, msg, msg_size);
     *label = VIEW_EXIT - (int32_t)slot;
@@ -1073,7 +1065,7 @@ static cm_status open_label(view_exits *v, uint32_t id, int32_t *label, char *ms
     }
     int64_t exit[CM_MAX_DIM];
     uint64_t slot = 0;
-    cm_status st = open_exit(v->c, id, exit, msg, msg_size);
+    cm_status st = cm_cluster_open_exit(v->c, id, exit, msg, msg_size);
     if (st == CM_OK)
         st = view_slot(v, exit, &slot, msg, msg_size);
     if (st == CM_OK) {
@@ -1162,7 +1154,7 @@ static bool view_label(const view_exits *v, const int64_t *cell, int32_t *label)
 /* The labels of n followed exits: diverged, outside, or the end of the
  * cell their orbit returned to (the view's label, else found region by
  * region). */
-static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int32_t *label,
+static cm_status returned_ends(view_exits *v, const cm_followed *f, uint64_t n, int32_t *label,
                                char *msg, size_t msg_size)
 {
     const int dim = v->dim;
@@ -1173,8 +1165,8 @@ static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int
                                         : cm_fail(CM_ENOMEM, msg, msg_size,
                                                   "out of memory for the view's exits");
     for (uint64_t e = 0; st == CM_OK && e < n; e++) {
-        label[e] = f[e].how == FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
-        if (f[e].how != FOLLOW_RETURNED || view_label(v, f[e].cell, &label[e]))
+        label[e] = f[e].how == CM_FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+        if (f[e].how != CM_FOLLOW_RETURNED || view_label(v, f[e].cell, &label[e]))
             continue;
         memcpy(cell + nasked * (uint64_t)dim, f[e].cell, (size_t)dim * sizeof *cell);
         asked[nasked++] = e;
@@ -1190,11 +1182,11 @@ static cm_status returned_ends(view_exits *v, const followed *f, uint64_t n, int
 }
 
 /* What the orbits of n exit cells (dim coordinates each) do, into f[0..n):
- * from the memo where it knows them, the others followed (follow_all) and
+ * from the memo where it knows them, the others followed (cm_exits_follow) and
  * added to it. Steps taken, as if every exit were followed, to *taken. */
 static cm_status follow_memo(const cm_model *m, const cm_computed *cells, const cm_lattice *lat,
                              const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
-                             cm_exit_memo *memo, followed *f, uint64_t *taken, char *msg,
+                             cm_exit_memo *memo, cm_followed *f, uint64_t *taken, char *msg,
                              size_t msg_size)
 {
     const int dim = lat->dim;
@@ -1214,10 +1206,10 @@ static cm_status follow_memo(const cm_model *m, const cm_computed *cells, const 
             miss[nmiss++] = e;
         }
     }
-    followed *fm = malloc(((size_t)nmiss + 1) * sizeof *fm);
+    cm_followed *fm = malloc(((size_t)nmiss + 1) * sizeof *fm);
     int64_t *box = malloc(((size_t)nmiss + 1) * 2 * bytes);
     cm_status st = miss && miss_cell && fm && box
-                       ? follow_all(m, lat, cells, miss_cell, nmiss, steps, threads, fm, box, taken,
+                       ? cm_exits_follow(m, lat, cells, miss_cell, nmiss, steps, threads, fm, box, taken,
                                     msg, msg_size)
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
     for (uint64_t i = 0; st == CM_OK && i < nmiss; i++) {
@@ -1247,14 +1239,14 @@ static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, in
     cm_cluster *c = v->c;
     cm_cluster_cells cc = {c, NULL, NULL};
     const cm_computed cells = cm_cluster_computed(&cc); /* holds only: ends come from view_end */
-    followed *f = NULL;
+    cm_followed *f = NULL;
     uint64_t *next = NULL, done = 0;
     *label = calloc(1, sizeof **label); /* no exit: no fate, but an array */
     cm_status st = *label ? CM_OK
                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
     while (st == CM_OK && done < v->n) {
         const uint64_t to = v->n;
-        followed *f2 = realloc(f, (size_t)to * sizeof *f);
+        cm_followed *f2 = realloc(f, (size_t)to * sizeof *f);
         f = f2 ? f2 : f;
         uint64_t *next2 = f2 ? realloc(next, (size_t)to * sizeof *next) : NULL;
         next = next2 ? next2 : next;
@@ -1267,7 +1259,7 @@ static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, in
         const int64_t *first = v->cell + done * (uint64_t)c->lat.dim;
         st = memo ? follow_memo(m, &cells, &c->lat, first, to - done, steps, threads, memo,
                                 f + done, taken, msg, msg_size)
-                  : follow_all(m, &c->lat, &cells, first, to - done, steps, threads, f + done,
+                  : cm_exits_follow(m, &c->lat, &cells, first, to - done, steps, threads, f + done,
                                NULL, taken, msg, msg_size);
         if (st == CM_OK)
             st = returned_ends(v, f + done, to - done, *label + done, msg, msg_size);
@@ -1371,7 +1363,7 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
         }
         memset(v.cached_open, 0xFF, OPEN_CACHE * sizeof *v.cached_open); /* CM_NODE_OPEN */
     }
-    const uint32_t steps = outside_budget(m, opt);
+    const uint32_t steps = cm_outside_budget(m, opt);
     const int threads = opt ? opt->threads : 0;
     int32_t *fate = NULL;
     uint64_t *weight = NULL, taken = 0;
@@ -1417,7 +1409,7 @@ cm_status cm_region_attractors(const cm_model *m, const cm_lattice *lat, const c
         return st;
     cm_region_cells rc = {r, m, lat, max_steps};
     const cm_computed cells = cm_region_computed(&rc);
-    return cm_attractors_outside(m, lat, x, &cells, outside_budget(m, opt), opt ? opt->threads : 0,
+    return cm_attractors_outside(m, lat, x, &cells, cm_outside_budget(m, opt), opt ? opt->threads : 0,
                                  out, msg, msg_size);
 }
 
@@ -1431,7 +1423,7 @@ cm_status cm_cluster_attractors(const cm_model *m, cm_cluster_cells *cc,
     if (st != CM_OK)
         return st;
     const cm_computed cells = cm_cluster_computed(cc);
-    return outside_fates(m, &c->lat, cc->exits, cc->spent, &cells, outside_budget(m, opt),
+    return outside_fates(m, &c->lat, cc->exits, cc->spent, &cells, cm_outside_budget(m, opt),
                          opt ? opt->threads : 0, out, msg, msg_size);
 }
 

@@ -182,6 +182,37 @@ cm_status cm_cluster_view_labels(const cm_model *m, cm_cluster *c, const cm_regi
                                  cm_exit_memo *memo, cm_attractor_set *s, int32_t *labels,
                                  char *msg, size_t msg_size);
 
+/* What following one exit's true orbit found (cm_exits_follow). */
+enum { CM_FOLLOW_DIVERGED = 0, CM_FOLLOW_OUTSIDE, CM_FOLLOW_RETURNED, CM_FOLLOW_ABORTED };
+typedef struct cm_followed {
+    int how;                  /* CM_FOLLOW_* */
+    uint32_t taken;           /* steps the orbit took */
+    int64_t cell[CM_MAX_DIM]; /* CM_FOLLOW_RETURNED: the computed cell it lands in */
+} cm_followed;
+
+/* The true orbits from the centres of n exit cells (dim coordinates each)
+ * as the header's comment describes, at most `steps` steps each, until
+ * each lands in a computed cell of `cells`, diverges or runs out of steps
+ * (outside), on `threads` OpenMP threads (0: all), into f[0..n); box (NULL:
+ * not wanted) gets each orbit's box of the cells it visited, exit and
+ * landing cell included (lo then hi, dim words each, per exit); the steps
+ * taken are added to *taken. The same results for any number of threads.
+ * CM_EMODEL when the model aborts, CM_ENOMEM. */
+cm_status cm_exits_follow(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
+                          const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
+                          cm_followed *f, int64_t *box, uint64_t *taken, char *msg,
+                          size_t msg_size);
+
+/* The steps an exit's orbit is followed for under opt (NULL: the model's
+ * defaults); 0 when orbits are not followed. */
+uint32_t cm_outside_budget(const cm_model *m, const cm_attractor_options *opt);
+
+/* The exit cell open node id of cluster c leads to, into cell (dim
+ * coordinates): from its region's open list, else from the region's exit
+ * table (the region is paged in). */
+cm_status cm_cluster_open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
+                               size_t msg_size);
+
 /* The label of every node of cluster c (node_label[id]): the label its
  * exit's chain of links ends on (a group's attractor; for an open node,
  * the fate s gives its exit, found from the cluster's escape index; 0 when

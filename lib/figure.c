@@ -269,6 +269,8 @@ bool figure_needs_gl(const png_opts *po, const cm_model *m)
     return po->path && !po->indexed && cm_plot_needs_gl(layers_of(po), m, m->dim);
 }
 
+bool figure_draws_steps(const png_opts *po) { return (layers_of(po) & CM_LAYER_STEPS) != 0; }
+
 bool parse_aspect(const char *s, double *aspect)
 {
     char *end = NULL;

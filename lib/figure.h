@@ -122,6 +122,11 @@ cm_status figure_check(const png_opts *po, const cm_model *m, const cm_lattice *
  * session keeps a context only for figures that do. */
 bool figure_needs_gl(const png_opts *po, const cm_model *m);
 
+/* Whether the figure of these options shades cells by their step numbers
+ * (the steps layer); otherwise a figure by attractors reads only the
+ * cells' labels (cellmap/view_keep.h). */
+bool figure_draws_steps(const png_opts *po);
+
 /* Draws and writes the figure's files (the PNG at opts->path, the SVG at
  * opts->svg, either may be NULL), each reaching its path only when
  * complete. */

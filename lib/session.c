@@ -456,6 +456,60 @@ cm_status session_labels(session *s, const cm_box *box, cm_region *flat, int32_t
     return st;
 }
 
+/* The shown cells, their groups and, by attractors, their labels
+ * (part_labels; the exits met kept for the next render). */
+static cm_status view_labels(session *s, bool by_attractors, cm_region *flat,
+                             cm_group_info **groups, cm_attractor_set *att, int32_t **labels,
+                             char *msg, size_t msg_size)
+{
+    uint32_t *open = NULL;
+    cm_status st = shown_cells(s, flat, by_attractors ? &open : NULL, groups, msg, msg_size);
+    if (st == CM_OK && by_attractors && !s->exit_memo)
+        s->exit_memo = cm_exit_memo_new(); /* NULL: labels without it */
+    if (st == CM_OK && by_attractors)
+        st = part_labels(&s->model, &s->c, flat, open, *groups, false, s->exit_memo, att, labels,
+                         msg, msg_size);
+    free(open);
+    return st;
+}
+
+/* Whether the view's labels can be kept between renders (cellmap/view_keep.h). */
+static bool kept_view_works(session *s)
+{
+    if (!s->c.keep_exits || s->c.resolved_cells || s->c.open_released)
+        return false;
+    if (!s->view_keep)
+        s->view_keep = cm_view_keep_new(); /* NULL: labels afresh */
+    if (!s->resolve_cache)
+        s->resolve_cache = cm_resolve_cache_new(); /* NULL: every node resolved */
+    return s->view_keep != NULL;
+}
+
+/* view_labels by attractors, from what the last render kept: flat gets
+ * what the figure reads of the cells besides their labels; both are the
+ * keep's (cm_view_keep_labels). */
+static cm_status kept_view_labels(session *s, cm_region *flat, cm_group_info **groups,
+                                  cm_attractor_set *att, int32_t **labels, char *msg,
+                                  size_t msg_size)
+{
+    cm_box box;
+    shown_box(s, &box);
+    uint64_t sink = 0;
+    *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
+    cm_status st = *groups ? CM_OK
+                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups",
+                                     s->c.ngroups);
+    if (st == CM_OK)
+        st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_attractors_find(&s->model, &s->c.lat, *groups, s->c.ngroups,
+                                cm_cluster_cells_group, &s->c, NULL, att, msg, msg_size);
+    if (st == CM_OK)
+        st = cm_view_keep_labels(s->view_keep, &s->model, &s->c, s->resolve_cache, &box, NULL,
+                                 att, labels, flat, msg, msg_size);
+    return st;
+}
+
 cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
 {
     const cm_file_use files[] = {{s->path, "the session's database", true, true},
@@ -470,19 +524,14 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
         return st;
     cm_region flat;
     cm_group_info *groups = NULL;
-    uint32_t *open = NULL;
     memset(&flat, 0, sizeof flat);
-    const bool by_attractors = po->by == BY_ATTRACTORS;
-    st = shown_cells(s, &flat, by_attractors ? &open : NULL, &groups, msg, msg_size);
     cm_attractor_set att;
     memset(&att, 0, sizeof att);
     int32_t *labels = NULL;
-    if (st == CM_OK && by_attractors && !s->exit_memo)
-        s->exit_memo = cm_exit_memo_new(); /* NULL: labels without it */
-    if (st == CM_OK && by_attractors)
-        st = part_labels(&s->model, &s->c, &flat, open, groups, false, s->exit_memo, &att,
-                         &labels, msg, msg_size);
-    free(open);
+    const bool by_attractors = po->by == BY_ATTRACTORS;
+    const bool kept = by_attractors && !figure_draws_steps(po) && kept_view_works(s);
+    st = kept ? kept_view_labels(s, &flat, &groups, &att, &labels, msg, msg_size)
+              : view_labels(s, by_attractors, &flat, &groups, &att, &labels, msg, msg_size);
     if (st == CM_OK && !s->gl && figure_needs_gl(po, &s->model))
         st = cm_gl_open(&s->gl, msg, msg_size);
     const basin_png png = {po,
@@ -496,12 +545,14 @@ cm_status session_render(session *s, png_opts *po, char *msg, size_t msg_size)
                            po->by == BY_ATTRACTORS ? &att : NULL,
                            NULL,
                            labels,
-                           &flat}; /* freed after the figure */
+                           &flat}; /* freed (or the keep's) after the figure */
     if (st == CM_OK)
         st = figure_write(&png, msg, msg_size);
-    cm_region_free(&flat);
+    if (!kept) {
+        cm_region_free(&flat);
+        free(labels);
+    }
     cm_attractors_free(&att);
-    free(labels);
     free(groups);
     return st;
 }
@@ -958,6 +1009,8 @@ cm_status session_close(session *s, char *msg, size_t msg_size)
     s->exit_memo = NULL;
     cm_resolve_cache_free(s->resolve_cache);
     s->resolve_cache = NULL;
+    cm_view_keep_free(s->view_keep);
+    s->view_keep = NULL;
     if (s->have_model)
         cm_model_release(&s->model);
     s->have_model = 0;

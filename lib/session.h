@@ -24,6 +24,7 @@
 
 #include <stdbool.h>
 
+#include "cellmap/view_keep.h"
 #include "lib/attractor_report.h"
 #include "lib/figure.h"
 #include "lib/project.h"
@@ -70,6 +71,11 @@ typedef struct session {
      * only the nodes whose outcome changed (made by the first render or
      * stats; NULL until then, or when there was no memory for it) */
     cm_resolve_cache *resolve_cache;
+    /* the last rendered view's cells' ends and the exits they reach, so
+     * that a pan's render by attractors finds only its new cells' (made by
+     * the first such render; NULL until then, or when there was no memory
+     * for it) */
+    cm_view_keep *view_keep;
     /* the journal of a script's run (session_journal_begin): which line
      * runs, and where a killed run of the same script stopped */
     uint64_t script_hash; /* 0: no journal (stdin, the prompt) */
