@@ -77,6 +77,8 @@ static void forget_slots(cm_view_keep *k)
 {
     k->n = 0;
     forget_tiles(k);
+    if (k->reached)
+        memset(k->reached, 0, (size_t)k->cap);
 }
 
 static void reset(cm_view_keep *k)
@@ -267,6 +269,7 @@ static cm_status exit_key(cm_view_keep *k, const int64_t *cell, uint32_t *key, c
     k->state[s] = SLOT_UNFOLLOWED;
     k->next[s] = KEY_OUTSIDE;
     k->taken[s] = 0;
+    k->reached[s] = 0;
     *at = (uint32_t)(s + 1);
     *key = KEY_EXIT | (uint32_t)s;
     return CM_OK;
@@ -367,23 +370,37 @@ static void fresh_part(const cm_view_keep *k, const cm_cluster *c, uint32_t adde
     }
 }
 
+/* Marks the slot of an exit key reached (relaxed: threads mark the same
+ * slots, with the same value). */
+static void mark_reached(uint8_t *reached, uint32_t key)
+{
+    if (is_exit(key))
+        __atomic_store_n(&reached[slot_of_key(key)], 1, __ATOMIC_RELAXED);
+}
+
 /* Copies the keys of the cells box shares with the last view, row by row
- * along dimension 0 (rows are contiguous in both). */
-static void copy_shared(const cm_view_keep *k, const cm_box *box, uint32_t *key, int threads)
+ * along dimension 0 (rows are contiguous in both), and marks the slots
+ * they reach. */
+static void copy_shared(cm_view_keep *k, const cm_box *box, uint32_t *key, int threads)
 {
     cm_box shared;
     if (!k->viewed || !cm_box_intersect(box, &k->box, &shared))
         return;
     const int64_t width = shared.hi[0] - shared.lo[0];
     const int64_t rows = (int64_t)(cm_box_cells(&shared) / (uint64_t)width);
+    uint8_t *reached = k->reached;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t q = 0; q < rows; q++) {
         int64_t cell[CM_MAX_DIM];
         cm_box row = shared;
         row.hi[0] = row.lo[0] + 1;
         cm_box_cell(&row, (uint64_t)q, cell);
-        memcpy(key + cm_box_index(box, cell), k->key + cm_box_index(&k->box, cell),
-               (size_t)width * sizeof *key);
+        uint32_t *to = key + cm_box_index(box, cell);
+        const uint32_t *from = k->key + cm_box_index(&k->box, cell);
+        for (int64_t i = 0; i < width; i++) {
+            to[i] = from[i];
+            mark_reached(reached, to[i]);
+        }
     }
 }
 
@@ -391,49 +408,90 @@ static void copy_shared(const cm_view_keep *k, const cm_box *box, uint32_t *key,
  * one tree, which share an open node, lie together). */
 #define OPEN_CACHE 4096
 
+/* While fresh_keys works: the key of the cell's image, in the part. */
+#define KEY_WALK UINT32_C(0x3FFFFFFD)
+
+/* The keys of the part's cells (flat, with the open nodes its cells leave
+ * by) into pk, where they need no walk: a group's cell its group, a sink
+ * cell that leaves the part its exit (the cell's image, or its open
+ * node's exit), and KEY_WALK for a sink cell whose image is a computed
+ * cell of the part. */
+static cm_status first_keys(cm_view_keep *k, cm_cluster *c, const cm_region *flat,
+                            const uint32_t *open, uint32_t *pk, char *msg, size_t msg_size)
+{
+    uint32_t cached_open[OPEN_CACHE], cached_key[OPEN_CACHE];
+    memset(cached_open, 0xFF, sizeof cached_open); /* CM_NODE_OPEN */
+    cm_status st = CM_OK;
+    for (uint64_t j = 0; j < flat->ncells && st == CM_OK; j++) {
+        const uint32_t g = flat->group[j], id = open[j], image = flat->image[j];
+        if (g != 0 || id == CM_NODE_OPEN) {
+            st = end_key(k, c, g, id, &pk[j], msg, msg_size);
+        } else if (image < flat->ncells && flat->group[image] != CM_GROUP_NONE) {
+            pk[j] = KEY_WALK;
+        } else if (image < flat->ncells) { /* into an uncomputed cell: that is its exit */
+            int64_t exit[CM_MAX_DIM];
+            cm_box_cell(&flat->box, image, exit);
+            st = exit_key(k, exit, &pk[j], msg, msg_size);
+        } else {
+            const uint32_t at = (id * UINT32_C(2654435761)) >> 20; /* 12 bits: OPEN_CACHE */
+            if (cached_open[at] != id) {
+                st = end_key(k, c, g, id, &cached_key[at], msg, msg_size);
+                cached_open[at] = id;
+            }
+            pk[j] = cached_key[at];
+        }
+    }
+    return st;
+}
+
+/* Every KEY_WALK cell of the part takes the key of the first cell its
+ * sequence reaches that has one, as do the cells on the way. */
+static void walk_keys(const cm_region *flat, uint32_t *pk)
+{
+    for (uint64_t j = 0; j < flat->ncells; j++) {
+        if (pk[j] != KEY_WALK)
+            continue;
+        uint64_t end = j;
+        while (pk[end] == KEY_WALK)
+            end = flat->image[end];
+        for (uint64_t i = j; i != end; i = flat->image[i])
+            pk[i] = pk[end];
+    }
+}
+
 /* The keys of the cells of part (in box), from the cluster flattened
- * afresh there. */
+ * afresh there; the slots they reach marked. */
 static cm_status fresh_keys(cm_view_keep *k, cm_cluster *c, cm_resolve_cache *cache,
                             const cm_box *part, const cm_box *box, uint32_t *key, char *msg,
                             size_t msg_size)
 {
     cm_region flat;
     memset(&flat, 0, sizeof flat);
-    uint32_t *open = malloc((size_t)(cm_box_cells(part) + 1) * sizeof *open);
-    uint32_t *cached_open = malloc(OPEN_CACHE * sizeof *cached_open);
-    uint32_t *cached_key = malloc(OPEN_CACHE * sizeof *cached_key);
-    cm_status st = open && cached_open && cached_key
+    const uint64_t n = cm_box_cells(part);
+    uint32_t *open = cm_cells_array(((size_t)n + 1) * sizeof *open);
+    uint32_t *pk = cm_cells_array(((size_t)n + 1) * sizeof *pk);
+    cm_status st = open && pk
                        ? cm_cluster_flatten_cached(c, part, cache, &flat, open, msg, msg_size)
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's cells");
-    if (cached_open)
-        memset(cached_open, 0xFF, OPEN_CACHE * sizeof *cached_open); /* CM_NODE_OPEN */
+    if (st == CM_OK)
+        st = first_keys(k, c, &flat, open, pk, msg, msg_size);
+    if (st == CM_OK)
+        walk_keys(&flat, pk);
     const int64_t width = part->hi[0] - part->lo[0];
-    const uint64_t rows = st == CM_OK ? flat.ncells / (uint64_t)width : 0;
-    for (uint64_t q = 0; q < rows && st == CM_OK; q++) {
+    const uint64_t rows = st == CM_OK ? n / (uint64_t)width : 0;
+    for (uint64_t q = 0; q < rows; q++) { /* rows are contiguous in both */
         int64_t cell[CM_MAX_DIM];
         cm_box_cell(part, q * (uint64_t)width, cell);
         uint32_t *to = key + cm_box_index(box, cell);
-        for (int64_t i = 0; i < width && st == CM_OK; i++) {
-            const uint64_t j = q * (uint64_t)width + (uint64_t)i;
-            const uint32_t g = flat.group[j], id = open[j];
-            if (g != 0 || id == CM_NODE_OPEN) {
-                st = end_key(k, c, g, id, &to[i], msg, msg_size);
-                continue;
-            }
-            const uint32_t at = (id * UINT32_C(2654435761)) >> 20; /* 12 bits: OPEN_CACHE */
-            if (cached_open[at] == id) {
-                to[i] = cached_key[at];
-                continue;
-            }
-            st = end_key(k, c, g, id, &to[i], msg, msg_size);
-            cached_open[at] = id;
-            cached_key[at] = to[i];
+        const uint32_t *from = pk + q * (uint64_t)width;
+        for (int64_t i = 0; i < width; i++) {
+            to[i] = from[i];
+            mark_reached(k->reached, to[i]);
         }
     }
     cm_region_free(&flat);
     free(open);
-    free(cached_open);
-    free(cached_key);
+    free(pk);
     return st;
 }
 
@@ -456,17 +514,12 @@ static cm_status reach(cm_view_keep *k, reach_list *l, uint32_t slot)
     return CM_OK;
 }
 
-/* The slots the view's cells reach, in slot order. */
-static cm_status reach_cells(cm_view_keep *k, const uint32_t *key, uint64_t ncells, int threads,
-                             reach_list *l)
+/* The slots the view's cells reach (marked as their keys were found), in
+ * slot order. */
+static cm_status reached_slots(const cm_view_keep *k, reach_list *l)
 {
-    uint8_t *reached = k->reached;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t i = 0; i < (int64_t)ncells; i++)
-        if (is_exit(key[i]))
-            __atomic_store_n(&reached[slot_of_key(key[i])], 1, __ATOMIC_RELAXED);
     for (uint64_t s = 0; s < k->n; s++)
-        if (reached[s]) {
+        if (k->reached[s]) {
             if (cm_grow((void **)&l->slot, &l->cap, l->n + 1, sizeof *l->slot) != CM_OK)
                 return CM_ENOMEM;
             l->slot[l->n++] = s;
@@ -831,7 +884,7 @@ cm_status cm_view_keep_labels(cm_view_keep *k, const cm_model *m, cm_cluster *c,
     shown->ngroups = c->ngroups;
     if (st == CM_OK)
         st = view_keys(k, c, cache, added_from, box, key, threads, msg, msg_size);
-    if (st == CM_OK && reach_cells(k, key, ncells, threads, &l) != CM_OK)
+    if (st == CM_OK && reached_slots(k, &l) != CM_OK)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
     if (st == CM_OK)
         st = update_reached(k, m, c, box, key, &l, threads, msg, msg_size);

@@ -156,11 +156,8 @@ static cm_status draw_raster(const cm_plot *p, uint8_t *rgba, int fig_width, cha
     for (int b = 0; b < pn->h; b++) {
         if (row[b] < 0)
             continue;
-        uint8_t *px = panel_pixel(p, pn, rgba, fig_width, 0, b);
-        const uint64_t line = s->base + (uint64_t)row[b] * s->row_stride;
-        for (int c = 0; c < pn->w; c++, px += 4)
-            if (col[c] >= 0)
-                cm_raster_rgb(p->ras, line + (uint64_t)col[c], px);
+        cm_raster_row_rgba(p->ras, s->base + (uint64_t)row[b] * s->row_stride, col, pn->w,
+                           panel_pixel(p, pn, rgba, fig_width, 0, b));
     }
     free(col);
     free(row);

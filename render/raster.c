@@ -117,6 +117,30 @@ void cm_raster_rgb(const cm_raster *ras, uint64_t k, uint8_t *p)
     p[2] = (uint8_t)((c[2] * shade) >> 8);
 }
 
+void cm_raster_row_rgba(const cm_raster *ras, uint64_t line, const int64_t *col, int n,
+                        uint8_t *px)
+{
+    if (ras->mode != CM_RASTER_BASIN) {
+        for (int c = 0; c < n; c++)
+            if (col[c] >= 0)
+                cm_raster_rgb(ras, line + (uint64_t)col[c], px + 4 * (size_t)c);
+        return;
+    }
+    const uint32_t *group = ras->cells->group + line; /* flat colours: the group's alone */
+    for (int c = 0; c < n; c++) {
+        if (col[c] < 0)
+            continue;
+        const uint32_t g = group[col[c]];
+        uint8_t *p = px + 4 * (size_t)c;
+        if (g == CM_GROUP_NONE) {
+            put_rgb(p, cm_colour_not_computed);
+            continue;
+        }
+        const uint8_t *rgb = ras->rgb + 3 * (size_t)g;
+        p[0] = rgb[0], p[1] = rgb[1], p[2] = rgb[2];
+    }
+}
+
 /* The cells of each group in the slice, in parallel over rows: the
  * colours depend on which groups are in view. */
 static void count_cells(const cm_region *r, cm_raster *ras)
