@@ -64,6 +64,10 @@ struct cm_view_keep {
 #define TILE_EDGE 8
 #define TILE_CELLS 64
 
+/* Box tests a sync of the slots may take before they are forgotten: about
+ * the time of labelling a view of a million cells afresh. */
+#define SYNC_MOST (UINT64_C(1) << 26)
+
 cm_view_keep *cm_view_keep_new(void) { return calloc(1, sizeof(cm_view_keep)); }
 
 static void forget_tiles(cm_view_keep *k)
@@ -300,10 +304,14 @@ static cm_status end_key(cm_view_keep *k, cm_cluster *c, uint32_t group, uint32_
 }
 
 /* Slots whose exit cell a region added since the last labelling holds are
- * computed now; orbits whose boxes such a region meets are no longer true. */
+ * computed now; orbits whose boxes such a region meets are no longer true.
+ * When that takes more work than labelling afresh (many regions added, as
+ * an extension adds them), the slots are forgotten instead. */
 static void sync_slots(cm_view_keep *k, const cm_cluster *c)
 {
     const int dim = k->dim;
+    if ((uint64_t)(c->nregions - k->regions) * k->n > SYNC_MOST)
+        reset(k); /* the slots and the last view: every key is found afresh */
     for (uint32_t r = k->regions; r < c->nregions; r++) {
         const cm_box *b = &c->regions[r].r.box;
         for (uint64_t s = 0; s < k->n; s++) {
@@ -326,6 +334,16 @@ static void sync_slots(cm_view_keep *k, const cm_cluster *c)
 
 /* ---- the view's cells ----------------------------------------------------- */
 
+/* Grows part (empty: *empty) to hold b. */
+static void add_to_part(cm_box *part, bool *empty, const cm_box *b)
+{
+    if (*empty)
+        *part = *b;
+    else
+        cm_box_grow(part, b);
+    *empty = false;
+}
+
 /* The part of box whose keys must be found afresh: where the last view did
  * not reach, and the regions added since (a bounding box; *empty when none). */
 static void fresh_part(const cm_view_keep *k, const cm_cluster *c, uint32_t added_from,
@@ -334,39 +352,22 @@ static void fresh_part(const cm_view_keep *k, const cm_cluster *c, uint32_t adde
     cm_box shared;
     *empty = true;
     if (!k->viewed || !cm_box_intersect(box, &k->box, &shared)) {
-        *part = *box;
-        *empty = false;
+        add_to_part(part, empty, box);
         return;
     }
     for (int d = 0; d < box->dim; d++) { /* the slabs of box outside shared, dimension by dimension */
-        cm_box slab = *box;
-        if (box->lo[d] < shared.lo[d]) {
-            slab.hi[d] = shared.lo[d];
-            if (*empty)
-                *part = slab;
-            else
-                cm_box_grow(part, &slab);
-            *empty = false;
-        }
-        slab = *box;
-        if (shared.hi[d] < box->hi[d]) {
-            slab.lo[d] = shared.hi[d];
-            if (*empty)
-                *part = slab;
-            else
-                cm_box_grow(part, &slab);
-            *empty = false;
-        }
+        cm_box below = *box, above = *box;
+        below.hi[d] = shared.lo[d];
+        above.lo[d] = shared.hi[d];
+        if (box->lo[d] < shared.lo[d])
+            add_to_part(part, empty, &below);
+        if (shared.hi[d] < box->hi[d])
+            add_to_part(part, empty, &above);
     }
     for (uint32_t r = added_from; r < c->nregions; r++) {
         cm_box met;
-        if (!cm_box_intersect(&c->regions[r].r.box, box, &met))
-            continue;
-        if (*empty)
-            *part = met;
-        else
-            cm_box_grow(part, &met);
-        *empty = false;
+        if (cm_box_intersect(&c->regions[r].r.box, box, &met))
+            add_to_part(part, empty, &met);
     }
 }
 

@@ -144,23 +144,35 @@ static cm_status draw_raster(const cm_plot *p, uint8_t *rgba, int fig_width, cha
         j1 = 1;
     }
     int64_t *col = malloc((size_t)pn->w * sizeof *col), *row = malloc((size_t)pn->h * sizeof *row);
-    if (!col || !row) {
+    int *blank = malloc((size_t)pn->w * sizeof *blank); /* the columns that show no cell */
+    if (!col || !row || !blank) {
         free(col);
         free(row);
+        free(blank);
         return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the raster's pixels");
     }
     const cm_quad_axis ax = axis_x(pn), ay = axis_y(pn);
     cells_of_pixels(&ax, s->x0, s->dx, i0, i1, col);
     cells_of_pixels(&ay, s->y0, s->dy, j0, j1, row);
+    int nblank = 0;
+    for (int c = 0; c < pn->w; c++)
+        if (col[c] < 0)
+            blank[nblank++] = c;
 #pragma omp parallel for schedule(static)
-    for (int b = 0; b < pn->h; b++) {
-        if (row[b] < 0)
+    for (int b = 0; b < pn->h; b++) { /* every pixel of the panel: a cell's, or the background */
+        uint8_t *px = panel_pixel(p, pn, rgba, fig_width, 0, b);
+        if (row[b] < 0) {
+            for (int c = 0; c < pn->w; c++)
+                put(px + 4 * (size_t)c, cm_colour_not_computed);
             continue;
-        cm_raster_row_rgba(p->ras, s->base + (uint64_t)row[b] * s->row_stride, col, pn->w,
-                           panel_pixel(p, pn, rgba, fig_width, 0, b));
+        }
+        cm_raster_row_rgba(p->ras, s->base + (uint64_t)row[b] * s->row_stride, col, pn->w, px);
+        for (int k = 0; k < nblank; k++)
+            put(px + 4 * (size_t)blank[k], cm_colour_not_computed);
     }
     free(col);
     free(row);
+    free(blank);
     return CM_OK;
 }
 
@@ -481,10 +493,12 @@ cm_status cm_plot_draw(const cm_plot *p, uint8_t *rgba, int fig_width, int *tile
                        size_t msg_size)
 {
     *tiles = 0;
-    fill_plot(p, rgba, fig_width);
-    cm_status st = p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS)
-                       ? draw_raster(p, rgba, fig_width, msg, msg_size)
-                       : CM_OK;
+    const bool raster = (p->layers & (CM_LAYER_BASIN | CM_LAYER_STEPS)) != 0;
+    const bool whole = p->basin.x == 0 && p->basin.y == 0 && p->basin.w == p->w &&
+                       p->basin.h == p->h;
+    if (!raster || !whole) /* the raster draws every pixel of its panel */
+        fill_plot(p, rgba, fig_width);
+    cm_status st = raster ? draw_raster(p, rgba, fig_width, msg, msg_size) : CM_OK;
     if (st != CM_OK)
         return st;
     if (!gl_draws(p)) {

@@ -1,6 +1,7 @@
 #include "render/raster.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
@@ -122,8 +123,10 @@ void cm_raster_row_rgba(const cm_raster *ras, uint64_t line, const int64_t *col,
 {
     if (ras->mode != CM_RASTER_BASIN) {
         for (int c = 0; c < n; c++)
-            if (col[c] >= 0)
+            if (col[c] >= 0) {
                 cm_raster_rgb(ras, line + (uint64_t)col[c], px + 4 * (size_t)c);
+                px[4 * (size_t)c + 3] = 255;
+            }
         return;
     }
     const uint32_t *group = ras->cells->group + line; /* flat colours: the group's alone */
@@ -134,10 +137,11 @@ void cm_raster_row_rgba(const cm_raster *ras, uint64_t line, const int64_t *col,
         uint8_t *p = px + 4 * (size_t)c;
         if (g == CM_GROUP_NONE) {
             put_rgb(p, cm_colour_not_computed);
+            p[3] = 255;
             continue;
         }
         const uint8_t *rgb = ras->rgb + 3 * (size_t)g;
-        p[0] = rgb[0], p[1] = rgb[1], p[2] = rgb[2];
+        p[0] = rgb[0], p[1] = rgb[1], p[2] = rgb[2], p[3] = 255;
     }
 }
 
@@ -209,28 +213,63 @@ static void classify_groups(const cm_lattice *lat, const cm_region *r, const cm_
         }
 }
 
-/* The periodic cells in slice order (serial: they are few and the order
- * must not depend on threads). */
-static cm_status collect_periodic(const cm_region *r, cm_raster *ras, char *msg, size_t msg_size)
+/* The periodic cells of rows [j0, j1) of the slice in order, appended to
+ * *list (of *n, room for *cap). False: out of memory. */
+static bool periodic_rows(const cm_region *r, const cm_slice *s, uint64_t j0, uint64_t j1,
+                          cm_periodic_cell **list, uint64_t *n, uint64_t *cap)
 {
-    const cm_slice *s = &ras->s;
-    uint64_t cap = 0;
-    for (uint64_t j = 0; j < s->ny; j++)
+    for (uint64_t j = j0; j < j1; j++)
         for (uint64_t i = 0; i < s->nx; i++) {
             const uint64_t k = s->base + j * s->row_stride + i;
             if (!cm_is_periodic(r, k))
                 continue;
-            if (ras->nperiodic == cap) {
-                cap = cap ? 2 * cap : 1024;
-                cm_periodic_cell *p = realloc(ras->periodic, cap * sizeof *p);
+            if (*n == *cap) {
+                *cap = *cap ? 2 * *cap : 1024;
+                cm_periodic_cell *p = realloc(*list, *cap * sizeof *p);
                 if (!p)
-                    return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for periodic cells");
-                ras->periodic = p;
+                    return false;
+                *list = p;
             }
-            ras->periodic[ras->nperiodic++] =
-                (cm_periodic_cell){(uint32_t)i, (uint32_t)j, r->group[k]};
+            (*list)[(*n)++] = (cm_periodic_cell){(uint32_t)i, (uint32_t)j, r->group[k]};
         }
-    return CM_OK;
+    return true;
+}
+
+/* The periodic cells in slice order: each thread finds those of its rows,
+ * and the threads' lists are joined in row order, so that the order does
+ * not depend on the threads. */
+static cm_status collect_periodic(const cm_region *r, cm_raster *ras, char *msg, size_t msg_size)
+{
+    const cm_slice *s = &ras->s;
+    const int nt = omp_get_max_threads();
+    cm_periodic_cell **part = calloc((size_t)nt, sizeof *part);
+    uint64_t *count = calloc((size_t)nt, sizeof *count);
+    int ok = part && count;
+    if (ok) {
+#pragma omp parallel num_threads(nt) reduction(&& : ok)
+        {
+            const uint64_t t = (uint64_t)omp_get_thread_num();
+            const uint64_t threads = (uint64_t)omp_get_num_threads();
+            uint64_t cap = 0;
+            ok = periodic_rows(r, s, s->ny * t / threads, s->ny * (t + 1) / threads, &part[t],
+                               &count[t], &cap);
+        }
+    }
+    uint64_t total = 0;
+    for (int t = 0; ok && t < nt; t++)
+        total += count[t];
+    ras->periodic = ok ? malloc((size_t)(total + 1) * sizeof *ras->periodic) : NULL;
+    ok = ras->periodic != NULL;
+    for (int t = 0; ok && t < nt; t++) {
+        if (count[t])
+            memcpy(ras->periodic + ras->nperiodic, part[t], (size_t)count[t] * sizeof *part[t]);
+        ras->nperiodic += count[t];
+    }
+    for (int t = 0; part && t < nt; t++)
+        free(part[t]);
+    free(part);
+    free(count);
+    return ok ? CM_OK : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for periodic cells");
 }
 
 cm_status cm_raster_build(const cm_lattice *lat, const cm_region *r, const cm_group_info *groups,

@@ -98,7 +98,8 @@ void cm_raster_rgb(const cm_raster *ras, uint64_t k, uint8_t *p);
 
 /* The colours of n cells of one row, local cells line + col[c] (none where
  * col[c] < 0: that pixel is left as it is), into px + 4 c: a row of RGBA
- * pixels, as cm_raster_rgb gives each (one call a row, not a pixel). */
+ * pixels, opaque, as cm_raster_rgb gives each (one call a row, not a
+ * pixel). */
 void cm_raster_row_rgba(const cm_raster *ras, uint64_t line, const int64_t *col, int n,
                         uint8_t *px);
 
