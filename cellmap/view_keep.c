@@ -126,10 +126,9 @@ static cm_status cells_room(cm_view_keep *k, uint64_t n)
     return k->next_cap >= n && k->out_cap >= n ? CM_OK : CM_ENOMEM;
 }
 
-void cm_view_keep_free(cm_view_keep *k)
+/* Frees every array: the keep is as new (slots are sized by dimension). */
+static void empty(cm_view_keep *k)
 {
-    if (!k)
-        return;
     free_cells(k);
     free(k->cell);
     free(k->span);
@@ -140,6 +139,14 @@ void cm_view_keep_free(cm_view_keep *k)
     free(k->tile_slot);
     free(k->tile_at);
     free(k->hash);
+    memset(k, 0, sizeof *k);
+}
+
+void cm_view_keep_free(cm_view_keep *k)
+{
+    if (!k)
+        return;
+    empty(k);
     free(k);
 }
 
@@ -815,13 +822,13 @@ static cm_status view_keys(cm_view_keep *k, cm_cluster *c, cm_resolve_cache *cac
                            char *msg, size_t msg_size)
 {
     cm_box part;
-    bool empty;
-    fresh_part(k, c, added_from, box, &part, &empty);
-    if (!empty && 2 * cm_box_cells(&part) > cm_box_cells(box))
+    bool none;
+    fresh_part(k, c, added_from, box, &part, &none);
+    if (!none && 2 * cm_box_cells(&part) > cm_box_cells(box))
         part = *box; /* mostly new: no copying first */
     else
         copy_shared(k, box, key, threads);
-    return empty ? CM_OK : fresh_keys(k, c, cache, &part, box, key, msg, msg_size);
+    return none ? CM_OK : fresh_keys(k, c, cache, &part, box, key, msg, msg_size);
 }
 
 /* The ends and fates of the reached slots, the cells' labels and counts. */
@@ -865,6 +872,8 @@ cm_status cm_view_keep_labels(cm_view_keep *k, const cm_model *m, cm_cluster *c,
                        box->dim, c->lat.dim);
     const uint32_t steps = cm_outside_budget(m, opt);
     const int threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    if (k->dim != c->lat.dim)
+        empty(k);
     if (k->dim != c->lat.dim || k->steps != steps || c->nregions < k->regions) {
         reset(k);
         k->dim = c->lat.dim;

@@ -11,6 +11,7 @@
 #include "cellmap/outside.h"
 #include "cellmap/store.h"
 #include "check.h"
+#include "shift_map.h"
 #include "cmdb_hash.h"
 #include "mix.h"
 #include "models/registry.h"
@@ -530,15 +531,6 @@ static uint64_t check_view_labels(cm_cluster *c, const cm_model *m, const cm_gro
     cm_attractors_free(&vs);
     cm_region_free(&part);
     return followed;
-}
-
-/* x moves 5 right until 40, where a fixed point waits at 45.5; y stays. */
-static int shift_step(const cm_model *m, const double *x, double *y)
-{
-    (void)m;
-    y[0] = x[0] < 40 ? x[0] + 5 : 45.5;
-    y[1] = x[1];
-    return CM_STEP_OK;
 }
 
 /* Three regions apart, A = 0..10, B = 20..30 and C = 40..50 (x, cells of

@@ -11,6 +11,7 @@
 #include "cellmap/outside.h"
 #include "cellmap/view_keep.h"
 #include "check.h"
+#include "shift_map.h"
 #include "models/registry.h"
 
 /* What one comparison saw, so that a test can check it was not vacuous. */
@@ -93,6 +94,32 @@ static void grow(cm_cluster *c, const cm_model *m, const cm_box *box, cm_group_i
     CHECK(cm_cluster_describe_new(c, m, *g, msg, sizeof msg) == CM_OK);
 }
 
+/* A cluster that grows, two keeps (one thread, two) that follow its
+ * views, and what the comparisons saw. */
+typedef struct growing {
+    cm_cluster c;
+    cm_view_keep *keeps[2];
+    cm_group_info *g;
+    seen saw;
+} growing;
+
+static void start(growing *w, const cm_lattice *lat)
+{
+    memset(w, 0, sizeof *w);
+    cm_cluster_init(&w->c, lat);
+    w->keeps[0] = cm_view_keep_new();
+    w->keeps[1] = cm_view_keep_new();
+    CHECK(w->keeps[0] && w->keeps[1]);
+}
+
+static void finish(growing *w)
+{
+    cm_view_keep_free(w->keeps[0]);
+    cm_view_keep_free(w->keeps[1]);
+    free(w->g);
+    cm_cluster_free(&w->c);
+}
+
 static cm_box box2(int64_t x0, int64_t x1, int64_t y0, int64_t y1)
 {
     return (cm_box){2, {x0, y0}, {x1, y1}};
@@ -109,61 +136,45 @@ static void test_panning(void)
     const char *const params[] = {"alpha=0.078,beta=0,P=0.007,D=0.02"};
     CHECK(cm_model_create("microchaos-pd", params, 1, &m, msg, sizeof msg) == CM_OK);
     const cm_lattice lat = {2, {0, -40}, {5, 0.8}};
-    cm_cluster c;
-    cm_cluster_init(&c, &lat);
-    cm_view_keep *keeps[2] = {cm_view_keep_new(), cm_view_keep_new()};
-    CHECK(keeps[0] && keeps[1]);
-    cm_group_info *g = NULL;
-    seen saw;
-    memset(&saw, 0, sizeof saw);
+    growing w;
+    start(&w, &lat);
     cm_box view = box2(0, 100, 0, 100);
-    grow(&c, &m, &view, &g);
-    check_view(&c, &m, g, keeps, &view, &saw);
+    grow(&w.c, &m, &view, &w.g);
+    check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw);
     for (int p = 0; p < 12; p++) { /* right */
         const cm_box strip = box2(view.hi[0], view.hi[0] + 10, view.lo[1], view.hi[1]);
-        grow(&c, &m, &strip, &g);
+        grow(&w.c, &m, &strip, &w.g);
         view.lo[0] += 10;
         view.hi[0] += 10;
-        check_view(&c, &m, g, keeps, &view, &saw);
+        check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw);
     }
     for (int p = 0; p < 3; p++) { /* up */
         const cm_box strip = box2(view.lo[0], view.hi[0], view.hi[1], view.hi[1] + 10);
-        grow(&c, &m, &strip, &g);
+        grow(&w.c, &m, &strip, &w.g);
         view.lo[1] += 10;
         view.hi[1] += 10;
-        check_view(&c, &m, g, keeps, &view, &saw);
+        check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw);
     }
     for (int p = 0; p < 4; p++) { /* back left, over cells solved before and some not */
         view.lo[0] -= 30;
         view.hi[0] -= 30;
-        check_view(&c, &m, g, keeps, &view, &saw);
+        check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw);
     }
     const cm_box out = box2(view.lo[0] - 40, view.hi[0] + 40, view.lo[1] - 30, view.hi[1] + 30);
-    check_view(&c, &m, g, keeps, &out, &saw); /* zoomed out: uncomputed cells around */
+    check_view(&w.c, &m, w.g, w.keeps, &out, &w.saw); /* zoomed out: uncomputed cells around */
     const cm_box hole = box2(view.lo[0] - 40, view.lo[0], view.hi[1] + 1, view.hi[1] + 20);
-    grow(&c, &m, &hole, &g); /* a region inside the last view, not at its edge */
-    check_view(&c, &m, g, keeps, &out, &saw);
-    check_view(&c, &m, g, keeps, &view, &saw); /* zoomed in again */
+    grow(&w.c, &m, &hole, &w.g); /* a region inside the last view, not at its edge */
+    check_view(&w.c, &m, w.g, w.keeps, &out, &w.saw);
+    check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw); /* zoomed in again */
+    const seen *saw = &w.saw;
     fprintf(stderr, "panning: %llu views, %llu cells in basins, %llu returned, %llu outside, "
                     "%llu diverged\n",
-            (unsigned long long)saw.views, (unsigned long long)saw.basin_cells,
-            (unsigned long long)saw.returned, (unsigned long long)saw.outside,
-            (unsigned long long)saw.diverged);
-    CHECK(saw.basin_cells > 0 && saw.returned > 0); /* exits whose orbits come back */
-    cm_view_keep_free(keeps[0]);
-    cm_view_keep_free(keeps[1]);
-    free(g);
-    cm_cluster_free(&c);
+            (unsigned long long)saw->views, (unsigned long long)saw->basin_cells,
+            (unsigned long long)saw->returned, (unsigned long long)saw->outside,
+            (unsigned long long)saw->diverged);
+    CHECK(saw->basin_cells > 0 && saw->returned > 0); /* exits whose orbits come back */
+    finish(&w);
     cm_model_release(&m);
-}
-
-/* x moves 5 right until 40, where a fixed point waits at 45.5; y stays. */
-static int shift_step(const cm_model *m, const double *x, double *y)
-{
-    (void)m;
-    y[0] = x[0] < 40 ? x[0] + 5 : 45.5;
-    y[1] = x[1];
-    return CM_STEP_OK;
 }
 
 /* Chains of exits: A = 0..10's exits land in B = 20..30's sink cells,
@@ -177,23 +188,15 @@ static void test_chains(void)
     const cm_lattice lat = {2, {0, 0}, {1, 1}};
     const cm_box order[4] = {box2(40, 50, 0, 4), box2(0, 10, 0, 4), box2(10, 14, 0, 4),
                              box2(20, 30, 0, 4)};
-    cm_cluster c;
-    cm_cluster_init(&c, &lat);
-    cm_view_keep *keeps[2] = {cm_view_keep_new(), cm_view_keep_new()};
-    CHECK(keeps[0] && keeps[1]);
-    cm_group_info *g = NULL;
-    seen saw;
-    memset(&saw, 0, sizeof saw);
+    growing w;
+    start(&w, &lat);
     const cm_box view = box2(0, 12, 0, 4);
     for (int k = 0; k < 4; k++) {
-        grow(&c, &m, &order[k], &g);
-        check_view(&c, &m, g, keeps, &view, &saw);
+        grow(&w.c, &m, &order[k], &w.g);
+        check_view(&w.c, &m, w.g, w.keeps, &view, &w.saw);
     }
-    CHECK(saw.returned > 0); /* once B is there, A's cells return (and so the gap's) */
-    cm_view_keep_free(keeps[0]);
-    cm_view_keep_free(keeps[1]);
-    free(g);
-    cm_cluster_free(&c);
+    CHECK(w.saw.returned > 0); /* once B is there, A's cells return (and so the gap's) */
+    finish(&w);
 }
 
 int main(void)
