@@ -345,7 +345,7 @@ static bool cluster_holds(const void *user, const int64_t *cell)
 /* The exit cell of open node id: from its region's open list (in node
  * order), else from its exit table (paged in). */
 cm_status cm_cluster_open_exit(cm_cluster *c, uint32_t id, int64_t *cell, char *msg,
-                           size_t msg_size)
+                               size_t msg_size)
 {
     const uint32_t k = cm_cluster_node_region(c, id);
     const cm_cluster_region *cr = &c->regions[k];
@@ -616,9 +616,9 @@ static void count_fates(const cm_exits *x, cm_attractor_set *s)
  * unless NULL: follow_batch); the steps taken added to *taken. CM_EMODEL
  * when the model aborts. */
 cm_status cm_exits_follow(const cm_model *m, const cm_lattice *lat, const cm_computed *cells,
-                            const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
-                            cm_followed *f, int64_t *box, uint64_t *taken, char *msg,
-                            size_t msg_size)
+                          const int64_t *exit_cell, uint64_t n, uint32_t steps, int threads,
+                          cm_followed *f, int64_t *box, uint64_t *taken, char *msg,
+                          size_t msg_size)
 {
     const int64_t batches = (int64_t)((n + FOLLOW_BATCH - 1) / FOLLOW_BATCH);
     uint64_t sum = 0;
@@ -738,12 +738,13 @@ static cm_status outside_fates(const cm_model *m, const cm_lattice *lat, const c
         cells->between(cells->user);
     for (uint64_t first = 0; st == CM_OK && first < x->n; first += chunk) {
         const uint64_t n = x->n - first < chunk ? x->n - first : chunk;
-        st = cm_exits_follow(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads, f, NULL,
-                        &taken, msg, msg_size);
+        st = cm_exits_follow(m, lat, cells, x->cell + first * (uint64_t)dim, n, steps, threads,
+                             f, NULL, &taken, msg, msg_size);
         for (uint64_t i = 0; st == CM_OK && i < n; i++) {
             const uint64_t e = first + i;
             next[e] = NEXT_LABEL;
-            s->exit_label[e] = f[i].how == CM_FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
+            s->exit_label[e] =
+                f[i].how == CM_FOLLOW_DIVERGED ? CM_LABEL_DIVERGED : CM_LABEL_OUTSIDE;
             if (f[i].how == CM_FOLLOW_RETURNED && returned_add(&back, dim, e, f[i].cell) != CM_OK)
                 st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the returned orbits");
         }
@@ -1209,8 +1210,8 @@ static cm_status follow_memo(const cm_model *m, const cm_computed *cells, const 
     cm_followed *fm = malloc(((size_t)nmiss + 1) * sizeof *fm);
     int64_t *box = malloc(((size_t)nmiss + 1) * 2 * bytes);
     cm_status st = miss && miss_cell && fm && box
-                       ? cm_exits_follow(m, lat, cells, miss_cell, nmiss, steps, threads, fm, box, taken,
-                                    msg, msg_size)
+                       ? cm_exits_follow(m, lat, cells, miss_cell, nmiss, steps, threads, fm,
+                                         box, taken, msg, msg_size)
                        : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the view's exits");
     for (uint64_t i = 0; st == CM_OK && i < nmiss; i++) {
         f[miss[i]] = fm[i];
@@ -1259,8 +1260,8 @@ static cm_status view_fates(const cm_model *m, view_exits *v, uint32_t steps, in
         const int64_t *first = v->cell + done * (uint64_t)c->lat.dim;
         st = memo ? follow_memo(m, &cells, &c->lat, first, to - done, steps, threads, memo,
                                 f + done, taken, msg, msg_size)
-                  : cm_exits_follow(m, &c->lat, &cells, first, to - done, steps, threads, f + done,
-                               NULL, taken, msg, msg_size);
+                  : cm_exits_follow(m, &c->lat, &cells, first, to - done, steps, threads,
+                                    f + done, NULL, taken, msg, msg_size);
         if (st == CM_OK)
             st = returned_ends(v, f + done, to - done, *label + done, msg, msg_size);
         for (uint64_t e = done; st == CM_OK && e < to; e++) {

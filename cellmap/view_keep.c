@@ -155,7 +155,8 @@ uint64_t cm_view_keep_bytes(const cm_view_keep *k)
     if (!k)
         return 0;
     const uint64_t per_slot = 3 * (uint64_t)k->dim * sizeof(int64_t) + 2 * sizeof(uint32_t) + 2;
-    const uint64_t per_tile = TILE_CELLS * sizeof *k->tile_slot + (uint64_t)k->dim * sizeof(int64_t);
+    const uint64_t per_tile =
+        TILE_CELLS * sizeof *k->tile_slot + (uint64_t)k->dim * sizeof(int64_t);
     return sizeof *k + (k->key_cap + k->next_cap + 3 * k->out_cap) * sizeof *k->key +
            k->cap * per_slot + k->tiles_cap * per_tile + k->hash_size * sizeof *k->hash;
 }
@@ -362,7 +363,7 @@ static void fresh_part(const cm_view_keep *k, const cm_cluster *c, uint32_t adde
         add_to_part(part, empty, box);
         return;
     }
-    for (int d = 0; d < box->dim; d++) { /* the slabs of box outside shared, dimension by dimension */
+    for (int d = 0; d < box->dim; d++) { /* the slabs of box outside shared, dimension by dim. */
         cm_box below = *box, above = *box;
         below.hi[d] = shared.lo[d];
         above.lo[d] = shared.hi[d];
