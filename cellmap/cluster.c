@@ -1864,6 +1864,16 @@ static void cache_empty(cm_resolve_cache *cache)
     cache->nregions = 0;
 }
 
+uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache)
+{
+    if (!cache)
+        return 0;
+    uint64_t bytes = sizeof *cache + (uint64_t)cache->nregions * sizeof *cache->region;
+    for (uint32_t k = 0; k < cache->nregions; k++) /* group, step, open and cycle a node */
+        bytes += cache->region[k].cap * (3 * sizeof(uint32_t) + 1);
+    return bytes;
+}
+
 void cm_resolve_cache_free(cm_resolve_cache *cache)
 {
     if (!cache)

@@ -529,6 +529,9 @@ typedef struct cm_resolve_cache cm_resolve_cache;
 cm_resolve_cache *cm_resolve_cache_new(void);
 void cm_resolve_cache_free(cm_resolve_cache *cache);
 
+/* The bytes the cache holds (0 for NULL). */
+uint64_t cm_resolve_cache_bytes(const cm_resolve_cache *cache);
+
 /* cm_cluster_flatten_open (open may be NULL) through cache, which then
  * holds the regions that meet box and no others (NULL: every node resolved
  * afresh, as cm_cluster_flatten_open does). On failure the cache is

@@ -37,10 +37,12 @@ void cm_exit_memo_free(cm_exit_memo *memo)
     free(memo);
 }
 
-uint64_t cm_exit_memo_count(const cm_exit_memo *memo) { return memo->n; }
+uint64_t cm_exit_memo_count(const cm_exit_memo *memo) { return memo ? memo->n : 0; }
 
 uint64_t cm_exit_memo_bytes(const cm_exit_memo *memo)
 {
+    if (!memo)
+        return 0;
     const uint64_t per = (uint64_t)WORDS * (uint64_t)memo->dim * sizeof *memo->coord +
                          sizeof *memo->how + sizeof *memo->taken + sizeof *memo->used;
     return memo->cap * per + memo->hash_size * sizeof *memo->hash;

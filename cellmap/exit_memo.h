@@ -50,7 +50,7 @@ typedef struct cm_exit_memo cm_exit_memo;
 cm_exit_memo *cm_exit_memo_new(void);
 void cm_exit_memo_free(cm_exit_memo *memo);
 
-/* Entries held, and the bytes they and the hash take. */
+/* Entries held, and the bytes they and the hash take (0 for NULL). */
 uint64_t cm_exit_memo_count(const cm_exit_memo *memo);
 uint64_t cm_exit_memo_bytes(const cm_exit_memo *memo);
 

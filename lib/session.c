@@ -623,6 +623,8 @@ cm_status session_count(session *s, session_stats *v, char *msg, size_t msg_size
         v->file_bytes = info.file_bytes;
     v->memory_bytes = cm_cluster_bytes(&s->c);
     v->resident_bytes = cm_cluster_resident_bytes(&s->c);
+    v->view_bytes = cm_view_keep_bytes(s->view_keep) + cm_exit_memo_bytes(s->exit_memo) +
+                    cm_resolve_cache_bytes(s->resolve_cache);
     return CM_OK;
 }
 

@@ -224,6 +224,8 @@ typedef struct session_stats {
     cm_attractor_set att;   /* the system's attractors */
     uint64_t *by_label;     /* cells per attractor label, at label + 2 (-2 and -1 first) */
     uint64_t memory_bytes, resident_bytes; /* the cluster's, in memory */
+    uint64_t view_bytes; /* what the session keeps of its views: the kept view, the exit memo
+                            and the resolve cache (outside --mem) */
 } session_stats;
 
 /* Counts the view (the session needs one); session_stats_free frees it,

@@ -92,12 +92,14 @@ void stats_report(FILE *f, const session *s, const session_stats *v)
     print_attractors(f, s, v);
     fprintf(f,
             "cluster: %u regions, %llu cells, %u groups; memory %.1f MiB (cell arrays, "
-            "node tables and open lists %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n",
+            "node tables and open lists %.1f MiB%s); disk %.1f MiB (%.2f bytes/cell)\n"
+            "kept of the views rendered: %.1f MiB (labels, exits, resolved nodes)\n",
             s->c.nregions, (unsigned long long)v->cluster_cells, s->c.ngroups,
             (double)v->memory_bytes / 1048576.0,
             (double)v->resident_bytes / 1048576.0,
             s->c.mem_budget ? ", within --mem" : "", (double)v->file_bytes / 1048576.0,
-            v->cluster_cells ? (double)v->file_bytes / (double)v->cluster_cells : 0.0);
+            v->cluster_cells ? (double)v->file_bytes / (double)v->cluster_cells : 0.0,
+            (double)v->view_bytes / 1048576.0);
 }
 
 void stats_json(FILE *f, const session *s, const session_stats *v)
@@ -143,6 +145,7 @@ void stats_json(FILE *f, const session *s, const session_stats *v)
     json_uint(&j, "memory_bytes", v->memory_bytes);
     json_uint(&j, "resident_bytes", v->resident_bytes);
     json_uint(&j, "file_bytes", v->file_bytes);
+    json_uint(&j, "view_bytes", v->view_bytes);
     json_object_end(&j);
     json_end(&j);
 }
