@@ -238,6 +238,8 @@ static cm_status find_attractors(const solve_request *q, solve_result *r, char *
                     : CM_OK;
 }
 
+bool solve_small(uint64_t cells, bool extends) { return !extends && cells < 32768; }
+
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
 {
     memset(r, 0, sizeof *r);

@@ -78,6 +78,15 @@ typedef struct solve_result {
     cm_store *store;
 } solve_result;
 
+/* Whether a solve of `cells` cells (extended or not) is better run on one
+ * thread than on all: below 32 768 cells without an extension, waking a
+ * second thread for each of its short parallel regions costs more than it
+ * saves (2 vCPUs: 128 x 128 cells, figure included, 16 ms on one thread
+ * against 27 on two; 256 x 256, 62 against 50; docs/engine.md). The results
+ * are the same for any number of threads. The caller, which owns the
+ * process's OpenMP settings, decides what to do with it. */
+bool solve_small(uint64_t cells, bool extends);
+
 /* Solves, summarises and finds the attractors (stored in the database).
  * *r is initialised here; solve_result_free frees it whatever the status. */
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size);

@@ -418,13 +418,6 @@ static int say_interrupted(const solve_args *a, const char *command, const solve
     return EXIT_INTERRUPTED;
 }
 
-/* Below this many cells a solve runs on one thread unless --threads says
- * otherwise: waking a second thread for each of its short parallel regions
- * costs more than it saves (2 vCPUs: 128 x 128 cells, figure included,
- * 16 ms on one thread against 27 on two; 256 x 256, 62 against 50). The
- * results are the same for any number of threads. */
-enum { SMALL_JOB_CELLS = 32768 };
-
 int cmd_solve(int argc, char **argv)
 {
     cli c = {"solve", argc, argv, 0, NULL, NULL};
@@ -457,7 +450,7 @@ int cmd_solve(int argc, char **argv)
         (png_opts_draws(&a.png) &&
          (rc = check_basin_png("solve", &a.png, &m, &q.lat, &q.box)) != EXIT_OK))
         goto done;
-    if (!a.threads && !a.extend && cm_box_cells(&q.box) < SMALL_JOB_CELLS)
+    if (!a.threads && solve_small(cm_box_cells(&q.box), a.extend))
         omp_set_num_threads(1);
     progress pr;
     progress_start(&pr, "solve", "cells", cm_box_cells(&q.box), a.quiet);
