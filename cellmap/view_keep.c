@@ -387,6 +387,15 @@ static void mark_reached(uint8_t *reached, uint32_t key)
         __atomic_store_n(&reached[slot_of_key(key)], 1, __ATOMIC_RELAXED);
 }
 
+/* Copies a row of width keys and marks the slots they reach. */
+static void copy_keys(uint32_t *to, const uint32_t *from, int64_t width, uint8_t *reached)
+{
+    for (int64_t i = 0; i < width; i++) {
+        to[i] = from[i];
+        mark_reached(reached, to[i]);
+    }
+}
+
 /* Copies the keys of the cells box shares with the last view, row by row
  * along dimension 0 (rows are contiguous in both), and marks the slots
  * they reach. */
@@ -404,12 +413,8 @@ static void copy_shared(cm_view_keep *k, const cm_box *box, uint32_t *key, int t
         cm_box row = shared;
         row.hi[0] = row.lo[0] + 1;
         cm_box_cell(&row, (uint64_t)q, cell);
-        uint32_t *to = key + cm_box_index(box, cell);
-        const uint32_t *from = k->key + cm_box_index(&k->box, cell);
-        for (int64_t i = 0; i < width; i++) {
-            to[i] = from[i];
-            mark_reached(reached, to[i]);
-        }
+        copy_keys(key + cm_box_index(box, cell), k->key + cm_box_index(&k->box, cell), width,
+                  reached);
     }
 }
 
@@ -491,12 +496,7 @@ static cm_status fresh_keys(cm_view_keep *k, cm_cluster *c, cm_resolve_cache *ca
     for (uint64_t q = 0; q < rows; q++) { /* rows are contiguous in both */
         int64_t cell[CM_MAX_DIM];
         cm_box_cell(part, q * (uint64_t)width, cell);
-        uint32_t *to = key + cm_box_index(box, cell);
-        const uint32_t *from = pk + q * (uint64_t)width;
-        for (int64_t i = 0; i < width; i++) {
-            to[i] = from[i];
-            mark_reached(k->reached, to[i]);
-        }
+        copy_keys(key + cm_box_index(box, cell), pk + q * (uint64_t)width, width, k->reached);
     }
     cm_region_free(&flat);
     free(open);
@@ -512,28 +512,32 @@ typedef struct reach_list {
     uint64_t n, cap;
 } reach_list;
 
+static cm_status list_add(reach_list *l, uint64_t slot)
+{
+    if (cm_grow((void **)&l->slot, &l->cap, l->n + 1, sizeof *l->slot) != CM_OK)
+        return CM_ENOMEM;
+    l->slot[l->n++] = slot;
+    return CM_OK;
+}
+
+/* Lists slot as reached, unless it is already. */
 static cm_status reach(cm_view_keep *k, reach_list *l, uint32_t slot)
 {
     if (k->reached[slot])
         return CM_OK;
-    if (cm_grow((void **)&l->slot, &l->cap, l->n + 1, sizeof *l->slot) != CM_OK)
-        return CM_ENOMEM;
     k->reached[slot] = 1;
-    l->slot[l->n++] = slot;
-    return CM_OK;
+    return list_add(l, slot);
 }
 
 /* The slots the view's cells reach (marked as their keys were found), in
  * slot order. */
 static cm_status reached_slots(const cm_view_keep *k, reach_list *l)
 {
-    for (uint64_t s = 0; s < k->n; s++)
-        if (k->reached[s]) {
-            if (cm_grow((void **)&l->slot, &l->cap, l->n + 1, sizeof *l->slot) != CM_OK)
-                return CM_ENOMEM;
-            l->slot[l->n++] = s;
-        }
-    return CM_OK;
+    cm_status st = CM_OK;
+    for (uint64_t s = 0; s < k->n && st == CM_OK; s++)
+        if (k->reached[s])
+            st = list_add(l, s);
+    return st;
 }
 
 /* The keys of n computed cells (dim words each): the view's keys for its
@@ -874,12 +878,11 @@ cm_status cm_view_keep_labels(cm_view_keep *k, const cm_model *m, cm_cluster *c,
     const uint32_t steps = cm_outside_budget(m, opt);
     const int threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
     if (k->dim != c->lat.dim)
-        empty(k);
-    if (k->dim != c->lat.dim || k->steps != steps || c->nregions < k->regions) {
+        empty(k); /* reset too: a keep as new */
+    else if (k->steps != steps || c->nregions < k->regions)
         reset(k);
-        k->dim = c->lat.dim;
-        k->steps = steps;
-    }
+    k->dim = c->lat.dim;
+    k->steps = steps;
     const uint32_t added_from = k->regions;
     sync_slots(k, c);
     const uint64_t ncells = cm_box_cells(box);

@@ -395,17 +395,24 @@ cm_status session_extend(session *s, const cm_box *tile, int steps, session_step
 
 /* ---- render, stats ------------------------------------------------------------ */
 
+/* The cluster's groups (ids 1..ngroups) into a new *groups, the caller's
+ * to free (also on failure). */
+static cm_status read_groups(session *s, cm_group_info **groups, char *msg, size_t msg_size)
+{
+    uint64_t sink = 0;
+    *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
+    return *groups ? cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size)
+                   : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups",
+                             s->c.ngroups);
+}
+
 /* The cells of box, flattened, and the cluster's groups; with open
  * non-NULL, also the cells' open nodes (cm_cluster_flatten_open) into a
  * new *open, the caller's to free. */
 static cm_status box_cells(session *s, const cm_box *box, cm_region *flat, uint32_t **open,
                            cm_group_info **groups, char *msg, size_t msg_size)
 {
-    uint64_t sink = 0;
-    *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
-    if (!*groups)
-        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups", s->c.ngroups);
-    cm_status st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
+    cm_status st = read_groups(s, groups, msg, msg_size);
     if (st != CM_OK)
         return st;
     if (!s->resolve_cache)
@@ -473,7 +480,9 @@ static cm_status view_labels(session *s, bool by_attractors, cm_region *flat,
     return st;
 }
 
-/* Whether the view's labels can be kept between renders (cellmap/view_keep.h). */
+/* Whether the view's labels can be kept between renders (cellmap/view_keep.h);
+ * the keep, and the resolve cache it flattens through, made when first
+ * needed. */
 static bool kept_view_works(session *s)
 {
     if (!s->c.keep_exits || s->c.resolved_cells || s->c.open_released)
@@ -494,13 +503,7 @@ static cm_status kept_view_labels(session *s, cm_region *flat, cm_group_info **g
 {
     cm_box box;
     shown_box(s, &box);
-    uint64_t sink = 0;
-    *groups = calloc((size_t)s->c.ngroups + 1, sizeof **groups);
-    cm_status st = *groups ? CM_OK
-                           : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u groups",
-                                     s->c.ngroups);
-    if (st == CM_OK)
-        st = cm_store_groups(s->store, *groups, s->c.ngroups, &sink, msg, msg_size);
+    cm_status st = read_groups(s, groups, msg, msg_size);
     if (st == CM_OK)
         st = cm_attractors_find(&s->model, &s->c.lat, *groups, s->c.ngroups,
                                 cm_cluster_cells_group, &s->c, NULL, att, msg, msg_size);
@@ -974,10 +977,8 @@ static cm_status save_attractors(session *s, char *msg, size_t msg_size)
         if (stored != CM_ENOTFOUND)
             return stored;
     }
-    cm_group_info *groups = calloc((size_t)s->c.ngroups + 1, sizeof *groups);
-    uint64_t sink = 0;
-    cm_status st = groups ? cm_store_groups(s->store, groups, s->c.ngroups, &sink, msg, msg_size)
-                          : cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for the groups");
+    cm_group_info *groups = NULL;
+    cm_status st = read_groups(s, &groups, msg, msg_size);
     memset(&att, 0, sizeof att);
     cm_attractor_options used;
     cm_attractor_defaults(&s->model, NULL, &used);
