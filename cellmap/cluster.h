@@ -206,6 +206,9 @@ typedef struct cm_cluster {
      * sequences most likely land, and evicts the others first. */
     const cm_box *upcoming;
     uint32_t nupcoming;
+    /* public: where cm_cluster_solve_boxes gets regions solved elsewhere
+     * (cellmap/join.h); NULL: it solves every box */
+    const struct cm_region_source *source;
     /* private */
     uint64_t cap, basin_cap, periodic_cap, clock;
     cm_idmap open;   /* weights of open nodes no open list holds, their node tables paged out */

@@ -549,6 +549,7 @@ typedef struct pipeline {
     plan pl;            /* pl.index NULL: the joins go without it */
     plan_target **targets; /* per slot: where its region's exits lead */
     cm_node **nodes;       /* per slot: its region's node table */
+    uint8_t *deferred;     /* per slot: solved elsewhere, fetched at its join */
 } pipeline;
 
 /* Where region r's exits lead among the boxes of the plan (on the thread
@@ -576,6 +577,23 @@ static cm_status locate_exits(const plan *pl, const cm_region *r, plan_target **
     return CM_OK;
 }
 
+/* What the join of the region in slot s needs of it alone: its node
+ * table, and where its exits lead among the plan's boxes. */
+static void prepare_region(pipeline *p, uint32_t s)
+{
+    if (p->status[s] == CM_OK &&
+        (cm_region_nodes(&p->slot[s], &p->nodes[s]) != CM_OK ||
+         (p->pl.index && locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)))
+        p->status[s] = cm_fail(CM_ENOMEM, p->msgs[s], sizeof p->msgs[s],
+                               "out of memory for its nodes");
+}
+
+static void pause_briefly(void)
+{
+    const struct timespec t = {0, 20000};
+    nanosleep(&t, NULL);
+}
+
 /* Claims and solves the next box if the window allows; false if it does not. */
 static bool solve_next(pipeline *p)
 {
@@ -585,24 +603,37 @@ static bool solve_next(pipeline *p)
             return false;
     } while (!atomic_compare_exchange_weak(&p->next, &b, b + 1));
     const uint32_t s = b % p->window;
-    p->status[s] = cm_region_alloc(&p->slot[s], &p->boxes[b], p->msgs[s], sizeof p->msgs[s]);
-    if (p->status[s] == CM_OK)
-        p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
-                                    sizeof p->msgs[s]);
-    /* what the join needs of the region alone is made here, off the joining thread */
-    if (p->status[s] == CM_OK &&
-        (cm_region_nodes(&p->slot[s], &p->nodes[s]) != CM_OK ||
-         (p->pl.index && locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)))
-        p->status[s] = cm_fail(CM_ENOMEM, p->msgs[s], sizeof p->msgs[s],
-                               "out of memory for its nodes");
+    const cm_region_source *src = p->c->source;
+    bool got = true;
+    if (src && src->elsewhere(src->user, b)) { /* if it has not come, its join fetches it */
+        p->status[s] = src->fetch(src->user, b, &p->slot[s], &got, p->msgs[s], sizeof p->msgs[s]);
+        p->deferred[s] = p->status[s] == CM_OK && !got;
+    } else {
+        p->status[s] = cm_region_alloc(&p->slot[s], &p->boxes[b], p->msgs[s], sizeof p->msgs[s]);
+        if (p->status[s] == CM_OK)
+            p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
+                                        sizeof p->msgs[s]);
+    }
+    if (got) /* what the join needs of the region alone, off the joining thread */
+        prepare_region(p, s);
     atomic_store(&p->ready[s], b + 1);
     return true;
 }
 
-static void pause_briefly(void)
+/* Box b, in slot s, solved elsewhere and not fetched when it was claimed:
+ * fetched now, the boxes after it solved meanwhile. */
+static void fetch_deferred(pipeline *p, uint32_t b, uint32_t s)
 {
-    const struct timespec t = {0, 20000};
-    nanosleep(&t, NULL);
+    const cm_region_source *src = p->c->source;
+    bool got = false;
+    while (p->status[s] == CM_OK && !got) {
+        p->status[s] = src->fetch(src->user, b, &p->slot[s], &got, p->msgs[s], sizeof p->msgs[s]);
+        if (p->status[s] == CM_OK && !got && !solve_next(p))
+            pause_briefly();
+    }
+    p->deferred[s] = 0;
+    if (got)
+        prepare_region(p, s);
 }
 
 /* Bytes of the regions after box b solved ahead of their joins (complete
@@ -633,6 +664,8 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         while (atomic_load(&p->ready[s]) != b + 1)
             if (!solve_next(p))
                 pause_briefly();
+        if (p->deferred[s])
+            fetch_deferred(p, b, s);
         if (p->status[s] != CM_OK)
             st = cm_fail(p->status[s], msg, msg_size, "region %u: %s", b, p->msgs[s]);
         const uint32_t ns = (b + 1) % p->window;
@@ -721,6 +754,7 @@ static void free_pipeline(pipeline *p)
     for (uint32_t k = 0; p->nodes && k < p->window; k++)
         free(p->nodes[k]);
     free(p->nodes);
+    free(p->deferred);
     free(p->slot);
     free(p->status);
     free(p->msgs);
@@ -736,8 +770,11 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 #ifdef _OPENMP
     threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #endif
-    pipeline p = {c, model, boxes, nboxes, 2 * (uint32_t)threads, opt ? *opt : (cm_scm_options){0},
-                  NULL, NULL, NULL, 0, 0, NULL, 0, {0}, NULL, NULL};
+    /* regions solved elsewhere come while this process solves its own */
+    const uint32_t processes = c->source && c->source->processes > 1 ? c->source->processes : 1;
+    pipeline p = {c,    model, boxes, nboxes, 2 * (uint32_t)threads * processes,
+                  opt ? *opt : (cm_scm_options){0},
+                  NULL, NULL, NULL, 0, 0, NULL, 0, {0}, NULL, NULL, NULL};
     p.one.record_exits = 1;
     /* one region per thread: classification is sequential, so this is how
      * a big box uses every core; a lone box (a strip uncovered by panning)
@@ -749,7 +786,8 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     p.ready = calloc(p.window, sizeof *p.ready);
     p.targets = calloc(p.window, sizeof *p.targets);
     p.nodes = calloc(p.window, sizeof *p.nodes);
-    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets || !p.nodes ||
+    p.deferred = calloc(p.window, sizeof *p.deferred);
+    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets || !p.nodes || !p.deferred ||
         plan_boxes(&p.pl, c, boxes, nboxes) != CM_OK) {
         free_pipeline(&p);
         free_plan(&p.pl, c);
@@ -757,7 +795,13 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     }
     if (stats)
         memset(stats, 0, sizeof *stats);
-    cm_status st = CM_OK;
+    const cm_region_source *src = c->source;
+    cm_status st = src ? src->ask(src->user, boxes, nboxes, msg, msg_size) : CM_OK;
+    if (st != CM_OK) {
+        free_pipeline(&p);
+        free_plan(&p.pl, c);
+        return st;
+    }
     const int team = nboxes > 1 ? threads : 1;
 #pragma omp parallel num_threads(team)
     {

@@ -36,12 +36,33 @@ typedef struct cm_join_stats {
 cm_status cm_cluster_join(cm_cluster *c, cm_region *r, cm_join_stats *stats, char *msg,
                           size_t msg_size);
 
+/* Regions that cm_cluster_solve_boxes takes from elsewhere (other processes,
+ * lib/ranks.h) instead of solving them: each made by cm_scm_solve with
+ * record_exits on the cluster's lattice and the solve's max_steps, as this
+ * process would make it, so the cluster is the same. */
+typedef struct cm_region_source {
+    /* Before a call's boxes are solved (on the calling thread): boxes[0..n)
+     * are the call's, in join order. */
+    cm_status (*ask)(void *user, const cm_box *boxes, uint32_t n, char *msg, size_t msg_size);
+    /* Whether box b of the call is solved elsewhere. */
+    bool (*elsewhere)(const void *user, uint32_t b);
+    /* Box b's region into *r (which cm_region_free releases) if it has
+     * come (*got), without waiting; from any of the solve's threads, until
+     * it has come. Meanwhile the solve goes on with other boxes. */
+    cm_status (*fetch)(void *user, uint32_t b, cm_region *r, bool *got, char *msg,
+                       size_t msg_size);
+    uint32_t processes; /* this one and those that solve elsewhere: how far
+                           ahead of the joins the boxes may go grows with it */
+    void *user;
+} cm_region_source;
+
 /* Called after each join of cm_cluster_solve_boxes (box is its index);
  * a status other than CM_OK stops the solve with it. */
 typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
                                   const cm_join_stats *stats, char *msg, size_t msg_size);
 
-/* Solves the boxes, one per thread (a lone box with every thread), and
+/* Solves the boxes, one per thread (a lone box with every thread; those
+ * c->source says are solved elsewhere fetched from it), and
  * joins them in the given order on the calling thread while the others go
  * on solving (at most two boxes per thread ahead of the joins), calling
  * joined (may be NULL) after every join. stats (may be NULL) sums the

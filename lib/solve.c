@@ -161,6 +161,7 @@ static cm_status solve_cluster(const solve_request *q, solve_result *r, char *ms
     r->c.keep_exits = q->db != NULL; /* only a database saves them; no image is read */
     r->c.threads = plan.opt.threads;
     r->c.mem_budget = q->mem ? q->mem : q->db ? project_default_mem() : 0;
+    r->c.source = q->ranks && q->ranks->size > 1 ? &q->ranks->source : NULL;
     r->first = "regions and joins";
     r->second = "summary";
     const double t0 = cm_seconds();
@@ -240,15 +241,68 @@ static cm_status find_attractors(const solve_request *q, solve_result *r, char *
 
 bool solve_small(uint64_t cells, bool extends) { return !extends && cells < 32768; }
 
+/* Whether a solve on q->ranks can share its regions among them: the same
+ * answer on every rank, which all give. */
+static cm_status ranks_can_share(const solve_request *q, char *msg, size_t msg_size)
+{
+    const int n = q->ranks->size;
+    if (!q->cluster || q->stage1)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a solve on %d ranks shares its regions among them: split the box "
+                       "(--split) or extend it (--extend)%s, or run it without mpirun",
+                       n, q->stage1 ? "; --stage1 runs in one process" : "");
+    const uint32_t regions = project_split(&q->plan, &q->box, NULL);
+    if (q->plan.extend == 0 && regions < (uint32_t)n)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "%d ranks for %u region%s: run at most %u (mpirun -n %u), or split the "
+                       "box into more regions (--split)",
+                       n, regions, regions == 1 ? "" : "s", regions, regions);
+    return CM_OK;
+}
+
+/* The start of a solve on several ranks: every rank checks that it can
+ * go on, and all agree; a worker then solves rank 0's boxes until it is
+ * told to stop (r->worker). */
+static cm_status ranks_begin(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
+{
+    solve_ranks *rk = q->ranks;
+    const cm_status st = ranks_can_share(q, msg, msg_size);
+    bool all_ok;
+    int failed;
+    rk->ready(rk, st == CM_OK, &all_ok, &failed);
+    if (st != CM_OK)
+        return st;
+    if (!all_ok)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "rank %d could not start the solve (rerun with CELLMAP_RANKS_STDERR=1 "
+                       "to see every rank's messages)",
+                       failed);
+    if (rk->rank == 0)
+        return CM_OK;
+    r->worker = true;
+    return rk->serve(rk, q->model, &q->lat, q->plan.opt.max_steps, q->plan.opt.threads, msg,
+                     msg_size);
+}
+
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size)
 {
     memset(r, 0, sizeof *r);
     for (int d = 0; d < CM_MAX_DIM; d++)
         r->slow[d] = NAN; /* known for a single region only */
-    cm_status st;
+    const bool ranked = q->ranks && q->ranks->size > 1;
+    cm_status st = ranked ? ranks_begin(q, r, msg, msg_size) : CM_OK;
+    if (st != CM_OK || r->worker)
+        return st;
     if (!q->stage1 && q->cluster) {
         const double t0 = cm_seconds();
         st = solve_cluster(q, r, msg, msg_size);
+        if (ranked) { /* the workers' part is done */
+            st = q->ranks->stop(q->ranks, st, msg, msg_size);
+            r->ranks = q->ranks->size;
+            r->ranks_regions = q->ranks->regions_received;
+            r->ranks_bytes_received = q->ranks->bytes_received;
+            r->ranks_bytes_sent = q->ranks->bytes_sent;
+        }
         if (st == CM_OK)
             st = summarise_cluster(q, r, msg, msg_size);
         r->t2 = cm_seconds() - t0 - r->t1;
@@ -258,6 +312,20 @@ cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t m
             st = summarise_region(q, r, msg, msg_size);
     }
     return st == CM_OK ? find_attractors(q, r, msg, msg_size) : st;
+}
+
+void solve_json_ranks(json *j, const solve_result *r)
+{
+    if (r->ranks < 2)
+        return;
+    json_object(j, "ranks");
+    json_int(j, "count", r->ranks);
+    json_uint(j, "regions_from_workers", r->ranks_regions);
+    json_uint(j, "bytes_received", r->ranks_bytes_received);
+    json_uint(j, "bytes_sent", r->ranks_bytes_sent);
+    const double bytes = (double)(r->ranks_bytes_received + r->ranks_bytes_sent);
+    json_num(j, "bytes_per_cell", r->cells ? bytes / (double)r->cells : 0);
+    json_object_end(j);
 }
 
 cm_status solve_draw(const solve_request *q, solve_result *r, const png_opts *po, char *msg,

@@ -23,7 +23,9 @@
 #include "cellmap/join_stage1.h"
 #include "lib/attractor_report.h"
 #include "lib/figure.h"
+#include "lib/json.h"
 #include "lib/project.h"
+#include "lib/ranks.h"
 #include "lib/work.h"
 
 /* The most extension steps one solve takes (--extend). */
@@ -47,6 +49,7 @@ typedef struct solve_request {
     const work_hooks *hooks;
     project_step_fn step_done; /* after each extension step (may be NULL) */
     void *step_user;
+    solve_ranks *ranks; /* MPI ranks that share the solve (lib/ranks.h); NULL: this process */
 } solve_request;
 
 typedef struct solve_result {
@@ -76,6 +79,9 @@ typedef struct solve_result {
     cm_cluster c;
     cluster_ends joined;
     cm_store *store;
+    bool worker; /* this rank solved regions for rank 0: it has nothing to report */
+    int ranks;   /* the ranks that shared the solve (q->ranks), and rank 0's traffic */
+    uint64_t ranks_regions, ranks_bytes_received, ranks_bytes_sent;
 } solve_result;
 
 /* Whether a solve of `cells` cells (extended or not) is better run on one
@@ -90,6 +96,11 @@ bool solve_small(uint64_t cells, bool extends);
 /* Solves, summarises and finds the attractors (stored in the database).
  * *r is initialised here; solve_result_free frees it whatever the status. */
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size);
+
+/* With q->ranks: the "ranks" object of solve --json (their count, the
+ * regions the workers solved, the bytes rank 0 received and sent, and those
+ * per cell computed). Nothing for a solve in one process. */
+void solve_json_ranks(json *j, const solve_result *r);
 
 /* Draws the solved cells, or those of po's view (cells outside the cluster
  * drawn as not computed), as po says (lib/figure.h). */

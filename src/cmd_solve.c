@@ -319,6 +319,7 @@ static void print_json(FILE *out, const cm_model *m, const cm_lattice *lat,
         json_seconds(&j, "joins", sum->join_seconds);
     json_seconds(&j, "attractors", sum->att_seconds);
     json_object_end(&j);
+    solve_json_ranks(&j, sum);
     if (extended)
         print_json_extension(&j, lat, sum);
     attractor_json(&j, lat, &sum->att);
@@ -418,7 +419,9 @@ static int say_interrupted(const solve_args *a, const char *command, const solve
     return EXIT_INTERRUPTED;
 }
 
-int cmd_solve(int argc, char **argv)
+int cmd_solve(int argc, char **argv) { return cmd_solve_on(argc, argv, NULL); }
+
+int cmd_solve_on(int argc, char **argv, solve_ranks *ranks)
 {
     cli c = {"solve", argc, argv, 0, NULL, NULL};
     solve_args a;
@@ -468,6 +471,7 @@ int cmd_solve(int argc, char **argv)
     q.att = a.att;
     q.slow_share = !a.json && !a.quiet; /* only the text summary shows it */
     q.hooks = &hooks;
+    q.ranks = ranks;
     step_report rep = {&a, &q.lat, r};
     q.step_done = report_step;
     q.step_user = &rep;
@@ -475,6 +479,10 @@ int cmd_solve(int argc, char **argv)
     rc = EXIT_FAIL;
     const cm_status st = solve_run(&q, r, msg, sizeof msg);
     progress_end(&pr);
+    if (r->worker) { /* rank 0 reports */
+        rc = st == CM_OK ? EXIT_OK : EXIT_FAIL;
+        goto done;
+    }
     cli_said_upgrade("solve", a.db, r->upgraded_from);
     if (st == CM_ECANCELED) {
         rc = say_interrupted(&a, command, r);

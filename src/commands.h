@@ -5,6 +5,9 @@
 
 int cmd_models(int argc, char **argv);
 int cmd_solve(int argc, char **argv);
+/* solve on MPI ranks (lib/ranks.h; the program cellmap-mpi) */
+struct solve_ranks;
+int cmd_solve_on(int argc, char **argv, struct solve_ranks *ranks);
 int cmd_orbit(int argc, char **argv);
 int cmd_equilibria(int argc, char **argv);
 int cmd_periodic(int argc, char **argv);

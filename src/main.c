@@ -8,28 +8,47 @@
 
 #include "lib/outfile.h"
 #include "lib/parse.h"
+#include "lib/ranks.h"
 #include "src/args.h"
 #include "src/commands.h"
 #include "src/run_env.h"
 
-/* `cellmap serve` runs cellmap-serve, the program beside this one: it
- * alone links the HTTP library (src/cmd_serve.c says why). */
-static int run_serve(int argc, char **argv)
+/* Runs `name`, the program built and installed beside this one, with
+ * argv (argv[0] becomes name): cellmap-serve alone links the HTTP library
+ * (src/cmd_serve.c says why), cellmap-mpi alone MPI. */
+static int run_beside(const char *name, char **argv, const char *why)
 {
-    (void)argc;
-    static char name[] = "cellmap-serve"; /* what ps and pkill show */
-    char path[4096] = "cellmap-serve";
-    const ssize_t n = readlink("/proc/self/exe", path, sizeof path - sizeof name);
+    char path[4096];
+    const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 32);
     if (n > 0) { /* an absolute path */
         path[n] = '\0';
         strcpy(strrchr(path, '/') + 1, name);
-        argv[0] = name;
+        argv[0] = (char *)name; /* what ps and pkill show */
         execv(path, argv);
     }
-    fprintf(stderr, "cellmap serve: cannot run %s: %s (cellmap-serve is built and installed "
-                    "beside cellmap)\n",
-            path, strerror(errno));
+    fprintf(stderr, "cellmap: cannot run %s: %s (%s)\n", n > 0 ? path : name, strerror(errno),
+            why);
     return EXIT_FAIL;
+}
+
+static int run_serve(int argc, char **argv)
+{
+    (void)argc;
+    return run_beside("cellmap-serve", argv, "cellmap-serve is built and installed beside cellmap");
+}
+
+/* Under mpirun (lib/ranks.h): solve runs as cellmap-mpi, built where MPI
+ * was found; other commands run on one rank. */
+static int run_ranked(const char *name, char **argv)
+{
+    if (strcmp(name, "solve") == 0)
+        return run_beside("cellmap-mpi", argv,
+                          "cellmap-mpi is built beside cellmap where MPI was found: install "
+                          "libopenmpi-dev and build again");
+    if (ranks_launched() > 1 && ranks_launched_rank() == 0)
+        fprintf(stderr, "cellmap %s: only solve shares its work among MPI ranks: run this one "
+                        "without mpirun\n", name);
+    return ranks_launched() > 1 ? EXIT_USAGE : -1;
 }
 
 static const struct {
@@ -157,6 +176,9 @@ int main(int argc, char **argv)
     for (int i = 2; i < argc; i++) /* -h is --help, for every command */
         if (strcmp(argv[i], "-h") == 0)
             argv[i] = help_flag;
+    const int ranked = !asks_help && ranks_launched() ? run_ranked(name, argv) : -1;
+    if (ranked >= 0)
+        return ranked;
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(name, commands[i].name) == 0)
             return finish(name, asks_help ? commands[i].run(2, help_argv)

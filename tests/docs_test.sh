@@ -190,6 +190,9 @@ for f in bin/cellmap share/man/man1/cellmap.1 share/bash-completion/completions/
   [ -s "$work/prefix/$f" ] || fail "cmake --install did not install $f"
 done
 "$work/prefix/bin/cellmap" --version | grep -q "^cellmap " || fail "the installed cellmap does not run"
+# under mpirun, the installed cellmap runs the cellmap-mpi installed beside it
+[ ! -e "$BUILD/cellmap-mpi" ] || [ -s "$work/prefix/bin/cellmap-mpi" ] ||
+  fail "cmake --install did not install cellmap-mpi beside cellmap"
 
 [ $fails -eq 0 ] && echo "docs tests passed"
 exit $fails

@@ -87,8 +87,10 @@ if not objects:
 # the command over the library only (6 000 lines for cellmap's 23
 # commands; 250 more for serve's options, signals and messages, whose
 # HTTP layer is lib/serve.c; 50 more for the environment a command asks
-# for by executing itself, src/run_env.c, which cannot live in a library)
-SRC_MAX_LINES = 6300
+# for by executing itself, src/run_env.c, which cannot live in a library;
+# 60 more for solves on MPI ranks: the program cellmap-mpi's entry point,
+# src/mpi_main.c, and the command's hand-over to it under mpirun)
+SRC_MAX_LINES = 6360
 src_lines = 0
 for path in sorted(glob.glob(os.path.join(root, "src", "*.[ch]"))):
     text = open(path).read()

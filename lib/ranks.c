@@ -1,0 +1,499 @@
+#include "lib/ranks.h"
+
+#include <fcntl.h>
+#include <mpi.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cellmap/scm.h"
+
+enum { TAG_BOXES = 1, TAG_STOP, TAG_DONE, TAG_REGION /* and above: a region, by its index */ };
+
+/* Arrays go in pieces of at most this many bytes: MPI counts in int. */
+#define PIECE (UINT64_C(1) << 30)
+
+/* A box a worker is asked to solve: its place in the solve's order. */
+typedef struct box_request {
+    uint64_t index;
+    cm_box box;
+} box_request;
+
+/* What a worker sends first for a box: the region's sizes, or why it
+ * could not solve it; then (solved) its image, group and step arrays and
+ * its exits, as separate messages. */
+typedef struct region_header {
+    uint64_t index, ncells, nexits;
+    int32_t status, exits_recorded;
+    uint32_t ngroups;
+    cm_box box;
+    char msg[256];
+} region_header;
+
+/* The boxes of one call sent to one worker, kept until the send is done. */
+typedef struct batch {
+    box_request *v;
+    MPI_Request req;
+} batch;
+
+typedef struct mpi_ranks {
+    solve_ranks pub;
+    pthread_mutex_t lock; /* rank 0's threads receive one at a time */
+    uint64_t asked;       /* boxes asked for by the calls before */
+    uint64_t first;       /* index of the current call's first box */
+    int tag_span;         /* region tags: TAG_REGION + index mod tag_span */
+    batch *batches;       /* per worker: the current call's */
+} mpi_ranks;
+
+static int owner(const mpi_ranks *m, uint64_t index)
+{
+    return (int)(index % (uint64_t)m->pub.size);
+}
+
+static int region_tag(const mpi_ranks *m, uint64_t index)
+{
+    return TAG_REGION + (int)(index % (uint64_t)m->tag_span);
+}
+
+static void recv_bytes(void *p, uint64_t n, int src, int tag)
+{
+    char *c = p;
+    do {
+        const int k = (int)(n < PIECE ? n : PIECE);
+        MPI_Recv(c, k, MPI_BYTE, src, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        c += k;
+        n -= (uint64_t)k;
+    } while (n > 0);
+}
+
+/* The bytes of a region's arrays after its header, in the order sent. */
+static void region_arrays(const region_header *h, uint64_t bytes[4])
+{
+    bytes[0] = bytes[1] = bytes[2] = h->ncells * sizeof(uint32_t);
+    bytes[3] = h->nexits * (uint64_t)h->box.dim * sizeof(int64_t);
+}
+
+/* ---- a worker ------------------------------------------------------------ */
+
+static bool stop_pending(void)
+{
+    int flag = 0;
+    MPI_Iprobe(0, TAG_STOP, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+    return flag != 0;
+}
+
+/* A region on its way to rank 0: sent without waiting, so that the worker
+ * solves its next box meanwhile; kept until rank 0 has taken it. */
+typedef struct outgoing {
+    region_header *h; /* on the heap: MPI reads it while the record moves */
+    cm_region r;
+    MPI_Request *req;
+    int nreq;
+} outgoing;
+
+static int pieces(uint64_t n) { return n == 0 ? 1 : (int)((n + PIECE - 1) / PIECE); }
+
+/* Starts sending box q's region (st CM_OK) or why it failed; o takes r. */
+static cm_status start_send(const mpi_ranks *m, const box_request *q, cm_region *r, cm_status st,
+                            const char *why, outgoing *o)
+{
+    memset(o, 0, sizeof *o);
+    region_header *h = o->h = calloc(1, sizeof *h);
+    if (!h)
+        return CM_ENOMEM;
+    h->index = q->index;
+    h->status = st;
+    snprintf(h->msg, sizeof h->msg, "%s", why);
+    if (st == CM_OK) {
+        h->ncells = r->ncells;
+        h->nexits = r->nexits;
+        h->exits_recorded = r->exits_recorded;
+        h->ngroups = r->ngroups;
+        h->box = r->box;
+        o->r = *r;
+        memset(r, 0, sizeof *r);
+    }
+    uint64_t bytes[4];
+    region_arrays(h, bytes);
+    int n = 1;
+    for (int a = 0; st == CM_OK && a < 4; a++)
+        n += pieces(bytes[a]);
+    if (!(o->req = malloc((size_t)n * sizeof *o->req)))
+        return CM_ENOMEM;
+    const int tag = region_tag(m, q->index);
+    MPI_Isend(h, (int)sizeof *h, MPI_BYTE, 0, tag, MPI_COMM_WORLD, &o->req[o->nreq++]);
+    const void *arrays[4] = {o->r.image, o->r.group, o->r.step, o->r.exit_target};
+    for (int a = 0; st == CM_OK && a < 4; a++) {
+        const char *c = arrays[a];
+        uint64_t left = bytes[a];
+        do { /* an empty array is one empty message */
+            const int k = (int)(left < PIECE ? left : PIECE);
+            MPI_Isend(c, k, MPI_BYTE, 0, tag, MPI_COMM_WORLD, &o->req[o->nreq++]);
+            c += k;
+            left -= (uint64_t)k;
+        } while (left > 0);
+    }
+    return CM_OK;
+}
+
+/* Whether o has gone (wait: once it has); its memory is freed then. */
+static bool sent(outgoing *o, bool wait)
+{
+    int done = 1;
+    if (wait)
+        MPI_Waitall(o->nreq, o->req, MPI_STATUSES_IGNORE);
+    else
+        MPI_Testall(o->nreq, o->req, &done, MPI_STATUSES_IGNORE);
+    if (done) {
+        free(o->req);
+        free(o->h);
+        cm_region_free(&o->r);
+    }
+    return done != 0;
+}
+
+/* Regions a worker holds while rank 0 has not taken them: at most this
+ * many, then it waits for the oldest. */
+#define OUTGOING_MAX 8
+
+typedef struct outbox {
+    outgoing v[OUTGOING_MAX];
+    int n;
+} outbox;
+
+/* While a worker solves, its sends go on: MPI moves a message between
+ * hosts only within MPI calls (cm_scm_solve's progress callback, on the
+ * thread that called it). */
+static int keep_sending(void *user, const char *phase, double fraction)
+{
+    outbox *o = user;
+    (void)phase;
+    (void)fraction;
+    for (int k = 0; k < o->n; k++) {
+        int done;
+        MPI_Testall(o->v[k].nreq, o->v[k].req, &done, MPI_STATUSES_IGNORE);
+    }
+    return 0;
+}
+
+static cm_status serve(solve_ranks *rk, const cm_model *model, const cm_lattice *lat,
+                       int max_steps, int threads, char *msg, size_t msg_size)
+{
+    const mpi_ranks *m = (const mpi_ranks *)rk;
+    outbox box = {.n = 0};
+    outgoing *out = box.v;
+    const cm_scm_options opt = {.max_steps = max_steps,
+                                .threads = threads,
+                                .record_exits = 1,
+                                .progress = keep_sending,
+                                .user = &box};
+    for (;;) {
+        MPI_Status s;
+        MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &s);
+        if (s.MPI_TAG == TAG_STOP) {
+            int32_t status;
+            MPI_Recv(&status, 1, MPI_INT32_T, 0, TAG_STOP, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            for (int i = 0; i < box.n; i++) /* rank 0 drains them */
+                sent(&out[i], true);
+            MPI_Send(NULL, 0, MPI_BYTE, 0, TAG_DONE, MPI_COMM_WORLD);
+            return status == CM_OK ? CM_OK
+                                   : cm_fail((cm_status)status, msg, msg_size, "rank 0 failed");
+        }
+        int count;
+        MPI_Get_count(&s, MPI_BYTE, &count);
+        box_request *v = malloc((size_t)count + 1);
+        if (!v) { /* its boxes would never come back */
+            fprintf(stderr, "cellmap solve: rank %d: out of memory for %d bytes\n", rk->rank,
+                    count);
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        MPI_Recv(v, count, MPI_BYTE, 0, TAG_BOXES, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        /* once rank 0 stops (it failed), the boxes left are not solved */
+        for (size_t i = 0; i < (size_t)count / sizeof *v && !stop_pending(); i++) {
+            int kept = 0; /* the regions rank 0 has not taken yet, oldest first */
+            for (int k = 0; k < box.n; k++)
+                if (!sent(&out[k], false))
+                    out[kept++] = out[k];
+            box.n = kept;
+            if (box.n == OUTGOING_MAX) {
+                sent(&out[0], true);
+                memmove(out, out + 1, --box.n * sizeof *out);
+            }
+            char why[256] = "";
+            cm_region r;
+            cm_status st = cm_region_alloc(&r, &v[i].box, why, sizeof why);
+            if (st == CM_OK)
+                st = cm_scm_solve(model, lat, &opt, &r, why, sizeof why);
+            if (start_send(m, &v[i], &r, st, why, &out[box.n]) != CM_OK) {
+                fprintf(stderr, "cellmap solve: rank %d: out of memory\n", rk->rank);
+                MPI_Abort(MPI_COMM_WORLD, 1);
+            }
+            box.n++;
+            cm_region_free(&r);
+        }
+        free(v);
+    }
+}
+
+/* ---- rank 0 ------------------------------------------------------------- */
+
+static bool elsewhere(const void *user, uint32_t b)
+{
+    const mpi_ranks *m = user;
+    return owner(m, m->first + b) != 0;
+}
+
+/* Waits for the boxes sent to workers by the last call to be received. */
+static void complete_batches(mpi_ranks *m)
+{
+    for (int w = 1; w < m->pub.size; w++)
+        if (m->batches[w].v) {
+            MPI_Wait(&m->batches[w].req, MPI_STATUS_IGNORE);
+            free(m->batches[w].v);
+            m->batches[w].v = NULL;
+        }
+}
+
+/* Sends each worker its boxes of the call, in one message. */
+static cm_status ask(void *user, const cm_box *boxes, uint32_t n, char *msg, size_t msg_size)
+{
+    mpi_ranks *m = user;
+    complete_batches(m);
+    m->first = m->asked;
+    m->asked += n;
+    for (int w = 1; w < m->pub.size; w++) {
+        uint32_t count = 0;
+        for (uint32_t b = 0; b < n; b++)
+            count += owner(m, m->first + b) == w;
+        if (count == 0)
+            continue;
+        if ((uint64_t)count * sizeof(box_request) > INT32_MAX)
+            return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions for rank %d at once", w);
+        box_request *v = malloc(count * sizeof *v);
+        if (!v)
+            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u boxes", count);
+        count = 0;
+        for (uint32_t b = 0; b < n; b++)
+            if (owner(m, m->first + b) == w)
+                v[count++] = (box_request){m->first + b, boxes[b]};
+        m->batches[w].v = v;
+        MPI_Isend(v, (int)(count * sizeof *v), MPI_BYTE, w, TAG_BOXES, MPI_COMM_WORLD,
+                  &m->batches[w].req);
+        m->pub.bytes_sent += count * sizeof *v;
+    }
+    return CM_OK;
+}
+
+/* Receives the region index from rank src into r (lock held). */
+static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region *r, char *msg,
+                                size_t msg_size)
+{
+    const int tag = region_tag(m, index);
+    region_header h;
+    MPI_Recv(&h, (int)sizeof h, MPI_BYTE, src, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    m->pub.bytes_received += sizeof h;
+    if (h.status != CM_OK)
+        return cm_fail((cm_status)h.status, msg, msg_size, "rank %d: %s", src, h.msg);
+    if (h.index != index)
+        return cm_fail(CM_EFORMAT, msg, msg_size, "rank %d sent region %llu for region %llu", src,
+                       (unsigned long long)h.index, (unsigned long long)index);
+    uint64_t bytes[4];
+    region_arrays(&h, bytes);
+    cm_status st = cm_region_alloc(r, &h.box, msg, msg_size);
+    if (st == CM_OK && !(r->exit_target = malloc(bytes[3] + 1)))
+        st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
+                     (unsigned long long)h.nexits);
+    if (st != CM_OK) { /* the arrays on their way could not be taken */
+        fprintf(stderr, "cellmap solve: %s\n", msg);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    r->nexits = h.nexits;
+    r->exits_recorded = h.exits_recorded;
+    r->ngroups = h.ngroups;
+    void *arrays[4] = {r->image, r->group, r->step, r->exit_target};
+    for (int a = 0; a < 4; a++) {
+        recv_bytes(arrays[a], bytes[a], src, tag);
+        m->pub.bytes_received += bytes[a];
+    }
+    m->pub.regions_received++;
+    return CM_OK;
+}
+
+static cm_status fetch(void *user, uint32_t b, cm_region *r, bool *got, char *msg,
+                       size_t msg_size)
+{
+    mpi_ranks *m = user;
+    const uint64_t index = m->first + b;
+    const int src = owner(m, index);
+    int flag = 0;
+    pthread_mutex_lock(&m->lock);
+    MPI_Iprobe(src, region_tag(m, index), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+    const cm_status st = flag ? receive_region(m, src, index, r, msg, msg_size) : CM_OK;
+    pthread_mutex_unlock(&m->lock);
+    *got = flag != 0;
+    return st;
+}
+
+/* Takes what worker w still sends before it stops: whole regions, dropped. */
+static void drain(int w)
+{
+    for (;;) {
+        MPI_Status s;
+        MPI_Probe(w, MPI_ANY_TAG, MPI_COMM_WORLD, &s);
+        if (s.MPI_TAG == TAG_DONE) {
+            MPI_Recv(NULL, 0, MPI_BYTE, w, TAG_DONE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            return;
+        }
+        region_header h;
+        MPI_Recv(&h, (int)sizeof h, MPI_BYTE, w, s.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        uint64_t bytes[4];
+        region_arrays(&h, bytes);
+        for (int a = 0; h.status == CM_OK && a < 4; a++)
+            for (uint64_t left = bytes[a];;) { /* piece by piece, as sent */
+                const int k = (int)(left < PIECE ? left : PIECE);
+                char *piece = malloc((size_t)k + 1);
+                if (!piece)
+                    MPI_Abort(MPI_COMM_WORLD, 1);
+                MPI_Recv(piece, k, MPI_BYTE, w, s.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                free(piece);
+                left -= (uint64_t)k;
+                if (left == 0)
+                    break;
+            }
+    }
+}
+
+static cm_status stop(solve_ranks *rk, cm_status status, char *msg, size_t msg_size)
+{
+    mpi_ranks *m = (mpi_ranks *)rk;
+    const int32_t s = status;
+    for (int w = 1; w < rk->size; w++)
+        MPI_Send(&s, 1, MPI_INT32_T, w, TAG_STOP, MPI_COMM_WORLD);
+    for (int w = 1; w < rk->size; w++)
+        drain(w);
+    complete_batches(m); /* received: every worker read up to the stop */
+    (void)msg;
+    (void)msg_size;
+    return status;
+}
+
+/* ---- every rank --------------------------------------------------------- */
+
+static cm_status ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed)
+{
+    int *oks = malloc((size_t)rk->size * sizeof *oks);
+    if (!oks)
+        MPI_Abort(MPI_COMM_WORLD, 1); /* the others wait for this rank */
+    int mine = ok;
+    MPI_Allgather(&mine, 1, MPI_INT, oks, 1, MPI_INT, MPI_COMM_WORLD);
+    *all_ok = true;
+    *first_failed = -1;
+    for (int k = 0; k < rk->size && *all_ok; k++)
+        if (!oks[k]) {
+            *all_ok = false;
+            *first_failed = k;
+        }
+    free(oks);
+    rk->readied = true;
+    return CM_OK;
+}
+
+/* A hash of this program's file: ranks that run another build differ. */
+static uint64_t program_hash(void)
+{
+    uint64_t h = UINT64_C(1469598103934665603);
+    const int fd = open("/proc/self/exe", O_RDONLY);
+    if (fd < 0)
+        return 0;
+    unsigned char buf[1 << 16];
+    ssize_t n;
+    while ((n = read(fd, buf, sizeof buf)) > 0)
+        for (ssize_t i = 0; i < n; i++)
+            h = (h ^ buf[i]) * UINT64_C(1099511628211);
+    close(fd);
+    return h;
+}
+
+static uint64_t args_hash(int argc, char **argv)
+{
+    uint64_t h = UINT64_C(1469598103934665603);
+    for (int i = 1; i < argc; i++)
+        for (const unsigned char *c = (const unsigned char *)argv[i];; c++) {
+            h = (h ^ *c) * UINT64_C(1099511628211);
+            if (!*c)
+                break;
+        }
+    return h;
+}
+
+/* Step 1: every rank runs rank 0's program with rank 0's arguments. */
+static cm_status same_everywhere(const solve_ranks *rk, int argc, char **argv, char *msg,
+                                 size_t msg_size)
+{
+    const uint64_t mine[2] = {program_hash(), args_hash(argc, argv)};
+    uint64_t *all = malloc((size_t)rk->size * sizeof mine);
+    if (!all)
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    MPI_Allgather(mine, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, MPI_COMM_WORLD);
+    cm_status st = CM_OK;
+    for (int k = 1; k < rk->size && st == CM_OK; k++)
+        if (all[2 * k] != all[0])
+            st = cm_fail(CM_EINVAL, msg, msg_size,
+                         "rank %d runs another cellmap program than rank 0 (its file differs): "
+                         "install the same build of cellmap on every host",
+                         k);
+        else if (all[2 * k + 1] != all[1])
+            st = cm_fail(CM_EINVAL, msg, msg_size,
+                         "rank %d was given other arguments than rank 0: start every rank with "
+                         "the same command line",
+                         k);
+    free(all);
+    return st;
+}
+
+cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size_t msg_size)
+{
+    *out = NULL;
+    int provided = MPI_THREAD_SINGLE;
+    if (MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
+        return cm_fail(CM_EIO, msg, msg_size, "MPI did not start");
+    mpi_ranks *m = calloc(1, sizeof *m);
+    if (!m)
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    MPI_Comm_rank(MPI_COMM_WORLD, &m->pub.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &m->pub.size);
+    int *tag_ub = NULL, found = 0;
+    MPI_Comm_get_attr(MPI_COMM_WORLD, MPI_TAG_UB, &tag_ub, &found);
+    m->tag_span = (found && tag_ub ? *tag_ub : 32767) - TAG_REGION;
+    m->batches = calloc((size_t)m->pub.size, sizeof *m->batches);
+    if (!m->batches)
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    pthread_mutex_init(&m->lock, NULL);
+    m->pub.ready = ready;
+    m->pub.serve = serve;
+    m->pub.stop = stop;
+    m->pub.source = (cm_region_source){ask, elsewhere, fetch, (uint32_t)m->pub.size, m};
+    *out = &m->pub;
+    if (provided < MPI_THREAD_SERIALIZED)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "this MPI gives threads level %d; cellmap needs MPI_THREAD_SERIALIZED",
+                       provided);
+    return same_everywhere(&m->pub, *argc, *argv, msg, msg_size);
+}
+
+void ranks_close(solve_ranks *rk, bool ok)
+{
+    if (!rk)
+        return;
+    bool all_ok;
+    int failed;
+    if (!rk->readied)
+        ready(rk, ok, &all_ok, &failed);
+    mpi_ranks *m = (mpi_ranks *)rk;
+    pthread_mutex_destroy(&m->lock);
+    free(m->batches);
+    free(m);
+    MPI_Finalize();
+}

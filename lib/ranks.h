@@ -1,0 +1,88 @@
+/* lib/ranks.h - a solve shared by several processes: MPI ranks, started by
+ * mpirun on one host or many.
+ *
+ * Rank 0 runs the solve as one process would. The regions of its clusters
+ * are assigned to ranks by their place in the order the solve asks for
+ * them: the k-th box asked for (counted over the whole solve, adaptive
+ * extension included) goes to rank k mod R. The other ranks (workers)
+ * solve what they are sent with all their threads and send the region
+ * back: its cells (image, group, step: 12 bytes a cell) and its exits.
+ * Rank 0 joins them in the order one process would, so the cluster, its
+ * database, figures and exports are byte for byte those of a solve
+ * without MPI, whatever R and each rank's thread count.
+ *
+ * The protocol, in order:
+ *   1. ranks_open (every rank, before the command): the ranks run the same
+ *      binary (a hash of its file) with the same command line, or rank 0
+ *      says which does not and every rank fails;
+ *   2. ranks->ready (every rank, once: where the solve starts, or after a
+ *      command that failed before it): whether every rank got there, so
+ *      that a rank that failed early (a plugin missing on its host) stops
+ *      the others instead of leaving them waiting;
+ *   3. workers: ranks->serve until rank 0 says stop; rank 0: the cluster's
+ *      region source (cellmap/join.h), then ranks->stop with its status,
+ *      which drains what workers still send.
+ * A rank killed mid-solve makes mpirun end the job; the database keeps
+ * every join committed, and a resumed solve completes it with any R.
+ *
+ * Implemented by lib/ranks.c, linked into cellmap-mpi only (the program
+ * `cellmap` runs under mpirun), so that no other command loads MPI. */
+#ifndef CM_LIB_RANKS_H
+#define CM_LIB_RANKS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "cellmap/join.h"
+
+/* The ranks mpirun started, from the environment it gives each process
+ * (Open MPI, or a PMI launcher such as MPICH's): 0 if it did not start this
+ * one. Read without MPI: the command decides whether to run cellmap-mpi. */
+static inline int ranks_launched(void)
+{
+    const char *n = getenv("OMPI_COMM_WORLD_SIZE");
+    if (!n)
+        n = getenv("PMI_SIZE");
+    return n ? atoi(n) : 0;
+}
+
+static inline int ranks_launched_rank(void)
+{
+    const char *n = getenv("OMPI_COMM_WORLD_RANK");
+    if (!n)
+        n = getenv("PMI_RANK");
+    return n ? atoi(n) : 0;
+}
+
+typedef struct solve_ranks solve_ranks;
+
+struct solve_ranks {
+    int rank, size;
+    /* Step 2: ok says whether this rank got to the solve. *all_ok: whether
+     * every rank did; *first_failed: the lowest rank that did not. */
+    cm_status (*ready)(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed);
+    /* Step 3, a worker: solves the boxes rank 0 sends, on the lattice with
+     * max_steps and `threads` threads (0: the OpenMP default), until rank 0
+     * stops it; returns rank 0's status then (CM_OK: the solve succeeded). */
+    cm_status (*serve)(solve_ranks *rk, const cm_model *model, const cm_lattice *lat,
+                       int max_steps, int threads, char *msg, size_t msg_size);
+    /* Step 3, rank 0: the workers stop; status is the solve's. */
+    cm_status (*stop)(solve_ranks *rk, cm_status status, char *msg, size_t msg_size);
+    cm_region_source source; /* rank 0's regions solved by workers */
+    bool readied;            /* step 2 done */
+    uint64_t bytes_received; /* by rank 0 from workers, requests and replies */
+    uint64_t bytes_sent;     /* by rank 0 to workers */
+    uint64_t regions_received;
+};
+
+/* Starts MPI (every rank, first thing) and does step 1: *out is this
+ * rank's (ranks_close frees it). On failure msg says why (rank 0 names the
+ * rank that differs); every rank then fails. */
+cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size_t msg_size);
+
+/* Step 2 for a command that ended before its solve did (if it did not
+ * already), then MPI's end. */
+void ranks_close(solve_ranks *rk, bool ok);
+
+#endif
