@@ -476,13 +476,11 @@ int cmd_solve_on(int argc, char **argv, solve_ranks *ranks)
     q.step_done = report_step;
     q.step_user = &rep;
     interrupt_catch();
-    rc = EXIT_FAIL;
     const cm_status st = solve_run(&q, r, msg, sizeof msg);
     progress_end(&pr);
-    if (r->worker) { /* rank 0 reports */
-        rc = st == CM_OK ? EXIT_OK : EXIT_FAIL;
+    rc = r->worker && st == CM_OK ? EXIT_OK : EXIT_FAIL;
+    if (r->worker) /* rank 0 reports */
         goto done;
-    }
     cli_said_upgrade("solve", a.db, r->upgraded_from);
     if (st == CM_ECANCELED) {
         rc = say_interrupted(&a, command, r);

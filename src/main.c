@@ -46,8 +46,7 @@ static int run_ranked(const char *name, char **argv)
                           "cellmap-mpi is built beside cellmap where MPI was found: install "
                           "libopenmpi-dev and build again");
     if (ranks_launched() > 1 && ranks_launched_rank() == 0)
-        fprintf(stderr, "cellmap %s: only solve shares its work among MPI ranks: run this one "
-                        "without mpirun\n", name);
+        fprintf(stderr, "cellmap %s: only solve runs on MPI ranks: run it without mpirun\n", name);
     return ranks_launched() > 1 ? EXIT_USAGE : -1;
 }
 
@@ -171,8 +170,9 @@ int main(int argc, char **argv)
     }
     const char *name = asks_help ? argv[2] : argv[1];
     if (!asks_help) /* returns unless a setting was missing */
-        run_env_apply(argv, (strcmp(name, "explore") == 0 ? RUN_ENV_PASSIVE_WAIT : 0) |
-                                (builds_cells(name, argc, argv) ? RUN_ENV_HUGE_PAGES : 0));
+        run_env_apply(argv, (strcmp(name, "explore") == 0 || ranks_launched() > 1) *
+                                    RUN_ENV_PASSIVE_WAIT |
+                                builds_cells(name, argc, argv) * RUN_ENV_HUGE_PAGES);
     for (int i = 2; i < argc; i++) /* -h is --help, for every command */
         if (strcmp(argv[i], "-h") == 0)
             argv[i] = help_flag;

@@ -1,8 +1,9 @@
 /* src/run_env.h - settings that libraries read from the environment before
  * main, which a command asks for by executing itself once more (measured
- * in docs/engine.md). Passive waiting (explore): libgomp's idle threads
- * sleep rather than spin between a session's short parallel regions, which
- * on 2 vCPUs sharing a core slowed the serial work between them. Huge
+ * in docs/engine.md). Passive waiting (explore, and every rank of a solve
+ * under mpirun): libgomp's idle threads sleep rather than spin between
+ * short parallel regions, which on 2 vCPUs sharing a core slowed the
+ * serial work between them, and the ranks' threads share the cores. Huge
  * pages for the heap (commands that build many cells): glibc (2.35 and
  * later) asks for transparent huge pages for its heaps with the tunable
  * glibc.malloc.hugetlb=1, where the kernel gives them on request (mode

@@ -117,7 +117,7 @@ out=$(mpi 3 solve --cells 40x20 --split 1x2 --db few.cmdb 2>&1); rc=$?
 out=$(mpi 2 solve --cells 40x20 2>&1); rc=$?
 [ "$rc" -ne 0 ] && grep -q 'split the box' <<<"$out" || fail "one region on 2 ranks: $rc '$out'"
 out=$(mpi 2 info nothing.cmdb 2>&1); rc=$?
-[ "$rc" -eq 2 ] && [ "$(grep -c 'only solve shares' <<<"$out")" = 1 ] ||
+[ "$rc" -eq 2 ] && [ "$(grep -c 'only solve runs on MPI ranks' <<<"$out")" = 1 ] ||
   fail "info on 2 ranks: $rc '$out'"
 # another binary on rank 1: a copy of the programs with cellmap-mpi changed
 mkdir other && cp "$CM" "$(dirname "$CM")/cellmap-mpi" other/ && echo >> other/cellmap-mpi
