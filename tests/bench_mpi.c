@@ -10,11 +10,18 @@
  *     thread against 1 process of 1 thread, the speed-up.
  * Each figure twice: the solve (rank 0's "regions and joins" and summary
  * from --json) and the whole command (mpirun's start and MPI's included).
- * usage: bench_mpi PATH/TO/cellmap [REPS]   (REPS default 5; mpirun on PATH) */
+ * Then the scaling model of docs/engine.md ("How a solve on ranks
+ * scales") against the solve's time on R = 1, 2, 3 ranks of t = 1, 2
+ * threads, for duffing and the Table 4.1 4x4 split: its inputs measured on
+ * 1 rank of 1 thread (S, J) and 2 ranks of 1 thread (X), its predictions
+ * and their errors for the other runs.
+ * usage: bench_mpi PATH/TO/cellmap [REPS] [CORES]   (REPS default 5; CORES
+ * default the online processors; mpirun on PATH) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bench_util.h"
 
@@ -33,15 +40,16 @@ typedef struct run_out {
     double wall, solve, joins, bytes_per_cell;
 } run_out;
 
-/* One solve: in one process (ranks 0), or on 2 ranks under mpirun. */
+/* One solve: in one process (ranks 0 or 1), or under mpirun on `ranks`. */
 static int run(const char *cm, int ranks, int threads, const char *args, run_out *o)
 {
-    char cmd[2048], out[1 << 16];
-    snprintf(cmd, sizeof cmd, "%s'%s' solve %s --threads %d --json",
-             ranks ? "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun "
-                     "--oversubscribe -n 2 "
-                   : "",
-             cm, args, threads);
+    char cmd[2048], out[1 << 16], launch[256] = "";
+    if (ranks > 1)
+        snprintf(launch, sizeof launch,
+                 "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun "
+                 "--oversubscribe -n %d ",
+                 ranks);
+    snprintf(cmd, sizeof cmd, "%s'%s' solve %s --threads %d --json", launch, cm, args, threads);
     const double t0 = now();
     FILE *p = popen(cmd, "r");
     if (!p)
@@ -58,8 +66,75 @@ static int run(const char *cm, int ranks, int threads, const char *args, run_out
     *w = '\0';
     o->solve = json_number(out, "regions and joins") + json_number(out, "summary");
     o->joins = json_number(out, "joins");
-    o->bytes_per_cell = ranks ? json_number(out, "bytes_per_cell") : 0;
+    o->bytes_per_cell = ranks > 1 ? json_number(out, "bytes_per_cell") : 0;
     return o->solve > 0 ? 0 : -1;
+}
+
+/* The scaling model (docs/engine.md): the solve's time on R ranks of t
+ * threads and P cores, from S (the regions' SCM on one thread), J (the
+ * joins, serial on rank 0) and X (what taking every region from other
+ * ranks would cost rank 0: receiving it, its node table, its exits
+ * located). The longest of three: rank 0's path (its share of the
+ * regions, the joins, its share of X; the joins on one thread), a
+ * worker's (its share of the regions), the host's (all the work over the
+ * cores it has). */
+static double model(double S, double J, double X, int R, int t, int P)
+{
+    const double XR = X * (R - 1) / R;
+    const double rank0 = fmax(J, (S / R + J + XR) / t);
+    const double worker = S / R / t;
+    const double host = (S + J + XR) / (R * t < P ? R * t : P);
+    return fmax(rank0, fmax(worker, host));
+}
+
+/* Medians of the solve and its joins on R ranks of t threads. */
+static int measure(const char *cm, int reps, int R, int t, const char *args, double *solve,
+                   double *joins)
+{
+    double v[MAX_REPS], w[MAX_REPS];
+    for (int r = 0; r < reps; r++) {
+        run_out o;
+        if (run(cm, R, t, args, &o) != 0)
+            return -1;
+        v[r] = o.solve;
+        w[r] = o.joins;
+    }
+    *solve = median(v, reps);
+    *joins = median(w, reps);
+    return 0;
+}
+
+static int model_table(const char *cm, int reps, int cores, const char *duffing,
+                       const char *table41_4x4)
+{
+    const char *names[2] = {"duffing 400^2", "table4.1 4x4"}, *args[2] = {duffing, table41_4x4};
+    printf("\nscaling model on %d cores (S, J from 1 rank x 1 thread, X from 2 x 1):\n", cores);
+    printf("%-14s %6s %6s %6s %2s %2s %10s %10s %7s\n", "case", "S_ms", "J_ms", "X_ms", "R", "t",
+           "measured", "model", "error");
+    for (int c = 0; c < 2; c++) {
+        double T11, J, T21, J21, S, X;
+        if (measure(cm, reps, 1, 1, args[c], &T11, &J) != 0 ||
+            measure(cm, reps, 2, 1, args[c], &T21, &J21) != 0) {
+            fprintf(stderr, "bench_mpi: %s failed\n", names[c]);
+            return 1;
+        }
+        S = T11 - J;
+        X = fmax(0, 2 * (T21 - S / 2 - J)); /* rank 0 takes half the regions from rank 1 */
+        for (int R = 1; R <= 3; R++)
+            for (int t = 1; t <= 2; t++) {
+                double T = T11, unused;
+                if (R == 2 && t == 1)
+                    T = T21;
+                else if ((R > 1 || t > 1) && measure(cm, reps, R, t, args[c], &T, &unused) != 0)
+                    return 1;
+                const double p = model(S, J, X, R, t, cores);
+                printf("%-14s %6.1f %6.1f %6.1f %2d %2d %10.1f %10.1f %6.0f%%%s\n", names[c], 1e3 * S,
+                       1e3 * J, 1e3 * X, R, t, 1e3 * T, 1e3 * p, 100 * (p - T) / T,
+                       (R == 1 && t == 1) || (R == 2 && t == 1) ? " (input)" : "");
+                fflush(stdout);
+            }
+    }
+    return 0;
 }
 
 static const char *const table41 =
@@ -94,7 +169,7 @@ int main(int argc, char **argv)
         for (int r = 0; r < reps; r++) {
             run_out a, m;
             if (run(argv[1], 0, cases[c].threads_alone, cases[c].args, &a) != 0 ||
-                run(argv[1], 1, 1, cases[c].args, &m) != 0) {
+                run(argv[1], 2, 1, cases[c].args, &m) != 0) {
                 fprintf(stderr, "bench_mpi: %s failed\n", cases[c].name);
                 return 1;
             }
@@ -113,5 +188,6 @@ int main(int argc, char **argv)
                median(cmd_ratio, reps), median(share, reps), median(bytes, reps));
         fflush(stdout);
     }
-    return 0;
+    const int cores = argc > 3 ? atoi(argv[3]) : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    return model_table(argv[1], reps, cores, cases[2].args, split4);
 }
