@@ -78,6 +78,16 @@ print(r["count"], r["regions_from_workers"] > 0, r["bytes_received"] > 0)' "$run
   done
 done
 
+# with a memory budget, rank 0 pages regions to the file while it joins
+paged=(--cells 800x400 --split 16x16 --mem 2M)
+"$CM" solve "${paged[@]}" --json --db mem-ref.cmdb > mem-ref.json &&
+  mpi 3 solve "${paged[@]}" --threads 2 --json --db mem-r3.cmdb > mem-r3.json &&
+  strip_json mem-ref.json > mem-ref.sjson && strip_json mem-r3.json > mem-r3.sjson &&
+  dump_db mem-ref.cmdb > mem-ref.dump && dump_db mem-r3.cmdb > mem-r3.dump ||
+  fail "--mem: a solve failed"
+cmp -s mem-ref.sjson mem-r3.sjson && cmp -s mem-ref.dump mem-r3.dump ||
+  fail "--mem 2M on 3 ranks: not the solve without MPI"
+
 # the ranks' JSON keeps to the schema
 python3 "$(dirname "$0")/schema_check.py" "$(dirname "$0")/../docs/cellmap.schema.json" \
   s16-r3-t2.json > /dev/null || fail "s16-r3-t2.json: not what the schema says"
