@@ -64,7 +64,8 @@ typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
 /* Solves the boxes, one per thread (a lone box with every thread; those
  * c->source says are solved elsewhere fetched from it), and
  * joins them in the given order on the calling thread while the others go
- * on solving (at most two boxes per thread ahead of the joins), calling
+ * on solving (at most two boxes per thread ahead of the joins, times the
+ * source's processes), calling
  * joined (may be NULL) after every join. stats (may be NULL) sums the
  * joins'. The cluster is the same whatever the thread count. */
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,

@@ -381,7 +381,7 @@ static void drain(int w)
     }
 }
 
-static cm_status stop(solve_ranks *rk, cm_status status, char *msg, size_t msg_size)
+static cm_status stop(solve_ranks *rk, cm_status status)
 {
     mpi_ranks *m = (mpi_ranks *)rk;
     const int32_t s = status;
@@ -390,14 +390,12 @@ static cm_status stop(solve_ranks *rk, cm_status status, char *msg, size_t msg_s
     for (int w = 1; w < rk->size; w++)
         drain(w);
     complete_batches(m); /* received: every worker read up to the stop */
-    (void)msg;
-    (void)msg_size;
     return status;
 }
 
 /* ---- every rank --------------------------------------------------------- */
 
-static cm_status ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed)
+static void ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed)
 {
     int *oks = malloc((size_t)rk->size * sizeof *oks);
     if (!oks)
@@ -413,7 +411,6 @@ static cm_status ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed
         }
     free(oks);
     rk->readied = true;
-    return CM_OK;
 }
 
 /* A hash of this program's file: ranks that run another build differ. */

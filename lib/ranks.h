@@ -61,14 +61,15 @@ struct solve_ranks {
     int rank, size;
     /* Step 2: ok says whether this rank got to the solve. *all_ok: whether
      * every rank did; *first_failed: the lowest rank that did not. */
-    cm_status (*ready)(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed);
+    void (*ready)(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed);
     /* Step 3, a worker: solves the boxes rank 0 sends, on the lattice with
      * max_steps and `threads` threads (0: the OpenMP default), until rank 0
      * stops it; returns rank 0's status then (CM_OK: the solve succeeded). */
     cm_status (*serve)(solve_ranks *rk, const cm_model *model, const cm_lattice *lat,
                        int max_steps, int threads, char *msg, size_t msg_size);
-    /* Step 3, rank 0: the workers stop; status is the solve's. */
-    cm_status (*stop)(solve_ranks *rk, cm_status status, char *msg, size_t msg_size);
+    /* Step 3, rank 0: the workers stop, told the solve's status, which is
+     * returned. */
+    cm_status (*stop)(solve_ranks *rk, cm_status status);
     cm_region_source source; /* rank 0's regions solved by workers */
     bool readied;            /* step 2 done */
     uint64_t bytes_received; /* by rank 0 from workers, requests and replies */

@@ -297,7 +297,7 @@ cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t m
         const double t0 = cm_seconds();
         st = solve_cluster(q, r, msg, msg_size);
         if (ranked) { /* the workers' part is done */
-            st = q->ranks->stop(q->ranks, st, msg, msg_size);
+            st = q->ranks->stop(q->ranks, st);
             r->ranks = q->ranks->size;
             r->ranks_regions = q->ranks->regions_received;
             r->ranks_bytes_received = q->ranks->bytes_received;
