@@ -58,15 +58,20 @@ static int region_tag(const mpi_ranks *m, uint64_t index)
     return TAG_REGION + (int)(index % (uint64_t)m->tag_span);
 }
 
+/* Receives n bytes sent in pieces into p, or drops them (p NULL). */
 static void recv_bytes(void *p, uint64_t n, int src, int tag)
 {
-    char *c = p;
+    char *c = p ? p : malloc((size_t)(n < PIECE ? n : PIECE) + 1);
+    if (!c)
+        MPI_Abort(MPI_COMM_WORLD, 1); /* the sender would wait forever */
     do {
         const int k = (int)(n < PIECE ? n : PIECE);
         MPI_Recv(c, k, MPI_BYTE, src, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        c += k;
+        c += p ? k : 0;
         n -= (uint64_t)k;
     } while (n > 0);
+    if (!p)
+        free(c);
 }
 
 /* The bytes of a region's arrays after its header, in the order sent. */
@@ -367,17 +372,7 @@ static void drain(int w)
         uint64_t bytes[4];
         region_arrays(&h, bytes);
         for (int a = 0; h.status == CM_OK && a < 4; a++)
-            for (uint64_t left = bytes[a];;) { /* piece by piece, as sent */
-                const int k = (int)(left < PIECE ? left : PIECE);
-                char *piece = malloc((size_t)k + 1);
-                if (!piece)
-                    MPI_Abort(MPI_COMM_WORLD, 1);
-                MPI_Recv(piece, k, MPI_BYTE, w, s.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                free(piece);
-                left -= (uint64_t)k;
-                if (left == 0)
-                    break;
-            }
+            recv_bytes(NULL, bytes[a], w, s.MPI_TAG);
     }
 }
 

@@ -14,8 +14,8 @@
 #include "src/run_env.h"
 
 /* Runs `name`, the program built and installed beside this one, with
- * argv (argv[0] becomes name): cellmap-serve alone links the HTTP library
- * (src/cmd_serve.c says why), cellmap-mpi alone MPI. */
+ * argv: cellmap-serve alone links the HTTP library (src/cmd_serve.c says
+ * why), cellmap-mpi alone MPI. */
 static int run_beside(const char *name, char **argv, const char *why)
 {
     char path[4096];
@@ -23,7 +23,6 @@ static int run_beside(const char *name, char **argv, const char *why)
     if (n > 0) { /* an absolute path */
         path[n] = '\0';
         strcpy(strrchr(path, '/') + 1, name);
-        argv[0] = (char *)name; /* what ps and pkill show */
         execv(path, argv);
     }
     fprintf(stderr, "cellmap: cannot run %s: %s (%s)\n", n > 0 ? path : name, strerror(errno),
@@ -33,7 +32,9 @@ static int run_beside(const char *name, char **argv, const char *why)
 
 static int run_serve(int argc, char **argv)
 {
+    static char name[] = "cellmap-serve";
     (void)argc;
+    argv[0] = name; /* what ps and pkill show */
     return run_beside("cellmap-serve", argv, "cellmap-serve is built and installed beside cellmap");
 }
 

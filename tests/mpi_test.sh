@@ -22,6 +22,23 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
 command -v mpirun >/dev/null || { echo "FAIL: mpirun not found (openmpi-bin)" >&2; exit 1; }
 [ -x "$(dirname "$CM")/cellmap-mpi" ] || { echo "FAIL: no cellmap-mpi beside $CM" >&2; exit 1; }
 mpi() { local n=$1; shift; mpirun -n "$n" "$CM" "$@"; }
+# rank_pids DB [RANK]: the ranks of the solve writing DB (all, or RANK's)
+rank_pids() {
+  local p
+  for p in $(pgrep -f -- "--db $1"); do
+    tr '\0' '\n' < /proc/"$p"/environ 2>/dev/null |
+      grep -q "^OMPI_COMM_WORLD_RANK=${2:-[0-9]*}\$" && echo "$p"
+  done
+}
+# wait_commit DB: until the solve writing DB has committed a region
+wait_commit() {
+  local n
+  for _ in $(seq 500); do
+    n=$([ -s "$1" ] && sqlite3 -readonly "$1" 'SELECT COUNT(*) FROM regions' 2>/dev/null)
+    [ "${n:-0}" -gt 0 ] && return
+    sleep 0.01
+  done
+}
 
 # the JSON without its times and the ranks' traffic, keys sorted
 strip_json() {
@@ -102,13 +119,9 @@ for k in 1 2 3; do
   rm -f big-$k.cmdb*
   mpi 3 solve "${big[@]}" --db big-$k.cmdb > /dev/null 2>&1 &
   launcher=$!
-  for _ in $(seq 500); do # once the solve commits its regions, at a random moment
-    n=$([ -s big-$k.cmdb ] && sqlite3 -readonly big-$k.cmdb 'SELECT COUNT(*) FROM regions' 2>/dev/null)
-    [ "${n:-0}" -gt 0 ] && break
-    sleep 0.01
-  done
+  wait_commit big-$k.cmdb # then at a random moment
   sleep "0.0$((RANDOM % 10))"
-  victims=($(pgrep -f "cellmap-mpi solve ${big[*]} --db big-$k.cmdb"))
+  victims=($(rank_pids big-$k.cmdb))
   [ ${#victims[@]} -gt 0 ] && kill -9 "${victims[RANDOM % ${#victims[@]}]}"
   wait "$launcher" || interrupted=$((interrupted + 1))
   case $k in 1) again=(mpirun -n 2 "$CM") ;; 2) again=("$CM") ;; 3) again=(mpirun -n 3 "$CM") ;; esac
@@ -118,6 +131,18 @@ for k in 1 2 3; do
   cmp -s big-ref.dump big-$k.dump || fail "big $k: the resumed cluster differs from the whole one"
 done
 [ "$interrupted" -gt 0 ] || fail "no kill of a rank interrupted the solve (it was too quick)"
+
+# Ctrl-C to rank 0: it stops after its last commit, says how to finish,
+# the workers stop with it (what they still send is drained), all fail
+mpi 3 solve "${big[@]}" --db int.cmdb > /dev/null 2> int.err &
+launcher=$!
+wait_commit int.cmdb
+kill -INT $(rank_pids int.cmdb 0)
+wait "$launcher" && fail "Ctrl-C to rank 0: mpirun exited 0"
+grep -q "cellmap solve: interrupted; int.cmdb keeps the .* To finish it: .*cellmap solve .*--resume" \
+  int.err || fail "Ctrl-C to rank 0: $(head -3 int.err)"
+"$CM" solve "${big[@]}" --db int.cmdb --resume > /dev/null 2>&1 && dump_db int.cmdb > int.dump &&
+  cmp -s big-ref.dump int.dump || fail "Ctrl-C to rank 0: the resumed cluster differs"
 
 # bad input: one message (rank 0's), failure everywhere, no file
 out=$(mpi 3 solve --cells 40x20 --split 1x2 --db few.cmdb 2>&1); rc=$?
