@@ -5,6 +5,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 cm_status cm_lattice_check(const cm_lattice *lat, char *msg, size_t msg_size)
 {
@@ -210,4 +211,22 @@ void cm_rect_box(const cm_lattice *lat, int n, const double *lo, const double *h
         box->lo[d] = cm_lattice_border(lat, d, lo[d], 0);
         box->hi[d] = cm_lattice_border(lat, d, hi[d], 1);
     }
+}
+
+cm_status cm_cell_table_rebuild(uint32_t **table, uint64_t *table_size, uint64_t size,
+                                const int64_t *cells, uint64_t n, int dim)
+{
+    uint32_t *t = calloc((size_t)size, sizeof *t);
+    if (!t)
+        return CM_ENOMEM;
+    for (uint64_t k = 0; k < n; k++) { /* distinct cells: no comparing (cache misses) */
+        uint64_t i = cm_cell_hash(cells + k * (uint64_t)dim, dim) & (size - 1);
+        while (t[i])
+            i = (i + 1) & (size - 1);
+        t[i] = (uint32_t)(k + 1);
+    }
+    free(*table);
+    *table = t;
+    *table_size = size;
+    return CM_OK;
 }

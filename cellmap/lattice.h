@@ -83,6 +83,26 @@ static inline bool cm_cell_same(const int64_t *a, const int64_t *b, int dim)
     return d == dim;
 }
 
+/* Open-addressing tables of distinct cells: entry i holds the index of a
+ * cell in an array of cells (dim coordinates each) plus one, 0 an empty
+ * entry; size a power of two, probed linearly from cm_cell_hash. */
+
+/* The entry of cell in table (size entries) over cells: its own, or the
+ * empty one it would take. */
+static inline uint64_t cm_cell_table_place(const uint32_t *table, uint64_t size,
+                                           const int64_t *cells, int dim, const int64_t *cell)
+{
+    uint64_t i = cm_cell_hash(cell, dim) & (size - 1);
+    while (table[i] && !cm_cell_same(cells + (table[i] - 1) * (uint64_t)dim, cell, dim))
+        i = (i + 1) & (size - 1);
+    return i;
+}
+
+/* A table of `size` entries over cells[0..n) (distinct: they are not
+ * compared) replaces *table, *table_size set; CM_ENOMEM leaves both. */
+cm_status cm_cell_table_rebuild(uint32_t **table, uint64_t *table_size, uint64_t size,
+                                const int64_t *cells, uint64_t n, int dim);
+
 /* Local row-major index of a cell inside the box (caller checked contains). */
 uint64_t cm_box_index(const cm_box *box, const int64_t *cell);
 

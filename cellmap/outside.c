@@ -961,10 +961,7 @@ typedef struct view_exits {
 /* Where cell's slot is, or the empty place it would take. */
 static uint64_t hash_place(const view_exits *v, const int64_t *cell)
 {
-    uint64_t i = cm_cell_hash(cell, v->dim) & (v->hash_size - 1);
-    while (v->hash[i] && !cm_cell_same(v->cell + (v->hash[i] - 1) * (uint64_t)v->dim, cell, v->dim))
-        i = (i + 1) & (v->hash_size - 1);
-    return i;
+    return cm_cell_table_place(v->hash, v->hash_size, v->cell, v->dim, cell);
 }
 
 /* Room for `need` slots: the cells, and the hash at most half full. */
@@ -985,19 +982,7 @@ static cm_status view_room(view_exits *v, uint64_t need)
     uint64_t size = v->hash_size ? 2 * v->hash_size : 2048;
     while (size < 2 * need)
         size *= 2;
-    uint32_t *hash = calloc((size_t)size, sizeof *hash);
-    if (!hash)
-        return CM_ENOMEM;
-    free(v->hash);
-    v->hash = hash;
-    v->hash_size = size;
-    for (uint64_t k = 0; k < v->n; k++) { /* distinct cells: no comparing (cache misses) */
-        uint64_t i = cm_cell_hash(v->cell + k * (uint64_t)v->dim, v->dim) & (size - 1);
-        while (v->hash[i])
-            i = (i + 1) & (size - 1);
-        v->hash[i] = (uint32_t)(k + 1);
-    }
-    return CM_OK;
+    return cm_cell_table_rebuild(&v->hash, &v->hash_size, size, v->cell, v->n, v->dim);
 }
 
 /* The slot of exit cell `cell`, added when new. */

@@ -180,11 +180,7 @@ static uint32_t tile_of(int dim, const int64_t *cell, int64_t *tile)
 /* Where tile is in the hash, or the empty place it would take. */
 static uint64_t hash_place(const cm_view_keep *k, const int64_t *tile)
 {
-    uint64_t i = cm_cell_hash(tile, k->dim) & (k->hash_size - 1);
-    while (k->hash[i] &&
-           !cm_cell_same(k->tile_at + (k->hash[i] - 1) * (uint64_t)k->dim, tile, k->dim))
-        i = (i + 1) & (k->hash_size - 1);
-    return i;
+    return cm_cell_table_place(k->hash, k->hash_size, k->tile_at, k->dim, tile);
 }
 
 static bool grow_array(void **a, uint64_t cap, size_t item)
@@ -207,20 +203,8 @@ static cm_status tile_room(cm_view_keep *k)
     }
     if (2 * (k->ntiles + 1) <= k->hash_size)
         return CM_OK;
-    const uint64_t size = k->hash_size ? 2 * k->hash_size : 4096;
-    uint32_t *hash = calloc((size_t)size, sizeof *hash);
-    if (!hash)
-        return CM_ENOMEM;
-    free(k->hash);
-    k->hash = hash;
-    k->hash_size = size;
-    for (uint64_t t = 0; t < k->ntiles; t++) { /* distinct tiles: no comparing */
-        uint64_t i = cm_cell_hash(k->tile_at + t * (uint64_t)k->dim, k->dim) & (size - 1);
-        while (k->hash[i])
-            i = (i + 1) & (size - 1);
-        k->hash[i] = (uint32_t)(t + 1);
-    }
-    return CM_OK;
+    return cm_cell_table_rebuild(&k->hash, &k->hash_size, k->hash_size ? 2 * k->hash_size : 4096,
+                                 k->tile_at, k->ntiles, k->dim);
 }
 
 /* Where the slot of cell is kept (its tile added when new); NULL when out

@@ -409,30 +409,36 @@ static void ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed)
 }
 
 /* A hash of this program's file: ranks that run another build differ. */
+#define HASH_START UINT64_C(1469598103934665603)
+
+/* FNV-1a of n bytes, going on from h. */
+static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
+{
+    for (const unsigned char *c = p; n > 0; n--, c++)
+        h = (h ^ *c) * UINT64_C(1099511628211);
+    return h;
+}
+
 static uint64_t program_hash(void)
 {
-    uint64_t h = UINT64_C(1469598103934665603);
+    uint64_t h = HASH_START;
     const int fd = open("/proc/self/exe", O_RDONLY);
     if (fd < 0)
         return 0;
     unsigned char buf[1 << 16];
     ssize_t n;
     while ((n = read(fd, buf, sizeof buf)) > 0)
-        for (ssize_t i = 0; i < n; i++)
-            h = (h ^ buf[i]) * UINT64_C(1099511628211);
+        h = hash_bytes(h, buf, (size_t)n);
     close(fd);
     return h;
 }
 
+/* The arguments, each with its terminating 0 (argv[0], the path, aside). */
 static uint64_t args_hash(int argc, char **argv)
 {
-    uint64_t h = UINT64_C(1469598103934665603);
+    uint64_t h = HASH_START;
     for (int i = 1; i < argc; i++)
-        for (const unsigned char *c = (const unsigned char *)argv[i];; c++) {
-            h = (h ^ *c) * UINT64_C(1099511628211);
-            if (!*c)
-                break;
-        }
+        h = hash_bytes(h, argv[i], strlen(argv[i]) + 1);
     return h;
 }
 

@@ -39,20 +39,21 @@
 /* The ranks mpirun started, from the environment it gives each process
  * (Open MPI, or a PMI launcher such as MPICH's): 0 if it did not start this
  * one. Read without MPI: the command decides whether to run cellmap-mpi. */
+static inline int ranks_launch_env(const char *open_mpi, const char *pmi)
+{
+    const char *n = getenv(open_mpi);
+    n = n ? n : getenv(pmi);
+    return n ? atoi(n) : 0;
+}
+
 static inline int ranks_launched(void)
 {
-    const char *n = getenv("OMPI_COMM_WORLD_SIZE");
-    if (!n)
-        n = getenv("PMI_SIZE");
-    return n ? atoi(n) : 0;
+    return ranks_launch_env("OMPI_COMM_WORLD_SIZE", "PMI_SIZE");
 }
 
 static inline int ranks_launched_rank(void)
 {
-    const char *n = getenv("OMPI_COMM_WORLD_RANK");
-    if (!n)
-        n = getenv("PMI_RANK");
-    return n ? atoi(n) : 0;
+    return ranks_launch_env("OMPI_COMM_WORLD_RANK", "PMI_RANK");
 }
 
 typedef struct solve_ranks solve_ranks;

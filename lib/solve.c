@@ -298,10 +298,7 @@ cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t m
         st = solve_cluster(q, r, msg, msg_size);
         if (ranked) { /* the workers' part is done */
             st = q->ranks->stop(q->ranks, st);
-            r->ranks = q->ranks->size;
-            r->ranks_regions = q->ranks->regions_received;
-            r->ranks_bytes_received = q->ranks->bytes_received;
-            r->ranks_bytes_sent = q->ranks->bytes_sent;
+            r->ranks = q->ranks;
         }
         if (st == CM_OK)
             st = summarise_cluster(q, r, msg, msg_size);
@@ -316,14 +313,15 @@ cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t m
 
 void solve_json_ranks(json *j, const solve_result *r)
 {
-    if (r->ranks < 2)
+    const solve_ranks *rk = r->ranks;
+    if (!rk)
         return;
     json_object(j, "ranks");
-    json_int(j, "count", r->ranks);
-    json_uint(j, "regions_from_workers", r->ranks_regions);
-    json_uint(j, "bytes_received", r->ranks_bytes_received);
-    json_uint(j, "bytes_sent", r->ranks_bytes_sent);
-    const double bytes = (double)(r->ranks_bytes_received + r->ranks_bytes_sent);
+    json_int(j, "count", rk->size);
+    json_uint(j, "regions_from_workers", rk->regions_received);
+    json_uint(j, "bytes_received", rk->bytes_received);
+    json_uint(j, "bytes_sent", rk->bytes_sent);
+    const double bytes = (double)(rk->bytes_received + rk->bytes_sent);
     json_num(j, "bytes_per_cell", r->cells ? bytes / (double)r->cells : 0);
     json_object_end(j);
 }

@@ -80,8 +80,8 @@ typedef struct solve_result {
     cluster_ends joined;
     cm_store *store;
     bool worker; /* this rank solved regions for rank 0: it has nothing to report */
-    int ranks;   /* the ranks that shared the solve (q->ranks), and rank 0's traffic */
-    uint64_t ranks_regions, ranks_bytes_received, ranks_bytes_sent;
+    const solve_ranks *ranks; /* the ranks that shared the solve, with rank 0's
+                                 traffic (q->ranks); NULL: one process */
 } solve_result;
 
 /* Whether a solve of `cells` cells (extended or not) is better run on one

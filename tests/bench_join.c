@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define CM_BENCH_COMMAND_JSON
 #include "bench_util.h"
 
 enum { MAX_REPS = 50 };
@@ -24,15 +25,6 @@ static const char *const configs[][4] = {
 };
 static const char *const splits[] = {NULL, "4x4", "16x16"};
 
-/* The number after "key": in text, or -1. */
-static double json_number(const char *text, const char *key)
-{
-    char quoted[64];
-    snprintf(quoted, sizeof quoted, "\"%s\":", key);
-    const char *at = strstr(text, quoted);
-    return at ? strtod(at + strlen(quoted), NULL) : -1;
-}
-
 /* One solve: its time and its joins' (0 whole), in seconds; 0 on success. */
 static int run(const char *cm, int c, int s, double *solve, double *joins)
 {
@@ -42,19 +34,8 @@ static int run(const char *cm, int c, int s, double *solve, double *joins)
              "%s%s --json",
              cm, configs[c][1], configs[c][2], configs[c][3], splits[s] ? "--split " : "",
              splits[s] ? splits[s] : "");
-    FILE *p = popen(cmd, "r");
-    if (!p)
+    if (command_json(cmd, out, sizeof out, NULL) != 0)
         return -1;
-    const size_t n = fread(out, 1, sizeof out - 1, p);
-    out[n] = '\0';
-    if (pclose(p) != 0)
-        return -1;
-    /* the keys as cmd_solve writes them, without spaces after the colon */
-    char *w = out;
-    for (const char *r = out; *r; r++)
-        if (!(*r == ' ' && r > out && r[-1] == ':'))
-            *w++ = *r;
-    *w = '\0';
     /* a cellmap older than time_s.joins: NaN (the other figures stand) */
     const double joined = json_number(out, "joins");
     *joins = !s ? 0 : joined >= 0 ? joined : NAN;

@@ -23,18 +23,10 @@
 #include <string.h>
 #include <unistd.h>
 
+#define CM_BENCH_COMMAND_JSON
 #include "bench_util.h"
 
 enum { MAX_REPS = 50 };
-
-/* The number after "key": in text, or -1. */
-static double json_number(const char *text, const char *key)
-{
-    char quoted[64];
-    snprintf(quoted, sizeof quoted, "\"%s\":", key);
-    const char *at = strstr(text, quoted);
-    return at ? strtod(at + strlen(quoted), NULL) : -1;
-}
 
 typedef struct run_out {
     double wall, solve, joins, bytes_per_cell;
@@ -50,20 +42,8 @@ static int run(const char *cm, int ranks, int threads, const char *args, run_out
                  "--oversubscribe -n %d ",
                  ranks);
     snprintf(cmd, sizeof cmd, "%s'%s' solve %s --threads %d --json", launch, cm, args, threads);
-    const double t0 = now();
-    FILE *p = popen(cmd, "r");
-    if (!p)
+    if (command_json(cmd, out, sizeof out, &o->wall) != 0)
         return -1;
-    const size_t n = fread(out, 1, sizeof out - 1, p);
-    out[n] = '\0';
-    if (pclose(p) != 0)
-        return -1;
-    o->wall = now() - t0;
-    char *w = out; /* the keys as cmd_solve writes them, without spaces after the colon */
-    for (const char *r = out; *r; r++)
-        if (!(*r == ' ' && r > out && r[-1] == ':'))
-            *w++ = *r;
-    *w = '\0';
     o->solve = json_number(out, "regions and joins") + json_number(out, "summary");
     o->joins = json_number(out, "joins");
     o->bytes_per_cell = ranks > 1 ? json_number(out, "bytes_per_cell") : 0;
