@@ -1295,21 +1295,51 @@ static cm_status init_nodes(cm_cluster *c, cm_cluster_region *cr, const cm_node 
     return CM_OK;
 }
 
-cm_status cm_region_nodes(const cm_region *r, cm_node **out)
+/* A node table of r's exits, every node open, trees not counted. */
+static cm_node *open_nodes(const cm_region *r)
 {
     /* every record is written below: fresh memory, in huge pages if big */
     cm_node *nodes = cm_cells_array((r->nexits + 1) * sizeof *nodes);
     if (!nodes)
-        return CM_ENOMEM;
+        return NULL;
     memset(&nodes[r->nexits], 0, sizeof *nodes);
     for (uint64_t e = 0; e < r->nexits; e++)
         nodes[e] = (cm_node){.next = CM_NODE_OPEN, .up = CM_NODE_OPEN, .first_in = CM_NODE_OPEN,
                              .sibling = CM_NODE_OPEN};
+    return nodes;
+}
+
+cm_status cm_region_nodes(const cm_region *r, cm_node **out)
+{
+    cm_node *nodes = open_nodes(r);
+    if (!nodes)
+        return CM_ENOMEM;
     for (uint64_t i = 0; i < r->ncells; i++)
         if (cm_is_node_ref(r->group[i]))
             nodes[r->group[i] & ~CM_NODE_REF].tree++;
     for (uint64_t e = 0; e < r->nexits; e++)
         set_weight(&nodes[e], nodes[e].tree); /* open: its own tree leaves */
+    *out = nodes;
+    return CM_OK;
+}
+
+void cm_region_trees(const cm_region *r, uint32_t *tree)
+{
+    memset(tree, 0, r->nexits * sizeof *tree);
+    for (uint64_t i = 0; i < r->ncells; i++)
+        if (cm_is_node_ref(r->group[i]))
+            tree[r->group[i] & ~CM_NODE_REF]++;
+}
+
+cm_status cm_region_nodes_of_trees(const cm_region *r, const uint32_t *tree, cm_node **out)
+{
+    cm_node *nodes = open_nodes(r);
+    if (!nodes)
+        return CM_ENOMEM;
+    for (uint64_t e = 0; e < r->nexits; e++) {
+        nodes[e].tree = tree[e];
+        set_weight(&nodes[e], tree[e]);
+    }
     *out = nodes;
     return CM_OK;
 }

@@ -250,6 +250,15 @@ int cm_cluster_threads(const cm_cluster *c);
  * another thread can make it while the cluster joins. */
 cm_status cm_region_nodes(const cm_region *r, cm_node **out);
 
+/* The size of each of r's nodes' trees (cells whose chains end on the
+ * node, itself included) into tree[0..r->nexits): what the node table
+ * takes of r's cells. Reads r only. */
+void cm_region_trees(const cm_region *r, uint32_t *tree);
+
+/* cm_region_nodes from those sizes (tree: r->nexits of them, from
+ * cm_region_trees, as another process sends them): no cell is read. */
+cm_status cm_region_nodes_of_trees(const cm_region *r, const uint32_t *tree, cm_node **out);
+
 /* Adds region r (solved with record_exits on the cluster's lattice; the
  * cluster takes its arrays, r is zeroed) without linking anything: its own
  * groups take the next ids, its nodes are open, its periodic cells are

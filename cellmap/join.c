@@ -578,12 +578,15 @@ static cm_status locate_exits(const plan *pl, const cm_region *r, plan_target **
 }
 
 /* What the join of the region in slot s needs of it alone: its node
- * table, and where its exits lead among the plan's boxes. */
-static void prepare_region(pipeline *p, uint32_t s)
+ * table (from its trees' sizes if another process sent them, else from
+ * its cells), and where its exits lead among the plan's boxes. */
+static void prepare_region(pipeline *p, uint32_t s, const uint32_t *tree)
 {
+    const cm_region *r = &p->slot[s];
     if (p->status[s] == CM_OK &&
-        (cm_region_nodes(&p->slot[s], &p->nodes[s]) != CM_OK ||
-         (p->pl.index && locate_exits(&p->pl, &p->slot[s], &p->targets[s]) != CM_OK)))
+        ((tree ? cm_region_nodes_of_trees(r, tree, &p->nodes[s])
+               : cm_region_nodes(r, &p->nodes[s])) != CM_OK ||
+         (p->pl.index && locate_exits(&p->pl, r, &p->targets[s]) != CM_OK)))
         p->status[s] = cm_fail(CM_ENOMEM, p->msgs[s], sizeof p->msgs[s],
                                "out of memory for its nodes");
 }
@@ -594,30 +597,57 @@ static void pause_briefly(void)
     nanosleep(&t, NULL);
 }
 
-/* Claims and solves the next box if the window allows; false if it does not. */
+/* Claims the next box into *b if the window allows; false if it does not. */
+static bool claim(pipeline *p, unsigned *b)
+{
+    *b = atomic_load(&p->next);
+    do {
+        if (*b >= p->nboxes || *b >= atomic_load(&p->joined) + p->window ||
+            atomic_load(&p->stop))
+            return false;
+    } while (!atomic_compare_exchange_weak(&p->next, b, *b + 1));
+    return true;
+}
+
+/* Box b, just claimed into slot s, goes to the source: its join fetches it. */
+static void send_away(pipeline *p, unsigned b)
+{
+    const uint32_t s = b % p->window;
+    p->status[s] = CM_OK;
+    p->deferred[s] = 1;
+    atomic_store(&p->ready[s], b + 1);
+}
+
+/* Claims the next box if the window allows, and solves it unless the
+ * source takes it; false if the window does not allow. */
 static bool solve_next(pipeline *p)
 {
-    unsigned b = atomic_load(&p->next);
-    do {
-        if (b >= p->nboxes || b >= atomic_load(&p->joined) + p->window || atomic_load(&p->stop))
-            return false;
-    } while (!atomic_compare_exchange_weak(&p->next, &b, b + 1));
-    const uint32_t s = b % p->window;
+    unsigned b;
+    if (!claim(p, &b))
+        return false;
     const cm_region_source *src = p->c->source;
-    bool got = true;
-    if (src && src->elsewhere(src->user, b)) { /* if it has not come, its join fetches it */
-        p->status[s] = src->fetch(src->user, b, &p->slot[s], &got, p->msgs[s], sizeof p->msgs[s]);
-        p->deferred[s] = p->status[s] == CM_OK && !got;
-    } else {
-        p->status[s] = cm_region_alloc(&p->slot[s], &p->boxes[b], p->msgs[s], sizeof p->msgs[s]);
-        if (p->status[s] == CM_OK)
-            p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
-                                        sizeof p->msgs[s]);
+    if (src && src->take(src->user, b)) {
+        send_away(p, b);
+        return true;
     }
-    if (got) /* what the join needs of the region alone, off the joining thread */
-        prepare_region(p, s);
+    const uint32_t s = b % p->window;
+    p->status[s] = cm_region_alloc(&p->slot[s], &p->boxes[b], p->msgs[s], sizeof p->msgs[s]);
+    if (p->status[s] == CM_OK)
+        p->status[s] = cm_scm_solve(p->model, &p->c->lat, &p->one, &p->slot[s], p->msgs[s],
+                                    sizeof p->msgs[s]);
+    prepare_region(p, s, NULL); /* what the join needs of the region alone, off the joining thread */
     atomic_store(&p->ready[s], b + 1);
     return true;
+}
+
+/* The joining thread keeps the source supplied: boxes are claimed for it
+ * while it has room (a box claimed when it has none meanwhile is solved
+ * here, as solve_next would). */
+static void supply_source(pipeline *p)
+{
+    const cm_region_source *src = p->c->source;
+    while (src && src->room(src->user) && solve_next(p))
+        ;
 }
 
 /* Box b, in slot s, solved elsewhere and not fetched when it was claimed:
@@ -626,14 +656,17 @@ static void fetch_deferred(pipeline *p, uint32_t b, uint32_t s)
 {
     const cm_region_source *src = p->c->source;
     bool got = false;
+    uint32_t *tree = NULL;
     while (p->status[s] == CM_OK && !got) {
-        p->status[s] = src->fetch(src->user, b, &p->slot[s], &got, p->msgs[s], sizeof p->msgs[s]);
+        p->status[s] =
+            src->fetch(src->user, b, &p->slot[s], &tree, &got, p->msgs[s], sizeof p->msgs[s]);
         if (p->status[s] == CM_OK && !got && !solve_next(p))
             pause_briefly();
     }
     p->deferred[s] = 0;
     if (got)
-        prepare_region(p, s);
+        prepare_region(p, s, tree);
+    free(tree);
 }
 
 /* Bytes of the regions after box b solved ahead of their joins (complete
@@ -661,6 +694,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
     cm_status st = CM_OK;
     for (uint32_t b = 0; b < p->nboxes && st == CM_OK; b++) {
         const uint32_t s = b % p->window;
+        supply_source(p);
         while (atomic_load(&p->ready[s]) != b + 1)
             if (!solve_next(p))
                 pause_briefly();

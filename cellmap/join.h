@@ -44,13 +44,21 @@ typedef struct cm_region_source {
     /* Before a call's boxes are solved (on the calling thread): boxes[0..n)
      * are the call's, in join order. */
     cm_status (*ask)(void *user, const cm_box *boxes, uint32_t n, char *msg, size_t msg_size);
-    /* Whether box b of the call is solved elsewhere. */
-    bool (*elsewhere)(const void *user, uint32_t b);
-    /* Box b's region into *r (which cm_region_free releases) if it has
-     * come (*got), without waiting; from any of the solve's threads, until
-     * it has come. Meanwhile the solve goes on with other boxes. */
-    cm_status (*fetch)(void *user, uint32_t b, cm_region *r, bool *got, char *msg,
-                       size_t msg_size);
+    /* Whether another process would take a box now (it has room for more
+     * than it is solving); from any of the solve's threads. */
+    bool (*room)(void *user);
+    /* Box b of the call, just claimed (boxes are claimed in order, from
+     * any of the solve's threads): whether another process solves it (it
+     * is sent there now; room said so, or it took one box more); false:
+     * this process does. */
+    bool (*take)(void *user, uint32_t b);
+    /* Box b's region, taken elsewhere, into *r (which cm_region_free
+     * releases) and its trees' sizes (cm_region_trees) into *tree, a new
+     * array the solve frees, if it has come (*got), without waiting; from
+     * any of the solve's threads, until it has come. Meanwhile the solve
+     * goes on with other boxes. */
+    cm_status (*fetch)(void *user, uint32_t b, cm_region *r, uint32_t **tree, bool *got,
+                       char *msg, size_t msg_size);
     uint32_t processes; /* this one and those that solve elsewhere: how far
                            ahead of the joins the boxes may go grows with it */
     void *user;
@@ -61,13 +69,17 @@ typedef struct cm_region_source {
 typedef cm_status (*cm_joined_fn)(void *user, cm_cluster *c, uint32_t box,
                                   const cm_join_stats *stats, char *msg, size_t msg_size);
 
-/* Solves the boxes, one per thread (a lone box with every thread; those
- * c->source says are solved elsewhere fetched from it), and
+/* Solves the boxes, one per thread (a lone box with every thread), and
  * joins them in the given order on the calling thread while the others go
  * on solving (at most two boxes per thread ahead of the joins, times the
- * source's processes), calling
+ * source's processes). With c->source, each box claimed goes to the
+ * source first while it has room, and the joining thread keeps it
+ * supplied between joins: this process solves a box itself only when the
+ * others are busy, so that the joins, which are this process's alone,
+ * weigh on it as little as they can. Calls
  * joined (may be NULL) after every join. stats (may be NULL) sums the
- * joins'. The cluster is the same whatever the thread count. */
+ * joins'. The cluster is the same whatever the thread count, and whoever
+ * solved each box. */
 cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_box *boxes,
                                  uint32_t nboxes, const cm_scm_options *opt, cm_joined_fn joined,
                                  void *user, cm_join_stats *stats, char *msg, size_t msg_size);

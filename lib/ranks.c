@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cellmap/grow.h"
 #include "cellmap/scm.h"
 
 enum { TAG_BOXES = 1, TAG_STOP, TAG_DONE, TAG_REGION /* and above: a region, by its index */ };
@@ -23,8 +24,9 @@ typedef struct box_request {
 } box_request;
 
 /* What a worker sends first for a box: the region's sizes, or why it
- * could not solve it; then (solved) its image, group and step arrays and
- * its exits, as separate messages. */
+ * could not solve it; then (solved) its image, group and step arrays, its
+ * exits and its trees' sizes (cm_region_trees, so that rank 0 makes the
+ * node table without a pass over the cells), as separate messages. */
 typedef struct region_header {
     uint64_t index, ncells, nexits;
     int32_t status, exits_recorded;
@@ -33,25 +35,31 @@ typedef struct region_header {
     char msg[256];
 } region_header;
 
-/* The boxes of one call sent to one worker, kept until the send is done. */
-typedef struct batch {
-    box_request *v;
+/* A box request on its way to a worker, kept until the send is done. */
+typedef struct pending_send {
+    box_request q;
     MPI_Request req;
-} batch;
+} pending_send;
+
+/* Boxes a worker is given beyond the one it solves: it goes on to the
+ * next without waiting for rank 0, which may be joining. */
+#define WORKER_QUEUE 2
 
 typedef struct mpi_ranks {
     solve_ranks pub;
-    pthread_mutex_t lock; /* rank 0's threads receive one at a time */
+    pthread_mutex_t lock; /* rank 0's threads use MPI one at a time */
     uint64_t asked;       /* boxes asked for by the calls before */
     uint64_t first;       /* index of the current call's first box */
+    const cm_box *boxes;  /* the current call's */
+    uint32_t nboxes;
+    uint32_t claimed;     /* boxes of the call claimed so far */
+    int *holder;          /* per box of the call: the worker solving it, 0: rank 0 */
+    int *held;            /* per worker: boxes given whose regions have not arrived */
+    uint64_t *given;      /* per worker: WORKER_QUEUE places, the first held in order */
     int tag_span;         /* region tags: TAG_REGION + index mod tag_span */
-    batch *batches;       /* per worker: the current call's */
+    pending_send **sends; /* box requests not known to be sent */
+    size_t nsends, sends_cap;
 } mpi_ranks;
-
-static int owner(const mpi_ranks *m, uint64_t index)
-{
-    return (int)(index % (uint64_t)m->pub.size);
-}
 
 static int region_tag(const mpi_ranks *m, uint64_t index)
 {
@@ -74,11 +82,14 @@ static void recv_bytes(void *p, uint64_t n, int src, int tag)
         free(c);
 }
 
+enum { REGION_ARRAYS = 5 };
+
 /* The bytes of a region's arrays after its header, in the order sent. */
-static void region_arrays(const region_header *h, uint64_t bytes[4])
+static void region_arrays(const region_header *h, uint64_t bytes[REGION_ARRAYS])
 {
     bytes[0] = bytes[1] = bytes[2] = h->ncells * sizeof(uint32_t);
     bytes[3] = h->nexits * (uint64_t)h->box.dim * sizeof(int64_t);
+    bytes[4] = h->nexits * sizeof(uint32_t);
 }
 
 /* ---- a worker ------------------------------------------------------------ */
@@ -110,6 +121,7 @@ static bool stop_pending(void)
 typedef struct outgoing {
     region_header *h; /* on the heap: MPI reads it while the record moves */
     cm_region r;
+    uint32_t *tree;
     MPI_Request *req;
     int nreq;
 } outgoing;
@@ -135,18 +147,22 @@ static cm_status start_send(const mpi_ranks *m, const box_request *q, cm_region 
         h->box = r->box;
         o->r = *r;
         memset(r, 0, sizeof *r);
+        if (!(o->tree = malloc(o->r.nexits * sizeof *o->tree + 1)))
+            return CM_ENOMEM;
+        cm_region_trees(&o->r, o->tree);
     }
-    uint64_t bytes[4];
+    uint64_t bytes[REGION_ARRAYS];
     region_arrays(h, bytes);
     int n = 1;
-    for (int a = 0; st == CM_OK && a < 4; a++)
+    for (int a = 0; st == CM_OK && a < REGION_ARRAYS; a++)
         n += pieces(bytes[a]);
     if (!(o->req = malloc((size_t)n * sizeof *o->req)))
         return CM_ENOMEM;
     const int tag = region_tag(m, q->index);
     MPI_Isend(h, (int)sizeof *h, MPI_BYTE, 0, tag, MPI_COMM_WORLD, &o->req[o->nreq++]);
-    const void *arrays[4] = {o->r.image, o->r.group, o->r.step, o->r.exit_target};
-    for (int a = 0; st == CM_OK && a < 4; a++) {
+    const void *arrays[REGION_ARRAYS] = {o->r.image, o->r.group, o->r.step, o->r.exit_target,
+                                         o->tree};
+    for (int a = 0; st == CM_OK && a < REGION_ARRAYS; a++) {
         const char *c = arrays[a];
         uint64_t left = bytes[a];
         do { /* an empty array is one empty message */
@@ -170,6 +186,7 @@ static bool sent(outgoing *o, bool wait)
     if (done) {
         free(o->req);
         free(o->h);
+        free(o->tree);
         cm_region_free(&o->r);
     }
     return done != 0;
@@ -260,56 +277,113 @@ static cm_status serve(solve_ranks *rk, const cm_model *model, const cm_lattice 
 
 /* ---- rank 0 ------------------------------------------------------------- */
 
-static bool elsewhere(const void *user, uint32_t b)
+/* Forgets worker w's boxes whose regions have arrived (lock held): a
+ * worker sends its regions in the order it was given the boxes, so the
+ * oldest comes first. A region that arrived waits for its join, and the
+ * worker goes on. */
+static void note_arrivals(mpi_ranks *m, int w)
 {
-    const mpi_ranks *m = user;
-    return owner(m, m->first + b) != 0;
+    uint64_t *given = &m->given[(size_t)w * WORKER_QUEUE];
+    for (int flag = 1; flag && m->held[w] > 0;) {
+        MPI_Iprobe(w, region_tag(m, given[0]), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+        if (flag)
+            memmove(given, given + 1, (size_t)--m->held[w] * sizeof *given);
+    }
 }
 
-/* Waits for the boxes sent to workers by the last call to be received. */
-static void complete_batches(mpi_ranks *m)
+/* The worker holding the fewest boxes, if it has room (lock held), or 0.
+ * Room is WORKER_QUEUE boxes, and no more than an even share of the
+ * boxes still to claim (from box b of the call): else a call of few boxes
+ * would go to the workers whole while rank 0 waits for them. */
+static int least_held(mpi_ranks *m, uint32_t b)
 {
-    for (int w = 1; w < m->pub.size; w++)
-        if (m->batches[w].v) {
-            MPI_Wait(&m->batches[w].req, MPI_STATUS_IGNORE);
-            free(m->batches[w].v);
-            m->batches[w].v = NULL;
-        }
+    const uint32_t left = m->nboxes - b, size = (uint32_t)m->pub.size;
+    const int share = (int)((left + size - 1) / size);
+    const int limit = share < WORKER_QUEUE ? share : WORKER_QUEUE;
+    int w = 0;
+    for (int k = 1; k < m->pub.size; k++) {
+        note_arrivals(m, k);
+        if (m->held[k] < limit && (w == 0 || m->held[k] < m->held[w]))
+            w = k;
+    }
+    return w;
 }
 
-/* Sends each worker its boxes of the call, in one message. */
+/* Frees the box requests sent (lock held); all of them: waits for them. */
+static void reap_sends(mpi_ranks *m, bool all)
+{
+    size_t kept = 0;
+    for (size_t i = 0; i < m->nsends; i++) {
+        int done = 1;
+        if (all)
+            MPI_Wait(&m->sends[i]->req, MPI_STATUS_IGNORE);
+        else
+            MPI_Test(&m->sends[i]->req, &done, MPI_STATUS_IGNORE);
+        if (done)
+            free(m->sends[i]);
+        else
+            m->sends[kept++] = m->sends[i];
+    }
+    m->nsends = kept;
+}
+
+static bool room(void *user)
+{
+    mpi_ranks *m = user;
+    pthread_mutex_lock(&m->lock);
+    const bool some = m->claimed < m->nboxes && least_held(m, m->claimed) != 0;
+    pthread_mutex_unlock(&m->lock);
+    return some;
+}
+
+/* Sends box b of the call to the worker with most room, if one has room. */
+static bool take(void *user, uint32_t b)
+{
+    mpi_ranks *m = user;
+    pthread_mutex_lock(&m->lock);
+    reap_sends(m, false);
+    m->claimed = b + 1;
+    const int w = least_held(m, b);
+    pending_send *ps = NULL;
+    if (w != 0 && (m->nsends < m->sends_cap ||
+                   cm_grow((void **)&m->sends, &m->sends_cap, m->nsends + 1,
+                           sizeof *m->sends) == CM_OK))
+        ps = malloc(sizeof *ps);
+    if (ps) { /* out of memory: rank 0 solves it */
+        ps->q = (box_request){m->first + b, m->boxes[b]};
+        MPI_Isend(&ps->q, (int)sizeof ps->q, MPI_BYTE, w, TAG_BOXES, MPI_COMM_WORLD, &ps->req);
+        m->sends[m->nsends++] = ps;
+        m->holder[b] = w;
+        m->given[(size_t)w * WORKER_QUEUE + m->held[w]++] = m->first + b;
+        m->pub.bytes_sent += sizeof ps->q;
+    }
+    pthread_mutex_unlock(&m->lock);
+    return ps != NULL;
+}
+
+/* A call's boxes: none given to a worker yet. */
 static cm_status ask(void *user, const cm_box *boxes, uint32_t n, char *msg, size_t msg_size)
 {
     mpi_ranks *m = user;
-    complete_batches(m);
+    int *holder = calloc((size_t)n + 1, sizeof *holder);
+    if (!holder)
+        return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u boxes", n);
+    pthread_mutex_lock(&m->lock);
+    free(m->holder);
+    m->holder = holder;
+    m->boxes = boxes;
+    m->nboxes = n;
+    m->claimed = 0;
     m->first = m->asked;
     m->asked += n;
-    for (int w = 1; w < m->pub.size; w++) {
-        uint32_t count = 0;
-        for (uint32_t b = 0; b < n; b++)
-            count += owner(m, m->first + b) == w;
-        if (count == 0)
-            continue;
-        if ((uint64_t)count * sizeof(box_request) > INT32_MAX)
-            return cm_fail(CM_ETOOBIG, msg, msg_size, "too many regions for rank %d at once", w);
-        box_request *v = malloc(count * sizeof *v);
-        if (!v)
-            return cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %u boxes", count);
-        count = 0;
-        for (uint32_t b = 0; b < n; b++)
-            if (owner(m, m->first + b) == w)
-                v[count++] = (box_request){m->first + b, boxes[b]};
-        m->batches[w].v = v;
-        MPI_Isend(v, (int)(count * sizeof *v), MPI_BYTE, w, TAG_BOXES, MPI_COMM_WORLD,
-                  &m->batches[w].req);
-        m->pub.bytes_sent += count * sizeof *v;
-    }
+    pthread_mutex_unlock(&m->lock);
     return CM_OK;
 }
 
-/* Receives the region index from rank src into r (lock held). */
-static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region *r, char *msg,
-                                size_t msg_size)
+/* Receives the region index from rank src into r, its trees' sizes into
+ * a new *tree (lock held). */
+static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region *r,
+                                uint32_t **tree, char *msg, size_t msg_size)
 {
     const int tag = region_tag(m, index);
     region_header h;
@@ -320,10 +394,11 @@ static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region
     if (h.index != index)
         return cm_fail(CM_EFORMAT, msg, msg_size, "rank %d sent region %llu for region %llu", src,
                        (unsigned long long)h.index, (unsigned long long)index);
-    uint64_t bytes[4];
+    uint64_t bytes[REGION_ARRAYS];
     region_arrays(&h, bytes);
     cm_status st = cm_region_alloc(r, &h.box, msg, msg_size);
-    if (st == CM_OK && !(r->exit_target = malloc(bytes[3] + 1)))
+    if (st == CM_OK &&
+        (!(r->exit_target = malloc(bytes[3] + 1)) || !(*tree = malloc(bytes[4] + 1))))
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for %llu exits",
                      (unsigned long long)h.nexits);
     if (st != CM_OK) { /* the arrays on their way could not be taken */
@@ -333,8 +408,8 @@ static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region
     r->nexits = h.nexits;
     r->exits_recorded = h.exits_recorded;
     r->ngroups = h.ngroups;
-    void *arrays[4] = {r->image, r->group, r->step, r->exit_target};
-    for (int a = 0; a < 4; a++) {
+    void *arrays[REGION_ARRAYS] = {r->image, r->group, r->step, r->exit_target, *tree};
+    for (int a = 0; a < REGION_ARRAYS; a++) {
         recv_bytes(arrays[a], bytes[a], src, tag);
         m->pub.bytes_received += bytes[a];
     }
@@ -342,16 +417,19 @@ static cm_status receive_region(mpi_ranks *m, int src, uint64_t index, cm_region
     return CM_OK;
 }
 
-static cm_status fetch(void *user, uint32_t b, cm_region *r, bool *got, char *msg,
-                       size_t msg_size)
+static cm_status fetch(void *user, uint32_t b, cm_region *r, uint32_t **tree, bool *got,
+                       char *msg, size_t msg_size)
 {
     mpi_ranks *m = user;
     const uint64_t index = m->first + b;
-    const int src = owner(m, index);
     int flag = 0;
     pthread_mutex_lock(&m->lock);
+    const int src = m->holder[b];
     MPI_Iprobe(src, region_tag(m, index), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
-    const cm_status st = flag ? receive_region(m, src, index, r, msg, msg_size) : CM_OK;
+    const cm_status st = flag ? receive_region(m, src, index, r, tree, msg, msg_size) : CM_OK;
+    uint64_t *given = &m->given[(size_t)src * WORKER_QUEUE];
+    if (flag && src != 0 && m->held[src] > 0 && given[0] == index) /* not noted before */
+        memmove(given, given + 1, (size_t)--m->held[src] * sizeof *given);
     pthread_mutex_unlock(&m->lock);
     *got = flag != 0;
     return st;
@@ -369,9 +447,9 @@ static void drain(int w)
         }
         region_header h;
         MPI_Recv(&h, (int)sizeof h, MPI_BYTE, w, s.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        uint64_t bytes[4];
+        uint64_t bytes[REGION_ARRAYS];
         region_arrays(&h, bytes);
-        for (int a = 0; h.status == CM_OK && a < 4; a++)
+        for (int a = 0; h.status == CM_OK && a < REGION_ARRAYS; a++)
             recv_bytes(NULL, bytes[a], w, s.MPI_TAG);
     }
 }
@@ -384,7 +462,7 @@ static cm_status stop(solve_ranks *rk, cm_status status)
         MPI_Send(&s, 1, MPI_INT32_T, w, TAG_STOP, MPI_COMM_WORLD);
     for (int w = 1; w < rk->size; w++)
         drain(w);
-    complete_batches(m); /* received: every worker read up to the stop */
+    reap_sends(m, true); /* received: every worker read up to the stop */
     return status;
 }
 
@@ -481,14 +559,15 @@ cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size
     int *tag_ub = NULL, found = 0;
     MPI_Comm_get_attr(MPI_COMM_WORLD, MPI_TAG_UB, &tag_ub, &found);
     m->tag_span = (found && tag_ub ? *tag_ub : 32767) - TAG_REGION;
-    m->batches = calloc((size_t)m->pub.size, sizeof *m->batches);
-    if (!m->batches)
+    m->held = calloc((size_t)m->pub.size, sizeof *m->held);
+    m->given = calloc((size_t)m->pub.size * WORKER_QUEUE, sizeof *m->given);
+    if (!m->held || !m->given)
         MPI_Abort(MPI_COMM_WORLD, 1);
     pthread_mutex_init(&m->lock, NULL);
     m->pub.ready = ready;
     m->pub.serve = serve;
     m->pub.stop = stop;
-    m->pub.source = (cm_region_source){ask, elsewhere, fetch, (uint32_t)m->pub.size, m};
+    m->pub.source = (cm_region_source){ask, room, take, fetch, (uint32_t)m->pub.size, m};
     *out = &m->pub;
     if (provided < MPI_THREAD_SERIALIZED)
         return cm_fail(CM_EINVAL, msg, msg_size,
@@ -507,7 +586,12 @@ void ranks_close(solve_ranks *rk, bool ok)
         ready(rk, ok, &all_ok, &failed);
     mpi_ranks *m = (mpi_ranks *)rk;
     pthread_mutex_destroy(&m->lock);
-    free(m->batches);
+    for (size_t i = 0; i < m->nsends; i++) /* none once stop() ran */
+        free(m->sends[i]);
+    free(m->holder);
+    free(m->held);
+    free(m->given);
+    free(m->sends);
     free(m);
     MPI_Finalize();
 }

@@ -1,15 +1,22 @@
 /* lib/ranks.h - a solve shared by several processes: MPI ranks, started by
  * mpirun on one host or many.
  *
- * Rank 0 runs the solve as one process would. The regions of its clusters
- * are assigned to ranks by their place in the order the solve asks for
- * them: the k-th box asked for (counted over the whole solve, adaptive
- * extension included) goes to rank k mod R. The other ranks (workers)
- * solve what they are sent with all their threads and send the region
- * back: its cells (image, group, step: 12 bytes a cell) and its exits.
- * Rank 0 joins them in the order one process would, so the cluster, its
- * database, figures and exports are byte for byte those of a solve
- * without MPI, whatever R and each rank's thread count.
+ * Rank 0 runs the solve as one process would. Its clusters' boxes go to
+ * the workers (the other ranks) as the solve claims them, in its order:
+ * a worker is given a box whenever it holds fewer than WORKER_QUEUE (2:
+ * the one it solves and the next), the one holding fewest first, and rank
+ * 0 solves a box itself only when every worker holds that many. Rank 0
+ * joins every region, which on one process takes a thread from the
+ * solving; so it solves what it can between joins, and a region costly
+ * to solve goes to whichever rank is free: the balance follows the
+ * measured cost of each box, not a rule fixed in advance. Which rank
+ * solved a box therefore depends on timing; nothing written does. A
+ * worker solves its boxes in order with all its threads and sends each
+ * region back: its cells (image, group, step: 12 bytes a cell), its
+ * exits and the sizes of its nodes' trees (so that rank 0 makes the node
+ * table without reading the cells). Rank 0 joins them in the order one process would, so the
+ * cluster, its database, figures and exports are byte for byte those of
+ * a solve without MPI, whatever R and each rank's thread count.
  *
  * The protocol, in order:
  *   1. ranks_open (every rank, before the command): the ranks run the same

@@ -54,17 +54,16 @@ static int run(const char *cm, int ranks, int threads, const char *args, run_out
  * threads and P cores, from S (the regions' SCM on one thread), J (the
  * joins, serial on rank 0) and X (what taking every region from other
  * ranks would cost rank 0: receiving it, its node table, its exits
- * located). The longest of three: rank 0's path (its share of the
- * regions, the joins, its share of X; the joins on one thread), a
- * worker's (its share of the regions), the host's (all the work over the
- * cores it has). */
+ * located). Boxes go to whichever thread is free (lib/ranks.h), so the
+ * workers take the share of their threads, (R - 1) / R, and rank 0 that
+ * share of X. The longer of two: rank 0's joining thread (the joins and
+ * what it receives), and all the work over the threads, or the cores. */
 static double model(double S, double J, double X, int R, int t, int P)
 {
     const double XR = X * (R - 1) / R;
-    const double rank0 = fmax(J, (S / R + J + XR) / t);
-    const double worker = S / R / t;
-    const double host = (S + J + XR) / (R * t < P ? R * t : P);
-    return fmax(rank0, fmax(worker, host));
+    const double joining = J + XR;
+    const double spread = (S + J + XR) / (R * t < P ? R * t : P);
+    return fmax(joining, spread);
 }
 
 /* Medians of the solve and its joins on R ranks of t threads. */
@@ -99,7 +98,8 @@ static int model_table(const char *cm, int reps, int cores, const char *duffing,
             return 1;
         }
         S = T11 - J;
-        X = fmax(0, 2 * (T21 - S / 2 - J)); /* rank 0 takes half the regions from rank 1 */
+        /* the model's 2 x 1 time inverted: each of its two terms grows with X */
+        X = fmax(0, fmin(2 * (T21 - J), 2 * ((cores < 2 ? cores : 2) * T21 - S - J)));
         for (int R = 1; R <= 3; R++)
             for (int t = 1; t <= 2; t++) {
                 double T = T11, unused;
