@@ -308,6 +308,25 @@ cm_status cm_result_figure(const cm_result *r, const cm_figure_options *o, char 
 
 /* ---- projects: databases made and grown ---- */
 
+/* The processes mpirun started (MPI ranks), for solves shared among them
+ * (cm_db_options.ranks): rank 0 runs the solve and writes the file, the
+ * others solve regions for it. Every rank opens them, makes the same calls
+ * with the same model, parameters, grid and plan (each may use its own
+ * threads), and closes them. Outside mpirun they are one rank (rank 0)
+ * and MPI is not loaded; under mpirun, cm_ranks_open loads
+ * libcellmap-mpi.so.0 from libcellmap's own directory (built where MPI is
+ * found: CM_ENOTFOUND without it) and starts MPI, unless the program
+ * started it (with MPI_THREAD_SERIALIZED or above), which then also ends
+ * it. Every rank must run the same libcellmap (a hash of its file), or
+ * every rank fails with rank 0 naming the one that differs. One per
+ * process, used from one thread at a time. */
+typedef struct cm_ranks cm_ranks;
+cm_status cm_ranks_open(cm_ranks **out, char *msg, size_t msg_size);
+int cm_ranks_rank(const cm_ranks *r);
+int cm_ranks_size(const cm_ranks *r);
+/* Ends them (and MPI, if cm_ranks_open started it); NULL: nothing. */
+void cm_ranks_close(cm_ranks *r);
+
 /* How a database is solved: as `cellmap solve --db` with --split, --extend,
  * --escape-below, --max-steps, --threads and --mem. */
 typedef struct cm_db_options {
@@ -321,6 +340,13 @@ typedef struct cm_db_options {
     const char *command;  /* the provenance the file records; NULL: "libcellmap" */
     cm_solve_progress_fn progress; /* optional: fraction of the grid's cells; nonzero cancels */
     void *user;
+    /* optional (cm_db_create, cm_db_resume): the regions (split, extend)
+     * shared among these ranks; on ranks other than 0 the call returns
+     * once rank 0's solve has ended, with its status, and writes nothing
+     * (progress is rank 0's). The file is the same bytes for any number
+     * of ranks. More ranks than regions, or ranks asked for different
+     * solves: every rank fails, rank 0 says why. */
+    cm_ranks *ranks;
 } cm_db_options;
 
 /* Solves grid for model `name` of set (NULL: the built-in models) with

@@ -21,6 +21,7 @@
 #include "render/png_out.h"
 #include "cellmap/output.h"
 #include "lib/api_models.h"
+#include "lib/api_ranks.h"
 #include "lib/attractor_view.h"
 #include "lib/export.h"
 #include "lib/figure.h"
@@ -737,11 +738,14 @@ static cm_status db_solve(const cm_models *set, const char *name, const char *pa
     call_hooks h = {o->progress, o->user, (double)cm_box_cells(&q.box), 0};
     const work_hooks hooks = {call_progress, call_stop, &h};
     q.hooks = &hooks;
+    q.ranks = api_ranks_solve(o->ranks);
     solve_result *r = st == CM_OK ? malloc(sizeof *r) : NULL;
     if (st == CM_OK && !r)
         st = cm_fail(CM_ENOMEM, msg, msg_size, "out of memory for a solve");
     if (st == CM_OK)
         st = solve_run(&q, r, msg, msg_size);
+    else if (q.ranks) /* the other ranks learn that this one cannot solve */
+        solve_ranks_refuse(q.ranks);
     if (st == CM_OK)
         st = solve_finish(r, msg, msg_size);
     if (r)

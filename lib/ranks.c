@@ -59,6 +59,7 @@ typedef struct mpi_ranks {
     int tag_span;         /* region tags: TAG_REGION + index mod tag_span */
     pending_send **sends; /* box requests not known to be sent */
     size_t nsends, sends_cap;
+    bool program_started_mpi; /* then the program ends it, not ranks_close */
 } mpi_ranks;
 
 static int region_tag(const mpi_ranks *m, uint64_t index)
@@ -468,25 +469,7 @@ static cm_status stop(solve_ranks *rk, cm_status status)
 
 /* ---- every rank --------------------------------------------------------- */
 
-static void ready(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed)
-{
-    int *oks = malloc((size_t)rk->size * sizeof *oks);
-    if (!oks)
-        MPI_Abort(MPI_COMM_WORLD, 1); /* the others wait for this rank */
-    int mine = ok;
-    MPI_Allgather(&mine, 1, MPI_INT, oks, 1, MPI_INT, MPI_COMM_WORLD);
-    *all_ok = true;
-    *first_failed = -1;
-    for (int k = 0; k < rk->size && *all_ok; k++)
-        if (!oks[k]) {
-            *all_ok = false;
-            *first_failed = k;
-        }
-    free(oks);
-    rk->readied = true;
-}
-
-/* A hash of this program's file: ranks that run another build differ. */
+/* A hash of the program's file and arguments, and of what a rank solves. */
 #define HASH_START UINT64_C(1469598103934665603)
 
 /* FNV-1a of n bytes, going on from h. */
@@ -497,10 +480,32 @@ static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
     return h;
 }
 
-static uint64_t program_hash(void)
+static void ready(solve_ranks *rk, bool ok, const char *what, bool *all_ok, int *first_failed,
+                  bool *differs)
+{
+    uint64_t *all = malloc((size_t)rk->size * 2 * sizeof *all);
+    if (!all)
+        MPI_Abort(MPI_COMM_WORLD, 1); /* the others wait for this rank */
+    const uint64_t mine[2] = {ok, what ? hash_bytes(HASH_START, what, strlen(what)) : 0};
+    MPI_Allgather(mine, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, MPI_COMM_WORLD);
+    *all_ok = true;
+    *first_failed = -1;
+    *differs = false;
+    for (int k = 0; k < rk->size && *all_ok; k++)
+        if (!all[2 * k] || all[2 * k + 1] != all[1]) {
+            *all_ok = false;
+            *first_failed = k;
+            *differs = all[2 * k] != 0;
+        }
+    free(all);
+    rk->readied = true;
+}
+
+/* A hash of this program's file: ranks that run another build differ. */
+static uint64_t program_hash(const char *program)
 {
     uint64_t h = HASH_START;
-    const int fd = open("/proc/self/exe", O_RDONLY);
+    const int fd = open(program ? program : "/proc/self/exe", O_RDONLY);
     if (fd < 0)
         return 0;
     unsigned char buf[1 << 16];
@@ -515,16 +520,16 @@ static uint64_t program_hash(void)
 static uint64_t args_hash(int argc, char **argv)
 {
     uint64_t h = HASH_START;
-    for (int i = 1; i < argc; i++)
+    for (int i = 1; argv && i < argc; i++)
         h = hash_bytes(h, argv[i], strlen(argv[i]) + 1);
     return h;
 }
 
 /* Step 1: every rank runs rank 0's program with rank 0's arguments. */
-static cm_status same_everywhere(const solve_ranks *rk, int argc, char **argv, char *msg,
-                                 size_t msg_size)
+static cm_status same_everywhere(const solve_ranks *rk, const char *program, int argc,
+                                 char **argv, char *msg, size_t msg_size)
 {
-    const uint64_t mine[2] = {program_hash(), args_hash(argc, argv)};
+    const uint64_t mine[2] = {program_hash(program), args_hash(argc, argv)};
     uint64_t *all = malloc((size_t)rk->size * sizeof mine);
     if (!all)
         MPI_Abort(MPI_COMM_WORLD, 1);
@@ -545,15 +550,20 @@ static cm_status same_everywhere(const solve_ranks *rk, int argc, char **argv, c
     return st;
 }
 
-cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size_t msg_size)
+cm_status ranks_open(int *argc, char ***argv, const char *program, solve_ranks **out, char *msg,
+                     size_t msg_size)
 {
     *out = NULL;
-    int provided = MPI_THREAD_SINGLE;
-    if (MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
+    int provided = MPI_THREAD_SINGLE, started = 0;
+    MPI_Initialized(&started);
+    if (started)
+        MPI_Query_thread(&provided);
+    else if (MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
         return cm_fail(CM_EIO, msg, msg_size, "MPI did not start");
     mpi_ranks *m = calloc(1, sizeof *m);
     if (!m)
         MPI_Abort(MPI_COMM_WORLD, 1);
+    m->program_started_mpi = started != 0;
     MPI_Comm_rank(MPI_COMM_WORLD, &m->pub.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &m->pub.size);
     int *tag_ub = NULL, found = 0;
@@ -571,20 +581,23 @@ cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size
     *out = &m->pub;
     if (provided < MPI_THREAD_SERIALIZED)
         return cm_fail(CM_EINVAL, msg, msg_size,
-                       "this MPI gives threads level %d; cellmap needs MPI_THREAD_SERIALIZED",
-                       provided);
-    return same_everywhere(&m->pub, *argc, *argv, msg, msg_size);
+                       "this MPI gives threads level %d; cellmap needs MPI_THREAD_SERIALIZED%s",
+                       provided,
+                       started ? " (start MPI with MPI_Init_thread at that level or above)" : "");
+    return same_everywhere(&m->pub, program, argc ? *argc : 0, argv ? *argv : NULL, msg,
+                           msg_size);
 }
 
 void ranks_close(solve_ranks *rk, bool ok)
 {
     if (!rk)
         return;
-    bool all_ok;
+    bool all_ok, differs;
     int failed;
     if (!rk->readied)
-        ready(rk, ok, &all_ok, &failed);
+        ready(rk, ok, NULL, &all_ok, &failed, &differs);
     mpi_ranks *m = (mpi_ranks *)rk;
+    const bool finalize = !m->program_started_mpi;
     pthread_mutex_destroy(&m->lock);
     for (size_t i = 0; i < m->nsends; i++) /* none once stop() ran */
         free(m->sends[i]);
@@ -593,5 +606,17 @@ void ranks_close(solve_ranks *rk, bool ok)
     free(m->given);
     free(m->sends);
     free(m);
-    MPI_Finalize();
+    if (finalize)
+        MPI_Finalize();
 }
+
+/* libcellmap-mpi.so's entry points (lib/ranks.h). */
+cm_status cm_mpi_ranks_open(const char *program, solve_ranks **out, char *msg, size_t msg_size);
+void cm_mpi_ranks_close(solve_ranks *rk, bool ok);
+
+cm_status cm_mpi_ranks_open(const char *program, solve_ranks **out, char *msg, size_t msg_size)
+{
+    return ranks_open(NULL, NULL, program, out, msg, msg_size);
+}
+
+void cm_mpi_ranks_close(solve_ranks *rk, bool ok) { ranks_close(rk, ok); }

@@ -32,8 +32,9 @@
  * A rank killed mid-solve makes mpirun end the job; the database keeps
  * every join committed, and a resumed solve completes it with any R.
  *
- * Implemented by lib/ranks.c, linked into cellmap-mpi only (the program
- * `cellmap` runs under mpirun), so that no other command loads MPI. */
+ * Implemented by lib/ranks.c, linked into cellmap-mpi (the program
+ * `cellmap` runs under mpirun) and into libcellmap-mpi.so (which
+ * libcellmap opens under mpirun), so that nothing else loads MPI. */
 #ifndef CM_LIB_RANKS_H
 #define CM_LIB_RANKS_H
 
@@ -67,9 +68,13 @@ typedef struct solve_ranks solve_ranks;
 
 struct solve_ranks {
     int rank, size;
-    /* Step 2: ok says whether this rank got to the solve. *all_ok: whether
-     * every rank did; *first_failed: the lowest rank that did not. */
-    void (*ready)(solve_ranks *rk, bool ok, bool *all_ok, int *first_failed);
+    /* Step 2: ok says whether this rank got to the solve, and `what` (a
+     * text) what it is to solve: ranks asked for different solves would
+     * make a wrong cluster. *all_ok: whether every rank got there with
+     * rank 0's text; *first_failed: the lowest rank that did not;
+     * *differs: that it got there with another text. */
+    void (*ready)(solve_ranks *rk, bool ok, const char *what, bool *all_ok, int *first_failed,
+                  bool *differs);
     /* Step 3, a worker: solves the boxes rank 0 sends, on the lattice with
      * max_steps and `threads` threads (0: the OpenMP default), until rank 0
      * stops it; returns rank 0's status then (CM_OK: the solve succeeded). */
@@ -85,13 +90,26 @@ struct solve_ranks {
     uint64_t regions_received;
 };
 
-/* Starts MPI (every rank, first thing) and does step 1: *out is this
+/* Starts MPI (every rank, first thing; argc and argv may be NULL, and MPI
+ * may have been started by the program, which then ends it) and does step
+ * 1: every rank runs the same `program` (a path; NULL: this process's
+ * executable) with the same arguments (argv, when given): *out is this
  * rank's (ranks_close frees it). On failure msg says why (rank 0 names the
  * rank that differs); every rank then fails. */
-cm_status ranks_open(int *argc, char ***argv, solve_ranks **out, char *msg, size_t msg_size);
+cm_status ranks_open(int *argc, char ***argv, const char *program, solve_ranks **out, char *msg,
+                     size_t msg_size);
 
 /* Step 2 for a command that ended before its solve did (if it did not
- * already), then MPI's end. */
+ * already), then MPI's end (unless the program started MPI). */
 void ranks_close(solve_ranks *rk, bool ok);
+
+/* The same two, exported by libcellmap-mpi.so for libcellmap, which opens
+ * it under mpirun (cm_ranks_open, cellmap/cellmap.h): program is the file
+ * of libcellmap. */
+typedef cm_status (*ranks_open_fn)(const char *program, solve_ranks **out, char *msg,
+                                   size_t msg_size);
+typedef void (*ranks_close_fn)(solve_ranks *rk, bool ok);
+#define RANKS_OPEN_SYMBOL "cm_mpi_ranks_open"
+#define RANKS_CLOSE_SYMBOL "cm_mpi_ranks_close"
 
 #endif

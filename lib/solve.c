@@ -260,6 +260,19 @@ static cm_status ranks_can_share(const solve_request *q, char *msg, size_t msg_s
     return CM_OK;
 }
 
+/* What a rank is to solve, as text: the model, its parameters, the
+ * lattice and the plan (the box, split, steps, extension). */
+static void solve_what(const solve_request *q, char *out, size_t size)
+{
+    char params[4096], plan[1024];
+    cm_params_json(&q->model->values, params, sizeof params);
+    project_plan_text(&q->plan, &q->box, plan, sizeof plan);
+    size_t used = (size_t)snprintf(out, size, "%s %s %s", q->model->name, params, plan);
+    for (int d = 0; d < q->lat.dim && used < size; d++)
+        used += (size_t)snprintf(out + used, size - used, " %.17g+%.17g", q->lat.origin[d],
+                                 q->lat.width[d]);
+}
+
 /* The start of a solve on several ranks: every rank checks that it can
  * go on, and all agree; a worker then solves rank 0's boxes until it is
  * told to stop (r->worker). */
@@ -267,11 +280,18 @@ static cm_status ranks_begin(const solve_request *q, solve_result *r, char *msg,
 {
     solve_ranks *rk = q->ranks;
     const cm_status st = ranks_can_share(q, msg, msg_size);
-    bool all_ok;
+    bool all_ok, differs;
     int failed;
-    rk->ready(rk, st == CM_OK, &all_ok, &failed);
+    char what[4096 + 1200];
+    solve_what(q, what, sizeof what);
+    rk->ready(rk, st == CM_OK, what, &all_ok, &failed, &differs);
     if (st != CM_OK)
         return st;
+    if (differs)
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "rank %d was asked for another solve than rank 0 (its model, parameters, "
+                       "lattice or plan differ): give every rank the same arguments",
+                       failed);
     if (!all_ok)
         return cm_fail(CM_EINVAL, msg, msg_size,
                        "rank %d could not start the solve (rerun with CELLMAP_RANKS_STDERR=1 "
@@ -282,6 +302,13 @@ static cm_status ranks_begin(const solve_request *q, solve_result *r, char *msg,
     r->worker = true;
     return rk->serve(rk, q->model, &q->lat, q->plan.opt.max_steps, q->plan.opt.threads, msg,
                      msg_size);
+}
+
+void solve_ranks_refuse(solve_ranks *rk)
+{
+    bool all_ok, differs;
+    int failed;
+    rk->ready(rk, false, NULL, &all_ok, &failed, &differs);
 }
 
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size)

@@ -97,6 +97,11 @@ bool solve_small(uint64_t cells, bool extends);
  * *r is initialised here; solve_result_free frees it whatever the status. */
 cm_status solve_run(const solve_request *q, solve_result *r, char *msg, size_t msg_size);
 
+/* For a rank that cannot go as far as solve_run (its request failed
+ * before): the step every rank takes there (lib/ranks.h, step 2), so that
+ * the others fail with it instead of waiting. */
+void solve_ranks_refuse(solve_ranks *rk);
+
 /* With q->ranks: the "ranks" object of solve --json (their count, the
  * regions the workers solved, the bytes rank 0 received and sent, and those
  * per cell computed). Nothing for a solve in one process. */

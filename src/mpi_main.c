@@ -12,7 +12,7 @@ int main(int argc, char **argv)
 {
     char msg[512];
     solve_ranks *rk;
-    int rc = ranks_open(&argc, &argv, &rk, msg, sizeof msg) == CM_OK ? EXIT_OK : EXIT_USAGE;
+    int rc = ranks_open(&argc, &argv, NULL, &rk, msg, sizeof msg) == CM_OK ? EXIT_OK : EXIT_USAGE;
     if (rk && rk->rank != 0 && !getenv("CELLMAP_RANKS_STDERR") && /* rank 0 speaks for all */
         (!freopen("/dev/null", "w", stderr) || !freopen("/dev/null", "w", stdout)))
         rc = EXIT_FAIL;

@@ -96,5 +96,65 @@ assert len(pd.step([1.0, 0.5])) == 2
 print("python module: labels and steps equal cellmap solve + export")
 PY
 
+# libcellmap on MPI ranks (cm_ranks, libcellmap-mpi.so.0 beside it): create()
+# on 2 and 3 ranks writes the file create() writes in one process, every
+# rank solving regions (the witness plugin notes the processes that step
+# its map); ranks asked for different solves, or more ranks than regions,
+# fail on every rank with rank 0's message and no file. Not in the
+# sanitizer build: Python there runs on preloaded runtimes, and the MPI
+# code is checked under the sanitizers by mpi_test.
+if [ -z "${CELLMAP_SANITIZE:-}" ] && [ -e "$(dirname "$lib")/libcellmap-mpi.so.0" ]; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+  cc -shared -fPIC $(pkg-config --cflags cellmap) -o libwitness.so "$SRC/tests/rank_witness.c" \
+    || fail "cc rank_witness"
+  cat > ranks.py <<'PY'
+import os, sys, cellmap
+path, split, differ = sys.argv[1], (int(sys.argv[2]), int(sys.argv[3])), len(sys.argv) > 4
+with cellmap.Ranks() as r:
+    # the last rank asks for other cells when told to differ
+    cells = (160, 120) if differ and r.rank == r.size - 1 else (160, 100)
+    try:
+        db = cellmap.create(path, "witness", plugins=["./libwitness.so"], region=[(-4, 4), (-4, 4)],
+                            cells=cells, split=split, threads=1, ranks=r)
+    except cellmap.CellmapError as e:  # a file per rank: mpirun interleaves their output
+        with open("%s.failed-%d" % (path, r.rank), "w") as f:
+            f.write(str(e))
+        sys.exit(3)
+    assert (db is not None) == (r.rank == 0), (r.rank, db)
+    print(r.rank, r.size)
+PY
+  mkdir w1 && CELLMAP_WITNESS=w1 $PY ranks.py one.cmdb 4 4 > one.out 2>&1 || fail "ranks.py: $(cat one.out)"
+  [ "$(cat one.out)" = "0 1" ] || fail "one process: '$(cat one.out)'"
+  sqlite3 one.cmdb .dump > one.sql && [ -s one.sql ] || fail "one process: no database"
+  for n in 2 3; do
+    mkdir "w$n"
+    CELLMAP_WITNESS=w$n mpirun -n "$n" -x CELLMAP_WITNESS -x PYTHONPATH -x CELLMAP_LIB $PY ranks.py \
+      "r$n.cmdb" 4 4 > "r$n.out" 2>&1 || fail "$n ranks: $(cat "r$n.out")"
+    sqlite3 "r$n.cmdb" .dump > "r$n.sql" && cmp -s one.sql "r$n.sql" \
+      || fail "$n ranks: another file than one process's"
+    [ "$(ls "w$n" | wc -l)" = "$n" ] || fail "$n ranks: the map stepped by $(ls "w$n" | wc -l) processes"
+  done
+  bad() { # bad NAME RANKS ARGS...: every rank fails, rank 0 names the problem, no file
+    local name=$1 n=$2
+    shift 2
+    mpirun -n "$n" -x PYTHONPATH -x CELLMAP_LIB $PY ranks.py "$name.cmdb" "$@" > "$name.out" 2>&1 \
+      && fail "$name: mpirun exited 0"
+    [ "$(ls "$name".cmdb.failed-* 2>/dev/null | wc -l)" = "$n" ] \
+      || fail "$name: not every rank failed: $(cat "$name.out")"
+    grep -q "$EXPECT" "$name.cmdb.failed-0" || fail "$name: rank 0 said: $(cat "$name.cmdb.failed-0")"
+    [ ! -e "$name.cmdb" ] || fail "$name: a file was made"
+  }
+  EXPECT="rank 1 was asked for another solve" bad differ 2 2 2 differ
+  EXPECT="3 ranks for 2 regions" bad many 3 2 1
+  # a libcellmap without the module beside it says so, under mpirun only
+  mkdir nomodule && cp "$lib" nomodule/ || fail "copy libcellmap"
+  out=$(CELLMAP_LIB=$PWD/nomodule/libcellmap.so.0 mpirun -n 2 -x PYTHONPATH -x CELLMAP_LIB $PY -c \
+    'import cellmap; cellmap.Ranks()' 2>&1) && fail "no module: mpirun exited 0"
+  grep -q "libcellmap needs $PWD/nomodule/libcellmap-mpi.so.0" <<<"$out" || fail "no module: $out"
+  CELLMAP_LIB=$PWD/nomodule/libcellmap.so.0 $PY -c 'import cellmap; assert cellmap.Ranks().size == 1' \
+    || fail "no module, no mpirun: not one rank"
+  echo "python module on 2 and 3 MPI ranks: the file of one process"
+fi
+
 [ $fails -eq 0 ] && echo "python tests passed"
 exit $fails

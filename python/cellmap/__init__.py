@@ -470,7 +470,8 @@ class _DbOptions(ctypes.Structure):
     _fields_ = [("threads", ctypes.c_int), ("max_steps", ctypes.c_int),
                 ("split", ctypes.c_int64 * _MAX_DIM), ("extend", ctypes.c_int),
                 ("escape_below", ctypes.c_double), ("mem", ctypes.c_uint64),
-                ("command", ctypes.c_char_p), ("progress", _PROGRESS), ("user", ctypes.c_void_p)]
+                ("command", ctypes.c_char_p), ("progress", _PROGRESS), ("user", ctypes.c_void_p),
+                ("ranks", ctypes.c_void_p)]
 
 
 class _SessionOptions(ctypes.Structure):
@@ -491,6 +492,10 @@ _sig("cm_system_from_function", ctypes.c_int, ctypes.c_char_p, ctypes.c_int, _ST
      ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
 _sig("cm_result_figure", ctypes.c_int, _P, ctypes.POINTER(_FigureOptions), ctypes.c_char_p,
      ctypes.c_size_t)
+_sig("cm_ranks_open", ctypes.c_int, ctypes.POINTER(_P), ctypes.c_char_p, ctypes.c_size_t)
+_sig("cm_ranks_rank", ctypes.c_int, _P)
+_sig("cm_ranks_size", ctypes.c_int, _P)
+_sig("cm_ranks_close", None, _P)
 for _name in ("cm_db_create", "cm_db_resume"):
     _sig(_name, ctypes.c_int, _P, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(_Grid),
          ctypes.c_char_p, ctypes.POINTER(_DbOptions), ctypes.c_char_p, ctypes.c_size_t)
@@ -557,8 +562,46 @@ def _figure_options(png, options):
     return o, keep
 
 
+class Ranks:
+    """The processes mpirun started, for solves shared among them:
+    create(..., ranks=r) and resume(..., ranks=r) on every rank, with the
+    same arguments; rank 0 solves and writes the file, the others solve
+    regions for it and get None back. Outside mpirun: one rank, and MPI is
+    not loaded. Under mpirun libcellmap loads libcellmap-mpi.so.0 (built
+    where MPI is found) and starts MPI, unless the program started it
+    (mpi4py, at MPI_THREAD_SERIALIZED or above). One per process; close()
+    (or `with`) ends them."""
+
+    def __init__(self):
+        h = _P()
+        _call(_lib.cm_ranks_open, ctypes.byref(h))
+        self._h = h
+
+    @property
+    def rank(self):
+        return _lib.cm_ranks_rank(self._h)
+
+    @property
+    def size(self):
+        return _lib.cm_ranks_size(self._h)
+
+    def close(self):
+        if getattr(self, "_h", None):
+            _lib.cm_ranks_close(self._h)
+            self._h = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        self.close()
+
+
 def _db_call(fn, path, model, params, plugins, region, cells, split, extend, escape_below,
-             threads, max_steps, mem, command, progress, kw):
+             threads, max_steps, mem, command, progress, kw, ranks=None):
     models = Models(plugins) if plugins else None
     dim = len(region)
     g = _grid(dim, region, cells)
@@ -571,30 +614,37 @@ def _db_call(fn, path, model, params, plugins, region, cells, split, extend, esc
     callback = _PROGRESS(lambda user, fraction: 1 if progress(fraction) else 0) \
         if progress else _PROGRESS()
     o.progress = callback
+    o.ranks = ranks._h if ranks is not None else None
     _call(fn, models._h if models else None, _text(model), _text(_params_text(params, kw)),
           ctypes.byref(g), _text(os.fspath(path)), ctypes.byref(o))
+    return ranks is None or ranks.rank == 0
 
 
 def create(path, model, region, cells, params=None, plugins=(), split=None, extend=0,
-           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None, **kw):
+           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None,
+           ranks=None, **kw):
     """Solves region [(lo, hi), ...] in cells (n0, n1, ...) of `model` into a
     new database at path, as `cellmap solve --db PATH` with --split, --extend,
     --escape-below, --max-steps, --threads and --mem; the system's attractors
     are stored with it. Parameter values as keywords (alpha=0.078) or
     params="k=v,...". progress(fraction) returning True cancels: the joins
-    done are kept, and resume() completes the file."""
-    _db_call(_lib.cm_db_create, path, model, params, plugins, region, cells, split, extend,
-             escape_below, threads, max_steps, mem, command, progress, kw)
-    return Database(path)
+    done are kept, and resume() completes the file. ranks (a Ranks): the
+    regions shared among MPI ranks; None on ranks other than 0."""
+    if _db_call(_lib.cm_db_create, path, model, params, plugins, region, cells, split, extend,
+                escape_below, threads, max_steps, mem, command, progress, kw, ranks):
+        return Database(path)
+    return None
 
 
 def resume(path, model, region, cells, params=None, plugins=(), split=None, extend=0,
-           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None, **kw):
+           escape_below=0.0, threads=0, max_steps=0, mem=0, command=None, progress=None,
+           ranks=None, **kw):
     """Completes a database create() (or `cellmap solve --db`) began, given
     the same model, parameters, region, cells and plan."""
-    _db_call(_lib.cm_db_resume, path, model, params, plugins, region, cells, split, extend,
-             escape_below, threads, max_steps, mem, command, progress, kw)
-    return Database(path)
+    if _db_call(_lib.cm_db_resume, path, model, params, plugins, region, cells, split, extend,
+                escape_below, threads, max_steps, mem, command, progress, kw, ranks):
+        return Database(path)
+    return None
 
 
 def _grown_options(threads, max_steps, mem, command):
