@@ -370,6 +370,29 @@ static cm_status check_replaceable(const char *path, const char *given, char *ms
     return CM_OK;
 }
 
+/* With no database at path: that no WAL or rollback journal is left there
+ * from one that was removed (a solve stopped, then its file deleted).
+ * SQLite would read it into the new file at that name: its pages over the
+ * new one's. Refused rather than removed: it may hold the last joins of
+ * the database that was there. */
+static cm_status check_no_leftovers(const char *path, const char *given, char *msg,
+                                    size_t msg_size)
+{
+    const char *suffixes[] = {"-wal", "-journal"};
+    for (int k = 0; k < 2; k++) {
+        char side[CM_OUTPUT_PATH_MAX + 16];
+        struct stat sb;
+        snprintf(side, sizeof side, "%s%s", path, suffixes[k]);
+        if (stat(side, &sb) == 0 && sb.st_size > 0)
+            return cm_fail(CM_EINVAL, msg, msg_size,
+                           "%s%s (%lld bytes) is left from a database %s that is gone, and "
+                           "SQLite would read it into the new one: remove it (and %s-shm), or "
+                           "move it away if it holds joins you want, or choose another --db file",
+                           given, suffixes[k], (long long)sb.st_size, given, given);
+    }
+    return CM_OK;
+}
+
 /* Removes the journal, WAL and shared-memory files next to path. */
 static void remove_side_files(const char *path)
 {
@@ -422,6 +445,10 @@ cm_status cm_store_create(const char *path, const cm_store_meta *meta, cm_store 
         st = check_replaceable(o.dest, path, msg, msg_size);
     if (st == CM_OK && replacing)
         st = lock_file(o.dest, &old_lock, msg, msg_size);
+    if (st == CM_OK && !replacing)
+        st = check_no_leftovers(o.dest, path, msg, msg_size);
+    if (st == CM_OK && !replacing) /* what is left holds nothing: an old -shm, empty files */
+        remove_side_files(o.dest);
     if (st == CM_OK) {
         remove_side_files(o.tmp);
         st = write_empty(o.tmp, meta, msg, msg_size);

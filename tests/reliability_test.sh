@@ -138,6 +138,36 @@ for s in "" -journal -wal; do [ ! -e "s.png.tmp-999999$s" ] || fail "stale s.png
 [ "$(id -u)" != 0 ] || [ -e s.png.tmp-999996 ] || fail "another user's temporary file was removed"
 exec 9<&-
 rm -f s.png.tmp-*
+
+# A solve stopped in WAL mode, then its file removed, leaves its -wal and
+# -shm: a new database at that name would have had the old one's pages read
+# into it (the new solve then failed on the old regions' rows, and the file
+# held the old cluster). Refused, naming the file, which is kept; the next
+# solve, once it is removed, makes a clean file. An -shm alone is removed.
+"$CM" solve --cells 60x60 --split 2x2 --db w.cmdb --quiet > /dev/null || fail "solve --db w.cmdb"
+python3 - <<'PY' || fail "copy w.cmdb with its WAL"
+import os, shutil, sqlite3
+# a writer's last commit still in its WAL, copied as a killed writer leaves it
+db = sqlite3.connect("w.cmdb", isolation_level=None)
+db.execute("PRAGMA journal_mode=WAL")
+db.execute("PRAGMA wal_autocheckpoint=0")
+db.execute("INSERT INTO meta(key, value) VALUES ('note.left', 'in the WAL only')")
+assert os.path.getsize("w.cmdb-wal") > 0
+for s in ("", "-wal", "-shm"):
+    shutil.copyfile("w.cmdb" + s, "left.cmdb" + s)
+PY
+rm left.cmdb
+wal=$(sha256sum < left.cmdb-wal)
+out=$("$CM" solve --cells 40x40 --db left.cmdb --quiet 2>&1)
+rc=$?
+[ $rc -ne 0 ] && grep -q "left.cmdb-wal (.* bytes) is left from a database left.cmdb that is gone" \
+  <<<"$out" || fail "a new database over a stale WAL: exit $rc, '$out'"
+[ ! -e left.cmdb ] && [ "$(sha256sum < left.cmdb-wal)" = "$wal" ] || fail "the stale WAL changed"
+rm left.cmdb-wal
+"$CM" solve --cells 40x40 --db left.cmdb --quiet > /dev/null || fail "solve once the WAL is gone"
+[ ! -e left.cmdb-shm ] || "$CM" info left.cmdb > /dev/null || fail "the new file beside an old -shm"
+[ "$(sqlite3 left.cmdb 'SELECT COUNT(*) FROM meta WHERE key = "note.left"')" = 0 ] \
+  || fail "the old WAL's rows are in the new file"
 # a killed export leaves its locked temporary file; the next export removes it
 "$CM" solve --cells 1500x1500 --db big.cmdb --quiet || fail "solve big.cmdb"
 "$CM" export big.cmdb --cells big.csv --quiet & exporter=$!
