@@ -650,8 +650,8 @@ static void supply_source(pipeline *p)
         ;
 }
 
-/* Box b, in slot s, solved elsewhere and not fetched when it was claimed:
- * fetched now, the boxes after it solved meanwhile. */
+/* Box b, in slot s, taken by the source when it was claimed: fetched at
+ * its join, the boxes after it solved meanwhile. */
 static void fetch_deferred(pipeline *p, uint32_t b, uint32_t s)
 {
     const cm_region_source *src = p->c->source;

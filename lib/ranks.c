@@ -337,7 +337,8 @@ static bool room(void *user)
     return some;
 }
 
-/* Sends box b of the call to the worker with most room, if one has room. */
+/* Sends box b of the call to the worker with most room, if one has room
+ * (and there is memory for the request: else rank 0 solves it). */
 static bool take(void *user, uint32_t b)
 {
     mpi_ranks *m = user;
@@ -350,7 +351,7 @@ static bool take(void *user, uint32_t b)
                    cm_grow((void **)&m->sends, &m->sends_cap, m->nsends + 1,
                            sizeof *m->sends) == CM_OK))
         ps = malloc(sizeof *ps);
-    if (ps) { /* out of memory: rank 0 solves it */
+    if (ps) {
         ps->q = (box_request){m->first + b, m->boxes[b]};
         MPI_Isend(&ps->q, (int)sizeof ps->q, MPI_BYTE, w, TAG_BOXES, MPI_COMM_WORLD, &ps->req);
         m->sends[m->nsends++] = ps;
@@ -429,7 +430,7 @@ static cm_status fetch(void *user, uint32_t b, cm_region *r, uint32_t **tree, bo
     MPI_Iprobe(src, region_tag(m, index), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
     const cm_status st = flag ? receive_region(m, src, index, r, tree, msg, msg_size) : CM_OK;
     uint64_t *given = &m->given[(size_t)src * WORKER_QUEUE];
-    if (flag && src != 0 && m->held[src] > 0 && given[0] == index) /* not noted before */
+    if (flag && m->held[src] > 0 && given[0] == index) /* its arrival not noted before */
         memmove(given, given + 1, (size_t)--m->held[src] * sizeof *given);
     pthread_mutex_unlock(&m->lock);
     *got = flag != 0;
