@@ -345,7 +345,8 @@ typedef struct cm_db_options {
      * once rank 0's solve has ended, with its status, and writes nothing
      * (progress is rank 0's). The file is the same bytes for any number
      * of ranks. More ranks than regions, or ranks asked for different
-     * solves: every rank fails, rank 0 says why. */
+     * solves: every rank fails, rank 0 says why. cm_db_add_box and
+     * cm_db_extend refuse more than one rank (CM_EINVAL). */
     cm_ranks *ranks;
 } cm_db_options;
 

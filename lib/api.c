@@ -1000,6 +1000,11 @@ static cm_status grown_session(const char *path, const cm_db_options *o, cm_sess
 {
     const cm_db_options none = {0};
     o = o ? o : &none;
+    if (api_ranks_solve(o->ranks)) /* each rank would write the file */
+        return cm_fail(CM_EINVAL, msg, msg_size,
+                       "a database grows in one process: call cm_db_add_box and cm_db_extend "
+                       "on rank 0 alone, without ranks (cm_db_create and cm_db_resume share "
+                       "theirs, --extend included)");
     const cm_session_options so = {.max_steps = o->max_steps, .threads = o->threads,
                                    .mem = o->mem, .command = o->command};
     return cm_session_open(path, &so, s, msg, msg_size);

@@ -121,6 +121,17 @@ with cellmap.Ranks() as r:
             f.write(str(e))
         sys.exit(3)
     assert (db is not None) == (r.rank == 0), (r.rank, db)
+    if r.size > 1:  # growing a file is one process's: refused on ranks
+        import ctypes
+        o = cellmap._DbOptions()
+        o.ranks = r._h
+        lo, hi = (ctypes.c_double * 2)(-5, -4), (ctypes.c_double * 2)(-4, 4)
+        try:
+            cellmap._call(cellmap._lib.cm_db_add_box, path.encode(), lo, hi, ctypes.byref(o),
+                          None)
+            raise AssertionError("cm_db_add_box on ranks accepted")
+        except cellmap.CellmapError as e:
+            assert "grows in one process" in str(e), e
     print(r.rank, r.size)
 PY
   mkdir w1 && CELLMAP_WITNESS=w1 $PY ranks.py one.cmdb 4 4 > one.out 2>&1 || fail "ranks.py: $(cat one.out)"
