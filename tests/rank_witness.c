@@ -3,6 +3,8 @@
  * point), which notes each process that steps it by creating the file
  * $CELLMAP_WITNESS/PID at its first step there. A worker of a solve steps
  * the map only when it solves a region, so the files say which ranks did.
+ * With abort_above = a, a state with x > a aborts the computation: a
+ * region that fails, on whichever rank solves it.
  * Build: cc -shared -fPIC $(pkg-config --cflags cellmap) -o librank_witness.so rank_witness.c */
 #include <cellmap/plugin.h>
 #include <fcntl.h>
@@ -12,7 +14,10 @@
 #include <string.h>
 #include <unistd.h>
 
-static const cm_param_spec witness_params[] = {{NULL, NULL, 0, 0, 0, NULL, NULL}};
+static const cm_param_spec witness_params[] = {
+    {"abort_above", "1e300", -1e300, 1e300, 1, NULL, "states with x above it abort"},
+    {NULL, NULL, 0, 0, 0, NULL, NULL},
+};
 static const char *const witness_state[] = {"x", "y"};
 static atomic_int noted;
 
@@ -30,8 +35,9 @@ static void note_process(void)
 
 static int witness_step(const cm_model *m, const double *x, double *y)
 {
-    (void)m;
     note_process();
+    if (x[0] > m->values.value[0].v[0])
+        return CM_STEP_ABORT;
     y[0] = x[0] / 2 + 1;
     y[1] = x[1] / 2;
     return CM_STEP_OK;
