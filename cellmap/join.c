@@ -526,6 +526,10 @@ static void pin_expected(cm_cluster *c, const cm_region *next, const plan *pl,
     }
 }
 
+/* Where a slot's region is: here (solved, or fetched from the source), at
+ * the source (taken by it, not fetched yet), or being fetched by a thread. */
+enum { AWAY_NONE, AWAY_WAITING, AWAY_FETCHING };
+
 /* The pipeline of cm_cluster_solve_boxes. Box b is solved into slot
  * b % window by whichever thread claims it: claims go in box order, at most
  * `window` boxes ahead of the joins. Thread 0 joins the boxes in order, and
@@ -549,7 +553,7 @@ typedef struct pipeline {
     plan pl;            /* pl.index NULL: the joins go without it */
     plan_target **targets; /* per slot: where its region's exits lead */
     cm_node **nodes;       /* per slot: its region's node table */
-    uint8_t *deferred;     /* per slot: solved elsewhere, fetched at its join */
+    atomic_uchar *away;    /* per slot: AWAY_* */
 } pipeline;
 
 /* Where region r's exits lead among the boxes of the plan (on the thread
@@ -609,13 +613,50 @@ static bool claim(pipeline *p, unsigned *b)
     return true;
 }
 
-/* Box b, just claimed into slot s, goes to the source: its join fetches it. */
+/* Box b, just claimed into slot s, goes to the source: a thread fetches
+ * it once it has come, its join at the latest. */
 static void send_away(pipeline *p, unsigned b)
 {
     const uint32_t s = b % p->window;
     p->status[s] = CM_OK;
-    p->deferred[s] = 1;
+    atomic_store(&p->away[s], (unsigned char)AWAY_WAITING);
     atomic_store(&p->ready[s], b + 1);
+}
+
+/* Fetches box b's region (slot s) if it has come and no other thread is
+ * fetching it, and prepares it for its join; whether this thread did. */
+static bool try_fetch(pipeline *p, uint32_t b, uint32_t s)
+{
+    unsigned char waiting = AWAY_WAITING;
+    if (!atomic_compare_exchange_strong(&p->away[s], &waiting, (unsigned char)AWAY_FETCHING))
+        return false;
+    const cm_region_source *src = p->c->source;
+    bool got = false;
+    uint32_t *tree = NULL;
+    p->status[s] = src->fetch(src->user, b, &p->slot[s], &tree, &got, p->msgs[s], sizeof p->msgs[s]);
+    if (got)
+        prepare_region(p, s, tree);
+    free(tree);
+    const bool done = got || p->status[s] != CM_OK; /* a failure goes to the join */
+    atomic_store(&p->away[s], (unsigned char)(done ? AWAY_NONE : AWAY_WAITING));
+    return done;
+}
+
+/* A thread that does not join takes the regions that have come for the
+ * boxes claimed (off the joining thread, which otherwise receives and
+ * prepares each at its join); whether it took one. */
+static bool fetch_arrived(pipeline *p)
+{
+    if (!p->c->source)
+        return false;
+    const uint32_t claimed = atomic_load(&p->next);
+    for (uint32_t b = atomic_load(&p->joined); b < claimed && b < p->nboxes; b++) {
+        const uint32_t s = b % p->window;
+        if (atomic_load(&p->ready[s]) == b + 1 && atomic_load(&p->away[s]) == AWAY_WAITING &&
+            try_fetch(p, b, s))
+            return true;
+    }
+    return false;
 }
 
 /* Claims the next box if the window allows, and solves it unless the
@@ -650,23 +691,13 @@ static void supply_source(pipeline *p)
         ;
 }
 
-/* Box b, in slot s, taken by the source when it was claimed: fetched at
- * its join, the boxes after it solved meanwhile. */
+/* Box b, in slot s, taken by the source when it was claimed: fetched now
+ * if no other thread did, the boxes after it solved meanwhile. */
 static void fetch_deferred(pipeline *p, uint32_t b, uint32_t s)
 {
-    const cm_region_source *src = p->c->source;
-    bool got = false;
-    uint32_t *tree = NULL;
-    while (p->status[s] == CM_OK && !got) {
-        p->status[s] =
-            src->fetch(src->user, b, &p->slot[s], &tree, &got, p->msgs[s], sizeof p->msgs[s]);
-        if (p->status[s] == CM_OK && !got && !solve_next(p))
+    while (atomic_load(&p->away[s]) != AWAY_NONE)
+        if (!try_fetch(p, b, s) && !solve_next(p))
             pause_briefly();
-    }
-    p->deferred[s] = 0;
-    if (got)
-        prepare_region(p, s, tree);
-    free(tree);
 }
 
 /* Bytes of the regions after box b solved ahead of their joins (complete
@@ -698,8 +729,7 @@ static cm_status join_in_order(pipeline *p, cm_joined_fn joined, void *user,
         while (atomic_load(&p->ready[s]) != b + 1)
             if (!solve_next(p))
                 pause_briefly();
-        if (p->deferred[s])
-            fetch_deferred(p, b, s);
+        fetch_deferred(p, b, s);
         if (p->status[s] != CM_OK)
             st = cm_fail(p->status[s], msg, msg_size, "region %u: %s", b, p->msgs[s]);
         const uint32_t ns = (b + 1) % p->window;
@@ -788,7 +818,7 @@ static void free_pipeline(pipeline *p)
     for (uint32_t k = 0; p->nodes && k < p->window; k++)
         free(p->nodes[k]);
     free(p->nodes);
-    free(p->deferred);
+    free(p->away);
     free(p->slot);
     free(p->status);
     free(p->msgs);
@@ -820,8 +850,8 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
     p.ready = calloc(p.window, sizeof *p.ready);
     p.targets = calloc(p.window, sizeof *p.targets);
     p.nodes = calloc(p.window, sizeof *p.nodes);
-    p.deferred = calloc(p.window, sizeof *p.deferred);
-    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets || !p.nodes || !p.deferred ||
+    p.away = calloc(p.window, sizeof *p.away);
+    if (!p.slot || !p.status || !p.msgs || !p.ready || !p.targets || !p.nodes || !p.away ||
         plan_boxes(&p.pl, c, boxes, nboxes) != CM_OK) {
         free_pipeline(&p);
         free_plan(&p.pl, c);
@@ -845,9 +875,10 @@ cm_status cm_cluster_solve_boxes(cm_cluster *c, const cm_model *model, const cm_
 #endif
         if (t == 0) {
             st = join_in_order(&p, joined, user, stats, msg, msg_size);
-        } else {
-            while (atomic_load(&p.next) < p.nboxes && !atomic_load(&p.stop))
-                if (!solve_next(&p))
+        } else { /* until the boxes are claimed and the source's regions taken */
+            while (atomic_load(&p.joined) < p.nboxes && !atomic_load(&p.stop) &&
+                   (atomic_load(&p.next) < p.nboxes || c->source))
+                if (!fetch_arrived(&p) && !solve_next(&p))
                     pause_briefly();
         }
     }
