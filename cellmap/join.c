@@ -630,6 +630,10 @@ static bool try_fetch(pipeline *p, uint32_t b, uint32_t s)
     unsigned char waiting = AWAY_WAITING;
     if (!atomic_compare_exchange_strong(&p->away[s], &waiting, (unsigned char)AWAY_FETCHING))
         return false;
+    if (atomic_load(&p->ready[s]) != b + 1) { /* b was joined, and the slot is another box's */
+        atomic_store(&p->away[s], (unsigned char)AWAY_WAITING);
+        return false;
+    }
     const cm_region_source *src = p->c->source;
     bool got = false;
     uint32_t *tree = NULL;
