@@ -359,6 +359,7 @@ static bool take(void *user, uint32_t b)
         m->given[(size_t)w * WORKER_QUEUE + m->held[w]++] = m->first + b;
         m->pub.bytes_sent += sizeof ps->q;
     }
+    m->pub.regions_by_rank[ps ? w : 0]++;
     pthread_mutex_unlock(&m->lock);
     return ps != NULL;
 }
@@ -572,7 +573,8 @@ cm_status ranks_open(int *argc, char ***argv, const char *program, solve_ranks *
     m->tag_span = (found && tag_ub ? *tag_ub : 32767) - TAG_REGION;
     m->held = calloc((size_t)m->pub.size, sizeof *m->held);
     m->given = calloc((size_t)m->pub.size * WORKER_QUEUE, sizeof *m->given);
-    if (!m->held || !m->given)
+    m->pub.regions_by_rank = calloc((size_t)m->pub.size, sizeof *m->pub.regions_by_rank);
+    if (!m->held || !m->given || !m->pub.regions_by_rank)
         MPI_Abort(MPI_COMM_WORLD, 1);
     pthread_mutex_init(&m->lock, NULL);
     m->pub.ready = ready;
@@ -606,6 +608,7 @@ void ranks_close(solve_ranks *rk, bool ok)
     free(m->held);
     free(m->given);
     free(m->sends);
+    free(m->pub.regions_by_rank);
     free(m);
     if (finalize)
         MPI_Finalize();

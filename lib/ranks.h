@@ -88,6 +88,7 @@ struct solve_ranks {
     uint64_t bytes_received; /* by rank 0 from workers, requests and replies */
     uint64_t bytes_sent;     /* by rank 0 to workers */
     uint64_t regions_received;
+    uint64_t *regions_by_rank; /* rank 0's: the boxes each rank was given to solve */
 };
 
 /* Starts MPI (every rank, first thing; argc and argv may be NULL, and MPI

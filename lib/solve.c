@@ -346,6 +346,10 @@ void solve_json_ranks(json *j, const solve_result *r)
     json_object(j, "ranks");
     json_int(j, "count", rk->size);
     json_uint(j, "regions_from_workers", rk->regions_received);
+    json_array(j, "regions_by_rank");
+    for (int k = 0; k < rk->size; k++)
+        json_uint(j, NULL, rk->regions_by_rank[k]);
+    json_array_end(j);
     json_uint(j, "bytes_received", rk->bytes_received);
     json_uint(j, "bytes_sent", rk->bytes_sent);
     const double bytes = (double)(rk->bytes_received + rk->bytes_sent);

@@ -88,8 +88,10 @@ for c in "${configs[@]}"; do
       same_as "$name-ref" "$run"
       if [ "$r" -gt 1 ]; then # the workers solved their share
         got=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1]))["ranks"]
-print(r["count"], r["regions_from_workers"] > 0, r["bytes_received"] > 0)' "$run.json")
-        [ "$got" = "$r True True" ] || fail "$run: its ranks: '$got'"
+by = r["regions_by_rank"]  # a count per rank, and every region from a worker came
+print(r["count"], r["regions_from_workers"] > 0, r["bytes_received"] > 0,
+      len(by) == r["count"] and sum(by[1:]) == r["regions_from_workers"])' "$run.json")
+        [ "$got" = "$r True True True" ] || fail "$run: its ranks: '$got'"
       fi
     done
   done
