@@ -162,6 +162,21 @@ PY
   # a region whose map aborts (the last column of boxes), on whichever rank
   # solves it: every rank fails with rank 0's message, which names it
   EXPECT="region 3: .*model witness aborted" bad abort 3 4 4 abort
+  # a program that starts MPI itself (mpi4py, at MPI_THREAD_MULTIPLE): the
+  # same file, and MPI still up after the ranks are closed (the program's)
+  cat > own_mpi.py <<'PY'
+import sys
+from mpi4py import MPI
+import cellmap
+r = cellmap.Ranks()
+cellmap.create(sys.argv[1], "witness", plugins=["./libwitness.so"], region=[(-4, 4), (-4, 4)],
+               cells=(160, 100), split=(4, 4), threads=1, ranks=r)
+r.close()
+MPI.COMM_WORLD.Barrier()
+PY
+  mpirun -n 2 -x PYTHONPATH -x CELLMAP_LIB $PY own_mpi.py own.cmdb > own.out 2>&1 \
+    || fail "mpi4py: $(cat own.out)"
+  sqlite3 own.cmdb .dump > own.sql && cmp -s one.sql own.sql || fail "mpi4py: another file"
   # a libcellmap without the module beside it says so, under mpirun only
   mkdir nomodule && cp "$lib" nomodule/ || fail "copy libcellmap"
   out=$(CELLMAP_LIB=$PWD/nomodule/libcellmap.so.0 mpirun -n 2 -x PYTHONPATH -x CELLMAP_LIB $PY -c \
