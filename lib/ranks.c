@@ -278,17 +278,24 @@ static cm_status serve(solve_ranks *rk, const cm_model *model, const cm_lattice 
 
 /* ---- rank 0 ------------------------------------------------------------- */
 
+/* Worker w's oldest box held is no longer (lock held). */
+static void forget_oldest(mpi_ranks *m, int w)
+{
+    uint64_t *given = &m->given[(size_t)w * WORKER_QUEUE];
+    memmove(given, given + 1, (size_t)--m->held[w] * sizeof *given);
+}
+
 /* Forgets worker w's boxes whose regions have arrived (lock held): a
  * worker sends its regions in the order it was given the boxes, so the
  * oldest comes first. A region that arrived waits for its join, and the
  * worker goes on. */
 static void note_arrivals(mpi_ranks *m, int w)
 {
-    uint64_t *given = &m->given[(size_t)w * WORKER_QUEUE];
     for (int flag = 1; flag && m->held[w] > 0;) {
-        MPI_Iprobe(w, region_tag(m, given[0]), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+        MPI_Iprobe(w, region_tag(m, m->given[(size_t)w * WORKER_QUEUE]), MPI_COMM_WORLD, &flag,
+                   MPI_STATUS_IGNORE);
         if (flag)
-            memmove(given, given + 1, (size_t)--m->held[w] * sizeof *given);
+            forget_oldest(m, w);
     }
 }
 
@@ -430,9 +437,8 @@ static cm_status fetch(void *user, uint32_t b, cm_region *r, uint32_t **tree, bo
     const int src = m->holder[b];
     MPI_Iprobe(src, region_tag(m, index), MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
     const cm_status st = flag ? receive_region(m, src, index, r, tree, msg, msg_size) : CM_OK;
-    uint64_t *given = &m->given[(size_t)src * WORKER_QUEUE];
-    if (flag && m->held[src] > 0 && given[0] == index) /* its arrival not noted before */
-        memmove(given, given + 1, (size_t)--m->held[src] * sizeof *given);
+    if (flag && m->held[src] > 0 && m->given[(size_t)src * WORKER_QUEUE] == index)
+        forget_oldest(m, src); /* its arrival was not noted before */
     pthread_mutex_unlock(&m->lock);
     *got = flag != 0;
     return st;
